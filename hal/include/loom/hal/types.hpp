@@ -1,0 +1,113 @@
+// Plain per-tick data exchanged between the sequencer and whatever drives the machine (CAN drives or
+// the simulator). Everything is SI (m, rad, s, N, N·m); drive counts exist only inside drivers/.
+// Every feedback value carries the tick it was refreshed, so staleness is visible in the data.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+namespace loom::hal {
+
+// The loop's time base: an integer tick counter. Seconds = tick * period; never a float clock.
+using Tick = std::int64_t;
+inline constexpr Tick kNeverTick = -1;
+
+// ---------------------------------------------------------------------------------------------------
+// Axes
+// ---------------------------------------------------------------------------------------------------
+enum class Axis : std::uint8_t {
+  kBeatCrank = 0,  // crank of the beat-up crank-rocker, position in rad (unwrapped)
+  kCarriage = 1,   // carriage slider across the width, position in m
+  kHelix = 2,      // helix shaft carrying the shuttle's magnetic carrier, position in rad (unwrapped)
+};
+inline constexpr std::size_t kAxisCount = 3;
+inline constexpr std::size_t index(Axis a) { return static_cast<std::size_t>(a); }
+const char* axis_name(Axis a);
+
+// CiA 402 power-state machine states, as decoded from the statusword (0x6041).
+enum class DriveState : std::uint8_t {
+  kUnknown = 0,  // no statusword seen yet
+  kNotReadyToSwitchOn,
+  kSwitchOnDisabled,
+  kReadyToSwitchOn,
+  kSwitchedOn,
+  kOperationEnabled,
+  kQuickStopActive,
+  kFaultReactionActive,
+  kFault,
+};
+const char* drive_state_name(DriveState s);
+
+// What the sequencer wants an axis' power stage to do. The HAL implementation walks the drive's state
+// machine toward it (CiA 402 transitions on CAN, immediate in the simulator).
+enum class AxisRequest : std::uint8_t {
+  kDisable = 0,     // voltage off / switch-on disabled
+  kEnable = 1,      // reach Operation Enabled and follow target_position
+  kQuickStop = 2,   // decelerate on the drive's quick-stop ramp, hold
+  kFaultReset = 3,  // rising edge of fault reset, then back to Switch On Disabled
+};
+
+struct AxisFeedback {
+  DriveState state = DriveState::kUnknown;
+  double position = 0.0;        // SI: rad (crank, helix) or m (carriage)
+  double velocity = 0.0;        // SI per second
+  double effort = 0.0;          // N·m (rotary) or N (linear); 0 when the drive does not report it
+  std::uint16_t fault_code = 0; // last CiA 301 EMCY / local error code (0 = none)
+  bool fault = false;           // drive reports Fault / Fault reaction, or the HAL lost the node
+  bool following_error = false; // statusword bit 13 in CSP
+  Tick refreshed = kNeverTick;  // tick this feedback was last received
+};
+
+struct AxisCommand {
+  AxisRequest request = AxisRequest::kDisable;
+  double target_position = 0.0;  // SI; in CSP the drive interpolates to it within one cycle
+};
+
+using AxisFeedbacks = std::array<AxisFeedback, kAxisCount>;
+using AxisCommands = std::array<AxisCommand, kAxisCount>;
+
+// ---------------------------------------------------------------------------------------------------
+// Digital I/O (the I/O node): two piston valves for the heald frames, their end sensors, the shuttle
+// arrival sensors at both selvedges, and the e-stop chain.
+// ---------------------------------------------------------------------------------------------------
+struct DigitalOutputs {
+  // Valve coil energised = that piston extends. Safe state (both false) leaves both frames retracted
+  // and vented; the shed closes, which never traps the shuttle because it cannot be picked then.
+  bool piston_a_extend = false;
+  bool piston_b_extend = false;
+};
+
+struct DigitalInputs {
+  bool piston_a_extended = false;  // end sensors (reed switches) of piston A
+  bool piston_a_retracted = false;
+  bool piston_b_extended = false;
+  bool piston_b_retracted = false;
+  bool shuttle_at_left = false;    // shuttle-arrival sensors at each selvedge
+  bool shuttle_at_right = false;
+  bool estop_ok = false;           // e-stop chain closed (true = healthy; broken wire reads as e-stop)
+  Tick refreshed = kNeverTick;
+};
+
+// ---------------------------------------------------------------------------------------------------
+// Bus / link health reported by the HAL implementation (zeros for the simulator unless a scene injects).
+// ---------------------------------------------------------------------------------------------------
+struct LinkStatus {
+  bool link_fault = false;          // bus-off, heartbeat lost, socket error: motion must stop
+  std::uint16_t link_fault_code = 0;
+  std::uint32_t tx_dropped = 0;     // frames not sent (ENOBUFS/EAGAIN), cumulative
+  std::uint32_t rx_errors = 0;      // error frames / malformed frames, cumulative
+};
+
+struct HalInputs {
+  AxisFeedbacks axes{};
+  DigitalInputs io{};
+  LinkStatus link{};
+};
+
+struct HalOutputs {
+  AxisCommands axes{};
+  DigitalOutputs io{};
+};
+
+}  // namespace loom::hal
