@@ -1,0 +1,36 @@
+// The one table of faults: code, name, operator text. Code, telemetry, logs and docs all come from it.
+// Every fault has the same reaction in this machine: quick stop every axis, valves hold, latch the
+// first fault, keep the production counters. (ODrive-style single error schema.)
+#pragma once
+
+#include <cstdint>
+
+namespace loom::sequencer {
+
+#define LOOM_FAULT_TABLE(X)                                                                              \
+  X(kNone, 0x0000, "none", "no fault")                                                                   \
+  X(kEStop, 0x1001, "estop", "e-stop chain opened")                                                      \
+  X(kDriveFault, 0x1002, "drive_fault", "a servo drive reported a fault")                                \
+  X(kHeartbeatLost, 0x1003, "heartbeat_lost", "a CAN node stopped sending heartbeats")                   \
+  X(kLinkFault, 0x1004, "link_fault", "CAN link fault (bus-off or socket error)")                        \
+  X(kStaleFeedback, 0x1005, "stale_feedback", "axis or I/O feedback not refreshed in time")              \
+  X(kEnableTimeout, 0x1006, "enable_timeout", "drives did not reach Operation Enabled in time")          \
+  X(kShedTimeout, 0x1007, "shed_timeout", "piston end sensors did not confirm the shed in time")         \
+  X(kShuttleNotArrived, 0x1008, "shuttle_not_arrived", "shuttle-arrival sensor did not see the shuttle") \
+  X(kShuttleLost, 0x1009, "shuttle_lost", "shuttle is at neither selvedge before a pick")                \
+  X(kCarriageInWarp, 0x100A, "interlock_carriage_in_warp", "carriage commanded while the beater is in the warp") \
+  X(kPickWithoutShed, 0x100B, "interlock_pick_without_shed", "pick commanded while the shed is not confirmed open") \
+  X(kShedWithShuttle, 0x100C, "interlock_shed_with_shuttle", "shed change commanded while the shuttle is in the shed") \
+  X(kStopRequested, 0x100D, "stop_requested", "operator stop")
+
+enum class Fault : std::uint8_t {
+#define LOOM_FAULT_ENUM(id, code, name, text) id,
+  LOOM_FAULT_TABLE(LOOM_FAULT_ENUM)
+#undef LOOM_FAULT_ENUM
+};
+
+std::uint16_t fault_code(Fault f);
+const char* fault_name(Fault f);
+const char* fault_text(Fault f);
+
+}  // namespace loom::sequencer

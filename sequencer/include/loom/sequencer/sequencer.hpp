@@ -1,0 +1,128 @@
+// The row cycle as a pure per-tick step: shed change → pick → beat sweep → row done, with the
+// interlocks, fault latching and production counters. No clock, no I/O: the tick index comes in, the
+// commands go out, so tests run it in virtual time. All motion comes from the precomputed ProfileSet.
+#pragma once
+
+#include <cstdint>
+
+#include "loom/hal/types.hpp"
+#include "loom/motion/jerk_move.hpp"
+#include "loom/motion/profile_set.hpp"
+#include "loom/sequencer/faults.hpp"
+#include "loom/sequencer/interlocks.hpp"
+
+namespace loom::sequencer {
+
+enum class State : std::uint8_t {
+  kIdle,         // drives disabled, waiting for start
+  kEnabling,     // walking the drives to Operation Enabled
+  kPositioning,  // re-arm: crank to park, carriage to the nearest selvedge, from measured positions
+  kShed,         // swapping the heald frames, waiting for the end sensors
+  kPick,         // helix shaft carries the shuttle across, waiting for arrival
+  kBeatSweep,    // crank beats while the carriage steps across the width
+  kDone,         // all requested rows woven (or stop at row end): holding, enabled
+  kFault,        // latched fault: quick stop, valves hold, counters kept
+};
+const char* state_name(State s);
+
+struct Counters {
+  std::uint32_t rows = 0;   // completed rows
+  std::uint32_t picks = 0;  // completed picks (shuttle arrived)
+  std::uint32_t beats = 0;  // beats delivered (beater passed the fell)
+};
+
+struct RowStats {
+  std::uint32_t row = 0;     // 1-based number of the row just completed
+  hal::Tick shed_ticks = 0, pick_ticks = 0, beat_ticks = 0, total_ticks = 0;
+  int beats = 0;
+  int carriage_steps = 0;
+};
+
+struct SequencerConfig {
+  double period_s = 0.002;
+  std::uint32_t rows_to_weave = 3;       // 0 = weave until stopped
+  double enable_timeout_s = 2.0;
+  double shed_timeout_s = 1.5;           // piston travel plus margin
+  double pick_timeout_margin_s = 0.5;    // beyond the planned pick duration
+  double stale_timeout_s = 0.05;         // feedback older than this is a fault
+  double crank_park_position_rad = 0.0;  // crank axis reading at the park pose (calibration)
+  double carriage_home_m = 0.0;          // carriage axis reading at the left selvedge
+  double park_tolerance_rad = 0.01;
+  double selvedge_tolerance_m = 0.001;
+  motion::JerkLimits carriage{.velocity = 0.5, .acceleration = 5.0, .jerk = 100.0};  // re-arm moves
+};
+
+class Sequencer {
+ public:
+  // Configure-time only. `profiles` must outlive the sequencer. `resume` seeds the counters (restart).
+  Sequencer(const motion::ProfileSet& profiles, const SequencerConfig& cfg, Counters resume = {});
+
+  void request_start() noexcept { start_requested_ = true; }       // RT-safe
+  void request_stop_at_row_end() noexcept { stop_requested_ = true; }  // RT-safe
+
+  // RT-safe. One tick: check faults → advance the row cycle → sample profiles → check interlocks →
+  // write every field of `out`.
+  void step(hal::Tick now, const hal::HalInputs& in, hal::HalOutputs& out) noexcept;
+
+  State state() const noexcept { return state_; }
+  const Counters& counters() const noexcept { return counters_; }
+  Fault first_fault() const noexcept { return first_fault_; }
+  int fault_axis() const noexcept { return fault_axis_; }              // -1 when not axis-specific
+  std::uint16_t fault_detail() const noexcept { return fault_detail_; }  // device code (EMCY) if any
+  hal::Tick fault_tick() const noexcept { return fault_tick_; }
+  const RowStats& last_row() const noexcept { return last_row_; }
+  // Beater crank phase from park of the current command (rad) and the table's rocker angle there.
+  double commanded_crank_phase() const noexcept;
+  double commanded_rocker_angle() const noexcept;
+  bool finished() const noexcept { return state_ == State::kDone || state_ == State::kFault; }
+
+ private:
+  hal::Tick ticks(double seconds) const noexcept;
+  double seconds_since(hal::Tick now, hal::Tick t0) const noexcept;
+  bool check_faults(hal::Tick now, const hal::HalInputs& in) noexcept;
+  void latch(Fault f, hal::Tick now, int axis = -1, std::uint16_t detail = 0) noexcept;
+  void enter(State s, hal::Tick now) noexcept;
+  void advance(hal::Tick now, const hal::HalInputs& in) noexcept;
+  void begin_row_shed(hal::Tick now, const hal::HalInputs& in) noexcept;
+  void play_moves(hal::Tick now) noexcept;
+
+  const motion::ProfileSet& profiles_;
+  SequencerConfig cfg_;
+  InterlockContext interlock_ctx_;
+  Counters counters_;
+  State state_ = State::kIdle;
+  hal::Tick state_since_ = 0;
+  bool start_requested_ = false;
+  bool stop_requested_ = false;
+
+  Fault first_fault_ = Fault::kNone;
+  int fault_axis_ = -1;
+  std::uint16_t fault_detail_ = 0;
+  hal::Tick fault_tick_ = hal::kNeverTick;
+
+  // Commanded state: what is written each tick.
+  hal::HalOutputs cmd_{};
+  hal::HalOutputs prev_cmd_{};
+  bool enabled_outputs_ = false;  // interlocks apply once drives may move
+
+  // Active moves: origin position + move profile started at a tick.
+  struct ActiveMove {
+    bool active = false;
+    hal::Tick t0 = 0;
+    double origin = 0.0;
+    motion::JerkMove move;
+  };
+  ActiveMove crank_move_, carriage_move_, helix_move_;
+  bool sweeping_ = false;          // carriage follows the cam on the crank move
+  double carriage_sweep_origin_ = 0.0;
+  double carriage_sweep_dir_ = 1.0;
+  double crank_sweep_origin_ = 0.0;
+  bool pick_to_right_ = true;
+
+  // Row bookkeeping.
+  hal::Tick row_start_ = 0, pick_start_ = 0, beat_start_ = 0;
+  int row_beats_ = 0;
+  RowStats last_row_{};
+};
+
+}  // namespace loom::sequencer

@@ -1,0 +1,277 @@
+// The row cycle. Order inside a tick is fixed: faults first (a fault this tick wins over any plan),
+// then the state machine, then the profiles are sampled into targets, then the interlocks judge the
+// result before it is written.
+#include "loom/sequencer/sequencer.hpp"
+
+#include <cmath>
+
+#include "loom/motion/angles.hpp"
+
+namespace loom::sequencer {
+namespace {
+using hal::Axis;
+using hal::AxisRequest;
+using hal::DriveState;
+using hal::index;
+constexpr std::uint16_t kHeartbeatCode = 0x8130;  // CiA 301 EMCY "life guard / heartbeat error"
+
+void request_all(hal::HalOutputs& o, AxisRequest r) {
+  for (auto& a : o.axes) a.request = r;
+}
+}  // namespace
+
+const char* state_name(State s) {
+  switch (s) {
+    case State::kIdle: return "idle";
+    case State::kEnabling: return "enabling";
+    case State::kPositioning: return "positioning";
+    case State::kShed: return "shed";
+    case State::kPick: return "pick";
+    case State::kBeatSweep: return "beat_sweep";
+    case State::kDone: return "done";
+    case State::kFault: return "fault";
+  }
+  return "?";
+}
+
+Sequencer::Sequencer(const motion::ProfileSet& profiles, const SequencerConfig& cfg, Counters resume)
+    : profiles_(profiles), cfg_(cfg), counters_(resume) {
+  interlock_ctx_.warp = &profiles_.beatup().warp();
+  interlock_ctx_.crank_park_position = cfg_.crank_park_position_rad;
+}
+
+hal::Tick Sequencer::ticks(double seconds) const noexcept {
+  return static_cast<hal::Tick>(std::ceil(seconds / cfg_.period_s));
+}
+
+double Sequencer::seconds_since(hal::Tick now, hal::Tick t0) const noexcept {
+  return static_cast<double>(now - t0) * cfg_.period_s;
+}
+
+double Sequencer::commanded_crank_phase() const noexcept {
+  return motion::wrap_two_pi(cmd_.axes[index(Axis::kBeatCrank)].target_position - cfg_.crank_park_position_rad);
+}
+
+double Sequencer::commanded_rocker_angle() const noexcept {
+  return profiles_.rocker().at(commanded_crank_phase()).value;
+}
+
+void Sequencer::latch(Fault f, hal::Tick now, int axis, std::uint16_t detail) noexcept {
+  if (first_fault_ == Fault::kNone) {
+    first_fault_ = f;
+    fault_axis_ = axis;
+    fault_detail_ = detail;
+    fault_tick_ = now;
+  }
+  crank_move_.active = carriage_move_.active = helix_move_.active = false;
+  sweeping_ = false;
+  enter(State::kFault, now);
+}
+
+void Sequencer::enter(State s, hal::Tick now) noexcept {
+  state_ = s;
+  state_since_ = now;
+}
+
+bool Sequencer::check_faults(hal::Tick now, const hal::HalInputs& in) noexcept {
+  if (!in.io.estop_ok) {
+    latch(Fault::kEStop, now);
+    return true;
+  }
+  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+    const hal::AxisFeedback& a = in.axes[i];
+    if (a.fault || a.state == DriveState::kFault || a.state == DriveState::kFaultReactionActive) {
+      latch(a.fault_code == kHeartbeatCode ? Fault::kHeartbeatLost : Fault::kDriveFault, now, static_cast<int>(i),
+            a.fault_code);
+      return true;
+    }
+  }
+  if (in.link.link_fault) {
+    latch(in.link.link_fault_code == kHeartbeatCode ? Fault::kHeartbeatLost : Fault::kLinkFault, now, -1,
+          in.link.link_fault_code);
+    return true;
+  }
+  const hal::Tick stale = ticks(cfg_.stale_timeout_s);
+  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+    if (in.axes[i].refreshed == hal::kNeverTick || now - in.axes[i].refreshed > stale) {
+      latch(Fault::kStaleFeedback, now, static_cast<int>(i));
+      return true;
+    }
+  }
+  if (in.io.refreshed == hal::kNeverTick || now - in.io.refreshed > stale) {
+    latch(Fault::kStaleFeedback, now);
+    return true;
+  }
+  return false;
+}
+
+void Sequencer::begin_row_shed(hal::Tick now, const hal::HalInputs& in) noexcept {
+  (void)in;
+  row_start_ = now;
+  row_beats_ = 0;
+  // Alternate the shed every pick: even picks lift frame A, odd picks frame B.
+  const bool a_up = counters_.picks % 2 == 0;
+  cmd_.io.piston_a_extend = a_up;
+  cmd_.io.piston_b_extend = !a_up;
+  enter(State::kShed, now);
+}
+
+void Sequencer::advance(hal::Tick now, const hal::HalInputs& in) noexcept {
+  const auto& crank_fb = in.axes[index(Axis::kBeatCrank)];
+  const auto& carriage_fb = in.axes[index(Axis::kCarriage)];
+  switch (state_) {
+    case State::kIdle:
+      request_all(cmd_, AxisRequest::kDisable);
+      for (std::size_t i = 0; i < hal::kAxisCount; ++i) cmd_.axes[i].target_position = in.axes[i].position;
+      if (start_requested_) {
+        start_requested_ = false;
+        enter(State::kEnabling, now);
+      }
+      break;
+
+    case State::kEnabling: {
+      request_all(cmd_, AxisRequest::kEnable);
+      // Until every drive is enabled the targets follow the measured positions: enabling never jumps.
+      bool all = true;
+      for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+        cmd_.axes[i].target_position = in.axes[i].position;
+        all = all && in.axes[i].state == DriveState::kOperationEnabled;
+      }
+      if (all) {
+        enabled_outputs_ = true;
+        // Re-arm from measured positions: crank to the nearest park, then carriage to the nearest selvedge.
+        const double phase = motion::wrap_pi(crank_fb.position - cfg_.crank_park_position_rad);
+        crank_move_ = {true, now, cmd_.axes[index(Axis::kBeatCrank)].target_position,
+                       motion::JerkMove::plan(-phase, profiles_.spec().crank)};
+        enter(State::kPositioning, now);
+      } else if (now - state_since_ > ticks(cfg_.enable_timeout_s)) {
+        latch(Fault::kEnableTimeout, now);
+      }
+      break;
+    }
+
+    case State::kPositioning:
+      if (crank_move_.active) break;
+      if (!carriage_move_.active) {
+        const double rel = carriage_fb.position - cfg_.carriage_home_m;
+        const double travel = profiles_.carriage_travel_m();
+        const double goal = rel < 0.5 * travel ? 0.0 : travel;
+        if (std::abs(rel - goal) > cfg_.selvedge_tolerance_m) {
+          carriage_move_ = {true, now, cmd_.axes[index(Axis::kCarriage)].target_position,
+                            motion::JerkMove::plan(goal - rel, cfg_.carriage)};
+          break;
+        }
+        begin_row_shed(now, in);
+      }
+      break;
+
+    case State::kShed:
+      if (shed_confirmed(in.io) && in.io.piston_a_extended == cmd_.io.piston_a_extend) {
+        if (!shuttle_at_selvedge(in.io)) {
+          latch(Fault::kShuttleLost, now);
+          break;
+        }
+        pick_to_right_ = in.io.shuttle_at_left;
+        helix_move_ = {true, now, cmd_.axes[index(Axis::kHelix)].target_position,
+                       pick_to_right_ ? profiles_.pick() : profiles_.pick_back()};
+        last_row_.shed_ticks = now - row_start_;
+        pick_start_ = now;
+        enter(State::kPick, now);
+      } else if (now - state_since_ > ticks(cfg_.shed_timeout_s)) {
+        latch(Fault::kShedTimeout, now);
+      }
+      break;
+
+    case State::kPick: {
+      const bool arrived = pick_to_right_ ? in.io.shuttle_at_right : in.io.shuttle_at_left;
+      if (!helix_move_.active && arrived) {
+        ++counters_.picks;
+        last_row_.pick_ticks = now - pick_start_;
+        // Beat sweep: the crank turns `beats` full turns from park; the carriage rides the cam on it.
+        const double rel = carriage_fb.position - cfg_.carriage_home_m;
+        carriage_sweep_dir_ = rel < 0.5 * profiles_.carriage_travel_m() ? 1.0 : -1.0;
+        carriage_sweep_origin_ = cmd_.axes[index(Axis::kCarriage)].target_position;
+        crank_sweep_origin_ = cmd_.axes[index(Axis::kBeatCrank)].target_position;
+        crank_move_ = {true, now, crank_sweep_origin_, profiles_.crank_sweep()};
+        sweeping_ = true;
+        beat_start_ = now;
+        enter(State::kBeatSweep, now);
+      } else if (seconds_since(now, state_since_) > profiles_.pick().duration() + cfg_.pick_timeout_margin_s) {
+        latch(Fault::kShuttleNotArrived, now);
+      }
+      break;
+    }
+
+    case State::kBeatSweep:
+      if (!crank_move_.active) {
+        sweeping_ = false;
+        ++counters_.rows;
+        last_row_.row = counters_.rows;
+        last_row_.beat_ticks = now - beat_start_;
+        last_row_.total_ticks = now - row_start_;
+        last_row_.beats = row_beats_;
+        last_row_.carriage_steps = profiles_.cam().steps();
+        const bool enough = cfg_.rows_to_weave != 0 && counters_.rows >= cfg_.rows_to_weave;
+        if (enough || stop_requested_) {
+          enter(State::kDone, now);
+        } else {
+          begin_row_shed(now, in);
+        }
+      }
+      break;
+
+    case State::kDone:
+    case State::kFault:
+      break;
+  }
+}
+
+void Sequencer::play_moves(hal::Tick now) noexcept {
+  const auto play = [&](ActiveMove& m, Axis axis) {
+    if (!m.active) return;
+    const double t = seconds_since(now, m.t0);
+    cmd_.axes[index(axis)].target_position = m.origin + m.move.at(t).position;
+    if (t >= m.move.duration()) m.active = false;
+  };
+  play(crank_move_, Axis::kBeatCrank);
+  play(carriage_move_, Axis::kCarriage);
+  play(helix_move_, Axis::kHelix);
+  if (sweeping_) {
+    const double phi = cmd_.axes[index(Axis::kBeatCrank)].target_position - crank_sweep_origin_;
+    cmd_.axes[index(Axis::kCarriage)].target_position =
+        carriage_sweep_origin_ + carriage_sweep_dir_ * profiles_.cam().at(phi).position;
+    // A beat is delivered when the commanded crank passes the fell of turn k.
+    const double fell = profiles_.beatup().warp().fell;
+    while (row_beats_ < profiles_.beats_per_row() && phi >= motion::kTwoPi * row_beats_ + fell) {
+      ++row_beats_;
+      ++counters_.beats;
+    }
+  }
+}
+
+void Sequencer::step(hal::Tick now, const hal::HalInputs& in, hal::HalOutputs& out) noexcept {
+  if (state_ != State::kIdle && state_ != State::kFault) check_faults(now, in);
+  if (state_ == State::kIdle && start_requested_ && !in.io.estop_ok) {
+    start_requested_ = false;
+    latch(Fault::kEStop, now);
+  }
+  advance(now, in);
+  if (state_ == State::kFault) {
+    // Quick stop, hold the last targets, valves keep their state (a stopped shuttle is never clamped).
+    request_all(cmd_, AxisRequest::kQuickStop);
+  } else {
+    play_moves(now);
+    if (enabled_outputs_) {
+      const Fault f = check_interlocks(interlock_ctx_, in, prev_cmd_, cmd_);
+      if (f != Fault::kNone) {
+        cmd_ = prev_cmd_;
+        latch(f, now);
+        request_all(cmd_, AxisRequest::kQuickStop);
+      }
+    }
+  }
+  prev_cmd_ = cmd_;
+  out = cmd_;
+}
+
+}  // namespace loom::sequencer

@@ -1,0 +1,140 @@
+// The sequencer driving the simulated loom in virtual time: rows complete with the planned beats, the
+// carriage covers the width, interlocks never trip, and injected faults stop motion with counters kept.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "loom/hal/hal.hpp"
+#include "loom/motion/angles.hpp"
+#include "loom/motion/profile_set.hpp"
+#include "loom/sequencer/sequencer.hpp"
+#include "loom/sim_hal/sim_world.hpp"
+
+using namespace loom;
+using sequencer::Fault;
+using sequencer::State;
+
+namespace {
+struct Rig {
+  motion::ProfileSet profiles{motion::ProfileSpec{}};
+  sequencer::SequencerConfig cfg{};
+  sim_hal::SimMachine machine{};
+  sim_hal::SceneSpec scene{};
+  std::unique_ptr<sim_hal::SimWorld> world;
+  std::unique_ptr<sequencer::Sequencer> seq;
+  hal::HalInputs in{};
+  hal::HalOutputs out{};
+  hal::Tick now = 0;
+
+  void build(std::uint32_t rows) {
+    cfg.rows_to_weave = rows;
+    world = std::make_unique<sim_hal::SimWorld>(machine, scene);
+    seq = std::make_unique<sequencer::Sequencer>(profiles, cfg);
+    seq->request_start();
+  }
+  // Runs until finished or max ticks; calls `each` after every tick.
+  template <class F>
+  void run(hal::Tick max_ticks, F&& each) {
+    hal::PortHal hal(*world, *world);
+    for (; now < max_ticks && !seq->finished(); ++now) {
+      hal.read(now, in);
+      seq->step(now, in, out);
+      hal.write(now, out);
+      each();
+    }
+  }
+};
+}  // namespace
+
+TEST(SequencerSim, WeavesThreeRowsWithEveryBeatAndFullCarriageTravel) {
+  Rig r;
+  r.build(3);
+  double carriage_min = 1e9, carriage_max = -1e9;
+  std::uint32_t rows_seen = 0;
+  r.run(200000, [&] {
+    const double x = r.world->axis(hal::Axis::kCarriage).position;
+    carriage_min = std::min(carriage_min, x);
+    carriage_max = std::max(carriage_max, x);
+    if (r.seq->counters().rows != rows_seen) {
+      rows_seen = r.seq->counters().rows;
+      const auto& row = r.seq->last_row();
+      EXPECT_EQ(row.beats, r.profiles.beats_per_row());
+      EXPECT_GT(row.shed_ticks, 0);
+      EXPECT_GT(row.pick_ticks, 0);
+      EXPECT_GT(row.beat_ticks, 0);
+    }
+  });
+  ASSERT_EQ(r.seq->state(), State::kDone) << sequencer::fault_name(r.seq->first_fault());
+  EXPECT_EQ(r.seq->counters().rows, 3u);
+  EXPECT_EQ(r.seq->counters().picks, 3u);
+  EXPECT_EQ(r.seq->counters().beats, 3u * static_cast<std::uint32_t>(r.profiles.beats_per_row()));
+  EXPECT_NEAR(carriage_min, 0.0, 1e-12);
+  EXPECT_NEAR(carriage_max, r.profiles.carriage_travel_m(), 1e-12);
+  // Three picks alternate: left→right, right→left, left→right.
+  EXPECT_TRUE(r.world->shuttle_x() > 1.19);
+}
+
+TEST(SequencerSim, ServoLagStillWeavesWithoutInterlockTrips) {
+  Rig r;
+  r.scene.effects = {"servo_lag"};
+  r.scene.servo_lag = sim_hal::ServoLag{0.004};
+  r.build(2);
+  r.run(200000, [] {});
+  EXPECT_EQ(r.seq->state(), State::kDone) << sequencer::fault_name(r.seq->first_fault());
+  EXPECT_EQ(r.seq->counters().rows, 2u);
+}
+
+TEST(SequencerSim, DriveFaultStopsEveryAxisAndKeepsCounters) {
+  Rig r;
+  r.scene.faults.push_back({.at_s = 12.0, .kind = sim_hal::InjectedFault::kDriveFault,
+                            .axis = hal::Axis::kCarriage, .code = 0x8611});
+  r.build(5);
+  r.run(200000, [] {});
+  ASSERT_EQ(r.seq->state(), State::kFault);
+  EXPECT_EQ(r.seq->first_fault(), Fault::kDriveFault);
+  EXPECT_EQ(r.seq->fault_axis(), static_cast<int>(hal::Axis::kCarriage));
+  EXPECT_EQ(r.seq->fault_detail(), 0x8611);
+  const auto counters = r.seq->counters();
+  EXPECT_GE(counters.rows, 1u);
+  // After the fault: every axis is asked to quick-stop and no target moves any more.
+  const hal::HalOutputs at_fault = r.out;
+  for (const auto& a : at_fault.axes) EXPECT_EQ(a.request, hal::AxisRequest::kQuickStop);
+  hal::PortHal hal(*r.world, *r.world);
+  for (int i = 0; i < 1000; ++i, ++r.now) {
+    hal.read(r.now, r.in);
+    r.seq->step(r.now, r.in, r.out);
+    hal.write(r.now, r.out);
+    for (std::size_t k = 0; k < hal::kAxisCount; ++k)
+      EXPECT_EQ(r.out.axes[k].target_position, at_fault.axes[k].target_position);
+  }
+  EXPECT_EQ(r.seq->counters().rows, counters.rows);
+  EXPECT_EQ(r.seq->first_fault(), Fault::kDriveFault);  // first fault stays latched
+}
+
+TEST(SequencerSim, EStopMidRowIsLatched) {
+  Rig r;
+  r.scene.faults.push_back({.at_s = 3.0, .kind = sim_hal::InjectedFault::kEStop});
+  r.build(2);
+  r.run(200000, [] {});
+  EXPECT_EQ(r.seq->first_fault(), Fault::kEStop);
+}
+
+TEST(SequencerSim, EveryBeatHappensAtFullCrankSpeed) {
+  Rig r;
+  r.build(1);
+  const double fell = r.profiles.beatup().warp().fell;
+  int beats = 0;
+  double prev_phase = 0.0;
+  double prev_pos = r.world->axis(hal::Axis::kBeatCrank).position;
+  r.run(200000, [&] {
+    const double pos = r.world->axis(hal::Axis::kBeatCrank).position;
+    const double phase = motion::wrap_two_pi(pos);
+    if (r.seq->state() == State::kBeatSweep && prev_phase < fell && phase >= fell && pos > prev_pos) {
+      ++beats;
+      EXPECT_NEAR((pos - prev_pos) / r.cfg.period_s, r.profiles.spec().crank.velocity, 1e-6);
+    }
+    prev_phase = phase;
+    prev_pos = pos;
+  });
+  EXPECT_EQ(beats, r.profiles.beats_per_row());
+}
