@@ -98,12 +98,13 @@ void SimWorld::step_axis(SimAxis& ax, const hal::AxisCommand& cmd) noexcept {
 
 void SimWorld::write_axes(hal::Tick, const hal::AxisCommands& axes) {
   for (std::size_t i = 0; i < hal::kAxisCount; ++i) step_axis(axes_[i], axes[i]);
-  // The shuttle rides the carrier on the helix shaft: one lead of travel per shaft turn.
-  const double helix = axes_[hal::index(hal::Axis::kHelix)].position;
-  shuttle_x_ = helix * m_.helix_lead_m / (2.0 * 3.14159265358979323846);
 }
 
-void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks&, hal::DigitalInputs& io) {
+void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::DigitalInputs& io) {
+  // The shuttle rides the carrier on the helix shaft: one lead of travel per shaft turn. Taken from the
+  // HAL's fresh helix feedback, so this I/O node also works beside real (CAN) drives.
+  const double helix = axes[hal::index(hal::Axis::kHelix)].position;
+  shuttle_x_ = helix * m_.helix_lead_m / (2.0 * 3.14159265358979323846);
   io.piston_a_extended = piston_[0] >= 1.0;
   io.piston_a_retracted = piston_[0] <= 0.0;
   io.piston_b_extended = piston_[1] >= 1.0;

@@ -1,0 +1,235 @@
+// Loom config and scene parsing. Values are read into the same structs the modules use, then the
+// profile set is built once here as the final check: a config that parses but cannot be woven (the
+// crank cannot reach speed before the first beat, the carriage step breaks its limits) is refused now,
+// with the motion module's message, rather than at the first row.
+#include <fstream>
+#include <sstream>
+
+#include "loom/firmware/config.hpp"
+#include "loom/motion/angles.hpp"
+#include "loom/motion/errors.hpp"
+#include "toml_reader.hpp"
+
+namespace loom::firmware {
+namespace {
+
+std::string read_file(const std::string& path) {
+  std::ifstream f(path);
+  if (!f) throw ConfigError(path + ": cannot open file");
+  std::ostringstream os;
+  os << f.rdbuf();
+  return os.str();
+}
+
+std::string in_range(double v, double lo, double hi) {
+  if (v >= lo && v <= hi) return "";
+  std::ostringstream os;
+  os << "must be in [" << lo << ", " << hi << "]";
+  return os.str();
+}
+
+}  // namespace
+
+LoomConfig parse_loom_config(const std::string& text, const std::string& source) {
+  TomlReader r(text, source);
+  LoomConfig c;
+  c.source = source;
+  r.string("loom.id", c.loom_id);
+  if (c.loom_id.empty() || c.loom_id.find_first_of(" ./*") != std::string::npos) {
+    r.fail("loom.id", '"' + c.loom_id + '"', "must be non-empty without spaces, dots, slashes or '*'");
+  }
+  auto& p = c.profile;
+  r.number("loom.width_m", p.width_m, [](double v) { return in_range(v, 0.2, 10.0); });
+
+  auto& bar = p.beatup.bar;
+  r.number("beatup.crank_m", bar.crank, positive);
+  r.number("beatup.coupler_m", bar.coupler, positive);
+  r.number("beatup.rocker_m", bar.rocker, positive);
+  r.number("beatup.ground_m", bar.ground, positive);
+  r.number("beatup.beater_arm_m", p.beatup.beater_arm_m, positive);
+  std::string branch = "positive", fell = "extended";
+  r.string("beatup.branch", branch, {"positive", "negative"});
+  p.beatup.branch = branch == "positive" ? motion::Branch::kPositive : motion::Branch::kNegative;
+  r.string("beatup.fell_at", fell, {"extended", "folded"});
+  p.beatup.fell_at = fell == "extended" ? motion::FellSide::kExtended : motion::FellSide::kFolded;
+  r.number("beatup.warp_depth_m", p.beatup.warp_depth_m, positive);
+  r.number("beatup.crank_speed_rad_s", p.crank.velocity, [](double v) { return in_range(v, 0.1, 100.0); });
+  r.number("beatup.crank_accel_rad_s2", p.crank.acceleration, positive);
+  r.number("beatup.crank_jerk_rad_s3", p.crank.jerk, positive);
+  r.number("beatup.beater_width_m", p.beater_width_m, positive);
+  r.number("beatup.overlap_m", p.overlap_m, non_negative);
+  double margin_deg = motion::deg(p.cam_margin_rad);
+  r.number("beatup.cam_margin_deg", margin_deg, [](double v) { return in_range(v, 0.0, 90.0); });
+  p.cam_margin_rad = motion::rad(margin_deg);
+  std::int64_t table = static_cast<std::int64_t>(p.table_size);
+  r.integer("beatup.table_size", table, 64, 1 << 20);
+  p.table_size = static_cast<std::size_t>(table);
+  r.number("beatup.crank_park_position_rad", c.sequencer.crank_park_position_rad);
+
+  r.number("carriage.max_speed_m_s", p.carriage_max_speed_m_s, positive);
+  r.number("carriage.max_accel_m_s2", p.carriage_max_accel_m_s2, positive);
+  r.number("carriage.jerk_m_s3", c.sequencer.carriage.jerk, positive);
+  r.number("carriage.home_position_m", c.sequencer.carriage_home_m);
+  c.sequencer.carriage.velocity = p.carriage_max_speed_m_s;
+  c.sequencer.carriage.acceleration = p.carriage_max_accel_m_s2;
+
+  r.number("helix.lead_m", p.helix_lead_m, positive);
+  r.number("helix.max_speed_rad_s", p.helix.velocity, positive);
+  r.number("helix.max_accel_rad_s2", p.helix.acceleration, positive);
+  r.number("helix.jerk_rad_s3", p.helix.jerk, positive);
+  r.number("helix.carrier_force_n", p.carrier_force_n, positive);
+  r.number("helix.shuttle_mass_kg", p.shuttle_mass_kg, positive);
+
+  r.number("shedding.piston_travel_s", c.machine.piston_travel_s, positive);
+  r.number("shedding.timeout_s", c.sequencer.shed_timeout_s, positive);
+
+  double period_ms = 2.0, stale_ms = 50.0;
+  r.number("timing.period_ms", period_ms, [](double v) { return in_range(v, 0.25, 20.0); });
+  r.number("timing.enable_timeout_s", c.sequencer.enable_timeout_s, positive);
+  r.number("timing.pick_timeout_margin_s", c.sequencer.pick_timeout_margin_s, positive);
+  r.number("timing.stale_timeout_ms", stale_ms, positive);
+  c.sequencer.period_s = period_ms * 1e-3;
+  c.sequencer.stale_timeout_s = stale_ms * 1e-3;
+  if (c.sequencer.stale_timeout_s < 2.0 * c.sequencer.period_s) {
+    r.fail("timing.stale_timeout_ms", std::to_string(stale_ms), "must be at least two periods");
+  }
+  c.machine.period_s = c.sequencer.period_s;
+  c.machine.width_m = p.width_m;
+  c.machine.helix_lead_m = p.helix_lead_m;
+
+  std::int64_t v = 0;
+  v = c.can.bitrate;
+  r.integer("can.bitrate", v, 10'000, 1'000'000);
+  c.can.bitrate = static_cast<std::uint32_t>(v);
+  r.number("can.bus_load_budget", c.can.bus_load_budget, [](double x) { return in_range(x, 0.05, 1.0); });
+  const auto node = [&](const char* key, std::uint8_t& out) {
+    std::int64_t n = out;
+    r.integer(key, n, 1, 127);
+    out = static_cast<std::uint8_t>(n);
+  };
+  node("can.node_beat_crank", c.can.node_beat_crank);
+  node("can.node_carriage", c.can.node_carriage);
+  node("can.node_helix", c.can.node_helix);
+  if (c.can.node_beat_crank == c.can.node_carriage || c.can.node_beat_crank == c.can.node_helix ||
+      c.can.node_carriage == c.can.node_helix) {
+    r.fail("can.node_helix", std::to_string(c.can.node_helix), "node ids of the three axes must differ");
+  }
+  r.number("can.counts_per_rev", c.can.counts_per_rev, positive);
+  r.number("can.carriage_counts_per_m", c.can.carriage_counts_per_m, positive);
+  const auto ms16 = [&](const char* key, std::uint16_t& out, std::int64_t lo) {
+    std::int64_t n = out;
+    r.integer(key, n, lo, 60000);
+    out = static_cast<std::uint16_t>(n);
+  };
+  ms16("can.heartbeat_ms", c.can.heartbeat_ms, 10);
+  ms16("can.heartbeat_timeout_ms", c.can.heartbeat_timeout_ms, 10);
+  ms16("can.sdo_timeout_ms", c.can.sdo_timeout_ms, 10);
+  if (c.can.heartbeat_timeout_ms <= c.can.heartbeat_ms || c.can.heartbeat_timeout_ms > 3 * c.can.heartbeat_ms) {
+    r.fail("can.heartbeat_timeout_ms", std::to_string(c.can.heartbeat_timeout_ms),
+           "must be above heartbeat_ms and at most three heartbeat periods");
+  }
+
+  r.string("telemetry.lcm_url", c.telemetry.lcm_url);
+  const auto every = [&](const char* key, std::uint32_t& out) {
+    std::int64_t n = out;
+    r.integer(key, n, 1, 1'000'000);
+    out = static_cast<std::uint32_t>(n);
+  };
+  every("telemetry.status_every", c.telemetry.status_every);
+  every("telemetry.axes_every", c.telemetry.axes_every);
+  every("telemetry.rt_every", c.telemetry.rt_every);
+  r.reject_unknown();
+
+  // Final check: the motion module must be able to build every profile from these numbers.
+  try {
+    motion::ProfileSet check(c.profile);
+  } catch (const motion::MotionError& e) {
+    throw ConfigError(source + ": motion profiles cannot be built: " + e.what());
+  }
+  return c;
+}
+
+LoomConfig load_loom_config(const std::string& path) { return parse_loom_config(read_file(path), path); }
+LoomConfig default_loom_config() { return parse_loom_config(kDefaultLoomToml, "<embedded default_loom.toml>"); }
+
+Scene parse_scene(const std::string& text, const std::string& source) {
+  TomlReader r(text, source);
+  Scene s;
+  s.source = source;
+  r.string("name", s.spec.name);
+  std::int64_t seed = static_cast<std::int64_t>(s.spec.seed);
+  r.integer("seed", seed, 0, INT64_MAX);
+  s.spec.seed = static_cast<std::uint64_t>(seed);
+  r.string("config", s.config_path);
+  r.string_list("effects", s.spec.effects);
+  for (const std::string& e : s.spec.effects) {
+    bool known = false;
+    for (const auto& k : sim_hal::known_effects()) known = known || k == e;
+    if (!known) {
+      std::string list;
+      for (const auto& k : sim_hal::known_effects()) list += (list.empty() ? "" : ", ") + k;
+      r.fail("effects", '"' + e + '"', "unknown effect (known: " + list + ")");
+    }
+  }
+  const bool lag_named = std::find(s.spec.effects.begin(), s.spec.effects.end(), "servo_lag") != s.spec.effects.end();
+  if (r.root().contains("servo_lag")) {
+    if (!lag_named) r.fail("servo_lag", "{...}", "parameters given for an effect the scene does not name");
+  }
+  if (lag_named) {
+    sim_hal::ServoLag lag;
+    r.number("servo_lag.tau_s", lag.tau_s, [](double v) { return in_range(v, 1e-5, 1.0); });
+    s.spec.servo_lag = lag;
+  }
+  r.consume("fault");
+  if (const toml::node* faults = r.root().get("fault")) {
+    const toml::array* arr = faults->as_array();
+    if (!arr || !arr->is_array_of_tables()) r.fail_at(*faults, "fault", "...", "expected [[fault]] tables");
+    for (const toml::node& fn : *arr) {
+      const toml::table& t = *fn.as_table();
+      sim_hal::FaultInjection f;
+      for (const auto& [k, v] : t) {
+        const std::string key(k.str());
+        const std::string field = "fault." + key;
+        if (key == "at_s") {
+          const auto x = v.value<double>();
+          if (!x || *x < 0) r.fail_at(v, field, "?", "must be a time >= 0 in seconds");
+          f.at_s = *x;
+        } else if (key == "kind") {
+          const auto x = v.value<std::string>();
+          if (x && *x == "drive_fault") {
+            f.kind = sim_hal::InjectedFault::kDriveFault;
+          } else if (x && *x == "estop") {
+            f.kind = sim_hal::InjectedFault::kEStop;
+          } else {
+            r.fail_at(v, field, x ? '"' + *x + '"' : "?", "must be one of: drive_fault, estop");
+          }
+        } else if (key == "axis") {
+          const auto x = v.value<std::string>();
+          if (x && *x == "beat_crank") {
+            f.axis = hal::Axis::kBeatCrank;
+          } else if (x && *x == "carriage") {
+            f.axis = hal::Axis::kCarriage;
+          } else if (x && *x == "helix") {
+            f.axis = hal::Axis::kHelix;
+          } else {
+            r.fail_at(v, field, x ? '"' + *x + '"' : "?", "must be one of: beat_crank, carriage, helix");
+          }
+        } else if (key == "code") {
+          const auto x = v.value_exact<std::int64_t>();
+          if (!x || *x < 0 || *x > 0xFFFF) r.fail_at(v, field, "?", "must be an integer in [0, 0xFFFF]");
+          f.code = static_cast<std::uint16_t>(*x);
+        } else {
+          r.fail_at(v, field, "?", "unknown field");
+        }
+      }
+      s.spec.faults.push_back(f);
+    }
+  }
+  r.reject_unknown();
+  return s;
+}
+
+Scene load_scene(const std::string& path) { return parse_scene(read_file(path), path); }
+Scene default_scene() { return parse_scene(kDefaultSceneToml, "<embedded default.toml scene>"); }
+
+}  // namespace loom::firmware

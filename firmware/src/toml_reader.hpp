@@ -1,0 +1,49 @@
+// A thin reader over toml++ that turns every problem into one ConfigError line
+// "file:line:col: field = value: why", and rejects keys nobody asked for (typos must not pass).
+#pragma once
+
+#include <functional>
+#include <set>
+#include <sstream>
+#include <string>
+#include <toml++/toml.h>
+
+#include "loom/firmware/config.hpp"
+
+namespace loom::firmware {
+
+class TomlReader {
+ public:
+  TomlReader(const std::string& text, std::string source);
+
+  const std::string& source() const { return source_; }
+  const toml::table& root() const { return root_; }
+
+  // Read `table.key` into `out` if present; `check` returns "" when valid or the reason.
+  void number(const std::string& path, double& out, const std::function<std::string(double)>& check = {});
+  void integer(const std::string& path, std::int64_t& out, std::int64_t lo, std::int64_t hi);
+  void string(const std::string& path, std::string& out, const std::set<std::string>& allowed = {});
+  void string_list(const std::string& path, std::vector<std::string>& out);
+
+  // Error at the node for `path` (or the file start when absent).
+  [[noreturn]] void fail(const std::string& path, const std::string& value, const std::string& why) const;
+  [[noreturn]] void fail_at(const toml::node& node, const std::string& field, const std::string& value,
+                            const std::string& why) const;
+
+  // After reading: every key in the file must have been consumed (arrays of tables are checked by
+  // their readers through `consume`).
+  void consume(const std::string& path) { used_.insert(path); }
+  void reject_unknown() const;
+
+ private:
+  const toml::node* find(const std::string& path) const;
+  std::string source_;
+  toml::table root_;
+  std::set<std::string> used_;
+};
+
+// Common checks.
+std::string positive(double v);
+std::string non_negative(double v);
+
+}  // namespace loom::firmware
