@@ -1,0 +1,144 @@
+// Config and CLI input errors: one line naming file, line, column, field and value; exit 2; nothing
+// started. Also the embedded defaults parse and the shipped scenes load.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "loom/firmware/config.hpp"
+
+using namespace loom::firmware;
+
+namespace {
+std::string config_error(const std::string& text) {
+  try {
+    (void)parse_loom_config(text, "loom.toml");
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+struct CliRun {
+  int exit_code;
+  std::string output;
+};
+CliRun run_loomctl(const std::string& args) {
+  const std::string cmd = std::string(LOOMCTL_PATH) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[512];
+  while (fgets(buf, sizeof buf, p)) out += buf;
+  const int st = pclose(p);
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+}
+std::string write_temp(const std::string& name, const std::string& text) {
+  const auto path = std::filesystem::temp_directory_path() / name;
+  std::ofstream(path) << text;
+  return path.string();
+}
+}  // namespace
+
+TEST(Config, EmbeddedDefaultsParse) {
+  const LoomConfig c = default_loom_config();
+  EXPECT_EQ(c.loom_id, "loom1");
+  EXPECT_DOUBLE_EQ(c.profile.beatup.bar.crank, 0.058);
+  EXPECT_DOUBLE_EQ(c.sequencer.period_s, 0.002);
+  const Scene s = default_scene();
+  EXPECT_EQ(s.spec.effects, std::vector<std::string>{"ideal"});
+}
+
+TEST(Config, ShippedScenesLoad) {
+  for (const char* name : {"default", "servo_lag", "drive_fault", "estop"}) {
+    const Scene s = load_scene(std::string(LOOM_SOURCE_DIR) + "/sim_hal/scenes/" + name + ".toml");
+    EXPECT_EQ(s.spec.name, name);
+  }
+}
+
+TEST(Config, OutOfRangeValueNamesFileLineColumnFieldAndValue) {
+  const std::string e = config_error("[loom]\nwidth_m = 1.2\n\n[beatup]\ncrank_m = -0.058\n");
+  EXPECT_EQ(e, "loom.toml:5:11: beatup.crank_m = -0.058: must be positive and finite");
+}
+
+TEST(Config, WrongTypeAndUnknownKeyAndBadEnum) {
+  EXPECT_EQ(config_error("[helix]\nlead_m = \"ten\"\n"), "loom.toml:2:10: helix.lead_m = \"ten\": expected a number");
+  EXPECT_EQ(config_error("[helix]\nleed_m = 0.1\n"), "loom.toml:2:10: helix.leed_m = 0.1: unknown field");
+  EXPECT_NE(config_error("[beatup]\nbranch = \"up\"\n").find("beatup.branch = \"up\": must be one of"),
+            std::string::npos);
+}
+
+TEST(Config, SyntaxErrorHasLineAndColumn) {
+  const std::string e = config_error("[loom]\nwidth_m = = 3\n");
+  EXPECT_EQ(e.rfind("loom.toml:2:", 0), 0u) << e;
+}
+
+TEST(Config, InfeasibleMotionIsRefusedWithTheLimits) {
+  // A crank so slow to accelerate that it cannot reach speed before the first beat.
+  const std::string e = config_error("[beatup]\ncrank_accel_rad_s2 = 5.0\n");
+  EXPECT_NE(e.find("cannot reach 15.5 rad/s before the first beat"), std::string::npos) << e;
+}
+
+TEST(Config, HeartbeatTimeoutMustDetectLossWithinThreePeriods) {
+  EXPECT_NE(config_error("[can]\nheartbeat_ms = 100\nheartbeat_timeout_ms = 400\n").find("three heartbeat periods"),
+            std::string::npos);
+}
+
+TEST(Config, SceneRejectsUnknownEffectsAndOrphanParameters) {
+  EXPECT_NE(std::string([] {
+              try {
+                (void)parse_scene("effects = [\"ideal\", \"warp_drive\"]\n", "s.toml");
+              } catch (const ConfigError& e) {
+                return std::string(e.what());
+              }
+              return std::string();
+            }())
+                .find("s.toml:1:"),
+            std::string::npos);
+  EXPECT_THROW((void)parse_scene("effects = [\"ideal\"]\n[servo_lag]\ntau_s = 0.01\n", "s.toml"), ConfigError);
+}
+
+TEST(LoomctlCli, BadConfigValueIsOneLineAndExit2) {
+  const std::string path = write_temp("loom_bad.toml", "[loom]\nwidth_m = 99\n");
+  const CliRun r = run_loomctl("weave --no-telemetry --config " + path);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.output, "loomctl: " + path + ":2:11: loom.width_m = 99: must be in [0.2, 10]\n");
+}
+
+TEST(LoomctlCli, BadArgumentsExit2) {
+  EXPECT_EQ(run_loomctl("weave --rows 0").exit_code, 2);
+  EXPECT_EQ(run_loomctl("weave --hal can").exit_code, 2);
+  EXPECT_EQ(run_loomctl("weave --hal socketcan").exit_code, 2);
+  EXPECT_EQ(run_loomctl("weave --period-ms 100 --no-telemetry").exit_code, 2);
+  EXPECT_EQ(run_loomctl("fly").exit_code, 2);
+}
+
+TEST(LoomctlCli, WeavesThreeRowsAndPrintsRowSummaries) {
+  const CliRun r = run_loomctl("weave --rows 3 --no-telemetry");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  for (const char* row : {"row 1/3:", "row 2/3:", "row 3/3:"}) EXPECT_NE(r.output.find(row), std::string::npos);
+  EXPECT_NE(r.output.find("15 beats, 14 carriage steps"), std::string::npos) << r.output;
+}
+
+TEST(LoomctlCli, FaultSceneExits3AndKeepsCounters) {
+  const std::string counters = (std::filesystem::temp_directory_path() / "loom_fault_counters.json").string();
+  std::filesystem::remove(counters);
+  const CliRun r = run_loomctl("weave --rows 5 --no-telemetry --counters " + counters + " --scene " +
+                            std::string(LOOM_SOURCE_DIR) + "/sim_hal/scenes/drive_fault.toml");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("FAULT drive_fault"), std::string::npos) << r.output;
+  std::ifstream f(counters);
+  std::string body((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  EXPECT_NE(body.find("\"rows\":1"), std::string::npos) << body;
+}
+
+TEST(LoomctlCli, ResumesFromSavedCounters) {
+  const std::string counters = write_temp("loom_resume_counters.json", "{\"rows\":7,\"picks\":7,\"beats\":105}\n");
+  const CliRun r = run_loomctl("weave --rows 1 --no-telemetry --counters " + counters);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("row 8/8:"), std::string::npos) << r.output;
+  std::ifstream f(counters);
+  std::string body((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(body, "{\"rows\":8,\"picks\":8,\"beats\":120}\n");
+}
