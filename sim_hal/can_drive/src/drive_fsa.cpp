@@ -30,33 +30,49 @@ DriveState drive_apply_controlword(DriveState state, std::uint16_t cw, std::uint
       return c == Command::kShutdown ? DriveState::kReadyToSwitchOn : state;  // 2
     case DriveState::kReadyToSwitchOn:
       switch (c) {
-        case Command::kSwitchOn: return DriveState::kSwitchedOn;                  // 3
-        case Command::kEnableOperation: return DriveState::kOperationEnabled;     // 3 + 4
+        case Command::kSwitchOn:
+          return DriveState::kSwitchedOn;  // 3
+        case Command::kEnableOperation:
+          return DriveState::kOperationEnabled;  // 3 + 4
         case Command::kDisableVoltage:
-        case Command::kQuickStop: return DriveState::kSwitchOnDisabled;           // 7
-        default: return state;
+        case Command::kQuickStop:
+          return DriveState::kSwitchOnDisabled;  // 7
+        default:
+          return state;
       }
     case DriveState::kSwitchedOn:
       switch (c) {
-        case Command::kEnableOperation: return DriveState::kOperationEnabled;     // 4
-        case Command::kShutdown: return DriveState::kReadyToSwitchOn;             // 6
+        case Command::kEnableOperation:
+          return DriveState::kOperationEnabled;  // 4
+        case Command::kShutdown:
+          return DriveState::kReadyToSwitchOn;  // 6
         case Command::kDisableVoltage:
-        case Command::kQuickStop: return DriveState::kSwitchOnDisabled;           // 10
-        default: return state;
+        case Command::kQuickStop:
+          return DriveState::kSwitchOnDisabled;  // 10
+        default:
+          return state;
       }
     case DriveState::kOperationEnabled:
       switch (c) {
-        case Command::kSwitchOn: return DriveState::kSwitchedOn;                  // 5
-        case Command::kShutdown: return DriveState::kReadyToSwitchOn;             // 8
-        case Command::kDisableVoltage: return DriveState::kSwitchOnDisabled;      // 9
-        case Command::kQuickStop: return DriveState::kQuickStopActive;            // 11
-        default: return state;
+        case Command::kSwitchOn:
+          return DriveState::kSwitchedOn;  // 5
+        case Command::kShutdown:
+          return DriveState::kReadyToSwitchOn;  // 8
+        case Command::kDisableVoltage:
+          return DriveState::kSwitchOnDisabled;  // 9
+        case Command::kQuickStop:
+          return DriveState::kQuickStopActive;  // 11
+        default:
+          return state;
       }
     case DriveState::kQuickStopActive:
       switch (c) {
-        case Command::kDisableVoltage: return DriveState::kSwitchOnDisabled;      // 12
-        case Command::kEnableOperation: return DriveState::kOperationEnabled;     // 16
-        default: return state;
+        case Command::kDisableVoltage:
+          return DriveState::kSwitchOnDisabled;  // 12
+        case Command::kEnableOperation:
+          return DriveState::kOperationEnabled;  // 16
+        default:
+          return state;
       }
     case DriveState::kUnknown:
     case DriveState::kNotReadyToSwitchOn:
@@ -69,9 +85,12 @@ DriveState drive_apply_controlword(DriveState state, std::uint16_t cw, std::uint
 DriveState drive_settle(DriveState state) {
   switch (state) {
     case DriveState::kUnknown:
-    case DriveState::kNotReadyToSwitchOn: return DriveState::kSwitchOnDisabled;
-    case DriveState::kFaultReactionActive: return DriveState::kFault;
-    default: return state;
+    case DriveState::kNotReadyToSwitchOn:
+      return DriveState::kSwitchOnDisabled;
+    case DriveState::kFaultReactionActive:
+      return DriveState::kFault;
+    default:
+      return state;
   }
 }
 
@@ -79,14 +98,30 @@ std::uint16_t drive_statusword(DriveState state, bool csp, bool target_reached, 
   std::uint16_t sw = 0;
   switch (state) {
     case DriveState::kUnknown:
-    case DriveState::kNotReadyToSwitchOn: sw = 0x0000; break;
-    case DriveState::kSwitchOnDisabled: sw = 0x0040; break;
-    case DriveState::kReadyToSwitchOn: sw = 0x0031; break;
-    case DriveState::kSwitchedOn: sw = 0x0033; break;
-    case DriveState::kOperationEnabled: sw = 0x0037; break;
-    case DriveState::kQuickStopActive: sw = 0x0017; break;
-    case DriveState::kFaultReactionActive: sw = 0x001F; break;
-    case DriveState::kFault: sw = 0x0008; break;
+    case DriveState::kNotReadyToSwitchOn:
+      sw = 0x0000;
+      break;
+    case DriveState::kSwitchOnDisabled:
+      sw = 0x0040;
+      break;
+    case DriveState::kReadyToSwitchOn:
+      sw = 0x0031;
+      break;
+    case DriveState::kSwitchedOn:
+      sw = 0x0033;
+      break;
+    case DriveState::kOperationEnabled:
+      sw = 0x0037;
+      break;
+    case DriveState::kQuickStopActive:
+      sw = 0x0017;
+      break;
+    case DriveState::kFaultReactionActive:
+      sw = 0x001F;
+      break;
+    case DriveState::kFault:
+      sw = 0x0008;
+      break;
   }
   sw |= 1U << 9;  // remote: controlled over the bus
   if (state == DriveState::kOperationEnabled && csp) sw |= 1U << 12;

@@ -84,7 +84,9 @@ void SimDriveNode::power_on(std::int64_t now_us) {
   send(drivers::make_heartbeat(config_.node_id, NmtState::kBootUp));
 }
 
-void SimDriveNode::power_off() { powered_ = false; }
+void SimDriveNode::power_off() {
+  powered_ = false;
+}
 
 void SimDriveNode::send(const CanFrame& f) {
   if (powered_) bus_.send(f);
@@ -120,9 +122,15 @@ void SimDriveNode::on_nmt(const CanFrame& f, std::int64_t now_us) {
   const auto msg = drivers::parse_nmt(f);
   if (!msg || (msg->node != 0 && msg->node != config_.node_id)) return;
   switch (msg->command) {
-    case drivers::NmtCommand::kStart: nmt_ = NmtState::kOperational; break;
-    case drivers::NmtCommand::kStop: nmt_ = NmtState::kStopped; break;
-    case drivers::NmtCommand::kEnterPreOperational: nmt_ = NmtState::kPreOperational; break;
+    case drivers::NmtCommand::kStart:
+      nmt_ = NmtState::kOperational;
+      break;
+    case drivers::NmtCommand::kStop:
+      nmt_ = NmtState::kStopped;
+      break;
+    case drivers::NmtCommand::kEnterPreOperational:
+      nmt_ = NmtState::kPreOperational;
+      break;
     case drivers::NmtCommand::kResetNode:
       reset_application();
       [[fallthrough]];
@@ -157,7 +165,8 @@ void SimDriveNode::on_sdo(const CanFrame& f, std::int64_t now_us) {
     case drivers::SdoRequestKind::kDownloadSegmented:
       send(drivers::make_sdo_abort(reply_id, req.index, req.sub, abort_code::kUnsupportedAccess));
       return;
-    case drivers::SdoRequestKind::kAbort: return;
+    case drivers::SdoRequestKind::kAbort:
+      return;
     case drivers::SdoRequestKind::kInvalid:
       send(drivers::make_sdo_abort(reply_id, req.index, req.sub, abort_code::kInvalidCommand));
       return;
@@ -188,10 +197,17 @@ void SimDriveNode::apply_rpdo(std::size_t k, const std::array<std::uint8_t, 8>& 
     for (std::size_t b = 0; b < bytes; ++b) v |= static_cast<std::uint32_t>(data[offset + b]) << (8 * b);
     offset += bytes;
     switch (m.index) {
-      case od::kControlword: set_controlword(static_cast<std::uint16_t>(v)); break;
-      case od::kTargetPosition: target_ = static_cast<std::int32_t>(v); break;
-      case od::kModesOfOperation: mode_ = static_cast<std::int8_t>(v); break;
-      default: break;
+      case od::kControlword:
+        set_controlword(static_cast<std::uint16_t>(v));
+        break;
+      case od::kTargetPosition:
+        target_ = static_cast<std::int32_t>(v);
+        break;
+      case od::kModesOfOperation:
+        mode_ = static_cast<std::int8_t>(v);
+        break;
+      default:
+        break;
     }
   }
 }
@@ -250,18 +266,24 @@ double SimDriveNode::interpolation_period_s() const {
 
 std::uint32_t SimDriveNode::mapped_value(std::uint16_t index) const {
   switch (index) {
-    case od::kStatusword: return statusword();
-    case od::kPositionActual: return static_cast<std::uint32_t>(position_);
+    case od::kStatusword:
+      return statusword();
+    case od::kPositionActual:
+      return static_cast<std::uint32_t>(position_);
     case od::kVelocityActual: {
       const auto delta = static_cast<std::int32_t>(static_cast<std::uint32_t>(position_) -
                                                    static_cast<std::uint32_t>(previous_position_));
       return static_cast<std::uint32_t>(
           static_cast<std::int32_t>(std::lround(delta / interpolation_period_s())));
     }
-    case od::kTorqueActual: return 0;  // ideal tracking needs no torque
-    case od::kModesOfOperationDisplay: return static_cast<std::uint8_t>(mode_);
-    case od::kErrorCode: return error_code_;
-    default: return 0;
+    case od::kTorqueActual:
+      return 0;  // ideal tracking needs no torque
+    case od::kModesOfOperationDisplay:
+      return static_cast<std::uint8_t>(mode_);
+    case od::kErrorCode:
+      return error_code_;
+    default:
+      return 0;
   }
 }
 
@@ -290,7 +312,9 @@ void SimDriveNode::enter_fault(std::uint16_t code) {
   }
 }
 
-void SimDriveNode::inject_fault(std::uint16_t code) { enter_fault(code); }
+void SimDriveNode::inject_fault(std::uint16_t code) {
+  enter_fault(code);
+}
 
 // ---------------------------------------------------------------------------------------------------
 // Timers
@@ -327,10 +351,10 @@ bool SimDriveNode::mappable(std::uint32_t entry, bool rx) const {
     bool rx;
   };
   static constexpr Mappable kTable[] = {
-      {od::kControlword, 16, true},         {od::kTargetPosition, 32, true},
-      {od::kModesOfOperation, 8, true},     {od::kStatusword, 16, false},
-      {od::kPositionActual, 32, false},     {od::kVelocityActual, 32, false},
-      {od::kTorqueActual, 16, false},       {od::kModesOfOperationDisplay, 8, false},
+      {od::kControlword, 16, true},     {od::kTargetPosition, 32, true},
+      {od::kModesOfOperation, 8, true}, {od::kStatusword, 16, false},
+      {od::kPositionActual, 32, false}, {od::kVelocityActual, 32, false},
+      {od::kTorqueActual, 16, false},   {od::kModesOfOperationDisplay, 8, false},
       {od::kErrorCode, 16, false},
   };
   for (const Mappable& t : kTable) {
@@ -350,14 +374,28 @@ std::uint32_t SimDriveNode::read_object(std::uint16_t index, std::uint8_t sub, s
   };
   const auto pdo_comm = [&](const PdoComm& c) -> std::uint32_t {
     switch (sub) {
-      case 0: value = 2; size = 1; return 0;
-      case 1: value = c.cob_id; size = 4; return 0;
-      case 2: value = c.type; size = 1; return 0;
-      default: return abort_code::kNoSubIndex;
+      case 0:
+        value = 2;
+        size = 1;
+        return 0;
+      case 1:
+        value = c.cob_id;
+        size = 4;
+        return 0;
+      case 2:
+        value = c.type;
+        size = 1;
+        return 0;
+      default:
+        return abort_code::kNoSubIndex;
     }
   };
   const auto pdo_map = [&](const PdoMap& m) -> std::uint32_t {
-    if (sub == 0) { value = m.count; size = 1; return 0; }
+    if (sub == 0) {
+      value = m.count;
+      size = 1;
+      return 0;
+    }
     if (sub > 8) return abort_code::kNoSubIndex;
     value = m.entries[sub - 1];
     size = 4;
@@ -368,33 +406,57 @@ std::uint32_t SimDriveNode::read_object(std::uint16_t index, std::uint8_t sub, s
   if (index >= od::kTpdoComm && index < od::kTpdoComm + 4) return pdo_comm(tpdo_comm_[index - od::kTpdoComm]);
   if (index >= od::kTpdoMap && index < od::kTpdoMap + 4) return pdo_map(tpdo_map_[index - od::kTpdoMap]);
   switch (index) {
-    case od::kDeviceType: return one(kDeviceTypeServo402, 4);
-    case od::kErrorRegister: return one(error_register_, 1);
-    case od::kHeartbeatProducer: return one(heartbeat_ms_, 2);
-    case od::kErrorCode: return one(error_code_, 2);
-    case od::kControlword: return one(controlword_, 2);
-    case od::kStatusword: return one(statusword(), 2);
+    case od::kDeviceType:
+      return one(kDeviceTypeServo402, 4);
+    case od::kErrorRegister:
+      return one(error_register_, 1);
+    case od::kHeartbeatProducer:
+      return one(heartbeat_ms_, 2);
+    case od::kErrorCode:
+      return one(error_code_, 2);
+    case od::kControlword:
+      return one(controlword_, 2);
+    case od::kStatusword:
+      return one(statusword(), 2);
     case od::kModesOfOperation:
-    case od::kModesOfOperationDisplay: return one(static_cast<std::uint8_t>(mode_), 1);
-    case od::kPositionActual: return one(static_cast<std::uint32_t>(position_), 4);
-    case od::kVelocityActual: return one(mapped_value(od::kVelocityActual), 4);
-    case od::kTorqueActual: return one(0, 2);
-    case od::kTargetPosition: return one(static_cast<std::uint32_t>(target_), 4);
-    case od::kSupportedDriveModes: return one(config_.supports_csp ? 0x85U : 0x05U, 4);  // pp, pv [, csp]
+    case od::kModesOfOperationDisplay:
+      return one(static_cast<std::uint8_t>(mode_), 1);
+    case od::kPositionActual:
+      return one(static_cast<std::uint32_t>(position_), 4);
+    case od::kVelocityActual:
+      return one(mapped_value(od::kVelocityActual), 4);
+    case od::kTorqueActual:
+      return one(0, 2);
+    case od::kTargetPosition:
+      return one(static_cast<std::uint32_t>(target_), 4);
+    case od::kSupportedDriveModes:
+      return one(config_.supports_csp ? 0x85U : 0x05U, 4);  // pp, pv [, csp]
     case od::kInterpolationPeriod:
       switch (sub) {
-        case 0: value = 2; size = 1; return 0;
-        case 1: value = ip_value_; size = 1; return 0;
-        case 2: value = static_cast<std::uint8_t>(ip_index_); size = 1; return 0;
-        default: return abort_code::kNoSubIndex;
+        case 0:
+          value = 2;
+          size = 1;
+          return 0;
+        case 1:
+          value = ip_value_;
+          size = 1;
+          return 0;
+        case 2:
+          value = static_cast<std::uint8_t>(ip_index_);
+          size = 1;
+          return 0;
+        default:
+          return abort_code::kNoSubIndex;
       }
-    default: return abort_code::kNoObject;
+    default:
+      return abort_code::kNoObject;
   }
 }
 
 std::uint32_t SimDriveNode::write_pdo_comm(PdoComm& c, bool rx, std::uint8_t sub, std::uint32_t value) {
   switch (sub) {
-    case 0: return abort_code::kReadOnly;
+    case 0:
+      return abort_code::kReadOnly;
     case 1: {
       const bool was_valid = (c.cob_id & kInvalid) == 0;
       const bool valid = (value & kInvalid) == 0;
@@ -409,7 +471,8 @@ std::uint32_t SimDriveNode::write_pdo_comm(PdoComm& c, bool rx, std::uint8_t sub
       c.type = static_cast<std::uint8_t>(value);
       return 0;
     }
-    default: return abort_code::kNoSubIndex;
+    default:
+      return abort_code::kNoSubIndex;
   }
 }
 
@@ -471,17 +534,28 @@ std::uint32_t SimDriveNode::write_object(std::uint16_t index, std::uint8_t sub, 
     return 0;
   }
   switch (index) {
-    case od::kDeviceType: case od::kErrorRegister: case od::kErrorCode: case od::kStatusword:
-    case od::kModesOfOperationDisplay: case od::kPositionActual: case od::kVelocityActual:
-    case od::kTorqueActual: case od::kSupportedDriveModes:
+    case od::kDeviceType:
+    case od::kErrorRegister:
+    case od::kErrorCode:
+    case od::kStatusword:
+    case od::kModesOfOperationDisplay:
+    case od::kPositionActual:
+    case od::kVelocityActual:
+    case od::kTorqueActual:
+    case od::kSupportedDriveModes:
       return sub == 0 ? abort_code::kReadOnly : abort_code::kNoSubIndex;
-    default: break;
+    default:
+      break;
   }
   if (sub != 0) {
     switch (index) {
-      case od::kHeartbeatProducer: case od::kControlword: case od::kModesOfOperation:
-      case od::kTargetPosition: return abort_code::kNoSubIndex;
-      default: return abort_code::kNoObject;
+      case od::kHeartbeatProducer:
+      case od::kControlword:
+      case od::kModesOfOperation:
+      case od::kTargetPosition:
+        return abort_code::kNoSubIndex;
+      default:
+        return abort_code::kNoObject;
     }
   }
   switch (index) {
@@ -505,7 +579,8 @@ std::uint32_t SimDriveNode::write_object(std::uint16_t index, std::uint8_t sub, 
       if (const std::uint32_t e = check_size(size, 4)) return e;
       target_ = static_cast<std::int32_t>(value);
       return 0;
-    default: return abort_code::kNoObject;
+    default:
+      return abort_code::kNoObject;
   }
 }
 

@@ -29,21 +29,22 @@ class SimDriveNode {
   // Configure-time only. The node is powered off until power_on().
   SimDriveNode(drivers::CanBus& bus, SimDriveConfig config);
 
-  // Power cycle: every object to its default, 402 state Switch On Disabled, boot-up sent.
+  // RT-safe (no allocation; sends through the bus). Power cycle: every object to its default, 402
+  // state Switch On Disabled, boot-up sent.
   void power_on(std::int64_t now_us);
-  // Silent from now on (cable pulled / power lost): sends nothing, ignores every frame.
+  // RT-safe. Silent from now on (cable pulled / power lost): sends nothing, ignores every frame.
   void power_off();
-  // Drive detects a fault: Fault Reaction Active, EMCY with `code`, Fault at the next SYNC.
+  // RT-safe. Drive detects a fault: Fault Reaction Active, EMCY with `code`, Fault at the next SYNC.
   void inject_fault(std::uint16_t code);
 
-  // One received frame (the node filters what is addressed to it).
+  // RT-safe. One received frame (the node filters what is addressed to it).
   void handle(const drivers::CanFrame& frame, std::int64_t now_us);
-  // Timers: heartbeat production.
+  // RT-safe. Timers: heartbeat production.
   void step(std::int64_t now_us);
-  // Earliest time step() has something to do (INT64_MAX when nothing is scheduled).
+  // RT-safe. Earliest time step() has something to do (INT64_MAX when nothing is scheduled).
   std::int64_t next_deadline_us() const;
 
-  // Observation for tests and the executable's log.
+  // Observation for tests and the executable's log; all RT-safe.
   std::uint8_t node_id() const { return config_.node_id; }
   bool powered() const { return powered_; }
   drivers::NmtState nmt_state() const { return nmt_; }
@@ -79,7 +80,8 @@ class SimDriveNode {
   void enter_fault(std::uint16_t code);
   bool object_missing(std::uint16_t index) const;
   // SDO server: 0 on success, else the abort code.
-  std::uint32_t read_object(std::uint16_t index, std::uint8_t sub, std::uint32_t& value, std::uint8_t& size) const;
+  std::uint32_t read_object(std::uint16_t index, std::uint8_t sub, std::uint32_t& value,
+                            std::uint8_t& size) const;
   std::uint32_t write_object(std::uint16_t index, std::uint8_t sub, std::uint32_t value, std::uint8_t size,
                              std::int64_t now_us);
   std::uint32_t write_pdo_comm(PdoComm& c, bool rx, std::uint8_t sub, std::uint32_t value);

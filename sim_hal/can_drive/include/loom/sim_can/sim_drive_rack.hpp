@@ -15,10 +15,10 @@ class SimDriveRack {
   // Configure-time only.
   SimDriveRack(drivers::CanBus& bus, const std::vector<SimDriveConfig>& nodes);
 
-  void power_on(std::int64_t now_us);
-  // Drain up to `max_frames` received frames into the nodes, then step their timers.
+  void power_on(std::int64_t now_us);  // RT-safe
+  // RT-safe. Drain up to `max_frames` received frames into the nodes, then step their timers.
   void step(std::int64_t now_us, int max_frames = 1024);
-  std::int64_t next_deadline_us() const;
+  std::int64_t next_deadline_us() const;  // RT-safe
 
   std::size_t size() const { return nodes_.size(); }
   SimDriveNode& node(std::size_t i) { return *nodes_[i]; }

@@ -1,0 +1,130 @@
+// The three servo axes (beat crank, carriage, helix shaft) as CiA 402 drives in cyclic synchronous
+// position mode behind hal::AxisPort. configure() brings the drives up by NMT and SDO (may block, with
+// timeouts); read_axes()/write_axes() are the per-tick RT path: SYNC + one RPDO per axis out, TPDOs,
+// heartbeats, EMCYs and error frames in, fixed arrays only, bounded work.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "loom/drivers/bus_load.hpp"
+#include "loom/drivers/can_frame.hpp"
+#include "loom/drivers/cia402.hpp"
+#include "loom/drivers/configure_clock.hpp"
+#include "loom/drivers/position_scaling.hpp"
+#include "loom/drivers/status.hpp"
+#include "loom/hal/hal.hpp"
+
+namespace loom::drivers {
+
+class SdoClient;
+
+// 20-bit single-turn encoders; the carriage's ball screw advances 10 mm per motor revolution.
+inline constexpr double kCountsPerRev = 1048576.0;  // 2^20
+inline constexpr double kDefaultCountsPerRad = kCountsPerRev / (2.0 * std::numbers::pi);
+inline constexpr double kDefaultCarriageLeadM = 0.010;
+inline constexpr double kDefaultCountsPerM = kCountsPerRev / kDefaultCarriageLeadM;
+
+struct CanAxisConfig {
+  std::uint8_t node_id = 1;
+  double counts_per_unit = kDefaultCountsPerRad;  // counts per rad (rotary) or per m (carriage)
+  double rated_effort = 0.0;  // N·m or N at 1000 ‰ of 0x6077; 0 = effort not reported (needs TPDO2)
+};
+
+struct CanAxisPortConfig {
+  // Indexed by hal::index(hal::Axis).
+  std::array<CanAxisConfig, hal::kAxisCount> axes{{
+      {1, kDefaultCountsPerRad, 0.0},  // beat crank
+      {2, kDefaultCountsPerM, 0.0},    // carriage
+      {3, kDefaultCountsPerRad, 0.0},  // helix shaft
+  }};
+  double cycle_period_s = 0.002;        // SYNC period = tick period; written to 0x60C2
+  double heartbeat_producer_s = 0.100;  // written to each drive's 0x1017 (whole ms)
+  // A drive is lost when no heartbeat arrived for longer than this. Must exceed the producer time and
+  // leave a lost drive detected within 3 producer periods (consumer + one cycle ≤ 3 × producer).
+  double heartbeat_consumer_s = 0.250;
+  double sdo_timeout_s = 0.100;
+  double boot_timeout_s = 2.0;          // wait for every boot-up after NMT reset-node
+  double state_timeout_s = 0.5;         // CiA 402 transition not confirmed → fault
+  bool tpdo2 = false;                   // velocity + torque PDO (adds 3 frames per cycle)
+  std::uint8_t tpdo2_every_n_sync = 1;  // 1..240
+  std::uint32_t bitrate_bps = 1'000'000;
+  double bus_load_budget = 0.70;                   // worst-case utilisation allowed
+  std::vector<FrameGroup> other_frames_per_cycle;  // other nodes sharing the bus (e.g. the I/O node)
+};
+
+// Configure-time only. Error naming the field and its value.
+Status validate(const CanAxisPortConfig& config);
+
+class CanAxisPort final : public hal::AxisPort {
+ public:
+  // Bounds of the RT path.
+  static constexpr int kMaxFramesPerRead = 64;
+
+  // Configure-time only.
+  explicit CanAxisPort(CanAxisPortConfig config);
+
+  // Configure-time only; blocks with timeouts. Validates the configuration and the bus load, then:
+  // NMT reset-node → every boot-up → per drive by SDO: 0x6502 has CSP, 0x6060 = 8 confirmed by 0x6061,
+  // 0x1017, 0x60C2, PDO mapping (pdo.hpp), 0x6041 and 0x6064 to seed state and the first target →
+  // NMT start → an operational heartbeat from every drive. Errors name node, axis and step. Calling it
+  // again (from the non-RT side) is how a lost drive or a bus-off is recovered.
+  Status configure(CanBus& bus, ConfigureClock& clock);
+  Status configure(CanBus& bus);  // with MonotonicConfigureClock
+
+  // RT-safe. Drains at most kMaxFramesPerRead frames, then reports every axis and the link.
+  void read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) override;
+  // RT-safe. SYNC, then one RPDO1 per axis (4 frames).
+  void write_axes(hal::Tick now, const hal::AxisCommands& axes) override;
+
+  // Diagnostics; RT-safe to read.
+  bool configured() const { return configured_; }
+  const BusLoad& bus_load() const { return bus_load_; }
+  const CanAxisPortConfig& config() const { return config_; }
+  std::uint16_t last_controlword(hal::Axis a) const { return axes_[hal::index(a)].tracker.last_controlword; }
+  std::int64_t last_target_counts(hal::Axis a) const { return axes_[hal::index(a)].last_target_counts; }
+  std::uint32_t heartbeat_consumer_ticks() const { return consumer_ticks_; }
+
+ private:
+  struct AxisRuntime {
+    std::uint8_t node = 0;
+    double counts_per_unit = 1.0;
+    double rated_effort = 0.0;
+    PositionUnwrapper position;
+    std::int64_t last_target_counts = 0;
+    std::uint16_t statusword = 0;
+    hal::DriveState state = hal::DriveState::kUnknown;
+    Cia402Tracker tracker;
+    hal::Tick refreshed = hal::kNeverTick;
+    double last_position_si = 0.0;
+    double velocity = 0.0;
+    double effort = 0.0;
+    hal::Tick last_heartbeat = hal::kNeverTick;
+    std::uint16_t emcy_code = 0;
+    std::uint16_t link_fault = 0;  // latched: heartbeat lost / rebooted / not operational
+  };
+
+  void reset_runtime();
+  void handle_frame(hal::Tick now, const CanFrame& frame);
+  void fill_feedback(hal::AxisFeedbacks& axes, hal::LinkStatus& link) const;
+  void count_send(SendResult r);
+  std::string node_label(std::size_t axis) const;
+  Status configure_node(std::size_t axis, SdoClient& sdo);
+
+  CanAxisPortConfig config_;
+  CanBus* bus_ = nullptr;
+  bool configured_ = false;
+  BusLoad bus_load_{};
+  std::uint32_t consumer_ticks_ = 0;
+  std::uint32_t state_timeout_ticks_ = 0;
+  std::array<AxisRuntime, hal::kAxisCount> axes_{};
+  std::array<std::int8_t, 128> axis_of_node_{};  // −1 = not ours
+  bool bus_off_ = false;                         // latched until configure()
+  std::uint32_t tx_dropped_ = 0;
+  std::uint32_t rx_errors_ = 0;
+};
+
+}  // namespace loom::drivers

@@ -1,0 +1,284 @@
+// The simulated CiA 402 drive seen from the bus: boot-up, NMT states, SDO server answers and aborts,
+// PDO re-map rules, heartbeat timing, PDOs only when operational, EMCY on length error and following
+// error. A raw test endpoint plays the master, so these checks do not depend on drivers::CanAxisPort.
+#include <gtest/gtest.h>
+
+#include <optional>
+
+#include "fake_can_network.hpp"
+#include "loom/drivers/cob_id.hpp"
+#include "loom/drivers/emcy.hpp"
+#include "loom/drivers/nmt.hpp"
+#include "loom/drivers/pdo.hpp"
+#include "loom/drivers/sdo.hpp"
+#include "loom/sim_can/sim_drive_node.hpp"
+
+namespace loom::sim_can {
+namespace {
+
+using drivers::CanFrame;
+using drivers::NmtCommand;
+using drivers::NmtState;
+
+class SimDriveNodeTest : public ::testing::Test {
+ protected:
+  SimDriveNodeTest() : node_(drive_ep_, config()) {}
+  static SimDriveConfig config() {
+    SimDriveConfig c;
+    c.node_id = 5;
+    c.initial_position = 4242;
+    c.max_step_counts = 1000;
+    return c;
+  }
+  // Deliver everything the tester sent to the node and let the node's timers run.
+  void pump() {
+    CanFrame f;
+    while (drive_ep_.receive(f)) node_.handle(f, now_);
+    node_.step(now_);
+  }
+  void advance_to(std::int64_t t) {
+    while (now_ < t) {
+      now_ = std::min(t, now_ + 1000);
+      net_.set_time(now_);
+      pump();
+    }
+  }
+  std::vector<CanFrame> take() {
+    std::vector<CanFrame> out;
+    CanFrame f;
+    while (tester_.receive(f)) out.push_back(f);
+    return out;
+  }
+  drivers::SdoReply sdo(const CanFrame& request) {
+    take();
+    tester_.send(request);
+    pump();
+    for (const CanFrame& f : take()) {
+      if (f.id == drivers::cob::sdo_tx(5)) return drivers::parse_sdo_reply(f);
+    }
+    return {};
+  }
+  std::uint32_t write(std::uint16_t index, std::uint8_t sub, std::uint32_t value, std::uint8_t size) {
+    const drivers::SdoReply r = sdo(drivers::make_sdo_download(5, index, sub, value, size));
+    return r.kind == drivers::SdoReplyKind::kAbort ? r.value : 0;
+  }
+  std::optional<std::uint32_t> read(std::uint16_t index, std::uint8_t sub) {
+    const drivers::SdoReply r = sdo(drivers::make_sdo_upload(5, index, sub));
+    if (r.kind != drivers::SdoReplyKind::kUploadExpedited) return std::nullopt;
+    return r.value;
+  }
+  std::uint32_t read_abort(std::uint16_t index, std::uint8_t sub) {
+    const drivers::SdoReply r = sdo(drivers::make_sdo_upload(5, index, sub));
+    return r.kind == drivers::SdoReplyKind::kAbort ? r.value : 0;
+  }
+  void send(const CanFrame& f) {
+    tester_.send(f);
+    pump();
+  }
+
+  test::FakeCanNetwork net_;
+  test::FakeCanNetwork::Endpoint& tester_ = net_.add_endpoint();
+  test::FakeCanNetwork::Endpoint& drive_ep_ = net_.add_endpoint();
+  SimDriveNode node_;
+  std::int64_t now_ = 0;
+};
+
+TEST_F(SimDriveNodeTest, PowerOnSendsBootUpAndEntersPreOperational) {
+  node_.power_on(now_);
+  const auto frames = take();
+  ASSERT_EQ(frames.size(), 1u);
+  EXPECT_EQ(frames[0].id, 0x705u);
+  EXPECT_EQ(frames[0].dlc, 1);
+  EXPECT_EQ(frames[0].data[0], 0x00);
+  EXPECT_EQ(node_.nmt_state(), NmtState::kPreOperational);
+  EXPECT_EQ(node_.drive_state(), hal::DriveState::kSwitchOnDisabled);
+}
+
+TEST_F(SimDriveNodeTest, SdoServerAnswersAndAborts) {
+  node_.power_on(now_);
+  EXPECT_EQ(read(0x1000, 0), 0x00020192u);  // device type: CiA 402 servo
+  EXPECT_EQ(read(0x6064, 0), 4242u);
+  EXPECT_EQ(read(0x6502, 0).value() & (1u << 7), 1u << 7);
+  EXPECT_EQ(read(0x6041, 0).value() & 0x4F, 0x40u);  // switch on disabled
+  EXPECT_EQ(read_abort(0x2000, 0), 0x06020000u);     // no such object
+  EXPECT_EQ(read_abort(0x6041, 1), 0x06090011u);     // no such sub-index
+  EXPECT_EQ(write(0x6041, 0, 0, 2), 0x06010002u);    // read-only
+  EXPECT_EQ(write(0x6060, 0, 8, 2), 0x06070012u);    // INT8 written with 2 bytes
+  EXPECT_EQ(write(0x6060, 0, 3, 1), 0x06090030u);    // profile velocity is not offered
+  EXPECT_EQ(write(0x6060, 0, 8, 1), 0u);
+  EXPECT_EQ(read(0x6061, 0), 8u);
+  EXPECT_EQ(write(0x60C2, 1, 2, 1), 0u);
+  EXPECT_EQ(write(0x60C2, 2, 0xFD, 1), 0u);  // −3
+  EXPECT_EQ(read(0x60C2, 2), 0xFDu);
+  // A segmented download is refused, not misread.
+  CanFrame seg = drivers::make_sdo_download(5, 0x1008, 0, 0, 4);
+  seg.data[0] = 0x21;
+  EXPECT_EQ(sdo(seg).kind, drivers::SdoReplyKind::kAbort);
+}
+
+TEST_F(SimDriveNodeTest, MissingObjectsAbortAsConfigured) {
+  SimDriveConfig c = config();
+  c.missing_objects = {0x60C2};
+  SimDriveNode lacking(drive_ep_, c);
+  lacking.power_on(now_);
+  take();
+  tester_.send(drivers::make_sdo_download(5, 0x60C2, 1, 2, 1));
+  CanFrame f;
+  ASSERT_TRUE(drive_ep_.receive(f));
+  lacking.handle(f, now_);
+  const auto frames = take();
+  ASSERT_EQ(frames.size(), 1u);
+  const drivers::SdoReply r = drivers::parse_sdo_reply(frames[0]);
+  EXPECT_EQ(r.kind, drivers::SdoReplyKind::kAbort);
+  EXPECT_EQ(r.value, 0x06020000u);
+}
+
+TEST_F(SimDriveNodeTest, PdoRemapFollowsTheCia301Procedure) {
+  node_.power_on(now_);
+  // Mapping a valid PDO is refused; invalidate first.
+  EXPECT_EQ(write(0x1A00, 0, 0, 1), 0x06010000u);
+  EXPECT_EQ(write(0x1800, 1, 0x80000185u, 4), 0u);
+  // Entries only while :00 = 0.
+  EXPECT_EQ(write(0x1A00, 1, 0x60410010u, 4), 0x06010000u);
+  EXPECT_EQ(write(0x1A00, 0, 0, 1), 0u);
+  EXPECT_EQ(write(0x1A00, 1, 0x60400010u, 4), 0x06040041u);  // controlword is not a TPDO object
+  EXPECT_EQ(write(0x1A00, 1, 0x60410020u, 4), 0x06040041u);  // wrong bit length
+  EXPECT_EQ(write(0x1A00, 1, 0x60640020u, 4), 0u);
+  EXPECT_EQ(write(0x1A00, 2, 0x606C0020u, 4), 0u);
+  EXPECT_EQ(write(0x1A00, 3, 0x60410010u, 4), 0u);
+  EXPECT_EQ(write(0x1A00, 0, 3, 1), 0x06040042u);  // 80 bits do not fit 8 bytes
+  EXPECT_EQ(write(0x1A00, 0, 2, 1), 0u);
+  // Changing a valid COB-ID directly is refused.
+  EXPECT_EQ(write(0x1800, 1, 0x185u, 4), 0u);
+  EXPECT_EQ(write(0x1800, 1, 0x186u, 4), 0x06090030u);
+  EXPECT_EQ(write(0x1800, 2, 241, 1), 0x06090030u);  // reserved transmission type
+}
+
+TEST_F(SimDriveNodeTest, HeartbeatAtTheProducerTime) {
+  node_.power_on(now_);
+  EXPECT_EQ(write(0x1017, 0, 50, 2), 0u);
+  take();
+  advance_to(500'000);
+  std::vector<std::int64_t> times;
+  for (const auto& l : net_.log()) {
+    if (l.frame.id == 0x705 && l.frame.data[0] == 0x7F) times.push_back(l.time_us);
+  }
+  ASSERT_EQ(times.size(), 10u);
+  for (std::size_t i = 1; i < times.size(); ++i) EXPECT_EQ(times[i] - times[i - 1], 50'000);
+}
+
+TEST_F(SimDriveNodeTest, PdosOnlyWhenOperational) {
+  node_.power_on(now_);
+  take();
+  send(drivers::make_sync());
+  EXPECT_TRUE(take().empty());  // pre-operational: SYNC ignored
+  send(drivers::make_nmt(NmtCommand::kStart, 5));
+  send(drivers::make_sync());
+  auto frames = take();
+  // Factory default: TPDO1 and TPDO2 both active.
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_EQ(frames[0].id, 0x185u);
+  EXPECT_EQ(frames[1].id, 0x285u);
+  const auto t1 = drivers::unpack_tpdo1(frames[0], 5);
+  ASSERT_TRUE(t1);
+  EXPECT_EQ(t1->position_actual, 4242);
+  // NMT stop: silent except for NMT.
+  send(drivers::make_nmt(NmtCommand::kStop, 0));
+  send(drivers::make_sync());
+  EXPECT_TRUE(take().empty());
+  // Reset node: boot-up again, pre-operational, defaults back.
+  send(drivers::make_nmt(NmtCommand::kResetNode, 5));
+  frames = take();
+  ASSERT_EQ(frames.size(), 1u);
+  EXPECT_EQ(frames[0].id, 0x705u);
+  EXPECT_EQ(frames[0].data[0], 0x00);
+  EXPECT_EQ(node_.nmt_state(), NmtState::kPreOperational);
+}
+
+TEST_F(SimDriveNodeTest, RpdoAppliedAtTheNextSyncAndCspTracks) {
+  node_.power_on(now_);
+  write(0x6060, 0, 8, 1);
+  send(drivers::make_nmt(NmtCommand::kStart, 5));
+  const std::uint16_t sequence[] = {0x0006, 0x0007, 0x000F};
+  for (std::uint16_t cw : sequence) {
+    send(drivers::pack_rpdo1(5, {cw, 4242}));
+    send(drivers::make_sync());
+  }
+  EXPECT_EQ(node_.drive_state(), hal::DriveState::kOperationEnabled);
+  send(drivers::pack_rpdo1(5, {0x000F, 4242 + 900}));
+  EXPECT_EQ(node_.position(), 4242);  // not before SYNC
+  take();
+  send(drivers::make_sync());
+  EXPECT_EQ(node_.position(), 4242 + 900);
+  const auto frames = take();
+  ASSERT_FALSE(frames.empty());
+  const auto t1 = drivers::unpack_tpdo1(frames[0], 5);
+  ASSERT_TRUE(t1);
+  EXPECT_EQ(t1->position_actual, 4242 + 900);
+  EXPECT_EQ(t1->statusword & 0x6F, 0x27);
+  EXPECT_NE(t1->statusword & (1u << 12), 0u);  // CSP: drive follows the target
+  const auto t2 = drivers::unpack_tpdo2(frames[1], 5);
+  ASSERT_TRUE(t2);
+  EXPECT_EQ(t2->velocity_actual, 900'000);  // 900 counts per 1 ms default interpolation period
+}
+
+TEST_F(SimDriveNodeTest, JumpBeyondTheWindowIsAFollowingErrorFault) {
+  node_.power_on(now_);
+  write(0x6060, 0, 8, 1);
+  send(drivers::make_nmt(NmtCommand::kStart, 5));
+  for (std::uint16_t cw : {std::uint16_t{0x0006}, std::uint16_t{0x0007}, std::uint16_t{0x000F}}) {
+    send(drivers::pack_rpdo1(5, {cw, 4242}));
+    send(drivers::make_sync());
+  }
+  take();
+  send(drivers::pack_rpdo1(5, {0x000F, 0}));  // the jump-on-enable bug: target 0 instead of actual
+  send(drivers::make_sync());
+  EXPECT_EQ(node_.position(), 4242);
+  const auto frames = take();
+  bool emcy = false;
+  for (const CanFrame& f : frames) {
+    if (auto e = drivers::parse_emcy(f)) {
+      EXPECT_EQ(e->code, 0x8611);
+      emcy = true;
+    }
+  }
+  EXPECT_TRUE(emcy);
+  EXPECT_EQ(node_.drive_state(), hal::DriveState::kFault);
+  // Fault reset: rising edge of bit 7 → switch on disabled and an EMCY "error reset".
+  send(drivers::pack_rpdo1(5, {0x0080, 4242}));
+  send(drivers::make_sync());
+  EXPECT_EQ(node_.drive_state(), hal::DriveState::kSwitchOnDisabled);
+  bool reset_seen = false;
+  for (const CanFrame& f : take()) {
+    if (auto e = drivers::parse_emcy(f)) reset_seen = e->code == 0x0000;
+  }
+  EXPECT_TRUE(reset_seen);
+}
+
+TEST_F(SimDriveNodeTest, ShortRpdoRaisesPdoLengthEmcy) {
+  node_.power_on(now_);
+  send(drivers::make_nmt(NmtCommand::kStart, 5));
+  take();
+  CanFrame shortp = drivers::pack_rpdo1(5, {0x0006, 0});
+  shortp.dlc = 4;
+  send(shortp);
+  const auto frames = take();
+  ASSERT_EQ(frames.size(), 1u);
+  const auto e = drivers::parse_emcy(frames[0]);
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->code, 0x8210);
+}
+
+TEST_F(SimDriveNodeTest, PoweredOffNodeIsSilent) {
+  node_.power_on(now_);
+  EXPECT_EQ(write(0x1017, 0, 10, 2), 0u);
+  take();
+  node_.power_off();
+  advance_to(100'000);
+  tester_.send(drivers::make_sdo_upload(5, 0x1000, 0));
+  pump();
+  EXPECT_TRUE(take().empty());
+}
+
+}  // namespace
+}  // namespace loom::sim_can
