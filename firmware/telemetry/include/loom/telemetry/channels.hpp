@@ -1,0 +1,34 @@
+// LCM channel names for one loom: <prefix>.<loom id>.STATUS / .AXES / .RT. The loom id is in the name
+// so a hall of looms can share one multicast group and a technician can subscribe to one loom or all.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+namespace loom::telemetry {
+
+inline constexpr std::string_view kDefaultChannelPrefix = "LOOM";
+inline constexpr std::size_t kMaxLoomIdLength = 32;
+
+// Configure-time only. "" when `id` is usable as a loom id (1..32 of A-Z a-z 0-9 _ -), otherwise a
+// one-line reason that quotes the value. Dots are refused because they separate channel fields.
+std::string loom_id_error(std::string_view id);
+
+// Configure-time only. "" when `prefix` is usable (dot-separated non-empty fields of A-Z a-z 0-9 _ -),
+// otherwise a one-line reason that quotes the value.
+std::string channel_prefix_error(std::string_view prefix);
+
+struct ChannelNames {
+  std::string status;
+  std::string axes;
+  std::string rt;
+};
+
+// Configure-time only (allocates). Assumes both parts passed the checks above.
+ChannelNames channel_names(std::string_view prefix, std::string_view loom_id);
+
+// Configure-time only. An LCM subscription regex for one channel kind ("STATUS", "AXES", "RT"):
+// that loom's channel when `loom_id` is non-empty, else the same channel of every loom.
+std::string channel_regex(std::string_view prefix, std::string_view loom_id, std::string_view kind);
+
+}  // namespace loom::telemetry

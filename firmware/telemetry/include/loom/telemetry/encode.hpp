@@ -1,0 +1,25 @@
+// Snapshot → LCM message conversion, kept pure (no LCM handle, no clock) so field mapping is testable
+// on its own. The caller stamps `utime`; everything else comes from the snapshot.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "loom/telemetry/snapshot.hpp"
+#include "loomlcm/axes_t.hpp"
+#include "loomlcm/rt_stats_t.hpp"
+#include "loomlcm/status_t.hpp"
+
+namespace loom::telemetry {
+
+// RT-safe. Loop time tick * period_ns in seconds.
+double loop_time_s(const Snapshot& s) noexcept;
+
+// Not RT-safe (allocates strings): publisher thread only. Each fills every field of its message.
+loomlcm::status_t to_status(const Snapshot& s, const std::string& loom_id, std::int64_t utime);
+loomlcm::axes_t to_axes(const Snapshot& s, const std::string& loom_id, std::int64_t utime);
+// `dropped` and `backlog` come from the ring, which knows about snapshots the loop never got to send.
+loomlcm::rt_stats_t to_rt_stats(const Snapshot& s, const std::string& loom_id, std::int64_t utime,
+                                std::uint64_t dropped, std::uint64_t backlog);
+
+}  // namespace loom::telemetry

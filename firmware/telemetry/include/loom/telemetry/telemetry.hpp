@@ -1,0 +1,46 @@
+// The one telemetry object the firmware holds: the snapshot ring plus its publisher. The RT loop only
+// ever calls push(); construction, start and stop belong to configure/shutdown.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "loom/telemetry/publisher.hpp"
+#include "loom/telemetry/snapshot.hpp"
+
+namespace loom::telemetry {
+
+class Telemetry {
+ public:
+  // Configure-time only. Allocates and pre-touches the ring, opens LCM; throws std::invalid_argument
+  // on a bad config or an LCM URL that will not open (message names the field and value).
+  explicit Telemetry(const PublisherConfig& cfg);
+
+  // Configure-time only.
+  void start() { publisher_.start(); }
+  // Non-RT. Publishes what is left in the ring, then joins the publishing thread.
+  void stop() { publisher_.stop(); }
+
+  // RT-safe. Copies the snapshot into the ring; when the ring is full the snapshot is dropped,
+  // counted in dropped(), and false is returned. Never blocks, never allocates.
+  bool push(const Snapshot& s) noexcept { return ring_->push_or_drop(s); }
+
+  // RT-safe. Like push() but a full ring is not counted as a drop: for a caller that will retry
+  // (virtual-time simulation, where the loop may wait for the publisher so nothing is lost).
+  bool try_push(const Snapshot& s) noexcept { return ring_->try_push(s); }
+
+  // NOT RT-safe: virtual time only. Retries (yielding the CPU) until the ring takes the snapshot;
+  // gives up and counts a drop if the publisher is not running, since then nobody would make room.
+  bool push_waiting(const Snapshot& s) noexcept;
+
+  // RT-safe, any thread.
+  std::uint64_t dropped() const noexcept { return ring_->dropped(); }
+  PublisherStats stats() const noexcept { return publisher_.stats(); }
+  const ChannelNames& channels() const noexcept { return publisher_.channels(); }
+
+ private:
+  std::unique_ptr<SnapshotRing> ring_;  // declared first: the publisher holds a reference to it
+  Publisher publisher_;
+};
+
+}  // namespace loom::telemetry

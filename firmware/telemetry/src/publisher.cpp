@@ -1,0 +1,147 @@
+// The publishing thread: ring → schedule → encode → lcm publish. Runs off the RT path, so it may
+// allocate and make syscalls; it only has to keep up, which batching the ring reads helps it do.
+#include "loom/telemetry/publisher.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <lcm/lcm-cpp.hpp>
+#include <span>
+#include <stdexcept>
+
+#include "loom/telemetry/encode.hpp"
+
+namespace loom::telemetry {
+
+namespace {
+
+std::int64_t wall_utime() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+PublisherConfig validated(const PublisherConfig& cfg) {
+  if (auto e = loom_id_error(cfg.loom_id); !e.empty()) throw std::invalid_argument("telemetry " + e);
+  if (auto e = channel_prefix_error(cfg.channel_prefix); !e.empty()) {
+    throw std::invalid_argument("telemetry " + e);
+  }
+  if (auto e = decimation_error(cfg.decimation); !e.empty()) throw std::invalid_argument(e);
+  if (cfg.batch < 1) throw std::invalid_argument("telemetry batch = 0 must be >= 1");
+  if (cfg.idle_sleep.count() < 0) {
+    throw std::invalid_argument("telemetry idle_sleep = " + std::to_string(cfg.idle_sleep.count()) +
+                                " us must be >= 0");
+  }
+  if (!std::isfinite(cfg.max_messages_per_s) || cfg.max_messages_per_s < 0.0) {
+    throw std::invalid_argument("telemetry max_messages_per_s = " + std::to_string(cfg.max_messages_per_s) +
+                                " must be a finite number >= 0 (0 = unpaced)");
+  }
+  return cfg;
+}
+
+}  // namespace
+
+Publisher::Publisher(const PublisherConfig& cfg, SnapshotRing& ring)
+    : ring_(ring),
+      cfg_(validated(cfg)),
+      channels_(channel_names(cfg_.channel_prefix, cfg_.loom_id)),
+      schedule_(cfg_.decimation),
+      lcm_(std::make_unique<lcm::LCM>(cfg_.lcm_url)),
+      batch_(cfg_.batch),
+      publish_gap_(cfg_.max_messages_per_s > 0.0
+                       ? std::chrono::nanoseconds(static_cast<std::int64_t>(1e9 / cfg_.max_messages_per_s))
+                       : std::chrono::nanoseconds(0)) {
+  if (!lcm_->good()) {
+    throw std::invalid_argument("telemetry lcm_url '" + cfg_.lcm_url +
+                                "' could not be opened by LCM (check the scheme udpm:// memq:// "
+                                "file://, the address and port, and that a multicast route exists)");
+  }
+}
+
+Publisher::~Publisher() {
+  stop();
+}
+
+void Publisher::start() {
+  if (thread_.joinable()) return;
+  stop_requested_.store(false, std::memory_order_relaxed);
+  running_.store(true, std::memory_order_release);
+  thread_ = std::thread([this] { run(); });
+}
+
+void Publisher::stop() {
+  if (!thread_.joinable()) return;
+  stop_requested_.store(true, std::memory_order_release);
+  thread_.join();
+  running_.store(false, std::memory_order_release);
+}
+
+PublisherStats Publisher::stats() const noexcept {
+  PublisherStats s;
+  s.snapshots = n_snapshots_.load(std::memory_order_relaxed);
+  s.status = n_status_.load(std::memory_order_relaxed);
+  s.axes = n_axes_.load(std::memory_order_relaxed);
+  s.rt = n_rt_.load(std::memory_order_relaxed);
+  s.publish_errors = n_errors_.load(std::memory_order_relaxed);
+  return s;
+}
+
+void Publisher::run() {
+  while (!stop_requested_.load(std::memory_order_acquire)) drain_once_or_nap();
+  // The producer may have pushed right up to stop(): publish all of it so the last row is not lost.
+  // Only what is there now, though — a loop still pushing must not keep stop() from returning.
+  std::size_t left = ring_.size_approx();
+  while (left > 0) {
+    const std::size_t n = drain_batch();
+    if (n == 0) break;
+    left -= std::min(n, left);
+  }
+}
+
+void Publisher::drain_once_or_nap() {
+  if (drain_batch() == 0) std::this_thread::sleep_for(cfg_.idle_sleep);
+}
+
+std::size_t Publisher::drain_batch() {
+  const std::size_t n = ring_.try_pop_many(std::span<Snapshot>(batch_));
+  for (std::size_t i = 0; i < n; ++i) publish(batch_[i]);
+  n_snapshots_.fetch_add(n, std::memory_order_relaxed);
+  return n;
+}
+
+void Publisher::pace() {
+  if (publish_gap_.count() == 0) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (next_publish_ > now) {
+    std::this_thread::sleep_until(next_publish_);
+    next_publish_ += publish_gap_;
+  } else {
+    // Idle time is not saved up as credit for a later burst.
+    next_publish_ = now + publish_gap_;
+  }
+}
+
+void Publisher::publish(const Snapshot& s) {
+  const ChannelSet due = schedule_.decide(s);
+  if (!due.status && !due.axes && !due.rt) return;
+  const std::int64_t utime = wall_utime();
+  const auto send = [this](const std::string& channel, const auto& msg, std::atomic<std::uint64_t>& counter) {
+    pace();
+    if (lcm_->publish(channel, &msg) == 0) {
+      counter.fetch_add(1, std::memory_order_relaxed);
+    } else {
+      n_errors_.fetch_add(1, std::memory_order_relaxed);
+    }
+  };
+  try {
+    if (due.status) send(channels_.status, to_status(s, cfg_.loom_id, utime), n_status_);
+    if (due.axes) send(channels_.axes, to_axes(s, cfg_.loom_id, utime), n_axes_);
+    if (due.rt) {
+      send(channels_.rt, to_rt_stats(s, cfg_.loom_id, utime, ring_.dropped(), ring_.size_approx()), n_rt_);
+    }
+  } catch (const std::exception&) {
+    // Out of memory while encoding: lose this message, keep the thread (and the loop) alive.
+    n_errors_.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
+}  // namespace loom::telemetry

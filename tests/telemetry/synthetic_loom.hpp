@@ -1,0 +1,89 @@
+// A scripted stand-in for the RT loop: the snapshot of any tick of a regular weaving run, computed in
+// closed form from the tick alone. Tests use it both to feed the publisher and as the independent
+// truth of which state and counters each tick must show.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <numbers>
+#include <string_view>
+
+#include "loom/hal/types.hpp"
+#include "loom/telemetry/snapshot.hpp"
+
+namespace loom::telemetry::test_support {
+
+struct WeaveScript {
+  std::int64_t shed_ticks = 10;    // shed change
+  std::int64_t pick_ticks = 20;    // shuttle crossing; the pick counts when it ends
+  std::int64_t beats_per_row = 4;  // crank turns per row, one beat each
+  std::int64_t ticks_per_beat = 15;
+  std::int64_t row_done_ticks = 5;  // counters persisted; the row counts when this ends
+  std::int64_t period_ns = 2'000'000;
+  std::int64_t fault_at_tick = -1;  // from this tick on: state "fault", first fault latched
+
+  std::int64_t row_ticks() const {
+    return shed_ticks + pick_ticks + beats_per_row * ticks_per_beat + row_done_ticks;
+  }
+  std::int64_t ticks_for_rows(std::int64_t rows) const { return rows * row_ticks(); }
+};
+
+inline void set_name(std::array<char, 24>& dst, std::string_view name) {
+  dst.fill('\0');
+  std::memcpy(dst.data(), name.data(), std::min(name.size(), dst.size() - 1));
+}
+inline void set_name(std::array<char, 32>& dst, std::string_view name) {
+  dst.fill('\0');
+  std::memcpy(dst.data(), name.data(), std::min(name.size(), dst.size() - 1));
+}
+
+// State name at `tick` (before a fault).
+inline std::string_view script_state(const WeaveScript& w, std::int64_t tick) {
+  const std::int64_t in_row = tick % w.row_ticks();
+  if (in_row < w.shed_ticks) return "shed";
+  if (in_row < w.shed_ticks + w.pick_ticks) return "pick";
+  if (in_row < w.row_ticks() - w.row_done_ticks) return "beat";
+  return "row_done";
+}
+
+inline Snapshot script_snapshot(const WeaveScript& w, std::int64_t tick) {
+  const bool faulted = w.fault_at_tick >= 0 && tick >= w.fault_at_tick;
+  // Counters freeze at the fault: the loop keeps them, it does not reset them.
+  const std::int64_t t = faulted ? w.fault_at_tick : tick;
+  const std::int64_t row = t / w.row_ticks();
+  const std::int64_t in_row = t % w.row_ticks();
+  const std::int64_t beat_start = w.shed_ticks + w.pick_ticks;
+  const std::int64_t beats_in_row =
+      in_row < beat_start ? 0 : std::min((in_row - beat_start) / w.ticks_per_beat, w.beats_per_row);
+
+  Snapshot s;
+  s.tick = tick;
+  s.period_ns = w.period_ns;
+  set_name(s.state, faulted ? std::string_view("fault") : script_state(w, t));
+  if (faulted) {
+    set_name(s.first_fault, "estop");
+    s.first_fault_code = 0x1001;
+  }
+  s.row = static_cast<std::uint32_t>(row);
+  s.pick = static_cast<std::uint32_t>(row + (in_row >= beat_start ? 1 : 0));
+  s.beat = static_cast<std::uint32_t>(row * w.beats_per_row + beats_in_row);
+  const double beat_progress =
+      in_row < beat_start ? 0.0
+                          : static_cast<double>(in_row - beat_start) / static_cast<double>(w.ticks_per_beat);
+  s.crank_phase_rad = std::fmod(beat_progress, 1.0) * 2.0 * std::numbers::pi;
+  for (std::size_t i = 0; i < s.axes.size(); ++i) {
+    AxisSample& a = s.axes[i];
+    a.position = static_cast<double>(tick) * 1e-3 * static_cast<double>(i + 1);
+    a.target = a.position + 1e-4;
+    a.following_error = a.target - a.position;
+    a.drive_state = static_cast<std::uint8_t>(hal::DriveState::kOperationEnabled);
+    a.request = static_cast<std::uint8_t>(hal::AxisRequest::kEnable);
+  }
+  s.tick_cost_ns = 10'000 + (tick % 7) * 100;
+  s.max_tick_cost_ns = 10'600;
+  return s;
+}
+
+}  // namespace loom::telemetry::test_support
