@@ -1,0 +1,343 @@
+// Unit tests of the HIL judge (candump parser and protocol checks) on synthetic logs written from the
+// CiA 301/402 rules, so the HIL tests can be trusted to fail: each broken rule must be caught and
+// named, and a conforming exchange must pass.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <initializer_list>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "canlog.hpp"
+#include "protocol_checks.hpp"
+
+namespace loom::hil {
+namespace {
+
+// ---------------------------------------------------------------------------------------------------
+// Parser
+// ---------------------------------------------------------------------------------------------------
+TEST(HilJudgeCandumpLine, ReadsStandardFrame) {
+  std::string err;
+  const auto f = parse_candump_line("(1700000000.123456) vcan0 701#05", err);
+  ASSERT_TRUE(f) << err;
+  EXPECT_EQ(f->t_us, 1700000000123456LL);
+  EXPECT_EQ(f->id, 0x701U);
+  EXPECT_FALSE(f->extended);
+  EXPECT_EQ(f->len, 1);
+  EXPECT_EQ(f->data[0], 0x05);
+}
+
+TEST(HilJudgeCandumpLine, ReadsEmptyRemoteExtendedAndErrorFrames) {
+  std::string err;
+  auto sync = parse_candump_line("(0000000001.000000)  vcan0  080#", err);
+  ASSERT_TRUE(sync) << err;
+  EXPECT_EQ(sync->len, 0);
+  auto rtr = parse_candump_line("(1.000001) vcan0 701#R", err);
+  ASSERT_TRUE(rtr) << err;
+  EXPECT_TRUE(rtr->rtr);
+  auto ext = parse_candump_line("(1.000002) vcan0 18DAF110#0102", err);
+  ASSERT_TRUE(ext) << err;
+  EXPECT_TRUE(ext->extended);
+  EXPECT_EQ(ext->id, 0x18DAF110U);
+  auto errf = parse_candump_line("(1.000003) vcan0 20000004#0000000000000000", err);
+  ASSERT_TRUE(errf) << err;
+  EXPECT_TRUE(errf->error_frame);
+}
+
+TEST(HilJudgeCandumpLine, LittleEndianFields) {
+  std::string err;
+  const auto f = parse_candump_line("(1.000000) vcan0 201#0F00FEFFFFFF", err);
+  ASSERT_TRUE(f) << err;
+  EXPECT_EQ(f->u16(0), 0x000F);
+  EXPECT_EQ(f->i32(2), -2);
+}
+
+TEST(HilJudgeCandumpLine, RejectsMalformedLinesNamingThePart) {
+  std::string err;
+  EXPECT_FALSE(parse_candump_line("(1.0) vcan0 701#05", err));
+  EXPECT_NE(err.find("timestamp"), std::string::npos) << err;
+  EXPECT_FALSE(parse_candump_line("(1.000000) vcan0 7010#05", err));
+  EXPECT_NE(err.find("id"), std::string::npos) << err;
+  EXPECT_FALSE(parse_candump_line("(1.000000) vcan0 801#05", err));
+  EXPECT_NE(err.find("0x7FF"), std::string::npos) << err;
+  EXPECT_FALSE(parse_candump_line("(1.000000) vcan0 701#0", err));
+  EXPECT_NE(err.find("data"), std::string::npos) << err;
+  EXPECT_FALSE(parse_candump_line("(1.000000) vcan0 701#000102030405060708", err));
+  EXPECT_FALSE(parse_candump_line("(1.000000) vcan0 701#ZZ", err));
+  EXPECT_FALSE(parse_candump_line("(1.000000) vcan0 123##1001122", err));
+  EXPECT_NE(err.find("FD"), std::string::npos) << err;
+  EXPECT_FALSE(parse_candump_line("(1.000000) vcan0", err));
+}
+
+TEST(HilJudgeCandumpLog, ReportsTheLineNumberOfABadLine) {
+  std::istringstream in("(1.000000) vcan0 080#\n\n(1.004000) vcan0 080#\nnonsense\n");
+  std::vector<Frame> frames;
+  std::string err;
+  EXPECT_FALSE(read_candump_log(in, frames, err));
+  EXPECT_EQ(err.rfind("line 4:", 0), 0U) << err;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Synthetic exchanges
+// ---------------------------------------------------------------------------------------------------
+class Bus {
+ public:
+  void at(std::int64_t t_us) { t_us_ = t_us; }
+  void advance(std::int64_t dt_us) { t_us_ += dt_us; }
+  void frame(unsigned id, std::initializer_list<unsigned> bytes) {
+    char head[48];
+    std::snprintf(head, sizeof head, "(%lld.%06lld) vcan0 %03X#", static_cast<long long>(t_us_ / 1000000),
+                  static_cast<long long>(t_us_ % 1000000), id);
+    out_ << head;
+    for (unsigned b : bytes) {
+      char byte[3];
+      std::snprintf(byte, sizeof byte, "%02X", b & 0xFFU);
+      out_ << byte;
+    }
+    out_ << "\n";
+    t_us_ += 50;  // frames on a bus never share a timestamp
+  }
+  void pdo(unsigned id, unsigned word, std::int32_t value) {
+    const auto v = static_cast<std::uint32_t>(value);
+    frame(id, {word & 0xFFU, word >> 8U, v & 0xFFU, (v >> 8U) & 0xFFU, (v >> 16U) & 0xFFU, v >> 24U});
+  }
+  std::vector<Frame> frames() const {
+    std::istringstream in(out_.str());
+    std::vector<Frame> fs;
+    std::string err;
+    EXPECT_TRUE(read_candump_log(in, fs, err)) << err;
+    return fs;
+  }
+  std::int64_t now() const { return t_us_; }
+
+ private:
+  std::ostringstream out_;
+  std::int64_t t_us_ = 1'700'000'000'000'000;
+};
+
+const std::vector<int> kNodes{1, 2, 3};
+
+// What a conforming master and drive say: reset, boot-ups, mode 8 set and confirmed, start, then 4 ms
+// SYNC cycles where the drive answers with its TPDO and the master with its RPDO (the controlword
+// computed from that statusword: shutdown, then enable once Ready to switch on).
+struct Script {
+  unsigned mode_read_back = 8;
+  unsigned mode_ack_cs = 0x60;
+  std::uint16_t sw_when_enabling = 0x0221;  // Ready to switch on
+  std::int32_t enable_target_offset = 0;    // 0 = seeded from the reported position
+  int cycles = 100;
+};
+
+void startup(Bus& bus, const Script& s) {
+  bus.frame(0x000, {0x81, 0x00});
+  for (int n : kNodes) bus.frame(0x700U + static_cast<unsigned>(n), {0x00});
+  for (int n : kNodes) {
+    const auto u = static_cast<unsigned>(n);
+    bus.frame(0x600 + u, {0x2F, 0x60, 0x60, 0x00, 0x08, 0, 0, 0});
+    bus.frame(0x580 + u, {s.mode_ack_cs, 0x60, 0x60, 0x00, 0, 0, 0, 0});
+    bus.frame(0x600 + u, {0x2B, 0x17, 0x10, 0x00, 100, 0, 0, 0});
+    bus.frame(0x580 + u, {0x60, 0x17, 0x10, 0x00, 0, 0, 0, 0});
+    bus.frame(0x600 + u, {0x40, 0x61, 0x60, 0x00, 0, 0, 0, 0});
+    bus.frame(0x580 + u, {0x4F, 0x61, 0x60, 0x00, s.mode_read_back, 0, 0, 0});
+  }
+  bus.frame(0x000, {0x01, 0x00});
+}
+
+// One 4 ms cycle; position[n] follows the target exactly (ideal drive).
+void cycle(Bus& bus, int k, const Script& s, std::vector<std::int32_t>& position, bool drives_alive = true,
+           unsigned cw_override = 0xFFFF, bool hold_target = false) {
+  bus.frame(0x080, {});
+  for (int n : kNodes) {
+    const auto u = static_cast<unsigned>(n);
+    std::int32_t& pos = position[static_cast<std::size_t>(n)];
+    const unsigned sw = k == 0 ? 0x0240U : (k == 1 ? s.sw_when_enabling : 0x1237U);
+    if (drives_alive) bus.pdo(0x180 + u, sw, pos);
+    unsigned cw = k == 0 ? 0x0006U : 0x000FU;
+    std::int32_t target = pos;
+    if (k == 1) target = pos + s.enable_target_offset;
+    if (k >= 2 && !hold_target) target = pos + 10 * n;
+    if (cw_override != 0xFFFF) cw = cw_override;
+    bus.pdo(0x200 + u, cw, target);
+    if (drives_alive) pos = target;
+  }
+  if (drives_alive && k >= 2 && k % 25 == 0) {
+    for (int n : kNodes) bus.frame(0x700U + static_cast<unsigned>(n), {0x05});
+  }
+  bus.advance(4000 - 50 * 7);
+}
+
+std::vector<Frame> weave_log(const Script& s) {
+  Bus bus;
+  startup(bus, s);
+  std::vector<std::int32_t> pos{0, 1000, -2000, 3000};
+  for (int k = 0; k < s.cycles; ++k) cycle(bus, k, s, pos);
+  return bus.frames();
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Weave protocol
+// ---------------------------------------------------------------------------------------------------
+TEST(HilJudgeWeaveProtocol, ConformingExchangePasses) {
+  const auto r = check_weave_protocol(weave_log({}), kNodes);
+  EXPECT_TRUE(r.ok) << r.failure;
+  EXPECT_EQ(r.notes.size(), kNodes.size());
+}
+
+TEST(HilJudgeWeaveProtocol, SummaryCountsEachService) {
+  const auto s = summarize(weave_log({}));
+  EXPECT_EQ(s.nmt, 2U);
+  EXPECT_EQ(s.sync, 100U);
+  EXPECT_EQ(s.rpdo, 300U);
+  EXPECT_EQ(s.tpdo, 300U);
+  EXPECT_EQ(s.sdo_request, 9U);
+  EXPECT_EQ(s.sdo_reply, 9U);
+  EXPECT_EQ(s.heartbeat, 3U + 3U * 3U);  // boot-ups + operational heartbeats at k = 25, 50, 75
+  EXPECT_EQ(s.total, 2U + 100U + 600U + 18U + 12U);
+}
+
+TEST(HilJudgeWeaveProtocol, MissingBootUpIsCaught) {
+  Bus bus;
+  bus.frame(0x000, {0x81, 0x00});
+  bus.frame(0x701, {0x00});
+  bus.frame(0x702, {0x00});  // node 3 never boots
+  const auto r = check_weave_protocol(bus.frames(), kNodes);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.failure.find("node 1: no SDO download 0x6060"), std::string::npos) << r.failure;
+  const auto r3 = check_weave_protocol(bus.frames(), {3});
+  EXPECT_NE(r3.failure.find("node 3: no boot-up 0x703"), std::string::npos) << r3.failure;
+}
+
+TEST(HilJudgeWeaveProtocol, WrongModeReadBackIsCaught) {
+  Script s;
+  s.mode_read_back = 3;  // profile velocity, not CSP
+  const auto r = check_weave_protocol(weave_log(s), kNodes);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.failure.find("0x6061 reads 3"), std::string::npos) << r.failure;
+}
+
+TEST(HilJudgeWeaveProtocol, AbortedModeDownloadIsCaught) {
+  Script s;
+  s.mode_ack_cs = 0x80;
+  const auto r = check_weave_protocol(weave_log(s), kNodes);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.failure.find("not acknowledged"), std::string::npos) << r.failure;
+}
+
+TEST(HilJudgeWeaveProtocol, EnablingWithoutConfirmedStatuswordIsCaught) {
+  Script s;
+  s.sw_when_enabling = 0x0240;  // still Switch on disabled: 0x000F would be a blind sequence
+  const auto r = check_weave_protocol(weave_log(s), kNodes);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.failure.find("statusword 0x0240"), std::string::npos) << r.failure;
+}
+
+TEST(HilJudgeWeaveProtocol, TargetJumpOnEnableIsCaught) {
+  Script s;
+  s.enable_target_offset = 5000;
+  const auto r = check_weave_protocol(weave_log(s), kNodes);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.failure.find("jump on enable"), std::string::npos) << r.failure;
+}
+
+TEST(HilJudgeWeaveProtocol, OrderMattersNotJustPresence) {
+  // NMT start before the mode was confirmed: every frame is there, the order is wrong.
+  Bus bus;
+  bus.frame(0x000, {0x81, 0x00});
+  bus.frame(0x701, {0x00});
+  bus.frame(0x000, {0x01, 0x00});
+  bus.frame(0x601, {0x2F, 0x60, 0x60, 0x00, 0x08, 0, 0, 0});
+  bus.frame(0x581, {0x60, 0x60, 0x60, 0x00, 0, 0, 0, 0});
+  bus.frame(0x601, {0x40, 0x61, 0x60, 0x00, 0, 0, 0, 0});
+  bus.frame(0x581, {0x4F, 0x61, 0x60, 0x00, 8, 0, 0, 0});
+  bus.frame(0x080, {});
+  const auto r = check_weave_protocol(bus.frames(), {1});
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.failure.find("no NMT start"), std::string::npos) << r.failure;
+}
+
+TEST(HilJudgeWeaveProtocol, MissingTpdosAreCaught) {
+  Bus bus;
+  Script s;
+  startup(bus, s);
+  std::vector<std::int32_t> pos{0, 0, 0, 0};
+  for (int k = 0; k < 20; ++k) cycle(bus, k, s, pos);
+  for (int k = 20; k < 40; ++k) cycle(bus, k, s, pos, /*drives_alive=*/false);
+  const auto r = check_weave_protocol(bus.frames(), kNodes);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.failure.find("40 SYNCs but 40 RPDOs and 20 TPDOs"), std::string::npos) << r.failure;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Heartbeat loss: 100 ms heartbeat, drives killed after cycle 60; the master notices `detect_cycles`
+// later and quick-stops (0x0002), holding the target.
+// ---------------------------------------------------------------------------------------------------
+struct Loss {
+  int detect_cycles = 40;          // 160 ms after the kill
+  bool moves_after_fault = false;
+  bool reenables = false;
+  bool reacts = true;
+};
+
+std::vector<Frame> loss_log(const Loss& loss) {
+  Bus bus;
+  Script s;
+  startup(bus, s);
+  std::vector<std::int32_t> pos{0, 0, 0, 0};
+  int k = 0;
+  for (; k <= 60; ++k) cycle(bus, k, s, pos);  // last heartbeat at k = 50
+  for (int i = 0; i < loss.detect_cycles; ++i, ++k) cycle(bus, k, s, pos, false);
+  if (!loss.reacts) return bus.frames();
+  for (int i = 0; i < 30; ++i, ++k) {
+    cycle(bus, k, s, pos, false, 0x0002, /*hold_target=*/!loss.moves_after_fault || i < 10);
+  }
+  if (loss.reenables) cycle(bus, k, s, pos, false, 0x000F, true);
+  return bus.frames();
+}
+
+TEST(HilJudgeHeartbeatLoss, TimelyQuickStopHoldingTargetPasses) {
+  // Last heartbeat at cycle 50; kill after cycle 60; fault at cycle 101 → ~204 ms ≤ 300 ms.
+  const auto r = check_heartbeat_loss(loss_log({}), kNodes, 0.100, 3);
+  EXPECT_TRUE(r.ok) << r.failure;
+  ASSERT_EQ(r.notes.size(), 3U);
+  EXPECT_NE(r.notes[0].find("0x0002"), std::string::npos) << r.notes[0];
+}
+
+TEST(HilJudgeHeartbeatLoss, LateReactionIsCaught) {
+  Loss loss;
+  loss.detect_cycles = 70;  // fault at cycle 131 → ~324 ms after the last heartbeat
+  const auto r = check_heartbeat_loss(loss_log(loss), kNodes, 0.100, 3);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.failure.find("limit 300 ms"), std::string::npos) << r.failure;
+  // The same log is within four periods: the limit is what decides.
+  EXPECT_TRUE(check_heartbeat_loss(loss_log(loss), kNodes, 0.100, 4).ok);
+}
+
+TEST(HilJudgeHeartbeatLoss, MotionAfterTheFaultIsCaught) {
+  Loss loss;
+  loss.moves_after_fault = true;
+  const auto r = check_heartbeat_loss(loss_log(loss), kNodes, 0.100, 3);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.failure.find("instead of the held"), std::string::npos) << r.failure;
+}
+
+TEST(HilJudgeHeartbeatLoss, ReEnableAfterTheFaultIsCaught) {
+  Loss loss;
+  loss.reenables = true;
+  const auto r = check_heartbeat_loss(loss_log(loss), kNodes, 0.100, 3);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.failure.find("re-enabled"), std::string::npos) << r.failure;
+}
+
+TEST(HilJudgeHeartbeatLoss, NoReactionIsCaught) {
+  Loss loss;
+  loss.reacts = false;
+  const auto r = check_heartbeat_loss(loss_log(loss), kNodes, 0.100, 3);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.failure.find("not acted on"), std::string::npos) << r.failure;
+}
+
+}  // namespace
+}  // namespace loom::hil

@@ -1,0 +1,319 @@
+// The HIL protocol checks. Each expectation is a CiA 301/402 fact (COB-IDs, NMT/SDO command bytes,
+// statusword masks, controlword values: shared/reference/canopen.md); each failure names the log line
+// and the frame, so a red test says what the bus showed.
+#include "protocol_checks.hpp"
+
+#include <cstdio>
+#include <functional>
+#include <optional>
+#include <sstream>
+
+namespace loom::hil {
+
+namespace {
+
+using Index = std::optional<std::size_t>;
+
+constexpr std::uint8_t kNmtStart = 0x01;
+constexpr std::uint8_t kNmtResetNode = 0x81;
+constexpr std::uint16_t kCwEnableOperation = 0x000F;
+
+std::uint32_t cob(std::uint32_t base, int node) { return base + static_cast<std::uint32_t>(node); }
+
+bool standard(const Frame& f) { return !f.extended && !f.error_frame && !f.rtr; }
+
+bool is_nmt(const Frame& f, std::uint8_t command, int node) {
+  return standard(f) && f.id == 0x000 && f.len == 2 && f.data[0] == command &&
+         (f.data[1] == 0 || f.data[1] == node);
+}
+bool is_heartbeat(const Frame& f, int node) {
+  return standard(f) && f.id == cob(0x700, node) && f.len == 1;
+}
+bool is_sync(const Frame& f) { return standard(f) && f.id == 0x080 && f.len <= 1; }
+bool is_sdo(const Frame& f, std::uint32_t base, int node, std::uint16_t index, std::uint8_t sub) {
+  return standard(f) && f.id == cob(base, node) && f.len == 8 && f.u16(1) == index && f.data[3] == sub;
+}
+bool is_rpdo(const Frame& f, int node) { return standard(f) && f.id == cob(0x200, node); }
+bool is_tpdo(const Frame& f, int node) { return standard(f) && f.id == cob(0x180, node); }
+
+// Controlword the master sent to `node` in this frame: RPDO1, or an SDO download to 0x6040.
+std::optional<std::uint16_t> controlword(const Frame& f, int node, const PdoLayout& l) {
+  if (is_rpdo(f, node) && f.len >= l.controlword_at + 2) return f.u16(l.controlword_at);
+  if (is_sdo(f, 0x600, node, 0x6040, 0) && f.data[0] == 0x2B) return f.u16(4);
+  return std::nullopt;
+}
+std::optional<std::int32_t> target(const Frame& f, int node, const PdoLayout& l) {
+  if (is_rpdo(f, node) && f.len >= l.target_at + 4) return f.i32(l.target_at);
+  return std::nullopt;
+}
+std::optional<std::uint16_t> statusword(const Frame& f, int node, const PdoLayout& l) {
+  if (is_tpdo(f, node) && f.len >= l.statusword_at + 2) return f.u16(l.statusword_at);
+  return std::nullopt;
+}
+
+Index find_from(const std::vector<Frame>& fs, std::size_t from,
+                const std::function<bool(const Frame&)>& pred) {
+  for (std::size_t i = from; i < fs.size(); ++i) {
+    if (pred(fs[i])) return i;
+  }
+  return std::nullopt;
+}
+
+std::string hex(std::uint32_t v, int width) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%0*X", width, v);
+  return buf;
+}
+
+// "line 12 (+0.123 s) 601#2F60600008000000": what a reader can grep for in the log.
+std::string show(const std::vector<Frame>& fs, std::size_t i) {
+  const Frame& f = fs[i];
+  char head[64];
+  std::snprintf(head, sizeof head, "line %zu (+%.3f s) %03X#", f.line,
+                static_cast<double>(f.t_us - fs.front().t_us) * 1e-6, static_cast<unsigned>(f.id));
+  std::string s = head;
+  for (std::size_t b = 0; b < f.len; ++b) {
+    char byte[3];
+    std::snprintf(byte, sizeof byte, "%02X", static_cast<unsigned>(f.data[b]));
+    s += byte;
+  }
+  return s;
+}
+
+CheckResult fail(CheckResult r, std::string why) {
+  r.ok = false;
+  r.failure = std::move(why);
+  return r;
+}
+
+std::string node_tag(int node) { return "node " + std::to_string(node) + ": "; }
+
+// Statusword decoding per CiA 402 (mask → value).
+bool ready_or_switched_on(std::uint16_t sw) {
+  return (sw & 0x6FU) == 0x21U || (sw & 0x6FU) == 0x23U;
+}
+bool operation_enabled(std::uint16_t sw) { return (sw & 0x6FU) == 0x27U; }
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------------
+// Summary
+// ---------------------------------------------------------------------------------------------------
+TrafficSummary summarize(const std::vector<Frame>& frames) {
+  TrafficSummary s;
+  s.total = frames.size();
+  if (!frames.empty()) {
+    s.span_s = static_cast<double>(frames.back().t_us - frames.front().t_us) * 1e-6;
+  }
+  for (const Frame& f : frames) {
+    if (f.error_frame) { ++s.error_frames; continue; }
+    if (f.extended) { ++s.other; continue; }
+    const std::uint32_t fn = f.id & 0x780U;  // function code (upper 4 bits of the 11-bit id)
+    const std::uint32_t node = f.id & 0x7FU;
+    if (f.id == 0x000) ++s.nmt;
+    else if (f.id == 0x080) ++s.sync;
+    else if (fn == 0x080 && node != 0) ++s.emcy;
+    else if ((fn == 0x180 || fn == 0x280 || fn == 0x380 || fn == 0x480) && node != 0) ++s.tpdo;
+    else if ((fn == 0x200 || fn == 0x300 || fn == 0x400 || fn == 0x500) && node != 0) ++s.rpdo;
+    else if (fn == 0x580 && node != 0) ++s.sdo_reply;
+    else if (fn == 0x600 && node != 0) ++s.sdo_request;
+    else if (fn == 0x700 && node != 0) ++s.heartbeat;
+    else ++s.other;
+  }
+  return s;
+}
+
+std::string describe(const TrafficSummary& s) {
+  std::ostringstream o;
+  o.setf(std::ios::fixed);
+  o.precision(2);
+  o << s.total << " frames in " << s.span_s << " s: nmt=" << s.nmt << " sync=" << s.sync
+    << " rpdo=" << s.rpdo << " tpdo=" << s.tpdo << " sdo_request=" << s.sdo_request
+    << " sdo_reply=" << s.sdo_reply << " heartbeat=" << s.heartbeat << " emcy=" << s.emcy
+    << " other=" << s.other << " error_frames=" << s.error_frames;
+  return o.str();
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Start-up and cyclic exchange
+// ---------------------------------------------------------------------------------------------------
+CheckResult check_weave_protocol(const std::vector<Frame>& fs, const std::vector<int>& nodes,
+                                 const PdoLayout& l) {
+  CheckResult r;
+  if (fs.empty()) return fail(r, "the log holds no frames");
+  for (const int n : nodes) {
+    const std::string tag = node_tag(n);
+    const Index reset = find_from(fs, 0, [&](const Frame& f) { return is_nmt(f, kNmtResetNode, n); });
+    if (!reset) return fail(r, tag + "no NMT reset-node (000#8100 or 000#81 with the node id)");
+
+    const Index boot = find_from(fs, *reset + 1, [&](const Frame& f) {
+      return is_heartbeat(f, n) && f.data[0] == 0x00;
+    });
+    if (!boot) return fail(r, tag + "no boot-up " + hex(cob(0x700, n), 3) + " [00] after the NMT reset at " + show(fs, *reset));
+
+    const Index mode_dl = find_from(fs, *boot + 1, [&](const Frame& f) {
+      return is_sdo(f, 0x600, n, 0x6060, 0) && f.data[0] == 0x2F && f.data[4] == 8;
+    });
+    if (!mode_dl) return fail(r, tag + "no SDO download 0x6060:00 = 8 (cs 0x2F) after the boot-up at " + show(fs, *boot));
+    const Index mode_ack = find_from(fs, *mode_dl + 1, [&](const Frame& f) { return is_sdo(f, 0x580, n, 0x6060, 0); });
+    if (!mode_ack) return fail(r, tag + "no SDO reply to the 0x6060 download at " + show(fs, *mode_dl));
+    if (fs[*mode_ack].data[0] != 0x60) {
+      return fail(r, tag + "0x6060 download not acknowledged with 0x60 (abort " + hex(fs[*mode_ack].u32(4), 8) + "?) at " + show(fs, *mode_ack));
+    }
+
+    const Index mode_ul = find_from(fs, *mode_ack + 1, [&](const Frame& f) {
+      return is_sdo(f, 0x600, n, 0x6061, 0) && f.data[0] == 0x40;
+    });
+    if (!mode_ul) return fail(r, tag + "no SDO upload of 0x6061:00 (cs 0x40) after the mode was set at " + show(fs, *mode_ack));
+    const Index mode_up = find_from(fs, *mode_ul + 1, [&](const Frame& f) { return is_sdo(f, 0x580, n, 0x6061, 0); });
+    if (!mode_up) return fail(r, tag + "no SDO reply to the 0x6061 upload at " + show(fs, *mode_ul));
+    // Expedited upload reply: ccs 2 (0x40) with the expedited bit (0x02); size bits may vary.
+    if ((fs[*mode_up].data[0] & 0xE2U) != 0x42U) {
+      return fail(r, tag + "0x6061 upload not answered expedited (cs 0x4F/0x43…) at " + show(fs, *mode_up));
+    }
+    if (fs[*mode_up].data[4] != 8) {
+      return fail(r, tag + "0x6061 reads " + std::to_string(fs[*mode_up].data[4]) + ", not 8 (CSP), at " + show(fs, *mode_up));
+    }
+
+    const Index start = find_from(fs, *mode_up + 1, [&](const Frame& f) { return is_nmt(f, kNmtStart, n); });
+    if (!start) return fail(r, tag + "no NMT start (000#0100 or with the node id) after 0x6061 was confirmed at " + show(fs, *mode_up));
+
+    const Index first_sync = find_from(fs, *start + 1, is_sync);
+    if (!first_sync) return fail(r, tag + "no SYNC (080) after the NMT start at " + show(fs, *start));
+    const Index first_tpdo = find_from(fs, *start + 1, [&](const Frame& f) { return is_tpdo(f, n); });
+    if (!first_tpdo) return fail(r, tag + "no TPDO " + hex(cob(0x180, n), 3) + " after the NMT start");
+    if (*first_tpdo < *first_sync) {
+      return fail(r, tag + "synchronous TPDO before any SYNC: " + show(fs, *first_tpdo));
+    }
+    std::size_t syncs = 0, rpdos = 0, tpdos = 0;
+    for (std::size_t i = *start + 1; i < fs.size(); ++i) {
+      syncs += is_sync(fs[i]) ? 1U : 0U;
+      rpdos += is_rpdo(fs[i], n) ? 1U : 0U;
+      tpdos += is_tpdo(fs[i], n) ? 1U : 0U;
+    }
+    // Every SYNC carries one RPDO and one TPDO per node in CSP; allow 10 % for VM scheduling gaps.
+    if (10 * rpdos < 9 * syncs || 10 * tpdos < 9 * syncs) {
+      return fail(r, tag + std::to_string(syncs) + " SYNCs but " + std::to_string(rpdos) + " RPDOs and " +
+                         std::to_string(tpdos) + " TPDOs after the NMT start (expected one each per SYNC)");
+    }
+
+    const Index enable = find_from(fs, *start + 1, [&](const Frame& f) {
+      return controlword(f, n, l) == std::optional<std::uint16_t>(kCwEnableOperation);
+    });
+    if (!enable) return fail(r, tag + "controlword 0x000F (enable operation) never sent after the NMT start");
+    Index last_sw;
+    for (std::size_t i = *start + 1; i < *enable; ++i) {
+      if (statusword(fs[i], n, l)) last_sw = i;
+    }
+    if (!last_sw) return fail(r, tag + "0x000F sent before any statusword was received: " + show(fs, *enable));
+    const std::uint16_t sw_before = *statusword(fs[*last_sw], n, l);
+    if (!ready_or_switched_on(sw_before)) {
+      return fail(r, tag + "0x000F sent on statusword " + hex(sw_before, 4) +
+                         " (not Ready to switch on / Switched on): " + show(fs, *enable) + " after " + show(fs, *last_sw));
+    }
+    if (const auto t = target(fs[*enable], n, l); t && fs[*last_sw].len >= l.position_at + 4) {
+      const std::int32_t actual = fs[*last_sw].i32(l.position_at);
+      const std::int64_t jump = static_cast<std::int64_t>(*t) - actual;
+      if (jump > 2 || jump < -2) {
+        return fail(r, tag + "first enabled target " + std::to_string(*t) + " is not the reported position " +
+                           std::to_string(actual) + " (a jump on enable): " + show(fs, *enable));
+      }
+    }
+    const Index op = find_from(fs, *enable, [&](const Frame& f) {
+      const auto sw = statusword(f, n, l);
+      return sw && operation_enabled(*sw);
+    });
+    if (!op) return fail(r, tag + "statusword never reached Operation enabled (&0x6F = 0x27) after 0x000F at " + show(fs, *enable));
+
+    r.notes.push_back(tag + "reset " + show(fs, *reset) + " → boot-up line " + std::to_string(fs[*boot].line) +
+                      " → 0x6060=8 line " + std::to_string(fs[*mode_dl].line) + "/" + std::to_string(fs[*mode_ack].line) +
+                      " → 0x6061=8 line " + std::to_string(fs[*mode_ul].line) + "/" + std::to_string(fs[*mode_up].line) +
+                      " → NMT start line " + std::to_string(fs[*start].line) + " → SYNC line " +
+                      std::to_string(fs[*first_sync].line) + " → 0x000F line " + std::to_string(fs[*enable].line) +
+                      " → Operation enabled line " + std::to_string(fs[*op].line) + "; after start " +
+                      std::to_string(syncs) + " SYNC, " + std::to_string(rpdos) + " RPDO, " + std::to_string(tpdos) + " TPDO");
+  }
+  return r;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Heartbeat loss
+// ---------------------------------------------------------------------------------------------------
+CheckResult check_heartbeat_loss(const std::vector<Frame>& fs, const std::vector<int>& nodes,
+                                 double heartbeat_s, int periods, const PdoLayout& l) {
+  CheckResult r;
+  if (fs.empty()) return fail(r, "the log holds no frames");
+  const auto limit_us = static_cast<std::int64_t>(heartbeat_s * periods * 1e6 + 0.5);
+  for (const int n : nodes) {
+    const std::string tag = node_tag(n);
+    Index last_hb;
+    std::size_t operational_hbs = 0;
+    for (std::size_t i = 0; i < fs.size(); ++i) {
+      if (!is_heartbeat(fs[i], n)) continue;
+      last_hb = i;
+      operational_hbs += fs[i].data[0] == 0x05 ? 1U : 0U;
+    }
+    if (!last_hb) return fail(r, tag + "no heartbeat " + hex(cob(0x700, n), 3) + " in the log");
+    if (operational_hbs < 2) return fail(r, tag + "fewer than two operational heartbeats (05): the node never ran");
+    if (fs[*last_hb].data[0] != 0x05) {
+      return fail(r, tag + "last heartbeat before the loss is not operational (05): " + show(fs, *last_hb));
+    }
+
+    const Index enable = find_from(fs, 0, [&](const Frame& f) {
+      return controlword(f, n, l) == std::optional<std::uint16_t>(kCwEnableOperation);
+    });
+    if (!enable || *enable > *last_hb) {
+      return fail(r, tag + "the master had not enabled the node (controlword 0x000F) before its last heartbeat at " + show(fs, *last_hb));
+    }
+    for (std::size_t i = *enable; i < *last_hb; ++i) {
+      const auto cw = controlword(fs[i], n, l);
+      if (cw && *cw != kCwEnableOperation) {
+        return fail(r, tag + "the master left enable-operation (controlword " + hex(*cw, 4) +
+                           ") before the heartbeat stopped: " + show(fs, i));
+      }
+    }
+
+    const Index fault = find_from(fs, *last_hb + 1, [&](const Frame& f) {
+      const auto cw = controlword(f, n, l);
+      return cw && *cw != kCwEnableOperation;
+    });
+    if (!fault) {
+      return fail(r, tag + "no quick-stop/disable controlword after the last heartbeat at " + show(fs, *last_hb) +
+                         ": the loss was not acted on");
+    }
+    const std::int64_t latency_us = fs[*fault].t_us - fs[*last_hb].t_us;
+    if (latency_us > limit_us) {
+      return fail(r, tag + "fault reaction " + std::to_string(latency_us / 1000) + " ms after the last heartbeat, limit " +
+                         std::to_string(limit_us / 1000) + " ms: " + show(fs, *last_hb) + " → " + show(fs, *fault));
+    }
+
+    // The target in force when the fault was raised: the fault RPDO's own, else the last one before.
+    std::optional<std::int32_t> held;
+    for (std::size_t i = 0; i <= *fault; ++i) {
+      if (auto t = target(fs[i], n, l)) held = t;
+    }
+    std::size_t rpdos_after = 0;
+    for (std::size_t i = *fault + 1; i < fs.size(); ++i) {
+      const auto cw = controlword(fs[i], n, l);
+      if (cw && *cw == kCwEnableOperation) {
+        return fail(r, tag + "re-enabled (0x000F) after the fault: " + show(fs, i));
+      }
+      const auto t = target(fs[i], n, l);
+      if (!t) continue;
+      ++rpdos_after;
+      if (held && *t != *held) {
+        return fail(r, tag + "RPDO after the fault commands target " + std::to_string(*t) + " instead of the held " +
+                           std::to_string(*held) + ": " + show(fs, i));
+      }
+    }
+    char ms[32];
+    std::snprintf(ms, sizeof ms, "%.1f ms", static_cast<double>(latency_us) * 1e-3);
+    r.notes.push_back(tag + "last heartbeat " + show(fs, *last_hb) + "; fault controlword " +
+                      hex(*controlword(fs[*fault], n, l), 4) + " " + show(fs, *fault) + " after " + ms +
+                      " (limit " + std::to_string(limit_us / 1000) + " ms); " + std::to_string(rpdos_after) +
+                      " RPDOs after it, all holding the target");
+  }
+  return r;
+}
+
+}  // namespace loom::hil

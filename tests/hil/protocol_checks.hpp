@@ -1,0 +1,56 @@
+// Protocol checks over a candump log for the HIL tests: what loomctl and the simulated drives said on
+// the bus, judged against CiA 301/402 facts (shared/reference/canopen.md), in order and content rather
+// than timing (the VM is not real-time). Configure-time only: test tooling, allocates freely.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "canlog.hpp"
+
+namespace loom::hil {
+
+// PDO layout the checks read (the mapping loomctl's master writes and the simulated drive uses):
+//   RPDO1 0x200+id: controlword UINT16 at byte 0, target position INT32 at byte 2 (6 bytes)
+//   TPDO1 0x180+id: statusword UINT16 at byte 0, position actual INT32 at byte 2 (6 bytes)
+struct PdoLayout {
+  std::size_t controlword_at = 0;
+  std::size_t target_at = 2;
+  std::size_t statusword_at = 0;
+  std::size_t position_at = 2;
+};
+
+// Frames per CANopen service, for the "frames exchanged" lines of the test logs.
+struct TrafficSummary {
+  std::size_t total = 0;
+  std::size_t nmt = 0, sync = 0, emcy = 0, tpdo = 0, rpdo = 0, sdo_request = 0, sdo_reply = 0;
+  std::size_t heartbeat = 0, other = 0, error_frames = 0;
+  double span_s = 0.0;  // first to last timestamp
+};
+TrafficSummary summarize(const std::vector<Frame>& frames);
+std::string describe(const TrafficSummary& s);  // one line: "N frames in S s: nmt=…"
+
+struct CheckResult {
+  bool ok = true;
+  std::vector<std::string> notes;  // what was found, in bus order, for the test log
+  std::string failure;             // first violated expectation, naming frame line and content
+};
+
+// Start-up and cyclic exchange of a master with CiA 402 nodes, per node:
+//   NMT reset-node (000#81 00|id) → boot-up 0x700+id [00] → SDO download 0x6060:00 = 8 acknowledged →
+//   SDO upload 0x6061:00 answered with 8 → NMT start (000#01 00|id) → SYNC 0x080 with RPDOs and TPDOs
+//   (each ≥ 90 % of SYNCs after start; the first TPDO after the first SYNC) → controlword 0x000F only
+//   after a statusword Ready to switch on / Switched on, first enabled target = reported position
+//   (±2 counts) → statusword Operation enabled.
+CheckResult check_weave_protocol(const std::vector<Frame>& frames, const std::vector<int>& nodes,
+                                 const PdoLayout& layout = {});
+
+// Heartbeat loss of every node in `nodes` (the drive process was killed): each node's heartbeat was
+// operational (05) while the master had it enabled (0x000F); the first controlword after its last
+// heartbeat that is not 0x000F (quick stop/disable: the fault reaction) came within
+// `periods` × `heartbeat_s`; and no RPDO after that fault commands a target other than the fault's own.
+CheckResult check_heartbeat_loss(const std::vector<Frame>& frames, const std::vector<int>& nodes,
+                                 double heartbeat_s, int periods, const PdoLayout& layout = {});
+
+}  // namespace loom::hil
