@@ -1,0 +1,75 @@
+// The loom-synth subcommands as plain functions: parsed arguments in, CSV on `out`, notes on `err`.
+// Bad input throws ArgError naming the argument and its value; main() turns it into exit code 2.
+#pragma once
+
+#include <ostream>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "loom/motion/errors.hpp"
+
+namespace loom::synth {
+
+class ArgError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// configure-time only. Runs f(); a MotionError it throws becomes an ArgError blaming `arg`
+// (e.g. "--beta 80").
+template <class F>
+auto blame(const std::string& arg, F&& f) -> decltype(f()) {
+  try {
+    return std::forward<F>(f)();
+  } catch (const motion::MotionError& e) {
+    throw ArgError(arg + ": " + e.what());
+  }
+}
+
+struct SliderCrankArgs {
+  double phi_deg = 0.0;
+  bool has_phi = false;
+  std::string phi_range;  // "first:last[:step]" in degrees
+  double stroke = 1.0;
+  double lambda = 0.0;
+  bool has_lambda = false;
+  bool full_precision = false;
+};
+// configure-time only (offline tool). phi_deg,a,b,c,mu_min_deg,lambda — one row per φ.
+void run_slider_crank(const SliderCrankArgs& args, std::ostream& out, std::ostream& err);
+
+struct CrankRockerArgs {
+  double psi_deg = 0.0;
+  double phi_deg = 0.0;
+  double beta_deg = 0.0;
+  bool has_beta = false;
+  double ground = 1.0;
+  bool full_precision = false;
+};
+// configure-time only (offline tool). beta_deg,a,b,c,mu_min_deg — one row per integer β from the
+// upper to the lower bound, or one for --beta.
+void run_crank_rocker(const CrankRockerArgs& args, std::ostream& out, std::ostream& err);
+
+struct DesignArgs {
+  double stroke = 0.0;
+  bool has_stroke = false;
+  double swing_deg = 0.0;
+  bool has_swing = false;
+  double phi_deg = 0.0;
+  double lambda = 0.0;
+  bool has_lambda = false;
+  double beta_deg = 0.0;
+  bool has_beta = false;
+  double ground = 1.0;
+  bool thesis_rounding = false;
+  bool full_precision = false;
+};
+// configure-time only (offline tool). One beat-up linkage: slider-crank from --stroke, crank-rocker
+// from --swing; one CSV row with link lengths, μ_min, Grashof class and dead centres.
+void run_design(const DesignArgs& args, std::ostream& out, std::ostream& err);
+
+// configure-time only. Throws ArgError unless v is a finite length > 0.
+void require_positive_length(const char* name, double v);
+
+}  // namespace loom::synth

@@ -1,0 +1,97 @@
+// loom-synth: the thesis' dimensional synthesis for loom builders — Söylemez slider-crank and
+// Khare–Dave crank-rocker tables as CSV, and a one-row beat-up linkage design. CSV on stdout,
+// notes and errors on stderr; bad arguments or impossible designs exit 2 naming the argument.
+#include <CLI/CLI.hpp>
+#include <exception>
+#include <iostream>
+
+#include "commands.hpp"
+
+namespace {
+
+int fail(const std::string& what) {
+  std::cerr << "loom-synth: error: " << what << "\n";
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace loom::synth;
+  CLI::App app{"Dimensional synthesis of the beat-up linkage (thesis 000 §4.5). Angles in degrees; "
+               "lengths relative to ground = 1 (crank-rocker) or stroke = 1 (slider-crank) unless "
+               "given."};
+  app.require_subcommand(1);
+
+  SliderCrankArgs sc;
+  CLI::App* sc_cmd = app.add_subcommand(
+      "slider-crank", "Söylemez slider-crank for a crank rotation phi between dead centres: "
+                      "phi_deg,a,b,c,mu_min_deg,lambda (Table 4.2)");
+  CLI::Option* sc_phi = sc_cmd->add_option("--phi", sc.phi_deg, "Crank rotation, 90 <= phi < 180 deg");
+  CLI::Option* sc_range =
+      sc_cmd->add_option("--phi-range", sc.phi_range, "Table of phi: first:last[:step] deg, e.g. 90:179");
+  sc_phi->excludes(sc_range);
+  sc_cmd->add_option("--stroke", sc.stroke, "Slider stroke; lengths come out in its unit")
+      ->capture_default_str();
+  CLI::Option* sc_lambda =
+      sc_cmd->add_option("--lambda", sc.lambda, "Crank/coupler ratio a/b (default: optimum lambda)");
+  sc_cmd->add_flag("--full-precision", sc.full_precision, "Print %.17g instead of the thesis' digits");
+
+  CrankRockerArgs cr;
+  CLI::App* cr_cmd = app.add_subcommand(
+      "crank-rocker", "Khare-Dave crank-rocker for swing psi and crank rotation phi: "
+                      "beta_deg,a,b,c,mu_min_deg, one row per integer beta (Tables 4.6-4.9)");
+  cr_cmd->add_option("--psi", cr.psi_deg, "Rocker swing angle, 0 < psi < 180 deg")->required();
+  cr_cmd->add_option("--phi", cr.phi_deg, "Crank rotation from extended to folded dead centre, deg")
+      ->required();
+  CLI::Option* cr_beta =
+      cr_cmd->add_option("--beta", cr.beta_deg, "Crank angle at the extended dead centre (one design)");
+  cr_cmd->add_option("--ground", cr.ground, "Ground link length; lengths come out in its unit")
+      ->capture_default_str();
+  cr_cmd->add_flag("--full-precision", cr.full_precision, "Print %.17g instead of the thesis' digits");
+
+  DesignArgs ds;
+  CLI::App* ds_cmd = app.add_subcommand(
+      "design", "One beat-up linkage: --stroke S gives a slider-crank, --swing PSI a crank-rocker");
+  CLI::Option* ds_stroke = ds_cmd->add_option("--stroke", ds.stroke, "Beater stroke (slider-crank)");
+  CLI::Option* ds_swing = ds_cmd->add_option("--swing", ds.swing_deg, "Rocker swing psi, deg (crank-rocker)");
+  ds_stroke->excludes(ds_swing);
+  ds_cmd->add_option("--phi", ds.phi_deg, "Crank rotation between dead centres, deg")->required();
+  CLI::Option* ds_lambda = ds_cmd->add_option(
+      "--lambda", ds.lambda, "Crank/coupler ratio a/b (default: the design maximising mu_min)");
+  CLI::Option* ds_beta = ds_cmd->add_option("--beta", ds.beta_deg, "Crank-rocker: crank angle at the extended dead centre, deg");
+  ds_cmd->add_option("--ground", ds.ground, "Crank-rocker: ground link length")->capture_default_str();
+  ds_cmd->add_flag("--thesis-rounding", ds.thesis_rounding,
+                   "Slider-crank: scale the 6-decimal unit-stroke design, as the thesis' Table 4.3 did");
+  ds_cmd->add_flag("--full-precision", ds.full_precision, "Print %.17g instead of the thesis' digits");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    return fail(e.what());
+  }
+
+  try {
+    if (*sc_cmd) {
+      sc.has_phi = sc_phi->count() > 0;
+      sc.has_lambda = sc_lambda->count() > 0;
+      run_slider_crank(sc, std::cout, std::cerr);
+    } else if (*cr_cmd) {
+      cr.has_beta = cr_beta->count() > 0;
+      run_crank_rocker(cr, std::cout, std::cerr);
+    } else if (*ds_cmd) {
+      ds.has_stroke = ds_stroke->count() > 0;
+      ds.has_swing = ds_swing->count() > 0;
+      ds.has_lambda = ds_lambda->count() > 0;
+      ds.has_beta = ds_beta->count() > 0;
+      run_design(ds, std::cout, std::cerr);
+    }
+  } catch (const ArgError& e) {
+    return fail(e.what());
+  } catch (const loom::motion::MotionError& e) {
+    return fail(e.what());
+  }
+  std::cout.flush();
+  return std::cout ? 0 : 1;
+}
