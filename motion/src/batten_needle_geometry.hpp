@@ -11,33 +11,10 @@
 
 namespace loom::motion::detail {
 
-// RT-safe. Point at distance r0 from c0 and r1 from c1, on the left (left = true) or right of the
-// directed line c0 -> c1. Returns false when the circles do not meet. The height uses the product
-// form ((r0+r1)² - d²)(d² - (r0-r1)²) so it keeps its accuracy away from tangency; a product that
-// rounds a hair below zero at exact tangency is clamped to zero.
-inline bool circle_intersection(const Eigen::Vector2d& c0, double r0, const Eigen::Vector2d& c1,
-                                double r1, bool left, Eigen::Vector2d& out) {
-  const Eigen::Vector2d dv = c1 - c0;
-  const double d = dv.norm();
-  if (!(d > 0.0)) return false;
-  const double outer = (r0 + r1 - d) * (r0 + r1 + d);
-  const double inner = (d - (r0 - r1)) * (d + (r0 - r1));
-  double prod = outer * inner;
-  const double scale = (r0 + r1 + d) * (r0 + r1 + d);
-  if (prod < 0.0) {
-    if (prod < -1e-14 * scale * scale) return false;
-    prod = 0.0;
-  }
-  const double h = std::sqrt(prod) / (2.0 * d);
-  const double a = (d * d + r0 * r0 - r1 * r1) / (2.0 * d);
-  const Eigen::Vector2d ex = dv / d;
-  const Eigen::Vector2d ey(-ex.y(), ex.x());
-  out = c0 + a * ex + (left ? h : -h) * ey;
-  return true;
-}
-
-// RT-safe. As circle_intersection, for a mechanism already validated to assemble: rounding that
-// would push a (near-)tangent intersection out of existence is clamped to the tangent point.
+// RT-safe. The point at distance r0 from c0 and r1 from c1, on the left (left = true) or right of
+// the directed line c0 -> c1, for a mechanism already validated to assemble. The height uses the
+// product form ((r0+r1)² - d²)(d² - (r0-r1)²), which keeps its accuracy away from tangency; a product
+// that rounds a hair below zero at (near-)tangency is clamped to the tangent point.
 inline Eigen::Vector2d circle_intersection_valid(const Eigen::Vector2d& c0, double r0,
                                                  const Eigen::Vector2d& c1, double r1, bool left) {
   const Eigen::Vector2d dv = c1 - c0;
@@ -50,11 +27,6 @@ inline Eigen::Vector2d circle_intersection_valid(const Eigen::Vector2d& c0, doub
   return c0 + a * ex + (left ? h : -h) * ey;
 }
 
-// RT-safe. z-component of the cross product: > 0 when b is counter-clockwise of a.
-inline double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-  return a.x() * b.y() - a.y() * b.x();
-}
-
 struct CosRange {
   double min;
   double max;
@@ -64,7 +36,7 @@ struct CosRange {
 // ±1 wherever a multiple of π lies inside the arc.
 inline CosRange cos_range(double lo, double hi) {
   CosRange r{std::min(std::cos(lo), std::cos(hi)), std::max(std::cos(lo), std::cos(hi))};
-  const double first_even = std::ceil(lo / kTwoPi) * kTwoPi;            // cos = +1
+  const double first_even = std::ceil(lo / kTwoPi) * kTwoPi;              // cos = +1
   const double first_odd = std::ceil((lo - kPi) / kTwoPi) * kTwoPi + kPi;  // cos = -1
   if (first_even <= hi) r.max = 1.0;
   if (first_odd <= hi) r.min = -1.0;

@@ -1,11 +1,13 @@
 // Elliptic k-lobed gear pair in closed form (seed 004, eqns 2-6 and 8, generalised from k = 2).
-// The integral φ2 = ∫ (1-e²)/(1 + e² + 2e cos kφ1) dφ1 is written as φ1 minus a bounded atan2 term
-// whose denominator 1 + e cos kφ1 >= 1 - e > 0, so it never jumps a branch, for any number of turns.
+// The integral φ2 = ∫ (1-e²)/(1 + e² + 2e cos kφ1) dφ1 is the focal-ellipse law
+// tan(kφ2/2) = q·tan(kφ1/2), q = (1-e)/(1+e), unrolled onto the right tread so it is continuous and
+// monotone for any number of turns and keeps full relative accuracy on the treads as e -> 1.
 #include "loom/motion/elliptic_gear.hpp"
 
 #include <cmath>
 #include <sstream>
 
+#include "loom/motion/angles.hpp"
 #include "loom/motion/errors.hpp"
 
 namespace loom::motion {
@@ -52,13 +54,31 @@ double EllipticGearPair::ratio(double phi1_rad) const {
 GearPhase EllipticGearPair::phase(double phi1_rad) const {
   const double u = k_ * phi1_rad;
   const double su = std::sin(u);
-  const double cu = std::cos(u);
   const double one_minus_e2 = (1.0 - e_) * (1.0 + e_);
   const double den = ratio_denominator(e_, u);
   GearPhase g{};
-  // d/du atan2(e sin u, 1 + e cos u) = (e cos u + e²)/den, hence dφ2/dφ1 = 1 - 2(e cos u + e²)/den
-  // = (1 - e²)/den, i.e. 004's eqn 5 integrand.
-  g.phi2_rad = phi1_rad - (2.0 / k_) * std::atan2(e_ * su, 1.0 + e_ * cu);
+  // d/dφ1 of (2/k)·atan(q tan(u/2)) = q/(cos²(u/2) + q² sin²(u/2)) = (1 - e²)/den: 004's eqn 5
+  // integrand, so the closed form and its derivatives are the same law.
+  if (e_ == 0.0) {
+    g.phi2_rad = phi1_rad;  // the circular gear is the identity, exactly
+  } else {
+    // Tread n holds kφ1/2 in [nπ - π/2, nπ + π/2]; on it kφ2/2 = nπ + atan(q tan(kφ1/2 - nπ)), and
+    // neighbouring treads meet at the same value, so φ2 is continuous across them. Unlike
+    // φ1 - atan2(...), this has no cancellation where the pinion nearly stands still (e -> 1).
+    const double half = 0.5 * u;
+    double n = std::nearbyint(half / kPi);
+    double h = half - n * kPi;
+    // Rounding can leave h a hair beyond ±π/2 at a tread edge, where tan changes sign: step over.
+    if (h > 0.5 * kPi) {
+      n += 1.0;
+      h -= kPi;
+    } else if (h < -0.5 * kPi) {
+      n -= 1.0;
+      h += kPi;
+    }
+    const double q = (1.0 - e_) / (1.0 + e_);
+    g.phi2_rad = (2.0 / k_) * (n * kPi + std::atan(q * std::tan(h)));
+  }
   g.dphi2 = one_minus_e2 / den;
   g.d2phi2 = 2.0 * e_ * k_ * su * one_minus_e2 / (den * den);
   return g;

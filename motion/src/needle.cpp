@@ -91,8 +91,8 @@ NeedleLinkage::NeedleLinkage(const NeedleDims& dims, NeedleBranch branch) : d_(d
   const Eigen::Vector2d c(d_.x1_m, d_.h1_m);
   const Eigen::Vector2d b_ext = detail::circle_intersection_valid(c, d_.l3_m, origin, d_.l2_m + d_.l1_m, left);
   const Eigen::Vector2d b_fold = detail::circle_intersection_valid(c, d_.l3_m, origin, d_.l2_m - d_.l1_m, left);
-  limits_.extended_rad = std::atan2(b_ext.y() - c.y(), b_ext.x() - c.x());
-  limits_.folded_rad = std::atan2(b_fold.y() - c.y(), b_fold.x() - c.x());
+  limits_.extended_rad = wrap_two_pi(std::atan2(b_ext.y() - c.y(), b_ext.x() - c.x()));
+  limits_.folded_rad = wrap_two_pi(std::atan2(b_fold.y() - c.y(), b_fold.x() - c.x()));
 
   // The rocker swings through less than π, on the arc that contains any actual pose.
   const double ref = evaluate(0.0, 0.0).theta3_rad;

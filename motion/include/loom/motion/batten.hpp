@@ -25,7 +25,7 @@ struct BattenDims {
 
 // Configure-time only. 004's dimensions: L1..L9 = 0.04, 0.09, 0.08, 0.09, 0.17, 0.1, 0.06, 0.05, 0.11 m.
 BattenDims batten_004_dims();
-// Configure-time only. 004's gear: a = 0.05 m, k = 2 (e is the experiment's variable).
+// 004's gear: a = 0.05 m with k = 2 lobes (e is the experiment's variable).
 inline constexpr double kBatten004GearA_m = 0.05;
 
 enum class LoopSide { kLeft, kRight };
@@ -33,14 +33,14 @@ enum class LoopSide { kLeft, kRight };
 // Assembly branch: loop 1 — B on the left or right of the directed line A -> O3; loop 2 — D on the
 // left or right of B -> P. Equivalently the signs of the two 2×2 blocks of the eqns (7) Jacobian:
 // det1 = -L2 L3 cos(γ2 + γ3) > 0 is loop-1 left, det2 = L4 L5 cos(γ4 - ψ) < 0 is loop-2 left.
-// The default (left, left) is the one whose batten swings twice per crank turn, as 004 describes.
+// The default (right, right) is the one whose batten swings twice per crank turn, as 004 describes.
 struct BattenBranch {
-  LoopSide loop1 = LoopSide::kLeft;
-  LoopSide loop2 = LoopSide::kLeft;
+  LoopSide loop1 = LoopSide::kRight;
+  LoopSide loop2 = LoopSide::kRight;
   bool operator==(const BattenBranch&) const = default;
 };
 
-// The unknowns x = (γ2, γ3, γ4, ψ) of eqns (7), rad.
+// The unknowns x = (γ2, γ3, γ4, ψ) of eqns (7), rad. vec()/from() are RT-safe conversions.
 struct BattenPose {
   double gamma2_rad, gamma3_rad, gamma4_rad, psi_rad;
   Eigen::Vector4d vec() const { return {gamma2_rad, gamma3_rad, gamma4_rad, psi_rad}; }
@@ -72,7 +72,7 @@ class BattenLinkage {
   // (loop 2 cannot close somewhere in the swing).
   explicit BattenLinkage(const BattenDims& dims, BattenBranch branch = {});
 
-  // RT-safe. Closed-form pose at crank angle φ2 on this linkage's branch. γ's in [-π, π),
+  // RT-safe. Closed-form pose at crank angle φ2 on this linkage's branch. γ's in (-π, π],
   // ψ in [0, 2π) (004's batten hangs near ψ = π).
   BattenPose solve(double crank_rad) const;
 
@@ -97,8 +97,8 @@ class BattenLinkage {
     double extended_rad;
     double folded_rad;
   };
+  // RT-safe accessors.
   RockerLimits rocker_limits() const { return limits_; }
-
   double largest_link_m() const { return scale_m_; }
   const BattenDims& dims() const { return d_; }
   BattenBranch branch() const { return branch_; }
@@ -133,6 +133,7 @@ class BattenDrive {
   BattenSample evaluate_newton(double phi1_rad, double omega1_rad_s, const BattenPose& guess,
                                const NewtonOptions& opt = {}, int* iterations = nullptr) const;
 
+  // RT-safe accessors.
   const EllipticGearPair& gear() const { return gear_; }
   const BattenLinkage& linkage() const { return linkage_; }
   double phi02_rad() const { return phi02_rad_; }
@@ -152,5 +153,17 @@ enum class BattenSolver { kClosedForm, kNewton };
 std::vector<BattenSample> batten_sweep(const BattenDrive& drive, int samples, double omega1_rad_s,
                                        BattenSolver solver = BattenSolver::kClosedForm,
                                        const NewtonOptions& opt = {});
+
+// A turning point of the batten: ψ' = 0 (a dead position; 004's beat happens at the front one).
+struct BattenExtreme {
+  double phi1_rad;         // driving-pinion angle of the turning point, in [0, 2π)
+  double psi_rad;          // batten angle there
+  double psi_ddot_rad_s2;  // batten acceleration there (at the sweep's ω1)
+  bool maximum;            // ψ has a local maximum (else a minimum)
+};
+
+// Configure-time only (allocates). Every turning point of ψ over one driving turn: sign changes of
+// ψ' between `samples` closed-form samples, each refined by bisection on ψ' to full precision.
+std::vector<BattenExtreme> batten_extremes(const BattenDrive& drive, int samples, double omega1_rad_s);
 
 }  // namespace loom::motion

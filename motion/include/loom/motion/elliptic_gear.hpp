@@ -32,6 +32,7 @@ class EllipticGearPair {
   // RT-safe. φ2 = ∫0^φ1 r1/(2a - r1) dφ1 in closed form, with first and second derivatives.
   GearPhase phase(double phi1_rad) const;
 
+  // RT-safe accessors and flags (below).
   double half_centre_distance_m() const { return a_m_; }
   double eccentricity() const { return e_; }
   int lobes() const { return k_; }

@@ -65,13 +65,13 @@ class NeedleLinkage {
   double closure_residual_m(const NeedleState& s) const;
 
   // θ3 at the two dead centres of the crank-rocker (crank and coupler collinear, extended and
-  // folded), found from the triangle O-B-C alone: the limits of the rocker swing.
+  // folded), found from the triangle O-B-C alone: the limits of the rocker swing, in [0, 2π).
   struct RockerLimits {
     double extended_rad;
     double folded_rad;
   };
+  // RT-safe accessors.
   RockerLimits rocker_limits() const { return limits_; }
-
   const NeedleDims& dims() const { return d_; }
   NeedleBranch branch() const { return branch_; }
 

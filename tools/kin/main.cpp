@@ -1,0 +1,36 @@
+// loom-kin: kinematics of the tufting-needle six-bar (002) and the elliptic-gear batten drive (004)
+// over one turn, as CSV on stdout. Bad arguments and impossible designs are reported on stderr,
+// naming the argument, with exit status 2; --help exits 0.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+
+#include "batten_cmd.hpp"
+#include "loom/motion/errors.hpp"
+#include "needle_cmd.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"loom-kin: needle six-bar (002) and elliptic-gear batten drive (004) kinematics as CSV"};
+  app.require_subcommand(1);
+  loom::kin::NeedleArgs needle;
+  loom::kin::BattenArgs batten;
+  loom::kin::BattenArgs phase;
+  phase.samples = 720;  // turning points are refined by bisection, so a coarse sweep suffices
+  CLI::App* needle_cmd = loom::kin::add_needle_command(app, needle);
+  CLI::App* batten_cmd = loom::kin::add_batten_command(app, batten);
+  CLI::App* phase_cmd = loom::kin::add_batten_phase_command(app, phase);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
+  try {
+    if (needle_cmd->parsed()) loom::kin::run_needle(needle);
+    if (batten_cmd->parsed()) loom::kin::run_batten(batten);
+    if (phase_cmd->parsed()) loom::kin::run_batten_phase(phase);
+  } catch (const loom::motion::MotionError& e) {
+    std::fprintf(stderr, "loom-kin: error (%s): %s\n", loom::motion::error_code_name(e.code()), e.what());
+    return 2;
+  }
+  return 0;
+}
