@@ -12,6 +12,10 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
   profiles_ = std::make_unique<motion::ProfileSet>(cfg_.profile);
   sequencer::SequencerConfig scfg = cfg_.sequencer;
   scfg.rows_to_weave = opt.rows;
+  if (opt.hal == HalKind::kSocketCan) {
+    // A dead drive first shows as stale PDOs (fast stop), then as a lost heartbeat (the root cause).
+    scfg.diagnosis_window_s = cfg_.can.heartbeat_timeout_ms * 1e-3 + 10.0 * cfg_.sequencer.period_s;
+  }
   sequencer_ = std::make_unique<sequencer::Sequencer>(*profiles_, scfg, resume);
   sim_ = std::make_unique<sim_hal::SimWorld>(cfg_.machine, scene.spec);
 

@@ -160,10 +160,15 @@ int weave(const WeaveArgs& a) {
   const auto& c = seq.counters();
   if (seq.state() == sequencer::State::kFault) {
     const sequencer::Fault f = seq.first_fault();
-    std::printf("FAULT %s (code 0x%04X%s%s, device code 0x%04X) at t=%.3f s: %s; rows completed %u, picks %u, beats %u\n",
+    const std::string stopped = seq.stopped_by() == f ? std::string()
+                                                        : std::string(" (motion stopped on ") +
+                                                              sequencer::fault_name(seq.stopped_by()) + ")";
+    std::printf("FAULT %s (code 0x%04X%s%s, device code 0x%04X) at t=%.3f s%s: %s; rows completed %u, picks %u, "
+                "beats %u\n",
                 sequencer::fault_name(f), sequencer::fault_code(f), seq.fault_axis() >= 0 ? ", axis " : "",
                 seq.fault_axis() >= 0 ? hal::axis_name(static_cast<hal::Axis>(seq.fault_axis())) : "",
-                seq.fault_detail(), secs(seq.fault_tick()), sequencer::fault_text(f), c.rows, c.picks, c.beats);
+                seq.fault_detail(), secs(seq.fault_tick()), stopped.c_str(), sequencer::fault_text(f), c.rows,
+                c.picks, c.beats);
     return kExitFault;
   }
   if (rows_this_run > 0) {

@@ -58,7 +58,7 @@ double Sequencer::commanded_rocker_angle() const noexcept {
 
 void Sequencer::latch(Fault f, hal::Tick now, int axis, std::uint16_t detail) noexcept {
   if (first_fault_ == Fault::kNone) {
-    first_fault_ = f;
+    first_fault_ = stopped_by_ = f;
     fault_axis_ = axis;
     fault_detail_ = detail;
     fault_tick_ = now;
@@ -91,18 +91,46 @@ bool Sequencer::check_faults(hal::Tick now, const hal::HalInputs& in) noexcept {
           in.link.link_fault_code);
     return true;
   }
+  // Data never seen counts as old as the time since arming: the first PDOs of a freshly started bus
+  // legitimately arrive a few cycles after the first SYNC.
   const hal::Tick stale = ticks(cfg_.stale_timeout_s);
+  const auto too_old = [&](hal::Tick refreshed) {
+    return now - (refreshed == hal::kNeverTick ? armed_since_ : refreshed) > stale;
+  };
   for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
-    if (in.axes[i].refreshed == hal::kNeverTick || now - in.axes[i].refreshed > stale) {
+    if (too_old(in.axes[i].refreshed)) {
       latch(Fault::kStaleFeedback, now, static_cast<int>(i));
       return true;
     }
   }
-  if (in.io.refreshed == hal::kNeverTick || now - in.io.refreshed > stale) {
+  if (too_old(in.io.refreshed)) {
     latch(Fault::kStaleFeedback, now);
     return true;
   }
   return false;
+}
+
+bool Sequencer::is_symptom(Fault f) noexcept {
+  return f == Fault::kStaleFeedback || f == Fault::kCarriageInWarp || f == Fault::kPickWithoutShed ||
+         f == Fault::kShedWithShuttle;
+}
+
+void Sequencer::refine_diagnosis(hal::Tick now, const hal::HalInputs& in) noexcept {
+  if (!is_symptom(first_fault_) || now - fault_tick_ > ticks(cfg_.diagnosis_window_s)) return;
+  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+    const hal::AxisFeedback& a = in.axes[i];
+    if (a.fault || a.state == DriveState::kFault || a.state == DriveState::kFaultReactionActive) {
+      first_fault_ = a.fault_code == kHeartbeatCode ? Fault::kHeartbeatLost : Fault::kDriveFault;
+      fault_axis_ = static_cast<int>(i);
+      fault_detail_ = a.fault_code;
+      return;
+    }
+  }
+  if (in.link.link_fault) {
+    first_fault_ = in.link.link_fault_code == kHeartbeatCode ? Fault::kHeartbeatLost : Fault::kLinkFault;
+    fault_axis_ = -1;
+    fault_detail_ = in.link.link_fault_code;
+  }
 }
 
 void Sequencer::begin_row_shed(hal::Tick now, const hal::HalInputs& in) noexcept {
@@ -125,6 +153,7 @@ void Sequencer::advance(hal::Tick now, const hal::HalInputs& in) noexcept {
       for (std::size_t i = 0; i < hal::kAxisCount; ++i) cmd_.axes[i].target_position = in.axes[i].position;
       if (start_requested_) {
         start_requested_ = false;
+        armed_since_ = now;
         enter(State::kEnabling, now);
       }
       break;
@@ -251,6 +280,7 @@ void Sequencer::play_moves(hal::Tick now) noexcept {
 
 void Sequencer::step(hal::Tick now, const hal::HalInputs& in, hal::HalOutputs& out) noexcept {
   if (state_ != State::kIdle && state_ != State::kFault) check_faults(now, in);
+  if (state_ == State::kFault) refine_diagnosis(now, in);
   if (state_ == State::kIdle && start_requested_ && !in.io.estop_ok) {
     start_requested_ = false;
     latch(Fault::kEStop, now);

@@ -138,3 +138,63 @@ TEST(SequencerSim, EveryBeatHappensAtFullCrankSpeed) {
   });
   EXPECT_EQ(beats, r.profiles.beats_per_row());
 }
+
+TEST(SequencerSim, NeverSeenFeedbackIsNotStaleRightAfterArming) {
+  // On a freshly started bus the first PDOs arrive a few cycles after the first SYNC.
+  Rig r;
+  r.build(1);
+  hal::PortHal hal(*r.world, *r.world);
+  for (; r.now < 5; ++r.now) {
+    hal.read(r.now, r.in);
+    for (auto& a : r.in.axes) a.refreshed = hal::kNeverTick;
+    r.seq->step(r.now, r.in, r.out);
+    hal.write(r.now, r.out);
+  }
+  EXPECT_NE(r.seq->state(), State::kFault) << sequencer::fault_name(r.seq->first_fault());
+  r.run(200000, [] {});
+  EXPECT_EQ(r.seq->state(), State::kDone);
+}
+
+TEST(SequencerSim, DeadDriveStopsOnStaleFeedbackAndIsReportedAsHeartbeatLoss) {
+  Rig r;
+  r.cfg.diagnosis_window_s = 0.3;
+  r.build(3);
+  hal::PortHal hal(*r.world, *r.world);
+  const hal::Tick dead_at = 4000, heartbeat_seen_at = dead_at + 120;  // 240 ms later at 2 ms
+  hal::AxisFeedbacks frozen{};
+  for (; r.now < dead_at + 400; ++r.now) {
+    hal.read(r.now, r.in);
+    if (r.now == dead_at) frozen = r.in.axes;
+    if (r.now >= dead_at) r.in.axes = frozen;  // no more PDOs from any drive
+    if (r.now >= heartbeat_seen_at) {
+      r.in.axes[hal::index(hal::Axis::kHelix)].fault = true;
+      r.in.axes[hal::index(hal::Axis::kHelix)].fault_code = 0x8130;
+    }
+    r.seq->step(r.now, r.in, r.out);
+    hal.write(r.now, r.out);
+    if (r.now == heartbeat_seen_at - 1) {
+      ASSERT_EQ(r.seq->state(), State::kFault);
+      EXPECT_EQ(r.seq->first_fault(), Fault::kStaleFeedback);  // motion already stopped
+    }
+  }
+  EXPECT_EQ(r.seq->first_fault(), Fault::kHeartbeatLost);
+  EXPECT_EQ(r.seq->stopped_by(), Fault::kStaleFeedback);
+  EXPECT_EQ(r.seq->fault_axis(), static_cast<int>(hal::Axis::kHelix));
+}
+
+TEST(SequencerSim, RootCauseOutsideTheWindowDoesNotRewriteHistory) {
+  Rig r;
+  r.cfg.diagnosis_window_s = 0.1;
+  r.build(3);
+  hal::PortHal hal(*r.world, *r.world);
+  hal::AxisFeedbacks frozen{};
+  for (; r.now < 5000; ++r.now) {
+    hal.read(r.now, r.in);
+    if (r.now == 4000) frozen = r.in.axes;
+    if (r.now >= 4000) r.in.axes = frozen;
+    if (r.now >= 4200) r.in.axes[0].fault = true;  // 400 ms later: too late to be the cause
+    r.seq->step(r.now, r.in, r.out);
+    hal.write(r.now, r.out);
+  }
+  EXPECT_EQ(r.seq->first_fault(), Fault::kStaleFeedback);
+}

@@ -18,7 +18,7 @@ struct ProfileSpec {
   double beater_width_m = 0.10;      // comb width (5–10 cm in handmade looms)
   double overlap_m = 0.02;           // overlap between neighbouring beats
   JerkLimits crank{.velocity = 15.5, .acceleration = 400.0, .jerk = 2.0e4};  // rad/s, rad/s², rad/s³
-  double cam_margin_rad = 0.1745;    // ≈10°: carriage keeps this far from the warp boundaries
+  double cam_margin_rad = 0.3491;    // 20°: carriage keeps this far from the warp boundaries
   double carriage_max_speed_m_s = 1.0;
   double carriage_max_accel_m_s2 = 20.0;
   double helix_lead_m = 0.10;        // carrier travel per shaft turn

@@ -45,6 +45,10 @@ struct SequencerConfig {
   double shed_timeout_s = 1.5;           // piston travel plus margin
   double pick_timeout_margin_s = 0.5;    // beyond the planned pick duration
   double stale_timeout_s = 0.05;         // feedback older than this is a fault
+  // After motion stops on a symptom (stale feedback, an interlock trip), a root cause reported within
+  // this window (a drive fault, a lost heartbeat) becomes the first fault. Set it to the heartbeat
+  // consumer time plus a few periods on CAN, so a dead drive is reported as such, not as its symptom.
+  double diagnosis_window_s = 0.3;
   double crank_park_position_rad = 0.0;  // crank axis reading at the park pose (calibration)
   double carriage_home_m = 0.0;          // carriage axis reading at the left selvedge
   double park_tolerance_rad = 0.01;
@@ -67,6 +71,9 @@ class Sequencer {
   State state() const noexcept { return state_; }
   const Counters& counters() const noexcept { return counters_; }
   Fault first_fault() const noexcept { return first_fault_; }
+  // The fault that actually stopped motion; differs from first_fault() when a symptom (stale feedback,
+  // an interlock) stopped the machine and the root cause was identified within the diagnosis window.
+  Fault stopped_by() const noexcept { return stopped_by_; }
   int fault_axis() const noexcept { return fault_axis_; }              // -1 when not axis-specific
   std::uint16_t fault_detail() const noexcept { return fault_detail_; }  // device code (EMCY) if any
   hal::Tick fault_tick() const noexcept { return fault_tick_; }
@@ -80,6 +87,8 @@ class Sequencer {
   hal::Tick ticks(double seconds) const noexcept;
   double seconds_since(hal::Tick now, hal::Tick t0) const noexcept;
   bool check_faults(hal::Tick now, const hal::HalInputs& in) noexcept;
+  void refine_diagnosis(hal::Tick now, const hal::HalInputs& in) noexcept;
+  static bool is_symptom(Fault f) noexcept;
   void latch(Fault f, hal::Tick now, int axis = -1, std::uint16_t detail = 0) noexcept;
   void enter(State s, hal::Tick now) noexcept;
   void advance(hal::Tick now, const hal::HalInputs& in) noexcept;
@@ -96,6 +105,8 @@ class Sequencer {
   bool stop_requested_ = false;
 
   Fault first_fault_ = Fault::kNone;
+  Fault stopped_by_ = Fault::kNone;
+  hal::Tick armed_since_ = 0;  // tick the drives were first asked to enable (staleness of never-seen data)
   int fault_axis_ = -1;
   std::uint16_t fault_detail_ = 0;
   hal::Tick fault_tick_ = hal::kNeverTick;
