@@ -15,6 +15,7 @@ packages=(
   libbenchmark-dev              # benchmarks
   libtomlplusplus-dev           # config files with line:column errors
   libcli11-dev                  # command lines
+  nlohmann-json3-dev            # run reports (summary.json)
   libnlopt-cxx-dev              # optimiser (balancing)
   iproute2 can-utils            # vcan set-up, candump/cansend for HIL checks
 )

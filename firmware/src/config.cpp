@@ -2,6 +2,7 @@
 // profile set is built once here as the final check: a config that parses but cannot be woven (the
 // crank cannot reach speed before the first beat, the carriage step breaks its limits) is refused now,
 // with the motion module's message, rather than at the first row.
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
@@ -74,11 +75,19 @@ LoomConfig parse_loom_config(const std::string& text, const std::string& source)
   c.sequencer.carriage.acceleration = p.carriage_max_accel_m_s2;
 
   r.number("helix.lead_m", p.helix_lead_m, positive);
+  r.number("helix.left_position_rad", c.sequencer.helix_left_position_rad);
   r.number("helix.max_speed_rad_s", p.helix.velocity, positive);
   r.number("helix.max_accel_rad_s2", p.helix.acceleration, positive);
   r.number("helix.jerk_rad_s3", p.helix.jerk, positive);
   r.number("helix.carrier_force_n", p.carrier_force_n, positive);
   r.number("helix.shuttle_mass_kg", p.shuttle_mass_kg, positive);
+
+  std::int64_t picks = c.sequencer.picks_per_row;
+  r.integer("recipe.picks_per_row", picks, 1, 16);
+  c.sequencer.picks_per_row = static_cast<std::uint32_t>(picks);
+  std::int64_t debounce = c.sequencer.debounce_ticks;
+  r.integer("timing.debounce_ticks", debounce, 1, 100);
+  c.sequencer.debounce_ticks = static_cast<int>(debounce);
 
   r.number("shedding.piston_travel_s", c.machine.piston_travel_s, positive);
   r.number("shedding.timeout_s", c.sequencer.shed_timeout_s, positive);
@@ -96,6 +105,8 @@ LoomConfig parse_loom_config(const std::string& text, const std::string& source)
   c.machine.period_s = c.sequencer.period_s;
   c.machine.width_m = p.width_m;
   c.machine.helix_lead_m = p.helix_lead_m;
+  c.machine.beatup = p.beatup;
+  c.machine.crank_park_position_rad = c.sequencer.crank_park_position_rad;
 
   std::int64_t v = 0;
   v = c.can.bitrate;
@@ -171,14 +182,45 @@ Scene parse_scene(const std::string& text, const std::string& source) {
       r.fail("effects", '"' + e + '"', "unknown effect (known: " + list + ")");
     }
   }
-  const bool lag_named = std::find(s.spec.effects.begin(), s.spec.effects.end(), "servo_lag") != s.spec.effects.end();
-  if (r.root().contains("servo_lag")) {
-    if (!lag_named) r.fail("servo_lag", "{...}", "parameters given for an effect the scene does not name");
+  // Parameter tables belong to named effects only: parameters for an effect that is not simulated
+  // would silently do nothing, which is exactly the mistake a scene file must not hide.
+  const auto named = [&](const char* effect) {
+    return std::find(s.spec.effects.begin(), s.spec.effects.end(), effect) != s.spec.effects.end();
+  };
+  for (const char* effect : {sim_hal::kEffectServoLag, sim_hal::kEffectPneumatics, sim_hal::kEffectShuttleSlip,
+                             sim_hal::kEffectSensorNoise, sim_hal::kEffectBeatContact}) {
+    if (r.root().contains(effect) && !named(effect)) {
+      r.fail(effect, "{...}", "parameters given for an effect the scene does not name");
+    }
   }
-  if (lag_named) {
+  if (named(sim_hal::kEffectServoLag)) {
     sim_hal::ServoLag lag;
     r.number("servo_lag.tau_s", lag.tau_s, [](double v) { return in_range(v, 1e-5, 1.0); });
     s.spec.servo_lag = lag;
+  }
+  if (named(sim_hal::kEffectPneumatics)) {
+    sim_hal::Pneumatics p;
+    r.number("pneumatics.fill_tau_s", p.fill_tau_s, [](double v) { return in_range(v, 1e-4, 5.0); });
+    r.number("pneumatics.breakaway", p.breakaway, [](double v) { return in_range(v, 0.0, 0.95); });
+    s.spec.pneumatics = p;
+  }
+  if (named(sim_hal::kEffectShuttleSlip)) {
+    sim_hal::ShuttleSlip p;
+    r.number("shuttle_slip.carrier_force_n", p.carrier_force_n, positive);
+    r.number("shuttle_slip.shuttle_mass_kg", p.shuttle_mass_kg, positive);
+    r.number("shuttle_slip.race_friction_m_s2", p.race_friction_m_s2, positive);
+    s.spec.shuttle_slip = p;
+  }
+  if (named(sim_hal::kEffectSensorNoise)) {
+    sim_hal::SensorNoise p;
+    r.number("sensor_noise.flip_probability", p.flip_probability, [](double v) { return in_range(v, 0.0, 0.2); });
+    s.spec.sensor_noise = p;
+  }
+  if (named(sim_hal::kEffectBeatContact)) {
+    sim_hal::BeatContact p;
+    r.number("beat_contact.beater_mass_kg", p.beater_mass_kg, positive);
+    r.number("beat_contact.contact_depth_m", p.contact_depth_m, positive);
+    s.spec.beat_contact = p;
   }
   r.consume("fault");
   if (const toml::node* faults = r.root().get("fault")) {
@@ -200,9 +242,37 @@ Scene parse_scene(const std::string& text, const std::string& source) {
             f.kind = sim_hal::InjectedFault::kDriveFault;
           } else if (x && *x == "estop") {
             f.kind = sim_hal::InjectedFault::kEStop;
+          } else if (x && *x == "stuck_piston") {
+            f.kind = sim_hal::InjectedFault::kStuckPiston;
+          } else if (x && *x == "stuck_sensor") {
+            f.kind = sim_hal::InjectedFault::kStuckSensor;
           } else {
-            r.fail_at(v, field, x ? '"' + *x + '"' : "?", "must be one of: drive_fault, estop");
+            r.fail_at(v, field, x ? '"' + *x + '"' : "?",
+                      "must be one of: drive_fault, estop, stuck_piston, stuck_sensor");
           }
+        } else if (key == "piston") {
+          const auto x = v.value<std::string>();
+          if (!x || (*x != "a" && *x != "b")) r.fail_at(v, field, x ? '"' + *x + '"' : "?", "must be \"a\" or \"b\"");
+          f.piston = *x == "a" ? 0 : 1;
+        } else if (key == "sensor") {
+          const auto x = v.value<std::string>();
+          bool found = false;
+          for (int i = 0; i < 6 && x; ++i) {
+            const auto sensor = static_cast<sim_hal::Sensor>(i);
+            if (*x == sim_hal::sensor_name(sensor)) {
+              f.sensor = sensor;
+              found = true;
+            }
+          }
+          if (!found) {
+            r.fail_at(v, field, x ? '"' + *x + '"' : "?",
+                      "must be a sensor: piston_a_extended, piston_a_retracted, piston_b_extended, "
+                      "piston_b_retracted, shuttle_at_left, shuttle_at_right");
+          }
+        } else if (key == "value") {
+          const auto x = v.value<bool>();
+          if (!x) r.fail_at(v, field, "?", "must be true or false");
+          f.stuck_value = *x;
         } else if (key == "axis") {
           const auto x = v.value<std::string>();
           if (x && *x == "beat_crank") {

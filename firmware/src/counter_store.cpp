@@ -1,4 +1,4 @@
-// Atomic counter persistence as a tiny JSON object {"rows":R,"picks":P,"beats":B}.
+// Atomic counter persistence as a tiny JSON object {"rows":R,"picks":P,"beats":B,"picks_in_row":K}.
 #include "loom/firmware/counter_store.hpp"
 
 #include <fcntl.h>
@@ -38,12 +38,14 @@ std::optional<sequencer::Counters> CounterStore::load() const {
   field("rows", c.rows);
   field("picks", c.picks);
   field("beats", c.beats);
+  field("picks_in_row", c.picks_in_row);
   return c;
 }
 
 void CounterStore::save(const sequencer::Counters& c) const {
   std::ostringstream os;
-  os << "{\"rows\":" << c.rows << ",\"picks\":" << c.picks << ",\"beats\":" << c.beats << "}\n";
+  os << "{\"rows\":" << c.rows << ",\"picks\":" << c.picks << ",\"beats\":" << c.beats
+     << ",\"picks_in_row\":" << c.picks_in_row << "}\n";
   const std::string body = os.str();
   const std::string tmp = path_ + ".tmp";
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);

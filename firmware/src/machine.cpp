@@ -18,6 +18,10 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
   }
   sequencer_ = std::make_unique<sequencer::Sequencer>(*profiles_, scfg, resume);
   sim_ = std::make_unique<sim_hal::SimWorld>(cfg_.machine, scene.spec);
+  if (!opt.sim_state_path.empty()) {
+    sim_state_ = std::make_unique<sim_hal::SimStateFile>(opt.sim_state_path);
+    sim_->attach_state_file(*sim_state_);
+  }
 
   if (opt.hal == HalKind::kSocketCan) {
     auto bus = drivers::SocketCanBus::open(opt.iface);

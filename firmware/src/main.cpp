@@ -14,6 +14,8 @@
 #include "loom/firmware/machine.hpp"
 #include "loom/firmware/runner.hpp"
 #include "loom/motion/angles.hpp"
+#include "loom/report/run_report.hpp"
+#include <unistd.h>
 
 using namespace loom;
 
@@ -24,9 +26,10 @@ std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int) { g_stop.store(true); }
 
 struct WeaveArgs {
-  std::string config, scene, hal = "sim", iface, counters, lcm_url, loom_id;
+  std::string config, scene, hal = "sim", iface, counters, lcm_url, loom_id, report, sim_state;
   std::uint32_t rows = 3;
   double period_ms = 0.0;
+  double pace = 1.0;
   bool realtime = false, allow_degraded = false, no_telemetry = false, quiet = false;
 };
 
@@ -101,6 +104,7 @@ int weave(const WeaveArgs& a) {
   mo.iface = a.iface;
   mo.telemetry = !a.no_telemetry;
   mo.rows = resume.rows + a.rows;  // the sequencer counts absolute rows; weave `rows` more
+  mo.sim_state_path = a.sim_state;
   std::unique_ptr<firmware::Machine> machine;
   try {
     machine = std::make_unique<firmware::Machine>(cfg, scene, mo, resume);
@@ -120,14 +124,37 @@ int weave(const WeaveArgs& a) {
   double machine_s_rows = 0.0;
   std::uint32_t rows_this_run = 0;
   const auto secs = [&](hal::Tick t) { return static_cast<double>(t) * period; };
+  // A progress bar on long runs (a terminal only; logs get the per-row lines).
+  const bool progress_bar = isatty(STDOUT_FILENO) && a.rows >= 20 && !a.quiet;
+  report::RunSummary summary;
+  summary.loom_id = cfg.loom_id;
+  summary.scene = hardware ? "socketcan:" + a.iface : scene.spec.name;
+  summary.effects = hardware ? std::vector<std::string>{} : scene.spec.effects;
+  summary.period_s = period;
+  std::uint32_t picks_at_row_start = resume.picks;
   const auto on_event = [&](const firmware::RunEvent& e) {
     if (e.kind == firmware::RunEvent::Kind::kRowDone) {
       const auto& r = e.row;
       ++rows_this_run;
       machine_s_rows += secs(r.total_ticks);
-      std::printf("row %u/%u: %.2f s (shed %.2f s, pick %.2f s, beat %.2f s), %d beats, %d carriage steps\n", r.row,
-                  target_rows, secs(r.total_ticks), secs(r.shed_ticks), secs(r.pick_ticks), secs(r.beat_ticks),
-                  r.beats, r.carriage_steps);
+      summary.rows.push_back(r);
+      summary.row_picks.push_back(e.counters.picks - picks_at_row_start);
+      picks_at_row_start = e.counters.picks;
+      if (progress_bar) {
+        const int width = 40;
+        const int done = static_cast<int>(width * rows_this_run / a.rows);
+        std::printf("\r[%.*s%*s] %u/%u rows", done, "########################################", width - done, "",
+                    rows_this_run, a.rows);
+        if (rows_this_run == a.rows) std::printf("\n");
+      } else {
+        std::printf("row %u/%u: %.2f s (shed %.2f s, pick %.2f s, beat %.2f s), %d beats, %d carriage steps", r.row,
+                    target_rows, secs(r.total_ticks), secs(r.shed_ticks), secs(r.pick_ticks), secs(r.beat_ticks),
+                    r.beats, r.carriage_steps);
+        if (r.force_measured) {
+          std::printf(", peak beat force min/mean/max %.1f/%.1f/%.1f N", r.force_min_n, r.force_mean_n, r.force_max_n);
+        }
+        std::printf("\n");
+      }
       std::fflush(stdout);
     }
     if (store) {
@@ -145,6 +172,7 @@ int weave(const WeaveArgs& a) {
   firmware::RunOptions ro;
   ro.period_s = period;
   ro.realtime = realtime;
+  ro.pace = hardware ? 1.0 : a.pace;
   ro.grace_ticks = static_cast<hal::Tick>(0.2 / period);
   ro.stop_flag = &g_stop;
   const firmware::RunResult res = firmware::run_loop(machine->loop(), seq, ro, on_event);
@@ -158,6 +186,24 @@ int weave(const WeaveArgs& a) {
               static_cast<long long>(res.median_tick_cost_ns), static_cast<long long>(res.max_tick_cost_ns),
               res.overruns);
   const auto& c = seq.counters();
+  summary.counters = c;
+  summary.machine_s = machine_s;
+  summary.wall_s = res.wall_s;
+  if (seq.state() == sequencer::State::kFault) {
+    const sequencer::Fault f = seq.first_fault();
+    summary.fault = report::FaultSummary{
+        sequencer::fault_name(f), sequencer::fault_code(f),
+        seq.fault_axis() >= 0 ? hal::axis_name(static_cast<hal::Axis>(seq.fault_axis())) : "", seq.fault_detail(),
+        secs(seq.fault_tick()), sequencer::fault_name(seq.stopped_by()), sequencer::fault_text(f)};
+  }
+  if (!a.report.empty()) {
+    try {
+      report::write_report(summary, a.report);
+      std::printf("report: %s/summary.json, beat_force.svg, row_timeline.svg\n", a.report.c_str());
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "loomctl: report not written: %s\n", e.what());
+    }
+  }
   if (seq.state() == sequencer::State::kFault) {
     const sequencer::Fault f = seq.first_fault();
     const std::string stopped = seq.stopped_by() == f ? std::string()
@@ -195,6 +241,8 @@ int main(int argc, char** argv) {
   weave_cmd->add_option("--iface", a.iface, "SocketCAN interface (with --hal socketcan), e.g. can0, vcan0");
   weave_cmd->add_option("--period-ms", a.period_ms, "control period in ms (overrides the config)");
   weave_cmd->add_flag("--realtime", a.realtime, "pace the simulated loom at the tick rate");
+  weave_cmd->add_option("--pace", a.pace, "with --realtime: run this many times faster than real time (sim only)")
+      ->check(CLI::Range(0.01, 1000.0));
   weave_cmd->add_flag("--allow-degraded", a.allow_degraded,
                       "run on hardware even if mlockall/SCHED_FIFO fail (timing not guaranteed)");
   weave_cmd->add_option("--counters", a.counters, "production counters file (resumed, written atomically)");
@@ -202,6 +250,9 @@ int main(int argc, char** argv) {
   weave_cmd->add_option("--loom-id", a.loom_id, "loom id used in telemetry channel names");
   weave_cmd->add_flag("--no-telemetry", a.no_telemetry, "do not publish LCM telemetry");
   weave_cmd->add_flag("--quiet", a.quiet, "no header");
+  weave_cmd->add_option("--report", a.report, "write DIR/summary.json and plots (beat force, row timeline)");
+  weave_cmd->add_option("--sim-state", a.sim_state,
+                        "sim HAL: keep the simulated machine's physical state in FILE (survives a kill)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -93,10 +93,11 @@ RunResult run_loop(ControlLoop& loop, sequencer::Sequencer& seq, const RunOption
     }
   };
 
-  const std::int64_t period_ns = static_cast<std::int64_t>(opt.period_s * 1e9);
+  const std::int64_t period_ns = static_cast<std::int64_t>(opt.period_s * 1e9 / opt.pace);
   const std::int64_t start = now_ns();
   std::int64_t deadline = start;
   std::uint32_t rows_seen = seq.counters().rows;
+  std::uint32_t picks_seen = seq.counters().picks;
   hal::Tick finished_at = -1;
   bool stop_sent = false;
   LoopStats& stats = loop.stats();
@@ -119,10 +120,12 @@ RunResult run_loop(ControlLoop& loop, sequencer::Sequencer& seq, const RunOption
     stats.max_tick_cost_ns = std::max(stats.max_tick_cost_ns, cost);
     hist->add(cost);
 
-    if (seq.counters().rows != rows_seen) {
+    if (seq.counters().rows != rows_seen || seq.counters().picks != picks_seen) {
+      const bool row_done = seq.counters().rows != rows_seen;
       rows_seen = seq.counters().rows;
+      picks_seen = seq.counters().picks;
       RunEvent e;
-      e.kind = RunEvent::Kind::kRowDone;
+      e.kind = row_done ? RunEvent::Kind::kRowDone : RunEvent::Kind::kPickDone;
       e.tick = tick;
       e.row = seq.last_row();
       e.counters = seq.counters();

@@ -28,6 +28,7 @@ const char* state_name(State s) {
     case State::kShed: return "shed";
     case State::kPick: return "pick";
     case State::kBeatSweep: return "beat_sweep";
+    case State::kPaused: return "paused";
     case State::kDone: return "done";
     case State::kFault: return "fault";
   }
@@ -133,15 +134,78 @@ void Sequencer::refine_diagnosis(hal::Tick now, const hal::HalInputs& in) noexce
   }
 }
 
-void Sequencer::begin_row_shed(hal::Tick now, const hal::HalInputs& in) noexcept {
-  (void)in;
-  row_start_ = now;
-  row_beats_ = 0;
+void Sequencer::debounce(const hal::DigitalInputs& raw) noexcept {
+  const std::array<bool, 6> r{raw.piston_a_extended, raw.piston_a_retracted, raw.piston_b_extended,
+                              raw.piston_b_retracted, raw.shuttle_at_left,  raw.shuttle_at_right};
+  std::array<bool*, 6> v{&io_.piston_a_extended, &io_.piston_a_retracted, &io_.piston_b_extended,
+                         &io_.piston_b_retracted, &io_.shuttle_at_left,  &io_.shuttle_at_right};
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    if (!io_primed_ || r[i] == *v[i]) {
+      *v[i] = r[i];
+      disagree_[i] = 0;
+    } else if (++disagree_[i] >= cfg_.debounce_ticks) {
+      *v[i] = r[i];
+      disagree_[i] = 0;
+    }
+  }
+  io_primed_ = true;
+  io_.estop_ok = raw.estop_ok;  // never filtered: an opened e-stop chain acts at once
+  io_.refreshed = raw.refreshed;
+}
+
+void Sequencer::begin_shed(hal::Tick now) noexcept {
+  if (!row_started_) {
+    row_started_ = true;
+    row_start_ = now;
+    row_beats_ = 0;
+    const std::uint32_t row = counters_.rows + 1;
+    row_ = RowStats{};
+    row_.row = row;
+  }
+  // The shed may only change with the shuttle out of it: a shuttle seen at neither selvedge is lost
+  // (stuck in the shed, or its sensor failed) and needs an operator, not a shed change.
+  if (!shuttle_at_selvedge(io_)) {
+    latch(Fault::kShuttleLost, now);
+    return;
+  }
   // Alternate the shed every pick: even picks lift frame A, odd picks frame B.
   const bool a_up = counters_.picks % 2 == 0;
   cmd_.io.piston_a_extend = a_up;
   cmd_.io.piston_b_extend = !a_up;
+  phase_start_ = now;
   enter(State::kShed, now);
+}
+
+void Sequencer::begin_sweep(hal::Tick now, const hal::HalInputs& in) noexcept {
+  if (!row_started_) {  // resumed after a restart with every pick of the row already done
+    row_started_ = true;
+    row_start_ = now;
+    row_ = RowStats{};
+    row_.row = counters_.rows + 1;
+  }
+  // The crank turns `beats` full turns from park; the carriage rides the cam on it, starting from the
+  // selvedge it stands at, so successive rows sweep in alternating directions.
+  const double rel = in.axes[index(Axis::kCarriage)].position - cfg_.carriage_home_m;
+  carriage_sweep_dir_ = rel < 0.5 * profiles_.carriage_travel_m() ? 1.0 : -1.0;
+  carriage_sweep_origin_ = cmd_.axes[index(Axis::kCarriage)].target_position;
+  crank_sweep_origin_ = cmd_.axes[index(Axis::kBeatCrank)].target_position;
+  crank_move_ = {true, now, crank_sweep_origin_, profiles_.crank_sweep()};
+  sweeping_ = true;
+  row_beats_ = 0;
+  phase_start_ = now;
+  enter(State::kBeatSweep, now);
+}
+
+void Sequencer::track_beat_force(const hal::HalInputs& in) noexcept {
+  if (!sweeping_ || !in.analog.beat_force_valid) return;
+  // Beat k is the k-th passage through the warp; its peak is recorded while the beater is in the warp.
+  const double phi = in.axes[index(Axis::kBeatCrank)].position - crank_sweep_origin_;
+  const int k = static_cast<int>(std::floor(phi / motion::kTwoPi));
+  if (k < 0 || k >= profiles_.beats_per_row() || k >= kMaxBeatsPerRow) return;
+  if (!beater_in_warp(interlock_ctx_, in.axes[index(Axis::kBeatCrank)].position)) return;
+  BeatRecord& b = row_.beat[static_cast<std::size_t>(k)];
+  b.peak_force_n = std::max(b.peak_force_n, static_cast<float>(in.analog.beat_force_n));
+  row_.force_measured = true;
 }
 
 void Sequencer::advance(hal::Tick now, const hal::HalInputs& in) noexcept {
@@ -151,6 +215,10 @@ void Sequencer::advance(hal::Tick now, const hal::HalInputs& in) noexcept {
     case State::kIdle:
       request_all(cmd_, AxisRequest::kDisable);
       for (std::size_t i = 0; i < hal::kAxisCount; ++i) cmd_.axes[i].target_position = in.axes[i].position;
+      // Valves hold the frames where the end sensors see them: starting up (or restarting after a power
+      // loss) never moves a frame, so a shuttle left in the shed is never clamped.
+      cmd_.io.piston_a_extend = io_.piston_a_extended;
+      cmd_.io.piston_b_extend = io_.piston_b_extended;
       if (start_requested_) {
         start_requested_ = false;
         armed_since_ = now;
@@ -172,6 +240,9 @@ void Sequencer::advance(hal::Tick now, const hal::HalInputs& in) noexcept {
         const double phase = motion::wrap_pi(crank_fb.position - cfg_.crank_park_position_rad);
         crank_move_ = {true, now, cmd_.axes[index(Axis::kBeatCrank)].target_position,
                        motion::JerkMove::plan(-phase, profiles_.spec().crank)};
+        // Valves hold whatever the frames show now, so re-arming never moves a frame over the shuttle.
+        cmd_.io.piston_a_extend = io_.piston_a_extended;
+        cmd_.io.piston_b_extend = io_.piston_b_extended;
         enter(State::kPositioning, now);
       } else if (now - state_since_ > ticks(cfg_.enable_timeout_s)) {
         latch(Fault::kEnableTimeout, now);
@@ -180,8 +251,8 @@ void Sequencer::advance(hal::Tick now, const hal::HalInputs& in) noexcept {
     }
 
     case State::kPositioning:
-      if (crank_move_.active) break;
-      if (!carriage_move_.active) {
+      if (crank_move_.active || carriage_move_.active) break;
+      {
         const double rel = carriage_fb.position - cfg_.carriage_home_m;
         const double travel = profiles_.carriage_travel_m();
         const double goal = rel < 0.5 * travel ? 0.0 : travel;
@@ -190,21 +261,57 @@ void Sequencer::advance(hal::Tick now, const hal::HalInputs& in) noexcept {
                             motion::JerkMove::plan(goal - rel, cfg_.carriage)};
           break;
         }
-        begin_row_shed(now, in);
+      }
+      // Power lost mid-pick: the shuttle is in the open shed on its carrier. Finish that pick rather than
+      // start a new one (nothing repeated, nothing lost); without an open shed it needs an operator.
+      if (!shuttle_at_selvedge(io_)) {
+        if (!shed_confirmed(io_)) {
+          latch(Fault::kShuttleLost, now);
+          break;
+        }
+        pick_to_right_ = counters_.picks % 2 == 0;  // the shuttle starts at the left: even picks go right
+        const double goal =
+            cfg_.helix_left_position_rad + (pick_to_right_ ? profiles_.pick().distance() : 0.0);
+        const double from = cmd_.axes[index(Axis::kHelix)].target_position;
+        helix_move_ = {true, now, from,
+                       motion::JerkMove::plan(goal - from, {.velocity = profiles_.spec().helix.velocity,
+                                                            .acceleration = profiles_.helix_accel_limit(),
+                                                            .jerk = profiles_.spec().helix.jerk})};
+        if (!row_started_) {
+          row_started_ = true;
+          row_start_ = now;
+          row_ = RowStats{};
+          row_.row = counters_.rows + 1;
+        }
+        phase_start_ = now;
+        enter(State::kPick, now);
+        break;
+      }
+      // A pick that completed just before a power loss may not have reached the counters file: the
+      // shuttle's side tells (it starts at the left, so an even pick count means left).
+      if (shuttle_at_selvedge(io_) && io_.shuttle_at_left != (counters_.picks % 2 == 0) &&
+          counters_.picks_in_row < cfg_.picks_per_row) {
+        ++counters_.picks;
+        ++counters_.picks_in_row;
+      }
+      if (counters_.picks_in_row >= cfg_.picks_per_row) {
+        begin_sweep(now, in);
+      } else {
+        begin_shed(now);
       }
       break;
 
     case State::kShed:
-      if (shed_confirmed(in.io) && in.io.piston_a_extended == cmd_.io.piston_a_extend) {
-        if (!shuttle_at_selvedge(in.io)) {
+      if (shed_confirmed(io_) && io_.piston_a_extended == cmd_.io.piston_a_extend) {
+        if (!shuttle_at_selvedge(io_)) {
           latch(Fault::kShuttleLost, now);
           break;
         }
-        pick_to_right_ = in.io.shuttle_at_left;
+        pick_to_right_ = io_.shuttle_at_left;
         helix_move_ = {true, now, cmd_.axes[index(Axis::kHelix)].target_position,
                        pick_to_right_ ? profiles_.pick() : profiles_.pick_back()};
-        last_row_.shed_ticks = now - row_start_;
-        pick_start_ = now;
+        row_.shed_ticks += now - phase_start_;
+        phase_start_ = now;
         enter(State::kPick, now);
       } else if (now - state_since_ > ticks(cfg_.shed_timeout_s)) {
         latch(Fault::kShedTimeout, now);
@@ -212,19 +319,20 @@ void Sequencer::advance(hal::Tick now, const hal::HalInputs& in) noexcept {
       break;
 
     case State::kPick: {
-      const bool arrived = pick_to_right_ ? in.io.shuttle_at_right : in.io.shuttle_at_left;
+      const bool arrived = pick_to_right_ ? io_.shuttle_at_right : io_.shuttle_at_left;
       if (!helix_move_.active && arrived) {
         ++counters_.picks;
-        last_row_.pick_ticks = now - pick_start_;
-        // Beat sweep: the crank turns `beats` full turns from park; the carriage rides the cam on it.
-        const double rel = carriage_fb.position - cfg_.carriage_home_m;
-        carriage_sweep_dir_ = rel < 0.5 * profiles_.carriage_travel_m() ? 1.0 : -1.0;
-        carriage_sweep_origin_ = cmd_.axes[index(Axis::kCarriage)].target_position;
-        crank_sweep_origin_ = cmd_.axes[index(Axis::kBeatCrank)].target_position;
-        crank_move_ = {true, now, crank_sweep_origin_, profiles_.crank_sweep()};
-        sweeping_ = true;
-        beat_start_ = now;
-        enter(State::kBeatSweep, now);
+        ++counters_.picks_in_row;
+        row_.pick_ticks += now - phase_start_;
+        if (counters_.picks_in_row < cfg_.picks_per_row) {
+          if (pause_requested_) {
+            enter(State::kPaused, now);
+          } else {
+            begin_shed(now);
+          }
+        } else {
+          begin_sweep(now, in);
+        }
       } else if (seconds_since(now, state_since_) > profiles_.pick().duration() + cfg_.pick_timeout_margin_s) {
         latch(Fault::kShuttleNotArrived, now);
       }
@@ -235,18 +343,38 @@ void Sequencer::advance(hal::Tick now, const hal::HalInputs& in) noexcept {
       if (!crank_move_.active) {
         sweeping_ = false;
         ++counters_.rows;
-        last_row_.row = counters_.rows;
-        last_row_.beat_ticks = now - beat_start_;
-        last_row_.total_ticks = now - row_start_;
-        last_row_.beats = row_beats_;
-        last_row_.carriage_steps = profiles_.cam().steps();
+        counters_.picks_in_row = 0;
+        row_started_ = false;
+        row_.beat_ticks = now - phase_start_;
+        row_.total_ticks = now - row_start_;
+        row_.beats = row_beats_;
+        row_.carriage_steps = profiles_.cam().steps();
+        if (row_.force_measured && row_beats_ > 0) {
+          double lo = 1e300, hi = 0.0, sum = 0.0;
+          for (int k = 0; k < row_beats_; ++k) {
+            const double f = row_.beat[static_cast<std::size_t>(k)].peak_force_n;
+            lo = std::min(lo, f);
+            hi = std::max(hi, f);
+            sum += f;
+          }
+          row_.force_min_n = lo;
+          row_.force_max_n = hi;
+          row_.force_mean_n = sum / row_beats_;
+        }
+        last_row_ = row_;
         const bool enough = cfg_.rows_to_weave != 0 && counters_.rows >= cfg_.rows_to_weave;
         if (enough || stop_requested_) {
           enter(State::kDone, now);
+        } else if (pause_requested_) {
+          enter(State::kPaused, now);
         } else {
-          begin_row_shed(now, in);
+          begin_shed(now);
         }
       }
+      break;
+
+    case State::kPaused:
+      if (!pause_requested_) begin_shed(now);
       break;
 
     case State::kDone:
@@ -272,13 +400,20 @@ void Sequencer::play_moves(hal::Tick now) noexcept {
     // A beat is delivered when the commanded crank passes the fell of turn k.
     const double fell = profiles_.beatup().warp().fell;
     while (row_beats_ < profiles_.beats_per_row() && phi >= motion::kTwoPi * row_beats_ + fell) {
+      if (row_beats_ < kMaxBeatsPerRow) {
+        row_.beat[static_cast<std::size_t>(row_beats_)].x_m = static_cast<float>(
+            cmd_.axes[index(Axis::kCarriage)].target_position - cfg_.carriage_home_m);
+      }
       ++row_beats_;
       ++counters_.beats;
     }
   }
 }
 
-void Sequencer::step(hal::Tick now, const hal::HalInputs& in, hal::HalOutputs& out) noexcept {
+void Sequencer::step(hal::Tick now, const hal::HalInputs& raw, hal::HalOutputs& out) noexcept {
+  debounce(raw.io);
+  hal::HalInputs in = raw;  // the sequencer and its interlocks see debounced sensors
+  in.io = io_;
   if (state_ != State::kIdle && state_ != State::kFault) check_faults(now, in);
   if (state_ == State::kFault) refine_diagnosis(now, in);
   if (state_ == State::kIdle && start_requested_ && !in.io.estop_ok) {
@@ -291,6 +426,7 @@ void Sequencer::step(hal::Tick now, const hal::HalInputs& in, hal::HalOutputs& o
     request_all(cmd_, AxisRequest::kQuickStop);
   } else {
     play_moves(now);
+    track_beat_force(in);
     if (enabled_outputs_) {
       const Fault f = check_interlocks(interlock_ctx_, in, prev_cmd_, cmd_);
       if (f != Fault::kNone) {

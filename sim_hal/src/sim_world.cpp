@@ -1,21 +1,45 @@
 // Simulated devices. Drive power states change in one tick (a real drive takes a few; the CAN drive
-// node models that). Positions only follow targets in Operation Enabled.
+// node models that). Positions only follow targets in Operation Enabled. Sensors are computed from the
+// true state, then stuck-sensor faults override them, then noise flips them.
 #include "loom/sim_hal/sim_world.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
+#include "loom/motion/angles.hpp"
 #include "loom/sim_hal/effects.hpp"
 
 namespace loom::sim_hal {
 
 const std::vector<std::string>& known_effects() {
-  static const std::vector<std::string> names{kEffectIdeal, kEffectServoLag};
+  static const std::vector<std::string> names{kEffectIdeal,      kEffectServoLag,   kEffectPneumatics,
+                                              kEffectShuttleSlip, kEffectSensorNoise, kEffectBeatContact};
   return names;
 }
 
-SimWorld::SimWorld(const SimMachine& machine, const SceneSpec& scene) : m_(machine), scene_(scene) {
+const char* sensor_name(Sensor s) {
+  switch (s) {
+    case Sensor::kPistonAExtended: return "piston_a_extended";
+    case Sensor::kPistonARetracted: return "piston_a_retracted";
+    case Sensor::kPistonBExtended: return "piston_b_extended";
+    case Sensor::kPistonBRetracted: return "piston_b_retracted";
+    case Sensor::kShuttleLeft: return "shuttle_at_left";
+    case Sensor::kShuttleRight: return "shuttle_at_right";
+  }
+  return "?";
+}
+
+double SimRandom::uniform() noexcept {
+  std::uint64_t z = (state_ += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  z ^= z >> 31;
+  return static_cast<double>(z >> 11) * 0x1.0p-53;
+}
+
+SimWorld::SimWorld(const SimMachine& machine, const SceneSpec& scene)
+    : m_(machine), scene_(scene), rng_(scene.seed) {
   for (const std::string& e : scene_.effects) {
     if (e == kEffectIdeal) continue;  // ideal tracking is the absence of axis effects
     if (e == kEffectServoLag) {
@@ -23,28 +47,74 @@ SimWorld::SimWorld(const SimMachine& machine, const SceneSpec& scene) : m_(machi
       for (auto& ax : axes_) ax.effects.push_back(make_servo_lag(lag));
       continue;
     }
-    throw std::invalid_argument("unknown simulation effect '" + e + "'");
+    // Device effects: their parameter blocks are what switches them on; default them if absent.
+    if (e == kEffectPneumatics) {
+      if (!scene_.pneumatics) scene_.pneumatics = Pneumatics{};
+    } else if (e == kEffectShuttleSlip) {
+      if (!scene_.shuttle_slip) scene_.shuttle_slip = ShuttleSlip{};
+    } else if (e == kEffectSensorNoise) {
+      if (!scene_.sensor_noise) scene_.sensor_noise = SensorNoise{};
+    } else if (e == kEffectBeatContact) {
+      if (!scene_.beat_contact) scene_.beat_contact = BeatContact{};
+    } else {
+      throw std::invalid_argument("unknown simulation effect '" + e + "'");
+    }
   }
+  beatup_ = std::make_unique<motion::BeatUp>(m_.beatup);
   std::sort(scene_.faults.begin(), scene_.faults.end(),
             [](const FaultInjection& a, const FaultInjection& b) { return a.at_s < b.at_s; });
 }
 
+SimWorld::~SimWorld() = default;
+
 std::size_t SimWorld::effect_count() const {
   std::size_t n = 0;
   for (const auto& ax : axes_) n += ax.effects.size();
+  n += scene_.pneumatics.has_value() + scene_.shuttle_slip.has_value() + scene_.sensor_noise.has_value() +
+       scene_.beat_contact.has_value();
   return n;
+}
+
+void SimWorld::set_initial_state(const hal::AxisFeedbacks& axes, std::array<double, 2> pistons) {
+  for (std::size_t i = 0; i < hal::kAxisCount; ++i) axes_[i].position = axes_[i].target = axes[i].position;
+  piston_ = pistons;
+  for (std::size_t i = 0; i < 2; ++i) pressure_[i] = pistons[i] > 0.5 ? 1.0 : -1.0;
+  const double helix = axes_[hal::index(hal::Axis::kHelix)].position;
+  shuttle_x_ = carrier_x_prev_ = helix * m_.helix_lead_m / motion::kTwoPi;
+}
+
+void SimWorld::attach_state_file(SimStateFile& file) {
+  PersistedMachine pm;
+  if (file.load(pm)) {
+    hal::AxisFeedbacks axes{};
+    for (std::size_t i = 0; i < hal::kAxisCount; ++i) axes[i].position = pm.axis_position[i];
+    set_initial_state(axes, pm.piston);
+    shuttle_x_ = pm.shuttle_x;
+  }
+  state_file_ = &file;
+}
+
+bool SimWorld::beater_in_warp() const {
+  const double phase = axes_[hal::index(hal::Axis::kBeatCrank)].position - m_.crank_park_position_rad;
+  const motion::WarpWindow& w = beatup_->warp();
+  const double p = motion::wrap_two_pi(phase);
+  return p > w.enter && p < w.exit;
 }
 
 void SimWorld::apply_injected_faults(hal::Tick now) noexcept {
   const double t = static_cast<double>(now) * m_.period_s;
   while (next_fault_ < scene_.faults.size() && scene_.faults[next_fault_].at_s <= t) {
     const FaultInjection& f = scene_.faults[next_fault_++];
-    if (f.kind == InjectedFault::kEStop) {
-      estop_ok_ = false;
-    } else {
-      SimAxis& ax = axes_[hal::index(f.axis)];
-      ax.state = hal::DriveState::kFault;
-      ax.fault_code = f.code;
+    switch (f.kind) {
+      case InjectedFault::kEStop: estop_ok_ = false; break;
+      case InjectedFault::kDriveFault: {
+        SimAxis& ax = axes_[hal::index(f.axis)];
+        ax.state = hal::DriveState::kFault;
+        ax.fault_code = f.code;
+        break;
+      }
+      case InjectedFault::kStuckPiston: piston_stuck_[static_cast<std::size_t>(f.piston)] = true; break;
+      case InjectedFault::kStuckSensor: stuck_sensor_[static_cast<std::size_t>(f.sensor)] = f.stuck_value; break;
     }
   }
 }
@@ -90,7 +160,10 @@ void SimWorld::step_axis(SimAxis& ax, const hal::AxisCommand& cmd) noexcept {
   if (ax.state == DriveState::kOperationEnabled) {
     ax.target = cmd.target_position;
     double actual = ax.target;
-    for (auto& e : ax.effects) actual = e->step(ax.target, ax.position, m_.period_s);
+    if (!ax.effects.empty()) {
+      actual = ax.position;
+      for (auto& e : ax.effects) actual = e->step(ax.target, actual, m_.period_s);
+    }
     ax.position = actual;
   }
   ax.velocity = (ax.position - before) / m_.period_s;
@@ -98,28 +171,104 @@ void SimWorld::step_axis(SimAxis& ax, const hal::AxisCommand& cmd) noexcept {
 
 void SimWorld::write_axes(hal::Tick, const hal::AxisCommands& axes) {
   for (std::size_t i = 0; i < hal::kAxisCount; ++i) step_axis(axes_[i], axes[i]);
+  if (scene_.beat_contact) step_beat_contact();
+}
+
+void SimWorld::step_beat_contact() noexcept {
+  const SimAxis& crank = axes_[hal::index(hal::Axis::kBeatCrank)];
+  const double omega = crank.velocity;
+  const double alpha = (omega - crank_v_prev_) / m_.period_s;
+  crank_v_prev_ = omega;
+  beat_force_n_ = 0.0;
+  if (!beater_in_warp()) return;  // the exact solve is only needed near the fell
+  const motion::BeaterState s = beatup_->at(crank.position - m_.crank_park_position_rad);
+  if (s.from_fell_m > scene_.beat_contact->contact_depth_m) return;
+  // Tangential tip acceleration from the kinematic coefficients: L·(θ4'' ω² + θ4' α).
+  const double a_t = m_.beatup.beater_arm_m * (s.d2 * omega * omega + s.d1 * alpha);
+  beat_force_n_ = scene_.beat_contact->beater_mass_kg * std::abs(a_t);
+}
+
+void SimWorld::read_analog(hal::Tick now, hal::AnalogInputs& analog) {
+  analog.beat_force_valid = scene_.beat_contact.has_value();
+  analog.beat_force_n = beat_force_n_;
+  analog.refreshed = now;
+}
+
+void SimWorld::step_shuttle(double helix) noexcept {
+  const double carrier = helix * m_.helix_lead_m / motion::kTwoPi;
+  if (!scene_.shuttle_slip) {
+    shuttle_x_ = carrier;
+    return;
+  }
+  const double dt = m_.period_s;
+  const double v = carrier_primed_ ? (carrier - carrier_x_prev_) / dt : 0.0;
+  const double a = carrier_primed_ ? (v - carrier_v_prev_) / dt : 0.0;
+  carrier_primed_ = true;
+  carrier_x_prev_ = carrier;
+  carrier_v_prev_ = v;
+  const ShuttleSlip& p = *scene_.shuttle_slip;
+  if (shuttle_coupled_) {
+    if (std::abs(a) * p.shuttle_mass_kg > p.carrier_force_n) {
+      shuttle_coupled_ = false;  // the magnet lets go: the shuttle slides on with its own speed
+      shuttle_v_ = v;
+    } else {
+      shuttle_x_ = carrier;
+      return;
+    }
+  }
+  const double dv = p.race_friction_m_s2 * dt;
+  shuttle_v_ = std::abs(shuttle_v_) <= dv ? 0.0 : shuttle_v_ - std::copysign(dv, shuttle_v_);
+  shuttle_x_ = std::clamp(shuttle_x_ + shuttle_v_ * dt, 0.0, m_.width_m);
+  // The carrier picks the shuttle up again when it passes over it at rest (after the operator clears it).
+  if (shuttle_v_ == 0.0 && std::abs(carrier - shuttle_x_) < 1e-3) shuttle_coupled_ = true;
 }
 
 void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::DigitalInputs& io) {
   // The shuttle rides the carrier on the helix shaft: one lead of travel per shaft turn. Taken from the
   // HAL's fresh helix feedback, so this I/O node also works beside real (CAN) drives.
-  const double helix = axes[hal::index(hal::Axis::kHelix)].position;
-  shuttle_x_ = helix * m_.helix_lead_m / (2.0 * 3.14159265358979323846);
-  io.piston_a_extended = piston_[0] >= 1.0;
-  io.piston_a_retracted = piston_[0] <= 0.0;
-  io.piston_b_extended = piston_[1] >= 1.0;
-  io.piston_b_retracted = piston_[1] <= 0.0;
-  io.shuttle_at_left = shuttle_x_ <= m_.selvedge_sensor_window_m;
-  io.shuttle_at_right = shuttle_x_ >= m_.width_m - m_.selvedge_sensor_window_m;
+  step_shuttle(axes[hal::index(hal::Axis::kHelix)].position);
+  std::array<bool, 6> v{piston_[0] >= 1.0,
+                        piston_[0] <= 0.0,
+                        piston_[1] >= 1.0,
+                        piston_[1] <= 0.0,
+                        shuttle_x_ <= m_.selvedge_sensor_window_m,
+                        shuttle_x_ >= m_.width_m - m_.selvedge_sensor_window_m};
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (stuck_sensor_[i]) v[i] = *stuck_sensor_[i];
+    if (scene_.sensor_noise && rng_.uniform() < scene_.sensor_noise->flip_probability) v[i] = !v[i];
+  }
+  io.piston_a_extended = v[0];
+  io.piston_a_retracted = v[1];
+  io.piston_b_extended = v[2];
+  io.piston_b_retracted = v[3];
+  io.shuttle_at_left = v[4];
+  io.shuttle_at_right = v[5];
   io.estop_ok = estop_ok_;
   io.refreshed = now;
 }
 
 void SimWorld::write_io(hal::Tick, const hal::DigitalOutputs& io) {
   valve_ = {io.piston_a_extend, io.piston_b_extend};
-  const double rate = m_.period_s / m_.piston_travel_s;  // fraction of stroke per tick
+  const double dt = m_.period_s;
+  const double full_speed = dt / m_.piston_travel_s;  // fraction of stroke per tick at full pressure
   for (std::size_t i = 0; i < 2; ++i) {
-    piston_[i] = std::clamp(piston_[i] + (valve_[i] ? rate : -rate), 0.0, 1.0);
+    const double goal = valve_[i] ? 1.0 : -1.0;
+    double step = goal * full_speed;
+    if (scene_.pneumatics) {
+      const Pneumatics& p = *scene_.pneumatics;
+      pressure_[i] += (goal - pressure_[i]) * (1.0 - std::exp(-dt / p.fill_tau_s));
+      const double margin = (std::abs(pressure_[i]) - p.breakaway) / (1.0 - p.breakaway);
+      step = margin > 0.0 ? std::copysign(margin * full_speed, pressure_[i]) : 0.0;
+    }
+    if (!piston_stuck_[i]) piston_[i] = std::clamp(piston_[i] + step, 0.0, 1.0);
+  }
+  if (state_file_ != nullptr) {
+    PersistedMachine pm;
+    pm.magic = PersistedMachine::kMagic;
+    for (std::size_t i = 0; i < hal::kAxisCount; ++i) pm.axis_position[i] = axes_[i].position;
+    pm.piston = piston_;
+    pm.shuttle_x = shuttle_x_;
+    state_file_->store(pm);
   }
 }
 

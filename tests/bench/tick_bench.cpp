@@ -27,14 +27,17 @@ void run_ticks(benchmark::State& state, const firmware::Scene& scene) {
   state.counters["rows"] = m.sequencer().counters().rows;
 }
 
-void BM_TickIdeal(benchmark::State& state) { run_ticks(state, firmware::default_scene()); }
-
-void BM_TickServoLag(benchmark::State& state) {
-  firmware::Scene s = firmware::default_scene();
-  s.spec.effects = {"servo_lag"};
-  s.spec.servo_lag = sim_hal::ServoLag{0.004};
-  run_ticks(state, s);
+// One benchmark per effect, each named alone on top of ideal tracking, and all of them together: the
+// cost table of "simulate only what the scene names". BM_Tick/ideal is the floor every unnamed effect
+// must match.
+firmware::Scene scene_with(const std::vector<std::string>& effects) {
+  firmware::Scene s;
+  s.spec.name = "bench";
+  s.spec.effects = effects;
+  return s;  // parameter blocks default when an effect is named without one
 }
+
+void BM_Tick(benchmark::State& state, std::vector<std::string> effects) { run_ticks(state, scene_with(effects)); }
 
 void BM_RockerExactSolve(benchmark::State& state) {
   const motion::BeatUp b(motion::default_beatup_geometry());
@@ -67,8 +70,14 @@ void BM_RockerTable(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(BM_TickIdeal);
-BENCHMARK(BM_TickServoLag);
+BENCHMARK_CAPTURE(BM_Tick, ideal, std::vector<std::string>{"ideal"});
+BENCHMARK_CAPTURE(BM_Tick, servo_lag, std::vector<std::string>{"servo_lag"});
+BENCHMARK_CAPTURE(BM_Tick, pneumatics, std::vector<std::string>{"ideal", "pneumatics"});
+BENCHMARK_CAPTURE(BM_Tick, shuttle_slip, std::vector<std::string>{"ideal", "shuttle_slip"});
+BENCHMARK_CAPTURE(BM_Tick, sensor_noise, std::vector<std::string>{"ideal", "sensor_noise"});
+BENCHMARK_CAPTURE(BM_Tick, beat_contact, std::vector<std::string>{"ideal", "beat_contact"});
+BENCHMARK_CAPTURE(BM_Tick, all, std::vector<std::string>{"servo_lag", "pneumatics", "shuttle_slip", "sensor_noise",
+                                                         "beat_contact"});
 BENCHMARK(BM_RockerExactSolve);
 BENCHMARK(BM_RockerTable)->RangeMultiplier(4)->Range(64, 65536);
 BENCHMARK_MAIN();

@@ -47,11 +47,14 @@ TEST(Config, EmbeddedDefaultsParse) {
   EXPECT_DOUBLE_EQ(c.profile.beatup.bar.crank, 0.058);
   EXPECT_DOUBLE_EQ(c.sequencer.period_s, 0.002);
   const Scene s = default_scene();
-  EXPECT_EQ(s.spec.effects, std::vector<std::string>{"ideal"});
+  EXPECT_EQ(s.spec.effects, (std::vector<std::string>{"servo_lag", "pneumatics", "beat_contact"}));
+  EXPECT_TRUE(s.spec.servo_lag && s.spec.pneumatics && s.spec.beat_contact);
+  EXPECT_FALSE(s.spec.shuttle_slip || s.spec.sensor_noise);
 }
 
 TEST(Config, ShippedScenesLoad) {
-  for (const char* name : {"default", "servo_lag", "drive_fault", "estop"}) {
+  for (const char* name : {"default", "ideal", "servo_lag", "drive_fault", "estop", "stuck_piston", "shuttle_slip",
+                           "stuck_sensor", "sensor_noise"}) {
     const Scene s = load_scene(std::string(LOOM_SOURCE_DIR) + "/sim_hal/scenes/" + name + ".toml");
     EXPECT_EQ(s.spec.name, name);
   }
@@ -134,11 +137,12 @@ TEST(LoomctlCli, FaultSceneExits3AndKeepsCounters) {
 }
 
 TEST(LoomctlCli, ResumesFromSavedCounters) {
-  const std::string counters = write_temp("loom_resume_counters.json", "{\"rows\":7,\"picks\":7,\"beats\":105}\n");
+  const std::string counters = write_temp("loom_resume_counters.json",
+                                         "{\"rows\":7,\"picks\":7,\"beats\":105,\"picks_in_row\":0}\n");
   const CliRun r = run_loomctl("weave --rows 1 --no-telemetry --counters " + counters);
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("row 8/8:"), std::string::npos) << r.output;
   std::ifstream f(counters);
   std::string body((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-  EXPECT_EQ(body, "{\"rows\":8,\"picks\":8,\"beats\":120}\n");
+  EXPECT_EQ(body, "{\"rows\":8,\"picks\":8,\"beats\":120,\"picks_in_row\":0}\n");
 }

@@ -158,6 +158,9 @@ hil_json_int() {
 HIL_NODES=1,2,3
 HIL_PERIOD_MS=${LOOM_HIL_PERIOD_MS:-4}  # the VM is not real-time: 4 ms cycles lost no replies there (reference/vcan-vm.md)
 
+# Where these scripts (and the HIL loom config) live.
+HIL_SRC=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+
 # Locate loomctl, loom-sim-drive and the judge (LOOM_HIL_LOOMCTL / LOOM_HIL_SIM_DRIVE override).
 hil_find_binaries() {
   HIL_LOOMCTL=${LOOM_HIL_LOOMCTL:-$HIL_BUILD/bin/loomctl}
@@ -183,5 +186,5 @@ hil_start_sim_drives() {
 # hil_weave_cmd ROWS COUNTERS_FILE — the loomctl command line under test, into HIL_CMD.
 hil_weave_cmd() {
   HIL_CMD=("$HIL_LOOMCTL" weave --hal socketcan --iface "$HIL_IFACE" --rows "$1" --period-ms "$HIL_PERIOD_MS"
-           --allow-degraded --counters "$2")
+           --allow-degraded --counters "$2" --config "$HIL_SRC/hil_loom.toml")
 }

@@ -25,6 +25,7 @@ struct MachineOptions {
   bool telemetry = true;
   bool lossless_telemetry = true;  // virtual time only: wait for ring space instead of dropping
   std::uint32_t rows = 3;
+  std::string sim_state_path;  // sim HAL: keep the simulated machine's physical state here (power-loss tests)
 };
 
 class Machine {
@@ -46,6 +47,7 @@ class Machine {
   LoomConfig cfg_;
   std::unique_ptr<motion::ProfileSet> profiles_;
   std::unique_ptr<sequencer::Sequencer> sequencer_;
+  std::unique_ptr<sim_hal::SimStateFile> sim_state_;
   std::unique_ptr<sim_hal::SimWorld> sim_;
   std::unique_ptr<drivers::SocketCanBus> bus_;
   std::unique_ptr<drivers::CanAxisPort> can_port_;

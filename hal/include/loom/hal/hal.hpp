@@ -24,6 +24,8 @@ class IoPort {
   // RT-safe. `axes` is this tick's fresh axis feedback: a simulated I/O node uses the helix shaft
   // position to decide when the shuttle arrives; real I/O ignores it.
   virtual void read_io(Tick now, const AxisFeedbacks& axes, DigitalInputs& io) = 0;
+  // RT-safe. Analog channels (beater load cell). Default: none fitted.
+  virtual void read_analog(Tick now, AnalogInputs& analog) { analog = AnalogInputs{}; (void)now; }
   // RT-safe.
   virtual void write_io(Tick now, const DigitalOutputs& io) = 0;
 };
@@ -43,6 +45,7 @@ class PortHal final : public Hal {
   void read(Tick now, HalInputs& in) override {
     axes_.read_axes(now, in.axes, in.link);
     io_.read_io(now, in.axes, in.io);
+    io_.read_analog(now, in.analog);
   }
   void write(Tick now, const HalOutputs& out) override {
     axes_.write_axes(now, out.axes);

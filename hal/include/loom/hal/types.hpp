@@ -90,6 +90,15 @@ struct DigitalInputs {
 };
 
 // ---------------------------------------------------------------------------------------------------
+// Analog inputs: the beater's load cell (force the comb exerts on the cloth fell), when fitted.
+// ---------------------------------------------------------------------------------------------------
+struct AnalogInputs {
+  double beat_force_n = 0.0;     // ≥ 0; meaningful only when beat_force_valid
+  bool beat_force_valid = false; // false when no load cell is fitted / simulated
+  Tick refreshed = kNeverTick;
+};
+
+// ---------------------------------------------------------------------------------------------------
 // Bus / link health reported by the HAL implementation (zeros for the simulator unless a scene injects).
 // ---------------------------------------------------------------------------------------------------
 struct LinkStatus {
@@ -102,6 +111,7 @@ struct LinkStatus {
 struct HalInputs {
   AxisFeedbacks axes{};
   DigitalInputs io{};
+  AnalogInputs analog{};
   LinkStatus link{};
 };
 

@@ -3,6 +3,7 @@
 // commands go out, so tests run it in virtual time. All motion comes from the precomputed ProfileSet.
 #pragma once
 
+#include <array>
 #include <cstdint>
 
 #include "loom/hal/types.hpp"
@@ -20,27 +21,41 @@ enum class State : std::uint8_t {
   kShed,         // swapping the heald frames, waiting for the end sensors
   kPick,         // helix shaft carries the shuttle across, waiting for arrival
   kBeatSweep,    // crank beats while the carriage steps across the width
+  kPaused,       // holding at a safe point (before a shed change), drives enabled, until resumed
   kDone,         // all requested rows woven (or stop at row end): holding, enabled
   kFault,        // latched fault: quick stop, valves hold, counters kept
 };
 const char* state_name(State s);
 
 struct Counters {
-  std::uint32_t rows = 0;   // completed rows
-  std::uint32_t picks = 0;  // completed picks (shuttle arrived)
-  std::uint32_t beats = 0;  // beats delivered (beater passed the fell)
+  std::uint32_t rows = 0;          // completed rows
+  std::uint32_t picks = 0;         // completed picks (shuttle arrived)
+  std::uint32_t beats = 0;         // beats delivered (beater passed the fell)
+  std::uint32_t picks_in_row = 0;  // picks of the row in progress (restart resumes here)
+};
+
+inline constexpr int kMaxBeatsPerRow = 256;
+
+struct BeatRecord {
+  float x_m = 0.0f;           // carriage position (beater's left edge from the left selvedge)
+  float peak_force_n = 0.0f;  // peak load-cell force during this beat (0 when no load cell)
 };
 
 struct RowStats {
   std::uint32_t row = 0;     // 1-based number of the row just completed
-  hal::Tick shed_ticks = 0, pick_ticks = 0, beat_ticks = 0, total_ticks = 0;
+  hal::Tick shed_ticks = 0, pick_ticks = 0, beat_ticks = 0, total_ticks = 0;  // shed/pick summed over picks
   int beats = 0;
   int carriage_steps = 0;
+  bool force_measured = false;
+  double force_min_n = 0.0, force_mean_n = 0.0, force_max_n = 0.0;
+  std::array<BeatRecord, kMaxBeatsPerRow> beat{};  // first `beats` entries
 };
 
 struct SequencerConfig {
   double period_s = 0.002;
-  std::uint32_t rows_to_weave = 3;       // 0 = weave until stopped
+  std::uint32_t rows_to_weave = 3;       // 0 = weave until stopped (absolute row count to reach)
+  std::uint32_t picks_per_row = 1;       // weft picks (each with its own shed change) before the beat sweep
+  int debounce_ticks = 3;                // a sensor must read the same this many ticks to count (not e-stop)
   double enable_timeout_s = 2.0;
   double shed_timeout_s = 1.5;           // piston travel plus margin
   double pick_timeout_margin_s = 0.5;    // beyond the planned pick duration
@@ -51,6 +66,7 @@ struct SequencerConfig {
   double diagnosis_window_s = 0.3;
   double crank_park_position_rad = 0.0;  // crank axis reading at the park pose (calibration)
   double carriage_home_m = 0.0;          // carriage axis reading at the left selvedge
+  double helix_left_position_rad = 0.0;  // helix axis reading with the carrier at the left selvedge
   double park_tolerance_rad = 0.01;
   double selvedge_tolerance_m = 0.001;
   motion::JerkLimits carriage{.velocity = 0.5, .acceleration = 5.0, .jerk = 100.0};  // re-arm moves
@@ -63,6 +79,8 @@ class Sequencer {
 
   void request_start() noexcept { start_requested_ = true; }       // RT-safe
   void request_stop_at_row_end() noexcept { stop_requested_ = true; }  // RT-safe
+  void request_pause() noexcept { pause_requested_ = true; }        // RT-safe: holds before the next shed
+  void request_resume() noexcept { pause_requested_ = false; }      // RT-safe
 
   // RT-safe. One tick: check faults → advance the row cycle → sample profiles → check interlocks →
   // write every field of `out`.
@@ -82,6 +100,8 @@ class Sequencer {
   double commanded_crank_phase() const noexcept;
   double commanded_rocker_angle() const noexcept;
   bool finished() const noexcept { return state_ == State::kDone || state_ == State::kFault; }
+  // Debounced digital inputs as the sequencer last used them.
+  const hal::DigitalInputs& debounced_io() const noexcept { return io_; }
 
  private:
   hal::Tick ticks(double seconds) const noexcept;
@@ -92,7 +112,10 @@ class Sequencer {
   void latch(Fault f, hal::Tick now, int axis = -1, std::uint16_t detail = 0) noexcept;
   void enter(State s, hal::Tick now) noexcept;
   void advance(hal::Tick now, const hal::HalInputs& in) noexcept;
-  void begin_row_shed(hal::Tick now, const hal::HalInputs& in) noexcept;
+  void begin_shed(hal::Tick now) noexcept;
+  void begin_sweep(hal::Tick now, const hal::HalInputs& in) noexcept;
+  void debounce(const hal::DigitalInputs& raw) noexcept;
+  void track_beat_force(const hal::HalInputs& in) noexcept;
   void play_moves(hal::Tick now) noexcept;
 
   const motion::ProfileSet& profiles_;
@@ -103,6 +126,8 @@ class Sequencer {
   hal::Tick state_since_ = 0;
   bool start_requested_ = false;
   bool stop_requested_ = false;
+  bool pause_requested_ = false;
+  bool row_started_ = false;  // a row is in progress (its start tick is set)
 
   Fault first_fault_ = Fault::kNone;
   Fault stopped_by_ = Fault::kNone;
@@ -130,10 +155,16 @@ class Sequencer {
   double crank_sweep_origin_ = 0.0;
   bool pick_to_right_ = true;
 
+  // Debounced inputs: the value in use and how many ticks the raw value has disagreed with it.
+  hal::DigitalInputs io_{};
+  std::array<int, 6> disagree_{};
+  bool io_primed_ = false;
+
   // Row bookkeeping.
-  hal::Tick row_start_ = 0, pick_start_ = 0, beat_start_ = 0;
+  hal::Tick row_start_ = 0, phase_start_ = 0;
   int row_beats_ = 0;
-  RowStats last_row_{};
+  RowStats row_{};       // being filled
+  RowStats last_row_{};  // the last completed row
 };
 
 }  // namespace loom::sequencer

@@ -8,25 +8,67 @@
 #include <vector>
 
 #include "loom/hal/types.hpp"
+#include "loom/motion/beatup.hpp"
 
 namespace loom::sim_hal {
 
 // Names of every effect this simulator knows; a scene naming anything else is rejected.
-inline constexpr const char* kEffectIdeal = "ideal";          // axes track their targets exactly
-inline constexpr const char* kEffectServoLag = "servo_lag";   // first-order lag of each servo axis
+inline constexpr const char* kEffectIdeal = "ideal";                // axes track their targets exactly
+inline constexpr const char* kEffectServoLag = "servo_lag";         // first-order lag of each servo axis
+inline constexpr const char* kEffectPneumatics = "pneumatics";      // valve fill time and piston breakaway
+inline constexpr const char* kEffectShuttleSlip = "shuttle_slip";   // shuttle lost above the carrier force
+inline constexpr const char* kEffectSensorNoise = "sensor_noise";   // end/arrival sensors bounce
+inline constexpr const char* kEffectBeatContact = "beat_contact";   // beater load cell at the cloth fell
 const std::vector<std::string>& known_effects();
 
 struct ServoLag {
   double tau_s = 0.005;  // time constant of the position loop
 };
 
-enum class InjectedFault : std::uint8_t { kDriveFault, kEStop };
+// Valve and cylinder: chamber pressure rises as 1 - exp(-t/fill_tau_s) after the valve switches; the
+// piston starts once it exceeds `breakaway` (fraction of supply), then moves at a speed proportional to
+// the pressure margin, covering the stroke in piston_travel_s at full pressure.
+struct Pneumatics {
+  double fill_tau_s = 0.04;
+  double breakaway = 0.3;
+};
+
+// The magnetic carrier drags the shuttle while carrier acceleration × shuttle mass stays below the
+// coupling force; above it the shuttle decouples and slides to rest on the race (it never arrives).
+struct ShuttleSlip {
+  double carrier_force_n = 20.0;
+  double shuttle_mass_kg = 0.40;
+  double race_friction_m_s2 = 4.0;  // deceleration of a decoupled shuttle
+};
+
+// Every binary sensor flips for one tick with this probability per tick (contact bounce, EMI).
+struct SensorNoise {
+  double flip_probability = 1e-3;
+};
+
+// The comb's teeth press the weft into the fell while the tip is within `contact_depth_m` of the fell
+// extreme; the force on the cloth is the beater's inertial force m·|a_tangential| (the thesis' model:
+// the linkage decelerates the beater and its inertia does the beating).
+struct BeatContact {
+  double beater_mass_kg = 2.5;
+  double contact_depth_m = 0.005;
+};
+
+enum class InjectedFault : std::uint8_t { kDriveFault, kEStop, kStuckPiston, kStuckSensor };
+
+enum class Sensor : std::uint8_t {
+  kPistonAExtended, kPistonARetracted, kPistonBExtended, kPistonBRetracted, kShuttleLeft, kShuttleRight
+};
+const char* sensor_name(Sensor s);
 
 struct FaultInjection {
   double at_s = 0.0;                       // virtual time from start
   InjectedFault kind = InjectedFault::kDriveFault;
-  hal::Axis axis = hal::Axis::kBeatCrank;  // for drive faults
+  hal::Axis axis = hal::Axis::kBeatCrank;  // drive faults
   std::uint16_t code = 0x8611;             // EMCY code reported (default: following error)
+  int piston = 0;                          // stuck piston: 0 = A, 1 = B
+  Sensor sensor = Sensor::kShuttleRight;   // stuck sensor
+  bool stuck_value = false;
 };
 
 // Physical facts of the simulated machine that are not effects (they come from the loom config).
@@ -36,13 +78,19 @@ struct SimMachine {
   double helix_lead_m = 0.10;
   double piston_travel_s = 0.25;          // heald frame stroke time with the nominal air supply
   double selvedge_sensor_window_m = 0.005;
+  motion::BeatUpGeometry beatup = motion::default_beatup_geometry();
+  double crank_park_position_rad = 0.0;   // crank axis reading at the park pose
 };
 
 struct SceneSpec {
   std::string name = "default";
   std::uint64_t seed = 1;
   std::vector<std::string> effects{kEffectIdeal};  // in the order named
-  std::optional<ServoLag> servo_lag;               // present iff "servo_lag" is named
+  std::optional<ServoLag> servo_lag;               // each present iff its effect is named
+  std::optional<Pneumatics> pneumatics;
+  std::optional<ShuttleSlip> shuttle_slip;
+  std::optional<SensorNoise> sensor_noise;
+  std::optional<BeatContact> beat_contact;
   std::vector<FaultInjection> faults;
 };
 

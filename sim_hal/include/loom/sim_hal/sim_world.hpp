@@ -1,14 +1,18 @@
 // The simulated loom behind the HAL: three servo axes, two pistons with end sensors, the shuttle on its
-// magnetic carrier with arrival sensors, the e-stop chain. Stepped in virtual time by the loop's own
-// tick (write() integrates one period), so it runs as fast as the machine allows.
+// magnetic carrier with arrival sensors, the e-stop chain, and (when named) the beater's load cell.
+// Stepped in virtual time by the loop's own tick (write() integrates one period), so it runs as fast as
+// the machine allows. Every effect is built only if the scene names it.
 #pragma once
 
 #include <array>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "loom/hal/hal.hpp"
+#include "loom/motion/beatup.hpp"
 #include "loom/sim_hal/scene.hpp"
+#include "loom/sim_hal/sim_state_file.hpp"
 
 namespace loom::sim_hal {
 
@@ -29,34 +33,69 @@ struct SimAxis {
   std::vector<std::unique_ptr<AxisEffect>> effects;  // built once from the scene
 };
 
+// Deterministic, allocation-free random numbers for noise effects (splitmix64).
+class SimRandom {
+ public:
+  explicit SimRandom(std::uint64_t seed) : state_(seed) {}
+  double uniform() noexcept;  // [0, 1)
+
+ private:
+  std::uint64_t state_;
+};
+
 class SimWorld final : public hal::AxisPort, public hal::IoPort {
  public:
   // Configure-time only: builds exactly the effects the scene names. Throws std::invalid_argument on an
   // unknown effect name (the firmware checks names earlier and reports file and line).
   SimWorld(const SimMachine& machine, const SceneSpec& scene);
+  ~SimWorld() override;
 
-  void read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) override;  // RT-safe
-  void write_axes(hal::Tick now, const hal::AxisCommands& axes) override;                   // RT-safe
+  void read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) override;       // RT-safe
+  void write_axes(hal::Tick now, const hal::AxisCommands& axes) override;                        // RT-safe
   void read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::DigitalInputs& io) override;  // RT-safe
-  void write_io(hal::Tick now, const hal::DigitalOutputs& io) override;                      // RT-safe
+  void write_io(hal::Tick now, const hal::DigitalOutputs& io) override;                          // RT-safe
+  void read_analog(hal::Tick now, hal::AnalogInputs& analog) override;                           // RT-safe
 
-  // Test access.
+  // Start the machine where a previous run left it (restart after a power loss): axis positions in SI
+  // and the heald frames' positions (0 retracted … 1 extended). Configure-time only.
+  void set_initial_state(const hal::AxisFeedbacks& axes, std::array<double, 2> pistons);
+  // Configure-time. Start from the state in `file` if it holds one, and keep it updated every tick.
+  void attach_state_file(SimStateFile& file);
+
+  // Ground truth for tests and reports (not what the controller sees).
   const SimAxis& axis(hal::Axis a) const { return axes_[hal::index(a)]; }
   double shuttle_x() const { return shuttle_x_; }
+  bool shuttle_coupled() const { return shuttle_coupled_; }
+  std::array<double, 2> pistons() const { return piston_; }
+  bool beater_in_warp() const;  // true tip position vs the warp, from the true crank position
   std::size_t effect_count() const;
 
  private:
   void apply_injected_faults(hal::Tick now) noexcept;
   void step_axis(SimAxis& ax, const hal::AxisCommand& cmd) noexcept;
+  void step_shuttle(double helix_position) noexcept;
+  void step_beat_contact() noexcept;
 
   SimMachine m_;
   SceneSpec scene_;
   std::array<SimAxis, hal::kAxisCount> axes_{};
-  std::array<double, 2> piston_{0.0, 0.0};  // 0 retracted … 1 extended
+  std::array<double, 2> piston_{0.0, 0.0};    // 0 retracted … 1 extended
+  std::array<double, 2> pressure_{0.0, 0.0};  // net drive −1 … 1 (pneumatics)
   std::array<bool, 2> valve_{false, false};
-  double shuttle_x_ = 0.0;
+  std::array<bool, 2> piston_stuck_{false, false};
+  std::array<std::optional<bool>, 6> stuck_sensor_{};
+  double shuttle_x_ = 0.0, shuttle_v_ = 0.0;
+  bool shuttle_coupled_ = true;
+  double carrier_x_prev_ = 0.0, carrier_v_prev_ = 0.0;
+  bool carrier_primed_ = false;
   bool estop_ok_ = true;
   std::size_t next_fault_ = 0;
+  SimRandom rng_;
+  std::unique_ptr<motion::BeatUp> beatup_;  // built for beat_contact and for the ground-truth warp test
+  double beat_force_n_ = 0.0;
+  double crank_v_prev_ = 0.0;
+  SimStateFile* state_file_ = nullptr;
+  hal::Tick last_tick_ = 0;
 };
 
 }  // namespace loom::sim_hal

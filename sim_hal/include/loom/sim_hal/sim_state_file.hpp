@@ -1,0 +1,40 @@
+// The simulated machine's physical state kept in a memory-mapped file, so that killing the controller
+// (a power cut) leaves the simulated loom where it physically was: the next run starts from there, as a
+// real loom would. Stores are plain memory writes into an already-mapped page (RT-safe); the kernel
+// keeps the page when the process dies.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+
+namespace loom::sim_hal {
+
+struct PersistedMachine {
+  std::uint64_t magic = 0;  // kMagic once written
+  std::array<double, 3> axis_position{};
+  std::array<double, 2> piston{};
+  double shuttle_x = 0.0;
+  std::uint64_t tick = 0;
+  static constexpr std::uint64_t kMagic = 0x4c4f4f4d53494d31ull;  // "LOOMSIM1"
+};
+
+class SimStateFile {
+ public:
+  // Configure-time only. Opens (creating) and maps `path`; throws std::runtime_error naming the path.
+  explicit SimStateFile(const std::string& path);
+  ~SimStateFile();
+  SimStateFile(const SimStateFile&) = delete;
+  SimStateFile& operator=(const SimStateFile&) = delete;
+
+  // Configure-time. True (and fills `out`) when the file holds a state from an earlier run.
+  bool load(PersistedMachine& out) const;
+  // RT-safe.
+  void store(const PersistedMachine& s) noexcept;
+
+ private:
+  int fd_ = -1;
+  PersistedMachine* map_ = nullptr;
+};
+
+}  // namespace loom::sim_hal

@@ -1,0 +1,108 @@
+// The shipped scenes, run in-process on the firmware's own machine assembly: each fault scene ends in
+// a safe stop with the expected first fault (every axis quick-stopped and no target moving afterwards,
+// counters kept); the default scene beats every point of the width with 80–100 N.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "loom/firmware/config.hpp"
+#include "loom/firmware/machine.hpp"
+
+using namespace loom;
+using sequencer::Fault;
+using sequencer::State;
+
+namespace {
+struct Outcome {
+  State state;
+  Fault first_fault;
+  sequencer::Counters counters;
+  std::vector<sequencer::RowStats> rows;
+  bool moved_after_fault = false;
+};
+
+Outcome run_scene(const std::string& name, std::uint32_t rows) {
+  const firmware::Scene scene = firmware::load_scene(std::string(LOOM_SOURCE_DIR) + "/sim_hal/scenes/" + name + ".toml");
+  firmware::MachineOptions opt;
+  opt.telemetry = false;
+  opt.rows = rows;
+  firmware::Machine m(firmware::default_loom_config(), scene, opt, {});
+  m.sequencer().request_start();
+  Outcome o;
+  std::uint32_t seen = 0;
+  hal::Tick t = 0;
+  for (; t < 400000 && !m.sequencer().finished(); ++t) {
+    m.loop().cycle(t);
+    if (m.sequencer().counters().rows != seen) {
+      seen = m.sequencer().counters().rows;
+      o.rows.push_back(m.sequencer().last_row());
+    }
+  }
+  // After the end: keep ticking; in a fault nothing may move any more.
+  const hal::HalOutputs at_end = m.loop().outputs();
+  for (int i = 0; i < 500; ++i, ++t) {
+    m.loop().cycle(t);
+    for (std::size_t k = 0; k < hal::kAxisCount; ++k) {
+      if (m.loop().outputs().axes[k].target_position != at_end.axes[k].target_position) o.moved_after_fault = true;
+      if (m.sequencer().state() == State::kFault &&
+          m.loop().outputs().axes[k].request != hal::AxisRequest::kQuickStop) {
+        o.moved_after_fault = true;
+      }
+    }
+  }
+  o.state = m.sequencer().state();
+  o.first_fault = m.sequencer().first_fault();
+  o.counters = m.sequencer().counters();
+  return o;
+}
+}  // namespace
+
+TEST(Scenes, DefaultSceneBeatsEveryPointOfTheWidthWithin80To100N) {
+  const Outcome o = run_scene("default", 3);
+  ASSERT_EQ(o.state, State::kDone) << sequencer::fault_name(o.first_fault);
+  ASSERT_EQ(o.rows.size(), 3u);
+  for (const auto& r : o.rows) {
+    ASSERT_TRUE(r.force_measured);
+    EXPECT_EQ(r.beats, 15);
+    for (int k = 0; k < r.beats; ++k) {
+      const auto& b = r.beat[static_cast<std::size_t>(k)];
+      EXPECT_GE(b.peak_force_n, 80.0f) << "row " << r.row << " beat " << k;
+      EXPECT_LE(b.peak_force_n, 100.0f) << "row " << r.row << " beat " << k;
+    }
+    // Beats cover the width: first at the left selvedge, last at width - beater width (or mirrored).
+    const float first = r.beat[0].x_m, last = r.beat[static_cast<std::size_t>(r.beats - 1)].x_m;
+    EXPECT_NEAR(std::min(first, last), 0.0, 1e-6);
+    EXPECT_NEAR(std::max(first, last), 1.1, 1e-6);
+  }
+  EXPECT_LT(static_cast<double>(o.rows[0].total_ticks) * 0.002, 300.0 / 20.0);  // ≥ 20× faster than weaving by hand
+}
+
+struct FaultCase {
+  const char* scene;
+  Fault expected;
+};
+
+class FaultScenes : public ::testing::TestWithParam<FaultCase> {};
+
+TEST_P(FaultScenes, EndInASafeStopWithTheExpectedFirstFault) {
+  const Outcome o = run_scene(GetParam().scene, 5);
+  EXPECT_EQ(o.state, State::kFault);
+  EXPECT_EQ(o.first_fault, GetParam().expected) << sequencer::fault_name(o.first_fault);
+  EXPECT_FALSE(o.moved_after_fault);
+  EXPECT_LT(o.counters.rows, 5u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Shipped, FaultScenes,
+                         ::testing::Values(FaultCase{"drive_fault", Fault::kDriveFault},
+                                           FaultCase{"stuck_piston", Fault::kShedTimeout},
+                                           FaultCase{"shuttle_slip", Fault::kShuttleNotArrived},
+                                           FaultCase{"stuck_sensor", Fault::kShuttleLost},
+                                           FaultCase{"estop", Fault::kEStop}),
+                         [](const auto& param_info) { return std::string(param_info.param.scene); });
+
+TEST(Scenes, SensorNoiseIsDebouncedAwayAndTheRunIsDeterministic) {
+  const Outcome a = run_scene("sensor_noise", 2), b = run_scene("sensor_noise", 2);
+  EXPECT_EQ(a.state, State::kDone) << sequencer::fault_name(a.first_fault);
+  ASSERT_EQ(a.rows.size(), b.rows.size());
+  for (std::size_t i = 0; i < a.rows.size(); ++i) EXPECT_EQ(a.rows[i].total_ticks, b.rows[i].total_ticks);
+}
