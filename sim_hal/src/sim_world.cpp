@@ -171,17 +171,16 @@ void SimWorld::step_axis(SimAxis& ax, const hal::AxisCommand& cmd) noexcept {
 
 void SimWorld::write_axes(hal::Tick, const hal::AxisCommands& axes) {
   for (std::size_t i = 0; i < hal::kAxisCount; ++i) step_axis(axes_[i], axes[i]);
-  if (scene_.beat_contact) step_beat_contact();
 }
 
-void SimWorld::step_beat_contact() noexcept {
-  const SimAxis& crank = axes_[hal::index(hal::Axis::kBeatCrank)];
-  const double omega = crank.velocity;
+void SimWorld::step_beat_contact(double crank_position, double omega) noexcept {
   const double alpha = (omega - crank_v_prev_) / m_.period_s;
   crank_v_prev_ = omega;
   beat_force_n_ = 0.0;
-  if (!beater_in_warp()) return;  // the exact solve is only needed near the fell
-  const motion::BeaterState s = beatup_->at(crank.position - m_.crank_park_position_rad);
+  const double phase = motion::wrap_two_pi(crank_position - m_.crank_park_position_rad);
+  const motion::WarpWindow& w = beatup_->warp();
+  if (!(phase > w.enter && phase < w.exit)) return;  // the exact solve is only needed near the fell
+  const motion::BeaterState s = beatup_->at(phase);
   if (s.from_fell_m > scene_.beat_contact->contact_depth_m) return;
   // Tangential tip acceleration from the kinematic coefficients: L·(θ4'' ω² + θ4' α).
   const double a_t = m_.beatup.beater_arm_m * (s.d2 * omega * omega + s.d1 * alpha);
@@ -227,6 +226,11 @@ void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::Digit
   // The shuttle rides the carrier on the helix shaft: one lead of travel per shaft turn. Taken from the
   // HAL's fresh helix feedback, so this I/O node also works beside real (CAN) drives.
   step_shuttle(axes[hal::index(hal::Axis::kHelix)].position);
+  // The load cell rides the beater, which the crank drives: real (CAN) or simulated, as fed back.
+  if (scene_.beat_contact) {
+    step_beat_contact(axes[hal::index(hal::Axis::kBeatCrank)].position,
+                      axes[hal::index(hal::Axis::kBeatCrank)].velocity);
+  }
   std::array<bool, 6> v{piston_[0] >= 1.0,
                         piston_[0] <= 0.0,
                         piston_[1] >= 1.0,

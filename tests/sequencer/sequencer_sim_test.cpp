@@ -198,3 +198,40 @@ TEST(SequencerSim, RootCauseOutsideTheWindowDoesNotRewriteHistory) {
   }
   EXPECT_EQ(r.seq->first_fault(), Fault::kStaleFeedback);
 }
+
+TEST(SequencerSim, PauseHoldsAtTheNextSafePointAndResumeContinues) {
+  Rig r;
+  r.build(3);
+  r.run(1000, [] {});  // into the first pick
+  r.seq->request_pause();
+  r.run(200000, [&] {
+    if (r.seq->state() == State::kPaused) r.now = 200000;  // stop the run loop once paused
+  });
+  ASSERT_EQ(r.seq->state(), State::kPaused);
+  EXPECT_EQ(r.seq->counters().rows, 1u);  // the row in progress was finished first
+  // Paused: nothing moves.
+  const hal::HalOutputs held = r.out;
+  hal::PortHal hal(*r.world, *r.world);
+  for (int i = 0; i < 500; ++i, ++r.now) {
+    hal.read(r.now, r.in);
+    r.seq->step(r.now, r.in, r.out);
+    hal.write(r.now, r.out);
+    for (std::size_t k = 0; k < hal::kAxisCount; ++k)
+      EXPECT_EQ(r.out.axes[k].target_position, held.axes[k].target_position);
+  }
+  r.seq->request_resume();
+  r.run(r.now + 200000, [] {});
+  EXPECT_EQ(r.seq->state(), State::kDone);
+  EXPECT_EQ(r.seq->counters().rows, 3u);
+  EXPECT_EQ(r.seq->counters().picks, 3u);
+}
+
+TEST(SequencerSim, TwoPicksPerRowAlternateTheShedAndTheShuttle) {
+  Rig r;
+  r.cfg.picks_per_row = 2;
+  r.build(2);
+  r.run(200000, [] {});
+  ASSERT_EQ(r.seq->state(), State::kDone) << sequencer::fault_name(r.seq->first_fault());
+  EXPECT_EQ(r.seq->counters().picks, 4u);
+  EXPECT_LT(r.world->shuttle_x(), 0.01);  // four picks: back at the left selvedge
+}

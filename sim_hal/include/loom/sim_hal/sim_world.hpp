@@ -74,7 +74,7 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   void apply_injected_faults(hal::Tick now) noexcept;
   void step_axis(SimAxis& ax, const hal::AxisCommand& cmd) noexcept;
   void step_shuttle(double helix_position) noexcept;
-  void step_beat_contact() noexcept;
+  void step_beat_contact(double crank_position, double crank_velocity) noexcept;
 
   SimMachine m_;
   SceneSpec scene_;
@@ -95,7 +95,6 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   double beat_force_n_ = 0.0;
   double crank_v_prev_ = 0.0;
   SimStateFile* state_file_ = nullptr;
-  hal::Tick last_tick_ = 0;
 };
 
 }  // namespace loom::sim_hal
