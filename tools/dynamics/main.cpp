@@ -1,0 +1,44 @@
+// loom-dynamics: dynamics and balancing of the loom's linkages as CSV on stdout (SI units, header
+// first) with optional SVG plots. Bad arguments and impossible designs are reported on stderr naming
+// the argument or quantity, with exit status 2; --help exits 0.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+
+#include "commands.hpp"
+#include "loom/motion/errors.hpp"
+
+int main(int argc, char** argv) {
+  using namespace loom::dyncli;
+  CLI::App app{"loom-dynamics: beat-up forces and crank speed, needle reactions (002), batten gain (004), "
+               "shaking balance (003), link mass properties"};
+  app.require_subcommand(1);
+  BeatupArgs beatup;
+  NeedleArgs needle;
+  BattenArgs batten;
+  BalanceArgs balance;
+  CLI::App* beatup_cmd = add_beatup(app, beatup);
+  CLI::App* needle_cmd = add_needle(app, needle);
+  CLI::App* batten_cmd = add_batten(app, batten);
+  CLI::App* balance_cmd = add_balance(app, balance);
+  CLI::App* mass_cmd = add_mass(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
+  try {
+    if (beatup_cmd->parsed()) run_beatup(*beatup_cmd, beatup);
+    if (needle_cmd->parsed()) run_needle(needle);
+    if (batten_cmd->parsed()) run_batten(*batten_cmd, batten);
+    if (balance_cmd->parsed()) run_balance(balance);
+    if (mass_cmd->parsed()) run_mass();
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "loom-dynamics: %s\n", e.what());
+    return 2;
+  } catch (const loom::motion::MotionError& e) {
+    std::fprintf(stderr, "loom-dynamics: error (%s): %s\n", loom::motion::error_code_name(e.code()), e.what());
+    return 2;
+  }
+  return 0;
+}
