@@ -8,7 +8,8 @@
 #include <cmath>
 #include <sstream>
 
-#include "batten_needle_geometry.hpp"
+#include "checks.hpp"
+#include "geometry.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/errors.hpp"
 
@@ -16,25 +17,7 @@ namespace loom::motion {
 
 namespace {
 
-[[noreturn]] void fail(ErrorCode code, const std::string& what) {
-  throw MotionError(code, "batten linkage: " + what);
-}
-
-void require_positive(const char* field, double v) {
-  if (!std::isfinite(v) || v <= 0.0) {
-    std::ostringstream os;
-    os << field << " = " << v << " m: must be a finite length > 0";
-    fail(ErrorCode::kInvalidInput, os.str());
-  }
-}
-
-void require_finite(const char* field, double v) {
-  if (!std::isfinite(v)) {
-    std::ostringstream os;
-    os << field << " = " << v << " m: must be finite";
-    fail(ErrorCode::kInvalidInput, os.str());
-  }
-}
+constexpr const char* kWho = "batten linkage";
 
 Eigen::Vector2d rocker_pivot(const BattenDims& d) { return {-d.l7_m, d.l6_m}; }
 Eigen::Vector2d batten_pivot(const BattenDims& d) { return {d.l9_m, 2.0 * d.l6_m + d.l8_m}; }
@@ -46,15 +29,13 @@ BattenDims batten_004_dims() {
 }
 
 BattenLinkage::BattenLinkage(const BattenDims& dims, BattenBranch branch) : d_(dims), branch_(branch) {
-  require_positive("L1", d_.l1_m);
-  require_positive("L2", d_.l2_m);
-  require_positive("L3", d_.l3_m);
-  require_positive("L4", d_.l4_m);
-  require_positive("L5", d_.l5_m);
-  require_finite("L6", d_.l6_m);
-  require_finite("L7", d_.l7_m);
-  require_finite("L8", d_.l8_m);
-  require_finite("L9", d_.l9_m);
+  static constexpr const char* kLinks[5] = {"L1", "L2", "L3", "L4", "L5"};
+  const double links[5] = {d_.l1_m, d_.l2_m, d_.l3_m, d_.l4_m, d_.l5_m};
+  for (int i = 0; i < 5; ++i) detail::require_positive_length(kWho, kLinks[i], links[i]);
+  detail::require_finite(kWho, "L6", d_.l6_m, " m");
+  detail::require_finite(kWho, "L7", d_.l7_m, " m");
+  detail::require_finite(kWho, "L8", d_.l8_m, " m");
+  detail::require_finite(kWho, "L9", d_.l9_m, " m");
 
   const Eigen::Vector2d o1(0.0, 0.0);
   const Eigen::Vector2d o3 = rocker_pivot(d_);
@@ -64,32 +45,30 @@ BattenLinkage::BattenLinkage(const BattenDims& dims, BattenBranch branch) : d_(d
   scale_m_ = std::max({d_.l1_m, d_.l2_m, d_.l3_m, d_.l4_m, d_.l5_m, g1, g2});
   const double tol = 1e-12 * scale_m_;
 
-  // Loop 1 must be a crank-rocker with L1 the crank: |A O3| sweeps [g1 - L1, g1 + L1] over a turn
-  // and has to stay strictly inside (|L2 - L3|, L2 + L3).
-  const double short_margin = (g1 - d_.l1_m) - std::abs(d_.l2_m - d_.l3_m);
-  const double long_margin = (d_.l2_m + d_.l3_m) - (g1 + d_.l1_m);
-  if (d_.l1_m >= g1 || short_margin < -tol || long_margin < -tol) {
+  // Loop 1 must be a crank-rocker with L1 the crank (shorter than the ground O1O3, so L3 rocks).
+  const detail::CrankTurn turn = detail::crank_turn(g1, d_.l1_m, d_.l2_m, d_.l3_m);
+  if (d_.l1_m >= g1 || turn == detail::CrankTurn::kBlocked) {
     std::ostringstream os;
     os << "L1 = " << d_.l1_m << " m cannot turn fully: a crank-rocker needs L1 < |O1O3| = " << g1
        << " m (from L6, L7), |O1O3| - L1 > |L2 - L3| and |O1O3| + L1 < L2 + L3";
-    fail(ErrorCode::kNotCrank, os.str());
+    detail::fail(kWho, ErrorCode::kNotCrank, os.str());
   }
-  if (short_margin <= tol || long_margin <= tol) {
-    fail(ErrorCode::kSingular, "loop 1 is a change-point four-bar (|O1O3| ± L1 equals L2 ± L3)");
+  if (turn == detail::CrankTurn::kChangePoint) {
+    detail::fail(kWho, ErrorCode::kSingular,
+                 "loop 1 is a change-point four-bar (|O1O3| ± L1 equals L2 ± L3)");
   }
 
-  // L3 swing limits at loop 1's dead centres. A lies on the line O1B on the same side of B as O1,
-  // so B's side of A->O3 equals its side of O1->O3 there.
+  // L3 swing limits at loop 1's dead centres. Loop 1's side is named along A -> O3, the shared
+  // four-bar helper's along O3 -> A: the opposite side.
   const bool left1 = branch_.loop1 == LoopSide::kLeft;
-  const Eigen::Vector2d b_ext = detail::circle_intersection_valid(o1, d_.l2_m + d_.l1_m, o3, d_.l3_m, left1);
-  const Eigen::Vector2d b_fold = detail::circle_intersection_valid(o1, d_.l2_m - d_.l1_m, o3, d_.l3_m, left1);
-  limits_.extended_rad = std::atan2(b_ext.y() - o3.y(), b_ext.x() - o3.x());
-  limits_.folded_rad = std::atan2(b_fold.y() - o3.y(), b_fold.x() - o3.x());
+  const detail::DeadCentrePins pins = detail::dead_centre_pins(o1, o3, d_.l1_m, d_.l2_m, d_.l3_m, !left1);
+  limits_.extended_rad = std::atan2(pins.extended.y() - o3.y(), pins.extended.x() - o3.x());
+  limits_.folded_rad = std::atan2(pins.folded.y() - o3.y(), pins.folded.x() - o3.x());
 
   // Loop 2 closes iff |BP| stays strictly inside (|L5 - L4|, L4 + L5) over the swing. With
   // |BP|² = L3² + g2² - 2 L3 g2 cos(γ3 - angle(O3P)) its extremes follow from cos over the arc.
   const Eigen::Vector2d a0(d_.l1_m, 0.0);
-  const Eigen::Vector2d b0 = detail::circle_intersection_valid(a0, d_.l2_m, o3, d_.l3_m, left1);
+  const Eigen::Vector2d b0 = detail::rocker_pin(o3, d_.l3_m, a0, d_.l2_m, !left1).point;
   const double ref = std::atan2(b0.y() - o3.y(), b0.x() - o3.x());
   const double da = wrap_pi(limits_.extended_rad - ref);
   const double db = wrap_pi(limits_.folded_rad - ref);
@@ -106,10 +85,11 @@ BattenLinkage::BattenLinkage(const BattenDims& dims, BattenBranch branch) : d_(d
     os << "loop 2 cannot close: over the L3 swing |BP| spans [" << bp_min << ", " << bp_max
        << "] m but L4 = " << d_.l4_m << " m and L5 = " << d_.l5_m << " m reach only [" << lo << ", "
        << hi << "] m";
-    fail(ErrorCode::kNotAssemblable, os.str());
+    detail::fail(kWho, ErrorCode::kNotAssemblable, os.str());
   }
   if (bp_min <= lo + tol || bp_max >= hi - tol) {
-    fail(ErrorCode::kSingular, "loop 2 reaches a toggle (L4 and L5 collinear) within the L3 swing");
+    detail::fail(kWho, ErrorCode::kSingular,
+                 "loop 2 reaches a toggle (L4 and L5 collinear) within the L3 swing");
   }
 }
 
@@ -118,7 +98,7 @@ BattenPose BattenLinkage::solve(double crank_rad) const {
   const Eigen::Vector2d o3 = rocker_pivot(d_);
   const Eigen::Vector2d p = batten_pivot(d_);
   const Eigen::Vector2d b =
-      detail::circle_intersection_valid(a, d_.l2_m, o3, d_.l3_m, branch_.loop1 == LoopSide::kLeft);
+      detail::rocker_pin(o3, d_.l3_m, a, d_.l2_m, branch_.loop1 == LoopSide::kRight).point;
   const Eigen::Vector2d dd =
       detail::circle_intersection_valid(b, d_.l4_m, p, d_.l5_m, branch_.loop2 == LoopSide::kLeft);
   BattenPose x{};

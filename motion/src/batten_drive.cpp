@@ -7,6 +7,7 @@
 #include "loom/motion/angles.hpp"
 #include "loom/motion/batten.hpp"
 #include "loom/motion/errors.hpp"
+#include "checks.hpp"
 
 namespace loom::motion {
 
@@ -61,13 +62,8 @@ BattenSample BattenDrive::evaluate_newton(double phi1_rad, double omega1_rad_s, 
 
 std::vector<BattenSample> batten_sweep(const BattenDrive& drive, int samples, double omega1_rad_s,
                                        BattenSolver solver, const NewtonOptions& opt) {
-  if (samples < 1) {
-    throw MotionError(ErrorCode::kInvalidInput,
-                      "batten sweep: samples = " + std::to_string(samples) + ": must be >= 1");
-  }
-  if (!std::isfinite(omega1_rad_s)) {
-    throw MotionError(ErrorCode::kInvalidInput, "batten sweep: omega1 must be finite");
-  }
+  detail::require_samples("batten sweep", samples);
+  detail::require_finite("batten sweep", "omega1", omega1_rad_s, " rad/s");
   std::vector<BattenSample> out;
   out.reserve(static_cast<std::size_t>(samples));
   for (int i = 0; i < samples; ++i) {

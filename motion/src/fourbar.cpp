@@ -1,56 +1,92 @@
 // Four-bar analysis by triangle geometry rather than the Freudenstein half-angle form: the half-angle
 // form divides by a coefficient that passes through zero inside a normal cycle, the triangle form only
-// degenerates at true toggle/change-point poses, where we report it instead of returning NaN.
+// degenerates at true toggle/change-point poses, where we report it instead of returning NaN. The
+// triangle is closed by the shared two-circle helper (product-form height), as in every linkage here.
 #include "loom/motion/fourbar.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <sstream>
-#include <tuple>
 #include <utility>
 
+#include "checks.hpp"
+#include "geometry.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/errors.hpp"
+#include "newton_solve.hpp"
 
 namespace loom::motion {
 namespace {
 
+// |sin μ| below this is a toggle: the coefficients' common denominator b·c·sin μ has no digits left.
+constexpr double kToggleSine = 1e-12;
+
 void check_lengths(const FourBar& m) {
   const std::array<std::pair<const char*, double>, 4> links{
       {{"ground", m.ground}, {"crank", m.crank}, {"coupler", m.coupler}, {"rocker", m.rocker}}};
-  for (const auto& [name, len] : links) {
-    if (!(len > 0.0) || !std::isfinite(len)) {
-      std::ostringstream os;
-      os << "four-bar " << name << " length must be positive and finite, got " << len;
-      throw MotionError(ErrorCode::kInvalidInput, os.str());
-    }
-  }
+  for (const auto& [name, len] : links) detail::require_positive_length("four-bar", name, len, "");
 }
 
-// Relative tolerance for treating a cosine just outside [-1, 1] as rounding (poses at a limit).
-constexpr double kCosSlack = 1e-12;
+double largest_link(const FourBar& m) {
+  return std::max({m.ground, m.crank, m.coupler, m.rocker});
+}
 
-double clamp_cos(double c, const char* what, double theta2) {
-  if (c > 1.0 + kCosSlack || c < -1.0 - kCosSlack) {
+std::string describe(const FourBar& m) {
+  std::ostringstream os;
+  os << "(ground " << m.ground << ", crank " << m.crank << ", coupler " << m.coupler << ", rocker "
+     << m.rocker << ")";
+  return os.str();
+}
+
+// Kinematic coefficients at a closed pose, from the differentiated loop closure
+// a·e^{iθ2} + b·e^{iθ3} = d + c·e^{iθ4}. Throws kSingular at toggle.
+FourBarPose with_coefficients(const FourBar& m, double theta2, double theta3, double theta4) {
+  const double a = m.crank, b = m.coupler, c = m.rocker;
+  FourBarPose p;
+  p.theta2 = theta2;
+  p.theta3 = theta3;
+  p.theta4 = theta4;
+  p.transmission = std::abs(wrap_pi(theta4 - theta3));
+  const double s34 = std::sin(theta3 - theta4);
+  if (std::abs(s34) < kToggleSine) {
     std::ostringstream os;
-    os << "four-bar cannot be assembled at crank angle " << deg(theta2) << " deg (" << what
-       << " cosine " << c << ")";
-    throw MotionError(ErrorCode::kNotAssemblable, os.str());
+    os << "four-bar at toggle (coupler and rocker colinear) at crank angle " << deg(theta2)
+       << " deg: velocity coefficients are unbounded " << describe(m);
+    throw MotionError(ErrorCode::kSingular, os.str());
   }
-  return std::clamp(c, -1.0, 1.0);
+  p.k3 = a * std::sin(theta4 - theta2) / (b * s34);
+  p.k4 = a * std::sin(theta3 - theta2) / (c * s34);
+  // Second derivatives: differentiate again (θ2'' = 0) and solve the same 2×2 system.
+  //   -b sinθ3 k3' + c sinθ4 k4' = a cosθ2 + b k3² cosθ3 - c k4² cosθ4
+  //    b cosθ3 k3' - c cosθ4 k4' = a sinθ2 + b k3² sinθ3 - c k4² sinθ4
+  const double s3 = std::sin(theta3), c3 = std::cos(theta3);
+  const double s4 = std::sin(theta4), c4 = std::cos(theta4);
+  const double r1 = a * std::cos(theta2) + b * p.k3 * p.k3 * c3 - c * p.k4 * p.k4 * c4;
+  const double r2 = a * std::sin(theta2) + b * p.k3 * p.k3 * s3 - c * p.k4 * p.k4 * s4;
+  // Cramer's rule on [[-b s3, c s4], [b c3, -c c4]]; determinant = b c sin(θ3 - θ4).
+  const double det = b * c * s34;
+  p.k3p = (r1 * (-c * c4) - c * s4 * r2) / det;
+  p.k4p = ((-b * s3) * r2 - b * c3 * r1) / det;
+  return p;
 }
 
 }  // namespace
 
 const char* grashof_class_name(GrashofClass c) {
   switch (c) {
-    case GrashofClass::kCrankRocker: return "crank-rocker";
-    case GrashofClass::kDoubleCrank: return "double-crank";
-    case GrashofClass::kRockerCrank: return "rocker-crank";
-    case GrashofClass::kDoubleRocker: return "double-rocker";
-    case GrashofClass::kTripleRocker: return "triple-rocker";
-    case GrashofClass::kChangePoint: return "change-point";
+    case GrashofClass::kCrankRocker:
+      return "crank-rocker";
+    case GrashofClass::kDoubleCrank:
+      return "double-crank";
+    case GrashofClass::kRockerCrank:
+      return "rocker-crank";
+    case GrashofClass::kDoubleRocker:
+      return "double-rocker";
+    case GrashofClass::kTripleRocker:
+      return "triple-rocker";
+    case GrashofClass::kChangePoint:
+      return "change-point";
   }
   return "?";
 }
@@ -71,89 +107,170 @@ GrashofClass classify(const FourBar& m) {
   return GrashofClass::kDoubleRocker;
 }
 
-FourBarPose solve(const FourBar& m, double theta2, Branch branch) {
+FourBarPosition solve_position(const FourBar& m, double theta2, Branch branch) {
   check_lengths(m);
+  if (!std::isfinite(theta2)) {
+    throw MotionError(ErrorCode::kInvalidInput, "four-bar: crank angle must be finite");
+  }
   const double a = m.crank, b = m.coupler, c = m.rocker, d = m.ground;
-  const double ax = a * std::cos(theta2), ay = a * std::sin(theta2);
-  // Diagonal f from B0 to A; the triangle (B0, A, B) with sides f, b, c fixes the rocker.
-  const double fx = ax - d, fy = ay;
-  const double f = std::hypot(fx, fy);
-  if (f <= 1e-15 * (a + d)) {
-    throw MotionError(ErrorCode::kNotAssemblable, "four-bar crank pin coincides with the rocker pivot");
-  }
-  const double delta = std::atan2(fy, fx);  // direction B0 → A
-  const double gamma = std::acos(clamp_cos((c * c + f * f - b * b) / (2.0 * c * f), "rocker", theta2));
-  const double sigma = static_cast<double>(branch);
-  FourBarPose p;
-  p.theta2 = theta2;
-  p.theta4 = delta + sigma * gamma;
-  const double bx = d + c * std::cos(p.theta4), by = c * std::sin(p.theta4);
-  p.theta3 = std::atan2(by - ay, bx - ax);
-
-  // Velocity coefficients from the differentiated loop closure a·e^{iθ2} + b·e^{iθ3} = d + c·e^{iθ4}.
-  const double s34 = std::sin(p.theta3 - p.theta4);
-  if (std::abs(s34) < 1e-12) {
+  const double tol = 1e-12 * largest_link(m);
+  const Eigen::Vector2d crank_pin(a * std::cos(theta2), a * std::sin(theta2));
+  const Eigen::Vector2d b0(d, 0.0);
+  if ((crank_pin - b0).norm() <= 1e-15 * (a + d)) {
+    // A on B0: any rocker angle closes the loop when b = c, none otherwise.
     std::ostringstream os;
-    os << "four-bar at toggle (coupler and rocker colinear) at crank angle " << deg(theta2) << " deg";
-    throw MotionError(ErrorCode::kSingular, os.str());
+    os << "four-bar crank pin coincides with the rocker pivot at crank angle " << deg(theta2) << " deg "
+       << describe(m);
+    throw MotionError(std::abs(b - c) <= tol ? ErrorCode::kSingular : ErrorCode::kNotAssemblable, os.str());
   }
-  p.k3 = a * std::sin(p.theta4 - theta2) / (b * s34);
-  p.k4 = a * std::sin(p.theta3 - theta2) / (c * s34);
-  // Second derivatives: differentiate again (θ2'' = 0) and solve the same 2×2 system.
-  //   -b sinθ3 k3' + c sinθ4 k4' = a cosθ2 + b k3² cosθ3 - c k4² cosθ4
-  //    b cosθ3 k3' - c cosθ4 k4' = a sinθ2 + b k3² sinθ3 - c k4² sinθ4
-  const double r1 = a * std::cos(theta2) + b * p.k3 * p.k3 * std::cos(p.theta3) -
-                    c * p.k4 * p.k4 * std::cos(p.theta4);
-  const double r2 = a * std::sin(theta2) + b * p.k3 * p.k3 * std::sin(p.theta3) -
-                    c * p.k4 * p.k4 * std::sin(p.theta4);
-  // Cramer's rule on [[-b s3, c s4], [b c3, -c c4]]; determinant = b c sin(θ3 - θ4).
-  const double det = b * c * s34;
-  const double s3 = std::sin(p.theta3), c3 = std::cos(p.theta3);
-  const double s4 = std::sin(p.theta4), c4 = std::cos(p.theta4);
-  p.k3p = (r1 * (-c * c4) - c * s4 * r2) / det;
-  p.k4p = ((-b * s3) * r2 - b * c3 * r1) / det;
-  // Transmission angle: between coupler and rocker at B.
+  // The triangle (B0, A, B) with sides |B0A|, b, c fixes the rocker on the branch's side of B0 → A.
+  const detail::CircleIntersection pin =
+      detail::rocker_pin_standard(d, a, b, c, theta2, branch == Branch::kPositive);
+  if (pin.margin < -tol) {
+    std::ostringstream os;
+    os << "four-bar cannot be assembled at crank angle " << deg(theta2) << " deg: coupler and rocker miss "
+       << "closing the loop by " << -pin.margin << " " << describe(m);
+    throw MotionError(ErrorCode::kNotAssemblable, os.str());
+  }
+  FourBarPosition p;
+  p.theta2 = theta2;
+  p.theta4 = std::atan2(pin.point.y(), pin.point.x() - d);
+  p.theta3 = std::atan2(pin.point.y() - crank_pin.y(), pin.point.x() - crank_pin.x());
   p.transmission = std::abs(wrap_pi(p.theta4 - p.theta3));
+  // A flat triangle: the side (branch) is not resolved there and the rates are not finite.
+  p.at_toggle = pin.clamped || std::abs(std::sin(p.transmission)) < kToggleSine;
   return p;
 }
 
-DeadCentres dead_centres(const FourBar& m, Branch branch) {
-  if (classify(m) != GrashofClass::kCrankRocker) {
+FourBarPose solve(const FourBar& m, double theta2, Branch branch) {
+  const FourBarPosition p = solve_position(m, theta2, branch);
+  if (p.at_toggle) {
     std::ostringstream os;
-    os << "dead centres need a crank-rocker; these lengths make a " << grashof_class_name(classify(m));
+    os << "four-bar at toggle (coupler and rocker colinear within rounding) at crank angle " << deg(theta2)
+       << " deg: velocity coefficients are unbounded " << describe(m);
+    throw MotionError(ErrorCode::kSingular, os.str());
+  }
+  return with_coefficients(m, theta2, p.theta3, p.theta4);
+}
+
+Branch branch_of(double theta3, double theta4) {
+  return std::sin(theta3 - theta4) > 0.0 ? Branch::kPositive : Branch::kNegative;
+}
+
+PointCoefficients point_coefficients(const FourBar& m, const FourBarPose& pose, FourBarLink link,
+                                     const Eigen::Vector2d& local) {
+  switch (link) {
+    case FourBarLink::kCrank:
+      return point_on_link(PointCoefficients{}, pose.theta2, 1.0, 0.0, local);
+    case FourBarLink::kCoupler: {
+      const Eigen::Vector2d pin(m.crank * std::cos(pose.theta2), m.crank * std::sin(pose.theta2));
+      const PointCoefficients origin{pin, Eigen::Vector2d(-pin.y(), pin.x()), -pin};
+      return point_on_link(origin, pose.theta3, pose.k3, pose.k3p, local);
+    }
+    case FourBarLink::kRocker:
+      return point_on_link(
+          PointCoefficients{Eigen::Vector2d(m.ground, 0.0), Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()},
+          pose.theta4, pose.k4, pose.k4p, local);
+  }
+  return {};
+}
+
+TransmissionRange transmission_range(const FourBar& m) {
+  const GrashofClass cls = classify(m);
+  if (cls != GrashofClass::kCrankRocker && cls != GrashofClass::kDoubleCrank) {
+    std::ostringstream os;
+    os << "transmission angle over a turn needs a crank that turns fully; these lengths make a "
+       << grashof_class_name(cls) << " " << describe(m);
     throw MotionError(ErrorCode::kNotCrank, os.str());
   }
-  const double a = m.crank, b = m.coupler, c = m.rocker, d = m.ground;
+  TransmissionRange r;
+  r.mu_min = detail::triangle_angle(std::abs(m.ground - m.crank), m.coupler, m.rocker);
+  r.mu_max = detail::triangle_angle(m.ground + m.crank, m.coupler, m.rocker);
+  r.worst_deviation_from_right = std::max(0.5 * kPi - r.mu_min, r.mu_max - 0.5 * kPi);
+  return r;
+}
+
+DeadCentres dead_centres(const FourBar& m, Branch branch) {
+  const GrashofClass cls = classify(m);
+  if (cls != GrashofClass::kCrankRocker) {
+    std::ostringstream os;
+    os << "dead centres need a crank-rocker; these lengths make a " << grashof_class_name(cls) << " "
+       << describe(m);
+    throw MotionError(ErrorCode::kNotCrank, os.str());
+  }
+  // At a dead centre A0, A, B are colinear and |A0B| = b ± a: one circle intersection each.
+  const Eigen::Vector2d a0(0.0, 0.0), b0(m.ground, 0.0);
+  const detail::DeadCentrePins pins =
+      detail::dead_centre_pins(a0, b0, m.crank, m.coupler, m.rocker, branch == Branch::kPositive);
   DeadCentres dc;
-  // At a dead centre A0, A, B are colinear and |A0B| = b ± a. Solve the triangle (A0, B0, B) for the
-  // crank direction, on the side of the chosen branch, then read the rocker from the full solve.
-  const auto crank_at = [&](double reach, bool extended) {
-    const double cos_at_a0 = clamp_cos((d * d + reach * reach - c * c) / (2.0 * d * reach), "dead-centre", 0);
-    const double angle_b = std::acos(cos_at_a0);
-    // Two mirror candidates (±angle_b); keep the one that lies on `branch`.
-    for (const double sgn : {1.0, -1.0}) {
-      const double dir_b = sgn * angle_b;  // direction A0 → B
-      const double th2 = extended ? dir_b : dir_b + kPi;
-      const FourBarPose pose = solve(m, th2, branch);
-      const double bx = d + c * std::cos(pose.theta4), by = c * std::sin(pose.theta4);
-      if (std::abs(wrap_pi(std::atan2(by, bx) - dir_b)) < 1e-6) {
-        return std::pair{wrap_two_pi(th2), pose.theta4};
-      }
-    }
-    throw MotionError(ErrorCode::kNotAssemblable, "four-bar dead centre not found on the requested branch");
-  };
-  std::tie(dc.crank_extended, dc.rocker_extended) = crank_at(b + a, true);
-  std::tie(dc.crank_folded, dc.rocker_folded) = crank_at(b - a, false);
+  dc.crank_extended = wrap_two_pi(std::atan2(pins.extended.y(), pins.extended.x()));
+  dc.crank_folded = wrap_two_pi(std::atan2(pins.folded.y(), pins.folded.x()) + kPi);
+  dc.rocker_extended = std::atan2(pins.extended.y(), pins.extended.x() - m.ground);
+  dc.rocker_folded = std::atan2(pins.folded.y(), pins.folded.x() - m.ground);
   dc.swing = std::abs(wrap_pi(dc.rocker_folded - dc.rocker_extended));
   dc.crank_rotation = wrap_two_pi(dc.crank_folded - dc.crank_extended);
   dc.time_ratio = dc.crank_rotation / (kTwoPi - dc.crank_rotation);
-  // μ extremes occur where the diagonal f is shortest or longest: θ2 = 0 and θ2 = π.
-  const auto mu_dev = [&](double f) {
-    const double mu = std::acos(std::clamp((b * b + c * c - f * f) / (2.0 * b * c), -1.0, 1.0));
-    return std::min(mu, kPi - mu);
-  };
-  dc.mu_min = std::min(mu_dev(d - a), mu_dev(d + a));
+  dc.mu_min = 0.5 * kPi - transmission_range(m).worst_deviation_from_right;
   return dc;
+}
+
+std::vector<FourBarPose> fourbar_sweep(const FourBar& m, Branch branch, int samples, double theta2_start) {
+  detail::require_samples("four-bar sweep", samples);
+  detail::require_finite("four-bar sweep", "theta2_start", theta2_start, " rad");
+  const GrashofClass cls = classify(m);
+  if (cls == GrashofClass::kChangePoint) {
+    std::ostringstream os;
+    os << "four-bar sweep: change-point linkage " << describe(m)
+       << ": both branches meet where it folds flat, so the motion beyond is not determined";
+    throw MotionError(ErrorCode::kSingular, os.str());
+  }
+  if (cls != GrashofClass::kCrankRocker && cls != GrashofClass::kDoubleCrank) {
+    std::ostringstream os;
+    os << "four-bar sweep: the crank cannot turn fully in a " << grashof_class_name(cls) << " "
+       << describe(m);
+    throw MotionError(ErrorCode::kNotCrank, os.str());
+  }
+  std::vector<FourBarPose> out;
+  out.reserve(static_cast<std::size_t>(samples));
+  for (int i = 0; i < samples; ++i) {
+    FourBarPose p =
+        solve(m, theta2_start + kTwoPi * static_cast<double>(i) / static_cast<double>(samples), branch);
+    if (!out.empty()) {
+      p.theta3 = out.back().theta3 + wrap_pi(p.theta3 - out.back().theta3);
+      p.theta4 = out.back().theta4 + wrap_pi(p.theta4 - out.back().theta4);
+    }
+    out.push_back(p);
+  }
+  return out;
+}
+
+FourBarNewtonResult solve_newton(const FourBar& m, double theta2, Branch branch, double theta3_guess,
+                                 double theta4_guess, const NewtonOptions& opt) {
+  check_lengths(m);
+  const double a = m.crank, b = m.coupler, c = m.rocker, d = m.ground;
+  const double ax = a * std::cos(theta2), ay = a * std::sin(theta2);
+  const auto residual = [&](const Eigen::Vector2d& x) {
+    return Eigen::Vector2d(ax + b * std::cos(x(0)) - d - c * std::cos(x(1)),
+                           ay + b * std::sin(x(0)) - c * std::sin(x(1)));
+  };
+  const auto jacobian = [&](const Eigen::Vector2d& x) {
+    Eigen::Matrix2d j;
+    j << -b * std::sin(x(0)), c * std::sin(x(1)),  //
+        b * std::cos(x(0)), -c * std::cos(x(1));
+    return j;
+  };
+  const detail::NewtonOutcome<2> n =
+      detail::newton_solve<2>("four-bar Newton", theta2, Eigen::Vector2d(theta3_guess, theta4_guess), opt,
+                              largest_link(m), 1e-12 * b * c, residual, jacobian);
+  const double theta3 = std::atan2(std::sin(n.x(0)), std::cos(n.x(0)));
+  const double theta4 = std::atan2(std::sin(n.x(1)), std::cos(n.x(1)));
+  if (branch_of(theta3, theta4) != branch) {
+    std::ostringstream os;
+    os << "four-bar Newton converged to the wrong assembly branch at crank angle " << deg(theta2) << " deg "
+       << "(wanted " << (branch == Branch::kPositive ? "positive" : "negative") << ")";
+    throw MotionError(ErrorCode::kWrongBranch, os.str());
+  }
+  return {with_coefficients(m, theta2, theta3, theta4), n.iterations, n.residual};
 }
 
 }  // namespace loom::motion

@@ -8,7 +8,8 @@
 #include <cmath>
 #include <sstream>
 
-#include "batten_needle_geometry.hpp"
+#include "checks.hpp"
+#include "geometry.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/errors.hpp"
 
@@ -16,25 +17,7 @@ namespace loom::motion {
 
 namespace {
 
-[[noreturn]] void fail(ErrorCode code, const std::string& what) {
-  throw MotionError(code, "needle six-bar: " + what);
-}
-
-void require_positive(const char* field, double v) {
-  if (!std::isfinite(v) || v <= 0.0) {
-    std::ostringstream os;
-    os << field << " = " << v << " m: must be a finite length > 0";
-    fail(ErrorCode::kInvalidInput, os.str());
-  }
-}
-
-void require_finite(const char* field, double v) {
-  if (!std::isfinite(v)) {
-    std::ostringstream os;
-    os << field << " = " << v << ": must be finite";
-    fail(ErrorCode::kInvalidInput, os.str());
-  }
-}
+constexpr const char* kWho = "needle six-bar";
 
 }  // namespace
 
@@ -54,45 +37,36 @@ NeedleDims needle_table1() {
 }
 
 NeedleLinkage::NeedleLinkage(const NeedleDims& dims, NeedleBranch branch) : d_(dims), branch_(branch) {
-  require_positive("l1", d_.l1_m);
-  require_positive("l2", d_.l2_m);
-  require_positive("l3", d_.l3_m);
-  require_positive("l4", d_.l4_m);
-  require_positive("l5", d_.l5_m);
-  require_positive("l6", d_.l6_m);
-  require_finite("x1", d_.x1_m);
-  require_finite("h1", d_.h1_m);
-  require_finite("x2", d_.x2_m);
-  require_finite("beta1", d_.beta1_rad);
+  static constexpr const char* kLinks[6] = {"l1", "l2", "l3", "l4", "l5", "l6"};
+  const double links[6] = {d_.l1_m, d_.l2_m, d_.l3_m, d_.l4_m, d_.l5_m, d_.l6_m};
+  for (int i = 0; i < 6; ++i) detail::require_positive_length(kWho, kLinks[i], links[i]);
+  detail::require_finite(kWho, "x1", d_.x1_m, " m");
+  detail::require_finite(kWho, "h1", d_.h1_m, " m");
+  detail::require_finite(kWho, "x2", d_.x2_m, " m");
+  detail::require_finite(kWho, "beta1", d_.beta1_rad, " rad");
 
-  // Crank-rocker test in its geometric form: |AC| sweeps [g - l1, g + l1] over a turn and must stay
-  // strictly inside (|l2 - l3|, l2 + l3); touching either end is the change point.
+  // The crank-rocker O-A-B-C: l1 shorter than |OC| (so l3 rocks) and turning fully.
   const double g = std::hypot(d_.x1_m, d_.h1_m);
-  const double big = std::max({d_.l1_m, d_.l2_m, d_.l3_m, g});
-  const double tol = 1e-12 * big;
-  const double short_margin = (g - d_.l1_m) - std::abs(d_.l2_m - d_.l3_m);
-  const double long_margin = (d_.l2_m + d_.l3_m) - (g + d_.l1_m);
-  if (d_.l1_m >= g || short_margin < -tol || long_margin < -tol) {
+  const detail::CrankTurn turn = detail::crank_turn(g, d_.l1_m, d_.l2_m, d_.l3_m);
+  if (d_.l1_m >= g || turn == detail::CrankTurn::kBlocked) {
     std::ostringstream os;
     os << "l1 = " << d_.l1_m << " m cannot turn fully: a crank-rocker needs l1 < |OC| = " << g
        << " m, |OC| - l1 > |l2 - l3| and |OC| + l1 < l2 + l3 (l2 = " << d_.l2_m
        << " m, l3 = " << d_.l3_m << " m)";
-    fail(ErrorCode::kNotCrank, os.str());
+    detail::fail(kWho, ErrorCode::kNotCrank, os.str());
   }
-  if (short_margin <= tol || long_margin <= tol) {
-    fail(ErrorCode::kSingular, "change-point crank-rocker (|OC| ± l1 equals l2 ± l3): the "
-                               "coupler and rocker fold flat once per turn");
+  if (turn == detail::CrankTurn::kChangePoint) {
+    detail::fail(kWho, ErrorCode::kSingular, "change-point crank-rocker (|OC| ± l1 equals l2 ± l3): the "
+                                             "coupler and rocker fold flat once per turn");
   }
 
-  // Rocker swing limits at the two dead centres: the side of B relative to C->A equals its side
-  // relative to C->O there, because A lies on the line OB on the same side of B as O.
+  // Rocker swing limits at the two dead centres.
   const bool left = branch_.rocker == NeedleRockerSide::kLeftOfCA;
   const Eigen::Vector2d origin(0.0, 0.0);
   const Eigen::Vector2d c(d_.x1_m, d_.h1_m);
-  const Eigen::Vector2d b_ext = detail::circle_intersection_valid(c, d_.l3_m, origin, d_.l2_m + d_.l1_m, left);
-  const Eigen::Vector2d b_fold = detail::circle_intersection_valid(c, d_.l3_m, origin, d_.l2_m - d_.l1_m, left);
-  limits_.extended_rad = wrap_two_pi(std::atan2(b_ext.y() - c.y(), b_ext.x() - c.x()));
-  limits_.folded_rad = wrap_two_pi(std::atan2(b_fold.y() - c.y(), b_fold.x() - c.x()));
+  const detail::DeadCentrePins pins = detail::dead_centre_pins(origin, c, d_.l1_m, d_.l2_m, d_.l3_m, left);
+  limits_.extended_rad = wrap_two_pi(std::atan2(pins.extended.y() - c.y(), pins.extended.x() - c.x()));
+  limits_.folded_rad = wrap_two_pi(std::atan2(pins.folded.y() - c.y(), pins.folded.x() - c.x()));
 
   // The rocker swings through less than π, on the arc that contains any actual pose.
   const double ref = evaluate(0.0, 0.0).theta3_rad;
@@ -109,11 +83,12 @@ NeedleLinkage::NeedleLinkage(const NeedleDims& dims, NeedleBranch branch) : d_(d
     os << "l5 = " << d_.l5_m << " m cannot reach the needle line: over the rocker swing the "
        << "horizontal gap x2 - l4 cos θ4 reaches " << reach << " m (x2 = " << d_.x2_m
        << " m, l4 = " << d_.l4_m << " m, beta1 = " << deg(d_.beta1_rad) << " deg)";
-    fail(ErrorCode::kNotAssemblable, os.str());
+    detail::fail(kWho, ErrorCode::kNotAssemblable, os.str());
   }
   if (reach >= d_.l5_m - rod_tol) {
-    fail(ErrorCode::kSingular, "the rod l5 lies horizontal (toggle) within the rocker swing: "
-                               "needle velocity would be unbounded");
+    detail::fail(
+        kWho, ErrorCode::kSingular,
+        "the rod l5 lies horizontal (toggle) within the rocker swing: needle velocity would be unbounded");
   }
 }
 
@@ -128,7 +103,7 @@ NeedleState NeedleLinkage::evaluate(double theta1_rad, double omega1_rad_s, doub
   const Eigen::Vector2d a(l1 * std::cos(theta1_rad), l1 * std::sin(theta1_rad));
   const Eigen::Vector2d c(d_.x1_m, d_.h1_m);
   const Eigen::Vector2d b =
-      detail::circle_intersection_valid(c, l3, a, l2, branch_.rocker == NeedleRockerSide::kLeftOfCA);
+      detail::rocker_pin(c, l3, a, l2, branch_.rocker == NeedleRockerSide::kLeftOfCA).point;
   s.theta3_rad = wrap_two_pi(std::atan2(b.y() - c.y(), b.x() - c.x()));
   s.theta2_rad = std::atan2(b.y() - a.y(), b.x() - a.x());
   s.theta4_rad = s.theta3_rad + d_.beta1_rad - kTwoPi;
@@ -182,13 +157,8 @@ double NeedleLinkage::closure_residual_m(const NeedleState& s) const {
 }
 
 std::vector<NeedleState> needle_sweep(const NeedleLinkage& linkage, int samples, double omega1_rad_s) {
-  if (samples < 1) {
-    throw MotionError(ErrorCode::kInvalidInput,
-                      "needle sweep: samples = " + std::to_string(samples) + ": must be >= 1");
-  }
-  if (!std::isfinite(omega1_rad_s)) {
-    throw MotionError(ErrorCode::kInvalidInput, "needle sweep: omega1 must be finite");
-  }
+  detail::require_samples("needle sweep", samples);
+  detail::require_finite("needle sweep", "omega1", omega1_rad_s, " rad/s");
   std::vector<NeedleState> out;
   out.reserve(static_cast<std::size_t>(samples));
   for (int i = 0; i < samples; ++i) {

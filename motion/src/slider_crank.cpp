@@ -6,6 +6,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "checks.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/errors.hpp"
 
@@ -13,33 +14,25 @@ namespace loom::motion {
 
 namespace {
 
-void require_positive_length(const char* name, double v) {
-  if (!std::isfinite(v) || !(v > 0.0)) {
-    std::ostringstream msg;
-    msg << "slider-crank: " << name << " = " << v << " must be a finite length > 0";
-    throw MotionError(ErrorCode::kInvalidInput, msg.str());
-  }
-}
-
 void check_lengths(const SliderCrank& m) {
-  require_positive_length("crank a", m.crank);
-  require_positive_length("coupler b", m.coupler);
-  if (!std::isfinite(m.offset)) {
-    std::ostringstream msg;
-    msg << "slider-crank: offset e = " << m.offset << " must be finite";
-    throw MotionError(ErrorCode::kInvalidInput, msg.str());
-  }
+  detail::require_positive_length("slider-crank", "crank a", m.crank, "");
+  detail::require_positive_length("slider-crank", "coupler b", m.coupler, "");
+  detail::require_finite("slider-crank", "offset e", m.offset, "");
 }
 
 // Grashof for a slider-crank: the crank turns fully only if the coupler spans crank + |offset|.
-// `slack` admits the change-point limit for the dead-centre analysis.
-void check_full_turn(const SliderCrank& m, double slack) {
+// A margin within 1e-12·b of zero is the change point, where the coupler stands perpendicular to
+// the slider line and the rates are unbounded: `accept_change_point` admits it for the dead-centre
+// analysis, which stays defined there; the state evaluation needs a real margin to stay finite.
+void check_full_turn(const SliderCrank& m, bool accept_change_point) {
   const double margin = m.coupler - m.crank - std::fabs(m.offset);
-  const bool turns = slack > 0.0 ? margin > -slack : margin > 0.0;
+  const double slack = 1e-12 * m.coupler;
+  const bool turns = accept_change_point ? margin > -slack : margin > slack;
   if (!turns) {
     std::ostringstream msg;
     msg << "slider-crank: coupler b = " << m.coupler << " must exceed crank a + |offset e| = "
         << m.crank + std::fabs(m.offset) << " for a full-turning crank";
+    if (std::fabs(margin) <= slack) msg << " (b = a + |e| within 1e-12 b: change point)";
     throw MotionError(ErrorCode::kNotCrank, msg.str());
   }
 }
@@ -48,32 +41,63 @@ void check_full_turn(const SliderCrank& m, double slack) {
 
 void validate_slider_crank(const SliderCrank& m) {
   check_lengths(m);
-  check_full_turn(m, 0.0);
+  check_full_turn(m, false);
 }
 
-SliderState slider_state(const SliderCrank& m, double theta_rad, double omega_rad_s,
-                         double alpha_rad_s2) noexcept {
+namespace {
+
+// Crank-angle derivatives of the slider-crank's loop: q is the height of the slider line above the
+// crank pin, h the coupler's run along the line (h² + q² = b²), x = a cos θ + h, and the coupler
+// angle φ3 = atan2(q, h) with dφ3/dθ = q'/h (from h h' = −q q').
+struct SliderCoefficients {
+  double x, dx, ddx;           // slider position and its θ-derivatives
+  double phi3, k3, k3p;        // coupler angle and its θ-derivatives
+  double q, h;
+};
+
+SliderCoefficients coefficients(const SliderCrank& m, double theta_rad) noexcept {
   const double a = m.crank;
   const double b = m.coupler;
   const double s = std::sin(theta_rad);
   const double c = std::cos(theta_rad);
-  // q: height of the slider line above the crank pin; h: the coupler's run along the line.
-  const double q = m.offset - a * s;
-  const double h = std::sqrt((b - q) * (b + q));
+  SliderCoefficients k{};
+  k.q = m.offset - a * s;
+  k.h = std::sqrt((b - k.q) * (b + k.q));
   const double dq = -a * c;
-  const double dh = -q * dq / h;
+  const double dh = -k.q * dq / k.h;
   const double ddq = a * s;
-  const double ddh = (-(dq * dq) - q * ddq - dh * dh) / h;  // from h·h'' = −q'² − q·q'' − h'²
+  const double ddh = (-(dq * dq) - k.q * ddq - dh * dh) / k.h;  // from h·h'' = −q'² − q·q'' − h'²
+  k.x = a * c + k.h;
+  k.dx = -a * s + dh;
+  k.ddx = -a * c + ddh;
+  k.phi3 = std::atan2(k.q, k.h);
+  k.k3 = dq / k.h;
+  k.k3p = (ddq * k.h - dq * dh) / (k.h * k.h);
+  return k;
+}
 
+}  // namespace
+
+SliderState slider_state(const SliderCrank& m, double theta_rad, double omega_rad_s,
+                         double alpha_rad_s2) noexcept {
+  const SliderCoefficients k = coefficients(m, theta_rad);
   SliderState st;
-  st.x = a * c + h;
-  const double dx = -a * s + dh;
-  const double ddx = -a * c + ddh;
-  st.x_dot = dx * omega_rad_s;
-  st.x_ddot = ddx * omega_rad_s * omega_rad_s + dx * alpha_rad_s2;
-  st.coupler_angle_rad = std::atan2(q, h);
-  st.transmission_rad = std::atan2(h, std::fabs(q));
+  st.x = k.x;
+  st.x_dot = k.dx * omega_rad_s;
+  st.x_ddot = k.ddx * omega_rad_s * omega_rad_s + k.dx * alpha_rad_s2;
+  st.coupler_angle_rad = k.phi3;
+  st.transmission_rad = std::atan2(k.h, std::fabs(k.q));
+  st.coupler_rate_rad_s = k.k3 * omega_rad_s;
+  st.coupler_accel_rad_s2 = k.k3 * alpha_rad_s2 + k.k3p * omega_rad_s * omega_rad_s;
   return st;
+}
+
+PointCoefficients slider_coupler_point(const SliderCrank& m, double theta_rad,
+                                       const Eigen::Vector2d& local) noexcept {
+  const SliderCoefficients k = coefficients(m, theta_rad);
+  const Eigen::Vector2d pin(m.crank * std::cos(theta_rad), m.crank * std::sin(theta_rad));
+  const PointCoefficients origin{pin, Eigen::Vector2d(-pin.y(), pin.x()), -pin};
+  return point_on_link(origin, k.phi3, k.k3, k.k3p, local);
 }
 
 SliderDeadCentres slider_dead_centres(const SliderCrank& m) {
@@ -84,7 +108,7 @@ SliderDeadCentres slider_dead_centres(const SliderCrank& m) {
   // The change-point limit b = a + |e| (a flagged synthesis result, maybe a few ulps short) still
   // has well-defined dead centres; anything shorter is rejected as by validate_slider_crank.
   check_lengths(m);
-  check_full_turn(m, 1e-12 * b);
+  check_full_turn(m, true);
   const double fold_margin = std::fmax(0.0, b - a - ae);
 
   SliderDeadCentres dc;

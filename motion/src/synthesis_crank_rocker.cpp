@@ -7,6 +7,8 @@
 #include <string>
 #include <sstream>
 
+#include "checks.hpp"
+#include "geometry.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/errors.hpp"
 #include "loom/motion/synthesis.hpp"
@@ -78,32 +80,16 @@ Problem classify(double psi, double phi) {
 }
 
 void check_ground(double ground) {
-  if (!std::isfinite(ground) || !(ground > 0.0)) {
-    std::ostringstream msg;
-    msg << "crank-rocker synthesis: ground = " << ground << " must be a finite length > 0";
-    throw MotionError(ErrorCode::kInvalidInput, msg.str());
-  }
+  detail::require_positive_length("crank-rocker synthesis", "ground", ground, "");
 }
 
 // ---------------------------------------------------------------------------------------------
 // Transmission angle.
 
-// Angle opposite side r in the triangle (p, q, r) by Kahan's formula, accurate for needle-like
-// triangles (a linkage near its change point). Out-of-range sides clamp to 0 or π.
-double triangle_angle(double r, double p, double q) {
-  if (p < q) std::swap(p, q);
-  const double mu = (q >= r) ? r - (p - q) : q - (p - r);
-  const double num = ((p - q) + r) * mu;
-  const double den = (p + (q + r)) * ((p - r) + q);
-  if (!(num > 0.0)) return 0.0;
-  if (!(den > 0.0)) return kPi;
-  return 2.0 * std::atan(std::sqrt(num / den));
-}
-
 // Extremes of the coupler–rocker angle occur with the crank along the ground line (|AB0| = d ∓ a).
 double mu_min_of(double a, double b, double c, double d) {
-  const double near = triangle_angle(std::fabs(d - a), b, c);
-  const double far = triangle_angle(d + a, b, c);
+  const double near = detail::triangle_angle(std::fabs(d - a), b, c);
+  const double far = detail::triangle_angle(d + a, b, c);
   return std::fmin(near, kPi - far);
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "checks.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/errors.hpp"
 #include "loom/motion/synthesis.hpp"
@@ -51,11 +52,7 @@ HalfAngles half_angles(double phi_rad) {
 }
 
 void check_stroke(double stroke) {
-  if (!std::isfinite(stroke) || !(stroke > 0.0)) {
-    std::ostringstream msg;
-    msg << "slider-crank synthesis: stroke = " << stroke << " must be a finite length > 0";
-    throw MotionError(ErrorCode::kInvalidInput, msg.str());
-  }
+  detail::require_positive_length("slider-crank synthesis", "stroke", stroke, "");
 }
 
 // Shared tail of both entry points. one_minus_lambda2 and k2_minus_lambda_s2 are passed in because

@@ -1,6 +1,7 @@
 // What accuracy costs for the batten linkage (004 eqns 7): closed-form positions versus Newton at
 // several tolerances, warm-started along a sweep (continuation) and from a rough guess. Each Newton
 // case reports its mean iterations and its largest angle error against the closed form.
+// Run with --markdown for the README table (tools/kinreport/accuracy_report.sh).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -9,6 +10,8 @@
 
 #include "loom/motion/angles.hpp"
 #include "loom/motion/batten.hpp"
+#include "bench_sweep.hpp"
+#include "markdown_reporter.hpp"
 
 namespace {
 
@@ -24,11 +27,7 @@ const BattenLinkage& linkage() {
   return l;
 }
 
-std::vector<double> cranks() {
-  std::vector<double> c(kSamples);
-  for (int i = 0; i < kSamples; ++i) c[i] = loom::motion::kTwoPi * i / kSamples;
-  return c;
-}
+std::vector<double> cranks() { return loom::test::sweep_angles(kSamples); }
 
 double max_error(const BattenPose& a, const BattenPose& b) {
   return (a.vec() - b.vec()).unaryExpr([](double v) { return std::abs(loom::motion::wrap_pi(v)); }).maxCoeff();
@@ -130,4 +129,7 @@ BENCHMARK(BM_DriveSample);
 
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  return loom::kinreport::run_benchmarks(argc, argv,
+                                         "Batten linkage (004 eqns 7): closed form vs Newton (errors against the closed form)");
+}

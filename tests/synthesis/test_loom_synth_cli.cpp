@@ -1,6 +1,9 @@
 // loom-synth as a loom builder runs it: CSV headers and rows, the thesis' tables, the 12 cm / 169°
 // round trip to Table 4.3, and bad input → stderr naming the argument, exit code 2.
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdio>
 #include <sys/wait.h>
 
 #include <cstdlib>
@@ -27,21 +30,25 @@ std::string slurp(const std::string& path) {
   return ss.str();
 }
 
-CliRun run(const std::string& args) {
 #ifndef LOOM_SYNTH_EXE
-  (void)args;
-  return {};
-#else
-  const std::string dir = ::testing::TempDir();
-  const std::string out = dir + "/loom_synth_out.txt", err = dir + "/loom_synth_err.txt";
+#error "LOOM_SYNTH_EXE must name the loom-synth executable under test"
+#endif
+
+CliRun run(const std::string& args) {
+  // One pair of files per test and process: ctest runs these tests in parallel.
+  const std::string stem = ::testing::TempDir() + "/loom_synth_" +
+                           ::testing::UnitTest::GetInstance()->current_test_info()->name() + "_" +
+                           std::to_string(::getpid());
+  const std::string out = stem + ".out", err = stem + ".err";
   const std::string cmd = std::string("'") + LOOM_SYNTH_EXE + "' " + args + " >'" + out + "' 2>'" + err + "'";
   const int status = std::system(cmd.c_str());
   CliRun r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   r.out = slurp(out);
   r.err = slurp(err);
+  std::remove(out.c_str());
+  std::remove(err.c_str());
   return r;
-#endif
 }
 
 std::vector<std::vector<std::string>> csv(const std::string& text) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "loom/motion/elliptic_gear.hpp"
+#include "loom/motion/newton.hpp"
 
 namespace loom::motion {
 
@@ -51,11 +52,6 @@ struct BattenPose {
 struct BattenRates {
   Eigen::Vector4d dot;   // (γ2', γ3', γ4', ψ') rad/s
   Eigen::Vector4d ddot;  // (γ2'', γ3'', γ4'', ψ'') rad/s²
-};
-
-struct NewtonOptions {
-  double tolerance = 1e-13;  // stop when max|F_i| <= tolerance · (largest link); >= 1e-15
-  int max_iterations = 50;
 };
 
 struct NewtonResult {

@@ -3,6 +3,10 @@
 // beat-up model (000 §4.5.1) is a slider-crank, and every Söylemez synthesis is checked against it.
 #pragma once
 
+#include <Eigen/Core>
+
+#include "loom/motion/link_point.hpp"
+
 namespace loom::motion {
 
 // Geometry: crank pivot A0 at the origin, crank angle θ measured counter-clockwise from +x; the
@@ -15,7 +19,8 @@ struct SliderCrank {
 };
 
 // configure-time only. Throws MotionError kInvalidInput for a non-finite or non-positive length,
-// kNotCrank when b ≤ a + |e| (the crank cannot turn a full revolution without toggling).
+// kNotCrank when b ≤ a + |e| + 1e-12·b (the crank cannot turn a full revolution without toggling,
+// or the linkage is a change point within rounding, where the rates are unbounded).
 void validate_slider_crank(const SliderCrank& m);
 
 struct SliderState {
@@ -24,12 +29,20 @@ struct SliderState {
   double x_ddot = 0.0;             // d² x / dt²
   double coupler_angle_rad = 0.0;  // direction A → B, counter-clockwise from +x
   double transmission_rad = 0.0;   // acute angle between the coupler and the slider line's normal
+  double coupler_rate_rad_s = 0.0;    // d(coupler angle)/dt
+  double coupler_accel_rad_s2 = 0.0;  // d²(coupler angle)/dt²
 };
 
 // RT-safe (no allocation, no throw). Slider state at crank angle θ turning at ω with acceleration α.
 // Requires a mechanism accepted by validate_slider_crank; then every output is finite.
 SliderState slider_state(const SliderCrank& m, double theta_rad, double omega_rad_s,
                          double alpha_rad_s2) noexcept;
+
+// RT-safe (no allocation, no throw). Position and θ-derivatives of the point `local` on the coupler
+// (origin at the crank pin A, x towards the slider pin B) at crank angle θ; point_motion() gives its
+// velocity and acceleration. Requires a mechanism accepted by validate_slider_crank.
+PointCoefficients slider_coupler_point(const SliderCrank& m, double theta_rad,
+                                       const Eigen::Vector2d& local) noexcept;
 
 struct SliderDeadCentres {
   double theta_extended_rad = 0.0;  // crank angle, crank and coupler extended in line, [0, 2π)

@@ -1,0 +1,151 @@
+// `loom-kin fourbar`: options are link lengths (any one unit, ground = 1 by default) and degrees; the
+// linkage is swept over one crank turn on the chosen assembly branch, one CSV row per sample, or
+// summarised in one row. Geometric refusals name the length options they come from.
+#include "fourbar_cmd.hpp"
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "checks.hpp"
+#include "csv.hpp"
+#include "loom/motion/angles.hpp"
+#include "loom/motion/errors.hpp"
+#include "loom/motion/fourbar.hpp"
+
+namespace loom::kin {
+
+namespace {
+
+constexpr const char* kLengthOptions = "--ground/--crank/--coupler/--rocker";
+
+loom::motion::FourBarLink link_of(const std::string& name) {
+  using loom::motion::FourBarLink;
+  if (name == "crank") return FourBarLink::kCrank;
+  if (name == "rocker") return FourBarLink::kRocker;
+  return FourBarLink::kCoupler;
+}
+
+std::string number(double v) {
+  std::string cell;
+  put(cell, v, true);
+  cell.pop_back();  // put() ends the cell with '\n'
+  return cell;
+}
+
+void write_summary(const loom::motion::FourBar& m, loom::motion::Branch branch) {
+  using namespace loom::motion;
+  const GrashofClass cls = classify(m);
+  // Cells that do not exist for this class stay empty (never NaN): μ needs a full-turning crank,
+  // dead centres need a rocker.
+  std::vector<std::string> cells(10);
+  cells[0] = grashof_class_name(cls);
+  if (cls == GrashofClass::kCrankRocker || cls == GrashofClass::kDoubleCrank) {
+    const TransmissionRange r = transmission_range(m);
+    cells[1] = number(deg(r.mu_min));
+    cells[2] = number(deg(r.mu_max));
+  }
+  if (cls == GrashofClass::kCrankRocker) {
+    const DeadCentres dc = dead_centres(m, branch);
+    cells[3] = number(deg(dc.crank_extended));
+    cells[4] = number(deg(dc.crank_folded));
+    cells[5] = number(deg(dc.rocker_extended));
+    cells[6] = number(deg(dc.rocker_folded));
+    cells[7] = number(deg(dc.swing));
+    cells[8] = number(deg(dc.crank_rotation));
+    cells[9] = number(dc.time_ratio);
+  }
+  std::string out =
+      "grashof,mu_min_deg,mu_max_deg,crank_extended_deg,crank_folded_deg,rocker_extended_deg,"
+      "rocker_folded_deg,swing_deg,crank_rotation_deg,time_ratio\n";
+  for (std::size_t i = 0; i < cells.size(); ++i) out += cells[i] + (i + 1 < cells.size() ? "," : "\n");
+  std::fwrite(out.data(), 1, out.size(), stdout);
+}
+
+void write_sweep(const FourBarArgs& a, const loom::motion::FourBar& m, loom::motion::Branch branch) {
+  using namespace loom::motion;
+  const std::vector<FourBarPose> sweep = fourbar_sweep(m, branch, a.samples, rad(a.start_deg));
+  const bool point = !a.point_link.empty();
+  std::string out = "theta2_deg,theta3_deg,theta4_deg,k3,k4,k3p,k4p,transmission_deg";
+  out += point ? ",point_x,point_y,point_vx,point_vy,point_ax,point_ay\n" : "\n";
+  for (std::size_t i = 0; i < sweep.size(); ++i) {
+    const FourBarPose& p = sweep[i];
+    put(out, a.start_deg + 360.0 * static_cast<double>(i) / static_cast<double>(a.samples));
+    put(out, deg(p.theta3));
+    put(out, deg(p.theta4));
+    put(out, p.k3);
+    put(out, p.k4);
+    put(out, p.k3p);
+    put(out, p.k4p);
+    put(out, deg(p.transmission), !point);
+    if (point) {
+      const PointMotion pm = point_motion(
+          point_coefficients(m, p, link_of(a.point_link), {a.point_x, a.point_y}), a.omega, a.alpha);
+      put(out, pm.position.x());
+      put(out, pm.position.y());
+      put(out, pm.velocity.x());
+      put(out, pm.velocity.y());
+      put(out, pm.acceleration.x());
+      put(out, pm.acceleration.y(), true);
+    }
+  }
+  std::fwrite(out.data(), 1, out.size(), stdout);
+}
+
+}  // namespace
+
+CLI::App* add_fourbar_command(CLI::App& app, FourBarArgs& a) {
+  CLI::App* c = app.add_subcommand(
+      "fourbar",
+      "Any four-bar (crank input) over one crank turn: angles, kinematic coefficients, transmission");
+  c->add_option("--ground", a.ground, "Ground link A0B0 (lengths in its unit)")
+      ->check(positive_number())
+      ->capture_default_str();
+  c->add_option("--crank", a.crank, "Crank A0A")->check(positive_number())->required();
+  c->add_option("--coupler", a.coupler, "Coupler AB")->check(positive_number())->required();
+  c->add_option("--rocker", a.rocker, "Rocker (output) B0B")->check(positive_number())->required();
+  c->add_option("--branch", a.branch, "Assembly: B counter-clockwise (positive) or clockwise of B0->A")
+      ->check(CLI::IsMember({"positive", "negative"}))
+      ->capture_default_str();
+  c->add_option("--samples", a.samples, "Samples over one crank turn")
+      ->check(CLI::Range(1, 10000000))
+      ->capture_default_str();
+  c->add_option("--start-deg", a.start_deg, "Crank angle of the first sample")
+      ->check(finite_number())
+      ->capture_default_str();
+  c->add_flag("--summary", a.summary,
+              "One row: Grashof class, transmission extremes, dead centres, time ratio");
+  CLI::Option* link =
+      c->add_option("--point-link", a.point_link, "Append a point on this link: crank, coupler or rocker")
+          ->check(CLI::IsMember({"crank", "coupler", "rocker"}));
+  c->add_option("--point-x", a.point_x, "Point along its link from the link's first pivot")
+      ->check(finite_number())
+      ->needs(link);
+  c->add_option("--point-y", a.point_y, "Point 90 deg counter-clockwise from the link line")
+      ->check(finite_number())
+      ->needs(link);
+  c->add_option("--omega", a.omega, "Crank speed for the point's velocity and acceleration, rad/s")
+      ->check(finite_number())
+      ->capture_default_str();
+  c->add_option("--alpha", a.alpha, "Crank acceleration for the point's acceleration, rad/s^2")
+      ->check(finite_number())
+      ->capture_default_str();
+  return c;
+}
+
+void run_fourbar(const FourBarArgs& a) {
+  using namespace loom::motion;
+  const FourBar m{a.ground, a.crank, a.coupler, a.rocker};
+  const Branch branch = a.branch == "negative" ? Branch::kNegative : Branch::kPositive;
+  try {
+    if (a.summary) {
+      write_summary(m, branch);
+    } else {
+      write_sweep(a, m, branch);
+    }
+  } catch (const MotionError& e) {
+    throw MotionError(e.code(), std::string(kLengthOptions) + ": " + e.what());
+  }
+}
+
+}  // namespace loom::kin
