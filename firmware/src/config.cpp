@@ -8,7 +8,9 @@
 
 #include "loom/firmware/config.hpp"
 #include "loom/motion/angles.hpp"
+#include "loom/motion/dynamics.hpp"
 #include "loom/motion/errors.hpp"
+#include "loom/motion/mass_properties.hpp"
 #include "toml_reader.hpp"
 
 namespace loom::firmware {
@@ -55,6 +57,19 @@ LoomConfig parse_loom_config(const std::string& text, const std::string& source)
   p.beatup.fell_at = fell == "extended" ? motion::FellSide::kExtended : motion::FellSide::kFolded;
   r.number("beatup.warp_depth_m", p.beatup.warp_depth_m, positive);
   r.number("beatup.crank_speed_rad_s", p.crank.velocity, [](double v) { return in_range(v, 0.1, 100.0); });
+  // A loom builder may ask for the beat force instead: the crank speed then comes from the linkage's
+  // inverse dynamics (the beater force is inertial, so it scales with ω²).
+  double force_target = 0.0;
+  r.number("beatup.beat_force_target_n", force_target, [](double v) { return in_range(v, 1.0, 1000.0); });
+  if (force_target > 0.0) {
+    if (r.root().at_path("beatup.crank_speed_rad_s").node() != nullptr) {
+      r.fail("beatup.beat_force_target_n", std::to_string(force_target),
+             "give either beat_force_target_n or crank_speed_rad_s, not both");
+    }
+    c.beat_force_target_n = force_target;
+  }
+  double beater_kg = 2.5;
+  r.number("beatup.beater_mass_kg", beater_kg, positive);
   r.number("beatup.crank_accel_rad_s2", p.crank.acceleration, positive);
   r.number("beatup.crank_jerk_rad_s3", p.crank.jerk, positive);
   r.number("beatup.beater_width_m", p.beater_width_m, positive);
@@ -151,6 +166,15 @@ LoomConfig parse_loom_config(const std::string& text, const std::string& source)
   every("telemetry.rt_every", c.telemetry.rt_every);
   r.reject_unknown();
 
+  if (c.beat_force_target_n > 0.0) {
+    try {
+      const motion::BeatUpDynamics dyn(p.beatup, motion::beatup_masses(p.beatup, beater_kg));
+      p.crank.velocity = dyn.crank_speed_for_beat_force(c.beat_force_target_n);
+    } catch (const motion::MotionError& e) {
+      r.fail("beatup.beat_force_target_n", std::to_string(c.beat_force_target_n), e.what());
+    }
+  }
+
   // Final check: the motion module must be able to build every profile from these numbers.
   try {
     motion::ProfileSet check(c.profile);
@@ -188,7 +212,8 @@ Scene parse_scene(const std::string& text, const std::string& source) {
     return std::find(s.spec.effects.begin(), s.spec.effects.end(), effect) != s.spec.effects.end();
   };
   for (const char* effect : {sim_hal::kEffectServoLag, sim_hal::kEffectPneumatics, sim_hal::kEffectShuttleSlip,
-                             sim_hal::kEffectSensorNoise, sim_hal::kEffectBeatContact}) {
+                             sim_hal::kEffectSensorNoise, sim_hal::kEffectBeatContact, sim_hal::kEffectInertia,
+                             sim_hal::kEffectJointFriction}) {
     if (r.root().contains(effect) && !named(effect)) {
       r.fail(effect, "{...}", "parameters given for an effect the scene does not name");
     }
@@ -215,6 +240,26 @@ Scene parse_scene(const std::string& text, const std::string& source) {
     sim_hal::SensorNoise p;
     r.number("sensor_noise.flip_probability", p.flip_probability, [](double v) { return in_range(v, 0.0, 0.2); });
     s.spec.sensor_noise = p;
+  }
+  if (named(sim_hal::kEffectJointFriction) && !named(sim_hal::kEffectInertia)) {
+    r.fail("effects", "\"joint_friction\"", "acts on the crank's dynamics: name \"inertia\" too");
+  }
+  if (named(sim_hal::kEffectInertia)) {
+    sim_hal::Inertia p;
+    r.number("inertia.motor_torque_limit_nm", p.motor_torque_limit_nm, positive);
+    r.number("inertia.drive_inertia_kg_m2", p.drive_inertia_kg_m2, non_negative);
+    r.number("inertia.bandwidth_hz", p.bandwidth_hz, [](double v) { return in_range(v, 1.0, 500.0); });
+    std::int64_t sub = p.substeps;
+    r.integer("inertia.substeps", sub, 1, 1000);
+    p.substeps = static_cast<int>(sub);
+    r.number("inertia.beater_mass_kg", p.beater_mass_kg, positive);
+    s.spec.inertia = p;
+  }
+  if (named(sim_hal::kEffectJointFriction)) {
+    sim_hal::JointFriction p;
+    r.number("joint_friction.viscous_nm_s", p.viscous_nm_s, non_negative);
+    r.number("joint_friction.coulomb_nm", p.coulomb_nm, non_negative);
+    s.spec.joint_friction = p;
   }
   if (named(sim_hal::kEffectBeatContact)) {
     sim_hal::BeatContact p;

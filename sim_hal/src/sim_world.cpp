@@ -13,8 +13,9 @@
 namespace loom::sim_hal {
 
 const std::vector<std::string>& known_effects() {
-  static const std::vector<std::string> names{kEffectIdeal,      kEffectServoLag,   kEffectPneumatics,
-                                              kEffectShuttleSlip, kEffectSensorNoise, kEffectBeatContact};
+  static const std::vector<std::string> names{kEffectIdeal,       kEffectServoLag,    kEffectPneumatics,
+                                              kEffectShuttleSlip,  kEffectSensorNoise, kEffectBeatContact,
+                                              kEffectInertia,      kEffectJointFriction};
   return names;
 }
 
@@ -56,6 +57,17 @@ SimWorld::SimWorld(const SimMachine& machine, const SceneSpec& scene)
       if (!scene_.sensor_noise) scene_.sensor_noise = SensorNoise{};
     } else if (e == kEffectBeatContact) {
       if (!scene_.beat_contact) scene_.beat_contact = BeatContact{};
+    } else if (e == kEffectInertia) {
+      if (!scene_.inertia) scene_.inertia = Inertia{};
+      const bool friction = std::find(scene_.effects.begin(), scene_.effects.end(), kEffectJointFriction) !=
+                            scene_.effects.end();
+      if (friction && !scene_.joint_friction) scene_.joint_friction = JointFriction{};
+      axes_[hal::index(hal::Axis::kBeatCrank)].effects.push_back(
+          make_crank_inertia(m_, *scene_.inertia, friction ? &*scene_.joint_friction : nullptr));
+    } else if (e == kEffectJointFriction) {
+      if (std::find(scene_.effects.begin(), scene_.effects.end(), kEffectInertia) == scene_.effects.end()) {
+        throw std::invalid_argument("effect 'joint_friction' acts on the crank's dynamics: name 'inertia' too");
+      }
     } else {
       throw std::invalid_argument("unknown simulation effect '" + e + "'");
     }
@@ -71,7 +83,7 @@ std::size_t SimWorld::effect_count() const {
   std::size_t n = 0;
   for (const auto& ax : axes_) n += ax.effects.size();
   n += scene_.pneumatics.has_value() + scene_.shuttle_slip.has_value() + scene_.sensor_noise.has_value() +
-       scene_.beat_contact.has_value();
+       scene_.beat_contact.has_value() + scene_.joint_friction.has_value();
   return n;
 }
 

@@ -36,6 +36,7 @@ struct TelemetrySettings {
 struct LoomConfig {
   std::string source = "<embedded default>";  // where it came from, for messages
   std::string loom_id = "loom1";
+  double beat_force_target_n = 0.0;  // > 0 when the crank speed was derived from a beat-force target
   motion::ProfileSpec profile;
   sequencer::SequencerConfig sequencer;
   sim_hal::SimMachine machine;

@@ -19,6 +19,8 @@ inline constexpr const char* kEffectPneumatics = "pneumatics";      // valve fil
 inline constexpr const char* kEffectShuttleSlip = "shuttle_slip";   // shuttle lost above the carrier force
 inline constexpr const char* kEffectSensorNoise = "sensor_noise";   // end/arrival sensors bounce
 inline constexpr const char* kEffectBeatContact = "beat_contact";   // beater load cell at the cloth fell
+inline constexpr const char* kEffectInertia = "inertia";             // rigid-body beat-up behind a torque-limited servo
+inline constexpr const char* kEffectJointFriction = "joint_friction"; // crank bearing friction (needs inertia)
 const std::vector<std::string>& known_effects();
 
 struct ServoLag {
@@ -52,6 +54,23 @@ struct SensorNoise {
 struct BeatContact {
   double beater_mass_kg = 2.5;
   double contact_depth_m = 0.005;
+};
+
+// The beat-up crank stops being a kinematic follower: the linkage's rigid-body dynamics (thesis cast-iron
+// links and beater, gravity) driven by the motor's torque, which a position loop of `bandwidth_hz`
+// computes from the target and limits to `motor_torque_limit_nm`. Integrated by RK4 in substeps.
+struct Inertia {
+  double motor_torque_limit_nm = 30.0;
+  double drive_inertia_kg_m2 = 0.01;  // motor and gearbox reflected to the crank
+  double bandwidth_hz = 25.0;
+  int substeps = 8;                   // RK4 steps per tick (the free linkage needs ≤ 0.25 ms steps)
+  double beater_mass_kg = 2.5;
+};
+
+// Crank bearing friction: viscous plus Coulomb (smoothed over 1e-3 rad/s so RK4 sees a continuous law).
+struct JointFriction {
+  double viscous_nm_s = 0.02;
+  double coulomb_nm = 0.3;
 };
 
 enum class InjectedFault : std::uint8_t { kDriveFault, kEStop, kStuckPiston, kStuckSensor };
@@ -91,6 +110,8 @@ struct SceneSpec {
   std::optional<ShuttleSlip> shuttle_slip;
   std::optional<SensorNoise> sensor_noise;
   std::optional<BeatContact> beat_contact;
+  std::optional<Inertia> inertia;
+  std::optional<JointFriction> joint_friction;
   std::vector<FaultInjection> faults;
 };
 
