@@ -76,8 +76,10 @@ BENCHMARK_CAPTURE(BM_Tick, pneumatics, std::vector<std::string>{"ideal", "pneuma
 BENCHMARK_CAPTURE(BM_Tick, shuttle_slip, std::vector<std::string>{"ideal", "shuttle_slip"});
 BENCHMARK_CAPTURE(BM_Tick, sensor_noise, std::vector<std::string>{"ideal", "sensor_noise"});
 BENCHMARK_CAPTURE(BM_Tick, beat_contact, std::vector<std::string>{"ideal", "beat_contact"});
+BENCHMARK_CAPTURE(BM_Tick, inertia, std::vector<std::string>{"inertia"});
+BENCHMARK_CAPTURE(BM_Tick, inertia_friction, std::vector<std::string>{"inertia", "joint_friction"});
 BENCHMARK_CAPTURE(BM_Tick, all, std::vector<std::string>{"servo_lag", "pneumatics", "shuttle_slip", "sensor_noise",
-                                                         "beat_contact"});
+                                                         "beat_contact", "inertia", "joint_friction"});
 BENCHMARK(BM_RockerExactSolve);
 BENCHMARK(BM_RockerTable)->RangeMultiplier(4)->Range(64, 65536);
 BENCHMARK_MAIN();
