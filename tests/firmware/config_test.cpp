@@ -54,7 +54,7 @@ TEST(Config, EmbeddedDefaultsParse) {
 
 TEST(Config, ShippedScenesLoad) {
   for (const char* name : {"default", "ideal", "servo_lag", "drive_fault", "estop", "stuck_piston", "shuttle_slip",
-                           "stuck_sensor", "sensor_noise"}) {
+                           "stuck_sensor", "sensor_noise", "dynamics"}) {
     const Scene s = load_scene(std::string(LOOM_SOURCE_DIR) + "/sim_hal/scenes/" + name + ".toml");
     EXPECT_EQ(s.spec.name, name);
   }
