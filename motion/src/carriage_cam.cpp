@@ -21,14 +21,20 @@ CamSample smooth_step(double u) noexcept {
   return s;
 }
 
-CarriageCam::CarriageCam(const WarpWindow& warp, double margin_rad, double pitch_m, int steps)
-    : pitch_(pitch_m), steps_(steps) {
+CarriageCam::CarriageCam(const WarpWindow& warp, double margin_rad, double pitch_m, int steps,
+                         int beats_per_position)
+    : pitch_(pitch_m), steps_(steps), beats_per_position_(beats_per_position) {
   start_ = warp.exit + margin_rad;
   length_ = warp.clear() - 2.0 * margin_rad;
   if (!(length_ > 0.0)) {
     std::ostringstream os;
     os << "carriage step window is empty: clear window " << deg(warp.clear()) << " deg minus 2 x margin "
        << deg(margin_rad) << " deg";
+    throw MotionError(ErrorCode::kInvalidInput, os.str());
+  }
+  if (beats_per_position < 1) {
+    std::ostringstream os;
+    os << "beats per carriage position must be >= 1, got " << beats_per_position;
     throw MotionError(ErrorCode::kInvalidInput, os.str());
   }
   if (!(pitch_m > 0.0) || steps < 0) {
@@ -41,12 +47,17 @@ CarriageCam::CarriageCam(const WarpWindow& warp, double margin_rad, double pitch
 CamSample CarriageCam::at(double phase) const noexcept {
   if (!(phase > start_) || steps_ == 0) return {};
   const double rel = phase - start_;
-  const double turns = std::floor(rel / kTwoPi);
-  if (turns >= static_cast<double>(steps_)) return {pitch_ * steps_, 0.0, 0.0, 0.0};
-  const double u = (rel - turns * kTwoPi) / length_;
+  // Window k follows turn k's beat; the carriage moves only in every beats_per_position-th window.
+  const double k = std::floor(rel / kTwoPi);
+  const double n = static_cast<double>(beats_per_position_);
+  const double started = std::floor((k + 1.0) / n);  // moves whose window has begun
+  const double total = static_cast<double>(steps_);
+  if (started > total || (started == total && std::fmod(k + 1.0, n) != 0.0)) return {pitch_ * total, 0.0, 0.0, 0.0};
+  if (std::fmod(k + 1.0, n) != 0.0) return {pitch_ * started, 0.0, 0.0, 0.0};  // dwelling between beats
+  const double u = (rel - k * kTwoPi) / length_;
   const CamSample s = smooth_step(u);
-  const double k = 1.0 / length_;
-  return {pitch_ * (turns + s.position), pitch_ * s.d1 * k, pitch_ * s.d2 * k * k, pitch_ * s.d3 * k * k * k};
+  const double c = 1.0 / length_;
+  return {pitch_ * (started - 1.0 + s.position), pitch_ * s.d1 * c, pitch_ * s.d2 * c * c, pitch_ * s.d3 * c * c * c};
 }
 
 }  // namespace loom::motion

@@ -84,3 +84,26 @@ TEST(CarriageCam, MovesOnlyWhileTheBeaterIsClear) {
   // The carriage sits at an exact multiple of the pitch at every fell (beat) of turn k.
   for (int k = 0; k < 15; ++k) EXPECT_DOUBLE_EQ(cam.at(k * kTwoPi + b.warp().fell).position, 0.08 * k);
 }
+
+TEST(CarriageCam, BeatsEveryPositionSeveralTimesBeforeStepping) {
+  const BeatUp b(default_beatup_geometry());
+  const int per = 3, steps = 4;
+  const CarriageCam cam(b.warp(), rad(20), 0.08, steps, per);
+  // Beat k (k = 0 … (steps+1)·per − 1) happens at the fell of turn k, at position floor(k / per).
+  for (int k = 0; k < (steps + 1) * per; ++k) {
+    EXPECT_DOUBLE_EQ(cam.at(k * kTwoPi + b.warp().fell).position, 0.08 * (k / per)) << "beat " << k;
+  }
+  // Still never in the warp, still monotone, and the last position is held.
+  double prev = 0.0;
+  for (int i = 0; i <= (steps + 1) * per * 720; ++i) {
+    const double phi = kTwoPi * i / 720.0;
+    const CamSample s = cam.at(phi);
+    if (b.at(phi).in_warp) {
+      EXPECT_EQ(s.d1, 0.0);
+    }
+    EXPECT_GE(s.position, prev);
+    prev = s.position;
+  }
+  EXPECT_DOUBLE_EQ(prev, 0.08 * steps);
+  EXPECT_THROW(CarriageCam(b.warp(), rad(20), 0.08, steps, 0), MotionError);
+}

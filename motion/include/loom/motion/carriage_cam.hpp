@@ -18,10 +18,11 @@ struct CamSample {
 class CarriageCam {
  public:
   CarriageCam() = default;
-  // Configure-time. `pitch_m` per step, `steps` steps (beats - 1), moving in the window
-  // [warp.exit + margin, warp.enter + 2π - margin] of each turn. Throws MotionError(kInvalidInput)
-  // when the margins leave no window or the pitch is not positive.
-  CarriageCam(const WarpWindow& warp, double margin_rad, double pitch_m, int steps);
+  // Configure-time. `pitch_m` per step, `steps` steps (positions - 1), moving in the window
+  // [warp.exit + margin, warp.enter + 2π - margin] after every `beats_per_position`-th turn, so each
+  // position is beaten that many times. Throws MotionError(kInvalidInput) when the margins leave no
+  // window, the pitch is not positive or beats_per_position < 1.
+  CarriageCam(const WarpWindow& warp, double margin_rad, double pitch_m, int steps, int beats_per_position = 1);
 
   // RT-safe. Φ = unwrapped crank phase since the sweep began.
   CamSample at(double crank_phase) const noexcept;
@@ -30,12 +31,14 @@ class CarriageCam {
   double window_length() const { return length_; }
   double pitch() const { return pitch_; }
   int steps() const { return steps_; }
+  int beats_per_position() const { return beats_per_position_; }
 
  private:
   double start_ = 0.0;
   double length_ = 1.0;
   double pitch_ = 0.0;
   int steps_ = 0;
+  int beats_per_position_ = 1;
 };
 
 // The smooth step s(u) = 35u⁴ − 84u⁵ + 70u⁶ − 20u⁷ on [0,1] and its derivatives: s, s', s'', s''' all
