@@ -11,6 +11,7 @@
 #include "loom/motion/dynamics.hpp"
 #include "loom/motion/errors.hpp"
 #include "loom/motion/mass_properties.hpp"
+#include "loom/motion/profile_crank.hpp"
 #include "toml_reader.hpp"
 
 namespace loom::firmware {
@@ -57,17 +58,18 @@ LoomConfig parse_loom_config(const std::string& text, const std::string& source)
   p.beatup.fell_at = fell == "extended" ? motion::FellSide::kExtended : motion::FellSide::kFolded;
   r.number("beatup.warp_depth_m", p.beatup.warp_depth_m, positive);
   r.number("beatup.crank_speed_rad_s", p.crank.velocity, [](double v) { return in_range(v, 0.1, 100.0); });
-  // A loom builder may ask for the beat force instead: the crank speed then comes from the linkage's
-  // inverse dynamics (the beater force is inertial, so it scales with ω²).
-  double force_target = 0.0;
+  // A loom builder asks for the beat force (default 90 N, thesis: 80–100 N) or fixes the crank speed;
+  // from a force, the crank speed comes from the linkage's inverse dynamics (the beater force is
+  // inertial, so it scales with ω²).
+  const bool speed_given = r.root().at_path("beatup.crank_speed_rad_s").node() != nullptr;
+  const bool force_given = r.root().at_path("beatup.beat_force_target_n").node() != nullptr;
+  double force_target = 90.0;
   r.number("beatup.beat_force_target_n", force_target, [](double v) { return in_range(v, 1.0, 1000.0); });
-  if (force_target > 0.0) {
-    if (r.root().at_path("beatup.crank_speed_rad_s").node() != nullptr) {
-      r.fail("beatup.beat_force_target_n", std::to_string(force_target),
-             "give either beat_force_target_n or crank_speed_rad_s, not both");
-    }
-    c.beat_force_target_n = force_target;
+  if (speed_given && force_given) {
+    r.fail("beatup.beat_force_target_n", std::to_string(force_target),
+           "give either beat_force_target_n or crank_speed_rad_s, not both");
   }
+  c.beat_force_target_n = speed_given ? 0.0 : force_target;
   double beater_kg = 2.5;
   r.number("beatup.beater_mass_kg", beater_kg, positive);
   r.number("beatup.crank_accel_rad_s2", p.crank.acceleration, positive);
@@ -80,10 +82,27 @@ LoomConfig parse_loom_config(const std::string& text, const std::string& source)
   std::int64_t table = static_cast<std::int64_t>(p.table_size);
   r.integer("beatup.table_size", table, 64, 1 << 20);
   p.table_size = static_cast<std::size_t>(table);
+  std::string interp = motion::interp_name(p.table_interp), precision = motion::precision_name(p.table_precision);
+  r.string("beatup.interp", interp, {"linear", "cubic", "quintic"});
+  motion::parse_interp(interp.c_str(), p.table_interp);
+  r.string("beatup.table_precision", precision, {"double", "float32"});
+  motion::parse_precision(precision.c_str(), p.table_precision);
+  r.number("beatup.max_table_error_rad", p.max_table_error_rad, positive);
+  std::string law = motion::crank_law_name(p.crank_law.kind);
+  r.string("beatup.crank_law", law, {"constant", "elliptic"});
+  motion::parse_crank_law(law.c_str(), p.crank_law.kind);
+  r.number("beatup.ellipse_e", p.crank_law.ellipse_e, [](double v) { return v >= 0.0 && v < 1.0 ? "" : "must be in [0, 1)"; });
+  std::int64_t lobes = p.crank_law.ellipse_lobes;
+  r.integer("beatup.ellipse_lobes", lobes, 1, 16);
+  p.crank_law.ellipse_lobes = static_cast<int>(lobes);
+  double phi02_deg = motion::deg(p.crank_law.ellipse_phi02_rad);
+  r.number("beatup.ellipse_phi02_deg", phi02_deg, [](double v) { return in_range(v, -360.0, 360.0); });
+  p.crank_law.ellipse_phi02_rad = motion::rad(phi02_deg);
   r.number("beatup.crank_park_position_rad", c.sequencer.crank_park_position_rad);
 
   r.number("carriage.max_speed_m_s", p.carriage_max_speed_m_s, positive);
   r.number("carriage.max_accel_m_s2", p.carriage_max_accel_m_s2, positive);
+  r.number("carriage.max_jerk_m_s3", p.carriage_max_jerk_m_s3, positive);
   r.number("carriage.jerk_m_s3", c.sequencer.carriage.jerk, positive);
   r.number("carriage.home_position_m", c.sequencer.carriage_home_m);
   c.sequencer.carriage.velocity = p.carriage_max_speed_m_s;
@@ -97,6 +116,9 @@ LoomConfig parse_loom_config(const std::string& text, const std::string& source)
   r.number("helix.carrier_force_n", p.carrier_force_n, positive);
   r.number("helix.shuttle_mass_kg", p.shuttle_mass_kg, positive);
 
+  std::int64_t per_position = p.beats_per_position;
+  r.integer("recipe.beats_per_position", per_position, 1, 16);
+  p.beats_per_position = static_cast<int>(per_position);
   std::int64_t picks = c.sequencer.picks_per_row;
   r.integer("recipe.picks_per_row", picks, 1, 16);
   c.sequencer.picks_per_row = static_cast<std::uint32_t>(picks);
@@ -104,8 +126,14 @@ LoomConfig parse_loom_config(const std::string& text, const std::string& source)
   r.integer("timing.debounce_ticks", debounce, 1, 100);
   c.sequencer.debounce_ticks = static_cast<int>(debounce);
 
-  r.number("shedding.piston_travel_s", c.machine.piston_travel_s, positive);
-  r.number("shedding.timeout_s", c.sequencer.shed_timeout_s, positive);
+  r.number("shedding.piston_travel_s", p.shed.piston_travel_s, positive);
+  c.machine.piston_travel_s = p.shed.piston_travel_s;
+  r.number("shedding.timeout_s", p.shed.timeout_s, positive);
+  r.number("shedding.earliest_fraction", p.shed.earliest_fraction, [](double v) { return in_range(v, 0.0, 0.99); });
+  r.number("shedding.release_timeout_s", p.shed.release_timeout_s, positive);
+  double settle_ms = p.shed.settle_s * 1e3;
+  r.number("shedding.settle_ms", settle_ms, non_negative);
+  p.shed.settle_s = settle_ms * 1e-3;
 
   double period_ms = 2.0, stale_ms = 50.0;
   r.number("timing.period_ms", period_ms, [](double v) { return in_range(v, 0.25, 20.0); });
@@ -169,7 +197,26 @@ LoomConfig parse_loom_config(const std::string& text, const std::string& source)
   if (c.beat_force_target_n > 0.0) {
     try {
       const motion::BeatUpDynamics dyn(p.beatup, motion::beatup_masses(p.beatup, beater_kg));
-      p.crank.velocity = dyn.crank_speed_for_beat_force(c.beat_force_target_n);
+      const double crank_speed_at_beat = dyn.crank_speed_for_beat_force(c.beat_force_target_n);
+      // With a speed law the crank is faster (or slower) than the master at the beat: the master runs
+      // at the crank speed divided by the law's ratio where the crank reaches the fell.
+      double ratio = 1.0;
+      if (p.crank_law.kind != motion::CrankLawKind::kConstant) {
+        const motion::BeatUp head(p.beatup);
+        const double fell_phase = head.warp().fell;
+        const motion::CrankLaw speed_law(
+            p.crank_law, fell_phase,
+            {.size = p.table_size, .interp = p.table_interp, .precision = p.table_precision, .rise = 0.0});
+        double m = fell_phase;  // Newton on Φc(m) = m + offset(m) = fell; dΦc/dm ≥ min ratio > 0
+        for (int i = 0; i < 50; ++i) {
+          const motion::CrankLawExact e = speed_law.exact(m);
+          const double step = (m + e.offset - fell_phase) / e.d1;
+          m -= step;
+          if (std::abs(step) < 1e-14) break;
+        }
+        ratio = speed_law.exact(m).d1;
+      }
+      p.crank.velocity = crank_speed_at_beat / ratio;
     } catch (const motion::MotionError& e) {
       r.fail("beatup.beat_force_target_n", std::to_string(c.beat_force_target_n), e.what());
     }

@@ -172,6 +172,8 @@ void Sequencer::begin_shed(hal::Tick now) noexcept {
   const bool a_up = counters_.picks % 2 == 0;
   cmd_.io.piston_a_extend = a_up;
   cmd_.io.piston_b_extend = !a_up;
+  shed_.start(a_up, !a_up, {io_.piston_a_extended, io_.piston_a_retracted},
+              {io_.piston_b_extended, io_.piston_b_retracted});
   phase_start_ = now;
   enter(State::kShed, now);
 }
@@ -301,8 +303,13 @@ void Sequencer::advance(hal::Tick now, const hal::HalInputs& in) noexcept {
       }
       break;
 
-    case State::kShed:
-      if (shed_confirmed(io_) && io_.piston_a_extended == cmd_.io.piston_a_extend) {
+    case State::kShed: {
+      // The end sensors must confirm inside the profiles' window (not faster than a stroke, frames
+      // off their start sensors early, by the timeout), then the frames settle before the pick.
+      const motion::ShedVerdict v = shed_.update(profiles_.shed(), seconds_since(now, state_since_),
+                                                 {io_.piston_a_extended, io_.piston_a_retracted},
+                                                 {io_.piston_b_extended, io_.piston_b_retracted});
+      if (v == motion::ShedVerdict::kOpen) {
         if (!shuttle_at_selvedge(io_)) {
           latch(Fault::kShuttleLost, now);
           break;
@@ -313,10 +320,15 @@ void Sequencer::advance(hal::Tick now, const hal::HalInputs& in) noexcept {
         row_.shed_ticks += now - phase_start_;
         phase_start_ = now;
         enter(State::kPick, now);
-      } else if (now - state_since_ > ticks(cfg_.shed_timeout_s)) {
+      } else if (v == motion::ShedVerdict::kTooEarly) {
+        latch(Fault::kShedSensorEarly, now);
+      } else if (v == motion::ShedVerdict::kNotReleased) {
+        latch(Fault::kShedNotReleased, now);
+      } else if (v == motion::ShedVerdict::kTimeout) {
         latch(Fault::kShedTimeout, now);
       }
       break;
+    }
 
     case State::kPick: {
       const bool arrived = pick_to_right_ ? io_.shuttle_at_right : io_.shuttle_at_left;
@@ -390,11 +402,15 @@ void Sequencer::play_moves(hal::Tick now) noexcept {
     cmd_.axes[index(axis)].target_position = m.origin + m.move.at(t).position;
     if (t >= m.move.duration()) m.active = false;
   };
+  const double sweep_t = seconds_since(now, crank_move_.t0);  // before play() may end the move
   play(crank_move_, Axis::kBeatCrank);
   play(carriage_move_, Axis::kCarriage);
   play(helix_move_, Axis::kHelix);
   if (sweeping_) {
-    const double phi = cmd_.axes[index(Axis::kBeatCrank)].target_position - crank_sweep_origin_;
+    // The sweep move is the master phase; the crank follows the speed law (constant: the same).
+    const motion::Phase master = motion::Phase::from_rad(crank_move_.move.at(sweep_t).position);
+    const double phi = profiles_.crank_at(master).phase;
+    cmd_.axes[index(Axis::kBeatCrank)].target_position = crank_sweep_origin_ + phi;
     cmd_.axes[index(Axis::kCarriage)].target_position =
         carriage_sweep_origin_ + carriage_sweep_dir_ * profiles_.cam().at(phi).position;
     // A beat is delivered when the commanded crank passes the fell of turn k.

@@ -8,6 +8,9 @@
 #include <string>
 
 #include "loom/firmware/config.hpp"
+#include "loom/motion/profile_set.hpp"
+
+#include <cmath>
 
 using namespace loom::firmware;
 
@@ -79,7 +82,7 @@ TEST(Config, SyntaxErrorHasLineAndColumn) {
 
 TEST(Config, InfeasibleMotionIsRefusedWithTheLimits) {
   // A crank so slow to accelerate that it cannot reach speed before the first beat.
-  const std::string e = config_error("[beatup]\ncrank_accel_rad_s2 = 5.0\n");
+  const std::string e = config_error("[beatup]\ncrank_speed_rad_s = 15.5\ncrank_accel_rad_s2 = 5.0\n");
   EXPECT_NE(e.find("cannot reach 15.5 rad/s before the first beat"), std::string::npos) << e;
 }
 
@@ -145,4 +148,27 @@ TEST(LoomctlCli, ResumesFromSavedCounters) {
   std::ifstream f(counters);
   std::string body((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
   EXPECT_EQ(body, "{\"rows\":8,\"picks\":8,\"beats\":120,\"picks_in_row\":0}\n");
+}
+
+TEST(Config, BeatForceTargetSetsTheCrankSpeedAndExcludesAFixedSpeed) {
+  const LoomConfig c = default_loom_config();
+  EXPECT_DOUBLE_EQ(c.beat_force_target_n, 90.0);
+  EXPECT_NEAR(c.profile.crank.velocity, 16.06, 0.01);  // the beat-up's inverse dynamics for 90 N
+  const LoomConfig slow = parse_loom_config("[beatup]\nbeat_force_target_n = 80.0\n", "loom.toml");
+  // The beater force is inertial: speed scales with the square root of the force.
+  EXPECT_NEAR(slow.profile.crank.velocity / c.profile.crank.velocity, std::sqrt(80.0 / 90.0), 1e-9);
+  const LoomConfig fixed = parse_loom_config("[beatup]\ncrank_speed_rad_s = 15.5\n", "loom.toml");
+  EXPECT_DOUBLE_EQ(fixed.profile.crank.velocity, 15.5);
+  EXPECT_EQ(fixed.beat_force_target_n, 0.0);
+  EXPECT_NE(config_error("[beatup]\ncrank_speed_rad_s = 15.5\nbeat_force_target_n = 90.0\n").find("not both"),
+            std::string::npos);
+}
+
+TEST(Config, BeatsPerPositionMultipliesTheBeatsOfARow) {
+  const LoomConfig c = parse_loom_config("[recipe]\nbeats_per_position = 3\n", "loom.toml");
+  const loom::motion::ProfileSet p(c.profile);
+  EXPECT_EQ(p.beats_per_row(), 45);
+  EXPECT_EQ(p.cam().steps(), 14);
+  EXPECT_EQ(config_error("[recipe]\nbeats_per_position = 0\n"),
+            "loom.toml:2:22: recipe.beats_per_position = 0: must be in [1, 16]");
 }

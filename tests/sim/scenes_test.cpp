@@ -94,7 +94,7 @@ TEST_P(FaultScenes, EndInASafeStopWithTheExpectedFirstFault) {
 
 INSTANTIATE_TEST_SUITE_P(Shipped, FaultScenes,
                          ::testing::Values(FaultCase{"drive_fault", Fault::kDriveFault},
-                                           FaultCase{"stuck_piston", Fault::kShedTimeout},
+                                           FaultCase{"stuck_piston", Fault::kShedNotReleased},
                                            FaultCase{"shuttle_slip", Fault::kShuttleNotArrived},
                                            FaultCase{"stuck_sensor", Fault::kShuttleLost},
                                            FaultCase{"estop", Fault::kEStop}),

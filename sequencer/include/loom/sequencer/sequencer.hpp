@@ -57,7 +57,6 @@ struct SequencerConfig {
   std::uint32_t picks_per_row = 1;       // weft picks (each with its own shed change) before the beat sweep
   int debounce_ticks = 3;                // a sensor must read the same this many ticks to count (not e-stop)
   double enable_timeout_s = 2.0;
-  double shed_timeout_s = 1.5;           // piston travel plus margin
   double pick_timeout_margin_s = 0.5;    // beyond the planned pick duration
   double stale_timeout_s = 0.05;         // feedback older than this is a fault
   // After motion stops on a symptom (stale feedback, an interlock trip), a root cause reported within
@@ -154,6 +153,7 @@ class Sequencer {
   double carriage_sweep_dir_ = 1.0;
   double crank_sweep_origin_ = 0.0;
   bool pick_to_right_ = true;
+  motion::ShedMonitor shed_;       // the current shed change against the profiles' windows
 
   // Debounced inputs: the value in use and how many ticks the raw value has disagreed with it.
   hal::DigitalInputs io_{};
