@@ -5,18 +5,20 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "loom/motion/errors.hpp"
+
 namespace loom::firmware {
 
 Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions& opt, sequencer::Counters resume)
     : cfg_(cfg) {
-  profiles_ = std::make_unique<motion::ProfileSet>(cfg_.profile);
+  slot_ = std::make_unique<motion::ProfileSlot>(std::make_unique<const motion::ProfileSet>(cfg_.profile));
   sequencer::SequencerConfig scfg = cfg_.sequencer;
   scfg.rows_to_weave = opt.rows;
   if (opt.hal == HalKind::kSocketCan) {
     // A dead drive first shows as stale PDOs (fast stop), then as a lost heartbeat (the root cause).
     scfg.diagnosis_window_s = cfg_.can.heartbeat_timeout_ms * 1e-3 + 10.0 * cfg_.sequencer.period_s;
   }
-  sequencer_ = std::make_unique<sequencer::Sequencer>(*profiles_, scfg, resume);
+  sequencer_ = std::make_unique<sequencer::Sequencer>(*slot_, scfg, resume);
   sim_ = std::make_unique<sim_hal::SimWorld>(cfg_.machine, scene.spec);
   if (!opt.sim_state_path.empty()) {
     sim_state_ = std::make_unique<sim_hal::SimStateFile>(opt.sim_state_path);
@@ -64,6 +66,19 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
   }
   loop_ = std::make_unique<ControlLoop>(*hal_, *sequencer_, telemetry_.get(), cfg_.sequencer.period_s,
                                         opt.lossless_telemetry && opt.hal == HalKind::kSim);
+}
+
+void Machine::publish_recipe(const LoomConfig& next) {
+  // What the running loop and its HAL were configured with cannot change between rows.
+  if (next.sequencer.period_s != cfg_.sequencer.period_s || next.loom_id != cfg_.loom_id ||
+      next.machine.width_m != cfg_.machine.width_m || next.profile.helix_lead_m != cfg_.profile.helix_lead_m) {
+    throw ConfigError(next.source + ": period, loom id, width and helix lead change only with a restart");
+  }
+  try {
+    slot_->publish(std::make_unique<const motion::ProfileSet>(next.profile));
+  } catch (const motion::MotionError& e) {
+    throw ConfigError(next.source + ": motion profiles cannot be built: " + e.what());
+  }
 }
 
 Machine::~Machine() {

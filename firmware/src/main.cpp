@@ -23,7 +23,9 @@ namespace {
 
 constexpr int kExitOk = 0, kExitBadInput = 2, kExitFault = 3, kExitNotArmed = 4;
 std::atomic<bool> g_stop{false};
+std::atomic<bool> g_reload{false};
 extern "C" void on_signal(int) { g_stop.store(true); }
+extern "C" void on_hangup(int) { g_reload.store(true); }
 
 struct WeaveArgs {
   std::string config, scene, hal = "sim", iface, counters, lcm_url, loom_id, report, sim_state;
@@ -57,11 +59,12 @@ int weave(const WeaveArgs& a) {
   // ---- configure: everything that can fail on input fails here, before anything moves ----
   firmware::Scene scene;
   firmware::LoomConfig cfg;
+  std::string config_path;
   sequencer::Counters resume{};
   std::unique_ptr<firmware::CounterStore> store;
   try {
     scene = a.scene.empty() ? firmware::default_scene() : firmware::load_scene(a.scene);
-    std::string config_path = a.config;
+    config_path = a.config;
     if (config_path.empty() && !scene.config_path.empty()) {
       config_path = (std::filesystem::path(a.scene).parent_path() / scene.config_path).string();
     }
@@ -133,6 +136,20 @@ int weave(const WeaveArgs& a) {
   summary.period_s = period;
   std::uint32_t picks_at_row_start = resume.picks;
   const auto on_event = [&](const firmware::RunEvent& e) {
+    // SIGHUP: re-read the recipe (the loom config file) and hand it to the loop for the next row.
+    machine->collect_retired_recipes();
+    if (g_reload.exchange(false)) {
+      try {
+        if (config_path.empty()) throw firmware::ConfigError("no --config file to reload (running the embedded default)");
+        firmware::LoomConfig next = firmware::load_loom_config(config_path);
+        if (a.period_ms > 0.0) next.sequencer.period_s = next.machine.period_s = a.period_ms * 1e-3;
+        if (!a.loom_id.empty()) next.loom_id = a.loom_id;
+        machine->publish_recipe(next);
+        std::printf("recipe: %s reloaded; the loom adopts it at the next row\n", config_path.c_str());
+      } catch (const firmware::ConfigError& ex) {
+        std::fprintf(stderr, "loomctl: recipe not reloaded, weaving on with the current one: %s\n", ex.what());
+      }
+    }
     if (e.kind == firmware::RunEvent::Kind::kRowDone) {
       const auto& r = e.row;
       ++rows_this_run;
@@ -167,6 +184,7 @@ int weave(const WeaveArgs& a) {
   };
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
+  std::signal(SIGHUP, on_hangup);
   auto& seq = machine->sequencer();
   seq.request_start();
   firmware::RunOptions ro;

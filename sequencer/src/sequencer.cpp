@@ -35,9 +35,14 @@ const char* state_name(State s) {
   return "?";
 }
 
+Sequencer::Sequencer(motion::ProfileSlot& slot, const SequencerConfig& cfg, Counters resume)
+    : Sequencer(slot.active(), cfg, resume) {
+  slot_ = &slot;
+}
+
 Sequencer::Sequencer(const motion::ProfileSet& profiles, const SequencerConfig& cfg, Counters resume)
-    : profiles_(profiles), cfg_(cfg), counters_(resume) {
-  interlock_ctx_.warp = &profiles_.beatup().warp();
+    : profiles_(&profiles), cfg_(cfg), counters_(resume) {
+  interlock_ctx_.warp = &profiles_->beatup().warp();
   interlock_ctx_.crank_park_position = cfg_.crank_park_position_rad;
 }
 
@@ -54,7 +59,7 @@ double Sequencer::commanded_crank_phase() const noexcept {
 }
 
 double Sequencer::commanded_rocker_angle() const noexcept {
-  return profiles_.rocker().at(commanded_crank_phase()).value;
+  return profiles_->rocker().at(commanded_crank_phase()).value;
 }
 
 void Sequencer::latch(Fault f, hal::Tick now, int axis, std::uint16_t detail) noexcept {
@@ -178,6 +183,19 @@ void Sequencer::begin_shed(hal::Tick now) noexcept {
   enter(State::kShed, now);
 }
 
+void Sequencer::begin_row(hal::Tick now) noexcept {
+  if (slot_ != nullptr && slot_->swap_at_row_boundary()) {
+    // A new recipe: its warp window guards the interlocks from now on, and the machine re-arms from
+    // its measured positions (crank to park, carriage to a selvedge of the new width) before the row.
+    profiles_ = &slot_->active();
+    interlock_ctx_.warp = &profiles_->beatup().warp();
+    ++recipe_changes_;
+    enter(State::kPositioning, now);
+    return;
+  }
+  begin_shed(now);
+}
+
 void Sequencer::begin_sweep(hal::Tick now, const hal::HalInputs& in) noexcept {
   if (!row_started_) {  // resumed after a restart with every pick of the row already done
     row_started_ = true;
@@ -188,10 +206,10 @@ void Sequencer::begin_sweep(hal::Tick now, const hal::HalInputs& in) noexcept {
   // The crank turns `beats` full turns from park; the carriage rides the cam on it, starting from the
   // selvedge it stands at, so successive rows sweep in alternating directions.
   const double rel = in.axes[index(Axis::kCarriage)].position - cfg_.carriage_home_m;
-  carriage_sweep_dir_ = rel < 0.5 * profiles_.carriage_travel_m() ? 1.0 : -1.0;
+  carriage_sweep_dir_ = rel < 0.5 * profiles_->carriage_travel_m() ? 1.0 : -1.0;
   carriage_sweep_origin_ = cmd_.axes[index(Axis::kCarriage)].target_position;
   crank_sweep_origin_ = cmd_.axes[index(Axis::kBeatCrank)].target_position;
-  crank_move_ = {true, now, crank_sweep_origin_, profiles_.crank_sweep()};
+  crank_move_ = {true, now, crank_sweep_origin_, profiles_->crank_sweep()};
   sweeping_ = true;
   row_beats_ = 0;
   phase_start_ = now;
@@ -203,7 +221,7 @@ void Sequencer::track_beat_force(const hal::HalInputs& in) noexcept {
   // Beat k is the k-th passage through the warp; its peak is recorded while the beater is in the warp.
   const double phi = in.axes[index(Axis::kBeatCrank)].position - crank_sweep_origin_;
   const int k = static_cast<int>(std::floor(phi / motion::kTwoPi));
-  if (k < 0 || k >= profiles_.beats_per_row() || k >= kMaxBeatsPerRow) return;
+  if (k < 0 || k >= profiles_->beats_per_row() || k >= kMaxBeatsPerRow) return;
   if (!beater_in_warp(interlock_ctx_, in.axes[index(Axis::kBeatCrank)].position)) return;
   BeatRecord& b = row_.beat[static_cast<std::size_t>(k)];
   b.peak_force_n = std::max(b.peak_force_n, static_cast<float>(in.analog.beat_force_n));
@@ -241,7 +259,7 @@ void Sequencer::advance(hal::Tick now, const hal::HalInputs& in) noexcept {
         // Re-arm from measured positions: crank to the nearest park, then carriage to the nearest selvedge.
         const double phase = motion::wrap_pi(crank_fb.position - cfg_.crank_park_position_rad);
         crank_move_ = {true, now, cmd_.axes[index(Axis::kBeatCrank)].target_position,
-                       motion::JerkMove::plan(-phase, profiles_.spec().crank)};
+                       motion::JerkMove::plan(-phase, profiles_->spec().crank)};
         // Valves hold whatever the frames show now, so re-arming never moves a frame over the shuttle.
         cmd_.io.piston_a_extend = io_.piston_a_extended;
         cmd_.io.piston_b_extend = io_.piston_b_extended;
@@ -256,7 +274,7 @@ void Sequencer::advance(hal::Tick now, const hal::HalInputs& in) noexcept {
       if (crank_move_.active || carriage_move_.active) break;
       {
         const double rel = carriage_fb.position - cfg_.carriage_home_m;
-        const double travel = profiles_.carriage_travel_m();
+        const double travel = profiles_->carriage_travel_m();
         const double goal = rel < 0.5 * travel ? 0.0 : travel;
         if (std::abs(rel - goal) > cfg_.selvedge_tolerance_m) {
           carriage_move_ = {true, now, cmd_.axes[index(Axis::kCarriage)].target_position,
@@ -273,12 +291,12 @@ void Sequencer::advance(hal::Tick now, const hal::HalInputs& in) noexcept {
         }
         pick_to_right_ = counters_.picks % 2 == 0;  // the shuttle starts at the left: even picks go right
         const double goal =
-            cfg_.helix_left_position_rad + (pick_to_right_ ? profiles_.pick().distance() : 0.0);
+            cfg_.helix_left_position_rad + (pick_to_right_ ? profiles_->pick().distance() : 0.0);
         const double from = cmd_.axes[index(Axis::kHelix)].target_position;
         helix_move_ = {true, now, from,
-                       motion::JerkMove::plan(goal - from, {.velocity = profiles_.spec().helix.velocity,
-                                                            .acceleration = profiles_.helix_accel_limit(),
-                                                            .jerk = profiles_.spec().helix.jerk})};
+                       motion::JerkMove::plan(goal - from, {.velocity = profiles_->spec().helix.velocity,
+                                                            .acceleration = profiles_->helix_accel_limit(),
+                                                            .jerk = profiles_->spec().helix.jerk})};
         if (!row_started_) {
           row_started_ = true;
           row_start_ = now;
@@ -306,7 +324,7 @@ void Sequencer::advance(hal::Tick now, const hal::HalInputs& in) noexcept {
     case State::kShed: {
       // The end sensors must confirm inside the profiles' window (not faster than a stroke, frames
       // off their start sensors early, by the timeout), then the frames settle before the pick.
-      const motion::ShedVerdict v = shed_.update(profiles_.shed(), seconds_since(now, state_since_),
+      const motion::ShedVerdict v = shed_.update(profiles_->shed(), seconds_since(now, state_since_),
                                                  {io_.piston_a_extended, io_.piston_a_retracted},
                                                  {io_.piston_b_extended, io_.piston_b_retracted});
       if (v == motion::ShedVerdict::kOpen) {
@@ -316,7 +334,7 @@ void Sequencer::advance(hal::Tick now, const hal::HalInputs& in) noexcept {
         }
         pick_to_right_ = io_.shuttle_at_left;
         helix_move_ = {true, now, cmd_.axes[index(Axis::kHelix)].target_position,
-                       pick_to_right_ ? profiles_.pick() : profiles_.pick_back()};
+                       pick_to_right_ ? profiles_->pick() : profiles_->pick_back()};
         row_.shed_ticks += now - phase_start_;
         phase_start_ = now;
         enter(State::kPick, now);
@@ -345,7 +363,7 @@ void Sequencer::advance(hal::Tick now, const hal::HalInputs& in) noexcept {
         } else {
           begin_sweep(now, in);
         }
-      } else if (seconds_since(now, state_since_) > profiles_.pick().duration() + cfg_.pick_timeout_margin_s) {
+      } else if (seconds_since(now, state_since_) > profiles_->pick().duration() + cfg_.pick_timeout_margin_s) {
         latch(Fault::kShuttleNotArrived, now);
       }
       break;
@@ -360,7 +378,7 @@ void Sequencer::advance(hal::Tick now, const hal::HalInputs& in) noexcept {
         row_.beat_ticks = now - phase_start_;
         row_.total_ticks = now - row_start_;
         row_.beats = row_beats_;
-        row_.carriage_steps = profiles_.cam().steps();
+        row_.carriage_steps = profiles_->cam().steps();
         if (row_.force_measured && row_beats_ > 0) {
           double lo = 1e300, hi = 0.0, sum = 0.0;
           for (int k = 0; k < row_beats_; ++k) {
@@ -380,13 +398,14 @@ void Sequencer::advance(hal::Tick now, const hal::HalInputs& in) noexcept {
         } else if (pause_requested_) {
           enter(State::kPaused, now);
         } else {
-          begin_shed(now);
+          begin_row(now);
         }
       }
       break;
 
     case State::kPaused:
-      if (!pause_requested_) begin_shed(now);
+      // Paused between the picks of a row resumes that row; paused at a row's end starts the next.
+      if (!pause_requested_) row_started_ ? begin_shed(now) : begin_row(now);
       break;
 
     case State::kDone:
@@ -409,13 +428,13 @@ void Sequencer::play_moves(hal::Tick now) noexcept {
   if (sweeping_) {
     // The sweep move is the master phase; the crank follows the speed law (constant: the same).
     const motion::Phase master = motion::Phase::from_rad(crank_move_.move.at(sweep_t).position);
-    const double phi = profiles_.crank_at(master).phase;
+    const double phi = profiles_->crank_at(master).phase;
     cmd_.axes[index(Axis::kBeatCrank)].target_position = crank_sweep_origin_ + phi;
     cmd_.axes[index(Axis::kCarriage)].target_position =
-        carriage_sweep_origin_ + carriage_sweep_dir_ * profiles_.cam().at(phi).position;
+        carriage_sweep_origin_ + carriage_sweep_dir_ * profiles_->cam().at(phi).position;
     // A beat is delivered when the commanded crank passes the fell of turn k.
-    const double fell = profiles_.beatup().warp().fell;
-    while (row_beats_ < profiles_.beats_per_row() && phi >= motion::kTwoPi * row_beats_ + fell) {
+    const double fell = profiles_->beatup().warp().fell;
+    while (row_beats_ < profiles_->beats_per_row() && phi >= motion::kTwoPi * row_beats_ + fell) {
       if (row_beats_ < kMaxBeatsPerRow) {
         row_.beat[static_cast<std::size_t>(row_beats_)].x_m = static_cast<float>(
             cmd_.axes[index(Axis::kCarriage)].target_position - cfg_.carriage_home_m);

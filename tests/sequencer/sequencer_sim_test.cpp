@@ -7,6 +7,7 @@
 #include "loom/hal/hal.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/profile_set.hpp"
+#include "loom/motion/profile_slot.hpp"
 #include "loom/sequencer/sequencer.hpp"
 #include "loom/sim_hal/sim_world.hpp"
 
@@ -234,4 +235,40 @@ TEST(SequencerSim, TwoPicksPerRowAlternateTheShedAndTheShuttle) {
   ASSERT_EQ(r.seq->state(), State::kDone) << sequencer::fault_name(r.seq->first_fault());
   EXPECT_EQ(r.seq->counters().picks, 4u);
   EXPECT_LT(r.world->shuttle_x(), 0.01);  // four picks: back at the left selvedge
+}
+
+TEST(SequencerSim, NewRecipeIsAdoptedAtTheNextRowBoundaryWithoutStopping) {
+  motion::ProfileSlot slot(std::make_unique<const motion::ProfileSet>(motion::ProfileSpec{}));
+  sequencer::SequencerConfig cfg;
+  cfg.rows_to_weave = 3;
+  sim_hal::SimWorld world(sim_hal::SimMachine{}, sim_hal::SceneSpec{});
+  sequencer::Sequencer seq(slot, cfg);
+  seq.request_start();
+  hal::PortHal hal(world, world);
+  hal::HalInputs in{};
+  hal::HalOutputs out{};
+  std::vector<int> beats;
+  std::uint32_t rows = 0;
+  bool published = false;
+  for (hal::Tick t = 0; t < 300000 && !seq.finished(); ++t) {
+    hal.read(t, in);
+    seq.step(t, in, out);
+    hal.write(t, out);
+    if (!published && seq.state() == State::kBeatSweep) {
+      // During row 1's beat sweep: a recipe beating every position twice. Row 1 must finish as planned.
+      motion::ProfileSpec twice;
+      twice.beats_per_position = 2;
+      slot.publish(std::make_unique<const motion::ProfileSet>(twice));
+      published = true;
+    }
+    if (seq.counters().rows != rows) {
+      rows = seq.counters().rows;
+      beats.push_back(seq.last_row().beats);
+    }
+    if (t % 1000 == 0) slot.collect();
+  }
+  ASSERT_EQ(seq.state(), State::kDone) << sequencer::fault_name(seq.first_fault());
+  EXPECT_EQ(beats, (std::vector<int>{15, 30, 30}));
+  EXPECT_EQ(seq.recipe_changes(), 1u);
+  EXPECT_EQ(seq.profiles().beats_per_row(), 30);
 }

@@ -11,6 +11,7 @@
 #include "loom/firmware/config.hpp"
 #include "loom/firmware/control_loop.hpp"
 #include "loom/motion/profile_set.hpp"
+#include "loom/motion/profile_slot.hpp"
 #include "loom/sequencer/sequencer.hpp"
 #include "loom/sim_hal/sim_world.hpp"
 #include "loom/telemetry/telemetry.hpp"
@@ -37,7 +38,14 @@ class Machine {
 
   ControlLoop& loop() { return *loop_; }
   sequencer::Sequencer& sequencer() { return *sequencer_; }
-  const motion::ProfileSet& profiles() const { return *profiles_; }
+  // The recipe the loop started with (the sequencer's current one is sequencer().profiles()).
+  const motion::ProfileSet& profiles() const { return sequencer_->profiles(); }
+  // Non-RT. Build the profiles of `next` and hand them to the running loop, which adopts them at the
+  // next row boundary. Throws ConfigError when `next` changes something only a restart can change
+  // (period, HAL settings, loom id) or its motion cannot be built; the running recipe is untouched.
+  void publish_recipe(const LoomConfig& next);
+  // Non-RT. Free a recipe the loop has retired. Call now and then (after each row is enough).
+  void collect_retired_recipes() { slot_->collect(); }
   telemetry::Telemetry* telemetry() { return telemetry_.get(); }
   const drivers::CanAxisPort* can() const { return can_port_.get(); }
   const sim_hal::SimWorld& sim() const { return *sim_; }
@@ -45,7 +53,7 @@ class Machine {
 
  private:
   LoomConfig cfg_;
-  std::unique_ptr<motion::ProfileSet> profiles_;
+  std::unique_ptr<motion::ProfileSlot> slot_;
   std::unique_ptr<sequencer::Sequencer> sequencer_;
   std::unique_ptr<sim_hal::SimStateFile> sim_state_;
   std::unique_ptr<sim_hal::SimWorld> sim_;

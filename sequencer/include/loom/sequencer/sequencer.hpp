@@ -9,6 +9,7 @@
 #include "loom/hal/types.hpp"
 #include "loom/motion/jerk_move.hpp"
 #include "loom/motion/profile_set.hpp"
+#include "loom/motion/profile_slot.hpp"
 #include "loom/sequencer/faults.hpp"
 #include "loom/sequencer/interlocks.hpp"
 
@@ -75,6 +76,9 @@ class Sequencer {
  public:
   // Configure-time only. `profiles` must outlive the sequencer. `resume` seeds the counters (restart).
   Sequencer(const motion::ProfileSet& profiles, const SequencerConfig& cfg, Counters resume = {});
+  // Configure-time only. Follows `slot`: a recipe published there is adopted at the next row boundary
+  // (then the machine re-arms, so a changed width re-homes the carriage). `slot` must outlive this.
+  Sequencer(motion::ProfileSlot& slot, const SequencerConfig& cfg, Counters resume = {});
 
   void request_start() noexcept { start_requested_ = true; }       // RT-safe
   void request_stop_at_row_end() noexcept { stop_requested_ = true; }  // RT-safe
@@ -95,6 +99,8 @@ class Sequencer {
   std::uint16_t fault_detail() const noexcept { return fault_detail_; }  // device code (EMCY) if any
   hal::Tick fault_tick() const noexcept { return fault_tick_; }
   const RowStats& last_row() const noexcept { return last_row_; }
+  const motion::ProfileSet& profiles() const noexcept { return *profiles_; }
+  std::uint32_t recipe_changes() const noexcept { return recipe_changes_; }
   // Beater crank phase from park of the current command (rad) and the table's rocker angle there.
   double commanded_crank_phase() const noexcept;
   double commanded_rocker_angle() const noexcept;
@@ -112,12 +118,15 @@ class Sequencer {
   void enter(State s, hal::Tick now) noexcept;
   void advance(hal::Tick now, const hal::HalInputs& in) noexcept;
   void begin_shed(hal::Tick now) noexcept;
+  void begin_row(hal::Tick now) noexcept;  // a row boundary: adopt a published recipe, else shed
   void begin_sweep(hal::Tick now, const hal::HalInputs& in) noexcept;
   void debounce(const hal::DigitalInputs& raw) noexcept;
   void track_beat_force(const hal::HalInputs& in) noexcept;
   void play_moves(hal::Tick now) noexcept;
 
-  const motion::ProfileSet& profiles_;
+  const motion::ProfileSet* profiles_;
+  motion::ProfileSlot* slot_ = nullptr;
+  std::uint32_t recipe_changes_ = 0;
   SequencerConfig cfg_;
   InterlockContext interlock_ctx_;
   Counters counters_;
