@@ -1,41 +1,14 @@
 // The CAN axis port's per-tick path allocates nothing: operator new is counted while read_axes and
 // write_axes run over 20,000 ticks against simulated drives, including a heartbeat loss, a drive fault
-// with EMCY and a fault reset. (Its own executable: it replaces the global operator new.)
+// with EMCY and a fault reset. (Its own executable: tests/support's counter replaces the global operator new.)
 #include <gtest/gtest.h>
 
-#include <cstdlib>
-#include <new>
 
 #include "fake_can_network.hpp"
 #include "loom/drivers/can_axis_port.hpp"
 #include "loom/sim_can/sim_drive_rack.hpp"
 #include "relay_bus.hpp"
-
-namespace {
-bool g_counting = false;
-long g_allocations = 0;
-}  // namespace
-
-void* operator new(std::size_t n) {
-  if (g_counting) ++g_allocations;
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) {
-  return operator new(n);
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p, std::size_t) noexcept {
-  std::free(p);
-}
+#include "alloc_counter.hpp"
 
 namespace loom::test {
 namespace {
@@ -80,8 +53,8 @@ TEST(CanAxisPortRt, TwentyThousandTicksWithoutAllocation) {
   for (hal::Tick k = 0; k < 20'000; ++k) {
     if (k == 8'000) rack.node(2).inject_fault(0x2310);
     if (k == 15'000) rack.node(1).power_off();
-    const long before = g_allocations;
-    g_counting = true;
+    const long before = static_cast<long>(allocations());
+    count_allocations(true);
     port.read_axes(k, fb, link);
     for (std::size_t i = 0; i < 3; ++i) {
       cmd[i].request =
@@ -90,8 +63,8 @@ TEST(CanAxisPortRt, TwentyThousandTicksWithoutAllocation) {
           fb[i].position + (fb[i].state == hal::DriveState::kOperationEnabled ? 1e-4 : 0.0);
     }
     port.write_axes(k, cmd);
-    g_counting = false;
-    worst = std::max(worst, g_allocations - before);
+    count_allocations(false);
+    worst = std::max(worst, static_cast<long>(allocations()) - before);
     saw_fault = saw_fault || fb[2].fault;
     saw_enabled = saw_enabled || fb[0].state == hal::DriveState::kOperationEnabled;
     relay.exchange();
@@ -105,7 +78,7 @@ TEST(CanAxisPortRt, TwentyThousandTicksWithoutAllocation) {
   EXPECT_TRUE(saw_enabled);
   EXPECT_TRUE(saw_fault);
   EXPECT_TRUE(link.link_fault);  // the heartbeat loss was seen too
-  EXPECT_EQ(g_allocations, 0);
+  EXPECT_EQ(allocations(), 0u);
   EXPECT_EQ(worst, 0);
 }
 

@@ -1,29 +1,11 @@
 // Proves the RT tick allocates nothing after start-up: global operator new is replaced in this test
-// executable and counts calls made on the loop's thread while ControlLoop::cycle runs, over a whole
+// executable (tests/support) and counts calls made on the loop's thread while ControlLoop::cycle runs, over a whole
 // weaving run (> 10,000 ticks) with telemetry publishing through real LCM on another thread.
 #include <gtest/gtest.h>
 
-#include <cstdlib>
-#include <new>
-
 #include "loom/firmware/config.hpp"
 #include "loom/firmware/machine.hpp"
-
-namespace {
-thread_local bool g_counting = false;
-thread_local std::size_t g_allocations = 0;
-}  // namespace
-
-void* operator new(std::size_t n) {
-  if (g_counting) ++g_allocations;
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) { return operator new(n); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+#include "alloc_counter.hpp"
 
 using namespace loom;
 
@@ -39,11 +21,11 @@ std::size_t allocations_while_weaving(const firmware::Scene& scene, std::uint32_
   hal::Tick t = 0;
   std::size_t total = 0;
   for (; t < 200000 && !m.sequencer().finished(); ++t) {
-    g_allocations = 0;
-    g_counting = true;
+    test::reset_allocations();
+    test::count_allocations(true);
     m.loop().cycle(t);
-    g_counting = false;
-    total += g_allocations;
+    test::count_allocations(false);
+    total += test::allocations();
   }
   *ticks_out = t;
   EXPECT_EQ(m.sequencer().state(), sequencer::State::kDone);
@@ -53,13 +35,13 @@ std::size_t allocations_while_weaving(const firmware::Scene& scene, std::uint32_
 
 TEST(TickAllocations, CounterSeesAnAllocation) {
   // The counter itself must be able to fail.
-  g_allocations = 0;
-  g_counting = true;
+  test::reset_allocations();
+  test::count_allocations(true);
   // A direct call: new-expressions may legally be elided by the optimiser, this may not.
   void* p = ::operator new(16);
-  g_counting = false;
+  test::count_allocations(false);
   ::operator delete(p);
-  EXPECT_EQ(g_allocations, 1u);
+  EXPECT_EQ(test::allocations(), 1u);
 }
 
 TEST(TickAllocations, WeavingRunAllocatesNothingPerTick) {

@@ -12,10 +12,20 @@
 #include "loom/motion/angles.hpp"
 #include "loom/motion/errors.hpp"
 #include "loom/motion/synthesis.hpp"
+#include "motion_error.hpp"
 #include "table_rows.hpp"
 #include "thesis_tables.hpp"
 
 namespace {
+
+// A typed refusal is expected: no error at all fails the test.
+template <class F>
+loom::motion::ErrorCode code_of_call(F&& f) {
+  const auto code = loom::test::error_of(f);
+  if (!code) ADD_FAILURE() << "expected a MotionError";
+  return code.value_or(loom::motion::ErrorCode::kSingular);
+}
+using loom::test::message_of;
 
 using loom::motion::CrankRockerCase;
 using loom::motion::CrankRockerDesign;
@@ -28,25 +38,6 @@ using loom::motion::kPi;
 using loom::motion::kTwoPi;
 using loom::motion::MotionError;
 using loom::motion::rad;
-
-ErrorCode code_of_call(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const MotionError& e) {
-    return e.code();
-  }
-  ADD_FAILURE() << "expected a MotionError";
-  return ErrorCode::kSingular;
-}
-
-std::string message_of_call(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const MotionError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 // ---------------------------------------------------------------------------------------------
 // Independent forward analysis. Ground A0 = (0,0), B0 = (d,0), coupler point B above the ground
@@ -272,7 +263,7 @@ TEST(KhareDave, BetaOutsideTheBoundsIsOutOfBoundsNamingThem) {
   EXPECT_EQ(code_of_call([] { khare_dave_crank_rocker(rad(30.0), rad(210.0), rad(70.0)); }),
             ErrorCode::kOutOfBounds);
   const std::string msg =
-      message_of_call([] { khare_dave_crank_rocker(rad(30.0), rad(120.0), rad(80.0)); });
+      message_of([] { khare_dave_crank_rocker(rad(30.0), rad(120.0), rad(80.0)); });
   EXPECT_NE(msg.find("beta = 80"), std::string::npos) << msg;
   EXPECT_NE(msg.find("[60, 75]"), std::string::npos) << msg;
   EXPECT_EQ(code_of_call([] { khare_dave_crank_rocker(rad(30.0), rad(120.0), std::nan("")); }),
@@ -290,7 +281,7 @@ TEST(KhareDave, ImpossibleSwingOrRotationIsInvalidInput) {
             ErrorCode::kInvalidInput);
   EXPECT_EQ(code_of_call([] { khare_dave_crank_rocker(rad(30.0), rad(180.0), rad(40.0), 0.0); }),
             ErrorCode::kInvalidInput);
-  const std::string msg = message_of_call([] { loom::motion::khare_dave_beta_bounds(rad(30.0), rad(100.0)); });
+  const std::string msg = message_of([] { loom::motion::khare_dave_beta_bounds(rad(30.0), rad(100.0)); });
   EXPECT_NE(msg.find("phi"), std::string::npos);
 }
 

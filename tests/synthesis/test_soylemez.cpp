@@ -11,10 +11,20 @@
 #include "loom/motion/errors.hpp"
 #include "loom/motion/slider_crank.hpp"
 #include "loom/motion/synthesis.hpp"
+#include "motion_error.hpp"
 #include "table_rows.hpp"
 #include "thesis_tables.hpp"
 
 namespace {
+
+// A typed refusal is expected: no error at all fails the test.
+template <class F>
+loom::motion::ErrorCode code_of_call(F&& f) {
+  const auto code = loom::test::error_of(f);
+  if (!code) ADD_FAILURE() << "expected a MotionError";
+  return code.value_or(loom::motion::ErrorCode::kSingular);
+}
+using loom::test::message_of;
 
 using loom::motion::deg;
 using loom::motion::ErrorCode;
@@ -24,25 +34,6 @@ using loom::motion::MotionError;
 using loom::motion::rad;
 using loom::motion::SliderCrankDesign;
 using loom::motion::soylemez_slider_crank;
-
-ErrorCode code_of_call(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const MotionError& e) {
-    return e.code();
-  }
-  ADD_FAILURE() << "expected a MotionError";
-  return ErrorCode::kSingular;
-}
-
-std::string message_of_call(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const MotionError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 // Forward check: the synthesised mechanism's own stroke and crank rotation.
 void expect_forward_matches(const SliderCrankDesign& d, double stroke, double phi) {
@@ -159,7 +150,7 @@ TEST(Soylemez, Phi180IsAnErrorWithTheRightLimits) {
   EXPECT_EQ(code_of_call([] { soylemez_slider_crank(1.0, rad(180.0)); }), ErrorCode::kInvalidInput);
   EXPECT_EQ(code_of_call([] { soylemez_slider_crank(1.0, std::nextafter(kPi, 0.0)); }),
             ErrorCode::kInvalidInput);  // within the 1e-14 rad snap of 180°
-  EXPECT_NE(message_of_call([] { soylemez_slider_crank(1.0, kPi); }).find("phi = 180"),
+  EXPECT_NE(message_of([] { soylemez_slider_crank(1.0, kPi); }).find("phi = 180"),
             std::string::npos);
   EXPECT_EQ(code_of_call([] { soylemez_slider_crank(1.0, rad(181.0)); }), ErrorCode::kInvalidInput);
   EXPECT_EQ(code_of_call([] { soylemez_slider_crank(1.0, rad(89.0)); }), ErrorCode::kInvalidInput);
@@ -212,7 +203,7 @@ TEST(Soylemez, GivenLambdaBoundsAndChangePoints) {
 
   EXPECT_EQ(code_of_call([&] { soylemez_slider_crank(1.0, phi, 1.01); }), ErrorCode::kOutOfBounds);
   EXPECT_EQ(code_of_call([&] { soylemez_slider_crank(1.0, phi, 0.005); }), ErrorCode::kOutOfBounds);
-  const std::string msg = message_of_call([&] { soylemez_slider_crank(1.0, phi, 1.01); });
+  const std::string msg = message_of([&] { soylemez_slider_crank(1.0, phi, 1.01); });
   EXPECT_NE(msg.find("lambda"), std::string::npos) << msg;
   EXPECT_NE(msg.find(", 1]"), std::string::npos) << msg;
   EXPECT_EQ(code_of_call([&] { soylemez_slider_crank(1.0, phi, std::nan("")); }),

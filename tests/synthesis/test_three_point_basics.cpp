@@ -11,23 +11,24 @@
 #include "loom/motion/errors.hpp"
 #include "loom/motion/three_point.hpp"
 
+#include "motion_error.hpp"
+
 namespace {
+
+// A typed refusal is expected: no error at all fails the test.
+template <class F>
+loom::motion::ErrorCode code_of_call(F&& f) {
+  const auto code = loom::test::error_of(f);
+  if (!code) ADD_FAILURE() << "expected a MotionError";
+  return code.value_or(loom::motion::ErrorCode::kSingular);
+}
+using loom::test::message_of;
 
 using loom::motion::ErrorCode;
 using loom::motion::MotionError;
 using loom::motion::PrecisionPoint;
 using loom::motion::rad;
 using loom::motion::three_point_synthesis;
-
-ErrorCode code_of_call(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const MotionError& e) {
-    return e.code();
-  }
-  ADD_FAILURE() << "expected a MotionError";
-  return ErrorCode::kSingular;
-}
 
 // The chain end for given lengths and angles: the independent truth the synthesis must invert.
 PrecisionPoint chain_end(double a0, double th0, double a1, double th1, double a2, double th2) {

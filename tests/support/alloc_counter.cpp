@@ -1,4 +1,4 @@
-// Replacement global operator new/delete for the RT-lookup test (see alloc_counter.hpp).
+// Replacement global operator new/delete for the allocation tests (see alloc_counter.hpp).
 #include "alloc_counter.hpp"
 
 #include <cstdlib>

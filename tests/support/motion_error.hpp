@@ -1,4 +1,4 @@
-// What a call into motion/ refused with, for the mechanism tests: the MotionError's code (empty when
+// What a call into motion/ refused with, for the motion tests: the MotionError's code (empty when
 // the call returned) or its message, so a test can say which typed error an impossible input gets.
 #pragma once
 
