@@ -26,6 +26,9 @@ std::atomic<bool> g_stop{false};
 std::atomic<bool> g_reload{false};
 extern "C" void on_signal(int) { g_stop.store(true); }
 extern "C" void on_hangup(int) { g_reload.store(true); }
+std::atomic<bool> g_pause{false};
+extern "C" void on_pause(int) { g_pause.store(true); }
+extern "C" void on_resume(int) { g_pause.store(false); }
 
 struct WeaveArgs {
   std::string config, scene, hal = "sim", iface, counters, lcm_url, loom_id, report, sim_state;
@@ -150,6 +153,11 @@ int weave(const WeaveArgs& a) {
         std::fprintf(stderr, "loomctl: recipe not reloaded, weaving on with the current one: %s\n", ex.what());
       }
     }
+    if (e.kind == firmware::RunEvent::Kind::kPaused || e.kind == firmware::RunEvent::Kind::kResumed) {
+      std::printf("%s after row %u, pick %u\n", e.kind == firmware::RunEvent::Kind::kPaused ? "paused" : "resumed",
+                  e.counters.rows, e.counters.picks);
+      std::fflush(stdout);
+    }
     if (e.kind == firmware::RunEvent::Kind::kRowDone) {
       const auto& r = e.row;
       ++rows_this_run;
@@ -185,6 +193,8 @@ int weave(const WeaveArgs& a) {
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   std::signal(SIGHUP, on_hangup);
+  std::signal(SIGUSR1, on_pause);   // pause at the next safe point (before a shed change)
+  std::signal(SIGUSR2, on_resume);
   auto& seq = machine->sequencer();
   seq.request_start();
   firmware::RunOptions ro;
@@ -193,6 +203,7 @@ int weave(const WeaveArgs& a) {
   ro.pace = hardware ? 1.0 : a.pace;
   ro.grace_ticks = static_cast<hal::Tick>(0.2 / period);
   ro.stop_flag = &g_stop;
+  ro.pause_flag = &g_pause;
   const firmware::RunResult res = firmware::run_loop(machine->loop(), seq, ro, on_event);
   if (auto* tm = machine->telemetry()) tm->stop();
 

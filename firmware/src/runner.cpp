@@ -100,6 +100,7 @@ RunResult run_loop(ControlLoop& loop, sequencer::Sequencer& seq, const RunOption
   std::uint32_t picks_seen = seq.counters().picks;
   hal::Tick finished_at = -1;
   bool stop_sent = false;
+  bool was_paused = false;
   LoopStats& stats = loop.stats();
   hal::Tick tick = 0;
   for (;; ++tick) {
@@ -112,6 +113,10 @@ RunResult run_loop(ControlLoop& loop, sequencer::Sequencer& seq, const RunOption
     if (opt.stop_flag != nullptr && !stop_sent && opt.stop_flag->load(std::memory_order_relaxed)) {
       seq.request_stop_at_row_end();
       stop_sent = true;
+    }
+    if (opt.pause_flag != nullptr) {
+      const bool want_pause = opt.pause_flag->load(std::memory_order_relaxed);
+      want_pause ? seq.request_pause() : seq.request_resume();
     }
     const std::int64_t t0 = now_ns();
     loop.cycle(tick);
@@ -128,6 +133,16 @@ RunResult run_loop(ControlLoop& loop, sequencer::Sequencer& seq, const RunOption
       e.kind = row_done ? RunEvent::Kind::kRowDone : RunEvent::Kind::kPickDone;
       e.tick = tick;
       e.row = seq.last_row();
+      e.counters = seq.counters();
+      e.state = seq.state();
+      emit(e);
+    }
+    const bool paused = seq.state() == sequencer::State::kPaused;
+    if (paused != was_paused) {
+      was_paused = paused;
+      RunEvent e;
+      e.kind = paused ? RunEvent::Kind::kPaused : RunEvent::Kind::kResumed;
+      e.tick = tick;
       e.counters = seq.counters();
       e.state = seq.state();
       emit(e);

@@ -23,7 +23,7 @@ struct RtSetup {
 RtSetup setup_realtime(int fifo_priority);
 
 struct RunEvent {
-  enum class Kind : std::uint8_t { kRowDone, kPickDone, kFinished } kind = Kind::kRowDone;
+  enum class Kind : std::uint8_t { kRowDone, kPickDone, kPaused, kResumed, kFinished } kind = Kind::kRowDone;
   hal::Tick tick = 0;
   sequencer::RowStats row{};
   sequencer::Counters counters{};
@@ -36,7 +36,8 @@ struct RunOptions {
   double pace = 1.0;             // with realtime: run this many times faster than real time (sim only)
   hal::Tick max_ticks = 0;       // 0 = no limit
   hal::Tick grace_ticks = 100;   // ticks run after the sequencer finishes (quick stop reaches the drives)
-  const std::atomic<bool>* stop_flag = nullptr;  // set asynchronously → stop at row end
+  const std::atomic<bool>* stop_flag = nullptr;   // set asynchronously → stop at row end
+  const std::atomic<bool>* pause_flag = nullptr;  // true → pause at the next safe point, false → resume
 };
 
 struct RunResult {
