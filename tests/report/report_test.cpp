@@ -62,6 +62,12 @@ TEST(RunReport, FaultAndMissingLoadCellAreExplicit) {
   EXPECT_TRUE(j.at("rows")[0].at("beats")[0].at("peak_force_n").is_null());
   EXPECT_EQ(j.at("result"), "fault");
   EXPECT_EQ(j.at("first_fault").at("name"), "drive_fault");
+  // The stopped row is listed, incomplete, with its fault.
+  ASSERT_EQ(j.at("rows").size(), 3u);
+  EXPECT_FALSE(j.at("rows")[2].at("complete").get<bool>());
+  EXPECT_EQ(j.at("rows")[2].at("row"), 3);
+  EXPECT_EQ(j.at("rows")[2].at("faults")[0].at("name"), "drive_fault");
+  EXPECT_TRUE(j.at("rows")[1].at("faults").empty());
 }
 
 TEST(RunReport, WritesSummaryAndSvgPlots) {

@@ -48,10 +48,28 @@ nlohmann::json to_json(const RunSummary& s) {
                     {"shed_s", static_cast<double>(r.shed_ticks) * s.period_s},
                     {"pick_s", static_cast<double>(r.pick_ticks) * s.period_s},
                     {"beat_s", static_cast<double>(r.beat_ticks) * s.period_s},
+                    {"complete", true},
                     {"picks", i < s.row_picks.size() ? s.row_picks[i] : 0u},
                     {"carriage_steps", r.carriage_steps},
                     {"beats", beats},
                     {"faults", json::array()}});
+  }
+  if (s.fault) {
+    // The row the fault stopped: not complete, so no times or beats, but its faults are where a
+    // reader of the rows looks for them.
+    rows.push_back({{"row", s.counters.rows + 1},
+                    {"complete", false},
+                    {"time_s", nullptr},
+                    {"shed_s", nullptr},
+                    {"pick_s", nullptr},
+                    {"beat_s", nullptr},
+                    {"picks", s.counters.picks_in_row},
+                    {"beats", json::array()},
+                    {"faults", json::array({{{"name", s.fault->name},
+                                             {"code", s.fault->code},
+                                             {"axis", s.fault->axis},
+                                             {"device_code", s.fault->device_code},
+                                             {"t_s", s.fault->t_s}}})}});
   }
   json totals = {{"rows", s.counters.rows},
                  {"picks", s.counters.picks},
@@ -99,6 +117,7 @@ void write_plots(const nlohmann::json& j, const std::string& dir) {
   bool any_force = false;
   std::size_t i = 0;
   for (const auto& row : j.at("rows")) {
+    if (!row.value("complete", true)) continue;
     Series s;
     s.label = "row " + std::to_string(row.at("row").get<int>());
     s.colour = kColours[i++ % 6];
@@ -119,8 +138,12 @@ void write_plots(const nlohmann::json& j, const std::string& dir) {
   Timeline tl;
   tl.title = "Row timeline";
   tl.lanes = {"shed", "pick", "beat sweep"};
-  if (!j.at("rows").empty()) {
-    const auto& r = j.at("rows").back();
+  const nlohmann::json* last = nullptr;
+  for (const auto& row : j.at("rows")) {
+    if (row.value("complete", true)) last = &row;
+  }
+  if (last != nullptr) {
+    const auto& r = *last;
     const double shed = r.at("shed_s"), pick = r.at("pick_s"), beat = r.at("beat_s");
     tl.title = "Row " + std::to_string(r.at("row").get<int>()) + " timeline (" + std::to_string(r.at("time_s").get<double>()).substr(0, 5) + " s)";
     tl.bars.push_back({"shed", 0.0, shed, "#2ca02c"});
