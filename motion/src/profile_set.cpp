@@ -110,11 +110,10 @@ ProfileSet::ProfileSet(const ProfileSpec& spec)
     infeasible(os);
   }
   const double carrier_limit = spec.carrier_force_n / spec.shuttle_mass_kg * kTwoPi / spec.helix_lead_m;
-  JerkLimits helix = spec.helix;
-  helix.acceleration = std::min(helix.acceleration, carrier_limit);
-  helix_accel_ = helix.acceleration;
-  pick_ = JerkMove::plan(kTwoPi * spec.width_m / spec.helix_lead_m, helix);
-  pick_back_ = JerkMove::plan(-kTwoPi * spec.width_m / spec.helix_lead_m, helix);
+  helix_ = spec.helix;
+  helix_.acceleration = std::min(helix_.acceleration, carrier_limit);
+  pick_ = JerkMove::plan(kTwoPi * spec.width_m / spec.helix_lead_m, helix_);
+  pick_back_ = JerkMove::plan(-kTwoPi * spec.width_m / spec.helix_lead_m, helix_);
 }
 
 PhaseSample ProfileSet::rocker_at(const Phase& master) const noexcept {

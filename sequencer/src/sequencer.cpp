@@ -293,10 +293,7 @@ void Sequencer::advance(hal::Tick now, const hal::HalInputs& in) noexcept {
         const double goal =
             cfg_.helix_left_position_rad + (pick_to_right_ ? profiles_->pick().distance() : 0.0);
         const double from = cmd_.axes[index(Axis::kHelix)].target_position;
-        helix_move_ = {true, now, from,
-                       motion::JerkMove::plan(goal - from, {.velocity = profiles_->spec().helix.velocity,
-                                                            .acceleration = profiles_->helix_accel_limit(),
-                                                            .jerk = profiles_->spec().helix.jerk})};
+        helix_move_ = {true, now, from, motion::JerkMove::plan(goal - from, profiles_->helix_limits())};
         if (!row_started_) {
           row_started_ = true;
           row_start_ = now;

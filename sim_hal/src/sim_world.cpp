@@ -264,11 +264,11 @@ void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::Digit
 }
 
 void SimWorld::write_io(hal::Tick, const hal::DigitalOutputs& io) {
-  valve_ = {io.piston_a_extend, io.piston_b_extend};
+  const std::array<bool, 2> valve{io.piston_a_extend, io.piston_b_extend};
   const double dt = m_.period_s;
   const double full_speed = dt / m_.piston_travel_s;  // fraction of stroke per tick at full pressure
   for (std::size_t i = 0; i < 2; ++i) {
-    const double goal = valve_[i] ? 1.0 : -1.0;
+    const double goal = valve[i] ? 1.0 : -1.0;
     double step = goal * full_speed;
     if (scene_.pneumatics) {
       const Pneumatics& p = *scene_.pneumatics;

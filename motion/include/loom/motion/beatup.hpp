@@ -6,6 +6,7 @@
 
 #include <cstdint>
 
+#include "loom/motion/angles.hpp"
 #include "loom/motion/fourbar.hpp"
 
 namespace loom::motion {
@@ -35,7 +36,7 @@ struct WarpWindow {
   double enter = 0.0;  // phase (rad, in (0, 2π)) where the teeth enter the warp, moving toward the fell
   double fell = 0.0;   // phase of the fell dead centre
   double exit = 0.0;   // phase where the teeth leave the warp; enter < fell < exit
-  double clear() const { return 6.283185307179586 - (exit - enter); }  // length of the clear window
+  double clear() const { return kTwoPi - (exit - enter); }  // length of the clear window
 };
 
 class BeatUp {

@@ -66,7 +66,9 @@ class ProfileSet {
   int beats_per_row() const noexcept { return beats_; }
   double pitch_m() const noexcept { return cam_.pitch(); }
   double carriage_travel_m() const noexcept { return spec_.width_m - spec_.beater_width_m; }
-  double helix_accel_limit() const noexcept { return helix_accel_; }  // rad/s² after the carrier limit
+  double helix_accel_limit() const noexcept { return helix_.acceleration; }  // rad/s² after the carrier limit
+  // The helix shaft's limits as every pick uses them (acceleration capped by the carrier).
+  const JerkLimits& helix_limits() const noexcept { return helix_; }
   double shuttle_accel_limit_m_s2() const noexcept { return spec_.carrier_force_n / spec_.shuttle_mass_kg; }
   std::size_t table_bytes() const noexcept { return rocker_.bytes() + crank_law_.table().bytes(); }
   // Worst error of the rocker and crank-law tables at the segment midpoints, measured at build (rad).
@@ -89,7 +91,7 @@ class ProfileSet {
   JerkMove sweep_;
   JerkMove pick_;
   JerkMove pick_back_;
-  double helix_accel_ = 0.0;
+  JerkLimits helix_{};
   double rocker_error_ = 0.0;
   double crank_error_ = 0.0;
 };

@@ -21,7 +21,6 @@ namespace loom::sequencer {
   X(kCarriageInWarp, 0x100A, "interlock_carriage_in_warp", "carriage commanded while the beater is in the warp") \
   X(kPickWithoutShed, 0x100B, "interlock_pick_without_shed", "pick commanded while the shed is not confirmed open") \
   X(kShedWithShuttle, 0x100C, "interlock_shed_with_shuttle", "shed change commanded while the shuttle is in the shed") \
-  X(kStopRequested, 0x100D, "stop_requested", "operator stop")                                          \
   X(kShedSensorEarly, 0x100E, "shed_sensor_early", "piston end sensors confirmed faster than a frame can move") \
   X(kShedNotReleased, 0x100F, "shed_not_released", "a heald frame never left its end position (valve, air, jam)")
 
