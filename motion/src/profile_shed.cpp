@@ -71,6 +71,10 @@ void ShedMonitor::start(bool a_extend, bool b_extend, PistonEnds a_now, PistonEn
   b_moves_ = !at_end(b_now, b_extend);
   a_left_ = !a_moves_;
   b_left_ = !b_moves_;
+  // Only a frame that starts on its start sensor travels the whole stroke; one left mid-stroke (a
+  // power cut during a shed change) may arrive as early as it likes.
+  a_full_stroke_ = a_moves_ && on_start(a_now, a_extend);
+  b_full_stroke_ = b_moves_ && on_start(b_now, b_extend);
   stable_since_ = -1.0;
   confirmed_at_ = -1.0;
   latched_ = ShedVerdict::kMoving;
@@ -82,7 +86,7 @@ ShedVerdict ShedMonitor::update(const ShedSpec& s, double t, PistonEnds a, Pisto
     // Confirmed: later sensor flicker is the interlocks' business during the pick, not a new verdict.
     return t - confirmed_at_ >= s.debounce_s + s.settle_s ? ShedVerdict::kOpen : ShedVerdict::kSettling;
   }
-  const bool moves = a_moves_ || b_moves_;
+  const bool full_stroke = a_full_stroke_ || b_full_stroke_;
   // A frame has left once its start sensor read open on any tick: a bouncing contact can only delay
   // this verdict to the timeout, never raise it falsely.
   a_left_ = a_left_ || !on_start(a, a_extend_);
@@ -90,7 +94,9 @@ ShedVerdict ShedMonitor::update(const ShedSpec& s, double t, PistonEnds a, Pisto
   if (at_end(a, a_extend_) && at_end(b, b_extend_)) {
     if (stable_since_ < 0.0) stable_since_ = t;
     if (t - stable_since_ >= s.debounce_s) {
-      if (moves && stable_since_ < s.earliest_fraction * s.piston_travel_s) return latched_ = ShedVerdict::kTooEarly;
+      if (full_stroke && stable_since_ < s.earliest_fraction * s.piston_travel_s) {
+        return latched_ = ShedVerdict::kTooEarly;
+      }
       confirmed_at_ = stable_since_;
       return t - confirmed_at_ >= s.debounce_s + s.settle_s ? ShedVerdict::kOpen : ShedVerdict::kSettling;
     }

@@ -91,6 +91,20 @@ TEST(Shed, SensorsConfirmingFasterThanAStrokeAreAFault) {
             ShedVerdict::kOpen);
 }
 
+TEST(Shed, FramesLeftMidStrokeMayArriveEarly) {
+  // Power cut during a shed change: on restart the frames sit between their sensors and finish the
+  // stroke in a fraction of the full time — healthy, not a sensor fault.
+  const ShedSpec s = kSpec;
+  const Outcome o = run(s, Piston{.start = 0.8, .extend = true}, Piston{.start = 0.2, .extend = false});
+  EXPECT_EQ(o.verdict, ShedVerdict::kOpen);
+  EXPECT_LT(o.at_s, s.earliest_fraction * s.piston_travel_s);
+  // A frame that starts on its start sensor still must take a plausible stroke time.
+  const Outcome miswired = run(s, kRising, Piston{.start = 0.2, .extend = false}, [](double t, PistonEnds& a, PistonEnds&) {
+    if (t > 0) a = {true, false};
+  });
+  EXPECT_EQ(miswired.verdict, ShedVerdict::kTooEarly);
+}
+
 TEST(Shed, FrameThatNeverLeavesItsStartSensorFaultsAtTheReleaseTimeout) {
   const ShedSpec s = kSpec;
   const Piston stuck{.start = 0.0, .stroke_s = INFINITY, .extend = true};

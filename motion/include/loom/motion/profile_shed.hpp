@@ -57,6 +57,7 @@ class ShedMonitor {
  private:
   bool a_extend_ = false, b_extend_ = false;
   bool a_moves_ = false, b_moves_ = false;
+  bool a_full_stroke_ = false, b_full_stroke_ = false;  // moving from the start sensor: a whole stroke
   bool a_left_ = true, b_left_ = true;  // the frame has been seen off its start sensor (or need not move)
   double stable_since_ = -1.0;
   double confirmed_at_ = -1.0;
