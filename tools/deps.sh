@@ -9,6 +9,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config
+  ccache                        # rebuilds in fresh clones and worktrees
   libeigen3-dev                 # motion/ linear algebra
   liblcm-dev liblcm-bin         # telemetry (lcm-gen, lcm-logger, lcm-logplayer)
   libgtest-dev libgmock-dev     # tests

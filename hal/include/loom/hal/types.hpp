@@ -76,6 +76,11 @@ struct DigitalOutputs {
   // and vented; the shed closes, which never traps the shuttle because it cannot be picked then.
   bool piston_a_extend = false;
   bool piston_b_extend = false;
+  // Stack light and buzzer (operator signalling only; nothing safety-relevant depends on them).
+  bool lamp_green = false;   // weaving
+  bool lamp_amber = false;   // waiting for the operator (armed, paused, waiting for the knotter)
+  bool lamp_red = false;     // fault latched, waiting for acknowledgement
+  bool buzzer = false;
 };
 
 struct DigitalInputs {
@@ -86,6 +91,12 @@ struct DigitalInputs {
   bool shuttle_at_left = false;    // shuttle-arrival sensors at each selvedge
   bool shuttle_at_right = false;
   bool estop_ok = false;           // e-stop chain closed (true = healthy; broken wire reads as e-stop)
+  // Operator inputs (push buttons / foot pedal on the I/O node): true while pressed. They request;
+  // the sequencer decides when a request is acted on. Not safety inputs (the e-stop chain is).
+  bool button_start = false;
+  bool button_pause = false;
+  bool button_ack = false;         // reset / acknowledge a latched fault
+  bool row_knotted = false;        // the weaver's "row knotted" pedal (knotting mode)
   Tick refreshed = kNeverTick;
 };
 
