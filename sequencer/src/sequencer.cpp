@@ -163,6 +163,7 @@ void Sequencer::begin_shed(hal::Tick now) noexcept {
     row_started_ = true;
     row_start_ = now;
     row_beats_ = 0;
+    beats_published_ = 0;
     const std::uint32_t row = counters_.rows + 1;
     row_ = RowStats{};
     row_.row = row;
@@ -212,6 +213,7 @@ void Sequencer::begin_sweep(hal::Tick now, const hal::HalInputs& in) noexcept {
   crank_move_ = {true, now, crank_sweep_origin_, profiles_->crank_sweep()};
   sweeping_ = true;
   row_beats_ = 0;
+  beats_published_ = 0;
   phase_start_ = now;
   enter(State::kBeatSweep, now);
 }
@@ -369,6 +371,7 @@ void Sequencer::advance(hal::Tick now, const hal::HalInputs& in) noexcept {
     case State::kBeatSweep:
       if (!crank_move_.active) {
         sweeping_ = false;
+        while (beats_published_ < row_beats_) publish_beat(beats_published_);
         ++counters_.rows;
         counters_.picks_in_row = 0;
         row_started_ = false;
@@ -439,7 +442,28 @@ void Sequencer::play_moves(hal::Tick now) noexcept {
       ++row_beats_;
       ++counters_.beats;
     }
+    // A counted beat is published once the beater has left the warp (its peak force is final then).
+    const double exit = profiles_->beatup().warp().exit;
+    while (beats_published_ < row_beats_ && phi >= motion::kTwoPi * beats_published_ + exit) {
+      publish_beat(beats_published_);
+    }
   }
+}
+
+void Sequencer::publish_beat(int k) noexcept {
+  BeatEvent e;
+  e.row = counters_.rows + 1;
+  e.index = static_cast<std::uint16_t>(k);
+  if (k < kMaxBeatsPerRow) {
+    const BeatRecord& b = row_.beat[static_cast<std::size_t>(k)];
+    e.x_m = b.x_m;
+    e.peak_force_n = b.peak_force_n;
+  }
+  e.force_measured = row_.force_measured;
+  e.in_band = e.force_measured && e.peak_force_n >= cfg_.beat_force_min_n && e.peak_force_n <= cfg_.beat_force_max_n;
+  last_beat_ = e;
+  ++beat_events_;
+  beats_published_ = k + 1;
 }
 
 void Sequencer::step(hal::Tick now, const hal::HalInputs& raw, hal::HalOutputs& out) noexcept {

@@ -42,6 +42,17 @@ struct BeatRecord {
   float peak_force_n = 0.0f;  // peak load-cell force during this beat (0 when no load cell)
 };
 
+// One beat as the technician sees it: published once per beat, when the beater has left the warp
+// after passing the fell (its peak force is then final).
+struct BeatEvent {
+  std::uint32_t row = 0;       // 1-based row being woven
+  std::uint16_t index = 0;     // 0-based beat within the row
+  float x_m = 0.0f;            // carriage position (beater's left edge from the left selvedge)
+  float peak_force_n = 0.0f;   // 0 when no load cell
+  bool force_measured = false;
+  bool in_band = false;        // force_measured and within [beat_force_min_n, beat_force_max_n]
+};
+
 struct RowStats {
   std::uint32_t row = 0;     // 1-based number of the row just completed
   hal::Tick shed_ticks = 0, pick_ticks = 0, beat_ticks = 0, total_ticks = 0;  // shed/pick summed over picks
@@ -69,6 +80,8 @@ struct SequencerConfig {
   double helix_left_position_rad = 0.0;  // helix axis reading with the carrier at the left selvedge
   double park_tolerance_rad = 0.01;
   double selvedge_tolerance_m = 0.001;
+  double beat_force_min_n = 80.0;         // the band every beat must hit (thesis: 80–100 N)
+  double beat_force_max_n = 100.0;
   motion::JerkLimits carriage{.velocity = 0.5, .acceleration = 5.0, .jerk = 100.0};  // re-arm moves
 };
 
@@ -99,6 +112,10 @@ class Sequencer {
   std::uint16_t fault_detail() const noexcept { return fault_detail_; }  // device code (EMCY) if any
   hal::Tick fault_tick() const noexcept { return fault_tick_; }
   const RowStats& last_row() const noexcept { return last_row_; }
+  // RT-safe. Counts completed beats since construction (never reset); when it changes, last_beat() is
+  // the newest. A reader that polls every tick sees every beat (at most one completes per tick).
+  std::uint32_t beat_events() const noexcept { return beat_events_; }
+  const BeatEvent& last_beat() const noexcept { return last_beat_; }
   const motion::ProfileSet& profiles() const noexcept { return *profiles_; }
   std::uint32_t recipe_changes() const noexcept { return recipe_changes_; }
   // Beater crank phase from park of the current command (rad) and the table's rocker angle there.
@@ -123,6 +140,7 @@ class Sequencer {
   void debounce(const hal::DigitalInputs& raw) noexcept;
   void track_beat_force(const hal::HalInputs& in) noexcept;
   void play_moves(hal::Tick now) noexcept;
+  void publish_beat(int k) noexcept;
 
   const motion::ProfileSet* profiles_;
   motion::ProfileSlot* slot_ = nullptr;
@@ -172,6 +190,9 @@ class Sequencer {
   // Row bookkeeping.
   hal::Tick row_start_ = 0, phase_start_ = 0;
   int row_beats_ = 0;
+  int beats_published_ = 0;        // beats of this row already published as BeatEvents
+  std::uint32_t beat_events_ = 0;
+  BeatEvent last_beat_{};
   RowStats row_{};       // being filled
   RowStats last_row_{};  // the last completed row
 };
