@@ -1,15 +1,21 @@
-// Loom config and scene parsing. Values are read into the same structs the modules use, then the
-// profile set is built once here as the final check: a config that parses but cannot be woven (the
-// crank cannot reach speed before the first beat, the carriage step breaks its limits) is refused now,
-// with the motion module's message, rather than at the first row.
+// Loom config parsing: one table of keys (section, class, plausible range, where the value goes), read
+// in file order; then the cross-field checks, each pointing at the line that is wrong; then the one
+// derivation of every module's config; then each module's own validation (motion builds the profiles,
+// the CAN master checks its timing and bus load). A config that parses but cannot be woven is refused
+// here, never at the first row.
 #include <algorithm>
-#include <fstream>
+#include <cmath>
+#include <functional>
+#include <map>
+#include <optional>
 #include <sstream>
 
+#include "loom/drivers/bus_load.hpp"
 #include "loom/firmware/config.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/dynamics.hpp"
 #include "loom/motion/errors.hpp"
+#include "loom/motion/fourbar.hpp"
 #include "loom/motion/mass_properties.hpp"
 #include "loom/motion/profile_crank.hpp"
 #include "toml_reader.hpp"
@@ -17,13 +23,7 @@
 namespace loom::firmware {
 namespace {
 
-std::string read_file(const std::string& path) {
-  std::ifstream f(path);
-  if (!f) throw ConfigError(path + ": cannot open file");
-  std::ostringstream os;
-  os << f.rdbuf();
-  return os.str();
-}
+std::string read_file(const std::string& path) { return read_config_file(path); }
 
 std::string in_range(double v, double lo, double hi) {
   if (v >= lo && v <= hi) return "";
@@ -32,207 +32,557 @@ std::string in_range(double v, double lo, double hi) {
   return os.str();
 }
 
-}  // namespace
+std::string fmt_num(double v) {
+  std::ostringstream os;
+  os.precision(10);
+  os << v;
+  return os.str();
+}
 
-LoomConfig parse_loom_config(const std::string& text, const std::string& source) {
-  TomlReader r(text, source);
-  LoomConfig c;
-  c.source = source;
-  r.string("loom.id", c.loom_id);
-  if (c.loom_id.empty() || c.loom_id.find_first_of(" ./*") != std::string::npos) {
-    r.fail("loom.id", '"' + c.loom_id + '"', "must be non-empty without spaces, dots, slashes or '*'");
+// Longest plausible row: a recipe whose row takes longer than this is a typo, not a carpet.
+constexpr double kMaxRowSeconds = 3600.0;
+
+// ---------------------------------------------------------------------------------------------------
+// The key table
+// ---------------------------------------------------------------------------------------------------
+enum class Klass { kMachine, kRecipe, kRun };
+const char* klass_name(Klass k) {
+  switch (k) {
+    case Klass::kMachine: return "machine";
+    case Klass::kRecipe: return "recipe";
+    case Klass::kRun: return "run";
   }
-  auto& p = c.profile;
-  r.number("loom.width_m", p.width_m, [](double v) { return in_range(v, 0.2, 10.0); });
+  return "?";
+}
 
-  auto& bar = p.beatup.bar;
-  r.number("beatup.crank_m", bar.crank, positive);
-  r.number("beatup.coupler_m", bar.coupler, positive);
-  r.number("beatup.rocker_m", bar.rocker, positive);
-  r.number("beatup.ground_m", bar.ground, positive);
-  r.number("beatup.beater_arm_m", p.beatup.beater_arm_m, positive);
-  std::string branch = "positive", fell = "extended";
-  r.string("beatup.branch", branch, {"positive", "negative"});
-  p.beatup.branch = branch == "positive" ? motion::Branch::kPositive : motion::Branch::kNegative;
-  r.string("beatup.fell_at", fell, {"extended", "folded"});
-  p.beatup.fell_at = fell == "extended" ? motion::FellSide::kExtended : motion::FellSide::kFolded;
-  r.number("beatup.warp_depth_m", p.beatup.warp_depth_m, positive);
-  r.number("beatup.crank_speed_rad_s", p.crank.velocity, [](double v) { return in_range(v, 0.1, 100.0); });
-  // A loom builder asks for the beat force (default 90 N, thesis: 80–100 N) or fixes the crank speed;
-  // from a force, the crank speed comes from the linkage's inverse dynamics (the beater force is
-  // inertial, so it scales with ω²).
-  const bool speed_given = r.root().at_path("beatup.crank_speed_rad_s").node() != nullptr;
-  const bool force_given = r.root().at_path("beatup.beat_force_target_n").node() != nullptr;
-  double force_target = 90.0;
-  r.number("beatup.beat_force_target_n", force_target, [](double v) { return in_range(v, 1.0, 1000.0); });
-  if (speed_given && force_given) {
-    r.fail("beatup.beat_force_target_n", std::to_string(force_target),
-           "give either beat_force_target_n or crank_speed_rad_s, not both");
-  }
-  c.beat_force_target_n = speed_given ? 0.0 : force_target;
-  double beater_kg = 2.5;
-  r.number("beatup.beater_mass_kg", beater_kg, positive);
-  r.number("beatup.crank_accel_rad_s2", p.crank.acceleration, positive);
-  r.number("beatup.crank_jerk_rad_s3", p.crank.jerk, positive);
-  r.number("beatup.beater_width_m", p.beater_width_m, positive);
-  r.number("beatup.overlap_m", p.overlap_m, non_negative);
-  double margin_deg = motion::deg(p.cam_margin_rad);
-  r.number("beatup.cam_margin_deg", margin_deg, [](double v) { return in_range(v, 0.0, 90.0); });
-  p.cam_margin_rad = motion::rad(margin_deg);
-  std::int64_t table = static_cast<std::int64_t>(p.table_size);
-  r.integer("beatup.table_size", table, 64, 1 << 20);
-  p.table_size = static_cast<std::size_t>(table);
-  std::string interp = motion::interp_name(p.table_interp), precision = motion::precision_name(p.table_precision);
-  r.string("beatup.interp", interp, {"linear", "cubic", "quintic"});
-  motion::parse_interp(interp.c_str(), p.table_interp);
-  r.string("beatup.table_precision", precision, {"double", "float32"});
-  motion::parse_precision(precision.c_str(), p.table_precision);
-  r.number("beatup.max_table_error_rad", p.max_table_error_rad, positive);
-  std::string law = motion::crank_law_name(p.crank_law.kind);
-  r.string("beatup.crank_law", law, {"constant", "elliptic"});
-  motion::parse_crank_law(law.c_str(), p.crank_law.kind);
-  r.number("beatup.ellipse_e", p.crank_law.ellipse_e, [](double v) { return v >= 0.0 && v < 1.0 ? "" : "must be in [0, 1)"; });
-  std::int64_t lobes = p.crank_law.ellipse_lobes;
-  r.integer("beatup.ellipse_lobes", lobes, 1, 16);
-  p.crank_law.ellipse_lobes = static_cast<int>(lobes);
-  double phi02_deg = motion::deg(p.crank_law.ellipse_phi02_rad);
-  r.number("beatup.ellipse_phi02_deg", phi02_deg, [](double v) { return in_range(v, -360.0, 360.0); });
-  p.crank_law.ellipse_phi02_rad = motion::rad(phi02_deg);
-  r.number("beatup.crank_park_position_rad", c.sequencer.crank_park_position_rad);
+struct Key {
+  std::string path;
+  Klass klass;
+  std::string range;  // for messages and `loomctl check --keys`
+  bool required;      // must be in a complete file (false: has a documented default or an alternative)
+  std::function<void(TomlReader&, LoomConfig&)> read;
+  std::function<std::string(const LoomConfig&)> value;  // canonical text, to compare two configs
+};
 
-  r.number("carriage.max_speed_m_s", p.carriage_max_speed_m_s, positive);
-  r.number("carriage.max_accel_m_s2", p.carriage_max_accel_m_s2, positive);
-  r.number("carriage.max_jerk_m_s3", p.carriage_max_jerk_m_s3, positive);
-  r.number("carriage.jerk_m_s3", c.sequencer.carriage.jerk, positive);
-  r.number("carriage.home_position_m", c.sequencer.carriage_home_m);
-  c.sequencer.carriage.velocity = p.carriage_max_speed_m_s;
-  c.sequencer.carriage.acceleration = p.carriage_max_accel_m_s2;
+using Num = std::function<double&(LoomConfig&)>;
 
-  r.number("helix.lead_m", p.helix_lead_m, positive);
-  r.number("helix.left_position_rad", c.sequencer.helix_left_position_rad);
-  r.number("helix.max_speed_rad_s", p.helix.velocity, positive);
-  r.number("helix.max_accel_rad_s2", p.helix.acceleration, positive);
-  r.number("helix.jerk_rad_s3", p.helix.jerk, positive);
-  r.number("helix.carrier_force_n", p.carrier_force_n, positive);
-  r.number("helix.shuttle_mass_kg", p.shuttle_mass_kg, positive);
-
-  std::int64_t per_position = p.beats_per_position;
-  r.integer("recipe.beats_per_position", per_position, 1, 16);
-  p.beats_per_position = static_cast<int>(per_position);
-  std::int64_t picks = c.sequencer.picks_per_row;
-  r.integer("recipe.picks_per_row", picks, 1, 16);
-  c.sequencer.picks_per_row = static_cast<std::uint32_t>(picks);
-  std::int64_t debounce = c.sequencer.debounce_ticks;
-  r.integer("timing.debounce_ticks", debounce, 1, 100);
-  c.sequencer.debounce_ticks = static_cast<int>(debounce);
-
-  r.number("shedding.piston_travel_s", p.shed.piston_travel_s, positive);
-  c.machine.piston_travel_s = p.shed.piston_travel_s;
-  r.number("shedding.timeout_s", p.shed.timeout_s, positive);
-  r.number("shedding.earliest_fraction", p.shed.earliest_fraction, [](double v) { return in_range(v, 0.0, 0.99); });
-  r.number("shedding.release_timeout_s", p.shed.release_timeout_s, positive);
-  double settle_ms = p.shed.settle_s * 1e3;
-  r.number("shedding.settle_ms", settle_ms, non_negative);
-  p.shed.settle_s = settle_ms * 1e-3;
-
-  double period_ms = 2.0, stale_ms = 50.0;
-  r.number("timing.period_ms", period_ms, [](double v) { return in_range(v, 0.25, 20.0); });
-  r.number("timing.enable_timeout_s", c.sequencer.enable_timeout_s, positive);
-  r.number("timing.pick_timeout_margin_s", c.sequencer.pick_timeout_margin_s, positive);
-  r.number("timing.stale_timeout_ms", stale_ms, positive);
-  c.sequencer.period_s = period_ms * 1e-3;
-  c.sequencer.stale_timeout_s = stale_ms * 1e-3;
-  if (c.sequencer.stale_timeout_s < 2.0 * c.sequencer.period_s) {
-    r.fail("timing.stale_timeout_ms", std::to_string(stale_ms), "must be at least two periods");
-  }
-  c.machine.period_s = c.sequencer.period_s;
-  c.machine.width_m = p.width_m;
-  c.machine.helix_lead_m = p.helix_lead_m;
-  c.machine.beatup = p.beatup;
-  c.machine.crank_park_position_rad = c.sequencer.crank_park_position_rad;
-
-  std::int64_t v = 0;
-  v = c.can.bitrate;
-  r.integer("can.bitrate", v, 10'000, 1'000'000);
-  c.can.bitrate = static_cast<std::uint32_t>(v);
-  r.number("can.bus_load_budget", c.can.bus_load_budget, [](double x) { return in_range(x, 0.05, 1.0); });
-  const auto node = [&](const char* key, std::uint8_t& out) {
-    std::int64_t n = out;
-    r.integer(key, n, 1, 127);
-    out = static_cast<std::uint8_t>(n);
+Key number(std::string path, Klass k, double lo, double hi, Num field, bool required = true) {
+  std::ostringstream range;
+  range << "[" << lo << ", " << hi << "]";
+  Key key{path, k, range.str(), required, nullptr, nullptr};
+  key.read = [=](TomlReader& r, LoomConfig& c) {
+    r.number(path, field(c), [=](double v) { return in_range(v, lo, hi); });
   };
-  node("can.node_beat_crank", c.can.node_beat_crank);
-  node("can.node_carriage", c.can.node_carriage);
-  node("can.node_helix", c.can.node_helix);
-  if (c.can.node_beat_crank == c.can.node_carriage || c.can.node_beat_crank == c.can.node_helix ||
-      c.can.node_carriage == c.can.node_helix) {
-    r.fail("can.node_helix", std::to_string(c.can.node_helix), "node ids of the three axes must differ");
-  }
-  r.number("can.counts_per_rev", c.can.counts_per_rev, positive);
-  r.number("can.carriage_counts_per_m", c.can.carriage_counts_per_m, positive);
-  const auto ms16 = [&](const char* key, std::uint16_t& out, std::int64_t lo) {
-    std::int64_t n = out;
-    r.integer(key, n, lo, 60000);
-    out = static_cast<std::uint16_t>(n);
-  };
-  ms16("can.heartbeat_ms", c.can.heartbeat_ms, 10);
-  ms16("can.heartbeat_timeout_ms", c.can.heartbeat_timeout_ms, 10);
-  ms16("can.sdo_timeout_ms", c.can.sdo_timeout_ms, 10);
-  if (c.can.heartbeat_timeout_ms <= c.can.heartbeat_ms || c.can.heartbeat_timeout_ms > 3 * c.can.heartbeat_ms) {
-    r.fail("can.heartbeat_timeout_ms", std::to_string(c.can.heartbeat_timeout_ms),
-           "must be above heartbeat_ms and at most three heartbeat periods");
-  }
+  key.value = [=](const LoomConfig& c) { return fmt_num(field(const_cast<LoomConfig&>(c))); };
+  return key;
+}
 
-  r.string("telemetry.lcm_url", c.telemetry.lcm_url);
-  const auto every = [&](const char* key, std::uint32_t& out) {
-    std::int64_t n = out;
-    r.integer(key, n, 1, 1'000'000);
-    out = static_cast<std::uint32_t>(n);
+// Angles are written in degrees (…_deg) and kept in radians.
+Key degrees(std::string path, Klass k, double lo, double hi, Num field_rad) {
+  Key key = number(path, k, lo, hi, field_rad);
+  key.read = [=](TomlReader& r, LoomConfig& c) {
+    double deg = motion::deg(field_rad(c));
+    r.number(path, deg, [=](double v) { return in_range(v, lo, hi); });
+    field_rad(c) = motion::rad(deg);
   };
-  every("telemetry.status_every", c.telemetry.status_every);
-  every("telemetry.axes_every", c.telemetry.axes_every);
-  every("telemetry.rt_every", c.telemetry.rt_every);
-  r.reject_unknown();
+  return key;
+}
 
-  if (c.beat_force_target_n > 0.0) {
-    try {
-      const motion::BeatUpDynamics dyn(p.beatup, motion::beatup_masses(p.beatup, beater_kg));
-      const double crank_speed_at_beat = dyn.crank_speed_for_beat_force(c.beat_force_target_n);
-      // With a speed law the crank is faster (or slower) than the master at the beat: the master runs
-      // at the crank speed divided by the law's ratio where the crank reaches the fell.
-      double ratio = 1.0;
-      if (p.crank_law.kind != motion::CrankLawKind::kConstant) {
-        const motion::BeatUp head(p.beatup);
-        const double fell_phase = head.warp().fell;
-        const motion::CrankLaw speed_law(
-            p.crank_law, fell_phase,
-            {.size = p.table_size, .interp = p.table_interp, .precision = p.table_precision, .rise = 0.0});
-        double m = fell_phase;  // Newton on Φc(m) = m + offset(m) = fell; dΦc/dm ≥ min ratio > 0
-        for (int i = 0; i < 50; ++i) {
-          const motion::CrankLawExact e = speed_law.exact(m);
-          const double step = (m + e.offset - fell_phase) / e.d1;
-          m -= step;
-          if (std::abs(step) < 1e-14) break;
+// Milliseconds in the file, seconds inside.
+Key millis(std::string path, Klass k, double lo, double hi, Num field_s) {
+  Key key = number(path, k, lo, hi, field_s);
+  key.read = [=](TomlReader& r, LoomConfig& c) {
+    double ms = field_s(c) * 1e3;
+    r.number(path, ms, [=](double v) { return in_range(v, lo, hi); });
+    field_s(c) = ms * 1e-3;
+  };
+  return key;
+}
+
+template <typename T>
+Key integer(std::string path, Klass k, std::int64_t lo, std::int64_t hi, std::function<T&(LoomConfig&)> field) {
+  Key key{path, k, "[" + std::to_string(lo) + ", " + std::to_string(hi) + "] (integer)", true, nullptr, nullptr};
+  key.read = [=](TomlReader& r, LoomConfig& c) {
+    std::int64_t v = static_cast<std::int64_t>(field(c));
+    r.integer(path, v, lo, hi);
+    field(c) = static_cast<T>(v);
+  };
+  key.value = [=](const LoomConfig& c) { return std::to_string(field(const_cast<LoomConfig&>(c))); };
+  return key;
+}
+
+// A string from a closed set, stored through name/parse functions.
+template <typename E>
+Key choice(std::string path, Klass k, std::set<std::string> allowed, std::function<E&(LoomConfig&)> field,
+           const char* (*name)(E), bool (*parse)(const char*, E&)) {
+  std::string list;
+  for (const auto& a : allowed) list += (list.empty() ? "" : " | ") + a;
+  Key key{path, k, list, true, nullptr, nullptr};
+  key.read = [=](TomlReader& r, LoomConfig& c) {
+    std::string s = name(field(c));
+    r.string(path, s, allowed);
+    parse(s.c_str(), field(c));
+  };
+  key.value = [=](const LoomConfig& c) { return std::string(name(field(const_cast<LoomConfig&>(c)))); };
+  return key;
+}
+
+const char* branch_name(motion::Branch b) { return b == motion::Branch::kPositive ? "positive" : "negative"; }
+bool parse_branch(const char* s, motion::Branch& b) {
+  b = std::string(s) == "positive" ? motion::Branch::kPositive : motion::Branch::kNegative;
+  return true;
+}
+const char* fell_name(motion::FellSide f) { return f == motion::FellSide::kExtended ? "extended" : "folded"; }
+bool parse_fell(const char* s, motion::FellSide& f) {
+  f = std::string(s) == "extended" ? motion::FellSide::kExtended : motion::FellSide::kFolded;
+  return true;
+}
+
+// Node ids, counts and rates are integers on the wire; ranges are the protocol's or a plausible
+// machine's. Every number has a range a real loom fits in with room to spare, so a unit slip (mm for
+// m, a missing exponent) or an absurd value (1e-320, 1e308, nan) is refused with the line.
+const std::vector<Key>& keys() {
+  using M = Klass;
+  static const std::vector<Key> k = [] {
+    std::vector<Key> v;
+    // [loom]
+    {
+      Key id{"loom.id", M::kMachine, "string without spaces, dots, slashes or '*'", true, nullptr, nullptr};
+      id.read = [](TomlReader& r, LoomConfig& c) {
+        r.string("loom.id", c.loom_id);
+        if (c.loom_id.empty() || c.loom_id.size() > 64 || c.loom_id.find_first_of(" ./*\t\"\\") != std::string::npos) {
+          r.fail("loom.id", '"' + c.loom_id + '"', "must be 1..64 characters without spaces, dots, slashes or '*'");
         }
-        ratio = speed_law.exact(m).d1;
+      };
+      id.value = [](const LoomConfig& c) { return c.loom_id; };
+      v.push_back(id);
+    }
+    v.push_back(number("loom.width_m", M::kMachine, 0.2, 10.0, [](LoomConfig& c) -> double& { return c.machine_spec.width_m; }));
+    // [beatup] — the linkage and the beater (machine)
+    v.push_back(number("beatup.crank_m", M::kMachine, 0.005, 2.0, [](LoomConfig& c) -> double& { return c.machine_spec.beatup.bar.crank; }));
+    v.push_back(number("beatup.coupler_m", M::kMachine, 0.005, 5.0, [](LoomConfig& c) -> double& { return c.machine_spec.beatup.bar.coupler; }));
+    v.push_back(number("beatup.rocker_m", M::kMachine, 0.005, 5.0, [](LoomConfig& c) -> double& { return c.machine_spec.beatup.bar.rocker; }));
+    v.push_back(number("beatup.ground_m", M::kMachine, 0.005, 5.0, [](LoomConfig& c) -> double& { return c.machine_spec.beatup.bar.ground; }));
+    v.push_back(number("beatup.beater_arm_m", M::kMachine, 0.01, 5.0, [](LoomConfig& c) -> double& { return c.machine_spec.beatup.beater_arm_m; }));
+    v.push_back(choice<motion::Branch>("beatup.branch", M::kMachine, {"positive", "negative"},
+                                       [](LoomConfig& c) -> motion::Branch& { return c.machine_spec.beatup.branch; },
+                                       branch_name, parse_branch));
+    v.push_back(choice<motion::FellSide>("beatup.fell_at", M::kMachine, {"extended", "folded"},
+                                         [](LoomConfig& c) -> motion::FellSide& { return c.machine_spec.beatup.fell_at; },
+                                         fell_name, parse_fell));
+    v.push_back(number("beatup.warp_depth_m", M::kMachine, 0.001, 0.5, [](LoomConfig& c) -> double& { return c.machine_spec.beatup.warp_depth_m; }));
+    v.push_back(number("beatup.beater_mass_kg", M::kMachine, 0.1, 50.0, [](LoomConfig& c) -> double& { return c.machine_spec.beater_mass_kg; }));
+    v.push_back(number("beatup.beater_width_m", M::kMachine, 0.01, 1.0, [](LoomConfig& c) -> double& { return c.machine_spec.beater_width_m; }));
+    v.push_back(number("beatup.crank_park_position_rad", M::kMachine, -1.0e5, 1.0e5,
+                       [](LoomConfig& c) -> double& { return c.machine_spec.calibration.crank_park_position_rad; }));
+    // [carriage]
+    v.push_back(number("carriage.max_speed_m_s", M::kMachine, 0.01, 10.0, [](LoomConfig& c) -> double& { return c.machine_spec.carriage_max_speed_m_s; }));
+    v.push_back(number("carriage.max_accel_m_s2", M::kMachine, 0.1, 1000.0, [](LoomConfig& c) -> double& { return c.machine_spec.carriage_max_accel_m_s2; }));
+    v.push_back(number("carriage.max_jerk_m_s3", M::kMachine, 1.0, 1.0e6, [](LoomConfig& c) -> double& { return c.machine_spec.carriage_max_jerk_m_s3; }));
+    v.push_back(number("carriage.jerk_m_s3", M::kMachine, 1.0, 1.0e6, [](LoomConfig& c) -> double& { return c.machine_spec.carriage_reposition_jerk_m_s3; }));
+    v.push_back(number("carriage.home_position_m", M::kMachine, -10.0, 10.0,
+                       [](LoomConfig& c) -> double& { return c.machine_spec.calibration.carriage_home_m; }));
+    // [helix]
+    v.push_back(number("helix.lead_m", M::kMachine, 0.005, 1.0, [](LoomConfig& c) -> double& { return c.machine_spec.helix_lead_m; }));
+    v.push_back(number("helix.left_position_rad", M::kMachine, -1.0e5, 1.0e5,
+                       [](LoomConfig& c) -> double& { return c.machine_spec.calibration.helix_left_position_rad; }));
+    v.push_back(number("helix.max_speed_rad_s", M::kMachine, 1.0, 1000.0, [](LoomConfig& c) -> double& { return c.machine_spec.helix.velocity; }));
+    v.push_back(number("helix.max_accel_rad_s2", M::kMachine, 1.0, 1.0e6, [](LoomConfig& c) -> double& { return c.machine_spec.helix.acceleration; }));
+    v.push_back(number("helix.jerk_rad_s3", M::kMachine, 10.0, 1.0e8, [](LoomConfig& c) -> double& { return c.machine_spec.helix.jerk; }));
+    v.push_back(number("helix.carrier_force_n", M::kMachine, 0.1, 1000.0, [](LoomConfig& c) -> double& { return c.machine_spec.carrier_force_n; }));
+    v.push_back(number("helix.shuttle_mass_kg", M::kMachine, 0.01, 10.0, [](LoomConfig& c) -> double& { return c.machine_spec.shuttle_mass_kg; }));
+    // [shedding]
+    v.push_back(number("shedding.piston_travel_s", M::kMachine, 0.01, 10.0, [](LoomConfig& c) -> double& { return c.machine_spec.shed.piston_travel_s; }));
+    v.push_back(number("shedding.timeout_s", M::kMachine, 0.05, 60.0, [](LoomConfig& c) -> double& { return c.machine_spec.shed.timeout_s; }));
+    v.push_back(number("shedding.earliest_fraction", M::kMachine, 0.0, 0.99, [](LoomConfig& c) -> double& { return c.machine_spec.shed.earliest_fraction; }));
+    v.push_back(number("shedding.release_timeout_s", M::kMachine, 0.005, 10.0, [](LoomConfig& c) -> double& { return c.machine_spec.shed.release_timeout_s; }));
+    v.push_back(millis("shedding.settle_ms", M::kMachine, 0.0, 1000.0, [](LoomConfig& c) -> double& { return c.machine_spec.shed.settle_s; }));
+    // [can]
+    {
+      Key bitrate{"can.bitrate", M::kMachine, "10000 | 20000 | 50000 | 125000 | 250000 | 500000 | 800000 | 1000000", true, nullptr, nullptr};
+      bitrate.read = [](TomlReader& r, LoomConfig& c) {
+        std::int64_t b = c.can.bitrate;
+        r.integer("can.bitrate", b, 10'000, 1'000'000);
+        static const std::set<std::int64_t> cia{10'000, 20'000, 50'000, 125'000, 250'000, 500'000, 800'000, 1'000'000};
+        if (!cia.count(b)) r.fail("can.bitrate", std::to_string(b), "must be a CiA 301 bit rate: 10000, 20000, 50000, 125000, 250000, 500000, 800000 or 1000000");
+        c.can.bitrate = static_cast<std::uint32_t>(b);
+      };
+      bitrate.value = [](const LoomConfig& c) { return std::to_string(c.can.bitrate); };
+      v.push_back(bitrate);
+    }
+    v.push_back(number("can.bus_load_budget", M::kMachine, 0.05, 1.0, [](LoomConfig& c) -> double& { return c.can.bus_load_budget; }));
+    v.push_back(integer<std::uint8_t>("can.node_beat_crank", M::kMachine, 1, 127, [](LoomConfig& c) -> std::uint8_t& { return c.can.node_beat_crank; }));
+    v.push_back(integer<std::uint8_t>("can.node_carriage", M::kMachine, 1, 127, [](LoomConfig& c) -> std::uint8_t& { return c.can.node_carriage; }));
+    v.push_back(integer<std::uint8_t>("can.node_helix", M::kMachine, 1, 127, [](LoomConfig& c) -> std::uint8_t& { return c.can.node_helix; }));
+    v.push_back(number("can.counts_per_rev", M::kMachine, 16.0, 2147483648.0, [](LoomConfig& c) -> double& { return c.can.counts_per_rev; }));
+    v.push_back(number("can.carriage_counts_per_m", M::kMachine, 100.0, 1.0e9, [](LoomConfig& c) -> double& { return c.can.carriage_counts_per_m; }));
+    v.push_back(integer<std::uint16_t>("can.heartbeat_ms", M::kMachine, 10, 10000, [](LoomConfig& c) -> std::uint16_t& { return c.can.heartbeat_ms; }));
+    v.push_back(integer<std::uint16_t>("can.heartbeat_timeout_ms", M::kMachine, 10, 30000, [](LoomConfig& c) -> std::uint16_t& { return c.can.heartbeat_timeout_ms; }));
+    v.push_back(integer<std::uint16_t>("can.sdo_timeout_ms", M::kMachine, 10, 10000, [](LoomConfig& c) -> std::uint16_t& { return c.can.sdo_timeout_ms; }));
+    // [recipe]
+    v.push_back(integer<std::uint32_t>("recipe.picks_per_row", M::kRecipe, 1, 16, [](LoomConfig& c) -> std::uint32_t& { return c.recipe.picks_per_row; }));
+    v.push_back(integer<int>("recipe.beats_per_position", M::kRecipe, 1, 16, [](LoomConfig& c) -> int& { return c.recipe.beats_per_position; }));
+    {
+      Key force = number("recipe.beat_force_target_n", M::kRecipe, 1.0, 1000.0, [](LoomConfig& c) -> double& { return c.recipe.beat_force_target_n; }, false);
+      Key speed = number("recipe.crank_speed_rad_s", M::kRecipe, 0.1, 100.0, [](LoomConfig& c) -> double& { return c.recipe.crank_speed_rad_s; }, false);
+      v.push_back(force);
+      v.push_back(speed);
+    }
+    v.push_back(number("recipe.beat_force_min_n", M::kRecipe, 1.0, 1000.0, [](LoomConfig& c) -> double& { return c.recipe.beat_force_min_n; }));
+    v.push_back(number("recipe.beat_force_max_n", M::kRecipe, 1.0, 1000.0, [](LoomConfig& c) -> double& { return c.recipe.beat_force_max_n; }));
+    v.push_back(number("recipe.crank_accel_rad_s2", M::kRecipe, 1.0, 1.0e5, [](LoomConfig& c) -> double& { return c.recipe.crank_accel_rad_s2; }));
+    v.push_back(number("recipe.crank_jerk_rad_s3", M::kRecipe, 10.0, 1.0e7, [](LoomConfig& c) -> double& { return c.recipe.crank_jerk_rad_s3; }));
+    v.push_back(choice<motion::CrankLawKind>("recipe.crank_law", M::kRecipe, {"constant", "elliptic"},
+                                             [](LoomConfig& c) -> motion::CrankLawKind& { return c.recipe.crank_law.kind; },
+                                             motion::crank_law_name, motion::parse_crank_law));
+    v.push_back(number("recipe.ellipse_e", M::kRecipe, 0.0, 0.9, [](LoomConfig& c) -> double& { return c.recipe.crank_law.ellipse_e; }));
+    v.push_back(integer<int>("recipe.ellipse_lobes", M::kRecipe, 1, 16, [](LoomConfig& c) -> int& { return c.recipe.crank_law.ellipse_lobes; }));
+    v.push_back(degrees("recipe.ellipse_phi02_deg", M::kRecipe, -360.0, 360.0, [](LoomConfig& c) -> double& { return c.recipe.crank_law.ellipse_phi02_rad; }));
+    v.push_back(number("recipe.overlap_m", M::kRecipe, 0.0, 1.0, [](LoomConfig& c) -> double& { return c.recipe.overlap_m; }));
+    v.push_back(degrees("recipe.cam_margin_deg", M::kRecipe, 0.0, 90.0, [](LoomConfig& c) -> double& { return c.recipe.cam_margin_rad; }));
+    // [profiles] — how the recipe's motion is tabulated (a recipe property: rebuilt with it)
+    {
+      Key size = integer<std::size_t>("profiles.table_size", M::kRecipe, 64, 1 << 20, [](LoomConfig& c) -> std::size_t& { return c.recipe.table_size; });
+      v.push_back(size);
+    }
+    v.push_back(choice<motion::Interp>("profiles.interp", M::kRecipe, {"linear", "cubic", "quintic"},
+                                       [](LoomConfig& c) -> motion::Interp& { return c.recipe.table_interp; },
+                                       motion::interp_name, motion::parse_interp));
+    v.push_back(choice<motion::Precision>("profiles.table_precision", M::kRecipe, {"double", "float32"},
+                                          [](LoomConfig& c) -> motion::Precision& { return c.recipe.table_precision; },
+                                          motion::precision_name, motion::parse_precision));
+    v.push_back(number("profiles.max_table_error_rad", M::kRecipe, 1e-12, 1e-2, [](LoomConfig& c) -> double& { return c.recipe.max_table_error_rad; }));
+    // [timing] (run)
+    v.push_back(millis("timing.period_ms", M::kRun, 0.25, 20.0, [](LoomConfig& c) -> double& { return c.run.period_s; }));
+    v.push_back(number("timing.enable_timeout_s", M::kRun, 0.05, 60.0, [](LoomConfig& c) -> double& { return c.run.enable_timeout_s; }));
+    v.push_back(number("timing.pick_timeout_margin_s", M::kRun, 0.01, 60.0, [](LoomConfig& c) -> double& { return c.run.pick_timeout_margin_s; }));
+    v.push_back(millis("timing.stale_timeout_ms", M::kRun, 0.5, 10000.0, [](LoomConfig& c) -> double& { return c.run.stale_timeout_s; }));
+    v.push_back(integer<int>("timing.debounce_ticks", M::kRun, 1, 100, [](LoomConfig& c) -> int& { return c.run.debounce_ticks; }));
+    // [telemetry] (run)
+    {
+      Key url{"telemetry.lcm_url", M::kRun, "LCM provider URL, \"\" = LCM's default", false, nullptr, nullptr};
+      url.read = [](TomlReader& r, LoomConfig& c) { r.string("telemetry.lcm_url", c.telemetry.lcm_url); };
+      url.value = [](const LoomConfig& c) { return c.telemetry.lcm_url; };
+      v.push_back(url);
+    }
+    v.push_back(integer<std::uint32_t>("telemetry.status_every", M::kRun, 1, 1'000'000, [](LoomConfig& c) -> std::uint32_t& { return c.telemetry.status_every; }));
+    v.push_back(integer<std::uint32_t>("telemetry.axes_every", M::kRun, 1, 1'000'000, [](LoomConfig& c) -> std::uint32_t& { return c.telemetry.axes_every; }));
+    v.push_back(integer<std::uint32_t>("telemetry.rt_every", M::kRun, 1, 1'000'000, [](LoomConfig& c) -> std::uint32_t& { return c.telemetry.rt_every; }));
+    return v;
+  }();
+  return k;
+}
+
+const std::set<std::string>& known_sections() {
+  static const std::set<std::string> s = [] {
+    std::set<std::string> out;
+    for (const Key& k : keys()) out.insert(k.path.substr(0, k.path.find('.')));
+    return out;
+  }();
+  return s;
+}
+
+// Where a derived problem is reported: the key in the file that the user can change to fix it.
+using Fail = std::function<void(const std::string& key, const std::string& value, const std::string& why)>;
+
+// ---------------------------------------------------------------------------------------------------
+// Cross-field checks (each at the line that is wrong)
+// ---------------------------------------------------------------------------------------------------
+void check_relations(const TomlReader& r, const LoomConfig& c) {
+  const auto present = [&](const std::string& path) { return r.root().at_path(path).node() != nullptr; };
+  // A duplicated node id is reported at its second use (in file order, whichever key repeats it).
+  {
+    struct Use { const char* key; std::uint8_t id; };
+    std::vector<Use> uses{{"can.node_beat_crank", c.can.node_beat_crank}, {"can.node_carriage", c.can.node_carriage},
+                          {"can.node_helix", c.can.node_helix}};
+    std::stable_sort(uses.begin(), uses.end(), [&](const Use& a, const Use& b) {
+      const toml::node* na = r.root().at_path(a.key).node();
+      const toml::node* nb = r.root().at_path(b.key).node();
+      const auto line = [](const toml::node* n) { return n ? n->source().begin.line : 0u; };
+      return line(na) < line(nb);
+    });
+    for (std::size_t i = 1; i < uses.size(); ++i) {
+      for (std::size_t j = 0; j < i; ++j) {
+        if (uses[i].id == uses[j].id) {
+          const char* at = present(uses[i].key) ? uses[i].key : uses[j].key;
+          r.fail(at, std::to_string(uses[i].id),
+                 std::string("node id already used by ") + (at == uses[i].key ? uses[j].key : uses[i].key));
+        }
       }
-      p.crank.velocity = crank_speed_at_beat / ratio;
-    } catch (const motion::MotionError& e) {
-      r.fail("beatup.beat_force_target_n", std::to_string(c.beat_force_target_n), e.what());
     }
   }
-
-  // Final check: the motion module must be able to build every profile from these numbers.
-  try {
-    motion::ProfileSet check(c.profile);
-  } catch (const motion::MotionError& e) {
-    throw ConfigError(source + ": motion profiles cannot be built: " + e.what());
+  const auto& m = c.machine_spec;
+  // The beat-up must be a Grashof crank-rocker: the crank turns fully, the rocker swings the beater.
+  if (motion::classify(m.beatup.bar) != motion::GrashofClass::kCrankRocker) {
+    const auto& b = m.beatup.bar;
+    std::ostringstream os;
+    os << "the linkage (crank " << b.crank << ", coupler " << b.coupler << ", rocker " << b.rocker << ", ground "
+       << b.ground << " m) is a " << motion::grashof_class_name(motion::classify(b))
+       << ", not a crank-rocker: the crank must be the shortest link and shortest + longest <= the other two";
+    r.fail("beatup.crank_m", fmt_num(b.crank), os.str());
   }
+  if (m.beater_width_m >= m.width_m) {
+    r.fail("beatup.beater_width_m", fmt_num(m.beater_width_m), "must be narrower than loom.width_m = " + fmt_num(m.width_m));
+  }
+  if (c.recipe.overlap_m >= m.beater_width_m) {
+    r.fail("recipe.overlap_m", fmt_num(c.recipe.overlap_m),
+           "must be less than beatup.beater_width_m = " + fmt_num(m.beater_width_m) + " (the carriage must step forward)");
+  }
+  if (c.recipe.beat_force_min_n >= c.recipe.beat_force_max_n) {
+    r.fail("recipe.beat_force_max_n", fmt_num(c.recipe.beat_force_max_n),
+           "must exceed recipe.beat_force_min_n = " + fmt_num(c.recipe.beat_force_min_n));
+  }
+  if (c.recipe.beat_force_target_n > 0.0 &&
+      (c.recipe.beat_force_target_n < c.recipe.beat_force_min_n || c.recipe.beat_force_target_n > c.recipe.beat_force_max_n)) {
+    r.fail("recipe.beat_force_target_n", fmt_num(c.recipe.beat_force_target_n),
+           "must lie in the band [beat_force_min_n, beat_force_max_n] = [" + fmt_num(c.recipe.beat_force_min_n) + ", " +
+               fmt_num(c.recipe.beat_force_max_n) + "]");
+  }
+  if (c.run.stale_timeout_s < 2.0 * c.run.period_s) {
+    r.fail("timing.stale_timeout_ms", fmt_num(c.run.stale_timeout_s * 1e3),
+           "must be at least two periods (timing.period_ms = " + fmt_num(c.run.period_s * 1e3) + ")");
+  }
+  if (m.shed.release_timeout_s >= m.shed.timeout_s) {
+    r.fail("shedding.release_timeout_s", fmt_num(m.shed.release_timeout_s),
+           "must be shorter than shedding.timeout_s = " + fmt_num(m.shed.timeout_s));
+  }
+}
+
+// The CAN master's own validation, with its complaint pinned to the key that sets the field.
+void check_can(const LoomConfig& c, const Fail& fail) {
+  const drivers::CanAxisPortConfig cc = can_axis_config(c);
+  if (const drivers::Status s = drivers::validate(cc); !s) {
+    const std::string& msg = s.message();
+    std::string key = "can.heartbeat_timeout_ms", value = std::to_string(c.can.heartbeat_timeout_ms);
+    if (msg.find("heartbeat_producer") == 0) key = "can.heartbeat_ms", value = std::to_string(c.can.heartbeat_ms);
+    if (msg.find("sdo") == 0) key = "can.sdo_timeout_ms", value = std::to_string(c.can.sdo_timeout_ms);
+    if (msg.find("counts_per_unit") != std::string::npos) key = "can.counts_per_rev", value = fmt_num(c.can.counts_per_rev);
+    fail(key, value, "the CAN master refuses it: " + msg);
+  }
+  const drivers::BusLoad load = drivers::servo_cycle_bus_load(hal::kAxisCount, cc.tpdo2, cc.bitrate_bps, cc.cycle_period_s);
+  if (const drivers::Status s = drivers::check_bus_load(load, c.can.bus_load_budget); !s) {
+    fail("can.bus_load_budget", fmt_num(c.can.bus_load_budget), s.message());
+  }
+}
+
+// Crank (master) speed for the recipe: given, or from the beat-force target through the linkage's
+// inverse dynamics (the beater force is inertial, so it scales with ω²) and the crank law.
+double master_crank_speed(const LoomConfig& c, const Fail& fail) {
+  const Recipe& rc = c.recipe;
+  if (rc.beat_force_target_n <= 0.0) return rc.crank_speed_rad_s;
+  const auto& m = c.machine_spec;
+  double crank_speed_at_beat = 0.0;
+  try {
+    const motion::BeatUpDynamics dyn(m.beatup, motion::beatup_masses(m.beatup, m.beater_mass_kg));
+    crank_speed_at_beat = dyn.crank_speed_for_beat_force(rc.beat_force_target_n);
+  } catch (const motion::MotionError& e) {
+    fail("recipe.beat_force_target_n", fmt_num(rc.beat_force_target_n), e.what());
+  }
+  // With a speed law the crank is faster (or slower) than the master at the beat: the master runs at
+  // the crank speed divided by the law's ratio where the crank reaches the fell.
+  double ratio = 1.0;
+  if (rc.crank_law.kind != motion::CrankLawKind::kConstant) {
+    const motion::BeatUp head(m.beatup);
+    const double fell_phase = head.warp().fell;
+    const motion::CrankLaw speed_law(rc.crank_law, fell_phase,
+                                     {.size = rc.table_size, .interp = rc.table_interp, .precision = rc.table_precision, .rise = 0.0});
+    double x = fell_phase;  // Newton on Φc(x) = x + offset(x) = fell; dΦc/dx ≥ min ratio > 0
+    for (int i = 0; i < 50; ++i) {
+      const motion::CrankLawExact e = speed_law.exact(x);
+      const double step = (x + e.offset - fell_phase) / e.d1;
+      x -= step;
+      if (std::abs(step) < 1e-14) break;
+    }
+    ratio = speed_law.exact(x).d1;
+  }
+  const double master = crank_speed_at_beat / ratio;
+  if (!std::isfinite(master) || master < 0.1 || master > 100.0) {
+    fail("recipe.beat_force_target_n", fmt_num(rc.beat_force_target_n),
+         "needs a crank speed of " + fmt_num(master) + " rad/s, outside the crank's [0.1, 100] rad/s");
+  }
+  return master;
+}
+
+void derive(LoomConfig& c, const Fail& fail) {
+  const MachineSpec& m = c.machine_spec;
+  const Recipe& rc = c.recipe;
+  c.beat_force_target_n = rc.beat_force_target_n > 0.0 ? rc.beat_force_target_n : 0.0;
+
+  motion::ProfileSpec& p = c.profile;
+  p = motion::ProfileSpec{};
+  p.beatup = m.beatup;
+  p.width_m = m.width_m;
+  p.beater_width_m = m.beater_width_m;
+  p.overlap_m = rc.overlap_m;
+  p.beats_per_position = rc.beats_per_position;
+  p.crank = {.velocity = 0.0, .acceleration = rc.crank_accel_rad_s2, .jerk = rc.crank_jerk_rad_s3};
+  p.crank_law = rc.crank_law;
+  p.cam_margin_rad = rc.cam_margin_rad;
+  p.carriage_max_speed_m_s = m.carriage_max_speed_m_s;
+  p.carriage_max_accel_m_s2 = m.carriage_max_accel_m_s2;
+  p.carriage_max_jerk_m_s3 = m.carriage_max_jerk_m_s3;
+  p.helix_lead_m = m.helix_lead_m;
+  p.helix = m.helix;
+  p.carrier_force_n = m.carrier_force_n;
+  p.shuttle_mass_kg = m.shuttle_mass_kg;
+  p.shed = m.shed;
+  p.table_size = rc.table_size;
+  p.table_interp = rc.table_interp;
+  p.table_precision = rc.table_precision;
+  p.max_table_error_rad = rc.max_table_error_rad;
+  p.crank.velocity = master_crank_speed(c, fail);
+
+  sequencer::SequencerConfig& s = c.sequencer;
+  s = sequencer::SequencerConfig{};
+  s.period_s = c.run.period_s;
+  s.picks_per_row = rc.picks_per_row;
+  s.debounce_ticks = c.run.debounce_ticks;
+  s.enable_timeout_s = c.run.enable_timeout_s;
+  s.pick_timeout_margin_s = c.run.pick_timeout_margin_s;
+  s.stale_timeout_s = c.run.stale_timeout_s;
+  s.crank_park_position_rad = m.calibration.crank_park_position_rad;
+  s.carriage_home_m = m.calibration.carriage_home_m;
+  s.helix_left_position_rad = m.calibration.helix_left_position_rad;
+  s.beat_force_min_n = rc.beat_force_min_n;
+  s.beat_force_max_n = rc.beat_force_max_n;
+  s.carriage = {.velocity = m.carriage_max_speed_m_s, .acceleration = m.carriage_max_accel_m_s2,
+                .jerk = m.carriage_reposition_jerk_m_s3};
+
+  sim_hal::SimMachine& sm = c.machine;
+  sm = sim_hal::SimMachine{};
+  sm.period_s = c.run.period_s;
+  sm.width_m = m.width_m;
+  sm.helix_lead_m = m.helix_lead_m;
+  sm.piston_travel_s = m.shed.piston_travel_s;
+  sm.beatup = m.beatup;
+  sm.crank_park_position_rad = m.calibration.crank_park_position_rad;
+}
+
+// The derived motion must be buildable, fit the sequencer's fixed capacities and end in finite time.
+void check_motion(const LoomConfig& c, const Fail& fail) {
+  const bool from_force = c.recipe.beat_force_target_n > 0.0;
+  const std::string speed_key = from_force ? "recipe.beat_force_target_n" : "recipe.crank_speed_rad_s";
+  const std::string speed_value = fmt_num(from_force ? c.recipe.beat_force_target_n : c.recipe.crank_speed_rad_s);
+  std::optional<motion::ProfileSet> set;
+  try {
+    set.emplace(c.profile);
+  } catch (const motion::MotionError& e) {
+    std::string why = std::string("motion profiles cannot be built: ") + e.what();
+    if (from_force) why += " (the force target asks for a crank speed of " + fmt_num(c.profile.crank.velocity) + " rad/s)";
+    fail(speed_key, speed_value, why);
+  }
+  if (set->beats_per_row() > sequencer::kMaxBeatsPerRow) {
+    fail("recipe.beats_per_position", std::to_string(c.recipe.beats_per_position),
+         "gives " + std::to_string(set->beats_per_row()) + " beats per row on a " + fmt_num(c.machine_spec.width_m) +
+             " m loom; the sequencer holds at most " + std::to_string(sequencer::kMaxBeatsPerRow));
+  }
+  const double pick_s = set->pick().duration(), sweep_s = set->crank_sweep().duration();
+  if (!std::isfinite(pick_s) || pick_s <= 0.0 || pick_s > 600.0) {
+    fail("helix.max_accel_rad_s2", fmt_num(c.machine_spec.helix.acceleration),
+         "a pick would take " + fmt_num(pick_s) + " s (must end within 600 s)");
+  }
+  const double row_s = c.recipe.picks_per_row * (c.machine_spec.shed.timeout_s + pick_s) + sweep_s;
+  if (!std::isfinite(sweep_s) || !std::isfinite(row_s) || row_s > kMaxRowSeconds) {
+    fail(speed_key, speed_value,
+         "a row would take up to " + fmt_num(row_s) + " s (beat sweep " + fmt_num(sweep_s) + " s); at most " +
+             fmt_num(kMaxRowSeconds) + " s");
+  }
+}
+
+LoomConfig parse_complete(const std::string& text, const std::string& source, const LoomConfig* base) {
+  TomlReader r(text, source);
+  r.consume("extends");
+  LoomConfig c = base ? *base : LoomConfig{};
+  c.source = source;
+  const auto present = [&](const std::string& path) { return r.root().at_path(path).node() != nullptr; };
+  for (const Key& k : keys()) {
+    if (present(k.path)) {
+      k.read(r, c);
+    } else {
+      r.consume(k.path);
+      if (!base && k.required) {
+        r.fail_missing(k.path, "missing: a config file must be complete, or begin with extends = \"default\" to take "
+                               "what it does not say from the embedded default loom");
+      }
+    }
+  }
+  // The crank speed is given, or follows from a beat-force target: exactly one of the two.
+  const bool speed = present("recipe.crank_speed_rad_s"), force = present("recipe.beat_force_target_n");
+  if (speed && force) {
+    r.fail("recipe.crank_speed_rad_s", fmt_num(c.recipe.crank_speed_rad_s), "give either beat_force_target_n or crank_speed_rad_s, not both");
+  }
+  if (speed) c.recipe.beat_force_target_n = 0.0;
+  if (force) c.recipe.crank_speed_rad_s = 0.0;
+  if (!speed && !force && !base) {
+    r.fail_missing("recipe.beat_force_target_n", "missing: give beat_force_target_n (N) or crank_speed_rad_s (rad/s)");
+  }
+  r.reject_unknown(known_sections());
+  check_relations(r, c);
+  const Fail fail = [&](const std::string& key, const std::string& value, const std::string& why) {
+    if (present(key)) r.fail(key, value, why);
+    throw ConfigError(source + ": " + key + " = " + value + " (from the embedded default): " + why);
+  };
+  derive(c, fail);
+  check_can(c, fail);
+  check_motion(c, fail);
   return c;
+}
+
+}  // namespace
+
+void derive_module_configs(LoomConfig& c) {
+  derive(c, [&](const std::string& key, const std::string& value, const std::string& why) {
+    throw ConfigError(c.source + ": " + key + " = " + value + ": " + why);
+  });
+}
+
+drivers::CanAxisPortConfig can_axis_config(const LoomConfig& c) {
+  drivers::CanAxisPortConfig cc;
+  const double counts_per_rad = c.can.counts_per_rev / (2.0 * M_PI);
+  cc.axes[hal::index(hal::Axis::kBeatCrank)] = {c.can.node_beat_crank, counts_per_rad, 0.0};
+  cc.axes[hal::index(hal::Axis::kCarriage)] = {c.can.node_carriage, c.can.carriage_counts_per_m, 0.0};
+  cc.axes[hal::index(hal::Axis::kHelix)] = {c.can.node_helix, counts_per_rad, 0.0};
+  cc.cycle_period_s = c.run.period_s;
+  cc.heartbeat_producer_s = c.can.heartbeat_ms * 1e-3;
+  cc.heartbeat_consumer_s = c.can.heartbeat_timeout_ms * 1e-3;
+  cc.sdo_timeout_s = c.can.sdo_timeout_ms * 1e-3;
+  cc.bitrate_bps = c.can.bitrate;
+  cc.bus_load_budget = c.can.bus_load_budget;
+  return cc;
+}
+
+LoomConfig parse_loom_config(const std::string& text, const std::string& source) {
+  // `extends` is read before anything else: it decides whether missing keys are errors.
+  const TomlReader probe(text, source);
+  if (const toml::node* ext = probe.root().get("extends")) {
+    const auto name = ext->value<std::string>();
+    if (!name || *name != "default") {
+      probe.fail("extends", name ? '"' + *name + '"' : "?", "only \"default\" (the embedded default loom) can be extended");
+    }
+    static const LoomConfig base = parse_complete(kDefaultLoomToml, "<embedded default_loom.toml>", nullptr);
+    return parse_complete(text, source, &base);
+  }
+  return parse_complete(text, source, nullptr);
 }
 
 LoomConfig load_loom_config(const std::string& path) { return parse_loom_config(read_file(path), path); }
 LoomConfig default_loom_config() { return parse_loom_config(kDefaultLoomToml, "<embedded default_loom.toml>"); }
+
+std::string restart_only_changes(const LoomConfig& running, const LoomConfig& next) {
+  std::string out;
+  for (const Key& k : keys()) {
+    if (k.klass == Klass::kRecipe) continue;
+    const std::string a = k.value(running), b = k.value(next);
+    if (a != b) out += (out.empty() ? "" : ", ") + k.path + " " + a + " -> " + b;
+  }
+  return out;
+}
+
+std::vector<KeyInfo> config_keys() {
+  std::vector<KeyInfo> out;
+  for (const Key& k : keys()) out.push_back({k.path.c_str(), klass_name(k.klass), k.range});
+  return out;
+}
 
 Scene parse_scene(const std::string& text, const std::string& source) {
   TomlReader r(text, source);

@@ -70,9 +70,11 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
 
 void Machine::publish_recipe(const LoomConfig& next) {
   // What the running loop and its HAL were configured with cannot change between rows.
-  if (next.sequencer.period_s != cfg_.sequencer.period_s || next.loom_id != cfg_.loom_id ||
-      next.machine.width_m != cfg_.machine.width_m || next.profile.helix_lead_m != cfg_.profile.helix_lead_m) {
-    throw ConfigError(next.source + ": period, loom id, width and helix lead change only with a restart");
+  // A reload may change the recipe only: the machine and the run settings are what the HAL, the
+  // simulator and the loop were built from.
+  if (const std::string changed = restart_only_changes(cfg_, next); !changed.empty()) {
+    throw ConfigError(next.source + ": only [recipe] and [profiles] may change while weaving; restart to change " +
+                      changed);
   }
   try {
     slot_->publish(std::make_unique<const motion::ProfileSet>(next.profile));

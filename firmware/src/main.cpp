@@ -76,7 +76,8 @@ int weave(const WeaveArgs& a) {
       if (a.period_ms < 0.25 || a.period_ms > 20.0) {
         throw firmware::ConfigError("--period-ms = " + std::to_string(a.period_ms) + ": must be in [0.25, 20]");
       }
-      cfg.sequencer.period_s = cfg.machine.period_s = a.period_ms * 1e-3;
+      cfg.run.period_s = a.period_ms * 1e-3;
+      firmware::derive_module_configs(cfg);
     }
     if (!a.lcm_url.empty()) cfg.telemetry.lcm_url = a.lcm_url;
     if (!a.loom_id.empty()) cfg.loom_id = a.loom_id;
@@ -145,8 +146,11 @@ int weave(const WeaveArgs& a) {
       try {
         if (config_path.empty()) throw firmware::ConfigError("no --config file to reload (running the embedded default)");
         firmware::LoomConfig next = firmware::load_loom_config(config_path);
-        if (a.period_ms > 0.0) next.sequencer.period_s = next.machine.period_s = a.period_ms * 1e-3;
-        if (!a.loom_id.empty()) next.loom_id = a.loom_id;
+        // Command-line overrides of run settings hold for the reloaded file too.
+        next.run.period_s = cfg.run.period_s;
+        next.telemetry.lcm_url = cfg.telemetry.lcm_url;
+        next.loom_id = cfg.loom_id;
+        firmware::derive_module_configs(next);
         machine->publish_recipe(next);
         std::printf("recipe: %s reloaded; the loom adopts it at the next row\n", config_path.c_str());
       } catch (const firmware::ConfigError& ex) {

@@ -1,7 +1,15 @@
 // TomlReader: parse errors and value errors share one format so a technician can jump to the line.
 #include "toml_reader.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <vector>
 
 namespace loom::firmware {
 namespace {
@@ -12,7 +20,7 @@ std::string where(const std::string& source, const toml::source_region& r) {
   return os.str();
 }
 
-std::string show(const toml::node& n) {
+std::string show_value(const toml::node& n) {
   std::ostringstream os;
   if (n.is_string()) {
     os << '"' << n.as_string()->get() << '"';
@@ -39,12 +47,115 @@ void collect_keys(const toml::table& t, const std::string& prefix, std::vector<s
   }
 }
 
+// toml++ recurses once per dotted-key segment and per nested array/inline table: a hostile file
+// (40,000 dots) would overflow the stack. No loom config needs more than a few levels.
+constexpr int kMaxKeyDepth = 16;
+constexpr int kMaxNesting = 32;
+
+void check_depth(const std::string& text, const std::string& source) {
+  int line = 1, col = 0, dots = 0, nesting = 0;
+  bool in_string = false, in_comment = false, in_key = true;
+  char quote = 0;
+  for (char ch : text) {
+    ++col;
+    if (ch == '\n') {
+      ++line, col = 0, dots = 0, in_comment = false, in_key = nesting == 0;
+      if (quote == '"' || quote == '\'') in_string = false, quote = 0;  // single-line strings end here
+      continue;
+    }
+    if (in_comment) continue;
+    if (in_string) {
+      if (ch == quote) in_string = false, quote = 0;
+      continue;
+    }
+    if (ch == '"' || ch == '\'') {
+      in_string = true, quote = ch;
+    } else if (ch == '#') {
+      in_comment = true;
+    } else if (ch == '=') {
+      in_key = false;
+    } else if (ch == '.' && in_key) {
+      if (++dots >= kMaxKeyDepth) {
+        throw ConfigError(source + ":" + std::to_string(line) + ":" + std::to_string(col) + ": key nested deeper than " +
+                          std::to_string(kMaxKeyDepth) + " levels");
+      }
+    } else if ((ch == '[' || ch == '{') && !in_key) {
+      if (++nesting > kMaxNesting) {
+        throw ConfigError(source + ":" + std::to_string(line) + ":" + std::to_string(col) +
+                          ": arrays/inline tables nested deeper than " + std::to_string(kMaxNesting) + " levels");
+      }
+    } else if ((ch == ']' || ch == '}') && !in_key && nesting > 0) {
+      --nesting;
+    }
+  }
+}
+
+// Edit distance, for "did you mean".
+std::size_t distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    cur[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+    }
+    std::swap(prev, cur);
+  }
+  return prev[b.size()];
+}
+
 }  // namespace
+
+std::string read_config_file(const std::string& path) {
+  constexpr off_t kMaxBytes = 1 << 20;
+  // O_NONBLOCK: opening a FIFO must not wait for a writer; the type check below refuses it anyway.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) throw ConfigError(path + ": cannot open: " + std::strerror(errno));
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    throw ConfigError(path + ": not a regular file");
+  }
+  if (st.st_size > kMaxBytes) {
+    ::close(fd);
+    throw ConfigError(path + ": " + std::to_string(st.st_size) + " bytes: larger than any config (limit 1 MiB)");
+  }
+  std::string text(static_cast<std::size_t>(st.st_size), '\0');
+  std::size_t got = 0;
+  while (got < text.size()) {
+    const ssize_t n = ::read(fd, text.data() + got, text.size() - got);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int err = errno;
+      ::close(fd);
+      throw ConfigError(path + ": cannot read" + (n < 0 ? std::string(": ") + std::strerror(err) : ": file shrank"));
+    }
+    got += static_cast<std::size_t>(n);
+  }
+  ::close(fd);
+  return text;
+}
 
 std::string positive(double v) { return v > 0.0 && std::isfinite(v) ? "" : "must be positive and finite"; }
 std::string non_negative(double v) { return v >= 0.0 && std::isfinite(v) ? "" : "must be >= 0 and finite"; }
 
+std::string TomlReader::show(const toml::node& n) const {
+  // The value as the user wrote it (1e-320 stays 1e-320), when it sits on one line.
+  const auto& r = n.source();
+  if (r.begin.line == r.end.line && r.begin.line >= 1 && r.begin.line <= lines_.size() && !n.is_table()) {
+    const std::string& line = lines_[r.begin.line - 1];
+    if (r.begin.column >= 1 && r.end.column > r.begin.column && r.end.column - 1 <= line.size()) {
+      return line.substr(r.begin.column - 1, r.end.column - r.begin.column);
+    }
+  }
+  return show_value(n);
+}
+
 TomlReader::TomlReader(const std::string& text, std::string source) : source_(std::move(source)) {
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines_.push_back(line);
+  if (text.find('\0') != std::string::npos) throw ConfigError(source_ + ":1:1: not a text file (contains NUL bytes)");
+  check_depth(text, source_);
   try {
     root_ = toml::parse(text, source_);
   } catch (const toml::parse_error& e) {
@@ -67,12 +178,22 @@ void TomlReader::fail_at(const toml::node& node, const std::string& field, const
   throw ConfigError(where(source_, node.source()) + ": " + field + " = " + value + ": " + why);
 }
 
+void TomlReader::fail_missing(const std::string& path, const std::string& why) const {
+  const std::string section = path.substr(0, path.find('.'));
+  const toml::node* sec = find(section);
+  if (sec && sec->source().begin.line > 0) {
+    throw ConfigError(where(source_, sec->source()) + ": [" + section + "] " + path.substr(path.find('.') + 1) + ": " + why);
+  }
+  throw ConfigError(source_ + ":1:1: " + path + ": " + why);
+}
+
 void TomlReader::number(const std::string& path, double& out, const std::function<std::string(double)>& check) {
   used_.insert(path);
   const toml::node* n = find(path);
   if (!n) return;
   const auto v = n->value<double>();  // integers convert
   if (!v) fail_at(*n, path, show(*n), "expected a number");
+  if (!std::isfinite(*v)) fail_at(*n, path, show(*n), "must be finite");
   if (check) {
     const std::string why = check(*v);
     if (!why.empty()) fail_at(*n, path, show(*n), why);
@@ -120,6 +241,24 @@ void TomlReader::string_list(const std::string& path, std::vector<std::string>& 
     if (!s) fail_at(e, path, show(e), "expected a string");
     out.push_back(*s);
   }
+}
+
+void TomlReader::reject_unknown(const std::set<std::string>& sections) const {
+  for (const auto& [k, v] : root_) {
+    const std::string name(k.str());
+    if (!v.is_table() || sections.count(name) || used_.count(name)) continue;
+    std::string best;
+    std::size_t best_d = 3;  // suggest only near misses
+    for (const auto& s : sections) {
+      const std::size_t d = distance(name, s);
+      if (d < best_d) best = s, best_d = d;
+    }
+    std::string list;
+    for (const auto& s : sections) list += (list.empty() ? "" : ", ") + s;
+    fail_at(v, "[" + name + "]", "{...}",
+            "unknown section" + (best.empty() ? " (sections: " + list + ")" : " (did you mean [" + best + "]?)"));
+  }
+  reject_unknown();
 }
 
 void TomlReader::reject_unknown() const {

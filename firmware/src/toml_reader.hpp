@@ -6,6 +6,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <vector>
 #include <toml++/toml.h>
 
 #include "loom/firmware/config.hpp"
@@ -29,18 +30,29 @@ class TomlReader {
   [[noreturn]] void fail(const std::string& path, const std::string& value, const std::string& why) const;
   [[noreturn]] void fail_at(const toml::node& node, const std::string& field, const std::string& value,
                             const std::string& why) const;
+  // A required key the file does not have: reported at its section's header (or the file's start).
+  [[noreturn]] void fail_missing(const std::string& path, const std::string& why) const;
 
   // After reading: every key in the file must have been consumed (arrays of tables are checked by
   // their readers through `consume`).
   void consume(const std::string& path) { used_.insert(path); }
   void reject_unknown() const;
+  // As reject_unknown, and a top-level table outside `sections` is reported as an unknown *section*
+  // (with the closest known name), not as its first key.
+  void reject_unknown(const std::set<std::string>& sections) const;
 
  private:
   const toml::node* find(const std::string& path) const;
+  std::string show(const toml::node& n) const;  // the value as written, for messages
+  std::vector<std::string> lines_;
   std::string source_;
   toml::table root_;
   std::set<std::string> used_;
 };
+
+// Configure-time only. The text of a config or scene file: a regular file of at most 1 MiB (a FIFO,
+// a device or /dev/zero is refused instead of blocking or reading without bound).
+std::string read_config_file(const std::string& path);
 
 // Common checks.
 std::string positive(double v);

@@ -96,8 +96,8 @@ CarriagePeaks check_carriage_step(const CarriageCam& cam, const CrankLaw& law, d
      << " m/s^2, " << p.jerk_m_s3 << " m/s^3; the limits are carriage.max_speed_m_s = " << limits.speed_m_s
      << (v ? " (exceeded)" : "") << ", carriage.max_accel_m_s2 = " << limits.accel_m_s2 << (a ? " (exceeded)" : "")
      << ", carriage.max_jerk_m_s3 = " << limits.jerk_m_s3 << (j ? " (exceeded)" : "")
-     << ". Lower beatup.crank_speed_rad_s to at most " << p.max_crank_speed_rad_s
-     << " rad/s, or shorten the pitch (beatup.beater_width_m, beatup.overlap_m), or lower beatup.cam_margin_deg";
+     << ". Lower recipe.crank_speed_rad_s to at most " << p.max_crank_speed_rad_s
+     << " rad/s, or shorten the pitch (beatup.beater_width_m, recipe.overlap_m), or lower recipe.cam_margin_deg";
   throw MotionError(ErrorCode::kInvalidInput, os.str());
 }
 

@@ -64,8 +64,8 @@ ProfileSet::ProfileSet(const ProfileSpec& spec)
     os << spec.table_size << "-knot " << interp_name(spec.table_interp) << " " << precision_name(spec.table_precision)
        << " tables miss the exact kinematics by up to " << std::max(rocker_error_, crank_error_)
        << " rad (rocker " << rocker_error_ << ", crank law " << crank_error_
-       << "), more than beatup.max_table_error_rad = " << spec.max_table_error_rad
-       << "; raise beatup.table_size or use beatup.interp = \"quintic\" (float32 knots stop near 3e-8 rad)";
+       << "), more than profiles.max_table_error_rad = " << spec.max_table_error_rad
+       << "; raise profiles.table_size or use profiles.interp = \"quintic\" (float32 knots stop near 3e-8 rad)";
     infeasible(os);
   }
   // Equal pitch from selvedge to selvedge: never more than the nominal pitch, so overlap is kept.
@@ -93,8 +93,8 @@ ProfileSet::ProfileSet(const ProfileSpec& spec)
     os << "beat-up crank cannot reach " << spec.crank.velocity << " rad/s before the first beat: run-up needs "
        << deg(ramp) << " deg of master phase (crank at " << deg(crank_at_speed) << " deg), the beater enters the warp "
        << deg(w.enter) << " deg after park and leaves it " << deg(kTwoPi - w.exit)
-       << " deg before park; raise beatup.crank_accel_rad_s2 / beatup.crank_jerk_rad_s3 or lower "
-          "beatup.crank_speed_rad_s";
+       << " deg before park; raise recipe.crank_accel_rad_s2 / recipe.crank_jerk_rad_s3 or lower "
+          "recipe.crank_speed_rad_s";
     infeasible(os);
   }
   carriage_peaks_ = check_carriage_step(

@@ -64,14 +64,14 @@ TEST(Config, ShippedScenesLoad) {
 }
 
 TEST(Config, OutOfRangeValueNamesFileLineColumnFieldAndValue) {
-  const std::string e = config_error("[loom]\nwidth_m = 1.2\n\n[beatup]\ncrank_m = -0.058\n");
-  EXPECT_EQ(e, "loom.toml:5:11: beatup.crank_m = -0.058: must be positive and finite");
+  const std::string e = config_error("extends = \"default\"\n[loom]\nwidth_m = 1.2\n\n[beatup]\ncrank_m = -0.058\n");
+  EXPECT_EQ(e, "loom.toml:6:11: beatup.crank_m = -0.058: must be in [0.005, 2]");
 }
 
 TEST(Config, WrongTypeAndUnknownKeyAndBadEnum) {
-  EXPECT_EQ(config_error("[helix]\nlead_m = \"ten\"\n"), "loom.toml:2:10: helix.lead_m = \"ten\": expected a number");
-  EXPECT_EQ(config_error("[helix]\nleed_m = 0.1\n"), "loom.toml:2:10: helix.leed_m = 0.1: unknown field");
-  EXPECT_NE(config_error("[beatup]\nbranch = \"up\"\n").find("beatup.branch = \"up\": must be one of"),
+  EXPECT_EQ(config_error("extends = \"default\"\n[helix]\nlead_m = \"ten\"\n"), "loom.toml:3:10: helix.lead_m = \"ten\": expected a number");
+  EXPECT_EQ(config_error("extends = \"default\"\n[helix]\nleed_m = 0.1\n"), "loom.toml:3:10: helix.leed_m = 0.1: unknown field");
+  EXPECT_NE(config_error("extends = \"default\"\n[beatup]\nbranch = \"up\"\n").find("beatup.branch = \"up\": must be one of"),
             std::string::npos);
 }
 
@@ -82,12 +82,12 @@ TEST(Config, SyntaxErrorHasLineAndColumn) {
 
 TEST(Config, InfeasibleMotionIsRefusedWithTheLimits) {
   // A crank so slow to accelerate that it cannot reach speed before the first beat.
-  const std::string e = config_error("[beatup]\ncrank_speed_rad_s = 15.5\ncrank_accel_rad_s2 = 5.0\n");
+  const std::string e = config_error("extends = \"default\"\n[recipe]\ncrank_speed_rad_s = 15.5\ncrank_accel_rad_s2 = 5.0\n");
   EXPECT_NE(e.find("cannot reach 15.5 rad/s before the first beat"), std::string::npos) << e;
 }
 
 TEST(Config, HeartbeatTimeoutMustDetectLossWithinThreePeriods) {
-  EXPECT_NE(config_error("[can]\nheartbeat_ms = 100\nheartbeat_timeout_ms = 400\n").find("three heartbeat periods"),
+  EXPECT_NE(config_error("extends = \"default\"\n[can]\nheartbeat_ms = 100\nheartbeat_timeout_ms = 400\n").find("loom.toml:4:24: can.heartbeat_timeout_ms = 400: the CAN master refuses it"),
             std::string::npos);
 }
 
@@ -106,10 +106,10 @@ TEST(Config, SceneRejectsUnknownEffectsAndOrphanParameters) {
 }
 
 TEST(LoomctlCli, BadConfigValueIsOneLineAndExit2) {
-  const std::string path = write_temp("loom_bad.toml", "[loom]\nwidth_m = 99\n");
+  const std::string path = write_temp("loom_bad.toml", "extends = \"default\"\n[loom]\nwidth_m = 99\n");
   const CliRun r = run_loomctl("weave --no-telemetry --config " + path);
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_EQ(r.output, "loomctl: " + path + ":2:11: loom.width_m = 99: must be in [0.2, 10]\n");
+  EXPECT_EQ(r.output, "loomctl: " + path + ":3:11: loom.width_m = 99: must be in [0.2, 10]\n");
 }
 
 TEST(LoomctlCli, BadArgumentsExit2) {
@@ -154,21 +154,21 @@ TEST(Config, BeatForceTargetSetsTheCrankSpeedAndExcludesAFixedSpeed) {
   const LoomConfig c = default_loom_config();
   EXPECT_DOUBLE_EQ(c.beat_force_target_n, 90.0);
   EXPECT_NEAR(c.profile.crank.velocity, 16.06, 0.01);  // the beat-up's inverse dynamics for 90 N
-  const LoomConfig slow = parse_loom_config("[beatup]\nbeat_force_target_n = 80.0\n", "loom.toml");
+  const LoomConfig slow = parse_loom_config("extends = \"default\"\n[recipe]\nbeat_force_target_n = 80.0\n", "loom.toml");
   // The beater force is inertial: speed scales with the square root of the force.
   EXPECT_NEAR(slow.profile.crank.velocity / c.profile.crank.velocity, std::sqrt(80.0 / 90.0), 1e-9);
-  const LoomConfig fixed = parse_loom_config("[beatup]\ncrank_speed_rad_s = 15.5\n", "loom.toml");
+  const LoomConfig fixed = parse_loom_config("extends = \"default\"\n[recipe]\ncrank_speed_rad_s = 15.5\n", "loom.toml");
   EXPECT_DOUBLE_EQ(fixed.profile.crank.velocity, 15.5);
   EXPECT_EQ(fixed.beat_force_target_n, 0.0);
-  EXPECT_NE(config_error("[beatup]\ncrank_speed_rad_s = 15.5\nbeat_force_target_n = 90.0\n").find("not both"),
+  EXPECT_NE(config_error("extends = \"default\"\n[recipe]\ncrank_speed_rad_s = 15.5\nbeat_force_target_n = 90.0\n").find("not both"),
             std::string::npos);
 }
 
 TEST(Config, BeatsPerPositionMultipliesTheBeatsOfARow) {
-  const LoomConfig c = parse_loom_config("[recipe]\nbeats_per_position = 3\n", "loom.toml");
+  const LoomConfig c = parse_loom_config("extends = \"default\"\n[recipe]\nbeats_per_position = 3\n", "loom.toml");
   const loom::motion::ProfileSet p(c.profile);
   EXPECT_EQ(p.beats_per_row(), 45);
   EXPECT_EQ(p.cam().steps(), 14);
-  EXPECT_EQ(config_error("[recipe]\nbeats_per_position = 0\n"),
-            "loom.toml:2:22: recipe.beats_per_position = 0: must be in [1, 16]");
+  EXPECT_EQ(config_error("extends = \"default\"\n[recipe]\nbeats_per_position = 0\n"),
+            "loom.toml:3:22: recipe.beats_per_position = 0: must be in [1, 16]");
 }

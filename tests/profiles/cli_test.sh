@@ -29,13 +29,13 @@ cd "$src"
 expect_exit 2 "" frobnicate
 expect_exit 2 "--out" report
 expect_exit 2 "--config" dump --out "$work/x"
-expect_exit 2 "cannot open file" dump --config "$work/none.toml" --out "$work/x"
+expect_exit 2 "cannot open" dump --config "$work/none.toml" --out "$work/x"
 expect_exit 2 "--ellipse-e" dump --config firmware/config/default_loom.toml --out "$work/x" --ellipse-e 1.5
 expect_exit 2 "--interp" dump --config firmware/config/default_loom.toml --out "$work/x" --interp cubicle
-expect_exit 2 "beatup.max_table_error_rad" dump --config firmware/config/default_loom.toml --out "$work/x" \
+expect_exit 2 "profiles.max_table_error_rad" dump --config firmware/config/default_loom.toml --out "$work/x" \
   --table-size 16 --interp linear
-printf '[beatup]\ncrank_speed_rad_s = "fast"\n' >"$work/bad.toml"
-expect_exit 2 "beatup.crank_speed_rad_s" dump --config "$work/bad.toml" --out "$work/x"
+printf 'extends = "default"\n[recipe]\ncrank_speed_rad_s = "fast"\n' >"$work/bad.toml"
+expect_exit 2 "recipe.crank_speed_rad_s" dump --config "$work/bad.toml" --out "$work/x"
 expect_exit 0 "" --help
 
 expect_exit 0 "default choice per profile" report --out "$work/report" --sizes 64 256 --min-time 0.0005 \

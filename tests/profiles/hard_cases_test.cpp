@@ -151,7 +151,7 @@ TEST(ProfileSetHard, TooShortBeatWindowNamesTheLimits) {
   const std::string msg = build_error(s);
   ASSERT_FALSE(msg.empty());
   for (const char* needle : {"carriage.max_speed_m_s = 1 (exceeded)", "carriage.max_accel_m_s2 = 20",
-                             "carriage.max_jerk_m_s3 = 2000", "beatup.crank_speed_rad_s", "deg of crank", "40 rad/s"}) {
+                             "carriage.max_jerk_m_s3 = 2000", "recipe.crank_speed_rad_s", "deg of crank", "40 rad/s"}) {
     EXPECT_NE(msg.find(needle), std::string::npos) << needle << " not in: " << msg;
   }
   // The named speed is the boundary: just below builds, just above is refused.
@@ -177,7 +177,7 @@ TEST(ProfileSetHard, RunUpTooLongForTheWindowIsRefused) {
   s.crank.acceleration = 50.0;  // the crank would still be speeding up in the warp
   const std::string msg = build_error(s);
   EXPECT_NE(msg.find("cannot reach 15.5 rad/s before the first beat"), std::string::npos) << msg;
-  EXPECT_NE(msg.find("beatup.crank_accel_rad_s2"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("recipe.crank_accel_rad_s2"), std::string::npos) << msg;
 }
 
 TEST(ProfileSetHard, TooCoarseTablesAreRefused) {
@@ -185,7 +185,7 @@ TEST(ProfileSetHard, TooCoarseTablesAreRefused) {
   s.table_size = 32;
   s.table_interp = Interp::kLinear;
   const std::string msg = build_error(s);
-  EXPECT_NE(msg.find("beatup.max_table_error_rad"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("profiles.max_table_error_rad"), std::string::npos) << msg;
   EXPECT_NE(msg.find("32-knot linear double"), std::string::npos) << msg;
 }
 

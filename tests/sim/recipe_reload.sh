@@ -7,12 +7,12 @@ loomctl=$1
 work=$(mktemp -d)
 trap 'kill %1 2>/dev/null || true; rm -rf "$work"' EXIT
 cfg=$work/loom.toml
-printf '[loom]\nwidth_m = 0.4\n\n[recipe]\nbeats_per_position = 1\n' >"$cfg"
+printf 'extends = "default"\n[loom]\nwidth_m = 0.4\n\n[recipe]\nbeats_per_position = 1\n' >"$cfg"
 "$loomctl" weave --config "$cfg" --rows 4 --realtime --pace 8 --no-telemetry --quiet >"$work/out" 2>&1 &
 pid=$!
 for _ in $(seq 1 200); do grep -q '^row 1/4' "$work/out" && break; sleep 0.05; done
 grep -q '^row 1/4' "$work/out" || { echo "FAIL: row 1 never completed"; cat "$work/out"; exit 1; }
-printf '[loom]\nwidth_m = 0.4\n\n[recipe]\nbeats_per_position = 2\n' >"$cfg"
+printf 'extends = "default"\n[loom]\nwidth_m = 0.4\n\n[recipe]\nbeats_per_position = 2\n' >"$cfg"
 kill -HUP "$pid"
 wait "$pid" || { echo "FAIL: loomctl exited $?"; cat "$work/out"; exit 1; }
 cat "$work/out"

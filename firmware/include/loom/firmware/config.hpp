@@ -1,11 +1,22 @@
-// The loom's configuration file and the simulation scene file, parsed and checked before anything
-// starts. Any bad value is one ConfigError whose message names file, line, column, field and value.
+// The loom's configuration: one machine description, parsed and checked before anything starts.
+//
+// The file has three kinds of facts, each stated once:
+//   - the physical MACHINE ([loom], [beatup], [carriage], [helix], [shedding], [can]): geometry,
+//     width, limits, drive scaling, node ids, calibration; changes only with a restart;
+//   - the RECIPE ([recipe], [profiles]): speeds or force target, crank law, picks per row, beats per
+//     position, overlap, table settings; may be swapped between rows (SIGHUP);
+//   - RUN settings ([timing], [telemetry]): period, timeouts, debouncing, telemetry.
+// One derivation (derive_module_configs) turns them into every module's own config (the profile
+// spec, the sequencer's, the simulator's, the CAN master's); each module's own validation runs at
+// parse time, so every refusal is one ConfigError naming file:line:col, key and value.
 #pragma once
 
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
+#include "loom/drivers/can_axis_port.hpp"
 #include "loom/motion/profile_set.hpp"
 #include "loom/sequencer/sequencer.hpp"
 #include "loom/sim_hal/scene.hpp"
@@ -17,6 +28,7 @@ class ConfigError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// ---- machine (restart only) ------------------------------------------------------------------------
 struct CanSettings {
   std::uint32_t bitrate = 1'000'000;
   double bus_load_budget = 0.7;
@@ -28,6 +40,54 @@ struct CanSettings {
   std::uint16_t sdo_timeout_ms = 500;
 };
 
+// Axis readings at the mechanical references, found when commissioning.
+struct Calibration {
+  double crank_park_position_rad = 0.0;  // crank axis reading at the park pose
+  double carriage_home_m = 0.0;          // carriage axis reading at the left selvedge
+  double helix_left_position_rad = 0.0;  // helix axis reading with the carrier at the left selvedge
+};
+
+struct MachineSpec {
+  double width_m = 1.2;
+  motion::BeatUpGeometry beatup = motion::default_beatup_geometry();
+  double beater_mass_kg = 2.5;
+  double beater_width_m = 0.10;
+  double carriage_max_speed_m_s = 1.0, carriage_max_accel_m_s2 = 20.0, carriage_max_jerk_m_s3 = 2000.0;
+  double carriage_reposition_jerk_m_s3 = 100.0;  // re-arm moves
+  double helix_lead_m = 0.10;
+  motion::JerkLimits helix{.velocity = 60.0, .acceleration = 3000.0, .jerk = 2.0e5};
+  double carrier_force_n = 20.0;
+  double shuttle_mass_kg = 0.40;
+  motion::ShedSpec shed{};  // piston stroke time and the end sensors' confirmation windows
+  Calibration calibration;
+};
+
+// ---- recipe (adopted at a row boundary) -----------------------------------------------------------
+struct Recipe {
+  double beat_force_target_n = 90.0;  // > 0: the crank speed follows from the linkage's dynamics
+  double crank_speed_rad_s = 0.0;     // > 0: fixed crank speed instead of a force target
+  double crank_accel_rad_s2 = 400.0, crank_jerk_rad_s3 = 2.0e4;
+  motion::CrankLawSpec crank_law{};
+  std::uint32_t picks_per_row = 1;
+  int beats_per_position = 1;
+  double overlap_m = 0.02;
+  double cam_margin_rad = 0.3491;
+  double beat_force_min_n = 80.0, beat_force_max_n = 100.0;  // the band every beat must hit
+  std::size_t table_size = 256;
+  motion::Interp table_interp = motion::Interp::kCubic;
+  motion::Precision table_precision = motion::Precision::kDouble;
+  double max_table_error_rad = 1e-7;
+};
+
+// ---- run settings (restart only) ------------------------------------------------------------------
+struct RunSettings {
+  double period_s = 0.002;
+  double enable_timeout_s = 2.0;
+  double pick_timeout_margin_s = 0.5;
+  double stale_timeout_s = 0.05;
+  int debounce_ticks = 3;
+};
+
 struct TelemetrySettings {
   std::string lcm_url;
   std::uint32_t status_every = 50, axes_every = 10, rt_every = 500;
@@ -35,26 +95,55 @@ struct TelemetrySettings {
 
 struct LoomConfig {
   std::string source = "<embedded default>";  // where it came from, for messages
+  // What the file says, each fact once.
   std::string loom_id = "loom1";
+  MachineSpec machine_spec;
+  CanSettings can;
+  Recipe recipe;
+  RunSettings run;
+  TelemetrySettings telemetry;
+
+  // Derived by derive_module_configs() from the facts above; never edited by hand.
   double beat_force_target_n = 0.0;  // > 0 when the crank speed was derived from a beat-force target
   motion::ProfileSpec profile;
   sequencer::SequencerConfig sequencer;
   sim_hal::SimMachine machine;
-  CanSettings can;
-  TelemetrySettings telemetry;
 };
+
+// Configure-time only. Fill every module's config from the machine, recipe and run settings (throws
+// ConfigError naming `source` when the recipe's force target cannot be met). Call again after
+// changing a fact (e.g. a --period-ms override).
+void derive_module_configs(LoomConfig& c);
+// Configure-time only. The CAN master's config for the three servo axes, from the same facts.
+drivers::CanAxisPortConfig can_axis_config(const LoomConfig& c);
+
+// Configure-time only. Parse a loom config from TOML text; `source` names it in errors. The file must
+// be complete, or start with `extends = "default"` to take what it does not say from the embedded
+// default loom.
+LoomConfig parse_loom_config(const std::string& text, const std::string& source);
+// Configure-time only. Read and parse a file (ConfigError if it cannot be read or is not a regular
+// file of reasonable size).
+LoomConfig load_loom_config(const std::string& path);
+LoomConfig default_loom_config();
+
+// Configure-time only. The keys a recipe reload changed that only a restart may change ("" if none):
+// `next` may differ from `running` in its [recipe] and [profiles] sections only.
+std::string restart_only_changes(const LoomConfig& running, const LoomConfig& next);
+
+// Every config key with its class (machine / recipe / run), unit range and meaning, in file order;
+// for `loomctl check` and the README.
+struct KeyInfo {
+  const char* path;
+  const char* klass;  // "machine", "recipe" or "run"
+  std::string range;
+};
+std::vector<KeyInfo> config_keys();
 
 struct Scene {
   std::string source = "<embedded default scene>";
   sim_hal::SceneSpec spec;
   std::string config_path;  // loom config named by the scene ("" = embedded default)
 };
-
-// Configure-time only. Parse a loom config from TOML text; `source` names it in errors.
-LoomConfig parse_loom_config(const std::string& text, const std::string& source);
-// Configure-time only. Read and parse a file (ConfigError if it cannot be read).
-LoomConfig load_loom_config(const std::string& path);
-LoomConfig default_loom_config();
 
 Scene parse_scene(const std::string& text, const std::string& source);
 Scene load_scene(const std::string& path);

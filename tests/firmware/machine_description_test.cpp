@@ -1,0 +1,185 @@
+// One machine description: every reproduction of "a config that parses but does harm" is refused at
+// parse time with file:line:col, key and value; each fact is stated once and derived everywhere; a
+// recipe reload may change the recipe only.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "loom/firmware/config.hpp"
+#include "loom/sequencer/sequencer.hpp"
+
+using namespace loom::firmware;
+
+namespace {
+
+std::string error_of(const std::string& text) {
+  try {
+    (void)parse_loom_config(text, "loom.toml");
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+std::string ext(const std::string& body) { return "extends = \"default\"\n" + body; }
+
+std::string load_error(const std::string& path) {
+  try {
+    (void)load_loom_config(path);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string temp_path(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / ("loom_md_" + std::to_string(::getpid()) + "_" + name)).string();
+}
+
+}  // namespace
+
+TEST(MachineDescription, EmptyOrCommentsOnlyFileIsNotTheDefaultLoom) {
+  EXPECT_EQ(error_of(""), "loom.toml:1:1: loom.id: missing: a config file must be complete, or begin with extends = "
+                          "\"default\" to take what it does not say from the embedded default loom");
+  EXPECT_NE(error_of("# just a comment\n").find("loom.id: missing"), std::string::npos);
+  // A partial file without `extends` names the first key it lacks, at its section's header.
+  EXPECT_EQ(error_of("[loom]\nid = \"x\"\n").rfind("loom.toml:1:1: [loom] width_m: missing", 0), 0u)
+      << error_of("[loom]\nid = \"x\"\n");
+  EXPECT_NE(error_of("extends = \"mine\"\n").find("extends = \"mine\": only \"default\""), std::string::npos);
+}
+
+TEST(MachineDescription, TheDefaultFileIsCompleteAndExtendingItChangesNothing) {
+  const LoomConfig a = default_loom_config();
+  const LoomConfig b = parse_loom_config("extends = \"default\"\n", "x.toml");
+  EXPECT_EQ(restart_only_changes(a, b), "");
+  EXPECT_EQ(a.profile.crank.velocity, b.profile.crank.velocity);
+  // Every key the parser knows is written in the shipped file (so a copy of it is complete).
+  for (const KeyInfo& k : config_keys()) {
+    const std::string key = std::string(k.path).substr(std::string(k.path).find('.') + 1);
+    const std::string section = std::string(k.path).substr(0, std::string(k.path).find('.'));
+    if (std::string(k.path) == "recipe.crank_speed_rad_s") continue;  // the alternative to the force target
+    EXPECT_NE(std::string(kDefaultLoomToml).find("\n" + key + " "), std::string::npos) << k.path;
+    EXPECT_NE(std::string(kDefaultLoomToml).find("[" + section + "]"), std::string::npos) << k.path;
+  }
+}
+
+TEST(MachineDescription, NonRegularOrHugeFilesAreRefusedWithoutReading) {
+  EXPECT_EQ(load_error("/dev/null"), "/dev/null: not a regular file");
+  EXPECT_EQ(load_error("/dev/zero"), "/dev/zero: not a regular file");
+  const std::string fifo = temp_path("fifo");
+  std::filesystem::remove(fifo);
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_EQ(load_error(fifo), fifo + ": not a regular file");  // returns at once: no writer needed
+  std::filesystem::remove(fifo);
+  const std::string big = temp_path("big.toml");
+  std::ofstream(big) << std::string(2 << 20, '#');
+  EXPECT_NE(load_error(big).find("larger than any config"), std::string::npos);
+  std::filesystem::remove(big);
+  EXPECT_NE(load_error(temp_path("absent.toml")).find("cannot open"), std::string::npos);
+}
+
+TEST(MachineDescription, DeeplyNestedKeysAreRefusedBeforeTheParserRecurses) {
+  std::string deep = "a";
+  for (int i = 0; i < 40000; ++i) deep += ".a";
+  EXPECT_EQ(error_of(deep + " = 1\n"), "loom.toml:1:32: key nested deeper than 16 levels");
+  std::string arrays = "x = ";
+  for (int i = 0; i < 40000; ++i) arrays += "[";
+  EXPECT_NE(error_of(arrays + "\n").find("nested deeper than 32 levels"), std::string::npos);
+  EXPECT_NE(error_of(std::string("a = 1\0b", 7)).find("NUL"), std::string::npos);
+}
+
+TEST(MachineDescription, BeatsPerRowBeyondTheSequencerCapacityAreRefused) {
+  const std::string e = error_of(ext("[loom]\nwidth_m = 3.0\n[recipe]\nbeats_per_position = 8\n"));
+  EXPECT_EQ(e, "loom.toml:5:22: recipe.beats_per_position = 8: gives 304 beats per row on a 3 m loom; the sequencer "
+               "holds at most " + std::to_string(loom::sequencer::kMaxBeatsPerRow));
+}
+
+TEST(MachineDescription, CalibrationOffsetsMustBeFiniteAndPlausible) {
+  for (const char* v : {"nan", "inf", "-inf", "1e308"}) {
+    for (const char* key : {"[beatup]\ncrank_park_position_rad", "[carriage]\nhome_position_m", "[helix]\nleft_position_rad"}) {
+      const std::string e = error_of(ext(std::string(key) + " = " + v + "\n"));
+      EXPECT_EQ(e.rfind("loom.toml:3:", 0), 0u) << key << " = " << v << ": " << e;
+      EXPECT_TRUE(e.find("must be finite") != std::string::npos || e.find("must be in [") != std::string::npos) << e;
+    }
+  }
+}
+
+TEST(MachineDescription, AbsurdPositiveValuesAreRefusedByPlausibleRanges) {
+  EXPECT_EQ(error_of(ext("[recipe]\ncrank_jerk_rad_s3 = 1e-320\n")),
+            "loom.toml:3:21: recipe.crank_jerk_rad_s3 = 1e-320: must be in [10, 1e+07]");
+  EXPECT_EQ(error_of(ext("[helix]\nlead_m = 1e-320\n")), "loom.toml:3:10: helix.lead_m = 1e-320: must be in [0.005, 1]");
+  EXPECT_EQ(error_of(ext("[beatup]\nbeater_mass_kg = 1e308\n")),
+            "loom.toml:3:18: beatup.beater_mass_kg = 1e308: must be in [0.1, 50]");
+  EXPECT_EQ(error_of(ext("[helix]\nshuttle_mass_kg = 1e308\n")),
+            "loom.toml:3:19: helix.shuttle_mass_kg = 1e308: must be in [0.01, 10]");
+  EXPECT_NE(error_of(ext("[timing]\nenable_timeout_s = 1e300\n")).find("must be in [0.05, 60]"), std::string::npos);
+  EXPECT_NE(error_of(ext("[can]\nbitrate = 123456\n")).find("must be a CiA 301 bit rate"), std::string::npos);
+}
+
+TEST(MachineDescription, EachCrossFieldErrorPointsAtTheLineThatIsWrong) {
+  // A duplicated node id at its second use, whichever key that is.
+  EXPECT_EQ(error_of(ext("[can]\nnode_helix = 7\nnode_carriage = 7\n")),
+            "loom.toml:4:17: can.node_carriage = 7: node id already used by can.node_helix");
+  // A non-Grashof linkage at the link lengths.
+  EXPECT_NE(error_of(ext("[beatup]\ncrank_m = 0.3\n")).find("loom.toml:3:11: beatup.crank_m = 0.3: the linkage"),
+            std::string::npos);
+  // A misspelled section is an unknown section, with the near miss suggested.
+  EXPECT_EQ(error_of(ext("[carriag]\nmax_speed_m_s = 1\n")),
+            "loom.toml:2:1: [carriag] = {...}: unknown section (did you mean [carriage]?)");
+  // A force target that cannot be met names the limit and the speed it asks for, at the target.
+  const std::string force = error_of(ext("[recipe]\nbeat_force_target_n = 400\nbeat_force_max_n = 500\n"));
+  EXPECT_EQ(force.rfind("loom.toml:3:23: recipe.beat_force_target_n = 400:", 0), 0u) << force;
+  EXPECT_NE(force.find("crank speed of"), std::string::npos) << force;
+  // A target outside the band the beats must hit.
+  EXPECT_NE(error_of(ext("[recipe]\nbeat_force_target_n = 120\n")).find("must lie in the band [beat_force_min_n"),
+            std::string::npos);
+  // The CAN master's own rule, at parse time (exit 2), not when the bus is opened (exit 4).
+  EXPECT_EQ(error_of(ext("[can]\nheartbeat_timeout_ms = 400\n")).rfind("loom.toml:3:24: can.heartbeat_timeout_ms = 400", 0), 0u);
+  EXPECT_NE(error_of(ext("[beatup]\nbeater_width_m = 0.05\n[recipe]\noverlap_m = 0.05\n")).find("loom.toml:5:13: recipe.overlap_m"),
+            std::string::npos);
+}
+
+TEST(MachineDescription, EveryModuleConfigIsDerivedFromOneFact) {
+  LoomConfig c = parse_loom_config(ext("[timing]\nperiod_ms = 4\n[beatup]\ncrank_park_position_rad = 0.5\n"), "x.toml");
+  EXPECT_EQ(c.sequencer.period_s, 0.004);
+  EXPECT_EQ(c.machine.period_s, 0.004);
+  EXPECT_EQ(can_axis_config(c).cycle_period_s, 0.004);
+  EXPECT_EQ(c.sequencer.crank_park_position_rad, 0.5);
+  EXPECT_EQ(c.machine.crank_park_position_rad, 0.5);
+  EXPECT_EQ(c.machine.width_m, c.profile.width_m);
+  EXPECT_EQ(c.machine.beatup.bar.crank, c.profile.beatup.bar.crank);
+  // An override changes the fact once; the derivation carries it everywhere.
+  c.run.period_s = 0.001;
+  derive_module_configs(c);
+  EXPECT_EQ(c.sequencer.period_s, 0.001);
+  EXPECT_EQ(c.machine.period_s, 0.001);
+  EXPECT_EQ(can_axis_config(c).cycle_period_s, 0.001);
+}
+
+TEST(MachineDescription, AReloadMayChangeOnlyTheRecipe) {
+  const LoomConfig running = default_loom_config();
+  const LoomConfig recipe = parse_loom_config(ext("[recipe]\nbeats_per_position = 2\n[profiles]\ninterp = \"quintic\"\n"), "r.toml");
+  EXPECT_EQ(restart_only_changes(running, recipe), "");
+  const LoomConfig geometry = parse_loom_config(ext("[beatup]\ncoupler_m = 0.19\n"), "g.toml");
+  EXPECT_EQ(restart_only_changes(running, geometry), "beatup.coupler_m 0.189 -> 0.19");
+  const LoomConfig run = parse_loom_config(ext("[timing]\ndebounce_ticks = 5\n[loom]\nwidth_m = 1.0\n"), "w.toml");
+  EXPECT_EQ(restart_only_changes(running, run), "loom.width_m 1.2 -> 1, timing.debounce_ticks 3 -> 5");
+}
+
+TEST(MachineDescription, EveryKeyHasAClassAndARange) {
+  int machine = 0, recipe = 0, run = 0;
+  for (const KeyInfo& k : config_keys()) {
+    const std::string klass = k.klass;
+    machine += klass == "machine";
+    recipe += klass == "recipe";
+    run += klass == "run";
+    EXPECT_FALSE(k.range.empty()) << k.path;
+  }
+  EXPECT_GT(machine, 30);
+  EXPECT_GT(recipe, 10);
+  EXPECT_GT(run, 5);
+}
