@@ -536,6 +536,18 @@ void derive_module_configs(LoomConfig& c) {
   });
 }
 
+void rederive_and_check(LoomConfig& c, const std::string& origin) {
+  const Fail fail = [&](const std::string& key, const std::string& value, const std::string& why) {
+    throw ConfigError(origin + ": with it, " + key + " = " + value + ": " + why);
+  };
+  if (c.run.stale_timeout_s < 2.0 * c.run.period_s) {
+    fail("timing.stale_timeout_ms", fmt_num(c.run.stale_timeout_s * 1e3), "must be at least two periods");
+  }
+  derive(c, fail);
+  check_can(c, fail);
+  check_motion(c, fail);
+}
+
 drivers::CanAxisPortConfig can_axis_config(const LoomConfig& c) {
   drivers::CanAxisPortConfig cc;
   const double counts_per_rad = c.can.counts_per_rev / (2.0 * M_PI);

@@ -1,13 +1,17 @@
 // Atomic counter persistence as a tiny JSON object {"rows":R,"picks":P,"beats":B,"picks_in_row":K}.
+// The parser accepts exactly that shape (whitespace aside): four distinct keys, each a whole number
+// in the 32-bit range; 1.5, -1, 1e3, 4294967296 and duplicates are refused, never rounded or wrapped.
 #include "loom/firmware/counter_store.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
-#include <fstream>
-#include <regex>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -15,55 +19,165 @@
 
 namespace loom::firmware {
 namespace {
+
 [[noreturn]] void sys_fail(const std::string& what, const std::string& path) {
   throw std::runtime_error(what + " " + path + ": " + std::strerror(errno));
 }
+
+// A cursor over the text that reports the column of what it could not accept.
+struct Cursor {
+  const std::string& text;
+  const std::string& source;
+  std::size_t i = 0;
+
+  [[noreturn]] void fail(const std::string& why) const {
+    throw ConfigError(source + ": offset " + std::to_string(i) + ": " + why + " (counters file: " +
+                      text.substr(0, 80) + (text.size() > 80 ? "..." : "") + ")");
+  }
+  void skip_ws() {
+    while (i < text.size() && (text[i] == ' ' || text[i] == '\t' || text[i] == '\n' || text[i] == '\r')) ++i;
+  }
+  void expect(char c) {
+    skip_ws();
+    if (i >= text.size() || text[i] != c) fail(std::string("expected '") + c + "'");
+    ++i;
+  }
+  bool peek(char c) {
+    skip_ws();
+    return i < text.size() && text[i] == c;
+  }
+  std::string key() {
+    expect('"');
+    const std::size_t start = i;
+    while (i < text.size() && text[i] != '"') {
+      if (!(std::islower(static_cast<unsigned char>(text[i])) || text[i] == '_')) fail("unexpected character in a key");
+      ++i;
+    }
+    if (i >= text.size()) fail("unterminated key");
+    return text.substr(start, i++ - start);
+  }
+  std::uint32_t count(const std::string& field) {
+    skip_ws();
+    const std::size_t start = i;
+    while (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i]))) ++i;
+    const std::string digits = text.substr(start, i - start);
+    // Anything glued to the digits (".5", "e3", "-") makes the value something other than a count.
+    const bool trailing = i < text.size() && (std::isalnum(static_cast<unsigned char>(text[i])) || text[i] == '.' ||
+                                               text[i] == '+' || text[i] == '-');
+    if (digits.empty() || trailing || (digits.size() > 1 && digits[0] == '0')) {
+      std::size_t end = i;
+      while (end < text.size() && text[end] != ',' && text[end] != '}') ++end;
+      fail("\"" + field + "\" = " + text.substr(start, end - start) + ": must be a whole number in 0..4294967295");
+    }
+    if (digits.size() > 10 || std::stoull(digits) > UINT32_MAX) {
+      fail("\"" + field + "\" = " + digits + ": beyond 4294967295 (a counter is never wrapped)");
+    }
+    return static_cast<std::uint32_t>(std::stoull(digits));
+  }
+};
+
 }  // namespace
 
-std::optional<sequencer::Counters> CounterStore::load() const {
-  std::ifstream f(path_);
-  if (!f) return std::nullopt;
-  std::ostringstream os;
-  os << f.rdbuf();
-  const std::string text = os.str();
-  sequencer::Counters c;
-  const auto field = [&](const char* key, std::uint32_t& out) {
-    const std::regex re(std::string("\"") + key + "\"\\s*:\\s*([0-9]{1,10})");
-    std::smatch m;
-    if (!std::regex_search(text, m, re)) {
-      throw ConfigError(path_ + ": counters file lacks a valid \"" + key + "\" (file: " + text.substr(0, 80) + ")");
-    }
-    out = static_cast<std::uint32_t>(std::stoul(m[1]));
-  };
-  field("rows", c.rows);
-  field("picks", c.picks);
-  field("beats", c.beats);
-  field("picks_in_row", c.picks_in_row);
-  return c;
-}
-
-void CounterStore::save(const sequencer::Counters& c) const {
+std::string CounterStore::format(const sequencer::Counters& c) {
   std::ostringstream os;
   os << "{\"rows\":" << c.rows << ",\"picks\":" << c.picks << ",\"beats\":" << c.beats
      << ",\"picks_in_row\":" << c.picks_in_row << "}\n";
-  const std::string body = os.str();
+  return os.str();
+}
+
+sequencer::Counters CounterStore::parse(const std::string& text, const std::string& source) {
+  Cursor cur{text, source};
+  std::map<std::string, std::uint32_t> fields;
+  cur.expect('{');
+  if (!cur.peek('}')) {
+    for (;;) {
+      const std::string k = cur.key();
+      if (k != "rows" && k != "picks" && k != "beats" && k != "picks_in_row") cur.fail("unknown field \"" + k + "\"");
+      if (fields.count(k)) cur.fail("field \"" + k + "\" given twice");
+      cur.expect(':');
+      fields[k] = cur.count(k);
+      if (cur.peek(',')) {
+        cur.expect(',');
+        continue;
+      }
+      break;
+    }
+  }
+  cur.expect('}');
+  cur.skip_ws();
+  if (cur.i != text.size()) cur.fail("trailing text after the counters object");
+  for (const char* k : {"rows", "picks", "beats", "picks_in_row"}) {
+    if (!fields.count(k)) cur.fail(std::string("lacks \"") + k + "\"");
+  }
+  sequencer::Counters c{fields["rows"], fields["picks"], fields["beats"], fields["picks_in_row"]};
+  // Every completed row had at least one pick and one beat; the picks of the row in progress are
+  // picks too. Counts that say otherwise were not written by loomctl.
+  const auto contradict = [&](const std::string& why) { throw ConfigError(source + ": counters contradict each other: " + why); };
+  if (static_cast<std::uint64_t>(c.rows) + c.picks_in_row > c.picks) {
+    contradict("picks = " + std::to_string(c.picks) + " is less than rows + picks_in_row = " +
+               std::to_string(static_cast<std::uint64_t>(c.rows) + c.picks_in_row));
+  }
+  if (c.beats < c.rows) {
+    contradict("beats = " + std::to_string(c.beats) + " is less than rows = " + std::to_string(c.rows));
+  }
+  return c;
+}
+
+std::optional<sequencer::Counters> CounterStore::load() const {
+  const int fd = ::open(path_.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) {
+    if (errno == ENOENT) return std::nullopt;  // the only case that starts from zero
+    throw ConfigError(path_ + ": counters file exists but cannot be read: " + std::strerror(errno) +
+                      " (refusing to restart the production counts)");
+  }
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || st.st_size > 4096) {
+    ::close(fd);
+    throw ConfigError(path_ + ": not a counters file (not a regular file of at most 4 KiB)");
+  }
+  std::string text(static_cast<std::size_t>(st.st_size), '\0');
+  std::size_t got = 0;
+  while (got < text.size()) {
+    const ssize_t n = ::read(fd, text.data() + got, text.size() - got);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int err = errno;
+      ::close(fd);
+      throw ConfigError(path_ + ": counters file cannot be read: " + (n < 0 ? std::strerror(err) : "it shrank"));
+    }
+    got += static_cast<std::size_t>(n);
+  }
+  ::close(fd);
+  return parse(text, path_);
+}
+
+void CounterStore::save(const sequencer::Counters& c) const {
+  const std::string body = format(c);
   const std::string tmp = path_ + ".tmp";
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) sys_fail("cannot create", tmp);
   const ssize_t n = ::write(fd, body.data(), body.size());
   if (n != static_cast<ssize_t>(body.size()) || ::fsync(fd) != 0) {
+    const int err = errno;
     ::close(fd);
+    ::unlink(tmp.c_str());
+    errno = n >= 0 && n != static_cast<ssize_t>(body.size()) ? ENOSPC : err;
     sys_fail("cannot write", tmp);
   }
-  ::close(fd);
-  if (::rename(tmp.c_str(), path_.c_str()) != 0) sys_fail("cannot rename onto", path_);
-  // Make the rename itself durable.
+  if (::close(fd) != 0) sys_fail("cannot close", tmp);
+  if (::rename(tmp.c_str(), path_.c_str()) != 0) {
+    const int err = errno;
+    ::unlink(tmp.c_str());
+    errno = err;
+    sys_fail("cannot rename onto", path_);
+  }
+  // Make the rename itself durable: a failed directory sync is a failed save.
   const std::string dir = path_.find('/') == std::string::npos ? "." : path_.substr(0, path_.rfind('/'));
   const int dfd = ::open(dir.empty() ? "/" : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd >= 0) {
-    ::fsync(dfd);
-    ::close(dfd);
-  }
+  if (dfd < 0) sys_fail("cannot open directory of", path_);
+  const int rc = ::fsync(dfd);
+  ::close(dfd);
+  if (rc != 0 && errno != EINVAL) sys_fail("cannot sync directory of", path_);
 }
 
 }  // namespace loom::firmware

@@ -21,7 +21,11 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
   sequencer_ = std::make_unique<sequencer::Sequencer>(*slot_, scfg, resume);
   sim_ = std::make_unique<sim_hal::SimWorld>(cfg_.machine, scene.spec);
   if (!opt.sim_state_path.empty()) {
-    sim_state_ = std::make_unique<sim_hal::SimStateFile>(opt.sim_state_path);
+    try {
+      sim_state_ = std::make_unique<sim_hal::SimStateFile>(opt.sim_state_path);
+    } catch (const std::invalid_argument& e) {
+      throw ConfigError(std::string("--sim-state ") + e.what());
+    }
     sim_->attach_state_file(*sim_state_);
   }
 

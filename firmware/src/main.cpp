@@ -3,6 +3,7 @@
 // time), and runs the fixed-rate loop until the rows are woven or a fault stops the machine.
 // Exit codes: 0 rows woven, 2 bad input (nothing started), 3 ended in a fault, 4 hardware not armed.
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -15,6 +16,7 @@
 #include "loom/firmware/runner.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/report/run_report.hpp"
+#include "check_cmd.hpp"
 #include <unistd.h>
 
 using namespace loom;
@@ -73,17 +75,32 @@ int weave(const WeaveArgs& a) {
     }
     cfg = config_path.empty() ? firmware::default_loom_config() : firmware::load_loom_config(config_path);
     if (a.period_ms > 0.0) {
-      if (a.period_ms < 0.25 || a.period_ms > 20.0) {
-        throw firmware::ConfigError("--period-ms = " + std::to_string(a.period_ms) + ": must be in [0.25, 20]");
-      }
       cfg.run.period_s = a.period_ms * 1e-3;
-      firmware::derive_module_configs(cfg);
+      firmware::rederive_and_check(cfg, "--period-ms = " + std::to_string(a.period_ms));
     }
     if (!a.lcm_url.empty()) cfg.telemetry.lcm_url = a.lcm_url;
     if (!a.loom_id.empty()) cfg.loom_id = a.loom_id;
     if (!a.counters.empty()) {
       store = std::make_unique<firmware::CounterStore>(a.counters);
       if (auto c = store->load()) resume = *c;
+      if (resume.picks_in_row >= cfg.recipe.picks_per_row) {
+        throw firmware::ConfigError(a.counters + ": picks_in_row = " + std::to_string(resume.picks_in_row) +
+                                    " but the recipe has " + std::to_string(cfg.recipe.picks_per_row) +
+                                    " pick(s) per row: these counters are not this loom's");
+      }
+    }
+    // `--rows N` weaves N more rows after the ones already counted; the sum must stay a count.
+    if (static_cast<std::uint64_t>(resume.rows) + a.rows > UINT32_MAX) {
+      throw firmware::ConfigError("--rows = " + std::to_string(a.rows) + ": after row " + std::to_string(resume.rows) +
+                                  " this would pass the row counter's range (4294967295); counters are never wrapped");
+    }
+    if (store) {
+      // Refuse to arm when the counters cannot be kept: prove the file writable before anything moves.
+      try {
+        store->save(resume);
+      } catch (const std::exception& ex) {
+        throw firmware::ConfigError(std::string("counters file cannot be written, refusing to arm: ") + ex.what());
+      }
     }
   } catch (const firmware::ConfigError& e) {
     std::fprintf(stderr, "loomctl: %s\n", e.what());
@@ -139,6 +156,7 @@ int weave(const WeaveArgs& a) {
   summary.effects = hardware ? std::vector<std::string>{} : scene.spec.effects;
   summary.period_s = period;
   std::uint32_t picks_at_row_start = resume.picks;
+  std::string counters_error;  // set when a save failed: the run ends in a fault
   const auto on_event = [&](const firmware::RunEvent& e) {
     // SIGHUP: re-read the recipe (the loom config file) and hand it to the loop for the next row.
     machine->collect_retired_recipes();
@@ -186,11 +204,15 @@ int weave(const WeaveArgs& a) {
       }
       std::fflush(stdout);
     }
-    if (store) {
+    if (store && counters_error.empty()) {
       try {
         store->save(e.counters);
       } catch (const std::exception& ex) {
-        std::fprintf(stderr, "loomctl: WARNING: counters not saved: %s\n", ex.what());
+        // Weaving on without a durable count would lose work at the next power cut: stop at the end
+        // of this row (a safe point), keep the in-memory counters, and say so.
+        counters_error = ex.what();
+        std::fprintf(stderr, "loomctl: FAULT counters_not_saved: %s; stopping at the end of the row\n", ex.what());
+        machine->sequencer().request_stop_at_row_end();
       }
     }
   };
@@ -250,6 +272,11 @@ int weave(const WeaveArgs& a) {
                 c.picks, c.beats);
     return kExitFault;
   }
+  if (!counters_error.empty()) {
+    std::printf("FAULT counters_not_saved: %s; rows completed %u, picks %u, beats %u (not on disk)\n",
+                counters_error.c_str(), c.rows, c.picks, c.beats);
+    return kExitFault;
+  }
   if (rows_this_run > 0) {
     const double per_row = machine_s_rows / rows_this_run;
     std::printf("woven %u rows (total %u): %.2f s per row vs ~300 s by hand (%.0fx faster); picks %u, beats %u\n",
@@ -259,6 +286,20 @@ int weave(const WeaveArgs& a) {
 }
 
 }  // namespace
+
+// CLI11's Range lets NaN through (every comparison with NaN is false): numbers must be finite first.
+const CLI::Validator kFinite(
+    [](std::string& text) {
+      try {
+        std::size_t used = 0;
+        const double v = std::stod(text, &used);
+        if (used != text.size() || !std::isfinite(v)) return "must be a finite number, not " + text;
+      } catch (const std::exception&) {
+        return "must be a finite number, not " + text;
+      }
+      return std::string();
+    },
+    "FINITE");
 
 int main(int argc, char** argv) {
   CLI::App app{"loomctl — mechanised handmade-carpet loom controller"};
@@ -272,10 +313,11 @@ int main(int argc, char** argv) {
   weave_cmd->add_option("--rows", a.rows, "rows to weave")->check(CLI::Range(1u, 1000000u));
   weave_cmd->add_option("--hal", a.hal, "sim | socketcan")->check(CLI::IsMember({"sim", "socketcan"}));
   weave_cmd->add_option("--iface", a.iface, "SocketCAN interface (with --hal socketcan), e.g. can0, vcan0");
-  weave_cmd->add_option("--period-ms", a.period_ms, "control period in ms (overrides the config)");
+  weave_cmd->add_option("--period-ms", a.period_ms, "control period in ms (overrides the config)")
+      ->check(kFinite & CLI::Range(0.25, 20.0));
   weave_cmd->add_flag("--realtime", a.realtime, "pace the simulated loom at the tick rate");
   weave_cmd->add_option("--pace", a.pace, "with --realtime: run this many times faster than real time (sim only)")
-      ->check(CLI::Range(0.01, 1000.0));
+      ->check(kFinite & CLI::Range(0.01, 1000.0));
   weave_cmd->add_flag("--allow-degraded", a.allow_degraded,
                       "run on hardware even if mlockall/SCHED_FIFO fail (timing not guaranteed)");
   weave_cmd->add_option("--counters", a.counters, "production counters file (resumed, written atomically)");
@@ -286,6 +328,11 @@ int main(int argc, char** argv) {
   weave_cmd->add_option("--report", a.report, "write DIR/summary.json and plots (beat force, row timeline)");
   weave_cmd->add_option("--sim-state", a.sim_state,
                         "sim HAL: keep the simulated machine's physical state in FILE (survives a kill)");
+  firmware::CheckArgs check;
+  CLI::App* check_cmd = app.add_subcommand("check", "validate a loom config (and scene) and print its plan; moves nothing");
+  check_cmd->add_option("--config", check.config, "loom config file (TOML); default: embedded default loom");
+  check_cmd->add_option("--scene", check.scene, "simulation scene file (TOML)");
+  check_cmd->add_flag("--keys", check.keys, "list every config key with its class (machine/recipe/run) and range");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -294,6 +341,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "loomctl: %s\n", e.what());
     return kExitBadInput;
   }
+  if (check_cmd->parsed()) return firmware::run_check(check);
   if (a.hal == "socketcan" && a.iface.empty()) {
     std::fprintf(stderr, "loomctl: --hal socketcan needs --iface NAME\n");
     return kExitBadInput;

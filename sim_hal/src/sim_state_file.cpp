@@ -3,18 +3,33 @@
 
 #include <fcntl.h>
 #include <sys/mman.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 
 namespace loom::sim_hal {
 
 SimStateFile::SimStateFile(const std::string& path) {
-  fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  // Never truncate or reinterpret a file that is not ours: an existing file must be exactly one
+  // PersistedMachine carrying the magic (or empty, as a fresh file is).
+  fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
   if (fd_ < 0) throw std::runtime_error("cannot open sim state file " + path + ": " + std::strerror(errno));
-  if (::ftruncate(fd_, sizeof(PersistedMachine)) != 0) {
+  const auto refuse = [&](const std::string& why) {
+    ::close(fd_);
+    fd_ = -1;
+    throw std::invalid_argument(path + ": " + why);
+  };
+  struct stat st {};
+  if (::fstat(fd_, &st) != 0 || !S_ISREG(st.st_mode)) refuse("not a regular file");
+  if (st.st_size != 0 && st.st_size != static_cast<off_t>(sizeof(PersistedMachine))) {
+    refuse("not a loomctl sim-state file (" + std::to_string(st.st_size) + " bytes, expected " +
+           std::to_string(sizeof(PersistedMachine)) + "); not touched");
+  }
+  if (st.st_size == 0 && ::ftruncate(fd_, sizeof(PersistedMachine)) != 0) {
     ::close(fd_);
     throw std::runtime_error("cannot size sim state file " + path + ": " + std::strerror(errno));
   }
@@ -24,6 +39,25 @@ SimStateFile::SimStateFile(const std::string& path) {
     throw std::runtime_error("cannot map sim state file " + path + ": " + std::strerror(errno));
   }
   map_ = static_cast<PersistedMachine*>(p);
+  if (st.st_size != 0) {
+    const PersistedMachine& m = *map_;
+    std::string why;
+    if (m.magic != PersistedMachine::kMagic) why = "not a loomctl sim-state file (no LOOMSIM1 magic); not touched";
+    for (double x : m.axis_position) {
+      if (why.empty() && !(std::isfinite(x) && std::abs(x) <= kMaxAbsPosition)) why = "axis position " + std::to_string(x) + " is not plausible";
+    }
+    for (double x : m.piston) {
+      if (why.empty() && !(x >= 0.0 && x <= 1.0)) why = "piston stroke fraction " + std::to_string(x) + " is outside [0, 1]";
+    }
+    if (why.empty() && !(std::isfinite(m.shuttle_x) && std::abs(m.shuttle_x) <= 100.0)) {
+      why = "shuttle position " + std::to_string(m.shuttle_x) + " m is not plausible";
+    }
+    if (!why.empty()) {
+      ::munmap(map_, sizeof(PersistedMachine));
+      map_ = nullptr;
+      refuse(why);
+    }
+  }
 }
 
 SimStateFile::~SimStateFile() {

@@ -114,6 +114,9 @@ struct LoomConfig {
 // ConfigError naming `source` when the recipe's force target cannot be met). Call again after
 // changing a fact (e.g. a --period-ms override).
 void derive_module_configs(LoomConfig& c);
+// Configure-time only. After a command-line override of a fact (`origin` names it, e.g.
+// "--period-ms = 4"): derive again and run every module's validation, as parsing does.
+void rederive_and_check(LoomConfig& c, const std::string& origin);
 // Configure-time only. The CAN master's config for the three servo axes, from the same facts.
 drivers::CanAxisPortConfig can_axis_config(const LoomConfig& c);
 

@@ -21,8 +21,11 @@ struct PersistedMachine {
 
 class SimStateFile {
  public:
-  // Configure-time only. Opens (creating) and maps `path`; throws std::runtime_error naming the path.
+  // Configure-time only. Opens (creating) and maps `path`; throws std::runtime_error naming the path
+  // when it cannot, and std::invalid_argument (nothing written) when the file exists but is not a
+  // sim-state file or holds implausible values (NaN, 1e300).
   explicit SimStateFile(const std::string& path);
+  static constexpr double kMaxAbsPosition = 1.0e6;  // rad or m: beyond any unwrapped axis reading
   ~SimStateFile();
   SimStateFile(const SimStateFile&) = delete;
   SimStateFile& operator=(const SimStateFile&) = delete;
