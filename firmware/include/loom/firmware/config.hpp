@@ -8,6 +8,7 @@
 
 #include "loom/motion/profile_set.hpp"
 #include "loom/sequencer/sequencer.hpp"
+#include "loom/firmware/scene_config.hpp"  // the scene file (kept here so callers of config.hpp see it)
 #include "loom/sim_hal/scene.hpp"
 
 namespace loom::firmware {
@@ -44,24 +45,13 @@ struct LoomConfig {
   TelemetrySettings telemetry;
 };
 
-struct Scene {
-  std::string source = "<embedded default scene>";
-  sim_hal::SceneSpec spec;
-  std::string config_path;  // loom config named by the scene ("" = embedded default)
-};
-
 // Configure-time only. Parse a loom config from TOML text; `source` names it in errors.
 LoomConfig parse_loom_config(const std::string& text, const std::string& source);
 // Configure-time only. Read and parse a file (ConfigError if it cannot be read).
 LoomConfig load_loom_config(const std::string& path);
 LoomConfig default_loom_config();
 
-Scene parse_scene(const std::string& text, const std::string& source);
-Scene load_scene(const std::string& path);
-Scene default_scene();
-
 // The embedded defaults (generated at build time from firmware/config and sim_hal/scenes).
 extern const char* const kDefaultLoomToml;
-extern const char* const kDefaultSceneToml;
 
 }  // namespace loom::firmware
