@@ -239,7 +239,30 @@ bool Sequencer::check_faults(hal::Tick now, const hal::HalInputs& in) noexcept {
           in.link.link_fault_code);
     return true;
   }
-  // Feedback that cannot be true: NaN/inf, or a position that moved farther in one tick than the axis can.
+  // Data never seen counts as old as the time since arming: the first PDOs of a freshly started bus
+  // legitimately arrive a few cycles after the first SYNC. Everything stale at once is the loop (or the
+  // whole bus) stalling, not one device going quiet.
+  const hal::Tick stale = ticks(cfg_.stale_timeout_s);
+  const auto too_old = [&](hal::Tick refreshed) {
+    return now - (refreshed == hal::kNeverTick ? armed_since_ : refreshed) > stale;
+  };
+  int stale_axis = -1, stale_count = 0;
+  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+    if (too_old(in.axes[i].refreshed)) {
+      if (stale_axis < 0) stale_axis = static_cast<int>(i);
+      ++stale_count;
+    }
+  }
+  const bool io_stale = too_old(in.io.refreshed);
+  if (stale_count == static_cast<int>(hal::kAxisCount) && io_stale) {
+    latch(Fault::kLoopStall, now);
+    return true;
+  }
+  if (stale_axis >= 0 || io_stale) {
+    latch(Fault::kStaleFeedback, now, stale_axis);
+    return true;
+  }
+  // Feedback that cannot be true (fresh, but NaN/inf, or moved farther in one tick than the axis can).
   for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
     const hal::AxisFeedback& a = in.axes[i];
     if (!finite(a.position) || !finite(a.velocity) || !finite(a.effort)) {
@@ -273,29 +296,6 @@ bool Sequencer::check_faults(hal::Tick now, const hal::HalInputs& in) noexcept {
       latch(Fault::kShuttleSensorConflict, now);
       return true;
     }
-  }
-  // Data never seen counts as old as the time since arming: the first PDOs of a freshly started bus
-  // legitimately arrive a few cycles after the first SYNC. Everything stale at once is the loop (or the
-  // whole bus) stalling, not one device going quiet.
-  const hal::Tick stale = ticks(cfg_.stale_timeout_s);
-  const auto too_old = [&](hal::Tick refreshed) {
-    return now - (refreshed == hal::kNeverTick ? armed_since_ : refreshed) > stale;
-  };
-  int stale_axis = -1, stale_count = 0;
-  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
-    if (too_old(in.axes[i].refreshed)) {
-      if (stale_axis < 0) stale_axis = static_cast<int>(i);
-      ++stale_count;
-    }
-  }
-  const bool io_stale = too_old(in.io.refreshed);
-  if (stale_count == static_cast<int>(hal::kAxisCount) && io_stale) {
-    latch(Fault::kLoopStall, now);
-    return true;
-  }
-  if (stale_axis >= 0 || io_stale) {
-    latch(Fault::kStaleFeedback, now, stale_axis);
-    return true;
   }
   return false;
 }
