@@ -83,7 +83,7 @@ int weave(const WeaveArgs& a) {
     if (!a.counters.empty()) {
       store = std::make_unique<firmware::CounterStore>(a.counters);
       if (auto c = store->load()) resume = *c;
-      if (resume.picks_in_row >= cfg.recipe.picks_per_row) {
+      if (resume.picks_in_row > cfg.recipe.picks_per_row) {
         throw firmware::ConfigError(a.counters + ": picks_in_row = " + std::to_string(resume.picks_in_row) +
                                     " but the recipe has " + std::to_string(cfg.recipe.picks_per_row) +
                                     " pick(s) per row: these counters are not this loom's");

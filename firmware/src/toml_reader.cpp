@@ -137,6 +137,12 @@ std::string read_config_file(const std::string& path) {
 }
 
 std::string positive(double v) { return v > 0.0 && std::isfinite(v) ? "" : "must be positive and finite"; }
+std::string in_range(double v, double lo, double hi) {
+  if (v >= lo && v <= hi) return "";
+  std::ostringstream os;
+  os << "must be in [" << lo << ", " << hi << "]";
+  return os.str();
+}
 std::string non_negative(double v) { return v >= 0.0 && std::isfinite(v) ? "" : "must be >= 0 and finite"; }
 
 std::string TomlReader::show(const toml::node& n) const {

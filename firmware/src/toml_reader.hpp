@@ -57,5 +57,6 @@ std::string read_config_file(const std::string& path);
 // Common checks.
 std::string positive(double v);
 std::string non_negative(double v);
+std::string in_range(double v, double lo, double hi);  // "" or "must be in [lo, hi]"
 
 }  // namespace loom::firmware

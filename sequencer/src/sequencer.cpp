@@ -1,9 +1,22 @@
-// The row cycle. Order inside a tick is fixed: faults first (a fault this tick wins over any plan),
-// then the state machine, then the profiles are sampled into targets, then the interlocks judge the
-// result before it is written.
+// The row cycle. One tick runs these steps in this order (LinuxCNC's emcmotController pattern); each
+// is one function below, in the same order:
+//   1. sense()             debounce sensors and buttons (the e-stop chain is never filtered)
+//   2. check_faults()      e-stop, stop-now, drives (fault, EMCY), link, non-finite or jumping feedback,
+//                          the load cell, impossible sensor pictures, staleness → latch the first fault
+//   3. refine_diagnosis()  in a fault: a root cause seen within the diagnosis window replaces a symptom
+//   4. operator_requests() buttons → start, pause/resume, acknowledge (requests, acted on when safe)
+//   5. run_state()         the current state's own function; the states, in cycle order:
+//        idle → enabling → positioning → shed_test → shed → pick → (shed → pick …) → beat_sweep
+//        → (row end) → shed …;   paused, done, fault
+//   6. play_moves()        sample the active moves and profiles into targets; count beats
+//   7. track_beat_force()  the load cell's peak per beat
+//   8. interlocks          judge the proposed outputs against the measured inputs; a trip latches
+//   9. signal()            the stack light
+// A fault found in step 2 wins over any plan: the state functions then only hold.
 #include "loom/sequencer/sequencer.hpp"
 
 #include <cmath>
+#include <stdexcept>
 
 #include "loom/motion/angles.hpp"
 
@@ -14,9 +27,15 @@ using hal::AxisRequest;
 using hal::DriveState;
 using hal::index;
 constexpr std::uint16_t kHeartbeatCode = 0x8130;  // CiA 301 EMCY "life guard / heartbeat error"
+constexpr double kArrivalMarginM = 0.002;         // carrier position uncertainty at the arrival sensor
+constexpr double kStepPlausibility = 4.0;         // an axis may move at most this × its top speed per tick
 
 void request_all(hal::HalOutputs& o, AxisRequest r) {
   for (auto& a : o.axes) a.request = r;
+}
+bool finite(double x) { return std::isfinite(x); }
+bool drive_in_fault(const hal::AxisFeedback& a) {
+  return a.fault || a.state == DriveState::kFault || a.state == DriveState::kFaultReactionActive;
 }
 }  // namespace
 
@@ -25,6 +44,7 @@ const char* state_name(State s) {
     case State::kIdle: return "idle";
     case State::kEnabling: return "enabling";
     case State::kPositioning: return "positioning";
+    case State::kShedTest: return "shed_test";
     case State::kShed: return "shed";
     case State::kPick: return "pick";
     case State::kBeatSweep: return "beat_sweep";
@@ -35,15 +55,69 @@ const char* state_name(State s) {
   return "?";
 }
 
+std::string validate(const SequencerConfig& c, const motion::ProfileSet& p) {
+  const auto fin = [](double v) { return std::isfinite(v); };
+  if (!(c.period_s > 0.0) || !fin(c.period_s)) return "timing.period_ms must be positive and finite";
+  if (p.beats_per_row() > kMaxBeatsPerRow) {
+    return "recipe.beats_per_position = " + std::to_string(p.spec().beats_per_position) + " gives " +
+           std::to_string(p.beats_per_row()) + " beats per row; the sequencer holds at most " +
+           std::to_string(kMaxBeatsPerRow) + " (narrow the loom or beat each position fewer times)";
+  }
+  if (c.picks_per_row < 1) return "recipe.picks_per_row must be at least 1";
+  if (c.debounce_ticks < 1) return "timing.debounce_ticks must be at least 1";
+  const struct {
+    const char* key;
+    double v;
+  } offsets[] = {{"beatup.crank_park_position_rad", c.crank_park_position_rad},
+                 {"carriage.home_position_m", c.carriage_home_m},
+                 {"helix.left_position_rad", c.helix_left_position_rad}};
+  for (const auto& o : offsets) {
+    if (!fin(o.v) || std::abs(o.v) > 1e6) return std::string(o.key) + " must be finite and within ±1e6";
+  }
+  // Every time-out becomes a tick count: it must be finite and fit the integer time base with room.
+  const struct {
+    const char* key;
+    double s;
+  } times[] = {{"timing.enable_timeout_s", c.enable_timeout_s},
+               {"timing.pick_timeout_margin_s", c.pick_timeout_margin_s},
+               {"timing.stale_timeout_ms", c.stale_timeout_s},
+               {"diagnosis window", c.diagnosis_window_s},
+               {"arrival grace", c.arrival_grace_s}};
+  for (const auto& t : times) {
+    if (!fin(t.s) || t.s < 0.0 || t.s / c.period_s > 1e12) {
+      return std::string(t.key) + " must be a finite time below 1e12 periods";
+    }
+  }
+  if (!(c.selvedge_sensor_window_m > 0.0) || !fin(c.selvedge_sensor_window_m)) {
+    return "machine selvedge sensor window must be positive and finite";
+  }
+  return "";
+}
+
 Sequencer::Sequencer(motion::ProfileSlot& slot, const SequencerConfig& cfg, Counters resume)
     : Sequencer(slot.active(), cfg, resume) {
   slot_ = &slot;
 }
 
 Sequencer::Sequencer(const motion::ProfileSet& profiles, const SequencerConfig& cfg, Counters resume)
-    : profiles_(&profiles), cfg_(cfg), counters_(resume) {
+    : profiles_(&profiles),
+      cfg_(cfg),
+      counters_(resume),
+      sensors_(cfg.debounce_ticks),
+      buttons_(cfg.debounce_ticks) {
+  if (const std::string why = validate(cfg_, *profiles_); !why.empty()) throw std::invalid_argument(why);
   interlock_ctx_.warp = &profiles_->beatup().warp();
   interlock_ctx_.crank_park_position = cfg_.crank_park_position_rad;
+  adopt_limits();
+}
+
+void Sequencer::adopt_limits() noexcept {
+  const motion::ProfileSpec& s = profiles_->spec();
+  const double dt = cfg_.period_s;
+  max_step_[index(Axis::kBeatCrank)] = kStepPlausibility * s.crank.velocity * dt + 1e-3;
+  max_step_[index(Axis::kCarriage)] =
+      kStepPlausibility * std::max(s.carriage_max_speed_m_s, cfg_.carriage.velocity) * dt + 1e-4;
+  max_step_[index(Axis::kHelix)] = kStepPlausibility * profiles_->helix_limits().velocity * dt + 1e-3;
 }
 
 hal::Tick Sequencer::ticks(double seconds) const noexcept {
@@ -79,16 +153,84 @@ void Sequencer::enter(State s, hal::Tick now) noexcept {
   state_since_ = now;
 }
 
+// ---------------------------------------------------------------------------------------------------
+// The tick
+// ---------------------------------------------------------------------------------------------------
+
+void Sequencer::step(hal::Tick now, const hal::HalInputs& raw, hal::HalOutputs& out) noexcept {
+  sense(raw);
+  hal::HalInputs in = raw;  // the sequencer and its interlocks see debounced sensors
+  in.io = io_;
+  if (state_ != State::kIdle && state_ != State::kFault) check_faults(now, in);
+  if (state_ == State::kFault) refine_diagnosis(now, in);
+  operator_requests();
+  if (state_ == State::kIdle && start_requested_ && !in.io.estop_ok) {
+    start_requested_ = false;
+    latch(Fault::kEStop, now);
+  }
+  acknowledged_this_tick_ = false;
+  run_state(now, in);
+  if (state_ == State::kFault) {
+    // Quick stop, hold the last targets, valves keep their state (a stopped shuttle is never clamped).
+    request_all(cmd_, AxisRequest::kQuickStop);
+  } else {
+    if (acknowledged_this_tick_) request_all(cmd_, AxisRequest::kFaultReset);
+    play_moves(now);
+    track_beat_force(in);
+    if (enabled_outputs_) {
+      const Fault f = check_interlocks(interlock_ctx_, in, prev_cmd_, cmd_);
+      if (f != Fault::kNone) {
+        cmd_ = prev_cmd_;
+        latch(f, now);
+        request_all(cmd_, AxisRequest::kQuickStop);
+      }
+    }
+  }
+  signal();
+  for (std::size_t i = 0; i < hal::kAxisCount; ++i) last_position_[i] = in.axes[i].position;
+  positions_primed_ = state_ != State::kIdle;
+  prev_cmd_ = cmd_;
+  out = cmd_;
+}
+
+void Sequencer::sense(const hal::HalInputs& raw) noexcept {
+  const hal::DigitalInputs& r = raw.io;
+  sensors_.update({r.piston_a_extended, r.piston_a_retracted, r.piston_b_extended, r.piston_b_retracted,
+                   r.shuttle_at_left, r.shuttle_at_right});
+  buttons_.update({r.button_start, r.button_pause, r.button_ack});
+  io_ = r;
+  io_.piston_a_extended = sensors_[0];
+  io_.piston_a_retracted = sensors_[1];
+  io_.piston_b_extended = sensors_[2];
+  io_.piston_b_retracted = sensors_[3];
+  io_.shuttle_at_left = sensors_[4];
+  io_.shuttle_at_right = sensors_[5];
+  io_.button_start = buttons_[0];
+  io_.button_pause = buttons_[1];
+  io_.button_ack = buttons_[2];
+  // estop_ok is never filtered: an opened e-stop chain acts at once.
+  if (sensed_ticks_ < 1000) ++sensed_ticks_;
+}
+
 bool Sequencer::check_faults(hal::Tick now, const hal::HalInputs& in) noexcept {
   if (!in.io.estop_ok) {
     latch(Fault::kEStop, now);
     return true;
   }
+  if (stop_now_requested_) {
+    latch(Fault::kStopRequested, now);
+    return true;
+  }
   for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
     const hal::AxisFeedback& a = in.axes[i];
-    if (a.fault || a.state == DriveState::kFault || a.state == DriveState::kFaultReactionActive) {
-      latch(a.fault_code == kHeartbeatCode ? Fault::kHeartbeatLost : Fault::kDriveFault, now, static_cast<int>(i),
-            a.fault_code);
+    const int axis = static_cast<int>(i);
+    if (drive_in_fault(a)) {
+      latch(a.fault_code == kHeartbeatCode ? Fault::kHeartbeatLost : Fault::kDriveFault, now, axis, a.fault_code);
+      return true;
+    }
+    // CiA 402: any EMCY with a non-zero code stops motion in the same tick, even if the drive stays enabled.
+    if (a.fault_code != 0) {
+      latch(a.fault_code == kHeartbeatCode ? Fault::kHeartbeatLost : Fault::kDriveEmcy, now, axis, a.fault_code);
       return true;
     }
   }
@@ -98,34 +240,76 @@ bool Sequencer::check_faults(hal::Tick now, const hal::HalInputs& in) noexcept {
     return true;
   }
   // Data never seen counts as old as the time since arming: the first PDOs of a freshly started bus
-  // legitimately arrive a few cycles after the first SYNC.
+  // legitimately arrive a few cycles after the first SYNC. Everything stale at once is the loop (or the
+  // whole bus) stalling, not one device going quiet.
   const hal::Tick stale = ticks(cfg_.stale_timeout_s);
   const auto too_old = [&](hal::Tick refreshed) {
     return now - (refreshed == hal::kNeverTick ? armed_since_ : refreshed) > stale;
   };
+  int stale_axis = -1, stale_count = 0;
   for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
     if (too_old(in.axes[i].refreshed)) {
-      latch(Fault::kStaleFeedback, now, static_cast<int>(i));
+      if (stale_axis < 0) stale_axis = static_cast<int>(i);
+      ++stale_count;
+    }
+  }
+  const bool io_stale = too_old(in.io.refreshed);
+  if (stale_count == static_cast<int>(hal::kAxisCount) && io_stale) {
+    latch(Fault::kLoopStall, now);
+    return true;
+  }
+  if (stale_axis >= 0 || io_stale) {
+    latch(Fault::kStaleFeedback, now, stale_axis);
+    return true;
+  }
+  // Feedback that cannot be true (fresh, but NaN/inf, or moved farther in one tick than the axis can).
+  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+    const hal::AxisFeedback& a = in.axes[i];
+    if (!finite(a.position) || !finite(a.velocity) || !finite(a.effort)) {
+      latch(Fault::kNonFiniteFeedback, now, static_cast<int>(i));
+      return true;
+    }
+    if (positions_primed_ && std::abs(a.position - last_position_[i]) > max_step_[i]) {
+      latch(Fault::kEncoderJump, now, static_cast<int>(i));
       return true;
     }
   }
-  if (too_old(in.io.refreshed)) {
-    latch(Fault::kStaleFeedback, now);
+  // The load cell, once fitted and seen, must keep reading a finite, plausible force.
+  if (in.analog.beat_force_valid) {
+    const double f = in.analog.beat_force_n;
+    if (!finite(f) || f < -0.05 * cfg_.load_cell_max_n || f > cfg_.load_cell_max_n) {
+      latch(Fault::kLoadCellFault, now);
+      return true;
+    }
+    load_cell_seen_ = true;
+  } else if (load_cell_seen_) {
+    latch(Fault::kLoadCellFault, now);
     return true;
+  }
+  // Sensor pictures that no machine state can produce (once the debouncer has some history).
+  if (sensed_ticks_ > cfg_.debounce_ticks) {
+    if ((io_.piston_a_extended && io_.piston_a_retracted) || (io_.piston_b_extended && io_.piston_b_retracted)) {
+      latch(Fault::kShedSensorConflict, now);
+      return true;
+    }
+    if (io_.shuttle_at_left && io_.shuttle_at_right) {
+      latch(Fault::kShuttleSensorConflict, now);
+      return true;
+    }
   }
   return false;
 }
 
 bool Sequencer::is_symptom(Fault f) noexcept {
-  return f == Fault::kStaleFeedback || f == Fault::kCarriageInWarp || f == Fault::kPickWithoutShed ||
-         f == Fault::kShedWithShuttle;
+  return f == Fault::kStaleFeedback || f == Fault::kLoopStall || f == Fault::kCarriageInWarp ||
+         f == Fault::kPickWithoutShed || f == Fault::kShedWithShuttle;
 }
 
 void Sequencer::refine_diagnosis(hal::Tick now, const hal::HalInputs& in) noexcept {
   if (!is_symptom(first_fault_) || now - fault_tick_ > ticks(cfg_.diagnosis_window_s)) return;
   for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
     const hal::AxisFeedback& a = in.axes[i];
-    if (a.fault || a.state == DriveState::kFault || a.state == DriveState::kFaultReactionActive) {
+    if (drive_in_fault(a)) {
       first_fault_ = a.fault_code == kHeartbeatCode ? Fault::kHeartbeatLost : Fault::kDriveFault;
       fault_axis_ = static_cast<int>(i);
       fault_detail_ = a.fault_code;
@@ -139,49 +323,242 @@ void Sequencer::refine_diagnosis(hal::Tick now, const hal::HalInputs& in) noexce
   }
 }
 
-void Sequencer::debounce(const hal::DigitalInputs& raw) noexcept {
-  const std::array<bool, 6> r{raw.piston_a_extended, raw.piston_a_retracted, raw.piston_b_extended,
-                              raw.piston_b_retracted, raw.shuttle_at_left,  raw.shuttle_at_right};
-  std::array<bool*, 6> v{&io_.piston_a_extended, &io_.piston_a_retracted, &io_.piston_b_extended,
-                         &io_.piston_b_retracted, &io_.shuttle_at_left,  &io_.shuttle_at_right};
-  for (std::size_t i = 0; i < r.size(); ++i) {
-    if (!io_primed_ || r[i] == *v[i]) {
-      *v[i] = r[i];
-      disagree_[i] = 0;
-    } else if (++disagree_[i] >= cfg_.debounce_ticks) {
-      *v[i] = r[i];
-      disagree_[i] = 0;
-    }
+void Sequencer::operator_requests() noexcept {
+  if (start_edge_.update(io_.button_start)) {
+    if (state_ == State::kIdle) start_requested_ = true;
+    if (state_ == State::kPaused || pause_requested_) pause_requested_ = false;  // start also resumes
   }
-  io_primed_ = true;
-  io_.estop_ok = raw.estop_ok;  // never filtered: an opened e-stop chain acts at once
-  io_.refreshed = raw.refreshed;
+  if (pause_edge_.update(io_.button_pause) && state_ != State::kIdle) pause_requested_ = true;
+  if (ack_edge_.update(io_.button_ack)) ack_requested_ = true;
 }
 
-void Sequencer::begin_shed(hal::Tick now) noexcept {
-  if (!row_started_) {
-    row_started_ = true;
-    row_start_ = now;
-    row_beats_ = 0;
-    beats_published_ = 0;
-    const std::uint32_t row = counters_.rows + 1;
-    row_ = RowStats{};
-    row_.row = row;
+void Sequencer::run_state(hal::Tick now, const hal::HalInputs& in) noexcept {
+  switch (state_) {
+    case State::kIdle: idle(now, in); break;
+    case State::kEnabling: enabling(now, in); break;
+    case State::kPositioning: positioning(now, in); break;
+    case State::kShedTest: shed_test(now); break;
+    case State::kShed: shed(now); break;
+    case State::kPick: pick(now, in); break;
+    case State::kBeatSweep: beat_sweep(now); break;
+    case State::kPaused: paused(now); break;
+    case State::kDone: break;
+    case State::kFault: fault(now); break;
   }
-  // The shed may only change with the shuttle out of it: a shuttle seen at neither selvedge is lost
-  // (stuck in the shed, or its sensor failed) and needs an operator, not a shed change.
-  if (!shuttle_at_selvedge(io_)) {
-    latch(Fault::kShuttleLost, now);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// One function per state
+// ---------------------------------------------------------------------------------------------------
+
+void Sequencer::idle(hal::Tick now, const hal::HalInputs& in) noexcept {
+  request_all(cmd_, AxisRequest::kDisable);
+  for (std::size_t i = 0; i < hal::kAxisCount; ++i) cmd_.axes[i].target_position = in.axes[i].position;
+  // Valves hold the frames where the end sensors see them: starting up (or restarting after a power
+  // loss) never moves a frame, so a shuttle left in the shed is never clamped.
+  cmd_.io.piston_a_extend = io_.piston_a_extended;
+  cmd_.io.piston_b_extend = io_.piston_b_extended;
+  if (start_requested_) {
+    start_requested_ = false;
+    armed_since_ = now;
+    enter(State::kEnabling, now);
+  }
+}
+
+void Sequencer::enabling(hal::Tick now, const hal::HalInputs& in) noexcept {
+  request_all(cmd_, AxisRequest::kEnable);
+  // Until every drive is enabled the targets follow the measured positions: enabling never jumps.
+  bool all = true;
+  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+    cmd_.axes[i].target_position = in.axes[i].position;
+    all = all && in.axes[i].state == DriveState::kOperationEnabled;
+  }
+  if (!all) {
+    if (now - state_since_ > ticks(cfg_.enable_timeout_s)) latch(Fault::kEnableTimeout, now);
     return;
   }
-  // Alternate the shed every pick: even picks lift frame A, odd picks frame B.
+  // The counters are checked against the machine before anything moves: what they say was done must
+  // be what the machine shows.
+  if (!reconcile_at_arming(now, in)) return;
+  enabled_outputs_ = true;
+  // Re-arm from measured positions: crank to the nearest park, then the carriage to the row's start side.
+  const double phase = motion::wrap_pi(in.axes[index(Axis::kBeatCrank)].position - cfg_.crank_park_position_rad);
+  crank_move_ = {true, now, cmd_.axes[index(Axis::kBeatCrank)].target_position,
+                 motion::JerkMove::plan(-phase, profiles_->spec().crank)};
+  // Valves hold whatever the frames show now, so re-arming never moves a frame over the shuttle.
+  cmd_.io.piston_a_extend = io_.piston_a_extended;
+  cmd_.io.piston_b_extend = io_.piston_b_extended;
+  enter(State::kPositioning, now);
+}
+
+void Sequencer::positioning(hal::Tick now, const hal::HalInputs& in) noexcept {
+  if (crank_move_.active || carriage_move_.active) return;
+  // Rows sweep in alternating directions: row n+1 starts at the left when n is even. The carriage goes
+  // there (a row cut mid-sweep is swept again from its start).
+  const double rel = in.axes[index(Axis::kCarriage)].position - cfg_.carriage_home_m;
+  const double goal = row_starts_left() ? 0.0 : profiles_->carriage_travel_m();
+  if (std::abs(rel - goal) > cfg_.selvedge_tolerance_m) {
+    carriage_move_ = {true, now, cmd_.axes[index(Axis::kCarriage)].target_position,
+                      motion::JerkMove::plan(goal - rel, cfg_.carriage)};
+    return;
+  }
+  // Power lost mid-pick: the shuttle is in the open shed on its carrier. Finish that pick rather than
+  // start a new one (nothing repeated, nothing lost); without an open shed it needs an operator.
+  if (!shuttle_at_selvedge(io_)) {
+    if (!shed_confirmed(io_)) {
+      latch(Fault::kShuttleLost, now);
+      return;
+    }
+    begin_pick(now, /*resumed=*/true);
+    return;
+  }
+  if (counters_.picks_in_row >= cfg_.picks_per_row) {
+    begin_sweep(now);
+  } else if (!sensors_proven_) {
+    shed_test_step_ = 0;
+    start_stroke(true, false);
+    enter(State::kShedTest, now);
+  } else {
+    begin_shed(now);
+  }
+}
+
+void Sequencer::shed_test(hal::Tick now) noexcept {
+  // Three strokes — A up, then B up, then A up — move each frame both ways, so every end sensor is seen
+  // to switch off and on (a stuck one is found now, not under a pick) and every stroke time is learned.
+  const ShedVerdict v = shed_.update(profiles_->shed(), seconds_since(now, state_since_), ends_a(), ends_b());
+  if (is_fault(v)) {
+    latch(shed_fault(v), now);
+    return;
+  }
+  if (v != ShedVerdict::kOpen) return;
+  if (++shed_test_step_ < 3) {
+    const bool a_up = shed_test_step_ != 1;
+    start_stroke(a_up, !a_up);
+    state_since_ = now;
+    return;
+  }
+  sensors_proven_ = true;
+  begin_shed(now);
+}
+
+void Sequencer::shed(hal::Tick now) noexcept {
+  // The end sensors must show a consistent, plausible picture (ShedMonitor), then the frames settle.
+  const ShedVerdict v = shed_.update(profiles_->shed(), seconds_since(now, state_since_), ends_a(), ends_b());
+  if (is_fault(v)) {
+    latch(shed_fault(v), now);
+    return;
+  }
+  if (v != ShedVerdict::kOpen) return;
+  if (!shuttle_where_counters_say(now)) return;
+  row_.add_shed(now - phase_start_);
+  begin_pick(now, /*resumed=*/false);
+}
+
+void Sequencer::pick(hal::Tick now, const hal::HalInputs& in) noexcept {
+  const bool arrived = pick_to_right_ ? io_.shuttle_at_right : io_.shuttle_at_left;
+  // Where the carrier really is: the arrival sensor can only see the shuttle once the carrier has
+  // brought it within the sensor's reach; it must see it soon after.
+  const double lead = profiles_->spec().helix_lead_m;
+  const double carrier_from_goal_m =
+      std::abs(in.axes[index(Axis::kHelix)].position - pick_goal_rad_) * lead / motion::kTwoPi;
+  if (carrier_from_goal_m <= cfg_.selvedge_sensor_window_m && carrier_at_selvedge_ == hal::kNeverTick) {
+    carrier_at_selvedge_ = now;
+  }
+  if (arrived && carrier_from_goal_m > cfg_.selvedge_sensor_window_m + kArrivalMarginM) {
+    latch(Fault::kShuttleSensorEarly, now);
+    return;
+  }
+  if (arrived && !helix_move_.active) {
+    ++counters_.picks;
+    ++counters_.picks_in_row;
+    row_.add_pick(now - phase_start_);
+    if (counters_.picks_in_row < cfg_.picks_per_row) {
+      if (pause_requested_) {
+        enter(State::kPaused, now);
+      } else {
+        begin_shed(now);
+      }
+    } else {
+      begin_sweep(now);
+    }
+    return;
+  }
+  const bool missed = !arrived && carrier_at_selvedge_ != hal::kNeverTick &&
+                      now - carrier_at_selvedge_ > cfg_.debounce_ticks + ticks(cfg_.arrival_grace_s);
+  if (missed || seconds_since(now, state_since_) > profiles_->pick().duration() + cfg_.pick_timeout_margin_s) {
+    latch(Fault::kShuttleNotArrived, now);
+  }
+}
+
+void Sequencer::beat_sweep(hal::Tick now) noexcept {
+  if (!crank_move_.active) end_row(now);
+}
+
+void Sequencer::paused(hal::Tick now) noexcept {
+  // Paused between the picks of a row resumes that row; paused at a row's end starts the next.
+  if (!pause_requested_) row_.started() ? begin_shed(now) : begin_row(now);
+}
+
+void Sequencer::fault(hal::Tick now) noexcept {
+  if (!ack_requested_) return;
+  ack_requested_ = false;
+  // Acknowledged: the drives get their fault-reset edge this tick, then the machine idles disabled and
+  // re-arms from measured positions on the next start, proving the sensors again.
+  first_fault_ = stopped_by_ = Fault::kNone;
+  fault_axis_ = -1;
+  fault_detail_ = 0;
+  fault_tick_ = hal::kNeverTick;
+  stop_now_requested_ = false;
+  enabled_outputs_ = false;
+  sensors_proven_ = false;
+  load_cell_seen_ = false;
+  shed_.forget_stroke_times();
+  acknowledged_this_tick_ = true;
+  enter(State::kIdle, now);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Transitions
+// ---------------------------------------------------------------------------------------------------
+
+bool Sequencer::reconcile_at_arming(hal::Tick now, const hal::HalInputs& in) noexcept {
+  if (counters_.picks_in_row > cfg_.picks_per_row || counters_.picks_in_row > counters_.picks) {
+    latch(Fault::kCountersInconsistent, now);
+    return false;
+  }
+  if (!shuttle_at_selvedge(io_) || io_.shuttle_at_left == expect_shuttle_left()) return true;
+  // The shuttle is on the side the counters say it left. Only one story fits that and is safe to
+  // continue: pick N completed just before a power loss and its count never reached the file. Then the
+  // shed is still open for pick N and the row's beat sweep has not begun (the carriage waits at the row's
+  // start side). Anything else — a reset or missing counters file, a machine moved by hand — would make
+  // the next beat a beat without weft: refuse, the operator checks the cloth and the counters.
   const bool a_up = counters_.picks % 2 == 0;
-  cmd_.io.piston_a_extend = a_up;
-  cmd_.io.piston_b_extend = !a_up;
-  shed_.start(a_up, !a_up, {io_.piston_a_extended, io_.piston_a_retracted},
-              {io_.piston_b_extended, io_.piston_b_retracted});
-  phase_start_ = now;
-  enter(State::kShed, now);
+  const bool shed_of_pick_n = shed_confirmed(io_) && io_.piston_a_extended == a_up;
+  const double rel = in.axes[index(Axis::kCarriage)].position - cfg_.carriage_home_m;
+  const double start = row_starts_left() ? 0.0 : profiles_->carriage_travel_m();
+  const bool before_sweep = std::abs(rel - start) <= cfg_.selvedge_tolerance_m;
+  if (counters_.picks_in_row < cfg_.picks_per_row && shed_of_pick_n && before_sweep) {
+    ++counters_.picks;
+    ++counters_.picks_in_row;
+    return true;
+  }
+  latch(Fault::kShuttleSideMismatch, now);
+  return false;
+}
+
+bool Sequencer::shuttle_where_counters_say(hal::Tick now) noexcept {
+  // Before every pick: the shuttle must be at exactly the selvedge the counters say (it starts at the
+  // left; every pick alternates). Never pick from, or count a pick at, the wrong side.
+  if (!shuttle_at_selvedge(io_)) {
+    latch(Fault::kShuttleLost, now);
+    return false;
+  }
+  if (io_.shuttle_at_left != expect_shuttle_left()) {
+    latch(Fault::kShuttleSideMismatch, now);
+    return false;
+  }
+  return true;
 }
 
 void Sequencer::begin_row(hal::Tick now) noexcept {
@@ -190,6 +567,7 @@ void Sequencer::begin_row(hal::Tick now) noexcept {
     // its measured positions (crank to park, carriage to a selvedge of the new width) before the row.
     profiles_ = &slot_->active();
     interlock_ctx_.warp = &profiles_->beatup().warp();
+    adopt_limits();
     ++recipe_changes_;
     enter(State::kPositioning, now);
     return;
@@ -197,222 +575,89 @@ void Sequencer::begin_row(hal::Tick now) noexcept {
   begin_shed(now);
 }
 
-void Sequencer::begin_sweep(hal::Tick now, const hal::HalInputs& in) noexcept {
-  if (!row_started_) {  // resumed after a restart with every pick of the row already done
-    row_started_ = true;
-    row_start_ = now;
-    row_ = RowStats{};
-    row_.row = counters_.rows + 1;
+void Sequencer::begin_shed(hal::Tick now) noexcept {
+  row_.begin(counters_.rows + 1, now);
+  // The shed may only change with the shuttle out of it, at the side the counters expect.
+  if (!shuttle_where_counters_say(now)) return;
+  // Alternate the shed every pick: even picks lift frame A, odd picks frame B.
+  const bool a_up = counters_.picks % 2 == 0;
+  start_stroke(a_up, !a_up);
+  phase_start_ = now;
+  enter(State::kShed, now);
+}
+
+void Sequencer::start_stroke(bool a_extend, bool b_extend) noexcept {
+  cmd_.io.piston_a_extend = a_extend;
+  cmd_.io.piston_b_extend = b_extend;
+  shed_.start(a_extend, b_extend, ends_a(), ends_b());
+}
+
+void Sequencer::begin_pick(hal::Tick now, bool resumed) noexcept {
+  row_.begin(counters_.rows + 1, now);
+  // The shuttle goes away from the side the counters say it started at.
+  pick_to_right_ = expect_shuttle_left();
+  const double from = cmd_.axes[index(Axis::kHelix)].target_position;
+  if (resumed) {
+    // A pick cut by a power loss: the carrier is somewhere in the shed; finish at the far selvedge.
+    pick_goal_rad_ = cfg_.helix_left_position_rad + (pick_to_right_ ? profiles_->pick().distance() : 0.0);
+    helix_move_ = {true, now, from, motion::JerkMove::plan(pick_goal_rad_ - from, profiles_->helix_limits())};
+  } else {
+    pick_goal_rad_ = from + (pick_to_right_ ? 1.0 : -1.0) * profiles_->pick().distance();
+    helix_move_ = {true, now, from, pick_to_right_ ? profiles_->pick() : profiles_->pick_back()};
   }
-  // The crank turns `beats` full turns from park; the carriage rides the cam on it, starting from the
-  // selvedge it stands at, so successive rows sweep in alternating directions.
-  const double rel = in.axes[index(Axis::kCarriage)].position - cfg_.carriage_home_m;
-  carriage_sweep_dir_ = rel < 0.5 * profiles_->carriage_travel_m() ? 1.0 : -1.0;
+  carrier_at_selvedge_ = hal::kNeverTick;
+  phase_start_ = now;
+  enter(State::kPick, now);
+}
+
+void Sequencer::begin_sweep(hal::Tick now) noexcept {
+  row_.begin(counters_.rows + 1, now);  // resumed after a restart with every pick of the row done
+  // The crank turns `beats` full turns from park; the carriage rides the cam on it from the row's start
+  // selvedge, so successive rows sweep in alternating directions.
+  carriage_sweep_dir_ = row_starts_left() ? 1.0 : -1.0;
   carriage_sweep_origin_ = cmd_.axes[index(Axis::kCarriage)].target_position;
   crank_sweep_origin_ = cmd_.axes[index(Axis::kBeatCrank)].target_position;
   crank_move_ = {true, now, crank_sweep_origin_, profiles_->crank_sweep()};
   sweeping_ = true;
   row_beats_ = 0;
   beats_published_ = 0;
-  phase_start_ = now;
+  sweep_start_ = now;
   enter(State::kBeatSweep, now);
 }
 
-void Sequencer::track_beat_force(const hal::HalInputs& in) noexcept {
-  if (!sweeping_ || !in.analog.beat_force_valid) return;
-  // Beat k is the k-th passage through the warp; its peak is recorded while the beater is in the warp.
-  const double phi = in.axes[index(Axis::kBeatCrank)].position - crank_sweep_origin_;
-  const int k = static_cast<int>(std::floor(phi / motion::kTwoPi));
-  if (k < 0 || k >= profiles_->beats_per_row() || k >= kMaxBeatsPerRow) return;
-  if (!beater_in_warp(interlock_ctx_, in.axes[index(Axis::kBeatCrank)].position)) return;
-  BeatRecord& b = row_.beat[static_cast<std::size_t>(k)];
-  b.peak_force_n = std::max(b.peak_force_n, static_cast<float>(in.analog.beat_force_n));
-  row_.force_measured = true;
-}
-
-void Sequencer::advance(hal::Tick now, const hal::HalInputs& in) noexcept {
-  const auto& crank_fb = in.axes[index(Axis::kBeatCrank)];
-  const auto& carriage_fb = in.axes[index(Axis::kCarriage)];
-  switch (state_) {
-    case State::kIdle:
-      request_all(cmd_, AxisRequest::kDisable);
-      for (std::size_t i = 0; i < hal::kAxisCount; ++i) cmd_.axes[i].target_position = in.axes[i].position;
-      // Valves hold the frames where the end sensors see them: starting up (or restarting after a power
-      // loss) never moves a frame, so a shuttle left in the shed is never clamped.
-      cmd_.io.piston_a_extend = io_.piston_a_extended;
-      cmd_.io.piston_b_extend = io_.piston_b_extended;
-      if (start_requested_) {
-        start_requested_ = false;
-        armed_since_ = now;
-        enter(State::kEnabling, now);
-      }
-      break;
-
-    case State::kEnabling: {
-      request_all(cmd_, AxisRequest::kEnable);
-      // Until every drive is enabled the targets follow the measured positions: enabling never jumps.
-      bool all = true;
-      for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
-        cmd_.axes[i].target_position = in.axes[i].position;
-        all = all && in.axes[i].state == DriveState::kOperationEnabled;
-      }
-      if (all) {
-        enabled_outputs_ = true;
-        // Re-arm from measured positions: crank to the nearest park, then carriage to the nearest selvedge.
-        const double phase = motion::wrap_pi(crank_fb.position - cfg_.crank_park_position_rad);
-        crank_move_ = {true, now, cmd_.axes[index(Axis::kBeatCrank)].target_position,
-                       motion::JerkMove::plan(-phase, profiles_->spec().crank)};
-        // Valves hold whatever the frames show now, so re-arming never moves a frame over the shuttle.
-        cmd_.io.piston_a_extend = io_.piston_a_extended;
-        cmd_.io.piston_b_extend = io_.piston_b_extended;
-        enter(State::kPositioning, now);
-      } else if (now - state_since_ > ticks(cfg_.enable_timeout_s)) {
-        latch(Fault::kEnableTimeout, now);
-      }
-      break;
-    }
-
-    case State::kPositioning:
-      if (crank_move_.active || carriage_move_.active) break;
-      {
-        const double rel = carriage_fb.position - cfg_.carriage_home_m;
-        const double travel = profiles_->carriage_travel_m();
-        const double goal = rel < 0.5 * travel ? 0.0 : travel;
-        if (std::abs(rel - goal) > cfg_.selvedge_tolerance_m) {
-          carriage_move_ = {true, now, cmd_.axes[index(Axis::kCarriage)].target_position,
-                            motion::JerkMove::plan(goal - rel, cfg_.carriage)};
-          break;
-        }
-      }
-      // Power lost mid-pick: the shuttle is in the open shed on its carrier. Finish that pick rather than
-      // start a new one (nothing repeated, nothing lost); without an open shed it needs an operator.
-      if (!shuttle_at_selvedge(io_)) {
-        if (!shed_confirmed(io_)) {
-          latch(Fault::kShuttleLost, now);
-          break;
-        }
-        pick_to_right_ = counters_.picks % 2 == 0;  // the shuttle starts at the left: even picks go right
-        const double goal =
-            cfg_.helix_left_position_rad + (pick_to_right_ ? profiles_->pick().distance() : 0.0);
-        const double from = cmd_.axes[index(Axis::kHelix)].target_position;
-        helix_move_ = {true, now, from, motion::JerkMove::plan(goal - from, profiles_->helix_limits())};
-        if (!row_started_) {
-          row_started_ = true;
-          row_start_ = now;
-          row_ = RowStats{};
-          row_.row = counters_.rows + 1;
-        }
-        phase_start_ = now;
-        enter(State::kPick, now);
-        break;
-      }
-      // A pick that completed just before a power loss may not have reached the counters file: the
-      // shuttle's side tells (it starts at the left, so an even pick count means left).
-      if (shuttle_at_selvedge(io_) && io_.shuttle_at_left != (counters_.picks % 2 == 0) &&
-          counters_.picks_in_row < cfg_.picks_per_row) {
-        ++counters_.picks;
-        ++counters_.picks_in_row;
-      }
-      if (counters_.picks_in_row >= cfg_.picks_per_row) {
-        begin_sweep(now, in);
-      } else {
-        begin_shed(now);
-      }
-      break;
-
-    case State::kShed: {
-      // The end sensors must confirm inside the profiles' window (not faster than a stroke, frames
-      // off their start sensors early, by the timeout), then the frames settle before the pick.
-      const motion::ShedVerdict v = shed_.update(profiles_->shed(), seconds_since(now, state_since_),
-                                                 {io_.piston_a_extended, io_.piston_a_retracted},
-                                                 {io_.piston_b_extended, io_.piston_b_retracted});
-      if (v == motion::ShedVerdict::kOpen) {
-        if (!shuttle_at_selvedge(io_)) {
-          latch(Fault::kShuttleLost, now);
-          break;
-        }
-        pick_to_right_ = io_.shuttle_at_left;
-        helix_move_ = {true, now, cmd_.axes[index(Axis::kHelix)].target_position,
-                       pick_to_right_ ? profiles_->pick() : profiles_->pick_back()};
-        row_.shed_ticks += now - phase_start_;
-        phase_start_ = now;
-        enter(State::kPick, now);
-      } else if (v == motion::ShedVerdict::kTooEarly) {
-        latch(Fault::kShedSensorEarly, now);
-      } else if (v == motion::ShedVerdict::kNotReleased) {
-        latch(Fault::kShedNotReleased, now);
-      } else if (v == motion::ShedVerdict::kTimeout) {
-        latch(Fault::kShedTimeout, now);
-      }
-      break;
-    }
-
-    case State::kPick: {
-      const bool arrived = pick_to_right_ ? io_.shuttle_at_right : io_.shuttle_at_left;
-      if (!helix_move_.active && arrived) {
-        ++counters_.picks;
-        ++counters_.picks_in_row;
-        row_.pick_ticks += now - phase_start_;
-        if (counters_.picks_in_row < cfg_.picks_per_row) {
-          if (pause_requested_) {
-            enter(State::kPaused, now);
-          } else {
-            begin_shed(now);
-          }
-        } else {
-          begin_sweep(now, in);
-        }
-      } else if (seconds_since(now, state_since_) > profiles_->pick().duration() + cfg_.pick_timeout_margin_s) {
-        latch(Fault::kShuttleNotArrived, now);
-      }
-      break;
-    }
-
-    case State::kBeatSweep:
-      if (!crank_move_.active) {
-        sweeping_ = false;
-        while (beats_published_ < row_beats_) publish_beat(beats_published_);
-        ++counters_.rows;
-        counters_.picks_in_row = 0;
-        row_started_ = false;
-        row_.beat_ticks = now - phase_start_;
-        row_.total_ticks = now - row_start_;
-        row_.beats = row_beats_;
-        row_.carriage_steps = profiles_->cam().steps();
-        if (row_.force_measured && row_beats_ > 0) {
-          double lo = 1e300, hi = 0.0, sum = 0.0;
-          for (int k = 0; k < row_beats_; ++k) {
-            const double f = row_.beat[static_cast<std::size_t>(k)].peak_force_n;
-            lo = std::min(lo, f);
-            hi = std::max(hi, f);
-            sum += f;
-          }
-          row_.force_min_n = lo;
-          row_.force_max_n = hi;
-          row_.force_mean_n = sum / row_beats_;
-        }
-        last_row_ = row_;
-        const bool enough = cfg_.rows_to_weave != 0 && counters_.rows >= cfg_.rows_to_weave;
-        if (enough || stop_requested_) {
-          enter(State::kDone, now);
-        } else if (pause_requested_) {
-          enter(State::kPaused, now);
-        } else {
-          begin_row(now);
-        }
-      }
-      break;
-
-    case State::kPaused:
-      // Paused between the picks of a row resumes that row; paused at a row's end starts the next.
-      if (!pause_requested_) row_started_ ? begin_shed(now) : begin_row(now);
-      break;
-
-    case State::kDone:
-    case State::kFault:
-      break;
+void Sequencer::end_row(hal::Tick now) noexcept {
+  sweeping_ = false;
+  while (beats_published_ < row_beats_) publish_beat(beats_published_);
+  ++counters_.rows;
+  counters_.picks_in_row = 0;
+  last_row_ = row_.finish(now, now - sweep_start_, row_beats_, profiles_->cam().steps());
+  const bool enough = cfg_.rows_to_weave != 0 && counters_.rows >= cfg_.rows_to_weave;
+  if (enough || stop_requested_) {
+    enter(State::kDone, now);
+  } else if (pause_requested_) {
+    enter(State::kPaused, now);
+  } else {
+    begin_row(now);
   }
 }
+
+Fault Sequencer::shed_fault(ShedVerdict v) const noexcept {
+  switch (v) {
+    case ShedVerdict::kTooEarly: return Fault::kShedSensorEarly;
+    case ShedVerdict::kNotReleased: return Fault::kShedNotReleased;
+    case ShedVerdict::kAirLost: return Fault::kAirLost;
+    case ShedVerdict::kConflict: return Fault::kShedSensorConflict;
+    case ShedVerdict::kTimeout: return Fault::kShedTimeout;
+    case ShedVerdict::kMoving:
+    case ShedVerdict::kSettling:
+    case ShedVerdict::kOpen: break;
+  }
+  return Fault::kNone;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Outputs
+// ---------------------------------------------------------------------------------------------------
 
 void Sequencer::play_moves(hal::Tick now) noexcept {
   const auto play = [&](ActiveMove& m, Axis axis) {
@@ -425,75 +670,64 @@ void Sequencer::play_moves(hal::Tick now) noexcept {
   play(crank_move_, Axis::kBeatCrank);
   play(carriage_move_, Axis::kCarriage);
   play(helix_move_, Axis::kHelix);
-  if (sweeping_) {
-    // The sweep move is the master phase; the crank follows the speed law (constant: the same).
-    const motion::Phase master = motion::Phase::from_rad(crank_move_.move.at(sweep_t).position);
-    const double phi = profiles_->crank_at(master).phase;
-    cmd_.axes[index(Axis::kBeatCrank)].target_position = crank_sweep_origin_ + phi;
-    cmd_.axes[index(Axis::kCarriage)].target_position =
-        carriage_sweep_origin_ + carriage_sweep_dir_ * profiles_->cam().at(phi).position;
-    // A beat is delivered when the commanded crank passes the fell of turn k.
-    const double fell = profiles_->beatup().warp().fell;
-    while (row_beats_ < profiles_->beats_per_row() && phi >= motion::kTwoPi * row_beats_ + fell) {
-      if (row_beats_ < kMaxBeatsPerRow) {
-        row_.beat[static_cast<std::size_t>(row_beats_)].x_m = static_cast<float>(
-            cmd_.axes[index(Axis::kCarriage)].target_position - cfg_.carriage_home_m);
-      }
-      ++row_beats_;
-      ++counters_.beats;
-    }
-    // A counted beat is published once the beater has left the warp (its peak force is final then).
-    const double exit = profiles_->beatup().warp().exit;
-    while (beats_published_ < row_beats_ && phi >= motion::kTwoPi * beats_published_ + exit) {
-      publish_beat(beats_published_);
-    }
+  if (!sweeping_) return;
+  // The sweep move is the master phase; the crank follows the speed law (constant: the same).
+  const motion::Phase master = motion::Phase::from_rad(crank_move_.move.at(sweep_t).position);
+  const double phi = profiles_->crank_at(master).phase;
+  cmd_.axes[index(Axis::kBeatCrank)].target_position = crank_sweep_origin_ + phi;
+  cmd_.axes[index(Axis::kCarriage)].target_position =
+      carriage_sweep_origin_ + carriage_sweep_dir_ * profiles_->cam().at(phi).position;
+  // A beat is delivered when the commanded crank passes the fell of turn k.
+  const double fell = profiles_->beatup().warp().fell;
+  while (row_beats_ < profiles_->beats_per_row() && phi >= motion::kTwoPi * row_beats_ + fell) {
+    row_.beat_at(row_beats_, cmd_.axes[index(Axis::kCarriage)].target_position - cfg_.carriage_home_m);
+    ++row_beats_;
+    ++counters_.beats;
   }
+  // A counted beat is published once the beater has left the warp (its peak force is final then).
+  const double exit = profiles_->beatup().warp().exit;
+  while (beats_published_ < row_beats_ && phi >= motion::kTwoPi * beats_published_ + exit) {
+    publish_beat(beats_published_);
+  }
+}
+
+void Sequencer::track_beat_force(const hal::HalInputs& in) noexcept {
+  if (!sweeping_ || !in.analog.beat_force_valid) return;
+  // Beat k is the k-th passage through the warp; its peak is recorded while the beater is in the warp.
+  const double crank = in.axes[index(Axis::kBeatCrank)].position;
+  const double phi = crank - crank_sweep_origin_;
+  const int k = static_cast<int>(std::floor(phi / motion::kTwoPi));
+  if (k < 0 || k >= profiles_->beats_per_row()) return;
+  if (!beater_in_warp(interlock_ctx_, crank)) return;
+  row_.force(k, in.analog.beat_force_n);
 }
 
 void Sequencer::publish_beat(int k) noexcept {
   BeatEvent e;
   e.row = counters_.rows + 1;
   e.index = static_cast<std::uint16_t>(k);
+  const RowStats& r = row_.stats();
   if (k < kMaxBeatsPerRow) {
-    const BeatRecord& b = row_.beat[static_cast<std::size_t>(k)];
+    const BeatRecord& b = r.beat[static_cast<std::size_t>(k)];
     e.x_m = b.x_m;
     e.peak_force_n = b.peak_force_n;
   }
-  e.force_measured = row_.force_measured;
+  e.force_measured = r.force_measured;
   e.in_band = e.force_measured && e.peak_force_n >= cfg_.beat_force_min_n && e.peak_force_n <= cfg_.beat_force_max_n;
   last_beat_ = e;
   ++beat_events_;
   beats_published_ = k + 1;
 }
 
-void Sequencer::step(hal::Tick now, const hal::HalInputs& raw, hal::HalOutputs& out) noexcept {
-  debounce(raw.io);
-  hal::HalInputs in = raw;  // the sequencer and its interlocks see debounced sensors
-  in.io = io_;
-  if (state_ != State::kIdle && state_ != State::kFault) check_faults(now, in);
-  if (state_ == State::kFault) refine_diagnosis(now, in);
-  if (state_ == State::kIdle && start_requested_ && !in.io.estop_ok) {
-    start_requested_ = false;
-    latch(Fault::kEStop, now);
-  }
-  advance(now, in);
-  if (state_ == State::kFault) {
-    // Quick stop, hold the last targets, valves keep their state (a stopped shuttle is never clamped).
-    request_all(cmd_, AxisRequest::kQuickStop);
-  } else {
-    play_moves(now);
-    track_beat_force(in);
-    if (enabled_outputs_) {
-      const Fault f = check_interlocks(interlock_ctx_, in, prev_cmd_, cmd_);
-      if (f != Fault::kNone) {
-        cmd_ = prev_cmd_;
-        latch(f, now);
-        request_all(cmd_, AxisRequest::kQuickStop);
-      }
-    }
-  }
-  prev_cmd_ = cmd_;
-  out = cmd_;
+void Sequencer::signal() noexcept {
+  // Stack light: red = a fault waits for acknowledgement; green = weaving; amber = waiting for the
+  // operator (idle, arming, paused, done).
+  const bool weaving = state_ == State::kPositioning || state_ == State::kShedTest || state_ == State::kShed ||
+                       state_ == State::kPick || state_ == State::kBeatSweep;
+  cmd_.io.lamp_red = state_ == State::kFault;
+  cmd_.io.lamp_green = weaving;
+  cmd_.io.lamp_amber = !weaving && state_ != State::kFault;
+  cmd_.io.buzzer = false;
 }
 
 }  // namespace loom::sequencer

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <csignal>
+#include <limits>
 #include <stdexcept>
 
 #include "loom/motion/angles.hpp"
@@ -30,6 +32,29 @@ const char* sensor_name(Sensor s) {
   }
   return "?";
 }
+
+const char* injected_fault_name(InjectedFault f) {
+  switch (f) {
+    case InjectedFault::kDriveFault: return "drive_fault";
+    case InjectedFault::kEStop: return "estop";
+    case InjectedFault::kStuckPiston: return "stuck_piston";
+    case InjectedFault::kStuckSensor: return "stuck_sensor";
+    case InjectedFault::kIntermittentSensor: return "intermittent_sensor";
+    case InjectedFault::kCanFrameLoss: return "can_frame_loss";
+    case InjectedFault::kCanLatency: return "can_latency";
+    case InjectedFault::kBusOff: return "bus_off";
+    case InjectedFault::kHeartbeatLoss: return "heartbeat_loss";
+    case InjectedFault::kEmcy: return "emcy";
+    case InjectedFault::kEncoderGlitch: return "encoder_glitch";
+    case InjectedFault::kLoadCellFailure: return "load_cell_failure";
+    case InjectedFault::kAirLoss: return "air_loss";
+    case InjectedFault::kLoopStall: return "loop_stall";
+    case InjectedFault::kPowerCut: return "power_cut";
+  }
+  return "?";
+}
+
+const char* load_cell_mode_name(LoadCellMode m) { return m == LoadCellMode::kNan ? "nan" : "lost"; }
 
 double SimRandom::uniform() noexcept {
   std::uint64_t z = (state_ += 0x9E3779B97F4A7C15ull);
@@ -73,8 +98,14 @@ SimWorld::SimWorld(const SimMachine& machine, const SceneSpec& scene)
     }
   }
   beatup_ = std::make_unique<motion::BeatUp>(m_.beatup);
-  std::sort(scene_.faults.begin(), scene_.faults.end(),
-            [](const FaultInjection& a, const FaultInjection& b) { return a.at_s < b.at_s; });
+  // Each fault strikes at the first tick whose time reaches at_s (a power cut: at its own tick).
+  const auto strike = [&](const FaultInjection& f) {
+    if (f.kind == InjectedFault::kPowerCut) return f.at_tick;
+    return static_cast<hal::Tick>(std::ceil(f.at_s / m_.period_s - 1e-9));
+  };
+  std::stable_sort(scene_.faults.begin(), scene_.faults.end(),
+                   [&](const FaultInjection& a, const FaultInjection& b) { return strike(a) < strike(b); });
+  for (const FaultInjection& f : scene_.faults) fault_tick_.push_back(strike(f));
 }
 
 SimWorld::~SimWorld() = default;
@@ -114,38 +145,102 @@ bool SimWorld::beater_in_warp() const {
 }
 
 void SimWorld::apply_injected_faults(hal::Tick now) noexcept {
-  const double t = static_cast<double>(now) * m_.period_s;
-  while (next_fault_ < scene_.faults.size() && scene_.faults[next_fault_].at_s <= t) {
+  const auto ticks = [&](double seconds) {
+    return seconds > 0.0 ? now + static_cast<hal::Tick>(std::ceil(seconds / m_.period_s - 1e-9))
+                         : std::numeric_limits<hal::Tick>::max();
+  };
+  while (next_fault_ < scene_.faults.size() && fault_tick_[next_fault_] <= now) {
     const FaultInjection& f = scene_.faults[next_fault_++];
+    const std::size_t ax = hal::index(f.axis);
     switch (f.kind) {
       case InjectedFault::kEStop: estop_ok_ = false; break;
-      case InjectedFault::kDriveFault: {
-        SimAxis& ax = axes_[hal::index(f.axis)];
-        ax.state = hal::DriveState::kFault;
-        ax.fault_code = f.code;
+      case InjectedFault::kDriveFault:
+        axes_[ax].state = hal::DriveState::kFault;
+        axes_[ax].fault_code = f.code;
         break;
-      }
       case InjectedFault::kStuckPiston: piston_stuck_[static_cast<std::size_t>(f.piston)] = true; break;
-      case InjectedFault::kStuckSensor: stuck_sensor_[static_cast<std::size_t>(f.sensor)] = f.stuck_value; break;
+      case InjectedFault::kStuckSensor:
+        stuck_sensor_[static_cast<std::size_t>(f.sensor)] = f.stuck_value;
+        sensor_until_[static_cast<std::size_t>(f.sensor)] = std::numeric_limits<hal::Tick>::max();
+        break;
+      case InjectedFault::kIntermittentSensor:
+        stuck_sensor_[static_cast<std::size_t>(f.sensor)] = f.stuck_value;
+        sensor_until_[static_cast<std::size_t>(f.sensor)] = ticks(f.duration_s);
+        break;
+      case InjectedFault::kCanFrameLoss:
+        frame_loss_p_ = f.probability;
+        frame_loss_until_ = ticks(f.duration_s);
+        break;
+      case InjectedFault::kCanLatency:
+        latency_ticks_ = std::min(static_cast<hal::Tick>(std::llround(f.latency_s / m_.period_s)),
+                                  static_cast<hal::Tick>(kHistory - 1));
+        latency_until_ = ticks(f.duration_s);
+        break;
+      case InjectedFault::kBusOff: bus_off_ = true; break;
+      case InjectedFault::kHeartbeatLoss: silent_since_[ax] = now; break;
+      case InjectedFault::kEmcy: axes_[ax].fault_code = f.code; break;  // still Operation Enabled
+      case InjectedFault::kEncoderGlitch:
+        glitch_left_[ax] = std::max(1, f.ticks);
+        glitch_jump_[ax] = f.jump;
+        break;
+      case InjectedFault::kLoadCellFailure: load_cell_failed_ = f.load_cell; break;
+      case InjectedFault::kAirLoss: air_lost_ = true; break;
+      case InjectedFault::kLoopStall:
+        stall_until_ = now + std::max(1, f.ticks);
+        injected_overruns_ += static_cast<std::uint32_t>(std::max(1, f.ticks));
+        break;
+      case InjectedFault::kPowerCut:
+        powered_off_ = true;
+        if (power_cut_handler_ == nullptr) std::raise(SIGKILL);  // as if killed: nothing more is written
+        power_cut_handler_(power_cut_ctx_);
+        return;
     }
   }
+  for (std::size_t i = 0; i < sensor_until_.size(); ++i) {
+    if (stuck_sensor_[i] && now >= sensor_until_[i]) stuck_sensor_[i].reset();  // an intermittent fault recovers
+  }
+  if (now >= frame_loss_until_) frame_loss_p_ = 0.0;
+  if (now >= latency_until_) latency_ticks_ = 0;
 }
 
 void SimWorld::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) {
   apply_injected_faults(now);
+  if (powered_off_ || stalled(now)) return;  // nothing refreshed: the values keep their old ticks
+  hal::AxisFeedbacks& truth = history_[static_cast<std::size_t>(now) % kHistory];
   for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
     const SimAxis& s = axes_[i];
-    hal::AxisFeedback& fb = axes[i];
+    hal::AxisFeedback& fb = truth[i];
     fb.state = s.state;
-    fb.position = s.position;
+    fb.position = s.position + (glitch_left_[i] > 0 ? glitch_jump_[i] : 0.0);
     fb.velocity = s.velocity;
     fb.effort = 0.0;
     fb.fault = s.state == hal::DriveState::kFault;
     fb.fault_code = s.fault_code;
     fb.following_error = false;
     fb.refreshed = now;
+    if (glitch_left_[i] > 0) --glitch_left_[i];
   }
   link = hal::LinkStatus{};
+  if (bus_off_) {  // no frame gets through any more
+    link.link_fault = true;
+    link.link_fault_code = kEmcyBusOff;
+    return;
+  }
+  // Latency: what arrives now was sampled `latency_ticks_` ago and carries that sample's tick.
+  const hal::Tick delay = std::min<hal::Tick>(latency_ticks_, now);
+  const hal::AxisFeedbacks& arrived = history_[static_cast<std::size_t>(now - delay) % kHistory];
+  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+    if (silent_since_[i] >= 0) {
+      // A silent node sends nothing; its heartbeat consumer reports it after the heartbeat time.
+      if (now - silent_since_[i] >= static_cast<hal::Tick>(std::ceil(kSimHeartbeatTimeoutS / m_.period_s))) {
+        axes[i].fault = true;
+        axes[i].fault_code = kEmcyHeartbeat;
+      }
+      continue;
+    }
+    if (frame_loss_p_ > 0.0 && rng_.uniform() < frame_loss_p_) continue;  // this frame was lost
+    axes[i] = arrived[i];
+  }
 }
 
 void SimWorld::step_axis(SimAxis& ax, const hal::AxisCommand& cmd) noexcept {
@@ -182,6 +277,8 @@ void SimWorld::step_axis(SimAxis& ax, const hal::AxisCommand& cmd) noexcept {
 }
 
 void SimWorld::write_axes(hal::Tick, const hal::AxisCommands& axes) {
+  if (powered_off_) return;
+  drives_simulated_ = true;
   for (std::size_t i = 0; i < hal::kAxisCount; ++i) step_axis(axes_[i], axes[i]);
 }
 
@@ -200,8 +297,11 @@ void SimWorld::step_beat_contact(double crank_position, double omega) noexcept {
 }
 
 void SimWorld::read_analog(hal::Tick now, hal::AnalogInputs& analog) {
+  if (powered_off_ || stalled(now)) return;
   analog.beat_force_valid = scene_.beat_contact.has_value();
   analog.beat_force_n = beat_force_n_;
+  if (load_cell_failed_ == LoadCellMode::kNan) analog.beat_force_n = std::numeric_limits<double>::quiet_NaN();
+  if (load_cell_failed_ == LoadCellMode::kLost) analog.beat_force_valid = false;
   analog.refreshed = now;
 }
 
@@ -235,14 +335,16 @@ void SimWorld::step_shuttle(double helix) noexcept {
 }
 
 void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::DigitalInputs& io) {
+  if (powered_off_ || stalled(now)) return;
   // The shuttle rides the carrier on the helix shaft: one lead of travel per shaft turn. Taken from the
   // HAL's fresh helix feedback, so this I/O node also works beside real (CAN) drives.
-  step_shuttle(axes[hal::index(hal::Axis::kHelix)].position);
-  // The load cell rides the beater, which the crank drives: real (CAN) or simulated, as fed back.
-  if (scene_.beat_contact) {
-    step_beat_contact(axes[hal::index(hal::Axis::kBeatCrank)].position,
-                      axes[hal::index(hal::Axis::kBeatCrank)].velocity);
-  }
+  // When this world also simulates the drives, the shuttle and the beater follow the true axes, not
+  // what the (possibly delayed or glitched) feedback says.
+  const auto pos = [&](hal::Axis a) { return drives_simulated_ ? axes_[hal::index(a)].position : axes[hal::index(a)].position; };
+  const auto vel = [&](hal::Axis a) { return drives_simulated_ ? axes_[hal::index(a)].velocity : axes[hal::index(a)].velocity; };
+  step_shuttle(pos(hal::Axis::kHelix));
+  // The load cell rides the beater, which the crank drives: real (CAN) or simulated.
+  if (scene_.beat_contact) step_beat_contact(pos(hal::Axis::kBeatCrank), vel(hal::Axis::kBeatCrank));
   std::array<bool, 6> v{piston_[0] >= 1.0,
                         piston_[0] <= 0.0,
                         piston_[1] >= 1.0,
@@ -264,6 +366,7 @@ void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::Digit
 }
 
 void SimWorld::write_io(hal::Tick, const hal::DigitalOutputs& io) {
+  if (powered_off_) return;
   const std::array<bool, 2> valve{io.piston_a_extend, io.piston_b_extend};
   const double dt = m_.period_s;
   const double full_speed = dt / m_.piston_travel_s;  // fraction of stroke per tick at full pressure
@@ -276,7 +379,7 @@ void SimWorld::write_io(hal::Tick, const hal::DigitalOutputs& io) {
       const double margin = (std::abs(pressure_[i]) - p.breakaway) / (1.0 - p.breakaway);
       step = margin > 0.0 ? std::copysign(margin * full_speed, pressure_[i]) : 0.0;
     }
-    if (!piston_stuck_[i]) piston_[i] = std::clamp(piston_[i] + step, 0.0, 1.0);
+    if (!piston_stuck_[i] && !air_lost_) piston_[i] = std::clamp(piston_[i] + step, 0.0, 1.0);
   }
   if (state_file_ != nullptr) {
     PersistedMachine pm;

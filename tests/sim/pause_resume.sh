@@ -6,7 +6,7 @@ set -euo pipefail
 loomctl=$1
 work=$(mktemp -d)
 trap 'kill %1 2>/dev/null || true; rm -rf "$work"' EXIT
-printf '[loom]\nwidth_m = 0.4\n' >"$work/loom.toml"
+printf 'extends = "default"\n[loom]\nwidth_m = 0.4\n' >"$work/loom.toml"
 "$loomctl" weave --config "$work/loom.toml" --rows 4 --realtime --pace 8 --no-telemetry --quiet >"$work/out" 2>&1 &
 pid=$!
 for _ in $(seq 1 200); do grep -q '^row 1/4' "$work/out" && break; sleep 0.05; done

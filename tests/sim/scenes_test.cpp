@@ -3,6 +3,7 @@
 // counters kept); the default scene beats every point of the width with 80–100 N.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <string>
 
 #include "loom/firmware/config.hpp"
@@ -14,6 +15,7 @@ using sequencer::State;
 
 namespace {
 struct Outcome {
+  bool power_cut = false;
   State state;
   Fault first_fault;
   sequencer::Counters counters;
@@ -27,16 +29,30 @@ Outcome run_scene(const std::string& name, std::uint32_t rows) {
   opt.telemetry = false;
   opt.rows = rows;
   firmware::Machine m(firmware::default_loom_config(), scene, opt, {});
-  m.sequencer().request_start();
   Outcome o;
+  m.sim().on_power_cut([](void* cut) { *static_cast<bool*>(cut) = true; }, &o.power_cut);
+  m.sequencer().request_start();
   std::uint32_t seen = 0;
   hal::Tick t = 0;
-  for (; t < 400000 && !m.sequencer().finished(); ++t) {
+  for (; t < 400000 && !m.sequencer().finished() && !o.power_cut; ++t) {
     m.loop().cycle(t);
     if (m.sequencer().counters().rows != seen) {
       seen = m.sequencer().counters().rows;
       o.rows.push_back(m.sequencer().last_row());
     }
+  }
+  o.state = m.sequencer().state();
+  if (o.power_cut) {
+    // The machine lost its power: whatever the controller (were it alive) commands, nothing moves.
+    std::array<double, hal::kAxisCount> at_cut{};
+    for (std::size_t k = 0; k < hal::kAxisCount; ++k) at_cut[k] = m.sim().axis(static_cast<hal::Axis>(k)).position;
+    for (int i = 0; i < 500; ++i, ++t) {
+      m.loop().cycle(t);
+      for (std::size_t k = 0; k < hal::kAxisCount; ++k) {
+        if (m.sim().axis(static_cast<hal::Axis>(k)).position != at_cut[k]) o.moved_after_fault = true;
+      }
+    }
+    return o;
   }
   // After the end: keep ticking; in a fault nothing may move any more.
   const hal::HalOutputs at_end = m.loop().outputs();
@@ -97,7 +113,18 @@ INSTANTIATE_TEST_SUITE_P(Shipped, FaultScenes,
                                            FaultCase{"stuck_piston", Fault::kShedNotReleased},
                                            FaultCase{"shuttle_slip", Fault::kShuttleNotArrived},
                                            FaultCase{"stuck_sensor", Fault::kShuttleLost},
-                                           FaultCase{"estop", Fault::kEStop}),
+                                           FaultCase{"estop", Fault::kEStop},
+                                           FaultCase{"stuck_end_sensor", Fault::kShedNotReleased},
+                                           FaultCase{"can_frame_loss", Fault::kStaleFeedback},
+                                           FaultCase{"can_latency", Fault::kStaleFeedback},
+                                           FaultCase{"bus_off", Fault::kLinkFault},
+                                           FaultCase{"heartbeat_loss", Fault::kHeartbeatLost},
+                                           FaultCase{"emcy", Fault::kDriveEmcy},
+                                           FaultCase{"intermittent_sensor", Fault::kShedSensorConflict},
+                                           FaultCase{"encoder_glitch", Fault::kEncoderJump},
+                                           FaultCase{"load_cell", Fault::kLoadCellFault},
+                                           FaultCase{"air_loss", Fault::kAirLost},
+                                           FaultCase{"loop_stall", Fault::kLoopStall}),
                          [](const auto& param_info) { return std::string(param_info.param.scene); });
 
 TEST(Scenes, SensorNoiseIsDebouncedAwayAndTheRunIsDeterministic) {
@@ -116,5 +143,18 @@ TEST(Scenes, RigidBodyCrankStillBeatsWithinTargetAndTracksItsServo) {
     ASSERT_TRUE(r.force_measured);
     EXPECT_GE(r.force_min_n, 80.0);
     EXPECT_LE(r.force_max_n, 100.0);
+  }
+}
+
+TEST(Scenes, PowerCutEndsTheRunAtItsTickWithNothingMovingAfterwards) {
+  const Outcome o = run_scene("power_cut", 5);
+  EXPECT_TRUE(o.power_cut);
+  EXPECT_EQ(o.state, State::kPick);  // tick 800 is mid-pick of the first row
+  EXPECT_FALSE(o.moved_after_fault);
+}
+
+TEST(Scenes, EveryShippedSceneParses) {
+  for (const auto& e : std::filesystem::directory_iterator(std::string(LOOM_SOURCE_DIR) + "/sim_hal/scenes")) {
+    EXPECT_NO_THROW(firmware::load_scene(e.path().string())) << e.path();
   }
 }

@@ -19,6 +19,7 @@
 #include "loom/drivers/can_axis_port.hpp"
 #include "loom/motion/profile_set.hpp"
 #include "loom/sequencer/sequencer.hpp"
+#include "loom/firmware/scene_config.hpp"  // the scene file (kept here so callers of config.hpp see it)
 #include "loom/sim_hal/scene.hpp"
 
 namespace loom::firmware {
@@ -142,18 +143,7 @@ struct KeyInfo {
 };
 std::vector<KeyInfo> config_keys();
 
-struct Scene {
-  std::string source = "<embedded default scene>";
-  sim_hal::SceneSpec spec;
-  std::string config_path;  // loom config named by the scene ("" = embedded default)
-};
-
-Scene parse_scene(const std::string& text, const std::string& source);
-Scene load_scene(const std::string& path);
-Scene default_scene();
-
-// The embedded defaults (generated at build time from firmware/config and sim_hal/scenes).
+// The embedded default loom (generated at build time from firmware/config/default_loom.toml).
 extern const char* const kDefaultLoomToml;
-extern const char* const kDefaultSceneToml;
 
 }  // namespace loom::firmware

@@ -49,6 +49,7 @@ class Machine {
   telemetry::Telemetry* telemetry() { return telemetry_.get(); }
   const drivers::CanAxisPort* can() const { return can_port_.get(); }
   const sim_hal::SimWorld& sim() const { return *sim_; }
+  sim_hal::SimWorld& sim() { return *sim_; }  // configure-time: e.g. a power-cut handler for in-process runs
   const LoomConfig& config() const { return cfg_; }
 
  private:

@@ -22,7 +22,19 @@ namespace loom::sequencer {
   X(kPickWithoutShed, 0x100B, "interlock_pick_without_shed", "pick commanded while the shed is not confirmed open") \
   X(kShedWithShuttle, 0x100C, "interlock_shed_with_shuttle", "shed change commanded while the shuttle is in the shed") \
   X(kShedSensorEarly, 0x100E, "shed_sensor_early", "piston end sensors confirmed faster than a frame can move") \
-  X(kShedNotReleased, 0x100F, "shed_not_released", "a heald frame never left its end position (valve, air, jam)")
+  X(kShedNotReleased, 0x100F, "shed_not_released", "a heald frame never left its end position (valve, air, jam)") \
+  X(kAirLost, 0x1010, "air_lost", "neither heald frame left its end position: no air at the valves")          \
+  X(kShedSensorConflict, 0x1011, "shed_sensor_conflict", "a piston reads extended and retracted at once (stuck sensor or wiring)") \
+  X(kShuttleSensorConflict, 0x1012, "shuttle_sensor_conflict", "the shuttle reads at both selvedges at once (stuck sensor or wiring)") \
+  X(kShuttleSensorEarly, 0x1013, "shuttle_sensor_early", "the arrival sensor saw the shuttle before its carrier could bring it") \
+  X(kShuttleSideMismatch, 0x1014, "shuttle_side_mismatch", "the shuttle is at the selvedge the production counters say it left") \
+  X(kCountersInconsistent, 0x1015, "counters_inconsistent", "the resumed production counters are impossible for this recipe") \
+  X(kNonFiniteFeedback, 0x1016, "nonfinite_feedback", "an axis reported a NaN or infinite position, velocity or effort") \
+  X(kEncoderJump, 0x1017, "encoder_jump", "an axis position jumped faster than the axis can move (encoder or wiring)") \
+  X(kDriveEmcy, 0x1018, "drive_emcy", "a drive sent an error code (EMCY) while still enabled")                 \
+  X(kLoadCellFault, 0x1019, "load_cell_fault", "the beater's load cell failed (lost, NaN or out of range)")     \
+  X(kLoopStall, 0x101A, "loop_stall", "feedback from every device stopped at once (the loop or the bus stalled)") \
+  X(kStopRequested, 0x101B, "stop_requested", "stopped at once on the operator's request (counters kept)")
 
 enum class Fault : std::uint8_t {
 #define LOOM_FAULT_ENUM(id, code, name, text) id,

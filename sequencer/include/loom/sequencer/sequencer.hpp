@@ -5,21 +5,26 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 
 #include "loom/hal/types.hpp"
 #include "loom/motion/jerk_move.hpp"
 #include "loom/motion/profile_set.hpp"
 #include "loom/motion/profile_slot.hpp"
+#include "loom/sequencer/debounce.hpp"
 #include "loom/sequencer/faults.hpp"
 #include "loom/sequencer/interlocks.hpp"
+#include "loom/sequencer/row_stats.hpp"
+#include "loom/sequencer/shed_monitor.hpp"
 
 namespace loom::sequencer {
 
 enum class State : std::uint8_t {
   kIdle,         // drives disabled, waiting for start
   kEnabling,     // walking the drives to Operation Enabled
-  kPositioning,  // re-arm: crank to park, carriage to the nearest selvedge, from measured positions
-  kShed,         // swapping the heald frames, waiting for the end sensors
+  kPositioning,  // re-arm: crank to park, carriage to the row's start selvedge, from measured positions
+  kShedTest,     // proving the end sensors: each frame stroked both ways before the first pick
+  kShed,         // swapping the heald frames, waiting for a consistent end-sensor picture
   kPick,         // helix shaft carries the shuttle across, waiting for arrival
   kBeatSweep,    // crank beats while the carriage steps across the width
   kPaused,       // holding at a safe point (before a shed change), drives enabled, until resumed
@@ -35,13 +40,6 @@ struct Counters {
   std::uint32_t picks_in_row = 0;  // picks of the row in progress (restart resumes here)
 };
 
-inline constexpr int kMaxBeatsPerRow = 256;
-
-struct BeatRecord {
-  float x_m = 0.0f;           // carriage position (beater's left edge from the left selvedge)
-  float peak_force_n = 0.0f;  // peak load-cell force during this beat (0 when no load cell)
-};
-
 // One beat as the technician sees it: published once per beat, when the beater has left the warp
 // after passing the fell (its peak force is then final).
 struct BeatEvent {
@@ -51,16 +49,6 @@ struct BeatEvent {
   float peak_force_n = 0.0f;   // 0 when no load cell
   bool force_measured = false;
   bool in_band = false;        // force_measured and within [beat_force_min_n, beat_force_max_n]
-};
-
-struct RowStats {
-  std::uint32_t row = 0;     // 1-based number of the row just completed
-  hal::Tick shed_ticks = 0, pick_ticks = 0, beat_ticks = 0, total_ticks = 0;  // shed/pick summed over picks
-  int beats = 0;
-  int carriage_steps = 0;
-  bool force_measured = false;
-  double force_min_n = 0.0, force_mean_n = 0.0, force_max_n = 0.0;
-  std::array<BeatRecord, kMaxBeatsPerRow> beat{};  // first `beats` entries
 };
 
 struct SequencerConfig {
@@ -80,14 +68,27 @@ struct SequencerConfig {
   double helix_left_position_rad = 0.0;  // helix axis reading with the carrier at the left selvedge
   double park_tolerance_rad = 0.01;
   double selvedge_tolerance_m = 0.001;
+  // The shuttle-arrival sensors see the shuttle within this distance of their selvedge (machine wiring).
+  // An arrival seen while the carrier is farther away than this (plus 2 mm) is a sensor fault; an arrival
+  // not seen within arrival_grace_s (plus the debounce) of the carrier entering it is a lost shuttle.
+  double selvedge_sensor_window_m = 0.005;
+  double arrival_grace_s = 0.02;
   double beat_force_min_n = 80.0;         // the band every beat must hit (thesis: 80–100 N)
   double beat_force_max_n = 100.0;
+  double load_cell_max_n = 5000.0;        // a load-cell reading beyond this is a failed cell, not a beat
   motion::JerkLimits carriage{.velocity = 0.5, .acceleration = 5.0, .jerk = 100.0};  // re-arm moves
 };
 
+// Configure-time only. "" when the sequencer can run `profiles` with `cfg`, else why not, naming the
+// config key: every fixed capacity (kMaxBeatsPerRow), finite calibration offsets and time-outs whose
+// tick counts fit the integer time base.
+std::string validate(const SequencerConfig& cfg, const motion::ProfileSet& profiles);
+
 class Sequencer {
  public:
-  // Configure-time only. `profiles` must outlive the sequencer. `resume` seeds the counters (restart).
+  // Configure-time only. `profiles` must outlive the sequencer. `resume` seeds the counters (restart);
+  // they are reconciled with the machine's measured state when it arms. Throws std::invalid_argument
+  // when validate() refuses the configuration.
   Sequencer(const motion::ProfileSet& profiles, const SequencerConfig& cfg, Counters resume = {});
   // Configure-time only. Follows `slot`: a recipe published there is adopted at the next row boundary
   // (then the machine re-arms, so a changed width re-homes the carriage). `slot` must outlive this.
@@ -97,6 +98,12 @@ class Sequencer {
   void request_stop_at_row_end() noexcept { stop_requested_ = true; }  // RT-safe
   void request_pause() noexcept { pause_requested_ = true; }        // RT-safe: holds before the next shed
   void request_resume() noexcept { pause_requested_ = false; }      // RT-safe
+  // RT-safe. Stop at once (the second SIGINT/SIGTERM): quick stop of every axis, valves hold, counters
+  // kept, latched as the named fault stop_requested.
+  void request_stop_now() noexcept { stop_now_requested_ = true; }
+  // RT-safe. Acknowledge a latched fault: the drives get their fault-reset edge, the machine goes idle
+  // and re-arms from measured positions on the next start. (The operator's ack button does the same.)
+  void request_acknowledge() noexcept { ack_requested_ = true; }
 
   // RT-safe. One tick: check faults → advance the row cycle → sample profiles → check interlocks →
   // write every field of `out`.
@@ -126,21 +133,46 @@ class Sequencer {
   const hal::DigitalInputs& debounced_io() const noexcept { return io_; }
 
  private:
-  hal::Tick ticks(double seconds) const noexcept;
-  double seconds_since(hal::Tick now, hal::Tick t0) const noexcept;
+  // ---- the tick, in order (see sequencer.cpp) ----
+  void sense(const hal::HalInputs& raw) noexcept;
   bool check_faults(hal::Tick now, const hal::HalInputs& in) noexcept;
   void refine_diagnosis(hal::Tick now, const hal::HalInputs& in) noexcept;
+  void operator_requests() noexcept;
+  void run_state(hal::Tick now, const hal::HalInputs& in) noexcept;
+  void play_moves(hal::Tick now) noexcept;
+  void track_beat_force(const hal::HalInputs& in) noexcept;
+  void signal() noexcept;
+  // ---- one function per state ----
+  void idle(hal::Tick now, const hal::HalInputs& in) noexcept;
+  void enabling(hal::Tick now, const hal::HalInputs& in) noexcept;
+  void positioning(hal::Tick now, const hal::HalInputs& in) noexcept;
+  void shed_test(hal::Tick now) noexcept;
+  void shed(hal::Tick now) noexcept;
+  void pick(hal::Tick now, const hal::HalInputs& in) noexcept;
+  void beat_sweep(hal::Tick now) noexcept;
+  void paused(hal::Tick now) noexcept;
+  void fault(hal::Tick now) noexcept;
+  // ---- transitions and helpers ----
+  hal::Tick ticks(double seconds) const noexcept;
+  double seconds_since(hal::Tick now, hal::Tick t0) const noexcept;
   static bool is_symptom(Fault f) noexcept;
   void latch(Fault f, hal::Tick now, int axis = -1, std::uint16_t detail = 0) noexcept;
   void enter(State s, hal::Tick now) noexcept;
-  void advance(hal::Tick now, const hal::HalInputs& in) noexcept;
-  void begin_shed(hal::Tick now) noexcept;
+  bool reconcile_at_arming(hal::Tick now, const hal::HalInputs& in) noexcept;
+  bool shuttle_where_counters_say(hal::Tick now) noexcept;
   void begin_row(hal::Tick now) noexcept;  // a row boundary: adopt a published recipe, else shed
-  void begin_sweep(hal::Tick now, const hal::HalInputs& in) noexcept;
-  void debounce(const hal::DigitalInputs& raw) noexcept;
-  void track_beat_force(const hal::HalInputs& in) noexcept;
-  void play_moves(hal::Tick now) noexcept;
+  void begin_shed(hal::Tick now) noexcept;
+  void start_stroke(bool a_extend, bool b_extend) noexcept;
+  void begin_pick(hal::Tick now, bool resumed) noexcept;
+  void begin_sweep(hal::Tick now) noexcept;
+  void end_row(hal::Tick now) noexcept;
+  void adopt_limits() noexcept;
+  Fault shed_fault(ShedVerdict v) const noexcept;
   void publish_beat(int k) noexcept;
+  bool expect_shuttle_left() const noexcept { return counters_.picks % 2 == 0; }  // it starts at the left
+  bool row_starts_left() const noexcept { return counters_.rows % 2 == 0; }      // sweeps alternate
+  PistonEnds ends_a() const noexcept { return {io_.piston_a_extended, io_.piston_a_retracted}; }
+  PistonEnds ends_b() const noexcept { return {io_.piston_b_extended, io_.piston_b_retracted}; }
 
   const motion::ProfileSet* profiles_;
   motion::ProfileSlot* slot_ = nullptr;
@@ -153,7 +185,9 @@ class Sequencer {
   bool start_requested_ = false;
   bool stop_requested_ = false;
   bool pause_requested_ = false;
-  bool row_started_ = false;  // a row is in progress (its start tick is set)
+  bool stop_now_requested_ = false;
+  bool ack_requested_ = false;
+  bool acknowledged_this_tick_ = false;
 
   Fault first_fault_ = Fault::kNone;
   Fault stopped_by_ = Fault::kNone;
@@ -179,21 +213,35 @@ class Sequencer {
   double carriage_sweep_origin_ = 0.0;
   double carriage_sweep_dir_ = 1.0;
   double crank_sweep_origin_ = 0.0;
-  bool pick_to_right_ = true;
-  motion::ShedMonitor shed_;       // the current shed change against the profiles' windows
 
-  // Debounced inputs: the value in use and how many ticks the raw value has disagreed with it.
+  // The pick in progress: where the carrier goes and when it entered the arrival sensor's reach.
+  bool pick_to_right_ = true;
+  double pick_goal_rad_ = 0.0;
+  hal::Tick carrier_at_selvedge_ = hal::kNeverTick;
+
+  // Shedding: the monitor of the change in progress; the arming test strokes (sensors proven).
+  ShedMonitor shed_;
+  int shed_test_step_ = 0;
+  bool sensors_proven_ = false;
+
+  // Sensors and buttons as the sequencer uses them (debounced), and plausibility state.
+  Debouncer<6> sensors_;
+  Debouncer<3> buttons_;
+  RisingEdge start_edge_, pause_edge_, ack_edge_;
   hal::DigitalInputs io_{};
-  std::array<int, 6> disagree_{};
-  bool io_primed_ = false;
+  int sensed_ticks_ = 0;                       // picture checks wait until the debouncer has history
+  std::array<double, hal::kAxisCount> last_position_{};
+  bool positions_primed_ = false;
+  std::array<double, hal::kAxisCount> max_step_{};  // the most an axis can move in one tick (m or rad)
+  bool load_cell_seen_ = false;
 
   // Row bookkeeping.
-  hal::Tick row_start_ = 0, phase_start_ = 0;
+  RowRecorder row_;
+  hal::Tick phase_start_ = 0, sweep_start_ = 0;
   int row_beats_ = 0;
   int beats_published_ = 0;        // beats of this row already published as BeatEvents
   std::uint32_t beat_events_ = 0;
   BeatEvent last_beat_{};
-  RowStats row_{};       // being filled
   RowStats last_row_{};  // the last completed row
 };
 

@@ -73,21 +73,58 @@ struct JointFriction {
   double coulomb_nm = 0.3;
 };
 
-enum class InjectedFault : std::uint8_t { kDriveFault, kEStop, kStuckPiston, kStuckSensor };
+// Faults a scene can inject, each at a time (at_s) from the start of the run. The first four keep their
+// numbers (older tools cast them).
+enum class InjectedFault : std::uint8_t {
+  kDriveFault,          // the drive of `axis` goes to Fault with EMCY `code`
+  kEStop,               // the e-stop chain opens
+  kStuckPiston,         // `piston` seizes where it is (a dry seal)
+  kStuckSensor,         // `sensor` reads `value` for ever
+  kIntermittentSensor,  // `sensor` reads `value` for `duration_s`, then recovers
+  kCanFrameLoss,        // a fraction `probability` of the axes' feedback frames is lost for `duration_s`
+  kCanLatency,          // axis feedback arrives `latency_s` late (stamped with its sample tick) for `duration_s`
+  kBusOff,              // the CAN controller goes bus-off: link fault, no more feedback
+  kHeartbeatLoss,       // the node of `axis` falls silent; after the heartbeat time it is reported lost
+  kEmcy,                // the drive of `axis` sends EMCY `code` but stays enabled
+  kEncoderGlitch,       // the position of `axis` reads `jump` (m or rad) off for `ticks` ticks
+  kLoadCellFailure,     // the beater's load cell reads NaN (`mode` "nan") or disappears ("lost")
+  kAirLoss,             // the air supply fails: neither piston moves any more
+  kLoopStall,           // the loop stalls for `ticks` ticks: no input refreshed, `ticks` overruns counted
+  kPowerCut,            // the power fails at tick `at_tick`: the run ends as if the process were killed
+};
+inline constexpr int kInjectedFaultCount = 15;
+const char* injected_fault_name(InjectedFault f);  // the scene file's `kind`
 
 enum class Sensor : std::uint8_t {
   kPistonAExtended, kPistonARetracted, kPistonBExtended, kPistonBRetracted, kShuttleLeft, kShuttleRight
 };
+inline constexpr int kSensorCount = 6;
 const char* sensor_name(Sensor s);
+
+enum class LoadCellMode : std::uint8_t { kNan, kLost };
+const char* load_cell_mode_name(LoadCellMode m);
+
+// The heartbeat consumer time of the simulated nodes: a silent node is reported lost this long after it
+// fell silent (its feedback is stale well before).
+inline constexpr double kSimHeartbeatTimeoutS = 0.15;
+inline constexpr std::uint16_t kEmcyHeartbeat = 0x8130;  // CiA 301 life guard / heartbeat error
+inline constexpr std::uint16_t kEmcyBusOff = 0x8140;     // CiA 301 recovered from bus-off (bus-off)
 
 struct FaultInjection {
   double at_s = 0.0;                       // virtual time from start
   InjectedFault kind = InjectedFault::kDriveFault;
-  hal::Axis axis = hal::Axis::kBeatCrank;  // drive faults
+  hal::Axis axis = hal::Axis::kBeatCrank;  // drive faults, heartbeat loss, EMCY, encoder glitch
   std::uint16_t code = 0x8611;             // EMCY code reported (default: following error)
   int piston = 0;                          // stuck piston: 0 = A, 1 = B
-  Sensor sensor = Sensor::kShuttleRight;   // stuck sensor
+  Sensor sensor = Sensor::kShuttleRight;   // stuck / intermittent sensor
   bool stuck_value = false;
+  double duration_s = 0.0;                 // intermittent sensor, frame loss, latency (0: for ever)
+  double probability = 1.0;                // frame loss
+  double latency_s = 0.0;                  // CAN latency
+  double jump = 0.0;                       // encoder glitch, SI (m or rad)
+  int ticks = 1;                           // encoder glitch, loop stall
+  LoadCellMode load_cell = LoadCellMode::kNan;
+  hal::Tick at_tick = -1;                  // power cut: the tick it strikes (at_s is ignored)
 };
 
 // Physical facts of the simulated machine that are not effects (they come from the loom config).

@@ -70,8 +70,18 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   bool beater_in_warp() const;  // true tip position vs the warp, from the true crank position
   std::size_t effect_count() const;
 
+  // Power cut (scene fault power_cut at tick N). By default the process dies there as if killed
+  // (SIGKILL): counters and the machine state file keep what they had, as after a real power loss.
+  // In-process users (tests, loom-safety) install a handler instead; the world then freezes (nothing
+  // moves, no input is refreshed) and power_cut() tells. Configure-time only.
+  void on_power_cut(void (*handler)(void* ctx), void* ctx) { power_cut_handler_ = handler, power_cut_ctx_ = ctx; }
+  bool power_cut() const { return powered_off_; }
+  // Overruns injected by loop_stall faults (the ticks the loop was stalled), for the loop's statistics.
+  std::uint32_t injected_overruns() const { return injected_overruns_; }
+
  private:
   void apply_injected_faults(hal::Tick now) noexcept;
+  bool stalled(hal::Tick now) const noexcept { return now < stall_until_; }
   void step_axis(SimAxis& ax, const hal::AxisCommand& cmd) noexcept;
   void step_shuttle(double helix_position) noexcept;
   void step_beat_contact(double crank_position, double crank_velocity) noexcept;
@@ -89,6 +99,26 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   bool carrier_primed_ = false;
   bool estop_ok_ = true;
   std::size_t next_fault_ = 0;
+  std::vector<hal::Tick> fault_tick_;          // the tick each scene fault strikes (sorted like the faults)
+  // State of the injected faults (see InjectedFault).
+  std::array<hal::Tick, kSensorCount> sensor_until_{};  // intermittent: stuck until then (-1: for ever)
+  double frame_loss_p_ = 0.0;
+  hal::Tick frame_loss_until_ = 0;
+  hal::Tick latency_ticks_ = 0, latency_until_ = 0;
+  static constexpr std::size_t kHistory = 512;           // axis feedback kept for the latency fault
+  std::array<hal::AxisFeedbacks, kHistory> history_{};
+  bool bus_off_ = false;
+  std::array<hal::Tick, hal::kAxisCount> silent_since_{-1, -1, -1};  // heartbeat loss
+  std::array<int, hal::kAxisCount> glitch_left_{};
+  std::array<double, hal::kAxisCount> glitch_jump_{};
+  std::optional<LoadCellMode> load_cell_failed_;
+  bool air_lost_ = false;
+  hal::Tick stall_until_ = 0;
+  std::uint32_t injected_overruns_ = 0;
+  bool powered_off_ = false;
+  bool drives_simulated_ = false;  // this world's axes are the drives (not real ones beside it)
+  void (*power_cut_handler_)(void*) = nullptr;
+  void* power_cut_ctx_ = nullptr;
   SimRandom rng_;
   std::unique_ptr<motion::BeatUp> beatup_;  // built for beat_contact and for the ground-truth warp test
   double beat_force_n_ = 0.0;

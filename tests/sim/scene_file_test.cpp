@@ -1,0 +1,93 @@
+// Scene files are read as strictly as loom configs: every refusal names file:line:col, key and value;
+// a scene written by scene_to_toml (loom-safety's violation files) reads back to the same scene.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "loom/firmware/config.hpp"
+#include "loom/firmware/scene_config.hpp"
+
+using namespace loom;
+
+namespace {
+// The ConfigError message for `text`, or "" when it parses.
+std::string error_of(const std::string& text) {
+  try {
+    firmware::parse_scene(text, "s.toml");
+  } catch (const firmware::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(SceneFile, NonFiniteOrNegativeTimesAreRefusedAtTheirLine) {
+  EXPECT_EQ(error_of("effects = [\"ideal\"]\n[[fault]]\nkind = \"estop\"\nat_s = nan\n"),
+            "s.toml:4:8: fault[0].at_s = nan: must be a finite number in [0, 1e+07]");
+  EXPECT_NE(error_of("effects = [\"ideal\"]\n[[fault]]\nkind = \"estop\"\nat_s = inf\n"), "");
+  EXPECT_NE(error_of("effects = [\"ideal\"]\n[[fault]]\nkind = \"estop\"\nat_s = -1.0\n"), "");
+}
+
+TEST(SceneFile, AnEmptyFaultIsRefusedNotADriveFaultAtZero) {
+  const std::string e = error_of("effects = [\"ideal\"]\n[[fault]]\n");
+  EXPECT_NE(e.find("s.toml:2:1: fault[0].kind = (missing)"), std::string::npos) << e;
+}
+
+TEST(SceneFile, EachKindNeedsItsFieldsAndTakesNoOthers) {
+  EXPECT_NE(error_of("effects = [\"ideal\"]\n[[fault]]\nkind = \"stuck_sensor\"\nat_s = 1.0\nsensor = \"shuttle_at_left\"\n")
+                .find("fault[0].value = (missing)"),
+            std::string::npos);
+  EXPECT_NE(error_of("effects = [\"ideal\"]\n[[fault]]\nkind = \"estop\"\nat_s = 1.0\naxis = \"helix\"\n")
+                .find("s.toml:5:8: fault[0].axis = \"helix\": not used by a estop fault"),
+            std::string::npos);
+  EXPECT_NE(error_of("effects = [\"ideal\"]\n[[fault]]\nkind = \"power_cut\"\nat_s = 1.0\n").find("at_tick"),
+            std::string::npos);
+  EXPECT_NE(error_of("effects = [\"ideal\"]\n[[fault]]\nkind = \"load_cell_failure\"\nat_s = 1.0\nmode = \"nan\"\n")
+                .find("beat_contact"),
+            std::string::npos);
+  EXPECT_NE(error_of("effects = [\"ideal\"]\n[[fault]]\nkind = \"emcy\"\nat_s = 1.0\naxis = \"helix\"\ncode = 0\n")
+                .find("fault[0].code = 0"),
+            std::string::npos);
+  EXPECT_NE(error_of("effects = [\"ideal\"]\n[[fault]]\nkind = \"warp_break\"\nat_s = 1.0\n").find("must be one of"),
+            std::string::npos);
+}
+
+TEST(SceneFile, DuplicatesAreRefused) {
+  EXPECT_NE(error_of("effects = [\"ideal\", \"servo_lag\", \"servo_lag\"]\n").find("named twice"), std::string::npos);
+  EXPECT_NE(error_of("effects = [\"ideal\"]\n[[fault]]\nkind = \"estop\"\nat_s = 1.0\n[[fault]]\nkind = \"estop\"\nat_s = 1.0\n")
+                .find("s.toml:5:1: fault[1]"),
+            std::string::npos);
+  EXPECT_NE(error_of("effects = []\n"), "");
+}
+
+TEST(SceneFile, EveryFaultKindRoundTripsThroughTheWriter) {
+  sim_hal::SceneSpec s;
+  s.name = "round \"trip\"";
+  s.seed = 42;
+  s.effects = {"ideal", "servo_lag", "beat_contact"};
+  s.servo_lag = sim_hal::ServoLag{0.0031};
+  s.beat_contact = sim_hal::BeatContact{2.4, 0.004};
+  for (int k = 0; k < sim_hal::kInjectedFaultCount; ++k) {
+    sim_hal::FaultInjection f;
+    f.kind = static_cast<sim_hal::InjectedFault>(k);
+    f.at_s = 0.1 * k + 1.0 / 3.0;
+    f.at_tick = 1234;
+    f.axis = hal::Axis::kHelix;
+    f.code = 0x2310;
+    f.sensor = sim_hal::Sensor::kPistonBExtended;
+    f.stuck_value = true;
+    f.duration_s = 0.25;
+    f.probability = 0.5;
+    f.latency_s = 0.01;
+    f.jump = -0.125;
+    f.ticks = 7;
+    f.load_cell = sim_hal::LoadCellMode::kLost;
+    s.faults.push_back(f);
+  }
+  const std::string text = firmware::scene_to_toml(s);
+  const firmware::Scene back = firmware::parse_scene(text, "written.toml");
+  EXPECT_EQ(firmware::scene_to_toml(back.spec), text);
+  ASSERT_EQ(back.spec.faults.size(), s.faults.size());
+  EXPECT_EQ(back.spec.faults[0].at_s, s.faults[0].at_s);  // 17 digits: exact
+  EXPECT_EQ(back.spec.name, s.name);
+}

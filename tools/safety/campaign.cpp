@@ -1,0 +1,251 @@
+// The campaign: scene generation, one checked run, and the runs spread over threads.
+#include "campaign.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+#include <random>
+#include <sstream>
+#include <thread>
+
+#include "loom/firmware/machine.hpp"
+
+namespace loom::safety {
+namespace {
+
+std::uint64_t mix(std::uint64_t z) {  // splitmix64 finaliser: independent streams per run
+  z += 0x9E3779B97F4A7C15ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+using sim_hal::InjectedFault;
+
+void ensure_effect(sim_hal::SceneSpec& s, const char* effect) {
+  if (std::find(s.effects.begin(), s.effects.end(), effect) == s.effects.end()) s.effects.push_back(effect);
+}
+
+sim_hal::FaultInjection random_fault(std::mt19937_64& rng, sim_hal::SceneSpec& s, std::ostringstream& d) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  sim_hal::FaultInjection f;
+  f.kind = static_cast<InjectedFault>(static_cast<int>(u(rng) * sim_hal::kInjectedFaultCount));
+  f.at_s = 16.0 * u(rng);
+  f.axis = static_cast<hal::Axis>(static_cast<int>(u(rng) * 3));
+  f.piston = u(rng) < 0.5 ? 0 : 1;
+  f.sensor = static_cast<sim_hal::Sensor>(static_cast<int>(u(rng) * sim_hal::kSensorCount));
+  f.stuck_value = u(rng) < 0.5;
+  switch (f.kind) {
+    case InjectedFault::kIntermittentSensor: f.duration_s = 0.002 + 0.5 * u(rng); break;
+    case InjectedFault::kCanFrameLoss:
+      f.probability = u(rng) < 0.3 ? 1.0 : 0.05 + 0.95 * u(rng);
+      f.duration_s = 0.01 + u(rng);
+      break;
+    case InjectedFault::kCanLatency:
+      f.latency_s = 0.002 + 0.1 * u(rng);
+      f.duration_s = 0.05 + 2.0 * u(rng);
+      break;
+    case InjectedFault::kEmcy: f.code = static_cast<std::uint16_t>(0x1000 + static_cast<int>(u(rng) * 0xE000)); break;
+    case InjectedFault::kEncoderGlitch: {
+      const double scale = f.axis == hal::Axis::kCarriage ? 0.1 : 2.0;
+      f.jump = (u(rng) < 0.5 ? -1.0 : 1.0) * scale * (0.005 + u(rng));
+      f.ticks = 1 + static_cast<int>(u(rng) * 5);
+      break;
+    }
+    case InjectedFault::kLoadCellFailure:
+      ensure_effect(s, sim_hal::kEffectBeatContact);
+      if (!s.beat_contact) s.beat_contact = sim_hal::BeatContact{};
+      f.load_cell = u(rng) < 0.5 ? sim_hal::LoadCellMode::kNan : sim_hal::LoadCellMode::kLost;
+      break;
+    case InjectedFault::kLoopStall: f.ticks = 1 + static_cast<int>(u(rng) * 100); break;
+    case InjectedFault::kPowerCut: f.at_tick = static_cast<hal::Tick>(u(rng) * 8000.0); break;
+    default: break;
+  }
+  d << sim_hal::injected_fault_name(f.kind);
+  if (f.kind == InjectedFault::kPowerCut) {
+    d << " at tick " << f.at_tick;
+  } else {
+    d << " at " << f.at_s << " s";
+  }
+  d << "; ";
+  return f;
+}
+
+constexpr double kMotionEpsilon = 1e-6;  // m or rad per tick
+bool moved(double a, double b) { return std::abs(a - b) > kMotionEpsilon; }
+bool shed_open(const std::array<double, 2>& p) {
+  return (p[0] >= 1.0 && p[1] <= 0.0) || (p[0] <= 0.0 && p[1] >= 1.0);
+}
+
+}  // namespace
+
+sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run, std::string& description) {
+  std::mt19937_64 rng(mix(seed ^ mix(run)));
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  sim_hal::SceneSpec s;
+  s.name = "safety-" + std::to_string(seed) + "-" + std::to_string(run);
+  s.seed = rng() & 0x7FFFFFFFFFFFFFFFull;
+  s.effects = {sim_hal::kEffectIdeal};
+  std::ostringstream d;
+  if (u(rng) < 0.5) {
+    s.effects.push_back(sim_hal::kEffectServoLag);
+    s.servo_lag = sim_hal::ServoLag{0.001 + 0.007 * u(rng)};
+    d << "servo_lag(" << s.servo_lag->tau_s << ") ";
+  }
+  if (u(rng) < 0.5) {
+    s.effects.push_back(sim_hal::kEffectPneumatics);
+    s.pneumatics = sim_hal::Pneumatics{0.01 + 0.08 * u(rng), 0.1 + 0.5 * u(rng)};
+    d << "pneumatics ";
+  }
+  if (u(rng) < 0.3) {
+    s.effects.push_back(sim_hal::kEffectSensorNoise);
+    s.sensor_noise = sim_hal::SensorNoise{0.01 * u(rng)};
+    d << "noise(" << s.sensor_noise->flip_probability << ") ";
+  }
+  if (u(rng) < 0.25) {
+    s.effects.push_back(sim_hal::kEffectShuttleSlip);
+    s.shuttle_slip = sim_hal::ShuttleSlip{10.0 + 15.0 * u(rng), 0.4, 4.0};
+    d << "slip(" << s.shuttle_slip->carrier_force_n << " N) ";
+  }
+  if (u(rng) < 0.3) {
+    s.effects.push_back(sim_hal::kEffectBeatContact);
+    s.beat_contact = sim_hal::BeatContact{};
+    d << "beat_contact ";
+  }
+  if (u(rng) < 0.02) {
+    s.effects.push_back(sim_hal::kEffectInertia);
+    s.inertia = sim_hal::Inertia{};
+    d << "inertia ";
+  }
+  d << "| ";
+  const double pick = u(rng);
+  if (pick < 0.08) {
+    // Shuttle slip with a stuck arrival sensor: the combination that once let a frame close on the shuttle.
+    if (!s.shuttle_slip) {
+      s.effects.push_back(sim_hal::kEffectShuttleSlip);
+      s.shuttle_slip = sim_hal::ShuttleSlip{10.0 + 8.0 * u(rng), 0.4, 4.0};
+    }
+    sim_hal::FaultInjection f;
+    f.kind = InjectedFault::kStuckSensor;
+    f.at_s = 16.0 * u(rng);
+    f.sensor = u(rng) < 0.5 ? sim_hal::Sensor::kShuttleLeft : sim_hal::Sensor::kShuttleRight;
+    f.stuck_value = true;
+    s.faults.push_back(f);
+    d << "slip + stuck " << sim_hal::sensor_name(f.sensor) << " at " << f.at_s << " s";
+  } else if (pick < 0.16) {
+    // A stuck end sensor, early in the run where the shed changes are.
+    sim_hal::FaultInjection f;
+    f.kind = InjectedFault::kStuckSensor;
+    f.at_s = (u(rng) < 0.5 ? 2.0 : 16.0) * u(rng);
+    f.sensor = static_cast<sim_hal::Sensor>(static_cast<int>(u(rng) * 4));
+    f.stuck_value = u(rng) < 0.7;
+    s.faults.push_back(f);
+    d << "stuck " << sim_hal::sensor_name(f.sensor) << " = " << f.stuck_value << " at " << f.at_s << " s";
+  } else {
+    const double n = u(rng);
+    const int count = n < 0.15 ? 0 : n < 0.8 ? 1 : 2;
+    for (int i = 0; i < count; ++i) s.faults.push_back(random_fault(rng, s, d));
+    // One power cut per scene.
+    if (count == 2 && s.faults[0].kind == InjectedFault::kPowerCut && s.faults[1].kind == InjectedFault::kPowerCut) {
+      s.faults.pop_back();
+    }
+    if (count == 0) d << "no fault";
+  }
+  description = d.str();
+  return s;
+}
+
+namespace {
+void note_power_cut(void* flag) { *static_cast<bool*>(flag) = true; }
+}  // namespace
+
+RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& spec, std::uint32_t rows) {
+  firmware::Scene scene;
+  scene.spec = spec;
+  firmware::MachineOptions opt;
+  opt.telemetry = false;
+  opt.rows = rows;
+  firmware::Machine m(cfg, scene, opt, {});
+  bool cut = false;
+  m.sim().on_power_cut(note_power_cut, &cut);
+  m.sequencer().request_start();
+  const auto& sim = m.sim();
+  const double window = cfg.machine.selvedge_sensor_window_m;
+  RunOutcome o;
+  std::ostringstream why;
+  double carriage = sim.axis(hal::Axis::kCarriage).position, helix = sim.axis(hal::Axis::kHelix).position;
+  double crank = sim.axis(hal::Axis::kBeatCrank).position;
+  std::array<double, 2> pistons = sim.pistons();
+  hal::Tick fault_at = -1;
+  hal::Tick t = 0;
+  for (; t < 60000; ++t) {
+    if (m.sequencer().finished() && (fault_at < 0 || t > fault_at + 300)) break;
+    const bool warp_before = sim.beater_in_warp();
+    const bool shed_before = shed_open(pistons);
+    const double x = sim.shuttle_x();
+    const bool shuttle_in_shed = x > window && x < cfg.machine.width_m - window;
+    m.loop().cycle(t);
+    if (cut) {
+      o.power_cut = true;
+      break;
+    }
+    const double c2 = sim.axis(hal::Axis::kCarriage).position, h2 = sim.axis(hal::Axis::kHelix).position;
+    const double k2 = sim.axis(hal::Axis::kBeatCrank).position;
+    const auto p2 = sim.pistons();
+    if (moved(c2, carriage) && warp_before && sim.beater_in_warp()) {
+      why << "carriage moved " << (c2 - carriage) << " m while the beater was in the warp at tick " << t;
+    } else if (moved(h2, helix) && !(shed_before && shed_open(p2))) {
+      why << "pick motion (helix " << (h2 - helix) << " rad) without an open shed (frames " << p2[0] << ", " << p2[1]
+          << ") at tick " << t;
+    } else if ((moved(p2[0], pistons[0]) || moved(p2[1], pistons[1])) && shuttle_in_shed) {
+      why << "heald frame moved over the shuttle (x = " << x << " m) at tick " << t;
+    } else if (fault_at >= 0 && t > fault_at + 1 && (moved(c2, carriage) || moved(h2, helix) || moved(k2, crank))) {
+      why << "an axis moved after the fault (" << sequencer::fault_name(m.sequencer().first_fault()) << ") at tick " << t;
+    }
+    if (!why.str().empty()) {
+      o.violated = true;
+      o.what = why.str() + " (state " + sequencer::state_name(m.sequencer().state()) + ", first fault " +
+               sequencer::fault_name(m.sequencer().first_fault()) + ")";
+      break;
+    }
+    if (fault_at < 0 && m.sequencer().state() == sequencer::State::kFault) fault_at = t;
+    carriage = c2, helix = h2, crank = k2, pistons = p2;
+  }
+  o.faulted = m.sequencer().state() == sequencer::State::kFault;
+  o.completed = m.sequencer().state() == sequencer::State::kDone;
+  o.first_fault = sequencer::fault_name(m.sequencer().first_fault());
+  return o;
+}
+
+CampaignResult run_campaign(const CampaignOptions& opt) {
+  const firmware::LoomConfig cfg = firmware::default_loom_config();
+  std::atomic<std::uint64_t> next{0};
+  std::mutex mu;
+  CampaignResult result;
+  const auto worker = [&] {
+    const firmware::LoomConfig local = cfg;
+    for (;;) {
+      if (opt.stop != nullptr && opt.stop->load()) return;
+      const std::uint64_t run = next.fetch_add(1);
+      if (run >= opt.runs) return;
+      std::string description;
+      const sim_hal::SceneSpec scene = random_scene(opt.seed, run, description);
+      const RunOutcome o = run_one(local, scene, opt.rows);
+      const std::lock_guard<std::mutex> lock(mu);
+      ++result.runs;
+      result.faulted += o.faulted;
+      result.completed += o.completed;
+      result.power_cuts += o.power_cut;
+      if (o.violated) result.violations.push_back({run, description, o.what, firmware::scene_to_toml(scene)});
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int i = 1; i < std::max(1, opt.threads); ++i) threads.emplace_back(worker);
+  worker();
+  for (auto& th : threads) th.join();
+  std::sort(result.violations.begin(), result.violations.end(),
+            [](const Violation& a, const Violation& b) { return a.run < b.run; });
+  return result;
+}
+
+}  // namespace loom::safety

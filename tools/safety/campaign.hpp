@@ -1,0 +1,58 @@
+// The safety property campaign behind loom-safety: random scenes (effects, parameters, seeds) with
+// random faults — every kind a scene can inject, alone and in the combinations that have hurt before
+// (shuttle slip with a stuck arrival sensor, stuck end sensors) — each woven on the firmware's own
+// machine assembly while the simulated machine's TRUE state (not what the controller believes) is
+// checked every tick:
+//   - the carriage never moves while the beater is in the warp;
+//   - the helix shaft (a pick) never moves unless the shed is truly open (both frames at their ends);
+//   - no heald frame moves while the shuttle is in the shed;
+//   - once a fault is latched no axis moves any more.
+// "Moves" means more than 1 µm (or µrad) in a tick: a servo's settling tail is not motion that can
+// catch a warp thread. Each run is deterministic for (campaign seed, run index), whatever the threads.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "loom/firmware/config.hpp"
+
+namespace loom::safety {
+
+struct RunOutcome {
+  bool violated = false;
+  std::string what;     // the violation, with its tick
+  bool faulted = false;
+  bool completed = false;
+  bool power_cut = false;
+  std::string first_fault;
+};
+
+// The scene of run `run` of the campaign seeded `seed`, and a one-line description of it.
+sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run, std::string& description);
+
+// Weave `rows` rows of `scene` on `cfg` and check the true state every tick.
+RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& scene, std::uint32_t rows);
+
+struct Violation {
+  std::uint64_t run = 0;
+  std::string description, what, scene_toml;
+};
+
+struct CampaignOptions {
+  std::uint64_t runs = 2000;
+  std::uint64_t seed = 1;
+  int threads = 1;
+  std::uint32_t rows = 2;
+  const std::atomic<bool>* stop = nullptr;  // set asynchronously: finish the runs in progress and return
+};
+
+struct CampaignResult {
+  std::uint64_t runs = 0, faulted = 0, completed = 0, power_cuts = 0;
+  std::vector<Violation> violations;  // in run order
+};
+
+CampaignResult run_campaign(const CampaignOptions& opt);
+
+}  // namespace loom::safety
