@@ -29,6 +29,7 @@ using hal::index;
 constexpr std::uint16_t kHeartbeatCode = 0x8130;  // CiA 301 EMCY "life guard / heartbeat error"
 constexpr double kArrivalMarginM = 0.002;         // carrier position uncertainty at the arrival sensor
 constexpr double kStepPlausibility = 4.0;         // an axis may move at most this × its top speed per tick
+constexpr int kShedTestStrokes = 4;               // arming shed test: A up, B up, A up, B up
 
 void request_all(hal::HalOutputs& o, AxisRequest r) {
   for (auto& a : o.axes) a.request = r;
@@ -424,16 +425,18 @@ void Sequencer::positioning(hal::Tick now, const hal::HalInputs& in) noexcept {
 }
 
 void Sequencer::shed_test(hal::Tick now) noexcept {
-  // Three strokes — A up, then B up, then A up — move each frame both ways, so every end sensor is seen
-  // to switch off and on (a stuck one is found now, not under a pick) and every stroke time is learned.
+  // Four strokes — A up, B up, A up, B up — move each frame both ways twice: every end sensor is seen to
+  // switch off and on (a stuck one is found now, not under a pick), every stroke time is learned, and
+  // every learned time is checked by a later stroke (a sensor sticking on during the learning stroke
+  // never lets go on the next one), so the first pick's shed is judged against proven stroke times.
   const ShedVerdict v = shed_.update(profiles_->shed(), seconds_since(now, state_since_), ends_a(), ends_b());
   if (is_fault(v)) {
     latch(shed_fault(v), now);
     return;
   }
   if (v != ShedVerdict::kOpen) return;
-  if (++shed_test_step_ < 3) {
-    const bool a_up = shed_test_step_ != 1;
+  if (++shed_test_step_ < kShedTestStrokes) {
+    const bool a_up = shed_test_step_ % 2 == 0;
     start_stroke(a_up, !a_up);
     state_since_ = now;
     return;

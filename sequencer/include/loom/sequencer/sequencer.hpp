@@ -23,7 +23,7 @@ enum class State : std::uint8_t {
   kIdle,         // drives disabled, waiting for start
   kEnabling,     // walking the drives to Operation Enabled
   kPositioning,  // re-arm: crank to park, carriage to the row's start selvedge, from measured positions
-  kShedTest,     // proving the end sensors: each frame stroked both ways before the first pick
+  kShedTest,     // proving the end sensors: each frame stroked both ways twice before the first pick
   kShed,         // swapping the heald frames, waiting for a consistent end-sensor picture
   kPick,         // helix shaft carries the shuttle across, waiting for arrival
   kBeatSweep,    // crank beats while the carriage steps across the width
