@@ -484,8 +484,10 @@ void Sequencer::pick(hal::Tick now, const hal::HalInputs& in) noexcept {
     latch(Fault::kShuttleSensorEarly, now);
     return;
   }
-  if (arrived && raw_arrival_at_m_ >= 0.0 && raw_arrival_at_m_ < reach - tol) {
-    latch(Fault::kShuttleSlipped, now);  // seen only once the carrier was well past the switching point
+  // The arrival edge must come as the carrier crosses the switching point: well before it the shuttle
+  // cannot be there (unless it ran ahead, off its carrier); well after it, it did not come with it.
+  if (arrived && raw_arrival_at_m_ >= 0.0 && (raw_arrival_at_m_ < reach - tol || raw_arrival_at_m_ > reach + 0.25 * tol)) {
+    latch(Fault::kShuttleSlipped, now);
     return;
   }
   if (arrived && !helix_move_.active) {
