@@ -29,6 +29,7 @@ using hal::index;
 constexpr std::uint16_t kHeartbeatCode = 0x8130;  // CiA 301 EMCY "life guard / heartbeat error"
 constexpr double kArrivalMarginM = 0.002;         // carrier position uncertainty at the arrival sensor
 constexpr double kStepPlausibility = 4.0;         // an axis may move at most this × its top speed per tick
+constexpr int kShedTestStrokes = 4;               // arming shed test: A up, B up, A up, B up
 
 void request_all(hal::HalOutputs& o, AxisRequest r) {
   for (auto& a : o.axes) a.request = r;
@@ -90,6 +91,9 @@ std::string validate(const SequencerConfig& c, const motion::ProfileSet& p) {
   }
   if (!(c.selvedge_sensor_window_m > 0.0) || !fin(c.selvedge_sensor_window_m)) {
     return "machine selvedge sensor window must be positive and finite";
+  }
+  if (!(c.shuttle_follow_tolerance_m > 0.0) || !(c.shuttle_follow_tolerance_m < c.selvedge_sensor_window_m)) {
+    return "shuttle follow tolerance must be positive and below the selvedge sensor window";
   }
   return "";
 }
@@ -198,6 +202,7 @@ void Sequencer::sense(const hal::HalInputs& raw) noexcept {
   sensors_.update({r.piston_a_extended, r.piston_a_retracted, r.piston_b_extended, r.piston_b_retracted,
                    r.shuttle_at_left, r.shuttle_at_right});
   buttons_.update({r.button_start, r.button_pause, r.button_ack});
+  raw_io_ = r;
   io_ = r;
   io_.piston_a_extended = sensors_[0];
   io_.piston_a_retracted = sensors_[1];
@@ -414,26 +419,24 @@ void Sequencer::positioning(hal::Tick now, const hal::HalInputs& in) noexcept {
   }
   if (counters_.picks_in_row >= cfg_.picks_per_row) {
     begin_sweep(now);
-  } else if (!sensors_proven_) {
-    shed_test_step_ = 0;
-    start_stroke(true, false);
-    enter(State::kShedTest, now);
   } else {
     begin_shed(now);
   }
 }
 
 void Sequencer::shed_test(hal::Tick now) noexcept {
-  // Three strokes — A up, then B up, then A up — move each frame both ways, so every end sensor is seen
-  // to switch off and on (a stuck one is found now, not under a pick) and every stroke time is learned.
+  // Four strokes — A up, B up, A up, B up — move each frame both ways twice: every end sensor is seen to
+  // switch off and on (a stuck one is found now, not under a pick), every stroke time is learned, and
+  // every learned time is checked by a later stroke (a sensor sticking on during the learning stroke
+  // never lets go on the next one), so the first pick's shed is judged against proven stroke times.
   const ShedVerdict v = shed_.update(profiles_->shed(), seconds_since(now, state_since_), ends_a(), ends_b());
   if (is_fault(v)) {
     latch(shed_fault(v), now);
     return;
   }
   if (v != ShedVerdict::kOpen) return;
-  if (++shed_test_step_ < 3) {
-    const bool a_up = shed_test_step_ != 1;
+  if (++shed_test_step_ < kShedTestStrokes) {
+    const bool a_up = shed_test_step_ % 2 == 0;
     start_stroke(a_up, !a_up);
     state_since_ = now;
     return;
@@ -457,16 +460,34 @@ void Sequencer::shed(hal::Tick now) noexcept {
 
 void Sequencer::pick(hal::Tick now, const hal::HalInputs& in) noexcept {
   const bool arrived = pick_to_right_ ? io_.shuttle_at_right : io_.shuttle_at_left;
-  // Where the carrier really is: the arrival sensor can only see the shuttle once the carrier has
-  // brought it within the sensor's reach; it must see it soon after.
+  const bool raw_arrived = pick_to_right_ ? raw_io_.shuttle_at_right : raw_io_.shuttle_at_left;
+  const bool still_at_start = pick_to_right_ ? io_.shuttle_at_left : io_.shuttle_at_right;
+  // Where the carrier really is. The shuttle rides it: the start sensor must let go when the carrier
+  // leaves its reach, the arrival sensor see the shuttle when the carrier enters its reach — not before
+  // (a stuck or miswired sensor), not after (the shuttle slipped off and a sensor lies or sticks).
   const double lead = profiles_->spec().helix_lead_m;
-  const double carrier_from_goal_m =
-      std::abs(in.axes[index(Axis::kHelix)].position - pick_goal_rad_) * lead / motion::kTwoPi;
-  if (carrier_from_goal_m <= cfg_.selvedge_sensor_window_m && carrier_at_selvedge_ == hal::kNeverTick) {
-    carrier_at_selvedge_ = now;
+  const double helix = in.axes[index(Axis::kHelix)].position;
+  const double to_goal_m = std::abs(helix - pick_goal_rad_) * lead / motion::kTwoPi;
+  const double from_start_m = std::abs(helix - pick_start_rad_) * lead / motion::kTwoPi;
+  const double reach = cfg_.selvedge_sensor_window_m, tol = cfg_.shuttle_follow_tolerance_m;
+  if (!pick_resumed_) {
+    if (carrier_left_ == hal::kNeverTick && from_start_m > reach + tol) carrier_left_ = now;
+    if (carrier_left_ != hal::kNeverTick && still_at_start && now - carrier_left_ > cfg_.debounce_ticks + 1) {
+      latch(Fault::kShuttleSlipped, now);
+      return;
+    }
   }
-  if (arrived && carrier_from_goal_m > cfg_.selvedge_sensor_window_m + kArrivalMarginM) {
+  if (to_goal_m <= reach && carrier_at_selvedge_ == hal::kNeverTick) carrier_at_selvedge_ = now;
+  if (raw_arrived && raw_arrival_at_m_ < 0.0 && to_goal_m <= reach + kArrivalMarginM) raw_arrival_at_m_ = to_goal_m;
+  if (!raw_arrived && !arrived && to_goal_m > reach) raw_arrival_at_m_ = -1.0;  // a bounce before the carrier came
+  if (arrived && to_goal_m > reach + kArrivalMarginM) {
     latch(Fault::kShuttleSensorEarly, now);
+    return;
+  }
+  // The arrival edge must come as the carrier crosses the switching point: well before it the shuttle
+  // cannot be there (unless it ran ahead, off its carrier); well after it, it did not come with it.
+  if (arrived && raw_arrival_at_m_ >= 0.0 && (raw_arrival_at_m_ < reach - tol || raw_arrival_at_m_ > reach + 0.25 * tol)) {
+    latch(Fault::kShuttleSlipped, now);
     return;
   }
   if (arrived && !helix_move_.active) {
@@ -579,6 +600,12 @@ void Sequencer::begin_shed(hal::Tick now) noexcept {
   row_.begin(counters_.rows + 1, now);
   // The shed may only change with the shuttle out of it, at the side the counters expect.
   if (!shuttle_where_counters_say(now)) return;
+  if (!sensors_proven_) {  // the first shed change since arming: prove the end sensors first
+    shed_test_step_ = 0;
+    start_stroke(true, false);
+    enter(State::kShedTest, now);
+    return;
+  }
   // Alternate the shed every pick: even picks lift frame A, odd picks frame B.
   const bool a_up = counters_.picks % 2 == 0;
   start_stroke(a_up, !a_up);
@@ -606,6 +633,10 @@ void Sequencer::begin_pick(hal::Tick now, bool resumed) noexcept {
     helix_move_ = {true, now, from, pick_to_right_ ? profiles_->pick() : profiles_->pick_back()};
   }
   carrier_at_selvedge_ = hal::kNeverTick;
+  carrier_left_ = hal::kNeverTick;
+  raw_arrival_at_m_ = -1.0;
+  pick_start_rad_ = from;
+  pick_resumed_ = resumed;
   phase_start_ = now;
   enter(State::kPick, now);
 }

@@ -111,7 +111,7 @@ TEST_P(FaultScenes, EndInASafeStopWithTheExpectedFirstFault) {
 INSTANTIATE_TEST_SUITE_P(Shipped, FaultScenes,
                          ::testing::Values(FaultCase{"drive_fault", Fault::kDriveFault},
                                            FaultCase{"stuck_piston", Fault::kShedNotReleased},
-                                           FaultCase{"shuttle_slip", Fault::kShuttleNotArrived},
+                                           FaultCase{"shuttle_slip", Fault::kShuttleSlipped},
                                            FaultCase{"stuck_sensor", Fault::kShuttleLost},
                                            FaultCase{"estop", Fault::kEStop},
                                            FaultCase{"stuck_end_sensor", Fault::kShedNotReleased},

@@ -237,6 +237,7 @@ CampaignResult run_campaign(const CampaignOptions& opt) {
       result.completed += o.completed;
       result.power_cuts += o.power_cut;
       if (o.violated) result.violations.push_back({run, description, o.what, firmware::scene_to_toml(scene)});
+      if (opt.on_run) opt.on_run(result, o.violated ? &result.violations.back() : nullptr);
     }
   };
   std::vector<std::thread> threads;

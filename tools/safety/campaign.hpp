@@ -13,6 +13,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,8 @@ struct CampaignOptions {
   int threads = 1;
   std::uint32_t rows = 2;
   const std::atomic<bool>* stop = nullptr;  // set asynchronously: finish the runs in progress and return
+  // Called (serialised) after each run with the totals so far and the run's violation, if any.
+  std::function<void(const struct CampaignResult&, const struct Violation*)> on_run;
 };
 
 struct CampaignResult {

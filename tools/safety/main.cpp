@@ -45,17 +45,10 @@ int main(int argc, char** argv) {
   std::fflush(stdout);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
-  opt.stop = &g_stop;
   const auto t0 = std::chrono::steady_clock::now();
-  loom::safety::CampaignResult r;
-  try {
-    r = loom::safety::run_campaign(opt);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "loom-safety: %s\n", e.what());
-    return 2;
-  }
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  for (const auto& v : r.violations) {
+  opt.stop = &g_stop;
+  // Violations are reported (and their scenes written) as they are found; progress every 10 %.
+  const auto write_scene = [&](const loom::safety::Violation& v) {
     std::error_code ec;
     std::filesystem::create_directories(out, ec);
     const std::string file = out + "/violation-" + std::to_string(opt.seed) + "-" + std::to_string(v.run) + ".toml";
@@ -65,7 +58,26 @@ int main(int argc, char** argv) {
       << v.scene_toml;
     std::printf("VIOLATION run %llu (%s): %s\n  scene: %s%s\n", static_cast<unsigned long long>(v.run),
                 v.description.c_str(), v.what.c_str(), file.c_str(), f ? "" : " (could not be written)");
+    std::fflush(stdout);
+  };
+  const std::uint64_t tenth = std::max<std::uint64_t>(1, opt.runs / 10);
+  opt.on_run = [&](const loom::safety::CampaignResult& so_far, const loom::safety::Violation* v) {
+    if (v != nullptr) write_scene(*v);
+    if (so_far.runs % tenth == 0 && so_far.runs < opt.runs) {
+      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      std::fprintf(stderr, "loom-safety: %llu/%llu runs, %zu violations, %.0f s\n",
+                   static_cast<unsigned long long>(so_far.runs), static_cast<unsigned long long>(opt.runs),
+                   so_far.violations.size(), s);
+    }
+  };
+  loom::safety::CampaignResult r;
+  try {
+    r = loom::safety::run_campaign(opt);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "loom-safety: %s\n", e.what());
+    return 2;
   }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("runs %llu, violations %zu (%llu ended in a fault, %llu completed, %llu power cuts) in %.1f s, %.0f runs/s\n",
               static_cast<unsigned long long>(r.runs), r.violations.size(), static_cast<unsigned long long>(r.faulted),
               static_cast<unsigned long long>(r.completed), static_cast<unsigned long long>(r.power_cuts), wall,

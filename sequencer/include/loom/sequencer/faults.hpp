@@ -34,7 +34,8 @@ namespace loom::sequencer {
   X(kDriveEmcy, 0x1018, "drive_emcy", "a drive sent an error code (EMCY) while still enabled")                 \
   X(kLoadCellFault, 0x1019, "load_cell_fault", "the beater's load cell failed (lost, NaN or out of range)")     \
   X(kLoopStall, 0x101A, "loop_stall", "feedback from every device stopped at once (the loop or the bus stalled)") \
-  X(kStopRequested, 0x101B, "stop_requested", "stopped at once on the operator's request (counters kept)")
+  X(kStopRequested, 0x101B, "stop_requested", "stopped at once on the operator's request (counters kept)") \
+  X(kShuttleSlipped, 0x101C, "shuttle_slipped", "the shuttle did not leave or arrive with its carrier (slipped off the magnet)")
 
 enum class Fault : std::uint8_t {
 #define LOOM_FAULT_ENUM(id, code, name, text) id,

@@ -23,7 +23,7 @@ enum class State : std::uint8_t {
   kIdle,         // drives disabled, waiting for start
   kEnabling,     // walking the drives to Operation Enabled
   kPositioning,  // re-arm: crank to park, carriage to the row's start selvedge, from measured positions
-  kShedTest,     // proving the end sensors: each frame stroked both ways before the first pick
+  kShedTest,     // proving the end sensors: each frame stroked both ways twice before the first pick
   kShed,         // swapping the heald frames, waiting for a consistent end-sensor picture
   kPick,         // helix shaft carries the shuttle across, waiting for arrival
   kBeatSweep,    // crank beats while the carriage steps across the width
@@ -73,6 +73,10 @@ struct SequencerConfig {
   // not seen within arrival_grace_s (plus the debounce) of the carrier entering it is a lost shuttle.
   double selvedge_sensor_window_m = 0.005;
   double arrival_grace_s = 0.02;
+  // The shuttle moves with its carrier: its start sensor must go off, and its arrival sensor come on, when
+  // the carrier passes the sensor's switching point, within this distance (the sensors' switching-point
+  // spread). A shuttle that lags its carrier by more has slipped off the magnet.
+  double shuttle_follow_tolerance_m = 0.002;
   double beat_force_min_n = 80.0;         // the band every beat must hit (thesis: 80–100 N)
   double beat_force_max_n = 100.0;
   double load_cell_max_n = 5000.0;        // a load-cell reading beyond this is a failed cell, not a beat
@@ -218,6 +222,10 @@ class Sequencer {
   bool pick_to_right_ = true;
   double pick_goal_rad_ = 0.0;
   hal::Tick carrier_at_selvedge_ = hal::kNeverTick;
+  double pick_start_rad_ = 0.0;
+  bool pick_resumed_ = false;
+  hal::Tick carrier_left_ = hal::kNeverTick;   // tick the carrier left the start sensor's reach
+  double raw_arrival_at_m_ = -1.0;             // carrier distance from the goal when the raw sensor came on
 
   // Shedding: the monitor of the change in progress; the arming test strokes (sensors proven).
   ShedMonitor shed_;
@@ -229,6 +237,7 @@ class Sequencer {
   Debouncer<3> buttons_;
   RisingEdge start_edge_, pause_edge_, ack_edge_;
   hal::DigitalInputs io_{};
+  hal::DigitalInputs raw_io_{};
   int sensed_ticks_ = 0;                       // picture checks wait until the debouncer has history
   std::array<double, hal::kAxisCount> last_position_{};
   bool positions_primed_ = false;

@@ -1,0 +1,172 @@
+// Feedback the sequencer must not believe (NaN, EMCY on an enabled drive, a vanished load cell), the
+// operator's requests (stop now, acknowledge, buttons) and the stack light, on the simulated loom.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+
+#include "loom/hal/hal.hpp"
+#include "loom/sequencer/sequencer.hpp"
+#include "loom/sim_hal/sim_world.hpp"
+
+using namespace loom;
+using sequencer::Fault;
+using sequencer::State;
+
+namespace {
+struct Rig {
+  motion::ProfileSet profiles{motion::ProfileSpec{}};
+  sequencer::SequencerConfig cfg{};
+  sim_hal::SceneSpec scene{};
+  std::unique_ptr<sim_hal::SimWorld> world;
+  std::unique_ptr<sequencer::Sequencer> seq;
+  hal::HalInputs in{};
+  hal::HalOutputs out{};
+  hal::Tick now = 0;
+  std::function<void(hal::Tick, hal::HalInputs&)> tamper = [](hal::Tick, hal::HalInputs&) {};
+
+  void build(std::uint32_t rows, bool start = true) {
+    cfg.rows_to_weave = rows;
+    world = std::make_unique<sim_hal::SimWorld>(sim_hal::SimMachine{}, scene);
+    seq = std::make_unique<sequencer::Sequencer>(profiles, cfg);
+    if (start) seq->request_start();
+  }
+  // Runs `ticks` ticks or until `until` says stop.
+  void run(hal::Tick ticks, const std::function<bool()>& until = [] { return false; }) {
+    hal::PortHal hal(*world, *world);
+    for (const hal::Tick end = now + ticks; now < end; ++now) {
+      hal.read(now, in);
+      tamper(now, in);
+      seq->step(now, in, out);
+      hal.write(now, out);
+      if (until()) {
+        ++now;
+        return;
+      }
+    }
+  }
+};
+}  // namespace
+
+TEST(SequencerFaults, NonFiniteAxisFeedbackIsAFaultOnThatAxis) {
+  Rig r;
+  r.tamper = [](hal::Tick t, hal::HalInputs& in) {
+    if (t >= 3000) in.axes[hal::index(hal::Axis::kCarriage)].velocity = std::numeric_limits<double>::quiet_NaN();
+  };
+  r.build(3);
+  r.run(5000);
+  EXPECT_EQ(r.seq->first_fault(), Fault::kNonFiniteFeedback);
+  EXPECT_EQ(r.seq->fault_axis(), static_cast<int>(hal::Axis::kCarriage));
+  EXPECT_EQ(r.seq->fault_tick(), 3000);
+}
+
+TEST(SequencerFaults, EmcyFromAnEnabledDriveStopsInTheSameTick) {
+  Rig r;
+  r.tamper = [](hal::Tick t, hal::HalInputs& in) {
+    if (t >= 3000) in.axes[hal::index(hal::Axis::kHelix)].fault_code = 0x2310;
+  };
+  r.build(3);
+  r.run(5000);
+  EXPECT_EQ(r.seq->first_fault(), Fault::kDriveEmcy);
+  EXPECT_EQ(r.seq->fault_detail(), 0x2310);
+  EXPECT_EQ(r.seq->fault_tick(), 3000);
+  for (const auto& a : r.out.axes) EXPECT_EQ(a.request, hal::AxisRequest::kQuickStop);
+}
+
+TEST(SequencerFaults, ALoadCellThatVanishesOrReadsNaNIsAFault) {
+  for (const bool nan : {false, true}) {
+    Rig r;
+    r.scene.effects = {"ideal", "beat_contact"};
+    r.tamper = [nan](hal::Tick t, hal::HalInputs& in) {
+      if (t < 3000) return;
+      if (nan) {
+        in.analog.beat_force_n = std::numeric_limits<double>::quiet_NaN();
+      } else {
+        in.analog.beat_force_valid = false;
+      }
+    };
+    r.build(3);
+    r.run(5000);
+    EXPECT_EQ(r.seq->first_fault(), Fault::kLoadCellFault) << "nan " << nan;
+  }
+}
+
+TEST(SequencerFaults, StopNowStopsAtOnceKeepsTheCountersAndAcknowledgeRearms) {
+  Rig r;
+  r.build(3);
+  r.run(1000);  // mid first row
+  const sequencer::Counters before = r.seq->counters();
+  r.seq->request_stop_now();
+  r.run(1);
+  EXPECT_EQ(r.seq->state(), State::kFault);
+  EXPECT_EQ(r.seq->first_fault(), Fault::kStopRequested);
+  EXPECT_EQ(r.seq->counters().picks, before.picks);
+  EXPECT_TRUE(r.out.io.lamp_red);
+  EXPECT_FALSE(r.out.io.lamp_green);
+  r.run(100);
+  EXPECT_EQ(r.seq->state(), State::kFault);  // latched until acknowledged
+  r.seq->request_acknowledge();
+  r.run(1);
+  EXPECT_EQ(r.seq->state(), State::kIdle);
+  EXPECT_EQ(r.seq->first_fault(), Fault::kNone);
+  for (const auto& a : r.out.axes) EXPECT_EQ(a.request, hal::AxisRequest::kFaultReset);
+  EXPECT_TRUE(r.out.io.lamp_amber);
+  r.seq->request_start();
+  r.run(200000, [&] { return r.seq->finished(); });
+  EXPECT_EQ(r.seq->state(), State::kDone) << sequencer::fault_name(r.seq->first_fault());
+  EXPECT_EQ(r.seq->counters().rows, 3u);
+  EXPECT_EQ(r.seq->counters().picks, 3u);  // the pick cut by the stop was finished, not repeated
+}
+
+TEST(SequencerFaults, ButtonsAreDebouncedEdgesAndAButtonHeldAtPowerOnIsNoPress) {
+  Rig r;
+  bool start = true, pause = false;
+  r.tamper = [&](hal::Tick, hal::HalInputs& in) {
+    in.io.button_start = start;
+    in.io.button_pause = pause;
+  };
+  r.build(2, /*start=*/false);
+  r.run(50);
+  EXPECT_EQ(r.seq->state(), State::kIdle);  // held since power-on: not a press
+  EXPECT_TRUE(r.out.io.lamp_amber);
+  start = false;
+  r.run(10);
+  start = true;
+  r.run(2);  // shorter than the debounce: contact bounce, not a press
+  start = false;
+  r.run(10);
+  EXPECT_EQ(r.seq->state(), State::kIdle);
+  start = true;
+  r.run(10);
+  start = false;
+  EXPECT_NE(r.seq->state(), State::kIdle);
+  r.run(100);
+  EXPECT_TRUE(r.out.io.lamp_green);
+  pause = true;
+  r.run(10);
+  pause = false;
+  r.run(200000, [&] { return r.seq->state() == State::kPaused; });
+  EXPECT_EQ(r.seq->state(), State::kPaused);
+  EXPECT_TRUE(r.out.io.lamp_amber);
+  start = true;  // start also resumes
+  r.run(10);
+  start = false;
+  r.run(200000, [&] { return r.seq->finished(); });
+  EXPECT_EQ(r.seq->state(), State::kDone) << sequencer::fault_name(r.seq->first_fault());
+  EXPECT_EQ(r.seq->counters().rows, 2u);
+}
+
+TEST(SequencerFaults, BeatsPerRowBeyondCapacityAreRefusedAtConfiguration) {
+  motion::ProfileSpec wide;
+  wide.width_m = 3.0;
+  wide.beats_per_position = 8;
+  const motion::ProfileSet p(wide);
+  ASSERT_GT(p.beats_per_row(), sequencer::kMaxBeatsPerRow);
+  const std::string why = sequencer::validate(sequencer::SequencerConfig{}, p);
+  EXPECT_NE(why.find("recipe.beats_per_position"), std::string::npos) << why;
+  EXPECT_THROW(sequencer::Sequencer(p, sequencer::SequencerConfig{}), std::invalid_argument);
+  sequencer::SequencerConfig nan_park;
+  nan_park.crank_park_position_rad = std::nan("");
+  EXPECT_NE(sequencer::validate(nan_park, motion::ProfileSet(motion::ProfileSpec{})), "");
+}
