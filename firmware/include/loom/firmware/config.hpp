@@ -2,10 +2,12 @@
 // starts. Any bad value is one ConfigError whose message names file, line, column, field and value.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
 
+#include "loom/drivers/can_io_port.hpp"
 #include "loom/motion/profile_set.hpp"
 #include "loom/sequencer/sequencer.hpp"
 #include "loom/sim_hal/scene.hpp"
@@ -26,6 +28,31 @@ struct CanSettings {
   std::uint16_t heartbeat_ms = 100;
   std::uint16_t heartbeat_timeout_ms = 250;
   std::uint16_t sdo_timeout_ms = 500;
+  // The master's own heartbeat (0x700 + master_node) and the consumer time written to every node's
+  // 0x1016 (drives and I/O module, where present). master_node = 0: neither.
+  std::uint8_t master_node = 0x7F;
+  std::uint16_t master_heartbeat_ms = 50;
+  std::uint16_t master_consumer_ms = 150;
+  // Per-drive bring-up windows, indexed beat_crank, carriage, helix; 0 = boot 2000 ms / operational
+  // = heartbeat_timeout_ms. Commercial drives may need hundreds of ms for either.
+  std::array<std::uint32_t, 3> boot_timeout_ms{0, 0, 0};
+  std::array<std::uint32_t, 3> operational_timeout_ms{0, 0, 0};
+  // Following-error supervision per axis (LinuxCNC rule): fault when |commanded − actual| >
+  // max(ferror_min, ferror_k_s · |commanded velocity|). Units: rad (crank, helix) or m (carriage); s.
+  // ferror_min = 0 disables it for that axis.
+  std::array<double, 3> ferror_min{0.2, 0.002, 0.5};
+  std::array<double, 3> ferror_k_s{0.05, 0.05, 0.05};
+};
+
+// Where the valves, sensors, e-stop chain, buttons and load cell come from on the CAN HAL.
+enum class IoKind { kCan, kSimulated };
+
+struct IoSettings {
+  IoKind kind = IoKind::kCan;  // simulated I/O beside real drives needs --io simulated as well
+  std::uint8_t node = 4;
+  std::uint32_t boot_timeout_ms = 2000;
+  std::uint32_t operational_timeout_ms = 500;
+  drivers::IoWiring wiring;  // bit per signal, polarity, load-cell channel and scaling
 };
 
 struct TelemetrySettings {
@@ -41,6 +68,7 @@ struct LoomConfig {
   sequencer::SequencerConfig sequencer;
   sim_hal::SimMachine machine;
   CanSettings can;
+  IoSettings io;
   TelemetrySettings telemetry;
 };
 
