@@ -113,8 +113,8 @@ Status validate(const CanAxisPortConfig& c) {
                          " must be 1..240 (synchronous transmission type)");
   }
   if (c.bitrate_bps == 0) return Status::error("bitrate_bps = 0 must be > 0");
-  if (!(c.operational_timeout_s >= 0.0)) {
-    return Status::error(fmt("operational_timeout_s = %g s must be ≥ 0", c.operational_timeout_s));
+  if (!(c.operational_timeout_s > 0.0)) {
+    return Status::error(fmt("operational_timeout_s = %g s must be > 0", c.operational_timeout_s));
   }
   if (c.master_node_id > kMaxNodeId) {
     return Status::error("master_node_id = " + std::to_string(c.master_node_id) + " is outside 0..127");
@@ -425,7 +425,7 @@ Status CanAxisPort::configure(CanBus& bus, ConfigureClock& clock) {
   for (std::size_t i = 0; i < axes_.size(); ++i) {
     const CanAxisConfig& a = config_.axes[i];
     boot_window[i] = a.boot_timeout_s > 0.0 ? a.boot_timeout_s : config_.boot_timeout_s;
-    const double op = config_.operational_timeout_s > 0.0 ? config_.operational_timeout_s : config_.heartbeat_consumer_s;
+    const double op = config_.operational_timeout_s;
     op_window[i] = a.operational_timeout_s > 0.0 ? a.operational_timeout_s : op;
   }
 

@@ -567,8 +567,10 @@ void CanIoPort::read_io(hal::Tick /*now*/, const hal::AxisFeedbacks& /*axes*/, h
   io.piston_b_retracted = input(w.piston_b_retracted);
   io.shuttle_at_left = input(w.shuttle_at_left);
   io.shuttle_at_right = input(w.shuttle_at_right);
-  // Until the first TPDO the chain reads open: nothing moves on inputs never seen.
-  io.estop_ok = inputs_refreshed_ != hal::kNeverTick && input(w.estop_ok);
+  // Before the first TPDO there is no news, not an opened chain: `refreshed` stays kNeverTick, which the
+  // sequencer counts as old from arming (stale → fault), and every sensor reads false, so nothing can
+  // be confirmed (no shed, no pick) on inputs never seen.
+  io.estop_ok = inputs_refreshed_ == hal::kNeverTick || input(w.estop_ok);
   io.button_start = input(w.button_start);
   io.button_pause = input(w.button_pause);
   io.button_ack = input(w.button_ack);

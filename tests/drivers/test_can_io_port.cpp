@@ -120,6 +120,12 @@ TEST(CanIoPort, BringsUpTheModuleAndExchangesEverySignal) {
   const drivers::Status s = r.configure();
   ASSERT_TRUE(s) << s.message();
   EXPECT_TRUE(r.port.notes().empty()) << r.port.notes().front();
+  // Before the first TPDO: no news (never refreshed), not an opened e-stop chain, no sensor confirmed.
+  hal::DigitalInputs before;
+  r.port.read_io(0, {}, before);
+  EXPECT_EQ(before.refreshed, hal::kNeverTick);
+  EXPECT_TRUE(before.estop_ok);
+  EXPECT_FALSE(before.piston_a_retracted || before.shuttle_at_left);
   r.enable_all();
   ASSERT_TRUE(r.in.io.estop_ok);
   EXPECT_TRUE(r.in.io.piston_a_retracted);
@@ -248,6 +254,7 @@ std::vector<sim_can::SimDriveConfig> fixed_drives(std::int64_t boot_us, std::int
 TEST(Interop, FixedPersonalityDriveIsAcceptedWithNotes) {
   drivers::CanAxisPortConfig ac;
   ac.tpdo2 = true;  // its fixed TPDO2 carries velocity + torque: used
+  ac.operational_timeout_s = 0.25;  // the per-node windows below are what let the slow drives in
   ac.axes[0].operational_timeout_s = 0.6;
   ac.axes[1].operational_timeout_s = 0.6;
   ac.axes[2].operational_timeout_s = 0.6;
@@ -265,7 +272,9 @@ TEST(Interop, FixedPersonalityDriveIsAcceptedWithNotes) {
 
 // Rule 4: per-node operational windows — the same slow drive fails the default window, naming it.
 TEST(Interop, SlowOperationalSwitchNeedsItsPerNodeWindow) {
-  IoRig r({}, fixed_drives(0, 400'000));
+  drivers::CanAxisPortConfig ac;
+  ac.operational_timeout_s = 0.25;  // port-wide window shorter than the drive needs
+  IoRig r({}, fixed_drives(0, 400'000), ac);
   const drivers::Status s = r.configure();
   ASSERT_FALSE(s);
   EXPECT_TRUE(contains(s.message(), "node 1 (beat_crank): no operational heartbeat after NMT start within 0.25 s"))

@@ -177,16 +177,15 @@ hil_find_binaries() {
 
 # Start the simulated drives and the simulated I/O node and wait until each has announced itself.
 # Sets HIL_SIM_PID; the I/O node's e-stop/buttons/silence follow the words in HIL_IO_CONTROL.
-# The fixed personality switches to operational after 200 ms (inside loomctl's default window).
+# The fixed personality boots after 300 ms and switches to operational after 400 ms (loomctl's
+# default operational window is 1 s).
 hil_start_sim_drives() {
   local mark n
   mark=$(hil_mark)
   HIL_IO_CONTROL=$HIL_WORK/io-control
   : >"$HIL_IO_CONTROL"
-  local extra=()
-  [[ $HIL_PERSONALITY == fixed ]] && extra=(--operational-delay-ms 200)
   hil_spawn sim "$HIL_SIM" --iface "$HIL_IFACE" --nodes "$HIL_NODES" --io-node "$HIL_IO_NODE" \
-    --io-control "$HIL_IO_CONTROL" --width-m 0.6 --personality "$HIL_PERSONALITY" "${extra[@]}"
+    --io-control "$HIL_IO_CONTROL" --width-m 0.6 --personality "$HIL_PERSONALITY"
   HIL_SIM_PID=$HIL_LAST_PID
   for n in ${HIL_NODES//,/ } $HIL_IO_NODE; do
     hil_expect "$mark" "$(printf '%03X' $((0x700 + n)))#00" 10 "boot-up of simulated node $n" >/dev/null

@@ -58,7 +58,9 @@ struct CanAxisPortConfig {
   double sdo_timeout_s = 0.100;
   double boot_timeout_s = 2.0;          // wait for every boot-up after NMT reset-node
   double state_timeout_s = 0.5;         // CiA 402 transition not confirmed → fault
-  double operational_timeout_s = 0.0;   // operational heartbeat after NMT start; 0 = heartbeat_consumer_s
+  // Operational heartbeat after NMT start (many commercial drives take hundreds of ms); per-node
+  // CanAxisConfig::operational_timeout_s overrides it.
+  double operational_timeout_s = 1.0;
   // The master's own heartbeat (0x700 + id, state operational) every master_heartbeat_s, and each drive's
   // consumer 0x1016:01 set to watch it for master_consumer_s where the drive has 0x1016, so a drive stops
   // when the host dies. master_node_id = 0: no master heartbeat, no consumer configured.
