@@ -96,7 +96,7 @@ TEST(CanAxisPort, OnlyTheMappedPdosFlowAtFourFramesOutPerTick) {
     }
   }
   EXPECT_EQ(from_master, 20 * 4);  // SYNC + 3 RPDO
-  EXPECT_EQ(master_heartbeats, 1);  // every 50 ms = 25 ticks
+  EXPECT_EQ(master_heartbeats, 1);  // every 100 ms = 50 ticks
   EXPECT_EQ(tpdo1, 20 * 3);
   EXPECT_EQ(other_pdo, 0);
 }

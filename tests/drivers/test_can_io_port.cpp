@@ -360,7 +360,7 @@ TEST(FaultReaction, MasterSilenceTripsTheNodesConsumers) {
   EXPECT_EQ(r.io.outputs(0) & 0x03, 0x02);
   EXPECT_TRUE(r.rig.port.has_consumer(hal::Axis::kBeatCrank));
   // The host dies: no more ticks, time goes on.
-  r.rig.advance(100'000);
+  r.rig.advance(400'000);
   EXPECT_FALSE(r.io.comm_lost());
   r.rig.advance(300'000);
   EXPECT_TRUE(r.io.comm_lost());

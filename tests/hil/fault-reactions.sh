@@ -87,7 +87,7 @@ HIL_PIDS=("${HIL_PIDS[@]/$loom_pid}")
 hil_stop_candump
 nodes=$HIL_NODES,$HIL_IO_NODE
 [[ $HIL_PERSONALITY == fixed ]] && nodes=$HIL_IO_NODE  # the fixed personality has no 0x1016
-"$HIL_CANLOG" master-loss "$HIL_LOG" --nodes "$nodes" --master 127 --consumer-ms 150 --slack-ms 1000 ||
+"$HIL_CANLOG" master-loss "$HIL_LOG" --nodes "$nodes" --master 127 --consumer-ms 500 --slack-ms 1000 ||
   hil_fail "master: the nodes' heartbeat consumers did not react; log: $HIL_LOG"
 kill -0 "$HIL_SIM_PID" 2>/dev/null || hil_fail "loom-sim-drive died: $(tail -n 5 "$HIL_WORK/sim.out")"
 hil_report_frames

@@ -65,8 +65,10 @@ struct CanAxisPortConfig {
   // consumer 0x1016:01 set to watch it for master_consumer_s where the drive has 0x1016, so a drive stops
   // when the host dies. master_node_id = 0: no master heartbeat, no consumer configured.
   std::uint8_t master_node_id = 0x7F;
-  double master_heartbeat_s = 0.050;
-  double master_consumer_s = 0.150;
+  // A CSP drive that stops receiving targets holds its last one at once; the consumer adds the power
+  // stage's own reaction (quick stop) and must not trip on a loaded host's scheduling stalls.
+  double master_heartbeat_s = 0.100;
+  double master_consumer_s = 0.500;
   bool tpdo2 = false;                   // velocity + torque PDO (adds 3 frames per cycle)
   std::uint8_t tpdo2_every_n_sync = 1;  // 1..240
   std::uint32_t bitrate_bps = 1'000'000;

@@ -100,7 +100,7 @@ struct CanIoConfig {
   // The module watches the master's heartbeat through 0x1016 (when it has one), so its valves go to
   // their safe state (0x6206/0x6207) when the host dies. 0 = do not configure a consumer.
   std::uint8_t master_node_id = 0x7F;
-  double master_consumer_s = 0.300;
+  double master_consumer_s = 0.500;
 };
 
 // Configure-time only.

@@ -31,8 +31,8 @@ struct CanSettings {
   // The master's own heartbeat (0x700 + master_node) and the consumer time written to every node's
   // 0x1016 (drives and I/O module, where present). master_node = 0: neither.
   std::uint8_t master_node = 0x7F;
-  std::uint16_t master_heartbeat_ms = 50;
-  std::uint16_t master_consumer_ms = 150;
+  std::uint16_t master_heartbeat_ms = 100;
+  std::uint16_t master_consumer_ms = 500;
   // Per-drive bring-up windows, indexed beat_crank, carriage, helix; 0 = boot 2000 ms / operational
   // = heartbeat_timeout_ms. Commercial drives may need hundreds of ms for either.
   std::array<std::uint32_t, 3> boot_timeout_ms{0, 0, 0};
