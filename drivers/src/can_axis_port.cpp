@@ -3,6 +3,7 @@
 // reported through hal::AxisFeedback / hal::LinkStatus, never thrown or logged.
 #include "loom/drivers/can_axis_port.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -11,6 +12,7 @@
 #include "loom/drivers/emcy.hpp"
 #include "loom/drivers/nmt.hpp"
 #include "loom/drivers/pdo.hpp"
+#include "loom/drivers/sdo.hpp"
 #include "loom/drivers/sdo_client.hpp"
 
 namespace loom::drivers {
@@ -25,6 +27,8 @@ std::string fmt(const char* format, double a, double b = 0.0, double c = 0.0) {
   std::snprintf(buf, sizeof(buf), format, a, b, c);
   return buf;
 }
+
+constexpr std::uint16_t kConsumerHeartbeat = 0x1016;
 
 std::uint32_t ceil_ticks(double seconds, double period_s) {
   return static_cast<std::uint32_t>(std::ceil(seconds / period_s - 1e-9));
@@ -58,6 +62,19 @@ Status validate(const CanAxisPortConfig& c) {
     }
     if (!(a.rated_effort >= 0.0) || !std::isfinite(a.rated_effort)) {
       return Status::error(field + fmt(".rated_effort = %g must be ≥ 0", a.rated_effort));
+    }
+    if (!(a.ferror_min >= 0.0) || !std::isfinite(a.ferror_min)) {
+      return Status::error(field + fmt(".ferror_min = %g must be ≥ 0 (0 = off)", a.ferror_min));
+    }
+    if (!(a.ferror_k_s >= 0.0) || !std::isfinite(a.ferror_k_s)) {
+      return Status::error(field + fmt(".ferror_k_s = %g s must be ≥ 0", a.ferror_k_s));
+    }
+    if (!(a.boot_timeout_s >= 0.0) || !(a.operational_timeout_s >= 0.0)) {
+      return Status::error(field + fmt(".boot_timeout_s = %g s / .operational_timeout_s = %g s must be ≥ 0",
+                                       a.boot_timeout_s, a.operational_timeout_s));
+    }
+    if (c.master_node_id == a.node_id) {
+      return Status::error(field + ".node_id = " + std::to_string(a.node_id) + " is the master's own node id");
     }
   }
   if (!(c.cycle_period_s > 0.0) || !encode_interpolation_period(c.cycle_period_s)) {
@@ -96,6 +113,20 @@ Status validate(const CanAxisPortConfig& c) {
                          " must be 1..240 (synchronous transmission type)");
   }
   if (c.bitrate_bps == 0) return Status::error("bitrate_bps = 0 must be > 0");
+  if (!(c.operational_timeout_s > 0.0)) {
+    return Status::error(fmt("operational_timeout_s = %g s must be > 0", c.operational_timeout_s));
+  }
+  if (c.master_node_id > kMaxNodeId) {
+    return Status::error("master_node_id = " + std::to_string(c.master_node_id) + " is outside 0..127");
+  }
+  if (c.master_node_id != 0) {
+    if (!(c.master_heartbeat_s >= c.cycle_period_s) || !(c.master_consumer_s > c.master_heartbeat_s) ||
+        !is_whole_ms(c.master_consumer_s) || c.master_consumer_s > 65.535) {
+      return Status::error(fmt("master_heartbeat_s = %g s / master_consumer_s = %g s: the heartbeat must be at "
+                               "least one cycle, the consumer time longer and a whole number of ms",
+                               c.master_heartbeat_s, c.master_consumer_s));
+    }
+  }
   if (!(c.bus_load_budget > 0.0 && c.bus_load_budget <= 1.0)) {
     return Status::error(fmt("bus_load_budget = %g must be in (0, 1]", c.bus_load_budget));
   }
@@ -112,15 +143,24 @@ CanAxisPort::CanAxisPort(CanAxisPortConfig config) : config_(std::move(config)) 
   reset_runtime();
 }
 
+void CanAxisPort::attach(CanNodeListener& node) {
+  if (n_listeners_ < listeners_.size()) listeners_[n_listeners_++] = &node;
+}
+
 void CanAxisPort::reset_runtime() {
   configured_ = false;
   bus_off_ = false;
+  foreign_emcy_code_ = 0;
+  next_master_hb_ = 0;
+  notes_.clear();
   axis_of_node_.fill(-1);
   for (std::size_t i = 0; i < axes_.size(); ++i) {
     axes_[i] = AxisRuntime{};
     axes_[i].node = config_.axes[i].node_id;
     axes_[i].counts_per_unit = config_.axes[i].counts_per_unit;
     axes_[i].rated_effort = config_.axes[i].rated_effort;
+    axes_[i].ferror_min = config_.axes[i].ferror_min;
+    axes_[i].ferror_k_s = config_.axes[i].ferror_k_s;
     if (axes_[i].node <= kMaxNodeId) axis_of_node_[axes_[i].node] = static_cast<std::int8_t>(i);
   }
 }
@@ -173,40 +213,20 @@ Status CanAxisPort::configure_node(std::size_t axis, SdoClient& sdo) {
     return fail(s);
   }
 
-  // PDO mapping (CiA 301 re-map procedure): invalidate, clear count, write entries, set count, set
-  // transmission type, validate. A disabled PDO only gets its invalid bit.
-  struct PdoPlan {
-    std::uint16_t comm;
-    std::uint16_t map;
-    std::uint32_t cob_id;
-    const PdoMapEntry* entries;
-    std::uint8_t n_entries;
-    std::uint8_t transmission_type;
-  };
-  const PdoPlan plans[] = {
-      {od::kRpdoComm, od::kRpdoMap, cob::rpdo(1, node), kRpdo1Mapping.data(), 2, 1},
-      {od::kTpdoComm, od::kTpdoMap, cob::tpdo(1, node), kTpdo1Mapping.data(), 2, 1},
-      {static_cast<std::uint16_t>(od::kTpdoComm + 1), static_cast<std::uint16_t>(od::kTpdoMap + 1),
-       cob::tpdo(2, node), config_.tpdo2 ? kTpdo2Mapping.data() : nullptr,
-       static_cast<std::uint8_t>(config_.tpdo2 ? 2 : 0), config_.tpdo2_every_n_sync},
-      {static_cast<std::uint16_t>(od::kTpdoComm + 2), 0, cob::tpdo(3, node), nullptr, 0, 0},
-      {static_cast<std::uint16_t>(od::kTpdoComm + 3), 0, cob::tpdo(4, node), nullptr, 0, 0},
-  };
-  for (const PdoPlan& p : plans) {
-    if (Status s = sdo.write(node, p.comm, 1, p.cob_id | od::kPdoInvalidBit, 4); !s) return fail(s);
-    if (p.entries == nullptr) continue;
-    if (Status s = sdo.write(node, p.map, 0, 0, 1); !s) return fail(s);
-    for (std::uint8_t k = 0; k < p.n_entries; ++k) {
-      if (Status s =
-              sdo.write(node, p.map, static_cast<std::uint8_t>(k + 1), encode_map_entry(p.entries[k]), 4);
-          !s) {
-        return fail(s);
-      }
+  // The master's heartbeat watched by the drive (optional object: used when present, noted when absent).
+  if (config_.master_node_id != 0) {
+    const std::uint32_t v = (static_cast<std::uint32_t>(config_.master_node_id) << 16) |
+                            static_cast<std::uint32_t>(std::lround(config_.master_consumer_s * 1e3));
+    if (Status s = sdo.write(node, kConsumerHeartbeat, 1, v, 4); !s) {
+      if (sdo.last_abort() != sdo_abort::kNoObject && sdo.last_abort() != sdo_abort::kNoSubIndex) return fail(s);
+      notes_.push_back(who + "0x1016 (consumer heartbeat time) absent: the drive will not stop by itself if the "
+                             "master dies");
+    } else {
+      axes_[axis].has_consumer = true;
     }
-    if (Status s = sdo.write(node, p.map, 0, p.n_entries, 1); !s) return fail(s);
-    if (Status s = sdo.write(node, p.comm, 2, p.transmission_type, 1); !s) return fail(s);
-    if (Status s = sdo.write(node, p.comm, 1, p.cob_id, 4); !s) return fail(s);
   }
+
+  if (Status s = configure_pdos(axis, sdo); !s) return s;
 
   // Seed the state machine and the first target from the drive, so enabling never jumps.
   Result<std::uint32_t> sw = sdo.read(node, od::kStatusword, 0);
@@ -222,15 +242,134 @@ Status CanAxisPort::configure_node(std::size_t axis, SdoClient& sdo) {
   return Status::ok();
 }
 
+Status CanAxisPort::configure_pdos(std::size_t axis, SdoClient& sdo) {
+  const std::uint8_t node = axes_[axis].node;
+  const std::string who = node_label(axis) + ": ";
+  const auto fail = [&](const Status& s) { return Status::error(who + s.message()); };
+  // A module with a fixed mapping refuses writes with read-only (0x06010002) or unsupported access.
+  const auto fixed_code = [&] {
+    return sdo.last_abort() == sdo_abort::kReadOnly || sdo.last_abort() == sdo_abort::kUnsupportedAccess;
+  };
+  const auto read_map = [&](std::uint16_t map, std::array<std::uint32_t, 8>& e) -> Result<std::uint32_t> {
+    Result<std::uint32_t> n = sdo.read(node, map, 0);
+    if (!n) return n;
+    if (n.value() > 8) return Status::error(describe_object(map, 0) + " = " + std::to_string(n.value()) + " (> 8)");
+    for (std::uint32_t k = 0; k < n.value(); ++k) {
+      Result<std::uint32_t> v = sdo.read(node, map, static_cast<std::uint8_t>(k + 1));
+      if (!v) return v.status();
+      e[k] = v.value();
+    }
+    return n;
+  };
+  // PDO mapping (CiA 301 re-map procedure): invalidate, clear count, write entries, set count, set
+  // transmission type, validate. When the drive's mapping is fixed, read it back and accept it only if it
+  // is exactly the layout the RT codec packs (pdo.hpp); otherwise refuse, naming what is missing.
+  struct PdoPlan {
+    std::uint16_t comm;
+    std::uint16_t map;
+    std::uint32_t cob_id;
+    const PdoMapEntry* entries;
+    std::uint8_t n_entries;
+    std::uint8_t transmission_type;
+    bool optional;  // used when the drive has it, noted when absent (TPDO2: velocity and torque)
+  };
+  const PdoPlan plans[] = {
+      {od::kRpdoComm, od::kRpdoMap, cob::rpdo(1, node), kRpdo1Mapping.data(), 2, 1, false},
+      {od::kTpdoComm, od::kTpdoMap, cob::tpdo(1, node), kTpdo1Mapping.data(), 2, 1, false},
+      {static_cast<std::uint16_t>(od::kTpdoComm + 1), static_cast<std::uint16_t>(od::kTpdoMap + 1),
+       cob::tpdo(2, node), config_.tpdo2 ? kTpdo2Mapping.data() : nullptr,
+       static_cast<std::uint8_t>(config_.tpdo2 ? 2 : 0), config_.tpdo2_every_n_sync, true},
+      {static_cast<std::uint16_t>(od::kTpdoComm + 2), 0, cob::tpdo(3, node), nullptr, 0, 0, true},
+      {static_cast<std::uint16_t>(od::kTpdoComm + 3), 0, cob::tpdo(4, node), nullptr, 0, 0, true},
+  };
+  for (const PdoPlan& p : plans) {
+    if (Status s = sdo.write(node, p.comm, 1, p.cob_id | od::kPdoInvalidBit, 4); !s) {
+      if (sdo.last_abort() == sdo_abort::kNoObject && p.optional) {
+        // Nothing to disable; a wanted optional PDO the drive lacks is reported.
+        if (p.entries != nullptr) {
+          notes_.push_back(who + describe_object(p.comm, 1) +
+                           " absent: no velocity/torque PDO, velocity is derived from positions");
+        }
+        continue;
+      }
+      if (!fixed_code()) return fail(s);
+      if (p.entries == nullptr) continue;  // cannot disable a fixed PDO: the master ignores its frames
+    }
+    if (p.entries == nullptr) continue;
+    bool fixed = false;
+    if (Status s = sdo.write(node, p.map, 0, 0, 1); !s) {
+      if (!fixed_code()) return fail(s);
+      fixed = true;
+    }
+    if (!fixed) {
+      for (std::uint8_t k = 0; k < p.n_entries; ++k) {
+        if (Status s = sdo.write(node, p.map, static_cast<std::uint8_t>(k + 1), encode_map_entry(p.entries[k]), 4);
+            !s) {
+          return fail(s);
+        }
+      }
+      if (Status s = sdo.write(node, p.map, 0, p.n_entries, 1); !s) return fail(s);
+    } else {
+      std::array<std::uint32_t, 8> e{};
+      Result<std::uint32_t> n = read_map(p.map, e);
+      if (!n) return fail(n.status());
+      bool same = n.value() == p.n_entries;
+      for (std::uint8_t k = 0; same && k < p.n_entries; ++k) same = e[k] == encode_map_entry(p.entries[k]);
+      if (!same) {
+        std::string missing;
+        for (std::uint8_t k = 0; k < p.n_entries; ++k) {
+          char buf[48];
+          std::snprintf(buf, sizeof(buf), "%s0x%04X (%s, %u bits) at entry %u", missing.empty() ? "" : ", ",
+                        p.entries[k].index, object_name(p.entries[k].index), p.entries[k].bits, k + 1U);
+          if (k >= n.value() || e[k] != encode_map_entry(p.entries[k])) missing += buf;
+        }
+        if (p.optional) {
+          notes_.push_back(who + describe_object(p.map, 0) + " is fixed and lacks " + missing +
+                           ": velocity is derived from positions");
+          continue;
+        }
+        return Status::error(who + describe_object(p.map, 0) + " is read-only and does not carry what the "
+                                   "master needs: missing " + missing);
+      }
+      notes_.push_back(who + describe_object(p.map, 0) + " is fixed (read-only); read back and accepted");
+    }
+    if (Status s = sdo.write(node, p.comm, 2, p.transmission_type, 1); !s) {
+      if (!fixed_code()) return fail(s);
+      Result<std::uint32_t> t = sdo.read(node, p.comm, 2);
+      if (!t) return fail(t.status());
+      if (t.value() < 1 || t.value() > 240) {
+        return Status::error(who + describe_object(p.comm, 2) + " = " + std::to_string(t.value()) +
+                             " cannot be changed and is not synchronous (1..240)");
+      }
+    }
+    if (Status s = sdo.write(node, p.comm, 1, p.cob_id, 4); !s) {
+      if (!fixed_code()) return fail(s);
+      Result<std::uint32_t> c = sdo.read(node, p.comm, 1);
+      if (!c) return fail(c.status());
+      if ((c.value() & od::kPdoInvalidBit) != 0 || (c.value() & 0x7FF) != p.cob_id) {
+        return Status::error(who + describe_object(p.comm, 1) + " cannot be set to the pre-defined COB-ID");
+      }
+    }
+    if (p.comm == od::kTpdoComm + 1) axes_[axis].has_tpdo2 = true;
+  }
+  return Status::ok();
+}
+
+BusLoad planned_bus_load(const CanAxisPortConfig& c) {
+  std::vector<FrameGroup> frames{{0, 1}, {kRpdo1Bytes, hal::kAxisCount}, {kTpdo1Bytes, hal::kAxisCount}};
+  if (c.tpdo2) frames.push_back({kTpdo2Bytes, hal::kAxisCount});
+  frames.insert(frames.end(), c.other_frames_per_cycle.begin(), c.other_frames_per_cycle.end());
+  // The master heartbeat (1 byte) counted as if it were sent every cycle: the worst cycle holds it.
+  if (c.master_node_id != 0) frames.push_back({1, 1});
+  return compute_bus_load(frames, c.bitrate_bps, c.cycle_period_s);
+}
+
 Status CanAxisPort::configure(CanBus& bus, ConfigureClock& clock) {
   reset_runtime();
   bus_ = nullptr;
   if (Status s = validate(config_); !s) return Status::error("CAN axis configuration: " + s.message());
 
-  std::vector<FrameGroup> frames{{0, 1}, {kRpdo1Bytes, hal::kAxisCount}, {kTpdo1Bytes, hal::kAxisCount}};
-  if (config_.tpdo2) frames.push_back({kTpdo2Bytes, hal::kAxisCount});
-  frames.insert(frames.end(), config_.other_frames_per_cycle.begin(), config_.other_frames_per_cycle.end());
-  bus_load_ = compute_bus_load(frames, config_.bitrate_bps, config_.cycle_period_s);
+  bus_load_ = planned_bus_load(config_);
   if (Status s = check_bus_load(bus_load_, config_.bus_load_budget); !s) return s;
 
   consumer_ticks_ = ceil_ticks(config_.heartbeat_consumer_s, config_.cycle_period_s);
@@ -267,26 +406,32 @@ Status CanAxisPort::configure(CanBus& bus, ConfigureClock& clock) {
       clock.idle();
     }
   };
-  // Wait until `done` holds for every axis, or name the first axis that did not make it.
-  const auto wait_all = [&](std::array<bool, hal::kAxisCount>& done, double timeout_s, const char* what,
-                            const char* hint) -> Status {
-    const std::int64_t deadline = clock.now_us() + static_cast<std::int64_t>(timeout_s * 1e6);
+  // Wait until `done` holds for every axis, each within its own window (per-node setting, else the
+  // port-wide one), or name the first axis that did not make it.
+  const auto wait_all = [&](std::array<bool, hal::kAxisCount>& done, std::array<double, hal::kAxisCount> timeout_s,
+                            const char* what, const char* hint) -> Status {
+    const std::int64_t start = clock.now_us();
     for (;;) {
       drain();
       if (bus_off_) return Status::error("CAN bus-off while waiting for " + std::string(what));
       bool all = true;
-      for (bool d : done) all = all && d;
-      if (all) return Status::ok();
-      if (clock.now_us() >= deadline) {
-        for (std::size_t i = 0; i < done.size(); ++i) {
-          if (!done[i]) {
-            return Status::error(node_label(i) + ": no " + what + fmt(" within %.3g s", timeout_s) + hint);
-          }
+      for (std::size_t i = 0; i < done.size(); ++i) {
+        all = all && done[i];
+        if (!done[i] && clock.now_us() - start >= static_cast<std::int64_t>(timeout_s[i] * 1e6)) {
+          return Status::error(node_label(i) + ": no " + what + fmt(" within %.3g s", timeout_s[i]) + hint);
         }
       }
+      if (all) return Status::ok();
       clock.idle();
     }
   };
+  std::array<double, hal::kAxisCount> boot_window{}, op_window{};
+  for (std::size_t i = 0; i < axes_.size(); ++i) {
+    const CanAxisConfig& a = config_.axes[i];
+    boot_window[i] = a.boot_timeout_s > 0.0 ? a.boot_timeout_s : config_.boot_timeout_s;
+    const double op = config_.operational_timeout_s;
+    op_window[i] = a.operational_timeout_s > 0.0 ? a.operational_timeout_s : op;
+  }
 
   drain();  // stale frames from before the reset mean nothing
   booted.fill(false);
@@ -296,7 +441,7 @@ Status CanAxisPort::configure(CanBus& bus, ConfigureClock& clock) {
       return s;
     }
   }
-  if (Status s = wait_all(booted, config_.boot_timeout_s, "boot-up after NMT reset-node",
+  if (Status s = wait_all(booted, boot_window, "boot-up after NMT reset-node",
                           " (is the drive powered, on this bus, with this node id?)");
       !s) {
     return s;
@@ -314,12 +459,16 @@ Status CanAxisPort::configure(CanBus& bus, ConfigureClock& clock) {
       return s;
     }
   }
-  if (Status s = wait_all(operational, config_.heartbeat_consumer_s, "operational heartbeat after NMT start",
+  if (Status s = wait_all(operational, op_window, "operational heartbeat after NMT start",
                           " (heartbeat producer time written to 0x1017 not honoured?)");
       !s) {
     return s;
   }
 
+  master_hb_ticks_ = config_.master_node_id == 0
+                        ? 0
+                        : std::max<std::uint32_t>(1, static_cast<std::uint32_t>(std::floor(
+                                                         config_.master_heartbeat_s / config_.cycle_period_s + 1e-9)));
   bus_ = &bus;
   configured_ = true;
   return Status::ok();
@@ -340,7 +489,17 @@ void CanAxisPort::handle_frame(hal::Tick now, const CanFrame& f) {
   }
   const CobDecoded cob_fn = decode_cob_id(f.id);
   const std::int8_t ax = cob_fn.node <= kMaxNodeId ? axis_of_node_[cob_fn.node] : std::int8_t{-1};
-  if (ax < 0) return;  // other nodes' traffic, SYNC/NMT echoes of other masters
+  if (ax < 0) {
+    // Any node's EMCY with a non-zero code stops every axis (error reset 0x0000 clears nothing here:
+    // recovery is the operator's acknowledgement).
+    if (cob_fn.function == CobFunction::kEmcy && cob_fn.node != 0) {
+      if (const auto e = parse_emcy(f); e && e->code != 0 && foreign_emcy_code_ == 0) foreign_emcy_code_ = e->code;
+    }
+    for (std::size_t k = 0; k < n_listeners_; ++k) {
+      if (listeners_[k]->node_id() == cob_fn.node) listeners_[k]->on_frame(now, f);
+    }
+    return;  // other nodes' traffic, SYNC/NMT echoes of other masters
+  }
   AxisRuntime& a = axes_[static_cast<std::size_t>(ax)];
 
   switch (cob_fn.function) {
@@ -359,6 +518,12 @@ void CanAxisPort::handle_frame(hal::Tick now, const CanFrame& f) {
       }
       a.last_position_si = pos;
       a.refreshed = now;
+      // Following error against the target commanded before this feedback (LinuxCNC's velocity-scaled rule).
+      if (a.ferror_min > 0.0 && a.cmd_valid && a.state == DriveState::kOperationEnabled) {
+        const double err = std::abs(a.last_cmd_si - pos);
+        if (err > a.ferror_high_water) a.ferror_high_water = err;
+        if (err > std::max(a.ferror_min, a.ferror_k_s * std::abs(a.cmd_velocity))) a.ferror_fault = true;
+      }
       return;
     }
     case CobFunction::kTpdo2: {
@@ -390,7 +555,14 @@ void CanAxisPort::handle_frame(hal::Tick now, const CanFrame& f) {
         ++rx_errors_;
         return;
       }
-      a.emcy_code = e->code;
+      // A non-zero code latches (even while the statusword still says Operation Enabled) until the
+      // operator acknowledges; the drive's 0x0000 (error reset) after that acknowledgement clears it.
+      if (e->code != 0) {
+        a.emcy_code = e->code;
+        a.acknowledged = false;
+      } else if (a.acknowledged) {
+        a.emcy_code = 0;
+      }
       return;
     }
     default:
@@ -409,6 +581,7 @@ void CanAxisPort::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkSt
         a.link_fault = fault_code::kHeartbeatLost;
       }
     }
+    for (std::size_t k = 0; k < n_listeners_; ++k) listeners_[k]->supervise(now);
   }
   fill_feedback(axes, link);
 }
@@ -426,7 +599,8 @@ void CanAxisPort::fill_feedback(hal::AxisFeedbacks& axes, hal::LinkStatus& link)
     fb.refreshed = a.refreshed;
     fb.following_error =
         a.state == DriveState::kOperationEnabled && (a.statusword & statusword::kCspFollowingError) != 0;
-    const bool drive_fault = a.state == DriveState::kFault || a.state == DriveState::kFaultReactionActive;
+    const bool drive_fault = a.state == DriveState::kFault || a.state == DriveState::kFaultReactionActive ||
+                             a.emcy_code != 0 || a.ferror_fault;
     fb.fault = !configured_ || a.link_fault != 0 || drive_fault || a.tracker.timed_out || bus_off_;
     if (a.link_fault != 0) {
       fb.fault_code = a.link_fault;
@@ -434,6 +608,8 @@ void CanAxisPort::fill_feedback(hal::AxisFeedbacks& axes, hal::LinkStatus& link)
       fb.fault_code = fault_code::kCommunication;
     } else if (a.emcy_code != 0) {
       fb.fault_code = a.emcy_code;
+    } else if (a.ferror_fault) {
+      fb.fault_code = fault_code::kFollowingError;
     } else if (a.tracker.timed_out) {
       fb.fault_code = fault_code::kStateTimeout;
     } else {
@@ -444,18 +620,69 @@ void CanAxisPort::fill_feedback(hal::AxisFeedbacks& axes, hal::LinkStatus& link)
       link.link_fault_code = a.link_fault;
     }
   }
+  // Other nodes: the I/O node's own faults, then an EMCY from any node that is not an axis.
+  for (std::size_t k = 0; k < n_listeners_ && !link.link_fault; ++k) {
+    if (const std::uint16_t c = listeners_[k]->link_fault_code(); c != 0) {
+      link.link_fault = true;
+      link.link_fault_code = c;
+    }
+  }
+  if (!link.link_fault && foreign_emcy_code_ != 0) {
+    link.link_fault = true;
+    link.link_fault_code = foreign_emcy_code_;
+  }
   link.tx_dropped = tx_dropped_;
   link.rx_errors = rx_errors_;
 }
 
-void CanAxisPort::write_axes(hal::Tick /*now*/, const hal::AxisCommands& commands) {
+bool CanAxisPort::any_fault() const {
+  if (bus_off_ || foreign_emcy_code_ != 0) return true;
+  for (const AxisRuntime& a : axes_) {
+    if (a.link_fault != 0 || a.emcy_code != 0 || a.ferror_fault || a.state == DriveState::kFault ||
+        a.state == DriveState::kFaultReactionActive) {
+      return true;
+    }
+  }
+  for (std::size_t k = 0; k < n_listeners_; ++k) {
+    if (listeners_[k]->link_fault_code() != 0) return true;
+  }
+  return false;
+}
+
+// The operator acknowledged (the sequencer requests a fault reset): latches whose cause the master
+// itself decided are cleared; a drive still in Fault gets its reset edge through the CiA 402 table.
+void CanAxisPort::acknowledge() {
+  foreign_emcy_code_ = 0;
+  for (AxisRuntime& a : axes_) {
+    a.ferror_fault = false;
+    a.acknowledged = true;
+    if (a.state != DriveState::kFault && a.state != DriveState::kFaultReactionActive) a.emcy_code = 0;
+  }
+  for (std::size_t k = 0; k < n_listeners_; ++k) listeners_[k]->acknowledge();
+}
+
+void CanAxisPort::write_axes(hal::Tick now, const hal::AxisCommands& commands) {
   if (!configured_) return;
+  bool reset = false;
+  for (const hal::AxisCommand& c : commands) reset = reset || c.request == AxisRequest::kFaultReset;
+  if (reset) acknowledge();
+  // Any fault anywhere on the bus (EMCY from any node, a lost node, following error) stops every axis in
+  // this very tick, whatever the sequencer asked and whatever the drives' statuswords say.
+  const bool stop_all = any_fault();
   count_send(bus_->send(make_sync()));
+  if (master_hb_ticks_ != 0 && now >= next_master_hb_) {
+    count_send(bus_->send(make_heartbeat(config_.master_node_id, NmtState::kOperational)));
+    next_master_hb_ = now + static_cast<hal::Tick>(master_hb_ticks_);
+  }
   for (std::size_t i = 0; i < axes_.size(); ++i) {
     AxisRuntime& a = axes_[i];
     // A drive we cannot supervise (lost, rebooted, bus-off) gets quick stop, never an enable command.
     const bool lost = a.link_fault != 0 || bus_off_;
-    const AxisRequest request = lost ? AxisRequest::kQuickStop : commands[i].request;
+    const AxisRequest wanted_request = commands[i].request;
+    const AxisRequest request =
+        lost || (stop_all && wanted_request != AxisRequest::kFaultReset && wanted_request != AxisRequest::kDisable)
+            ? AxisRequest::kQuickStop
+            : wanted_request;
     const Cia402Step step = cia402_step(a.state, request, a.tracker, state_timeout_ticks_);
     a.tracker = step.next;
 
@@ -466,6 +693,10 @@ void CanAxisPort::write_axes(hal::Tick /*now*/, const hal::AxisCommands& command
         std::isfinite(wanted)) {
       target = si_to_counts(wanted, a.counts_per_unit);
     }
+    const double cmd_si = counts_to_si(target, a.counts_per_unit);
+    a.cmd_velocity = a.cmd_valid ? (cmd_si - a.last_cmd_si) / config_.cycle_period_s : 0.0;
+    a.last_cmd_si = cmd_si;
+    a.cmd_valid = true;
     a.last_target_counts = target;
     count_send(bus_->send(pack_rpdo1(a.node, Rpdo1{step.controlword, wire_counts(target)})));
   }

@@ -28,6 +28,7 @@ SdoClient::SdoClient(CanBus& bus, ConfigureClock& clock, std::int64_t timeout_us
 
 Result<SdoReply> SdoClient::exchange(std::uint8_t node, const CanFrame& request, const std::string& what) {
   const SdoRequest req = parse_sdo_request(request);
+  last_abort_ = 0;
   const std::int64_t deadline = clock_.now_us() + timeout_us_;
 
   // A full transmit queue is not an error during bring-up: retry until the deadline.
@@ -48,6 +49,7 @@ Result<SdoReply> SdoClient::exchange(std::uint8_t node, const CanFrame& request,
       }
       const SdoReply reply = parse_sdo_reply(f);
       if (reply.kind == SdoReplyKind::kAbort) {
+        last_abort_ = reply.value;
         return Status::error(what + " aborted: " + hex32(reply.value) + " (" + sdo_abort_text(reply.value) +
                              ")");
       }

@@ -43,8 +43,8 @@ Result<std::unique_ptr<SocketCanBus>> SocketCanBus::open(const std::string& ifac
     if (err == EAFNOSUPPORT) {
       return Status::error(
           open_error(iface, "this kernel has no CAN support (socket(PF_CAN) failed: " + errno_text(err) +
-                                "); load the can and can-raw modules, or run against vcan inside the VM "
-                                "(shared/reference/vcan-vm.md)"));
+                                "); load the can and can-raw modules (modprobe can can-raw), or run the HIL "
+                                "tests in a qemu VM that has CAN: tools/vcan/hil-run, see tools/vcan/README.md"));
     }
     if (err == EPROTONOSUPPORT) {
       return Status::error(open_error(

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "loom/drivers/bus_load.hpp"
+#include "loom/drivers/required_objects.hpp"
 #include "loom/firmware/config.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/profile_set.hpp"
@@ -74,13 +75,24 @@ void print_plan(const LoomConfig& c) {
   std::printf("  about %.2f s per row (%.0fx faster than ~300 s by hand)\n", row, 300.0 / row);
 
   std::printf("\nCAN (for --hal socketcan)\n");
-  const drivers::CanAxisPortConfig cc = can_axis_config(c);
-  const drivers::BusLoad load = drivers::servo_cycle_bus_load(hal::kAxisCount, cc.tpdo2, cc.bitrate_bps, cc.cycle_period_s);
-  std::printf("  nodes: beat crank %u, carriage %u, helix %u; heartbeat %u ms, consumer %u ms\n", c.can.node_beat_crank,
-              c.can.node_carriage, c.can.node_helix, c.can.heartbeat_ms, c.can.heartbeat_timeout_ms);
+  const drivers::BusLoad load = can_bus_load(c);  // the figure the CAN master checks when it configures
+  std::printf("  nodes: beat crank %u, carriage %u, helix %u, I/O module %u (%s); controller heartbeat %s\n",
+              c.can.node_beat_crank, c.can.node_carriage, c.can.node_helix, c.io.node,
+              c.io.kind == IoKind::kCan ? "on the bus" : "SIMULATED: needs --io simulated on hardware",
+              c.can.master_node != 0 ? ("node " + std::to_string(c.can.master_node) + ", every " +
+                                        std::to_string(c.can.master_heartbeat_ms) + " ms, consumers " +
+                                        std::to_string(c.can.master_consumer_ms) + " ms").c_str()
+                                     : "off");
+  std::printf("  heartbeats %u ms, lost after %u ms; bit rate %u bit/s\n", c.can.heartbeat_ms, c.can.heartbeat_timeout_ms,
+              c.can.bitrate);
   std::printf("  bus load: %s (budget %.0f %%)\n", drivers::describe_bus_load(load).c_str(), c.can.bus_load_budget * 100.0);
   std::printf("  scaling: %.0f counts/rev (crank, helix), %.0f counts/m (carriage)\n", c.can.counts_per_rev,
               c.can.carriage_counts_per_m);
+  std::printf("  objects every drive (nodes %u, %u, %u) must support:\n", c.can.node_beat_crank, c.can.node_carriage,
+              c.can.node_helix);
+  for (const auto& o : drivers::drive_objects()) std::printf("    %s\n", drivers::describe(o).c_str());
+  std::printf("  objects the I/O module (node %u) must support:\n", c.io.node);
+  for (const auto& o : drivers::io_module_objects()) std::printf("    %s\n", drivers::describe(o).c_str());
 }
 
 void print_scene(const Scene& s) {

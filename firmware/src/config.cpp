@@ -121,6 +121,27 @@ Key choice(std::string path, Klass k, std::set<std::string> allowed, std::functi
   return key;
 }
 
+Key boolean(std::string path, Klass k, std::function<bool&(LoomConfig&)> field) {
+  Key key{path, k, "true | false", true, nullptr, nullptr};
+  key.read = [=](TomlReader& r, LoomConfig& c) { r.boolean(path, field(c)); };
+  key.value = [=](const LoomConfig& c) { return std::string(field(const_cast<LoomConfig&>(c)) ? "true" : "false"); };
+  return key;
+}
+
+const char* io_kind_name(IoKind k) { return k == IoKind::kCan ? "can" : "simulated"; }
+bool parse_io_kind(const char* s, IoKind& k) {
+  k = std::string(s) == "can" ? IoKind::kCan : IoKind::kSimulated;
+  return true;
+}
+
+// One wired signal of the I/O module: `io.<name>_bit` (-1 = not wired) and `io.<name>_active_low`.
+void io_signal(std::vector<Key>& v, const std::string& name, drivers::IoBit drivers::IoWiring::*member) {
+  v.push_back(integer<int>("io." + name + "_bit", Klass::kMachine, -1, drivers::kIoMaxBits - 1,
+                           [member](LoomConfig& c) -> int& { return (c.io.wiring.*member).bit; }));
+  v.push_back(boolean("io." + name + "_active_low", Klass::kMachine,
+                      [member](LoomConfig& c) -> bool& { return (c.io.wiring.*member).active_low; }));
+}
+
 const char* branch_name(motion::Branch b) { return b == motion::Branch::kPositive ? "positive" : "negative"; }
 bool parse_branch(const char* s, motion::Branch& b) {
   b = std::string(s) == "positive" ? motion::Branch::kPositive : motion::Branch::kNegative;
@@ -213,6 +234,51 @@ const std::vector<Key>& keys() {
     v.push_back(integer<std::uint16_t>("can.heartbeat_ms", M::kMachine, 10, 10000, [](LoomConfig& c) -> std::uint16_t& { return c.can.heartbeat_ms; }));
     v.push_back(integer<std::uint16_t>("can.heartbeat_timeout_ms", M::kMachine, 10, 30000, [](LoomConfig& c) -> std::uint16_t& { return c.can.heartbeat_timeout_ms; }));
     v.push_back(integer<std::uint16_t>("can.sdo_timeout_ms", M::kMachine, 10, 10000, [](LoomConfig& c) -> std::uint16_t& { return c.can.sdo_timeout_ms; }));
+    v.push_back(integer<std::uint8_t>("can.master_node", M::kMachine, 0, 127, [](LoomConfig& c) -> std::uint8_t& { return c.can.master_node; }));
+    v.push_back(integer<std::uint16_t>("can.master_heartbeat_ms", M::kMachine, 10, 10000, [](LoomConfig& c) -> std::uint16_t& { return c.can.master_heartbeat_ms; }));
+    v.push_back(integer<std::uint16_t>("can.master_consumer_ms", M::kMachine, 20, 30000, [](LoomConfig& c) -> std::uint16_t& { return c.can.master_consumer_ms; }));
+    {
+      static const char* const axes[] = {"beat_crank", "carriage", "helix"};
+      static const char* const units[] = {"rad", "m", "rad"};
+      for (std::size_t i = 0; i < 3; ++i) {
+        const std::string a = axes[i];
+        v.push_back(integer<std::uint32_t>("can." + a + "_boot_ms", M::kMachine, 0, 60000,
+                                           [i](LoomConfig& c) -> std::uint32_t& { return c.can.boot_timeout_ms[i]; }));
+        v.push_back(integer<std::uint32_t>("can." + a + "_operational_ms", M::kMachine, 0, 60000,
+                                           [i](LoomConfig& c) -> std::uint32_t& { return c.can.operational_timeout_ms[i]; }));
+        v.push_back(number("can." + a + "_ferror_min_" + units[i], M::kMachine, 0.0, i == 1 ? 1.0 : 100.0,
+                           [i](LoomConfig& c) -> double& { return c.can.ferror_min[i]; }));
+        v.push_back(number("can." + a + "_ferror_k_s", M::kMachine, 0.0, 10.0,
+                           [i](LoomConfig& c) -> double& { return c.can.ferror_k_s[i]; }));
+      }
+    }
+    // [io] — the CiA 401 module: where each signal is wired
+    v.push_back(choice<IoKind>("io.kind", M::kMachine, {"can", "simulated"}, [](LoomConfig& c) -> IoKind& { return c.io.kind; },
+                               io_kind_name, parse_io_kind));
+    v.push_back(integer<std::uint8_t>("io.node", M::kMachine, 1, 127, [](LoomConfig& c) -> std::uint8_t& { return c.io.node; }));
+    v.push_back(integer<std::uint32_t>("io.boot_timeout_ms", M::kMachine, 10, 60000, [](LoomConfig& c) -> std::uint32_t& { return c.io.boot_timeout_ms; }));
+    v.push_back(integer<std::uint32_t>("io.operational_timeout_ms", M::kMachine, 10, 60000, [](LoomConfig& c) -> std::uint32_t& { return c.io.operational_timeout_ms; }));
+    using W = drivers::IoWiring;
+    io_signal(v, "piston_a_extended", &W::piston_a_extended);
+    io_signal(v, "piston_a_retracted", &W::piston_a_retracted);
+    io_signal(v, "piston_b_extended", &W::piston_b_extended);
+    io_signal(v, "piston_b_retracted", &W::piston_b_retracted);
+    io_signal(v, "shuttle_at_left", &W::shuttle_at_left);
+    io_signal(v, "shuttle_at_right", &W::shuttle_at_right);
+    io_signal(v, "estop_ok", &W::estop_ok);
+    io_signal(v, "button_start", &W::button_start);
+    io_signal(v, "button_pause", &W::button_pause);
+    io_signal(v, "button_ack", &W::button_ack);
+    io_signal(v, "row_knotted", &W::row_knotted);
+    io_signal(v, "piston_a_extend", &W::piston_a_extend);
+    io_signal(v, "piston_b_extend", &W::piston_b_extend);
+    io_signal(v, "lamp_green", &W::lamp_green);
+    io_signal(v, "lamp_amber", &W::lamp_amber);
+    io_signal(v, "lamp_red", &W::lamp_red);
+    io_signal(v, "buzzer", &W::buzzer);
+    v.push_back(integer<int>("io.load_cell_channel", M::kMachine, 0, 254, [](LoomConfig& c) -> int& { return c.io.wiring.load_cell_channel; }));
+    v.push_back(number("io.load_cell_n_per_count", M::kMachine, -1.0e3, 1.0e3, [](LoomConfig& c) -> double& { return c.io.wiring.load_cell_n_per_count; }));
+    v.push_back(number("io.load_cell_offset_n", M::kMachine, -1.0e4, 1.0e4, [](LoomConfig& c) -> double& { return c.io.wiring.load_cell_offset_n; }));
     // [recipe]
     v.push_back(integer<std::uint32_t>("recipe.picks_per_row", M::kRecipe, 1, 16, [](LoomConfig& c) -> std::uint32_t& { return c.recipe.picks_per_row; }));
     v.push_back(integer<int>("recipe.beats_per_position", M::kRecipe, 1, 16, [](LoomConfig& c) -> int& { return c.recipe.beats_per_position; }));
@@ -342,19 +408,46 @@ void check_relations(const TomlReader& r, const LoomConfig& c) {
   }
 }
 
-// The CAN master's own validation, with its complaint pinned to the key that sets the field.
+// The CAN master's own validation (drives and I/O module), with its complaint pinned to the key that
+// sets the field; the worst-case bus load counts every node's frames.
 void check_can(const LoomConfig& c, const Fail& fail) {
   const drivers::CanAxisPortConfig cc = can_axis_config(c);
   if (const drivers::Status s = drivers::validate(cc); !s) {
     const std::string& msg = s.message();
     std::string key = "can.heartbeat_timeout_ms", value = std::to_string(c.can.heartbeat_timeout_ms);
     if (msg.find("heartbeat_producer") == 0) key = "can.heartbeat_ms", value = std::to_string(c.can.heartbeat_ms);
+    if (msg.find("master_heartbeat") == 0) key = "can.master_heartbeat_ms", value = std::to_string(c.can.master_heartbeat_ms);
+    if (msg.find("master_consumer") == 0) key = "can.master_consumer_ms", value = std::to_string(c.can.master_consumer_ms);
     if (msg.find("sdo") == 0) key = "can.sdo_timeout_ms", value = std::to_string(c.can.sdo_timeout_ms);
     if (msg.find("counts_per_unit") != std::string::npos) key = "can.counts_per_rev", value = fmt_num(c.can.counts_per_rev);
+    if (msg.find("bus") != std::string::npos || msg.find("bit") != std::string::npos) {
+      key = "can.bus_load_budget", value = fmt_num(c.can.bus_load_budget);
+    }
     fail(key, value, "the CAN master refuses it: " + msg);
   }
-  const drivers::BusLoad load = drivers::servo_cycle_bus_load(hal::kAxisCount, cc.tpdo2, cc.bitrate_bps, cc.cycle_period_s);
-  if (const drivers::Status s = drivers::check_bus_load(load, c.can.bus_load_budget); !s) {
+  if (c.io.kind == IoKind::kCan) {
+    for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+      if (cc.axes[i].node_id == c.io.node) {
+        fail("io.node", std::to_string(c.io.node),
+             std::string("node id already used by the ") + hal::axis_name(static_cast<hal::Axis>(i)) + " drive");
+      }
+    }
+    if (const drivers::Status s = drivers::validate(can_io_config(c)); !s) {
+      // The driver names the signal ("io.inputs.estop_ok.bit = 3 ..."): point at that signal's key.
+      std::string key = "io.node", value = std::to_string(c.io.node);
+      const std::string& msg = s.message();
+      for (const Key& k : keys()) {
+        if (k.path.rfind("io.", 0) != 0 || k.path.size() < 4) continue;
+        const std::string name = k.path.substr(3, k.path.rfind('_') - 3);
+        if (k.path.size() > 4 && k.path.substr(k.path.size() - 4) == "_bit" && msg.find("." + name + ".") != std::string::npos) {
+          key = k.path, value = k.value(c);
+          break;
+        }
+      }
+      fail(key, value, "the I/O module refuses it: " + msg);
+    }
+  }
+  if (const drivers::Status s = drivers::check_bus_load(can_bus_load(c), c.can.bus_load_budget); !s) {
     fail("can.bus_load_budget", fmt_num(c.can.bus_load_budget), s.message());
   }
 }
@@ -545,16 +638,49 @@ void rederive_and_check(LoomConfig& c, const std::string& origin) {
 drivers::CanAxisPortConfig can_axis_config(const LoomConfig& c) {
   drivers::CanAxisPortConfig cc;
   const double counts_per_rad = c.can.counts_per_rev / (2.0 * M_PI);
-  cc.axes[hal::index(hal::Axis::kBeatCrank)] = {c.can.node_beat_crank, counts_per_rad, 0.0};
-  cc.axes[hal::index(hal::Axis::kCarriage)] = {c.can.node_carriage, c.can.carriage_counts_per_m, 0.0};
-  cc.axes[hal::index(hal::Axis::kHelix)] = {c.can.node_helix, counts_per_rad, 0.0};
+  const std::array<std::uint8_t, 3> nodes{c.can.node_beat_crank, c.can.node_carriage, c.can.node_helix};
+  const std::array<double, 3> counts{counts_per_rad, c.can.carriage_counts_per_m, counts_per_rad};
+  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+    drivers::CanAxisConfig& a = cc.axes[i];
+    a.node_id = nodes[i];
+    a.counts_per_unit = counts[i];
+    a.rated_effort = 0.0;
+    a.ferror_min = c.can.ferror_min[i];
+    a.ferror_k_s = c.can.ferror_k_s[i];
+    a.boot_timeout_s = c.can.boot_timeout_ms[i] * 1e-3;
+    a.operational_timeout_s = c.can.operational_timeout_ms[i] * 1e-3;
+  }
   cc.cycle_period_s = c.run.period_s;
   cc.heartbeat_producer_s = c.can.heartbeat_ms * 1e-3;
   cc.heartbeat_consumer_s = c.can.heartbeat_timeout_ms * 1e-3;
   cc.sdo_timeout_s = c.can.sdo_timeout_ms * 1e-3;
   cc.bitrate_bps = c.can.bitrate;
   cc.bus_load_budget = c.can.bus_load_budget;
+  cc.master_node_id = c.can.master_node;
+  cc.master_heartbeat_s = c.can.master_heartbeat_ms * 1e-3;
+  cc.master_consumer_s = c.can.master_consumer_ms * 1e-3;
+  if (c.io.kind == IoKind::kCan) cc.other_frames_per_cycle = drivers::io_frames_per_cycle(c.io.wiring);
   return cc;
+}
+
+drivers::CanIoConfig can_io_config(const LoomConfig& c) {
+  drivers::CanIoConfig ic;
+  ic.node_id = c.io.node;
+  ic.wiring = c.io.wiring;
+  ic.cycle_period_s = c.run.period_s;
+  ic.heartbeat_producer_s = c.can.heartbeat_ms * 1e-3;
+  ic.heartbeat_consumer_s = c.can.heartbeat_timeout_ms * 1e-3;
+  ic.sdo_timeout_s = c.can.sdo_timeout_ms * 1e-3;
+  ic.boot_timeout_s = c.io.boot_timeout_ms * 1e-3;
+  ic.operational_timeout_s = c.io.operational_timeout_ms * 1e-3;
+  ic.master_node_id = c.can.master_node;
+  ic.master_consumer_s = c.can.master_consumer_ms * 1e-3;
+  return ic;
+}
+
+drivers::BusLoad can_bus_load(const LoomConfig& c) {
+  const drivers::CanAxisPortConfig cc = can_axis_config(c);
+  return drivers::planned_bus_load(cc);
 }
 
 LoomConfig parse_loom_config(const std::string& text, const std::string& source) {

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "loom/drivers/can_link_info.hpp"
+#include "loom/drivers/configure_clock.hpp"
 #include "loom/motion/errors.hpp"
 
 namespace loom::firmware {
@@ -30,26 +32,7 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
   }
 
   if (opt.hal == HalKind::kSocketCan) {
-    auto bus = drivers::SocketCanBus::open(opt.iface);
-    if (!bus) throw std::runtime_error(bus.error());
-    bus_ = std::move(bus.value());
-    drivers::CanAxisPortConfig cc;
-    const double counts_per_rad = cfg_.can.counts_per_rev / (2.0 * M_PI);
-    cc.axes[hal::index(hal::Axis::kBeatCrank)] = {cfg_.can.node_beat_crank, counts_per_rad, 0.0};
-    cc.axes[hal::index(hal::Axis::kCarriage)] = {cfg_.can.node_carriage, cfg_.can.carriage_counts_per_m, 0.0};
-    cc.axes[hal::index(hal::Axis::kHelix)] = {cfg_.can.node_helix, counts_per_rad, 0.0};
-    cc.cycle_period_s = cfg_.sequencer.period_s;
-    cc.heartbeat_producer_s = cfg_.can.heartbeat_ms * 1e-3;
-    cc.heartbeat_consumer_s = cfg_.can.heartbeat_timeout_ms * 1e-3;
-    cc.sdo_timeout_s = cfg_.can.sdo_timeout_ms * 1e-3;
-    cc.bitrate_bps = cfg_.can.bitrate;
-    cc.bus_load_budget = cfg_.can.bus_load_budget;
-    can_port_ = std::make_unique<drivers::CanAxisPort>(cc);
-    const drivers::Status st = can_port_->configure(*bus_);
-    if (!st) throw std::runtime_error(st.message());
-    // The I/O node is still simulated on this HAL: valves and sensors come from the sim world, which
-    // follows the real helix shaft's position for the shuttle sensors.
-    hal_ = std::make_unique<hal::PortHal>(*can_port_, *sim_);
+    build_can_hal(opt);
   } else {
     hal_ = std::make_unique<hal::PortHal>(*sim_, *sim_);
   }
@@ -70,6 +53,57 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
   }
   loop_ = std::make_unique<ControlLoop>(*hal_, *sequencer_, telemetry_.get(), cfg_.sequencer.period_s,
                                         opt.lossless_telemetry && opt.hal == HalKind::kSim);
+}
+
+// The CAN HAL: three CiA 402 drives and the CiA 401 I/O node on one bus (or, only when asked for on
+// the command line, the drives beside the simulated I/O node). Every refusal that needs no bus comes
+// before the bus is opened.
+void Machine::build_can_hal(const MachineOptions& opt) {
+  const IoKind io_kind = opt.io.value_or(cfg_.io.kind);
+  if (io_kind == IoKind::kSimulated && opt.io != IoKind::kSimulated) {
+    throw ConfigError(cfg_.source +
+                      ": io.kind = \"simulated\" with the CAN HAL: the servos would move while the e-stop chain, "
+                      "sensors and valves are imaginary; give --io simulated to do this on purpose");
+  }
+  // Derived from the machine description (and validated when it was read).
+  const drivers::CanIoConfig ic = can_io_config(cfg_);
+  drivers::CanAxisPortConfig cc = can_axis_config(cfg_);
+  if (io_kind != IoKind::kCan) cc.other_frames_per_cycle.clear();
+  if (io_kind == IoKind::kCan && cfg_.io.kind != IoKind::kCan) {  // --io can over a simulated config
+    if (drivers::Status s = drivers::validate(ic); !s) throw ConfigError(cfg_.source + ": " + s.message());
+    cc.other_frames_per_cycle = drivers::io_frames_per_cycle(ic.wiring);
+  }
+
+  // The interface's real bitrate, from the kernel, before anything is sent.
+  auto link = drivers::read_can_link_info(opt.iface);
+  if (!link) throw std::runtime_error(link.error());
+  std::string note;
+  if (drivers::Status s = drivers::check_can_bitrate(opt.iface, link.value(), cfg_.can.bitrate, note); !s) {
+    throw ConfigError(cfg_.source + ": can.bitrate: " + s.message());
+  }
+  if (!note.empty()) notes_.push_back(note);
+
+  auto bus = drivers::SocketCanBus::open(opt.iface);
+  if (!bus) throw std::runtime_error(bus.error());
+  bus_ = std::move(bus.value());
+  can_port_ = std::make_unique<drivers::CanAxisPort>(cc);
+  if (io_kind == IoKind::kCan) {
+    io_port_ = std::make_unique<drivers::CanIoPort>(ic);
+    can_port_->attach(*io_port_);
+  }
+  if (const drivers::Status st = can_port_->configure(*bus_); !st) throw std::runtime_error(st.message());
+  notes_.push_back("CAN bus load: " + drivers::describe_bus_load(can_port_->bus_load()));
+  notes_.insert(notes_.end(), can_port_->notes().begin(), can_port_->notes().end());
+  if (io_port_) {
+    drivers::MonotonicConfigureClock clock;
+    if (const drivers::Status st = io_port_->configure(*bus_, clock); !st) throw std::runtime_error(st.message());
+    notes_.insert(notes_.end(), io_port_->notes().begin(), io_port_->notes().end());
+    hal_ = std::make_unique<hal::PortHal>(*can_port_, *io_port_);
+  } else {
+    // Asked for explicitly: the simulated I/O node follows the real helix shaft for its shuttle sensors.
+    banner_ = kSimulatedIoBanner;
+    hal_ = std::make_unique<hal::PortHal>(*can_port_, *sim_);
+  }
 }
 
 void Machine::publish_recipe(const LoomConfig& next) {

@@ -33,7 +33,7 @@ extern "C" void on_pause(int) { g_pause.store(true); }
 extern "C" void on_resume(int) { g_pause.store(false); }
 
 struct WeaveArgs {
-  std::string config, scene, hal = "sim", iface, counters, lcm_url, loom_id, report, sim_state;
+  std::string config, scene, hal = "sim", iface, counters, lcm_url, loom_id, report, sim_state, io;
   std::uint32_t rows = 3;
   double period_ms = 0.0;
   double pace = 1.0;
@@ -57,7 +57,7 @@ void print_header(const firmware::Machine& m, const firmware::Scene& scene, cons
               motion::deg(w.exit), p.beats_per_row(), p.spec().crank.velocity, p.pitch_m() * 1e3);
   std::printf("  pick: %.2f helix turns in %.3f s (accel limit %.0f rad/s^2, carrier and drive)\n",
               p.spec().width_m / p.spec().helix_lead_m, p.pick().duration(), p.helix_accel_limit());
-  if (const auto* can = m.can()) std::printf("  CAN: %s\n", drivers::describe_bus_load(can->bus_load()).c_str());
+  for (const std::string& n : m.notes()) std::printf("  CAN: %s\n", n.c_str());
 }
 
 int weave(const WeaveArgs& a) {
@@ -129,6 +129,7 @@ int weave(const WeaveArgs& a) {
   mo.telemetry = !a.no_telemetry;
   mo.rows = resume.rows + a.rows;  // the sequencer counts absolute rows; weave `rows` more
   mo.sim_state_path = a.sim_state;
+  if (!a.io.empty()) mo.io = a.io == "simulated" ? firmware::IoKind::kSimulated : firmware::IoKind::kCan;
   std::unique_ptr<firmware::Machine> machine;
   try {
     machine = std::make_unique<firmware::Machine>(cfg, scene, mo, resume);
@@ -139,6 +140,7 @@ int weave(const WeaveArgs& a) {
     std::fprintf(stderr, "loomctl: cannot arm: %s\n", e.what());
     return kExitNotArmed;
   }
+  if (!machine->banner().empty()) std::fprintf(stderr, "loomctl: WARNING: %s\n", machine->banner().c_str());
   if (!a.quiet) print_header(*machine, scene, a);
   if (resume.rows > 0) std::printf("  resuming after row %u (picks %u, beats %u)\n", resume.rows, resume.picks, resume.beats);
 
@@ -313,6 +315,9 @@ int main(int argc, char** argv) {
   weave_cmd->add_option("--rows", a.rows, "rows to weave")->check(CLI::Range(1u, 1000000u));
   weave_cmd->add_option("--hal", a.hal, "sim | socketcan")->check(CLI::IsMember({"sim", "socketcan"}));
   weave_cmd->add_option("--iface", a.iface, "SocketCAN interface (with --hal socketcan), e.g. can0, vcan0");
+  weave_cmd->add_option("--io", a.io,
+                        "with --hal socketcan: can (the CiA 401 I/O node) | simulated (refused unless given here)")
+      ->check(CLI::IsMember({"can", "simulated"}));
   weave_cmd->add_option("--period-ms", a.period_ms, "control period in ms (overrides the config)")
       ->check(kFinite & CLI::Range(0.25, 20.0));
   weave_cmd->add_flag("--realtime", a.realtime, "pace the simulated loom at the tick rate");

@@ -221,6 +221,15 @@ void TomlReader::integer(const std::string& path, std::int64_t& out, std::int64_
   out = *v;
 }
 
+void TomlReader::boolean(const std::string& path, bool& out) {
+  used_.insert(path);
+  const toml::node* n = find(path);
+  if (!n) return;
+  const auto v = n->value_exact<bool>();
+  if (!v) fail_at(*n, path, show(*n), "expected true or false");
+  out = *v;
+}
+
 void TomlReader::string(const std::string& path, std::string& out, const std::set<std::string>& allowed) {
   used_.insert(path);
   const toml::node* n = find(path);

@@ -23,6 +23,7 @@ class TomlReader {
   // Read `table.key` into `out` if present; `check` returns "" when valid or the reason.
   void number(const std::string& path, double& out, const std::function<std::string(double)>& check = {});
   void integer(const std::string& path, std::int64_t& out, std::int64_t lo, std::int64_t hi);
+  void boolean(const std::string& path, bool& out);
   void string(const std::string& path, std::string& out, const std::set<std::string>& allowed = {});
   void string_list(const std::string& path, std::vector<std::string>& out);
 

@@ -75,7 +75,7 @@ TEST(CanAxisPort, ConfigureBringsEveryDriveUpInOrder) {
     EXPECT_GT(write_mode, 0u);
     EXPECT_GT(read_display, write_mode);
   }
-  EXPECT_EQ(rig.port.bus_load().frames, 7u);
+  EXPECT_EQ(rig.port.bus_load().frames, 8u);  // SYNC, 3 RPDO, 3 TPDO, the master heartbeat
 }
 
 TEST(CanAxisPort, OnlyTheMappedPdosFlowAtFourFramesOutPerTick) {
@@ -83,11 +83,12 @@ TEST(CanAxisPort, OnlyTheMappedPdosFlowAtFourFramesOutPerTick) {
   ASSERT_TRUE(rig.configure().is_ok());
   const std::size_t start = rig.net.log().size();
   for (int i = 0; i < 20; ++i) rig.tick(DriveRig::hold(kEnable));
-  int from_master = 0, tpdo1 = 0, other_pdo = 0;
+  int from_master = 0, tpdo1 = 0, other_pdo = 0, master_heartbeats = 0;
   for (std::size_t i = start; i < rig.net.log().size(); ++i) {
     const auto& l = rig.net.log()[i];
     const auto fn = drivers::decode_cob_id(l.frame.id).function;
-    if (l.from == 0) ++from_master;
+    if (l.from == 0 && fn == drivers::CobFunction::kHeartbeat) ++master_heartbeats;
+    if (l.from == 0 && fn != drivers::CobFunction::kHeartbeat) ++from_master;
     if (fn == drivers::CobFunction::kTpdo1) ++tpdo1;
     if (fn == drivers::CobFunction::kTpdo2 || fn == drivers::CobFunction::kTpdo3 ||
         fn == drivers::CobFunction::kTpdo4) {
@@ -95,6 +96,7 @@ TEST(CanAxisPort, OnlyTheMappedPdosFlowAtFourFramesOutPerTick) {
     }
   }
   EXPECT_EQ(from_master, 20 * 4);  // SYNC + 3 RPDO
+  EXPECT_EQ(master_heartbeats, 1);  // every 100 ms = 50 ticks
   EXPECT_EQ(tpdo1, 20 * 3);
   EXPECT_EQ(other_pdo, 0);
 }
@@ -403,7 +405,7 @@ TEST(CanAxisPort, VelocityFromTpdo2OrFromFiniteDifferences) {
     const double tol = 1.0 / (cfg.axes[2].counts_per_unit * dt);
     EXPECT_NEAR(rig.feedback[2].velocity, v, tol) << "tpdo2=" << tpdo2;
     EXPECT_EQ(rig.feedback[2].effort, 0.0);  // the ideal drive needs no torque
-    EXPECT_EQ(rig.port.bus_load().frames, tpdo2 ? 10u : 7u);
+    EXPECT_EQ(rig.port.bus_load().frames, tpdo2 ? 11u : 8u);  // incl. the master heartbeat
   }
 }
 
@@ -467,10 +469,10 @@ TEST(CanAxisPortConfigure, OverloadedBusIsRefusedBeforeAnyFrame) {
   DriveRig rig(three_drives(), cfg);
   const drivers::Status s = rig.configure();
   ASSERT_FALSE(s.is_ok());
-  // SYNC + 9 × 6 B at 1 ms: 55 + 9·115 = 1090 worst-case bits = 109 %.
-  EXPECT_TRUE(contains(s.message(), "10 frames/cycle")) << s.message();
-  EXPECT_TRUE(contains(s.message(), "1090 worst-case")) << s.message();
-  EXPECT_TRUE(contains(s.message(), "109.0 %")) << s.message();
+  // SYNC + 9 × 6 B + master heartbeat (1 B) at 1 ms: 55 + 9·115 + 65 = 1155 worst-case bits = 115.5 %.
+  EXPECT_TRUE(contains(s.message(), "11 frames/cycle")) << s.message();
+  EXPECT_TRUE(contains(s.message(), "1155 worst-case")) << s.message();
+  EXPECT_TRUE(contains(s.message(), "115.5 %")) << s.message();
   EXPECT_TRUE(contains(s.message(), "budget of 70 %")) << s.message();
   for (const auto& l : rig.net.log()) EXPECT_NE(l.from, 0u) << "the master sent a frame";
 }
@@ -481,7 +483,7 @@ TEST(CanAxisPortConfigure, OtherNodesCountTowardTheBudget) {
   DriveRig rig(three_drives(), cfg);
   const drivers::Status s = rig.configure();
   ASSERT_FALSE(s.is_ok());
-  EXPECT_TRUE(contains(s.message(), "1825 worst-case")) << s.message();  // 745 + 1080
+  EXPECT_TRUE(contains(s.message(), "1890 worst-case")) << s.message();  // 745 + 65 + 1080
 }
 
 TEST(CanAxisPortConfigure, InvalidFieldsAreNamed) {

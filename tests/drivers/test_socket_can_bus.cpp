@@ -7,6 +7,7 @@
 
 #include <cerrno>
 
+#include "loom/drivers/can_link_info.hpp"
 #include "loom/drivers/socket_can_bus.hpp"
 
 namespace loom::drivers {
@@ -51,3 +52,32 @@ TEST(SocketCanBus, BadNamesAreRefusedBeforeAnySyscall) {
 
 }  // namespace
 }  // namespace loom::drivers
+
+// ---- the kernel's view of the link (netlink) ------------------------------------------------------
+TEST(CanLinkInfo, LoopbackIsNotACanLinkAndMissingInterfacesAreNamed) {
+  auto lo = loom::drivers::read_can_link_info("lo");
+  ASSERT_TRUE(lo) << lo.error();
+  EXPECT_EQ(lo.value().kind, "");
+  EXPECT_TRUE(lo.value().up);
+  std::string note;
+  EXPECT_EQ(loom::drivers::check_can_bitrate("lo", lo.value(), 1000000, note).message(),
+            "lo is not a CAN interface (link kind '')");
+  auto none = loom::drivers::read_can_link_info("nosuchcan9");
+  ASSERT_FALSE(none);
+  EXPECT_EQ(none.error(), "CAN interface 'nosuchcan9' does not exist");
+}
+
+TEST(CanLinkInfo, BitrateMismatchIsRefusedWithTheFixAndVcanIsAcceptedWithANote) {
+  std::string note;
+  loom::drivers::CanLinkInfo can0{"can", 500000, true};
+  const auto s = loom::drivers::check_can_bitrate("can0", can0, 1000000, note);
+  EXPECT_EQ(s.message(),
+            "can0 runs at 500000 bit/s but can.bitrate = 1000000; bring it up with: ip link set can0 down && "
+            "ip link set can0 type can bitrate 1000000 && ip link set can0 up");
+  can0.bitrate_bps = 1000000;
+  EXPECT_TRUE(loom::drivers::check_can_bitrate("can0", can0, 1000000, note));
+  EXPECT_TRUE(note.empty());
+  loom::drivers::CanLinkInfo vcan{"vcan", 0, true};
+  EXPECT_TRUE(loom::drivers::check_can_bitrate("vcan0", vcan, 1000000, note));
+  EXPECT_NE(note.find("virtual CAN link (vcan): it has no bitrate"), std::string::npos);
+}

@@ -341,3 +341,50 @@ TEST(HilJudgeHeartbeatLoss, NoReactionIsCaught) {
 
 }  // namespace
 }  // namespace loom::hil
+
+// ---- I/O node traffic, EMCY stop, master loss (judge's own unit tests) -----------------------------
+namespace loom::hil {
+namespace {
+
+std::vector<Frame> parse_log(const std::string& text) {
+  std::istringstream in(text);
+  std::vector<Frame> frames;
+  std::string error;
+  EXPECT_TRUE(read_candump_log(in, frames, error)) << error;
+  return frames;
+}
+
+TEST(HilJudgeIo, EverySignalSeenPassesAndAMissingOneIsNamed) {
+  const std::string full =
+      "(1.000000) vcan0 204#01\n(1.002000) vcan0 204#02\n(1.004000) vcan0 184#4A00\n"
+      "(1.006000) vcan0 184#5500\n(1.008000) vcan0 184#6000\n(1.010000) vcan0 284#2C01\n";
+  EXPECT_TRUE(check_io_traffic(parse_log(full), 4).ok);
+  const std::string no_right = "(1.000000) vcan0 204#03\n(1.004000) vcan0 184#5F00\n(1.010000) vcan0 284#2C01\n";
+  const CheckResult r = check_io_traffic(parse_log(no_right), 4);
+  ASSERT_FALSE(r.ok);
+  EXPECT_EQ(r.failure, "never seen on the bus: shuttle at right");
+}
+
+TEST(HilJudgeEmcy, QuickStopRightAfterTheEmcyPassesAndLateOrReenabledFails) {
+  const std::string ok =
+      "(1.000000) vcan0 201#0F0000000000\n(1.000100) vcan0 202#0F0000000000\n(1.001000) vcan0 082#1023030000000000\n"
+      "(1.004000) vcan0 201#020000000000\n(1.004100) vcan0 202#020000000000\n(1.008000) vcan0 201#000000000000\n";
+  EXPECT_TRUE(check_emcy_stop(parse_log(ok), {1, 2}, 2).ok);
+  const std::string late =
+      "(1.001000) vcan0 082#1023030000000000\n(1.004000) vcan0 201#0F0000000000\n(1.004100) vcan0 202#020000000000\n";
+  EXPECT_FALSE(check_emcy_stop(parse_log(late), {1, 2}, 2).ok);
+  const std::string again =
+      "(1.001000) vcan0 082#1023030000000000\n(1.004000) vcan0 201#020000000000\n(1.008000) vcan0 201#0F0000000000\n";
+  EXPECT_FALSE(check_emcy_stop(parse_log(again), {1}, 2).ok);
+}
+
+TEST(HilJudgeMasterLoss, EveryConsumerMustReactInTime) {
+  const std::string ok =
+      "(1.000000) vcan0 77F#05\n(1.160000) vcan0 081#3081100000000000\n(1.170000) vcan0 084#3081110000000000\n";
+  EXPECT_TRUE(check_master_loss(parse_log(ok), {1, 4}, 127, 0.150, 0.05).ok);
+  EXPECT_FALSE(check_master_loss(parse_log(ok), {1, 2}, 127, 0.150, 0.05).ok);  // node 2 silent
+  EXPECT_FALSE(check_master_loss(parse_log(ok), {1, 4}, 127, 0.100, 0.01).ok);  // too late for 100 ms
+}
+
+}  // namespace
+}  // namespace loom::hil

@@ -9,7 +9,7 @@ set -euo pipefail
 hil_init heartbeat_loss "${1:-}"
 hil_require_vcan
 hil_find_binaries
-heartbeat_ms=${LOOM_HIL_HEARTBEAT_MS:-100}  # loomctl's default producer time for the drives
+heartbeat_ms=${LOOM_HIL_HEARTBEAT_MS:-200}  # the drives' producer time in hil_loom.toml
 hil_start_candump
 hil_start_sim_drives
 

@@ -156,7 +156,11 @@ hil_json_int() {
 # loomctl against simulated drives (weave-row.sh, heartbeat-loss.sh)
 # ---------------------------------------------------------------------------------------------------
 HIL_NODES=1,2,3
-HIL_PERIOD_MS=${LOOM_HIL_PERIOD_MS:-4}  # the VM is not real-time: 4 ms cycles lost no replies there (reference/vcan-vm.md)
+HIL_IO_NODE=4
+# Drive personality of loom-sim-drive: standard (writable mappings, 0x1016) or fixed (read-only
+# mappings, no TPDO3/4, no 0x1016, slow boot and switch to operational).
+HIL_PERSONALITY=${LOOM_HIL_PERSONALITY:-standard}
+HIL_PERIOD_MS=${LOOM_HIL_PERIOD_MS:-4}  # the VM is not real-time: 4 ms cycles lost no replies there (tools/vcan/README.md)
 
 # Where these scripts (and the HIL loom config) live.
 HIL_SRC=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
@@ -171,20 +175,30 @@ hil_find_binaries() {
   hil_need_exec "$HIL_CANLOG" loom-hil-canlog
 }
 
-# Start the simulated drives and wait until each has announced itself. Sets HIL_SIM_PID.
+# Start the simulated drives and the simulated I/O node and wait until each has announced itself.
+# Sets HIL_SIM_PID; the I/O node's e-stop/buttons/silence follow the words in HIL_IO_CONTROL.
+# The fixed personality boots after 300 ms and switches to operational after 400 ms (loomctl's
+# default operational window is 1 s).
 hil_start_sim_drives() {
   local mark n
   mark=$(hil_mark)
-  hil_spawn sim "$HIL_SIM" --iface "$HIL_IFACE" --nodes "$HIL_NODES"
+  HIL_IO_CONTROL=$HIL_WORK/io-control
+  : >"$HIL_IO_CONTROL"
+  hil_spawn sim "$HIL_SIM" --iface "$HIL_IFACE" --nodes "$HIL_NODES" --io-node "$HIL_IO_NODE" \
+    --io-control "$HIL_IO_CONTROL" --width-m 0.6 --personality "$HIL_PERSONALITY"
   HIL_SIM_PID=$HIL_LAST_PID
-  for n in ${HIL_NODES//,/ }; do
-    hil_expect "$mark" "$(printf '%03X' $((0x700 + n)))#00" 10 "boot-up of simulated drive node $n" >/dev/null
+  for n in ${HIL_NODES//,/ } $HIL_IO_NODE; do
+    hil_expect "$mark" "$(printf '%03X' $((0x700 + n)))#00" 10 "boot-up of simulated node $n" >/dev/null
   done
-  hil_note "loom-sim-drive up: nodes $HIL_NODES booted (pid $HIL_SIM_PID)"
+  hil_note "loom-sim-drive up ($HIL_PERSONALITY drives): nodes $HIL_NODES and I/O node $HIL_IO_NODE booted (pid $HIL_SIM_PID)"
 }
+
+# hil_io_control WORDS... — what the simulated I/O node's e-stop chain and buttons see from now on.
+hil_io_control() { printf '%s\n' "$*" >"$HIL_IO_CONTROL.tmp" && mv "$HIL_IO_CONTROL.tmp" "$HIL_IO_CONTROL"; }
+
 
 # hil_weave_cmd ROWS COUNTERS_FILE — the loomctl command line under test, into HIL_CMD.
 hil_weave_cmd() {
   HIL_CMD=("$HIL_LOOMCTL" weave --hal socketcan --iface "$HIL_IFACE" --rows "$1" --period-ms "$HIL_PERIOD_MS"
-           --allow-degraded --counters "$2" --config "$HIL_SRC/hil_loom.toml")
+           --allow-degraded --counters "$2" --config "$HIL_SRC/hil_loom.toml" --io can)
 }

@@ -67,6 +67,22 @@ int main(int argc, char** argv) {
   loss->add_option("--periods", periods, "allowed heartbeat periods until the fault reaction")
       ->check(CLI::Range(1, 100));
 
+  int io_node = 4, emcy_node = 0, master = 0x7F;
+  double consumer_ms = 150.0, slack_ms = 500.0;
+  auto* io = app.add_subcommand("io", "every valve and sensor of the CiA 401 I/O node crossed the bus");
+  io->add_option("log", log, "candump -L log")->required();
+  io->add_option("--node", io_node, "I/O node id")->check(CLI::Range(1, 127));
+  auto* emcy = app.add_subcommand("emcy-stop", "quick stop of every drive right after an EMCY");
+  emcy->add_option("log", log, "candump -L log")->required();
+  emcy->add_option("--nodes", nodes, "drive node ids")->required()->delimiter(',')->check(CLI::Range(1, 127));
+  emcy->add_option("--emcy-node", emcy_node, "node whose EMCY is checked")->required()->check(CLI::Range(1, 127));
+  auto* mloss = app.add_subcommand("master-loss", "every node's 0x1016 consumer reacts when the master dies");
+  mloss->add_option("log", log, "candump -L log")->required();
+  mloss->add_option("--nodes", nodes, "node ids")->required()->delimiter(',')->check(CLI::Range(1, 127));
+  mloss->add_option("--master", master, "master node id")->check(CLI::Range(1, 127));
+  mloss->add_option("--consumer-ms", consumer_ms, "consumer time (ms)")->check(CLI::Range(1.0, 65535.0));
+  mloss->add_option("--slack-ms", slack_ms, "allowed lateness (the VM is not real-time)")->check(CLI::Range(0.0, 10000.0));
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -81,5 +97,10 @@ int main(int argc, char** argv) {
   std::cout << log << ": " << loom::hil::describe(loom::hil::summarize(frames)) << "\n";
   if (summary->parsed()) return 0;
   if (weave->parsed()) return report("weave protocol", loom::hil::check_weave_protocol(frames, nodes));
+  if (io->parsed()) return report("I/O traffic", loom::hil::check_io_traffic(frames, io_node));
+  if (emcy->parsed()) return report("EMCY stop", loom::hil::check_emcy_stop(frames, nodes, emcy_node));
+  if (mloss->parsed()) {
+    return report("master loss", loom::hil::check_master_loss(frames, nodes, master, consumer_ms * 1e-3, slack_ms * 1e-3));
+  }
   return report("heartbeat loss", loom::hil::check_heartbeat_loss(frames, nodes, heartbeat_ms * 1e-3, periods));
 }

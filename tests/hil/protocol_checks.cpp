@@ -1,5 +1,5 @@
 // The HIL protocol checks. Each expectation is a CiA 301/402 fact (COB-IDs, NMT/SDO command bytes,
-// statusword masks, controlword values: shared/reference/canopen.md); each failure names the log line
+// statusword masks, controlword values: CiA 301 / CiA 402); each failure names the log line
 // and the frame, so a red test says what the bus showed.
 #include "protocol_checks.hpp"
 
@@ -312,6 +312,149 @@ CheckResult check_heartbeat_loss(const std::vector<Frame>& fs, const std::vector
                       hex(*controlword(fs[*fault], n, l), 4) + " " + show(fs, *fault) + " after " + ms +
                       " (limit " + std::to_string(limit_us / 1000) + " ms); " + std::to_string(rpdos_after) +
                       " RPDOs after it, all holding the target");
+  }
+  return r;
+}
+
+}  // namespace loom::hil
+
+// ---------------------------------------------------------------------------------------------------
+// I/O node and fault reactions (written from CiA 301/401 byte layouts, not the master's codec)
+// ---------------------------------------------------------------------------------------------------
+namespace loom::hil {
+
+namespace {
+std::string at_line(const Frame& f) {
+  return "line " + std::to_string(f.line);
+}
+}  // namespace
+
+CheckResult check_io_traffic(const std::vector<Frame>& frames, int io_node) {
+  CheckResult r;
+  const auto rpdo = static_cast<std::uint32_t>(0x200 + io_node);
+  const auto tpdo = static_cast<std::uint32_t>(0x180 + io_node);
+  const auto analog = static_cast<std::uint32_t>(0x280 + io_node);
+  int n_out = 0, n_in = 0, n_an = 0;
+  std::uint8_t out_seen = 0, in_seen = 0;
+  bool loaded = false;
+  for (const Frame& f : frames) {
+    if (f.error_frame || f.rtr || f.extended) continue;
+    if (f.id == rpdo && f.len >= 1) {
+      ++n_out;
+      out_seen |= f.data[0];
+    } else if (f.id == tpdo && f.len >= 1) {
+      ++n_in;
+      in_seen |= f.data[0];
+    } else if (f.id == analog && f.len >= 2) {
+      ++n_an;
+      loaded = loaded || static_cast<std::int16_t>(f.u16(0)) > 0;
+    }
+  }
+  r.notes.push_back("I/O node " + std::to_string(io_node) + ": " + std::to_string(n_out) + " output RPDOs, " +
+                    std::to_string(n_in) + " input TPDOs, " + std::to_string(n_an) + " load-cell TPDOs");
+  const char* const in_names[] = {"piston A extended", "piston A retracted", "piston B extended",
+                                  "piston B retracted", "shuttle at left", "shuttle at right", "e-stop chain closed"};
+  std::string missing;
+  if ((out_seen & 1) == 0) missing += ", valve A on";
+  if ((out_seen & 2) == 0) missing += ", valve B on";
+  for (int b = 0; b < 7; ++b) {
+    if ((in_seen & (1 << b)) == 0) missing += std::string(", ") + in_names[b];
+  }
+  if (!loaded) missing += ", a load-cell force > 0";
+  if (!missing.empty()) {
+    r.ok = false;
+    r.failure = "never seen on the bus: " + missing.substr(2);
+  }
+  return r;
+}
+
+CheckResult check_emcy_stop(const std::vector<Frame>& frames, const std::vector<int>& nodes, int emcy_node) {
+  CheckResult r;
+  std::size_t k = 0;
+  for (; k < frames.size(); ++k) {
+    const Frame& f = frames[k];
+    if (!f.error_frame && f.id == static_cast<std::uint32_t>(0x80 + emcy_node) && f.len == 8 && f.u16(0) != 0) break;
+  }
+  if (k == frames.size()) {
+    r.ok = false;
+    r.failure = "no EMCY with a non-zero code from node " + std::to_string(emcy_node);
+    return r;
+  }
+  const Frame& emcy = frames[k];
+  char buf[160];
+  std::snprintf(buf, sizeof(buf), "EMCY 0x%04X from node %d at %s", emcy.u16(0), emcy_node, at_line(emcy).c_str());
+  r.notes.push_back(buf);
+  for (int node : nodes) {
+    bool first = true;
+    for (std::size_t j = k + 1; j < frames.size(); ++j) {
+      const Frame& f = frames[j];
+      if (f.error_frame || f.id != static_cast<std::uint32_t>(0x200 + node) || f.len < 2) continue;
+      const std::uint16_t cw = f.u16(0);
+      if (first) {
+        first = false;
+        const bool stop = (cw & 0x0F) == 0x02 || (cw & 0x02) == 0;
+        std::snprintf(buf, sizeof(buf), "node %d: first RPDO1 after the EMCY at %s (%.1f ms later): controlword 0x%04X",
+                      node, at_line(f).c_str(), static_cast<double>(f.t_us - emcy.t_us) * 1e-3, cw);
+        r.notes.push_back(buf);
+        if (!stop) {
+          r.ok = false;
+          r.failure = std::string(buf) + " is not quick stop (0x0002) or disable voltage";
+          return r;
+        }
+      } else if ((cw & 0x0F) == 0x0F) {
+        r.ok = false;
+        std::snprintf(buf, sizeof(buf), "node %d re-enabled after the EMCY at %s (controlword 0x%04X)", node,
+                      at_line(f).c_str(), cw);
+        r.failure = buf;
+        return r;
+      }
+    }
+    if (first) {
+      r.ok = false;
+      r.failure = "no RPDO1 to node " + std::to_string(node) + " after the EMCY";
+      return r;
+    }
+  }
+  return r;
+}
+
+CheckResult check_master_loss(const std::vector<Frame>& frames, const std::vector<int>& nodes, int master,
+                              double consumer_s, double slack_s) {
+  CheckResult r;
+  const Frame* last_hb = nullptr;
+  for (const Frame& f : frames) {
+    if (!f.error_frame && f.id == static_cast<std::uint32_t>(0x700 + master) && f.len == 1) last_hb = &f;
+  }
+  if (last_hb == nullptr) {
+    r.ok = false;
+    r.failure = "the master (node " + std::to_string(master) + ") never sent a heartbeat";
+    return r;
+  }
+  r.notes.push_back("last master heartbeat at " + at_line(*last_hb));
+  for (int node : nodes) {
+    const Frame* emcy = nullptr;
+    for (const Frame& f : frames) {
+      if (f.line > last_hb->line && !f.error_frame && f.id == static_cast<std::uint32_t>(0x80 + node) && f.len == 8 &&
+          f.u16(0) == 0x8130) {
+        emcy = &f;
+        break;
+      }
+    }
+    if (emcy == nullptr) {
+      r.ok = false;
+      r.failure = "node " + std::to_string(node) + " sent no EMCY 0x8130 after the master's last heartbeat";
+      return r;
+    }
+    const double dt = static_cast<double>(emcy->t_us - last_hb->t_us) * 1e-6;
+    char buf[128];
+    std::snprintf(buf, sizeof(buf), "node %d: EMCY 0x8130 %.0f ms after the last master heartbeat (%s)", node,
+                  dt * 1e3, at_line(*emcy).c_str());
+    r.notes.push_back(buf);
+    if (dt > consumer_s + slack_s) {
+      r.ok = false;
+      r.failure = std::string(buf) + ": later than the consumer time + slack";
+      return r;
+    }
   }
   return r;
 }

@@ -1,5 +1,5 @@
 // Protocol checks over a candump log for the HIL tests: what loomctl and the simulated drives said on
-// the bus, judged against CiA 301/402 facts (shared/reference/canopen.md), in order and content rather
+// the bus, judged against CiA 301/402 facts (CiA 301 / CiA 402), in order and content rather
 // than timing (the VM is not real-time). Configure-time only: test tooling, allocates freely.
 #pragma once
 
@@ -52,5 +52,24 @@ CheckResult check_weave_protocol(const std::vector<Frame>& frames, const std::ve
 // `periods` × `heartbeat_s`; and no RPDO after that fault commands a target other than the fault's own.
 CheckResult check_heartbeat_loss(const std::vector<Frame>& frames, const std::vector<int>& nodes,
                                  double heartbeat_s, int periods, const PdoLayout& layout = {});
+
+}  // namespace loom::hil
+
+namespace loom::hil {
+
+// Every actuator and sensor of the CiA 401 I/O node `io_node` crossed the bus (pre-defined PDO ids, the
+// HIL wiring: outputs bit 0/1 = valves A/B; inputs bit 0..6 = A extended, A retracted, B extended,
+// B retracted, shuttle left, shuttle right, e-stop chain closed; TPDO2 = load cell, signed 16 bit).
+CheckResult check_io_traffic(const std::vector<Frame>& frames, int io_node);
+
+// An EMCY with a non-zero code from `emcy_node` (the first such frame in the log): the master's next
+// RPDO1 to every drive in `nodes` after it carries quick stop (controlword bits 2 and 7 clear, bit 1 set:
+// 0x0002) or disable voltage (0x0000), and no later RPDO1 enables operation again.
+CheckResult check_emcy_stop(const std::vector<Frame>& frames, const std::vector<int>& nodes, int emcy_node);
+
+// The master's heartbeat (0x700 + master) stops (it was killed): every node in `nodes` sends an EMCY
+// 0x8130 (heartbeat consumer) within `consumer_s` + `slack_s` of the master's last heartbeat.
+CheckResult check_master_loss(const std::vector<Frame>& frames, const std::vector<int>& nodes, int master,
+                              double consumer_s, double slack_s);
 
 }  // namespace loom::hil

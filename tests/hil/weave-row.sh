@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
-# HIL: loomctl weaves one row over SocketCAN against the simulated CiA 402 drives on a real vcan0.
+# HIL: loomctl weaves one row over SocketCAN against the simulated CiA 402 drives and the simulated
+# CiA 401 I/O node on a real vcan0 (drive personality from LOOM_HIL_PERSONALITY: standard or fixed), so
+# every valve, sensor, e-stop and load-cell value crosses the bus.
 # Judged from candump's record of the bus (loom-hil-canlog weave): NMT reset → boot-ups → 0x6060 = 8
 # confirmed by 0x6061 → NMT start → SYNC with RPDOs and TPDOs → Operation enabled; and from loomctl's
 # exit status (0), its per-row summary line and the counters file it writes.
 # usage: weave-row.sh BUILD_DIR   (exit 77 = skipped: no vcan0 here)
 set -euo pipefail
 . "$(dirname "$0")/hil-lib.sh"
-hil_init weave_row "${1:-}"
+hil_init "weave_row_${LOOM_HIL_PERSONALITY:-standard}" "${1:-}"
 hil_require_vcan
 hil_find_binaries
 hil_start_candump
@@ -41,4 +43,5 @@ done
 hil_note "loomctl completed 1 row (exit 0); counters: $(tr -d '\n' <"$counters")"
 
 "$HIL_CANLOG" weave "$HIL_LOG" --nodes "$HIL_NODES" || hil_fail "bus protocol check failed (see above); log: $HIL_LOG"
+"$HIL_CANLOG" io "$HIL_LOG" --node "$HIL_IO_NODE" || hil_fail "I/O node traffic incomplete (see above); log: $HIL_LOG"
 hil_report_frames

@@ -1,6 +1,11 @@
-// loom-sim-drive: simulated CiA 402 servo drives on a (v)CAN interface, so the firmware's CANopen master
-// can be tested end to end without hardware. Runs until SIGINT/SIGTERM; bad arguments exit 2.
-//   loom-sim-drive --iface vcan0 --nodes 1,2,3 [--counts-per-unit A,B,C] [--initial-position a,b,c]
+// loom-sim-drive: simulated CiA 402 servo drives and (optionally) the loom's CiA 401 I/O node on a (v)CAN
+// interface, so the firmware's CANopen master can be tested end to end without hardware. Runs until
+// SIGINT/SIGTERM; bad arguments exit 2.
+//   loom-sim-drive --iface vcan0 --nodes 1,2,3 [--io-node 4] [--personality standard|fixed]
+//                  [--counts-per-unit A,B,C] [--initial-position a,b,c] [--io-control FILE]
+// The I/O node's pistons follow its valve outputs, its shuttle sensors the helix drive (3rd node), its
+// load cell the crank drive (1st node). --io-control FILE is re-read when it changes: whitespace-separated
+// words estop, start, pause, ack, knotted, silent (present = active), for HIL fault tests.
 #include <poll.h>
 #include <time.h>
 
@@ -12,8 +17,11 @@
 #include <cstdio>
 #include <iostream>
 #include <limits>
+#include <fstream>
 #include <set>
+#include <sstream>
 #include <string>
+#include <sys/stat.h>
 #include <vector>
 
 #include "loom/drivers/can_axis_port.hpp"
@@ -54,7 +62,22 @@ int main(int argc, char** argv) {
   std::vector<double> initial_position;
   std::uint32_t max_step_counts = 0;
   bool verbose = false;
+  int io_node = 0;
+  std::string personality = "standard";
+  std::string io_control;
+  double boot_delay_ms = -1.0, operational_delay_ms = -1.0;
+  double width_m = 0.6, helix_lead_m = 0.1;
   app.add_option("--iface", iface, "CAN interface, e.g. vcan0")->required();
+  app.add_option("--io-node", io_node, "also simulate the CiA 401 I/O node with this node id (1..127)");
+  app.add_option("--io-control", io_control, "file of words estop/start/pause/ack/knotted/silent for the I/O node");
+  app.add_option("--width-m", width_m, "loom width for the I/O node's shuttle sensors (default 0.6)");
+  app.add_option("--helix-lead-m", helix_lead_m, "helix lead for the I/O node's shuttle sensors (default 0.1)");
+  app.add_option("--personality", personality,
+                 "standard | fixed (read-only PDO mappings, no TPDO3/4, no 0x1016, slow boot and start)")
+      ->check(CLI::IsMember({"standard", "fixed"}));
+  app.add_option("--boot-delay-ms", boot_delay_ms, "boot-up delay (default 0; fixed personality 300)");
+  app.add_option("--operational-delay-ms", operational_delay_ms,
+                 "NMT start → operational delay (default 0; fixed personality 400)");
   app.add_option("--nodes", nodes, "node ids, comma separated (1..127)")->delimiter(',');
   app.add_option("--counts-per-unit", counts_per_unit,
                  "counts per SI unit per node (rad or m); default 2^20/2π, 2^20/0.01 m, 2^20/2π")
@@ -78,6 +101,19 @@ int main(int argc, char** argv) {
     if (!seen.insert(n).second) return usage_error("--nodes: node id " + std::to_string(n) + " given twice");
   }
   if (nodes.empty()) return usage_error("--nodes: at least one node id is needed");
+  if (io_node != 0 && (io_node < 1 || io_node > 127)) {
+    return usage_error("--io-node: node id " + std::to_string(io_node) + " is outside 1..127");
+  }
+  if (io_node != 0 && seen.count(io_node) != 0) {
+    return usage_error("--io-node: node id " + std::to_string(io_node) + " is already a drive in --nodes");
+  }
+  const bool fixed = personality == "fixed";
+  if (boot_delay_ms < 0.0) boot_delay_ms = fixed ? 300.0 : 0.0;
+  if (operational_delay_ms < 0.0) operational_delay_ms = fixed ? 400.0 : 0.0;
+  if (boot_delay_ms > 60000.0 || operational_delay_ms > 60000.0) {
+    return usage_error("--boot-delay-ms / --operational-delay-ms: at most 60000");
+  }
+  if (!(width_m > 0.0) || !(helix_lead_m > 0.0)) return usage_error("--width-m / --helix-lead-m must be > 0");
   if (!counts_per_unit.empty() && counts_per_unit.size() != nodes.size()) {
     return usage_error("--counts-per-unit: " + std::to_string(counts_per_unit.size()) + " values for " +
                        std::to_string(nodes.size()) + " nodes");
@@ -102,6 +138,12 @@ int main(int argc, char** argv) {
     c.node_id = static_cast<std::uint8_t>(nodes[i]);
     c.initial_position = static_cast<std::int32_t>(std::lround(x));
     c.max_step_counts = max_step_counts;
+    c.boot_delay_us = static_cast<std::int64_t>(boot_delay_ms * 1000.0);
+    c.operational_delay_us = static_cast<std::int64_t>(operational_delay_ms * 1000.0);
+    if (fixed) {
+      c.fixed_mapping = true;
+      c.missing_objects = {0x1802, 0x1803, 0x1A02, 0x1A03, 0x1016};
+    }
     configs.push_back(c);
   }
 
@@ -116,10 +158,49 @@ int main(int argc, char** argv) {
   std::signal(SIGTERM, on_signal);
 
   loom::sim_can::SimDriveRack rack(bus, configs);
+  std::unique_ptr<loom::sim_can::SimIoNode> io;
+  if (io_node != 0) {
+    loom::sim_can::SimIoConfig ic;
+    ic.node_id = static_cast<std::uint8_t>(io_node);
+    ic.width_m = width_m;
+    ic.helix_lead_m = helix_lead_m;
+    io = std::make_unique<loom::sim_can::SimIoNode>(bus, ic);
+    const double crank_cpr = counts_per_unit.empty() ? default_counts_per_unit(0) : counts_per_unit[0];
+    const double helix_cpr =
+        counts_per_unit.size() > 2 ? counts_per_unit[2] : default_counts_per_unit(2);
+    rack.attach_io(*io, {0, 2, crank_cpr, helix_cpr});
+  }
+  // The control file (HIL fault tests): re-read when its modification time changes.
+  timespec control_mtime{};
+  const auto read_control = [&] {
+    if (io_control.empty()) return;
+    struct stat st {};
+    if (::stat(io_control.c_str(), &st) != 0) return;
+    if (st.st_mtim.tv_sec == control_mtime.tv_sec && st.st_mtim.tv_nsec == control_mtime.tv_nsec) return;
+    control_mtime = st.st_mtim;
+    std::ifstream in(io_control);
+    std::stringstream words;
+    words << in.rdbuf();
+    loom::sim_can::IoPlant& p = rack.io_controls();
+    p.estop_open = p.button_start = p.button_pause = p.button_ack = p.row_knotted = p.silent = false;
+    std::string w;
+    while (words >> w) {
+      if (w == "estop") p.estop_open = true;
+      else if (w == "start") p.button_start = true;
+      else if (w == "pause") p.button_pause = true;
+      else if (w == "ack") p.button_ack = true;
+      else if (w == "knotted") p.row_knotted = true;
+      else if (w == "silent") p.silent = true;
+      else std::cerr << "loom-sim-drive: --io-control: unknown word '" << w << "' ignored\n";
+    }
+    std::cerr << "loom-sim-drive: I/O controls now: " << words.str();
+  };
   rack.power_on(monotonic_us());
-  std::cerr << "loom-sim-drive: " << nodes.size() << " drive(s) on " << iface << ", nodes";
+  std::cerr << "loom-sim-drive: " << nodes.size() << " " << personality << " drive(s) on " << iface << ", nodes";
   for (int n : nodes) std::cerr << ' ' << n;
+  if (io_node != 0) std::cerr << ", I/O node " << io_node;
   std::cerr << std::endl;
+  std::int64_t next_control_check = 0;
 
   std::vector<std::pair<loom::drivers::NmtState, loom::hal::DriveState>> shown(rack.size());
   while (g_stop == 0) {
@@ -132,7 +213,12 @@ int main(int argc, char** argv) {
       std::perror("loom-sim-drive: poll");
       return 1;
     }
-    rack.step(monotonic_us());
+    const std::int64_t t = monotonic_us();
+    if (t >= next_control_check) {
+      read_control();
+      next_control_check = t + 20'000;
+    }
+    rack.step(t);
     if (verbose) {
       for (std::size_t i = 0; i < rack.size(); ++i) {
         const auto& n = rack.node(i);

@@ -57,6 +57,16 @@ void SimDriveNode::reset_communication() {
   rpdo_comm_[0].type = 1;
   rpdo_map_[0] = PdoMap{2, {0x60400010, 0x607A0020}};
   tpdo_map_[0] = PdoMap{2, {0x60410010, 0x60640020}};
+  if (!config_.tpdo1_factory_mapping.empty()) {
+    tpdo_map_[0] = PdoMap{};
+    for (std::size_t e = 0; e < config_.tpdo1_factory_mapping.size() && e < 8; ++e) {
+      tpdo_map_[0].entries[e] = config_.tpdo1_factory_mapping[e];
+    }
+    tpdo_map_[0].count = static_cast<std::uint8_t>(std::min<std::size_t>(8, config_.tpdo1_factory_mapping.size()));
+  }
+  consumer_ = 0;
+  master_seen_us_ = -1;
+  master_lost_ = false;
   tpdo_map_[1] = PdoMap{2, {0x606C0020, 0x60770010}};
   rpdo_pending_.fill(false);
   syncs_ = 0;
@@ -81,6 +91,16 @@ void SimDriveNode::power_on(std::int64_t now_us) {
   reset_application();
   nmt_ = NmtState::kPreOperational;
   next_heartbeat_us_ = now_us;
+  boot_up(now_us);
+}
+
+void SimDriveNode::boot_up(std::int64_t now_us) {
+  operational_at_us_ = -1;
+  if (config_.boot_delay_us > 0) {
+    boot_at_us_ = now_us + config_.boot_delay_us;  // silent until then
+    return;
+  }
+  boot_at_us_ = -1;
   send(drivers::make_heartbeat(config_.node_id, NmtState::kBootUp));
 }
 
@@ -96,7 +116,12 @@ void SimDriveNode::send(const CanFrame& f) {
 // Frames in
 // ---------------------------------------------------------------------------------------------------
 void SimDriveNode::handle(const CanFrame& f, std::int64_t now_us) {
-  if (!powered_ || f.is_error() || f.is_rtr()) return;
+  if (!powered_ || f.is_error() || f.is_rtr() || boot_at_us_ >= 0) return;
+  // The master's heartbeat, watched through 0x1016:01 (node << 16 | ms).
+  if (consumer_ != 0 && f.id == drivers::cob::heartbeat(static_cast<std::uint8_t>((consumer_ >> 16) & 0x7F))) {
+    master_seen_us_ = now_us;
+    return;
+  }
   if (f.id == drivers::cob::kNmt) {
     on_nmt(f, now_us);
     return;
@@ -123,7 +148,11 @@ void SimDriveNode::on_nmt(const CanFrame& f, std::int64_t now_us) {
   if (!msg || (msg->node != 0 && msg->node != config_.node_id)) return;
   switch (msg->command) {
     case drivers::NmtCommand::kStart:
-      nmt_ = NmtState::kOperational;
+      if (config_.operational_delay_us > 0) {
+        operational_at_us_ = now_us + config_.operational_delay_us;
+      } else {
+        nmt_ = NmtState::kOperational;
+      }
       break;
     case drivers::NmtCommand::kStop:
       nmt_ = NmtState::kStopped;
@@ -138,7 +167,7 @@ void SimDriveNode::on_nmt(const CanFrame& f, std::int64_t now_us) {
       reset_communication();
       nmt_ = NmtState::kPreOperational;
       next_heartbeat_us_ = now_us;
-      send(drivers::make_heartbeat(config_.node_id, NmtState::kBootUp));
+      boot_up(now_us);
       break;
   }
 }
@@ -320,7 +349,27 @@ void SimDriveNode::inject_fault(std::uint16_t code) {
 // Timers
 // ---------------------------------------------------------------------------------------------------
 void SimDriveNode::step(std::int64_t now_us) {
-  if (!powered_ || heartbeat_ms_ == 0) return;
+  if (!powered_) return;
+  if (boot_at_us_ >= 0) {
+    if (now_us < boot_at_us_) return;
+    boot_at_us_ = -1;
+    send(drivers::make_heartbeat(config_.node_id, NmtState::kBootUp));
+  }
+  if (operational_at_us_ >= 0 && now_us >= operational_at_us_) {
+    operational_at_us_ = -1;
+    nmt_ = NmtState::kOperational;
+  }
+  // Heartbeat consumer expired: the drive's abort-connection reaction (0x6007 = 3, quick stop) and an
+  // EMCY 0x8130, by itself, whatever the master last commanded.
+  const std::int64_t window_us = static_cast<std::int64_t>(consumer_ & 0xFFFF) * 1000;
+  if (consumer_ != 0 && window_us > 0 && master_seen_us_ >= 0 && !master_lost_ &&
+      now_us - master_seen_us_ > window_us) {
+    master_lost_ = true;
+    if (state_ == DriveState::kOperationEnabled) state_ = DriveState::kQuickStopActive;
+    error_register_ |= 0x10;  // communication
+    send(drivers::make_emcy(config_.node_id, drivers::fault_code::kHeartbeatLost, error_register_));
+  }
+  if (heartbeat_ms_ == 0) return;
   if (now_us >= next_heartbeat_us_) {
     send(drivers::make_heartbeat(config_.node_id, nmt_));
     const std::int64_t period_us = static_cast<std::int64_t>(heartbeat_ms_) * 1000;
@@ -330,8 +379,14 @@ void SimDriveNode::step(std::int64_t now_us) {
 }
 
 std::int64_t SimDriveNode::next_deadline_us() const {
-  if (!powered_ || heartbeat_ms_ == 0) return std::numeric_limits<std::int64_t>::max();
-  return next_heartbeat_us_;
+  if (!powered_) return std::numeric_limits<std::int64_t>::max();
+  std::int64_t t = heartbeat_ms_ == 0 ? std::numeric_limits<std::int64_t>::max() : next_heartbeat_us_;
+  if (boot_at_us_ >= 0) t = std::min(t, boot_at_us_);
+  if (operational_at_us_ >= 0) t = std::min(t, operational_at_us_);
+  if (consumer_ != 0 && master_seen_us_ >= 0 && !master_lost_) {
+    t = std::min(t, master_seen_us_ + static_cast<std::int64_t>(consumer_ & 0xFFFF) * 1000 + 1);
+  }
+  return t;
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -412,6 +467,16 @@ std::uint32_t SimDriveNode::read_object(std::uint16_t index, std::uint8_t sub, s
       return one(error_register_, 1);
     case od::kHeartbeatProducer:
       return one(heartbeat_ms_, 2);
+    case 0x1016:
+      if (sub == 0) {
+        value = 1;
+        size = 1;
+        return 0;
+      }
+      if (sub != 1) return abort_code::kNoSubIndex;
+      value = consumer_;
+      size = 4;
+      return 0;
     case od::kErrorCode:
       return one(error_code_, 2);
     case od::kControlword:
@@ -479,6 +544,7 @@ std::uint32_t SimDriveNode::write_pdo_comm(PdoComm& c, bool rx, std::uint8_t sub
 std::uint32_t SimDriveNode::write_pdo_map(PdoMap& m, const PdoComm& c, bool rx, std::uint8_t sub,
                                           std::uint32_t value) {
   if (sub > 8) return abort_code::kNoSubIndex;
+  if (config_.fixed_mapping) return abort_code::kReadOnly;
   // CiA 301: the mapping may change only while the PDO is invalid, entries only while :00 = 0.
   if ((c.cob_id & kInvalid) == 0) return abort_code::kUnsupportedAccess;
   if (sub == 0) {
@@ -518,6 +584,15 @@ std::uint32_t SimDriveNode::write_object(std::uint16_t index, std::uint8_t sub, 
     if (const std::uint32_t e = check_size(size, sub == 0 ? 1 : 4)) return e;
     const std::size_t k = index - od::kTpdoMap;
     return write_pdo_map(tpdo_map_[k], tpdo_comm_[k], false, sub, value);
+  }
+  if (index == 0x1016) {
+    if (sub == 0) return abort_code::kReadOnly;
+    if (sub != 1) return abort_code::kNoSubIndex;
+    if (const std::uint32_t e = check_size(size, 4)) return e;
+    consumer_ = value;
+    master_seen_us_ = -1;
+    master_lost_ = false;
+    return 0;
   }
   if (index == od::kInterpolationPeriod) {
     if (sub == 0) return abort_code::kReadOnly;

@@ -10,21 +10,39 @@ SimDriveRack::SimDriveRack(drivers::CanBus& bus, const std::vector<SimDriveConfi
   for (const SimDriveConfig& c : nodes) nodes_.push_back(std::make_unique<SimDriveNode>(bus_, c));
 }
 
+void SimDriveRack::attach_io(SimIoNode& io, IoPlantSource source) {
+  io_ = &io;
+  io_source_ = source;
+}
+
 void SimDriveRack::power_on(std::int64_t now_us) {
   for (auto& n : nodes_) n->power_on(now_us);
+  if (io_ != nullptr) io_->power_on(now_us);
 }
 
 void SimDriveRack::step(std::int64_t now_us, int max_frames) {
   drivers::CanFrame f;
   for (int i = 0; i < max_frames && bus_.receive(f); ++i) {
     for (auto& n : nodes_) n->handle(f, now_us);
+    if (io_ != nullptr) io_->handle(f, now_us);
   }
   for (auto& n : nodes_) n->step(now_us);
+  if (io_ != nullptr) {
+    IoPlant p = io_controls_;
+    if (io_source_.crank < nodes_.size()) {
+      p.crank_rad = static_cast<double>(nodes_[io_source_.crank]->position()) / io_source_.crank_counts_per_rad;
+    }
+    if (io_source_.helix < nodes_.size()) {
+      p.helix_rad = static_cast<double>(nodes_[io_source_.helix]->position()) / io_source_.helix_counts_per_rad;
+    }
+    io_->step(now_us, p);
+  }
 }
 
 std::int64_t SimDriveRack::next_deadline_us() const {
   std::int64_t t = std::numeric_limits<std::int64_t>::max();
   for (const auto& n : nodes_) t = std::min(t, n->next_deadline_us());
+  if (io_ != nullptr) t = std::min(t, io_->next_deadline_us());
   return t;
 }
 

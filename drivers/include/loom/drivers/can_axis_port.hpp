@@ -12,6 +12,7 @@
 
 #include "loom/drivers/bus_load.hpp"
 #include "loom/drivers/can_frame.hpp"
+#include "loom/drivers/can_io_port.hpp"
 #include "loom/drivers/cia402.hpp"
 #include "loom/drivers/configure_clock.hpp"
 #include "loom/drivers/position_scaling.hpp"
@@ -32,6 +33,14 @@ struct CanAxisConfig {
   std::uint8_t node_id = 1;
   double counts_per_unit = kDefaultCountsPerRad;  // counts per rad (rotary) or per m (carriage)
   double rated_effort = 0.0;  // N·m or N at 1000 ‰ of 0x6077; 0 = effort not reported (needs TPDO2)
+  // Following-error supervision (LinuxCNC rule): |commanded − actual| > max(ferror_min, ferror_k_s·|v_cmd|)
+  // is a fault. SI units of the axis (rad or m) and seconds. ferror_min = 0 disables it.
+  double ferror_min = 0.0;
+  double ferror_k_s = 0.0;
+  // Per-node bring-up windows (drives differ: some boot or go operational in hundreds of ms).
+  // 0 = the port-wide boot_timeout_s / operational_timeout_s.
+  double boot_timeout_s = 0.0;
+  double operational_timeout_s = 0.0;
 };
 
 struct CanAxisPortConfig {
@@ -49,6 +58,17 @@ struct CanAxisPortConfig {
   double sdo_timeout_s = 0.100;
   double boot_timeout_s = 2.0;          // wait for every boot-up after NMT reset-node
   double state_timeout_s = 0.5;         // CiA 402 transition not confirmed → fault
+  // Operational heartbeat after NMT start (many commercial drives take hundreds of ms); per-node
+  // CanAxisConfig::operational_timeout_s overrides it.
+  double operational_timeout_s = 1.0;
+  // The master's own heartbeat (0x700 + id, state operational) every master_heartbeat_s, and each drive's
+  // consumer 0x1016:01 set to watch it for master_consumer_s where the drive has 0x1016, so a drive stops
+  // when the host dies. master_node_id = 0: no master heartbeat, no consumer configured.
+  std::uint8_t master_node_id = 0x7F;
+  // A CSP drive that stops receiving targets holds its last one at once; the consumer adds the power
+  // stage's own reaction (quick stop) and must not trip on a loaded host's scheduling stalls.
+  double master_heartbeat_s = 0.100;
+  double master_consumer_s = 0.500;
   bool tpdo2 = false;                   // velocity + torque PDO (adds 3 frames per cycle)
   std::uint8_t tpdo2_every_n_sync = 1;  // 1..240
   std::uint32_t bitrate_bps = 1'000'000;
@@ -58,6 +78,10 @@ struct CanAxisPortConfig {
 
 // Configure-time only. Error naming the field and its value.
 Status validate(const CanAxisPortConfig& config);
+// Configure-time only. The worst cycle this configuration puts on the bus: SYNC, each drive's RPDO1
+// and TPDO1 (and TPDO2), the other nodes' frames and the master heartbeat. The same figure the port
+// checks against its budget when it configures, and `loomctl check` prints.
+BusLoad planned_bus_load(const CanAxisPortConfig& config);
 
 class CanAxisPort final : public hal::AxisPort {
  public:
@@ -66,6 +90,10 @@ class CanAxisPort final : public hal::AxisPort {
 
   // Configure-time only.
   explicit CanAxisPort(CanAxisPortConfig config);
+
+  // Configure-time only. Another node on this bus (the I/O node): every frame it sends is handed to it
+  // in read_axes(), its faults stop every axis, its fault code is reported as a link fault. At most 4.
+  void attach(CanNodeListener& node);
 
   // Configure-time only; blocks with timeouts. Validates the configuration and the bus load, then:
   // NMT reset-node → every boot-up → per drive by SDO: 0x6502 has CSP, 0x6060 = 8 confirmed by 0x6061,
@@ -82,6 +110,12 @@ class CanAxisPort final : public hal::AxisPort {
 
   // Diagnostics; RT-safe to read.
   bool configured() const { return configured_; }
+  // What configure() found optional and absent (0x1016, TPDO2) or accepted as read back; one line each.
+  const std::vector<std::string>& notes() const { return notes_; }
+  // Largest following error seen per axis since configure(), in SI units (telemetry high-water mark).
+  double ferror_high_water(hal::Axis a) const { return axes_[hal::index(a)].ferror_high_water; }
+  bool has_consumer(hal::Axis a) const { return axes_[hal::index(a)].has_consumer; }
+  bool has_tpdo2(hal::Axis a) const { return axes_[hal::index(a)].has_tpdo2; }
   const BusLoad& bus_load() const { return bus_load_; }
   const CanAxisPortConfig& config() const { return config_; }
   std::uint16_t last_controlword(hal::Axis a) const { return axes_[hal::index(a)].tracker.last_controlword; }
@@ -105,6 +139,16 @@ class CanAxisPort final : public hal::AxisPort {
     hal::Tick last_heartbeat = hal::kNeverTick;
     std::uint16_t emcy_code = 0;
     std::uint16_t link_fault = 0;  // latched: heartbeat lost / rebooted / not operational
+    double ferror_min = 0.0;
+    double ferror_k_s = 0.0;
+    double last_cmd_si = 0.0;       // last commanded target (SI), for following-error supervision
+    double cmd_velocity = 0.0;      // SI/s, from successive commanded targets
+    bool cmd_valid = false;
+    bool ferror_fault = false;      // latched until acknowledged
+    bool acknowledged = false;      // operator acked while the drive was in Fault: its EMCY 0x0000 clears
+    double ferror_high_water = 0.0;
+    bool has_consumer = false;      // the drive watches our heartbeat (0x1016)
+    bool has_tpdo2 = false;         // velocity/torque PDO configured
   };
 
   void reset_runtime();
@@ -113,6 +157,9 @@ class CanAxisPort final : public hal::AxisPort {
   void count_send(SendResult r);
   std::string node_label(std::size_t axis) const;
   Status configure_node(std::size_t axis, SdoClient& sdo);
+  Status configure_pdos(std::size_t axis, SdoClient& sdo);
+  bool any_fault() const;
+  void acknowledge();
 
   CanAxisPortConfig config_;
   CanBus* bus_ = nullptr;
@@ -123,6 +170,12 @@ class CanAxisPort final : public hal::AxisPort {
   std::array<AxisRuntime, hal::kAxisCount> axes_{};
   std::array<std::int8_t, 128> axis_of_node_{};  // −1 = not ours
   bool bus_off_ = false;                         // latched until configure()
+  std::array<CanNodeListener*, 4> listeners_{};
+  std::size_t n_listeners_ = 0;
+  std::uint16_t foreign_emcy_code_ = 0;  // EMCY from a node that is not an axis (latched until ack)
+  std::uint32_t master_hb_ticks_ = 0;
+  hal::Tick next_master_hb_ = 0;
+  std::vector<std::string> notes_;
   std::uint32_t tx_dropped_ = 0;
   std::uint32_t rx_errors_ = 0;
 };

@@ -28,6 +28,9 @@ class SdoClient {
                std::uint8_t size);
   // Configure-time only. Expedited upload; the value is zero-extended from the reply's size.
   Result<std::uint32_t> read(std::uint8_t node, std::uint16_t index, std::uint8_t sub);
+  // The abort code of the last request the server aborted (0 when it was answered or timed out), so
+  // callers can apply CiA 301 interoperability rules to specific codes (read-only mapping, no object).
+  std::uint32_t last_abort() const { return last_abort_; }
 
  private:
   Result<SdoReply> exchange(std::uint8_t node, const CanFrame& request, const std::string& what);
@@ -36,6 +39,7 @@ class SdoClient {
   ConfigureClock& clock_;
   std::int64_t timeout_us_;
   FrameHandler other_frames_;
+  std::uint32_t last_abort_ = 0;
 };
 
 // "0x60C2:01 (interpolation time period)". Configure-time only.

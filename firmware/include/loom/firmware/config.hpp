@@ -11,12 +11,14 @@
 // parse time, so every refusal is one ConfigError naming file:line:col, key and value.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "loom/drivers/can_axis_port.hpp"
+#include "loom/drivers/can_io_port.hpp"
 #include "loom/motion/profile_set.hpp"
 #include "loom/sequencer/sequencer.hpp"
 #include "loom/firmware/scene_config.hpp"  // the scene file (kept here so callers of config.hpp see it)
@@ -39,6 +41,31 @@ struct CanSettings {
   std::uint16_t heartbeat_ms = 100;
   std::uint16_t heartbeat_timeout_ms = 250;
   std::uint16_t sdo_timeout_ms = 500;
+  // The master's own heartbeat (0x700 + master_node) and the consumer time written to every node's
+  // 0x1016 (drives and I/O module, where present). master_node = 0: neither.
+  std::uint8_t master_node = 0x7F;
+  std::uint16_t master_heartbeat_ms = 100;
+  std::uint16_t master_consumer_ms = 500;
+  // Per-drive bring-up windows, indexed beat_crank, carriage, helix; 0 = boot 2000 ms / operational
+  // = heartbeat_timeout_ms. Commercial drives may need hundreds of ms for either.
+  std::array<std::uint32_t, 3> boot_timeout_ms{0, 0, 0};
+  std::array<std::uint32_t, 3> operational_timeout_ms{0, 0, 0};
+  // Following-error supervision per axis (LinuxCNC rule): fault when |commanded − actual| >
+  // max(ferror_min, ferror_k_s · |commanded velocity|). Units: rad (crank, helix) or m (carriage); s.
+  // ferror_min = 0 disables it for that axis.
+  std::array<double, 3> ferror_min{0.2, 0.002, 0.5};
+  std::array<double, 3> ferror_k_s{0.05, 0.05, 0.05};
+};
+
+// Where the valves, sensors, e-stop chain, buttons and load cell come from on the CAN HAL.
+enum class IoKind { kCan, kSimulated };
+
+struct IoSettings {
+  IoKind kind = IoKind::kCan;  // simulated I/O beside real drives needs --io simulated as well
+  std::uint8_t node = 4;
+  std::uint32_t boot_timeout_ms = 2000;
+  std::uint32_t operational_timeout_ms = 500;
+  drivers::IoWiring wiring;  // bit per signal, polarity, load-cell channel and scaling
 };
 
 // Axis readings at the mechanical references, found when commissioning.
@@ -100,6 +127,7 @@ struct LoomConfig {
   std::string loom_id = "loom1";
   MachineSpec machine_spec;
   CanSettings can;
+  IoSettings io;
   Recipe recipe;
   RunSettings run;
   TelemetrySettings telemetry;
@@ -120,6 +148,11 @@ void derive_module_configs(LoomConfig& c);
 void rederive_and_check(LoomConfig& c, const std::string& origin);
 // Configure-time only. The CAN master's config for the three servo axes, from the same facts.
 drivers::CanAxisPortConfig can_axis_config(const LoomConfig& c);
+// Configure-time only. The CAN I/O module's config, from the same facts.
+drivers::CanIoConfig can_io_config(const LoomConfig& c);
+// Configure-time only. The worst-case bus load of the whole machine (drives, I/O module, master
+// heartbeat) — the figure the CAN master checks when it configures.
+drivers::BusLoad can_bus_load(const LoomConfig& c);
 
 // Configure-time only. Parse a loom config from TOML text; `source` names it in errors. The file must
 // be complete, or start with `extends = "default"` to take what it does not say from the embedded

@@ -4,9 +4,12 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "loom/drivers/can_axis_port.hpp"
+#include "loom/drivers/can_io_port.hpp"
 #include "loom/drivers/socket_can_bus.hpp"
 #include "loom/firmware/config.hpp"
 #include "loom/firmware/control_loop.hpp"
@@ -27,12 +30,21 @@ struct MachineOptions {
   bool lossless_telemetry = true;  // virtual time only: wait for ring space instead of dropping
   std::uint32_t rows = 3;
   std::string sim_state_path;  // sim HAL: keep the simulated machine's physical state here (power-loss tests)
+  // `--io`: overrides the config's io.kind. Real drives with simulated I/O only when this says
+  // kSimulated explicitly (the config alone is not enough), and then banner() is set.
+  std::optional<IoKind> io;
 };
+
+// Printed on every start when real drives run beside simulated I/O.
+inline constexpr const char* kSimulatedIoBanner =
+    "SIMULATED I/O: the e-stop chain, end sensors, shuttle sensors, valves and load cell are simulated; "
+    "the interlocks are not protecting anything on this machine";
 
 class Machine {
  public:
-  // Throws ConfigError on bad input, std::runtime_error when the hardware cannot be armed (the message
-  // names interface, node and step).
+  // Throws ConfigError on bad input (including real drives with simulated I/O not asked for on the
+  // command line, refused before the bus is opened), std::runtime_error when the hardware cannot be
+  // armed (the message names interface, node and step).
   Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions& opt, sequencer::Counters resume);
   ~Machine();
 
@@ -48,11 +60,19 @@ class Machine {
   void collect_retired_recipes() { slot_->collect(); }
   telemetry::Telemetry* telemetry() { return telemetry_.get(); }
   const drivers::CanAxisPort* can() const { return can_port_.get(); }
+  const drivers::CanIoPort* can_io() const { return io_port_.get(); }
+  // Non-empty when the caller must print it on every start (kSimulatedIoBanner).
+  const std::string& banner() const { return banner_; }
+  // What bring-up found optional and absent or accepted as read back (0x1016, fixed mappings), and the
+  // bus load and bitrate check; one line each, for the start-up log.
+  const std::vector<std::string>& notes() const { return notes_; }
   const sim_hal::SimWorld& sim() const { return *sim_; }
   sim_hal::SimWorld& sim() { return *sim_; }  // configure-time: e.g. a power-cut handler for in-process runs
   const LoomConfig& config() const { return cfg_; }
 
  private:
+  void build_can_hal(const MachineOptions& opt);
+
   LoomConfig cfg_;
   std::unique_ptr<motion::ProfileSlot> slot_;
   std::unique_ptr<sequencer::Sequencer> sequencer_;
@@ -60,6 +80,9 @@ class Machine {
   std::unique_ptr<sim_hal::SimWorld> sim_;
   std::unique_ptr<drivers::SocketCanBus> bus_;
   std::unique_ptr<drivers::CanAxisPort> can_port_;
+  std::unique_ptr<drivers::CanIoPort> io_port_;
+  std::string banner_;
+  std::vector<std::string> notes_;
   std::unique_ptr<hal::PortHal> hal_;
   std::unique_ptr<telemetry::Telemetry> telemetry_;
   std::unique_ptr<ControlLoop> loop_;

@@ -22,6 +22,12 @@ struct SimDriveConfig {
   std::uint32_t max_step_counts = 0;
   bool supports_csp = true;                    // 0x6502 bit 7; false refuses 0x6060 = 8
   std::vector<std::uint16_t> missing_objects;  // indices this drive lacks (SDO abort 0x06020000)
+  // "Commercial" personality: PDO mapping objects read-only, sub-index 0 included (abort 0x06010002);
+  // the factory TPDO1 mapping may be replaced (empty = statusword + position actual).
+  bool fixed_mapping = false;
+  std::vector<std::uint32_t> tpdo1_factory_mapping;
+  std::int64_t boot_delay_us = 0;         // power-on / NMT reset → boot-up frame
+  std::int64_t operational_delay_us = 0;  // NMT start → operational
 };
 
 class SimDriveNode {
@@ -56,6 +62,7 @@ class SimDriveNode {
   std::uint16_t controlword() const { return controlword_; }
   std::uint16_t statusword() const;
   std::uint32_t syncs_seen() const { return syncs_; }
+  bool master_lost() const { return master_lost_; }  // 0x1016 consumer expired (the drive quick-stopped)
 
  private:
   struct PdoComm {
@@ -68,6 +75,7 @@ class SimDriveNode {
   };
 
   void reset_communication();
+  void boot_up(std::int64_t now_us);
   void reset_application();
   void send(const drivers::CanFrame& f);
   void on_nmt(const drivers::CanFrame& f, std::int64_t now_us);
@@ -118,6 +126,12 @@ class SimDriveNode {
   std::uint8_t ip_value_ = 1;
   std::int8_t ip_index_ = -3;
   bool following_error_ = false;
+  // Timers of the slow personality and the 0x1016 heartbeat consumer.
+  std::int64_t boot_at_us_ = -1;
+  std::int64_t operational_at_us_ = -1;
+  std::uint32_t consumer_ = 0;  // 0x1016:01
+  std::int64_t master_seen_us_ = -1;
+  bool master_lost_ = false;
 };
 
 }  // namespace loom::sim_can

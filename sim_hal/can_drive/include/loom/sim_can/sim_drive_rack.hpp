@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "loom/sim_can/sim_drive_node.hpp"
+#include "loom/sim_can/sim_io_node.hpp"
 
 namespace loom::sim_can {
 
@@ -14,6 +15,18 @@ class SimDriveRack {
  public:
   // Configure-time only.
   SimDriveRack(drivers::CanBus& bus, const std::vector<SimDriveConfig>& nodes);
+
+  // Configure-time only. An I/O node on the same endpoint, whose plant follows the drives at rack
+  // positions `crank` and `helix` (counts → rad with their counts per rad).
+  struct IoPlantSource {
+    std::size_t crank = 0;
+    std::size_t helix = 2;
+    double crank_counts_per_rad = 1.0;
+    double helix_counts_per_rad = 1.0;
+  };
+  void attach_io(SimIoNode& io, IoPlantSource source);
+  // The e-stop, buttons and "silent" switch the I/O node sees (tests and the control file set them).
+  IoPlant& io_controls() { return io_controls_; }
 
   void power_on(std::int64_t now_us);  // RT-safe
   // RT-safe. Drain up to `max_frames` received frames into the nodes, then step their timers.
@@ -27,6 +40,9 @@ class SimDriveRack {
  private:
   drivers::CanBus& bus_;
   std::vector<std::unique_ptr<SimDriveNode>> nodes_;
+  SimIoNode* io_ = nullptr;
+  IoPlantSource io_source_{};
+  IoPlant io_controls_{};
 };
 
 }  // namespace loom::sim_can

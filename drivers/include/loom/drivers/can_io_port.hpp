@@ -1,0 +1,198 @@
+// The loom's I/O node as a CANopen CiA 401 generic I/O module behind hal::IoPort: valve coils and the
+// stack light through 0x6200 in an RPDO, end sensors, shuttle sensors, the e-stop chain and the operator
+// buttons through 0x6000 in a TPDO, the beater's load cell through 0x6401 in a TPDO. Which bit is which
+// signal, its polarity and the load-cell scaling are wiring (config), so any module can be used.
+//
+// The module shares the bus with the servo drives: CanAxisPort owns the receive side and hands every
+// frame of this node to it (CanNodeListener), so one drain per tick serves all nodes and a fault of this
+// node stops every axis in the same tick. configure() may block (NMT, SDO); the rest is RT-safe.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "loom/drivers/bus_load.hpp"
+#include "loom/drivers/can_frame.hpp"
+#include "loom/drivers/configure_clock.hpp"
+#include "loom/drivers/status.hpp"
+#include "loom/hal/hal.hpp"
+
+namespace loom::drivers {
+
+// CiA 401 objects.
+namespace od401 {
+inline constexpr std::uint16_t kDigitalInputs8 = 0x6000;   // read input 8-bit, sub 1..n
+inline constexpr std::uint16_t kDigitalOutputs8 = 0x6200;  // write output 8-bit, sub 1..n
+inline constexpr std::uint16_t kOutputErrorMode = 0x6206;  // 1 = output goes to 0x6207 on failure
+inline constexpr std::uint16_t kOutputErrorValue = 0x6207;
+inline constexpr std::uint16_t kAnalogInput16 = 0x6401;    // read analog input 16-bit, sub 1..n
+inline constexpr std::uint16_t kConsumerHeartbeat = 0x1016;
+inline constexpr std::uint16_t kDeviceProfile401 = 0x0191;  // low word of 0x1000
+}  // namespace od401
+
+// One node on the shared bus that is not a servo axis. CanAxisPort drains the bus once per tick and
+// hands this node's frames here, then asks for its health. All RT-safe.
+class CanNodeListener {
+ public:
+  virtual ~CanNodeListener() = default;
+  virtual std::uint8_t node_id() const = 0;
+  virtual void on_frame(hal::Tick now, const CanFrame& frame) = 0;
+  // After the tick's frames: run timers (heartbeat consumer).
+  virtual void supervise(hal::Tick now) = 0;
+  // 0 = healthy; else a fault code (emcy.hpp) that stops every axis and is reported as a link fault.
+  virtual std::uint16_t link_fault_code() const = 0;
+  // The operator acknowledged (fault reset requested): clear latches whose cause is gone.
+  virtual void acknowledge() = 0;
+};
+
+// One signal on a digital input or output: bit number across the 8-bit objects (bit b lives in
+// sub-index b/8 + 1, bit b%8), and polarity. bit = −1: not wired.
+struct IoBit {
+  int bit = -1;
+  bool active_low = false;  // the signal is true when the electrical bit is 0
+};
+
+// Inputs read from 0x6000:01..02 and outputs written to 0x6200:01..02 (16 bits each way).
+inline constexpr int kIoMaxBits = 16;
+
+struct IoWiring {
+  // Inputs (0x6000). The six sensors and the e-stop chain must be wired; buttons are optional.
+  IoBit piston_a_extended{0};
+  IoBit piston_a_retracted{1};
+  IoBit piston_b_extended{2};
+  IoBit piston_b_retracted{3};
+  IoBit shuttle_at_left{4};
+  IoBit shuttle_at_right{5};
+  IoBit estop_ok{6};  // chain closed = 1 (a broken wire reads as e-stop)
+  IoBit button_start{8};
+  IoBit button_pause{9};
+  IoBit button_ack{10};
+  IoBit row_knotted{11};
+  // Outputs (0x6200). Valves must be wired; the stack light and buzzer are optional.
+  IoBit piston_a_extend{0};
+  IoBit piston_b_extend{1};
+  IoBit lamp_green{4};
+  IoBit lamp_amber{5};
+  IoBit lamp_red{6};
+  IoBit buzzer{7};
+  // Beater load cell on analog input 0x6401:load_cell_channel (0 = no load cell fitted):
+  // force_n = gain · counts + offset.
+  int load_cell_channel = 1;
+  double load_cell_n_per_count = 0.01;
+  double load_cell_offset_n = 0.0;
+};
+
+// Configure-time only. Error naming the field ("io.inputs.estop_ok.bit = 3 is already used by
+// io.inputs.piston_b_retracted") and its value.
+Status validate(const IoWiring& wiring);
+
+struct CanIoConfig {
+  std::uint8_t node_id = 4;
+  IoWiring wiring;
+  double cycle_period_s = 0.002;
+  double heartbeat_producer_s = 0.100;  // written to the module's 0x1017
+  double heartbeat_consumer_s = 0.250;  // silence longer than this = node lost
+  double sdo_timeout_s = 0.100;
+  double boot_timeout_s = 2.0;          // boot-up after NMT reset-node
+  double operational_timeout_s = 0.5;   // operational heartbeat after NMT start
+  // The module watches the master's heartbeat through 0x1016 (when it has one), so its valves go to
+  // their safe state (0x6206/0x6207) when the host dies. 0 = do not configure a consumer.
+  std::uint8_t master_node_id = 0x7F;
+  double master_consumer_s = 0.500;
+};
+
+// Configure-time only.
+Status validate(const CanIoConfig& config);
+
+// The frames this node adds to every cycle with `wiring` (one RPDO, one or two TPDOs).
+std::vector<FrameGroup> io_frames_per_cycle(const IoWiring& wiring);
+
+// The output values the module is told to adopt by itself on failure (0x6206/0x6207): both valve coils
+// de-energised (frames retracted and vented; no shed, so no pick can start and nothing is trapped),
+// green/amber off, red on, buzzer off.
+hal::DigitalOutputs io_safe_outputs();
+
+class CanIoPort final : public hal::IoPort, public CanNodeListener {
+ public:
+  static constexpr int kMaxPdoEntries = 8;
+
+  // Configure-time only.
+  explicit CanIoPort(CanIoConfig config);
+
+  // Configure-time only; blocks with timeouts. NMT reset-node → boot-up → device type 0x1000 is CiA 401
+  // → 0x1017 → 0x6206/0x6207 (safe outputs) → 0x1016 consumer of the master heartbeat → PDO mapping
+  // (written, or read back when the module's mapping is fixed, and accepted only when it carries every
+  // object the wiring needs) → NMT start → operational heartbeat. Errors name node, object and step.
+  Status configure(CanBus& bus, ConfigureClock& clock);
+
+  // What configure() found optional and absent, or accepted instead of what it asked for (one line each).
+  const std::vector<std::string>& notes() const { return notes_; }
+
+  // hal::IoPort (RT-safe).
+  void read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::DigitalInputs& io) override;
+  void read_analog(hal::Tick now, hal::AnalogInputs& analog) override;
+  void write_io(hal::Tick now, const hal::DigitalOutputs& io) override;
+
+  // CanNodeListener (RT-safe).
+  std::uint8_t node_id() const override { return config_.node_id; }
+  void on_frame(hal::Tick now, const CanFrame& frame) override;
+  void supervise(hal::Tick now) override;
+  std::uint16_t link_fault_code() const override { return link_fault_; }
+  void acknowledge() override;
+
+  // Diagnostics; RT-safe.
+  bool configured() const { return configured_; }
+  const CanIoConfig& config() const { return config_; }
+  std::uint16_t last_emcy_code() const { return emcy_code_; }
+  std::uint32_t rx_errors() const { return rx_errors_; }
+  std::uint32_t tx_dropped() const { return tx_dropped_; }
+
+ private:
+  // Where one object sits in the PDOs the module actually uses (after configure()).
+  struct Slot {
+    int pdo = -1;  // 0..3, −1 = not mapped
+    std::uint8_t offset = 0;
+    std::uint8_t bytes = 0;
+  };
+  struct PdoLayout {
+    std::uint8_t count = 0;
+    std::array<std::uint32_t, kMaxPdoEntries> entries{};
+  };
+
+  Status configure_mapping(class SdoClient& sdo);
+  Status map_pdo(SdoClient& sdo, bool rx, int pdo, const std::vector<std::uint32_t>& wanted,
+                 std::uint8_t transmission_type, PdoLayout& actual);
+  Status disable_pdo(SdoClient& sdo, bool rx, int pdo);
+  static Slot find(const std::array<PdoLayout, 4>& layouts, std::uint32_t entry_without_len);
+  std::string who() const;
+  bool input(const IoBit& b) const;
+
+  CanIoConfig config_;
+  CanBus* bus_ = nullptr;
+  bool configured_ = false;
+  std::vector<std::string> notes_;
+  std::uint32_t consumer_ticks_ = 0;
+
+  std::array<PdoLayout, 4> tpdo_{};
+  std::array<PdoLayout, 4> rpdo_{};
+  std::array<Slot, 2> input_slot_{};   // 0x6000:01, :02
+  std::array<Slot, 2> output_slot_{};  // 0x6200:01, :02
+  Slot analog_slot_{};
+  int output_pdo_ = -1;
+  std::uint8_t output_pdo_bytes_ = 0;
+
+  // RT state.
+  std::array<std::uint8_t, 2> inputs_{};
+  hal::Tick inputs_refreshed_ = hal::kNeverTick;
+  std::int16_t analog_counts_ = 0;
+  hal::Tick analog_refreshed_ = hal::kNeverTick;
+  hal::Tick last_heartbeat_ = hal::kNeverTick;
+  std::uint16_t link_fault_ = 0;
+  std::uint16_t emcy_code_ = 0;
+  std::uint32_t rx_errors_ = 0;
+  std::uint32_t tx_dropped_ = 0;
+};
+
+}  // namespace loom::drivers

@@ -1,0 +1,615 @@
+// CiA 401 I/O node (see can_io_port.hpp): configure-time bring-up by NMT and SDO with the CiA 301
+// interoperability rules (fixed mappings read back, missing PDOs and optional objects tolerated and
+// noted), and the RT exchange decoded through the layout the module really uses.
+#include "loom/drivers/can_io_port.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "loom/drivers/can_error_frame.hpp"
+#include "loom/drivers/cob_id.hpp"
+#include "loom/drivers/emcy.hpp"
+#include "loom/drivers/nmt.hpp"
+#include "loom/drivers/pdo.hpp"
+#include "loom/drivers/sdo.hpp"
+#include "loom/drivers/sdo_client.hpp"
+
+namespace loom::drivers {
+
+namespace {
+
+std::string hex(std::uint32_t v, int digits) {
+  char buf[16];
+  std::snprintf(buf, sizeof(buf), "0x%0*X", digits, v);
+  return buf;
+}
+
+std::string seconds(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g s", s);
+  return buf;
+}
+
+constexpr std::uint32_t entry(std::uint16_t index, std::uint8_t sub, std::uint8_t bits) {
+  return encode_map_entry(PdoMapEntry{index, sub, bits});
+}
+
+struct NamedBit {
+  const char* name;
+  const IoBit* bit;
+  bool required;
+};
+
+// The wiring's signals by name, inputs then outputs, for validation and messages.
+std::vector<NamedBit> inputs_of(const IoWiring& w) {
+  return {{"io.inputs.piston_a_extended", &w.piston_a_extended, true},
+          {"io.inputs.piston_a_retracted", &w.piston_a_retracted, true},
+          {"io.inputs.piston_b_extended", &w.piston_b_extended, true},
+          {"io.inputs.piston_b_retracted", &w.piston_b_retracted, true},
+          {"io.inputs.shuttle_at_left", &w.shuttle_at_left, true},
+          {"io.inputs.shuttle_at_right", &w.shuttle_at_right, true},
+          {"io.inputs.estop_ok", &w.estop_ok, true},
+          {"io.inputs.button_start", &w.button_start, false},
+          {"io.inputs.button_pause", &w.button_pause, false},
+          {"io.inputs.button_ack", &w.button_ack, false},
+          {"io.inputs.row_knotted", &w.row_knotted, false}};
+}
+std::vector<NamedBit> outputs_of(const IoWiring& w) {
+  return {{"io.outputs.piston_a_extend", &w.piston_a_extend, true},
+          {"io.outputs.piston_b_extend", &w.piston_b_extend, true},
+          {"io.outputs.lamp_green", &w.lamp_green, false},
+          {"io.outputs.lamp_amber", &w.lamp_amber, false},
+          {"io.outputs.lamp_red", &w.lamp_red, false},
+          {"io.outputs.buzzer", &w.buzzer, false}};
+}
+
+Status check_bits(const std::vector<NamedBit>& bits) {
+  std::array<const char*, kIoMaxBits> used{};
+  for (const NamedBit& b : bits) {
+    const int n = b.bit->bit;
+    if (n == -1) {
+      if (b.required) return Status::error(std::string(b.name) + ".bit = -1: this signal must be wired");
+      continue;
+    }
+    if (n < 0 || n >= kIoMaxBits) {
+      return Status::error(std::string(b.name) + ".bit = " + std::to_string(n) + " is outside 0.." +
+                           std::to_string(kIoMaxBits - 1) + " (-1 = not wired)");
+    }
+    if (used[static_cast<std::size_t>(n)] != nullptr) {
+      return Status::error(std::string(b.name) + ".bit = " + std::to_string(n) + " is already used by " +
+                           used[static_cast<std::size_t>(n)]);
+    }
+    used[static_cast<std::size_t>(n)] = b.name;
+  }
+  return Status::ok();
+}
+
+int highest_bit(const std::vector<NamedBit>& bits) {
+  int hi = -1;
+  for (const NamedBit& b : bits) hi = std::max(hi, b.bit->bit);
+  return hi;
+}
+
+// The 8-bit subs (1 or 2) a set of signals needs.
+std::uint8_t bytes_for(const std::vector<NamedBit>& bits) {
+  return highest_bit(bits) >= 8 ? 2 : 1;
+}
+
+bool interop_readback_code(std::uint32_t abort) {
+  // A module with a fixed mapping says read-only (0x06010002) or unsupported access (0x06010000).
+  return abort == sdo_abort::kReadOnly || abort == sdo_abort::kUnsupportedAccess;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------------
+// Configuration
+// ---------------------------------------------------------------------------------------------------
+Status validate(const IoWiring& w) {
+  if (Status s = check_bits(inputs_of(w)); !s) return s;
+  if (Status s = check_bits(outputs_of(w)); !s) return s;
+  if (w.load_cell_channel < 0 || w.load_cell_channel > 254) {
+    return Status::error("io.load_cell.channel = " + std::to_string(w.load_cell_channel) +
+                         " is outside 0..254 (0 = no load cell, else the sub-index of 0x6401)");
+  }
+  if (!std::isfinite(w.load_cell_n_per_count) || w.load_cell_n_per_count == 0.0) {
+    char buf[128];
+    std::snprintf(buf, sizeof(buf), "io.load_cell.n_per_count = %g must be a non-zero number",
+                  w.load_cell_n_per_count);
+    return Status::error(buf);
+  }
+  if (!std::isfinite(w.load_cell_offset_n)) {
+    return Status::error("io.load_cell.offset_n is not a finite number");
+  }
+  return Status::ok();
+}
+
+Status validate(const CanIoConfig& c) {
+  if (c.node_id < kMinNodeId || c.node_id > kMaxNodeId) {
+    return Status::error("io.node = " + std::to_string(c.node_id) + " is outside 1..127");
+  }
+  if (Status s = validate(c.wiring); !s) return s;
+  if (!(c.cycle_period_s > 0.0)) return Status::error("io: cycle period " + seconds(c.cycle_period_s) + " must be > 0");
+  const double producer_ms = c.heartbeat_producer_s * 1e3;
+  if (!(producer_ms >= 1.0 && producer_ms <= 65535.0) || std::abs(producer_ms - std::round(producer_ms)) > 1e-6) {
+    return Status::error("io: heartbeat producer time " + seconds(c.heartbeat_producer_s) +
+                         " must be a whole number of ms in 0.001..65.535 s");
+  }
+  if (!(c.heartbeat_consumer_s > c.heartbeat_producer_s)) {
+    return Status::error("io: heartbeat consumer time " + seconds(c.heartbeat_consumer_s) +
+                         " must exceed the producer time " + seconds(c.heartbeat_producer_s));
+  }
+  if (!(c.sdo_timeout_s > 0.0)) return Status::error("io: SDO timeout " + seconds(c.sdo_timeout_s) + " must be > 0");
+  if (!(c.boot_timeout_s > 0.0)) {
+    return Status::error("io.boot_timeout_s = " + seconds(c.boot_timeout_s) + " must be > 0");
+  }
+  if (!(c.operational_timeout_s > 0.0)) {
+    return Status::error("io.operational_timeout_s = " + seconds(c.operational_timeout_s) + " must be > 0");
+  }
+  if (c.master_node_id > kMaxNodeId) {
+    return Status::error("can.master_node = " + std::to_string(c.master_node_id) + " is outside 0..127");
+  }
+  if (c.master_node_id != 0) {
+    const double ms = c.master_consumer_s * 1e3;
+    if (!(ms >= 1.0 && ms <= 65535.0)) {
+      return Status::error("io: master heartbeat consumer time " + seconds(c.master_consumer_s) +
+                           " must be in 0.001..65.535 s");
+    }
+  }
+  return Status::ok();
+}
+
+std::vector<FrameGroup> io_frames_per_cycle(const IoWiring& w) {
+  std::vector<FrameGroup> g;
+  g.push_back({bytes_for(outputs_of(w)), 1});  // RPDO: digital outputs
+  g.push_back({bytes_for(inputs_of(w)), 1});   // TPDO: digital inputs
+  if (w.load_cell_channel != 0) g.push_back({2, 1});  // TPDO: load cell
+  return g;
+}
+
+hal::DigitalOutputs io_safe_outputs() {
+  hal::DigitalOutputs o;
+  o.lamp_red = true;
+  return o;
+}
+
+CanIoPort::CanIoPort(CanIoConfig config) : config_(std::move(config)) {}
+
+std::string CanIoPort::who() const {
+  return "node " + std::to_string(config_.node_id) + " (I/O node): ";
+}
+
+CanIoPort::Slot CanIoPort::find(const std::array<PdoLayout, 4>& layouts, std::uint32_t wanted) {
+  for (std::size_t k = 0; k < layouts.size(); ++k) {
+    std::uint32_t offset_bits = 0;
+    for (std::size_t e = 0; e < layouts[k].count; ++e) {
+      const std::uint32_t v = layouts[k].entries[e];
+      if ((v & 0xFFFFFF00U) == (wanted & 0xFFFFFF00U) && (v & 0xFF) % 8 == 0 && offset_bits % 8 == 0) {
+        return Slot{static_cast<int>(k), static_cast<std::uint8_t>(offset_bits / 8),
+                    static_cast<std::uint8_t>((v & 0xFF) / 8)};
+      }
+      offset_bits += v & 0xFF;
+    }
+  }
+  return Slot{};
+}
+
+Status CanIoPort::disable_pdo(SdoClient& sdo, bool rx, int pdo) {
+  const auto comm = static_cast<std::uint16_t>((rx ? od::kRpdoComm : od::kTpdoComm) + pdo);
+  const std::uint8_t id = config_.node_id;
+  const std::uint32_t cob = rx ? cob::rpdo(pdo + 1, id) : cob::tpdo(pdo + 1, id);
+  if (Status s = sdo.write(id, comm, 1, cob | od::kPdoInvalidBit, 4); !s) {
+    // A module with fewer PDOs has nothing to disable (CiA 301 interoperability).
+    if (sdo.last_abort() == sdo_abort::kNoObject) return Status::ok();
+    return Status::error(who() + s.message());
+  }
+  return Status::ok();
+}
+
+// Write `wanted` into PDO `pdo`; when the module refuses because its mapping is fixed, read back what it
+// has. Either way `actual` ends as what the module reports, which the caller checks.
+Status CanIoPort::map_pdo(SdoClient& sdo, bool rx, int pdo, const std::vector<std::uint32_t>& wanted,
+                          std::uint8_t transmission_type, PdoLayout& actual) {
+  const std::uint8_t id = config_.node_id;
+  const auto comm = static_cast<std::uint16_t>((rx ? od::kRpdoComm : od::kTpdoComm) + pdo);
+  const auto map = static_cast<std::uint16_t>((rx ? od::kRpdoMap : od::kTpdoMap) + pdo);
+  const std::uint32_t cob = rx ? cob::rpdo(pdo + 1, id) : cob::tpdo(pdo + 1, id);
+  const auto fail = [&](const Status& s) { return Status::error(who() + s.message()); };
+
+  bool fixed = false;
+  if (Status s = sdo.write(id, comm, 1, cob | od::kPdoInvalidBit, 4); !s) {
+    if (!interop_readback_code(sdo.last_abort())) return fail(s);
+    fixed = true;  // cannot even invalidate it: use it as it is
+  }
+  if (!fixed) {
+    if (Status s = sdo.write(id, map, 0, 0, 1); !s) {
+      if (!interop_readback_code(sdo.last_abort())) return fail(s);
+      fixed = true;
+    }
+  }
+  if (!fixed) {
+    for (std::size_t k = 0; k < wanted.size(); ++k) {
+      if (Status s = sdo.write(id, map, static_cast<std::uint8_t>(k + 1), wanted[k], 4); !s) return fail(s);
+    }
+    if (Status s = sdo.write(id, map, 0, static_cast<std::uint32_t>(wanted.size()), 1); !s) return fail(s);
+  }
+  if (fixed) notes_.push_back(who() + hex(map, 4) + " mapping is fixed (write refused): read back and used as found");
+
+  // Synchronous transmission so silence is visible every cycle (TPDO) / outputs apply on SYNC (RPDO: any).
+  if (!rx) {
+    if (Status s = sdo.write(id, comm, 2, transmission_type, 1); !s) {
+      if (!interop_readback_code(sdo.last_abort())) return fail(s);
+      Result<std::uint32_t> t = sdo.read(id, comm, 2);
+      if (!t) return fail(t.status());
+      if (t.value() < 1 || t.value() > 240) {
+        return Status::error(who() + hex(comm, 4) + ":02 transmission type is " + std::to_string(t.value()) +
+                             " and cannot be changed; the master needs a synchronous TPDO (1..240)");
+      }
+    }
+  }
+  if (Status s = sdo.write(id, comm, 1, cob, 4); !s) {
+    if (!interop_readback_code(sdo.last_abort())) return fail(s);
+    Result<std::uint32_t> c = sdo.read(id, comm, 1);
+    if (!c) return fail(c.status());
+    if ((c.value() & od::kPdoInvalidBit) != 0 || (c.value() & 0x7FF) != cob) {
+      return Status::error(who() + hex(comm, 4) + ":01 COB-ID is " + hex(c.value(), 8) +
+                           " and cannot be changed to " + hex(cob, 3));
+    }
+  }
+
+  // What the module really maps (after our write, or its fixed mapping).
+  Result<std::uint32_t> n = sdo.read(id, map, 0);
+  if (!n) return fail(n.status());
+  if (n.value() > kMaxPdoEntries) {
+    return Status::error(who() + hex(map, 4) + ":00 = " + std::to_string(n.value()) + " entries (at most 8)");
+  }
+  actual.count = static_cast<std::uint8_t>(n.value());
+  for (std::uint8_t k = 0; k < actual.count; ++k) {
+    Result<std::uint32_t> e = sdo.read(id, map, static_cast<std::uint8_t>(k + 1));
+    if (!e) return fail(e.status());
+    actual.entries[k] = e.value();
+  }
+  return Status::ok();
+}
+
+Status CanIoPort::configure_mapping(SdoClient& sdo) {
+  const IoWiring& w = config_.wiring;
+  const std::uint8_t in_bytes = bytes_for(inputs_of(w));
+  const std::uint8_t out_bytes = bytes_for(outputs_of(w));
+
+  std::vector<std::uint32_t> inputs{entry(od401::kDigitalInputs8, 1, 8)};
+  if (in_bytes == 2) inputs.push_back(entry(od401::kDigitalInputs8, 2, 8));
+  std::vector<std::uint32_t> outputs{entry(od401::kDigitalOutputs8, 1, 8)};
+  if (out_bytes == 2) outputs.push_back(entry(od401::kDigitalOutputs8, 2, 8));
+  const bool analog = w.load_cell_channel != 0;
+  const std::uint32_t load_cell = entry(od401::kAnalogInput16, static_cast<std::uint8_t>(w.load_cell_channel), 16);
+
+  tpdo_ = {};
+  rpdo_ = {};
+  if (Status s = map_pdo(sdo, false, 0, inputs, 1, tpdo_[0]); !s) return s;
+  if (analog) {
+    if (Status s = map_pdo(sdo, false, 1, {load_cell}, 1, tpdo_[1]); !s) return s;
+  } else if (Status s = disable_pdo(sdo, false, 1); !s) {
+    return s;
+  }
+  for (int k = 2; k < 4; ++k) {
+    if (Status s = disable_pdo(sdo, false, k); !s) return s;
+  }
+  if (Status s = map_pdo(sdo, true, 0, outputs, 255, rpdo_[0]); !s) return s;
+  for (int k = 1; k < 4; ++k) {
+    if (Status s = disable_pdo(sdo, true, k); !s) return s;
+  }
+
+  // Every object the wiring needs must be in what the module reports; else refuse, naming it.
+  const auto need = [&](const std::array<PdoLayout, 4>& l, std::uint32_t e, const char* what, Slot& slot) {
+    slot = find(l, e);
+    if (slot.pdo < 0) {
+      return Status::error(who() + "no PDO carries " + hex(e >> 16, 4) + ":" + hex((e >> 8) & 0xFF, 2).substr(2) +
+                           " (" + what + "); the module's mapping (fixed or refused) lacks it");
+    }
+    if (slot.bytes != ((e & 0xFF) / 8)) {
+      return Status::error(who() + hex(e >> 16, 4) + " is mapped with " + std::to_string(slot.bytes * 8) +
+                           " bits, the master needs " + std::to_string(e & 0xFF));
+    }
+    return Status::ok();
+  };
+  input_slot_ = {};
+  output_slot_ = {};
+  analog_slot_ = {};
+  for (std::size_t k = 0; k < inputs.size(); ++k) {
+    if (Status s = need(tpdo_, inputs[k], "digital inputs", input_slot_[k]); !s) return s;
+  }
+  for (std::size_t k = 0; k < outputs.size(); ++k) {
+    if (Status s = need(rpdo_, outputs[k], "digital outputs", output_slot_[k]); !s) return s;
+  }
+  if (analog) {
+    if (Status s = need(tpdo_, load_cell, "load cell", analog_slot_); !s) return s;
+  }
+  if (input_slot_.size() == 2 && in_bytes == 2 && input_slot_[1].pdo != input_slot_[0].pdo) {
+    return Status::error(who() + "0x6000:01 and 0x6000:02 are in different TPDOs; the master needs them in one");
+  }
+  output_pdo_ = output_slot_[0].pdo;
+  if (out_bytes == 2 && output_slot_[1].pdo != output_pdo_) {
+    return Status::error(who() + "0x6200:01 and 0x6200:02 are in different RPDOs; the master needs them in one");
+  }
+  std::uint32_t bits = 0;
+  const PdoLayout& out = rpdo_[static_cast<std::size_t>(output_pdo_)];
+  for (std::size_t e = 0; e < out.count; ++e) bits += out.entries[e] & 0xFF;
+  output_pdo_bytes_ = static_cast<std::uint8_t>((bits + 7) / 8);
+  if (output_pdo_bytes_ > 8) return Status::error(who() + "the output RPDO maps more than 64 bits");
+  return Status::ok();
+}
+
+Status CanIoPort::configure(CanBus& bus, ConfigureClock& clock) {
+  configured_ = false;
+  bus_ = nullptr;
+  notes_.clear();
+  link_fault_ = 0;
+  emcy_code_ = 0;
+  inputs_refreshed_ = analog_refreshed_ = last_heartbeat_ = hal::kNeverTick;
+  if (Status s = validate(config_); !s) return Status::error("CAN I/O configuration: " + s.message());
+  consumer_ticks_ = static_cast<std::uint32_t>(std::ceil(config_.heartbeat_consumer_s / config_.cycle_period_s - 1e-9));
+  const std::uint8_t id = config_.node_id;
+
+  bool booted = false, operational = false, bus_off = false;
+  const auto note = [&](const CanFrame& f) {
+    if (f.is_error()) {
+      bus_off = bus_off || decode_error_frame(f).bus_off;
+      return;
+    }
+    if (auto hb = parse_heartbeat(f); hb && hb->node == id) {
+      if (hb->state == NmtState::kBootUp) booted = true;
+      operational = hb->state == NmtState::kOperational;
+    }
+  };
+  const auto wait = [&](const bool& flag, double timeout_s, const std::string& what) -> Status {
+    const std::int64_t deadline = clock.now_us() + static_cast<std::int64_t>(timeout_s * 1e6);
+    for (;;) {
+      CanFrame f;
+      for (int i = 0; i < 4096 && bus.receive(f); ++i) note(f);
+      if (bus_off) return Status::error(who() + "CAN bus-off while waiting for " + what);
+      if (flag) return Status::ok();
+      if (clock.now_us() >= deadline) return Status::error(who() + "no " + what + " within " + seconds(timeout_s));
+      clock.idle();
+    }
+  };
+  const auto send = [&](const CanFrame& f, const char* what) -> Status {
+    const std::int64_t deadline = clock.now_us() + static_cast<std::int64_t>(config_.sdo_timeout_s * 1e6);
+    for (;;) {
+      const SendResult r = bus.send(f);
+      if (r == SendResult::kOk) return Status::ok();
+      if (r == SendResult::kError || clock.now_us() >= deadline) {
+        return Status::error(who() + what + ": the CAN bus refused the frame");
+      }
+      clock.idle();
+    }
+  };
+
+  {
+    CanFrame f;
+    for (int i = 0; i < 4096 && bus.receive(f); ++i) {
+    }
+  }
+  if (Status s = send(make_nmt(NmtCommand::kResetNode, id), "NMT reset-node"); !s) return s;
+  if (Status s = wait(booted, config_.boot_timeout_s,
+                      "boot-up after NMT reset-node (is the I/O module powered, on this bus, with this node id?)");
+      !s) {
+    return s;
+  }
+
+  SdoClient sdo(bus, clock, static_cast<std::int64_t>(config_.sdo_timeout_s * 1e6), note);
+  const auto fail = [&](const Status& s) { return Status::error(who() + s.message()); };
+
+  Result<std::uint32_t> type = sdo.read(id, od::kDeviceType, 0);
+  if (!type) return fail(type.status());
+  if ((type.value() & 0xFFFF) != od401::kDeviceProfile401) {
+    return Status::error(who() + "0x1000 device type = " + hex(type.value(), 8) +
+                         ": not a CiA 401 generic I/O module (low word 0x0191)");
+  }
+  const auto producer_ms = static_cast<std::uint32_t>(std::lround(config_.heartbeat_producer_s * 1e3));
+  if (Status s = sdo.write(id, od::kHeartbeatProducer, 0, producer_ms, 2); !s) return fail(s);
+
+  // The module's own reaction to a failure: valves off (see io_safe_outputs()).
+  {
+    const IoWiring& w = config_.wiring;
+    const hal::DigitalOutputs safe = io_safe_outputs();
+    std::array<std::uint8_t, 2> mode{}, value{};
+    const auto put = [&](const IoBit& b, bool on) {
+      if (b.bit < 0) return;
+      const auto byte = static_cast<std::size_t>(b.bit / 8);
+      const auto mask = static_cast<std::uint8_t>(1U << (b.bit % 8));
+      mode[byte] |= mask;
+      if (on != b.active_low) value[byte] |= mask;
+    };
+    put(w.piston_a_extend, safe.piston_a_extend);
+    put(w.piston_b_extend, safe.piston_b_extend);
+    put(w.lamp_green, safe.lamp_green);
+    put(w.lamp_amber, safe.lamp_amber);
+    put(w.lamp_red, safe.lamp_red);
+    put(w.buzzer, safe.buzzer);
+    const std::uint8_t bytes = bytes_for(outputs_of(w));
+    bool absent = false;
+    for (std::uint8_t k = 0; k < bytes && !absent; ++k) {
+      if (Status s = sdo.write(id, od401::kOutputErrorMode, static_cast<std::uint8_t>(k + 1), mode[k], 1); !s) {
+        if (sdo.last_abort() != sdo_abort::kNoObject) return fail(s);
+        absent = true;
+        break;
+      }
+      if (Status s = sdo.write(id, od401::kOutputErrorValue, static_cast<std::uint8_t>(k + 1), value[k], 1); !s) {
+        if (sdo.last_abort() != sdo_abort::kNoObject) return fail(s);
+        absent = true;
+      }
+    }
+    if (absent) {
+      notes_.push_back(who() + "0x6206/0x6207 (output error mode/value) absent: the outputs keep their last "
+                               "state if the master dies; wire the valves' supply through the e-stop chain");
+    }
+  }
+
+  if (config_.master_node_id != 0) {
+    const std::uint32_t v = (static_cast<std::uint32_t>(config_.master_node_id) << 16) |
+                            static_cast<std::uint32_t>(std::lround(config_.master_consumer_s * 1e3));
+    if (Status s = sdo.write(id, od401::kConsumerHeartbeat, 1, v, 4); !s) {
+      if (sdo.last_abort() != sdo_abort::kNoObject && sdo.last_abort() != sdo_abort::kNoSubIndex) return fail(s);
+      notes_.push_back(who() + "0x1016 (consumer heartbeat time) absent: the module cannot notice that the "
+                               "master died; only its own failure mode protects the outputs");
+    }
+  }
+
+  if (Status s = configure_mapping(sdo); !s) return s;
+
+  operational = false;
+  if (Status s = send(make_nmt(NmtCommand::kStart, id), "NMT start"); !s) return s;
+  if (Status s = wait(operational, config_.operational_timeout_s,
+                      "operational heartbeat after NMT start (heartbeat producer time 0x1017 not honoured?)");
+      !s) {
+    return s;
+  }
+  bus_ = &bus;
+  configured_ = true;
+  return Status::ok();
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Per tick (RT-safe)
+// ---------------------------------------------------------------------------------------------------
+void CanIoPort::on_frame(hal::Tick now, const CanFrame& f) {
+  if (!configured_ || f.is_error()) return;
+  const CobDecoded d = decode_cob_id(f.id);
+  if (d.node != config_.node_id) return;
+  const auto read_le = [&](const Slot& s, std::uint32_t& v) {
+    if (s.offset + s.bytes > f.dlc) return false;
+    v = 0;
+    for (std::size_t b = 0; b < s.bytes; ++b) v |= static_cast<std::uint32_t>(f.data[s.offset + b]) << (8 * b);
+    return true;
+  };
+  int tpdo = -1;
+  switch (d.function) {
+    case CobFunction::kTpdo1: tpdo = 0; break;
+    case CobFunction::kTpdo2: tpdo = 1; break;
+    case CobFunction::kTpdo3: tpdo = 2; break;
+    case CobFunction::kTpdo4: tpdo = 3; break;
+    case CobFunction::kHeartbeat: {
+      const auto hb = parse_heartbeat(f);
+      if (!hb) {
+        ++rx_errors_;
+        return;
+      }
+      last_heartbeat_ = now;
+      if (link_fault_ == 0 && hb->state == NmtState::kBootUp) link_fault_ = fault_code::kNodeRebooted;
+      if (link_fault_ == 0 && hb->state != NmtState::kOperational && hb->state != NmtState::kBootUp) {
+        link_fault_ = fault_code::kNodeNotOperational;
+      }
+      return;
+    }
+    case CobFunction::kEmcy: {
+      const auto e = parse_emcy(f);
+      if (!e) {
+        ++rx_errors_;
+        return;
+      }
+      if (e->code != 0) emcy_code_ = e->code;
+      return;
+    }
+    default:
+      return;
+  }
+  bool used = false;
+  std::uint32_t v = 0;
+  if (input_slot_[0].pdo == tpdo) {
+    for (std::size_t k = 0; k < input_slot_.size(); ++k) {
+      if (input_slot_[k].pdo != tpdo) continue;
+      if (!read_le(input_slot_[k], v)) {
+        ++rx_errors_;
+        return;
+      }
+      inputs_[k] = static_cast<std::uint8_t>(v);
+    }
+    inputs_refreshed_ = now;
+    used = true;
+  }
+  if (analog_slot_.pdo == tpdo) {
+    if (!read_le(analog_slot_, v)) {
+      ++rx_errors_;
+      return;
+    }
+    analog_counts_ = static_cast<std::int16_t>(static_cast<std::uint16_t>(v));
+    analog_refreshed_ = now;
+    used = true;
+  }
+  if (!used) ++rx_errors_;  // a TPDO we disabled: the module ignores its configuration
+}
+
+void CanIoPort::supervise(hal::Tick now) {
+  if (!configured_) return;
+  // The consumer starts counting at the first tick; heartbeats during bring-up carry no tick.
+  if (last_heartbeat_ == hal::kNeverTick) last_heartbeat_ = now;
+  if (link_fault_ == 0 && now - last_heartbeat_ > static_cast<hal::Tick>(consumer_ticks_)) {
+    link_fault_ = fault_code::kHeartbeatLost;
+  }
+}
+
+void CanIoPort::acknowledge() {
+  emcy_code_ = 0;  // the module's own fault clears with its error reset; ours with the operator's ack
+}
+
+bool CanIoPort::input(const IoBit& b) const {
+  if (b.bit < 0) return false;
+  const bool level = ((inputs_[static_cast<std::size_t>(b.bit / 8)] >> (b.bit % 8)) & 1U) != 0;
+  return level != b.active_low;
+}
+
+void CanIoPort::read_io(hal::Tick /*now*/, const hal::AxisFeedbacks& /*axes*/, hal::DigitalInputs& io) {
+  const IoWiring& w = config_.wiring;
+  io.piston_a_extended = input(w.piston_a_extended);
+  io.piston_a_retracted = input(w.piston_a_retracted);
+  io.piston_b_extended = input(w.piston_b_extended);
+  io.piston_b_retracted = input(w.piston_b_retracted);
+  io.shuttle_at_left = input(w.shuttle_at_left);
+  io.shuttle_at_right = input(w.shuttle_at_right);
+  // Before the first TPDO there is no news, not an opened chain: `refreshed` stays kNeverTick, which the
+  // sequencer counts as old from arming (stale → fault), and every sensor reads false, so nothing can
+  // be confirmed (no shed, no pick) on inputs never seen.
+  io.estop_ok = inputs_refreshed_ == hal::kNeverTick || input(w.estop_ok);
+  io.button_start = input(w.button_start);
+  io.button_pause = input(w.button_pause);
+  io.button_ack = input(w.button_ack);
+  io.row_knotted = input(w.row_knotted);
+  io.refreshed = inputs_refreshed_;
+}
+
+void CanIoPort::read_analog(hal::Tick /*now*/, hal::AnalogInputs& analog) {
+  const IoWiring& w = config_.wiring;
+  analog.beat_force_valid = w.load_cell_channel != 0 && analog_refreshed_ != hal::kNeverTick;
+  analog.beat_force_n = analog.beat_force_valid
+                            ? w.load_cell_n_per_count * static_cast<double>(analog_counts_) + w.load_cell_offset_n
+                            : 0.0;
+  analog.refreshed = analog_refreshed_;
+}
+
+void CanIoPort::write_io(hal::Tick /*now*/, const hal::DigitalOutputs& requested) {
+  if (!configured_) return;
+  // A node we cannot supervise gets its safe outputs (it may still hear us).
+  const hal::DigitalOutputs& o = link_fault_ != 0 ? io_safe_outputs() : requested;
+  const IoWiring& w = config_.wiring;
+  std::array<std::uint8_t, 2> bytes{};
+  const auto put = [&](const IoBit& b, bool on) {
+    if (b.bit < 0) return;
+    if (on != b.active_low) bytes[static_cast<std::size_t>(b.bit / 8)] |= static_cast<std::uint8_t>(1U << (b.bit % 8));
+  };
+  put(w.piston_a_extend, o.piston_a_extend);
+  put(w.piston_b_extend, o.piston_b_extend);
+  put(w.lamp_green, o.lamp_green);
+  put(w.lamp_amber, o.lamp_amber);
+  put(w.lamp_red, o.lamp_red);
+  put(w.buzzer, o.buzzer);
+  CanFrame f;
+  f.id = cob::rpdo(output_pdo_ + 1, config_.node_id);
+  f.dlc = output_pdo_bytes_;
+  for (std::size_t k = 0; k < output_slot_.size(); ++k) {
+    if (output_slot_[k].pdo == output_pdo_ && output_slot_[k].bytes == 1) f.data[output_slot_[k].offset] = bytes[k];
+  }
+  if (bus_->send(f) != SendResult::kOk) ++tx_dropped_;
+}
+
+}  // namespace loom::drivers

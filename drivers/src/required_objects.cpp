@@ -1,0 +1,58 @@
+// Required objects per node kind, named with the master's own od:: constants.
+#include "loom/drivers/required_objects.hpp"
+
+#include <cstdio>
+
+#include "loom/drivers/can_io_port.hpp"
+#include "loom/drivers/pdo.hpp"
+
+namespace loom::drivers {
+
+std::vector<RequiredObject> drive_objects() {
+  return {
+      {od::kDeviceType, "device type", false, "identifies a CiA 402 drive"},
+      {od::kErrorRegister, "error register", false, "EMCY context"},
+      {od::kHeartbeatProducer, "producer heartbeat time", false, "the drive is supervised by its heartbeat"},
+      {od401::kConsumerHeartbeat, "consumer heartbeat time", true, "the drive stops by itself when the controller dies"},
+      {od::kRpdoComm, "RPDO1 communication", false, "controlword + target position every SYNC"},
+      {od::kRpdoMap, "RPDO1 mapping (writable, or fixed to 0x6040 + 0x607A)", false, "read back when read-only"},
+      {od::kTpdoComm, "TPDO1 communication", false, "statusword + position actual every SYNC"},
+      {od::kTpdoMap, "TPDO1 mapping (writable, or fixed to 0x6041 + 0x6064)", false, "read back when read-only"},
+      {static_cast<std::uint16_t>(od::kTpdoComm + 1), "TPDO2 communication", true, "velocity + torque actual"},
+      {od::kErrorCode, "error code", false, "fault text for the technician"},
+      {od::kControlword, "controlword", false, "CiA 402 power state machine"},
+      {od::kStatusword, "statusword", false, "CiA 402 state, following error bit"},
+      {od::kModesOfOperation, "modes of operation", false, "set to 8 (cyclic synchronous position)"},
+      {od::kModesOfOperationDisplay, "modes of operation display", false, "confirms mode 8"},
+      {od::kPositionActual, "position actual value", false, "feedback; seeds the first target"},
+      {od::kVelocityActual, "velocity actual value", true, "in TPDO2 when present"},
+      {od::kTorqueActual, "torque actual value", true, "in TPDO2 when present"},
+      {od::kTargetPosition, "target position", false, "the profile, every SYNC"},
+      {od::kInterpolationPeriod, "interpolation time period", false, "set to the control period"},
+      {od::kSupportedDriveModes, "supported drive modes", false, "must offer CSP (bit 7)"},
+  };
+}
+
+std::vector<RequiredObject> io_module_objects() {
+  return {
+      {od::kDeviceType, "device type", false, "must be CiA 401"},
+      {od::kHeartbeatProducer, "producer heartbeat time", false, "the module is supervised by its heartbeat"},
+      {od401::kConsumerHeartbeat, "consumer heartbeat time", true, "valves drop when the controller dies"},
+      {od::kRpdoComm, "RPDO1 communication/mapping", false, "digital outputs every SYNC"},
+      {od::kTpdoComm, "TPDO1 communication/mapping", false, "digital inputs every SYNC"},
+      {static_cast<std::uint16_t>(od::kTpdoComm + 1), "TPDO2 communication/mapping", true, "load cell (when wired)"},
+      {od401::kDigitalInputs8, "read digital inputs, 8-bit", false, "sensors, e-stop chain, buttons"},
+      {od401::kDigitalOutputs8, "write digital outputs, 8-bit", false, "valves, stack light, buzzer"},
+      {od401::kOutputErrorMode, "output error mode", true, "the module adopts the safe outputs by itself"},
+      {od401::kOutputErrorValue, "output error value", true, "both valves de-energised on failure"},
+      {od401::kAnalogInput16, "read analog input, 16-bit", true, "the beater's load cell (when wired)"},
+  };
+}
+
+std::string describe(const RequiredObject& o) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "0x%04X %s%s: %s", o.index, o.name, o.optional ? " (optional)" : "", o.why);
+  return buf;
+}
+
+}  // namespace loom::drivers

@@ -1,0 +1,120 @@
+// A simulated CiA 401 generic I/O module as a CANopen node, with the loom's plant behind it: two
+// pneumatic pistons (valve coil → end sensors after a fill time), the shuttle-arrival sensors (the
+// shuttle rides the helix shaft's carrier), the beater's load cell (from the crank angle), the e-stop
+// chain and the operator buttons (set by the test or the executable's control file).
+//
+// Deliberately independent of the master's codec: its object dictionary is one table in
+// sim_io_node.cpp (index, sub, size, access, PDO direction, default) from which SDO read/write, PDO
+// mapping checks and PDO packing all come, and its frames are built from CiA 301 byte layouts here, not
+// from drivers/. A bug in the master's encoders therefore cannot hide behind the same bug in the peer.
+// Only the transport (drivers::CanBus, CanFrame) is shared.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "loom/drivers/can_frame.hpp"
+
+namespace loom::sim_can {
+
+// What the module's inputs physically see, set by the caller every step (RT-safe plain data).
+struct IoPlant {
+  double helix_rad = 0.0;     // helix shaft position (shuttle carrier), rad
+  double crank_rad = 0.0;     // beat-up crank position, rad
+  bool estop_open = false;    // e-stop chain opened
+  bool button_start = false;
+  bool button_pause = false;
+  bool button_ack = false;
+  bool row_knotted = false;
+  bool silent = false;        // cable pulled: sends nothing, hears nothing
+};
+
+struct SimIoConfig {
+  std::uint8_t node_id = 4;
+  // Plant.
+  double width_m = 1.2;              // loom width between the selvedge sensors' far edges
+  double helix_lead_m = 0.1;         // shuttle travel per helix turn
+  double selvedge_window_m = 0.005;  // shuttle sensor sees the shuttle this close to its selvedge
+  double piston_travel_s = 0.25;     // valve switched → the piston reaches its other end
+  double beat_peak_n = 90.0;         // load-cell force at the fell
+  double fell_crank_rad = 3.14159265358979;  // crank angle (mod 2π) at which the beater meets the fell
+  double load_cell_n_per_count = 0.01;
+  // Interoperability variants.
+  bool fixed_mapping = false;                   // 0x16xx/0x1Axx read-only, sub 0 included
+  std::vector<std::uint16_t> absent_objects;    // e.g. 0x1016, 0x6206, 0x1802
+  std::int64_t boot_delay_us = 0;               // power-on / reset → boot-up
+};
+
+class SimIoNode {
+ public:
+  // Configure-time only. Powered off until power_on().
+  SimIoNode(drivers::CanBus& bus, SimIoConfig config);
+
+  void power_on(std::int64_t now_us);  // RT-safe
+  void power_off();                    // RT-safe
+  // RT-safe. One received frame; the node filters what concerns it.
+  void handle(const drivers::CanFrame& frame, std::int64_t now_us);
+  // RT-safe. Plant and timers (boot-up, heartbeat producer, master-heartbeat consumer).
+  void step(std::int64_t now_us, const IoPlant& plant);
+  std::int64_t next_deadline_us() const;
+
+  // Observation (tests, logs).
+  std::uint8_t node_id() const { return config_.node_id; }
+  std::uint8_t nmt_state() const { return nmt_; }  // 0x00, 0x04, 0x05, 0x7F as on the wire
+  std::uint8_t outputs(int byte) const;            // what drives the valve coils now (error state applied)
+  std::uint8_t inputs(int byte) const { return in_[static_cast<std::size_t>(byte)]; }
+  std::int16_t analog_counts() const { return analog_; }
+  bool comm_lost() const { return comm_lost_; }     // master heartbeat consumer expired
+  double piston_a() const { return piston_[0]; }   // 0 = retracted … 1 = extended
+  double piston_b() const { return piston_[1]; }
+
+  // One object-dictionary entry (public for the table in the .cpp).
+  enum class Access : std::uint8_t { kConst, kRo, kRw };
+  struct Entry {
+    std::uint16_t index;
+    std::uint8_t sub;
+    std::uint8_t bytes;
+    Access access;
+    char pdo;  // 'T' mappable into a TPDO, 'R' into an RPDO, 0 not mappable
+    std::uint32_t default_value;
+  };
+
+ private:
+  int find(std::uint16_t index, std::uint8_t sub) const;  // entry position, −1 none
+  bool object_exists(std::uint16_t index) const;
+  std::uint32_t& value(std::uint16_t index, std::uint8_t sub);
+  std::uint32_t get(std::uint16_t index, std::uint8_t sub) const;
+  std::uint32_t sdo_write(std::uint16_t index, std::uint8_t sub, std::uint32_t v, int size, std::int64_t now_us);
+  std::uint32_t sdo_read(std::uint16_t index, std::uint8_t sub, std::uint32_t& v, int& size) const;
+  void on_sdo(const drivers::CanFrame& f, std::int64_t now_us);
+  void on_sync();
+  void apply_rpdo(int pdo, const std::array<std::uint8_t, 8>& data, std::uint8_t dlc);
+  void send_tpdo(int pdo);
+  void reset_communication(std::int64_t now_us);
+  void reset_application();
+  void send(std::uint32_t id, std::uint8_t dlc, const std::array<std::uint8_t, 8>& data);
+  void update_inputs();
+
+  drivers::CanBus& bus_;
+  SimIoConfig config_;
+  std::vector<std::uint32_t> values_;  // one per table entry
+  bool powered_ = false;
+  std::uint8_t nmt_ = 0x7F;
+  std::int64_t boot_at_us_ = -1;  // pending boot-up
+  std::int64_t next_hb_us_ = 0;
+  std::int64_t master_seen_us_ = -1;
+  bool comm_lost_ = false;
+  std::uint32_t syncs_ = 0;
+  std::array<bool, 4> rpdo_pending_{};
+  std::array<std::array<std::uint8_t, 8>, 4> rpdo_data_{};
+  std::array<std::uint8_t, 4> rpdo_dlc_{};
+  // Plant.
+  IoPlant plant_{};
+  std::int64_t last_step_us_ = -1;
+  std::array<double, 2> piston_{0.0, 0.0};
+  std::array<std::uint8_t, 2> in_{};
+  std::int16_t analog_ = 0;
+};
+
+}  // namespace loom::sim_can

@@ -1,0 +1,424 @@
+// The CiA 401 I/O node driver and the master's interoperability and fault rules, against simulated
+// nodes on the fake CAN network. The I/O node's peer (sim_can::SimIoNode) has its own object dictionary
+// and frame layouts, independent of the master's codec.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+
+#include "drive_rig.hpp"
+#include "loom/drivers/can_io_port.hpp"
+#include "loom/drivers/cia402.hpp"
+#include "loom/drivers/emcy.hpp"
+#include "loom/drivers/nmt.hpp"
+#include "loom/sim_can/sim_io_node.hpp"
+
+namespace loom::test {
+namespace {
+
+using drivers::CanIoConfig;
+using drivers::CanIoPort;
+using drivers::IoWiring;
+using hal::AxisRequest;
+using hal::DriveState;
+
+bool contains(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
+bool any_note(const std::vector<std::string>& notes, const std::string& part) {
+  return std::any_of(notes.begin(), notes.end(), [&](const std::string& n) { return contains(n, part); });
+}
+
+// Servo drives + the I/O node on one endpoint, the master's two ports on the other.
+struct IoRig {
+  explicit IoRig(sim_can::SimIoConfig io_cfg = {}, std::vector<sim_can::SimDriveConfig> drives = three_drives(),
+                 drivers::CanAxisPortConfig axis_cfg = {}, CanIoConfig port_cfg = {})
+      : rig(std::move(drives), with_io_frames(axis_cfg, port_cfg)), io(rig.drives, io_cfg), port(port_cfg) {
+    rig.rack.attach_io(io, {0, 2, drivers::kDefaultCountsPerRad, drivers::kDefaultCountsPerRad});
+    rig.port.attach(port);
+  }
+  static drivers::CanAxisPortConfig with_io_frames(drivers::CanAxisPortConfig c, const CanIoConfig& io) {
+    c.other_frames_per_cycle = drivers::io_frames_per_cycle(io.wiring);
+    return c;
+  }
+  drivers::Status configure() {
+    if (drivers::Status s = rig.configure(); !s) return s;
+    return port.configure(rig.master, rig.clock);
+  }
+  // One RT cycle through the joined HAL, as the control loop runs it.
+  void tick(AxisRequest r, const hal::DigitalOutputs& out = {}) {
+    hal::PortHal hal(rig.port, port);
+    hal.read(rig.tick_index, in);
+    rig.feedback = in.axes;
+    hal::HalOutputs o;
+    for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+      o.axes[i].request = r;
+      o.axes[i].target_position = in.axes[i].position;
+    }
+    o.io = out;
+    hal.write(rig.tick_index, o);
+    ++rig.tick_index;
+    rig.advance(rig.period_us());
+  }
+  void enable_all() {
+    for (int i = 0; i < 50 && !rig.all_in(DriveState::kOperationEnabled); ++i) tick(AxisRequest::kEnable);
+    ASSERT_TRUE(rig.all_in(DriveState::kOperationEnabled));
+  }
+
+  DriveRig rig;
+  sim_can::SimIoNode io;
+  CanIoPort port;
+  hal::HalInputs in{};
+};
+
+// ---------------------------------------------------------------------------------------------------
+// Wiring validation
+// ---------------------------------------------------------------------------------------------------
+TEST(IoWiring, DefaultsAreValid) {
+  EXPECT_TRUE(drivers::validate(IoWiring{}));
+}
+
+TEST(IoWiring, DuplicateBitNamesBothSignals) {
+  IoWiring w;
+  w.estop_ok.bit = 3;
+  const drivers::Status s = drivers::validate(w);
+  ASSERT_FALSE(s);
+  EXPECT_EQ(s.message(), "io.inputs.estop_ok.bit = 3 is already used by io.inputs.piston_b_retracted");
+}
+
+TEST(IoWiring, BitOutOfRangeAndUnwiredRequiredSignal) {
+  IoWiring w;
+  w.lamp_red.bit = 16;
+  EXPECT_EQ(drivers::validate(w).message(), "io.outputs.lamp_red.bit = 16 is outside 0..15 (-1 = not wired)");
+  IoWiring u;
+  u.piston_b_extend.bit = -1;
+  EXPECT_EQ(drivers::validate(u).message(), "io.outputs.piston_b_extend.bit = -1: this signal must be wired");
+  IoWiring b;
+  b.button_ack.bit = -1;  // optional
+  EXPECT_TRUE(drivers::validate(b));
+  IoWiring g;
+  g.load_cell_n_per_count = 0.0;
+  EXPECT_TRUE(contains(drivers::validate(g).message(), "io.load_cell.n_per_count = 0"));
+}
+
+TEST(IoWiring, FramesPerCycle) {
+  IoWiring w;
+  auto g = drivers::io_frames_per_cycle(w);
+  ASSERT_EQ(g.size(), 3u);  // outputs RPDO (1 B), inputs TPDO (2 B: buttons on bits 8..11), load cell TPDO
+  EXPECT_EQ(g[0].data_bytes, 1u);
+  EXPECT_EQ(g[1].data_bytes, 2u);
+  EXPECT_EQ(g[2].data_bytes, 2u);
+  w.load_cell_channel = 0;
+  EXPECT_EQ(drivers::io_frames_per_cycle(w).size(), 2u);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Bring-up and the exchange
+// ---------------------------------------------------------------------------------------------------
+TEST(CanIoPort, BringsUpTheModuleAndExchangesEverySignal) {
+  IoRig r;
+  const drivers::Status s = r.configure();
+  ASSERT_TRUE(s) << s.message();
+  EXPECT_TRUE(r.port.notes().empty()) << r.port.notes().front();
+  // Before the first TPDO: no news (never refreshed), not an opened e-stop chain, no sensor confirmed.
+  hal::DigitalInputs before;
+  r.port.read_io(0, {}, before);
+  EXPECT_EQ(before.refreshed, hal::kNeverTick);
+  EXPECT_TRUE(before.estop_ok);
+  EXPECT_FALSE(before.piston_a_retracted || before.shuttle_at_left);
+  r.enable_all();
+  ASSERT_TRUE(r.in.io.estop_ok);
+  EXPECT_TRUE(r.in.io.piston_a_retracted);
+  EXPECT_TRUE(r.in.io.piston_b_retracted);
+  EXPECT_TRUE(r.in.io.shuttle_at_left);  // helix at 0
+  EXPECT_FALSE(r.in.io.shuttle_at_right);
+  EXPECT_EQ(r.in.io.refreshed, r.rig.tick_index - 1);  // a TPDO every SYNC
+
+  // Valve A on: after the piston's travel time, A's extended sensor.
+  hal::DigitalOutputs out;
+  out.piston_a_extend = true;
+  out.lamp_green = true;
+  for (int i = 0; i < 10; ++i) r.tick(AxisRequest::kEnable, out);
+  EXPECT_EQ(r.io.outputs(0) & 0x13, 0x11);  // valve A (bit 0) and green (bit 4), not valve B
+  EXPECT_FALSE(r.in.io.piston_a_extended);
+  for (int i = 0; i < 150; ++i) r.tick(AxisRequest::kEnable, out);
+  EXPECT_TRUE(r.in.io.piston_a_extended);
+  EXPECT_FALSE(r.in.io.piston_a_retracted);
+  EXPECT_TRUE(r.in.io.piston_b_retracted);
+
+  // Buttons and the e-stop chain.
+  r.rig.rack.io_controls().button_ack = true;
+  r.rig.rack.io_controls().row_knotted = true;
+  for (int i = 0; i < 3; ++i) r.tick(AxisRequest::kEnable, out);
+  EXPECT_TRUE(r.in.io.button_ack);
+  EXPECT_TRUE(r.in.io.row_knotted);
+  EXPECT_FALSE(r.in.io.button_start);
+  r.rig.rack.io_controls().estop_open = true;
+  for (int i = 0; i < 3; ++i) r.tick(AxisRequest::kEnable, out);
+  EXPECT_FALSE(r.in.io.estop_ok);
+}
+
+TEST(CanIoPort, LoadCellScaledByTheWiringAndShuttleFollowsTheHelix) {
+  CanIoConfig pc;
+  pc.wiring.load_cell_n_per_count = 0.02;  // master's scaling
+  pc.wiring.load_cell_offset_n = 1.0;
+  sim_can::SimIoConfig ic;
+  ic.load_cell_n_per_count = 0.01;  // the module's: the master sees twice the force plus 1 N
+  ic.beat_peak_n = 90.0;
+  ic.fell_crank_rad = 0.0;  // crank at 0 rad = at the fell
+  IoRig r(ic, three_drives(0, 0, static_cast<std::int32_t>(11.97 * 2 * 3.14159265358979 *
+                                                            drivers::kDefaultCountsPerRad)),
+          {}, pc);
+  ASSERT_TRUE(r.configure());
+  r.enable_all();
+  EXPECT_TRUE(r.in.analog.beat_force_valid);
+  EXPECT_NEAR(r.in.analog.beat_force_n, 2.0 * 90.0 + 1.0, 1e-9);
+  EXPECT_EQ(r.in.analog.refreshed, r.rig.tick_index - 1);
+  EXPECT_TRUE(r.in.io.shuttle_at_right);  // 11.97 turns × 0.1 m within 5 mm of the 1.2 m selvedge
+}
+
+TEST(CanIoPort, RefusesAModuleThatIsNotCiA401) {
+  IoRig r;
+  drivers::Status s = r.rig.configure();
+  ASSERT_TRUE(s);
+  CanIoConfig pc;
+  pc.node_id = 1;  // a servo drive: device type 0x00020192
+  CanIoPort wrong(pc);
+  s = wrong.configure(r.rig.master, r.rig.clock);
+  ASSERT_FALSE(s);
+  EXPECT_TRUE(contains(s.message(), "node 1 (I/O node): 0x1000 device type = 0x00020192")) << s.message();
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Interoperability rules (CiA 301)
+// ---------------------------------------------------------------------------------------------------
+// Rule 1: a mapping that cannot be written is read back and accepted when it carries what we need.
+TEST(Interop, IoModuleWithFixedMappingIsReadBackAndAccepted) {
+  sim_can::SimIoConfig ic;
+  ic.fixed_mapping = true;
+  IoRig r(ic);
+  const drivers::Status s = r.configure();
+  ASSERT_TRUE(s) << s.message();
+  EXPECT_TRUE(any_note(r.port.notes(), "0x1A00 mapping is fixed"));
+  r.enable_all();
+  EXPECT_TRUE(r.in.io.estop_ok);
+  EXPECT_TRUE(r.in.analog.beat_force_valid);
+}
+
+// Rule 1, refusal: the fixed mapping lacks an object the wiring needs → refused, naming node, object.
+TEST(Interop, IoModuleWithFixedMappingLackingTheLoadCellIsRefused) {
+  sim_can::SimIoConfig ic;
+  ic.fixed_mapping = true;  // TPDO2 carries 0x6401:01 only
+  CanIoConfig pc;
+  pc.wiring.load_cell_channel = 2;
+  IoRig r(ic, three_drives(), {}, pc);
+  const drivers::Status s = r.configure();
+  ASSERT_FALSE(s);
+  EXPECT_TRUE(contains(s.message(), "node 4 (I/O node): no PDO carries 0x6401:02 (load cell)")) << s.message();
+}
+
+// Rule 2: "object does not exist" while disabling an unused PDO is not an error.
+TEST(Interop, IoModuleWithoutTpdo3And4AndWithoutErrorModeIsAccepted) {
+  sim_can::SimIoConfig ic;
+  ic.absent_objects = {0x1802, 0x1803, 0x1A02, 0x1A03, 0x1401, 0x1601};
+  IoRig r(ic);
+  const drivers::Status s = r.configure();
+  ASSERT_TRUE(s) << s.message();
+  EXPECT_TRUE(r.port.notes().empty());
+}
+
+// Rule 3: optional objects used when present, reported when absent (I/O node: 0x1016, 0x6206/0x6207).
+TEST(Interop, IoModuleOptionalObjectsAbsentAreReported) {
+  sim_can::SimIoConfig ic;
+  ic.absent_objects = {0x1016, 0x6206, 0x6207};
+  IoRig r(ic);
+  const drivers::Status s = r.configure();
+  ASSERT_TRUE(s) << s.message();
+  EXPECT_TRUE(any_note(r.port.notes(), "0x1016 (consumer heartbeat time) absent"));
+  EXPECT_TRUE(any_note(r.port.notes(), "0x6206/0x6207 (output error mode/value) absent"));
+}
+
+// The "commercial" drive personality: fixed mapping, no TPDO3/TPDO4 objects, no 0x1016, slow boot
+// and slow switch to operational.
+std::vector<sim_can::SimDriveConfig> fixed_drives(std::int64_t boot_us, std::int64_t op_us) {
+  auto d = three_drives();
+  for (auto& c : d) {
+    c.fixed_mapping = true;
+    c.missing_objects = {0x1802, 0x1803, 0x1A02, 0x1A03, 0x1016};
+    c.boot_delay_us = boot_us;
+    c.operational_delay_us = op_us;
+  }
+  return d;
+}
+
+TEST(Interop, FixedPersonalityDriveIsAcceptedWithNotes) {
+  drivers::CanAxisPortConfig ac;
+  ac.tpdo2 = true;  // its fixed TPDO2 carries velocity + torque: used
+  ac.operational_timeout_s = 0.25;  // the per-node windows below are what let the slow drives in
+  ac.axes[0].operational_timeout_s = 0.6;
+  ac.axes[1].operational_timeout_s = 0.6;
+  ac.axes[2].operational_timeout_s = 0.6;
+  IoRig r({}, fixed_drives(300'000, 400'000), ac);
+  const drivers::Status s = r.configure();
+  ASSERT_TRUE(s) << s.message();
+  const auto& notes = r.rig.port.notes();
+  EXPECT_TRUE(any_note(notes, "node 1 (beat_crank): 0x1016 (consumer heartbeat time) absent"));
+  EXPECT_TRUE(any_note(notes, "0x1600:00 (RPDO1 mapping) is fixed (read-only); read back and accepted") ||
+              any_note(notes, "0x1600:00") );
+  EXPECT_TRUE(r.rig.port.has_tpdo2(hal::Axis::kCarriage));
+  EXPECT_FALSE(r.rig.port.has_consumer(hal::Axis::kCarriage));
+  r.enable_all();
+}
+
+// Rule 4: per-node operational windows — the same slow drive fails the default window, naming it.
+TEST(Interop, SlowOperationalSwitchNeedsItsPerNodeWindow) {
+  drivers::CanAxisPortConfig ac;
+  ac.operational_timeout_s = 0.25;  // port-wide window shorter than the drive needs
+  IoRig r({}, fixed_drives(0, 400'000), ac);
+  const drivers::Status s = r.configure();
+  ASSERT_FALSE(s);
+  EXPECT_TRUE(contains(s.message(), "node 1 (beat_crank): no operational heartbeat after NMT start within 0.25 s"))
+      << s.message();
+}
+
+TEST(Interop, FixedMappingThatLacksThePositionIsRefusedNamingWhatIsMissing) {
+  auto d = fixed_drives(0, 0);
+  d[1].tpdo1_factory_mapping = {0x60410010, 0x60630020};  // position actual in increments, not 0x6064
+  drivers::CanAxisPortConfig ac;
+  ac.operational_timeout_s = 0.5;
+  IoRig r({}, d, ac);
+  const drivers::Status s = r.configure();
+  ASSERT_FALSE(s);
+  EXPECT_TRUE(contains(s.message(), "node 2 (carriage): 0x1A00:00")) << s.message();
+  EXPECT_TRUE(contains(s.message(), "missing 0x6064")) << s.message();
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Fault reactions
+// ---------------------------------------------------------------------------------------------------
+// An EMCY while the drive's statusword still says Operation Enabled stops every axis in that tick.
+TEST(FaultReaction, EmcyFromAnEnabledDriveQuickStopsEveryAxisInTheSameTick) {
+  IoRig r;
+  ASSERT_TRUE(r.configure());
+  r.enable_all();
+  r.rig.drives.send(drivers::make_emcy(2, 0x2310, 0x03));  // over-current; the drive stays enabled
+  r.rig.advance(100);
+  r.tick(AxisRequest::kEnable);
+  EXPECT_TRUE(r.in.axes[1].fault);
+  EXPECT_EQ(r.in.axes[1].fault_code, 0x2310);
+  for (hal::Axis a : {hal::Axis::kBeatCrank, hal::Axis::kCarriage, hal::Axis::kHelix}) {
+    EXPECT_EQ(r.rig.port.last_controlword(a), drivers::controlword::kQuickStop) << hal::axis_name(a);
+  }
+}
+
+TEST(FaultReaction, EmcyFromTheIoNodeStopsEveryAxisAndIsALinkFault) {
+  IoRig r;
+  ASSERT_TRUE(r.configure());
+  r.enable_all();
+  r.rig.drives.send(drivers::make_emcy(4, 0x5000, 0x01));
+  r.rig.advance(100);
+  r.tick(AxisRequest::kEnable);
+  EXPECT_TRUE(r.in.link.link_fault);
+  EXPECT_EQ(r.in.link.link_fault_code, 0x5000);
+  EXPECT_EQ(r.rig.port.last_controlword(hal::Axis::kHelix), drivers::controlword::kQuickStop);
+  // Latched until the operator acknowledges (fault reset request).
+  for (int i = 0; i < 5; ++i) r.tick(AxisRequest::kEnable);
+  EXPECT_TRUE(r.in.link.link_fault);
+  r.tick(AxisRequest::kFaultReset);
+  r.tick(AxisRequest::kDisable);
+  EXPECT_FALSE(r.in.link.link_fault);
+}
+
+TEST(FaultReaction, SilentIoNodeIsLostWithinItsConsumerTimeAndStopsEveryAxis) {
+  IoRig r;
+  ASSERT_TRUE(r.configure());
+  r.enable_all();
+  r.rig.rack.io_controls().silent = true;
+  const hal::Tick cut = r.rig.tick_index;
+  int n = 0;
+  while (!r.in.link.link_fault && n < 500) {
+    r.tick(AxisRequest::kEnable);
+    ++n;
+  }
+  ASSERT_TRUE(r.in.link.link_fault);
+  EXPECT_EQ(r.in.link.link_fault_code, drivers::fault_code::kHeartbeatLost);
+  // The last heartbeat came up to one producer period (100 ms) before the cut; consumer 250 ms.
+  EXPECT_LE(static_cast<double>(r.rig.tick_index - cut) * 0.002, 0.250 + 0.004);
+  EXPECT_LE(r.in.io.refreshed, cut + 1);  // stale inputs keep their old tick (one frame was in flight)
+  EXPECT_EQ(r.rig.port.last_controlword(hal::Axis::kCarriage), drivers::controlword::kQuickStop);
+}
+
+// The master produces its heartbeat; the I/O module and the drives watch it (0x1016) and react by
+// themselves when the master dies: valves to their safe state, drives quick stop.
+TEST(FaultReaction, MasterSilenceTripsTheNodesConsumers) {
+  IoRig r;
+  ASSERT_TRUE(r.configure());
+  r.enable_all();
+  hal::DigitalOutputs out;
+  out.piston_b_extend = true;
+  for (int i = 0; i < 5; ++i) r.tick(AxisRequest::kEnable, out);
+  EXPECT_EQ(r.io.outputs(0) & 0x03, 0x02);
+  EXPECT_TRUE(r.rig.port.has_consumer(hal::Axis::kBeatCrank));
+  // The host dies: no more ticks, time goes on.
+  r.rig.advance(400'000);
+  EXPECT_FALSE(r.io.comm_lost());
+  r.rig.advance(300'000);
+  EXPECT_TRUE(r.io.comm_lost());
+  EXPECT_EQ(r.io.outputs(0) & 0x03, 0x00);  // both valve coils off (0x6207)
+  EXPECT_EQ(r.io.outputs(0) & 0x40, 0x40);  // red lamp on
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_TRUE(r.rig.rack.node(i).master_lost());
+    EXPECT_EQ(r.rig.rack.node(i).drive_state(), DriveState::kQuickStopActive);
+  }
+}
+
+TEST(FaultReaction, FollowingErrorScalesWithCommandedSpeedAndKeepsAHighWaterMark) {
+  drivers::CanAxisPortConfig ac;
+  ac.axes[2].ferror_min = 0.5;   // rad
+  ac.axes[2].ferror_k_s = 0.01;  // 5 cycles of lag at the commanded speed
+  IoRig r({}, three_drives(), ac);
+  ASSERT_TRUE(r.configure());
+  r.enable_all();
+  // Ramp the helix at 100 rad/s: the ideal drive lags one to two cycles (0.2..0.4 rad) < max(0.5, 1.0).
+  hal::HalOutputs o;
+  double target = r.in.axes[2].position;
+  hal::PortHal hal(r.rig.port, r.port);
+  for (int i = 0; i < 100; ++i) {
+    hal.read(r.rig.tick_index, r.in);
+    for (std::size_t k = 0; k < 3; ++k) {
+      o.axes[k].request = AxisRequest::kEnable;
+      o.axes[k].target_position = r.in.axes[k].position;
+    }
+    target += 100.0 * 0.002;
+    o.axes[2].target_position = target;
+    hal.write(r.rig.tick_index, o);
+    ++r.rig.tick_index;
+    r.rig.advance(r.rig.period_us());
+  }
+  EXPECT_FALSE(r.in.axes[2].fault);
+  const double hw = r.rig.port.ferror_high_water(hal::Axis::kHelix);
+  EXPECT_GT(hw, 0.15);
+  EXPECT_LT(hw, 0.5);
+  // The drive stops receiving its targets (RPDOs lost): the error grows 0.2 rad per cycle and trips
+  // at max(0.5, 0.01 s × 100 rad/s) = 1.0 rad, as fault 0x8611, and every axis stops in that tick.
+  r.rig.net.drop = [](const drivers::CanFrame& f) { return f.id == 0x203; };
+  int n = 0;
+  for (; n < 20 && !r.in.axes[2].fault; ++n) {
+    hal.read(r.rig.tick_index, r.in);
+    for (std::size_t k = 0; k < 3; ++k) o.axes[k].target_position = r.in.axes[k].position;
+    target += 100.0 * 0.002;
+    o.axes[2].target_position = target;
+    hal.write(r.rig.tick_index, o);
+    ++r.rig.tick_index;
+    r.rig.advance(r.rig.period_us());
+  }
+  ASSERT_TRUE(r.in.axes[2].fault);
+  EXPECT_EQ(r.in.axes[2].fault_code, drivers::fault_code::kFollowingError);
+  EXPECT_GE(n, 4);
+  EXPECT_LE(n, 8);
+  EXPECT_EQ(r.rig.port.last_controlword(hal::Axis::kBeatCrank), drivers::controlword::kQuickStop);
+  EXPECT_GT(r.rig.port.ferror_high_water(hal::Axis::kHelix), 0.99);
+}
+
+}  // namespace
+}  // namespace loom::test

@@ -1,0 +1,93 @@
+#!/usr/bin/env bash
+# HIL: the fault reactions over a real vcan0, each from a fresh loomctl run against the same simulated
+# drives + I/O node (loomctl resets the nodes at bring-up):
+#   estop     — the I/O node's e-stop input opens → exit 3, first fault estop, counters kept;
+#   io_silent — the I/O node goes silent → exit 3, first fault heartbeat_lost, counters kept;
+#   emcy      — an EMCY 0x2310 from drive 2 while its statusword stays Operation Enabled → exit 3,
+#               drive_fault; judged from candump: the next RPDO1 to every drive is quick stop;
+#   master    — loomctl is killed (SIGKILL) → every node's 0x1016 consumer reacts (EMCY 0x8130 each),
+#               judged from candump against the consumer time.
+# Reaction times are printed from candump's timestamps (the VM is not real-time: order is asserted,
+# times are reported with a generous bound).  usage: fault-reactions.sh BUILD_DIR  (77 = no vcan0)
+set -euo pipefail
+. "$(dirname "$0")/hil-lib.sh"
+hil_init fault_reactions "${1:-}"
+hil_require_vcan
+hil_find_binaries
+BASE=$HIL_NAME
+HIL_NAME=${BASE}_setup
+hil_start_candump
+hil_start_sim_drives
+hil_stop_candump
+
+# run_until_armed NAME — start loomctl (2 rows) and return once it has been weaving for a while.
+run_until_armed() {
+  HIL_NAME=${BASE}_$1
+  hil_start_candump
+  counters=$HIL_WORK/$1.counters.json
+  out=$HIL_WORK/$1.loomctl.out
+  hil_weave_cmd 2 "$counters"
+  "${HIL_CMD[@]}" >"$out" 2>&1 &
+  loom_pid=$!
+  HIL_PIDS+=("$loom_pid")
+  # Armed = drive 1 commanded to Operation Enabled (RPDO1 controlword 0x000F), from candump.
+  local deadline=$((SECONDS + 30))
+  until [[ -n $(hil_frames_after 0 '201#0F00[0-9A-F]{8}' | head -n1) ]]; do
+    kill -0 "$loom_pid" 2>/dev/null || { sed 's/^/  loomctl| /' "$out"; hil_fail "$1: loomctl exited during bring-up"; }
+    ((SECONDS < deadline)) || hil_fail "$1: drives not enabled within 30 s"
+    sleep 0.05
+  done
+  sleep "${LOOM_HIL_FAULT_AFTER_S:-2}"
+  kill -0 "$loom_pid" 2>/dev/null || { sed 's/^/  loomctl| /' "$out"; hil_fail "$1: loomctl ended before the fault"; }
+}
+
+# expect_fault NAME REGEX — loomctl stops by itself with exit 3 and a FAULT line matching REGEX; the
+# counters file is kept.
+expect_fault() {
+  local deadline=$((SECONDS + 20)) status=0
+  while kill -0 "$loom_pid" 2>/dev/null && ((SECONDS < deadline)); do sleep 0.05; done
+  kill -0 "$loom_pid" 2>/dev/null && hil_fail "$1: loomctl still running 20 s after the fault"
+  wait "$loom_pid" || status=$?
+  sed 's/^/  loomctl| /' "$out"
+  cp "$out" "$HIL_LOGDIR/$HIL_NAME.loomctl.out"
+  hil_stop_candump
+  ((status == 3)) || hil_fail "$1: loomctl exited with $status, expected 3 (fault)"
+  local line
+  line=$(grep '^FAULT' "$out" | head -n1 || true)
+  grep -qE "$2" <<<"$line" || hil_fail "$1: first fault line does not match /$2/: $line"
+  [[ -f $counters ]] || hil_fail "$1: no counters file kept"
+  hil_note "$1: exit 3, $line"
+}
+
+# --- e-stop input -------------------------------------------------------------------------------------
+run_until_armed estop
+hil_io_control estop
+expect_fault estop 'estop'
+hil_io_control ""
+
+# --- I/O node silenced --------------------------------------------------------------------------------
+run_until_armed io_silent
+hil_io_control silent
+expect_fault io_silent 'heartbeat'
+hil_io_control ""
+sleep 0.2
+
+# --- EMCY while the drive stays enabled ---------------------------------------------------------------
+run_until_armed emcy
+cansend "$HIL_IFACE" 082#1023030000000000
+expect_fault emcy 'drive_fault.*0x2310|0x2310.*drive_fault'
+"$HIL_CANLOG" emcy-stop "$HIL_LOG" --nodes "$HIL_NODES" --emcy-node 2 ||
+  hil_fail "emcy: the bus does not show a quick stop of every drive right after the EMCY; log: $HIL_LOG"
+
+# --- the master dies ----------------------------------------------------------------------------------
+run_until_armed master
+kill -KILL "$loom_pid"
+sleep 1
+HIL_PIDS=("${HIL_PIDS[@]/$loom_pid}")
+hil_stop_candump
+nodes=$HIL_NODES,$HIL_IO_NODE
+[[ $HIL_PERSONALITY == fixed ]] && nodes=$HIL_IO_NODE  # the fixed personality has no 0x1016
+"$HIL_CANLOG" master-loss "$HIL_LOG" --nodes "$nodes" --master 127 --consumer-ms 500 --slack-ms 1000 ||
+  hil_fail "master: the nodes' heartbeat consumers did not react; log: $HIL_LOG"
+kill -0 "$HIL_SIM_PID" 2>/dev/null || hil_fail "loom-sim-drive died: $(tail -n 5 "$HIL_WORK/sim.out")"
+hil_report_frames
