@@ -184,7 +184,11 @@ hil_start_sim_drives() {
   mark=$(hil_mark)
   HIL_IO_CONTROL=$HIL_WORK/io-control
   : >"$HIL_IO_CONTROL"
-  hil_spawn sim "$HIL_SIM" --iface "$HIL_IFACE" --nodes "$HIL_NODES" --io-node "$HIL_IO_NODE" \
+  # The simulated nodes stand for separate hardware: loomctl's SCHED_FIFO loop (which overruns in the VM)
+  # must not starve them, so they run at a higher real-time priority where that is allowed.
+  local rt=()
+  chrt -f 90 true 2>/dev/null && rt=(chrt -f 90)
+  hil_spawn sim "${rt[@]}" "$HIL_SIM" --iface "$HIL_IFACE" --nodes "$HIL_NODES" --io-node "$HIL_IO_NODE" \
     --io-control "$HIL_IO_CONTROL" --width-m 0.6 --personality "$HIL_PERSONALITY"
   HIL_SIM_PID=$HIL_LAST_PID
   for n in ${HIL_NODES//,/ } $HIL_IO_NODE; do

@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <iostream>
 #include <limits>
+#include <deque>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -45,6 +46,29 @@ int usage_error(const std::string& message) {
   std::cerr << "loom-sim-drive: " << message << "\n";
   return 2;
 }
+
+// The simulated nodes answer a burst of SYNCs (after this process was descheduled) with a burst of
+// frames; the socket's transmit queue then overflows. A real node's CAN controller queues and retries,
+// so this one does too: frames the socket refuses wait here, in order, and go out first next time.
+class RetryingBus final : public loom::drivers::CanBus {
+ public:
+  explicit RetryingBus(loom::drivers::CanBus& inner) : inner_(inner) {}
+  loom::drivers::SendResult send(const loom::drivers::CanFrame& f) override {
+    flush();
+    if (pending_.empty() && inner_.send(f) == loom::drivers::SendResult::kOk) return loom::drivers::SendResult::kOk;
+    if (pending_.size() < 4096) pending_.push_back(f);
+    return loom::drivers::SendResult::kOk;
+  }
+  bool receive(loom::drivers::CanFrame& f) override { return inner_.receive(f); }
+  void flush() {
+    while (!pending_.empty() && inner_.send(pending_.front()) == loom::drivers::SendResult::kOk) pending_.pop_front();
+  }
+  bool pending() const { return !pending_.empty(); }
+
+ private:
+  loom::drivers::CanBus& inner_;
+  std::deque<loom::drivers::CanFrame> pending_;
+};
 
 // Default scaling of the loom's axes by node position: crank and helix in counts/rad, carriage in
 // counts/m (same defaults as the master's CanAxisPortConfig).
@@ -152,7 +176,8 @@ int main(int argc, char** argv) {
     std::cerr << "loom-sim-drive: " << opened.error() << "\n";
     return 1;
   }
-  loom::drivers::SocketCanBus& bus = *opened.value();
+  loom::drivers::SocketCanBus& socket_bus = *opened.value();
+  RetryingBus bus(socket_bus);
 
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
@@ -206,8 +231,9 @@ int main(int argc, char** argv) {
   while (g_stop == 0) {
     const std::int64_t now = monotonic_us();
     const std::int64_t deadline = rack.next_deadline_us();
-    const std::int64_t wait_us = std::clamp<std::int64_t>(deadline - now, 0, 100'000);
-    pollfd pfd{bus.fd(), POLLIN, 0};
+    // Frames waiting for the transmit queue are retried every millisecond.
+    const std::int64_t wait_us = std::clamp<std::int64_t>(deadline - now, 0, bus.pending() ? 1'000 : 100'000);
+    pollfd pfd{socket_bus.fd(), POLLIN, 0};
     const int rc = ::poll(&pfd, 1, static_cast<int>((wait_us + 999) / 1000));
     if (rc < 0 && errno != EINTR) {
       std::perror("loom-sim-drive: poll");
@@ -218,6 +244,7 @@ int main(int argc, char** argv) {
       read_control();
       next_control_check = t + 20'000;
     }
+    bus.flush();
     rack.step(t);
     if (verbose) {
       for (std::size_t i = 0; i < rack.size(); ++i) {

@@ -22,10 +22,14 @@ void SimDriveRack::power_on(std::int64_t now_us) {
 
 void SimDriveRack::step(std::int64_t now_us, int max_frames) {
   drivers::CanFrame f;
-  for (int i = 0; i < max_frames && bus_.receive(f); ++i) {
+  int drained = 0;
+  for (; drained < max_frames && bus_.receive(f); ++drained) {
     for (auto& n : nodes_) n->handle(f, now_us);
     if (io_ != nullptr) io_->handle(f, now_us);
   }
+  // A backlog (this process was descheduled) is worked off before any timer runs: a heartbeat the
+  // master sent long ago but we have not read yet must not look like the master's silence.
+  if (drained == max_frames) return;
   for (auto& n : nodes_) n->step(now_us);
   if (io_ != nullptr) {
     IoPlant p = io_controls_;

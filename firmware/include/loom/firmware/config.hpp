@@ -53,8 +53,9 @@ struct CanSettings {
   // Following-error supervision per axis (LinuxCNC rule): fault when |commanded − actual| >
   // max(ferror_min, ferror_k_s · |commanded velocity|). Units: rad (crank, helix) or m (carriage); s.
   // ferror_min = 0 disables it for that axis.
-  std::array<double, 3> ferror_min{0.2, 0.002, 0.5};
-  std::array<double, 3> ferror_k_s{0.05, 0.05, 0.05};
+  // Defaults allow 0.1 s of lag at any speed (a CSP drive lags 1–2 cycles; a loaded VM many more).
+  std::array<double, 3> ferror_min{0.3, 0.005, 1.0};
+  std::array<double, 3> ferror_k_s{0.1, 0.1, 0.1};
 };
 
 // Where the valves, sensors, e-stop chain, buttons and load cell come from on the CAN HAL.
