@@ -43,7 +43,7 @@ void design_slider_crank(const DesignArgs& args, std::ostream& out, std::ostream
   const CsvFormat f(args.full_precision);
   // The row is formatted before anything is printed: a value that is not finite prints nothing.
   std::ostringstream row;
-  write_row(row, {"slider-crank", input_value(args.phi_deg), f.length(dc.stroke),
+  write_row(row, {"slider-crank", f.input(args.phi_deg), f.length(dc.stroke),
                   f.length(d.mechanism.crank), f.length(d.mechanism.coupler),
                   f.length(d.mechanism.offset), f.ratio(d.lambda), f.angle_deg(deg(d.mu_min_rad)),
                   change_point ? "change-point" : "crank-slider",
@@ -88,7 +88,7 @@ void design_crank_rocker(const DesignArgs& args, std::ostream& out, std::ostream
   const CsvFormat f(args.full_precision);
   const double lambda = d.coupler > 0.0 ? d.crank / d.coupler : 0.0;
   std::ostringstream row;
-  write_row(row, {"crank-rocker", input_value(args.swing_deg), input_value(args.phi_deg),
+  write_row(row, {"crank-rocker", f.input(args.swing_deg), f.input(args.phi_deg),
                   f.angle_deg(deg(d.beta_rad)), f.length(d.crank), f.length(d.coupler),
                   f.length(d.rocker), f.length(d.ground), f.ratio(lambda),
                   f.angle_deg(deg(d.mu_min_rad)), grashof_name(d),
