@@ -6,11 +6,13 @@
 
 #include <algorithm>
 #include <array>
+#include <functional>
 #include <cmath>
 #include <sstream>
 #include <utility>
 
 #include "checks.hpp"
+#include "scale.hpp"
 #include "geometry.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/errors.hpp"
@@ -107,8 +109,17 @@ GrashofClass classify(const FourBar& m) {
   return GrashofClass::kDoubleRocker;
 }
 
-FourBarPosition solve_position(const FourBar& m, double theta2, Branch branch) {
-  check_lengths(m);
+// The linkage in units of a power of two near its largest link (scale.hpp): angles, coefficients and
+// the relative tolerances are unchanged, and no square of a length can overflow at 1e150 or vanish at
+// 1e-150.
+static FourBar unit_scaled(const FourBar& m) {
+  const double L = detail::length_scale(largest_link(m));
+  return FourBar{m.ground / L, m.crank / L, m.coupler / L, m.rocker / L};
+}
+
+FourBarPosition solve_position(const FourBar& given, double theta2, Branch branch) {
+  check_lengths(given);
+  const FourBar m = unit_scaled(given);
   if (!std::isfinite(theta2)) {
     throw MotionError(ErrorCode::kInvalidInput, "four-bar: crank angle must be finite");
   }
@@ -120,7 +131,7 @@ FourBarPosition solve_position(const FourBar& m, double theta2, Branch branch) {
     // A on B0: any rocker angle closes the loop when b = c, none otherwise.
     std::ostringstream os;
     os << "four-bar crank pin coincides with the rocker pivot at crank angle " << deg(theta2) << " deg "
-       << describe(m);
+       << describe(given);
     throw MotionError(std::abs(b - c) <= tol ? ErrorCode::kSingular : ErrorCode::kNotAssemblable, os.str());
   }
   // The triangle (B0, A, B) with sides |B0A|, b, c fixes the rocker on the branch's side of B0 → A.
@@ -129,7 +140,7 @@ FourBarPosition solve_position(const FourBar& m, double theta2, Branch branch) {
   if (pin.margin < -tol) {
     std::ostringstream os;
     os << "four-bar cannot be assembled at crank angle " << deg(theta2) << " deg: coupler and rocker miss "
-       << "closing the loop by " << -pin.margin << " " << describe(m);
+       << "closing the loop by " << -pin.margin * (largest_link(given) / largest_link(m)) << " " << describe(given);
     throw MotionError(ErrorCode::kNotAssemblable, os.str());
   }
   FourBarPosition p;
@@ -142,12 +153,13 @@ FourBarPosition solve_position(const FourBar& m, double theta2, Branch branch) {
   return p;
 }
 
-FourBarPose solve(const FourBar& m, double theta2, Branch branch) {
-  const FourBarPosition p = solve_position(m, theta2, branch);
+FourBarPose solve(const FourBar& given, double theta2, Branch branch) {
+  const FourBarPosition p = solve_position(given, theta2, branch);
+  const FourBar m = unit_scaled(given);
   if (p.at_toggle) {
     std::ostringstream os;
     os << "four-bar at toggle (coupler and rocker colinear within rounding) at crank angle " << deg(theta2)
-       << " deg: velocity coefficients are unbounded " << describe(m);
+       << " deg: velocity coefficients are unbounded " << describe(given);
     throw MotionError(ErrorCode::kSingular, os.str());
   }
   return with_coefficients(m, theta2, p.theta3, p.theta4);
@@ -175,27 +187,31 @@ PointCoefficients point_coefficients(const FourBar& m, const FourBarPose& pose, 
   return {};
 }
 
-TransmissionRange transmission_range(const FourBar& m) {
-  const GrashofClass cls = classify(m);
+TransmissionRange transmission_range(const FourBar& given) {
+  const GrashofClass cls = classify(given);
+  const FourBar m = unit_scaled(given);
   if (cls != GrashofClass::kCrankRocker && cls != GrashofClass::kDoubleCrank) {
     std::ostringstream os;
     os << "transmission angle over a turn needs a crank that turns fully; these lengths make a "
-       << grashof_class_name(cls) << " " << describe(m);
+       << grashof_class_name(cls) << " " << describe(given);
     throw MotionError(ErrorCode::kNotCrank, os.str());
   }
   TransmissionRange r;
   r.mu_min = detail::triangle_angle(std::abs(m.ground - m.crank), m.coupler, m.rocker);
   r.mu_max = detail::triangle_angle(m.ground + m.crank, m.coupler, m.rocker);
   r.worst_deviation_from_right = std::max(0.5 * kPi - r.mu_min, r.mu_max - 0.5 * kPi);
+  r.min_abs_sin_mu = std::min(std::sin(r.mu_min), std::sin(r.mu_max));
+  r.near_toggle = r.min_abs_sin_mu < kNearToggleSine;
   return r;
 }
 
-DeadCentres dead_centres(const FourBar& m, Branch branch) {
-  const GrashofClass cls = classify(m);
+DeadCentres dead_centres(const FourBar& given, Branch branch) {
+  const GrashofClass cls = classify(given);
+  const FourBar m = unit_scaled(given);
   if (cls != GrashofClass::kCrankRocker) {
     std::ostringstream os;
     os << "dead centres need a crank-rocker; these lengths make a " << grashof_class_name(cls) << " "
-       << describe(m);
+       << describe(given);
     throw MotionError(ErrorCode::kNotCrank, os.str());
   }
   // At a dead centre A0, A, B are colinear and |A0B| = b ± a: one circle intersection each.
@@ -215,6 +231,14 @@ DeadCentres dead_centres(const FourBar& m, Branch branch) {
 }
 
 std::vector<FourBarPose> fourbar_sweep(const FourBar& m, Branch branch, int samples, double theta2_start) {
+  std::vector<FourBarPose> out;
+  out.reserve(static_cast<std::size_t>(std::max(samples, 0)));
+  fourbar_sweep(m, branch, samples, theta2_start, [&](const FourBarPose& p) { out.push_back(p); });
+  return out;
+}
+
+void fourbar_sweep(const FourBar& m, Branch branch, int samples, double theta2_start,
+                   const std::function<void(const FourBarPose&)>& sink) {
   detail::require_samples("four-bar sweep", samples);
   detail::require_finite("four-bar sweep", "theta2_start", theta2_start, " rad");
   const GrashofClass cls = classify(m);
@@ -230,18 +254,17 @@ std::vector<FourBarPose> fourbar_sweep(const FourBar& m, Branch branch, int samp
        << describe(m);
     throw MotionError(ErrorCode::kNotCrank, os.str());
   }
-  std::vector<FourBarPose> out;
-  out.reserve(static_cast<std::size_t>(samples));
+  FourBarPose prev{};
   for (int i = 0; i < samples; ++i) {
     FourBarPose p =
         solve(m, theta2_start + kTwoPi * static_cast<double>(i) / static_cast<double>(samples), branch);
-    if (!out.empty()) {
-      p.theta3 = out.back().theta3 + wrap_pi(p.theta3 - out.back().theta3);
-      p.theta4 = out.back().theta4 + wrap_pi(p.theta4 - out.back().theta4);
+    if (i > 0) {
+      p.theta3 = prev.theta3 + wrap_pi(p.theta3 - prev.theta3);
+      p.theta4 = prev.theta4 + wrap_pi(p.theta4 - prev.theta4);
     }
-    out.push_back(p);
+    sink(p);
+    prev = p;
   }
-  return out;
 }
 
 FourBarNewtonResult solve_newton(const FourBar& m, double theta2, Branch branch, double theta3_guess,

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "checks.hpp"
+#include "scale.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/errors.hpp"
 
@@ -55,13 +56,16 @@ struct SliderCoefficients {
   double q, h;
 };
 
+// Scale-free: the loop is solved in units of L, a power of two near the largest length (so squares and products cannot
+// overflow or underflow at any scale a double can hold) and the lengths are scaled back.
 SliderCoefficients coefficients(const SliderCrank& m, double theta_rad) noexcept {
-  const double a = m.crank;
-  const double b = m.coupler;
+  const double L = detail::length_scale(std::fmax(std::fmax(m.crank, m.coupler), std::fabs(m.offset)));
+  const double a = m.crank / L;
+  const double b = m.coupler / L;
   const double s = std::sin(theta_rad);
   const double c = std::cos(theta_rad);
   SliderCoefficients k{};
-  k.q = m.offset - a * s;
+  k.q = m.offset / L - a * s;
   k.h = std::sqrt((b - k.q) * (b + k.q));
   const double dq = -a * c;
   const double dh = -k.q * dq / k.h;
@@ -73,6 +77,11 @@ SliderCoefficients coefficients(const SliderCrank& m, double theta_rad) noexcept
   k.phi3 = std::atan2(k.q, k.h);
   k.k3 = dq / k.h;
   k.k3p = (ddq * k.h - dq * dh) / (k.h * k.h);
+  k.x *= L;
+  k.dx *= L;
+  k.ddx *= L;
+  k.q *= L;
+  k.h *= L;
   return k;
 }
 
@@ -101,9 +110,12 @@ PointCoefficients slider_coupler_point(const SliderCrank& m, double theta_rad,
 }
 
 SliderDeadCentres slider_dead_centres(const SliderCrank& m) {
-  const double a = m.crank;
-  const double b = m.coupler;
-  const double e = m.offset;
+  // In units of L, a power of two near the largest length (scale-free, see coefficients()); lengths scaled back below.
+  check_lengths(m);
+  const double L = detail::length_scale(std::fmax(std::fmax(m.crank, m.coupler), std::fabs(m.offset)));
+  const double a = m.crank / L;
+  const double b = m.coupler / L;
+  const double e = m.offset / L;
   const double ae = std::fabs(e);
   // The change-point limit b = a + |e| (a flagged synthesis result, maybe a few ulps short) still
   // has well-defined dead centres; anything shorter is rejected as by validate_slider_crank.
@@ -134,6 +146,9 @@ SliderDeadCentres slider_dead_centres(const SliderCrank& m) {
   // The coupler leans most when the crank pin is farthest from the slider line (|q| = a + |e|).
   dc.mu_min_rad = std::atan2(std::sqrt(fold_margin * (b + a + ae)), a + ae);
   dc.theta_mu_min_rad = e < 0.0 ? 0.5 * kPi : 1.5 * kPi;
+  dc.x_extended *= L;
+  dc.x_folded *= L;
+  dc.stroke *= L;
   return dc;
 }
 

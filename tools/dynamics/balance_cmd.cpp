@@ -6,15 +6,17 @@
 #include <string>
 #include <vector>
 
-#include "checks.hpp"
 #include "commands.hpp"
-#include "csv.hpp"
-#include "loom/motion/balancing.hpp"
+#include "loom/cli/csv.hpp"
+#include "loom/cli/numbers.hpp"
+#include "loom/motion/design/balancing.hpp"
 #include "svg_plot.hpp"
 
 namespace loom::dyncli {
 
 using namespace loom::motion;
+using cli::non_negative_number;
+using cli::positive_number;
 
 CLI::App* add_balance(CLI::App& app, BalanceArgs& a) {
   CLI::App* c = app.add_subcommand("balance", "Shaking-force/moment balancing of the beat-up (003), before/after (CSV)");
@@ -33,6 +35,7 @@ CLI::App* add_balance(CLI::App& app, BalanceArgs& a) {
   c->add_option("--trace", a.trace, "Write every objective evaluation (convergence) as CSV to this file");
   c->add_option("--svg-force", a.svg_force, "Plot shaking force magnitude vs crank angle, before/after, to this SVG");
   c->add_option("--svg-moment", a.svg_moment, "Plot shaking moment vs crank angle, before/after, to this SVG");
+  add_linkage_options(c, a.linkage);
   return c;
 }
 
@@ -49,27 +52,27 @@ std::vector<ShakingLoad> history(const LinkageMotionSamples& s, const std::vecto
   return h;
 }
 
-void common_columns(std::string& out, const BalanceResult& r) {
-  put(out, r.before.force_n);
-  put(out, r.after.force_n);
-  put(out, 100.0 * r.force_reduction());
-  put(out, r.before.moment_nm);
-  put(out, r.after.moment_nm);
-  put(out, 100.0 * r.moment_reduction());
-  put(out, r.objective_before);
-  put(out, r.objective_after);
-  put(out, static_cast<double>(r.evaluations));
-  put(out, r.stop_reason);
-  put(out, r.converged ? 1.0 : 0.0, true);
+void common_columns(cli::CsvWriter& out, const BalanceResult& r) {
+  out.num(r.before.force_n).num(r.after.force_n).num(100.0 * r.force_reduction());
+  out.num(r.before.moment_nm).num(r.after.moment_nm).num(100.0 * r.moment_reduction());
+  out.num(r.objective_before).num(r.objective_after).num(static_cast<double>(r.evaluations));
+  out.text(r.stop_reason).num(r.converged ? 1.0 : 0.0);
+  out.end_row();
 }
 
 }  // namespace
 
-void run_balance(const BalanceArgs& a) {
+void run_balance(const CLI::App& cmd, const BalanceArgs& a) {
   if (!(a.w1 + a.w2 > 0.0)) throw UsageError("balance: --w1 and --w2 are both 0: nothing to minimise");
-  const BeatUpGeometry g = default_beatup_geometry();
-  const BeatUpDynamics d(g, beatup_masses(g));
-  const LinkageMotionSamples s = beatup_balancing_samples(d, a.crank_rad_s, a.samples);
+  const Linkage linkage = make_linkage(cmd, a.linkage);
+  const BeatUpDynamics d(linkage.geometry, linkage.masses);
+  // The crank speed: the option, else the config's speed or the speed of its beat-force target.
+  double speed = a.crank_rad_s;
+  if (cmd.count("--crank-rad-s") == 0 && linkage.config_crank_speed_rad_s) speed = *linkage.config_crank_speed_rad_s;
+  if (cmd.count("--crank-rad-s") == 0 && !linkage.config_crank_speed_rad_s && linkage.config_beat_force_target_n) {
+    speed = d.crank_speed_for_beat_force(*linkage.config_beat_force_target_n);
+  }
+  const LinkageMotionSamples s = beatup_balancing_samples(d, speed, a.samples);
   BalanceOptions o;
   o.w1 = a.w1;
   o.w2 = a.w2;
@@ -81,32 +84,23 @@ void run_balance(const BalanceArgs& a) {
   if (a.method != "redistribution") results.push_back(balance_with_counterweights(s, o));
   if (a.method != "counterweight") results.push_back(balance_by_redistribution(s, o));
 
-  std::string out =
+  cli::CsvWriter out(
       "method,link,mass_kg,radius_m,angle_deg,inertia_kg_m2,rms_force_before_n,rms_force_after_n,"
       "force_reduction_pct,rms_moment_before_nm,rms_moment_after_nm,moment_reduction_pct,objective_before,"
-      "objective_after,evaluations,stop_reason,converged\n";
+      "objective_after,evaluations,stop_reason,converged");
   for (const BalanceResult& r : results) {
     if (r.method == "counterweight") {
       // One row per counterweight: its mass, where its centre sits, and its own (disc) inertia.
       for (const Counterweight& c : r.counterweights) {
-        put(out, r.method);
-        put(out, c.link);
-        put(out, c.mass_kg);
-        put(out, c.radius_m);
-        put(out, deg(c.angle_rad));
-        put(out, c.inertia_kg_m2);
+        out.text(r.method).text(c.link).num(c.mass_kg).num(c.radius_m).num(deg(c.angle_rad)).num(c.inertia_kg_m2);
         common_columns(out, r);
       }
     } else {
       // One row per link: its new mass, centre of mass (distance, angle) and central inertia.
       for (std::size_t i = 0; i < r.links_after.size(); ++i) {
         const PlanarInertia& b = r.links_after[i];
-        put(out, r.method);
-        put(out, s.links[i].name);
-        put(out, b.mass_kg);
-        put(out, b.centre_m.norm());
-        put(out, deg(std::atan2(b.centre_m.y(), b.centre_m.x())));
-        put(out, b.inertia_kg_m2);
+        out.text(r.method).text(s.links[i].name).num(b.mass_kg).num(b.centre_m.norm());
+        out.num(deg(std::atan2(b.centre_m.y(), b.centre_m.x()))).num(b.inertia_kg_m2);
         common_columns(out, r);
       }
     }
@@ -117,11 +111,8 @@ void run_balance(const BalanceArgs& a) {
     std::string t = "method,evaluation,objective,rms_force_n,rms_moment_nm\n";
     for (const BalanceResult& r : results) {
       for (const OptimiserStep& st : r.trace) {
-        put(t, r.method);
-        put(t, static_cast<double>(st.evaluation));
-        put(t, st.objective);
-        put(t, st.rms.force_n);
-        put(t, st.rms.moment_nm, true);
+        t += r.method + "," + std::to_string(st.evaluation) + "," + cli::format_number(st.objective) + "," +
+             cli::format_number(st.rms.force_n) + "," + cli::format_number(st.rms.moment_nm) + "\n";
       }
     }
     f << t;
@@ -148,7 +139,7 @@ void run_balance(const BalanceArgs& a) {
     if (!a.svg_force.empty() && !write_svg(force, a.svg_force)) throw UsageError("--svg-force: cannot write '" + a.svg_force + "'");
     if (!a.svg_moment.empty() && !write_svg(moment, a.svg_moment)) throw UsageError("--svg-moment: cannot write '" + a.svg_moment + "'");
   }
-  emit(out);
+  out.finish();
 }
 
 }  // namespace loom::dyncli

@@ -3,15 +3,20 @@
 // with --search the φ02 that maximises it.
 #include <string>
 
-#include "checks.hpp"
+#include <cstdio>
+
 #include "commands.hpp"
-#include "csv.hpp"
+#include "loom/cli/csv.hpp"
+#include "loom/cli/numbers.hpp"
 #include "loom/motion/angles.hpp"
-#include "loom/motion/dynamics_batten.hpp"
+#include "loom/motion/design/dynamics_batten.hpp"
 
 namespace loom::dyncli {
 
 using namespace loom::motion;
+using cli::eccentricity;
+using cli::finite_number;
+using cli::positive_number;
 
 CLI::App* add_batten(CLI::App& app, BattenArgs& a) {
   CLI::App* c = app.add_subcommand("batten", "Elliptic-gear batten (004): acceleration gain at the beat vs e = 0 (CSV)");
@@ -35,15 +40,24 @@ CLI::App* add_batten(CLI::App& app, BattenArgs& a) {
 
 namespace {
 
-void row(std::string& out, const BattenGain& g) {
-  put(out, g.eccentricity);
-  put(out, g.phi02_rad);
-  put(out, deg(g.phi02_rad));
-  put(out, std::string(batten_beat_side_name(g.side)));
-  put(out, g.accel_rad_s2);
-  put(out, g.circular_accel_rad_s2);
-  put(out, g.gain);
-  put(out, g.phi1_rad, true);
+// Per visit (004's double swing visits the beat side twice per turn): each visit's gain and crank
+// angle, and which visit is the beat (the harder one with the circular gear). Columns for visits a
+// linkage does not make stay empty.
+constexpr int kVisitColumns = 2;
+
+void row(cli::CsvWriter& out, const BattenGain& g) {
+  out.num(g.eccentricity).num(g.phi02_rad).num(deg(g.phi02_rad)).text(batten_beat_side_name(g.side));
+  out.num(g.accel_rad_s2).num(g.circular_accel_rad_s2).num(g.gain).num(g.phi1_rad);
+  out.num(static_cast<double>(g.visits.size()));
+  for (int v = 0; v < kVisitColumns; ++v) {
+    if (v < static_cast<int>(g.visits.size())) {
+      out.num(deg(g.visits[static_cast<std::size_t>(v)].crank_rad)).num(g.visits[static_cast<std::size_t>(v)].gain);
+    } else {
+      out.text("").text("");
+    }
+  }
+  out.num(g.beat_visit + 1).num(g.visits.empty() ? 0.0 : g.visits[static_cast<std::size_t>(g.beat_visit)].gain);
+  out.end_row();
 }
 
 }  // namespace
@@ -56,7 +70,15 @@ void run_batten(const CLI::App& cmd, const BattenArgs& a) {
   const BattenBeatSide side = a.side == "psi-max"   ? BattenBeatSide::kPsiMax
                               : a.side == "psi-min" ? BattenBeatSide::kPsiMin
                                                     : batten_front_side(linkage, a.omega1_rad_s, a.samples);
-  std::string out = "e,phi02_rad,phi02_deg,side,beat_accel_rad_s2,circular_accel_rad_s2,gain,beat_phi1_rad\n";
+  if (gear.near_degenerate()) {
+    std::fprintf(stderr,
+                 "loom-dynamics: warning: extreme ratio: --e %.17g is near 1: the crank speed swings by %.3g:1 and "
+                 "the gain is its square; the results are finite but ill-conditioned\n",
+                 a.e, gear.max_speed_ratio() * gear.max_speed_ratio());
+  }
+  cli::CsvWriter out(
+      "e,phi02_rad,phi02_deg,side,beat_accel_rad_s2,circular_accel_rad_s2,gain,beat_phi1_rad,visits,"
+      "visit1_crank_deg,visit1_gain,visit2_crank_deg,visit2_gain,beat_visit,beat_visit_gain");
   if (a.search) {
     const BattenSearch s = batten_best_phi02(linkage, gear, side, a.omega1_rad_s, a.scan_points, a.samples);
     if (a.scan) {
@@ -66,7 +88,7 @@ void run_batten(const CLI::App& cmd, const BattenArgs& a) {
   } else {
     row(out, batten_gain(linkage, gear, a.phi02_rad, side, a.omega1_rad_s, a.samples));
   }
-  emit(out);
+  out.finish();
 }
 
 }  // namespace loom::dyncli

@@ -4,27 +4,26 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
-#include <stdexcept>
 #include <string>
+
+#include "linkage_options.hpp"
+#include "loom/cli/run.hpp"
 
 namespace loom::dyncli {
 
-// A bad combination of options (each value valid alone), reported like a parse error.
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+using cli::UsageError;
 
 struct BeatupArgs {
   double crank_rad_s = 0.0;
   double target_force_n = 0.0;
   int samples = 360;
-  double beater_kg = 2.5;
   double contact_n = 0.0;
   double gravity_deg = -90.0;  // direction of gravity in the linkage frame (A0->B0 = 0 deg)
   double cam_e = 0.0;          // elliptic-gear crank law (electronic cam), 0 = constant speed
   double cam_phi02_rad = 0.0;
   std::string svg;
   bool extra = false;
+  LinkageArgs linkage;
 };
 CLI::App* add_beatup(CLI::App& app, BeatupArgs& a);
 void run_beatup(const CLI::App& cmd, const BeatupArgs& a);
@@ -33,6 +32,8 @@ struct NeedleArgs {
   int samples = 360;
   double rpm = 160.0;
   double friction_n = 1000.0;
+  std::string rocker_side = "away";  // 002's assembly (see loom-kin needle)
+  std::string rod_side = "hanging";
   std::string svg;
 };
 CLI::App* add_needle(CLI::App& app, NeedleArgs& a);
@@ -63,9 +64,10 @@ struct BalanceArgs {
   int max_evaluations = 4000;
   std::string trace;
   std::string svg_force, svg_moment;
+  LinkageArgs linkage;
 };
 CLI::App* add_balance(CLI::App& app, BalanceArgs& a);
-void run_balance(const BalanceArgs& a);
+void run_balance(const CLI::App& cmd, const BalanceArgs& a);
 
 CLI::App* add_mass(CLI::App& app);
 void run_mass();

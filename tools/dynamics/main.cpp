@@ -2,10 +2,8 @@
 // first) with optional SVG plots. Bad arguments and impossible designs are reported on stderr naming
 // the argument or quantity, with exit status 2; --help exits 0.
 #include <CLI/CLI.hpp>
-#include <cstdio>
 
 #include "commands.hpp"
-#include "loom/motion/errors.hpp"
 
 int main(int argc, char** argv) {
   using namespace loom::dyncli;
@@ -21,24 +19,11 @@ int main(int argc, char** argv) {
   CLI::App* batten_cmd = add_batten(app, batten);
   CLI::App* balance_cmd = add_balance(app, balance);
   CLI::App* mass_cmd = add_mass(app);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
-  }
-  try {
+  return loom::cli::run_cli("loom-dynamics", app, argc, argv, [&] {
     if (beatup_cmd->parsed()) run_beatup(*beatup_cmd, beatup);
     if (needle_cmd->parsed()) run_needle(needle);
     if (batten_cmd->parsed()) run_batten(*batten_cmd, batten);
-    if (balance_cmd->parsed()) run_balance(balance);
+    if (balance_cmd->parsed()) run_balance(*balance_cmd, balance);
     if (mass_cmd->parsed()) run_mass();
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "loom-dynamics: %s\n", e.what());
-    return 2;
-  } catch (const loom::motion::MotionError& e) {
-    std::fprintf(stderr, "loom-dynamics: error (%s): %s\n", loom::motion::error_code_name(e.code()), e.what());
-    return 2;
-  }
-  return 0;
+  });
 }

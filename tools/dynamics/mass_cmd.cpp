@@ -3,7 +3,7 @@
 #include <string>
 
 #include "commands.hpp"
-#include "csv.hpp"
+#include "loom/cli/csv.hpp"
 #include "loom/motion/mass_properties.hpp"
 
 namespace loom::dyncli {
@@ -19,30 +19,22 @@ void run_mass() {
   const BeatUpMasses m = beatup_masses(g);
   const ThesisTable51 t;
   const BarSection sec;
-  std::string out =
-      "link,length_m,mass_kg,centre_m,inertia_kg_m2,thesis_mass_kg,thesis_inertia_kg_m2,half_width_inertia_kg_m2\n";
+  cli::CsvWriter out(
+      "link,length_m,mass_kg,centre_m,inertia_kg_m2,thesis_mass_kg,thesis_inertia_kg_m2,half_width_inertia_kg_m2");
   const auto link = [&](const char* name, double len, const PlanarInertia& p, double tm, double tj) {
-    put(out, std::string(name));
-    put(out, len);
-    put(out, p.mass_kg);
-    put(out, p.centre_m.norm());
-    put(out, p.inertia_kg_m2);
-    put(out, tm);
-    put(out, tj);
+    out.text(name).num(len).num(p.mass_kg).num(p.centre_m.norm()).num(p.inertia_kg_m2).num(tm).num(tj);
     // m(L² + (w/2)²)/12: the formula whose values Table 5.1 prints.
-    put(out, p.mass_kg * (len * len + 0.25 * sec.width_m * sec.width_m) / 12.0, true);
+    out.num(p.mass_kg * (len * len + 0.25 * sec.width_m * sec.width_m) / 12.0);
+    out.end_row();
   };
   link("crank", g.bar.crank, m.crank, t.m2_kg, t.j2_kg_m2);
   link("coupler", g.bar.coupler, m.coupler, t.m3_kg, t.j3_kg_m2);
   link("rocker", g.beater_arm_m, m.rocker, t.m4_kg, t.j4_kg_m2);
   const PlanarInertia rb = m.rocker_with_beater();
-  out += "rocker_with_beater,";
-  put(out, g.beater_arm_m);
-  put(out, rb.mass_kg);
-  put(out, rb.centre_m.norm());
-  put(out, rb.inertia_kg_m2);
-  out += ",,\n";
-  emit(out);
+  out.text("rocker_with_beater").num(g.beater_arm_m).num(rb.mass_kg).num(rb.centre_m.norm()).num(rb.inertia_kg_m2);
+  out.text("").text("").text("");
+  out.end_row();
+  out.finish();
 }
 
 }  // namespace loom::dyncli

@@ -8,12 +8,16 @@
 #include <string>
 #include <vector>
 
-#include "checks.hpp"
-#include "csv.hpp"
+#include "loom/cli/csv.hpp"
+#include "loom/cli/numbers.hpp"
 #include "loom/motion/angles.hpp"
-#include "loom/motion/batten.hpp"
+#include "loom/motion/design/batten.hpp"
 
 namespace loom::kin {
+
+using cli::eccentricity;
+using cli::finite_number;
+using cli::positive_number;
 
 namespace {
 
@@ -89,22 +93,17 @@ void run_batten(const BattenArgs& a) {
   const BattenDrive drive = make_drive(a, a.phi02_rad);
   warn_about_gear(drive.gear());
   const BattenSolver solver = a.solver == "newton" ? BattenSolver::kNewton : BattenSolver::kClosedForm;
-  const std::vector<BattenSample> sw = batten_sweep(drive, a.samples, a.omega1_rad_s, solver, NewtonOptions{a.newton_tol, 50});
-  std::string out = "phi1_rad,phi2_rad,psi_rad,psi_dot_rad_s,psi_ddot_rad_s2";
-  out += a.pose ? ",gamma2_rad,gamma3_rad,gamma4_rad\n" : "\n";
-  for (const BattenSample& s : sw) {
-    put(out, s.phi1_rad);
-    put(out, s.phi2_rad);
-    put(out, s.psi_rad);
-    put(out, s.psi_dot_rad_s);
-    put(out, s.psi_ddot_rad_s2, !a.pose);
-    if (a.pose) {
-      put(out, s.pose.gamma2_rad);
-      put(out, s.pose.gamma3_rad);
-      put(out, s.pose.gamma4_rad, true);
-    }
-  }
-  std::fwrite(out.data(), 1, out.size(), stdout);
+  cli::CsvWriter out(std::string("phi1_rad,phi2_rad,psi_rad,psi_dot_rad_s,psi_ddot_rad_s2") +
+                     (a.pose ? ",gamma2_rad,gamma3_rad,gamma4_rad" : ""));
+  batten_sweep(
+      drive, a.samples, a.omega1_rad_s,
+      [&](const BattenSample& s) {
+        out.num(s.phi1_rad).num(s.phi2_rad).num(s.psi_rad).num(s.psi_dot_rad_s).num(s.psi_ddot_rad_s2);
+        if (a.pose) out.num(s.pose.gamma2_rad).num(s.pose.gamma3_rad).num(s.pose.gamma4_rad);
+        out.end_row();
+      },
+      solver, NewtonOptions{a.newton_tol, 50});
+  out.finish();
 }
 
 namespace {
@@ -118,7 +117,7 @@ struct PhaseMetrics {
 PhaseMetrics metrics(const loom::motion::BattenDrive& d, int samples, double omega1) {
   using namespace loom::motion;
   PhaseMetrics m{0.0, 0.0, 0.0};
-  for (const BattenSample& s : batten_sweep(d, samples, omega1)) m.peak = std::max(m.peak, std::abs(s.psi_ddot_rad_s2));
+  batten_sweep(d, samples, omega1, [&](const BattenSample& s) { m.peak = std::max(m.peak, std::abs(s.psi_ddot_rad_s2)); });
   for (const BattenExtreme& x : batten_extremes(d, samples, omega1)) {
     double& slot = x.maximum ? m.at_max : m.at_min;
     slot = std::max(slot, std::abs(x.psi_ddot_rad_s2));
@@ -135,22 +134,18 @@ void run_batten_phase(const BattenArgs& a) {
   circular.e = 0.0;
   // With e = 0 the crank turns uniformly and φ02 only shifts the curves: one reference serves all.
   const PhaseMetrics ref = metrics(make_drive(circular, 0.0), a.samples, a.omega1_rad_s);
-  std::string out =
+  cli::CsvWriter out(
       "phi02_deg,psi_ddot_peak_rad_s2,psi_ddot_at_psi_max_rad_s2,psi_ddot_at_psi_min_rad_s2,"
-      "gain_peak,gain_at_psi_max,gain_at_psi_min\n";
+      "gain_peak,gain_at_psi_max,gain_at_psi_min");
   const int steps = static_cast<int>(std::floor(360.0 / a.step_deg + 1e-9));
   for (int i = 0; i < steps; ++i) {
     const double phi02_deg = a.step_deg * i;
     const PhaseMetrics m = metrics(make_drive(a, rad(phi02_deg)), a.samples, a.omega1_rad_s);
-    put(out, phi02_deg);
-    put(out, m.peak);
-    put(out, m.at_max);
-    put(out, m.at_min);
-    put(out, m.peak / ref.peak);
-    put(out, ref.at_max > 0.0 ? m.at_max / ref.at_max : 0.0);
-    put(out, ref.at_min > 0.0 ? m.at_min / ref.at_min : 0.0, true);
+    out.num(phi02_deg).num(m.peak).num(m.at_max).num(m.at_min).num(m.peak / ref.peak);
+    out.num(ref.at_max > 0.0 ? m.at_max / ref.at_max : 0.0).num(ref.at_min > 0.0 ? m.at_min / ref.at_min : 0.0);
+    out.end_row();
   }
-  std::fwrite(out.data(), 1, out.size(), stdout);
+  out.finish();
 }
 
 }  // namespace loom::kin

@@ -6,14 +6,19 @@
 #include <cstdio>
 #include <string>
 #include <vector>
+#include <cmath>
 
-#include "checks.hpp"
-#include "csv.hpp"
+#include "loom/cli/csv.hpp"
+#include "loom/cli/numbers.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/errors.hpp"
 #include "loom/motion/fourbar.hpp"
 
 namespace loom::kin {
+
+using cli::eccentricity;
+using cli::finite_number;
+using cli::positive_number;
 
 namespace {
 
@@ -26,70 +31,66 @@ loom::motion::FourBarLink link_of(const std::string& name) {
   return FourBarLink::kCoupler;
 }
 
-std::string number(double v) {
-  std::string cell;
-  put(cell, v, true);
-  cell.pop_back();  // put() ends the cell with '\n'
-  return cell;
+void warn_near_toggle(const loom::motion::FourBar& m) {
+  using namespace loom::motion;
+  const GrashofClass cls = classify(m);
+  if (cls != GrashofClass::kCrankRocker && cls != GrashofClass::kDoubleCrank) return;
+  const TransmissionRange r = transmission_range(m);
+  if (r.near_toggle) {
+    std::fprintf(stderr,
+                 "loom-kin: warning: near toggle: the transmission angle reaches %.6g deg (|sin mu| = %.3g < %g); "
+                 "rates there are amplified by 1/|sin mu| and small length errors move the linkage a long way\n",
+                 deg(std::sin(r.mu_min) <= std::sin(r.mu_max) ? r.mu_min : r.mu_max), r.min_abs_sin_mu,
+                 kNearToggleSine);
+  }
 }
 
 void write_summary(const loom::motion::FourBar& m, loom::motion::Branch branch) {
   using namespace loom::motion;
   const GrashofClass cls = classify(m);
+  cli::CsvWriter out(
+      "grashof,mu_min_deg,mu_max_deg,crank_extended_deg,crank_folded_deg,rocker_extended_deg,"
+      "rocker_folded_deg,swing_deg,crank_rotation_deg,time_ratio");
+  out.text(grashof_class_name(cls));
   // Cells that do not exist for this class stay empty (never NaN): μ needs a full-turning crank,
   // dead centres need a rocker.
-  std::vector<std::string> cells(10);
-  cells[0] = grashof_class_name(cls);
   if (cls == GrashofClass::kCrankRocker || cls == GrashofClass::kDoubleCrank) {
     const TransmissionRange r = transmission_range(m);
-    cells[1] = number(deg(r.mu_min));
-    cells[2] = number(deg(r.mu_max));
+    out.num(deg(r.mu_min)).num(deg(r.mu_max));
+  } else {
+    out.text("").text("");
   }
   if (cls == GrashofClass::kCrankRocker) {
     const DeadCentres dc = dead_centres(m, branch);
-    cells[3] = number(deg(dc.crank_extended));
-    cells[4] = number(deg(dc.crank_folded));
-    cells[5] = number(deg(dc.rocker_extended));
-    cells[6] = number(deg(dc.rocker_folded));
-    cells[7] = number(deg(dc.swing));
-    cells[8] = number(deg(dc.crank_rotation));
-    cells[9] = number(dc.time_ratio);
+    out.num(deg(dc.crank_extended)).num(deg(dc.crank_folded)).num(deg(dc.rocker_extended));
+    out.num(deg(dc.rocker_folded)).num(deg(dc.swing)).num(deg(dc.crank_rotation)).num(dc.time_ratio);
+  } else {
+    for (int i = 0; i < 7; ++i) out.text("");
   }
-  std::string out =
-      "grashof,mu_min_deg,mu_max_deg,crank_extended_deg,crank_folded_deg,rocker_extended_deg,"
-      "rocker_folded_deg,swing_deg,crank_rotation_deg,time_ratio\n";
-  for (std::size_t i = 0; i < cells.size(); ++i) out += cells[i] + (i + 1 < cells.size() ? "," : "\n");
-  std::fwrite(out.data(), 1, out.size(), stdout);
+  out.end_row();
+  out.finish();
 }
 
 void write_sweep(const FourBarArgs& a, const loom::motion::FourBar& m, loom::motion::Branch branch) {
   using namespace loom::motion;
-  const std::vector<FourBarPose> sweep = fourbar_sweep(m, branch, a.samples, rad(a.start_deg));
   const bool point = !a.point_link.empty();
-  std::string out = "theta2_deg,theta3_deg,theta4_deg,k3,k4,k3p,k4p,transmission_deg";
-  out += point ? ",point_x,point_y,point_vx,point_vy,point_ax,point_ay\n" : "\n";
-  for (std::size_t i = 0; i < sweep.size(); ++i) {
-    const FourBarPose& p = sweep[i];
-    put(out, a.start_deg + 360.0 * static_cast<double>(i) / static_cast<double>(a.samples));
-    put(out, deg(p.theta3));
-    put(out, deg(p.theta4));
-    put(out, p.k3);
-    put(out, p.k4);
-    put(out, p.k3p);
-    put(out, p.k4p);
-    put(out, deg(p.transmission), !point);
+  std::string header = "theta2_deg,theta3_deg,theta4_deg,k3,k4,k3p,k4p,transmission_deg";
+  if (point) header += ",point_x,point_y,point_vx,point_vy,point_ax,point_ay";
+  cli::CsvWriter out(header);
+  long i = 0;
+  fourbar_sweep(m, branch, a.samples, rad(a.start_deg), [&](const FourBarPose& p) {
+    out.num(a.start_deg + 360.0 * static_cast<double>(i++) / static_cast<double>(a.samples));
+    out.num(deg(p.theta3)).num(deg(p.theta4)).num(p.k3).num(p.k4).num(p.k3p).num(p.k4p);
+    out.num(deg(p.transmission));
     if (point) {
       const PointMotion pm = point_motion(
           point_coefficients(m, p, link_of(a.point_link), {a.point_x, a.point_y}), a.omega, a.alpha);
-      put(out, pm.position.x());
-      put(out, pm.position.y());
-      put(out, pm.velocity.x());
-      put(out, pm.velocity.y());
-      put(out, pm.acceleration.x());
-      put(out, pm.acceleration.y(), true);
+      out.num(pm.position.x()).num(pm.position.y()).num(pm.velocity.x()).num(pm.velocity.y());
+      out.num(pm.acceleration.x()).num(pm.acceleration.y());
     }
-  }
-  std::fwrite(out.data(), 1, out.size(), stdout);
+    out.end_row();
+  });
+  out.finish();
 }
 
 }  // namespace
@@ -138,6 +139,7 @@ void run_fourbar(const FourBarArgs& a) {
   const FourBar m{a.ground, a.crank, a.coupler, a.rocker};
   const Branch branch = a.branch == "negative" ? Branch::kNegative : Branch::kPositive;
   try {
+    warn_near_toggle(m);
     if (a.summary) {
       write_summary(m, branch);
     } else {

@@ -2,11 +2,10 @@
 // the elliptic-gear batten drive (004) over one turn, as CSV on stdout. Bad arguments and impossible
 // designs are reported on stderr, naming the argument, with exit status 2; --help exits 0.
 #include <CLI/CLI.hpp>
-#include <cstdio>
 
 #include "batten_cmd.hpp"
 #include "fourbar_cmd.hpp"
-#include "loom/motion/errors.hpp"
+#include "loom/cli/run.hpp"
 #include "needle_cmd.hpp"
 #include "slider_crank_cmd.hpp"
 
@@ -25,21 +24,11 @@ int main(int argc, char** argv) {
   CLI::App* needle_cmd = loom::kin::add_needle_command(app, needle);
   CLI::App* batten_cmd = loom::kin::add_batten_command(app, batten);
   CLI::App* phase_cmd = loom::kin::add_batten_phase_command(app, phase);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
-  }
-  try {
+  return loom::cli::run_cli("loom-kin", app, argc, argv, [&] {
     if (fourbar_cmd->parsed()) loom::kin::run_fourbar(fourbar);
     if (slider_cmd->parsed()) loom::kin::run_slider_crank(slider);
     if (needle_cmd->parsed()) loom::kin::run_needle(needle);
     if (batten_cmd->parsed()) loom::kin::run_batten(batten);
     if (phase_cmd->parsed()) loom::kin::run_batten_phase(phase);
-  } catch (const loom::motion::MotionError& e) {
-    std::fprintf(stderr, "loom-kin: error (%s): %s\n", loom::motion::error_code_name(e.code()), e.what());
-    return 2;
-  }
-  return 0;
+  });
 }

@@ -6,12 +6,16 @@
 #include <cstdio>
 #include <string>
 
-#include "checks.hpp"
-#include "csv.hpp"
+#include "loom/cli/csv.hpp"
+#include "loom/cli/numbers.hpp"
 #include "loom/motion/angles.hpp"
-#include "loom/motion/needle.hpp"
+#include "loom/motion/design/needle.hpp"
 
 namespace loom::kin {
+
+using cli::eccentricity;
+using cli::finite_number;
+using cli::positive_number;
 
 CLI::App* add_needle_command(CLI::App& app, NeedleArgs& a) {
   CLI::App* c = app.add_subcommand("needle", "Tufting-needle six-bar (002) over one main-shaft turn");
@@ -33,10 +37,13 @@ CLI::App* add_needle_command(CLI::App& app, NeedleArgs& a) {
       ->check(finite_number())->capture_default_str();
   c->add_option("--beta1-deg", a.beta1_deg, "Fixed angle between l3 and l4")
       ->check(finite_number())->capture_default_str();
-  c->add_option("--rocker-side", a.rocker_side, "Side of B relative to the line C->A (002: right)")
-      ->check(CLI::IsMember({"right", "left"}))->capture_default_str();
-  c->add_option("--rod-side", a.rod_side, "Pin E above or below D (002: above)")
-      ->check(CLI::IsMember({"above", "below"}))->capture_default_str();
+  c->add_option("--rocker-side", a.rocker_side,
+                "Rocker pin B on the side of the line O-C away from the needle (002) or toward it")
+      ->check(CLI::IsMember({"away", "toward"}))->capture_default_str();
+  c->add_option("--rod-side", a.rod_side,
+                "Rod D-E hanging from the arm down to the needle bar (002's Fig. 2, theta5 in the third "
+                "quadrant) or standing above it (the mirror image)")
+      ->check(CLI::IsMember({"hanging", "standing"}))->capture_default_str();
   c->add_option("--rpm", a.rpm, "Main-shaft speed for --rates")->check(positive_number())->capture_default_str();
   c->add_flag("--rates", a.rates, "Append angular velocities/accelerations and needle velocity/acceleration");
   return c;
@@ -56,35 +63,31 @@ void run_needle(const NeedleArgs& a) {
   d.h1_m = a.h1_mm * 1e-3;
   d.beta1_rad = rad(a.beta1_deg);
   NeedleBranch b;
-  b.rocker = a.rocker_side == "left" ? NeedleRockerSide::kLeftOfCA : NeedleRockerSide::kRightOfCA;
-  b.rod = a.rod_side == "below" ? NeedleRodSide::kEBelowD : NeedleRodSide::kEAboveD;
+  b.rocker = a.rocker_side == "toward" ? NeedleRockerSide::kPinTowardNeedle : NeedleRockerSide::kPinAwayFromNeedle;
+  b.rod = a.rod_side == "standing" ? NeedleRodSide::kStandingRod : NeedleRodSide::kHangingRod;
   const NeedleLinkage n(d, b);
   const double omega1 = a.rpm * kTwoPi / 60.0;
-  const std::vector<NeedleState> sweep = needle_sweep(n, a.samples, omega1);
 
-  std::string out = "theta1_deg,theta2_deg,theta3_deg,theta4_deg,theta5_deg,needle_mm";
+  std::string header = "theta1_deg,theta2_deg,theta3_deg,theta4_deg,theta5_deg,needle_mm";
   if (a.rates) {
-    out += ",omega2_rad_s,omega3_rad_s,omega4_rad_s,omega5_rad_s,alpha2_rad_s2,alpha3_rad_s2,"
-           "alpha4_rad_s2,alpha5_rad_s2,needle_v_m_s,needle_a_m_s2";
+    header += ",omega2_rad_s,omega3_rad_s,omega4_rad_s,omega5_rad_s,alpha2_rad_s2,alpha3_rad_s2,"
+              "alpha4_rad_s2,alpha5_rad_s2,needle_v_m_s,needle_a_m_s2";
   }
-  out += '\n';
-  for (std::size_t i = 0; i < sweep.size(); ++i) {
-    const NeedleState& s = sweep[i];
-    put(out, 360.0 * static_cast<double>(i) / static_cast<double>(a.samples));
-    put(out, deg(s.theta2_rad));
-    put(out, deg(s.theta3_rad));
-    put(out, deg(s.theta4_rad));
-    put(out, deg(s.theta5_rad));
-    put(out, s.needle_m * 1e3, !a.rates);
+  cli::CsvWriter out(header);
+  long i = 0;
+  needle_sweep(n, a.samples, omega1, [&](const NeedleState& s) {
+    out.num(360.0 * static_cast<double>(i++) / static_cast<double>(a.samples));
+    out.num(deg(s.theta2_rad)).num(deg(s.theta3_rad)).num(deg(s.theta4_rad)).num(deg(s.theta5_rad));
+    out.num(s.needle_m * 1e3);
     if (a.rates) {
       for (double v : {s.omega2_rad_s, s.omega3_rad_s, s.omega4_rad_s, s.omega5_rad_s, s.alpha2_rad_s2,
-                       s.alpha3_rad_s2, s.alpha4_rad_s2, s.alpha5_rad_s2, s.needle_v_m_s}) {
-        put(out, v);
+                       s.alpha3_rad_s2, s.alpha4_rad_s2, s.alpha5_rad_s2, s.needle_v_m_s, s.needle_a_m_s2}) {
+        out.num(v);
       }
-      put(out, s.needle_a_m_s2, true);
     }
-  }
-  std::fwrite(out.data(), 1, out.size(), stdout);
+    out.end_row();
+  });
+  out.finish();
 }
 
 }  // namespace loom::kin

@@ -6,13 +6,17 @@
 #include <cstdio>
 #include <string>
 
-#include "checks.hpp"
-#include "csv.hpp"
+#include "loom/cli/csv.hpp"
+#include "loom/cli/numbers.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/errors.hpp"
 #include "loom/motion/slider_crank.hpp"
 
 namespace loom::kin {
+
+using cli::eccentricity;
+using cli::finite_number;
+using cli::positive_number;
 
 CLI::App* add_slider_crank_command(CLI::App& app, SliderCrankArgs& a) {
   CLI::App* c = app.add_subcommand(
@@ -37,36 +41,37 @@ CLI::App* add_slider_crank_command(CLI::App& app, SliderCrankArgs& a) {
 void run_slider_crank(const SliderCrankArgs& a) {
   using namespace loom::motion;
   const SliderCrank m{a.crank, a.coupler, a.offset};
-  std::string out;
   try {
     if (a.summary) {
       const SliderDeadCentres dc = slider_dead_centres(m);
-      out =
+      cli::CsvWriter out(
           "theta_extended_deg,theta_folded_deg,x_extended,x_folded,stroke,phi_extend_to_fold_deg,"
-          "phi_fold_to_extend_deg,time_ratio,mu_min_deg\n";
-      for (double v :
-           {deg(dc.theta_extended_rad), deg(dc.theta_folded_rad), dc.x_extended, dc.x_folded, dc.stroke,
-            deg(dc.phi_extend_to_fold_rad), deg(dc.phi_fold_to_extend_rad), dc.time_ratio}) {
-        put(out, v);
+          "phi_fold_to_extend_deg,time_ratio,mu_min_deg");
+      for (double v : {deg(dc.theta_extended_rad), deg(dc.theta_folded_rad), dc.x_extended, dc.x_folded, dc.stroke,
+                       deg(dc.phi_extend_to_fold_rad), deg(dc.phi_fold_to_extend_rad), dc.time_ratio,
+                       deg(dc.mu_min_rad)}) {
+        out.num(v);
       }
-      put(out, deg(dc.mu_min_rad), true);
+      out.end_row();
+      out.finish();
     } else {
       validate_slider_crank(m);
-      out = "theta_deg,x,x_dot,x_ddot,coupler_deg,coupler_rate_rad_s,coupler_accel_rad_s2,transmission_deg\n";
+      cli::CsvWriter out(
+          "theta_deg,x,x_dot,x_ddot,coupler_deg,coupler_rate_rad_s,coupler_accel_rad_s2,transmission_deg");
       for (int i = 0; i < a.samples; ++i) {
         const double theta_deg = 360.0 * static_cast<double>(i) / static_cast<double>(a.samples);
         const SliderState s = slider_state(m, rad(theta_deg), a.omega, a.alpha);
         for (double v : {theta_deg, s.x, s.x_dot, s.x_ddot, deg(s.coupler_angle_rad), s.coupler_rate_rad_s,
-                         s.coupler_accel_rad_s2}) {
-          put(out, v);
+                         s.coupler_accel_rad_s2, deg(s.transmission_rad)}) {
+          out.num(v);
         }
-        put(out, deg(s.transmission_rad), true);
+        out.end_row();
       }
+      out.finish();
     }
   } catch (const MotionError& e) {
     throw MotionError(e.code(), std::string("--crank/--coupler/--offset: ") + e.what());
   }
-  std::fwrite(out.data(), 1, out.size(), stdout);
 }
 
 }  // namespace loom::kin

@@ -1,30 +1,32 @@
 // `loom-synth crank-rocker`: Khare–Dave crank-rockers for a swing ψ and crank rotation φ (thesis
 // Tables 4.6–4.9): one row per integer β from the upper to the lower bound, or one for --beta.
-// Rows at a bound are change-point linkages (μ_min = 0); a note on stderr says so.
+// Rows at a bound are change-point linkages (μ_min = 0); a note on stderr says so. A row that is no
+// mechanism (the null crank at φ = 180°, β = 0) is reported on stderr and the others are printed;
+// alone (--beta) it is an error. Lengths carry 8 decimals (some published tables print that many).
 #include <cmath>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "commands.hpp"
-#include "csv.hpp"
 #include "loom/motion/angles.hpp"
-#include "loom/motion/synthesis.hpp"
+#include "loom/motion/design/synthesis.hpp"
 
 namespace loom::synth {
 
 namespace {
 
-void note_degenerate(std::ostream& err, double beta_deg, unsigned flags) {
-  if (flags & motion::kDesignNullCrank) {
-    err << "loom-synth: note: beta_deg=" << input_value(beta_deg)
-        << ": lower bound at phi = 180: zero-length crank and rocker (not a mechanism), mu_min = 0"
-           " (limit from inside: 90 - psi/2)\n";
-  } else if (flags & motion::kDesignChangePoint) {
-    err << "loom-synth: note: beta_deg=" << input_value(beta_deg)
-        << ": beta at a bound, change-point linkage, mu_min = 0\n";
-  }
-}
+constexpr int kLengthDecimals = 8;
 
 }  // namespace
+
+void note_near_special_case(std::ostream& err, double psi_deg, double phi_deg) {
+  err << "loom-synth: warning: near special case: phi = " << input_value(phi_deg) << " deg is within "
+      << input_value(motion::deg(motion::kNearSpecialCase_rad)) << " deg of 180 + psi = " << input_value(180.0 + psi_deg)
+      << " deg: b and c grow like 1/|phi - 180 - psi| towards a limit that depends on the path, not the "
+         "case-III linkage (use --phi "
+      << input_value(180.0 + psi_deg) << " for that); these lengths are ill-conditioned\n";
+}
 
 void run_crank_rocker(const CrankRockerArgs& args, std::ostream& out, std::ostream& err) {
   require_positive_length("--ground", args.ground);
@@ -48,21 +50,30 @@ void run_crank_rocker(const CrankRockerArgs& args, std::ostream& out, std::ostre
     }
   }
 
-  std::vector<motion::CrankRockerDesign> designs;
-  for (double beta_deg : betas_deg) {
-    designs.push_back(blame("--beta " + input_value(beta_deg), [&] {
-      return motion::khare_dave_crank_rocker(psi, phi, motion::rad(beta_deg), args.ground);
-    }));
-  }
-
   const CsvFormat f(args.full_precision);
-  out << "beta_deg,a,b,c,mu_min_deg\n";
-  for (std::size_t i = 0; i < designs.size(); ++i) {
-    const motion::CrankRockerDesign& d = designs[i];
-    write_row(out, {input_value(betas_deg[i]), f.length(d.crank), f.length(d.coupler),
-                    f.length(d.rocker), f.angle_deg(motion::deg(d.mu_min_rad))});
-    note_degenerate(err, betas_deg[i], d.flags);
+  std::vector<std::string> rows;
+  bool near_special = false;
+  for (double beta_deg : betas_deg) {
+    motion::CrankRockerDesign d;
+    try {
+      d = motion::khare_dave_crank_rocker(psi, phi, motion::rad(beta_deg), args.ground);
+    } catch (const motion::MotionError& e) {
+      if (args.has_beta) throw ArgError("--beta " + input_value(beta_deg) + ": " + e.what());
+      err << "loom-synth: note: beta_deg=" << input_value(beta_deg) << ": no row: " << e.what() << "\n";
+      continue;
+    }
+    std::ostringstream row;
+    write_row(row, {f.input(beta_deg), f.length(d.crank, kLengthDecimals), f.length(d.coupler, kLengthDecimals),
+                    f.length(d.rocker, kLengthDecimals), f.angle_deg(motion::deg(d.mu_min_rad))});
+    rows.push_back(row.str());
+    if (d.flags & motion::kDesignChangePoint) {
+      err << "loom-synth: note: beta_deg=" << input_value(beta_deg) << ": beta at a bound, change-point linkage, mu_min = 0\n";
+    }
+    near_special = near_special || (d.flags & motion::kDesignNearSpecialCase) != 0;
   }
+  if (near_special) note_near_special_case(err, args.psi_deg, args.phi_deg);
+  out << "beta_deg,a,b,c,mu_min_deg\n";
+  for (const std::string& r : rows) out << r;
 }
 
 }  // namespace loom::synth

@@ -2,13 +2,13 @@
 // from (stroke, φ) or a Khare–Dave crank-rocker from (swing ψ, φ) — with link lengths, μ_min,
 // Grashof class and dead centres in one CSV row. --thesis-rounding reproduces Table 4.3's digits.
 #include <cmath>
+#include <sstream>
 
 #include "commands.hpp"
-#include "csv.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/fourbar.hpp"
 #include "loom/motion/slider_crank.hpp"
-#include "loom/motion/synthesis.hpp"
+#include "loom/motion/design/synthesis.hpp"
 
 namespace loom::synth {
 
@@ -41,14 +41,17 @@ void design_slider_crank(const DesignArgs& args, std::ostream& out, std::ostream
   const bool change_point = (d.flags & motion::kDesignChangePoint) != 0;
 
   const CsvFormat f(args.full_precision);
-  out << "mechanism,phi_deg,stroke,a,b,c,lambda,mu_min_deg,grashof,crank_extended_deg,"
-         "crank_folded_deg,slider_extended,slider_folded\n";
-  write_row(out, {"slider-crank", input_value(args.phi_deg), f.length(dc.stroke),
+  // The row is formatted before anything is printed: a value that is not finite prints nothing.
+  std::ostringstream row;
+  write_row(row, {"slider-crank", f.input(args.phi_deg), f.length(dc.stroke),
                   f.length(d.mechanism.crank), f.length(d.mechanism.coupler),
                   f.length(d.mechanism.offset), f.ratio(d.lambda), f.angle_deg(deg(d.mu_min_rad)),
                   change_point ? "change-point" : "crank-slider",
                   f.angle_deg(deg(dc.theta_extended_rad)), f.angle_deg(deg(dc.theta_folded_rad)),
                   f.length(dc.x_extended), f.length(dc.x_folded)});
+  out << "mechanism,phi_deg,stroke,a,b,c,lambda,mu_min_deg,grashof,crank_extended_deg,"
+         "crank_folded_deg,slider_extended,slider_folded\n"
+      << row.str();
   if (change_point) {
     err << "loom-synth: note: change-point slider-crank (b = a + c): mu_min = 0, not a usable "
            "beat-up\n";
@@ -56,7 +59,6 @@ void design_slider_crank(const DesignArgs& args, std::ostream& out, std::ostream
 }
 
 const char* grashof_name(const motion::CrankRockerDesign& d) {
-  if (d.flags & motion::kDesignNullCrank) return "null-crank";
   if (d.flags & motion::kDesignChangePoint) return "change-point";
   return motion::grashof_class_name(
       motion::classify(motion::FourBar{d.ground, d.crank, d.coupler, d.rocker}));
@@ -84,19 +86,22 @@ void design_crank_rocker(const DesignArgs& args, std::ostream& out, std::ostream
   }
 
   const CsvFormat f(args.full_precision);
-  out << "mechanism,psi_deg,phi_deg,beta_deg,a,b,c,d,lambda,mu_min_deg,grashof,crank_extended_deg,"
-         "crank_folded_deg,rocker_extended_deg,rocker_folded_deg\n";
   const double lambda = d.coupler > 0.0 ? d.crank / d.coupler : 0.0;
-  write_row(out, {"crank-rocker", input_value(args.swing_deg), input_value(args.phi_deg),
+  std::ostringstream row;
+  write_row(row, {"crank-rocker", f.input(args.swing_deg), f.input(args.phi_deg),
                   f.angle_deg(deg(d.beta_rad)), f.length(d.crank), f.length(d.coupler),
                   f.length(d.rocker), f.length(d.ground), f.ratio(lambda),
                   f.angle_deg(deg(d.mu_min_rad)), grashof_name(d),
                   f.angle_deg(deg(d.crank_extended_rad)), f.angle_deg(deg(d.crank_folded_rad)),
                   f.angle_deg(deg(d.rocker_extended_rad)), f.angle_deg(deg(d.rocker_folded_rad))});
-  if (d.flags != 0) {
+  out << "mechanism,psi_deg,phi_deg,beta_deg,a,b,c,d,lambda,mu_min_deg,grashof,crank_extended_deg,"
+         "crank_folded_deg,rocker_extended_deg,rocker_folded_deg\n"
+      << row.str();
+  if (d.flags & motion::kDesignChangePoint) {
     err << "loom-synth: note: beta at a bound: degenerate linkage, mu_min = 0, not a usable "
            "beat-up\n";
   }
+  if (d.flags & motion::kDesignNearSpecialCase) note_near_special_case(err, args.swing_deg, args.phi_deg);
 }
 
 }  // namespace

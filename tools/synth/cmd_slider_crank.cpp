@@ -1,14 +1,14 @@
 // `loom-synth slider-crank`: Söylemez's optimum slider-crank (thesis Table 4.2 / 4.3) for one crank
-// rotation φ or a range of them, at λ_opt or a given λ. Every row is computed before any is
-// printed, so a bad φ in a range gives an error and no partial table.
+// rotation φ or a range of them, at λ_opt or a given λ. In a range, a φ with no design (e.g. 180°) is
+// reported on stderr and the other rows are printed; a single --phi with no design is an error, and
+// so is a range in which no φ has one.
 #include <cmath>
 #include <sstream>
 #include <vector>
 
 #include "commands.hpp"
-#include "csv.hpp"
 #include "loom/motion/angles.hpp"
-#include "loom/motion/synthesis.hpp"
+#include "loom/motion/design/synthesis.hpp"
 
 namespace loom::synth {
 
@@ -71,32 +71,33 @@ void run_slider_crank(const SliderCrankArgs& args, std::ostream& out, std::ostre
   const std::vector<double> phis = args.has_phi ? std::vector<double>{args.phi_deg}
                                                 : parse_range(args.phi_range);
 
-  std::vector<motion::SliderCrankDesign> designs;
-  designs.reserve(phis.size());
+  const CsvFormat f(args.full_precision);
+  std::ostringstream table;
+  std::size_t printed = 0;
   for (double phi_deg : phis) {
     const double phi = motion::rad(phi_deg);
-    blame("--phi " + input_value(phi_deg), [&] { return motion::soylemez_lambda_bounds(phi); });
-    if (args.has_lambda) {
-      designs.push_back(blame("--lambda " + input_value(args.lambda), [&] {
-        return motion::soylemez_slider_crank(args.stroke, phi, args.lambda);
-      }));
-    } else {
-      designs.push_back(motion::soylemez_slider_crank(args.stroke, phi));
+    motion::SliderCrankDesign d;
+    try {
+      motion::soylemez_lambda_bounds(phi);
+      d = args.has_lambda ? motion::soylemez_slider_crank(args.stroke, phi, args.lambda)
+                          : motion::soylemez_slider_crank(args.stroke, phi);
+    } catch (const motion::MotionError& e) {
+      const std::string arg = args.has_lambda ? "--phi " + input_value(phi_deg) + " --lambda " + input_value(args.lambda)
+                                              : "--phi " + input_value(phi_deg);
+      if (args.has_phi) throw ArgError(arg + ": " + e.what());
+      err << "loom-synth: note: phi_deg=" << input_value(phi_deg) << ": no row: " << e.what() << "\n";
+      continue;
     }
-  }
-
-  const CsvFormat f(args.full_precision);
-  out << "phi_deg,a,b,c,mu_min_deg,lambda\n";
-  for (std::size_t i = 0; i < designs.size(); ++i) {
-    const motion::SliderCrankDesign& d = designs[i];
-    write_row(out, {input_value(phis[i]), f.length(d.mechanism.crank), f.length(d.mechanism.coupler),
-                    f.length(d.mechanism.offset), f.angle_deg(motion::deg(d.mu_min_rad)),
-                    f.ratio(d.lambda)});
+    write_row(table, {f.input(phi_deg), f.length(d.mechanism.crank), f.length(d.mechanism.coupler),
+                      f.length(d.mechanism.offset), f.angle_deg(motion::deg(d.mu_min_rad)), f.ratio(d.lambda)});
+    ++printed;
     if (d.flags & motion::kDesignChangePoint) {
-      err << "loom-synth: note: phi_deg=" << input_value(phis[i])
+      err << "loom-synth: note: phi_deg=" << input_value(phi_deg)
           << ": lambda at a bound, change-point slider-crank (b = a + c), mu_min = 0\n";
     }
   }
+  if (printed == 0) throw ArgError("--phi-range " + args.phi_range + ": no phi in the range has a design");
+  out << "phi_deg,a,b,c,mu_min_deg,lambda\n" << table.str();
 }
 
 }  // namespace loom::synth

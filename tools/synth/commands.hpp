@@ -6,14 +6,22 @@
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
+#include "loom/cli/run.hpp"
+#include "loom/cli/table_format.hpp"
 #include "loom/motion/errors.hpp"
 
 namespace loom::synth {
 
-class ArgError : public std::runtime_error {
+using cli::CsvFormat;
+using cli::input_value;
+using cli::write_row;
+
+// A bad argument or combination, naming it; main() reports it with exit status 2.
+class ArgError : public cli::UsageError {
  public:
-  using std::runtime_error::runtime_error;
+  using cli::UsageError::UsageError;
 };
 
 // configure-time only. Runs f(); a MotionError it throws becomes an ArgError blaming `arg`
@@ -71,5 +79,17 @@ void run_design(const DesignArgs& args, std::ostream& out, std::ostream& err);
 
 // configure-time only. Throws ArgError unless v is a finite length > 0.
 void require_positive_length(const char* name, double v);
+
+// configure-time only. The stderr note for a Khare–Dave design flagged kDesignNearSpecialCase.
+void note_near_special_case(std::ostream& err, double psi_deg, double phi_deg);
+
+struct ThreePointArgs {
+  double theta0_deg = 0.0;
+  std::vector<std::string> points;  // "RX,RY,THETA2": mm, mm, degrees
+  bool full_precision = false;
+};
+// configure-time only (offline tool). Seed 001's three-precision-point synthesis:
+// lambda,a0,a1,a2,theta1_1_deg,theta1_2_deg,theta1_3_deg,closure_residual — one row per real solution.
+void run_three_point(const ThreePointArgs& args, std::ostream& out, std::ostream& err);
 
 }  // namespace loom::synth

@@ -2,19 +2,10 @@
 // Khare–Dave crank-rocker tables as CSV, and a one-row beat-up linkage design. CSV on stdout,
 // notes and errors on stderr; bad arguments or impossible designs exit 2 naming the argument.
 #include <CLI/CLI.hpp>
-#include <exception>
+#include <stdexcept>
 #include <iostream>
 
 #include "commands.hpp"
-
-namespace {
-
-int fail(const std::string& what) {
-  std::cerr << "loom-synth: error: " << what << "\n";
-  return 2;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   using namespace loom::synth;
@@ -65,14 +56,16 @@ int main(int argc, char** argv) {
                    "Slider-crank: scale the 6-decimal unit-stroke design, as the thesis' Table 4.3 did");
   ds_cmd->add_flag("--full-precision", ds.full_precision, "Print %.17g instead of the thesis' digits");
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);  // --help
-    return fail(e.what());
-  }
+  ThreePointArgs tp;
+  CLI::App* tp_cmd = app.add_subcommand(
+      "three-point", "Three-precision-point synthesis of the knotting chain (seed 001): "
+                     "lambda,a0,a1,a2,theta1_i_deg,closure_residual, one row per real solution (mm, deg)");
+  tp_cmd->add_option("--theta0-deg", tp.theta0_deg, "Fixed angle of the first link A0-O1, degrees")->required();
+  tp_cmd->add_option("--point", tp.points, "Precision point RX,RY,THETA2 (mm, mm, last link's angle in degrees); three times")
+      ->required();
+  tp_cmd->add_flag("--full-precision", tp.full_precision, "Print %.17g instead of 6 decimals");
 
-  try {
+  return loom::cli::run_cli("loom-synth", app, argc, argv, [&] {
     if (*sc_cmd) {
       sc.has_phi = sc_phi->count() > 0;
       sc.has_lambda = sc_lambda->count() > 0;
@@ -86,12 +79,10 @@ int main(int argc, char** argv) {
       ds.has_lambda = ds_lambda->count() > 0;
       ds.has_beta = ds_beta->count() > 0;
       run_design(ds, std::cout, std::cerr);
+    } else if (*tp_cmd) {
+      run_three_point(tp, std::cout, std::cerr);
     }
-  } catch (const ArgError& e) {
-    return fail(e.what());
-  } catch (const loom::motion::MotionError& e) {
-    return fail(e.what());
-  }
-  std::cout.flush();
-  return std::cout ? 0 : 1;
+    std::cout.flush();
+    if (!std::cout) throw std::runtime_error("cannot write the CSV output");
+  });
 }

@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "loom/motion/link_point.hpp"
@@ -116,10 +117,16 @@ DeadCentres dead_centres(const FourBar& m, Branch branch);
 
 // Transmission angle over a whole crank turn. μ grows with the diagonal |A B0|, which runs from
 // |d − a| at θ2 = 0 to d + a at θ2 = π, so both extremes are closed forms (and branch-independent).
+// |sin μ| below this somewhere in the turn is a near toggle: the linkage turns, but its rates there
+// are amplified by 1/|sin μ| > 1000 and small length errors move it a long way — flagged, not refused.
+inline constexpr double kNearToggleSine = 1e-3;
+
 struct TransmissionRange {
   double mu_min = 0.0;                      // smallest μ over the turn (rad), at θ2 = 0
   double mu_max = 0.0;                      // largest μ over the turn, at θ2 = π
   double worst_deviation_from_right = 0.0;  // max over the turn of |μ − π/2|
+  double min_abs_sin_mu = 0.0;              // min over the turn of |sin μ| (at μ_min or μ_max)
+  bool near_toggle = false;                 // min_abs_sin_mu < kNearToggleSine
 };
 // configure-time only. For a linkage whose crank turns fully (crank-rocker, double-crank); throws
 // kNotCrank otherwise, kInvalidInput on bad lengths. Accurate for needle-like triangles (Kahan).
@@ -132,6 +139,10 @@ TransmissionRange transmission_range(const FourBar& m);
 // so which way it moves on from there is not determined by the geometry).
 std::vector<FourBarPose> fourbar_sweep(const FourBar& m, Branch branch, int samples,
                                        double theta2_start = 0.0);
+// configure-time only. The same sweep handed to `sink` one pose at a time, in constant memory (the
+// offline tools stream millions of samples this way). Throws as above, before the first pose.
+void fourbar_sweep(const FourBar& m, Branch branch, int samples, double theta2_start,
+                   const std::function<void(const FourBarPose&)>& sink);
 
 struct FourBarNewtonResult {
   FourBarPose pose;  // coefficients from the converged angles
