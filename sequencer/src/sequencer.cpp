@@ -675,6 +675,7 @@ void Sequencer::end_row(hal::Tick now) noexcept {
 Fault Sequencer::shed_fault(ShedVerdict v) const noexcept {
   switch (v) {
     case ShedVerdict::kTooEarly: return Fault::kShedSensorEarly;
+    case ShedVerdict::kTooLate: return Fault::kShedSensorLate;
     case ShedVerdict::kNotReleased: return Fault::kShedNotReleased;
     case ShedVerdict::kAirLost: return Fault::kAirLost;
     case ShedVerdict::kConflict: return Fault::kShedSensorConflict;

@@ -15,6 +15,7 @@ const char* shed_verdict_name(ShedVerdict v) noexcept {
     case ShedVerdict::kSettling: return "settling";
     case ShedVerdict::kOpen: return "open";
     case ShedVerdict::kTooEarly: return "too_early";
+    case ShedVerdict::kTooLate: return "too_late";
     case ShedVerdict::kNotReleased: return "not_released";
     case ShedVerdict::kAirLost: return "air_lost";
     case ShedVerdict::kTimeout: return "timeout";
@@ -79,6 +80,13 @@ ShedVerdict ShedMonitor::update(const motion::ShedSpec& s, double t, PistonEnds 
     confirmed_at_ = std::max(frame_[0].arrived, frame_[1].arrived);
     open_at_ = open_at;
     return t >= open_at_ ? ShedVerdict::kOpen : ShedVerdict::kSettling;
+  }
+  for (std::size_t i = 0; i < 2; ++i) {
+    const Frame& f = frame_[i];
+    const double learned = learned_[i][f.extend ? 1 : 0];
+    if (f.full_stroke && learned > 0.0 && f.arrived < 0.0 && t > kLearnedLatestFactor * learned + kLateMarginS) {
+      return latched_ = ShedVerdict::kTooLate;
+    }
   }
   if (t >= s.release_timeout_s && !(frame_[0].left && frame_[1].left)) {
     const bool both_stuck = frame_[0].moves && frame_[1].moves && !frame_[0].left && !frame_[1].left;

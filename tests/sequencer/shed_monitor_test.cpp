@@ -88,3 +88,11 @@ TEST(ShedMonitor, AFrameLeftMidStrokeMayArriveAnyTime) {
   EXPECT_EQ(m.update(spec(), 0.01, kExtended, kRetracted), ShedVerdict::kSettling);
   EXPECT_EQ(m.update(spec(), 0.04, kExtended, kRetracted), ShedVerdict::kOpen);
 }
+
+TEST(ShedMonitor, AStrokeFarSlowerThanLearnedIsAFrameStuckOnItsWay) {
+  ShedMonitor m;
+  ASSERT_EQ(stroke_a_up(m, 0.30).v, ShedVerdict::kOpen);
+  const Result late = stroke_a_up(m, 0.50);  // > 1.25 × 0.30 + 0.02
+  EXPECT_EQ(late.v, ShedVerdict::kTooLate);
+  EXPECT_NEAR(late.t, 1.25 * 0.30 + 0.02, 0.0021);
+}

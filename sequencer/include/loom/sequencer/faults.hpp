@@ -35,7 +35,8 @@ namespace loom::sequencer {
   X(kLoadCellFault, 0x1019, "load_cell_fault", "the beater's load cell failed (lost, NaN or out of range)")     \
   X(kLoopStall, 0x101A, "loop_stall", "feedback from every device stopped at once (the loop or the bus stalled)") \
   X(kStopRequested, 0x101B, "stop_requested", "stopped at once on the operator's request (counters kept)") \
-  X(kShuttleSlipped, 0x101C, "shuttle_slipped", "the shuttle did not leave or arrive with its carrier (slipped off the magnet)")
+  X(kShuttleSlipped, 0x101C, "shuttle_slipped", "the shuttle did not leave or arrive with its carrier (slipped off the magnet)") \
+  X(kShedSensorLate, 0x101D, "shed_sensor_late", "a heald frame took far longer than its learned stroke (stuck on its way)")
 
 enum class Fault : std::uint8_t {
 #define LOOM_FAULT_ENUM(id, code, name, text) id,

@@ -4,6 +4,8 @@
 //   - both end sensors of one piston on at once: a stuck sensor or a wiring fault (kConflict);
 //   - a whole stroke confirmed faster than the profiles' window allows (earliest_fraction of the
 //     nominal stroke), or faster than 80 % of the stroke time this frame showed last time (kTooEarly);
+//   - a whole stroke confirmed far slower than the frame's learned stroke time (kTooLate): a frame
+//     that stuck on its way, or a sensor claiming an arrival that never happened;
 //   - a moving frame never seen off its start sensor (kNotReleased; both frames: kAirLost);
 //   - no confirmation by the timeout (kTimeout).
 // A confirmed whole stroke is not trusted before the frame can have finished it: the pick waits until
@@ -29,6 +31,7 @@ enum class ShedVerdict : std::uint8_t {
   kSettling,     // confirmed; waiting for the frames to settle (and to have had time to arrive)
   kOpen,         // confirmed, plausible and settled: the pick may start
   kTooEarly,     // fault: a whole stroke confirmed faster than the frame can move
+  kTooLate,      // fault: a whole stroke confirmed far slower than this frame moves (stuck on the way)
   kNotReleased,  // fault: a frame that must move was never seen off its start sensor
   kAirLost,      // fault: both frames had to move and neither left its start sensor
   kTimeout,      // fault: not confirmed within the timeout
@@ -43,6 +46,10 @@ class ShedMonitor {
  public:
   // A whole stroke confirming faster than this fraction of the frame's last stroke time is a sensor fault.
   static constexpr double kLearnedEarliestFraction = 0.8;
+  // ... and one slower than this multiple of it (plus kLateMarginS) is a frame that stuck on its way —
+  // or a sensor that claims an arrival the frame never made.
+  static constexpr double kLearnedLatestFactor = 1.25;
+  static constexpr double kLateMarginS = 0.02;
 
   // RT-safe. Begin a change to piston A extended = a_extend, B extended = b_extend, with the (debounced)
   // end sensors as they read now; a frame already in its commanded end position does not need to move.
