@@ -19,6 +19,7 @@ packages=(
   nlohmann-json3-dev            # run reports (summary.json)
   libnlopt-cxx-dev              # optimiser (balancing)
   iproute2 can-utils            # vcan set-up, candump/cansend for HIL checks
+  clang libclang-rt-14-dev llvm # fuzz build: clang++ -fsanitize=fuzzer (libFuzzer), llvm-symbolizer
 )
 
 missing=()

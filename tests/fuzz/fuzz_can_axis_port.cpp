@@ -1,0 +1,168 @@
+// libFuzzer harness: the receive path of drivers::CanAxisPort (the RT master of the three servo axes)
+// fed an arbitrary sequence of frames between its ticks.
+//
+// Once per process the port is brought up for real — NMT + SDO against simulated CiA 402 drives over the
+// in-memory CAN network of the driver tests — and ticked until every drive is in Operation Enabled. That
+// port is the template: each input starts from a copy of it, now on a bus the input alone feeds (the
+// simulated drives are gone), and plays operations read from the input:
+//   any frame (any COB-ID, data, error or RTR frame, DLC 0..8);
+//   a well-formed TPDO1 or heartbeat of one of the three drives with fuzzed contents (reaches deep states);
+//   a tick (read_axes → hold the measured position with a fuzzed request → write_axes);
+//   a gap of several ticks; a full transmit queue for a few sends.
+// Besides crashes and sanitizer reports it checks what the sequencer relies on: feedback is always
+// finite, and a bus-off error frame, once read, latches the link fault.
+#include <fuzzer/FuzzedDataProvider.h>
+
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+
+#include "drive_rig.hpp"
+#include "loom/drivers/can_error_frame.hpp"
+#include "loom/drivers/cob_id.hpp"
+#include "loom/drivers/nmt.hpp"
+#include "loom/drivers/pdo.hpp"
+
+namespace {
+
+using namespace loom;
+
+[[noreturn]] void fail(const char* what, std::size_t axis, double value) {
+  std::fprintf(stderr, "CanAxisPort property violated: %s (axis %zu, value %g)\n", what, axis, value);
+  std::abort();
+}
+
+constexpr int kMaxOps = 512;
+
+// The port's bus. During bring-up it relays to the simulated drives' network; afterwards it delivers
+// only what the input queues, and accepts (or, while "full", refuses) what the port sends.
+class FuzzBus final : public drivers::CanBus {
+ public:
+  drivers::CanBus* relay = nullptr;
+  int tx_full = 0;
+
+  drivers::SendResult send(const drivers::CanFrame& f) override {
+    if (relay != nullptr) return relay->send(f);
+    if (tx_full > 0) {
+      --tx_full;
+      return drivers::SendResult::kWouldBlock;
+    }
+    return drivers::SendResult::kOk;
+  }
+  bool receive(drivers::CanFrame& f) override {
+    if (relay != nullptr) return relay->receive(f);
+    if (head_ == tail_) return false;
+    f = queue_[head_++ % queue_.size()];
+    return true;
+  }
+  // False (frame lost, as on a real controller's full rx FIFO) when the queue is full.
+  bool queue(const drivers::CanFrame& f) {
+    if (tail_ - head_ == queue_.size()) return false;
+    queue_[tail_++ % queue_.size()] = f;
+    return true;
+  }
+  std::size_t pending() const { return tail_ - head_; }
+  void reset() {
+    head_ = tail_ = 0;
+    tx_full = 0;
+  }
+
+ private:
+  std::array<drivers::CanFrame, 256> queue_{};
+  std::size_t head_ = 0, tail_ = 0;
+};
+
+struct Template {
+  test::DriveRig rig{test::three_drives(1000, -2000, 3000)};
+  FuzzBus bus;
+  hal::Tick tick = 0;
+
+  Template() {
+    rig.rack.power_on(rig.now_us);
+    bus.relay = &rig.master;
+    const drivers::Status s = rig.port.configure(bus, rig.clock);
+    if (!s.is_ok()) {
+      std::fprintf(stderr, "bring-up against the simulated drives failed: %s\n", s.message().c_str());
+      std::abort();
+    }
+    rig.run_until(test::DriveRig::hold(hal::AxisRequest::kEnable),
+                  [&] { return rig.all_in(hal::DriveState::kOperationEnabled); }, 100);
+    if (!rig.all_in(hal::DriveState::kOperationEnabled)) {
+      std::fprintf(stderr, "the simulated drives did not reach Operation Enabled\n");
+      std::abort();
+    }
+    bus.relay = nullptr;
+    tick = rig.tick_index;
+  }
+};
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  static Template* const tmpl = new Template();  // process lifetime; never freed (libFuzzer exits)
+  FuzzBus& bus = tmpl->bus;
+  bus.reset();
+  drivers::CanAxisPort port = tmpl->rig.port;  // configured, drives enabled, bound to `bus`
+  hal::Tick now = tmpl->tick;
+  hal::AxisFeedbacks feedback{};
+  hal::LinkStatus link{};
+  hal::AxisCommands commands{};
+  bool bus_off_queued = false;
+
+  FuzzedDataProvider in(data, size);
+  for (int op = 0; op < kMaxOps && in.remaining_bytes() > 0; ++op) {
+    switch (in.ConsumeIntegralInRange<int>(0, 5)) {
+      case 0: {  // any frame
+        drivers::CanFrame f;
+        f.flags = in.ConsumeIntegral<std::uint8_t>() & (drivers::CanFrame::kError | drivers::CanFrame::kRtr);
+        f.id = f.is_error() ? in.ConsumeIntegral<std::uint32_t>()
+                            : in.ConsumeIntegral<std::uint16_t>() & drivers::kMaxStandardId;
+        f.dlc = in.ConsumeIntegralInRange<std::uint8_t>(0, 8);
+        for (auto& b : f.data) b = in.ConsumeIntegral<std::uint8_t>();
+        if (bus.queue(f) && f.is_error() && drivers::decode_error_frame(f).bus_off) bus_off_queued = true;
+        break;
+      }
+      case 1: {  // a TPDO1 of one of the drives
+        const auto node = in.ConsumeIntegralInRange<std::uint8_t>(1, 3);
+        drivers::Tpdo1 p;
+        p.statusword = in.ConsumeIntegral<std::uint16_t>();
+        p.position_actual = in.ConsumeIntegral<std::int32_t>();
+        (void)bus.queue(drivers::pack_tpdo1(node, p));
+        break;
+      }
+      case 2: {  // a heartbeat / boot-up of one of the drives, any state byte
+        drivers::CanFrame f = drivers::make_heartbeat(in.ConsumeIntegralInRange<std::uint8_t>(1, 3),
+                                                      drivers::NmtState::kOperational);
+        f.data[0] = in.ConsumeIntegral<std::uint8_t>();
+        (void)bus.queue(f);
+        break;
+      }
+      case 3: {  // one RT cycle
+        const auto request = static_cast<hal::AxisRequest>(in.ConsumeIntegralInRange<int>(0, 3));
+        port.read_axes(now, feedback, link);
+        for (std::size_t i = 0; i < feedback.size(); ++i) {
+          const auto& fb = feedback[i];
+          if (!std::isfinite(fb.position)) fail("position not finite", i, fb.position);
+          if (!std::isfinite(fb.velocity)) fail("velocity not finite", i, fb.velocity);
+          if (!std::isfinite(fb.effort)) fail("effort not finite", i, fb.effort);
+        }
+        if (bus_off_queued && bus.pending() == 0 && !link.link_fault) fail("bus-off read but no link fault", 0, 0.0);
+        test::DriveRig::hold(request)(feedback, commands);
+        port.write_axes(now, commands);
+        ++now;
+        break;
+      }
+      case 4:  // ticks without a cycle (a stalled loop)
+        now += in.ConsumeIntegralInRange<int>(1, 1000);
+        break;
+      case 5:
+        bus.tx_full = in.ConsumeIntegralInRange<int>(0, 8);
+        break;
+    }
+  }
+  return 0;
+}
