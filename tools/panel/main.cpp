@@ -11,6 +11,9 @@
 
 #include <CLI/CLI.hpp>
 #include <atomic>
+#include <chrono>
+#include <map>
+#include <memory>
 #include <csignal>
 #include <cstdio>
 #include <lcm/lcm-cpp.hpp>
@@ -18,6 +21,7 @@
 #include <thread>
 
 #include "hall.hpp"
+#include "udpm_receiver.hpp"
 #include "loom/telemetry/channels.hpp"
 
 namespace loom::panel {
@@ -47,20 +51,63 @@ struct PanelOptions {
   std::string control_socket;
 };
 
-template <typename Msg>
-void handler(const lcm::ReceiveBuffer*, const std::string&, const Msg* m, Hall* hall);
-template <>
-void handler(const lcm::ReceiveBuffer*, const std::string&, const loomlcm::status_t* m, Hall* h) { h->on_status(*m); }
-template <>
-void handler(const lcm::ReceiveBuffer*, const std::string&, const loomlcm::axes_t* m, Hall* h) { h->on_axes(*m); }
-template <>
-void handler(const lcm::ReceiveBuffer*, const std::string&, const loomlcm::rt_stats_t* m, Hall* h) { h->on_rt(*m); }
-template <>
-void handler(const lcm::ReceiveBuffer*, const std::string&, const loomlcm::beat_t* m, Hall* h) { h->on_beat(*m); }
-template <>
-void handler(const lcm::ReceiveBuffer*, const std::string&, const loomlcm::fault_t* m, Hall* h) { h->on_fault(*m); }
-template <>
-void handler(const lcm::ReceiveBuffer*, const std::string&, const loomlcm::row_t* m, Hall* h) { h->on_row(*m); }
+// Routes one received message by its channel, <prefix>.<loom id>.<KIND>, to the hall. AXES comes at
+// up to 50 Hz per loom; a page needs a few per second, so each loom's AXES is decoded at most every
+// 100 ms and the rest are skipped before decoding.
+class Router {
+ public:
+  Router(Hall& hall, std::string prefix) : hall_(hall), prefix_(std::move(prefix) + ".") {}
+
+  void route(std::string_view channel, const void* data, std::size_t size) {
+    if (channel.substr(0, prefix_.size()) != prefix_) return;
+    const std::string_view rest = channel.substr(prefix_.size());
+    const auto dot = rest.rfind('.');
+    if (dot == std::string_view::npos) return;
+    const std::string_view id = rest.substr(0, dot), kind = rest.substr(dot + 1);
+    if (!loom::telemetry::loom_id_error(id).empty()) return;
+    const int len = static_cast<int>(size);
+    if (kind == "STATUS") {
+      decode<loomlcm::status_t>(data, len, [&](const auto& m) { hall_.on_status(m); });
+    } else if (kind == "AXES") {
+      const auto now = std::chrono::steady_clock::now();
+      auto it = last_axes_.find(id);
+      if (it == last_axes_.end()) it = last_axes_.emplace(std::string(id), now - std::chrono::seconds(1)).first;
+      if (now - it->second < std::chrono::milliseconds(100)) return;
+      it->second = now;
+      decode<loomlcm::axes_t>(data, len, [&](const auto& m) { hall_.on_axes(m); });
+    } else if (kind == "RT") {
+      decode<loomlcm::rt_stats_t>(data, len, [&](const auto& m) { hall_.on_rt(m); });
+    } else if (kind == "BEAT") {
+      decode<loomlcm::beat_t>(data, len, [&](const auto& m) { hall_.on_beat(m); });
+    } else if (kind == "FAULT") {
+      decode<loomlcm::fault_t>(data, len, [&](const auto& m) { hall_.on_fault(m); });
+    } else if (kind == "ROW") {
+      decode<loomlcm::row_t>(data, len, [&](const auto& m) { hall_.on_row(m); });
+    }
+  }
+  std::uint64_t decode_errors() const { return decode_errors_; }
+
+  // For LCM's own receive path (file://, memq://, or a udpm the lean receiver cannot open).
+  static void on_lcm(const lcm::ReceiveBuffer* rbuf, const std::string& channel, Router* self) {
+    self->route(channel, rbuf->data, rbuf->data_size);
+  }
+
+ private:
+  template <typename Msg, typename F>
+  void decode(const void* data, int len, F&& use) {
+    Msg m;
+    // decode() checks the type's fingerprint first: another type on the channel is an error, not garbage.
+    if (m.decode(data, 0, len) < 0) {
+      ++decode_errors_;
+      return;
+    }
+    use(m);
+  }
+  Hall& hall_;
+  std::string prefix_;
+  std::map<std::string, std::chrono::steady_clock::time_point, std::less<>> last_axes_;
+  std::uint64_t decode_errors_ = 0;
+};
 
 std::string json_for(const Hall& hall, const std::string& loom) {
   if (loom.empty()) return hall.hall_json().dump();
@@ -96,19 +143,27 @@ int main(int argc, char** argv) {
   }
 
   Hall hall;
-  lcm::LCM lcm(o.lcm_url);
-  if (!lcm.good()) {
-    std::fprintf(stderr, "loom-panel: --lcm-url '%s' could not be opened by LCM\n", o.lcm_url.c_str());
-    return 1;
+  Router router(hall, o.channel_prefix);
+  // udpm (the normal case): the lean batched receiver. Anything else: LCM's own provider.
+  std::unique_ptr<loom::panel::UdpmReceiver> udpm;
+  std::unique_ptr<lcm::LCM> lcm;
+  if (const auto addr = loom::panel::parse_udpm_url(o.lcm_url)) {
+    try {
+      udpm = std::make_unique<loom::panel::UdpmReceiver>(*addr);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "loom-panel: --lcm-url '%s': %s\n", o.lcm_url.c_str(), e.what());
+      return 1;
+    }
+  } else {
+    lcm = std::make_unique<lcm::LCM>(o.lcm_url);
+    if (!lcm->good()) {
+      std::fprintf(stderr, "loom-panel: --lcm-url '%s' could not be opened by LCM\n", o.lcm_url.c_str());
+      return 1;
+    }
+    std::string re;
+    for (char c : o.channel_prefix) re += c == '.' ? std::string("\\.") : std::string(1, c);
+    lcm->subscribeFunction(re + "\\..*", &Router::on_lcm, &router)->setQueueCapacity(10000);
   }
-  const auto re = [&](const char* kind) { return loom::telemetry::channel_regex(o.channel_prefix, "", kind); };
-  constexpr int kQueue = 10000;  // 20 looms at full rate between two handle() calls fit easily
-  lcm.subscribeFunction(re("STATUS"), &handler<loomlcm::status_t>, &hall)->setQueueCapacity(kQueue);
-  lcm.subscribeFunction(re("AXES"), &handler<loomlcm::axes_t>, &hall)->setQueueCapacity(kQueue);
-  lcm.subscribeFunction(re("RT"), &handler<loomlcm::rt_stats_t>, &hall)->setQueueCapacity(kQueue);
-  lcm.subscribeFunction(re("BEAT"), &handler<loomlcm::beat_t>, &hall)->setQueueCapacity(kQueue);
-  lcm.subscribeFunction(re("FAULT"), &handler<loomlcm::fault_t>, &hall)->setQueueCapacity(kQueue);
-  lcm.subscribeFunction(re("ROW"), &handler<loomlcm::row_t>, &hall)->setQueueCapacity(kQueue);
 
   httplib::Server svr;
   svr.new_task_queue = [&] { return new httplib::ThreadPool(static_cast<std::size_t>(o.http_threads)); };
@@ -183,8 +238,10 @@ int main(int argc, char** argv) {
   std::thread http([&] { svr.listen_after_bind(); });
   std::fprintf(stderr, "loom-panel: serving http://%s:%d/ (read-only), LCM %s\n", o.bind.c_str(), port,
                o.lcm_url.empty() ? "default URL" : o.lcm_url.c_str());
+  const auto on_packet = [&](const loom::panel::LcmPacket& p) { router.route(p.channel, p.data, p.size); };
   while (!g_stop.load()) {
-    if (lcm.handleTimeout(200) < 0) {
+    const int r = udpm ? udpm->poll(200, on_packet) : lcm->handleTimeout(200);
+    if (r < 0) {
       std::fprintf(stderr, "loom-panel: LCM stopped delivering messages\n");
       break;
     }
