@@ -57,6 +57,8 @@ struct PanelOptions {
 class Router {
  public:
   Router(Hall& hall, std::string prefix) : hall_(hall), prefix_(std::move(prefix) + ".") {}
+  // Live traffic only: a log replayed at full speed would otherwise keep just its first AXES.
+  void throttle_axes(bool on) { throttle_axes_ = on; }
 
   void route(std::string_view channel, const void* data, std::size_t size) {
     if (channel.substr(0, prefix_.size()) != prefix_) return;
@@ -69,10 +71,10 @@ class Router {
     if (kind == "STATUS") {
       decode<loomlcm::status_t>(data, len, [&](const auto& m) { hall_.on_status(m); });
     } else if (kind == "AXES") {
-      const auto now = std::chrono::steady_clock::now();
+      const auto now = throttle_axes_ ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
       auto it = last_axes_.find(id);
       if (it == last_axes_.end()) it = last_axes_.emplace(std::string(id), now - std::chrono::seconds(1)).first;
-      if (now - it->second < std::chrono::milliseconds(100)) return;
+      if (throttle_axes_ && now - it->second < std::chrono::milliseconds(100)) return;
       it->second = now;
       decode<loomlcm::axes_t>(data, len, [&](const auto& m) { hall_.on_axes(m); });
     } else if (kind == "RT") {
@@ -107,6 +109,7 @@ class Router {
   std::string prefix_;
   std::map<std::string, std::chrono::steady_clock::time_point, std::less<>> last_axes_;
   std::uint64_t decode_errors_ = 0;
+  bool throttle_axes_ = true;
 };
 
 std::string json_for(const Hall& hall, const std::string& loom) {
@@ -155,6 +158,7 @@ int main(int argc, char** argv) {
       return 1;
     }
   } else {
+    router.throttle_axes(false);
     lcm = std::make_unique<lcm::LCM>(o.lcm_url);
     if (!lcm->good()) {
       std::fprintf(stderr, "loom-panel: --lcm-url '%s' could not be opened by LCM\n", o.lcm_url.c_str());
@@ -242,6 +246,12 @@ int main(int argc, char** argv) {
   while (!g_stop.load()) {
     const int r = udpm ? udpm->poll(200, on_packet) : lcm->handleTimeout(200);
     if (r < 0) {
+      if (o.lcm_url.rfind("file://", 0) == 0) {
+        // A log read to its end: keep serving what it held until told to stop.
+        std::fprintf(stderr, "loom-panel: end of log; still serving (Ctrl-C to stop)\n");
+        while (!g_stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(200));
+        break;
+      }
       std::fprintf(stderr, "loom-panel: LCM stopped delivering messages\n");
       break;
     }
