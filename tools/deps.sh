@@ -21,7 +21,7 @@ packages=(
   iproute2 can-utils            # vcan set-up, candump/cansend for HIL checks
   libcpp-httplib-dev            # loom-panel's HTTP server
   default-jdk-headless liblcm-java libjchart2d-java  # loomlcm.jar and loom-spy (lcm-spy)
-  chromium xvfb imagemagick nodejs  # browser and Xvfb tests of loom-panel and loom-spy
+  chromium xvfb xauth imagemagick nodejs  # browser and Xvfb tests of loom-panel and loom-spy
 )
 
 missing=()
