@@ -105,6 +105,8 @@ for (let i = 0; i < 40; i++) {
   await sleep(250);
 }
 if (!hall || !hall.includes(loomId)) fail(`the hall page does not list ${loomId}: ${JSON.stringify(hall)}`);
+const hallShot = await send("Page.captureScreenshot", { format: "png" }, hallPage);
+writeFileSync(pngPath.replace(/\.png$/, "_hall.png"), Buffer.from(hallShot.data, "base64"));
 
 console.log(`PASS: panel showed row ${first.row} -> ${last.row}, ${last.forces.length} beat forces in band ` +
   `(${last.forces.map(f => f.n).join(" ")}), hall lists ${hall.join(",")}; screenshot ${pngPath}`);

@@ -2,7 +2,7 @@
 # loom-panel in a real browser: a simulated loom weaves in real time (4x) on a private LCM URL, the
 # panel listens on it, and headless Chromium (driven over the DevTools protocol by panel_browser.mjs)
 # must see the row count advance and every beat force of the row drawn in the 80-100 N band.
-# Writes <build>/panel/loom_panel.png. Exit 77 (skip) when chromium or node is missing.
+# Writes <build>/panel/loom_panel.png and loom_panel_hall.png. Exit 77 (skip) when chromium or node is missing.
 # Usage: panel_browser.sh <loomctl> <loom-panel> <out dir>
 set -euo pipefail
 LOOMCTL=$1
