@@ -1,4 +1,4 @@
-// The control cycle and its telemetry snapshot.
+// The control cycle, its events and its telemetry snapshot.
 #include "loom/firmware/control_loop.hpp"
 
 #include <cmath>
@@ -13,6 +13,10 @@ void copy_name(std::array<char, N>& dst, const char* src) noexcept {
   std::size_t i = 0;
   for (; i + 1 < N && src[i] != '\0'; ++i) dst[i] = src[i];
   for (; i < N; ++i) dst[i] = '\0';
+}
+
+bool axis_faulted(const hal::AxisFeedback& a) noexcept {
+  return a.fault || a.state == hal::DriveState::kFault || a.state == hal::DriveState::kFaultReactionActive;
 }
 }  // namespace
 
@@ -29,6 +33,8 @@ void ControlLoop::cycle(hal::Tick now) noexcept {
   seq_.step(now, in_, out_);
   hal_.write(now, out_);
   if (telemetry_ != nullptr) {
+    // Events first: the publisher sends a tick's events before that tick's samples.
+    push_events(now);
     fill_snapshot(now);
     if (lossless_) {
       telemetry_->push_waiting(snap_);
@@ -38,26 +44,161 @@ void ControlLoop::cycle(hal::Tick now) noexcept {
   }
 }
 
+std::uint32_t ControlLoop::row_in_progress() const noexcept {
+  // Once the run is done the last row woven is "the row"; otherwise it is the one being (or about
+  // to be) woven, so row 1 reads 1 while it is woven.
+  const std::uint32_t done = seq_.counters().rows;
+  return seq_.state() == sequencer::State::kDone && done > 0 ? done : done + 1;
+}
+
+void ControlLoop::push_event(const telemetry::Event& e) noexcept {
+  if (lossless_) {
+    telemetry_->push_event_waiting(e);
+  } else {
+    telemetry_->push_event(e);
+  }
+}
+
+void ControlLoop::fill_event_context(telemetry::Event& e, hal::Tick now) const noexcept {
+  e.tick = now;
+  e.period_ns = period_ns_;
+  e.row = row_in_progress();
+  e.rows_done = seq_.counters().rows;
+  e.pick = seq_.counters().picks;
+  e.beat = seq_.counters().beats;
+  e.beats_per_row = static_cast<std::uint16_t>(seq_.profiles().beats_per_row());
+  e.band_min_n = ctx_.beat_force_min_n;
+  e.band_max_n = ctx_.beat_force_max_n;
+}
+
+void ControlLoop::push_events(hal::Tick now) noexcept {
+  if (!primed_) {
+    // Counters resumed from disk are not events of this run.
+    beat_events_seen_ = seq_.beat_events();
+    rows_seen_ = seq_.counters().rows;
+    primed_ = true;
+  }
+  // BEAT: the sequencer completes at most one beat per tick, so polling every tick sees each once.
+  if (seq_.beat_events() != beat_events_seen_) {
+    beat_events_seen_ = seq_.beat_events();
+    const sequencer::BeatEvent& b = seq_.last_beat();
+    telemetry::Event e;
+    e.kind = telemetry::Event::Kind::kBeat;
+    fill_event_context(e, now);
+    e.row = b.row;
+    e.beat_index = b.index;
+    e.x_m = b.x_m;
+    e.peak_force_n = b.peak_force_n;
+    e.force_measured = b.force_measured;
+    e.in_band = b.in_band;
+    push_event(e);
+  }
+  // ROW: a completed row with its time split and force summary.
+  if (seq_.counters().rows != rows_seen_) {
+    rows_seen_ = seq_.counters().rows;
+    const sequencer::RowStats& r = seq_.last_row();
+    telemetry::Event e;
+    e.kind = telemetry::Event::Kind::kRow;
+    fill_event_context(e, now);
+    e.row = r.row;
+    e.row_ticks = r.total_ticks;
+    e.shed_ticks = r.shed_ticks;
+    e.pick_ticks = r.pick_ticks;
+    e.beat_ticks = r.beat_ticks;
+    e.beats = static_cast<std::uint16_t>(r.beats);
+    e.carriage_steps = static_cast<std::uint16_t>(r.carriage_steps);
+    e.force_measured = r.force_measured;
+    e.force_min_n = r.force_min_n;
+    e.force_mean_n = r.force_mean_n;
+    e.force_max_n = r.force_max_n;
+    std::uint16_t in_band = 0;
+    const int n = r.beats < sequencer::kMaxBeatsPerRow ? r.beats : sequencer::kMaxBeatsPerRow;
+    for (int k = 0; r.force_measured && k < n; ++k) {  // bounded: kMaxBeatsPerRow
+      const double f = r.beat[static_cast<std::size_t>(k)].peak_force_n;
+      if (f >= ctx_.beat_force_min_n && f <= ctx_.beat_force_max_n) ++in_band;
+    }
+    e.beats_in_band = in_band;
+    push_event(e);
+  }
+  // FAULT: the latched first fault, a later diagnosis of its root cause, and every device report.
+  const sequencer::Fault f = seq_.first_fault();
+  const auto fault_event = [&](telemetry::Event::FaultKind kind, sequencer::Fault which, int axis,
+                               std::uint16_t device_code) {
+    telemetry::Event e;
+    e.kind = telemetry::Event::Kind::kFault;
+    fill_event_context(e, now);
+    e.fault_kind = kind;
+    e.fault = static_cast<std::uint8_t>(which);
+    e.axis = static_cast<std::int8_t>(axis);
+    e.device_code = device_code;
+    copy_name(e.state, sequencer::state_name(prev_state_));
+    push_event(e);
+  };
+  int first_axis_reported = -2;  // axis of a first/diagnosis event this tick (-1: none), -2: no such event
+  bool link_reported = false;
+  if (f != prev_fault_ || seq_.fault_axis() != prev_fault_axis_ || seq_.fault_detail() != prev_fault_detail_) {
+    if (f != sequencer::Fault::kNone) {
+      fault_event(prev_fault_ == sequencer::Fault::kNone ? telemetry::Event::FaultKind::kFirst
+                                                          : telemetry::Event::FaultKind::kDiagnosis,
+                  f, seq_.fault_axis(), seq_.fault_detail());
+      first_axis_reported = seq_.fault_axis();
+      link_reported = f == sequencer::Fault::kLinkFault ||
+                      (f == sequencer::Fault::kHeartbeatLost && seq_.fault_axis() < 0);
+    }
+    prev_fault_ = f;
+    prev_fault_axis_ = seq_.fault_axis();
+    prev_fault_detail_ = seq_.fault_detail();
+  }
+  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+    const hal::AxisFeedback& a = in_.axes[i];
+    const bool faulted = axis_faulted(a);
+    const bool report = faulted && (!prev_axis_fault_[i] || a.fault_code != prev_axis_fault_code_[i]);
+    if (report && static_cast<int>(i) != first_axis_reported) {
+      fault_event(telemetry::Event::FaultKind::kDevice, sequencer::Fault::kDriveFault, static_cast<int>(i),
+                  a.fault_code);
+    }
+    prev_axis_fault_[i] = faulted;
+    prev_axis_fault_code_[i] = faulted ? a.fault_code : 0;
+  }
+  if (in_.link.link_fault && !prev_link_fault_ && !link_reported) {
+    fault_event(telemetry::Event::FaultKind::kDevice, sequencer::Fault::kLinkFault, -1, in_.link.link_fault_code);
+  }
+  prev_link_fault_ = in_.link.link_fault;
+  prev_state_ = seq_.state();
+}
+
 void ControlLoop::fill_snapshot(hal::Tick now) noexcept {
   telemetry::Snapshot& s = snap_;
   s.tick = now;
   s.period_ns = period_ns_;
   copy_name(s.state, sequencer::state_name(seq_.state()));
   const sequencer::Fault f = seq_.first_fault();
-  copy_name(s.first_fault, f == sequencer::Fault::kNone ? "" : sequencer::fault_name(f));
+  const bool faulted = f != sequencer::Fault::kNone;
+  copy_name(s.first_fault, faulted ? sequencer::fault_name(f) : "");
   s.first_fault_code = sequencer::fault_code(f);
+  s.fault_axis = static_cast<std::int8_t>(faulted ? seq_.fault_axis() : -1);
+  s.fault_device_code = faulted ? seq_.fault_detail() : 0;
+  s.fault_tick = faulted ? seq_.fault_tick() : hal::kNeverTick;
+  copy_name(s.stopped_by, faulted ? sequencer::fault_name(seq_.stopped_by()) : "");
   s.row = seq_.counters().rows;
   s.pick = seq_.counters().picks;
   s.beat = seq_.counters().beats;
+  s.row_in_progress = row_in_progress();
+  s.rows_target = ctx_.rows_target;
+  s.beats_per_row = static_cast<std::uint16_t>(seq_.profiles().beats_per_row());
   s.crank_phase_rad = seq_.commanded_crank_phase();
   s.beater_angle_rad = seq_.commanded_rocker_angle();
+  s.beat_force_valid = in_.analog.beat_force_valid;
+  s.beat_force_n = in_.analog.beat_force_valid ? in_.analog.beat_force_n : 0.0;
   for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
     telemetry::AxisSample& a = s.axes[i];
     a.position = in_.axes[i].position;
     a.velocity = in_.axes[i].velocity;
     a.target = out_.axes[i].target_position;
     a.following_error = a.target - a.position;
+    a.following_error_limit = ctx_.following_error_limit[i];
     a.effort = in_.axes[i].effort;
+    a.fault_code = in_.axes[i].fault_code;
     a.drive_state = static_cast<std::uint8_t>(in_.axes[i].state);
     a.request = static_cast<std::uint8_t>(out_.axes[i].request);
   }
@@ -70,7 +211,12 @@ void ControlLoop::fill_snapshot(hal::Tick now) noexcept {
   s.overruns = stats_.overruns;
   s.tick_cost_ns = stats_.last_tick_cost_ns;
   s.max_tick_cost_ns = stats_.max_tick_cost_ns;
+  s.wake_latency_p50_ns = stats_.wake_latency_p50_ns;
+  s.wake_latency_p99_ns = stats_.wake_latency_p99_ns;
+  s.wake_latency_max_ns = stats_.wake_latency_max_ns;
   s.telemetry_dropped = static_cast<std::uint32_t>(telemetry_->dropped());
+  s.can_tx_dropped = in_.link.tx_dropped;
+  s.can_rx_errors = in_.link.rx_errors;
 }
 
 }  // namespace loom::firmware

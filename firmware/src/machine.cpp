@@ -53,6 +53,11 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
   }
   loop_ = std::make_unique<ControlLoop>(*hal_, *sequencer_, telemetry_.get(), cfg_.sequencer.period_s,
                                         opt.lossless_telemetry && opt.hal == HalKind::kSim);
+  TelemetryContext tc;
+  tc.beat_force_min_n = cfg_.sequencer.beat_force_min_n;
+  tc.beat_force_max_n = cfg_.sequencer.beat_force_max_n;
+  tc.rows_target = opt.rows;
+  loop_->set_telemetry_context(tc);
 }
 
 // The CAN HAL: three CiA 402 drives and the CiA 401 I/O node on one bus (or, only when asked for on

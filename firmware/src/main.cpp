@@ -152,11 +152,23 @@ int weave(const WeaveArgs& a) {
   const auto secs = [&](hal::Tick t) { return static_cast<double>(t) * period; };
   // A progress bar on long runs (a terminal only; logs get the per-row lines).
   const bool progress_bar = isatty(STDOUT_FILENO) && a.rows >= 20 && !a.quiet;
-  report::RunSummary summary;
-  summary.loom_id = cfg.loom_id;
-  summary.scene = hardware ? "socketcan:" + a.iface : scene.spec.name;
-  summary.effects = hardware ? std::vector<std::string>{} : scene.spec.effects;
-  summary.period_s = period;
+  // The report streams each row to disk as it completes (constant memory, however many rows).
+  std::unique_ptr<report::ReportWriter> report_writer;
+  if (!a.report.empty()) {
+    report::RunHeader rh;
+    rh.loom_id = cfg.loom_id;
+    rh.scene = hardware ? "socketcan:" + a.iface : scene.spec.name;
+    rh.effects = hardware ? std::vector<std::string>{} : scene.spec.effects;
+    rh.period_s = period;
+    rh.beat_force_min_n = cfg.sequencer.beat_force_min_n;
+    rh.beat_force_max_n = cfg.sequencer.beat_force_max_n;
+    try {
+      report_writer = std::make_unique<report::ReportWriter>(a.report, rh);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "loomctl: --report %s: %s\n", a.report.c_str(), e.what());
+      return kExitBadInput;
+    }
+  }
   std::uint32_t picks_at_row_start = resume.picks;
   std::string counters_error;  // set when a save failed: the run ends in a fault
   const auto on_event = [&](const firmware::RunEvent& e) {
@@ -186,8 +198,13 @@ int weave(const WeaveArgs& a) {
       const auto& r = e.row;
       ++rows_this_run;
       machine_s_rows += secs(r.total_ticks);
-      summary.rows.push_back(r);
-      summary.row_picks.push_back(e.counters.picks - picks_at_row_start);
+      if (report_writer) {
+        try {
+          report_writer->add_row(r, e.counters.picks - picks_at_row_start, secs(e.tick));
+        } catch (const std::exception& ex) {
+          std::fprintf(stderr, "loomctl: WARNING: report row not written: %s\n", ex.what());
+        }
+      }
       picks_at_row_start = e.counters.picks;
       if (progress_bar) {
         const int width = 40;
@@ -243,6 +260,7 @@ int weave(const WeaveArgs& a) {
               static_cast<long long>(res.median_tick_cost_ns), static_cast<long long>(res.max_tick_cost_ns),
               res.overruns);
   const auto& c = seq.counters();
+  report::RunEnd summary;
   summary.counters = c;
   summary.machine_s = machine_s;
   summary.wall_s = res.wall_s;
@@ -253,9 +271,9 @@ int weave(const WeaveArgs& a) {
         seq.fault_axis() >= 0 ? hal::axis_name(static_cast<hal::Axis>(seq.fault_axis())) : "", seq.fault_detail(),
         secs(seq.fault_tick()), sequencer::fault_name(seq.stopped_by()), sequencer::fault_text(f)};
   }
-  if (!a.report.empty()) {
+  if (report_writer) {
     try {
-      report::write_report(summary, a.report);
+      report_writer->finish(summary);
       std::printf("report: %s/summary.json, beat_force.svg, row_timeline.svg\n", a.report.c_str());
     } catch (const std::exception& e) {
       std::fprintf(stderr, "loomctl: report not written: %s\n", e.what());

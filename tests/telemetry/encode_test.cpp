@@ -21,11 +21,21 @@ Snapshot sample() {
   test_support::set_name(s.first_fault, "heartbeat_lost");
   s.first_fault_code = 0x8130;
   s.row = 7;
+  s.row_in_progress = 8;
+  s.rows_target = 20;
+  s.fault_axis = 1;
+  s.fault_device_code = 0x8611;
+  s.fault_tick = 100'000;
+  test_support::set_name(s.stopped_by, "stale_feedback");
   s.pick = 8;
   s.beat = 29;
   s.crank_phase_rad = 1.25;
   s.beater_angle_rad = -0.3;
   s.beat_force_n = 91.5;
+  s.beat_force_valid = true;
+  s.can_tx_dropped = 6;
+  s.can_rx_errors = 9;
+  s.wake_latency_p99_ns = 12'000;
   for (std::size_t i = 0; i < s.axes.size(); ++i) {
     const double k = static_cast<double>(i + 1);
     s.axes[i] = {.position = 1.0 * k,
@@ -33,6 +43,8 @@ Snapshot sample() {
                  .target = 3.0 * k,
                  .following_error = 4.0 * k,
                  .effort = 5.0 * k,
+                 .following_error_limit = 6.0 * k,
+                 .fault_code = static_cast<std::uint16_t>(0x8600 + i),
                  .drive_state = static_cast<std::uint8_t>(loom::hal::DriveState::kFault),
                  .request = static_cast<std::uint8_t>(loom::hal::AxisRequest::kQuickStop)};
   }
@@ -61,11 +73,18 @@ TEST(Encode, StatusCarriesStateCountersAndFault) {
   EXPECT_DOUBLE_EQ(m.time_s, 123'456 * 0.002);
   EXPECT_EQ(m.period_ns, 2'000'000);
   EXPECT_EQ(m.state, "beat");
-  EXPECT_EQ(m.row, 7);
+  EXPECT_EQ(m.row, 8);  // the row in progress
+  EXPECT_EQ(m.rows_done, 7);
+  EXPECT_EQ(m.rows_target, 20);
   EXPECT_EQ(m.pick, 8);
   EXPECT_EQ(m.beat, 29);
   EXPECT_EQ(m.first_fault, "heartbeat_lost");
   EXPECT_EQ(m.first_fault_code, 0x8130);
+  EXPECT_EQ(m.fault_axis, "carriage");
+  EXPECT_EQ(m.fault_device_code, 0x8611);
+  EXPECT_EQ(m.fault_text, "a CAN node stopped sending heartbeats");  // from the fault table
+  EXPECT_DOUBLE_EQ(m.fault_time_s, 200.0);
+  EXPECT_EQ(m.stopped_by, "stale_feedback");
   EXPECT_EQ(m.outputs, 0b10);
   EXPECT_EQ(m.inputs, 0b1000101);
 }
@@ -76,6 +95,7 @@ TEST(Encode, AxesCarryEveryAxisWithNames) {
   EXPECT_DOUBLE_EQ(m.crank_phase_rad, 1.25);
   EXPECT_DOUBLE_EQ(m.beater_angle_rad, -0.3);
   EXPECT_DOUBLE_EQ(m.beat_force_n, 91.5);
+  EXPECT_TRUE(m.beat_force_valid);
   ASSERT_EQ(m.num_axes, 3);
   ASSERT_EQ(m.axes.size(), 3u);
   EXPECT_EQ(m.axes[0].name, "beat_crank");
@@ -88,6 +108,8 @@ TEST(Encode, AxesCarryEveryAxisWithNames) {
     EXPECT_DOUBLE_EQ(m.axes[i].target, 3.0 * k);
     EXPECT_DOUBLE_EQ(m.axes[i].following_error, 4.0 * k);
     EXPECT_DOUBLE_EQ(m.axes[i].effort, 5.0 * k);
+    EXPECT_DOUBLE_EQ(m.axes[i].following_error_limit, 6.0 * k);
+    EXPECT_EQ(m.axes[i].fault_code, static_cast<int>(0x8600 + i));
     EXPECT_EQ(m.axes[i].drive_state, "fault");
     EXPECT_EQ(m.axes[i].drive_state_code, static_cast<int>(loom::hal::DriveState::kFault));
     EXPECT_EQ(m.axes[i].request, static_cast<int>(loom::hal::AxisRequest::kQuickStop));
@@ -102,8 +124,117 @@ TEST(Encode, RtTakesDropsAndBacklogFromTheRing) {
   EXPECT_EQ(m.max_tick_cost_ns, 97'000);
   EXPECT_EQ(m.dropped_snapshots, 11);
   EXPECT_EQ(m.backlog, 5);
+  EXPECT_EQ(m.can_tx_dropped, 6);
+  EXPECT_EQ(m.can_rx_errors, 9);
+  EXPECT_EQ(m.wake_latency_p99_ns, 12'000);
+  EXPECT_EQ(round_trip(to_rt_stats(sample(), "L7", 42, 0, 0, 4)).dropped_events, 4);
   // Counters beyond int64 saturate instead of wrapping negative.
   EXPECT_EQ(to_rt_stats(sample(), "L7", 0, ~0ull, 0).dropped_snapshots, INT64_MAX);
+}
+
+TEST(Encode, NoFaultMeansNoFaultDetails) {
+  Snapshot s = sample();
+  s.first_fault.fill('\0');
+  s.first_fault_code = 0;
+  const auto m = to_status(s, "L7", 0);
+  EXPECT_EQ(m.fault_axis, "");
+  EXPECT_EQ(m.fault_device_code, 0);
+  EXPECT_EQ(m.fault_text, "");
+}
+
+TEST(Encode, UnmeasuredForceIsZero) {
+  Snapshot s = sample();
+  s.beat_force_valid = false;
+  EXPECT_EQ(to_axes(s, "L7", 0).beat_force_n, 0.0);
+  EXPECT_FALSE(to_axes(s, "L7", 0).beat_force_valid);
+}
+
+Event event(Event::Kind k) {
+  Event e;
+  e.kind = k;
+  e.tick = 5000;
+  e.period_ns = 2'000'000;
+  e.row = 3;
+  e.rows_done = 2;
+  e.pick = 3;
+  e.beat = 33;
+  e.beats_per_row = 15;
+  e.band_min_n = 80.0;
+  e.band_max_n = 100.0;
+  return e;
+}
+
+TEST(Encode, BeatEvent) {
+  Event e = event(Event::Kind::kBeat);
+  e.beat_index = 4;
+  e.x_m = 0.25f;
+  e.peak_force_n = 89.5f;
+  e.force_measured = true;
+  e.in_band = true;
+  const auto m = round_trip(to_beat(e, "L7", 9));
+  EXPECT_EQ(m.loom_id, "L7");
+  EXPECT_EQ(m.tick, 5000);
+  EXPECT_DOUBLE_EQ(m.time_s, 10.0);
+  EXPECT_EQ(m.row, 3);
+  EXPECT_EQ(m.index, 4);
+  EXPECT_EQ(m.beats_per_row, 15);
+  EXPECT_DOUBLE_EQ(m.x_m, 0.25);
+  EXPECT_DOUBLE_EQ(m.peak_force_n, 89.5);
+  EXPECT_TRUE(m.force_measured);
+  EXPECT_TRUE(m.in_band);
+  EXPECT_DOUBLE_EQ(m.band_min_n, 80.0);
+  EXPECT_DOUBLE_EQ(m.band_max_n, 100.0);
+}
+
+TEST(Encode, FaultEventNamesAxisCodeAndText) {
+  Event e = event(Event::Kind::kFault);
+  e.fault_kind = Event::FaultKind::kFirst;
+  e.fault = 2;  // the fault table's third entry: drive_fault
+  e.axis = 1;
+  e.device_code = 0x8611;
+  test_support::set_name(e.state, "beat_sweep");
+  const auto m = round_trip(to_fault(e, "L7", 9));
+  EXPECT_EQ(m.kind, "first");
+  EXPECT_EQ(m.name, "drive_fault");
+  EXPECT_EQ(m.code, 0x1002);
+  EXPECT_EQ(m.text, "a servo drive reported a fault");
+  EXPECT_EQ(m.axis, "carriage");
+  EXPECT_EQ(m.device_code, 0x8611);
+  EXPECT_EQ(m.state, "beat_sweep");
+  EXPECT_EQ(m.row, 3);
+  EXPECT_EQ(m.rows_done, 2);
+  EXPECT_EQ(m.beat, 33);
+  e.axis = -1;
+  e.fault_kind = Event::FaultKind::kDevice;
+  EXPECT_EQ(to_fault(e, "L7", 9).axis, "");
+  EXPECT_EQ(to_fault(e, "L7", 9).kind, "device");
+}
+
+TEST(Encode, RowEventSplitsTimeInSeconds) {
+  Event e = event(Event::Kind::kRow);
+  e.row = 2;
+  e.row_ticks = 3770;
+  e.shed_ticks = 160;
+  e.pick_ticks = 646;
+  e.beat_ticks = 2964;
+  e.beats = 15;
+  e.carriage_steps = 14;
+  e.beats_in_band = 14;
+  e.force_measured = true;
+  e.force_min_n = 79.0;
+  e.force_mean_n = 89.0;
+  e.force_max_n = 91.0;
+  const auto m = round_trip(to_row(e, "L7", 9));
+  EXPECT_EQ(m.row, 2);
+  EXPECT_DOUBLE_EQ(m.row_s, 7.54);
+  EXPECT_DOUBLE_EQ(m.shed_s, 0.32);
+  EXPECT_DOUBLE_EQ(m.pick_s, 1.292);
+  EXPECT_DOUBLE_EQ(m.beat_s, 5.928);
+  EXPECT_EQ(m.beats, 15);
+  EXPECT_EQ(m.carriage_steps, 14);
+  EXPECT_EQ(m.beats_in_band, 14);
+  EXPECT_DOUBLE_EQ(m.force_min_n, 79.0);
+  EXPECT_DOUBLE_EQ(m.force_max_n, 91.0);
 }
 
 TEST(Encode, UnterminatedNamesStopAtTheArrayEnd) {

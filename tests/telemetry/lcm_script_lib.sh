@@ -62,11 +62,14 @@ start_monitor() {
   fail "loom-monitor did not start listening within 5 s"
 }
 
-# check_rows <status-lines-file> <final-row>: rows start at 0, never go back, rise by at most one per
-# line, and end at <final-row>.
+# check_rows <status-lines-file> <final-row>: completed rows (done=) start at 0, never go back, rise by
+# at most one per line, and end at <final-row>; the row in progress (row=) is always done + 1 except
+# once the run is done.
 check_rows() {
   awk -v final="$2" '
-    { for (i = 1; i <= NF; i++) if ($i ~ /^row=/) { r = substr($i, 5) + 0 } }
+    { for (i = 1; i <= NF; i++) { if ($i ~ /^done=/) r = substr($i, 6) + 0; if ($i ~ /^row=/) p = substr($i, 5) + 0;
+                                  if ($i ~ /^state=/) st = substr($i, 7) } }
+    st != "done" && p != r + 1 { print "row in progress " p " with " r " done at line " NR; bad = 1 }
     NR == 1 && r != 0 { print "first row " r " is not 0"; bad = 1 }
     NR > 1 && (r < prev || r > prev + 1) { print "row went " prev " -> " r " at line " NR; bad = 1 }
     { prev = r }

@@ -7,6 +7,9 @@
 #include <vector>
 
 #include "loomlcm/axes_t.hpp"
+#include "loomlcm/beat_t.hpp"
+#include "loomlcm/fault_t.hpp"
+#include "loomlcm/row_t.hpp"
 #include "loomlcm/rt_stats_t.hpp"
 #include "loomlcm/status_t.hpp"
 
@@ -16,6 +19,9 @@ struct LoggedMessages {
   std::vector<loomlcm::status_t> status;
   std::vector<loomlcm::axes_t> axes;
   std::vector<loomlcm::rt_stats_t> rt;
+  std::vector<loomlcm::beat_t> beat;
+  std::vector<loomlcm::fault_t> fault;
+  std::vector<loomlcm::row_t> row;
   std::vector<std::string> other_channels;
   int decode_errors = 0;
 };
@@ -43,6 +49,12 @@ inline LoggedMessages read_log(const std::string& path, const std::string& prefi
       ok = decode_into(*ev, out.axes);
     else if (ev->channel == prefix_and_id + ".RT")
       ok = decode_into(*ev, out.rt);
+    else if (ev->channel == prefix_and_id + ".BEAT")
+      ok = decode_into(*ev, out.beat);
+    else if (ev->channel == prefix_and_id + ".FAULT")
+      ok = decode_into(*ev, out.fault);
+    else if (ev->channel == prefix_and_id + ".ROW")
+      ok = decode_into(*ev, out.row);
     else
       out.other_channels.push_back(ev->channel);
     if (!ok) ++out.decode_errors;

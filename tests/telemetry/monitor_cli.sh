@@ -26,6 +26,8 @@ expect 2 "'a.b'" --loom-id a.b
 expect 2 "'LOOM..X'" --channel-prefix LOOM..X
 expect 2 "'nosuch://x'" --lcm-url nosuch://x
 expect 2 "stray" stray
+expect 2 "--channel 'beats'" --channel beats
+expect 2 "--status-every-s" --status-every-s -1
 "$MONITOR" --help >/dev/null || fail "--help did not exit 0"
 
 LOG="$WORK/run.lcmlog"
@@ -34,13 +36,21 @@ N=$(sed -n 's/.* status=\([0-9]*\).*/\1/p' <<<"$FEED_OUT")
 [ "${N:-0}" -gt 0 ] || fail "feed wrote no STATUS: $FEED_OUT"
 
 # Another loom's id sees nothing: exit 1 at the end of the log.
-expect 1 "no STATUS message" --lcm-url "file://$LOG?mode=r" --loom-id L2 --timeout-s 20
+expect 1 "no message" --lcm-url "file://$LOG?mode=r" --loom-id L2 --timeout-s 20
 # The log's own loom: exactly N lines, the first at row 0, the last at row 2; --count N exits 0.
-"$MONITOR" --lcm-url "file://$LOG?mode=r" --loom-id L1 --count "$N" --timeout-s 20 >"$WORK/lines" 2>"$WORK/err" ||
+"$MONITOR" --lcm-url "file://$LOG?mode=r" --loom-id L1 --channel status --count "$N" --timeout-s 20 >"$WORK/lines" 2>"$WORK/err" ||
   fail "reading the log with --count $N failed: $(cat "$WORK/err")"
 [ "$(grep -c '^loom=L1 ' "$WORK/lines")" -eq "$N" ] || fail "expected $N STATUS lines"
-head -1 "$WORK/lines" | grep -q " state=shed row=0 pick=0 beat=0 fault=none" || fail "first line: $(head -1 "$WORK/lines")"
-tail -1 "$WORK/lines" | grep -q " state=shed row=2 " || fail "last line: $(tail -1 "$WORK/lines")"
+head -1 "$WORK/lines" | grep -q " state=shed row=1 done=0 pick=0 beat=0 fault=none fault_code=0x0000$" ||
+  fail "first line: $(head -1 "$WORK/lines")"
+tail -1 "$WORK/lines" | grep -q " state=shed row=3 done=2 " || fail "last line: $(tail -1 "$WORK/lines")"
 # Asking for more than the log holds: exit 1, saying how many came.
-expect 1 "of $((N + 1)) STATUS" --lcm-url "file://$LOG?mode=r" --count $((N + 1)) --timeout-s 20
+expect 1 "of $((N + 1)) lines" --lcm-url "file://$LOG?mode=r" --channel status --count $((N + 1)) --timeout-s 20
+# The event view of the same log: one line per state change (the script's states) and compact status
+# lines at most once per second of loop time.
+"$MONITOR" --lcm-url "file://$LOG?mode=r" --loom-id L1 --timeout-s 20 >"$WORK/view" 2>"$WORK/err" ||
+  fail "event view of the log failed: $(cat "$WORK/err")"
+grep -q "^L1 t=0.000s state - -> shed, row 1$" "$WORK/view" || fail "event view: first line $(head -1 "$WORK/view")"
+n_changes=$(grep -c " state " "$WORK/view")
+[ "$n_changes" -eq 9 ] || fail "event view: $n_changes state changes, expected 9 (shed pick beat row_done x2, shed)"
 echo "PASS: loom-monitor CLI errors exit 2, empty runs exit 1, $N STATUS lines read from a log"

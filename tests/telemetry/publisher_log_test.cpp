@@ -101,11 +101,12 @@ TEST_F(PublisherLog, WeavingRunShowsEveryStatusChangeInOrder) {
   }
   std::vector<Key> got;
   for (const auto& m : log.status) {
-    got.emplace_back(m.state, m.row, m.pick, m.beat, m.first_fault, m.first_fault_code);
+    got.emplace_back(m.state, m.rows_done, m.pick, m.beat, m.first_fault, m.first_fault_code);
   }
   EXPECT_EQ(got, want);
   ASSERT_FALSE(log.status.empty());
-  EXPECT_EQ(log.status.back().row, 3);
+  EXPECT_EQ(log.status.back().rows_done, 3);
+  EXPECT_EQ(log.status.back().row, 4);  // the row the fault stopped
   EXPECT_EQ(log.status.back().state, "fault");
   EXPECT_EQ(log.status.back().first_fault, "estop");
 }

@@ -67,6 +67,7 @@ inline Snapshot script_snapshot(const WeaveScript& w, std::int64_t tick) {
     s.first_fault_code = 0x1001;
   }
   s.row = static_cast<std::uint32_t>(row);
+  s.row_in_progress = static_cast<std::uint32_t>(row + 1);
   s.pick = static_cast<std::uint32_t>(row + (in_row >= beat_start ? 1 : 0));
   s.beat = static_cast<std::uint32_t>(row * w.beats_per_row + beats_in_row);
   const double beat_progress =

@@ -30,7 +30,7 @@ class StatusCollector {
   static void on_status(const lcm::ReceiveBuffer*, const std::string&, const loomlcm::status_t* m,
                         StatusCollector* self) {
     std::lock_guard lock(self->mu_);
-    self->got_.emplace_back(m->state, m->row, m->pick, m->beat);
+    self->got_.emplace_back(m->state, m->rows_done, m->pick, m->beat);
   }
   static void on_axes(const lcm::ReceiveBuffer*, const std::string&, const loomlcm::axes_t* m,
                       StatusCollector* self) {

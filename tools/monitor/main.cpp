@@ -1,7 +1,11 @@
-// loom-monitor: a technician's terminal view of a loom's LCM telemetry — one line per STATUS message
-// (optionally AXES and RT), live, from lcm-logplayer, or straight from a log (file://…?mode=r). Exit 0
-// after --count messages (or, without --count, on Ctrl-C / end of log once something arrived), 1 when
-// the timeout or the log ends without them, 2 on bad arguments.
+// loom-monitor: a technician's terminal view of a loom's LCM telemetry, live, from lcm-logplayer, or
+// straight from a log (file://…?mode=r).
+//   default             one line per event (state change, beat, row done with its force summary,
+//                       fault with axis, hex codes and text) and a compact status at most once per
+//                       second of loop time
+//   --channel KIND,...  one key=value line per message of those channels (status axes rt beat fault row)
+// Exit 0 after --count lines (or, without --count, on Ctrl-C / end of log once something was printed),
+// 1 when the timeout or the log ends without them, 2 on bad arguments.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -10,7 +14,9 @@
 #include <cstdint>
 #include <cstdio>
 #include <lcm/lcm-cpp.hpp>
+#include <set>
 #include <string>
+#include <vector>
 
 #include "lines.hpp"
 #include "loom/telemetry/channels.hpp"
@@ -28,37 +34,60 @@ struct Options {
   std::string lcm_url;
   std::string loom_id;
   std::string channel_prefix = std::string(loom::telemetry::kDefaultChannelPrefix);
+  std::vector<std::string> channels;  // empty: the event view
   std::int64_t count = 0;
   double timeout_s = 0.0;
-  bool axes = false;
-  bool rt = false;
+  double status_every_s = 1.0;
+  bool no_beats = false;
 };
 
-// Prints each message as it is handled; counts STATUS, the only kind --count refers to.
 // Handlers are static functions with a context pointer (subscribeFunction) rather than member
 // functions: LCM 1.3.1's member-function subscribe() crashes when built with -fsanitize=undefined.
 class Printer {
+  using View = loom::monitor::EventView;
+
  public:
-  static void on_status(const lcm::ReceiveBuffer*, const std::string&, const loomlcm::status_t* m,
-                        Printer* self) {
-    print(loom::monitor::status_line(*m));
-    ++self->status_seen;
+  Printer(bool event_view, std::set<std::string> raw, double status_every_s, bool show_beats)
+      : event_view_(event_view), raw_(std::move(raw)), view_(status_every_s, show_beats) {}
+
+  template <typename Msg>
+  static void on(const lcm::ReceiveBuffer*, const std::string&, const Msg* m, Printer* self) {
+    self->handle(*m);
   }
-  static void on_axes(const lcm::ReceiveBuffer*, const std::string&, const loomlcm::axes_t* m, Printer*) {
-    print(loom::monitor::axes_line(*m));
-  }
-  static void on_rt(const lcm::ReceiveBuffer*, const std::string&, const loomlcm::rt_stats_t* m, Printer*) {
-    print(loom::monitor::rt_line(*m));
-  }
-  std::int64_t status_seen = 0;
+  std::int64_t printed = 0;
 
  private:
+  void handle(const loomlcm::status_t& m) { dispatch("status", m, &loom::monitor::status_line, &View::on_status); }
+  void handle(const loomlcm::axes_t& m) {
+    dispatch("axes", m, &loom::monitor::axes_line, static_cast<std::vector<std::string> (View::*)(const loomlcm::axes_t&)>(nullptr));
+  }
+  void handle(const loomlcm::rt_stats_t& m) { dispatch("rt", m, &loom::monitor::rt_line, &View::on_rt); }
+  void handle(const loomlcm::beat_t& m) { dispatch("beat", m, &loom::monitor::beat_line, &View::on_beat); }
+  void handle(const loomlcm::fault_t& m) { dispatch("fault", m, &loom::monitor::fault_line, &View::on_fault); }
+  void handle(const loomlcm::row_t& m) { dispatch("row", m, &loom::monitor::row_line, &View::on_row); }
+
+  template <typename Msg>
+  void dispatch(const char* kind, const Msg& m, std::string (*raw_line)(const Msg&),
+                std::vector<std::string> (View::*view_lines)(const Msg&)) {
+    if (event_view_) {
+      if (view_lines != nullptr) {
+        for (const auto& line : (view_.*view_lines)(m)) print(line);
+      }
+    } else if (raw_.count(kind) != 0) {
+      print(raw_line(m));
+    }
+  }
   // Flushed per line so `loom-monitor | grep` and scripts see each message as it arrives.
-  static void print(const std::string& line) {
+  void print(const std::string& line) {
     std::fputs(line.c_str(), stdout);
     std::fputc('\n', stdout);
     std::fflush(stdout);
+    ++printed;
   }
+
+  bool event_view_;
+  std::set<std::string> raw_;
+  View view_;
 };
 
 int usage_error(const std::string& msg) {
@@ -66,23 +95,36 @@ int usage_error(const std::string& msg) {
   return 2;
 }
 
+std::string upper(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   Options o;
-  CLI::App app{"Print a loom's LCM telemetry: one line per STATUS message, optionally AXES and RT."};
+  CLI::App app{
+      "Print a loom's LCM telemetry: by default one line per event (state change, beat, row done, fault) and a "
+      "compact status once per second; with --channel one key=value line per message."};
   app.add_option("--lcm-url", o.lcm_url,
-                 "LCM URL, e.g. udpm://239.255.76.67:7667?ttl=0 (default: $LCM_DEFAULT_URL or LCM's "
-                 "own default)");
+                 "LCM URL, e.g. udpm://239.255.76.67:7667?ttl=0 or file:///x.lcmlog?mode=r (default: "
+                 "$LCM_DEFAULT_URL or LCM's own default)");
   app.add_option("--loom-id", o.loom_id, "Only this loom (default: every loom on the URL)");
-  app.add_option("--count", o.count, "Exit 0 after this many STATUS messages (0: no limit)");
+  app.add_option("--channel", o.channels,
+                 "Print every message of these channels as key=value lines: status, axes, rt, beat, fault, row "
+                 "(repeat or comma-separate)")
+      ->delimiter(',');
+  app.add_option("--count", o.count, "Exit 0 after printing this many lines (0: no limit)");
   app.add_option("--timeout-s", o.timeout_s,
                  "Give up after this many seconds, exit 1 if --count was not reached or nothing "
-                 "arrived (0: wait forever)");
+                 "was printed (0: wait forever)");
+  app.add_option("--status-every-s", o.status_every_s,
+                 "Event view: a compact status line at most this often, in seconds of loop time")
+      ->capture_default_str();
+  app.add_flag("--no-beats", o.no_beats, "Event view: leave out the per-beat lines");
   app.add_option("--channel-prefix", o.channel_prefix, "First field of the channel names")
       ->capture_default_str();
-  app.add_flag("--axes", o.axes, "Also print AXES messages");
-  app.add_flag("--rt", o.rt, "Also print RT (loop health) messages");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -94,34 +136,49 @@ int main(int argc, char** argv) {
     return usage_error("--timeout-s " + std::to_string(o.timeout_s) +
                        " must be a number of seconds in [0, 1e7]");
   }
+  if (!std::isfinite(o.status_every_s) || o.status_every_s < 0.0 || o.status_every_s > kMaxTimeoutS) {
+    return usage_error("--status-every-s " + std::to_string(o.status_every_s) + " must be a number of seconds >= 0");
+  }
   if (!o.loom_id.empty()) {
     if (auto e = loom::telemetry::loom_id_error(o.loom_id); !e.empty()) return usage_error("--loom-id: " + e);
   }
   if (auto e = loom::telemetry::channel_prefix_error(o.channel_prefix); !e.empty()) {
     return usage_error("--channel-prefix: " + e);
   }
+  std::set<std::string> raw;
+  for (const auto& c : o.channels) {
+    static const std::set<std::string> kKnown = {"status", "axes", "rt", "beat", "fault", "row"};
+    if (kKnown.count(c) == 0) {
+      return usage_error("--channel '" + c + "' is not one of status, axes, rt, beat, fault, row");
+    }
+    raw.insert(c);
+  }
+  const bool event_view = raw.empty();
 
   lcm::LCM lcm(o.lcm_url);
   if (!lcm.good()) {
     return usage_error("--lcm-url '" + o.lcm_url + "' could not be opened by LCM");
   }
 
-  Printer printer;
-  const std::string status_re = loom::telemetry::channel_regex(o.channel_prefix, o.loom_id, "STATUS");
+  Printer printer(event_view, raw, o.status_every_s, !o.no_beats);
   // LCM keeps 30 unhandled messages per subscription by default; a log replayed fast or a burst of
   // row-end changes can exceed that, so allow a generous queue.
   constexpr int kQueue = 10000;
-  lcm.subscribeFunction(status_re, &Printer::on_status, &printer)->setQueueCapacity(kQueue);
-  if (o.axes) {
-    lcm.subscribeFunction(loom::telemetry::channel_regex(o.channel_prefix, o.loom_id, "AXES"),
-                          &Printer::on_axes, &printer)
-        ->setQueueCapacity(kQueue);
-  }
-  if (o.rt) {
-    lcm.subscribeFunction(loom::telemetry::channel_regex(o.channel_prefix, o.loom_id, "RT"), &Printer::on_rt,
-                          &printer)
-        ->setQueueCapacity(kQueue);
-  }
+  const auto re = [&](const char* kind) { return loom::telemetry::channel_regex(o.channel_prefix, o.loom_id, kind); };
+  const auto wanted = [&](const char* kind, bool in_view) {
+    return event_view ? in_view : raw.count(kind) != 0;
+  };
+  std::string listening;
+  const auto sub = [&](const char* kind, auto handler) {
+    lcm.subscribeFunction(re(upper(kind).c_str()), handler, &printer)->setQueueCapacity(kQueue);
+    listening += (listening.empty() ? "" : " ") + re(upper(kind).c_str());
+  };
+  if (wanted("status", true)) sub("status", &Printer::on<loomlcm::status_t>);
+  if (wanted("axes", false)) sub("axes", &Printer::on<loomlcm::axes_t>);
+  if (wanted("rt", true)) sub("rt", &Printer::on<loomlcm::rt_stats_t>);
+  if (wanted("beat", !o.no_beats)) sub("beat", &Printer::on<loomlcm::beat_t>);
+  if (wanted("fault", true)) sub("fault", &Printer::on<loomlcm::fault_t>);
+  if (wanted("row", true)) sub("row", &Printer::on<loomlcm::row_t>);
 
   struct sigaction sa {};
   sa.sa_handler = on_signal;
@@ -131,7 +188,7 @@ int main(int argc, char** argv) {
 
   // Scripts wait for this line before they start publishing or replaying.
   std::fprintf(stderr, "loom-monitor: listening on %s for %s\n",
-               o.lcm_url.empty() ? "LCM's default URL" : o.lcm_url.c_str(), status_re.c_str());
+               o.lcm_url.empty() ? "LCM's default URL" : o.lcm_url.c_str(), listening.c_str());
 
   using Clock = std::chrono::steady_clock;
   const auto deadline =
@@ -141,7 +198,7 @@ int main(int argc, char** argv) {
   const bool reading_log = o.lcm_url.rfind("file://", 0) == 0;
   const char* why = "interrupted";
   while (true) {
-    if (o.count > 0 && printer.status_seen >= o.count) return 0;
+    if (o.count > 0 && printer.printed >= o.count) return 0;
     if (g_interrupted) break;
     int slice_ms = kSliceMs;
     if (o.timeout_s > 0.0) {
@@ -164,13 +221,12 @@ int main(int argc, char** argv) {
   }
 
   if (o.count > 0) {
-    std::fprintf(stderr, "loom-monitor: %s with %lld of %lld STATUS messages on %s\n", why,
-                 static_cast<long long>(printer.status_seen), static_cast<long long>(o.count),
-                 status_re.c_str());
+    std::fprintf(stderr, "loom-monitor: %s with %lld of %lld lines on %s\n", why,
+                 static_cast<long long>(printer.printed), static_cast<long long>(o.count), listening.c_str());
     return 1;
   }
-  if (printer.status_seen == 0) {
-    std::fprintf(stderr, "loom-monitor: %s with no STATUS message on %s\n", why, status_re.c_str());
+  if (printer.printed == 0) {
+    std::fprintf(stderr, "loom-monitor: %s with no message on %s\n", why, listening.c_str());
     return 1;
   }
   return 0;

@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   if (out.empty()) out = ".";
   nlohmann::json j;
   try {
+    std::filesystem::create_directories(out);
     std::ifstream f(summary);
     j = nlohmann::json::parse(f);
     loom::report::write_plots(j, out);

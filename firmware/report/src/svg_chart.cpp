@@ -90,21 +90,34 @@ std::string render_svg(const Chart& c) {
       xlo = std::min(xlo, x), xhi = std::max(xhi, x), ylo = std::min(ylo, y), yhi = std::max(yhi, y);
     }
   }
-  for (const auto& b : c.bands) ylo = std::min(ylo, b.y0), yhi = std::max(yhi, b.y1);
-  if (xlo > xhi) xlo = 0, xhi = 1, ylo = 0, yhi = 1;
+  const bool have_points = xlo <= xhi;
+  if (!c.zoom_to_data || !have_points) {
+    for (const auto& b : c.bands) ylo = std::min(ylo, b.y0), yhi = std::max(yhi, b.y1);
+  }
+  if (xlo > xhi) xlo = 0, xhi = 1;
+  if (ylo > yhi) ylo = 0, yhi = 1;
   Frame f;
   f.w = c.width_px;
   f.h = c.height_px;
   f.x = padded(xlo, xhi);
-  f.y = padded(std::min(0.0, ylo), yhi);
+  if (c.zoom_to_data && have_points) {
+    const double mid = 0.5 * (ylo + yhi);
+    const double half = 0.5 * std::max(c.min_y_span, (yhi - ylo) * 1.2);
+    f.y = padded(mid - half, mid + half);
+  } else {
+    f.y = padded(std::min(0.0, ylo), yhi);
+  }
   std::ostringstream os;
   os << "<svg xmlns='http://www.w3.org/2000/svg' width='" << f.w << "' height='" << f.h
      << "' font-family='sans-serif'>\n<rect width='100%' height='100%' fill='white'/>\n";
   os << "<text x='" << f.w / 2 << "' y='22' font-size='14' text-anchor='middle'>" << esc(c.title) << "</text>\n";
   for (const auto& b : c.bands) {
-    os << "<rect x='" << f.left << "' y='" << f.py(b.y1) << "' width='" << f.w - f.left - f.right << "' height='"
-       << f.py(b.y0) - f.py(b.y1) << "' fill='#2ca02c' fill-opacity='0.12'/><text x='" << f.w - f.right - 4
-       << "' y='" << f.py(b.y1) + 13 << "' font-size='11' text-anchor='end' fill='#2ca02c'>" << esc(b.label)
+    // Clipped to the frame: with the axis zoomed to the data the band may cover all of it.
+    const double y0 = std::max(b.y0, f.y.lo), y1 = std::min(b.y1, f.y.hi);
+    if (y1 <= y0) continue;
+    os << "<rect x='" << f.left << "' y='" << f.py(y1) << "' width='" << f.w - f.left - f.right << "' height='"
+       << f.py(y0) - f.py(y1) << "' fill='#2ca02c' fill-opacity='0.12'/><text x='" << f.w - f.right - 4
+       << "' y='" << f.py(y1) + 13 << "' font-size='11' text-anchor='end' fill='#2ca02c'>" << esc(b.label)
        << "</text>\n";
   }
   axes(os, f, c.x_label, c.y_label, true);
@@ -130,6 +143,7 @@ std::string render_svg(const Chart& c) {
 std::string render_svg(const Timeline& t) {
   double thi = 0.0, tlo = 1e300;
   for (const auto& b : t.bars) thi = std::max(thi, b.t1), tlo = std::min(tlo, b.t0);
+  for (const auto& m : t.markers) thi = std::max(thi, m.t), tlo = std::min(tlo, m.t);
   if (tlo > thi) tlo = 0, thi = 1;
   Frame f;
   f.left = 90;
@@ -148,11 +162,27 @@ std::string render_svg(const Timeline& t) {
        << esc(t.lanes[i]) << "</text>\n";
   }
   for (const auto& b : t.bars) {
-    const auto it = std::find(t.lanes.begin(), t.lanes.end(), b.lane);
-    if (it == t.lanes.end()) continue;
-    const double yc = f.y.hi - static_cast<double>(it - t.lanes.begin()) - 0.5;
-    os << "<rect x='" << f.px(b.t0) << "' y='" << f.py(yc + 0.35) << "' width='" << std::max(1.0, f.px(b.t1) - f.px(b.t0))
-       << "' height='" << f.py(yc - 0.35) - f.py(yc + 0.35) << "' fill='" << b.colour << "'/>\n";
+    double top = f.y.hi - 0.1, bottom = f.y.lo + 0.1;  // "" lane: across every lane
+    if (!b.lane.empty()) {
+      const auto it = std::find(t.lanes.begin(), t.lanes.end(), b.lane);
+      if (it == t.lanes.end()) continue;
+      const double yc = f.y.hi - static_cast<double>(it - t.lanes.begin()) - 0.5;
+      top = yc + 0.35, bottom = yc - 0.35;
+    }
+    const double w = std::max(1.0, f.px(b.t1) - f.px(b.t0));
+    os << "<rect x='" << f.px(b.t0) << "' y='" << f.py(top) << "' width='" << w << "' height='" << f.py(bottom) - f.py(top)
+       << (b.outline ? "' fill='none' stroke-dasharray='5,3' stroke-width='1.5' stroke='" : "' fill='") << b.colour
+       << "'/>\n";
+    // An outlined bar (a row that did not finish) is always labelled: that is the point of drawing it.
+    if (!b.label.empty() && (b.outline || w >= 7.0 * static_cast<double>(b.label.size()) * 0.8)) {
+      os << "<text x='" << f.px(b.t0) + w / 2 << "' y='" << f.py(top) - 3 << "' font-size='10' text-anchor='middle' fill='"
+         << b.colour << "'>" << esc(b.label) << "</text>\n";
+    }
+  }
+  for (const auto& m : t.markers) {
+    os << "<line x1='" << f.px(m.t) << "' x2='" << f.px(m.t) << "' y1='" << f.top << "' y2='" << f.h - f.bottom
+       << "' stroke='" << m.colour << "' stroke-width='2'/><text x='" << f.px(m.t) - 4 << "' y='" << f.top + 12
+       << "' font-size='11' text-anchor='end' fill='" << m.colour << "'>" << esc(m.label) << "</text>\n";
   }
   os << "</svg>\n";
   return os.str();

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "loom/hal/types.hpp"
+#include "loom/sequencer/faults.hpp"
 
 namespace loom::telemetry {
 
@@ -22,11 +23,37 @@ std::int64_t to_i64(std::uint64_t v) noexcept {
       std::min<std::uint64_t>(v, static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())));
 }
 
+double seconds(hal::Tick ticks, std::int64_t period_ns) noexcept {
+  return static_cast<double>(ticks) * static_cast<double>(period_ns) * 1e-9;
+}
+
+std::string axis_or_empty(int axis) {
+  return axis >= 0 && axis < static_cast<int>(hal::kAxisCount) ? hal::axis_name(static_cast<hal::Axis>(axis))
+                                                                : std::string();
+}
+
+// The operator text of a fault named in a snapshot (the snapshot carries the name, not the enum).
+std::string fault_text_of(const std::string& name) {
+#define LOOM_FAULT_TEXT(id, code, fname, text) \
+  if (name == fname) return text;
+  LOOM_FAULT_TABLE(LOOM_FAULT_TEXT)
+#undef LOOM_FAULT_TEXT
+  return {};
+}
+
 }  // namespace
 
 double loop_time_s(const Snapshot& s) noexcept {
-  return static_cast<double>(s.tick) * static_cast<double>(s.period_ns) * 1e-9;
+  return seconds(s.tick, s.period_ns);
 }
+
+namespace {
+// A fault value from the ring (the sequencer's enum, carried as a byte); the table's lookups answer
+// "?" for a value outside it.
+sequencer::Fault fault_of(std::uint8_t v) noexcept {
+  return static_cast<sequencer::Fault>(v);
+}
+}  // namespace
 
 loomlcm::status_t to_status(const Snapshot& s, const std::string& loom_id, std::int64_t utime) {
   loomlcm::status_t m;
@@ -36,11 +63,20 @@ loomlcm::status_t to_status(const Snapshot& s, const std::string& loom_id, std::
   m.time_s = loop_time_s(s);
   m.period_ns = s.period_ns;
   m.state = from_cstr(s.state);
-  m.row = s.row;
+  m.row = s.row_in_progress;
+  m.rows_done = s.row;
+  m.rows_target = s.rows_target;
   m.pick = s.pick;
   m.beat = s.beat;
+  m.beats_per_row = s.beats_per_row;
   m.first_fault = from_cstr(s.first_fault);
   m.first_fault_code = s.first_fault_code;
+  const bool faulted = !m.first_fault.empty();
+  m.fault_axis = faulted ? axis_or_empty(s.fault_axis) : std::string();
+  m.fault_device_code = faulted ? s.fault_device_code : 0;
+  m.fault_text = faulted ? fault_text_of(m.first_fault) : std::string();
+  m.fault_time_s = faulted && s.fault_tick >= 0 ? seconds(s.fault_tick, s.period_ns) : 0.0;
+  m.stopped_by = from_cstr(s.stopped_by);
   m.outputs = s.outputs;
   m.inputs = s.inputs;
   return m;
@@ -54,7 +90,8 @@ loomlcm::axes_t to_axes(const Snapshot& s, const std::string& loom_id, std::int6
   m.time_s = loop_time_s(s);
   m.crank_phase_rad = s.crank_phase_rad;
   m.beater_angle_rad = s.beater_angle_rad;
-  m.beat_force_n = s.beat_force_n;
+  m.beat_force_n = s.beat_force_valid ? s.beat_force_n : 0.0;
+  m.beat_force_valid = s.beat_force_valid;
   m.num_axes = static_cast<std::int8_t>(s.axes.size());
   m.axes.resize(s.axes.size());
   for (std::size_t i = 0; i < s.axes.size(); ++i) {
@@ -65,6 +102,8 @@ loomlcm::axes_t to_axes(const Snapshot& s, const std::string& loom_id, std::int6
     o.velocity = a.velocity;
     o.target = a.target;
     o.following_error = a.following_error;
+    o.following_error_limit = a.following_error_limit;
+    o.fault_code = a.fault_code;
     o.effort = a.effort;
     o.drive_state = hal::drive_state_name(static_cast<hal::DriveState>(a.drive_state));
     o.drive_state_code = static_cast<std::int8_t>(a.drive_state);
@@ -74,7 +113,7 @@ loomlcm::axes_t to_axes(const Snapshot& s, const std::string& loom_id, std::int6
 }
 
 loomlcm::rt_stats_t to_rt_stats(const Snapshot& s, const std::string& loom_id, std::int64_t utime,
-                                std::uint64_t dropped, std::uint64_t backlog) {
+                                std::uint64_t dropped, std::uint64_t backlog, std::uint64_t dropped_events) {
   loomlcm::rt_stats_t m;
   m.utime = utime;
   m.loom_id = loom_id;
@@ -84,8 +123,85 @@ loomlcm::rt_stats_t to_rt_stats(const Snapshot& s, const std::string& loom_id, s
   m.overruns = s.overruns;
   m.tick_cost_ns = s.tick_cost_ns;
   m.max_tick_cost_ns = s.max_tick_cost_ns;
+  m.wake_latency_p50_ns = s.wake_latency_p50_ns;
+  m.wake_latency_p99_ns = s.wake_latency_p99_ns;
+  m.wake_latency_max_ns = s.wake_latency_max_ns;
   m.dropped_snapshots = to_i64(dropped);
+  m.dropped_events = to_i64(dropped_events);
   m.backlog = to_i64(backlog);
+  m.can_tx_dropped = s.can_tx_dropped;
+  m.can_rx_errors = s.can_rx_errors;
+  return m;
+}
+
+const char* fault_kind_name(Event::FaultKind k) noexcept {
+  switch (k) {
+    case Event::FaultKind::kFirst: return "first";
+    case Event::FaultKind::kDiagnosis: return "diagnosis";
+    case Event::FaultKind::kDevice: return "device";
+  }
+  return "unknown";
+}
+
+loomlcm::beat_t to_beat(const Event& e, const std::string& loom_id, std::int64_t utime) {
+  loomlcm::beat_t m;
+  m.utime = utime;
+  m.loom_id = loom_id;
+  m.tick = e.tick;
+  m.time_s = seconds(e.tick, e.period_ns);
+  m.row = static_cast<std::int32_t>(e.row);
+  m.index = static_cast<std::int16_t>(e.beat_index);
+  m.beats_per_row = static_cast<std::int16_t>(e.beats_per_row);
+  m.x_m = e.x_m;
+  m.peak_force_n = e.force_measured ? e.peak_force_n : 0.0;
+  m.force_measured = e.force_measured;
+  m.in_band = e.in_band;
+  m.band_min_n = e.band_min_n;
+  m.band_max_n = e.band_max_n;
+  return m;
+}
+
+loomlcm::fault_t to_fault(const Event& e, const std::string& loom_id, std::int64_t utime) {
+  loomlcm::fault_t m;
+  m.utime = utime;
+  m.loom_id = loom_id;
+  m.tick = e.tick;
+  m.time_s = seconds(e.tick, e.period_ns);
+  m.kind = fault_kind_name(e.fault_kind);
+  const sequencer::Fault f = fault_of(e.fault);
+  m.name = sequencer::fault_name(f);
+  m.code = sequencer::fault_code(f);
+  m.text = sequencer::fault_text(f);
+  m.axis = axis_or_empty(e.axis);
+  m.device_code = e.device_code;
+  m.state = from_cstr(e.state);
+  m.row = static_cast<std::int32_t>(e.row);
+  m.rows_done = e.rows_done;
+  m.pick = e.pick;
+  m.beat = e.beat;
+  return m;
+}
+
+loomlcm::row_t to_row(const Event& e, const std::string& loom_id, std::int64_t utime) {
+  loomlcm::row_t m;
+  m.utime = utime;
+  m.loom_id = loom_id;
+  m.tick = e.tick;
+  m.time_s = seconds(e.tick, e.period_ns);
+  m.row = static_cast<std::int32_t>(e.row);
+  m.row_s = seconds(e.row_ticks, e.period_ns);
+  m.shed_s = seconds(e.shed_ticks, e.period_ns);
+  m.pick_s = seconds(e.pick_ticks, e.period_ns);
+  m.beat_s = seconds(e.beat_ticks, e.period_ns);
+  m.beats = static_cast<std::int16_t>(e.beats);
+  m.carriage_steps = static_cast<std::int16_t>(e.carriage_steps);
+  m.force_measured = e.force_measured;
+  m.force_min_n = e.force_measured ? e.force_min_n : 0.0;
+  m.force_mean_n = e.force_measured ? e.force_mean_n : 0.0;
+  m.force_max_n = e.force_measured ? e.force_max_n : 0.0;
+  m.beats_in_band = static_cast<std::int16_t>(e.beats_in_band);
+  m.band_min_n = e.band_min_n;
+  m.band_max_n = e.band_max_n;
   return m;
 }
 

@@ -40,8 +40,9 @@ PublisherConfig validated(const PublisherConfig& cfg) {
 
 }  // namespace
 
-Publisher::Publisher(const PublisherConfig& cfg, SnapshotRing& ring)
+Publisher::Publisher(const PublisherConfig& cfg, SnapshotRing& ring, EventRing& events)
     : ring_(ring),
+      events_(events),
       cfg_(validated(cfg)),
       channels_(channel_names(cfg_.channel_prefix, cfg_.loom_id)),
       schedule_(cfg_.decimation),
@@ -81,6 +82,10 @@ PublisherStats Publisher::stats() const noexcept {
   s.status = n_status_.load(std::memory_order_relaxed);
   s.axes = n_axes_.load(std::memory_order_relaxed);
   s.rt = n_rt_.load(std::memory_order_relaxed);
+  s.beat = n_beat_.load(std::memory_order_relaxed);
+  s.fault = n_fault_.load(std::memory_order_relaxed);
+  s.row = n_row_.load(std::memory_order_relaxed);
+  s.events = s.beat + s.fault + s.row;
   s.publish_errors = n_errors_.load(std::memory_order_relaxed);
   return s;
 }
@@ -95,6 +100,8 @@ void Publisher::run() {
     if (n == 0) break;
     left -= std::min(n, left);
   }
+  // Every event queued so far goes out, even one whose tick's snapshot was dropped.
+  publish_events_up_to(hal::kNeverTick);
 }
 
 void Publisher::drain_once_or_nap() {
@@ -103,7 +110,12 @@ void Publisher::drain_once_or_nap() {
 
 std::size_t Publisher::drain_batch() {
   const std::size_t n = ring_.try_pop_many(std::span<Snapshot>(batch_));
-  for (std::size_t i = 0; i < n; ++i) publish(batch_[i]);
+  for (std::size_t i = 0; i < n; ++i) {
+    // Events of a tick are pushed before that tick's snapshot, so everything up to and including
+    // this snapshot's tick is already in the event ring.
+    publish_events_up_to(batch_[i].tick + 1);
+    publish(batch_[i]);
+  }
   n_snapshots_.fetch_add(n, std::memory_order_relaxed);
   return n;
 }
@@ -117,6 +129,37 @@ void Publisher::pace() {
   } else {
     // Idle time is not saved up as credit for a later burst.
     next_publish_ = now + publish_gap_;
+  }
+}
+
+void Publisher::publish_events_up_to(hal::Tick tick) {
+  for (;;) {
+    if (!have_pending_) have_pending_ = events_.try_pop(pending_);
+    if (!have_pending_) return;
+    if (tick != hal::kNeverTick && pending_.tick >= tick) return;
+    publish_event(pending_);
+    have_pending_ = false;
+  }
+}
+
+void Publisher::publish_event(const Event& e) {
+  const std::int64_t utime = wall_utime();
+  const auto send = [this](const std::string& channel, const auto& msg, std::atomic<std::uint64_t>& counter) {
+    pace();
+    if (lcm_->publish(channel, &msg) == 0) {
+      counter.fetch_add(1, std::memory_order_relaxed);
+    } else {
+      n_errors_.fetch_add(1, std::memory_order_relaxed);
+    }
+  };
+  try {
+    switch (e.kind) {
+      case Event::Kind::kBeat: send(channels_.beat, to_beat(e, cfg_.loom_id, utime), n_beat_); break;
+      case Event::Kind::kFault: send(channels_.fault, to_fault(e, cfg_.loom_id, utime), n_fault_); break;
+      case Event::Kind::kRow: send(channels_.row, to_row(e, cfg_.loom_id, utime), n_row_); break;
+    }
+  } catch (const std::exception&) {
+    n_errors_.fetch_add(1, std::memory_order_relaxed);
   }
 }
 
@@ -136,7 +179,7 @@ void Publisher::publish(const Snapshot& s) {
     if (due.status) send(channels_.status, to_status(s, cfg_.loom_id, utime), n_status_);
     if (due.axes) send(channels_.axes, to_axes(s, cfg_.loom_id, utime), n_axes_);
     if (due.rt) {
-      send(channels_.rt, to_rt_stats(s, cfg_.loom_id, utime, ring_.dropped(), ring_.size_approx()), n_rt_);
+      send(channels_.rt, to_rt_stats(s, cfg_.loom_id, utime, ring_.dropped(), ring_.size_approx(), events_.dropped()), n_rt_);
     }
   } catch (const std::exception&) {
     // Out of memory while encoding: lose this message, keep the thread (and the loop) alive.

@@ -1,9 +1,10 @@
 // One control cycle, no loop inside, steps in a fixed order (LinuxCNC's motion controller pattern):
 //   read inputs → sequencer (checks faults, advances the row cycle, samples profiles, interlocks)
-//   → write outputs → push a POD telemetry snapshot.
+//   → write outputs → push the tick's events (BEAT, ROW, FAULT; never decimated) → push a POD snapshot.
 // Everything the cycle touches is allocated before the first tick.
 #pragma once
 
+#include <array>
 #include <cstdint>
 
 #include "loom/hal/hal.hpp"
@@ -20,6 +21,19 @@ struct LoopStats {
   std::uint32_t overruns = 0;
   std::int64_t last_tick_cost_ns = 0;
   std::int64_t max_tick_cost_ns = 0;
+  // Wake-up latency (actual wake − deadline), filled by a runner that measures it; 0 = not measured.
+  std::int64_t wake_latency_p50_ns = 0;
+  std::int64_t wake_latency_p99_ns = 0;
+  std::int64_t wake_latency_max_ns = 0;
+};
+
+// What telemetry reports about the loom beyond what the sequencer knows per tick: set once at
+// configure time (defaults: the thesis' 80–100 N band, no following-error limit checked here).
+struct TelemetryContext {
+  double beat_force_min_n = 80.0;
+  double beat_force_max_n = 100.0;
+  std::uint32_t rows_target = 0;  // 0 = until stopped / unknown
+  std::array<double, hal::kAxisCount> following_error_limit{};  // SI per axis; 0 = not checked
 };
 
 class ControlLoop {
@@ -28,6 +42,9 @@ class ControlLoop {
   // waits for ring space instead of dropping: only for virtual time, where nothing is real-time.
   ControlLoop(hal::Hal& hal, sequencer::Sequencer& seq, telemetry::Telemetry* telemetry, double period_s,
               bool lossless_telemetry);
+
+  // Configure-time only.
+  void set_telemetry_context(const TelemetryContext& c) noexcept { ctx_ = c; }
 
   // RT-safe (unless lossless_telemetry). One tick.
   void cycle(hal::Tick now) noexcept;
@@ -39,6 +56,10 @@ class ControlLoop {
 
  private:
   void fill_snapshot(hal::Tick now) noexcept;
+  void push_events(hal::Tick now) noexcept;
+  void push_event(const telemetry::Event& e) noexcept;
+  void fill_event_context(telemetry::Event& e, hal::Tick now) const noexcept;
+  std::uint32_t row_in_progress() const noexcept;
 
   hal::Hal& hal_;
   sequencer::Sequencer& seq_;
@@ -49,6 +70,18 @@ class ControlLoop {
   hal::HalOutputs out_{};
   telemetry::Snapshot snap_{};
   LoopStats stats_{};
+  TelemetryContext ctx_{};
+  // What the previous tick showed, so each event is pushed exactly once.
+  std::uint32_t beat_events_seen_ = 0;
+  std::uint32_t rows_seen_ = 0;
+  bool primed_ = false;
+  sequencer::State prev_state_ = sequencer::State::kIdle;
+  sequencer::Fault prev_fault_ = sequencer::Fault::kNone;
+  int prev_fault_axis_ = -1;
+  std::uint16_t prev_fault_detail_ = 0;
+  std::array<std::uint16_t, hal::kAxisCount> prev_axis_fault_code_{};
+  std::array<bool, hal::kAxisCount> prev_axis_fault_{};
+  bool prev_link_fault_ = false;
 };
 
 }  // namespace loom::firmware

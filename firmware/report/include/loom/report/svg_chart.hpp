@@ -26,20 +26,33 @@ struct Chart {
   std::vector<Series> series;
   std::vector<Band> bands;
   double width_px = 760, height_px = 420;
+  // true: the y axis spans the data (at least `min_y_span`), bands are clipped to it, so a 0.4 N
+  // spread is visible; false: the axis starts at 0 and includes every band.
+  bool zoom_to_data = false;
+  double min_y_span = 1.0;
 };
 
 std::string render_svg(const Chart& chart);
 
 struct TimelineBar {
-  std::string lane;  // row label, e.g. "shed"
+  std::string lane;  // lane label, e.g. "shed"; "" spans every lane (e.g. an incomplete row)
   double t0 = 0.0, t1 = 0.0;
   std::string colour = "#1f77b4";
+  bool outline = false;  // drawn as a dashed outline (something that did not finish)
+  std::string label;     // written above the bar when there is room
+};
+
+struct TimelineMarker {  // a vertical line across every lane, e.g. a fault
+  double t = 0.0;
+  std::string label;
+  std::string colour = "#d62728";
 };
 
 struct Timeline {
   std::string title, x_label = "time (s)";
   std::vector<std::string> lanes;  // top to bottom
   std::vector<TimelineBar> bars;
+  std::vector<TimelineMarker> markers;
   double width_px = 760, height_px = 260;
 };
 

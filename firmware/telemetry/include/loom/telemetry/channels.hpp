@@ -1,4 +1,5 @@
-// LCM channel names for one loom: <prefix>.<loom id>.STATUS / .AXES / .RT. The loom id is in the name
+// LCM channel names for one loom: <prefix>.<loom id>.STATUS / .AXES / .RT (samples, decimated) and
+// .BEAT / .FAULT / .ROW (events, each sent once). The loom id is in the name
 // so a hall of looms can share one multicast group and a technician can subscribe to one loom or all.
 #pragma once
 
@@ -22,12 +23,18 @@ struct ChannelNames {
   std::string status;
   std::string axes;
   std::string rt;
+  std::string beat;   // events, never decimated
+  std::string fault;
+  std::string row;
 };
+
+// Every channel kind, in the order a reader lists them.
+inline constexpr std::string_view kChannelKinds[] = {"STATUS", "AXES", "RT", "BEAT", "FAULT", "ROW"};
 
 // Configure-time only (allocates). Assumes both parts passed the checks above.
 ChannelNames channel_names(std::string_view prefix, std::string_view loom_id);
 
-// Configure-time only. An LCM subscription regex for one channel kind ("STATUS", "AXES", "RT"):
+// Configure-time only. An LCM subscription regex for one channel kind ("STATUS", "AXES", …):
 // that loom's channel when `loom_id` is non-empty, else the same channel of every loom.
 std::string channel_regex(std::string_view prefix, std::string_view loom_id, std::string_view kind);
 

@@ -7,6 +7,9 @@
 
 #include "loom/telemetry/snapshot.hpp"
 #include "loomlcm/axes_t.hpp"
+#include "loomlcm/beat_t.hpp"
+#include "loomlcm/fault_t.hpp"
+#include "loomlcm/row_t.hpp"
 #include "loomlcm/rt_stats_t.hpp"
 #include "loomlcm/status_t.hpp"
 
@@ -20,6 +23,13 @@ loomlcm::status_t to_status(const Snapshot& s, const std::string& loom_id, std::
 loomlcm::axes_t to_axes(const Snapshot& s, const std::string& loom_id, std::int64_t utime);
 // `dropped` and `backlog` come from the ring, which knows about snapshots the loop never got to send.
 loomlcm::rt_stats_t to_rt_stats(const Snapshot& s, const std::string& loom_id, std::int64_t utime,
-                                std::uint64_t dropped, std::uint64_t backlog);
+                                std::uint64_t dropped, std::uint64_t backlog, std::uint64_t dropped_events = 0);
+
+// Not RT-safe (allocates strings): publisher thread only. One message per event of that kind.
+loomlcm::beat_t to_beat(const Event& e, const std::string& loom_id, std::int64_t utime);
+loomlcm::fault_t to_fault(const Event& e, const std::string& loom_id, std::int64_t utime);
+loomlcm::row_t to_row(const Event& e, const std::string& loom_id, std::int64_t utime);
+// The FAULT message's kind field for an event's fault kind: "first", "diagnosis", "device".
+const char* fault_kind_name(Event::FaultKind k) noexcept;
 
 }  // namespace loom::telemetry

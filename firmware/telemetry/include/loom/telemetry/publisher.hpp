@@ -26,6 +26,9 @@ namespace loom::telemetry {
 // 4096 snapshots: 8 s of buffer at the 2 ms CAN cycle, about 1.3 MB.
 inline constexpr std::size_t kSnapshotRingCapacity = 4096;
 using SnapshotRing = SpscRing<Snapshot, kSnapshotRingCapacity>;
+// 1024 events: a beat every 0.4 s at the default loom is minutes of slack for a stalled publisher.
+inline constexpr std::size_t kEventRingCapacity = 1024;
+using EventRing = SpscRing<Event, kEventRingCapacity>;
 
 struct PublisherConfig {
   // "" = LCM's default: $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0 (host only).
@@ -49,6 +52,10 @@ struct PublisherStats {
   std::uint64_t status = 0;     // messages published per channel
   std::uint64_t axes = 0;
   std::uint64_t rt = 0;
+  std::uint64_t events = 0;  // BEAT + FAULT + ROW messages published
+  std::uint64_t beat = 0;
+  std::uint64_t fault = 0;
+  std::uint64_t row = 0;
   std::uint64_t publish_errors = 0;  // lcm publish() failures (e.g. no multicast route)
 };
 
@@ -56,8 +63,9 @@ class Publisher {
  public:
   // Configure-time only. Validates the config and opens LCM on `cfg.lcm_url`; throws
   // std::invalid_argument naming the field and value (the URL for an LCM that will not open).
-  // `ring` must outlive the publisher.
-  Publisher(const PublisherConfig& cfg, SnapshotRing& ring);
+  // `ring` and `events` must outlive the publisher. Events are published in tick order with the
+  // snapshots: an event goes out just before the first snapshot of a later tick (or at stop()).
+  Publisher(const PublisherConfig& cfg, SnapshotRing& ring, EventRing& events);
   // Configure-time only. Stops (and drains) if still running.
   ~Publisher();
   Publisher(const Publisher&) = delete;
@@ -81,9 +89,14 @@ class Publisher {
   void drain_once_or_nap();
   std::size_t drain_batch();
   void publish(const Snapshot& s);
+  void publish_events_up_to(hal::Tick tick);  // events with tick < `tick`; all of them for kNeverTick
+  void publish_event(const Event& e);
   void pace();
 
   SnapshotRing& ring_;
+  EventRing& events_;
+  Event pending_{};             // popped from the event ring, waiting for its turn
+  bool have_pending_ = false;
   PublisherConfig cfg_;
   ChannelNames channels_;
   ChannelSchedule schedule_;
@@ -95,6 +108,7 @@ class Publisher {
   std::atomic<bool> running_{false};
   std::atomic<bool> stop_requested_{false};
   std::atomic<std::uint64_t> n_snapshots_{0}, n_status_{0}, n_axes_{0}, n_rt_{0}, n_errors_{0};
+  std::atomic<std::uint64_t> n_beat_{0}, n_fault_{0}, n_row_{0};
 };
 
 }  // namespace loom::telemetry

@@ -15,6 +15,8 @@ struct AxisSample {
   double target = 0.0;           // SI, commanded this tick
   double following_error = 0.0;  // target - position, SI
   double effort = 0.0;           // N·m or N as reported
+  double following_error_limit = 0.0;  // SI; 0 = not checked by the loop (the drive checks its own)
+  std::uint16_t fault_code = 0;  // the drive's last EMCY / error code
   std::uint8_t drive_state = 0;  // hal::DriveState
   std::uint8_t request = 0;      // hal::AxisRequest
 };
@@ -28,16 +30,61 @@ struct Snapshot {
   std::uint32_t row = 0;               // production counters (completed rows, picks, beats)
   std::uint32_t pick = 0;
   std::uint32_t beat = 0;
+  std::uint32_t row_in_progress = 0;   // 1-based row being woven (the last row once done)
+  std::uint32_t rows_target = 0;       // rows this run weaves up to (0 = unknown / until stopped)
+  std::uint16_t beats_per_row = 0;
+  std::int8_t fault_axis = -1;         // axis of the first fault, -1 when none / not axis-specific
+  std::uint16_t fault_device_code = 0; // device (EMCY) code of the first fault
+  hal::Tick fault_tick = hal::kNeverTick;
+  std::array<char, 32> stopped_by{};   // the fault that stopped motion, "" when none
   double crank_phase_rad = 0.0;        // beat-up crank phase within the turn [0, 2π)
   double beater_angle_rad = 0.0;       // rocker angle from the profile
-  double beat_force_n = 0.0;           // last measured/simulated beat force (0 when unknown)
+  double beat_force_n = 0.0;           // load-cell force at this tick (0 when not measured)
+  bool beat_force_valid = false;
   std::array<AxisSample, hal::kAxisCount> axes{};
   std::uint8_t outputs = 0;            // bit0 piston A extend, bit1 piston B extend
   std::uint8_t inputs = 0;             // bit0 A ext, 1 A ret, 2 B ext, 3 B ret, 4 shuttle L, 5 shuttle R, 6 estop ok
   std::uint32_t overruns = 0;          // RT loop overruns so far
   std::int64_t tick_cost_ns = 0;       // this tick's compute time (0 in virtual time if not measured)
   std::int64_t max_tick_cost_ns = 0;
+  std::int64_t wake_latency_p50_ns = 0; // wake-up latency figures from the runner (0 = not measured)
+  std::int64_t wake_latency_p99_ns = 0;
+  std::int64_t wake_latency_max_ns = 0;
   std::uint32_t telemetry_dropped = 0; // snapshots dropped because the ring was full
+  std::uint32_t can_tx_dropped = 0;    // link counters from the HAL (cumulative)
+  std::uint32_t can_rx_errors = 0;
+};
+
+// An event the loop reports once, never decimated (BEAT, FAULT, ROW). One plain struct for all kinds
+// so one ring carries them in order; `kind` says which part is meaningful.
+struct Event {
+  enum class Kind : std::uint8_t { kBeat, kFault, kRow };
+  Kind kind = Kind::kBeat;
+  hal::Tick tick = 0;
+  std::int64_t period_ns = 0;
+  std::uint32_t row = 0;        // 1-based row the event belongs to
+  std::uint32_t rows_done = 0;  // production counters at the event
+  std::uint32_t pick = 0;
+  std::uint32_t beat = 0;
+  std::uint16_t beats_per_row = 0;
+  double band_min_n = 0.0, band_max_n = 0.0;  // beat-force target band
+  // kBeat
+  std::uint16_t beat_index = 0;
+  float x_m = 0.0f;
+  float peak_force_n = 0.0f;
+  bool force_measured = false;
+  bool in_band = false;
+  // kFault
+  enum class FaultKind : std::uint8_t { kFirst, kDiagnosis, kDevice };
+  FaultKind fault_kind = FaultKind::kFirst;
+  std::uint8_t fault = 0;          // sequencer::Fault value
+  std::int8_t axis = -1;           // -1 when not axis-specific
+  std::uint16_t device_code = 0;
+  std::array<char, 24> state{};    // sequencer state just before the fault
+  // kRow
+  hal::Tick row_ticks = 0, shed_ticks = 0, pick_ticks = 0, beat_ticks = 0;
+  std::uint16_t beats = 0, carriage_steps = 0, beats_in_band = 0;
+  double force_min_n = 0.0, force_mean_n = 0.0, force_max_n = 0.0;
 };
 
 }  // namespace loom::telemetry

@@ -15,6 +15,7 @@ class Telemetry {
   // Configure-time only. Allocates and pre-touches the ring, opens LCM; throws std::invalid_argument
   // on a bad config or an LCM URL that will not open (message names the field and value).
   explicit Telemetry(const PublisherConfig& cfg);
+  ~Telemetry() { publisher_.stop(); }  // the publisher reads both rings: stop it before they go
 
   // Configure-time only.
   void start() { publisher_.start(); }
@@ -33,13 +34,21 @@ class Telemetry {
   // gives up and counts a drop if the publisher is not running, since then nobody would make room.
   bool push_waiting(const Snapshot& s) noexcept;
 
+  // RT-safe. Queues an event (BEAT, FAULT, ROW) on the event ring, which is separate from the
+  // snapshot ring and never decimated; when it is full the event is dropped and counted.
+  bool push_event(const Event& e) noexcept { return events_->push_or_drop(e); }
+  // NOT RT-safe: virtual time only, like push_waiting().
+  bool push_event_waiting(const Event& e) noexcept;
+  std::uint64_t dropped_events() const noexcept { return events_->dropped(); }
+
   // RT-safe, any thread.
   std::uint64_t dropped() const noexcept { return ring_->dropped(); }
   PublisherStats stats() const noexcept { return publisher_.stats(); }
   const ChannelNames& channels() const noexcept { return publisher_.channels(); }
 
  private:
-  std::unique_ptr<SnapshotRing> ring_;  // declared first: the publisher holds a reference to it
+  std::unique_ptr<SnapshotRing> ring_;  // declared first: the publisher holds references to both rings
+  std::unique_ptr<EventRing> events_;
   Publisher publisher_;
 };
 

@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# loom-panel in a real browser: a simulated loom weaves in real time (4x) on a private LCM URL, the
+# panel listens on it, and headless Chromium (driven over the DevTools protocol by panel_browser.mjs)
+# must see the row count advance and every beat force of the row drawn in the 80-100 N band.
+# Writes <build>/panel/loom_panel.png and loom_panel_hall.png. Exit 77 (skip) when chromium or node is missing.
+# Usage: panel_browser.sh <loomctl> <loom-panel> <out dir>
+set -euo pipefail
+LOOMCTL=$1
+PANEL=$2
+OUT=$3
+fail() { echo "FAIL: $*" >&2; exit 1; }
+CHROMIUM=$(command -v chromium || command -v chromium-browser || true)
+[ -n "$CHROMIUM" ] || { echo "SKIP: chromium not installed (tools/deps.sh installs it)"; exit 77; }
+command -v node >/dev/null || { echo "SKIP: node not installed"; exit 77; }
+# The DevTools client uses node's built-in WebSocket (node >= 20.10 with --experimental-websocket, or 22).
+node --experimental-websocket -e 'if (typeof WebSocket !== "function") process.exit(1)' 2>/dev/null ||
+  node -e 'if (typeof WebSocket !== "function") process.exit(1)' 2>/dev/null ||
+  { echo "SKIP: this node ($(node --version)) has no built-in WebSocket"; exit 77; }
+mkdir -p "$OUT"
+WORK=$(mktemp -d "${TMPDIR:-/tmp}/loom_panel_browser.XXXXXX")
+PIDS=()
+cleanup() {
+  for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null || true; done
+  rm -rf "$WORK"
+}
+trap cleanup EXIT
+
+PORT=$((20000 + ($$ * 7) % 20000))
+URL="udpm://239.255.76.67:${PORT}?ttl=0"
+ID="panel$$"
+
+"$PANEL" --port 0 --lcm-url "$URL" 2>"$WORK/panel.err" &
+PIDS+=($!)
+for _ in $(seq 1 100); do
+  grep -q "serving http" "$WORK/panel.err" 2>/dev/null && break
+  sleep 0.05
+done
+BASE=$(sed -n 's|.*serving \(http://[0-9.]*:[0-9]*\)/.*|\1|p' "$WORK/panel.err")
+[ -n "$BASE" ] || fail "loom-panel did not start: $(cat "$WORK/panel.err")"
+
+# 3 rows at 4x real time: about 6 s of wall time per 3 rows... a row every ~1.9 s.
+"$LOOMCTL" weave --rows 6 --realtime --pace 4 --lcm-url "$URL" --loom-id "$ID" --quiet >"$WORK/weave.out" 2>&1 &
+PIDS+=($!)
+
+node --experimental-websocket "$(dirname "$0")/panel_browser.mjs" "$CHROMIUM" "$BASE" "$ID" \
+  "$OUT/loom_panel.png" 60 2>&1 | grep -v ExperimentalWarning | grep -v "node --trace-warnings" || fail "browser check failed"
+[ -s "$OUT/loom_panel.png" ] || fail "no screenshot written"

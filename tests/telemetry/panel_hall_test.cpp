@@ -1,0 +1,156 @@
+// loom-panel's model of the hall: bounded per loom (rows, faults, beats), the current row's beats
+// become the previous row's when the next row starts, a restarted loop starts its loom afresh, JSON
+// never carries NaN; and its udpm receiver reads what a real LCM publisher sends.
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+
+#include <cmath>
+#include <limits>
+
+#include "hall.hpp"
+#include "udpm_receiver.hpp"
+
+using namespace loom::panel;
+
+namespace {
+
+loomlcm::beat_t beat(const std::string& id, int row, int index, double force) {
+  loomlcm::beat_t m{};
+  m.loom_id = id;
+  m.row = row;
+  m.index = static_cast<std::int16_t>(index);
+  m.x_m = 0.1 * index;
+  m.peak_force_n = force;
+  m.force_measured = 1;
+  m.in_band = force >= 80 && force <= 100;
+  m.band_min_n = 80;
+  m.band_max_n = 100;
+  return m;
+}
+
+loomlcm::status_t status(const std::string& id, std::int64_t tick, int row) {
+  loomlcm::status_t m{};
+  m.loom_id = id;
+  m.tick = tick;
+  m.state = "beat_sweep";
+  m.row = row;
+  m.rows_done = row - 1;
+  return m;
+}
+
+}  // namespace
+
+TEST(PanelHall, CurrentRowBecomesPreviousWhenTheNextRowBeats) {
+  Hall h;
+  for (int k = 0; k < 3; ++k) h.on_beat(beat("A", 1, k, 89.0 + k));
+  h.on_beat(beat("A", 2, 0, 75.0));
+  const auto j = h.loom_json("A").value();
+  EXPECT_EQ(j["current_row"]["row"], 2);
+  ASSERT_EQ(j["current_row"]["beats"].size(), 1u);
+  EXPECT_FALSE(j["current_row"]["beats"][0]["in_band"].get<bool>());
+  EXPECT_EQ(j["previous_row"]["row"], 1);
+  EXPECT_EQ(j["previous_row"]["beats"].size(), 3u);
+  EXPECT_EQ(j["beats_seen"], 4);
+  EXPECT_EQ(j["beats_in_band"], 3);
+  // A row that is not the next one (a restart elsewhere) leaves no "previous" row.
+  h.on_beat(beat("A", 7, 0, 90.0));
+  EXPECT_EQ(h.loom_json("A").value()["previous_row"]["beats"].size(), 0u);
+}
+
+TEST(PanelHall, EverythingKeptIsBounded) {
+  HallLimits lim;
+  lim.looms = 2;
+  lim.rows_kept = 3;
+  lim.faults_kept = 2;
+  lim.beats_per_row = 4;
+  Hall h(lim);
+  for (int r = 1; r <= 10; ++r) {
+    loomlcm::row_t row{};
+    row.loom_id = "A";
+    row.row = r;
+    h.on_row(row);
+    loomlcm::fault_t f{};
+    f.loom_id = "A";
+    f.name = "estop";
+    f.row = r;
+    h.on_fault(f);
+  }
+  for (int k = 0; k < 10; ++k) h.on_beat(beat("A", 1, k, 90));
+  h.on_status(status("B", 1, 1));
+  h.on_status(status("C", 1, 1));  // a third loom: over the limit, counted, not kept
+  const auto j = h.loom_json("A").value();
+  ASSERT_EQ(j["rows"].size(), 3u);
+  EXPECT_EQ(j["rows"][0]["row"], 8);
+  ASSERT_EQ(j["faults"].size(), 2u);
+  EXPECT_EQ(j["faults"][1]["row"], 10);
+  EXPECT_EQ(j["faults_seen"], 10);
+  EXPECT_EQ(j["current_row"]["beats"].size(), 4u);
+  EXPECT_FALSE(h.loom_json("C").has_value());
+  EXPECT_EQ(h.ignored_looms(), 1u);
+  EXPECT_EQ(h.hall_json()["looms"].size(), 2u);
+}
+
+TEST(PanelHall, RestartedLoopStartsAfreshAndNaNIsNull) {
+  Hall h;
+  h.on_status(status("A", 5000, 3));
+  h.on_beat(beat("A", 3, 0, 90));
+  h.on_status(status("A", 10, 1));  // tick went back: a new run
+  auto j = h.loom_json("A").value();
+  EXPECT_EQ(j["beats_seen"], 0);
+  EXPECT_EQ(j["status"]["row"], 1);
+  loomlcm::axes_t a{};
+  a.loom_id = "A";
+  a.num_axes = 1;
+  a.axes.resize(1);
+  a.axes[0].name = "carriage";
+  a.axes[0].following_error = std::numeric_limits<double>::quiet_NaN();
+  h.on_axes(a);
+  j = h.loom_json("A").value();
+  EXPECT_TRUE(j["axes"]["axes"][0]["following_error"].is_null());
+  EXPECT_FALSE(nlohmann::json::parse(j.dump()).is_discarded());
+  const auto v = h.version();
+  h.on_rt(loomlcm::rt_stats_t{});
+  EXPECT_GT(h.wait_for_change(v, std::chrono::milliseconds(10)), v);
+}
+
+TEST(PanelUdpm, UrlsAndPackets) {
+  const auto a = parse_udpm_url("udpm://239.255.76.67:7771?ttl=0");
+  ASSERT_TRUE(a.has_value());
+  EXPECT_EQ(a->group, "239.255.76.67");
+  EXPECT_EQ(a->port, 7771);
+  EXPECT_FALSE(parse_udpm_url("file:///tmp/x.lcmlog?mode=r").has_value());
+  EXPECT_FALSE(parse_udpm_url("udpm://10.0.0.1:7667").has_value());  // not a multicast group
+  EXPECT_FALSE(parse_udpm_url("udpm://239.255.76.67:0").has_value());
+  EXPECT_FALSE(parse_udpm_url("udpm://239.255.76.67:70000").has_value());
+  // "LC02", sequence number, channel, NUL, payload.
+  const std::uint8_t pkt[] = {0x4c, 0x43, 0x30, 0x32, 0, 0, 0, 7, 'A', '.', 'B', 0, 1, 2, 3};
+  const auto p = parse_lcm_packet(pkt, sizeof pkt);
+  ASSERT_TRUE(p.has_value());
+  EXPECT_EQ(p->channel, "A.B");
+  EXPECT_EQ(p->size, 3u);
+  EXPECT_EQ(p->data[2], 3);
+  EXPECT_FALSE(parse_lcm_packet(pkt, 10).has_value());  // channel not terminated
+  const std::uint8_t fragment[] = {0x4c, 0x43, 0x30, 0x33, 0, 0, 0, 7, 'A', 0, 1};
+  EXPECT_FALSE(parse_lcm_packet(fragment, sizeof fragment).has_value());
+}
+
+TEST(PanelUdpm, ReceivesWhatLcmPublishes) {
+  const std::string url = "udpm://239.255.76.67:7793?ttl=0";
+  UdpmReceiver rx(parse_udpm_url(url).value());
+  lcm::LCM tx(url);
+  ASSERT_TRUE(tx.good());
+  loomlcm::beat_t b = beat("L9", 4, 2, 88.5);
+  ASSERT_EQ(tx.publish("LOOM.L9.BEAT", &b), 0);
+  int got = 0;
+  for (int i = 0; i < 20 && got == 0; ++i) {
+    rx.poll(100, [&](const LcmPacket& p) {
+      if (p.channel != "LOOM.L9.BEAT") return;
+      loomlcm::beat_t m;
+      ASSERT_GT(m.decode(p.data, 0, static_cast<int>(p.size)), 0);
+      EXPECT_EQ(m.row, 4);
+      EXPECT_DOUBLE_EQ(m.peak_force_n, 88.5);
+      ++got;
+    });
+  }
+  EXPECT_EQ(got, 1);
+}

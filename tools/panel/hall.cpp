@@ -1,0 +1,248 @@
+// The panel's bounded model of the hall (see hall.hpp).
+#include "hall.hpp"
+
+#include <cmath>
+
+namespace loom::panel {
+namespace {
+
+using nlohmann::json;
+
+// JSON has no NaN/inf: a non-finite number from the wire is sent as null, never as invalid JSON.
+json num(double v) {
+  return std::isfinite(v) ? json(v) : json(nullptr);
+}
+
+std::string hex(std::int64_t code) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%04llX", static_cast<unsigned long long>(code) & 0xFFFFFFFFull);
+  return buf;
+}
+
+json status_json(const loomlcm::status_t& m) {
+  json j = {{"tick", m.tick},
+            {"time_s", num(m.time_s)},
+            {"state", m.state},
+            {"row", m.row},
+            {"rows_done", m.rows_done},
+            {"rows_target", m.rows_target},
+            {"picks", m.pick},
+            {"beats", m.beat},
+            {"beats_per_row", m.beats_per_row}};
+  if (!m.first_fault.empty()) {
+    j["fault"] = {{"name", m.first_fault}, {"code", hex(m.first_fault_code)},  {"axis", m.fault_axis},
+                  {"device_code", hex(m.fault_device_code)}, {"text", m.fault_text},
+                  {"time_s", num(m.fault_time_s)}, {"stopped_by", m.stopped_by}};
+  } else {
+    j["fault"] = nullptr;
+  }
+  return j;
+}
+
+json axes_json(const loomlcm::axes_t& m) {
+  json axes = json::array();
+  for (const auto& a : m.axes) {
+    axes.push_back({{"name", a.name},
+                    {"position", num(a.position)},
+                    {"velocity", num(a.velocity)},
+                    {"target", num(a.target)},
+                    {"following_error", num(a.following_error)},
+                    {"following_error_limit", num(a.following_error_limit)},
+                    {"effort", num(a.effort)},
+                    {"drive_state", a.drive_state},
+                    {"fault_code", a.fault_code != 0 ? json(hex(a.fault_code)) : json(nullptr)}});
+  }
+  return {{"time_s", num(m.time_s)},
+          {"crank_phase_rad", num(m.crank_phase_rad)},
+          {"beater_angle_rad", num(m.beater_angle_rad)},
+          {"beat_force_n", m.beat_force_valid ? num(m.beat_force_n) : json(nullptr)},
+          {"axes", axes}};
+}
+
+json rt_json(const loomlcm::rt_stats_t& m) {
+  return {{"period_ns", m.period_ns},
+          {"overruns", m.overruns},
+          {"tick_cost_ns", m.tick_cost_ns},
+          {"max_tick_cost_ns", m.max_tick_cost_ns},
+          {"wake_latency_p50_ns", m.wake_latency_p50_ns},
+          {"wake_latency_p99_ns", m.wake_latency_p99_ns},
+          {"wake_latency_max_ns", m.wake_latency_max_ns},
+          {"dropped_snapshots", m.dropped_snapshots},
+          {"dropped_events", m.dropped_events},
+          {"backlog", m.backlog},
+          {"can_tx_dropped", m.can_tx_dropped},
+          {"can_rx_errors", m.can_rx_errors}};
+}
+
+json row_json(const loomlcm::row_t& m) {
+  json j = {{"row", m.row},       {"time_s", num(m.row_s)}, {"shed_s", num(m.shed_s)}, {"pick_s", num(m.pick_s)},
+            {"beat_s", num(m.beat_s)}, {"beats", m.beats}, {"carriage_steps", m.carriage_steps},
+            {"beats_in_band", m.beats_in_band}};
+  if (m.force_measured) {
+    j["force"] = {{"min", num(m.force_min_n)}, {"mean", num(m.force_mean_n)}, {"max", num(m.force_max_n)}};
+  } else {
+    j["force"] = nullptr;
+  }
+  return j;
+}
+
+json fault_json(const loomlcm::fault_t& m) {
+  return {{"time_s", num(m.time_s)}, {"kind", m.kind},   {"name", m.name},   {"code", hex(m.code)},
+          {"text", m.text},          {"axis", m.axis},   {"device_code", hex(m.device_code)},
+          {"state", m.state},        {"row", m.row},     {"picks", m.pick},  {"beats", m.beat}};
+}
+
+}  // namespace
+
+Hall::Loom* Hall::loom(const std::string& id) {
+  auto it = looms_.find(id);
+  if (it == looms_.end()) {
+    if (looms_.size() >= limits_.looms) {
+      ++ignored_;
+      return nullptr;
+    }
+    it = looms_.emplace(id, Loom{}).first;
+  }
+  it->second.heard = Clock::now();
+  return &it->second;
+}
+
+void Hall::changed() {
+  ++version_;
+  cv_.notify_all();
+}
+
+void Hall::on_status(const loomlcm::status_t& m) {
+  std::lock_guard lock(mu_);
+  if (Loom* l = loom(m.loom_id)) {
+    if (l->status && m.tick < l->status->tick) {  // the loop restarted: what was kept belongs to the previous run
+      *l = Loom{};
+      l->heard = Clock::now();
+    }
+    l->status = m;
+    changed();
+  }
+}
+
+void Hall::on_axes(const loomlcm::axes_t& m) {
+  std::lock_guard lock(mu_);
+  if (Loom* l = loom(m.loom_id)) {
+    l->axes = m;
+    changed();
+  }
+}
+
+void Hall::on_rt(const loomlcm::rt_stats_t& m) {
+  std::lock_guard lock(mu_);
+  if (Loom* l = loom(m.loom_id)) {
+    l->rt = m;
+    changed();
+  }
+}
+
+void Hall::on_beat(const loomlcm::beat_t& m) {
+  std::lock_guard lock(mu_);
+  Loom* l = loom(m.loom_id);
+  if (l == nullptr) return;
+  if (m.row != l->current.row) {
+    // A new row: the one before becomes "previous" (only if it is the row just before).
+    l->previous = m.row == l->current.row + 1 ? std::move(l->current) : BeatRow{};
+    l->current = BeatRow{m.row, {}};
+  }
+  if (l->current.beats.size() < limits_.beats_per_row) {
+    l->current.beats.push_back({m.index, m.x_m, m.peak_force_n, m.force_measured != 0, m.in_band != 0});
+  }
+  l->band_min_n = m.band_min_n;
+  l->band_max_n = m.band_max_n;
+  ++l->beats_seen;
+  if (m.in_band) ++l->beats_in_band;
+  changed();
+}
+
+void Hall::on_fault(const loomlcm::fault_t& m) {
+  std::lock_guard lock(mu_);
+  if (Loom* l = loom(m.loom_id)) {
+    l->faults.push_back(m);
+    while (l->faults.size() > limits_.faults_kept) l->faults.pop_front();
+    ++l->faults_seen;
+    changed();
+  }
+}
+
+void Hall::on_row(const loomlcm::row_t& m) {
+  std::lock_guard lock(mu_);
+  if (Loom* l = loom(m.loom_id)) {
+    l->rows.push_back(m);
+    while (l->rows.size() > limits_.rows_kept) l->rows.pop_front();
+    changed();
+  }
+}
+
+json Hall::summary(const std::string& id, const Loom& l, Clock::time_point now) {
+  json j = {{"id", id},
+            {"heard_s_ago", std::chrono::duration<double>(now - l.heard).count()},
+            {"beats_seen", l.beats_seen},
+            {"beats_in_band", l.beats_in_band},
+            {"faults_seen", l.faults_seen}};
+  j["status"] = l.status ? status_json(*l.status) : json(nullptr);
+  j["last_row"] = l.rows.empty() ? json(nullptr) : row_json(l.rows.back());
+  return j;
+}
+
+json Hall::hall_json() const {
+  std::lock_guard lock(mu_);
+  const auto now = Clock::now();
+  json looms = json::array();
+  for (const auto& [id, l] : looms_) looms.push_back(summary(id, l, now));
+  return {{"version", version_}, {"looms", looms}, {"ignored_looms", ignored_}};
+}
+
+std::optional<json> Hall::loom_json(const std::string& id) const {
+  std::lock_guard lock(mu_);
+  const auto it = looms_.find(id);
+  if (it == looms_.end()) return std::nullopt;
+  const Loom& l = it->second;
+  json j = summary(id, l, Clock::now());
+  j["version"] = version_;
+  j["axes"] = l.axes ? axes_json(*l.axes) : json(nullptr);
+  j["rt"] = l.rt ? rt_json(*l.rt) : json(nullptr);
+  j["band"] = {{"min_n", num(l.band_min_n)}, {"max_n", num(l.band_max_n)}};
+  const auto beats = [](const BeatRow& r) {
+    json b = json::array();
+    for (const auto& x : r.beats) {
+      b.push_back({{"index", x.index}, {"x_m", num(x.x_m)},
+                   {"force_n", x.measured ? num(x.force_n) : json(nullptr)}, {"in_band", x.in_band}});
+    }
+    return json{{"row", r.row}, {"beats", b}};
+  };
+  j["current_row"] = beats(l.current);
+  j["previous_row"] = beats(l.previous);
+  json rows = json::array();
+  for (const auto& r : l.rows) rows.push_back(row_json(r));
+  j["rows"] = rows;
+  json faults = json::array();
+  for (const auto& f : l.faults) faults.push_back(fault_json(f));
+  j["faults"] = faults;
+  // Operator buttons are not offered: the panel is read-only until it can act through the board's
+  // local control socket (see main.cpp, PanelOptions::control_socket).
+  j["controls"] = false;
+  return j;
+}
+
+std::uint64_t Hall::version() const {
+  std::lock_guard lock(mu_);
+  return version_;
+}
+
+std::uint64_t Hall::wait_for_change(std::uint64_t seen, std::chrono::milliseconds timeout) const {
+  std::unique_lock lock(mu_);
+  cv_.wait_for(lock, timeout, [&] { return version_ != seen; });
+  return version_;
+}
+
+std::size_t Hall::ignored_looms() const {
+  std::lock_guard lock(mu_);
+  return ignored_;
+}
+
+}  // namespace loom::panel

@@ -1,0 +1,89 @@
+// What loom-panel knows about every loom it hears: the latest STATUS, AXES and RT samples, the beats
+// of the row being woven and of the row before it, the last rows' time splits and the last faults —
+// each bounded, so the panel runs for months in constant memory. Fed by the LCM thread, read by the
+// HTTP threads as JSON; one mutex guards it (nothing here is real-time).
+#pragma once
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "loomlcm/axes_t.hpp"
+#include "loomlcm/beat_t.hpp"
+#include "loomlcm/fault_t.hpp"
+#include "loomlcm/row_t.hpp"
+#include "loomlcm/rt_stats_t.hpp"
+#include "loomlcm/status_t.hpp"
+
+namespace loom::panel {
+
+struct HallLimits {
+  std::size_t looms = 256;        // loom ids kept; more are counted as ignored
+  std::size_t rows_kept = 20;     // row summaries per loom
+  std::size_t faults_kept = 50;   // faults per loom
+  std::size_t beats_per_row = 512;  // beats kept per row (the firmware caps a row at 256)
+};
+
+class Hall {
+ public:
+  using Clock = std::chrono::steady_clock;
+  explicit Hall(HallLimits limits = {}) : limits_(limits) {}
+
+  // LCM thread. Each records the message under its loom id and bumps the version.
+  void on_status(const loomlcm::status_t& m);
+  void on_axes(const loomlcm::axes_t& m);
+  void on_rt(const loomlcm::rt_stats_t& m);
+  void on_beat(const loomlcm::beat_t& m);
+  void on_fault(const loomlcm::fault_t& m);
+  void on_row(const loomlcm::row_t& m);
+
+  // HTTP threads. The hall: every loom heard, one summary object each. A loom: everything kept, or
+  // nullopt when that id was never heard.
+  nlohmann::json hall_json() const;
+  std::optional<nlohmann::json> loom_json(const std::string& id) const;
+  // Changes so far; wait_for_change returns the version once it differs from `seen` (or at timeout).
+  std::uint64_t version() const;
+  std::uint64_t wait_for_change(std::uint64_t seen, std::chrono::milliseconds timeout) const;
+  std::size_t ignored_looms() const;
+
+ private:
+  struct Beat {
+    int index = 0;
+    double x_m = 0.0, force_n = 0.0;
+    bool measured = false, in_band = false;
+  };
+  struct BeatRow {
+    int row = 0;
+    std::vector<Beat> beats;
+  };
+  struct Loom {
+    Clock::time_point heard{};
+    std::optional<loomlcm::status_t> status;
+    std::optional<loomlcm::axes_t> axes;
+    std::optional<loomlcm::rt_stats_t> rt;
+    BeatRow current, previous;
+    double band_min_n = 80.0, band_max_n = 100.0;
+    std::deque<loomlcm::row_t> rows;
+    std::deque<loomlcm::fault_t> faults;
+    std::uint64_t beats_seen = 0, beats_in_band = 0, faults_seen = 0;
+  };
+  Loom* loom(const std::string& id);  // nullptr when over the loom limit; caller holds mu_
+  void changed();                      // caller holds mu_
+  static nlohmann::json summary(const std::string& id, const Loom& l, Clock::time_point now);
+
+  HallLimits limits_;
+  mutable std::mutex mu_;
+  mutable std::condition_variable cv_;
+  std::map<std::string, Loom> looms_;
+  std::uint64_t version_ = 0;
+  std::size_t ignored_ = 0;
+};
+
+}  // namespace loom::panel

@@ -1,0 +1,262 @@
+// loom-panel — a live page per loom and a hall page, for a phone, a tablet or a hall PC. A separate,
+// non-real-time process: it subscribes to the looms' LCM telemetry (every loom id it hears), keeps a
+// bounded picture of each (hall.hpp) and serves it over HTTP with live updates as server-sent events.
+//   loom-panel [--port 8080] [--bind 127.0.0.1] [--lcm-url URL]
+//   GET /                 the hall: every loom heard          GET /loom/<id>      one loom
+//   GET /api/hall         the hall as JSON                    GET /api/loom/<id>  one loom as JSON
+//   GET /events[?loom=ID] server-sent events: the same JSON, pushed on change (at most 4 per second)
+// Read-only: nothing it receives over HTTP reaches the loom. Binds to 127.0.0.1 unless --bind says
+// otherwise (a hall network). Exit 2 on bad arguments, 1 when it cannot listen or open LCM.
+#include <httplib.h>
+
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <chrono>
+#include <map>
+#include <memory>
+#include <csignal>
+#include <cstdio>
+#include <lcm/lcm-cpp.hpp>
+#include <string>
+#include <thread>
+
+#include "hall.hpp"
+#include "udpm_receiver.hpp"
+#include "loom/telemetry/channels.hpp"
+
+namespace loom::panel {
+extern const char* const kPanelHtml;
+}
+
+namespace {
+
+using loom::panel::Hall;
+
+std::atomic<bool> g_stop{false};
+httplib::Server* g_server = nullptr;
+extern "C" void on_signal(int) {
+  g_stop.store(true);
+}
+
+struct PanelOptions {
+  int port = 8080;
+  std::string bind = "127.0.0.1";
+  std::string lcm_url;
+  std::string channel_prefix = std::string(loom::telemetry::kDefaultChannelPrefix);
+  double min_push_interval_s = 0.25;  // live updates are coalesced to at most this often per client
+  int http_threads = 32;              // each open page holds one for its event stream
+  // Operator buttons (pause / resume / stop at row end / acknowledge) will act through the board's
+  // local control socket, never over LCM. Empty = read-only, and no option sets it yet: the socket
+  // is the board's to provide. The page shows buttons only when the JSON says "controls": true.
+  std::string control_socket;
+};
+
+// Routes one received message by its channel, <prefix>.<loom id>.<KIND>, to the hall. AXES comes at
+// up to 50 Hz per loom; a page needs a few per second, so each loom's AXES is decoded at most every
+// 100 ms and the rest are skipped before decoding.
+class Router {
+ public:
+  Router(Hall& hall, std::string prefix) : hall_(hall), prefix_(std::move(prefix) + ".") {}
+  // Live traffic only: a log replayed at full speed would otherwise keep just its first AXES.
+  void throttle_axes(bool on) { throttle_axes_ = on; }
+
+  void route(std::string_view channel, const void* data, std::size_t size) {
+    if (channel.substr(0, prefix_.size()) != prefix_) return;
+    const std::string_view rest = channel.substr(prefix_.size());
+    const auto dot = rest.rfind('.');
+    if (dot == std::string_view::npos) return;
+    const std::string_view id = rest.substr(0, dot), kind = rest.substr(dot + 1);
+    if (!loom::telemetry::loom_id_error(id).empty()) return;
+    const int len = static_cast<int>(size);
+    if (kind == "STATUS") {
+      decode<loomlcm::status_t>(data, len, [&](const auto& m) { hall_.on_status(m); });
+    } else if (kind == "AXES") {
+      const auto now = throttle_axes_ ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
+      auto it = last_axes_.find(id);
+      if (it == last_axes_.end()) it = last_axes_.emplace(std::string(id), now - std::chrono::seconds(1)).first;
+      if (throttle_axes_ && now - it->second < std::chrono::milliseconds(100)) return;
+      it->second = now;
+      decode<loomlcm::axes_t>(data, len, [&](const auto& m) { hall_.on_axes(m); });
+    } else if (kind == "RT") {
+      decode<loomlcm::rt_stats_t>(data, len, [&](const auto& m) { hall_.on_rt(m); });
+    } else if (kind == "BEAT") {
+      decode<loomlcm::beat_t>(data, len, [&](const auto& m) { hall_.on_beat(m); });
+    } else if (kind == "FAULT") {
+      decode<loomlcm::fault_t>(data, len, [&](const auto& m) { hall_.on_fault(m); });
+    } else if (kind == "ROW") {
+      decode<loomlcm::row_t>(data, len, [&](const auto& m) { hall_.on_row(m); });
+    }
+  }
+  std::uint64_t decode_errors() const { return decode_errors_; }
+
+  // For LCM's own receive path (file://, memq://, or a udpm the lean receiver cannot open).
+  static void on_lcm(const lcm::ReceiveBuffer* rbuf, const std::string& channel, Router* self) {
+    self->route(channel, rbuf->data, rbuf->data_size);
+  }
+
+ private:
+  template <typename Msg, typename F>
+  void decode(const void* data, int len, F&& use) {
+    Msg m;
+    // decode() checks the type's fingerprint first: another type on the channel is an error, not garbage.
+    if (m.decode(data, 0, len) < 0) {
+      ++decode_errors_;
+      return;
+    }
+    use(m);
+  }
+  Hall& hall_;
+  std::string prefix_;
+  std::map<std::string, std::chrono::steady_clock::time_point, std::less<>> last_axes_;
+  std::uint64_t decode_errors_ = 0;
+  bool throttle_axes_ = true;
+};
+
+std::string json_for(const Hall& hall, const std::string& loom) {
+  if (loom.empty()) return hall.hall_json().dump();
+  const auto j = hall.loom_json(loom);
+  return j ? j->dump() : nlohmann::json{{"id", loom}, {"heard", false}}.dump();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  PanelOptions o;
+  CLI::App app{"loom-panel — live web page of every loom's LCM telemetry (read-only)"};
+  app.add_option("--port", o.port, "TCP port (0: any free port, printed on start)")
+      ->check(CLI::Range(0, 65535))
+      ->capture_default_str();
+  app.add_option("--bind", o.bind, "address to listen on (0.0.0.0 for a hall network)")->capture_default_str();
+  app.add_option("--lcm-url", o.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or udpm://239.255.76.67:7667?ttl=0)");
+  app.add_option("--channel-prefix", o.channel_prefix, "first field of the channel names")->capture_default_str();
+  app.add_option("--min-push-interval-s", o.min_push_interval_s, "shortest gap between two live updates of a page")
+      ->check(CLI::Range(0.01, 60.0))
+      ->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "loom-panel: %s\n", e.what());
+    return 2;
+  }
+  if (auto e = loom::telemetry::channel_prefix_error(o.channel_prefix); !e.empty()) {
+    std::fprintf(stderr, "loom-panel: --channel-prefix: %s\n", e.c_str());
+    return 2;
+  }
+
+  Hall hall;
+  Router router(hall, o.channel_prefix);
+  // udpm (the normal case): the lean batched receiver. Anything else: LCM's own provider.
+  std::unique_ptr<loom::panel::UdpmReceiver> udpm;
+  std::unique_ptr<lcm::LCM> lcm;
+  if (const auto addr = loom::panel::parse_udpm_url(o.lcm_url)) {
+    try {
+      udpm = std::make_unique<loom::panel::UdpmReceiver>(*addr);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "loom-panel: --lcm-url '%s': %s\n", o.lcm_url.c_str(), e.what());
+      return 1;
+    }
+  } else {
+    router.throttle_axes(false);
+    lcm = std::make_unique<lcm::LCM>(o.lcm_url);
+    if (!lcm->good()) {
+      std::fprintf(stderr, "loom-panel: --lcm-url '%s' could not be opened by LCM\n", o.lcm_url.c_str());
+      return 1;
+    }
+    std::string re;
+    for (char c : o.channel_prefix) re += c == '.' ? std::string("\\.") : std::string(1, c);
+    lcm->subscribeFunction(re + "\\..*", &Router::on_lcm, &router)->setQueueCapacity(10000);
+  }
+
+  httplib::Server svr;
+  svr.new_task_queue = [&] { return new httplib::ThreadPool(static_cast<std::size_t>(o.http_threads)); };
+  const auto page = [](const httplib::Request&, httplib::Response& res) {
+    res.set_header("Cache-Control", "no-store");
+    res.set_content(loom::panel::kPanelHtml, "text/html; charset=utf-8");
+  };
+  svr.Get("/", page);
+  svr.Get(R"(/loom/([A-Za-z0-9_-]{1,32}))", page);
+  svr.Get("/api/hall", [&](const httplib::Request&, httplib::Response& res) {
+    res.set_content(hall.hall_json().dump(), "application/json");
+  });
+  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32}))", [&](const httplib::Request& req, httplib::Response& res) {
+    const auto j = hall.loom_json(req.matches[1]);
+    if (!j) {
+      res.status = 404;
+      res.set_content(nlohmann::json{{"error", "loom not heard"}, {"id", std::string(req.matches[1])}}.dump(),
+                      "application/json");
+      return;
+    }
+    res.set_content(j->dump(), "application/json");
+  });
+  svr.Get("/events", [&](const httplib::Request& req, httplib::Response& res) {
+    const std::string loom = req.has_param("loom") ? req.get_param_value("loom") : std::string();
+    if (!loom.empty() && !loom::telemetry::loom_id_error(loom).empty()) {
+      res.status = 400;
+      res.set_content("bad loom id\n", "text/plain");
+      return;
+    }
+    res.set_header("Cache-Control", "no-store");
+    const auto gap = std::chrono::duration_cast<std::chrono::milliseconds>(
+        std::chrono::duration<double>(o.min_push_interval_s));
+    // Each call of the provider sends one event: the current JSON, once it differs from the last sent.
+    auto seen = std::make_shared<std::uint64_t>(~std::uint64_t{0});
+    res.set_chunked_content_provider("text/event-stream", [&hall, loom, gap, seen](std::size_t, httplib::DataSink& sink) {
+      const auto t0 = std::chrono::steady_clock::now();
+      // Wake every second to notice a closed page or a stopping server; a comment keeps proxies awake.
+      for (;;) {
+        if (g_stop.load() || !sink.is_writable()) return false;
+        const std::uint64_t v = hall.wait_for_change(*seen, std::chrono::milliseconds(1000));
+        if (v != *seen) break;
+        if (std::chrono::steady_clock::now() - t0 > std::chrono::seconds(15)) {
+          static const char kKeepAlive[] = ": keep-alive\n\n";
+          return sink.write(kKeepAlive, sizeof kKeepAlive - 1);
+        }
+      }
+      *seen = hall.version();
+      const std::string msg = "data: " + json_for(hall, loom) + "\n\n";
+      if (!sink.write(msg.data(), msg.size())) return false;
+      std::this_thread::sleep_for(gap);  // coalesce: a busy loom costs at most one update per gap
+      return true;
+    });
+  });
+
+  int port = o.port;
+  if (port == 0) {
+    port = svr.bind_to_any_port(o.bind);
+  } else if (!svr.bind_to_port(o.bind, port)) {
+    port = -1;
+  }
+  if (port < 0) {
+    std::fprintf(stderr, "loom-panel: cannot listen on %s:%d\n", o.bind.c_str(), o.port);
+    return 1;
+  }
+  g_server = &svr;
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+
+  std::thread http([&] { svr.listen_after_bind(); });
+  std::fprintf(stderr, "loom-panel: serving http://%s:%d/ (read-only), LCM %s\n", o.bind.c_str(), port,
+               o.lcm_url.empty() ? "default URL" : o.lcm_url.c_str());
+  const auto on_packet = [&](const loom::panel::LcmPacket& p) { router.route(p.channel, p.data, p.size); };
+  while (!g_stop.load()) {
+    const int r = udpm ? udpm->poll(200, on_packet) : lcm->handleTimeout(200);
+    if (r < 0) {
+      if (o.lcm_url.rfind("file://", 0) == 0) {
+        // A log read to its end: keep serving what it held until told to stop.
+        std::fprintf(stderr, "loom-panel: end of log; still serving (Ctrl-C to stop)\n");
+        while (!g_stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(200));
+        break;
+      }
+      std::fprintf(stderr, "loom-panel: LCM stopped delivering messages\n");
+      break;
+    }
+  }
+  svr.stop();
+  http.join();
+  return g_stop.load() ? 0 : 1;
+}
