@@ -13,6 +13,7 @@
 #include "loom/firmware/counter_store.hpp"
 #include "loom/firmware/machine.hpp"
 #include "loom/firmware/runner.hpp"
+#include "loom/firmware/serve/commands.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/report/run_report.hpp"
 #include <unistd.h>
@@ -109,6 +110,7 @@ int weave(const WeaveArgs& a) {
   mo.hal = hardware ? firmware::HalKind::kSocketCan : firmware::HalKind::kSim;
   mo.iface = a.iface;
   mo.telemetry = !a.no_telemetry;
+  mo.lossless_telemetry = !realtime;  // real time never waits on telemetry: drop and count
   mo.rows = resume.rows + a.rows;  // the sequencer counts absolute rows; weave `rows` more
   mo.sim_state_path = a.sim_state;
   std::unique_ptr<firmware::Machine> machine;
@@ -204,16 +206,18 @@ int weave(const WeaveArgs& a) {
   ro.grace_ticks = static_cast<hal::Tick>(0.2 / period);
   ro.stop_flag = &g_stop;
   ro.pause_flag = &g_pause;
+  ro.require_fifo = hardware && !a.allow_degraded;
+  ro.overrun_stop_after = hardware ? 10 : 0;
   const firmware::RunResult res = firmware::run_loop(machine->loop(), seq, ro, on_event);
   if (auto* tm = machine->telemetry()) tm->stop();
+  if (res.end == firmware::RunResult::End::kError) {
+    std::fprintf(stderr, "loomctl: refusing to run: %s\n", res.error.c_str());
+    return kExitNotArmed;
+  }
 
   // ---- report ----
   const double machine_s = static_cast<double>(res.ticks) * period;
-  std::printf("loop: %lld ticks (%.2f s machine time) in %.3f s wall (%.0fx real time); tick cost median %lld ns, "
-              "max %lld ns; overruns %u\n",
-              static_cast<long long>(res.ticks), machine_s, res.wall_s, machine_s / std::max(res.wall_s, 1e-9),
-              static_cast<long long>(res.median_tick_cost_ns), static_cast<long long>(res.max_tick_cost_ns),
-              res.overruns);
+  std::printf("%s\n", firmware::describe_run(res, ro).c_str());
   const auto& c = seq.counters();
   summary.counters = c;
   summary.machine_s = machine_s;
@@ -280,16 +284,20 @@ int main(int argc, char** argv) {
   weave_cmd->add_flag("--no-telemetry", a.no_telemetry, "do not publish LCM telemetry");
   weave_cmd->add_flag("--quiet", a.quiet, "no header");
   weave_cmd->add_option("--report", a.report, "write DIR/summary.json and plots (beat force, row timeline)");
+  const firmware::serve::BoardCommands board(app);  // serve, ctl, --version
   weave_cmd->add_option("--sim-state", a.sim_state,
                         "sim HAL: keep the simulated machine's physical state in FILE (survives a kill)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "loomctl: %s\n", e.what());
     return kExitBadInput;
   }
+  if (const auto rc = board.run()) return *rc;
   if (a.hal == "socketcan" && a.iface.empty()) {
     std::fprintf(stderr, "loomctl: --hal socketcan needs --iface NAME\n");
     return kExitBadInput;

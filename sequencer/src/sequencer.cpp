@@ -471,6 +471,7 @@ void Sequencer::step(hal::Tick now, const hal::HalInputs& raw, hal::HalOutputs& 
   hal::HalInputs in = raw;  // the sequencer and its interlocks see debounced sensors
   in.io = io_;
   if (state_ != State::kIdle && state_ != State::kFault) check_faults(now, in);
+  if (external_fault_ != Fault::kNone && state_ != State::kFault) latch(external_fault_, now);
   if (state_ == State::kFault) refine_diagnosis(now, in);
   if (state_ == State::kIdle && start_requested_ && !in.io.estop_ok) {
     start_requested_ = false;

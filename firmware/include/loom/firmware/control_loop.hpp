@@ -20,6 +20,12 @@ struct LoopStats {
   std::uint32_t overruns = 0;
   std::int64_t last_tick_cost_ns = 0;
   std::int64_t max_tick_cost_ns = 0;
+  // Written by the runner in real time (0 in virtual time): how late the loop woke after its deadline.
+  std::int64_t last_wake_latency_ns = 0;
+  std::int64_t max_wake_latency_ns = 0;
+  std::int64_t wake_latency_p99_ns = 0;  // over the run so far, refreshed about once a second
+  std::int64_t tick_cost_p999_ns = 0;    // likewise
+  std::uint32_t events_dropped = 0;      // run events lost to a full reporter ring
 };
 
 class ControlLoop {

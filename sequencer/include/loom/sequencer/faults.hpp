@@ -22,7 +22,8 @@ namespace loom::sequencer {
   X(kPickWithoutShed, 0x100B, "interlock_pick_without_shed", "pick commanded while the shed is not confirmed open") \
   X(kShedWithShuttle, 0x100C, "interlock_shed_with_shuttle", "shed change commanded while the shuttle is in the shed") \
   X(kShedSensorEarly, 0x100E, "shed_sensor_early", "piston end sensors confirmed faster than a frame can move") \
-  X(kShedNotReleased, 0x100F, "shed_not_released", "a heald frame never left its end position (valve, air, jam)")
+  X(kShedNotReleased, 0x100F, "shed_not_released", "a heald frame never left its end position (valve, air, jam)") \
+  X(kLoopOverrun, 0x1010, "loop_overrun", "the control loop missed its deadline too many ticks in a row")
 
 enum class Fault : std::uint8_t {
 #define LOOM_FAULT_ENUM(id, code, name, text) id,

@@ -97,6 +97,9 @@ class Sequencer {
   void request_stop_at_row_end() noexcept { stop_requested_ = true; }  // RT-safe
   void request_pause() noexcept { pause_requested_ = true; }        // RT-safe: holds before the next shed
   void request_resume() noexcept { pause_requested_ = false; }      // RT-safe
+  // RT-safe. A fault found outside the sequencer (the runner's overrun policy): latched at the next step
+  // with the same reaction as any other fault (quick stop, valves hold, counters kept).
+  void request_safe_stop(Fault f) noexcept { external_fault_ = f; }
 
   // RT-safe. One tick: check faults → advance the row cycle → sample profiles → check interlocks →
   // write every field of `out`.
@@ -154,6 +157,7 @@ class Sequencer {
   bool stop_requested_ = false;
   bool pause_requested_ = false;
   bool row_started_ = false;  // a row is in progress (its start tick is set)
+  Fault external_fault_ = Fault::kNone;  // set by request_safe_stop, latched at the next step
 
   Fault first_fault_ = Fault::kNone;
   Fault stopped_by_ = Fault::kNone;
