@@ -24,6 +24,7 @@ packages=(
   nlohmann-json3-dev            # run reports (summary.json)
   libnlopt-cxx-dev              # optimiser (balancing)
   iproute2 can-utils            # vcan set-up, candump/cansend for HIL checks
+  rt-tests                      # cyclictest: the latency floor the loop is compared with
 )
 
 arm64=0

@@ -43,10 +43,11 @@ set(CPACK_DEBIAN_PACKAGE_ARCHITECTURE ${LOOM_DEB_ARCH})
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION misc)
 set(CPACK_STRIP_FILES ON)
-# Runtime dependencies by Debian name (checked against the binaries' NEEDED entries by
-# tests/board/package_test.sh): the C++ runtime, LCM (and the GLib it uses), toml++, NLopt.
+# Runtime dependencies by Debian name (tests/board/package_test.sh checks that every library the
+# binaries load comes from one of these): the C++ runtime, LCM, toml++, NLopt (loom-dynamics' balancing)
+# and Google Benchmark (loom-profile's lookup timings). Names are the same on amd64 and arm64.
 set(CPACK_DEBIAN_PACKAGE_DEPENDS
-    "libc6 (>= 2.36), libstdc++6 (>= 12), libgcc-s1, liblcm1 (>= 1.3.1), libglib2.0-0, libtomlplusplus3 (>= 3.3.0), libnlopt-cxx0 (>= 2.7.1)")
+    "libc6 (>= 2.36), libstdc++6 (>= 12), libgcc-s1, liblcm1 (>= 1.3.1), libtomlplusplus3 (>= 3.3.0), libnlopt0 (>= 2.7.1), libbenchmark1debian (>= 1.7.1)")
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "can-utils, iproute2")
 set(CPACK_DEBIAN_PACKAGE_SUGGESTS "rt-tests, liblcm-bin")
 configure_file(${pkg}/postinst ${CMAKE_BINARY_DIR}/packaging/postinst COPYONLY)
@@ -54,5 +55,4 @@ configure_file(${pkg}/conffiles ${CMAKE_BINARY_DIR}/packaging/conffiles COPYONLY
 set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA "${CMAKE_BINARY_DIR}/packaging/postinst;${CMAKE_BINARY_DIR}/packaging/conffiles")
 set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION ON)
 set(CPACK_PACKAGE_DIRECTORY ${CMAKE_BINARY_DIR}/packages)
-set(CPACK_OUTPUT_FILE_PREFIX ${CMAKE_BINARY_DIR}/packages)
 include(CPack)

@@ -202,7 +202,9 @@ class LoopBody {
         return true;
       }
     }
-    if (has(Command::kStop)) {
+    if (has(Command::kStop) && s != sequencer::State::kIdle && s != sequencer::State::kDone &&
+        s != sequencer::State::kFault) {
+      // Only a loom that is weaving stops at row end: a stop while idle must not cut the next start short.
       seq_.request_stop_at_row_end();
       seq_.request_resume();  // paused between picks: finish the row, then stop
     }
@@ -320,7 +322,13 @@ void* loop_thread_main(void* arg) {
 
 void drain_events(Runtime& rt) {
   RunEvent e;
-  while (rt.events.try_pop(e)) rt.on_event(e);
+  while (rt.events.try_pop(e)) {
+    try {
+      rt.on_event(e);
+    } catch (...) {
+      // The loop thread is still running on `rt`: a handler's exception must not unwind past it.
+    }
+  }
 }
 
 }  // namespace

@@ -176,3 +176,74 @@ TEST(RunnerClock, FallingBehindThePaceIsReportedHonestly) {
   EXPECT_NE(text.find("could not keep up"), std::string::npos) << text;
   EXPECT_NE(text.find("0.25x real time"), std::string::npos) << text;
 }
+
+// ---- operator commands through the OperatorLink (virtual time: same handling, no thread) ----
+namespace {
+RunResult run_virtual(Rig& r, hal::Tick ticks, firmware::OperatorLink& link, bool hold = true) {
+  RunOptions o;
+  o.period_s = r.cfg.sequencer.period_s;
+  o.max_ticks = ticks;
+  o.clock = &r.clock;
+  o.link = &link;
+  o.hold_when_finished = hold;
+  return firmware::run_loop(*r.loop, *r.seq, o, [](const firmware::RunEvent&) {});
+}
+}  // namespace
+
+TEST(RunnerCommands, NothingMovesUntilStartAndStatusIsPublished) {
+  Rig r;  // note: Rig::run() would request a start; here only the link may
+  firmware::OperatorLink link;
+  run_virtual(r, 200, link);
+  EXPECT_EQ(r.seq->state(), sequencer::State::kIdle);
+  EXPECT_EQ(link.state.load(), static_cast<std::uint8_t>(sequencer::State::kIdle));
+  EXPECT_EQ(link.tick.load(), 199);
+  link.post(firmware::Command::kStart);
+  run_virtual(r, 50, link);
+  EXPECT_NE(r.seq->state(), sequencer::State::kIdle);
+  EXPECT_EQ(link.pending.load(), 0u) << "a command was left pending";
+}
+
+TEST(RunnerCommands, StopWhileIdleDoesNotCutTheNextStartShort) {
+  Rig r;
+  r.slow->default_cost_ns = 0;
+  firmware::OperatorLink link;
+  link.post(firmware::Command::kStop);
+  run_virtual(r, 10, link);
+  link.post(firmware::Command::kStart);
+  // Weave until the first row is done and a little more: rows_to_weave is 0 (until stopped), so the
+  // loom must be weaving its second row, not done.
+  RunOptions o;
+  o.period_s = r.cfg.sequencer.period_s;
+  o.clock = &r.clock;
+  o.link = &link;
+  o.hold_when_finished = true;
+  o.max_ticks = 6000;  // 12 s: the first row (about 7.6 s) done, the second under way
+  ASSERT_EQ(r.seq->counters().rows, 0u);
+  firmware::run_loop(*r.loop, *r.seq, o, [](const firmware::RunEvent&) {});
+  EXPECT_GE(r.seq->counters().rows, 1u);
+  EXPECT_NE(r.seq->state(), sequencer::State::kDone);
+  EXPECT_NE(r.seq->state(), sequencer::State::kFault) << sequencer::fault_name(r.seq->first_fault());
+}
+
+TEST(RunnerCommands, AckOfALatchedFaultEndsTheSessionForReArming) {
+  Rig r;
+  firmware::OperatorLink link;
+  r.seq->request_safe_stop(sequencer::Fault::kLoopOverrun);
+  link.post(firmware::Command::kAck);  // while not faulted yet: ignored
+  run_virtual(r, 10, link);
+  ASSERT_EQ(r.seq->state(), sequencer::State::kFault);
+  EXPECT_EQ(link.first_fault.load(), static_cast<std::uint8_t>(sequencer::Fault::kLoopOverrun));
+  link.post(firmware::Command::kAck);
+  const RunResult res = run_virtual(r, 1000, link);
+  EXPECT_EQ(res.end, RunResult::End::kAckRequested);
+  EXPECT_EQ(res.ticks, 0);
+}
+
+TEST(RunnerCommands, ExitWhileIdleLeavesAtOnce) {
+  Rig r;
+  firmware::OperatorLink link;
+  link.post(firmware::Command::kExit);
+  const RunResult res = run_virtual(r, 1000, link);
+  EXPECT_EQ(res.end, RunResult::End::kExitRequested);
+  EXPECT_LE(res.ticks, 1);
+}
