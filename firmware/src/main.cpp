@@ -284,9 +284,9 @@ int main(int argc, char** argv) {
   weave_cmd->add_flag("--no-telemetry", a.no_telemetry, "do not publish LCM telemetry");
   weave_cmd->add_flag("--quiet", a.quiet, "no header");
   weave_cmd->add_option("--report", a.report, "write DIR/summary.json and plots (beat force, row timeline)");
-  const firmware::serve::BoardCommands board(app);  // serve, ctl, --version
   weave_cmd->add_option("--sim-state", a.sim_state,
                         "sim HAL: keep the simulated machine's physical state in FILE (survives a kill)");
+  const firmware::serve::BoardCommands board(app);  // serve, ctl, --version
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
