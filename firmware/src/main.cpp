@@ -14,6 +14,7 @@
 #include "loom/firmware/counter_store.hpp"
 #include "loom/firmware/machine.hpp"
 #include "loom/firmware/runner.hpp"
+#include "loom/firmware/serve/commands.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/report/run_report.hpp"
 #include "check_cmd.hpp"
@@ -127,6 +128,7 @@ int weave(const WeaveArgs& a) {
   mo.hal = hardware ? firmware::HalKind::kSocketCan : firmware::HalKind::kSim;
   mo.iface = a.iface;
   mo.telemetry = !a.no_telemetry;
+  mo.lossless_telemetry = !realtime;  // real time never waits on telemetry: drop and count
   mo.rows = resume.rows + a.rows;  // the sequencer counts absolute rows; weave `rows` more
   mo.sim_state_path = a.sim_state;
   if (!a.io.empty()) mo.io = a.io == "simulated" ? firmware::IoKind::kSimulated : firmware::IoKind::kCan;
@@ -249,16 +251,18 @@ int weave(const WeaveArgs& a) {
   ro.grace_ticks = static_cast<hal::Tick>(0.2 / period);
   ro.stop_flag = &g_stop;
   ro.pause_flag = &g_pause;
+  ro.require_fifo = hardware && !a.allow_degraded;
+  ro.overrun_stop_after = hardware ? 10 : 0;
   const firmware::RunResult res = firmware::run_loop(machine->loop(), seq, ro, on_event);
   if (auto* tm = machine->telemetry()) tm->stop();
+  if (res.end == firmware::RunResult::End::kError) {
+    std::fprintf(stderr, "loomctl: refusing to run: %s\n", res.error.c_str());
+    return kExitNotArmed;
+  }
 
   // ---- report ----
   const double machine_s = static_cast<double>(res.ticks) * period;
-  std::printf("loop: %lld ticks (%.2f s machine time) in %.3f s wall (%.0fx real time); tick cost median %lld ns, "
-              "max %lld ns; overruns %u\n",
-              static_cast<long long>(res.ticks), machine_s, res.wall_s, machine_s / std::max(res.wall_s, 1e-9),
-              static_cast<long long>(res.median_tick_cost_ns), static_cast<long long>(res.max_tick_cost_ns),
-              res.overruns);
+  std::printf("%s\n", firmware::describe_run(res, ro).c_str());
   const auto& c = seq.counters();
   report::RunEnd summary;
   summary.counters = c;
@@ -356,15 +360,19 @@ int main(int argc, char** argv) {
   check_cmd->add_option("--config", check.config, "loom config file (TOML); default: embedded default loom");
   check_cmd->add_option("--scene", check.scene, "simulation scene file (TOML)");
   check_cmd->add_flag("--keys", check.keys, "list every config key with its class (machine/recipe/run) and range");
+  const firmware::serve::BoardCommands board(app);  // serve, ctl, --version
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "loomctl: %s\n", e.what());
     return kExitBadInput;
   }
   if (check_cmd->parsed()) return firmware::run_check(check);
+  if (const auto rc = board.run()) return *rc;
   if (a.hal == "socketcan" && a.iface.empty()) {
     std::fprintf(stderr, "loomctl: --hal socketcan needs --iface NAME\n");
     return kExitBadInput;

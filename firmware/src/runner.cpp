@@ -1,181 +1,474 @@
-// The loop runner. The reporter thread exists only in real time: printing and fsync-ing counters must
-// never delay a tick, so the RT thread hands events over through an SPSC ring and goes on.
+// The loop runner. In real time the loop gets its own thread with explicit attributes and the caller's
+// thread becomes the reporter: printing and fsync-ing counters must never delay a tick, so the loop
+// hands events over through a heap-allocated SPSC ring and goes on (drop and count when full).
 #include "loom/firmware/runner.hpp"
 
+#include <alloca.h>
+#include <malloc.h>
+#include <pthread.h>
 #include <sched.h>
 #include <sys/mman.h>
 #include <time.h>
 
-#include <array>
 #include <cerrno>
+#include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <memory>
 #include <thread>
 
+#include "loom/firmware/latency_histogram.hpp"
 #include "loom/telemetry/spsc_ring.hpp"
 
 namespace loom::firmware {
-namespace {
 
-std::int64_t now_ns() {
+// ---------------------------------------------------------------------------------------------------
+// Clock
+// ---------------------------------------------------------------------------------------------------
+std::int64_t MonotonicClock::now_ns() noexcept {
   timespec ts{};
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
 
-timespec to_timespec(std::int64_t ns) {
-  return timespec{static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
+void MonotonicClock::sleep_until(std::int64_t deadline_ns) noexcept {
+  const timespec ts{static_cast<time_t>(deadline_ns / 1'000'000'000), static_cast<long>(deadline_ns % 1'000'000'000)};
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+  }
 }
 
-// Tick-cost histogram: 100 ns buckets up to 1 ms; enough to report a median without allocating.
-class CostHistogram {
- public:
-  void add(std::int64_t ns) noexcept {
-    const std::int64_t b = std::min<std::int64_t>(ns / 100, kBuckets - 1);
-    ++bins_[static_cast<std::size_t>(std::max<std::int64_t>(b, 0))];
-    ++count_;
+namespace {
+
+// ---------------------------------------------------------------------------------------------------
+// Thread attributes
+// ---------------------------------------------------------------------------------------------------
+// Fills `attr` for the loop thread: explicit scheduling (never inherited from the creator), the policy
+// and priority asked for, the stack size, and an optional CPU. Returns an errno-style code.
+int make_attrs(pthread_attr_t& attr, int policy, int priority, std::size_t stack_bytes, int cpu) {
+  int rc = pthread_attr_init(&attr);
+  if (rc != 0) return rc;
+  if ((rc = pthread_attr_setinheritsched(&attr, PTHREAD_EXPLICIT_SCHED)) != 0) return rc;
+  if ((rc = pthread_attr_setschedpolicy(&attr, policy)) != 0) return rc;
+  sched_param sp{};
+  sp.sched_priority = policy == SCHED_FIFO ? priority : 0;
+  if ((rc = pthread_attr_setschedparam(&attr, &sp)) != 0) return rc;
+  if ((rc = pthread_attr_setstacksize(&attr, std::max<std::size_t>(stack_bytes, PTHREAD_STACK_MIN))) != 0) return rc;
+  if (cpu >= 0) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(static_cast<unsigned>(cpu), &set);
+    if ((rc = pthread_attr_setaffinity_np(&attr, sizeof(set), &set)) != 0) return rc;
   }
-  std::int64_t median() const noexcept {
-    std::uint64_t seen = 0;
-    for (std::size_t i = 0; i < bins_.size(); ++i) {
-      seen += bins_[i];
-      if (2 * seen >= count_) return static_cast<std::int64_t>(i) * 100 + 50;
+  return 0;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Everything the loop touches, allocated (and its pages touched) before the first tick.
+// ---------------------------------------------------------------------------------------------------
+struct Runtime {
+  Runtime(ControlLoop& l, sequencer::Sequencer& s, const RunOptions& o, LoopClock& c, const EventHandler& h)
+      : loop(l), seq(s), opt(o), clock(c), on_event(h) {}
+  ControlLoop& loop;
+  sequencer::Sequencer& seq;
+  const RunOptions& opt;
+  LoopClock& clock;
+  const EventHandler& on_event;
+  LatencyHistogram cost;
+  LatencyHistogram wake;
+  telemetry::SpscRing<RunEvent, kEventRingCapacity> events;
+  std::atomic<bool> loop_done{false};
+  RunResult result;
+};
+
+class LoopBody {
+ public:
+  explicit LoopBody(Runtime& rt) : rt_(rt), seq_(rt.seq), opt_(rt.opt), stats_(rt.loop.stats()) {}
+
+  // The loop. RT-safe after its first statement: no allocation, no locks, no syscalls but the clock's.
+  void run() noexcept {
+    RunResult& res = rt_.result;
+    const std::int64_t period_ns =
+        std::max<std::int64_t>(1, std::llround(opt_.period_s * 1e9 / (opt_.realtime ? opt_.pace : 1.0)));
+    rows_seen_ = seq_.counters().rows;
+    picks_seen_ = seq_.counters().picks;
+    const hal::Tick refresh_every = std::max<hal::Tick>(1, static_cast<hal::Tick>(1.0 / opt_.period_s));
+    const std::int64_t begin = rt_.clock.now_ns();
+    std::int64_t deadline = begin + period_ns;
+    std::uint32_t consecutive = 0;
+    hal::Tick finished_at = -1;
+    hal::Tick tick = 0;
+    res.end = RunResult::End::kFinished;
+    for (;; ++tick) {
+      if (opt_.max_ticks > 0 && tick >= opt_.max_ticks) {
+        res.end = RunResult::End::kMaxTicks;
+        break;
+      }
+      if (opt_.realtime) {
+        rt_.clock.sleep_until(deadline);
+        const std::int64_t late = rt_.clock.now_ns() - deadline;
+        rt_.wake.add(late);
+        stats_.last_wake_latency_ns = late;
+        stats_.max_wake_latency_ns = std::max(stats_.max_wake_latency_ns, late);
+      }
+      if (take_commands()) break;  // a command ended the session
+
+      const std::int64_t t0 = rt_.clock.now_ns();
+      rt_.loop.cycle(tick);
+      const std::int64_t t1 = rt_.clock.now_ns();
+      const std::int64_t cost = t1 - t0;
+      stats_.last_tick_cost_ns = cost;
+      stats_.max_tick_cost_ns = std::max(stats_.max_tick_cost_ns, cost);
+      rt_.cost.add(cost);
+
+      report_changes(tick);
+      publish_status(tick);
+      if (tick % refresh_every == 0) {
+        // Bounded (two scans of a fixed histogram), once a second, in the tick's slack.
+        stats_.wake_latency_p50_ns = rt_.wake.percentile(0.5);
+        stats_.wake_latency_p99_ns = rt_.wake.percentile(0.99);
+        stats_.wake_latency_max_ns = stats_.max_wake_latency_ns;
+        stats_.tick_cost_p999_ns = rt_.cost.percentile(0.999);
+        stats_.events_dropped = static_cast<std::uint32_t>(rt_.events.dropped());
+      }
+
+      if (seq_.finished() && finished_at < 0) finished_at = tick;
+      if (!opt_.hold_when_finished && finished_at >= 0 && tick - finished_at >= opt_.grace_ticks) break;
+      if (exit_pending_ && quiet_state()) {
+        res.end = RunResult::End::kExitRequested;
+        break;
+      }
+
+      if (opt_.realtime) {
+        const std::int64_t next = deadline + period_ns;
+        const std::int64_t after = rt_.clock.now_ns();
+        if (after > next) {
+          // Missed the next deadline: count it and re-phase onto the period grid after now, instead of
+          // bursting to catch up (the tick index still advances by one: motion stretches, never jumps).
+          ++stats_.overruns;
+          ++consecutive;
+          res.max_consecutive_overruns = std::max(res.max_consecutive_overruns, consecutive);
+          deadline = next + ((after - next) / period_ns + 1) * period_ns;
+          if (opt_.overrun_stop_after > 0 && consecutive >= opt_.overrun_stop_after && !res.overrun_stop) {
+            res.overrun_stop = true;
+            seq_.request_safe_stop(sequencer::Fault::kLoopOverrun);
+            RunEvent e = base_event(RunEvent::Kind::kOverrunStop, tick);
+            emit(e);
+          }
+        } else {
+          consecutive = 0;
+          deadline = next;
+        }
+      }
     }
-    return 0;
+    RunEvent fin = base_event(RunEvent::Kind::kFinished, tick);
+    emit(fin);
+    res.ticks = tick;
+    // The loop's own time (thread start-up and the reporter's last drain are not the loop's pace).
+    res.wall_s = static_cast<double>(rt_.clock.now_ns() - begin) * 1e-9;
   }
 
  private:
-  static constexpr std::int64_t kBuckets = 10000;
-  std::array<std::uint64_t, kBuckets> bins_{};
-  std::uint64_t count_ = 0;
+  // Applies operator commands (and button edges). True when the session ends here.
+  bool take_commands() noexcept {
+    std::uint32_t cmds = 0;
+    if (opt_.link != nullptr && opt_.link->pending.load(std::memory_order_relaxed) != 0) {
+      cmds = opt_.link->pending.exchange(0, std::memory_order_acquire);
+    }
+    if (opt_.operator_buttons) {
+      const hal::DigitalInputs& io = rt_.loop.inputs().io;
+      if (io.button_start && !prev_start_) cmds |= static_cast<std::uint32_t>(Command::kStart);
+      if (io.button_pause && !prev_pause_) cmds |= static_cast<std::uint32_t>(Command::kPause);
+      if (io.button_ack && !prev_ack_) cmds |= static_cast<std::uint32_t>(Command::kAck);
+      prev_start_ = io.button_start;
+      prev_pause_ = io.button_pause;
+      prev_ack_ = io.button_ack;
+    }
+    if (opt_.stop_flag != nullptr && !stop_sent_ && opt_.stop_flag->load(std::memory_order_relaxed)) {
+      seq_.request_stop_at_row_end();
+      stop_sent_ = true;
+    }
+    if (opt_.pause_flag != nullptr) {
+      opt_.pause_flag->load(std::memory_order_relaxed) ? seq_.request_pause() : seq_.request_resume();
+    }
+    if (cmds == 0) return false;
+    const auto has = [&](Command c) { return (cmds & static_cast<std::uint32_t>(c)) != 0; };
+    const sequencer::State s = seq_.state();
+    RunResult& res = rt_.result;
+    if (has(Command::kPause)) seq_.request_pause();
+    if (has(Command::kResume)) seq_.request_resume();
+    if (has(Command::kStart)) {
+      if (s == sequencer::State::kIdle) seq_.request_start();
+      if (s == sequencer::State::kPaused) seq_.request_resume();
+      if (s == sequencer::State::kDone && opt_.hold_when_finished) {
+        res.end = RunResult::End::kStartRequested;
+        return true;
+      }
+    }
+    if (has(Command::kStop) && s != sequencer::State::kIdle && s != sequencer::State::kDone &&
+        s != sequencer::State::kFault) {
+      // Only a loom that is weaving stops at row end: a stop while idle must not cut the next start short.
+      seq_.request_stop_at_row_end();
+      seq_.request_resume();  // paused between picks: finish the row, then stop
+    }
+    if (has(Command::kAck) && s == sequencer::State::kFault && opt_.hold_when_finished) {
+      res.end = RunResult::End::kAckRequested;
+      return true;
+    }
+    if (has(Command::kExit)) {
+      exit_pending_ = true;
+      if (!quiet_state()) seq_.request_stop_at_row_end();
+    }
+    return false;
+  }
+
+  // Nothing is moving towards a goal: leaving the loop here loses no row in progress.
+  bool quiet_state() const noexcept {
+    const sequencer::State s = seq_.state();
+    return s == sequencer::State::kIdle || s == sequencer::State::kPaused || s == sequencer::State::kDone ||
+           s == sequencer::State::kFault;
+  }
+
+  RunEvent base_event(RunEvent::Kind kind, hal::Tick tick) const noexcept {
+    RunEvent e;
+    e.kind = kind;
+    e.tick = tick;
+    e.counters = seq_.counters();
+    e.state = seq_.state();
+    e.fault = seq_.first_fault();
+    e.stopped_by = seq_.stopped_by();
+    e.fault_axis = seq_.fault_axis();
+    e.fault_detail = seq_.fault_detail();
+    return e;
+  }
+
+  void emit(const RunEvent& e) noexcept {
+    if (opt_.realtime) {
+      rt_.events.push_or_drop(e);
+    } else {
+      // Virtual time: the loop runs on the caller's thread, so the handler is called in place.
+      try {
+        rt_.on_event(e);
+      } catch (...) {
+        // A handler's failure must not tear the loop down; the handler reports its own errors.
+      }
+    }
+  }
+
+  void report_changes(hal::Tick tick) noexcept {
+    const sequencer::Counters& c = seq_.counters();
+    if (c.rows != rows_seen_ || c.picks != picks_seen_) {
+      const bool row_done = c.rows != rows_seen_;
+      rows_seen_ = c.rows;
+      picks_seen_ = c.picks;
+      RunEvent e = base_event(row_done ? RunEvent::Kind::kRowDone : RunEvent::Kind::kPickDone, tick);
+      if (row_done) e.row = seq_.last_row();
+      emit(e);
+    }
+    const sequencer::State s = seq_.state();
+    const bool paused = s == sequencer::State::kPaused;
+    if (paused != was_paused_) {
+      was_paused_ = paused;
+      emit(base_event(paused ? RunEvent::Kind::kPaused : RunEvent::Kind::kResumed, tick));
+    }
+    const bool fault = s == sequencer::State::kFault;
+    if (fault && !was_fault_) emit(base_event(RunEvent::Kind::kFault, tick));
+    was_fault_ = fault;
+  }
+
+  void publish_status(hal::Tick tick) noexcept {
+    OperatorLink* l = opt_.link;
+    if (l == nullptr) return;
+    constexpr auto r = std::memory_order_relaxed;
+    l->state.store(static_cast<std::uint8_t>(seq_.state()), r);
+    l->first_fault.store(static_cast<std::uint8_t>(seq_.first_fault()), r);
+    l->rows.store(seq_.counters().rows, r);
+    l->picks.store(seq_.counters().picks, r);
+    l->beats.store(seq_.counters().beats, r);
+    l->overruns.store(stats_.overruns, r);
+    l->max_wake_latency_ns.store(stats_.max_wake_latency_ns, r);
+    l->tick.store(tick, std::memory_order_release);
+  }
+
+  Runtime& rt_;
+  sequencer::Sequencer& seq_;
+  const RunOptions& opt_;
+  LoopStats& stats_;
+  std::uint32_t rows_seen_ = 0, picks_seen_ = 0;
+  bool was_paused_ = false, was_fault_ = false;
+  bool stop_sent_ = false, exit_pending_ = false;
+  bool prev_start_ = false, prev_pause_ = false, prev_ack_ = false;
 };
+
+// Touches `bytes` of this thread's stack so the loop never takes a first-touch page fault on it.
+__attribute__((noinline)) void prefault_stack(std::size_t bytes) {
+  auto* p = static_cast<volatile unsigned char*>(alloca(bytes));
+  for (std::size_t i = 0; i < bytes; i += 4096) p[i] = 0;
+}
+
+void* loop_thread_main(void* arg) {
+  auto& rt = *static_cast<Runtime*>(arg);
+  pthread_setname_np(pthread_self(), "loom-rt");
+  int policy = -1;
+  sched_param sp{};
+  if (pthread_getschedparam(pthread_self(), &policy, &sp) == 0) {
+    rt.result.loop_policy = policy;
+    rt.result.loop_priority = sp.sched_priority;
+  }
+  // Leave room for the frames below this one and for the loop's own (small) frames.
+  const std::size_t stack = std::max<std::size_t>(rt.opt.stack_bytes, PTHREAD_STACK_MIN);
+  if (stack > (64u << 10)) prefault_stack(stack - (64u << 10));
+  LoopBody(rt).run();
+  rt.loop_done.store(true, std::memory_order_release);
+  return nullptr;
+}
+
+void drain_events(Runtime& rt) {
+  RunEvent e;
+  while (rt.events.try_pop(e)) {
+    try {
+      rt.on_event(e);
+    } catch (...) {
+      // The loop thread is still running on `rt`: a handler's exception must not unwind past it.
+    }
+  }
+}
 
 }  // namespace
 
-RtSetup setup_realtime(int fifo_priority) {
+// ---------------------------------------------------------------------------------------------------
+// Process-wide preparation
+// ---------------------------------------------------------------------------------------------------
+RtSetup setup_realtime(int fifo_priority, std::size_t heap_prefault_bytes) {
   RtSetup r;
   if (mlockall(MCL_CURRENT | MCL_FUTURE) == 0) {
     r.memory_locked = true;
+    // Keep freed heap in the process and serve large blocks from it, not from fresh mmaps, then
+    // touch a block once: later configure-time allocations land on pages that are already resident.
+    mallopt(M_TRIM_THRESHOLD, -1);
+    mallopt(M_MMAP_MAX, 0);
+    if (heap_prefault_bytes > 0) {
+      auto* block = static_cast<volatile unsigned char*>(std::malloc(heap_prefault_bytes));
+      if (block != nullptr) {
+        for (std::size_t i = 0; i < heap_prefault_bytes; i += 4096) block[i] = 0;
+        std::free(const_cast<unsigned char*>(block));
+      }
+    }
   } else {
     r.problems += std::string("mlockall failed: ") + std::strerror(errno) + "; ";
   }
-  sched_param sp{};
-  sp.sched_priority = fifo_priority;
-  if (sched_setscheduler(0, SCHED_FIFO, &sp) == 0) {
+  // Probe with a real thread created the way the loop's will be: the process itself never changes policy.
+  pthread_attr_t attr;
+  int rc = make_attrs(attr, SCHED_FIFO, fifo_priority, PTHREAD_STACK_MIN + (64u << 10), -1);
+  pthread_t th{};
+  if (rc == 0) rc = pthread_create(&th, &attr, [](void*) -> void* { return nullptr; }, nullptr);
+  pthread_attr_destroy(&attr);
+  if (rc == 0) {
+    pthread_join(th, nullptr);
     r.fifo = true;
   } else {
-    r.problems += std::string("SCHED_FIFO failed: ") + std::strerror(errno) + "; ";
+    r.problems += "SCHED_FIFO " + std::to_string(fifo_priority) + " not granted: " + std::strerror(rc) + "; ";
   }
   return r;
 }
 
+// ---------------------------------------------------------------------------------------------------
+// The runner
+// ---------------------------------------------------------------------------------------------------
 RunResult run_loop(ControlLoop& loop, sequencer::Sequencer& seq, const RunOptions& opt, const EventHandler& on_event) {
-  RunResult result;
-  auto hist = std::make_unique<CostHistogram>();
-  telemetry::SpscRing<RunEvent, 256> events;
-  std::atomic<bool> reporter_done{false};
-  std::thread reporter;
+  MonotonicClock monotonic;
+  LoopClock& clock = opt.clock != nullptr ? *opt.clock : monotonic;
+  // Configure-time: the ring and the histograms live on the heap (the ring is ~2 MB), value-initialised,
+  // which touches every page before the loop starts.
+  auto rt = std::make_unique<Runtime>(loop, seq, opt, clock, on_event);
+
+  if (!opt.realtime) {
+    LoopBody(*rt).run();
+  } else {
+    const bool want_fifo = opt.fifo_priority > 0;
+    pthread_attr_t attr;
+    int rc = make_attrs(attr, want_fifo ? SCHED_FIFO : SCHED_OTHER, opt.fifo_priority, opt.stack_bytes, opt.cpu);
+    pthread_t th{};
+    if (rc == 0) rc = pthread_create(&th, &attr, loop_thread_main, rt.get());
+    pthread_attr_destroy(&attr);
+    if (rc == EPERM && want_fifo && !opt.require_fifo) {
+      // Not allowed SCHED_FIFO: run anyway at SCHED_OTHER (simulation), and say so in the result.
+      rt->result.fifo_refused = true;
+      rc = make_attrs(attr, SCHED_OTHER, 0, opt.stack_bytes, opt.cpu);
+      if (rc == 0) rc = pthread_create(&th, &attr, loop_thread_main, rt.get());
+      pthread_attr_destroy(&attr);
+    }
+    if (rc != 0) {
+      rt->result.end = RunResult::End::kError;
+      rt->result.fifo_refused = rc == EPERM && want_fifo;
+      rt->result.error = std::string("cannot start the loop thread") +
+                         (want_fifo ? " at SCHED_FIFO " + std::to_string(opt.fifo_priority) : std::string()) +
+                         (opt.cpu >= 0 ? " on CPU " + std::to_string(opt.cpu) : std::string()) + ": " +
+                         std::strerror(rc);
+      return rt->result;
+    }
+    // The caller's thread (SCHED_OTHER) is the reporter.
+    while (!rt->loop_done.load(std::memory_order_acquire)) {
+      drain_events(*rt);
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    pthread_join(th, nullptr);
+    drain_events(*rt);
+  }
+
+  RunResult res = rt->result;
+  const LoopStats& stats = loop.stats();
+  res.overruns = stats.overruns;
+  res.max_tick_cost_ns = stats.max_tick_cost_ns;
+  res.median_tick_cost_ns = rt->cost.percentile(0.5);
+  res.p999_tick_cost_ns = rt->cost.percentile(0.999);
   if (opt.realtime) {
-    reporter = std::thread([&] {
-      RunEvent e;
-      for (;;) {
-        const bool last = reporter_done.load(std::memory_order_acquire);
-        while (events.try_pop(e)) on_event(e);
-        if (last) break;
-        std::this_thread::sleep_for(std::chrono::milliseconds(5));
-      }
-    });
+    res.wake_latency_p50_ns = rt->wake.percentile(0.5);
+    res.wake_latency_p99_ns = rt->wake.percentile(0.99);
+    res.wake_latency_max_ns = rt->wake.max();
   }
-  const auto emit = [&](const RunEvent& e) {
-    if (opt.realtime) {
-      events.try_push(e);  // 256 events of room; rows complete seconds apart
-    } else {
-      on_event(e);
-    }
-  };
+  res.events_dropped = rt->events.dropped();
+  loop.stats().events_dropped = static_cast<std::uint32_t>(res.events_dropped);
+  const double machine_s = static_cast<double>(res.ticks) * opt.period_s;
+  res.achieved_ratio = machine_s / std::max(res.wall_s, 1e-9);
+  res.fell_behind = opt.realtime && res.ticks > 0 && res.achieved_ratio < 0.97 * opt.pace;
+  return res;
+}
 
-  const std::int64_t period_ns = static_cast<std::int64_t>(opt.period_s * 1e9 / opt.pace);
-  const std::int64_t start = now_ns();
-  std::int64_t deadline = start;
-  std::uint32_t rows_seen = seq.counters().rows;
-  std::uint32_t picks_seen = seq.counters().picks;
-  hal::Tick finished_at = -1;
-  bool stop_sent = false;
-  bool was_paused = false;
-  LoopStats& stats = loop.stats();
-  hal::Tick tick = 0;
-  for (;; ++tick) {
-    if (opt.max_ticks > 0 && tick >= opt.max_ticks) break;
-    if (opt.realtime) {
-      const timespec ts = to_timespec(deadline);
-      while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-      }
-    }
-    if (opt.stop_flag != nullptr && !stop_sent && opt.stop_flag->load(std::memory_order_relaxed)) {
-      seq.request_stop_at_row_end();
-      stop_sent = true;
-    }
-    if (opt.pause_flag != nullptr) {
-      const bool want_pause = opt.pause_flag->load(std::memory_order_relaxed);
-      want_pause ? seq.request_pause() : seq.request_resume();
-    }
-    const std::int64_t t0 = now_ns();
-    loop.cycle(tick);
-    const std::int64_t cost = now_ns() - t0;
-    stats.last_tick_cost_ns = cost;
-    stats.max_tick_cost_ns = std::max(stats.max_tick_cost_ns, cost);
-    hist->add(cost);
-
-    if (seq.counters().rows != rows_seen || seq.counters().picks != picks_seen) {
-      const bool row_done = seq.counters().rows != rows_seen;
-      rows_seen = seq.counters().rows;
-      picks_seen = seq.counters().picks;
-      RunEvent e;
-      e.kind = row_done ? RunEvent::Kind::kRowDone : RunEvent::Kind::kPickDone;
-      e.tick = tick;
-      e.row = seq.last_row();
-      e.counters = seq.counters();
-      e.state = seq.state();
-      emit(e);
-    }
-    const bool paused = seq.state() == sequencer::State::kPaused;
-    if (paused != was_paused) {
-      was_paused = paused;
-      RunEvent e;
-      e.kind = paused ? RunEvent::Kind::kPaused : RunEvent::Kind::kResumed;
-      e.tick = tick;
-      e.counters = seq.counters();
-      e.state = seq.state();
-      emit(e);
-    }
-    if (seq.finished() && finished_at < 0) finished_at = tick;
-    if (finished_at >= 0 && tick - finished_at >= opt.grace_ticks) break;
-
-    if (opt.realtime) {
-      deadline += period_ns;
-      const std::int64_t after = now_ns();
-      if (after > deadline) {
-        // Missed the next deadline: count it and re-phase from now instead of bursting to catch up.
-        ++stats.overruns;
-        deadline = after + period_ns - (after - deadline) % period_ns;
-      }
-    }
-  }
-  RunEvent fin;
-  fin.kind = RunEvent::Kind::kFinished;
-  fin.tick = tick;
-  fin.counters = seq.counters();
-  fin.state = seq.state();
-  emit(fin);
+std::string describe_run(const RunResult& r, const RunOptions& opt) {
+  char buf[768];
+  const double machine_s = static_cast<double>(r.ticks) * opt.period_s;
+  const char* ratio_fmt = r.achieved_ratio < 10.0 ? "%.2f" : "%.0f";
+  char ratio[32];
+  std::snprintf(ratio, sizeof ratio, ratio_fmt, r.achieved_ratio);
+  int n = std::snprintf(buf, sizeof buf,
+                        "loop: %lld ticks (%.2f s machine time) in %.3f s wall (%sx real time); tick cost median %lld "
+                        "ns, p99.9 %lld ns, max %lld ns; overruns %u",
+                        static_cast<long long>(r.ticks), machine_s, r.wall_s, ratio,
+                        static_cast<long long>(r.median_tick_cost_ns), static_cast<long long>(r.p999_tick_cost_ns),
+                        static_cast<long long>(r.max_tick_cost_ns), r.overruns);
+  std::string s(buf, static_cast<std::size_t>(std::max(n, 0)));
   if (opt.realtime) {
-    reporter_done.store(true, std::memory_order_release);
-    reporter.join();
+    n = std::snprintf(buf, sizeof buf, "; wake-up latency p50 %lld ns, p99 %lld ns, max %lld ns; loop thread %s",
+                      static_cast<long long>(r.wake_latency_p50_ns), static_cast<long long>(r.wake_latency_p99_ns),
+                      static_cast<long long>(r.wake_latency_max_ns),
+                      r.loop_policy == SCHED_FIFO ? ("SCHED_FIFO " + std::to_string(r.loop_priority)).c_str()
+                                                  : "SCHED_OTHER");
+    s.append(buf, static_cast<std::size_t>(std::max(n, 0)));
   }
-  result.ticks = tick;
-  result.wall_s = static_cast<double>(now_ns() - start) * 1e-9;
-  result.overruns = stats.overruns;
-  result.max_tick_cost_ns = stats.max_tick_cost_ns;
-  result.median_tick_cost_ns = hist->median();
-  return result;
+  if (r.events_dropped > 0) s += "; run events dropped " + std::to_string(r.events_dropped);
+  if (r.fifo_refused) s += "\nloomctl: WARNING: SCHED_FIFO was refused; the loop ran at SCHED_OTHER";
+  if (r.fell_behind) {
+    n = std::snprintf(buf, sizeof buf,
+                      "\nloomctl: WARNING: could not keep up: asked for %gx real time, achieved %.2fx (%u overruns; "
+                      "a tick period of %.0f ns is shorter than the loop can hold)",
+                      opt.pace, r.achieved_ratio, r.overruns, opt.period_s * 1e9 / opt.pace);
+    s.append(buf, static_cast<std::size_t>(std::max(n, 0)));
+  }
+  if (r.overrun_stop) {
+    s += "\nloomctl: the loop overran " + std::to_string(opt.overrun_stop_after) +
+         " deadlines in a row: safe stop (loop_overrun)";
+  }
+  return s;
 }
 
 }  // namespace loom::firmware

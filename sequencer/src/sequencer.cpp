@@ -166,6 +166,10 @@ void Sequencer::step(hal::Tick now, const hal::HalInputs& raw, hal::HalOutputs& 
   hal::HalInputs in = raw;  // the sequencer and its interlocks see debounced sensors
   in.io = io_;
   if (state_ != State::kIdle && state_ != State::kFault) check_faults(now, in);
+  if (external_fault_ != Fault::kNone) {  // the runner's overrun policy: latched once, like any fault
+    if (state_ != State::kFault) latch(external_fault_, now);
+    external_fault_ = Fault::kNone;
+  }
   if (state_ == State::kFault) refine_diagnosis(now, in);
   operator_requests();
   if (state_ == State::kIdle && start_requested_ && !in.io.estop_ok) {

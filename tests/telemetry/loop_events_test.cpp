@@ -89,7 +89,11 @@ TEST(LoopEvents, EveryBeatOfATwoRowRunIsOneBeatMessage) {
     EXPECT_EQ(row.row, i + 1);
     EXPECT_EQ(row.beats, 15);
     EXPECT_EQ(row.beats_in_band, 15);
-    EXPECT_NEAR(row.row_s, row.shed_s + row.pick_s + row.beat_s, 0.1);
+    // Row 1 also holds the shed test every arming starts with (the frames stroked to learn them).
+    EXPECT_GE(row.row_s, row.shed_s + row.pick_s + row.beat_s - 0.01);
+    if (i > 0) {
+      EXPECT_NEAR(row.row_s, row.shed_s + row.pick_s + row.beat_s, 0.1);
+    }
     EXPECT_GE(row.force_min_n, 80.0);
     EXPECT_LE(row.force_max_n, 100.0);
   }

@@ -25,6 +25,10 @@ struct LoopStats {
   std::int64_t wake_latency_p50_ns = 0;
   std::int64_t wake_latency_p99_ns = 0;
   std::int64_t wake_latency_max_ns = 0;
+  std::int64_t last_wake_latency_ns = 0;
+  std::int64_t max_wake_latency_ns = 0;
+  std::int64_t tick_cost_p999_ns = 0;  // over the run so far, refreshed about once a second
+  std::uint32_t events_dropped = 0;    // run events lost to a full reporter ring
 };
 
 // What telemetry reports about the loom beyond what the sequencer knows per tick: set once at

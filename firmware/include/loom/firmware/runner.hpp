@@ -1,6 +1,10 @@
 // Drives ControlLoop::cycle at the fixed rate: in virtual time as fast as the machine allows, or paced
-// in real time with absolute-deadline sleeps (clock_nanosleep TIMER_ABSTIME; overruns counted and
-// re-phased, never caught up in a burst). Only this module and main read the clock.
+// in real time with absolute-deadline sleeps (overruns counted and re-phased onto the period grid, never
+// caught up in a burst; N in a row → safe stop). In real time the loop runs on its own thread created
+// with explicit attributes (the LinuxCNC uspace way): SCHED_FIFO at the configured priority,
+// PTHREAD_EXPLICIT_SCHED so nothing is inherited, optional CPU affinity, a pre-faulted stack. Every other
+// thread — the LCM publisher, the reporter (the caller's thread), the control socket — stays
+// SCHED_OTHER. Only this module and main read the clock, through the injectable LoopClock.
 #pragma once
 
 #include <atomic>
@@ -13,22 +17,87 @@
 
 namespace loom::firmware {
 
-// Configure-time only. Lock memory and switch to SCHED_FIFO; says what failed instead of throwing.
+// ---------------------------------------------------------------------------------------------------
+// Time: injected so overrun handling and re-phasing are tested with a fake clock.
+// ---------------------------------------------------------------------------------------------------
+class LoopClock {
+ public:
+  virtual ~LoopClock() = default;
+  // RT-safe. Monotonic nanoseconds.
+  virtual std::int64_t now_ns() noexcept = 0;
+  // RT-safe (the one wait the loop makes). Sleep until the absolute time `deadline_ns`.
+  virtual void sleep_until(std::int64_t deadline_ns) noexcept = 0;
+};
+
+// CLOCK_MONOTONIC with clock_nanosleep(TIMER_ABSTIME): absolute deadlines never drift.
+class MonotonicClock final : public LoopClock {
+ public:
+  std::int64_t now_ns() noexcept override;
+  void sleep_until(std::int64_t deadline_ns) noexcept override;
+};
+
+// ---------------------------------------------------------------------------------------------------
+// Process-wide real-time preparation (configure-time only).
+// ---------------------------------------------------------------------------------------------------
 struct RtSetup {
-  bool memory_locked = false;
-  bool fifo = false;
-  std::string problems;  // "" when both succeeded
+  bool memory_locked = false;   // mlockall(MCL_CURRENT | MCL_FUTURE) and a pre-faulted heap
+  bool fifo = false;            // a thread may be created at SCHED_FIFO `fifo_priority` (probed, not taken)
+  std::string problems;         // "" when both succeeded
   bool ok() const { return memory_locked && fifo; }
 };
-RtSetup setup_realtime(int fifo_priority);
+// Locks memory, pre-faults `heap_prefault_bytes` of heap (and keeps glibc from returning it or serving
+// big blocks by mmap), and probes — by creating and joining a short-lived thread with explicit SCHED_FIFO
+// attributes — that the loop thread will get its priority. It does NOT change this process' scheduling:
+// threads started afterwards (telemetry, reporter) stay SCHED_OTHER. Says what failed instead of throwing.
+RtSetup setup_realtime(int fifo_priority, std::size_t heap_prefault_bytes = 8u << 20);
 
+// ---------------------------------------------------------------------------------------------------
+// Operator commands into the loop and live status out of it (the control socket's side of the loop).
+// ---------------------------------------------------------------------------------------------------
+enum class Command : std::uint32_t {
+  kStart = 1u << 0,   // idle → weave; done → a new session (the runner returns kStartRequested)
+  kPause = 1u << 1,   // hold at the next safe point
+  kResume = 1u << 2,
+  kStop = 1u << 3,    // stop at the end of the row in progress
+  kAck = 1u << 4,     // acknowledge a latched fault (the runner returns kAckRequested; the owner re-arms)
+  kExit = 1u << 5,    // leave the loop (service shutdown): stop at row end first when weaving
+};
+
+// Shared between the loop thread and any number of non-RT threads. Commands are bits in one atomic word
+// (set with fetch_or, taken with exchange: lock-free, no lost commands, nothing allocated); status is a
+// set of relaxed atomics the loop stores every tick, each field individually consistent.
+struct OperatorLink {
+  std::atomic<std::uint32_t> pending{0};
+  void post(Command c) noexcept { pending.fetch_or(static_cast<std::uint32_t>(c), std::memory_order_release); }
+
+  std::atomic<std::uint8_t> state{0};        // sequencer::State
+  std::atomic<std::uint8_t> first_fault{0};  // sequencer::Fault
+  std::atomic<std::uint32_t> rows{0}, picks{0}, beats{0};
+  std::atomic<std::uint32_t> overruns{0};
+  std::atomic<std::int64_t> max_wake_latency_ns{0};
+  std::atomic<std::int64_t> tick{0};
+};
+
+// ---------------------------------------------------------------------------------------------------
+// Events for the non-RT side.
+// ---------------------------------------------------------------------------------------------------
 struct RunEvent {
-  enum class Kind : std::uint8_t { kRowDone, kPickDone, kPaused, kResumed, kFinished } kind = Kind::kRowDone;
+  enum class Kind : std::uint8_t { kRowDone, kPickDone, kPaused, kResumed, kFault, kOverrunStop, kFinished };
+  Kind kind = Kind::kRowDone;
   hal::Tick tick = 0;
   sequencer::RowStats row{};
   sequencer::Counters counters{};
   sequencer::State state = sequencer::State::kIdle;
+  sequencer::Fault fault = sequencer::Fault::kNone;  // kFault: the first fault
+  sequencer::Fault stopped_by = sequencer::Fault::kNone;
+  int fault_axis = -1;
+  std::uint16_t fault_detail = 0;
 };
+// Run events waiting for the reporter. An event is at most one per row, pick, pause, resume or fault,
+// and a pick is never shorter than a shed change (hundreds of ms), so 1024 pending events cover a
+// reporter stalled for minutes (e.g. an fsync on a slow SD card). Overflow is counted, never waited on;
+// the next event carries the full counters again, so a counter save is never lost for long.
+inline constexpr std::size_t kEventRingCapacity = 1024;
 
 struct RunOptions {
   double period_s = 0.002;
@@ -38,20 +107,58 @@ struct RunOptions {
   hal::Tick grace_ticks = 100;   // ticks run after the sequencer finishes (quick stop reaches the drives)
   const std::atomic<bool>* stop_flag = nullptr;   // set asynchronously → stop at row end
   const std::atomic<bool>* pause_flag = nullptr;  // true → pause at the next safe point, false → resume
+
+  // Real-time thread (realtime only).
+  int fifo_priority = 80;        // SCHED_FIFO priority of the loop thread; 0 = SCHED_OTHER
+  bool require_fifo = false;     // true: refuse to run (RunResult::error) when SCHED_FIFO is not granted
+  int cpu = -1;                  // pin the loop thread to this CPU (an isolated one); -1 = any
+  std::size_t stack_bytes = 512u << 10;  // loop thread stack, pre-faulted before the first tick
+  // Overrun policy: this many consecutive overruns latch loop_overrun (safe stop). 0 = count only.
+  std::uint32_t overrun_stop_after = 0;
+
+  // Operator commands and live status (serve). With `hold_when_finished` the loop keeps cycling after
+  // the sequencer is done or faulted (drives held / quick-stopped) until a command ends the session.
+  OperatorLink* link = nullptr;
+  bool operator_buttons = false;   // the I/O node's start/pause/ack buttons act like the commands
+  bool hold_when_finished = false;
+
+  LoopClock* clock = nullptr;      // nullptr = MonotonicClock
 };
 
 struct RunResult {
+  enum class End : std::uint8_t { kFinished, kMaxTicks, kExitRequested, kStartRequested, kAckRequested, kError };
+  End end = End::kFinished;
+  std::string error;  // kError: why the loop could not start (e.g. SCHED_FIFO refused)
   hal::Tick ticks = 0;
   double wall_s = 0.0;
   std::uint32_t overruns = 0;
+  std::uint32_t max_consecutive_overruns = 0;
+  bool overrun_stop = false;       // the overrun policy latched loop_overrun
   std::int64_t max_tick_cost_ns = 0;
   std::int64_t median_tick_cost_ns = 0;  // from a fixed-size histogram, no allocation while running
+  std::int64_t p999_tick_cost_ns = 0;
+  // Real time only: how late the loop woke after each deadline.
+  std::int64_t wake_latency_p50_ns = 0, wake_latency_p99_ns = 0, wake_latency_max_ns = 0;
+  std::uint64_t events_dropped = 0;
+  // What the loop thread actually ran at (realtime only; read back with pthread_getschedparam inside it).
+  int loop_policy = -1;            // SCHED_FIFO, SCHED_OTHER, ...; -1 = ran on the caller (virtual time)
+  int loop_priority = 0;
+  bool fifo_refused = false;       // SCHED_FIFO was requested and refused; the loop ran at SCHED_OTHER
+  // Achieved speed against the request: machine seconds per wall second (pace in real time).
+  double achieved_ratio = 0.0;
+  bool fell_behind = false;        // realtime and the achieved ratio is below 97 % of the requested pace
 };
 
-// Non-RT callback for row completions and the end of the run. In virtual time it is called between
-// ticks; in real time from a separate reporter thread fed through a lock-free ring.
+// Non-RT callback for row completions, faults and the end of the run. In virtual time it is called
+// between ticks; in real time on the caller's thread (SCHED_OTHER), fed through a lock-free ring.
 using EventHandler = std::function<void(const RunEvent&)>;
 
+// Runs the loop until the sequencer finishes (plus grace), max_ticks, or — with a link — a command ends
+// the session. In real time the caller's thread becomes the reporter while a new thread runs the loop.
 RunResult run_loop(ControlLoop& loop, sequencer::Sequencer& seq, const RunOptions& opt, const EventHandler& on_event);
+
+// One line for the end of a run: ticks, wall time, achieved ratio, tick cost p50/p99.9/max, wake-up
+// latency p50/p99/max, overruns, dropped events; and a WARNING line when it fell behind.
+std::string describe_run(const RunResult& r, const RunOptions& opt);
 
 }  // namespace loom::firmware

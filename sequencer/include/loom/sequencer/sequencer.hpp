@@ -108,6 +108,9 @@ class Sequencer {
   // RT-safe. Acknowledge a latched fault: the drives get their fault-reset edge, the machine goes idle
   // and re-arms from measured positions on the next start. (The operator's ack button does the same.)
   void request_acknowledge() noexcept { ack_requested_ = true; }
+  // RT-safe. A fault found outside the sequencer (the runner's overrun policy): latched at the next step
+  // with the same reaction as any other fault (quick stop, valves hold, counters kept).
+  void request_safe_stop(Fault f) noexcept { external_fault_ = f; }
 
   // RT-safe. One tick: check faults → advance the row cycle → sample profiles → check interlocks →
   // write every field of `out`.
@@ -192,6 +195,7 @@ class Sequencer {
   bool stop_now_requested_ = false;
   bool ack_requested_ = false;
   bool acknowledged_this_tick_ = false;
+  Fault external_fault_ = Fault::kNone;  // set by request_safe_stop, latched at the next step
 
   Fault first_fault_ = Fault::kNone;
   Fault stopped_by_ = Fault::kNone;

@@ -1,0 +1,55 @@
+// The board-side subcommands of loomctl: `serve` (what the systemd unit runs: configure, arm, wait for
+// the operator) and `ctl` (the operator's client for serve's control socket), plus `--version` and the
+// man-style help footer. main() registers them with one call and runs the chosen one after parsing.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <memory>
+#include <optional>
+#include <string>
+
+namespace loom::firmware::serve {
+
+const char* version();  // e.g. "0.1.0", from the CMake project version
+
+struct ServeArgs {
+  std::string config;              // "" → /etc/loomctl/loom.toml when present, else the embedded default
+  std::string scene;               // sim HAL only
+  std::string hal = "sim";
+  std::string iface;
+  std::string state_dir = "/var/lib/loomctl";
+  std::string socket;              // "" → /run/loomctl/<loom-id>.sock
+  std::string group = "loom";
+  std::string loom_id, lcm_url;
+  std::uint32_t rows = 0;          // rows per `start` (0: until `stop`)
+  double pace = 1.0;               // sim only: run this many times faster than real time
+  int rt_priority = 80;
+  int cpu = -1;
+  std::uint32_t overrun_stop = 10;
+  bool allow_degraded = false, no_telemetry = false;
+};
+int serve_main(const ServeArgs& a);
+
+struct CtlArgs {
+  std::string command;
+  std::string socket;
+  std::string loom_id = "loom1";
+  int timeout_ms = 5000;
+};
+int ctl_main(const CtlArgs& a);
+
+// Adds `serve`, `ctl`, `--version` and the help footer to `app`. After app.parse(), run() executes the
+// chosen board subcommand and returns its exit code, or nullopt when another subcommand was chosen.
+class BoardCommands {
+ public:
+  explicit BoardCommands(CLI::App& app);
+  std::optional<int> run() const;
+
+ private:
+  CLI::App* serve_ = nullptr;
+  CLI::App* ctl_ = nullptr;
+  std::unique_ptr<ServeArgs> serve_args_ = std::make_unique<ServeArgs>();
+  std::unique_ptr<CtlArgs> ctl_args_ = std::make_unique<CtlArgs>();
+};
+
+}  // namespace loom::firmware::serve

@@ -1,0 +1,282 @@
+// `loomctl serve`: the service a board runs. Configures the loom, arms it (drives stay disabled, valves
+// hold), and waits: weaving starts, pauses, resumes, stops at row end and faults are acknowledged only on
+// an operator command (control socket or the I/O node's buttons). Counters, the simulated machine's
+// state and the fault history live in the state directory, so a board that reboots after a power cut
+// comes up resumable — armed at the same row and pick — and not moving.
+//
+// Sessions: one Machine per session. A session ends when the service stops, when `start` comes after the
+// rows were woven (a new session starts weaving at once), or when a fault is acknowledged (a new
+// session re-arms from the measured positions and waits).
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include "loom/firmware/config.hpp"
+#include "loom/firmware/counter_store.hpp"
+#include "loom/firmware/machine.hpp"
+#include "loom/firmware/runner.hpp"
+#include "loom/firmware/serve/commands.hpp"
+#include "loom/firmware/serve/control_socket.hpp"
+#include "loom/firmware/serve/fault_history.hpp"
+#include "loom/firmware/serve/journal.hpp"
+
+namespace loom::firmware::serve {
+namespace {
+
+constexpr int kExitOk = 0, kExitBadInput = 2, kExitNotArmed = 4;
+constexpr const char* kEtcConfig = "/etc/loomctl/loom.toml";
+
+OperatorLink* g_link = nullptr;
+extern "C" void on_terminate(int) {
+  if (g_link != nullptr) g_link->post(Command::kExit);  // lock-free fetch_or: async-signal-safe
+}
+
+std::string axis_label(int axis) {
+  return axis >= 0 ? hal::axis_name(static_cast<hal::Axis>(axis)) : "";
+}
+
+std::string status_text(const OperatorLink& l, const std::string& loom_id) {
+  constexpr auto r = std::memory_order_relaxed;
+  const auto f = static_cast<sequencer::Fault>(l.first_fault.load(r));
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "loom=%s state=%s rows=%u picks=%u beats=%u fault=%s overruns=%u max_wake_latency_ns=%lld tick=%lld\n",
+                loom_id.c_str(), sequencer::state_name(static_cast<sequencer::State>(l.state.load(r))),
+                l.rows.load(r), l.picks.load(r), l.beats.load(r),
+                f == sequencer::Fault::kNone ? "none" : sequencer::fault_name(f), l.overruns.load(r),
+                static_cast<long long>(l.max_wake_latency_ns.load(r)), static_cast<long long>(l.tick.load(r)));
+  return buf;
+}
+
+}  // namespace
+
+int serve_main(const ServeArgs& a) {
+  // ---- configure: every input error is reported here, before anything is armed ----
+  LoomConfig cfg;
+  Scene scene;
+  std::string config_path = a.config;
+  if (config_path.empty() && std::filesystem::exists(kEtcConfig)) config_path = kEtcConfig;
+  const bool hardware = a.hal == "socketcan";
+  try {
+    cfg = config_path.empty() ? default_loom_config() : load_loom_config(config_path);
+    if (!a.scene.empty()) scene = load_scene(a.scene);
+    else scene = default_scene();
+    if (!a.loom_id.empty()) cfg.loom_id = a.loom_id;
+    if (!a.lcm_url.empty()) cfg.telemetry.lcm_url = a.lcm_url;
+    if (hardware && a.pace != 1.0) throw ConfigError("--pace = " + std::to_string(a.pace) + ": simulation only");
+    if (hardware && a.iface.empty()) throw ConfigError("--hal socketcan needs --iface NAME");
+  } catch (const ConfigError& e) {
+    log(Severity::kErr, "loomctl serve: %s", e.what());
+    return kExitBadInput;
+  }
+  std::error_code ec;
+  std::filesystem::create_directories(a.state_dir, ec);
+  if (ec || !std::filesystem::is_directory(a.state_dir)) {
+    log(Severity::kErr, "loomctl serve: state directory %s cannot be created: %s", a.state_dir.c_str(),
+        ec ? ec.message().c_str() : "not a directory");
+    return kExitBadInput;
+  }
+  const std::string state = std::filesystem::path(a.state_dir).string();
+  CounterStore store(state + "/counters.json");
+  FaultHistory history(state + "/faults.log");
+  const std::string socket_path = a.socket.empty() ? "/run/loomctl/" + cfg.loom_id + ".sock" : a.socket;
+
+  // Real time: memory locked and SCHED_FIFO probed for the loop thread only (this thread, the control
+  // thread and the telemetry publisher stay SCHED_OTHER).
+  if (hardware) {
+    const RtSetup rt = setup_realtime(a.rt_priority);
+    if (!rt.ok()) {
+      if (!a.allow_degraded) {
+        log(Severity::kErr, "loomctl serve: refusing to arm: real-time setup failed (%s) — check LimitRTPRIO/"
+            "LimitMEMLOCK or pass --allow-degraded", rt.problems.c_str());
+        return kExitNotArmed;
+      }
+      log(Severity::kWarning, "RUNNING DEGRADED: %s timing is not guaranteed", rt.problems.c_str());
+    }
+  }
+
+  OperatorLink link;
+  g_link = &link;
+  std::signal(SIGTERM, on_terminate);
+  std::signal(SIGINT, on_terminate);
+
+  std::unique_ptr<ControlServer> server;
+  try {
+    server = std::make_unique<ControlServer>(socket_path, a.group, [&](const std::string& req) -> std::string {
+      if (req == "start") link.post(Command::kStart);
+      else if (req == "pause") link.post(Command::kPause);
+      else if (req == "resume") link.post(Command::kResume);
+      else if (req == "stop") link.post(Command::kStop);
+      else if (req == "ack") link.post(Command::kAck);
+      else if (req == "status") return status_text(link, cfg.loom_id);
+      else if (req == "faults") {
+        std::string out;
+        for (const std::string& line : history.read_all()) out += line + "\n";
+        return out.empty() ? "no faults recorded in " + history.path() + "\n" : out;
+      } else if (req == "next") {
+        return "error: next: this loom has no knotting mode (the sequencer waits for no 'row knotted')\n";
+      } else {
+        return "error: unknown command '" + req + "' (start, pause, resume, stop, ack, status, faults, next)\n";
+      }
+      log(Severity::kNotice, "operator: %s (control socket)", req.c_str());
+      return "ok " + req + "\n";
+    });
+  } catch (const std::exception& e) {
+    log(Severity::kErr, "loomctl serve: %s", e.what());
+    return kExitBadInput;
+  }
+  if (!server->group_note().empty()) log(Severity::kWarning, "%s", server->group_note().c_str());
+  log(Severity::kNotice, "loomctl %s serve: loom '%s' (%s), HAL %s%s%s, state %s, control socket %s", version(),
+      cfg.loom_id.c_str(), cfg.source.c_str(), a.hal.c_str(), hardware ? " " : "", hardware ? a.iface.c_str() : "",
+      state.c_str(), socket_path.c_str());
+
+  bool start_at_once = false;
+  for (;;) {
+    // ---- arm one session from what is on disk ----
+    sequencer::Counters resume{};
+    try {
+      if (auto c = store.load()) resume = *c;
+    } catch (const ConfigError& e) {
+      log(Severity::kErr, "loomctl serve: %s", e.what());
+      return kExitBadInput;
+    }
+    MachineOptions mo;
+    mo.hal = hardware ? HalKind::kSocketCan : HalKind::kSim;
+    mo.iface = a.iface;
+    mo.telemetry = !a.no_telemetry;
+    mo.lossless_telemetry = false;  // real time: a slow subscriber loses snapshots, never delays a tick
+    mo.rows = a.rows == 0 ? 0 : resume.rows + a.rows;
+    if (!hardware) mo.sim_state_path = state + "/sim-state.bin";
+    std::unique_ptr<Machine> machine;
+    try {
+      machine = std::make_unique<Machine>(cfg, scene, mo, resume);
+    } catch (const ConfigError& e) {
+      log(Severity::kErr, "loomctl serve: %s", e.what());
+      return kExitBadInput;
+    } catch (const std::exception& e) {
+      log(Severity::kErr, "loomctl serve: cannot arm: %s", e.what());
+      return kExitNotArmed;
+    }
+    auto& seq = machine->sequencer();
+    if (start_at_once) {
+      seq.request_start();
+      start_at_once = false;
+    }
+    log(Severity::kNotice, "armed, %s: rows %u, picks %u (%u in the row in progress), beats %u",
+        seq.state() == sequencer::State::kIdle ? "waiting for the operator (ctl start or the start button)"
+                                               : "weaving",
+        resume.rows, resume.picks, resume.picks_in_row, resume.beats);
+
+    const double period = cfg.sequencer.period_s;
+    const auto on_event = [&](const RunEvent& e) {
+      machine->collect_retired_recipes();
+      switch (e.kind) {
+        case RunEvent::Kind::kRowDone:
+          log(Severity::kInfo, "row %u done: %.2f s, %d beats, %d carriage steps (picks %u, beats %u)", e.row.row,
+              static_cast<double>(e.row.total_ticks) * period, e.row.beats, e.row.carriage_steps, e.counters.picks,
+              e.counters.beats);
+          break;
+        case RunEvent::Kind::kPaused:
+        case RunEvent::Kind::kResumed:
+          log(Severity::kNotice, "%s after row %u, pick %u", e.kind == RunEvent::Kind::kPaused ? "paused" : "resumed",
+              e.counters.rows, e.counters.picks);
+          break;
+        case RunEvent::Kind::kFault:
+        case RunEvent::Kind::kOverrunStop: {
+          const bool overrun = e.kind == RunEvent::Kind::kOverrunStop;
+          const sequencer::Fault f = overrun ? sequencer::Fault::kLoopOverrun : e.fault;
+          FaultRecord r;
+          r.loom_id = cfg.loom_id;
+          r.kind = overrun ? "overrun_stop" : "fault";
+          r.name = sequencer::fault_name(f);
+          r.code = sequencer::fault_code(f);
+          r.axis = overrun ? "" : axis_label(e.fault_axis);
+          r.device_code = overrun ? 0 : e.fault_detail;
+          r.rows = e.counters.rows;
+          r.picks = e.counters.picks;
+          r.beats = e.counters.beats;
+          r.text = sequencer::fault_text(f);
+          if (!overrun && e.stopped_by != e.fault) r.text += std::string(" (motion stopped on ") +
+                                                            sequencer::fault_name(e.stopped_by) + ")";
+          log(Severity::kErr, "FAULT %s (0x%04X)%s%s: %s; rows %u, picks %u — acknowledge with ctl ack or the ack "
+              "button", r.name.c_str(), r.code, r.axis.empty() ? "" : " axis ", r.axis.c_str(), r.text.c_str(),
+              r.rows, r.picks);
+          try {
+            history.append(r);
+          } catch (const std::exception& ex) {
+            log(Severity::kErr, "%s", ex.what());
+          }
+          break;
+        }
+        case RunEvent::Kind::kPickDone:
+        case RunEvent::Kind::kFinished:
+          break;
+      }
+      try {
+        store.save(e.counters);
+      } catch (const std::exception& ex) {
+        log(Severity::kErr, "counters not saved: %s", ex.what());
+      }
+    };
+
+    RunOptions ro;
+    ro.period_s = period;
+    ro.realtime = true;
+    ro.pace = hardware ? 1.0 : a.pace;
+    ro.fifo_priority = a.rt_priority;
+    ro.require_fifo = hardware && !a.allow_degraded;
+    ro.cpu = a.cpu;
+    ro.overrun_stop_after = a.overrun_stop;
+    ro.link = &link;
+    ro.operator_buttons = true;
+    ro.hold_when_finished = true;
+    const RunResult res = run_loop(machine->loop(), seq, ro, on_event);
+    if (auto* tm = machine->telemetry()) tm->stop();
+    const std::string summary = describe_run(res, ro);
+    log(res.fell_behind || res.overrun_stop ? Severity::kWarning : Severity::kInfo, "%s", summary.c_str());
+
+    switch (res.end) {
+      case RunResult::End::kError:
+        log(Severity::kErr, "loomctl serve: %s", res.error.c_str());
+        return kExitNotArmed;
+      case RunResult::End::kStartRequested:
+        log(Severity::kNotice, "start after the woven rows: re-arming for the next rows");
+        start_at_once = true;
+        continue;
+      case RunResult::End::kAckRequested: {
+        FaultRecord r;
+        r.loom_id = cfg.loom_id;
+        r.kind = "ack";
+        const sequencer::Fault f = seq.first_fault();
+        r.name = sequencer::fault_name(f);
+        r.code = sequencer::fault_code(f);
+        r.rows = seq.counters().rows;
+        r.picks = seq.counters().picks;
+        r.beats = seq.counters().beats;
+        r.text = "acknowledged by the operator; re-arming from the measured positions";
+        try {
+          history.append(r);
+        } catch (const std::exception& ex) {
+          log(Severity::kErr, "%s", ex.what());
+        }
+        log(Severity::kNotice, "fault %s acknowledged: re-arming from the measured positions", r.name.c_str());
+        continue;
+      }
+      case RunResult::End::kExitRequested:
+      case RunResult::End::kFinished:
+      case RunResult::End::kMaxTicks:
+        break;
+    }
+    log(Severity::kNotice, "loomctl serve: stopped (rows %u, picks %u, beats %u kept in %s)", seq.counters().rows,
+        seq.counters().picks, seq.counters().beats, store.path().c_str());
+    break;
+  }
+  g_link = nullptr;
+  return kExitOk;
+}
+
+}  // namespace loom::firmware::serve

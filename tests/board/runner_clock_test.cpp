@@ -1,0 +1,249 @@
+// The runner's real-time pacing against an injected fake clock: deadlines stay on the period grid, an
+// overrun is counted and re-phased (never caught up in a burst), N consecutive overruns latch
+// loop_overrun (a safe stop), and the wake-up latency and tick cost it reports are the ones the clock
+// and the HAL were scripted to produce. The loop is the real one: sim HAL, real sequencer.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <vector>
+
+#include "loom/firmware/config.hpp"
+#include "loom/firmware/control_loop.hpp"
+#include "loom/firmware/runner.hpp"
+#include "loom/sim_hal/sim_world.hpp"
+
+using namespace loom;
+using firmware::RunOptions;
+using firmware::RunResult;
+
+namespace {
+
+constexpr std::int64_t kPeriodNs = 2'000'000;
+
+// Time moves only when the loop sleeps (to the deadline plus a scripted wake-up latency) or when the
+// HAL "works" (the scripted cost of a tick). Only the loop thread touches it while the loop runs.
+class FakeClock final : public firmware::LoopClock {
+ public:
+  std::int64_t now_ns() noexcept override { return now_; }
+  void sleep_until(std::int64_t d) noexcept override {
+    sleeps.push_back(d);
+    now_before_sleep.push_back(now_);
+    if (d > now_) now_ = d;
+    now_ += wake_latency_ns;
+  }
+  void advance(std::int64_t ns) noexcept { now_ += ns; }
+  std::int64_t now_ = 1'000'000'000;
+  std::int64_t wake_latency_ns = 0;
+  std::vector<std::int64_t> sleeps, now_before_sleep;
+};
+
+// The simulated HAL, plus a scripted cost per tick charged to the fake clock inside cycle().
+class SlowHal final : public hal::Hal {
+ public:
+  SlowHal(hal::Hal& inner, FakeClock& clock) : inner_(inner), clock_(clock) {}
+  void read(hal::Tick now, hal::HalInputs& in) override {
+    const auto i = static_cast<std::size_t>(now);
+    clock_.advance(i < cost_ns.size() ? cost_ns[i] : default_cost_ns);
+    inner_.read(now, in);
+  }
+  void write(hal::Tick now, const hal::HalOutputs& out) override { inner_.write(now, out); }
+  std::vector<std::int64_t> cost_ns;
+  std::int64_t default_cost_ns = 10'000;
+
+ private:
+  hal::Hal& inner_;
+  FakeClock& clock_;
+};
+
+struct Rig {
+  Rig() {
+    cfg = firmware::default_loom_config();
+    profiles = std::make_unique<motion::ProfileSet>(cfg.profile);
+    seq = std::make_unique<sequencer::Sequencer>(*profiles, cfg.sequencer);
+    sim = std::make_unique<sim_hal::SimWorld>(cfg.machine, firmware::default_scene().spec);
+    port = std::make_unique<hal::PortHal>(*sim, *sim);
+    slow = std::make_unique<SlowHal>(*port, clock);
+    loop = std::make_unique<firmware::ControlLoop>(*slow, *seq, nullptr, cfg.sequencer.period_s, false);
+  }
+  RunResult run(hal::Tick ticks, std::uint32_t overrun_stop_after = 0) {
+    RunOptions o;
+    o.period_s = cfg.sequencer.period_s;
+    o.realtime = true;
+    o.fifo_priority = 0;  // the fake clock never sleeps: a SCHED_FIFO spin here would starve the machine
+    o.max_ticks = ticks;
+    o.clock = &clock;
+    o.overrun_stop_after = overrun_stop_after;
+    seq->request_start();
+    return firmware::run_loop(*loop, *seq, o, [](const firmware::RunEvent&) {});
+  }
+  firmware::LoomConfig cfg;
+  FakeClock clock;
+  std::unique_ptr<motion::ProfileSet> profiles;
+  std::unique_ptr<sequencer::Sequencer> seq;
+  std::unique_ptr<sim_hal::SimWorld> sim;
+  std::unique_ptr<hal::PortHal> port;
+  std::unique_ptr<SlowHal> slow;
+  std::unique_ptr<firmware::ControlLoop> loop;
+};
+
+}  // namespace
+
+TEST(RunnerClock, DeadlinesFollowThePeriodGridWithoutOverruns) {
+  Rig r;
+  ASSERT_EQ(r.cfg.sequencer.period_s, 0.002);
+  const std::int64_t t0 = r.clock.now_;
+  const RunResult res = r.run(500);
+  EXPECT_EQ(res.overruns, 0u);
+  ASSERT_EQ(r.clock.sleeps.size(), 500u);
+  for (std::size_t i = 0; i < r.clock.sleeps.size(); ++i) {
+    ASSERT_EQ(r.clock.sleeps[i], t0 + static_cast<std::int64_t>(i + 1) * kPeriodNs) << "tick " << i;
+  }
+}
+
+TEST(RunnerClock, AnOverrunIsCountedAndRephasedOntoTheGridWithoutABurst) {
+  Rig r;
+  const std::int64_t t0 = r.clock.now_;
+  r.slow->cost_ns.assign(20, 10'000);
+  r.slow->cost_ns[10] = 5 * kPeriodNs + 300'000;  // tick 10 takes 5.15 periods
+  const RunResult res = r.run(20);
+  EXPECT_EQ(res.overruns, 1u);
+  EXPECT_EQ(res.max_consecutive_overruns, 1u);
+  EXPECT_FALSE(res.overrun_stop);
+  ASSERT_EQ(r.clock.sleeps.size(), 20u);
+  // Ticks 0..10 slept to deadlines 1..11 periods; tick 10 woke at 11 periods and ran until 16.15.
+  // The next deadline is the first grid point after that (17 periods), not 12 (a burst of catch-ups).
+  EXPECT_EQ(r.clock.sleeps[10], t0 + 11 * kPeriodNs);
+  EXPECT_EQ(r.clock.sleeps[11], t0 + 17 * kPeriodNs);
+  for (std::size_t i = 1; i < r.clock.sleeps.size(); ++i) {
+    EXPECT_EQ((r.clock.sleeps[i] - t0) % kPeriodNs, 0) << "deadline off the grid at tick " << i;
+    EXPECT_GT(r.clock.sleeps[i], r.clock.now_before_sleep[i]) << "a deadline already past at tick " << i;
+  }
+}
+
+TEST(RunnerClock, ConsecutiveOverrunsLatchLoopOverrunAsASafeStop) {
+  Rig r;
+  r.slow->cost_ns.assign(200, 10'000);
+  for (int i = 50; i < 55; ++i) r.slow->cost_ns[static_cast<std::size_t>(i)] = kPeriodNs + 500'000;
+  const RunResult res = r.run(200, 5);
+  EXPECT_TRUE(res.overrun_stop);
+  EXPECT_EQ(res.max_consecutive_overruns, 5u);
+  EXPECT_EQ(r.seq->state(), sequencer::State::kFault);
+  EXPECT_EQ(r.seq->first_fault(), sequencer::Fault::kLoopOverrun);
+}
+
+TEST(RunnerClock, OverrunsThatAreNotConsecutiveDoNotStop) {
+  Rig r;
+  r.slow->cost_ns.assign(200, 10'000);
+  // Four in a row, one good tick, four in a row: never five consecutive.
+  for (int i : {50, 51, 52, 53, 55, 56, 57, 58}) r.slow->cost_ns[static_cast<std::size_t>(i)] = kPeriodNs + 500'000;
+  const RunResult res = r.run(200, 5);
+  EXPECT_EQ(res.overruns, 8u);
+  EXPECT_EQ(res.max_consecutive_overruns, 4u);
+  EXPECT_FALSE(res.overrun_stop);
+  EXPECT_NE(r.seq->state(), sequencer::State::kFault);
+}
+
+TEST(RunnerClock, ReportsTheScriptedWakeLatencyAndTickCost) {
+  Rig r;
+  r.clock.wake_latency_ns = 7'000;
+  r.slow->cost_ns.assign(1000, 20'000);
+  r.slow->cost_ns[500] = 900'000;  // one slow tick: the maximum, not the median
+  const RunResult res = r.run(1000);
+  // The histogram reports the middle of a bucket 1/32 wide: within 3 % of the true value.
+  EXPECT_NEAR(static_cast<double>(res.wake_latency_p50_ns), 7'000.0, 7'000.0 / 32);
+  EXPECT_NEAR(static_cast<double>(res.wake_latency_p99_ns), 7'000.0, 7'000.0 / 32);
+  EXPECT_EQ(res.wake_latency_max_ns, 7'000);
+  EXPECT_NEAR(static_cast<double>(res.median_tick_cost_ns), 20'000.0, 20'000.0 / 32);
+  EXPECT_EQ(res.max_tick_cost_ns, 900'000);
+  EXPECT_EQ(res.overruns, 0u);
+  EXPECT_EQ(r.loop->stats().max_wake_latency_ns, 7'000);
+}
+
+TEST(RunnerClock, FallingBehindThePaceIsReportedHonestly) {
+  Rig r;
+  r.slow->default_cost_ns = 3 * kPeriodNs;  // every tick takes three periods
+  RunOptions o;
+  o.period_s = 0.002;
+  o.realtime = true;
+  o.fifo_priority = 0;
+  o.max_ticks = 100;
+  o.clock = &r.clock;
+  r.seq->request_start();
+  const RunResult res = firmware::run_loop(*r.loop, *r.seq, o, [](const firmware::RunEvent&) {});
+  EXPECT_TRUE(res.fell_behind);
+  EXPECT_NEAR(res.achieved_ratio, 1.0 / 4.0, 0.05);  // 3 periods of work, re-phased to the 4th
+  const std::string text = firmware::describe_run(res, o);
+  EXPECT_NE(text.find("could not keep up"), std::string::npos) << text;
+  EXPECT_NE(text.find("0.25x real time"), std::string::npos) << text;
+}
+
+// ---- operator commands through the OperatorLink (virtual time: same handling, no thread) ----
+namespace {
+RunResult run_virtual(Rig& r, hal::Tick ticks, firmware::OperatorLink& link, bool hold = true) {
+  RunOptions o;
+  o.period_s = r.cfg.sequencer.period_s;
+  o.max_ticks = ticks;
+  o.clock = &r.clock;
+  o.link = &link;
+  o.hold_when_finished = hold;
+  return firmware::run_loop(*r.loop, *r.seq, o, [](const firmware::RunEvent&) {});
+}
+}  // namespace
+
+TEST(RunnerCommands, NothingMovesUntilStartAndStatusIsPublished) {
+  Rig r;  // note: Rig::run() would request a start; here only the link may
+  firmware::OperatorLink link;
+  run_virtual(r, 200, link);
+  EXPECT_EQ(r.seq->state(), sequencer::State::kIdle);
+  EXPECT_EQ(link.state.load(), static_cast<std::uint8_t>(sequencer::State::kIdle));
+  EXPECT_EQ(link.tick.load(), 199);
+  link.post(firmware::Command::kStart);
+  run_virtual(r, 50, link);
+  EXPECT_NE(r.seq->state(), sequencer::State::kIdle);
+  EXPECT_EQ(link.pending.load(), 0u) << "a command was left pending";
+}
+
+TEST(RunnerCommands, StopWhileIdleDoesNotCutTheNextStartShort) {
+  Rig r;
+  r.slow->default_cost_ns = 0;
+  firmware::OperatorLink link;
+  link.post(firmware::Command::kStop);
+  run_virtual(r, 10, link);
+  link.post(firmware::Command::kStart);
+  // Weave until the first row is done and a little more: rows_to_weave is 0 (until stopped), so the
+  // loom must be weaving its second row, not done.
+  RunOptions o;
+  o.period_s = r.cfg.sequencer.period_s;
+  o.clock = &r.clock;
+  o.link = &link;
+  o.hold_when_finished = true;
+  o.max_ticks = 6000;  // 12 s: the first row (about 7.6 s) done, the second under way
+  ASSERT_EQ(r.seq->counters().rows, 0u);
+  firmware::run_loop(*r.loop, *r.seq, o, [](const firmware::RunEvent&) {});
+  EXPECT_GE(r.seq->counters().rows, 1u);
+  EXPECT_NE(r.seq->state(), sequencer::State::kDone);
+  EXPECT_NE(r.seq->state(), sequencer::State::kFault) << sequencer::fault_name(r.seq->first_fault());
+}
+
+TEST(RunnerCommands, AckOfALatchedFaultEndsTheSessionForReArming) {
+  Rig r;
+  firmware::OperatorLink link;
+  r.seq->request_safe_stop(sequencer::Fault::kLoopOverrun);
+  link.post(firmware::Command::kAck);  // while not faulted yet: ignored
+  run_virtual(r, 10, link);
+  ASSERT_EQ(r.seq->state(), sequencer::State::kFault);
+  EXPECT_EQ(link.first_fault.load(), static_cast<std::uint8_t>(sequencer::Fault::kLoopOverrun));
+  link.post(firmware::Command::kAck);
+  const RunResult res = run_virtual(r, 1000, link);
+  EXPECT_EQ(res.end, RunResult::End::kAckRequested);
+  EXPECT_EQ(res.ticks, 0);
+}
+
+TEST(RunnerCommands, ExitWhileIdleLeavesAtOnce) {
+  Rig r;
+  firmware::OperatorLink link;
+  link.post(firmware::Command::kExit);
+  const RunResult res = run_virtual(r, 1000, link);
+  EXPECT_EQ(res.end, RunResult::End::kExitRequested);
+  EXPECT_LE(res.ticks, 1);
+}

@@ -1,0 +1,115 @@
+#!/usr/bin/env bash
+# loomctl serve end to end on the simulated loom (paced 25x real time, no telemetry), with a temporary
+# state directory and control socket:
+#   1. serve arms and waits: nothing moves until `ctl start`;
+#   2. `ctl start` weaves; a row completes; `ctl stop` stops at the end of the row (state done);
+#   3. SIGTERM ends the service (exit 0); restarted on the same state it comes up armed at the same
+#      row, idle (resumable, not moving); killed with SIGKILL mid-row and restarted, likewise;
+#   4. a fault scene: the fault is logged with severity <3>, kept in the fault history (`ctl faults`),
+#      and `ctl ack` re-arms (state idle again, the ack recorded);
+#   5. bad commands are refused (exit 2 from the CLI, exit 1 from the service).
+# Usage: serve_test.sh LOOMCTL SOURCE_DIR
+set -euo pipefail
+loomctl=$1
+src=$2
+work=$(mktemp -d /tmp/loom_serve_test.XXXXXX)
+pid=
+cleanup() {
+  [[ -n $pid ]] && kill -9 "$pid" 2>/dev/null || true
+  rm -rf "$work"
+}
+trap cleanup EXIT
+sock=$work/loom.sock
+fail() { echo "FAIL: $*" >&2; echo "--- serve log:" >&2; cat "$work"/serve*.log >&2 || true; exit 1; }
+ctl() { "$loomctl" ctl --socket "$sock" "$@"; }
+field() { ctl status | tr ' ' '\n' | sed -n "s/^$1=//p"; }
+start_serve() {  # start_serve LOG [extra args]
+  local log=$1; shift
+  JOURNAL_STREAM=8:1 "$loomctl" serve --state-dir "$work/state" --socket "$sock" --group "" --no-telemetry \
+    --pace 25 "$@" >"$work/$log" 2>&1 &
+  pid=$!
+  for _ in $(seq 1 200); do
+    [[ -S $sock ]] && ctl status >/dev/null 2>&1 && return 0
+    kill -0 "$pid" 2>/dev/null || fail "serve exited early"
+    sleep 0.05
+  done
+  fail "serve did not open its control socket"
+}
+wait_for() {  # wait_for FIELD VALUE SECONDS
+  local i
+  for i in $(seq 1 $(($3 * 20))); do
+    [[ $(field "$1") == "$2" ]] && return 0
+    sleep 0.05
+  done
+  fail "waited $3 s for $1=$2; status: $(ctl status)"
+}
+stop_serve() {
+  kill -TERM "$pid"
+  local rc=0
+  wait "$pid" || rc=$?
+  pid=
+  [[ $rc -eq 0 ]] || fail "serve exited $rc on SIGTERM"
+}
+
+# 1. armed and waiting
+start_serve serve1.log
+sleep 0.5
+[[ $(field state) == idle ]] || fail "not idle before start: $(ctl status)"
+[[ $(field tick) -gt 100 ]] || fail "the loop is not cycling while waiting: $(ctl status)"
+[[ $(stat -c %a "$sock") == 660 ]] || fail "socket mode $(stat -c %a "$sock"), want 660"
+grep -q '^<5>armed, waiting for the operator' "$work/serve1.log" || fail "no <5> armed line"
+
+# 2. start → a row → stop at row end
+ctl start | grep -q '^ok start' || fail "start not acknowledged"
+wait_for rows 1 30
+ctl stop >/dev/null
+wait_for state done 30
+rows=$(field rows)
+[[ $rows -ge 1 ]] || fail "no row woven"
+grep -q '^<6>row 1 done' "$work/serve1.log" || fail "no <6> row line"
+ctl faults | grep -q 'no faults recorded' || fail "a fault recorded on a clean run"
+ctl next 2>/dev/null && fail "next accepted without a knotting mode"
+
+# 3. restart on the same state: armed at the same row, idle
+stop_serve
+grep -q '^<5>loomctl serve: stopped' "$work/serve1.log" || fail "no stop line"
+[[ -f $work/state/counters.json ]] || fail "no counters in the state dir"
+start_serve serve2.log
+[[ $(field state) == idle ]] || fail "restart is not idle: $(ctl status)"
+[[ $(field rows) == "$rows" ]] || fail "restart lost rows: $(ctl status), want rows=$rows"
+# start again, kill -9 mid-row (power cut), restart: idle at the same row with the picks kept
+ctl start >/dev/null
+wait_for state beat_sweep 30
+kill -9 "$pid"; wait "$pid" 2>/dev/null || true; pid=
+rm -f "$sock"
+start_serve serve3.log
+[[ $(field state) == idle ]] || fail "not idle after a power cut: $(ctl status)"
+[[ $(field rows) == "$rows" ]] || fail "rows changed by a power cut: $(ctl status)"
+grep -q "rows $rows, picks" "$work/serve3.log" || fail "armed line does not name the resumed counters"
+ctl start >/dev/null
+wait_for rows $((rows + 1)) 30
+ctl stop >/dev/null
+wait_for state done 30
+stop_serve
+
+# 4. a fault: logged <3>, in the history, acknowledged → idle, ack recorded
+rm -rf "$work/state"
+start_serve serve4.log --scene "$src/sim_hal/scenes/drive_fault.toml"
+ctl start >/dev/null
+wait_for state fault 60
+grep -q '^<3>FAULT drive_fault' "$work/serve4.log" || fail "no <3> FAULT line"
+ctl faults | grep -q ' fault loom1 drive_fault 0x1002' || fail "fault not in the history: $(ctl faults)"
+ctl ack >/dev/null
+wait_for state idle 30
+ctl faults | grep -q ' ack loom1 drive_fault' || fail "ack not in the history: $(ctl faults)"
+stop_serve
+[[ -s $work/state/faults.log ]] || fail "no faults.log in the state dir"
+
+# 5. refusals
+set +e
+"$loomctl" ctl --socket "$sock" dance 2>/dev/null; rc=$?
+[[ $rc -eq 2 ]] || fail "unknown ctl command exit $rc, want 2"
+"$loomctl" ctl --socket "$work/none.sock" status 2>/dev/null; rc=$?
+[[ $rc -eq 1 ]] || fail "ctl without a server exit $rc, want 1"
+set -e
+echo "serve_test: ok"
