@@ -37,7 +37,7 @@ struct CanSettings {
   double bus_load_budget = 0.7;
   std::uint8_t node_beat_crank = 1, node_carriage = 2, node_helix = 3;
   double counts_per_rev = 1048576.0;
-  double carriage_counts_per_m = 1.0e6;
+  double carriage_counts_per_m = 104857600.0;  // 2^20 counts per 10 mm
   std::uint16_t heartbeat_ms = 100;
   std::uint16_t heartbeat_timeout_ms = 250;
   std::uint16_t sdo_timeout_ms = 500;
