@@ -27,7 +27,12 @@ namespace {
 constexpr int kExitOk = 0, kExitBadInput = 2, kExitFault = 3, kExitNotArmed = 4;
 std::atomic<bool> g_stop{false};
 std::atomic<bool> g_reload{false};
-extern "C" void on_signal(int) { g_stop.store(true); }
+std::atomic<bool> g_stop_now{false};
+// The first SIGINT/SIGTERM stops at the end of the row; a second one stops at once (safe stop: quick
+// stop of every axis, valves hold, counters kept, fault stop_requested).
+extern "C" void on_signal(int) {
+  if (g_stop.exchange(true)) g_stop_now.store(true);
+}
 extern "C" void on_hangup(int) { g_reload.store(true); }
 std::atomic<bool> g_pause{false};
 extern "C" void on_pause(int) { g_pause.store(true); }
@@ -250,6 +255,7 @@ int weave(const WeaveArgs& a) {
   ro.pace = hardware ? 1.0 : a.pace;
   ro.grace_ticks = static_cast<hal::Tick>(0.2 / period);
   ro.stop_flag = &g_stop;
+  ro.stop_now_flag = &g_stop_now;
   ro.pause_flag = &g_pause;
   ro.require_fifo = hardware && !a.allow_degraded;
   ro.overrun_stop_after = hardware ? 10 : 0;

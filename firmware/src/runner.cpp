@@ -187,6 +187,10 @@ class LoopBody {
       seq_.request_stop_at_row_end();
       stop_sent_ = true;
     }
+    if (opt_.stop_now_flag != nullptr && !stop_now_sent_ && opt_.stop_now_flag->load(std::memory_order_relaxed)) {
+      seq_.request_stop_now();
+      stop_now_sent_ = true;
+    }
     if (opt_.pause_flag != nullptr) {
       opt_.pause_flag->load(std::memory_order_relaxed) ? seq_.request_pause() : seq_.request_resume();
     }
@@ -295,7 +299,7 @@ class LoopBody {
   LoopStats& stats_;
   std::uint32_t rows_seen_ = 0, picks_seen_ = 0;
   bool was_paused_ = false, was_fault_ = false;
-  bool stop_sent_ = false, exit_pending_ = false;
+  bool stop_sent_ = false, stop_now_sent_ = false, exit_pending_ = false;
   bool prev_start_ = false, prev_pause_ = false, prev_ack_ = false;
 };
 

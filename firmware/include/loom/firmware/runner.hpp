@@ -106,6 +106,7 @@ struct RunOptions {
   hal::Tick max_ticks = 0;       // 0 = no limit
   hal::Tick grace_ticks = 100;   // ticks run after the sequencer finishes (quick stop reaches the drives)
   const std::atomic<bool>* stop_flag = nullptr;   // set asynchronously → stop at row end
+  const std::atomic<bool>* stop_now_flag = nullptr;  // set asynchronously → safe stop at once (stop_requested)
   const std::atomic<bool>* pause_flag = nullptr;  // true → pause at the next safe point, false → resume
 
   // Real-time thread (realtime only).
