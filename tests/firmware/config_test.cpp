@@ -2,6 +2,8 @@
 // started. Also the embedded defaults parse and the shipped scenes load.
 #include <gtest/gtest.h>
 
+#include "cli_run.hpp"
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -24,19 +26,8 @@ std::string config_error(const std::string& text) {
   return "";
 }
 
-struct CliRun {
-  int exit_code;
-  std::string output;
-};
-CliRun run_loomctl(const std::string& args) {
-  const std::string cmd = std::string(LOOMCTL_PATH) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[512];
-  while (fgets(buf, sizeof buf, p)) out += buf;
-  const int st = pclose(p);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
-}
+using loom::test::CliRun;
+CliRun run_loomctl(const std::string& args) { return loom::test::run_command(std::string(LOOMCTL_PATH) + " " + args); }
 std::string write_temp(const std::string& name, const std::string& text) {
   const auto path = std::filesystem::temp_directory_path() / name;
   std::ofstream(path) << text;

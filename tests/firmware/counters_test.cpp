@@ -2,6 +2,8 @@
 // wrapped), the counts agree with each other, a counters file that cannot be written refuses to arm,
 // and a save that fails mid-run stops the loom at the end of the row with a named fault.
 #include <gtest/gtest.h>
+
+#include "cli_run.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -29,19 +31,8 @@ std::string parse_error(const std::string& text) {
   return "";
 }
 
-struct CliRun {
-  int exit_code;
-  std::string output;
-};
-CliRun run_loomctl(const std::string& args) {
-  const std::string cmd = std::string(LOOMCTL_PATH) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[512];
-  while (fgets(buf, sizeof buf, p)) out += buf;
-  const int st = pclose(p);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
-}
+using loom::test::CliRun;
+CliRun run_loomctl(const std::string& args) { return loom::test::run_command(std::string(LOOMCTL_PATH) + " " + args); }
 
 fs::path temp_dir(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("loom_counters_" + std::to_string(::getpid()) + "_" + name);
