@@ -318,6 +318,8 @@ const std::vector<Key>& keys() {
     v.push_back(number("timing.pick_timeout_margin_s", M::kRun, 0.01, 60.0, [](LoomConfig& c) -> double& { return c.run.pick_timeout_margin_s; }));
     v.push_back(millis("timing.stale_timeout_ms", M::kRun, 0.5, 10000.0, [](LoomConfig& c) -> double& { return c.run.stale_timeout_s; }));
     v.push_back(integer<int>("timing.debounce_ticks", M::kRun, 1, 100, [](LoomConfig& c) -> int& { return c.run.debounce_ticks; }));
+    v.push_back(integer<std::uint32_t>("timing.overrun_stop_after", M::kRun, 0, 1'000'000,
+                                       [](LoomConfig& c) -> std::uint32_t& { return c.run.overrun_stop_after; }));
     // [telemetry] (run)
     {
       Key url{"telemetry.lcm_url", M::kRun, "LCM provider URL, \"\" = LCM's default", false, nullptr, nullptr};

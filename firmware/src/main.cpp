@@ -258,7 +258,7 @@ int weave(const WeaveArgs& a) {
   ro.stop_now_flag = &g_stop_now;
   ro.pause_flag = &g_pause;
   ro.require_fifo = hardware && !a.allow_degraded;
-  ro.overrun_stop_after = hardware ? 10 : 0;
+  ro.overrun_stop_after = hardware ? cfg.run.overrun_stop_after : 0;
   const firmware::RunResult res = firmware::run_loop(machine->loop(), seq, ro, on_event);
   if (auto* tm = machine->telemetry()) tm->stop();
   if (res.end == firmware::RunResult::End::kError) {

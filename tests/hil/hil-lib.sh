@@ -189,7 +189,8 @@ hil_start_sim_drives() {
   local rt=()
   chrt -f 90 true 2>/dev/null && rt=(chrt -f 90)
   hil_spawn sim "${rt[@]}" "$HIL_SIM" --iface "$HIL_IFACE" --nodes "$HIL_NODES" --io-node "$HIL_IO_NODE" \
-    --io-control "$HIL_IO_CONTROL" --width-m 0.6 --personality "$HIL_PERSONALITY"
+    --io-control "$HIL_IO_CONTROL" --width-m 0.6 --personality "$HIL_PERSONALITY" \
+    --plant-cycle-ms "$HIL_PERIOD_MS"
   HIL_SIM_PID=$HIL_LAST_PID
   for n in ${HIL_NODES//,/ } $HIL_IO_NODE; do
     hil_expect "$mark" "$(printf '%03X' $((0x700 + n)))#00" 10 "boot-up of simulated node $n" >/dev/null

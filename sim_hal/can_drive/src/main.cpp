@@ -85,6 +85,7 @@ int main(int argc, char** argv) {
   std::vector<double> counts_per_unit;
   std::vector<double> initial_position;
   std::uint32_t max_step_counts = 0;
+  double plant_cycle_ms = 0.0;
   bool verbose = false;
   int io_node = 0;
   std::string personality = "standard";
@@ -108,6 +109,9 @@ int main(int argc, char** argv) {
       ->delimiter(',');
   app.add_option("--initial-position", initial_position, "initial position per node in SI units")
       ->delimiter(',');
+  app.add_option("--plant-cycle-ms", plant_cycle_ms,
+                 "I/O node plant: advance this much machine time per SYNC (0 = wall clock)")
+      ->check(CLI::Range(0.0, 100.0));
   app.add_option("--max-step-counts", max_step_counts,
                  "largest target step per SYNC before a following-error fault (0 = off)");
   app.add_flag("--verbose", verbose, "print NMT and drive state changes");
@@ -189,6 +193,7 @@ int main(int argc, char** argv) {
     ic.node_id = static_cast<std::uint8_t>(io_node);
     ic.width_m = width_m;
     ic.helix_lead_m = helix_lead_m;
+    ic.plant_cycle_s = plant_cycle_ms * 1e-3;
     io = std::make_unique<loom::sim_can::SimIoNode>(bus, ic);
     const double crank_cpr = counts_per_unit.empty() ? default_counts_per_unit(0) : counts_per_unit[0];
     const double helix_cpr =

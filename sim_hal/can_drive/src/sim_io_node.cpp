@@ -274,6 +274,7 @@ void SimIoNode::send_tpdo(int pdo) {
 
 void SimIoNode::on_sync() {
   ++syncs_;
+  ++syncs_total_;
   for (int k = 0; k < 4; ++k) {
     if (rpdo_pending_[static_cast<std::size_t>(k)]) {
       rpdo_pending_[static_cast<std::size_t>(k)] = false;
@@ -423,8 +424,12 @@ void SimIoNode::update_inputs() {
 
 void SimIoNode::step(std::int64_t now_us, const IoPlant& plant) {
   plant_ = plant;
-  const double dt = last_step_us_ < 0 ? 0.0 : static_cast<double>(now_us - last_step_us_) * 1e-6;
+  double dt = last_step_us_ < 0 ? 0.0 : static_cast<double>(now_us - last_step_us_) * 1e-6;
   last_step_us_ = now_us;
+  if (config_.plant_cycle_s > 0.0) {  // machine time = SYNCs seen × the controller's cycle
+    dt = static_cast<double>(syncs_total_ - syncs_at_last_step_) * config_.plant_cycle_s;
+    syncs_at_last_step_ = syncs_total_;
+  }
   if (!powered_) return;
   // Pistons follow their valve coils (as the outputs really are, error state included).
   const std::uint8_t out = outputs(0);

@@ -115,6 +115,7 @@ struct RunSettings {
   double pick_timeout_margin_s = 0.5;
   double stale_timeout_s = 0.05;
   int debounce_ticks = 3;
+  std::uint32_t overrun_stop_after = 10;  // on hardware: this many overruns in a row → safe stop (0 = never)
 };
 
 struct TelemetrySettings {

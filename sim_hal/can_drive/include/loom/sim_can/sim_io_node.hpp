@@ -37,6 +37,11 @@ struct SimIoConfig {
   double helix_lead_m = 0.1;         // shuttle travel per helix turn
   double selvedge_window_m = 0.005;  // shuttle sensor sees the shuttle this close to its selvedge
   double piston_travel_s = 0.25;     // valve switched → the piston reaches its other end
+  // > 0: the plant (pistons) advances this much per SYNC received — machine time follows the
+  // controller's cycle, as it does on a real loom whose controller keeps time. 0: wall-clock time.
+  // (A controller under emulation runs slower than real time; a wall-clock plant then moves faster
+  // than any frame can, and the sequencer rightly calls that a sensor fault.)
+  double plant_cycle_s = 0.0;
   double beat_peak_n = 90.0;         // load-cell force at the fell
   double fell_crank_rad = 3.14159265358979;  // crank angle (mod 2π) at which the beater meets the fell
   double load_cell_n_per_count = 0.01;
@@ -106,6 +111,7 @@ class SimIoNode {
   std::int64_t master_seen_us_ = -1;
   bool comm_lost_ = false;
   std::uint32_t syncs_ = 0;
+  std::uint64_t syncs_total_ = 0, syncs_at_last_step_ = 0;  // plant_cycle_s: machine time in SYNCs
   std::array<bool, 4> rpdo_pending_{};
   std::array<std::array<std::uint8_t, 8>, 4> rpdo_data_{};
   std::array<std::uint8_t, 4> rpdo_dlc_{};
