@@ -59,7 +59,7 @@ TEST(UdpmRoundTrip, SubscriberSeesRowsAndStatesAdvanceInOrder) {
 
   lcm::LCM sub(url);
   ASSERT_TRUE(sub.good()) << "LCM could not open " << url
-                          << " (no multicast route? see ../shared/reference/lcm.md)";
+                          << " (no multicast route? udpm needs one, e.g. ip route add 224.0.0.0/4 dev lo)";
   StatusCollector collector;
   const ChannelNames ch = channel_names(kDefaultChannelPrefix, loom_id);
   sub.subscribeFunction(ch.status, &StatusCollector::on_status, &collector)->setQueueCapacity(100'000);
