@@ -17,13 +17,7 @@
 
 namespace {
 
-// A typed refusal is expected: no error at all fails the test.
-template <class F>
-loom::motion::ErrorCode code_of_call(F&& f) {
-  const auto code = loom::test::error_of(f);
-  if (!code) ADD_FAILURE() << "expected a MotionError";
-  return code.value_or(loom::motion::ErrorCode::kSingular);
-}
+using loom::test::code_of_call;
 using loom::test::message_of;
 
 using loom::motion::deg;

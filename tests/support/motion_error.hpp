@@ -5,6 +5,8 @@
 #include <optional>
 #include <string>
 
+#include <gtest/gtest.h>
+
 #include "loom/motion/errors.hpp"
 
 namespace loom::test {
@@ -27,6 +29,14 @@ std::string message_of(F&& f) {
     return e.what();
   }
   return "";
+}
+
+// A typed refusal is expected: no error at all fails the test (and kSingular stands in for "none").
+template <class F>
+motion::ErrorCode code_of_call(F&& f) {
+  const auto code = error_of(f);
+  if (!code) ADD_FAILURE() << "expected a MotionError";
+  return code.value_or(motion::ErrorCode::kSingular);
 }
 
 }  // namespace loom::test
