@@ -97,7 +97,9 @@ void read_fault(const TomlReader& r, const toml::table& t, std::size_t n,
   for (const std::string& k : fields.required) {
     if (t.get(k) == nullptr) r.fail_at(t, prefix + k, "(missing)", "a " + *kind + " fault needs " + k);
   }
-  for (const auto& [key, v] : t) {
+  for (const auto& [key, node] : t) {
+    // A named reference, not the structured binding: clang before 16 cannot capture bindings in lambdas.
+    const toml::node& v = node;
     const std::string k(key.str());
     const std::string field = prefix + k;
     if (k == "kind") continue;

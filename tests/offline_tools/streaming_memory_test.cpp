@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "sanitizer.hpp"
+
 namespace {
 
 struct Run {
@@ -36,6 +38,7 @@ Run run_child(const std::vector<std::string>& argv) {
 }
 
 void expect_constant_memory(std::vector<std::string> argv, const std::string& samples_flag) {
+  LOOM_SKIP_MEMORY_FOOTPRINT_UNDER_ASAN();
   argv.push_back(samples_flag);
   argv.push_back("50000");
   const Run small = run_child(argv);

@@ -11,6 +11,7 @@
 #include "loom/firmware/machine.hpp"
 #include "loom/firmware/runner.hpp"
 #include "loom/report/run_report.hpp"
+#include "sanitizer.hpp"
 
 using namespace loom;
 
@@ -31,6 +32,7 @@ long vm_rss_kb() {
 }  // namespace
 
 TEST(ReportMemory, RssIsFlatOverTenThousandRows) {
+  LOOM_SKIP_MEMORY_FOOTPRINT_UNDER_ASAN();
   constexpr std::uint32_t kRows = 10000;
   firmware::LoomConfig cfg = firmware::default_loom_config();
   // The default 2 ms period: 10,000 rows are ~38 M ticks of the ideal simulator.

@@ -69,7 +69,7 @@ BoardCommands::BoardCommands(CLI::App& app) {
   serve_->add_option("--rt-priority", s.rt_priority, "SCHED_FIFO priority of the loop thread (0: SCHED_OTHER)")
       ->check(CLI::Range(0, 99));
   serve_->add_option("--cpu", s.cpu, "pin the loop thread to this (isolated) CPU; -1 = any")->check(CLI::Range(-1, 1023));
-  serve_->add_option("--overrun-stop", s.overrun_stop, "consecutive overruns that stop the loom safely (0: never)");
+  serve_->add_option("--overrun-stop", s.overrun_stop, "consecutive overruns that stop the loom safely (0: never; default timing.overrun_stop_after on hardware, never in simulation)");
   serve_->add_flag("--allow-degraded", s.allow_degraded, "arm on hardware even if mlockall/SCHED_FIFO fail");
 
   CtlArgs& c = *ctl_args_;

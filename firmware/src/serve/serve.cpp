@@ -230,7 +230,7 @@ int serve_main(const ServeArgs& a) {
     ro.fifo_priority = a.rt_priority;
     ro.require_fifo = hardware && !a.allow_degraded;
     ro.cpu = a.cpu;
-    ro.overrun_stop_after = a.overrun_stop;
+    ro.overrun_stop_after = a.overrun_stop.value_or(hardware ? cfg.run.overrun_stop_after : 0);
     ro.link = &link;
     ro.operator_buttons = true;
     ro.hold_when_finished = true;

@@ -25,7 +25,9 @@ struct ServeArgs {
   double pace = 1.0;               // sim only: run this many times faster than real time
   int rt_priority = 80;
   int cpu = -1;
-  std::uint32_t overrun_stop = 10;
+  // Consecutive overruns that latch loop_overrun; unset → timing.overrun_stop_after on hardware, never in
+  // simulation (a paced simulator that falls behind endangers nothing).
+  std::optional<std::uint32_t> overrun_stop;
   bool allow_degraded = false, no_telemetry = false;
 };
 int serve_main(const ServeArgs& a);
