@@ -474,23 +474,40 @@ void Sequencer::pick(hal::Tick now, const hal::HalInputs& in) noexcept {
   const double to_goal_m = std::abs(helix - pick_goal_rad_) * lead / motion::kTwoPi;
   const double from_start_m = std::abs(helix - pick_start_rad_) * lead / motion::kTwoPi;
   const double reach = cfg_.selvedge_sensor_window_m, tol = cfg_.shuttle_follow_tolerance_m;
+  // Sensors and positions are samples. An edge is seen at the first sample after it happened, so the
+  // carrier may have gone up to one tick's travel past the switching point unseen; and when the I/O
+  // node's inputs and the helix drive's position were refreshed on different ticks, they describe the
+  // carrier up to that many ticks apart. The windows below widen by exactly these amounts (at 2 ms on
+  // a synchronous bus: ~2 mm; at 20 ms, ten times that), instead of assuming one loop period.
+  carrier_prev_step_m_ = carrier_step_m_;
+  carrier_step_m_ = std::abs(helix - prev_helix_rad_) * lead / motion::kTwoPi;
+  prev_helix_rad_ = helix;
+  const hal::Tick io_at = in.io.refreshed, helix_at = in.axes[index(Axis::kHelix)].refreshed;
+  const hal::Tick skew_ticks =
+      io_at == hal::kNeverTick || helix_at == hal::kNeverTick ? 0 : (io_at > helix_at ? io_at - helix_at : helix_at - io_at);
+  const double skew_m = static_cast<double>(std::min<hal::Tick>(skew_ticks, cfg_.debounce_ticks + 1)) *
+                        std::max(carrier_step_m_, carrier_prev_step_m_);
   if (!pick_resumed_) {
-    if (carrier_left_ == hal::kNeverTick && from_start_m > reach + tol) carrier_left_ = now;
-    if (carrier_left_ != hal::kNeverTick && still_at_start && now - carrier_left_ > cfg_.debounce_ticks + 1) {
+    if (carrier_left_ == hal::kNeverTick && from_start_m > reach + tol + skew_m) carrier_left_ = now;
+    if (carrier_left_ != hal::kNeverTick && still_at_start && now - carrier_left_ > cfg_.debounce_ticks + 1 + skew_ticks) {
       latch(Fault::kShuttleSlipped, now);
       return;
     }
   }
   if (to_goal_m <= reach && carrier_at_selvedge_ == hal::kNeverTick) carrier_at_selvedge_ = now;
-  if (raw_arrived && raw_arrival_at_m_ < 0.0 && to_goal_m <= reach + kArrivalMarginM) raw_arrival_at_m_ = to_goal_m;
+  if (raw_arrived && raw_arrival_at_m_ < 0.0 && to_goal_m <= reach + kArrivalMarginM + skew_m) {
+    raw_arrival_at_m_ = to_goal_m;
+    raw_arrival_lateness_m_ = carrier_step_m_ + skew_m;
+  }
   if (!raw_arrived && !arrived && to_goal_m > reach) raw_arrival_at_m_ = -1.0;  // a bounce before the carrier came
-  if (arrived && to_goal_m > reach + kArrivalMarginM) {
+  if (arrived && to_goal_m > reach + kArrivalMarginM + skew_m) {
     latch(Fault::kShuttleSensorEarly, now);
     return;
   }
   // The arrival edge must come as the carrier crosses the switching point: well before it the shuttle
   // cannot be there (unless it ran ahead, off its carrier); well after it, it did not come with it.
-  if (arrived && raw_arrival_at_m_ >= 0.0 && (raw_arrival_at_m_ < reach - tol || raw_arrival_at_m_ > reach + 0.25 * tol)) {
+  if (arrived && raw_arrival_at_m_ >= 0.0 &&
+      (raw_arrival_at_m_ < reach - tol - raw_arrival_lateness_m_ || raw_arrival_at_m_ > reach + 0.25 * tol + skew_m)) {
     latch(Fault::kShuttleSlipped, now);
     return;
   }
@@ -639,6 +656,9 @@ void Sequencer::begin_pick(hal::Tick now, bool resumed) noexcept {
   carrier_at_selvedge_ = hal::kNeverTick;
   carrier_left_ = hal::kNeverTick;
   raw_arrival_at_m_ = -1.0;
+  raw_arrival_lateness_m_ = 0.0;
+  prev_helix_rad_ = from;
+  carrier_step_m_ = carrier_prev_step_m_ = 0.0;
   pick_start_rad_ = from;
   pick_resumed_ = resumed;
   phase_start_ = now;

@@ -23,12 +23,18 @@ struct Outcome {
   bool moved_after_fault = false;
 };
 
-Outcome run_scene(const std::string& name, std::uint32_t rows) {
+// `period_ms` 0: the default loop period.
+Outcome run_scene(const std::string& name, std::uint32_t rows, double period_ms = 0.0) {
   const firmware::Scene scene = firmware::load_scene(std::string(LOOM_SOURCE_DIR) + "/sim_hal/scenes/" + name + ".toml");
   firmware::MachineOptions opt;
   opt.telemetry = false;
   opt.rows = rows;
-  firmware::Machine m(firmware::default_loom_config(), scene, opt, {});
+  firmware::LoomConfig cfg = firmware::default_loom_config();
+  if (period_ms > 0.0) {
+    cfg.run.period_s = period_ms * 1e-3;
+    firmware::rederive_and_check(cfg, "test period");
+  }
+  firmware::Machine m(cfg, scene, opt, {});
   Outcome o;
   m.sim().on_power_cut([](void* cut) { *static_cast<bool*>(cut) = true; }, &o.power_cut);
   m.sequencer().request_start();
@@ -92,6 +98,26 @@ TEST(Scenes, DefaultSceneBeatsEveryPointOfTheWidthWithin80To100N) {
   }
   EXPECT_LT(static_cast<double>(o.rows[0].total_ticks) * 0.002, 300.0 / 20.0);  // ≥ 20× faster than weaving by hand
 }
+
+// The shuttle's follow checks compare sensor edges with the carrier's position; both are samples, so the
+// windows must scale with the carrier's travel per tick. At loop periods from the default to the longest
+// the config allows (shorter ones are refused by the CAN bus-load budget of the default machine), the
+// default scene weaves without a false shuttle fault, and a slipping shuttle is still caught.
+class LoopPeriods : public ::testing::TestWithParam<double> {};
+
+TEST_P(LoopPeriods, ShuttleChecksHoldAtThisPeriod) {
+  const Outcome ok = run_scene("default", 2, GetParam());
+  EXPECT_EQ(ok.state, State::kDone) << GetParam() << " ms: " << sequencer::fault_name(ok.first_fault);
+  EXPECT_EQ(ok.counters.rows, 2u);
+  const Outcome slip = run_scene("shuttle_slip", 5, GetParam());
+  EXPECT_EQ(slip.state, State::kFault) << GetParam() << " ms";
+  EXPECT_TRUE(slip.first_fault == Fault::kShuttleSlipped || slip.first_fault == Fault::kShuttleNotArrived)
+      << GetParam() << " ms: " << sequencer::fault_name(slip.first_fault);
+  EXPECT_FALSE(slip.moved_after_fault);
+}
+
+INSTANTIATE_TEST_SUITE_P(AllowedRange, LoopPeriods, ::testing::Values(2.0, 5.0, 10.0, 20.0),
+                         [](const auto& period) { return std::to_string(static_cast<int>(period.param * 100)) + "0us"; });
 
 struct FaultCase {
   const char* scene;

@@ -230,6 +230,12 @@ class Sequencer {
   bool pick_resumed_ = false;
   hal::Tick carrier_left_ = hal::kNeverTick;   // tick the carrier left the start sensor's reach
   double raw_arrival_at_m_ = -1.0;             // carrier distance from the goal when the raw sensor came on
+  double raw_arrival_lateness_m_ = 0.0;        // how far the carrier may have gone past the edge, unseen
+  // The carrier's travel per tick, so that position tests on sensor edges scale with the period and the
+  // carrier's speed (a sensor edge is only seen at the next sample).
+  double prev_helix_rad_ = 0.0;
+  double carrier_step_m_ = 0.0;       // travel over the last tick
+  double carrier_prev_step_m_ = 0.0;  // over the tick before
 
   // Shedding: the monitor of the change in progress; the arming test strokes (sensors proven).
   ShedMonitor shed_;
