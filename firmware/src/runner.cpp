@@ -12,6 +12,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -318,9 +319,21 @@ void* loop_thread_main(void* arg) {
     rt.result.loop_policy = policy;
     rt.result.loop_priority = sp.sched_priority;
   }
-  // Leave room for the frames below this one and for the loop's own (small) frames.
-  const std::size_t stack = std::max<std::size_t>(rt.opt.stack_bytes, PTHREAD_STACK_MIN);
-  if (stack > (64u << 10)) prefault_stack(stack - (64u << 10));
+  // Pre-fault what is left of this thread's stack below here, minus a margin for the loop's own frames.
+  // Measured from the thread's real stack bounds, not from the size asked for: the C library and
+  // sanitizers take part of the stack for themselves (ThreadSanitizer faulted on the size asked for).
+  pthread_attr_t attr;
+  if (pthread_getattr_np(pthread_self(), &attr) == 0) {
+    void* low = nullptr;
+    std::size_t size = 0;
+    if (pthread_attr_getstack(&attr, &low, &size) == 0) {
+      const auto here = reinterpret_cast<std::uintptr_t>(__builtin_frame_address(0));
+      const auto bottom = reinterpret_cast<std::uintptr_t>(low);
+      constexpr std::uintptr_t kMargin = 64u << 10;
+      if (here > bottom + 2 * kMargin) prefault_stack(static_cast<std::size_t>(here - bottom - kMargin));
+    }
+    pthread_attr_destroy(&attr);
+  }
   LoopBody(rt).run();
   rt.loop_done.store(true, std::memory_order_release);
   return nullptr;

@@ -195,7 +195,10 @@ void Sequencer::step(hal::Tick now, const hal::HalInputs& raw, hal::HalOutputs& 
     }
   }
   signal();
-  for (std::size_t i = 0; i < hal::kAxisCount; ++i) last_position_[i] = in.axes[i].position;
+  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+    last_position_[i] = in.axes[i].position;
+    last_refreshed_[i] = in.axes[i].refreshed;
+  }
   positions_primed_ = state_ != State::kIdle;
   prev_cmd_ = cmd_;
   out = cmd_;
@@ -278,7 +281,12 @@ bool Sequencer::check_faults(hal::Tick now, const hal::HalInputs& in) noexcept {
       latch(Fault::kNonFiniteFeedback, now, static_cast<int>(i));
       return true;
     }
-    if (positions_primed_ && std::abs(a.position - last_position_[i]) > max_step_[i]) {
+    // Compared sample to sample: feedback that arrived late comes in bursts (two samples in one tick
+    // after none in the tick before), so the allowance is per tick between the samples' refresh ticks.
+    const hal::Tick apart = a.refreshed != hal::kNeverTick && last_refreshed_[i] != hal::kNeverTick
+                                ? std::max<hal::Tick>(1, a.refreshed - last_refreshed_[i])
+                                : 1;
+    if (positions_primed_ && std::abs(a.position - last_position_[i]) > max_step_[i] * static_cast<double>(apart)) {
       latch(Fault::kEncoderJump, now, static_cast<int>(i));
       return true;
     }

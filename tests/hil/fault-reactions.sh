@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # HIL: the fault reactions over a real vcan0, each from a fresh loomctl run against the same simulated
-# drives + I/O node (loomctl resets the nodes at bring-up):
+# drives + I/O node (loomctl resets the nodes at bring-up). Like a real loom, each run resumes from the
+# counters the last one kept: the simulated shuttle stays where the last run left it, and a fresh
+# counters file would (rightly) be refused as shuttle_side_mismatch.
 #   estop     — the I/O node's e-stop input opens → exit 3, first fault estop, counters kept;
 #   io_silent — the I/O node goes silent → exit 3, first fault heartbeat_lost, counters kept;
 #   emcy      — an EMCY 0x2310 from drive 2 while its statusword stays Operation Enabled → exit 3,
@@ -24,7 +26,7 @@ hil_stop_candump
 run_until_armed() {
   HIL_NAME=${BASE}_$1
   hil_start_candump
-  counters=$HIL_WORK/$1.counters.json
+  counters=$HIL_WORK/counters.json
   out=$HIL_WORK/$1.loomctl.out
   hil_weave_cmd 2 "$counters"
   "${HIL_CMD[@]}" >"$out" 2>&1 &
@@ -56,6 +58,7 @@ expect_fault() {
   line=$(grep '^FAULT' "$out" | head -n1 || true)
   grep -qE "$2" <<<"$line" || hil_fail "$1: first fault line does not match /$2/: $line"
   [[ -f $counters ]] || hil_fail "$1: no counters file kept"
+  cp "$counters" "$HIL_LOGDIR/$HIL_NAME.counters.json"
   hil_note "$1: exit 3, $line"
 }
 

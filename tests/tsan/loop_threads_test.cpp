@@ -46,9 +46,12 @@ TEST(LoopThreads, LoopPublisherReporterAndRecipeSwapsShareNoUnsynchronisedState)
   cfg.loom_id = "tsan" + std::to_string(port);
   const std::vector<LoomConfig> recipes = {recipe_with_crank_speed(14.0), recipe_with_crank_speed(15.0),
                                            recipe_with_crank_speed(17.0)};
-  std::vector<LoomConfig> published;  // the same recipes with the running loop's identity
+  // The same recipes with the running loop's identity and run settings (a reload may change only the
+  // recipe; loomctl carries its command-line overrides over the same way).
+  std::vector<LoomConfig> published;
   for (LoomConfig r : recipes) {
     r.loom_id = cfg.loom_id;
+    r.telemetry = cfg.telemetry;
     published.push_back(r);
   }
 

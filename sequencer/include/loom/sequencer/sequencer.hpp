@@ -250,6 +250,7 @@ class Sequencer {
   hal::DigitalInputs raw_io_{};
   int sensed_ticks_ = 0;                       // picture checks wait until the debouncer has history
   std::array<double, hal::kAxisCount> last_position_{};
+  std::array<hal::Tick, hal::kAxisCount> last_refreshed_{};  // tick each last_position_ sample arrived
   bool positions_primed_ = false;
   std::array<double, hal::kAxisCount> max_step_{};  // the most an axis can move in one tick (m or rad)
   bool load_cell_seen_ = false;
