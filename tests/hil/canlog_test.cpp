@@ -315,6 +315,19 @@ TEST(HilJudgeHeartbeatLoss, LateReactionIsCaught) {
   EXPECT_TRUE(check_heartbeat_loss(loss_log(loss), kNodes, 0.100, 4).ok);
 }
 
+TEST(HilJudgeHeartbeatLoss, OnTheMastersClockTheLimitIsInItsCycles) {
+  // The same late log (81 cycles of 4 ms wall after the last heartbeat), judged on a master whose loop
+  // ran at half real time (2 ms of its clock per 4 ms of wall): 162 ms of master time, within 300 ms.
+  Loss loss;
+  loss.detect_cycles = 70;
+  EXPECT_TRUE(check_heartbeat_loss(loss_log(loss), kNodes, 0.100, 3, {}, 0.002).ok);
+  // ... and a master that needed 200 of its cycles (400 ms of its own time) is late whatever the wall says.
+  loss.detect_cycles = 190;
+  const auto r = check_heartbeat_loss(loss_log(loss), kNodes, 0.100, 3, {}, 0.002);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.failure.find("master cycles"), std::string::npos) << r.failure;
+}
+
 TEST(HilJudgeHeartbeatLoss, MotionAfterTheFaultIsCaught) {
   Loss loss;
   loss.moves_after_fault = true;

@@ -48,7 +48,13 @@ run_until_armed() {
 expect_fault() {
   local deadline=$((SECONDS + 20)) status=0
   while kill -0 "$loom_pid" 2>/dev/null && ((SECONDS < deadline)); do sleep 0.05; done
-  kill -0 "$loom_pid" 2>/dev/null && hil_fail "$1: loomctl still running 20 s after the fault"
+  if kill -0 "$loom_pid" 2>/dev/null; then
+    kill -TERM "$loom_pid" 2>/dev/null || true
+    sleep 1
+    sed 's/^/  loomctl| /' "$out"
+    hil_stop_candump
+    hil_fail "$1: loomctl still running 20 s after the fault (stopped with SIGTERM; its output above, bus: $HIL_LOG)"
+  fi
   wait "$loom_pid" || status=$?
   sed 's/^/  loomctl| /' "$out"
   cp "$out" "$HIL_LOGDIR/$HIL_NAME.loomctl.out"

@@ -66,6 +66,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1.0, 65535.0));
   loss->add_option("--periods", periods, "allowed heartbeat periods until the fault reaction")
       ->check(CLI::Range(1, 100));
+  double master_cycle_ms = 0.0;
+  loss->add_option("--master-cycle-ms", master_cycle_ms,
+                   "judge on the master's clock: its SYNCs, one per cycle of this length (0: wall time)")
+      ->check(CLI::Range(0.0, 1000.0));
 
   int io_node = 4, emcy_node = 0, master = 0x7F;
   double consumer_ms = 150.0, slack_ms = 500.0;
@@ -102,5 +106,6 @@ int main(int argc, char** argv) {
   if (mloss->parsed()) {
     return report("master loss", loom::hil::check_master_loss(frames, nodes, master, consumer_ms * 1e-3, slack_ms * 1e-3));
   }
-  return report("heartbeat loss", loom::hil::check_heartbeat_loss(frames, nodes, heartbeat_ms * 1e-3, periods));
+  return report("heartbeat loss",
+                loom::hil::check_heartbeat_loss(frames, nodes, heartbeat_ms * 1e-3, periods, {}, master_cycle_ms * 1e-3));
 }

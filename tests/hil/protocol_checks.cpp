@@ -3,6 +3,8 @@
 // and the frame, so a red test says what the bus showed.
 #include "protocol_checks.hpp"
 
+#include <cmath>
+
 #include <cstdio>
 #include <functional>
 #include <optional>
@@ -240,7 +242,7 @@ CheckResult check_weave_protocol(const std::vector<Frame>& fs, const std::vector
 // Heartbeat loss
 // ---------------------------------------------------------------------------------------------------
 CheckResult check_heartbeat_loss(const std::vector<Frame>& fs, const std::vector<int>& nodes,
-                                 double heartbeat_s, int periods, const PdoLayout& l) {
+                                 double heartbeat_s, int periods, const PdoLayout& l, double master_cycle_s) {
   CheckResult r;
   if (fs.empty()) return fail(r, "the log holds no frames");
   const auto limit_us = static_cast<std::int64_t>(heartbeat_s * periods * 1e6 + 0.5);
@@ -282,7 +284,16 @@ CheckResult check_heartbeat_loss(const std::vector<Frame>& fs, const std::vector
                          ": the loss was not acted on");
     }
     const std::int64_t latency_us = fs[*fault].t_us - fs[*last_hb].t_us;
-    if (latency_us > limit_us) {
+    std::size_t cycles = 0;
+    for (std::size_t i = *last_hb + 1; i < *fault; ++i) cycles += is_sync(fs[i]) ? 1U : 0U;
+    if (master_cycle_s > 0.0) {
+      const auto limit_cycles = static_cast<std::size_t>(std::ceil(heartbeat_s * periods / master_cycle_s));
+      if (cycles > limit_cycles) {
+        return fail(r, tag + "fault reaction " + std::to_string(cycles) + " master cycles (SYNCs) after the last heartbeat, limit " +
+                           std::to_string(limit_cycles) + " (" + std::to_string(limit_us / 1000) + " ms of master time; " +
+                           std::to_string(latency_us / 1000) + " ms wall): " + show(fs, *last_hb) + " → " + show(fs, *fault));
+      }
+    } else if (latency_us > limit_us) {
       return fail(r, tag + "fault reaction " + std::to_string(latency_us / 1000) + " ms after the last heartbeat, limit " +
                          std::to_string(limit_us / 1000) + " ms: " + show(fs, *last_hb) + " → " + show(fs, *fault));
     }
@@ -310,7 +321,8 @@ CheckResult check_heartbeat_loss(const std::vector<Frame>& fs, const std::vector
     std::snprintf(ms, sizeof ms, "%.1f ms", static_cast<double>(latency_us) * 1e-3);
     r.notes.push_back(tag + "last heartbeat " + show(fs, *last_hb) + "; fault controlword " +
                       hex(*controlword(fs[*fault], n, l), 4) + " " + show(fs, *fault) + " after " + ms +
-                      " (limit " + std::to_string(limit_us / 1000) + " ms); " + std::to_string(rpdos_after) +
+                      " (limit " + std::to_string(limit_us / 1000) + " ms), " + std::to_string(cycles) +
+                      " master cycles; " + std::to_string(rpdos_after) +
                       " RPDOs after it, all holding the target");
   }
   return r;

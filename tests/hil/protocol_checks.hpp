@@ -50,8 +50,12 @@ CheckResult check_weave_protocol(const std::vector<Frame>& frames, const std::ve
 // operational (05) while the master had it enabled (0x000F); the first controlword after its last
 // heartbeat that is not 0x000F (quick stop/disable: the fault reaction) came within
 // `periods` × `heartbeat_s`; and no RPDO after that fault commands a target other than the fault's own.
+// With `master_cycle_s` > 0 the limit is on the master's own clock — the SYNCs it sent between the last
+// heartbeat and the reaction, one per cycle — instead of wall time: a master that runs slower than real
+// time (a loop in a non-real-time VM) supervises in its cycles; on a board the two agree. Both are reported.
 CheckResult check_heartbeat_loss(const std::vector<Frame>& frames, const std::vector<int>& nodes,
-                                 double heartbeat_s, int periods, const PdoLayout& layout = {});
+                                 double heartbeat_s, int periods, const PdoLayout& layout = {},
+                                 double master_cycle_s = 0.0);
 
 }  // namespace loom::hil
 

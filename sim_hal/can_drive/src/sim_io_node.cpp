@@ -438,7 +438,13 @@ void SimIoNode::step(std::int64_t now_us, const IoPlant& plant) {
     const double step = dt / config_.piston_travel_s;
     piston_[i] = std::clamp(piston_[i] + (valve[i] ? step : -step), 0.0, 1.0);
   }
-  if (plant_.silent) return;
+  if (plant_.silent) {
+    // A silenced node (HIL: the I/O node dies) sends nothing, but its heartbeat timer runs on: a deadline
+    // left in the past made the rack's loop spin at real-time priority and starve the master under test.
+    const std::int64_t hb_us = static_cast<std::int64_t>(get(0x1017, 0)) * 1000;
+    if (hb_us > 0 && now_us >= next_hb_us_) next_hb_us_ = now_us + hb_us;
+    return;
+  }
   if (boot_at_us_ >= 0 && now_us >= boot_at_us_) {
     boot_at_us_ = -1;
     send(kErrCtl + config_.node_id, 1, {0x00, 0, 0, 0, 0, 0, 0, 0});
@@ -474,6 +480,8 @@ void SimIoNode::step(std::int64_t now_us, const IoPlant& plant) {
 std::int64_t SimIoNode::next_deadline_us() const {
   if (!powered_) return std::numeric_limits<std::int64_t>::max();
   std::int64_t t = std::numeric_limits<std::int64_t>::max();
+  // Silent: only the plant keeps time (nothing is sent, so no boot-up or heartbeat deadline applies).
+  if (plant_.silent) return last_step_us_ + 10'000;
   if (boot_at_us_ >= 0) t = boot_at_us_;
   if (get(0x1017, 0) != 0) t = std::min(t, next_hb_us_);
   // The plant moves continuously: step at least every 10 ms.
