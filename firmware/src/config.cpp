@@ -316,6 +316,7 @@ const std::vector<Key>& keys() {
     v.push_back(millis("timing.period_ms", M::kRun, 0.25, 20.0, [](LoomConfig& c) -> double& { return c.run.period_s; }));
     v.push_back(number("timing.enable_timeout_s", M::kRun, 0.05, 60.0, [](LoomConfig& c) -> double& { return c.run.enable_timeout_s; }));
     v.push_back(number("timing.pick_timeout_margin_s", M::kRun, 0.01, 60.0, [](LoomConfig& c) -> double& { return c.run.pick_timeout_margin_s; }));
+    v.push_back(number("timing.row_save_timeout_s", M::kRun, 0.1, 600.0, [](LoomConfig& c) -> double& { return c.run.row_save_timeout_s; }));
     v.push_back(millis("timing.stale_timeout_ms", M::kRun, 0.5, 10000.0, [](LoomConfig& c) -> double& { return c.run.stale_timeout_s; }));
     v.push_back(integer<int>("timing.debounce_ticks", M::kRun, 1, 100, [](LoomConfig& c) -> int& { return c.run.debounce_ticks; }));
     v.push_back(integer<std::uint32_t>("timing.overrun_stop_after", M::kRun, 0, 1'000'000,
@@ -528,6 +529,7 @@ void derive(LoomConfig& c, const Fail& fail) {
   s.debounce_ticks = c.run.debounce_ticks;
   s.enable_timeout_s = c.run.enable_timeout_s;
   s.pick_timeout_margin_s = c.run.pick_timeout_margin_s;
+  s.row_save_timeout_s = c.run.row_save_timeout_s;
   s.stale_timeout_s = c.run.stale_timeout_s;
   s.crank_park_position_rad = m.calibration.crank_park_position_rad;
   s.carriage_home_m = m.calibration.carriage_home_m;

@@ -16,6 +16,7 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
   slot_ = std::make_unique<motion::ProfileSlot>(std::make_unique<const motion::ProfileSet>(cfg_.profile));
   sequencer::SequencerConfig scfg = cfg_.sequencer;
   scfg.rows_to_weave = opt.rows;
+  scfg.await_row_saved = opt.await_row_saved;
   if (opt.hal == HalKind::kSocketCan) {
     // A dead drive first shows as stale PDOs (fast stop), then as a lost heartbeat (the root cause).
     scfg.diagnosis_window_s = cfg_.can.heartbeat_timeout_ms * 1e-3 + 10.0 * cfg_.sequencer.period_s;

@@ -136,6 +136,7 @@ int weave(const WeaveArgs& a) {
   mo.lossless_telemetry = !realtime;  // real time never waits on telemetry: drop and count
   mo.rows = resume.rows + a.rows;  // the sequencer counts absolute rows; weave `rows` more
   mo.sim_state_path = a.sim_state;
+  mo.await_row_saved = store != nullptr;  // no row starts before the one before it is on disk
   if (!a.io.empty()) mo.io = a.io == "simulated" ? firmware::IoKind::kSimulated : firmware::IoKind::kCan;
   std::unique_ptr<firmware::Machine> machine;
   try {
@@ -177,7 +178,8 @@ int weave(const WeaveArgs& a) {
     }
   }
   std::uint32_t picks_at_row_start = resume.picks;
-  std::string counters_error;  // set when a save failed: the run ends in a fault
+  std::string counters_error;  // why the last save failed: the sequencer stops at the row boundary
+  firmware::RowSaves row_saves;
   const auto on_event = [&](const firmware::RunEvent& e) {
     // SIGHUP: re-read the recipe (the loom config file) and hand it to the loop for the next row.
     machine->collect_retired_recipes();
@@ -230,15 +232,19 @@ int weave(const WeaveArgs& a) {
       }
       std::fflush(stdout);
     }
-    if (store && counters_error.empty()) {
+    // Saved after the reload above, so a row that waits for this save starts with the new recipe.
+    if (store) {
       try {
         store->save(e.counters);
+        row_saves.saved(e.counters.rows);
       } catch (const std::exception& ex) {
-        // Weaving on without a durable count would lose work at the next power cut: stop at the end
-        // of this row (a safe point), keep the in-memory counters, and say so.
+        // Weaving on without a durable count would lose work at the next power cut: the sequencer
+        // stops at the row boundary (a safe point) with counters_not_saved, keeping its counters.
+        if (counters_error.empty()) {
+          std::fprintf(stderr, "loomctl: counters not saved: %s; stopping at the end of the row\n", ex.what());
+        }
         counters_error = ex.what();
-        std::fprintf(stderr, "loomctl: FAULT counters_not_saved: %s; stopping at the end of the row\n", ex.what());
-        machine->sequencer().request_stop_at_row_end();
+        row_saves.failed();
       }
     }
   };
@@ -256,6 +262,7 @@ int weave(const WeaveArgs& a) {
   ro.grace_ticks = static_cast<hal::Tick>(0.2 / period);
   ro.stop_flag = &g_stop;
   ro.stop_now_flag = &g_stop_now;
+  ro.row_saves = store ? &row_saves : nullptr;
   ro.pause_flag = &g_pause;
   ro.require_fifo = hardware && !a.allow_degraded;
   ro.overrun_stop_after = hardware ? cfg.run.overrun_stop_after : 0;
@@ -300,6 +307,9 @@ int weave(const WeaveArgs& a) {
                 seq.fault_axis() >= 0 ? hal::axis_name(static_cast<hal::Axis>(seq.fault_axis())) : "",
                 seq.fault_detail(), secs(seq.fault_tick()), stopped.c_str(), sequencer::fault_text(f), c.rows,
                 c.picks, c.beats);
+    if (f == sequencer::Fault::kCountersNotSaved && !counters_error.empty()) {
+      std::printf("  the save failed: %s\n", counters_error.c_str());
+    }
     return kExitFault;
   }
   if (!counters_error.empty()) {

@@ -195,6 +195,10 @@ class LoopBody {
     if (opt_.pause_flag != nullptr) {
       opt_.pause_flag->load(std::memory_order_relaxed) ? seq_.request_pause() : seq_.request_resume();
     }
+    if (opt_.row_saves != nullptr) {
+      const std::uint32_t on_disk = opt_.row_saves->rows_on_disk.load(std::memory_order_acquire);
+      seq_.note_rows_saved(on_disk, opt_.row_saves->last_save_failed.load(std::memory_order_acquire));
+    }
     if (cmds == 0) return false;
     const auto has = [&](Command c) { return (cmds & static_cast<std::uint32_t>(c)) != 0; };
     const sequencer::State s = seq_.state();

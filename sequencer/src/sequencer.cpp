@@ -7,7 +7,7 @@
 //   4. operator_requests() buttons → start, pause/resume, acknowledge (requests, acted on when safe)
 //   5. run_state()         the current state's own function; the states, in cycle order:
 //        idle → enabling → positioning → shed_test → shed → pick → (shed → pick …) → beat_sweep
-//        → (row end) → shed …;   paused, done, fault
+//        → row_end (only when the row's counters must be on disk first) → shed …;   paused, done, fault
 //   6. play_moves()        sample the active moves and profiles into targets; count beats
 //   7. track_beat_force()  the load cell's peak per beat
 //   8. interlocks          judge the proposed outputs against the measured inputs; a trip latches
@@ -49,6 +49,7 @@ const char* state_name(State s) {
     case State::kShed: return "shed";
     case State::kPick: return "pick";
     case State::kBeatSweep: return "beat_sweep";
+    case State::kRowEnd: return "row_end";
     case State::kPaused: return "paused";
     case State::kDone: return "done";
     case State::kFault: return "fault";
@@ -83,7 +84,8 @@ std::string validate(const SequencerConfig& c, const motion::ProfileSet& p) {
                {"timing.pick_timeout_margin_s", c.pick_timeout_margin_s},
                {"timing.stale_timeout_ms", c.stale_timeout_s},
                {"diagnosis window", c.diagnosis_window_s},
-               {"arrival grace", c.arrival_grace_s}};
+               {"arrival grace", c.arrival_grace_s},
+               {"timing.row_save_timeout_s", c.row_save_timeout_s}};
   for (const auto& t : times) {
     if (!fin(t.s) || t.s < 0.0 || t.s / c.period_s > 1e12) {
       return std::string(t.key) + " must be a finite time below 1e12 periods";
@@ -358,6 +360,7 @@ void Sequencer::run_state(hal::Tick now, const hal::HalInputs& in) noexcept {
     case State::kShed: shed(now); break;
     case State::kPick: pick(now, in); break;
     case State::kBeatSweep: beat_sweep(now); break;
+    case State::kRowEnd: row_end(now); break;
     case State::kPaused: paused(now); break;
     case State::kDone: break;
     case State::kFault: fault(now); break;
@@ -694,6 +697,26 @@ void Sequencer::end_row(hal::Tick now) noexcept {
   ++counters_.rows;
   counters_.picks_in_row = 0;
   last_row_ = row_.finish(now, now - sweep_start_, row_beats_, profiles_->cam().steps());
+  if (cfg_.await_row_saved) {
+    enter(State::kRowEnd, now);
+    return;
+  }
+  after_row(now);
+}
+
+void Sequencer::row_end(hal::Tick now) noexcept {
+  // Parked at the boundary (beater out of the warp, shuttle at a selvedge): the next row waits for
+  // the reporter to confirm that the finished one is on disk; a failed or unconfirmed save stops here.
+  if (rows_on_disk_ >= counters_.rows) {
+    after_row(now);
+    return;
+  }
+  if (last_save_failed_ || seconds_since(now, state_since_) > cfg_.row_save_timeout_s) {
+    latch(Fault::kCountersNotSaved, now);
+  }
+}
+
+void Sequencer::after_row(hal::Tick now) noexcept {
   const bool enough = cfg_.rows_to_weave != 0 && counters_.rows >= cfg_.rows_to_weave;
   if (enough || stop_requested_) {
     enter(State::kDone, now);
@@ -787,7 +810,7 @@ void Sequencer::signal() noexcept {
   // Stack light: red = a fault waits for acknowledgement; green = weaving; amber = waiting for the
   // operator (idle, arming, paused, done).
   const bool weaving = state_ == State::kPositioning || state_ == State::kShedTest || state_ == State::kShed ||
-                       state_ == State::kPick || state_ == State::kBeatSweep;
+                       state_ == State::kPick || state_ == State::kBeatSweep || state_ == State::kRowEnd;
   cmd_.io.lamp_red = state_ == State::kFault;
   cmd_.io.lamp_green = weaving;
   cmd_.io.lamp_amber = !weaving && state_ != State::kFault;

@@ -272,3 +272,65 @@ TEST(SequencerSim, NewRecipeIsAdoptedAtTheNextRowBoundaryWithoutStopping) {
   EXPECT_EQ(seq.recipe_changes(), 1u);
   EXPECT_EQ(seq.profiles().beats_per_row(), 30);
 }
+
+// The row-boundary handshake (a counters file is kept): the sequencer parks at each row end until the
+// reporter confirms the row on disk; nothing moves meanwhile; a failed save and a save never confirmed
+// are the fault counters_not_saved at that safe point, with the counters kept.
+TEST(SequencerSim, EachRowWaitsUntilTheOneBeforeIsOnDisk) {
+  Rig r;
+  r.cfg.await_row_saved = true;
+  r.build(2);
+  hal::Tick row_end_at = -1;  // when row 1 ended
+  hal::HalOutputs parked{};
+  bool moved_while_waiting = false, waiting = false;
+  r.run(200000, [&] {
+    if (r.seq->state() != State::kRowEnd) {
+      waiting = false;
+      return;
+    }
+    if (!waiting) {  // just parked at a boundary
+      waiting = true;
+      parked = r.out;
+      if (row_end_at < 0) row_end_at = r.now;
+    }
+    for (std::size_t k = 0; k < hal::kAxisCount; ++k) {
+      moved_while_waiting = moved_while_waiting || r.out.axes[k].target_position != parked.axes[k].target_position;
+    }
+    // The reporter confirms row 1 one second (500 ticks) after it ended.
+    if (r.now - row_end_at == 500) r.seq->note_rows_saved(1, false);
+    if (r.seq->counters().rows == 2) r.seq->note_rows_saved(2, false);
+  });
+  ASSERT_EQ(r.seq->state(), State::kDone) << sequencer::fault_name(r.seq->first_fault());
+  EXPECT_EQ(r.seq->counters().rows, 2u);
+  EXPECT_FALSE(moved_while_waiting);
+  ASSERT_GE(row_end_at, 0);
+  // Row 2 (started only after the confirmation) ended at least 500 ticks plus its own length after row 1.
+  EXPECT_GE(r.now - row_end_at, 500 + r.seq->last_row().total_ticks);
+}
+
+TEST(SequencerSim, AFailedRowSaveStopsAtTheBoundaryWithCountersNotSaved) {
+  Rig r;
+  r.cfg.await_row_saved = true;
+  r.build(3);
+  r.run(200000, [&] {
+    if (r.seq->state() == State::kRowEnd) r.seq->note_rows_saved(0, true);
+  });
+  EXPECT_EQ(r.seq->state(), State::kFault);
+  EXPECT_EQ(r.seq->first_fault(), Fault::kCountersNotSaved);
+  EXPECT_EQ(r.seq->counters().rows, 1u);
+  EXPECT_EQ(r.seq->counters().picks, 1u);
+}
+
+TEST(SequencerSim, ASaveNeverConfirmedTimesOutWithCountersNotSaved) {
+  Rig r;
+  r.cfg.await_row_saved = true;
+  r.cfg.row_save_timeout_s = 0.5;
+  r.build(3);
+  hal::Tick row_end_at = -1;
+  r.run(200000, [&] {
+    if (r.seq->state() == State::kRowEnd && row_end_at < 0) row_end_at = r.now;
+  });
+  EXPECT_EQ(r.seq->first_fault(), Fault::kCountersNotSaved);
+  EXPECT_EQ(r.seq->counters().rows, 1u);
+  EXPECT_NEAR(static_cast<double>(r.seq->fault_tick() - row_end_at) * r.cfg.period_s, 0.5, 2.0 * r.cfg.period_s);
+}

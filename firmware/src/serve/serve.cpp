@@ -150,6 +150,7 @@ int serve_main(const ServeArgs& a) {
     mo.telemetry = !a.no_telemetry;
     mo.lossless_telemetry = false;  // real time: a slow subscriber loses snapshots, never delays a tick
     mo.rows = a.rows == 0 ? 0 : resume.rows + a.rows;
+    mo.await_row_saved = true;  // the state dir always keeps the counters
     if (!hardware) mo.sim_state_path = state + "/sim-state.bin";
     std::unique_ptr<Machine> machine;
     try {
@@ -172,6 +173,8 @@ int serve_main(const ServeArgs& a) {
         resume.rows, resume.picks, resume.picks_in_row, resume.beats);
 
     const double period = cfg.sequencer.period_s;
+    RowSaves row_saves;
+    row_saves.saved(resume.rows);
     const auto on_event = [&](const RunEvent& e) {
       machine->collect_retired_recipes();
       switch (e.kind) {
@@ -218,8 +221,11 @@ int serve_main(const ServeArgs& a) {
       }
       try {
         store.save(e.counters);
+        row_saves.saved(e.counters.rows);
       } catch (const std::exception& ex) {
+        // The sequencer stops at the row boundary with counters_not_saved (a fault like any other).
         log(Severity::kErr, "counters not saved: %s", ex.what());
+        row_saves.failed();
       }
     };
 
@@ -231,6 +237,7 @@ int serve_main(const ServeArgs& a) {
     ro.require_fifo = hardware && !a.allow_degraded;
     ro.cpu = a.cpu;
     ro.overrun_stop_after = a.overrun_stop.value_or(hardware ? cfg.run.overrun_stop_after : 0);
+    ro.row_saves = &row_saves;
     ro.link = &link;
     ro.operator_buttons = true;
     ro.hold_when_finished = true;
@@ -264,6 +271,13 @@ int serve_main(const ServeArgs& a) {
           log(Severity::kErr, "%s", ex.what());
         }
         log(Severity::kNotice, "fault %s acknowledged: re-arming from the measured positions", r.name.c_str());
+        // The counters in memory are the truth (a fault keeps them; counters_not_saved means the disk
+        // lags them): write them before re-arming, which reads them back.
+        try {
+          store.save(seq.counters());
+        } catch (const std::exception& ex) {
+          log(Severity::kErr, "counters still not saved (%s): re-arming from the file's older counts", ex.what());
+        }
         continue;
       }
       case RunResult::End::kExitRequested:

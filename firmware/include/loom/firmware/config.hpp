@@ -114,6 +114,7 @@ struct RunSettings {
   double enable_timeout_s = 2.0;
   double pick_timeout_margin_s = 0.5;
   double stale_timeout_s = 0.05;
+  double row_save_timeout_s = 5.0;  // a finished row's counters not confirmed on disk by then: a fault
   int debounce_ticks = 3;
   std::uint32_t overrun_stop_after = 10;  // on hardware: this many overruns in a row → safe stop (0 = never)
 };

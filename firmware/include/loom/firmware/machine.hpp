@@ -29,6 +29,8 @@ struct MachineOptions {
   bool telemetry = true;
   bool lossless_telemetry = true;  // virtual time only: wait for ring space instead of dropping
   std::uint32_t rows = 3;
+  // A counters file is kept: each row waits until the one before it is on disk (RunOptions::row_saves).
+  bool await_row_saved = false;
   std::string sim_state_path;  // sim HAL: keep the simulated machine's physical state here (power-loss tests)
   // `--io`: overrides the config's io.kind. Real drives with simulated I/O only when this says
   // kSimulated explicitly (the config alone is not enough), and then banner() is set.

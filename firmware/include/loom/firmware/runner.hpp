@@ -99,6 +99,19 @@ struct RunEvent {
 // the next event carries the full counters again, so a counter save is never lost for long.
 inline constexpr std::size_t kEventRingCapacity = 1024;
 
+// The reporter's side of the row-boundary handshake (SequencerConfig::await_row_saved): after each save
+// it stores the rows now on disk, or that the save failed; the loop hands both to the sequencer every
+// tick, and no row starts before the one before it is on disk. Written by one thread, read by the loop.
+struct RowSaves {
+  std::atomic<std::uint32_t> rows_on_disk{0};
+  std::atomic<bool> last_save_failed{false};
+  void saved(std::uint32_t rows) noexcept {
+    last_save_failed.store(false, std::memory_order_relaxed);
+    rows_on_disk.store(rows, std::memory_order_release);
+  }
+  void failed() noexcept { last_save_failed.store(true, std::memory_order_release); }
+};
+
 struct RunOptions {
   double period_s = 0.002;
   bool realtime = false;         // pace at the tick rate (always true with hardware)
@@ -108,6 +121,7 @@ struct RunOptions {
   const std::atomic<bool>* stop_flag = nullptr;   // set asynchronously → stop at row end
   const std::atomic<bool>* stop_now_flag = nullptr;  // set asynchronously → safe stop at once (stop_requested)
   const std::atomic<bool>* pause_flag = nullptr;  // true → pause at the next safe point, false → resume
+  RowSaves* row_saves = nullptr;                  // the counters-file handshake, when one is kept
 
   // Real-time thread (realtime only).
   int fifo_priority = 80;        // SCHED_FIFO priority of the loop thread; 0 = SCHED_OTHER

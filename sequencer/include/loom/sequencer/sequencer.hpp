@@ -27,6 +27,7 @@ enum class State : std::uint8_t {
   kShed,         // swapping the heald frames, waiting for a consistent end-sensor picture
   kPick,         // helix shaft carries the shuttle across, waiting for arrival
   kBeatSweep,    // crank beats while the carriage steps across the width
+  kRowEnd,       // row woven, beater parked: waiting until its counters are on disk (when asked to)
   kPaused,       // holding at a safe point (before a shed change), drives enabled, until resumed
   kDone,         // all requested rows woven (or stop at row end): holding, enabled
   kFault,        // latched fault: quick stop, valves hold, counters kept
@@ -81,6 +82,12 @@ struct SequencerConfig {
   double beat_force_max_n = 100.0;
   double load_cell_max_n = 5000.0;        // a load-cell reading beyond this is a failed cell, not a beat
   motion::JerkLimits carriage{.velocity = 0.5, .acceleration = 5.0, .jerk = 100.0};  // re-arm moves
+  // Row-boundary handshake: with await_row_saved, no row starts before the reporter has confirmed that
+  // the row before it is on disk (note_rows_saved); a save that fails, or is not confirmed within
+  // row_save_timeout_s, is the fault counters_not_saved at that safe point (beater parked, shuttle at
+  // a selvedge). A recipe reloaded meanwhile is adopted by the row that follows.
+  bool await_row_saved = false;
+  double row_save_timeout_s = 5.0;
 };
 
 // Configure-time only. "" when the sequencer can run `profiles` with `cfg`, else why not, naming the
@@ -111,6 +118,12 @@ class Sequencer {
   // RT-safe. A fault found outside the sequencer (the runner's overrun policy): latched at the next step
   // with the same reaction as any other fault (quick stop, valves hold, counters kept).
   void request_safe_stop(Fault f) noexcept { external_fault_ = f; }
+  // RT-safe. The reporter's latest word on the counters file: the rows it holds, and whether the most
+  // recent save failed (see SequencerConfig::await_row_saved).
+  void note_rows_saved(std::uint32_t rows_on_disk, bool last_save_failed) noexcept {
+    rows_on_disk_ = rows_on_disk;
+    last_save_failed_ = last_save_failed;
+  }
 
   // RT-safe. One tick: check faults → advance the row cycle → sample profiles → check interlocks →
   // write every field of `out`.
@@ -157,6 +170,7 @@ class Sequencer {
   void shed(hal::Tick now) noexcept;
   void pick(hal::Tick now, const hal::HalInputs& in) noexcept;
   void beat_sweep(hal::Tick now) noexcept;
+  void row_end(hal::Tick now) noexcept;
   void paused(hal::Tick now) noexcept;
   void fault(hal::Tick now) noexcept;
   // ---- transitions and helpers ----
@@ -173,6 +187,7 @@ class Sequencer {
   void begin_pick(hal::Tick now, bool resumed) noexcept;
   void begin_sweep(hal::Tick now) noexcept;
   void end_row(hal::Tick now) noexcept;
+  void after_row(hal::Tick now) noexcept;  // done, paused or the next row, once the boundary is passed
   void adopt_limits() noexcept;
   Fault shed_fault(ShedVerdict v) const noexcept;
   void publish_beat(int k) noexcept;
@@ -251,6 +266,8 @@ class Sequencer {
   int sensed_ticks_ = 0;                       // picture checks wait until the debouncer has history
   std::array<double, hal::kAxisCount> last_position_{};
   std::array<hal::Tick, hal::kAxisCount> last_refreshed_{};  // tick each last_position_ sample arrived
+  std::uint32_t rows_on_disk_ = 0;   // the row-boundary handshake (note_rows_saved)
+  bool last_save_failed_ = false;
   bool positions_primed_ = false;
   std::array<double, hal::kAxisCount> max_step_{};  // the most an axis can move in one tick (m or rad)
   bool load_cell_seen_ = false;
