@@ -281,6 +281,7 @@ const std::vector<Key>& keys() {
     v.push_back(number("io.load_cell_offset_n", M::kMachine, -1.0e4, 1.0e4, [](LoomConfig& c) -> double& { return c.io.wiring.load_cell_offset_n; }));
     // [recipe]
     v.push_back(integer<std::uint32_t>("recipe.picks_per_row", M::kRecipe, 1, 16, [](LoomConfig& c) -> std::uint32_t& { return c.recipe.picks_per_row; }));
+    v.push_back(boolean("recipe.knotting", M::kRecipe, [](LoomConfig& c) -> bool& { return c.recipe.knotting; }));
     v.push_back(integer<int>("recipe.beats_per_position", M::kRecipe, 1, 16, [](LoomConfig& c) -> int& { return c.recipe.beats_per_position; }));
     {
       Key force = number("recipe.beat_force_target_n", M::kRecipe, 1.0, 1000.0, [](LoomConfig& c) -> double& { return c.recipe.beat_force_target_n; }, false);
@@ -526,6 +527,7 @@ void derive(LoomConfig& c, const Fail& fail) {
   s = sequencer::SequencerConfig{};
   s.period_s = c.run.period_s;
   s.picks_per_row = rc.picks_per_row;
+  s.knotting = rc.knotting;
   s.debounce_ticks = c.run.debounce_ticks;
   s.enable_timeout_s = c.run.enable_timeout_s;
   s.pick_timeout_margin_s = c.run.pick_timeout_margin_s;

@@ -120,6 +120,20 @@ void Machine::publish_recipe(const LoomConfig& next) {
     throw ConfigError(next.source + ": only [recipe] and [profiles] may change while weaving; restart to change " +
                       changed);
   }
+  // Recipe keys the sequencer holds (not the profiles) are fixed for the run: say so rather than
+  // acknowledge a reload that would not change them.
+  std::string fixed;
+  const auto differs = [&](bool d, const char* key) {
+    if (d) fixed += (fixed.empty() ? "" : ", ") + std::string(key);
+  };
+  differs(next.sequencer.picks_per_row != cfg_.sequencer.picks_per_row, "recipe.picks_per_row");
+  differs(next.sequencer.knotting != cfg_.sequencer.knotting, "recipe.knotting");
+  differs(next.sequencer.beat_force_min_n != cfg_.sequencer.beat_force_min_n ||
+              next.sequencer.beat_force_max_n != cfg_.sequencer.beat_force_max_n,
+          "recipe.beat_force_min_n/max_n");
+  if (!fixed.empty()) {
+    throw ConfigError(next.source + ": " + fixed + " change only with a restart (the sequencer holds them)");
+  }
   try {
     slot_->publish(std::make_unique<const motion::ProfileSet>(next.profile));
   } catch (const motion::MotionError& e) {

@@ -43,6 +43,7 @@ struct WeaveArgs {
   std::uint32_t rows = 3;
   double period_ms = 0.0;
   double pace = 1.0;
+  double knotting_s = 0.0;  // sim: a simulated weaver says "row knotted" this long after each wait begins
   bool realtime = false, allow_degraded = false, no_telemetry = false, quiet = false;
 };
 
@@ -115,6 +116,12 @@ int weave(const WeaveArgs& a) {
 
   const bool hardware = a.hal == "socketcan";
   const bool realtime = hardware || a.realtime;
+  if (a.knotting_s > 0.0 && (hardware || !cfg.sequencer.knotting)) {
+    std::fprintf(stderr, "loomctl: --knotting-s = %g: %s\n", a.knotting_s,
+                 hardware ? "the simulated weaver exists in simulation only (on a loom the weaver presses the pedal)"
+                          : "the recipe has no knotting mode (set recipe.knotting = true)");
+    return kExitBadInput;
+  }
   if (hardware) {
     const firmware::RtSetup rt = firmware::setup_realtime(80);
     if (!rt.ok()) {
@@ -225,6 +232,7 @@ int weave(const WeaveArgs& a) {
         std::printf("row %u/%u: %.2f s (shed %.2f s, pick %.2f s, beat %.2f s), %d beats, %d carriage steps", r.row,
                     target_rows, secs(r.total_ticks), secs(r.shed_ticks), secs(r.pick_ticks), secs(r.beat_ticks),
                     r.beats, r.carriage_steps);
+        if (r.knotting_ticks > 0) std::printf(", knotted in %.2f s before it", secs(r.knotting_ticks));
         if (r.force_measured) {
           std::printf(", peak beat force min/mean/max %.1f/%.1f/%.1f N", r.force_min_n, r.force_mean_n, r.force_max_n);
         }
@@ -263,6 +271,7 @@ int weave(const WeaveArgs& a) {
   ro.stop_flag = &g_stop;
   ro.stop_now_flag = &g_stop_now;
   ro.row_saves = store ? &row_saves : nullptr;
+  ro.simulated_knotting_s = a.knotting_s;
   ro.pause_flag = &g_pause;
   ro.require_fifo = hardware && !a.allow_degraded;
   ro.overrun_stop_after = hardware ? cfg.run.overrun_stop_after : 0;
@@ -359,6 +368,10 @@ int main(int argc, char** argv) {
   weave_cmd->add_option("--period-ms", a.period_ms, "control period in ms (overrides the config)")
       ->check(kFinite & CLI::Range(0.25, 20.0));
   weave_cmd->add_flag("--realtime", a.realtime, "pace the simulated loom at the tick rate");
+  weave_cmd->add_option("--knotting-s", a.knotting_s,
+                        "sim, knotting mode: a simulated weaver says \"row knotted\" this many seconds after each "
+                        "wait begins")
+      ->check(kFinite & CLI::Range(0.0, 3600.0));
   weave_cmd->add_option("--pace", a.pace, "with --realtime: run this many times faster than real time (sim only)")
       ->check(kFinite & CLI::Range(0.01, 1000.0));
   weave_cmd->add_flag("--allow-degraded", a.allow_degraded,

@@ -195,6 +195,10 @@ class LoopBody {
     if (opt_.pause_flag != nullptr) {
       opt_.pause_flag->load(std::memory_order_relaxed) ? seq_.request_pause() : seq_.request_resume();
     }
+    if (opt_.simulated_knotting_s > 0.0) {
+      knotting_wait_ = seq_.state() == sequencer::State::kAwaitKnotting ? knotting_wait_ + 1 : 0;
+      if (static_cast<double>(knotting_wait_) * opt_.period_s >= opt_.simulated_knotting_s) seq_.request_row_knotted();
+    }
     if (opt_.row_saves != nullptr) {
       const std::uint32_t on_disk = opt_.row_saves->rows_on_disk.load(std::memory_order_acquire);
       seq_.note_rows_saved(on_disk, opt_.row_saves->last_save_failed.load(std::memory_order_acquire));
@@ -203,6 +207,7 @@ class LoopBody {
     const auto has = [&](Command c) { return (cmds & static_cast<std::uint32_t>(c)) != 0; };
     const sequencer::State s = seq_.state();
     RunResult& res = rt_.result;
+    if (has(Command::kNext)) seq_.request_row_knotted();
     if (has(Command::kPause)) seq_.request_pause();
     if (has(Command::kResume)) seq_.request_resume();
     if (has(Command::kStart)) {
@@ -306,6 +311,7 @@ class LoopBody {
   bool was_paused_ = false, was_fault_ = false;
   bool stop_sent_ = false, stop_now_sent_ = false, exit_pending_ = false;
   bool prev_start_ = false, prev_pause_ = false, prev_ack_ = false;
+  std::int64_t knotting_wait_ = 0;  // ticks the loom has waited for the simulated weaver
 };
 
 // Touches `bytes` of this thread's stack so the loop never takes a first-touch page fault on it.

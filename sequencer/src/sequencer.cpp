@@ -7,7 +7,8 @@
 //   4. operator_requests() buttons → start, pause/resume, acknowledge (requests, acted on when safe)
 //   5. run_state()         the current state's own function; the states, in cycle order:
 //        idle → enabling → positioning → shed_test → shed → pick → (shed → pick …) → beat_sweep
-//        → row_end (only when the row's counters must be on disk first) → shed …;   paused, done, fault
+//        → row_end (only when the row's counters must be on disk first) → await_knotting (knotting
+//        mode only) → shed …;   paused, done, fault
 //   6. play_moves()        sample the active moves and profiles into targets; count beats
 //   7. track_beat_force()  the load cell's peak per beat
 //   8. interlocks          judge the proposed outputs against the measured inputs; a trip latches
@@ -50,6 +51,7 @@ const char* state_name(State s) {
     case State::kPick: return "pick";
     case State::kBeatSweep: return "beat_sweep";
     case State::kRowEnd: return "row_end";
+    case State::kAwaitKnotting: return "await_knotting";
     case State::kPaused: return "paused";
     case State::kDone: return "done";
     case State::kFault: return "fault";
@@ -210,7 +212,7 @@ void Sequencer::sense(const hal::HalInputs& raw) noexcept {
   const hal::DigitalInputs& r = raw.io;
   sensors_.update({r.piston_a_extended, r.piston_a_retracted, r.piston_b_extended, r.piston_b_retracted,
                    r.shuttle_at_left, r.shuttle_at_right});
-  buttons_.update({r.button_start, r.button_pause, r.button_ack});
+  buttons_.update({r.button_start, r.button_pause, r.button_ack, r.row_knotted});
   raw_io_ = r;
   io_ = r;
   io_.piston_a_extended = sensors_[0];
@@ -222,6 +224,7 @@ void Sequencer::sense(const hal::HalInputs& raw) noexcept {
   io_.button_start = buttons_[0];
   io_.button_pause = buttons_[1];
   io_.button_ack = buttons_[2];
+  io_.row_knotted = buttons_[3];
   // estop_ok is never filtered: an opened e-stop chain acts at once.
   if (sensed_ticks_ < 1000) ++sensed_ticks_;
 }
@@ -349,6 +352,7 @@ void Sequencer::operator_requests() noexcept {
   }
   if (pause_edge_.update(io_.button_pause) && state_ != State::kIdle) pause_requested_ = true;
   if (ack_edge_.update(io_.button_ack)) ack_requested_ = true;
+  if (knotted_edge_.update(io_.row_knotted)) knot_requested_ = true;
 }
 
 void Sequencer::run_state(hal::Tick now, const hal::HalInputs& in) noexcept {
@@ -361,6 +365,7 @@ void Sequencer::run_state(hal::Tick now, const hal::HalInputs& in) noexcept {
     case State::kPick: pick(now, in); break;
     case State::kBeatSweep: beat_sweep(now); break;
     case State::kRowEnd: row_end(now); break;
+    case State::kAwaitKnotting: await_knotting(now); break;
     case State::kPaused: paused(now); break;
     case State::kDone: break;
     case State::kFault: fault(now); break;
@@ -434,6 +439,8 @@ void Sequencer::positioning(hal::Tick now, const hal::HalInputs& in) noexcept {
   }
   if (counters_.picks_in_row >= cfg_.picks_per_row) {
     begin_sweep(now);
+  } else if (counters_.picks_in_row == 0 && !row_.started()) {
+    next_row(now);  // a fresh row: in knotting mode the weaver knots it first
   } else {
     begin_shed(now);
   }
@@ -550,7 +557,7 @@ void Sequencer::beat_sweep(hal::Tick now) noexcept {
 
 void Sequencer::paused(hal::Tick now) noexcept {
   // Paused between the picks of a row resumes that row; paused at a row's end starts the next.
-  if (!pause_requested_) row_.started() ? begin_shed(now) : begin_row(now);
+  if (!pause_requested_) row_.started() ? begin_shed(now) : next_row(now);
 }
 
 void Sequencer::fault(hal::Tick now) noexcept {
@@ -630,6 +637,11 @@ void Sequencer::begin_row(hal::Tick now) noexcept {
 
 void Sequencer::begin_shed(hal::Tick now) noexcept {
   row_.begin(counters_.rows + 1, now);
+  row_knotted_ = false;       // the row is under way: the next one needs its own knotting
+  if (knotting_ticks_ > 0) {  // the weaver's knotting before this row, recorded with it
+    row_.set_knotting(knotting_ticks_);
+    knotting_ticks_ = 0;
+  }
   // The shed may only change with the shuttle out of it, at the side the counters expect.
   if (!shuttle_where_counters_say(now)) return;
   if (!sensors_proven_) {  // the first shed change since arming: prove the end sensors first
@@ -723,8 +735,31 @@ void Sequencer::after_row(hal::Tick now) noexcept {
   } else if (pause_requested_) {
     enter(State::kPaused, now);
   } else {
-    begin_row(now);
+    next_row(now);
   }
+}
+
+void Sequencer::next_row(hal::Tick now) noexcept {
+  if (cfg_.knotting && !row_knotted_) {
+    knot_requested_ = false;  // a pedal press from before the row was woven does not count for the next
+    enter(State::kAwaitKnotting, now);
+    return;
+  }
+  begin_row(now);  // (a recipe swapped here re-arms first and comes back through next_row, still knotted)
+}
+
+void Sequencer::await_knotting(hal::Tick now) noexcept {
+  // Parked (beater out of the warp, shuttle at a selvedge, drives enabled and holding) while the weaver
+  // knots the row; a stop goes to done from here, a pause simply waits with it.
+  if (stop_requested_) {
+    enter(State::kDone, now);
+    return;
+  }
+  if (!knot_requested_) return;
+  knot_requested_ = false;
+  row_knotted_ = true;
+  knotting_ticks_ = now - state_since_;
+  next_row(now);
 }
 
 Fault Sequencer::shed_fault(ShedVerdict v) const noexcept {

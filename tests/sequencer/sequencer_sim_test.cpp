@@ -334,3 +334,64 @@ TEST(SequencerSim, ASaveNeverConfirmedTimesOutWithCountersNotSaved) {
   EXPECT_EQ(r.seq->counters().rows, 1u);
   EXPECT_NEAR(static_cast<double>(r.seq->fault_tick() - row_end_at) * r.cfg.period_s, 0.5, 2.0 * r.cfg.period_s);
 }
+
+// Knotting mode: before every new row the loom parks and waits for the weaver's "row knotted" — the
+// pedal input (debounced, on its rising edge) or request_row_knotted() — and records how long it waited.
+TEST(SequencerSim, KnottingModeWaitsBeforeEveryRowForTheWeaver) {
+  Rig r;
+  r.cfg.knotting = true;
+  r.build(2);
+  hal::PortHal hal(*r.world, *r.world);
+  hal::Tick waiting_since = -1;
+  int waits = 0, pedal_ticks = 0;
+  bool moved_while_waiting = false;
+  hal::HalOutputs parked{};
+  for (; r.now < 200000 && !r.seq->finished(); ++r.now) {
+    hal.read(r.now, r.in);
+    // The weaver presses the pedal 300 ticks into each wait and holds it for 20 ticks (the simulated
+    // world has no pedal: the input is set here on every tick).
+    r.in.io.row_knotted = waiting_since >= 0 && r.now - waiting_since >= 300 && pedal_ticks < 20;
+    if (r.in.io.row_knotted) ++pedal_ticks;
+    r.seq->step(r.now, r.in, r.out);
+    hal.write(r.now, r.out);
+    if (r.seq->state() == State::kAwaitKnotting) {
+      if (waiting_since < 0) {
+        waiting_since = r.now;
+        parked = r.out;
+        pedal_ticks = 0;
+        ++waits;
+      }
+      for (std::size_t k = 0; k < hal::kAxisCount; ++k) {
+        moved_while_waiting = moved_while_waiting || r.out.axes[k].target_position != parked.axes[k].target_position;
+      }
+      EXPECT_TRUE(r.out.io.lamp_amber);
+    } else if (pedal_ticks >= 20) {
+      waiting_since = -1;  // the pedal released: the next wait is a new one
+    }
+  }
+  ASSERT_EQ(r.seq->state(), State::kDone) << sequencer::fault_name(r.seq->first_fault()) << " waits " << waits
+                                          << " rows " << r.seq->counters().rows;
+  EXPECT_EQ(waits, 2);  // before row 1 and before row 2
+  EXPECT_FALSE(moved_while_waiting);
+  // Recorded with the row: the pedal's debounce (3 ticks) after 300 ticks, give or take a tick.
+  EXPECT_NEAR(static_cast<double>(r.seq->last_row().knotting_ticks), 300.0 + r.cfg.debounce_ticks, 2.0);
+}
+
+TEST(SequencerSim, KnottingWaitEndsOnRequestAndAStopThereIsDone) {
+  Rig r;
+  r.cfg.knotting = true;
+  r.build(3);
+  int knots = 0;
+  r.run(200000, [&] {
+    if (r.seq->state() != State::kAwaitKnotting) return;
+    if (r.seq->counters().rows < 1) {
+      r.seq->request_row_knotted();
+      ++knots;
+    } else {
+      r.seq->request_stop_at_row_end();  // waiting before row 2: a stop ends the session here
+    }
+  });
+  EXPECT_EQ(r.seq->state(), State::kDone);
+  EXPECT_EQ(r.seq->counters().rows, 1u);
+  EXPECT_EQ(knots, 1);
+}

@@ -118,7 +118,10 @@ int serve_main(const ServeArgs& a) {
         for (const std::string& line : history.read_all()) out += line + "\n";
         return out.empty() ? "no faults recorded in " + history.path() + "\n" : out;
       } else if (req == "next") {
-        return "error: next: this loom has no knotting mode (the sequencer waits for no 'row knotted')\n";
+        if (!cfg.sequencer.knotting) {
+          return "error: next: this loom's recipe has no knotting mode (recipe.knotting = false)\n";
+        }
+        link.post(Command::kNext);
       } else {
         return "error: unknown command '" + req + "' (start, pause, resume, stop, ack, status, faults, next)\n";
       }
@@ -179,9 +182,16 @@ int serve_main(const ServeArgs& a) {
       machine->collect_retired_recipes();
       switch (e.kind) {
         case RunEvent::Kind::kRowDone:
-          log(Severity::kInfo, "row %u done: %.2f s, %d beats, %d carriage steps (picks %u, beats %u)", e.row.row,
+        {
+          char knotting[64] = "";
+          if (e.row.knotting_ticks > 0) {
+            std::snprintf(knotting, sizeof knotting, ", knotted in %.2f s before it",
+                          static_cast<double>(e.row.knotting_ticks) * period);
+          }
+          log(Severity::kInfo, "row %u done: %.2f s, %d beats, %d carriage steps (picks %u, beats %u)%s", e.row.row,
               static_cast<double>(e.row.total_ticks) * period, e.row.beats, e.row.carriage_steps, e.counters.picks,
-              e.counters.beats);
+              e.counters.beats, knotting);
+        }
           break;
         case RunEvent::Kind::kPaused:
         case RunEvent::Kind::kResumed:

@@ -98,6 +98,7 @@ struct Recipe {
   double crank_accel_rad_s2 = 400.0, crank_jerk_rad_s3 = 2.0e4;
   motion::CrankLawSpec crank_law{};
   std::uint32_t picks_per_row = 1;
+  bool knotting = false;  // park before every row until the weaver's "row knotted" (handmade carpets)
   int beats_per_position = 1;
   double overlap_m = 0.02;
   double cam_margin_rad = 0.3491;

@@ -61,6 +61,7 @@ enum class Command : std::uint32_t {
   kStop = 1u << 3,    // stop at the end of the row in progress
   kAck = 1u << 4,     // acknowledge a latched fault (the runner returns kAckRequested; the owner re-arms)
   kExit = 1u << 5,    // leave the loop (service shutdown): stop at row end first when weaving
+  kNext = 1u << 6,    // knotting mode: the weaver has knotted the row, weave it
 };
 
 // Shared between the loop thread and any number of non-RT threads. Commands are bits in one atomic word
@@ -122,6 +123,8 @@ struct RunOptions {
   const std::atomic<bool>* stop_now_flag = nullptr;  // set asynchronously → safe stop at once (stop_requested)
   const std::atomic<bool>* pause_flag = nullptr;  // true → pause at the next safe point, false → resume
   RowSaves* row_saves = nullptr;                  // the counters-file handshake, when one is kept
+  // Simulation: a weaver who says "row knotted" this long after the loom starts waiting (knotting mode).
+  double simulated_knotting_s = 0.0;
 
   // Real-time thread (realtime only).
   int fifo_priority = 80;        // SCHED_FIFO priority of the loop thread; 0 = SCHED_OTHER

@@ -22,6 +22,7 @@ struct BeatRecord {
 struct RowStats {
   std::uint32_t row = 0;     // 1-based number of the row just completed
   hal::Tick shed_ticks = 0, pick_ticks = 0, beat_ticks = 0, total_ticks = 0;  // shed/pick summed over picks
+  hal::Tick knotting_ticks = 0;  // knotting mode: how long the weaver knotted before this row (not in total)
   int beats = 0;
   int carriage_steps = 0;
   bool force_measured = false;
@@ -43,6 +44,7 @@ class RowRecorder {
     stats_.row = row;
   }
   void add_shed(hal::Tick ticks) noexcept { stats_.shed_ticks += ticks; }
+  void set_knotting(hal::Tick ticks) noexcept { stats_.knotting_ticks = ticks; }
   void add_pick(hal::Tick ticks) noexcept { stats_.pick_ticks += ticks; }
   void beat_at(int k, double x_m) noexcept {
     if (k >= 0 && k < kMaxBeatsPerRow) stats_.beat[static_cast<std::size_t>(k)].x_m = static_cast<float>(x_m);

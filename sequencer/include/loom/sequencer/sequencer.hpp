@@ -28,6 +28,7 @@ enum class State : std::uint8_t {
   kPick,         // helix shaft carries the shuttle across, waiting for arrival
   kBeatSweep,    // crank beats while the carriage steps across the width
   kRowEnd,       // row woven, beater parked: waiting until its counters are on disk (when asked to)
+  kAwaitKnotting,  // knotting mode: parked before a new row until the weaver says the row is knotted
   kPaused,       // holding at a safe point (before a shed change), drives enabled, until resumed
   kDone,         // all requested rows woven (or stop at row end): holding, enabled
   kFault,        // latched fault: quick stop, valves hold, counters kept
@@ -88,6 +89,9 @@ struct SequencerConfig {
   // a selvedge). A recipe reloaded meanwhile is adopted by the row that follows.
   bool await_row_saved = false;
   double row_save_timeout_s = 5.0;
+  // Knotting mode (handmade carpets: knot a row, pass the weft, beat): before every new row the loom
+  // parks and waits for "row knotted" — the pedal/button input row_knotted, or request_row_knotted().
+  bool knotting = false;
 };
 
 // Configure-time only. "" when the sequencer can run `profiles` with `cfg`, else why not, naming the
@@ -115,6 +119,8 @@ class Sequencer {
   // RT-safe. Acknowledge a latched fault: the drives get their fault-reset edge, the machine goes idle
   // and re-arms from measured positions on the next start. (The operator's ack button does the same.)
   void request_acknowledge() noexcept { ack_requested_ = true; }
+  // RT-safe. The weaver has knotted the row (knotting mode): weave it. Ignored unless waiting for it.
+  void request_row_knotted() noexcept { knot_requested_ = true; }
   // RT-safe. A fault found outside the sequencer (the runner's overrun policy): latched at the next step
   // with the same reaction as any other fault (quick stop, valves hold, counters kept).
   void request_safe_stop(Fault f) noexcept { external_fault_ = f; }
@@ -171,6 +177,7 @@ class Sequencer {
   void pick(hal::Tick now, const hal::HalInputs& in) noexcept;
   void beat_sweep(hal::Tick now) noexcept;
   void row_end(hal::Tick now) noexcept;
+  void await_knotting(hal::Tick now) noexcept;
   void paused(hal::Tick now) noexcept;
   void fault(hal::Tick now) noexcept;
   // ---- transitions and helpers ----
@@ -188,6 +195,7 @@ class Sequencer {
   void begin_sweep(hal::Tick now) noexcept;
   void end_row(hal::Tick now) noexcept;
   void after_row(hal::Tick now) noexcept;  // done, paused or the next row, once the boundary is passed
+  void next_row(hal::Tick now) noexcept;   // a new row: first knotted by the weaver in knotting mode
   void adopt_limits() noexcept;
   Fault shed_fault(ShedVerdict v) const noexcept;
   void publish_beat(int k) noexcept;
@@ -259,8 +267,11 @@ class Sequencer {
 
   // Sensors and buttons as the sequencer uses them (debounced), and plausibility state.
   Debouncer<6> sensors_;
-  Debouncer<3> buttons_;
-  RisingEdge start_edge_, pause_edge_, ack_edge_;
+  Debouncer<4> buttons_;  // start, pause, ack, row knotted
+  RisingEdge start_edge_, pause_edge_, ack_edge_, knotted_edge_;
+  bool knot_requested_ = false;  // "row knotted" since the loom last started waiting for it
+  bool row_knotted_ = false;     // the row about to start has been knotted
+  hal::Tick knotting_ticks_ = 0;
   hal::DigitalInputs io_{};
   hal::DigitalInputs raw_io_{};
   int sensed_ticks_ = 0;                       // picture checks wait until the debouncer has history
