@@ -78,17 +78,21 @@ grep -q '^<5>loomctl serve: stopped' "$work/serve1.log" || fail "no stop line"
 start_serve serve2.log
 [[ $(field state) == idle ]] || fail "restart is not idle: $(ctl status)"
 [[ $(field rows) == "$rows" ]] || fail "restart lost rows: $(ctl status), want rows=$rows"
-# start again, kill -9 mid-row (power cut), restart: idle at the same row with the picks kept
+# start again, kill -9 while weaving (power cut), restart: idle, resuming exactly the counters on disk
+# (which row the kill lands in depends on the machine's load; what the board must do does not)
 ctl start >/dev/null
 wait_for state beat_sweep 30
 kill -9 "$pid"; wait "$pid" 2>/dev/null || true; pid=
 rm -f "$sock"
+on_disk=$(cat "$work/state/counters.json")
 start_serve serve3.log
 [[ $(field state) == idle ]] || fail "not idle after a power cut: $(ctl status)"
-[[ $(field rows) == "$rows" ]] || fail "rows changed by a power cut: $(ctl status)"
-grep -q "rows $rows, picks" "$work/serve3.log" || fail "armed line does not name the resumed counters"
+cut_rows=$(field rows)
+[[ $cut_rows -ge $rows ]] || fail "rows went back after a power cut: $(ctl status), had $rows"
+grep -q "\"rows\":$cut_rows," <<<"$on_disk" || fail "resumed rows=$cut_rows, the counters file said $on_disk"
+grep -q "rows $cut_rows, picks" "$work/serve3.log" || fail "armed line does not name the resumed counters"
 ctl start >/dev/null
-wait_for rows $((rows + 1)) 30
+wait_for rows $((cut_rows + 1)) 30
 ctl stop >/dev/null
 wait_for state done 30
 stop_serve
