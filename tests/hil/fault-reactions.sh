@@ -1,8 +1,7 @@
 #!/usr/bin/env bash
-# HIL: the fault reactions over a real vcan0, each from a fresh loomctl run against the same simulated
-# drives + I/O node (loomctl resets the nodes at bring-up). Like a real loom, each run resumes from the
-# counters the last one kept: the simulated shuttle stays where the last run left it, and a fresh
-# counters file would (rightly) be refused as shuttle_side_mismatch.
+# HIL: the fault reactions over a real vcan0, each on a fresh machine: a new loom-sim-drive (drives and
+# I/O node, shuttle at the left selvedge, shed closed) and fresh counters, so what one fault left behind
+# (a shuttle stopped mid-shed by the e-stop, rightly refused as shuttle_lost) cannot decide the next:
 #   estop     — the I/O node's e-stop input opens → exit 3, first fault estop, counters kept;
 #   io_silent — the I/O node goes silent → exit 3, first fault heartbeat_lost, counters kept;
 #   emcy      — an EMCY 0x2310 from drive 2 while its statusword stays Operation Enabled → exit 3,
@@ -17,16 +16,25 @@ hil_init fault_reactions "${1:-}"
 hil_require_vcan
 hil_find_binaries
 BASE=$HIL_NAME
-HIL_NAME=${BASE}_setup
-hil_start_candump
-hil_start_sim_drives
-hil_stop_candump
 
-# run_until_armed NAME — start loomctl (2 rows) and return once it has been weaving for a while.
+# fresh_machine — (re)start the simulated drives and I/O node: the machine as it comes from the builder.
+fresh_machine() {
+  if [[ -n ${HIL_SIM_PID:-} ]]; then
+    kill "$HIL_SIM_PID" 2>/dev/null || true
+    local i
+    for i in $(seq 1 100); do kill -0 "$HIL_SIM_PID" 2>/dev/null || break; sleep 0.05; done
+    HIL_PIDS=("${HIL_PIDS[@]/$HIL_SIM_PID}")
+  fi
+  hil_start_sim_drives  # (its I/O control file starts empty: e-stop closed, nothing silenced)
+}
+
+# run_until_armed NAME — on a fresh machine, start loomctl (2 rows) and return once it has been weaving
+# for a while.
 run_until_armed() {
   HIL_NAME=${BASE}_$1
   hil_start_candump
-  counters=$HIL_WORK/counters.json
+  fresh_machine
+  counters=$HIL_WORK/$1.counters.json
   out=$HIL_WORK/$1.loomctl.out
   hil_weave_cmd 2 "$counters"
   "${HIL_CMD[@]}" >"$out" 2>&1 &
