@@ -23,7 +23,7 @@ fresh_machine() {
     kill "$HIL_SIM_PID" 2>/dev/null || true
     local i
     for i in $(seq 1 100); do kill -0 "$HIL_SIM_PID" 2>/dev/null || break; sleep 0.05; done
-    HIL_PIDS=("${HIL_PIDS[@]/$HIL_SIM_PID}")
+    hil_forget_pid "$HIL_SIM_PID"
   fi
   hil_start_sim_drives  # (its I/O control file starts empty: e-stop closed, nothing silenced)
 }
@@ -100,7 +100,7 @@ expect_fault emcy 'drive_fault.*0x2310|0x2310.*drive_fault'
 run_until_armed master
 kill -KILL "$loom_pid"
 sleep 1
-HIL_PIDS=("${HIL_PIDS[@]/$loom_pid}")
+hil_forget_pid "$loom_pid"
 hil_stop_candump
 nodes=$HIL_NODES,$HIL_IO_NODE
 [[ $HIL_PERSONALITY == fixed ]] && nodes=$HIL_IO_NODE  # the fixed personality has no 0x1016

@@ -83,7 +83,12 @@ hil_need_exec() {
 hil_start_candump() {
   HIL_LOG=$HIL_WORK/$HIL_NAME.candump.log
   : >"$HIL_LOG"
-  stdbuf -oL candump -L -d -r 8388608 "$HIL_IFACE" >"$HIL_LOG" &
+  # The recorder must never starve: loomctl's SCHED_FIFO loop saturates the VM's one CPU once it falls
+  # behind, and a starved candump that is then stopped loses what waited in its socket (a log that ended
+  # at the moment of interest). It runs above the loop, like the simulated nodes, where that is allowed.
+  local rt=()
+  chrt -f 85 true 2>/dev/null && rt=(chrt -f 85)
+  "${rt[@]}" stdbuf -oL candump -L -d -r 8388608 "$HIL_IFACE" >"$HIL_LOG" &
   HIL_CANDUMP_PID=$!
   local i
   for ((i = 0; i < 50; i++)); do
@@ -137,6 +142,14 @@ hil_spawn() {
   HIL_LAST_PID=$!
   disown "$HIL_LAST_PID"
   HIL_PIDS+=("$HIL_LAST_PID")
+}
+
+# hil_forget_pid PID — drop PID (exactly: not every pid that contains its digits) from the processes the
+# cleanup kills, once the test has ended it itself.
+hil_forget_pid() {
+  local kept=() p
+  for p in "${HIL_PIDS[@]}"; do [[ $p == "$1" ]] || kept+=("$p"); done
+  HIL_PIDS=("${kept[@]}")
 }
 
 # The closing line every HIL test prints; hil-run adds the per-test logs up.
