@@ -47,7 +47,7 @@ set(CPACK_STRIP_FILES ON)
 # binaries load comes from one of these): the C++ runtime, LCM, toml++, NLopt (loom-dynamics' balancing)
 # and Google Benchmark (loom-profile's lookup timings). Names are the same on amd64 and arm64.
 set(CPACK_DEBIAN_PACKAGE_DEPENDS
-    "libc6 (>= 2.36), libstdc++6 (>= 12), libgcc-s1, liblcm1 (>= 1.3.1), libtomlplusplus3 (>= 3.3.0), libnlopt0 (>= 2.7.1), libbenchmark1debian (>= 1.7.1)")
+    "libc6 (>= 2.36), libstdc++6 (>= 12), libgcc-s1, liblcm1 (>= 1.3.1), libtomlplusplus3 (>= 3.3.0), libnlopt0 (>= 2.7.1), libbenchmark1debian (>= 1.7.1), libpng16-16 (>= 1.6.39)")
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "can-utils, iproute2")
 set(CPACK_DEBIAN_PACKAGE_SUGGESTS "rt-tests, liblcm-bin")
 configure_file(${pkg}/postinst ${CMAKE_BINARY_DIR}/packaging/postinst COPYONLY)

@@ -25,6 +25,26 @@ namespace {
 
 std::string read_file(const std::string& path) { return read_config_file(path); }
 
+// The recipe's design file, read relative to the config file's folder (the working directory for the
+// embedded default). A design that cannot be used is reported at the recipe.design line, with the
+// design file's own line:col inside the message.
+std::shared_ptr<const design::Design> load_design_for(const TomlReader& r, const std::string& file) {
+  if (file.empty()) return nullptr;
+  std::string path = file;
+  const std::string& src = r.source();
+  if (file[0] != '/' && !src.empty() && src[0] != '<' && src.find('/') != std::string::npos) {
+    path = src.substr(0, src.rfind('/') + 1) + file;
+  }
+  constexpr long kMaxDesignBytes = 16L << 20;
+  try {
+    return std::make_shared<const design::Design>(design::parse_design(read_config_file(path, kMaxDesignBytes, "design"), path));
+  } catch (const ConfigError& e) {
+    r.fail("recipe.design", '"' + file + '"', e.what());
+  } catch (const design::DesignError& e) {
+    r.fail("recipe.design", '"' + file + '"', e.what());
+  }
+}
+
 
 std::string fmt_num(double v) {
   std::ostringstream os;
@@ -282,6 +302,16 @@ const std::vector<Key>& keys() {
     // [recipe]
     v.push_back(integer<std::uint32_t>("recipe.picks_per_row", M::kRecipe, 1, 16, [](LoomConfig& c) -> std::uint32_t& { return c.recipe.picks_per_row; }));
     v.push_back(boolean("recipe.knotting", M::kRecipe, [](LoomConfig& c) -> bool& { return c.recipe.knotting; }));
+    {
+      Key design{"recipe.design", M::kRecipe, "file: .csv grid of colour codes or .png, one pixel per knot; \"\" = none",
+                 false, nullptr, nullptr};
+      design.read = [](TomlReader& r, LoomConfig& c) {
+        r.string("recipe.design", c.recipe.design_file);
+        c.recipe.design = load_design_for(r, c.recipe.design_file);
+      };
+      design.value = [](const LoomConfig& c) { return c.recipe.design_file; };
+      v.push_back(design);
+    }
     v.push_back(integer<int>("recipe.beats_per_position", M::kRecipe, 1, 16, [](LoomConfig& c) -> int& { return c.recipe.beats_per_position; }));
     {
       Key force = number("recipe.beat_force_target_n", M::kRecipe, 1.0, 1000.0, [](LoomConfig& c) -> double& { return c.recipe.beat_force_target_n; }, false);

@@ -105,6 +105,7 @@ void ControlLoop::push_events(hal::Tick now) noexcept {
     e.shed_ticks = r.shed_ticks;
     e.pick_ticks = r.pick_ticks;
     e.beat_ticks = r.beat_ticks;
+    e.knotting_ticks = r.knotting_ticks;
     e.beats = static_cast<std::uint16_t>(r.beats);
     e.carriage_steps = static_cast<std::uint16_t>(r.carriage_steps);
     e.force_measured = r.force_measured;

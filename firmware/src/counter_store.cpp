@@ -16,13 +16,10 @@
 #include <stdexcept>
 
 #include "loom/firmware/config.hpp"
+#include "loom/firmware/durable_file.hpp"
 
 namespace loom::firmware {
 namespace {
-
-[[noreturn]] void sys_fail(const std::string& what, const std::string& path) {
-  throw std::runtime_error(what + " " + path + ": " + std::strerror(errno));
-}
 
 // A cursor over the text that reports the column of what it could not accept.
 struct Cursor {
@@ -152,32 +149,7 @@ std::optional<sequencer::Counters> CounterStore::load() const {
 }
 
 void CounterStore::save(const sequencer::Counters& c) const {
-  const std::string body = format(c);
-  const std::string tmp = path_ + ".tmp";
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) sys_fail("cannot create", tmp);
-  const ssize_t n = ::write(fd, body.data(), body.size());
-  if (n != static_cast<ssize_t>(body.size()) || ::fsync(fd) != 0) {
-    const int err = errno;
-    ::close(fd);
-    ::unlink(tmp.c_str());
-    errno = n >= 0 && n != static_cast<ssize_t>(body.size()) ? ENOSPC : err;
-    sys_fail("cannot write", tmp);
-  }
-  if (::close(fd) != 0) sys_fail("cannot close", tmp);
-  if (::rename(tmp.c_str(), path_.c_str()) != 0) {
-    const int err = errno;
-    ::unlink(tmp.c_str());
-    errno = err;
-    sys_fail("cannot rename onto", path_);
-  }
-  // Make the rename itself durable: a failed directory sync is a failed save.
-  const std::string dir = path_.find('/') == std::string::npos ? "." : path_.substr(0, path_.rfind('/'));
-  const int dfd = ::open(dir.empty() ? "/" : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd < 0) sys_fail("cannot open directory of", path_);
-  const int rc = ::fsync(dfd);
-  ::close(dfd);
-  if (rc != 0 && errno != EINVAL) sys_fail("cannot sync directory of", path_);
+  write_file_durably(path_, format(c));
 }
 
 }  // namespace loom::firmware

@@ -45,6 +45,9 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
     pc.decimation.status_every_n_ticks = cfg_.telemetry.status_every;
     pc.decimation.axes_every_n_ticks = cfg_.telemetry.axes_every;
     pc.decimation.rt_every_n_ticks = cfg_.telemetry.rt_every;
+    pc.design = cfg_.recipe.design;
+    pc.design_rows_at_start = opt.design_rows_done;
+    pc.counter_rows_at_start = resume.rows;
     try {
       telemetry_ = std::make_unique<telemetry::Telemetry>(pc);
     } catch (const std::invalid_argument& e) {
@@ -128,11 +131,13 @@ void Machine::publish_recipe(const LoomConfig& next) {
   };
   differs(next.sequencer.picks_per_row != cfg_.sequencer.picks_per_row, "recipe.picks_per_row");
   differs(next.sequencer.knotting != cfg_.sequencer.knotting, "recipe.knotting");
+  // The design's remembered row and the panel's view are bound to the carpet on the loom.
+  differs(next.recipe.design_file != cfg_.recipe.design_file, "recipe.design");
   differs(next.sequencer.beat_force_min_n != cfg_.sequencer.beat_force_min_n ||
               next.sequencer.beat_force_max_n != cfg_.sequencer.beat_force_max_n,
           "recipe.beat_force_min_n/max_n");
   if (!fixed.empty()) {
-    throw ConfigError(next.source + ": " + fixed + " change only with a restart (the sequencer holds them)");
+    throw ConfigError(next.source + ": " + fixed + " change only with a restart (the sequencer or the design progress holds them)");
   }
   try {
     slot_->publish(std::make_unique<const motion::ProfileSet>(next.profile));

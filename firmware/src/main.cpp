@@ -12,6 +12,7 @@
 #include "loom/drivers/bus_load.hpp"
 #include "loom/firmware/config.hpp"
 #include "loom/firmware/counter_store.hpp"
+#include "loom/firmware/design_book.hpp"
 #include "loom/firmware/machine.hpp"
 #include "loom/firmware/runner.hpp"
 #include "loom/firmware/serve/commands.hpp"
@@ -74,6 +75,8 @@ int weave(const WeaveArgs& a) {
   std::string config_path;
   sequencer::Counters resume{};
   std::unique_ptr<firmware::CounterStore> store;
+  std::unique_ptr<firmware::DesignBook> book;  // with --counters and a design: the row each design reached
+  std::uint64_t design_rows = 0;                 // rows of the recipe's design woven before this run
   try {
     scene = a.scene.empty() ? firmware::default_scene() : firmware::load_scene(a.scene);
     config_path = a.config;
@@ -107,6 +110,18 @@ int weave(const WeaveArgs& a) {
         store->save(resume);
       } catch (const std::exception& ex) {
         throw firmware::ConfigError(std::string("counters file cannot be written, refusing to arm: ") + ex.what());
+      }
+      // The row each design has reached is kept beside the counters (designs.json).
+      if (cfg.recipe.design) {
+        const auto dir = std::filesystem::path(a.counters).parent_path();
+        book = std::make_unique<firmware::DesignBook>((dir.empty() ? std::string("designs.json") : (dir / "designs.json").string()));
+        try {
+          design_rows = book->activate(cfg.recipe.design->name(), resume.rows);
+        } catch (const firmware::ConfigError&) {
+          throw;
+        } catch (const std::exception& ex) {
+          throw firmware::ConfigError(std::string("design book cannot be written, refusing to arm: ") + ex.what());
+        }
       }
     }
   } catch (const firmware::ConfigError& e) {
@@ -144,6 +159,7 @@ int weave(const WeaveArgs& a) {
   mo.rows = resume.rows + a.rows;  // the sequencer counts absolute rows; weave `rows` more
   mo.sim_state_path = a.sim_state;
   mo.await_row_saved = store != nullptr;  // no row starts before the one before it is on disk
+  mo.design_rows_done = design_rows;
   if (!a.io.empty()) mo.io = a.io == "simulated" ? firmware::IoKind::kSimulated : firmware::IoKind::kCan;
   std::unique_ptr<firmware::Machine> machine;
   try {
@@ -158,6 +174,11 @@ int weave(const WeaveArgs& a) {
   if (!machine->banner().empty()) std::fprintf(stderr, "loomctl: WARNING: %s\n", machine->banner().c_str());
   if (!a.quiet) print_header(*machine, scene, a);
   if (resume.rows > 0) std::printf("  resuming after row %u (picks %u, beats %u)\n", resume.rows, resume.picks, resume.beats);
+  if (const auto& d = cfg.recipe.design; d && !a.quiet) {
+    const auto pos = design::position_after(*d, design_rows);
+    std::printf("  design %s (%d x %d knots): row %d to knot next%s\n", d->name().c_str(), d->width(), d->height(),
+                pos.row + 1, book ? "" : " (no --counters: the row reached is not remembered)");
+  }
 
   // ---- run ----
   const double period = cfg.sequencer.period_s;
@@ -244,6 +265,7 @@ int weave(const WeaveArgs& a) {
     if (store) {
       try {
         store->save(e.counters);
+        if (book) book->record(e.counters.rows);  // after the counters: a cut between lags, never leads
         row_saves.saved(e.counters.rows);
       } catch (const std::exception& ex) {
         // Weaving on without a durable count would lose work at the next power cut: the sequencer

@@ -106,8 +106,8 @@ std::size_t distance(const std::string& a, const std::string& b) {
 
 }  // namespace
 
-std::string read_config_file(const std::string& path) {
-  constexpr off_t kMaxBytes = 1 << 20;
+std::string read_config_file(const std::string& path, long max_bytes, const char* what) {
+  const auto kMaxBytes = static_cast<off_t>(max_bytes);
   // O_NONBLOCK: opening a FIFO must not wait for a writer; the type check below refuses it anyway.
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0) throw ConfigError(path + ": cannot open: " + std::strerror(errno));
@@ -118,7 +118,8 @@ std::string read_config_file(const std::string& path) {
   }
   if (st.st_size > kMaxBytes) {
     ::close(fd);
-    throw ConfigError(path + ": " + std::to_string(st.st_size) + " bytes: larger than any config (limit 1 MiB)");
+    throw ConfigError(path + ": " + std::to_string(st.st_size) + " bytes: larger than any " + what + " (limit " +
+                      std::to_string(max_bytes >> 20) + " MiB)");
   }
   std::string text(static_cast<std::size_t>(st.st_size), '\0');
   std::size_t got = 0;

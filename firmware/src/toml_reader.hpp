@@ -51,9 +51,10 @@ class TomlReader {
   std::set<std::string> used_;
 };
 
-// Configure-time only. The text of a config or scene file: a regular file of at most 1 MiB (a FIFO,
-// a device or /dev/zero is refused instead of blocking or reading without bound).
-std::string read_config_file(const std::string& path);
+// Configure-time only. The text of a config, scene or design file: a regular file of at most
+// `max_bytes` (a FIFO, a device or /dev/zero is refused instead of blocking or reading without bound).
+// `what` names the kind of file in the size refusal.
+std::string read_config_file(const std::string& path, long max_bytes = 1L << 20, const char* what = "config");
 
 // Common checks.
 std::string positive(double v);

@@ -7,7 +7,8 @@
 #      row, idle (resumable, not moving); killed with SIGKILL mid-row and restarted, likewise;
 #   4. a fault scene: the fault is logged with severity <3>, kept in the fault history (`ctl faults`),
 #      and `ctl ack` re-arms (state idle again, the ack recorded);
-#   5. knotting mode: parked before every row until `ctl next`, the knotting time logged with the row;
+#   5. knotting mode with a design: parked before every row until `ctl next`, the knotting time logged
+#      with the row, the design row to knot in `ctl status` and remembered across a restart;
 #   6. bad commands are refused (exit 2 from the CLI, exit 1 from the service).
 # Usage: serve_test.sh LOOMCTL SOURCE_DIR
 set -euo pipefail
@@ -110,20 +111,29 @@ ctl faults | grep -q ' ack loom1 drive_fault' || fail "ack not in the history: $
 stop_serve
 [[ -s $work/state/faults.log ]] || fail "no faults.log in the state dir"
 
-# 5. knotting mode: the loom parks before every row until `ctl next` (the weaver's "row knotted")
+# 5. knotting mode with a design: the loom parks before every row until `ctl next` (the weaver's "row
+#    knotted"); status says which design row to knot; the row reached is kept per design across restarts
 rm -rf "$work/state"
-printf 'extends = "default"\n[recipe]\nknotting = true\n' >"$work/knotting.toml"
+cp "$src/tests/firmware/designs/border.csv" "$work/border.csv"
+printf 'extends = "default"\n[recipe]\nknotting = true\ndesign = "border.csv"\n' >"$work/knotting.toml"
 start_serve serve5.log --config "$work/knotting.toml"
 ctl start >/dev/null
 wait_for state await_knotting 30
 sleep 0.3
 [[ $(field state) == await_knotting ]] || fail "did not keep waiting for the weaver: $(ctl status)"
 [[ $(field rows) == 0 ]] || fail "wove before the row was knotted: $(ctl status)"
+[[ $(field design) == border.csv && $(field design_row) == 1/6 ]] || fail "design row 1/6 not shown: $(ctl status)"
 ctl next | grep -q '^ok next' || fail "next not acknowledged"
 wait_for rows 1 30
 wait_for state await_knotting 30
 [[ $(field rows) == 1 ]] || fail "did not wait for the weaver after row 1: $(ctl status)"
+[[ $(field design_row) == 2/6 ]] || fail "design row 2/6 not next after row 1: $(ctl status)"
 grep -q 'knotted in' "$work/serve5.log" || fail "no knotting time in the row line"
+stop_serve
+grep -q '"border.csv":1' "$work/state/designs.json" || fail "designs.json: $(cat "$work/state/designs.json")"
+start_serve serve5b.log --config "$work/knotting.toml"
+[[ $(field design_row) == 2/6 ]] || fail "design row not remembered across a restart: $(ctl status)"
+grep -q 'design border.csv (12 x 6 knots): row 2 to knot next' "$work/serve5b.log" || fail "no design line at arming"
 stop_serve
 
 # 6. refusals

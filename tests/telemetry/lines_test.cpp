@@ -146,10 +146,14 @@ TEST(MonitorLines, BeatFaultAndRowLines) {
   r.beats_in_band = 15;
   EXPECT_EQ(row_line(r),
             "row loom=L t=7.564s row=1 time=7.56s shed=0.33s pick=1.29s beat=5.93s beats=15 steps=14 "
-            "force_min=89.3N force_mean=89.5N force_max=89.7N in_band=15/15");
+            "force_min=89.3N force_mean=89.5N force_max=89.7N in_band=15/15 knotting=0.00s");
   EXPECT_EQ(v.on_row(r).at(0),
             "L t=7.564s row 1 done in 7.56 s (shed 0.33, pick 1.29, beat 5.93 s), 15 beats, force min/mean/max "
             "89.3/89.5/89.7 N, 15/15 in band");
+  r.knotting_s = 212.4;  // knotting mode: the weaver's time before the row
+  EXPECT_EQ(v.on_row(r).at(0),
+            "L t=7.564s row 1 done in 7.56 s (shed 0.33, pick 1.29, beat 5.93 s), 15 beats, force min/mean/max "
+            "89.3/89.5/89.7 N, 15/15 in band, knotted in 212.4 s before it");
 }
 
 TEST(MonitorLines, EventViewSaysBandAndKeepsStatusSparse) {

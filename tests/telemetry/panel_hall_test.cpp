@@ -113,6 +113,51 @@ TEST(PanelHall, RestartedLoopStartsAfreshAndNaNIsNull) {
   EXPECT_GT(h.wait_for_change(v, std::chrono::milliseconds(10)), v);
 }
 
+TEST(PanelHall, DesignShowsTheNextRowAndOnlyANewRowIsAChange) {
+  Hall hall;
+  loomlcm::design_t d{};
+  d.loom_id = "L1";
+  d.name = "rug.csv";
+  d.width = 2;
+  d.height = 6;
+  d.rows_done = 1;
+  d.next_row = 2;
+  d.repeat = 1;
+  d.n_colours = 2;
+  d.code = {"R", "B"};
+  d.colour_name = {"madder", ""};
+  d.rgb = {0x9b1b30, 0x1d3f8a};
+  d.n_rows = 2;
+  d.row_number = {1, 2};
+  d.next_index = 1;
+  d.knots = {{0, 1}, {1, 7}};  // 7: beyond the palette (a corrupt message) is shown as unknown
+  hall.on_design(d);
+  const auto v = hall.version();
+  hall.on_design(d);  // the periodic repeat of the same row
+  EXPECT_EQ(hall.version(), v);
+  const auto j = *hall.loom_json("L1");
+  EXPECT_EQ(j["design"]["next_row"], 2);
+  EXPECT_EQ(j["design"]["palette"][0]["rgb"], "#9b1b30");
+  EXPECT_EQ(j["design"]["rows"][1]["next"], true);
+  EXPECT_EQ(j["design"]["rows"][0]["next"], false);
+  EXPECT_TRUE(j["design"]["rows"][1]["knots"][1].is_null());
+  EXPECT_EQ(hall.hall_json()["looms"][0]["design"]["next_row"], 2);
+  d.rows_done = 2;
+  d.next_row = 3;
+  hall.on_design(d);
+  EXPECT_GT(hall.version(), v);
+}
+
+TEST(PanelHall, RowsCarryTheKnottingTime) {
+  Hall hall;
+  loomlcm::row_t r{};
+  r.loom_id = "L1";
+  r.row = 1;
+  r.knotting_s = 42.5;
+  hall.on_row(r);
+  EXPECT_EQ((*hall.loom_json("L1"))["rows"][0]["knotting_s"], 42.5);
+}
+
 TEST(PanelUdpm, UrlsAndPackets) {
   const auto a = parse_udpm_url("udpm://239.255.76.67:7771?ttl=0");
   ASSERT_TRUE(a.has_value());

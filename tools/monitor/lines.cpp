@@ -125,7 +125,7 @@ std::string row_line(const loomlcm::row_t& m) {
   } else {
     line += " force_min=- force_mean=- force_max=- in_band=-";
   }
-  return line;
+  return line + fmt(" knotting=%.2fs", m.knotting_s);
 }
 
 // ---- the event view ----
@@ -187,6 +187,7 @@ std::vector<std::string> EventView::on_row(const loomlcm::row_t& m) {
     line += fmt(", force min/mean/max %.1f/%.1f/%.1f N, %d/%d in band", m.force_min_n, m.force_mean_n,
                 m.force_max_n, m.beats_in_band, m.beats);
   }
+  if (m.knotting_s > 0.0) line += fmt(", knotted in %.1f s before it", m.knotting_s);
   return {line};
 }
 

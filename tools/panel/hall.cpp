@@ -76,7 +76,8 @@ json rt_json(const loomlcm::rt_stats_t& m) {
 
 json row_json(const loomlcm::row_t& m) {
   json j = {{"row", m.row},       {"time_s", num(m.row_s)}, {"shed_s", num(m.shed_s)}, {"pick_s", num(m.pick_s)},
-            {"beat_s", num(m.beat_s)}, {"beats", m.beats}, {"carriage_steps", m.carriage_steps},
+            {"beat_s", num(m.beat_s)}, {"knotting_s", num(m.knotting_s)}, {"beats", m.beats},
+            {"carriage_steps", m.carriage_steps},
             {"beats_in_band", m.beats_in_band}};
   if (m.force_measured) {
     j["force"] = {{"min", num(m.force_min_n)}, {"mean", num(m.force_mean_n)}, {"max", num(m.force_max_n)}};
@@ -84,6 +85,30 @@ json row_json(const loomlcm::row_t& m) {
     j["force"] = nullptr;
   }
   return j;
+}
+
+std::string rgb_hex(std::int32_t rgb) {
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "#%06x", static_cast<unsigned>(rgb) & 0xFFFFFFu);
+  return buf;
+}
+
+// The design row to knot next and its neighbours, with the palette, as the page draws them. Indices
+// outside the palette (a corrupt message) are sent as null rather than trusted.
+json design_json(const loomlcm::design_t& m) {
+  json palette = json::array();
+  for (int i = 0; i < m.n_colours; ++i) {
+    palette.push_back({{"code", m.code[static_cast<std::size_t>(i)]}, {"name", m.colour_name[static_cast<std::size_t>(i)]},
+                       {"rgb", rgb_hex(m.rgb[static_cast<std::size_t>(i)])}});
+  }
+  json rows = json::array();
+  for (int r = 0; r < m.n_rows; ++r) {
+    json knots = json::array();
+    for (std::int16_t k : m.knots[static_cast<std::size_t>(r)]) knots.push_back(k >= 0 && k < m.n_colours ? json(k) : json(nullptr));
+    rows.push_back({{"row", m.row_number[static_cast<std::size_t>(r)]}, {"next", r == m.next_index}, {"knots", knots}});
+  }
+  return {{"name", m.name},           {"width", m.width},   {"height", m.height}, {"rows_done", m.rows_done},
+          {"next_row", m.next_row},   {"repeat", m.repeat}, {"palette", palette}, {"rows", rows}};
 }
 
 json fault_json(const loomlcm::fault_t& m) {
@@ -178,6 +203,16 @@ void Hall::on_row(const loomlcm::row_t& m) {
   }
 }
 
+void Hall::on_design(const loomlcm::design_t& m) {
+  std::lock_guard lock(mu_);
+  if (Loom* l = loom(m.loom_id)) {
+    // Only a new row is a change worth pushing to every page; the periodic repeat just refreshes it.
+    const bool moved = !l->design || l->design->rows_done != m.rows_done || l->design->name != m.name;
+    l->design = m;
+    if (moved) changed();
+  }
+}
+
 json Hall::summary(const std::string& id, const Loom& l, Clock::time_point now) {
   json j = {{"id", id},
             {"heard_s_ago", std::chrono::duration<double>(now - l.heard).count()},
@@ -186,6 +221,9 @@ json Hall::summary(const std::string& id, const Loom& l, Clock::time_point now) 
             {"faults_seen", l.faults_seen}};
   j["status"] = l.status ? status_json(*l.status) : json(nullptr);
   j["last_row"] = l.rows.empty() ? json(nullptr) : row_json(l.rows.back());
+  j["design"] = l.design ? json{{"name", l.design->name}, {"next_row", l.design->next_row}, {"height", l.design->height},
+                                {"repeat", l.design->repeat}}
+                         : json(nullptr);
   return j;
 }
 
@@ -223,9 +261,8 @@ std::optional<json> Hall::loom_json(const std::string& id) const {
   json faults = json::array();
   for (const auto& f : l.faults) faults.push_back(fault_json(f));
   j["faults"] = faults;
-  // Operator buttons are not offered: the panel is read-only until it can act through the board's
-  // local control socket (see main.cpp, PanelOptions::control_socket).
-  j["controls"] = false;
+  j["design"] = l.design ? design_json(*l.design) : json(nullptr);
+  j["controls"] = false;  // the HTTP side says whether it may act on this loom (main.cpp)
   return j;
 }
 

@@ -17,6 +17,7 @@
 
 #include "loomlcm/axes_t.hpp"
 #include "loomlcm/beat_t.hpp"
+#include "loomlcm/design_t.hpp"
 #include "loomlcm/fault_t.hpp"
 #include "loomlcm/row_t.hpp"
 #include "loomlcm/rt_stats_t.hpp"
@@ -43,6 +44,7 @@ class Hall {
   void on_beat(const loomlcm::beat_t& m);
   void on_fault(const loomlcm::fault_t& m);
   void on_row(const loomlcm::row_t& m);
+  void on_design(const loomlcm::design_t& m);
 
   // HTTP threads. The hall: every loom heard, one summary object each. A loom: everything kept, or
   // nullopt when that id was never heard.
@@ -72,6 +74,7 @@ class Hall {
     double band_min_n = 80.0, band_max_n = 100.0;
     std::deque<loomlcm::row_t> rows;
     std::deque<loomlcm::fault_t> faults;
+    std::optional<loomlcm::design_t> design;  // the weaver's next row (looms weaving a design)
     std::uint64_t beats_seen = 0, beats_in_band = 0, faults_seen = 0;
   };
   Loom* loom(const std::string& id);  // nullptr when over the loom limit; caller holds mu_

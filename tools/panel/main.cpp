@@ -5,9 +5,14 @@
 //   GET /                 the hall: every loom heard          GET /loom/<id>      one loom
 //   GET /api/hall         the hall as JSON                    GET /api/loom/<id>  one loom as JSON
 //   GET /events[?loom=ID] server-sent events: the same JSON, pushed on change (at most 4 per second)
-// Read-only: nothing it receives over HTTP reaches the loom. Binds to 127.0.0.1 unless --bind says
-// otherwise (a hall network). Exit 2 on bad arguments, 1 when it cannot listen or open LCM.
+//   POST /api/loom/<id>/ctl/<pause|resume|stop|ack|next>   operator buttons, only with --control-dir
+// Read-only by default: nothing it receives over HTTP reaches the loom. With --control-dir DIR the
+// page offers pause / resume / stop at row end / acknowledge and "row knotted", each sent to that
+// loom's local control socket DIR/<id>.sock (loomctl serve's), never published on LCM. Binds to
+// 127.0.0.1 unless --bind says otherwise (a hall network). Exit 2 on bad arguments, 1 when it cannot
+// listen or open LCM.
 #include <httplib.h>
+#include <sys/stat.h>
 
 #include <CLI/CLI.hpp>
 #include <atomic>
@@ -22,6 +27,7 @@
 
 #include "hall.hpp"
 #include "udpm_receiver.hpp"
+#include "loom/firmware/serve/control_socket.hpp"
 #include "loom/telemetry/channels.hpp"
 
 namespace loom::panel {
@@ -45,11 +51,25 @@ struct PanelOptions {
   std::string channel_prefix = std::string(loom::telemetry::kDefaultChannelPrefix);
   double min_push_interval_s = 0.25;  // live updates are coalesced to at most this often per client
   int http_threads = 32;              // each open page holds one for its event stream
-  // Operator buttons (pause / resume / stop at row end / acknowledge) will act through the board's
-  // local control socket, never over LCM. Empty = read-only, and no option sets it yet: the socket
-  // is the board's to provide. The page shows buttons only when the JSON says "controls": true.
-  std::string control_socket;
+  // Operator buttons act through the board's local control sockets, <control_dir>/<loom id>.sock,
+  // never over LCM. Empty = read-only. The page shows buttons only when the JSON says "controls": true
+  // (the option is set and that loom's socket exists).
+  std::string control_dir;
 };
+
+// The commands the page's buttons may send: no `start` (a loom is set going by the person beside it).
+bool panel_command(const std::string& c) {
+  return c == "pause" || c == "resume" || c == "stop" || c == "ack" || c == "next";
+}
+
+std::string control_socket_of(const PanelOptions& o, const std::string& loom) {
+  return o.control_dir + "/" + loom + ".sock";
+}
+
+bool controls_for(const PanelOptions& o, const std::string& loom) {
+  struct stat st {};
+  return !o.control_dir.empty() && ::stat(control_socket_of(o, loom).c_str(), &st) == 0 && S_ISSOCK(st.st_mode);
+}
 
 // Routes one received message by its channel, <prefix>.<loom id>.<KIND>, to the hall. AXES comes at
 // up to 50 Hz per loom; a page needs a few per second, so each loom's AXES is decoded at most every
@@ -85,6 +105,8 @@ class Router {
       decode<loomlcm::fault_t>(data, len, [&](const auto& m) { hall_.on_fault(m); });
     } else if (kind == "ROW") {
       decode<loomlcm::row_t>(data, len, [&](const auto& m) { hall_.on_row(m); });
+    } else if (kind == "DESIGN") {
+      decode<loomlcm::design_t>(data, len, [&](const auto& m) { hall_.on_design(m); });
     }
   }
   std::uint64_t decode_errors() const { return decode_errors_; }
@@ -112,9 +134,15 @@ class Router {
   bool throttle_axes_ = true;
 };
 
-std::string json_for(const Hall& hall, const std::string& loom) {
+std::optional<nlohmann::json> loom_json(const Hall& hall, const PanelOptions& o, const std::string& loom) {
+  auto j = hall.loom_json(loom);
+  if (j) (*j)["controls"] = controls_for(o, loom);
+  return j;
+}
+
+std::string json_for(const Hall& hall, const PanelOptions& o, const std::string& loom) {
   if (loom.empty()) return hall.hall_json().dump();
-  const auto j = hall.loom_json(loom);
+  const auto j = loom_json(hall, o, loom);
   return j ? j->dump() : nlohmann::json{{"id", loom}, {"heard", false}}.dump();
 }
 
@@ -129,6 +157,9 @@ int main(int argc, char** argv) {
   app.add_option("--bind", o.bind, "address to listen on (0.0.0.0 for a hall network)")->capture_default_str();
   app.add_option("--lcm-url", o.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or udpm://239.255.76.67:7667?ttl=0)");
   app.add_option("--channel-prefix", o.channel_prefix, "first field of the channel names")->capture_default_str();
+  app.add_option("--control-dir", o.control_dir,
+                 "operator buttons: send them to the looms' control sockets DIR/<loom id>.sock (loomctl serve; "
+                 "on a board /run/loomctl). Without it the panel is read-only");
   app.add_option("--min-push-interval-s", o.min_push_interval_s, "shortest gap between two live updates of a page")
       ->check(CLI::Range(0.01, 60.0))
       ->capture_default_str();
@@ -181,7 +212,7 @@ int main(int argc, char** argv) {
     res.set_content(hall.hall_json().dump(), "application/json");
   });
   svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32}))", [&](const httplib::Request& req, httplib::Response& res) {
-    const auto j = hall.loom_json(req.matches[1]);
+    const auto j = loom_json(hall, o, req.matches[1]);
     if (!j) {
       res.status = 404;
       res.set_content(nlohmann::json{{"error", "loom not heard"}, {"id", std::string(req.matches[1])}}.dump(),
@@ -189,6 +220,28 @@ int main(int argc, char** argv) {
       return;
     }
     res.set_content(j->dump(), "application/json");
+  });
+ // An operator button. A custom header is required so a page on another site cannot fire it with a
+  // plain form post (browsers send custom headers cross-origin only after a preflight we never grant).
+  svr.Post(R"(/api/loom/([A-Za-z0-9_-]{1,32})/ctl/([a-z]{1,16}))", [&](const httplib::Request& req,
+                                                                       httplib::Response& res) {
+    const std::string loom = req.matches[1], cmd = req.matches[2];
+    const auto reply = [&](int status, const std::string& text) {
+      res.status = status;
+      res.set_content(nlohmann::json{{"loom", loom}, {"command", cmd}, {"reply", text}}.dump(), "application/json");
+    };
+    if (req.get_header_value("X-Loom-Panel") != "1") return reply(403, "missing X-Loom-Panel header");
+    if (o.control_dir.empty()) return reply(403, "read-only panel (start it with --control-dir to offer buttons)");
+    if (!panel_command(cmd)) return reply(400, "unknown command (pause, resume, stop, ack, next)");
+    std::string text;
+    try {
+      text = loom::firmware::serve::control_request(control_socket_of(o, loom), cmd, 3000);
+    } catch (const std::exception& e) {
+      return reply(503, e.what());
+    }
+    while (!text.empty() && text.back() == '\n') text.pop_back();
+    std::fprintf(stderr, "loom-panel: %s %s -> %s\n", loom.c_str(), cmd.c_str(), text.c_str());
+    reply(text.rfind("ok", 0) == 0 ? 200 : 409, text);
   });
   svr.Get("/events", [&](const httplib::Request& req, httplib::Response& res) {
     const std::string loom = req.has_param("loom") ? req.get_param_value("loom") : std::string();
@@ -202,7 +255,7 @@ int main(int argc, char** argv) {
         std::chrono::duration<double>(o.min_push_interval_s));
     // Each call of the provider sends one event: the current JSON, once it differs from the last sent.
     auto seen = std::make_shared<std::uint64_t>(~std::uint64_t{0});
-    res.set_chunked_content_provider("text/event-stream", [&hall, loom, gap, seen](std::size_t, httplib::DataSink& sink) {
+    res.set_chunked_content_provider("text/event-stream", [&hall, &o, loom, gap, seen](std::size_t, httplib::DataSink& sink) {
       const auto t0 = std::chrono::steady_clock::now();
       // Wake every second to notice a closed page or a stopping server; a comment keeps proxies awake.
       for (;;) {
@@ -215,7 +268,7 @@ int main(int argc, char** argv) {
         }
       }
       *seen = hall.version();
-      const std::string msg = "data: " + json_for(hall, loom) + "\n\n";
+      const std::string msg = "data: " + json_for(hall, o, loom) + "\n\n";
       if (!sink.write(msg.data(), msg.size())) return false;
       std::this_thread::sleep_for(gap);  // coalesce: a busy loom costs at most one update per gap
       return true;
@@ -240,7 +293,8 @@ int main(int argc, char** argv) {
   sigaction(SIGTERM, &sa, nullptr);
 
   std::thread http([&] { svr.listen_after_bind(); });
-  std::fprintf(stderr, "loom-panel: serving http://%s:%d/ (read-only), LCM %s\n", o.bind.c_str(), port,
+  std::fprintf(stderr, "loom-panel: serving http://%s:%d/ (%s), LCM %s\n", o.bind.c_str(), port,
+               o.control_dir.empty() ? "read-only" : ("operator buttons via " + o.control_dir).c_str(),
                o.lcm_url.empty() ? "default URL" : o.lcm_url.c_str());
   const auto on_packet = [&](const loom::panel::LcmPacket& p) { router.route(p.channel, p.data, p.size); };
   while (!g_stop.load()) {

@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -17,6 +18,7 @@
 
 #include "loom/firmware/config.hpp"
 #include "loom/firmware/counter_store.hpp"
+#include "loom/firmware/design_book.hpp"
 #include "loom/firmware/machine.hpp"
 #include "loom/firmware/runner.hpp"
 #include "loom/firmware/serve/commands.hpp"
@@ -39,17 +41,33 @@ std::string axis_label(int axis) {
   return axis >= 0 ? hal::axis_name(static_cast<hal::Axis>(axis)) : "";
 }
 
-std::string status_text(const OperatorLink& l, const std::string& loom_id) {
+// Where the session's design stands: rows of it woven when the session was armed, against the
+// production rows then (the control thread reads it while the loop weaves).
+struct DesignProgress {
+  std::atomic<std::uint64_t> rows_at_arm{0};
+  std::atomic<std::uint32_t> counter_rows_at_arm{0};
+};
+
+std::string status_text(const OperatorLink& l, const std::string& loom_id, const design::Design* d,
+                        const DesignProgress& p) {
   constexpr auto r = std::memory_order_relaxed;
   const auto f = static_cast<sequencer::Fault>(l.first_fault.load(r));
   char buf[512];
   std::snprintf(buf, sizeof buf,
-                "loom=%s state=%s rows=%u picks=%u beats=%u fault=%s overruns=%u max_wake_latency_ns=%lld tick=%lld\n",
+                "loom=%s state=%s rows=%u picks=%u beats=%u fault=%s overruns=%u max_wake_latency_ns=%lld tick=%lld",
                 loom_id.c_str(), sequencer::state_name(static_cast<sequencer::State>(l.state.load(r))),
                 l.rows.load(r), l.picks.load(r), l.beats.load(r),
                 f == sequencer::Fault::kNone ? "none" : sequencer::fault_name(f), l.overruns.load(r),
                 static_cast<long long>(l.max_wake_latency_ns.load(r)), static_cast<long long>(l.tick.load(r)));
-  return buf;
+  std::string out = buf;
+  if (d != nullptr) {
+    const std::uint32_t rows = l.rows.load(r), at_arm = p.counter_rows_at_arm.load(r);
+    const auto pos = design::position_after(*d, p.rows_at_arm.load(r) + (rows >= at_arm ? rows - at_arm : 0));
+    std::snprintf(buf, sizeof buf, " design=%s design_row=%d/%d repeat=%d", d->name().c_str(), pos.row + 1,
+                  d->height(), pos.repeat);
+    out += buf;
+  }
+  return out + "\n";
 }
 
 }  // namespace
@@ -83,6 +101,10 @@ int serve_main(const ServeArgs& a) {
   const std::string state = std::filesystem::path(a.state_dir).string();
   CounterStore store(state + "/counters.json");
   FaultHistory history(state + "/faults.log");
+  // The row each design has reached, beside the counters (only when the recipe names a design).
+  std::unique_ptr<DesignBook> book;
+  if (cfg.recipe.design) book = std::make_unique<DesignBook>(state + "/designs.json");
+  DesignProgress design_progress;
   const std::string socket_path = a.socket.empty() ? "/run/loomctl/" + cfg.loom_id + ".sock" : a.socket;
 
   // Real time: memory locked and SCHED_FIFO probed for the loop thread only (this thread, the control
@@ -112,7 +134,7 @@ int serve_main(const ServeArgs& a) {
       else if (req == "resume") link.post(Command::kResume);
       else if (req == "stop") link.post(Command::kStop);
       else if (req == "ack") link.post(Command::kAck);
-      else if (req == "status") return status_text(link, cfg.loom_id);
+      else if (req == "status") return status_text(link, cfg.loom_id, cfg.recipe.design.get(), design_progress);
       else if (req == "faults") {
         std::string out;
         for (const std::string& line : history.read_all()) out += line + "\n";
@@ -147,7 +169,26 @@ int serve_main(const ServeArgs& a) {
       log(Severity::kErr, "loomctl serve: %s", e.what());
       return kExitBadInput;
     }
+    std::uint64_t design_rows = 0;
+    if (book) {
+      try {
+        design_rows = book->activate(cfg.recipe.design->name(), resume.rows);
+      } catch (const ConfigError& e) {
+        log(Severity::kErr, "loomctl serve: %s", e.what());
+        return kExitBadInput;
+      } catch (const std::exception& e) {
+        log(Severity::kErr, "loomctl serve: design book cannot be written, refusing to arm: %s", e.what());
+        return kExitBadInput;
+      }
+      design_progress.rows_at_arm.store(design_rows);
+      design_progress.counter_rows_at_arm.store(resume.rows);
+      const auto pos = design::position_after(*cfg.recipe.design, design_rows);
+      log(Severity::kNotice, "design %s (%d x %d knots): row %d to knot next%s", cfg.recipe.design->name().c_str(),
+          cfg.recipe.design->width(), cfg.recipe.design->height(), pos.row + 1,
+          pos.repeat > 1 ? (", repeat " + std::to_string(pos.repeat)).c_str() : "");
+    }
     MachineOptions mo;
+    mo.design_rows_done = design_rows;
     mo.hal = hardware ? HalKind::kSocketCan : HalKind::kSim;
     mo.iface = a.iface;
     mo.telemetry = !a.no_telemetry;
@@ -231,6 +272,7 @@ int serve_main(const ServeArgs& a) {
       }
       try {
         store.save(e.counters);
+        if (book) book->record(e.counters.rows);  // after the counters: a cut between lags, never leads
         row_saves.saved(e.counters.rows);
       } catch (const std::exception& ex) {
         // The sequencer stops at the row boundary with counters_not_saved (a fault like any other).
@@ -285,6 +327,7 @@ int serve_main(const ServeArgs& a) {
         // lags them): write them before re-arming, which reads them back.
         try {
           store.save(seq.counters());
+          if (book) book->record(seq.counters().rows);
         } catch (const std::exception& ex) {
           log(Severity::kErr, "counters still not saved (%s): re-arming from the file's older counts", ex.what());
         }

@@ -202,6 +202,40 @@ loomlcm::row_t to_row(const Event& e, const std::string& loom_id, std::int64_t u
   m.beats_in_band = static_cast<std::int16_t>(e.beats_in_band);
   m.band_min_n = e.band_min_n;
   m.band_max_n = e.band_max_n;
+  m.knotting_s = seconds(e.knotting_ticks, e.period_ns);
+  m.knotting_s = seconds(e.knotting_ticks, e.period_ns);
+  return m;
+}
+
+loomlcm::design_t to_design(const design::Design& d, std::uint64_t rows_done, const std::string& loom_id,
+                            std::int64_t utime) {
+  loomlcm::design_t m;
+  m.utime = utime;
+  m.loom_id = loom_id;
+  m.name = d.name();
+  m.width = d.width();
+  m.height = d.height();
+  m.rows_done = static_cast<std::int64_t>(std::min<std::uint64_t>(rows_done, INT64_MAX));
+  const design::DesignPosition next = design::position_after(d, rows_done);
+  m.next_row = next.row + 1;
+  m.repeat = next.repeat;
+  m.n_colours = static_cast<std::int16_t>(d.palette().size());
+  for (const design::Colour& c : d.palette()) {
+    m.code.push_back(c.code);
+    m.colour_name.push_back(c.name);
+    m.rgb.push_back(static_cast<std::int32_t>(c.rgb));
+  }
+  // Absolute rows (counting every repeat) from the one knotted last to two after the next.
+  const std::uint64_t first = rows_done > 0 ? rows_done - 1 : rows_done;
+  const std::uint64_t h = static_cast<std::uint64_t>(d.height());
+  for (std::uint64_t a = first; a <= rows_done + 2; ++a) {
+    if (a == rows_done) m.next_index = static_cast<std::int16_t>(m.row_number.size());
+    const int r = static_cast<int>(a % h);
+    m.row_number.push_back(r + 1);
+    const auto knots = d.row(r);
+    m.knots.emplace_back(knots.begin(), knots.end());
+  }
+  m.n_rows = static_cast<std::int16_t>(m.row_number.size());
   return m;
 }
 

@@ -85,6 +85,7 @@ PublisherStats Publisher::stats() const noexcept {
   s.beat = n_beat_.load(std::memory_order_relaxed);
   s.fault = n_fault_.load(std::memory_order_relaxed);
   s.row = n_row_.load(std::memory_order_relaxed);
+  s.design = n_design_.load(std::memory_order_relaxed);
   s.events = s.beat + s.fault + s.row;
   s.publish_errors = n_errors_.load(std::memory_order_relaxed);
   return s;
@@ -142,16 +143,18 @@ void Publisher::publish_events_up_to(hal::Tick tick) {
   }
 }
 
+template <typename Msg>
+void Publisher::send(const std::string& channel, const Msg& msg, std::atomic<std::uint64_t>& counter) {
+  pace();
+  if (lcm_->publish(channel, &msg) == 0) {
+    counter.fetch_add(1, std::memory_order_relaxed);
+  } else {
+    n_errors_.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
 void Publisher::publish_event(const Event& e) {
   const std::int64_t utime = wall_utime();
-  const auto send = [this](const std::string& channel, const auto& msg, std::atomic<std::uint64_t>& counter) {
-    pace();
-    if (lcm_->publish(channel, &msg) == 0) {
-      counter.fetch_add(1, std::memory_order_relaxed);
-    } else {
-      n_errors_.fetch_add(1, std::memory_order_relaxed);
-    }
-  };
   try {
     switch (e.kind) {
       case Event::Kind::kBeat: send(channels_.beat, to_beat(e, cfg_.loom_id, utime), n_beat_); break;
@@ -163,20 +166,28 @@ void Publisher::publish_event(const Event& e) {
   }
 }
 
+// With STATUS: when the design row changed, and at most once a second otherwise (a panel opened late
+// learns the row within a second; an unchanged row is not re-sent at STATUS's rate).
+void Publisher::publish_design(const Snapshot& s, std::int64_t utime) {
+  if (!cfg_.design) return;
+  const std::uint64_t woven = s.row >= cfg_.counter_rows_at_start ? s.row - cfg_.counter_rows_at_start : 0;
+  const std::uint64_t rows = cfg_.design_rows_at_start + woven;
+  const auto now = std::chrono::steady_clock::now();
+  if (rows == design_rows_sent_ && now - design_sent_at_ < std::chrono::seconds(1)) return;
+  send(channels_.design, to_design(*cfg_.design, rows, cfg_.loom_id, utime), n_design_);
+  design_rows_sent_ = rows;
+  design_sent_at_ = now;
+}
+
 void Publisher::publish(const Snapshot& s) {
   const ChannelSet due = schedule_.decide(s);
   if (!due.status && !due.axes && !due.rt) return;
   const std::int64_t utime = wall_utime();
-  const auto send = [this](const std::string& channel, const auto& msg, std::atomic<std::uint64_t>& counter) {
-    pace();
-    if (lcm_->publish(channel, &msg) == 0) {
-      counter.fetch_add(1, std::memory_order_relaxed);
-    } else {
-      n_errors_.fetch_add(1, std::memory_order_relaxed);
-    }
-  };
   try {
-    if (due.status) send(channels_.status, to_status(s, cfg_.loom_id, utime), n_status_);
+    if (due.status) {
+      send(channels_.status, to_status(s, cfg_.loom_id, utime), n_status_);
+      publish_design(s, utime);
+    }
     if (due.axes) send(channels_.axes, to_axes(s, cfg_.loom_id, utime), n_axes_);
     if (due.rt) {
       send(channels_.rt, to_rt_stats(s, cfg_.loom_id, utime, ring_.dropped(), ring_.size_approx(), events_.dropped()), n_rt_);

@@ -3,64 +3,18 @@
 // the loom's row count advancing and every beat force of the current row drawn in the target band;
 // the hall page listing the loom. Writes a screenshot of the loom page.
 // Usage: node --experimental-websocket panel_browser.mjs <chromium> <panel base url> <loom id> <png> <timeout s>
-import { spawn } from "node:child_process";
-import { mkdtempSync, writeFileSync, rmSync } from "node:fs";
-import { tmpdir } from "node:os";
-import { join } from "node:path";
+import { writeFileSync } from "node:fs";
+import { launch, sleep } from "./cdp.mjs";
 
 const [chromiumBin, base, loomId, pngPath, timeoutArg] = process.argv.slice(2);
 const minBeats = Number(process.env.PANEL_MIN_BEATS || 3);  // more for a fuller screenshot
 const timeoutMs = Number(timeoutArg || 60) * 1000;
 const started = Date.now();
-const fail = msg => { console.error("FAIL: " + msg); cleanup(); process.exit(1); };
-const profile = mkdtempSync(join(tmpdir(), "loom_panel_chromium."));
-const chrome = spawn(chromiumBin, [
-  "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-  "--disable-background-networking", "--disable-component-update", "--disable-sync",
-  "--disable-dev-shm-usage", `--user-data-dir=${profile}`, "--remote-debugging-port=0",
-  "--remote-debugging-address=127.0.0.1", "--window-size=1200,1500", "about:blank"], { stdio: ["ignore", "ignore", "pipe"] });
-function cleanup() { try { chrome.kill("SIGKILL"); } catch {} try { rmSync(profile, { recursive: true, force: true }); } catch {} }
+let browser = null;
+const fail = msg => { console.error("FAIL: " + msg); browser?.close(); process.exit(1); };
 setTimeout(() => fail(`gave up after ${timeoutMs / 1000} s`), timeoutMs).unref();
-
-const wsUrl = await new Promise((resolve, reject) => {
-  let err = "";
-  chrome.stderr.on("data", d => {
-    err += d;
-    const m = err.match(/DevTools listening on (ws:\/\/\S+)/);
-    if (m) resolve(m[1]);
-  });
-  chrome.on("exit", code => reject(new Error(`chromium exited ${code}: ${err.slice(-2000)}`)));
-}).catch(e => fail(e.message));
-
-const ws = new WebSocket(wsUrl);
-await new Promise((res, rej) => { ws.onopen = res; ws.onerror = () => rej(new Error("devtools websocket")); });
-let nextId = 1;
-const pending = new Map();
-ws.onmessage = ev => {
-  const msg = JSON.parse(ev.data);
-  if (msg.id && pending.has(msg.id)) {
-    const { resolve, reject } = pending.get(msg.id);
-    pending.delete(msg.id);
-    msg.error ? reject(new Error(JSON.stringify(msg.error))) : resolve(msg.result);
-  }
-};
-const send = (method, params = {}, sessionId) => new Promise((resolve, reject) => {
-  const id = nextId++;
-  pending.set(id, { resolve, reject });
-  ws.send(JSON.stringify(sessionId ? { id, method, params, sessionId } : { id, method, params }));
-});
-const sleep = ms => new Promise(r => setTimeout(r, ms));
-
-async function open(url) {
-  const { targetId } = await send("Target.createTarget", { url });
-  const { sessionId } = await send("Target.attachToTarget", { targetId, flatten: true });
-  await send("Runtime.enable", {}, sessionId);
-  return sessionId;
-}
-async function evaluate(session, expression) {
-  const r = await send("Runtime.evaluate", { expression, returnByValue: true }, session);
-  return r.result.value;
-}
+browser = await launch(chromiumBin, fail);
+const { send, open, evaluate } = browser;
 
 // ---- the loom page ----
 const loomPage = await open(`${base}/loom/${loomId}`);
@@ -110,6 +64,5 @@ writeFileSync(pngPath.replace(/\.png$/, "_hall.png"), Buffer.from(hallShot.data,
 
 console.log(`PASS: panel showed row ${first.row} -> ${last.row}, ${last.forces.length} beat forces in band ` +
   `(${last.forces.map(f => f.n).join(" ")}), hall lists ${hall.join(",")}; screenshot ${pngPath}`);
-ws.close();
-cleanup();
+browser.close();
 process.exit(0);

@@ -13,10 +13,12 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "loom/design/design.hpp"
 #include "loom/drivers/can_axis_port.hpp"
 #include "loom/drivers/can_io_port.hpp"
 #include "loom/motion/profile_set.hpp"
@@ -99,6 +101,10 @@ struct Recipe {
   motion::CrankLawSpec crank_law{};
   std::uint32_t picks_per_row = 1;
   bool knotting = false;  // park before every row until the weaver's "row knotted" (handmade carpets)
+  // The carpet's knot map, shown to the weaver row by row: the file as written (relative to the config
+  // file's folder) and what was loaded from it (null when the recipe names none).
+  std::string design_file;
+  std::shared_ptr<const design::Design> design;
   int beats_per_position = 1;
   double overlap_m = 0.02;
   double cam_margin_rad = 0.3491;

@@ -35,6 +35,9 @@ struct MachineOptions {
   // `--io`: overrides the config's io.kind. Real drives with simulated I/O only when this says
   // kSimulated explicitly (the config alone is not enough), and then banner() is set.
   std::optional<IoKind> io;
+  // The recipe's design: rows of it woven before this session (from the design book), so DESIGN
+  // telemetry shows the weaver the right row to knot next.
+  std::uint64_t design_rows_done = 0;
 };
 
 // Printed on every start when real drives run beside simulated I/O.

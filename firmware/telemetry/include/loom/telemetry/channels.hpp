@@ -1,5 +1,6 @@
 // LCM channel names for one loom: <prefix>.<loom id>.STATUS / .AXES / .RT (samples, decimated) and
-// .BEAT / .FAULT / .ROW (events, each sent once). The loom id is in the name
+// .BEAT / .FAULT / .ROW (events, each sent once), and .DESIGN (the weaver's next row, when the recipe
+// names a design). The loom id is in the name
 // so a hall of looms can share one multicast group and a technician can subscribe to one loom or all.
 #pragma once
 
@@ -26,10 +27,11 @@ struct ChannelNames {
   std::string beat;   // events, never decimated
   std::string fault;
   std::string row;
+  std::string design;  // the weaver's next row, from the publisher (looms with a design only)
 };
 
 // Every channel kind, in the order a reader lists them.
-inline constexpr std::string_view kChannelKinds[] = {"STATUS", "AXES", "RT", "BEAT", "FAULT", "ROW"};
+inline constexpr std::string_view kChannelKinds[] = {"STATUS", "AXES", "RT", "BEAT", "FAULT", "ROW", "DESIGN"};
 
 // Configure-time only (allocates). Assumes both parts passed the checks above.
 ChannelNames channel_names(std::string_view prefix, std::string_view loom_id);

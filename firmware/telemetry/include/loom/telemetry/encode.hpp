@@ -5,7 +5,9 @@
 #include <cstdint>
 #include <string>
 
+#include "loom/design/design.hpp"
 #include "loom/telemetry/snapshot.hpp"
+#include "loomlcm/design_t.hpp"
 #include "loomlcm/axes_t.hpp"
 #include "loomlcm/beat_t.hpp"
 #include "loomlcm/fault_t.hpp"
@@ -29,6 +31,10 @@ loomlcm::rt_stats_t to_rt_stats(const Snapshot& s, const std::string& loom_id, s
 loomlcm::beat_t to_beat(const Event& e, const std::string& loom_id, std::int64_t utime);
 loomlcm::fault_t to_fault(const Event& e, const std::string& loom_id, std::int64_t utime);
 loomlcm::row_t to_row(const Event& e, const std::string& loom_id, std::int64_t utime);
+// Not RT-safe: publisher thread only. The design's row to knot after `rows_done` design rows, with the
+// row knotted last (when any) and the two after it.
+loomlcm::design_t to_design(const design::Design& d, std::uint64_t rows_done, const std::string& loom_id,
+                            std::int64_t utime);
 // The FAULT message's kind field for an event's fault kind: "first", "diagnosis", "device".
 const char* fault_kind_name(Event::FaultKind k) noexcept;
 

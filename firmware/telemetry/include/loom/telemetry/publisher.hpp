@@ -12,6 +12,7 @@
 #include <thread>
 #include <vector>
 
+#include "loom/design/design.hpp"
 #include "loom/telemetry/channels.hpp"
 #include "loom/telemetry/schedule.hpp"
 #include "loom/telemetry/snapshot.hpp"
@@ -45,6 +46,11 @@ struct PublisherConfig {
   // the ring instead, and a virtual-time loop waits (push_waiting) rather than losing data. A real-time
   // loop publishes far below this (about 100 messages/s at the default decimation at 2 ms).
   double max_messages_per_s = 5000.0;
+  // The carpet design whose next row DESIGN carries (null: no DESIGN messages). Design rows woven at a
+  // snapshot = design_rows_at_start + (its completed rows − counter_rows_at_start).
+  std::shared_ptr<const design::Design> design;
+  std::uint64_t design_rows_at_start = 0;
+  std::uint32_t counter_rows_at_start = 0;
 };
 
 struct PublisherStats {
@@ -56,6 +62,7 @@ struct PublisherStats {
   std::uint64_t beat = 0;
   std::uint64_t fault = 0;
   std::uint64_t row = 0;
+  std::uint64_t design = 0;  // DESIGN messages (not events: sent by the publisher)
   std::uint64_t publish_errors = 0;  // lcm publish() failures (e.g. no multicast route)
 };
 
@@ -92,6 +99,9 @@ class Publisher {
   void publish_events_up_to(hal::Tick tick);  // events with tick < `tick`; all of them for kNeverTick
   void publish_event(const Event& e);
   void pace();
+  void publish_design(const Snapshot& s, std::int64_t utime);
+  template <typename Msg>
+  void send(const std::string& channel, const Msg& msg, std::atomic<std::uint64_t>& counter);
 
   SnapshotRing& ring_;
   EventRing& events_;
@@ -108,7 +118,9 @@ class Publisher {
   std::atomic<bool> running_{false};
   std::atomic<bool> stop_requested_{false};
   std::atomic<std::uint64_t> n_snapshots_{0}, n_status_{0}, n_axes_{0}, n_rt_{0}, n_errors_{0};
-  std::atomic<std::uint64_t> n_beat_{0}, n_fault_{0}, n_row_{0};
+  std::atomic<std::uint64_t> n_beat_{0}, n_fault_{0}, n_row_{0}, n_design_{0};
+  std::uint64_t design_rows_sent_ = UINT64_MAX;  // design rows done in the last DESIGN sent
+  std::chrono::steady_clock::time_point design_sent_at_{};
 };
 
 }  // namespace loom::telemetry

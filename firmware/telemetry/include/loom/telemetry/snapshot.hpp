@@ -83,6 +83,7 @@ struct Event {
   std::array<char, 24> state{};    // sequencer state just before the fault
   // kRow
   hal::Tick row_ticks = 0, shed_ticks = 0, pick_ticks = 0, beat_ticks = 0;
+  hal::Tick knotting_ticks = 0;  // knotting mode: the weaver's time before the row
   std::uint16_t beats = 0, carriage_steps = 0, beats_in_band = 0;
   double force_min_n = 0.0, force_mean_n = 0.0, force_max_n = 0.0;
 };

@@ -1,0 +1,66 @@
+#!/usr/bin/env bash
+# The weaver's panel in knotting mode, end to end: `loomctl serve` weaves the simulated loom (4x real
+# time) with a knotting recipe and a test design; loom-panel listens to its LCM telemetry and offers
+# operator buttons through serve's control socket; headless Chromium checks that the page shows design
+# row 1's colour codes while the loom waits, presses "Row knotted", and sees row 1 woven and design
+# row 2 shown. Writes <out>/loom_panel_knotting.png. Exit 77 (skip) without chromium or node.
+# Usage: panel_knotting.sh <loomctl> <loom-panel> <design csv> <out dir>
+set -euo pipefail
+LOOMCTL=$1
+PANEL=$2
+DESIGN=$3
+OUT=$4
+here=$(dirname "$0")
+fail() { echo "FAIL: $*" >&2; for f in "$WORK"/*.log; do echo "--- $f" >&2; tail -20 "$f" >&2; done; exit 1; }
+CHROMIUM=$(command -v chromium || command -v chromium-browser || true)
+[ -n "$CHROMIUM" ] || { echo "SKIP: chromium not installed (tools/deps.sh installs it)"; exit 77; }
+command -v node >/dev/null || { echo "SKIP: node not installed"; exit 77; }
+node --experimental-websocket -e 'if (typeof WebSocket !== "function") process.exit(1)' 2>/dev/null ||
+  { echo "SKIP: this node ($(node --version)) has no built-in WebSocket"; exit 77; }
+mkdir -p "$OUT"
+WORK=$(mktemp -d "${TMPDIR:-/tmp}/loom_panel_knotting.XXXXXX")
+PIDS=()
+cleanup() {
+  for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null || true; done
+  for p in "${PIDS[@]}"; do wait "$p" 2>/dev/null || true; done  # serve writes its state until it exits
+  rm -rf "$WORK" || true
+}
+trap cleanup EXIT
+
+PORT=$((20000 + ($$ * 11) % 20000))
+URL="udpm://239.255.76.67:${PORT}?ttl=0"
+ID="knot$$"
+mkdir -p "$WORK/run"
+cp "$DESIGN" "$WORK/$(basename "$DESIGN")"
+printf 'extends = "default"\n[recipe]\nknotting = true\ndesign = "%s"\n' "$(basename "$DESIGN")" >"$WORK/loom.toml"
+
+# What the page must show: design row 1 is the file's last grid line, row 2 the one above it.
+rows_json=$(grep -v '^[[:space:]]*#' "$DESIGN" | grep -v '^palette,' | grep -v '^[[:space:]]*$' | tac | head -2 |
+  sed 's/[[:space:]]//g; s/,/","/g; s/^/["/; s/$/"]/' | paste -sd, | sed 's/^/[/; s/$/]/')
+height=$(grep -v '^[[:space:]]*#' "$DESIGN" | grep -v '^palette,' | grep -vc '^[[:space:]]*$')
+
+"$PANEL" --port 0 --lcm-url "$URL" --control-dir "$WORK/run" 2>"$WORK/panel.log" &
+PIDS+=($!)
+for _ in $(seq 1 100); do
+  grep -q "serving http" "$WORK/panel.log" 2>/dev/null && break
+  sleep 0.05
+done
+BASE=$(sed -n 's|.*serving \(http://[0-9.]*:[0-9]*\)/.*|\1|p' "$WORK/panel.log")
+[ -n "$BASE" ] || fail "loom-panel did not start"
+
+SOCK="$WORK/run/$ID.sock"
+"$LOOMCTL" serve --config "$WORK/loom.toml" --state-dir "$WORK/state" --socket "$SOCK" --group "" \
+  --loom-id "$ID" --lcm-url "$URL" --pace 4 >"$WORK/serve.log" 2>&1 &
+PIDS+=($!)
+for _ in $(seq 1 200); do
+  [ -S "$SOCK" ] && "$LOOMCTL" ctl --socket "$SOCK" status >/dev/null 2>&1 && break
+  sleep 0.05
+done
+"$LOOMCTL" ctl --socket "$SOCK" start >/dev/null || fail "serve did not take start"
+
+node --experimental-websocket "$here/panel_knotting.mjs" "$CHROMIUM" "$BASE" "$ID" "$OUT/loom_panel_knotting.png" 80 \
+  "$rows_json" "$height" 2>&1 | grep -v ExperimentalWarning | grep -v "node --trace-warnings" ||
+  fail "browser check failed"
+grep -q "$ID next -> ok next" "$WORK/panel.log" || fail "the panel did not log the button it sent"
+grep -q 'operator: next (control socket)' "$WORK/serve.log" || fail "serve did not receive the panel's next"
+[ -s "$OUT/loom_panel_knotting.png" ] || fail "no screenshot written"
