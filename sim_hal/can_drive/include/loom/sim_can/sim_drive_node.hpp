@@ -13,9 +13,14 @@
 #include <vector>
 
 #include "loom/drivers/can_frame.hpp"
-#include "loom/drivers/nmt.hpp"  // the NmtState type of nmt_state() only; frames are built in slave_od
 #include "loom/hal/types.hpp"
 #include "loom/sim_can/slave_od.hpp"
+
+// The master's NMT state type is nmt_state()'s return type only (its values are the heartbeat bytes);
+// declared, not included, so no drivers/ codec reaches the simulated node.
+namespace loom::drivers {
+enum class NmtState : std::uint8_t;
+}  // namespace loom::drivers
 
 namespace loom::sim_can {
 
