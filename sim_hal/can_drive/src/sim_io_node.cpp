@@ -165,10 +165,10 @@ void SimIoNode::handle(const drivers::CanFrame& f, std::int64_t now_us) {
   }
   if (nmt_ != nmt::kOperational) return;
   if (slave::is_sync(f)) {
-    on_sync();
+    on_sync(now_us);
     return;
   }
-  if (const int pdo = od_.rpdo_for(f.id); pdo >= 0) on_rpdo(pdo, f);
+  if (const int pdo = od_.rpdo_for(f.id); pdo >= 0) on_rpdo(pdo, f, now_us);
 }
 
 void SimIoNode::on_nmt(std::uint8_t command, std::int64_t now_us) {
@@ -199,7 +199,7 @@ void SimIoNode::on_sdo(const drivers::CanFrame& f, std::int64_t now_us) {
   if (const auto reply = slave::sdo_serve(od_, *this, config_.node_id, f, now_us)) send(*reply);
 }
 
-void SimIoNode::on_rpdo(int pdo, const drivers::CanFrame& f) {
+void SimIoNode::on_rpdo(int pdo, const drivers::CanFrame& f, std::int64_t now_us) {
   if (!od_.rpdo_length_ok(pdo, f.dlc)) {
     send(slave::emcy(config_.node_id, slave::emcy_code::kPdoLength, slave::kErrorRegisterGeneric));
     return;
@@ -209,7 +209,7 @@ void SimIoNode::on_rpdo(int pdo, const drivers::CanFrame& f) {
     rpdo_data_[k] = f.data;
     rpdo_pending_[k] = true;  // applied at the next SYNC
   } else {
-    od_.unpack_rpdo(pdo, f.data, *this, 0);
+    od_.unpack_rpdo(pdo, f.data, *this, now_us);
   }
 }
 
@@ -219,13 +219,13 @@ void SimIoNode::send_tpdo(int pdo) {
   send(slave::pdo_frame(od_.pdo_can_id(static_cast<std::uint16_t>(slave::kTpdoComm + pdo)), dlc, data));
 }
 
-void SimIoNode::on_sync() {
+void SimIoNode::on_sync(std::int64_t now_us) {
   ++syncs_;
   ++syncs_total_;
   for (std::size_t k = 0; k < rpdo_pending_.size(); ++k) {
     if (!rpdo_pending_[k]) continue;
     rpdo_pending_[k] = false;
-    od_.unpack_rpdo(static_cast<int>(k), rpdo_data_[k], *this, 0);
+    od_.unpack_rpdo(static_cast<int>(k), rpdo_data_[k], *this, now_us);
   }
   update_inputs();
   for (int k = 0; k < slave::kPdos; ++k) {

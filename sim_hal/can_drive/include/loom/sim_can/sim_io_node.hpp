@@ -81,8 +81,8 @@ class SimIoNode : private slave::ObjectHooks {
 
   void on_nmt(std::uint8_t command, std::int64_t now_us);
   void on_sdo(const drivers::CanFrame& f, std::int64_t now_us);
-  void on_sync();
-  void on_rpdo(int pdo, const drivers::CanFrame& f);
+  void on_sync(std::int64_t now_us);
+  void on_rpdo(int pdo, const drivers::CanFrame& f, std::int64_t now_us);
   void send_tpdo(int pdo);
   void send_changed_inputs();
   void reset_communication(std::int64_t now_us);
