@@ -3,7 +3,9 @@
 // error. A raw test endpoint plays the master, so these checks do not depend on drivers::CanAxisPort.
 #include <gtest/gtest.h>
 
+#include <initializer_list>
 #include <optional>
+#include <vector>
 
 #include "fake_can_network.hpp"
 #include "loom/drivers/cob_id.hpp"
@@ -278,6 +280,189 @@ TEST_F(SimDriveNodeTest, PoweredOffNodeIsSilent) {
   tester_.send(drivers::make_sdo_upload(5, 0x1000, 0));
   pump();
   EXPECT_TRUE(take().empty());
+}
+
+// ---- Raw frames (bytes written out from CiA 301, not through drivers/' codecs) ---------------------
+class SimDriveNodeRawTest : public ::testing::Test {
+ protected:
+  // One node with `c` on the bus; everything it sent so far is discarded.
+  void start(SimDriveConfig c) {
+    c.node_id = 5;
+    node_.emplace(drive_ep_, c);
+    node_->power_on(now_);
+    take();
+  }
+  void pump() {
+    CanFrame f;
+    while (drive_ep_.receive(f)) node_->handle(f, now_);
+    node_->step(now_);
+  }
+  void advance_to(std::int64_t t) {
+    while (now_ < t) {
+      now_ = std::min(t, now_ + 1000);
+      net_.set_time(now_);
+      pump();
+    }
+  }
+  std::vector<CanFrame> take() {
+    std::vector<CanFrame> out;
+    CanFrame f;
+    while (tester_.receive(f)) out.push_back(f);
+    return out;
+  }
+  void send(std::uint32_t id, std::initializer_list<std::uint8_t> bytes) {
+    CanFrame f;
+    f.id = id;
+    f.dlc = static_cast<std::uint8_t>(bytes.size());
+    std::size_t k = 0;
+    for (std::uint8_t b : bytes) f.data[k++] = b;
+    tester_.send(f);
+    pump();
+  }
+  // The SDO reply (0x585) to one request on 0x605.
+  std::array<std::uint8_t, 8> sdo(std::initializer_list<std::uint8_t> request) {
+    take();
+    send(0x605, request);
+    for (const CanFrame& f : take()) {
+      if (f.id == 0x585 && f.dlc == 8) return f.data;
+    }
+    return {};
+  }
+
+  test::FakeCanNetwork net_;
+  test::FakeCanNetwork::Endpoint& tester_ = net_.add_endpoint();
+  test::FakeCanNetwork::Endpoint& drive_ep_ = net_.add_endpoint();
+  std::optional<SimDriveNode> node_;
+  std::int64_t now_ = 0;
+};
+
+using Bytes = std::array<std::uint8_t, 8>;
+
+TEST_F(SimDriveNodeRawTest, StatuswordUploadIs4BWithTheStatuswordLittleEndian) {
+  start({});
+  const std::uint16_t sw = node_->statusword();
+  EXPECT_EQ(sdo({0x40, 0x41, 0x60, 0x00, 0, 0, 0, 0}),
+            (Bytes{0x4B, 0x41, 0x60, 0x00, static_cast<std::uint8_t>(sw & 0xFF),
+                   static_cast<std::uint8_t>(sw >> 8), 0, 0}));
+  EXPECT_EQ(sw & 0x4F, 0x40);  // switch on disabled
+  // Device type 0x00020192 and the CSP bit of 0x6502.
+  EXPECT_EQ(sdo({0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0}),
+            (Bytes{0x43, 0x00, 0x10, 0x00, 0x92, 0x01, 0x02, 0x00}));
+  EXPECT_EQ(sdo({0x40, 0x02, 0x65, 0x00, 0, 0, 0, 0}),
+            (Bytes{0x43, 0x02, 0x65, 0x00, 0x85, 0x00, 0x00, 0x00}));
+  // Factory TPDO2 mapping: velocity (32 bits), torque (16 bits).
+  EXPECT_EQ(sdo({0x40, 0x01, 0x1A, 0x00, 0, 0, 0, 0}), (Bytes{0x4F, 0x01, 0x1A, 0x00, 0x02, 0, 0, 0}));
+  EXPECT_EQ(sdo({0x40, 0x01, 0x1A, 0x02, 0, 0, 0, 0}),
+            (Bytes{0x43, 0x01, 0x1A, 0x02, 0x10, 0x00, 0x77, 0x60}));
+}
+
+TEST_F(SimDriveNodeRawTest, CommercialPersonalityLacksTpdo3And4And1016AndHasFixedMapping) {
+  SimDriveConfig c;
+  c.fixed_mapping = true;
+  c.missing_objects = {0x1802, 0x1803, 0x1A02, 0x1A03, 0x1016};
+  start(c);
+  for (std::uint8_t index_lo : {std::uint8_t{0x02}, std::uint8_t{0x03}}) {
+    EXPECT_EQ(sdo({0x23, index_lo, 0x18, 0x01, 0x80, 0x03, 0x00, 0x80}),
+              (Bytes{0x80, index_lo, 0x18, 0x01, 0x00, 0x00, 0x02, 0x06}));
+  }
+  EXPECT_EQ(sdo({0x40, 0x16, 0x10, 0x01, 0, 0, 0, 0}),
+            (Bytes{0x80, 0x16, 0x10, 0x01, 0x00, 0x00, 0x02, 0x06}));
+  // Invalidating the PDO is allowed; its mapping stays read-only, sub-index 0 included.
+  EXPECT_EQ(sdo({0x23, 0x00, 0x14, 0x01, 0x05, 0x02, 0x00, 0x80}),
+            (Bytes{0x60, 0x00, 0x14, 0x01, 0, 0, 0, 0}));
+  EXPECT_EQ(sdo({0x2F, 0x00, 0x16, 0x00, 0x00, 0, 0, 0}),
+            (Bytes{0x80, 0x00, 0x16, 0x00, 0x02, 0x00, 0x01, 0x06}));
+  EXPECT_EQ(sdo({0x23, 0x00, 0x16, 0x01, 0x10, 0x00, 0x40, 0x60}),
+            (Bytes{0x80, 0x00, 0x16, 0x01, 0x02, 0x00, 0x01, 0x06}));
+  EXPECT_EQ(sdo({0x40, 0x00, 0x16, 0x02, 0, 0, 0, 0}),
+            (Bytes{0x43, 0x00, 0x16, 0x02, 0x20, 0x00, 0x7A, 0x60}));
+}
+
+TEST_F(SimDriveNodeRawTest, FactoryTpdo1MappingOfThePersonalityIsWhatTheDriveSends) {
+  SimDriveConfig c;
+  c.fixed_mapping = true;
+  c.tpdo1_factory_mapping = {0x60410010, 0x60630020};
+  start(c);
+  EXPECT_EQ(sdo({0x40, 0x00, 0x1A, 0x02, 0, 0, 0, 0}),
+            (Bytes{0x43, 0x00, 0x1A, 0x02, 0x20, 0x00, 0x63, 0x60}));
+  send(0x000, {0x01, 0x05});
+  take();
+  send(0x080, {});
+  const auto frames = take();
+  ASSERT_FALSE(frames.empty());
+  EXPECT_EQ(frames[0].id, 0x185u);
+  EXPECT_EQ(frames[0].dlc, 6);  // 16 + 32 bits, whatever the drive does not have reads 0
+}
+
+TEST_F(SimDriveNodeRawTest, DriveWithoutCspRefusesMode8) {
+  SimDriveConfig c;
+  c.supports_csp = false;
+  start(c);
+  EXPECT_EQ(sdo({0x40, 0x02, 0x65, 0x00, 0, 0, 0, 0}),
+            (Bytes{0x43, 0x02, 0x65, 0x00, 0x05, 0x00, 0x00, 0x00}));
+  EXPECT_EQ(sdo({0x2F, 0x60, 0x60, 0x00, 0x08, 0, 0, 0}),
+            (Bytes{0x80, 0x60, 0x60, 0x00, 0x30, 0x00, 0x09, 0x06}));
+  EXPECT_EQ(sdo({0x2F, 0x60, 0x60, 0x00, 0x00, 0, 0, 0}), (Bytes{0x60, 0x60, 0x60, 0x00, 0, 0, 0, 0}));
+}
+
+TEST_F(SimDriveNodeRawTest, MasterHeartbeatLostQuickStopsAndRaisesEmcy8130) {
+  start({});
+  // Consumer: master node 0x7F, 100 ms.
+  EXPECT_EQ(sdo({0x23, 0x16, 0x10, 0x01, 0x64, 0x00, 0x7F, 0x00}),
+            (Bytes{0x60, 0x16, 0x10, 0x01, 0, 0, 0, 0}));
+  EXPECT_EQ(sdo({0x2F, 0x60, 0x60, 0x00, 0x08, 0, 0, 0}), (Bytes{0x60, 0x60, 0x60, 0x00, 0, 0, 0, 0}));
+  send(0x000, {0x01, 0x05});
+  for (std::uint8_t cw : {std::uint8_t{0x06}, std::uint8_t{0x07}, std::uint8_t{0x0F}}) {
+    EXPECT_EQ(sdo({0x2B, 0x40, 0x60, 0x00, cw, 0x00, 0, 0}), (Bytes{0x60, 0x40, 0x60, 0x00, 0, 0, 0, 0}));
+  }
+  EXPECT_EQ(node_->drive_state(), hal::DriveState::kOperationEnabled);
+  send(0x77F, {0x05});  // the master's heartbeat starts the consumer
+  take();
+  advance_to(now_ + 100'000);
+  EXPECT_FALSE(node_->master_lost());
+  advance_to(now_ + 2'000);
+  EXPECT_TRUE(node_->master_lost());
+  EXPECT_EQ(node_->drive_state(), hal::DriveState::kQuickStopActive);
+  bool emcy = false;
+  for (const CanFrame& f : take()) {
+    if (f.id == 0x085) {
+      EXPECT_EQ(f.data, (Bytes{0x30, 0x81, 0x10, 0, 0, 0, 0, 0}));
+      emcy = true;
+    }
+  }
+  EXPECT_TRUE(emcy);
+}
+
+TEST_F(SimDriveNodeRawTest, InjectedFaultSendsEmcyAndReportsItIn603F) {
+  start({});
+  node_->inject_fault(0x2310);
+  const auto frames = take();
+  ASSERT_EQ(frames.size(), 1u);
+  EXPECT_EQ(frames[0].id, 0x085u);
+  EXPECT_EQ(frames[0].data, (Bytes{0x10, 0x23, 0x01, 0, 0, 0, 0, 0}));
+  EXPECT_EQ(sdo({0x40, 0x3F, 0x60, 0x00, 0, 0, 0, 0}), (Bytes{0x4B, 0x3F, 0x60, 0x00, 0x10, 0x23, 0, 0}));
+  EXPECT_EQ(sdo({0x40, 0x01, 0x10, 0x00, 0, 0, 0, 0}), (Bytes{0x4F, 0x01, 0x10, 0x00, 0x01, 0, 0, 0}));
+}
+
+TEST_F(SimDriveNodeRawTest, SlowPersonalityBootsAndStartsLate) {
+  SimDriveConfig c;
+  c.boot_delay_us = 300'000;
+  c.operational_delay_us = 400'000;
+  c.node_id = 5;
+  node_.emplace(drive_ep_, c);
+  node_->power_on(now_);
+  EXPECT_TRUE(take().empty());
+  advance_to(299'000);
+  EXPECT_TRUE(take().empty());
+  advance_to(300'000);
+  const auto boot = take();
+  ASSERT_EQ(boot.size(), 1u);
+  EXPECT_EQ(boot[0].id, 0x705u);
+  EXPECT_EQ(boot[0].data[0], 0x00);
+  send(0x000, {0x01, 0x00});
+  EXPECT_EQ(node_->nmt_state(), NmtState::kPreOperational);
+  advance_to(now_ + 400'000);
+  EXPECT_EQ(node_->nmt_state(), NmtState::kOperational);
 }
 
 }  // namespace

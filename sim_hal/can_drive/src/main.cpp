@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "loom/drivers/can_axis_port.hpp"
+#include "loom/drivers/nmt.hpp"
 #include "loom/drivers/socket_can_bus.hpp"
 #include "loom/sim_can/sim_drive_rack.hpp"
 

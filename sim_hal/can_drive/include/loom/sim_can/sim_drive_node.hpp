@@ -2,6 +2,10 @@
 // objects the master configures, PDO mapping that is really honoured, heartbeat producer, EMCY, and the
 // drive state machine with ideal position tracking on SYNC. Driven through drivers::CanBus with injected
 // time, so tests run master and drives in one process and the executable runs them on (v)CAN.
+//
+// Its object dictionary is one table in sim_drive_node.cpp served by the slave-side CiA 301 code in
+// slave_od.hpp (shared with SimIoNode, independent of the master's codecs in drivers/); the
+// personalities below only filter or override that table.
 #pragma once
 
 #include <array>
@@ -9,8 +13,14 @@
 #include <vector>
 
 #include "loom/drivers/can_frame.hpp"
-#include "loom/drivers/nmt.hpp"
 #include "loom/hal/types.hpp"
+#include "loom/sim_can/slave_od.hpp"
+
+// The master's NMT state type is nmt_state()'s return type only (its values are the heartbeat bytes);
+// declared, not included, so no drivers/ codec reaches the simulated node.
+namespace loom::drivers {
+enum class NmtState : std::uint8_t;
+}  // namespace loom::drivers
 
 namespace loom::sim_can {
 
@@ -30,7 +40,7 @@ struct SimDriveConfig {
   std::int64_t operational_delay_us = 0;  // NMT start → operational
 };
 
-class SimDriveNode {
+class SimDriveNode : private slave::ObjectHooks {
  public:
   // Configure-time only. The node is powered off until power_on().
   SimDriveNode(drivers::CanBus& bus, SimDriveConfig config);
@@ -53,83 +63,64 @@ class SimDriveNode {
   // Observation for tests and the executable's log; all RT-safe.
   std::uint8_t node_id() const { return config_.node_id; }
   bool powered() const { return powered_; }
-  drivers::NmtState nmt_state() const { return nmt_; }
+  drivers::NmtState nmt_state() const { return static_cast<drivers::NmtState>(nmt_); }
   hal::DriveState drive_state() const { return state_; }
   std::int32_t position() const { return position_; }
-  std::int32_t target() const { return target_; }
-  std::int8_t mode() const { return mode_; }
-  std::uint16_t heartbeat_ms() const { return heartbeat_ms_; }
+  std::int32_t target() const;
+  std::int8_t mode() const;
+  std::uint16_t heartbeat_ms() const;
   std::uint16_t controlword() const { return controlword_; }
   std::uint16_t statusword() const;
   std::uint32_t syncs_seen() const { return syncs_; }
   bool master_lost() const { return master_lost_; }  // 0x1016 consumer expired (the drive quick-stopped)
 
  private:
-  struct PdoComm {
-    std::uint32_t cob_id = 0;  // bit 31 = invalid
-    std::uint8_t type = 1;
-  };
-  struct PdoMap {
-    std::uint8_t count = 0;
-    std::array<std::uint32_t, 8> entries{};
-  };
+  // The bus's writes reach the drive through the ObjectHooks (object rules beyond CiA 301, side effects).
+  std::uint32_t check(std::uint16_t index, std::uint8_t sub, std::uint32_t value) const override;
+  void written(std::uint16_t index, std::uint8_t sub, std::uint32_t value, std::int64_t now_us) override;
 
   void reset_communication();
-  void boot_up(std::int64_t now_us);
   void reset_application();
+  void restart(std::int64_t now_us);
+  void boot_up(std::int64_t now_us);
   void send(const drivers::CanFrame& f);
-  void on_nmt(const drivers::CanFrame& f, std::int64_t now_us);
+  void on_nmt(std::uint8_t command, std::int64_t now_us);
   void on_sdo(const drivers::CanFrame& f, std::int64_t now_us);
-  void on_sync();
-  void on_rpdo(std::size_t pdo, const drivers::CanFrame& f);
-  void apply_rpdo(std::size_t pdo, const std::array<std::uint8_t, 8>& data);
-  void send_tpdo(std::size_t pdo);
+  void on_sync(std::int64_t now_us);
+  void on_rpdo(int pdo, const drivers::CanFrame& f, std::int64_t now_us);
+  void track_target();
+  void send_tpdos();
+  void publish();
   void set_controlword(std::uint16_t cw);
   void enter_fault(std::uint16_t code);
-  bool object_missing(std::uint16_t index) const;
-  // SDO server: 0 on success, else the abort code.
-  std::uint32_t read_object(std::uint16_t index, std::uint8_t sub, std::uint32_t& value,
-                            std::uint8_t& size) const;
-  std::uint32_t write_object(std::uint16_t index, std::uint8_t sub, std::uint32_t value, std::uint8_t size,
-                             std::int64_t now_us);
-  std::uint32_t write_pdo_comm(PdoComm& c, bool rx, std::uint8_t sub, std::uint32_t value);
-  std::uint32_t write_pdo_map(PdoMap& m, const PdoComm& c, bool rx, std::uint8_t sub, std::uint32_t value);
-  bool mappable(std::uint32_t entry, bool rx) const;
-  std::uint32_t mapped_value(std::uint16_t index) const;
-  double interpolation_period_s() const;
+  void watch_master(std::int64_t now_us);
+  void produce_heartbeat(std::int64_t now_us);
+  std::int32_t velocity() const;
+  std::int64_t consumer_window_us() const;
 
   drivers::CanBus& bus_;
   SimDriveConfig config_;
+  slave::ObjectDictionary od_;  // communication parameters, commands, and what the drive reports
   bool powered_ = false;
-  drivers::NmtState nmt_ = drivers::NmtState::kBootUp;
+  std::uint8_t nmt_ = slave::nmt::kBootUp;  // as the heartbeat carries it
 
-  // Communication objects.
-  std::uint16_t heartbeat_ms_ = 0;
+  // Communication state.
   std::int64_t next_heartbeat_us_ = 0;
-  std::array<PdoComm, 4> rpdo_comm_{};
-  std::array<PdoMap, 4> rpdo_map_{};
-  std::array<PdoComm, 4> tpdo_comm_{};
-  std::array<PdoMap, 4> tpdo_map_{};
-  std::array<bool, 4> rpdo_pending_{};
-  std::array<std::array<std::uint8_t, 8>, 4> rpdo_data_{};
+  std::array<bool, slave::kPdos> rpdo_pending_{};
+  std::array<std::array<std::uint8_t, 8>, slave::kPdos> rpdo_data_{};
   std::uint32_t syncs_ = 0;
 
-  // Drive objects.
+  // Drive state (the physical side; published into the dictionary before the bus reads it).
   hal::DriveState state_ = hal::DriveState::kNotReadyToSwitchOn;
-  std::uint16_t controlword_ = 0;
-  std::int8_t mode_ = 0;
+  std::uint16_t controlword_ = 0;  // last one the state machine saw (fault reset is an edge)
   std::int32_t position_ = 0;
   std::int32_t previous_position_ = 0;
-  std::int32_t target_ = 0;
   std::uint16_t error_code_ = 0;
   std::uint8_t error_register_ = 0;
-  std::uint8_t ip_value_ = 1;
-  std::int8_t ip_index_ = -3;
   bool following_error_ = false;
   // Timers of the slow personality and the 0x1016 heartbeat consumer.
   std::int64_t boot_at_us_ = -1;
   std::int64_t operational_at_us_ = -1;
-  std::uint32_t consumer_ = 0;  // 0x1016:01
   std::int64_t master_seen_us_ = -1;
   bool master_lost_ = false;
 };

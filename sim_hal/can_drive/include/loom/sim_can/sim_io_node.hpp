@@ -5,9 +5,9 @@
 //
 // Deliberately independent of the master's codec: its object dictionary is one table in
 // sim_io_node.cpp (index, sub, size, access, PDO direction, default) from which SDO read/write, PDO
-// mapping checks and PDO packing all come, and its frames are built from CiA 301 byte layouts here, not
-// from drivers/. A bug in the master's encoders therefore cannot hide behind the same bug in the peer.
-// Only the transport (drivers::CanBus, CanFrame) is shared.
+// mapping checks and PDO packing all come, through the slave-side CiA 301 code in slave_od.hpp (shared
+// with SimDriveNode), not drivers/. A bug in the master's encoders therefore cannot hide behind the
+// same bug in the peer. Only the transport (drivers::CanBus, CanFrame) is shared.
 #pragma once
 
 #include <array>
@@ -15,19 +15,20 @@
 #include <vector>
 
 #include "loom/drivers/can_frame.hpp"
+#include "loom/sim_can/slave_od.hpp"
 
 namespace loom::sim_can {
 
 // What the module's inputs physically see, set by the caller every step (RT-safe plain data).
 struct IoPlant {
-  double helix_rad = 0.0;     // helix shaft position (shuttle carrier), rad
-  double crank_rad = 0.0;     // beat-up crank position, rad
-  bool estop_open = false;    // e-stop chain opened
+  double helix_rad = 0.0;   // helix shaft position (shuttle carrier), rad
+  double crank_rad = 0.0;   // beat-up crank position, rad
+  bool estop_open = false;  // e-stop chain opened
   bool button_start = false;
   bool button_pause = false;
   bool button_ack = false;
   bool row_knotted = false;
-  bool silent = false;        // cable pulled: sends nothing, hears nothing
+  bool silent = false;  // cable pulled: sends nothing, hears nothing
 };
 
 struct SimIoConfig {
@@ -42,16 +43,16 @@ struct SimIoConfig {
   // (A controller under emulation runs slower than real time; a wall-clock plant then moves faster
   // than any frame can, and the sequencer rightly calls that a sensor fault.)
   double plant_cycle_s = 0.0;
-  double beat_peak_n = 90.0;         // load-cell force at the fell
+  double beat_peak_n = 90.0;                 // load-cell force at the fell
   double fell_crank_rad = 3.14159265358979;  // crank angle (mod 2π) at which the beater meets the fell
   double load_cell_n_per_count = 0.01;
   // Interoperability variants.
-  bool fixed_mapping = false;                   // 0x16xx/0x1Axx read-only, sub 0 included
-  std::vector<std::uint16_t> absent_objects;    // e.g. 0x1016, 0x6206, 0x1802
-  std::int64_t boot_delay_us = 0;               // power-on / reset → boot-up
+  bool fixed_mapping = false;                 // 0x16xx/0x1Axx read-only, sub 0 included
+  std::vector<std::uint16_t> absent_objects;  // e.g. 0x1016, 0x6206, 0x1802
+  std::int64_t boot_delay_us = 0;             // power-on / reset → boot-up
 };
 
-class SimIoNode {
+class SimIoNode : private slave::ObjectHooks {
  public:
   // Configure-time only. Powered off until power_on().
   SimIoNode(drivers::CanBus& bus, SimIoConfig config);
@@ -70,43 +71,34 @@ class SimIoNode {
   std::uint8_t outputs(int byte) const;            // what drives the valve coils now (error state applied)
   std::uint8_t inputs(int byte) const { return in_[static_cast<std::size_t>(byte)]; }
   std::int16_t analog_counts() const { return analog_; }
-  bool comm_lost() const { return comm_lost_; }     // master heartbeat consumer expired
-  double piston_a() const { return piston_[0]; }   // 0 = retracted … 1 = extended
+  bool comm_lost() const { return comm_lost_; }   // master heartbeat consumer expired
+  double piston_a() const { return piston_[0]; }  // 0 = retracted … 1 = extended
   double piston_b() const { return piston_[1]; }
 
-  // One object-dictionary entry (public for the table in the .cpp).
-  enum class Access : std::uint8_t { kConst, kRo, kRw };
-  struct Entry {
-    std::uint16_t index;
-    std::uint8_t sub;
-    std::uint8_t bytes;
-    Access access;
-    char pdo;  // 'T' mappable into a TPDO, 'R' into an RPDO, 0 not mappable
-    std::uint32_t default_value;
-  };
-
  private:
-  int find(std::uint16_t index, std::uint8_t sub) const;  // entry position, −1 none
-  bool object_exists(std::uint16_t index) const;
-  std::uint32_t& value(std::uint16_t index, std::uint8_t sub);
-  std::uint32_t get(std::uint16_t index, std::uint8_t sub) const;
-  std::uint32_t sdo_write(std::uint16_t index, std::uint8_t sub, std::uint32_t v, int size, std::int64_t now_us);
-  std::uint32_t sdo_read(std::uint16_t index, std::uint8_t sub, std::uint32_t& v, int& size) const;
+  // The bus's writes reach the module through the ObjectHooks (timers react to them).
+  void written(std::uint16_t index, std::uint8_t sub, std::uint32_t value, std::int64_t now_us) override;
+
+  void on_nmt(std::uint8_t command, std::int64_t now_us);
   void on_sdo(const drivers::CanFrame& f, std::int64_t now_us);
-  void on_sync();
-  void apply_rpdo(int pdo, const std::array<std::uint8_t, 8>& data, std::uint8_t dlc);
+  void on_sync(std::int64_t now_us);
+  void on_rpdo(int pdo, const drivers::CanFrame& f, std::int64_t now_us);
   void send_tpdo(int pdo);
+  void send_changed_inputs();
   void reset_communication(std::int64_t now_us);
   void reset_application();
-  void send(std::uint32_t id, std::uint8_t dlc, const std::array<std::uint8_t, 8>& data);
+  void send(const drivers::CanFrame& f);
   void update_inputs();
+  void move_pistons(double dt);
+  void watch_master(std::int64_t now_us);
+  void produce_heartbeat(std::int64_t now_us);
 
   drivers::CanBus& bus_;
   SimIoConfig config_;
-  std::vector<std::uint32_t> values_;  // one per table entry
+  slave::ObjectDictionary od_;
   bool powered_ = false;
-  std::uint8_t nmt_ = 0x7F;
-  std::int64_t boot_at_us_ = -1;  // pending boot-up
+  std::uint8_t nmt_ = slave::nmt::kPreOperational;  // as the heartbeat carries it
+  std::int64_t boot_at_us_ = -1;                    // pending boot-up
   std::int64_t next_hb_us_ = 0;
   std::int64_t master_seen_us_ = -1;
   bool comm_lost_ = false;
@@ -114,7 +106,6 @@ class SimIoNode {
   std::uint64_t syncs_total_ = 0, syncs_at_last_step_ = 0;  // plant_cycle_s: machine time in SYNCs
   std::array<bool, 4> rpdo_pending_{};
   std::array<std::array<std::uint8_t, 8>, 4> rpdo_data_{};
-  std::array<std::uint8_t, 4> rpdo_dlc_{};
   // Plant.
   IoPlant plant_{};
   std::int64_t last_step_us_ = -1;
