@@ -150,6 +150,7 @@ void CanAxisPort::attach(CanNodeListener& node) {
 void CanAxisPort::reset_runtime() {
   configured_ = false;
   bus_off_ = false;
+  restarted_ = false;
   foreign_emcy_code_ = 0;
   next_master_hb_ = 0;
   notes_.clear();
@@ -484,7 +485,12 @@ void CanAxisPort::count_send(SendResult r) {
 void CanAxisPort::handle_frame(hal::Tick now, const CanFrame& f) {
   if (f.is_error()) {
     ++rx_errors_;
-    if (decode_error_frame(f).bus_off) bus_off_ = true;
+    const CanErrorInfo e = decode_error_frame(f);
+    if (e.bus_off) {
+      bus_off_ = true;
+      restarted_ = false;
+    }
+    if (e.restarted && bus_off_) restarted_ = true;
     return;
   }
   const CobDecoded cob_fn = decode_cob_id(f.id);
@@ -543,6 +549,7 @@ void CanAxisPort::handle_frame(hal::Tick now, const CanFrame& f) {
         return;
       }
       a.last_heartbeat = now;
+      if (hb->state == NmtState::kBootUp) a.booted = true;
       if (a.link_fault == 0 && hb->state == NmtState::kBootUp) a.link_fault = fault_code::kNodeRebooted;
       if (a.link_fault == 0 && hb->state != NmtState::kOperational && hb->state != NmtState::kBootUp) {
         a.link_fault = fault_code::kNodeNotOperational;
@@ -583,10 +590,36 @@ void CanAxisPort::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkSt
     }
     for (std::size_t k = 0; k < n_listeners_; ++k) listeners_[k]->supervise(now);
   }
-  fill_feedback(axes, link);
+  fill_feedback(now, axes, link);
 }
 
-void CanAxisPort::fill_feedback(hal::AxisFeedbacks& axes, hal::LinkStatus& link) const {
+hal::LinkRecovery CanAxisPort::recovery(hal::Tick now, std::uint8_t& silent) const {
+  using R = hal::LinkRecovery;
+  if (bus_off_ && !restarted_) return R::kBusOff;
+  const auto heard = [&](const AxisRuntime& a) {
+    return a.booted || (a.last_heartbeat != hal::kNeverTick && now - a.last_heartbeat <= static_cast<hal::Tick>(consumer_ticks_));
+  };
+  bool faulted = bus_off_ || !configured_ || foreign_emcy_code_ != 0;
+  for (const AxisRuntime& a : axes_) {
+    if (a.link_fault == 0) continue;
+    faulted = true;
+    if (!heard(a)) {
+      silent = a.node;
+      return R::kNodeSilent;
+    }
+  }
+  for (std::size_t k = 0; k < n_listeners_; ++k) {
+    if (listeners_[k]->link_fault_code() == 0) continue;
+    faulted = true;
+    if (!listeners_[k]->heard_again(now)) {
+      silent = listeners_[k]->node_id();
+      return R::kNodeSilent;
+    }
+  }
+  return faulted ? R::kReady : R::kHealthy;
+}
+
+void CanAxisPort::fill_feedback(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) const {
   link.link_fault = !configured_ || bus_off_;
   link.link_fault_code = link.link_fault ? fault_code::kCommunication : fault_code::kNone;
   for (std::size_t i = 0; i < axes_.size(); ++i) {
@@ -633,6 +666,8 @@ void CanAxisPort::fill_feedback(hal::AxisFeedbacks& axes, hal::LinkStatus& link)
   }
   link.tx_dropped = tx_dropped_;
   link.rx_errors = rx_errors_;
+  link.silent_node = 0;
+  link.recovery = recovery(now, link.silent_node);
 }
 
 bool CanAxisPort::any_fault() const {

@@ -32,4 +32,12 @@ CanFrame make_bus_off_error_frame() {
   return f;
 }
 
+CanFrame make_restarted_error_frame() {
+  CanFrame f;
+  f.flags = CanFrame::kError;
+  f.id = CAN_ERR_RESTARTED;
+  f.dlc = CAN_ERR_DLC;
+  return f;
+}
+
 }  // namespace loom::drivers

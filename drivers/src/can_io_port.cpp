@@ -347,6 +347,7 @@ Status CanIoPort::configure(CanBus& bus, ConfigureClock& clock) {
   link_fault_ = 0;
   emcy_code_ = 0;
   inputs_refreshed_ = analog_refreshed_ = last_heartbeat_ = hal::kNeverTick;
+  booted_ = false;
   if (Status s = validate(config_); !s) return Status::error("CAN I/O configuration: " + s.message());
   consumer_ticks_ = static_cast<std::uint32_t>(std::ceil(config_.heartbeat_consumer_s / config_.cycle_period_s - 1e-9));
   const std::uint8_t id = config_.node_id;
@@ -496,6 +497,7 @@ void CanIoPort::on_frame(hal::Tick now, const CanFrame& f) {
         return;
       }
       last_heartbeat_ = now;
+      if (hb->state == NmtState::kBootUp) booted_ = true;
       if (link_fault_ == 0 && hb->state == NmtState::kBootUp) link_fault_ = fault_code::kNodeRebooted;
       if (link_fault_ == 0 && hb->state != NmtState::kOperational && hb->state != NmtState::kBootUp) {
         link_fault_ = fault_code::kNodeNotOperational;
@@ -610,6 +612,10 @@ void CanIoPort::write_io(hal::Tick /*now*/, const hal::DigitalOutputs& requested
     if (output_slot_[k].pdo == output_pdo_ && output_slot_[k].bytes == 1) f.data[output_slot_[k].offset] = bytes[k];
   }
   if (bus_->send(f) != SendResult::kOk) ++tx_dropped_;
+}
+
+bool CanIoPort::heard_again(hal::Tick now) const {
+  return booted_ || (last_heartbeat_ != hal::kNeverTick && now - last_heartbeat_ <= static_cast<hal::Tick>(consumer_ticks_));
 }
 
 }  // namespace loom::drivers

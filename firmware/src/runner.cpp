@@ -225,6 +225,13 @@ class LoopBody {
       seq_.request_resume();  // paused between picks: finish the row, then stop
     }
     if (has(Command::kAck) && s == sequencer::State::kFault && opt_.hold_when_finished) {
+      // Re-arming reconfigures the link: pointless (and the operator would think it done) while the
+      // controller is still off the bus or a lost node is still silent. The status says which.
+      const hal::LinkRecovery rec = rt_.loop.inputs().link.recovery;
+      if (rec == hal::LinkRecovery::kBusOff || rec == hal::LinkRecovery::kNodeSilent) {
+        ++res.acks_refused;
+        return false;
+      }
       res.end = RunResult::End::kAckRequested;
       return true;
     }
@@ -300,6 +307,8 @@ class LoopBody {
     l->beats.store(seq_.counters().beats, r);
     l->overruns.store(stats_.overruns, r);
     l->max_wake_latency_ns.store(stats_.max_wake_latency_ns, r);
+    l->link_recovery.store(static_cast<std::uint8_t>(rt_.loop.inputs().link.recovery), r);
+    l->silent_node.store(rt_.loop.inputs().link.silent_node, r);
     l->tick.store(tick, std::memory_order_release);
   }
 

@@ -27,4 +27,14 @@ const char* drive_state_name(DriveState s) {
   return "?";
 }
 
+const char* link_recovery_name(LinkRecovery r) {
+  switch (r) {
+    case LinkRecovery::kHealthy: return "healthy";
+    case LinkRecovery::kBusOff: return "bus_off";
+    case LinkRecovery::kNodeSilent: return "node_silent";
+    case LinkRecovery::kReady: return "ready";
+  }
+  return "?";
+}
+
 }  // namespace loom::hal

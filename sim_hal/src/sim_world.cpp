@@ -221,9 +221,10 @@ void SimWorld::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatu
     if (glitch_left_[i] > 0) --glitch_left_[i];
   }
   link = hal::LinkStatus{};
-  if (bus_off_) {  // no frame gets through any more
+  if (bus_off_) {  // no frame gets through any more, and the simulated controller never restarts
     link.link_fault = true;
     link.link_fault_code = kEmcyBusOff;
+    link.recovery = hal::LinkRecovery::kBusOff;
     return;
   }
   // Latency: what arrives now was sampled `latency_ticks_` ago and carries that sample's tick.

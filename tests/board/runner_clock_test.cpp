@@ -4,6 +4,8 @@
 // and the HAL were scripted to produce. The loop is the real one: sim HAL, real sequencer.
 #include <gtest/gtest.h>
 
+#include <optional>
+
 #include <memory>
 #include <vector>
 
@@ -45,10 +47,16 @@ class SlowHal final : public hal::Hal {
     const auto i = static_cast<std::size_t>(now);
     clock_.advance(i < cost_ns.size() ? cost_ns[i] : default_cost_ns);
     inner_.read(now, in);
+    if (recovery) {  // a CAN link's recovery state, as the CAN ports report it
+      in.link.recovery = *recovery;
+      in.link.silent_node = silent_node;
+    }
   }
   void write(hal::Tick now, const hal::HalOutputs& out) override { inner_.write(now, out); }
   std::vector<std::int64_t> cost_ns;
   std::int64_t default_cost_ns = 10'000;
+  std::optional<hal::LinkRecovery> recovery;
+  std::uint8_t silent_node = 0;
 
  private:
   hal::Hal& inner_;
@@ -237,6 +245,30 @@ TEST(RunnerCommands, AckOfALatchedFaultEndsTheSessionForReArming) {
   const RunResult res = run_virtual(r, 1000, link);
   EXPECT_EQ(res.end, RunResult::End::kAckRequested);
   EXPECT_EQ(res.ticks, 0);
+}
+
+TEST(RunnerCommands, AckIsRefusedWhileALostNodeIsSilentOrTheBusIsOff) {
+  Rig r;
+  firmware::OperatorLink link;
+  r.seq->request_safe_stop(sequencer::Fault::kLoopOverrun);
+  run_virtual(r, 10, link);
+  ASSERT_EQ(r.seq->state(), sequencer::State::kFault);
+  for (const auto rec : {hal::LinkRecovery::kNodeSilent, hal::LinkRecovery::kBusOff}) {
+    r.slow->recovery = rec;
+    r.slow->silent_node = 3;
+    run_virtual(r, 2, link);  // the loop judges an acknowledgement by the inputs it last read
+    link.post(firmware::Command::kAck);
+    const RunResult res = run_virtual(r, 100, link);
+    EXPECT_EQ(res.end, RunResult::End::kMaxTicks) << hal::link_recovery_name(rec);
+    EXPECT_EQ(res.acks_refused, 1u);
+    EXPECT_EQ(link.link_recovery.load(), static_cast<std::uint8_t>(rec));
+    EXPECT_EQ(link.silent_node.load(), 3);
+    EXPECT_EQ(r.seq->state(), sequencer::State::kFault);
+  }
+  r.slow->recovery = hal::LinkRecovery::kReady;  // the node is heard again: re-arming can reconfigure it
+  run_virtual(r, 2, link);
+  link.post(firmware::Command::kAck);
+  EXPECT_EQ(run_virtual(r, 100, link).end, RunResult::End::kAckRequested);
 }
 
 TEST(RunnerCommands, ExitWhileIdleLeavesAtOnce) {

@@ -46,4 +46,9 @@ void FakeCanNetwork::bus_off() {
   for (auto& ep : endpoints_) ep->rx_.push_back(drivers::make_bus_off_error_frame());
 }
 
+void FakeCanNetwork::restart() {
+  bus_off_ = false;
+  for (auto& ep : endpoints_) ep->rx_.push_back(drivers::make_restarted_error_frame());
+}
+
 }  // namespace loom::test

@@ -52,9 +52,10 @@ class FakeCanNetwork {
   std::int64_t latency_us = 0;
   // The next `n` send() calls report a full transmit queue and lose the frame.
   void fill_tx_queue(int n) { would_block_ = n; }
-  // Bus-off: every endpoint receives an error frame; sends fail until restart().
+  // Bus-off: every endpoint receives an error frame; sends fail until restart(), which (as the kernel
+  // does after restart-ms) tells every endpoint with a CAN_ERR_RESTARTED error frame.
   void bus_off();
-  void restart() { bus_off_ = false; }
+  void restart();
 
   const std::vector<Logged>& log() const { return log_; }
 

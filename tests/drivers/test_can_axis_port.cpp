@@ -179,6 +179,7 @@ TEST(CanAxisPort, HeartbeatLossFaultsWithinThreeProducerPeriodsAndStopsEnabling)
   for (int i = 0; i < 200; ++i) rig.tick(DriveRig::hold(kEnable));
   for (const auto& f : rig.feedback) ASSERT_FALSE(f.fault);
   ASSERT_FALSE(rig.link.link_fault);
+  EXPECT_EQ(rig.link.recovery, hal::LinkRecovery::kHealthy);
 
   const std::int64_t t_off = rig.now_us;
   rig.rack.node(1).power_off();  // carriage drive disappears
@@ -200,6 +201,9 @@ TEST(CanAxisPort, HeartbeatLossFaultsWithinThreeProducerPeriodsAndStopsEnabling)
   // it comes back (a reboot lost its configuration: it needs configure() again).
   const std::size_t mark = rig.net.log().size();
   for (int i = 0; i < 100; ++i) rig.tick(DriveRig::hold(kEnable));
+  // Until the node is heard again an acknowledgement could not re-arm it: the link says which node.
+  EXPECT_EQ(rig.link.recovery, hal::LinkRecovery::kNodeSilent);
+  EXPECT_EQ(rig.link.silent_node, 2);
   rig.rack.node(1).power_on(rig.now_us);
   for (int i = 0; i < 100; ++i) rig.tick(DriveRig::hold(kEnable));
   const auto after = rig.rpdos_to(2, mark);
@@ -211,6 +215,8 @@ TEST(CanAxisPort, HeartbeatLossFaultsWithinThreeProducerPeriodsAndStopsEnabling)
   }
   EXPECT_TRUE(carriage.fault);
   EXPECT_NE(rig.rack.node(1).drive_state(), DriveState::kOperationEnabled);
+  // Its boot-up was heard (a rebooted node sends no heartbeat until configured): ready to re-arm.
+  EXPECT_EQ(rig.link.recovery, hal::LinkRecovery::kReady);
 
   // Recovery is configure() from the non-RT side.
   ASSERT_TRUE(rig.configure().is_ok());
@@ -326,9 +332,11 @@ TEST(CanAxisPort, BusOffLatchesALinkFaultAndCountsDroppedFrames) {
   EXPECT_EQ(rig.link.tx_dropped, 0u);
   rig.tick(DriveRig::hold(kEnable));
   EXPECT_EQ(rig.link.tx_dropped, 4u);  // the previous tick's SYNC + 3 RPDO were refused by the bus
+  EXPECT_EQ(rig.link.recovery, hal::LinkRecovery::kBusOff);  // an acknowledgement cannot help yet
   rig.net.restart();
   for (int i = 0; i < 5; ++i) rig.tick(DriveRig::hold(kEnable));
   EXPECT_TRUE(rig.link.link_fault);  // latched until configure()
+  EXPECT_EQ(rig.link.recovery, hal::LinkRecovery::kReady);  // the controller is back: re-arming can work
   EXPECT_EQ(rig.port.last_controlword(hal::Axis::kBeatCrank), drivers::controlword::kQuickStop);
 }
 

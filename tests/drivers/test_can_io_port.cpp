@@ -351,6 +351,13 @@ TEST(FaultReaction, SilentIoNodeIsLostWithinItsConsumerTimeAndStopsEveryAxis) {
   EXPECT_LE(static_cast<double>(r.rig.tick_index - cut) * 0.002, 0.250 + 0.004);
   EXPECT_LE(r.in.io.refreshed, cut + 1);  // stale inputs keep their old tick (one frame was in flight)
   EXPECT_EQ(r.rig.port.last_controlword(hal::Axis::kCarriage), drivers::controlword::kQuickStop);
+  // Until it is heard again, acknowledging cannot re-arm: the link names the silent node.
+  EXPECT_EQ(r.in.link.recovery, hal::LinkRecovery::kNodeSilent);
+  EXPECT_EQ(r.in.link.silent_node, 4);
+  r.rig.rack.io_controls().silent = false;  // the cable is back: its heartbeats resume
+  for (int i = 0; i < 100 && r.in.link.recovery != hal::LinkRecovery::kReady; ++i) r.tick(AxisRequest::kEnable);
+  EXPECT_EQ(r.in.link.recovery, hal::LinkRecovery::kReady);
+  EXPECT_TRUE(r.in.link.link_fault);  // still latched: only re-arming (configure) clears it
 }
 
 // The master produces its heartbeat; the I/O module and the drives watch it (0x1016) and react by

@@ -9,6 +9,10 @@ trap 'kill %1 2>/dev/null || true; rm -rf "$work"' EXIT
 pid=$!
 for _ in $(seq 1 200); do grep -q '^row 1/5' "$work/out" && break; sleep 0.05; done
 grep -q '^row 1/5' "$work/out" || { echo "FAIL: row 1 never finished"; cat "$work/out"; exit 1; }
+# Row 2 starts only once row 1's counters are on disk; a signal before that lands between rows, where
+# stopping at the row end is stopping at once. Signal inside row 2 (about 1.9 s long at 4x).
+for _ in $(seq 1 200); do grep -q '"rows":1,' "$work/c.json" 2>/dev/null && break; sleep 0.05; done
+sleep 0.3
 kill -INT "$pid"
 sleep 0.2
 kill -INT "$pid"

@@ -60,6 +60,11 @@ std::string status_text(const OperatorLink& l, const std::string& loom_id, const
                 f == sequencer::Fault::kNone ? "none" : sequencer::fault_name(f), l.overruns.load(r),
                 static_cast<long long>(l.max_wake_latency_ns.load(r)), static_cast<long long>(l.tick.load(r)));
   std::string out = buf;
+  const auto rec = static_cast<hal::LinkRecovery>(l.link_recovery.load(r));
+  if (rec != hal::LinkRecovery::kHealthy) {
+    out += std::string(" link=") + hal::link_recovery_name(rec);
+    if (rec == hal::LinkRecovery::kNodeSilent) out += " silent_node=" + std::to_string(l.silent_node.load(r));
+  }
   if (d != nullptr) {
     const std::uint32_t rows = l.rows.load(r), at_arm = p.counter_rows_at_arm.load(r);
     const auto pos = design::position_after(*d, p.rows_at_arm.load(r) + (rows >= at_arm ? rows - at_arm : 0));
@@ -133,7 +138,20 @@ int serve_main(const ServeArgs& a) {
       else if (req == "pause") link.post(Command::kPause);
       else if (req == "resume") link.post(Command::kResume);
       else if (req == "stop") link.post(Command::kStop);
-      else if (req == "ack") link.post(Command::kAck);
+      else if (req == "ack") {
+        // The loop refuses it too (the I/O node's button goes there directly); saying why here spares
+        // the operator an acknowledgement that silently does nothing.
+        const auto rec = static_cast<hal::LinkRecovery>(link.link_recovery.load(std::memory_order_relaxed));
+        if (rec == hal::LinkRecovery::kBusOff) {
+          return std::string("error: ack: the CAN controller is still bus-off; it must restart first (ip link set ") +
+                 (a.iface.empty() ? "can0" : a.iface) + " type can restart-ms 100, or ip link set ... type can restart)\n";
+        }
+        if (rec == hal::LinkRecovery::kNodeSilent) {
+          return "error: ack: node " + std::to_string(link.silent_node.load(std::memory_order_relaxed)) +
+                 " is still silent (no heartbeat, no boot-up): check its power and cable, then acknowledge\n";
+        }
+        link.post(Command::kAck);
+      }
       else if (req == "status") return status_text(link, cfg.loom_id, cfg.recipe.design.get(), design_progress);
       else if (req == "faults") {
         std::string out;

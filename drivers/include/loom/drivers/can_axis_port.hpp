@@ -99,7 +99,10 @@ class CanAxisPort final : public hal::AxisPort {
   // NMT reset-node → every boot-up → per drive by SDO: 0x6502 has CSP, 0x6060 = 8 confirmed by 0x6061,
   // 0x1017, 0x60C2, PDO mapping (pdo.hpp), 0x6041 and 0x6064 to seed state and the first target →
   // NMT start → an operational heartbeat from every drive. Errors name node, axis and step. Calling it
-  // again (from the non-RT side) is how a lost drive or a bus-off is recovered.
+  // again (from the non-RT side, after the loop has stopped using the port, on a fresh bus) is how a lost
+  // drive or a bus-off is recovered; read_axes() reports in LinkStatus::recovery whether that can work
+  // yet (the controller restarted, every lost node heard again), and the loop honours the operator's
+  // acknowledgement only then.
   Status configure(CanBus& bus, ConfigureClock& clock);
   Status configure(CanBus& bus);  // with MonotonicConfigureClock
 
@@ -137,6 +140,7 @@ class CanAxisPort final : public hal::AxisPort {
     double velocity = 0.0;
     double effort = 0.0;
     hal::Tick last_heartbeat = hal::kNeverTick;
+    bool booted = false;           // a boot-up since configure(): back on the bus, needing configuration
     std::uint16_t emcy_code = 0;
     std::uint16_t link_fault = 0;  // latched: heartbeat lost / rebooted / not operational
     double ferror_min = 0.0;
@@ -153,7 +157,9 @@ class CanAxisPort final : public hal::AxisPort {
 
   void reset_runtime();
   void handle_frame(hal::Tick now, const CanFrame& frame);
-  void fill_feedback(hal::AxisFeedbacks& axes, hal::LinkStatus& link) const;
+  void fill_feedback(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) const;
+  // The recovery state of a link fault (see hal::LinkRecovery); `silent` names the node still missing.
+  hal::LinkRecovery recovery(hal::Tick now, std::uint8_t& silent) const;
   void count_send(SendResult r);
   std::string node_label(std::size_t axis) const;
   Status configure_node(std::size_t axis, SdoClient& sdo);
@@ -170,6 +176,7 @@ class CanAxisPort final : public hal::AxisPort {
   std::array<AxisRuntime, hal::kAxisCount> axes_{};
   std::array<std::int8_t, 128> axis_of_node_{};  // −1 = not ours
   bool bus_off_ = false;                         // latched until configure()
+  bool restarted_ = false;                       // the controller restarted after the bus-off
   std::array<CanNodeListener*, 4> listeners_{};
   std::size_t n_listeners_ = 0;
   std::uint16_t foreign_emcy_code_ = 0;  // EMCY from a node that is not an axis (latched until ack)

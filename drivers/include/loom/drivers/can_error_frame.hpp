@@ -26,5 +26,7 @@ CanErrorInfo decode_error_frame(const CanFrame& frame);
 // Error-frame content a simulated or fake bus injects to signal bus-off (same bits as the kernel's).
 // RT-safe.
 CanFrame make_bus_off_error_frame();
+// ... and that the controller restarted after bus-off (CAN_ERR_RESTARTED, as the kernel sends it).
+CanFrame make_restarted_error_frame();
 
 }  // namespace loom::drivers

@@ -45,6 +45,9 @@ class CanNodeListener {
   virtual std::uint16_t link_fault_code() const = 0;
   // The operator acknowledged (fault reset requested): clear latches whose cause is gone.
   virtual void acknowledge() = 0;
+  // RT-safe. After a link fault of its own: the node is on the bus again (heard within its consumer
+  // time, or booted since), so re-arming can reconfigure it.
+  virtual bool heard_again(hal::Tick now) const = 0;
 };
 
 // One signal on a digital input or output: bit number across the 8-bit objects (bit b lives in
@@ -141,6 +144,7 @@ class CanIoPort final : public hal::IoPort, public CanNodeListener {
   void supervise(hal::Tick now) override;
   std::uint16_t link_fault_code() const override { return link_fault_; }
   void acknowledge() override;
+  bool heard_again(hal::Tick now) const override;
 
   // Diagnostics; RT-safe.
   bool configured() const { return configured_; }
@@ -189,6 +193,7 @@ class CanIoPort final : public hal::IoPort, public CanNodeListener {
   std::int16_t analog_counts_ = 0;
   hal::Tick analog_refreshed_ = hal::kNeverTick;
   hal::Tick last_heartbeat_ = hal::kNeverTick;
+  bool booted_ = false;  // a boot-up since configure(): the node is back, needing its configuration
   std::uint16_t link_fault_ = 0;
   std::uint16_t emcy_code_ = 0;
   std::uint32_t rx_errors_ = 0;

@@ -76,6 +76,8 @@ struct OperatorLink {
   std::atomic<std::uint32_t> rows{0}, picks{0}, beats{0};
   std::atomic<std::uint32_t> overruns{0};
   std::atomic<std::int64_t> max_wake_latency_ns{0};
+  std::atomic<std::uint8_t> link_recovery{0};  // hal::LinkRecovery: whether an acknowledgement can re-arm
+  std::atomic<std::uint8_t> silent_node{0};    // the lost node still silent (kNodeSilent)
   std::atomic<std::int64_t> tick{0};
 };
 
@@ -158,6 +160,7 @@ struct RunResult {
   // Real time only: how late the loop woke after each deadline.
   std::int64_t wake_latency_p50_ns = 0, wake_latency_p99_ns = 0, wake_latency_max_ns = 0;
   std::uint64_t events_dropped = 0;
+  std::uint32_t acks_refused = 0;  // acknowledgements while the link could not be re-armed yet
   // What the loop thread actually ran at (realtime only; read back with pthread_getschedparam inside it).
   int loop_policy = -1;            // SCHED_FIFO, SCHED_OTHER, ...; -1 = ran on the caller (virtual time)
   int loop_priority = 0;

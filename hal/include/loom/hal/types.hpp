@@ -112,9 +112,22 @@ struct AnalogInputs {
 // ---------------------------------------------------------------------------------------------------
 // Bus / link health reported by the HAL implementation (zeros for the simulator unless a scene injects).
 // ---------------------------------------------------------------------------------------------------
+// How far a link fault has recovered: the HAL works it out every tick from what the bus says, and the
+// loop honours the operator's acknowledgement (which re-arms and reconfigures the link from the non-RT
+// side) only once nothing is still missing.
+enum class LinkRecovery : std::uint8_t {
+  kHealthy,     // no link fault
+  kBusOff,      // the CAN controller left the bus and has not restarted (restart-ms, or ip link ... restart)
+  kNodeSilent,  // a lost node has not been heard again (no heartbeat within the consumer time, no boot-up)
+  kReady,       // every node is on the bus again: an acknowledgement re-arms and reconfigures the link
+};
+const char* link_recovery_name(LinkRecovery r);
+
 struct LinkStatus {
   bool link_fault = false;          // bus-off, heartbeat lost, socket error: motion must stop
   std::uint16_t link_fault_code = 0;
+  LinkRecovery recovery = LinkRecovery::kHealthy;
+  std::uint8_t silent_node = 0;     // kNodeSilent: the first node still missing
   std::uint32_t tx_dropped = 0;     // frames not sent (ENOBUFS/EAGAIN), cumulative
   std::uint32_t rx_errors = 0;      // error frames / malformed frames, cumulative
 };
