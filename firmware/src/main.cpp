@@ -19,6 +19,7 @@
 #include "loom/motion/angles.hpp"
 #include "loom/report/run_report.hpp"
 #include "check_cmd.hpp"
+#include "commission_cmd.hpp"
 #include <unistd.h>
 
 using namespace loom;
@@ -411,6 +412,21 @@ int main(int argc, char** argv) {
   check_cmd->add_option("--config", check.config, "loom config file (TOML); default: embedded default loom");
   check_cmd->add_option("--scene", check.scene, "simulation scene file (TOML)");
   check_cmd->add_flag("--keys", check.keys, "list every config key with its class (machine/recipe/run) and range");
+  firmware::CommissionArgs com;
+  CLI::App* com_cmd = app.add_subcommand(
+      "commission", "drives disabled: show live axis positions and I/O inputs, capture the calibration into the config");
+  com_cmd->add_option("--config", com.config, "the loom config file the calibration is written into")->required();
+  com_cmd->add_option("--hal", com.hal, "sim | socketcan")->check(CLI::IsMember({"sim", "socketcan"}));
+  com_cmd->add_option("--iface", com.iface, "SocketCAN interface (with --hal socketcan)");
+  com_cmd->add_option("--io", com.io, "can | simulated (overrides io.kind; simulated I/O beside real drives only so)")
+      ->check(CLI::IsMember({"can", "simulated"}));
+  com_cmd->add_option("--sim-state", com.sim_state, "sim HAL: the simulated machine's physical state file");
+  com_cmd->add_option("--capture", com.capture, "capture these at once: park, home, left (non-interactive)")
+      ->delimiter(',');
+  com_cmd->add_flag("--write", com.write, "with --capture: write the captured values into the config");
+  com_cmd->add_flag("--io-once", com.io_once, "print the positions and every input once, then exit");
+  com_cmd->add_option("--settle-s", com.settle_s, "non-interactive: run this long before reading")
+      ->check(kFinite & CLI::Range(0.05, 30.0));
   const firmware::serve::BoardCommands board(app);  // serve, ctl, --version
   try {
     app.parse(argc, argv);
@@ -423,6 +439,7 @@ int main(int argc, char** argv) {
     return kExitBadInput;
   }
   if (check_cmd->parsed()) return firmware::run_check(check);
+  if (com_cmd->parsed()) return firmware::run_commission(com);
   if (const auto rc = board.run()) return *rc;
   if (a.hal == "socketcan" && a.iface.empty()) {
     std::fprintf(stderr, "loomctl: --hal socketcan needs --iface NAME\n");

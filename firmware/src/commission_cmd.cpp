@@ -1,0 +1,271 @@
+// See commission_cmd.hpp. The loop here is not the weaving loop: nothing moves, so it ticks on the
+// calling thread at normal priority (SYNC and the master heartbeat keep the drives and the I/O node
+// supervised) and reads the loop's inputs between ticks, on the same thread.
+#include "commission_cmd.hpp"
+
+#include <poll.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include "loom/firmware/config.hpp"
+#include "loom/firmware/durable_file.hpp"
+#include "loom/firmware/machine.hpp"
+#include "loom/firmware/toml_edit.hpp"
+#include "toml_reader.hpp"
+
+namespace loom::firmware {
+namespace {
+
+constexpr int kExitOk = 0, kExitBadInput = 2, kExitNotArmed = 4;
+
+// What each capture name measures, and the config key it writes.
+struct Capture {
+  const char* name;
+  hal::Axis axis;
+  const char* section;
+  const char* key;
+  const char* pose;
+};
+constexpr Capture kCaptures[] = {
+    {"park", hal::Axis::kBeatCrank, "beatup", "crank_park_position_rad", "the crank at its park pose, beater clear of the warp"},
+    {"home", hal::Axis::kCarriage, "carriage", "home_position_m", "the carriage at the left selvedge"},
+    {"left", hal::Axis::kHelix, "helix", "left_position_rad", "the helix carrier at the left selvedge"},
+};
+
+const Capture* capture_named(const std::string& n) {
+  for (const Capture& c : kCaptures) {
+    if (n == c.name) return &c;
+  }
+  return nullptr;
+}
+
+std::string inputs_line(const hal::HalInputs& in) {
+  const hal::DigitalInputs& io = in.io;
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "inputs: piston_a_extended=%d piston_a_retracted=%d piston_b_extended=%d piston_b_retracted=%d "
+                "shuttle_at_left=%d shuttle_at_right=%d estop_ok=%d button_start=%d button_pause=%d button_ack=%d "
+                "row_knotted=%d load_cell=%s",
+                io.piston_a_extended, io.piston_a_retracted, io.piston_b_extended, io.piston_b_retracted,
+                io.shuttle_at_left, io.shuttle_at_right, io.estop_ok, io.button_start, io.button_pause, io.button_ack,
+                io.row_knotted, in.analog.beat_force_valid ? (std::to_string(in.analog.beat_force_n) + "N").c_str() : "-");
+  return buf;
+}
+
+std::string positions_line(const hal::HalInputs& in) {
+  std::string s = "positions:";
+  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+    const hal::AxisFeedback& fb = in.axes[i];
+    char buf[160];
+    std::snprintf(buf, sizeof buf, " %s=%.9f %s (%s)", hal::axis_name(static_cast<hal::Axis>(i)), fb.position,
+                  i == hal::index(hal::Axis::kCarriage) ? "m" : "rad", hal::drive_state_name(fb.state));
+    s += buf;
+  }
+  return s;
+}
+
+// Every input whose value changed since the last call, one line each: wiring is checked by working
+// each sensor by hand and watching its line appear.
+void print_input_changes(const hal::DigitalInputs& now, hal::DigitalInputs& last) {
+  const struct {
+    const char* name;
+    bool hal::DigitalInputs::*field;
+  } kInputs[] = {{"piston_a_extended", &hal::DigitalInputs::piston_a_extended},
+                 {"piston_a_retracted", &hal::DigitalInputs::piston_a_retracted},
+                 {"piston_b_extended", &hal::DigitalInputs::piston_b_extended},
+                 {"piston_b_retracted", &hal::DigitalInputs::piston_b_retracted},
+                 {"shuttle_at_left", &hal::DigitalInputs::shuttle_at_left},
+                 {"shuttle_at_right", &hal::DigitalInputs::shuttle_at_right},
+                 {"estop_ok", &hal::DigitalInputs::estop_ok},
+                 {"button_start", &hal::DigitalInputs::button_start},
+                 {"button_pause", &hal::DigitalInputs::button_pause},
+                 {"button_ack", &hal::DigitalInputs::button_ack},
+                 {"row_knotted", &hal::DigitalInputs::row_knotted}};
+  for (const auto& in : kInputs) {
+    if (now.*in.field != last.*in.field) std::printf("input %s %d -> %d\n", in.name, last.*in.field, now.*in.field);
+  }
+  last = now;
+}
+
+class Commissioning {
+ public:
+  Commissioning(const CommissionArgs& a, LoomConfig cfg, std::string text)
+      : a_(a), cfg_(std::move(cfg)), text_(std::move(text)) {}
+
+  int run(Machine& m) {
+    loop_ = &m.loop();
+    seq_ = &m.sequencer();
+    realtime_ = a_.hal == "socketcan" || (a_.capture.empty() && !a_.io_once);
+    period_ns_ = static_cast<std::int64_t>(std::llround(cfg_.sequencer.period_s * 1e9));
+    clock_gettime(CLOCK_MONOTONIC, &next_);
+    tick(static_cast<hal::Tick>(std::ceil(a_.settle_s / cfg_.sequencer.period_s)));
+    if (!all_disabled()) {
+      std::fprintf(stderr, "loomctl commission: a drive is not disabled (%s); refusing to go on\n",
+                   positions_line(loop_->inputs()).c_str());
+      return kExitNotArmed;
+    }
+    if (a_.io_once || !a_.capture.empty()) {
+      std::printf("%s\n%s\n", positions_line(loop_->inputs()).c_str(), inputs_line(loop_->inputs()).c_str());
+      for (const std::string& c : a_.capture) take(*capture_named(c));
+      return a_.write ? write() : kExitOk;
+    }
+    return interactive();
+  }
+
+ private:
+  // Runs `n` ticks at the loop period (real time on a bus, as fast as possible in a simulation run
+  // non-interactively); drives are never asked to enable: the sequencer is idle and stays so.
+  void tick(hal::Tick n) {
+    for (hal::Tick i = 0; i < n; ++i) {
+      loop_->cycle(now_++);
+      if (!realtime_) continue;
+      next_.tv_nsec += period_ns_;
+      while (next_.tv_nsec >= 1'000'000'000) {
+        next_.tv_nsec -= 1'000'000'000;
+        ++next_.tv_sec;
+      }
+      clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next_, nullptr);
+    }
+  }
+
+  bool all_disabled() const {
+    for (const hal::AxisFeedback& fb : loop_->inputs().axes) {
+      if (fb.state == hal::DriveState::kOperationEnabled) return false;
+    }
+    return seq_->state() == sequencer::State::kIdle || seq_->state() == sequencer::State::kFault;
+  }
+
+  void take(const Capture& c) {
+    const double v = loop_->inputs().axes[hal::index(c.axis)].position;
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.9f", v);
+    captured_.push_back({c.section, c.key, buf});
+    std::printf("captured %s: %s.%s = %s (%s)\n", c.name, c.section, c.key, buf, c.pose);
+  }
+
+  int write() {
+    if (captured_.empty()) {
+      std::printf("nothing captured: %s unchanged\n", a_.config.c_str());
+      return kExitOk;
+    }
+    std::vector<std::string> changes;
+    std::string next;
+    try {
+      next = set_toml_values(text_, captured_, changes);
+      parse_loom_config(next, a_.config);  // the file must still be a valid loom before it replaces the old one
+      write_file_durably(a_.config, next);
+    } catch (const ConfigError& e) {
+      std::fprintf(stderr, "loomctl commission: %s: not written: %s\n", a_.config.c_str(), e.what());
+      return kExitBadInput;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "loomctl commission: %s: not written: %s\n", a_.config.c_str(), e.what());
+      return kExitBadInput;
+    }
+    for (const std::string& c : changes) std::printf("%s:%s\n", a_.config.c_str(), c.c_str());
+    text_ = next;
+    captured_.clear();
+    return kExitOk;
+  }
+
+  int interactive() {
+    std::printf("%s\n%s\n", positions_line(loop_->inputs()).c_str(), inputs_line(loop_->inputs()).c_str());
+    std::printf("drives disabled: move each axis by hand. Type park (crank at its park pose), home (carriage at the "
+                "left selvedge), left (helix carrier at the left selvedge), write, positions, io, or quit.\n");
+    hal::DigitalInputs last = loop_->inputs().io;
+    const hal::Tick per_second = static_cast<hal::Tick>(std::llround(1.0 / cfg_.sequencer.period_s));
+    std::string pending;
+    for (hal::Tick t = 0;; ++t) {
+      tick(per_second / 10);
+      print_input_changes(loop_->inputs().io, last);
+      if (t % 10 == 9) std::printf("%s\n", positions_line(loop_->inputs()).c_str());
+      std::fflush(stdout);
+      pollfd p{STDIN_FILENO, POLLIN, 0};
+      if (::poll(&p, 1, 0) <= 0) continue;
+      char buf[256];
+      const ssize_t n = ::read(STDIN_FILENO, buf, sizeof buf);
+      if (n <= 0) return captured_.empty() ? kExitOk : write();  // end of input: keep what was captured
+      pending.append(buf, static_cast<std::size_t>(n));
+      for (auto nl = pending.find('\n'); nl != std::string::npos; nl = pending.find('\n')) {
+        std::string cmd = pending.substr(0, nl);
+        pending.erase(0, nl + 1);
+        while (!cmd.empty() && (cmd.back() == ' ' || cmd.back() == '\r')) cmd.pop_back();
+        if (cmd == "quit") return captured_.empty() ? kExitOk : (std::printf("not written (quit)\n"), kExitOk);
+        if (cmd == "write") {
+          if (const int rc = write(); rc != kExitOk) return rc;
+        } else if (cmd == "positions") {
+          std::printf("%s\n", positions_line(loop_->inputs()).c_str());
+        } else if (cmd == "io") {
+          std::printf("%s\n", inputs_line(loop_->inputs()).c_str());
+        } else if (const Capture* c = capture_named(cmd)) {
+          take(*c);
+        } else if (!cmd.empty()) {
+          std::printf("unknown command '%s' (park, home, left, write, positions, io, quit)\n", cmd.c_str());
+        }
+      }
+    }
+  }
+
+  const CommissionArgs& a_;
+  LoomConfig cfg_;
+  std::string text_;
+  ControlLoop* loop_ = nullptr;
+  sequencer::Sequencer* seq_ = nullptr;
+  bool realtime_ = false;
+  std::int64_t period_ns_ = 0;
+  timespec next_{};
+  hal::Tick now_ = 0;
+  std::vector<TomlAssignment> captured_;
+};
+
+}  // namespace
+
+int run_commission(const CommissionArgs& a) {
+  for (const std::string& c : a.capture) {
+    if (capture_named(c) == nullptr) {
+      std::fprintf(stderr, "loomctl commission: --capture %s: want park, home or left\n", c.c_str());
+      return kExitBadInput;
+    }
+  }
+  if (a.write && a.capture.empty()) {
+    std::fprintf(stderr, "loomctl commission: --write needs --capture (interactively, type write)\n");
+    return kExitBadInput;
+  }
+  if (a.hal == "socketcan" && a.iface.empty()) {
+    std::fprintf(stderr, "loomctl commission: --hal socketcan needs --iface NAME\n");
+    return kExitBadInput;
+  }
+  LoomConfig cfg;
+  std::string text;
+  try {
+    text = read_config_file(a.config);
+    cfg = parse_loom_config(text, a.config);
+  } catch (const ConfigError& e) {
+    std::fprintf(stderr, "loomctl commission: %s\n", e.what());
+    return kExitBadInput;
+  }
+  MachineOptions mo;
+  mo.hal = a.hal == "socketcan" ? HalKind::kSocketCan : HalKind::kSim;
+  mo.iface = a.iface;
+  mo.telemetry = false;
+  mo.rows = 0;
+  mo.sim_state_path = a.sim_state;
+  if (!a.io.empty()) mo.io = a.io == "simulated" ? IoKind::kSimulated : IoKind::kCan;
+  std::unique_ptr<Machine> machine;
+  try {
+    machine = std::make_unique<Machine>(cfg, default_scene(), mo, sequencer::Counters{});
+  } catch (const ConfigError& e) {
+    std::fprintf(stderr, "loomctl commission: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "loomctl commission: cannot bring the bus up: %s\n", e.what());
+    return kExitNotArmed;
+  }
+  if (!machine->banner().empty()) std::fprintf(stderr, "loomctl commission: WARNING: %s\n", machine->banner().c_str());
+  return Commissioning(a, cfg, text).run(*machine);
+}
+
+}  // namespace loom::firmware
