@@ -192,6 +192,7 @@ hil_find_binaries() {
 # Sets HIL_SIM_PID; the I/O node's e-stop/buttons/silence follow the words in HIL_IO_CONTROL.
 # The fixed personality boots after 300 ms and switches to operational after 400 ms (loomctl's
 # default operational window is 1 s).
+HIL_SIM_EXTRA=()  # more loom-sim-drive arguments (e.g. --initial-position)
 hil_start_sim_drives() {
   local mark n
   mark=$(hil_mark)
@@ -203,7 +204,7 @@ hil_start_sim_drives() {
   chrt -f 90 true 2>/dev/null && rt=(chrt -f 90)
   hil_spawn sim "${rt[@]}" "$HIL_SIM" --iface "$HIL_IFACE" --nodes "$HIL_NODES" --io-node "$HIL_IO_NODE" \
     --io-control "$HIL_IO_CONTROL" --width-m 0.6 --personality "$HIL_PERSONALITY" \
-    --plant-cycle-ms "$HIL_PERIOD_MS"
+    --plant-cycle-ms "$HIL_PERIOD_MS" "${HIL_SIM_EXTRA[@]}"
   HIL_SIM_PID=$HIL_LAST_PID
   for n in ${HIL_NODES//,/ } $HIL_IO_NODE; do
     hil_expect "$mark" "$(printf '%03X' $((0x700 + n)))#00" 10 "boot-up of simulated node $n" >/dev/null
