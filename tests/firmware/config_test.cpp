@@ -217,3 +217,37 @@ TEST(LoomctlCli, CoarseLoopPeriodIsRefusedByCheckAndWeave) {
       << c.output;
   EXPECT_EQ(run_loomctl("weave --rows 1 --no-telemetry --period-ms 10").exit_code, 0);
 }
+
+// One default, not two: the embedded default TOML and a default-constructed LoomConfig must say the same
+// thing, or code that builds a LoomConfig without parsing (tests, tools) runs a different machine.
+TEST(Config, StructDefaultsAgreeWithTheEmbeddedDefaultToml) {
+  const LoomConfig parsed = default_loom_config();
+  const LoomConfig built;
+  // Every machine, CAN, I/O, timing and telemetry key, compared as loomctl prints them.
+  EXPECT_EQ(restart_only_changes(built, parsed), "");
+  EXPECT_DOUBLE_EQ(built.can.carriage_counts_per_m, 104857600.0);  // 2^20 counts per 10 mm, as the drives assume
+  EXPECT_DOUBLE_EQ(built.can.carriage_counts_per_m, loom::drivers::kDefaultCountsPerM);
+  // The recipe's numeric keys (restart_only_changes leaves the recipe out).
+  const Recipe& a = built.recipe;
+  const Recipe& b = parsed.recipe;
+  EXPECT_DOUBLE_EQ(a.beat_force_target_n, b.beat_force_target_n);
+  EXPECT_DOUBLE_EQ(a.crank_speed_rad_s, b.crank_speed_rad_s);
+  EXPECT_DOUBLE_EQ(a.crank_accel_rad_s2, b.crank_accel_rad_s2);
+  EXPECT_DOUBLE_EQ(a.crank_jerk_rad_s3, b.crank_jerk_rad_s3);
+  EXPECT_EQ(a.picks_per_row, b.picks_per_row);
+  EXPECT_EQ(a.knotting, b.knotting);
+  EXPECT_EQ(a.beats_per_position, b.beats_per_position);
+  EXPECT_DOUBLE_EQ(a.overlap_m, b.overlap_m);
+  EXPECT_DOUBLE_EQ(a.cam_margin_rad, b.cam_margin_rad);
+  EXPECT_DOUBLE_EQ(a.beat_force_min_n, b.beat_force_min_n);
+  EXPECT_DOUBLE_EQ(a.beat_force_max_n, b.beat_force_max_n);
+  EXPECT_EQ(a.crank_law.kind, b.crank_law.kind);
+  EXPECT_DOUBLE_EQ(a.crank_law.ellipse_e, b.crank_law.ellipse_e);
+  EXPECT_EQ(a.crank_law.ellipse_lobes, b.crank_law.ellipse_lobes);
+  EXPECT_DOUBLE_EQ(a.crank_law.ellipse_phi02_rad, b.crank_law.ellipse_phi02_rad);
+  EXPECT_EQ(a.table_size, b.table_size);
+  EXPECT_EQ(a.table_interp, b.table_interp);
+  EXPECT_EQ(a.table_precision, b.table_precision);
+  EXPECT_DOUBLE_EQ(a.max_table_error_rad, b.max_table_error_rad);
+  EXPECT_EQ(built.loom_id, parsed.loom_id);
+}
