@@ -5,6 +5,7 @@
 // here, never at the first row.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <map>
 #include <optional>
@@ -486,6 +487,25 @@ void check_can(const LoomConfig& c, const Fail& fail) {
   }
 }
 
+// Crank speed at the fell / master speed: 1 at constant speed, the crank law's ratio where the crank
+// reaches the fell otherwise.
+double beat_speed_ratio(const LoomConfig& c) {
+  const Recipe& rc = c.recipe;
+  if (rc.crank_law.kind == motion::CrankLawKind::kConstant) return 1.0;
+  const motion::BeatUp head(c.machine_spec.beatup);
+  const double fell_phase = head.warp().fell;
+  const motion::CrankLaw speed_law(rc.crank_law, fell_phase,
+                                   {.size = rc.table_size, .interp = rc.table_interp, .precision = rc.table_precision, .rise = 0.0});
+  double x = fell_phase;  // Newton on Φc(x) = x + offset(x) = fell; dΦc/dx ≥ min ratio > 0
+  for (int i = 0; i < 50; ++i) {
+    const motion::CrankLawExact e = speed_law.exact(x);
+    const double step = (x + e.offset - fell_phase) / e.d1;
+    x -= step;
+    if (std::abs(step) < 1e-14) break;
+  }
+  return speed_law.exact(x).d1;
+}
+
 // Crank (master) speed for the recipe: given, or from the beat-force target through the linkage's
 // inverse dynamics (the beater force is inertial, so it scales with ω²) and the crank law.
 double master_crank_speed(const LoomConfig& c, const Fail& fail) {
@@ -501,22 +521,7 @@ double master_crank_speed(const LoomConfig& c, const Fail& fail) {
   }
   // With a speed law the crank is faster (or slower) than the master at the beat: the master runs at
   // the crank speed divided by the law's ratio where the crank reaches the fell.
-  double ratio = 1.0;
-  if (rc.crank_law.kind != motion::CrankLawKind::kConstant) {
-    const motion::BeatUp head(m.beatup);
-    const double fell_phase = head.warp().fell;
-    const motion::CrankLaw speed_law(rc.crank_law, fell_phase,
-                                     {.size = rc.table_size, .interp = rc.table_interp, .precision = rc.table_precision, .rise = 0.0});
-    double x = fell_phase;  // Newton on Φc(x) = x + offset(x) = fell; dΦc/dx ≥ min ratio > 0
-    for (int i = 0; i < 50; ++i) {
-      const motion::CrankLawExact e = speed_law.exact(x);
-      const double step = (x + e.offset - fell_phase) / e.d1;
-      x -= step;
-      if (std::abs(step) < 1e-14) break;
-    }
-    ratio = speed_law.exact(x).d1;
-  }
-  const double master = crank_speed_at_beat / ratio;
+  const double master = crank_speed_at_beat / beat_speed_ratio(c);
   if (!std::isfinite(master) || master < 0.1 || master > 100.0) {
     fail("recipe.beat_force_target_n", fmt_num(rc.beat_force_target_n),
          "needs a crank speed of " + fmt_num(master) + " rad/s, outside the crank's [0.1, 100] rad/s");
@@ -612,6 +617,35 @@ void check_motion(const LoomConfig& c, const Fail& fail) {
   }
 }
 
+// The loop period must resolve the beat. A beat presses the comb into the fell for only a short arc of
+// crank (the simulated load cell: the last 5 mm of the tip's travel, about 33 deg of crank); its force
+// rises through the contact and peaks as the beater leaves the cloth. The load cell is read once per
+// tick, so the peak the sequencer records (and checks against the band) can come up to one tick of crank
+// travel early. Measured with the default scene and recipe (90 N target, 80..100 N band, 16.06 rad/s):
+//   period ms    2     4     5     8     10    12    15    16    18    19    20
+//   deg/tick     1.8   3.7   4.6   7.4   9.2   11.0  13.8  14.7  16.6  17.5  18.4
+//   min peak N   89.3  88.7  88.3  86.9  85.6  84.2  82.6  81.6  79.8  78.4  78.8
+// about 0.45..0.6 N lost per degree of crank per tick, so 20 ms beats fall out of the band. The sampling
+// may use at most half of the band's 10 N headroom below the target (the other half is for servo lag,
+// load-cell noise and speed ripple): at most 10 deg of crank per tick at the beat, which loses ~4.6 N.
+constexpr double kMaxBeatCrankDegPerTick = 10.0;
+
+void check_beat_resolution(const LoomConfig& c, const Fail& fail) {
+  const double omega = c.profile.crank.velocity * beat_speed_ratio(c);  // crank speed at the fell (rad/s)
+  const double deg_per_tick = motion::deg(omega * c.run.period_s);
+  if (!(deg_per_tick > kMaxBeatCrankDegPerTick)) return;
+  // The largest period this recipe allows, rounded down to 0.01 ms so that it is itself accepted.
+  const double max_period_ms = std::floor(motion::rad(kMaxBeatCrankDegPerTick) / omega * 1e5) / 100.0;
+  char why[512];
+  std::snprintf(why, sizeof why,
+                "the crank turns %.1f deg per tick at the beat (%.2f rad/s); at most %.0f deg per tick, i.e. "
+                "period_ms <= %.2f for this recipe: a beat's contact with the fell lasts only a few ticks and the "
+                "load cell, read once per tick, can miss its peak by up to a tick of crank travel (simulated at "
+                "20 ms with the default recipe: beats down to 78.8 N against the 80 N minimum)",
+                deg_per_tick, omega, kMaxBeatCrankDegPerTick, max_period_ms);
+  fail("timing.period_ms", fmt_num(c.run.period_s * 1e3), why);
+}
+
 LoomConfig parse_complete(const std::string& text, const std::string& source, const LoomConfig* base) {
   TomlReader r(text, source);
   r.consume("extends");
@@ -648,6 +682,7 @@ LoomConfig parse_complete(const std::string& text, const std::string& source, co
   derive(c, fail);
   check_can(c, fail);
   check_motion(c, fail);
+  check_beat_resolution(c, fail);
   return c;
 }
 
@@ -669,6 +704,7 @@ void rederive_and_check(LoomConfig& c, const std::string& origin) {
   derive(c, fail);
   check_can(c, fail);
   check_motion(c, fail);
+  check_beat_resolution(c, fail);
 }
 
 drivers::CanAxisPortConfig can_axis_config(const LoomConfig& c) {

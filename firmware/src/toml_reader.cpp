@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <vector>
 
@@ -90,6 +91,180 @@ void check_depth(const std::string& text, const std::string& source) {
   }
 }
 
+// toml++ 3.3.0 (Debian 12) has undefined behaviour on non-ASCII text where it looks for whitespace
+// (marzer/tomlplusplus#295: impl::is_non_ascii_horizontal_whitespace reaches __builtin_unreachable() for
+// most code points in U+00A1..U+FEFE). So the text is checked before toml++ sees it: it must be valid UTF-8,
+// and non-ASCII is allowed only where TOML allows it and toml++ never asks "is this whitespace?": inside
+// basic/literal strings (single- and multi-line) and comments. Two places inside multi-line basic strings
+// are whitespace lookups too and are refused: the character after a backslash, and the first character
+// after a line-ending backslash (toml++ skips the whitespace that follows it).
+std::string hex_code_point(char32_t c) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "U+%04X", static_cast<unsigned>(c));
+  return buf;
+}
+
+std::string hex_byte(unsigned char b) {
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "0x%02X", static_cast<unsigned>(b));
+  return buf;
+}
+
+// Decodes one UTF-8 sequence at text[i]; returns its length, or 0 with `why` set when it is invalid.
+std::size_t decode_utf8(const std::string& text, std::size_t i, char32_t& cp, std::string& why) {
+  const auto at = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
+  const unsigned char b0 = at(i);
+  if (b0 < 0x80) {
+    cp = b0;
+    return 1;
+  }
+  std::size_t len = 0;
+  char32_t min = 0;
+  if (b0 >= 0xC2 && b0 <= 0xDF) {
+    len = 2, min = 0x80, cp = b0 & 0x1FU;
+  } else if (b0 >= 0xE0 && b0 <= 0xEF) {
+    len = 3, min = 0x800, cp = b0 & 0x0FU;
+  } else if (b0 >= 0xF0 && b0 <= 0xF4) {
+    len = 4, min = 0x10000, cp = b0 & 0x07U;
+  } else {
+    why = b0 < 0xC0 ? "invalid UTF-8: stray continuation byte " + hex_byte(b0)
+                    : "invalid UTF-8: byte " + hex_byte(b0) + " never starts a character";
+    return 0;
+  }
+  for (std::size_t k = 1; k < len; ++k) {
+    if (i + k >= text.size() || (at(i + k) & 0xC0U) != 0x80) {
+      why = "invalid UTF-8: sequence starting with " + hex_byte(b0) + " cut short";
+      return 0;
+    }
+    cp = (cp << 6) | (at(i + k) & 0x3FU);
+  }
+  if (cp < min) {
+    why = "invalid UTF-8: overlong encoding of " + hex_code_point(cp);
+  } else if (cp >= 0xD800 && cp <= 0xDFFF) {
+    why = "invalid UTF-8: encoded surrogate " + hex_code_point(cp);
+  } else if (cp > 0x10FFFF) {
+    why = "invalid UTF-8: code point beyond U+10FFFF";
+  } else {
+    return len;
+  }
+  return 0;
+}
+
+void check_text(const std::string& text, const std::string& source) {
+  enum class In { kToml, kComment, kBasic, kLiteral, kMultiBasic, kMultiLiteral };
+  In in = In::kToml;
+  bool escaped = false;         // the previous character was a backslash in a basic string
+  bool line_ending = false;     // after a multi-line string's `\` + space/tab: only space/tab until the break
+  bool skipping = false;        // after a line-ending backslash: toml++ skips whitespace and line breaks
+  std::size_t line = 1, col = 0;
+  const auto fail = [&](const std::string& why) {
+    throw ConfigError(source + ":" + std::to_string(line) + ":" + std::to_string(col) + ": " + why);
+  };
+  const auto run = [&](std::size_t i, char q) {
+    std::size_t n = 0;
+    while (i + n < text.size() && text[i + n] == q) ++n;
+    return n;
+  };
+  std::size_t i = 0;
+  // A byte order mark at the start is allowed (toml++ skips it; some editors write one).
+  if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) i = 3;
+  while (i < text.size()) {
+    char32_t cp = 0;
+    std::string why;
+    ++col;
+    const std::size_t len = decode_utf8(text, i, cp, why);
+    if (len == 0) fail(why);
+    const char ch = static_cast<char>(cp);  // meaningful only when cp < 0x80
+    const bool ascii = cp < 0x80;
+    if (cp == '\n') {
+      ++line, col = 0;
+      if (in == In::kComment || in == In::kBasic || in == In::kLiteral) in = In::kToml;  // (single-line ends)
+      if ((escaped && in == In::kMultiBasic) || line_ending) skipping = true;  // a line-ending backslash
+      escaped = line_ending = false;
+      i += 1;
+      continue;
+    }
+    switch (in) {
+      case In::kToml:
+        if (!ascii) fail("non-ASCII character " + hex_code_point(cp) + " outside a string or comment");
+        if (ch == '#') {
+          in = In::kComment;
+        } else if (ch == '"' || ch == '\'') {
+          const bool multi = run(i, ch) >= 3;
+          in = ch == '"' ? (multi ? In::kMultiBasic : In::kBasic) : (multi ? In::kMultiLiteral : In::kLiteral);
+          if (multi) i += 2, col += 2;
+        }
+        break;
+      case In::kComment:
+        break;
+      case In::kLiteral:
+        if (ch == '\'') in = In::kToml;
+        break;
+      case In::kMultiLiteral:
+        if (ch == '\'') {
+          const std::size_t n = run(i, '\'');
+          if (n >= 3) {
+            const std::size_t take = std::min<std::size_t>(n, 5);
+            i += take - 1, col += take - 1;
+            in = In::kToml;
+          }
+        }
+        break;
+      case In::kBasic:
+      case In::kMultiBasic:
+        if (escaped) {
+          escaped = false;
+          if (!ascii) {
+            fail("non-ASCII character " + hex_code_point(cp) + " after a backslash in a string (not a TOML escape)");
+          }
+          if (in == In::kMultiBasic && (ch == ' ' || ch == '\t')) line_ending = true;
+          if (in == In::kMultiBasic && ch == '\r') skipping = true;
+          break;
+        }
+        if (line_ending) {
+          if (!ascii) {
+            fail("non-ASCII character " + hex_code_point(cp) +
+                 " after a line-ending backslash (only spaces and tabs may follow it on its line)");
+          }
+          line_ending = false;
+          if (ch == ' ' || ch == '\t') {
+            line_ending = true;
+            break;
+          }
+          if (ch == '\r') {
+            skipping = true;
+            break;
+          }
+          // anything else: toml++ refuses it ("line-ending backslashes must be the last ...")
+        }
+        if (skipping) {
+          if (ch == ' ' || ch == '\t' || ch == '\r') break;
+          if (!ascii) {
+            fail("non-ASCII character " + hex_code_point(cp) +
+                 " first after a line-ending backslash (toml++ 3.3.0 cannot parse it there; write it as \\u" +
+                 hex_code_point(cp).substr(2) + ")");
+          }
+          skipping = false;
+        }
+        if (ch == '\\') {
+          escaped = true;
+        } else if (ch == '"') {
+          if (in == In::kBasic) {
+            in = In::kToml;
+          } else if (const std::size_t n = run(i, '"'); n >= 3) {
+            const std::size_t take = std::min<std::size_t>(n, 5);
+            i += take - 1, col += take - 1;
+            in = In::kToml;
+          } else {
+            i += n - 1, col += n - 1;
+          }
+        }
+        break;
+    }
+    i += len;
+  }
+}
+
 // Edit distance, for "did you mean".
 std::size_t distance(const std::string& a, const std::string& b) {
   std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
@@ -151,8 +326,18 @@ std::string TomlReader::show(const toml::node& n) const {
   const auto& r = n.source();
   if (r.begin.line == r.end.line && r.begin.line >= 1 && r.begin.line <= lines_.size() && !n.is_table()) {
     const std::string& line = lines_[r.begin.line - 1];
-    if (r.begin.column >= 1 && r.end.column > r.begin.column && r.end.column - 1 <= line.size()) {
-      return line.substr(r.begin.column - 1, r.end.column - r.begin.column);
+    // toml++ counts columns in code points; the line is UTF-8 (checked), so step over continuation bytes.
+    const auto byte_of = [&line](std::size_t column) {
+      std::size_t b = 0;
+      for (std::size_t c = 1; c < column && b < line.size(); ++c) {
+        ++b;
+        while (b < line.size() && (static_cast<unsigned char>(line[b]) & 0xC0U) == 0x80) ++b;
+      }
+      return b;
+    };
+    if (r.begin.column >= 1 && r.end.column > r.begin.column) {
+      const std::size_t begin = byte_of(r.begin.column), end = byte_of(r.end.column);
+      if (end > begin && end <= line.size()) return line.substr(begin, end - begin);
     }
   }
   return show_value(n);
@@ -162,6 +347,7 @@ TomlReader::TomlReader(const std::string& text, std::string source) : source_(st
   std::istringstream in(text);
   for (std::string line; std::getline(in, line);) lines_.push_back(line);
   if (text.find('\0') != std::string::npos) throw ConfigError(source_ + ":1:1: not a text file (contains NUL bytes)");
+  check_text(text, source_);
   check_depth(text, source_);
   try {
     root_ = toml::parse(text, source_);

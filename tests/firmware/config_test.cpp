@@ -165,3 +165,89 @@ TEST(Config, BeatsPerPositionMultipliesTheBeatsOfARow) {
   EXPECT_EQ(config_error("extends = \"default\"\n[recipe]\nbeats_per_position = 0\n"),
             "loom.toml:3:22: recipe.beats_per_position = 0: must be in [1, 16]");
 }
+
+// The loop period must resolve the beat: the load cell is read once per tick and a beat's contact with
+// the fell lasts only a few ticks, so at most 10 deg of crank per tick at the beat (at 20 ms the default
+// recipe's beats came out down to 78.8 N, under the 80 N band). Default recipe: 16.06 rad/s at the beat,
+// so 10.8 ms (9.9 deg) is the longest representable period (0x60C2: value·10^index) still accepted.
+TEST(Config, LoopPeriodMustResolveTheBeat) {
+  const std::string head = "extends = \"default\"\n[timing]\n";
+  EXPECT_EQ(config_error(head + "period_ms = 10.8\n"), "");
+  EXPECT_EQ(config_error(head + "period_ms = 10\n"), "");
+  const std::string e = config_error(head + "period_ms = 10.9\n");
+  EXPECT_EQ(e.rfind("loom.toml:3:13: timing.period_ms = 10.9: the crank turns 10.0 deg per tick at the beat (16.06 rad/s); "
+                    "at most 10 deg per tick, i.e. period_ms <= 10.86 for this recipe",
+                    0),
+            0u)
+      << e;
+  const std::string e20 = config_error(head + "period_ms = 20\n");
+  EXPECT_EQ(e20.rfind("loom.toml:3:13: timing.period_ms = 20: the crank turns 18.4 deg per tick at the beat", 0), 0u) << e20;
+  EXPECT_NE(e20.find("the load cell, read once per tick, can miss its peak"), std::string::npos) << e20;
+  // A slower crank allows a longer period: 12.5 rad/s turns 8.6 deg in 12 ms.
+  EXPECT_EQ(config_error("extends = \"default\"\n[recipe]\ncrank_speed_rad_s = 12.5\n[timing]\nperiod_ms = 12\n"), "");
+  EXPECT_NE(config_error("extends = \"default\"\n[recipe]\ncrank_speed_rad_s = 12.5\n[timing]\nperiod_ms = 15\n")
+                .find("timing.period_ms = 15: the crank turns 10.7 deg per tick at the beat (12.50 rad/s)"),
+            std::string::npos);
+}
+
+TEST(Config, LoopPeriodFromTheCommandLineIsCheckedToo) {
+  LoomConfig c = default_loom_config();
+  c.run.period_s = 0.0108;
+  EXPECT_NO_THROW(rederive_and_check(c, "--period-ms 10.8"));
+  c.run.period_s = 0.02;
+  try {
+    rederive_and_check(c, "--period-ms 20");
+    ADD_FAILURE() << "20 ms accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("--period-ms 20: with it, timing.period_ms = 20: the crank turns 18.4 deg", 0), 0u)
+        << e.what();
+  }
+}
+
+TEST(LoomctlCli, CoarseLoopPeriodIsRefusedByCheckAndWeave) {
+  const CliRun w = run_loomctl("weave --rows 1 --no-telemetry --period-ms 20");
+  EXPECT_EQ(w.exit_code, 2) << w.output;
+  EXPECT_NE(w.output.find("timing.period_ms = 20: the crank turns 18.4 deg per tick at the beat"), std::string::npos)
+      << w.output;
+  const std::string path = write_temp("loom_period20.toml", "extends = \"default\"\n[timing]\nperiod_ms = 20\n");
+  const CliRun c = run_loomctl("check --config " + path);
+  EXPECT_EQ(c.exit_code, 2) << c.output;
+  EXPECT_NE(c.output.find(path + ":3:13: timing.period_ms = 20: the crank turns 18.4 deg per tick at the beat"),
+            std::string::npos)
+      << c.output;
+  EXPECT_EQ(run_loomctl("weave --rows 1 --no-telemetry --period-ms 10").exit_code, 0);
+}
+
+// One default, not two: the embedded default TOML and a default-constructed LoomConfig must say the same
+// thing, or code that builds a LoomConfig without parsing (tests, tools) runs a different machine.
+TEST(Config, StructDefaultsAgreeWithTheEmbeddedDefaultToml) {
+  const LoomConfig parsed = default_loom_config();
+  const LoomConfig built;
+  // Every machine, CAN, I/O, timing and telemetry key, compared as loomctl prints them.
+  EXPECT_EQ(restart_only_changes(built, parsed), "");
+  EXPECT_DOUBLE_EQ(built.can.carriage_counts_per_m, 104857600.0);  // 2^20 counts per 10 mm, as the drives assume
+  EXPECT_DOUBLE_EQ(built.can.carriage_counts_per_m, loom::drivers::kDefaultCountsPerM);
+  // The recipe's numeric keys (restart_only_changes leaves the recipe out).
+  const Recipe& a = built.recipe;
+  const Recipe& b = parsed.recipe;
+  EXPECT_DOUBLE_EQ(a.beat_force_target_n, b.beat_force_target_n);
+  EXPECT_DOUBLE_EQ(a.crank_speed_rad_s, b.crank_speed_rad_s);
+  EXPECT_DOUBLE_EQ(a.crank_accel_rad_s2, b.crank_accel_rad_s2);
+  EXPECT_DOUBLE_EQ(a.crank_jerk_rad_s3, b.crank_jerk_rad_s3);
+  EXPECT_EQ(a.picks_per_row, b.picks_per_row);
+  EXPECT_EQ(a.knotting, b.knotting);
+  EXPECT_EQ(a.beats_per_position, b.beats_per_position);
+  EXPECT_DOUBLE_EQ(a.overlap_m, b.overlap_m);
+  EXPECT_DOUBLE_EQ(a.cam_margin_rad, b.cam_margin_rad);
+  EXPECT_DOUBLE_EQ(a.beat_force_min_n, b.beat_force_min_n);
+  EXPECT_DOUBLE_EQ(a.beat_force_max_n, b.beat_force_max_n);
+  EXPECT_EQ(a.crank_law.kind, b.crank_law.kind);
+  EXPECT_DOUBLE_EQ(a.crank_law.ellipse_e, b.crank_law.ellipse_e);
+  EXPECT_EQ(a.crank_law.ellipse_lobes, b.crank_law.ellipse_lobes);
+  EXPECT_DOUBLE_EQ(a.crank_law.ellipse_phi02_rad, b.crank_law.ellipse_phi02_rad);
+  EXPECT_EQ(a.table_size, b.table_size);
+  EXPECT_EQ(a.table_interp, b.table_interp);
+  EXPECT_EQ(a.table_precision, b.table_precision);
+  EXPECT_DOUBLE_EQ(a.max_table_error_rad, b.max_table_error_rad);
+  EXPECT_EQ(built.loom_id, parsed.loom_id);
+}

@@ -55,9 +55,10 @@ struct CanSettings {
   // Following-error supervision per axis (LinuxCNC rule): fault when |commanded − actual| >
   // max(ferror_min, ferror_k_s · |commanded velocity|). Units: rad (crank, helix) or m (carriage); s.
   // ferror_min = 0 disables it for that axis.
-  // Defaults allow 0.1 s of lag at any speed (a CSP drive lags 1–2 cycles; a loaded VM many more).
-  std::array<double, 3> ferror_min{0.3, 0.005, 1.0};
-  std::array<double, 3> ferror_k_s{0.1, 0.1, 0.1};
+  // The same defaults as firmware/config/default_loom.toml (a test holds them equal): the embedded TOML is
+  // what every loomctl run starts from.
+  std::array<double, 3> ferror_min{0.2, 0.002, 0.5};
+  std::array<double, 3> ferror_k_s{0.05, 0.05, 0.05};
 };
 
 // Where the valves, sensors, e-stop chain, buttons and load cell come from on the CAN HAL.
@@ -107,7 +108,7 @@ struct Recipe {
   std::shared_ptr<const design::Design> design;
   int beats_per_position = 1;
   double overlap_m = 0.02;
-  double cam_margin_rad = 0.3491;
+  double cam_margin_rad = 20.0 * 3.141592653589793 / 180.0;  // cam_margin_deg = 20
   double beat_force_min_n = 80.0, beat_force_max_n = 100.0;  // the band every beat must hit
   std::size_t table_size = 256;
   motion::Interp table_interp = motion::Interp::kCubic;
