@@ -128,6 +128,30 @@ std::string row_line(const loomlcm::row_t& m) {
   return line + fmt(" knotting=%.2fs", m.knotting_s);
 }
 
+// The next row's knots as runs of one colour, left to right ("B×2 R×2 B×4 ..."): what a weaver counts.
+std::string knot_runs(const loomlcm::design_t& m) {
+  const auto next = static_cast<std::size_t>(m.next_index);
+  if (next >= m.knots.size()) return "-";
+  std::string out;
+  const auto& row = m.knots[next];
+  for (std::size_t i = 0; i < row.size();) {
+    std::size_t j = i;
+    while (j < row.size() && row[j] == row[i]) ++j;
+    const int k = row[i];
+    const std::string code = k >= 0 && k < m.n_colours ? printable_field(m.code[static_cast<std::size_t>(k)]) : "?";
+    out += (out.empty() ? "" : " ") + code + fmt("x%d", static_cast<int>(j - i));
+    i = j;
+  }
+  return out;
+}
+
+std::string design_line(const loomlcm::design_t& m) {
+  return "design loom=" + printable_field(m.loom_id) + " name=" + printable_field(m.name) +
+         fmt(" next_row=%d/%d repeat=%d rows_done=%lld width=%d knots=", m.next_row, m.height, m.repeat,
+             ll(m.rows_done), m.width) +
+         knot_runs(m);
+}
+
 // ---- the event view ----
 
 std::vector<std::string> EventView::on_status(const loomlcm::status_t& m) {
@@ -209,6 +233,15 @@ std::vector<std::string> EventView::on_rt(const loomlcm::rt_stats_t& m) {
   l.can_tx_dropped = m.can_tx_dropped;
   l.can_rx_errors = m.can_rx_errors;
   return {};
+}
+
+std::vector<std::string> EventView::on_design(const loomlcm::design_t& m) {
+  Loom& l = looms_[m.loom_id];
+  if (l.design_rows_done == m.rows_done) return {};
+  l.design_rows_done = m.rows_done;
+  return {printable_field(m.loom_id) + " knot row " + fmt("%d/%d", m.next_row, m.height) +
+          (m.repeat > 1 ? fmt(" (repeat %d)", m.repeat) : std::string()) + " of " + printable_field(m.name) + ": " +
+          knot_runs(m)};
 }
 
 }  // namespace loom::monitor

@@ -14,6 +14,7 @@
 
 #include "loomlcm/axes_t.hpp"
 #include "loomlcm/beat_t.hpp"
+#include "loomlcm/design_t.hpp"
 #include "loomlcm/fault_t.hpp"
 #include "loomlcm/row_t.hpp"
 #include "loomlcm/rt_stats_t.hpp"
@@ -38,6 +39,7 @@ std::string fault_line(const loomlcm::fault_t& m);
 // row loom=<id> t=<s>s row=<n> time=<s>s shed=<s>s pick=<s>s beat=<s>s beats=<n> steps=<n>
 //   force_min=<N>N force_mean=<N>N force_max=<N>N in_band=<k>/<n>   (force fields "-" when unmeasured)
 std::string row_line(const loomlcm::row_t& m);
+std::string design_line(const loomlcm::design_t& m);
 
 // Received text is printed only after replacing spaces and non-printable bytes with '?', so a
 // malformed or hostile message cannot break the one-line, space-separated format.
@@ -56,6 +58,8 @@ class EventView {
   std::vector<std::string> on_fault(const loomlcm::fault_t& m);
   std::vector<std::string> on_row(const loomlcm::row_t& m);
   std::vector<std::string> on_rt(const loomlcm::rt_stats_t& m);
+  // A line only when the row to knot next changes (DESIGN repeats every second).
+  std::vector<std::string> on_design(const loomlcm::design_t& m);
 
  private:
   struct Loom {
@@ -64,6 +68,7 @@ class EventView {
     std::int64_t last_tick = -1;
     std::int64_t overruns = 0, dropped = 0, dropped_events = 0, can_tx_dropped = 0, can_rx_errors = 0;
     bool rt_seen = false;
+    std::int64_t design_rows_done = -1;
   };
   double status_every_s_;
   bool show_beats_;

@@ -65,6 +65,7 @@ class Printer {
   void handle(const loomlcm::beat_t& m) { dispatch("beat", m, &loom::monitor::beat_line, &View::on_beat); }
   void handle(const loomlcm::fault_t& m) { dispatch("fault", m, &loom::monitor::fault_line, &View::on_fault); }
   void handle(const loomlcm::row_t& m) { dispatch("row", m, &loom::monitor::row_line, &View::on_row); }
+  void handle(const loomlcm::design_t& m) { dispatch("design", m, &loom::monitor::design_line, &View::on_design); }
 
   template <typename Msg>
   void dispatch(const char* kind, const Msg& m, std::string (*raw_line)(const Msg&),
@@ -147,9 +148,9 @@ int main(int argc, char** argv) {
   }
   std::set<std::string> raw;
   for (const auto& c : o.channels) {
-    static const std::set<std::string> kKnown = {"status", "axes", "rt", "beat", "fault", "row"};
+    static const std::set<std::string> kKnown = {"status", "axes", "rt", "beat", "fault", "row", "design"};
     if (kKnown.count(c) == 0) {
-      return usage_error("--channel '" + c + "' is not one of status, axes, rt, beat, fault, row");
+      return usage_error("--channel '" + c + "' is not one of status, axes, rt, beat, fault, row, design");
     }
     raw.insert(c);
   }
@@ -179,6 +180,7 @@ int main(int argc, char** argv) {
   if (wanted("beat", !o.no_beats)) sub("beat", &Printer::on<loomlcm::beat_t>);
   if (wanted("fault", true)) sub("fault", &Printer::on<loomlcm::fault_t>);
   if (wanted("row", true)) sub("row", &Printer::on<loomlcm::row_t>);
+  if (wanted("design", true)) sub("design", &Printer::on<loomlcm::design_t>);
 
   struct sigaction sa {};
   sa.sa_handler = on_signal;
