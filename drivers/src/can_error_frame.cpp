@@ -24,20 +24,19 @@ CanErrorInfo decode_error_frame(const CanFrame& frame) {
   return info;
 }
 
-CanFrame make_bus_off_error_frame() {
+namespace {
+
+CanFrame error_frame(std::uint32_t error_class) {
   CanFrame f;
   f.flags = CanFrame::kError;
-  f.id = CAN_ERR_BUSOFF;
+  f.id = error_class;
   f.dlc = CAN_ERR_DLC;
   return f;
 }
 
-CanFrame make_restarted_error_frame() {
-  CanFrame f;
-  f.flags = CanFrame::kError;
-  f.id = CAN_ERR_RESTARTED;
-  f.dlc = CAN_ERR_DLC;
-  return f;
-}
+}  // namespace
+
+CanFrame make_bus_off_error_frame() { return error_frame(CAN_ERR_BUSOFF); }
+CanFrame make_restarted_error_frame() { return error_frame(CAN_ERR_RESTARTED); }
 
 }  // namespace loom::drivers

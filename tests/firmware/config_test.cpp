@@ -9,6 +9,7 @@
 #include <fstream>
 #include <string>
 
+#include "config_error.hpp"
 #include "loom/firmware/config.hpp"
 #include "loom/motion/profile_set.hpp"
 
@@ -17,15 +18,8 @@
 using namespace loom::firmware;
 
 namespace {
-std::string config_error(const std::string& text) {
-  try {
-    (void)parse_loom_config(text, "loom.toml");
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "";
-}
 
+using loom::test::config_error;
 using loom::test::CliRun;
 CliRun run_loomctl(const std::string& args) { return loom::test::run_command(std::string(LOOMCTL_PATH) + " " + args); }
 std::string write_temp(const std::string& name, const std::string& text) {

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <string>
 
+#include "config_error.hpp"
 #include "loom/firmware/config.hpp"
 #include "loom/sequencer/sequencer.hpp"
 
@@ -17,14 +18,8 @@ using namespace loom::firmware;
 
 namespace {
 
-std::string error_of(const std::string& text) {
-  try {
-    (void)parse_loom_config(text, "loom.toml");
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "";
-}
+using loom::test::config_error;
+
 std::string ext(const std::string& body) { return "extends = \"default\"\n" + body; }
 
 std::string load_error(const std::string& path) {
@@ -43,13 +38,13 @@ std::string temp_path(const std::string& name) {
 }  // namespace
 
 TEST(MachineDescription, EmptyOrCommentsOnlyFileIsNotTheDefaultLoom) {
-  EXPECT_EQ(error_of(""), "loom.toml:1:1: loom.id: missing: a config file must be complete, or begin with extends = "
+  EXPECT_EQ(config_error(""), "loom.toml:1:1: loom.id: missing: a config file must be complete, or begin with extends = "
                           "\"default\" to take what it does not say from the embedded default loom");
-  EXPECT_NE(error_of("# just a comment\n").find("loom.id: missing"), std::string::npos);
+  EXPECT_NE(config_error("# just a comment\n").find("loom.id: missing"), std::string::npos);
   // A partial file without `extends` names the first key it lacks, at its section's header.
-  EXPECT_EQ(error_of("[loom]\nid = \"x\"\n").rfind("loom.toml:1:1: [loom] width_m: missing", 0), 0u)
-      << error_of("[loom]\nid = \"x\"\n");
-  EXPECT_NE(error_of("extends = \"mine\"\n").find("extends = \"mine\": only \"default\""), std::string::npos);
+  EXPECT_EQ(config_error("[loom]\nid = \"x\"\n").rfind("loom.toml:1:1: [loom] width_m: missing", 0), 0u)
+      << config_error("[loom]\nid = \"x\"\n");
+  EXPECT_NE(config_error("extends = \"mine\"\n").find("extends = \"mine\": only \"default\""), std::string::npos);
 }
 
 TEST(MachineDescription, TheDefaultFileIsCompleteAndExtendingItChangesNothing) {
@@ -85,15 +80,15 @@ TEST(MachineDescription, NonRegularOrHugeFilesAreRefusedWithoutReading) {
 TEST(MachineDescription, DeeplyNestedKeysAreRefusedBeforeTheParserRecurses) {
   std::string deep = "a";
   for (int i = 0; i < 40000; ++i) deep += ".a";
-  EXPECT_EQ(error_of(deep + " = 1\n"), "loom.toml:1:32: key nested deeper than 16 levels");
+  EXPECT_EQ(config_error(deep + " = 1\n"), "loom.toml:1:32: key nested deeper than 16 levels");
   std::string arrays = "x = ";
   for (int i = 0; i < 40000; ++i) arrays += "[";
-  EXPECT_NE(error_of(arrays + "\n").find("nested deeper than 32 levels"), std::string::npos);
-  EXPECT_NE(error_of(std::string("a = 1\0b", 7)).find("NUL"), std::string::npos);
+  EXPECT_NE(config_error(arrays + "\n").find("nested deeper than 32 levels"), std::string::npos);
+  EXPECT_NE(config_error(std::string("a = 1\0b", 7)).find("NUL"), std::string::npos);
 }
 
 TEST(MachineDescription, BeatsPerRowBeyondTheSequencerCapacityAreRefused) {
-  const std::string e = error_of(ext("[loom]\nwidth_m = 3.0\n[recipe]\nbeats_per_position = 8\n"));
+  const std::string e = config_error(ext("[loom]\nwidth_m = 3.0\n[recipe]\nbeats_per_position = 8\n"));
   EXPECT_EQ(e, "loom.toml:5:22: recipe.beats_per_position = 8: gives 304 beats per row on a 3 m loom; the sequencer "
                "holds at most " + std::to_string(loom::sequencer::kMaxBeatsPerRow));
 }
@@ -101,7 +96,7 @@ TEST(MachineDescription, BeatsPerRowBeyondTheSequencerCapacityAreRefused) {
 TEST(MachineDescription, CalibrationOffsetsMustBeFiniteAndPlausible) {
   for (const char* v : {"nan", "inf", "-inf", "1e308"}) {
     for (const char* key : {"[beatup]\ncrank_park_position_rad", "[carriage]\nhome_position_m", "[helix]\nleft_position_rad"}) {
-      const std::string e = error_of(ext(std::string(key) + " = " + v + "\n"));
+      const std::string e = config_error(ext(std::string(key) + " = " + v + "\n"));
       EXPECT_EQ(e.rfind("loom.toml:3:", 0), 0u) << key << " = " << v << ": " << e;
       EXPECT_TRUE(e.find("must be finite") != std::string::npos || e.find("must be in [") != std::string::npos) << e;
     }
@@ -109,37 +104,37 @@ TEST(MachineDescription, CalibrationOffsetsMustBeFiniteAndPlausible) {
 }
 
 TEST(MachineDescription, AbsurdPositiveValuesAreRefusedByPlausibleRanges) {
-  EXPECT_EQ(error_of(ext("[recipe]\ncrank_jerk_rad_s3 = 1e-320\n")),
+  EXPECT_EQ(config_error(ext("[recipe]\ncrank_jerk_rad_s3 = 1e-320\n")),
             "loom.toml:3:21: recipe.crank_jerk_rad_s3 = 1e-320: must be in [10, 1e+07]");
-  EXPECT_EQ(error_of(ext("[helix]\nlead_m = 1e-320\n")), "loom.toml:3:10: helix.lead_m = 1e-320: must be in [0.005, 1]");
-  EXPECT_EQ(error_of(ext("[beatup]\nbeater_mass_kg = 1e308\n")),
+  EXPECT_EQ(config_error(ext("[helix]\nlead_m = 1e-320\n")), "loom.toml:3:10: helix.lead_m = 1e-320: must be in [0.005, 1]");
+  EXPECT_EQ(config_error(ext("[beatup]\nbeater_mass_kg = 1e308\n")),
             "loom.toml:3:18: beatup.beater_mass_kg = 1e308: must be in [0.1, 50]");
-  EXPECT_EQ(error_of(ext("[helix]\nshuttle_mass_kg = 1e308\n")),
+  EXPECT_EQ(config_error(ext("[helix]\nshuttle_mass_kg = 1e308\n")),
             "loom.toml:3:19: helix.shuttle_mass_kg = 1e308: must be in [0.01, 10]");
-  EXPECT_NE(error_of(ext("[timing]\nenable_timeout_s = 1e300\n")).find("must be in [0.05, 60]"), std::string::npos);
-  EXPECT_NE(error_of(ext("[can]\nbitrate = 123456\n")).find("must be a CiA 301 bit rate"), std::string::npos);
+  EXPECT_NE(config_error(ext("[timing]\nenable_timeout_s = 1e300\n")).find("must be in [0.05, 60]"), std::string::npos);
+  EXPECT_NE(config_error(ext("[can]\nbitrate = 123456\n")).find("must be a CiA 301 bit rate"), std::string::npos);
 }
 
 TEST(MachineDescription, EachCrossFieldErrorPointsAtTheLineThatIsWrong) {
   // A duplicated node id at its second use, whichever key that is.
-  EXPECT_EQ(error_of(ext("[can]\nnode_helix = 7\nnode_carriage = 7\n")),
+  EXPECT_EQ(config_error(ext("[can]\nnode_helix = 7\nnode_carriage = 7\n")),
             "loom.toml:4:17: can.node_carriage = 7: node id already used by can.node_helix");
   // A non-Grashof linkage at the link lengths.
-  EXPECT_NE(error_of(ext("[beatup]\ncrank_m = 0.3\n")).find("loom.toml:3:11: beatup.crank_m = 0.3: the linkage"),
+  EXPECT_NE(config_error(ext("[beatup]\ncrank_m = 0.3\n")).find("loom.toml:3:11: beatup.crank_m = 0.3: the linkage"),
             std::string::npos);
   // A misspelled section is an unknown section, with the near miss suggested.
-  EXPECT_EQ(error_of(ext("[carriag]\nmax_speed_m_s = 1\n")),
+  EXPECT_EQ(config_error(ext("[carriag]\nmax_speed_m_s = 1\n")),
             "loom.toml:2:1: [carriag] = {...}: unknown section (did you mean [carriage]?)");
   // A force target that cannot be met names the limit and the speed it asks for, at the target.
-  const std::string force = error_of(ext("[recipe]\nbeat_force_target_n = 400\nbeat_force_max_n = 500\n"));
+  const std::string force = config_error(ext("[recipe]\nbeat_force_target_n = 400\nbeat_force_max_n = 500\n"));
   EXPECT_EQ(force.rfind("loom.toml:3:23: recipe.beat_force_target_n = 400:", 0), 0u) << force;
   EXPECT_NE(force.find("crank speed of"), std::string::npos) << force;
   // A target outside the band the beats must hit.
-  EXPECT_NE(error_of(ext("[recipe]\nbeat_force_target_n = 120\n")).find("must lie in the band [beat_force_min_n"),
+  EXPECT_NE(config_error(ext("[recipe]\nbeat_force_target_n = 120\n")).find("must lie in the band [beat_force_min_n"),
             std::string::npos);
   // The CAN master's own rule, at parse time (exit 2), not when the bus is opened (exit 4).
-  EXPECT_EQ(error_of(ext("[can]\nheartbeat_timeout_ms = 400\n")).rfind("loom.toml:3:24: can.heartbeat_timeout_ms = 400", 0), 0u);
-  EXPECT_NE(error_of(ext("[beatup]\nbeater_width_m = 0.05\n[recipe]\noverlap_m = 0.05\n")).find("loom.toml:5:13: recipe.overlap_m"),
+  EXPECT_EQ(config_error(ext("[can]\nheartbeat_timeout_ms = 400\n")).rfind("loom.toml:3:24: can.heartbeat_timeout_ms = 400", 0), 0u);
+  EXPECT_NE(config_error(ext("[beatup]\nbeater_width_m = 0.05\n[recipe]\noverlap_m = 0.05\n")).find("loom.toml:5:13: recipe.overlap_m"),
             std::string::npos);
 }
 

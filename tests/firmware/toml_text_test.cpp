@@ -6,29 +6,15 @@
 
 #include <string>
 
+#include "config_error.hpp"
 #include "loom/firmware/config.hpp"
 
 using namespace loom::firmware;
 
 namespace {
-std::string config_error(const std::string& text) {
-  try {
-    (void)parse_loom_config(text, "loom.toml");
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "";
-}
 
-std::string scene_error(const std::string& text) {
-  try {
-    (void)parse_scene(text, "scene.toml");
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "";
-}
-
+using loom::test::config_error;
+using loom::test::scene_error;
 const std::string kHead = "extends = \"default\"\n";
 }  // namespace
 

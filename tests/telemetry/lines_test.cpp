@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "synthetic_loom.hpp"
+
 namespace {
 
 using namespace loom::monitor;
@@ -179,22 +181,7 @@ TEST(MonitorLines, EventViewSaysBandAndKeepsStatusSparse) {
 }  // namespace
 
 TEST(MonitorLines, DesignShowsTheRowToKnotAsRunsOnceEachRow) {
-  loomlcm::design_t d{};
-  d.loom_id = "L";
-  d.name = "rug.csv";
-  d.width = 5;
-  d.height = 6;
-  d.rows_done = 1;
-  d.next_row = 2;
-  d.repeat = 1;
-  d.n_colours = 2;
-  d.code = {"R", "B"};
-  d.colour_name = {"", ""};
-  d.rgb = {0xff0000, 0x0000ff};
-  d.n_rows = 2;
-  d.row_number = {1, 2};
-  d.next_index = 1;
-  d.knots = {{0, 0, 0, 0, 0}, {1, 1, 0, 0, 1}};
+  const auto d = loom::telemetry::test_support::design_message("L", {{0, 0, 0, 0, 0}, {1, 1, 0, 0, 1}});
   EXPECT_EQ(loom::monitor::design_line(d), "design loom=L name=rug.csv next_row=2/6 repeat=1 rows_done=1 width=5 knots=Bx2 Rx2 Bx1");
   loom::monitor::EventView v;
   EXPECT_EQ(v.on_design(d).at(0), "L knot row 2/6 of rug.csv: Bx2 Rx2 Bx1");

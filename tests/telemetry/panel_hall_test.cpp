@@ -9,6 +9,7 @@
 
 #include "hall.hpp"
 #include "udpm_receiver.hpp"
+#include "synthetic_loom.hpp"
 
 using namespace loom::panel;
 
@@ -115,22 +116,8 @@ TEST(PanelHall, RestartedLoopStartsAfreshAndNaNIsNull) {
 
 TEST(PanelHall, DesignShowsTheNextRowAndOnlyANewRowIsAChange) {
   Hall hall;
-  loomlcm::design_t d{};
-  d.loom_id = "L1";
-  d.name = "rug.csv";
-  d.width = 2;
-  d.height = 6;
-  d.rows_done = 1;
-  d.next_row = 2;
-  d.repeat = 1;
-  d.n_colours = 2;
-  d.code = {"R", "B"};
-  d.colour_name = {"madder", ""};
-  d.rgb = {0x9b1b30, 0x1d3f8a};
-  d.n_rows = 2;
-  d.row_number = {1, 2};
-  d.next_index = 1;
-  d.knots = {{0, 1}, {1, 7}};  // 7: beyond the palette (a corrupt message) is shown as unknown
+  // 7: beyond the palette (a corrupt message) is shown as unknown.
+  auto d = loom::telemetry::test_support::design_message("L1", {{0, 1}, {1, 7}});
   hall.on_design(d);
   const auto v = hall.version();
   hall.on_design(d);  // the periodic repeat of the same row

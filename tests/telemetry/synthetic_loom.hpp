@@ -8,10 +8,13 @@
 #include <cstdint>
 #include <cstring>
 #include <numbers>
+#include <string>
 #include <string_view>
+#include <vector>
 
 #include "loom/hal/types.hpp"
 #include "loom/telemetry/snapshot.hpp"
+#include "loomlcm/design_t.hpp"
 
 namespace loom::telemetry::test_support {
 
@@ -85,6 +88,28 @@ inline Snapshot script_snapshot(const WeaveScript& w, std::int64_t tick) {
   s.tick_cost_ns = 10'000 + (tick % 7) * 100;
   s.max_tick_cost_ns = 10'600;
   return s;
+}
+
+// A DESIGN message: design "rug.csv", 6 rows, two colours (R madder, B), row 1 woven, carrying row 1
+// (knotted last) and row 2 (next) with the given knots.
+inline loomlcm::design_t design_message(const std::string& loom_id, std::vector<std::vector<std::int16_t>> knots) {
+  loomlcm::design_t d{};
+  d.loom_id = loom_id;
+  d.name = "rug.csv";
+  d.width = static_cast<std::int32_t>(knots.at(0).size());
+  d.height = 6;
+  d.rows_done = 1;
+  d.next_row = 2;
+  d.repeat = 1;
+  d.n_colours = 2;
+  d.code = {"R", "B"};
+  d.colour_name = {"madder", ""};
+  d.rgb = {0x9b1b30, 0x1d3f8a};
+  d.n_rows = static_cast<std::int16_t>(knots.size());
+  d.row_number = {1, 2};
+  d.next_index = 1;
+  d.knots = std::move(knots);
+  return d;
 }
 
 }  // namespace loom::telemetry::test_support

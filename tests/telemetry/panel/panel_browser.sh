@@ -9,13 +9,7 @@ LOOMCTL=$1
 PANEL=$2
 OUT=$3
 fail() { echo "FAIL: $*" >&2; exit 1; }
-CHROMIUM=$(command -v chromium || command -v chromium-browser || true)
-[ -n "$CHROMIUM" ] || { echo "SKIP: chromium not installed (tools/deps.sh installs it)"; exit 77; }
-command -v node >/dev/null || { echo "SKIP: node not installed"; exit 77; }
-# The DevTools client uses node's built-in WebSocket (node >= 20.10 with --experimental-websocket, or 22).
-node --experimental-websocket -e 'if (typeof WebSocket !== "function") process.exit(1)' 2>/dev/null ||
-  node -e 'if (typeof WebSocket !== "function") process.exit(1)' 2>/dev/null ||
-  { echo "SKIP: this node ($(node --version)) has no built-in WebSocket"; exit 77; }
+. "$(dirname "$0")/browser_lib.sh"
 mkdir -p "$OUT"
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/loom_panel_browser.XXXXXX")
 PIDS=()

@@ -12,11 +12,7 @@ DESIGN=$3
 OUT=$4
 here=$(dirname "$0")
 fail() { echo "FAIL: $*" >&2; for f in "$WORK"/*.log; do echo "--- $f" >&2; tail -20 "$f" >&2; done; exit 1; }
-CHROMIUM=$(command -v chromium || command -v chromium-browser || true)
-[ -n "$CHROMIUM" ] || { echo "SKIP: chromium not installed (tools/deps.sh installs it)"; exit 77; }
-command -v node >/dev/null || { echo "SKIP: node not installed"; exit 77; }
-node --experimental-websocket -e 'if (typeof WebSocket !== "function") process.exit(1)' 2>/dev/null ||
-  { echo "SKIP: this node ($(node --version)) has no built-in WebSocket"; exit 77; }
+. "$(dirname "$0")/browser_lib.sh"
 mkdir -p "$OUT"
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/loom_panel_knotting.XXXXXX")
 PIDS=()
