@@ -156,6 +156,10 @@ void check_text(const std::string& text, const std::string& source) {
   bool escaped = false;         // the previous character was a backslash in a basic string
   bool line_ending = false;     // after a multi-line string's `\` + space/tab: only space/tab until the break
   bool skipping = false;        // after a line-ending backslash: toml++ skips whitespace and line breaks
+  // The last non-blank character outside strings on this line (0 at its start). A quote opens a string
+  // only where TOML can have one — at the start of a line or after = [ , { . — so a quote in the middle
+  // of a bare token (`x"=χ`, invalid TOML that toml++ still walks through) cannot hide what follows it.
+  char before = 0;
   std::size_t line = 1, col = 0;
   const auto fail = [&](const std::string& why) {
     throw ConfigError(source + ":" + std::to_string(line) + ":" + std::to_string(col) + ": " + why);
@@ -178,6 +182,7 @@ void check_text(const std::string& text, const std::string& source) {
     const bool ascii = cp < 0x80;
     if (cp == '\n') {
       ++line, col = 0;
+      before = 0;
       if (in == In::kComment || in == In::kBasic || in == In::kLiteral) in = In::kToml;  // (single-line ends)
       if ((escaped && in == In::kMultiBasic) || line_ending) skipping = true;  // a line-ending backslash
       escaped = line_ending = false;
@@ -189,16 +194,19 @@ void check_text(const std::string& text, const std::string& source) {
         if (!ascii) fail("non-ASCII character " + hex_code_point(cp) + " outside a string or comment");
         if (ch == '#') {
           in = In::kComment;
-        } else if (ch == '"' || ch == '\'') {
+        } else if ((ch == '"' || ch == '\'') &&
+                   (before == 0 || before == '=' || before == '[' || before == ',' || before == '{' || before == '.')) {
           const bool multi = run(i, ch) >= 3;
           in = ch == '"' ? (multi ? In::kMultiBasic : In::kBasic) : (multi ? In::kMultiLiteral : In::kLiteral);
           if (multi) i += 2, col += 2;
+        } else if (ch != ' ' && ch != '\t' && ch != '\r') {
+          before = ch;
         }
         break;
       case In::kComment:
         break;
       case In::kLiteral:
-        if (ch == '\'') in = In::kToml;
+        if (ch == '\'') in = In::kToml, before = '\'';
         break;
       case In::kMultiLiteral:
         if (ch == '\'') {
@@ -206,7 +214,7 @@ void check_text(const std::string& text, const std::string& source) {
           if (n >= 3) {
             const std::size_t take = std::min<std::size_t>(n, 5);
             i += take - 1, col += take - 1;
-            in = In::kToml;
+            in = In::kToml, before = '"';  // a string token ended
           }
         }
         break;
@@ -250,11 +258,11 @@ void check_text(const std::string& text, const std::string& source) {
           escaped = true;
         } else if (ch == '"') {
           if (in == In::kBasic) {
-            in = In::kToml;
+            in = In::kToml, before = '"';  // a string token ended
           } else if (const std::size_t n = run(i, '"'); n >= 3) {
             const std::size_t take = std::min<std::size_t>(n, 5);
             i += take - 1, col += take - 1;
-            in = In::kToml;
+            in = In::kToml, before = '"';  // a string token ended
           } else {
             i += n - 1, col += n - 1;
           }

@@ -140,3 +140,18 @@ TEST(TomlText, FuzzReproducersAreRefusedBeforeToml) {
         << e.what();
   }
 }
+
+// Found by fuzz_loom_config: a quote in the middle of a bare token (`x"=χ`) is not the start of a
+// string — TOML has none there, yet toml++ walks on to the χ — so it must not hide what follows it.
+TEST(TomlText, AQuoteInsideABareTokenDoesNotOpenAString) {
+  EXPECT_EQ(config_error("key =----x\"=\xCF\x87\n"),
+            "loom.toml:1:13: non-ASCII character U+03C7 outside a string or comment");
+  EXPECT_EQ(config_error("a = \"x\" \"\xCF\x87\"\n"), "loom.toml:1:10: non-ASCII character U+03C7 outside a string or comment");
+  // Where TOML does open strings: after = [ , { . and at the start of a line (a quoted key).
+  EXPECT_EQ(config_error(kHead + "[loom]\nloom_id = \"\xCF\x87\"\n").find("non-ASCII"), std::string::npos);
+  EXPECT_EQ(config_error(kHead + "\"\xCF\x87\" = 1\n").find("non-ASCII"), std::string::npos);
+  EXPECT_EQ(config_error(kHead + "[loom]\nx = [\"a\", \"\xCF\x87\"]\n").find("non-ASCII"), std::string::npos);
+  EXPECT_EQ(config_error(kHead + "[loom]\nx = { y = \"\xCF\x87\" }\n").find("non-ASCII"), std::string::npos);
+  const std::string dir = std::string(LOOM_SOURCE_DIR) + "/tests/fuzz/corpus/loom_config/";
+  EXPECT_THROW((void)load_loom_config(dir + "toml_unreachable_quote_inside_a_bare_token.toml"), ConfigError);
+}
