@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -150,16 +151,70 @@ std::size_t decode_utf8(const std::string& text, std::size_t i, char32_t& cp, st
   return 0;
 }
 
+// Where a quote opens a string as toml++ reads a line: at the start of a key or of a value. Inside a bare
+// token it is just another character — and toml++ walks a bare value (a number, a date, or garbage) to
+// its terminator asking "is this whitespace?" of every character, so a quote there must not make the
+// check treat what follows it as string content (`x = --x="χ`, found by fuzz_loom_config).
+class TokenContext {
+ public:
+  void new_line() { *this = TokenContext{}; }
+  bool quote_opens_string() const {
+    return !in_bare_ && (before_ == 0 || before_ == '=' || before_ == '[' || before_ == ',' || before_ == '{' ||
+                         before_ == '.');
+  }
+  void string_closed() {
+    in_bare_ = false;
+    before_ = '"';
+  }
+  void take(char ch) {
+    const bool blank = ch == ' ' || ch == '\t' || ch == '\r';
+    if (in_bare_) {
+      // A bare key is [A-Za-z0-9_-]; a bare value runs to whitespace , ] } (or a comment, seen earlier).
+      const bool key_char = std::isalnum(static_cast<unsigned char>(ch)) != 0 || ch == '_' || ch == '-';
+      const bool ends = bare_is_key_ ? !key_char : (blank || ch == ',' || ch == ']' || ch == '}');
+      if (!ends) {
+        before_ = ch;
+        return;
+      }
+      in_bare_ = false;
+    }
+    if (blank) return;
+    switch (ch) {
+      case '=': key_next_ = false; break;
+      case ',': key_next_ = braces_ > 0; break;
+      case '{':
+        ++braces_;
+        key_next_ = true;
+        break;
+      case '}':
+        if (braces_ > 0) --braces_;
+        break;
+      case '[':
+      case ']':
+      case '.': break;
+      default:
+        in_bare_ = true;
+        bare_is_key_ = key_next_;
+        break;
+    }
+    before_ = ch;
+  }
+
+ private:
+  bool in_bare_ = false;     // inside a bare token
+  bool bare_is_key_ = false; // ... a key (ended by any non-key character) or a value (ended by a terminator)
+  bool key_next_ = true;     // the next token is a key: at the line's start, after { and after , inside { }
+  int braces_ = 0;
+  char before_ = 0;          // the last character outside strings on this line, 0 at its start
+};
+
 void check_text(const std::string& text, const std::string& source) {
   enum class In { kToml, kComment, kBasic, kLiteral, kMultiBasic, kMultiLiteral };
   In in = In::kToml;
   bool escaped = false;         // the previous character was a backslash in a basic string
   bool line_ending = false;     // after a multi-line string's `\` + space/tab: only space/tab until the break
   bool skipping = false;        // after a line-ending backslash: toml++ skips whitespace and line breaks
-  // The last non-blank character outside strings on this line (0 at its start). A quote opens a string
-  // only where TOML can have one — at the start of a line or after = [ , { . — so a quote in the middle
-  // of a bare token (`x"=χ`, invalid TOML that toml++ still walks through) cannot hide what follows it.
-  char before = 0;
+  TokenContext tokens;
   std::size_t line = 1, col = 0;
   const auto fail = [&](const std::string& why) {
     throw ConfigError(source + ":" + std::to_string(line) + ":" + std::to_string(col) + ": " + why);
@@ -182,7 +237,7 @@ void check_text(const std::string& text, const std::string& source) {
     const bool ascii = cp < 0x80;
     if (cp == '\n') {
       ++line, col = 0;
-      before = 0;
+      tokens.new_line();
       if (in == In::kComment || in == In::kBasic || in == In::kLiteral) in = In::kToml;  // (single-line ends)
       if ((escaped && in == In::kMultiBasic) || line_ending) skipping = true;  // a line-ending backslash
       escaped = line_ending = false;
@@ -194,19 +249,18 @@ void check_text(const std::string& text, const std::string& source) {
         if (!ascii) fail("non-ASCII character " + hex_code_point(cp) + " outside a string or comment");
         if (ch == '#') {
           in = In::kComment;
-        } else if ((ch == '"' || ch == '\'') &&
-                   (before == 0 || before == '=' || before == '[' || before == ',' || before == '{' || before == '.')) {
+        } else if ((ch == '"' || ch == '\'') && tokens.quote_opens_string()) {
           const bool multi = run(i, ch) >= 3;
           in = ch == '"' ? (multi ? In::kMultiBasic : In::kBasic) : (multi ? In::kMultiLiteral : In::kLiteral);
           if (multi) i += 2, col += 2;
-        } else if (ch != ' ' && ch != '\t' && ch != '\r') {
-          before = ch;
+        } else {
+          tokens.take(ch);
         }
         break;
       case In::kComment:
         break;
       case In::kLiteral:
-        if (ch == '\'') in = In::kToml, before = '\'';
+        if (ch == '\'') in = In::kToml, tokens.string_closed();
         break;
       case In::kMultiLiteral:
         if (ch == '\'') {
@@ -214,7 +268,7 @@ void check_text(const std::string& text, const std::string& source) {
           if (n >= 3) {
             const std::size_t take = std::min<std::size_t>(n, 5);
             i += take - 1, col += take - 1;
-            in = In::kToml, before = '"';  // a string token ended
+            in = In::kToml, tokens.string_closed();
           }
         }
         break;
@@ -258,11 +312,11 @@ void check_text(const std::string& text, const std::string& source) {
           escaped = true;
         } else if (ch == '"') {
           if (in == In::kBasic) {
-            in = In::kToml, before = '"';  // a string token ended
+            in = In::kToml, tokens.string_closed();
           } else if (const std::size_t n = run(i, '"'); n >= 3) {
             const std::size_t take = std::min<std::size_t>(n, 5);
             i += take - 1, col += take - 1;
-            in = In::kToml, before = '"';  // a string token ended
+            in = In::kToml, tokens.string_closed();
           } else {
             i += n - 1, col += n - 1;
           }

@@ -152,6 +152,10 @@ TEST(TomlText, AQuoteInsideABareTokenDoesNotOpenAString) {
   EXPECT_EQ(config_error(kHead + "\"\xCF\x87\" = 1\n").find("non-ASCII"), std::string::npos);
   EXPECT_EQ(config_error(kHead + "[loom]\nx = [\"a\", \"\xCF\x87\"]\n").find("non-ASCII"), std::string::npos);
   EXPECT_EQ(config_error(kHead + "[loom]\nx = { y = \"\xCF\x87\" }\n").find("non-ASCII"), std::string::npos);
+  // A bare value runs to whitespace , ] }: an '=' inside it does not start a value (toml++ walks on).
+  EXPECT_EQ(config_error("key =--x=\"\x16=\xCF\x85\n"), "loom.toml:1:13: non-ASCII character U+03C5 outside a string or comment");
+  EXPECT_EQ(config_error(kHead + "[loom]\nx = {a=\"\xCF\x87\", b=\"\xCF\x87\"}\n").find("non-ASCII"), std::string::npos);
   const std::string dir = std::string(LOOM_SOURCE_DIR) + "/tests/fuzz/corpus/loom_config/";
   EXPECT_THROW((void)load_loom_config(dir + "toml_unreachable_quote_inside_a_bare_token.toml"), ConfigError);
+  EXPECT_THROW((void)load_loom_config(dir + "toml_unreachable_quote_inside_a_bare_value.toml"), ConfigError);
 }
