@@ -492,6 +492,9 @@ std::string describe_run(const RunResult& r, const RunOptions& opt) {
     s.append(buf, static_cast<std::size_t>(std::max(n, 0)));
   }
   if (r.events_dropped > 0) s += "; run events dropped " + std::to_string(r.events_dropped);
+  if (r.acks_refused > 0) {
+    s += "; acknowledgements refused while the link could not be re-armed " + std::to_string(r.acks_refused);
+  }
   if (r.fifo_refused) s += "\nloomctl: WARNING: SCHED_FIFO was refused; the loop ran at SCHED_OTHER";
   if (r.fell_behind) {
     n = std::snprintf(buf, sizeof buf,

@@ -261,6 +261,8 @@ TEST(RunnerCommands, AckIsRefusedWhileALostNodeIsSilentOrTheBusIsOff) {
     const RunResult res = run_virtual(r, 100, link);
     EXPECT_EQ(res.end, RunResult::End::kMaxTicks) << hal::link_recovery_name(rec);
     EXPECT_EQ(res.acks_refused, 1u);
+    EXPECT_NE(firmware::describe_run(res, RunOptions{}).find("acknowledgements refused while the link could not be re-armed 1"),
+              std::string::npos);
     EXPECT_EQ(link.link_recovery.load(), static_cast<std::uint8_t>(rec));
     EXPECT_EQ(link.silent_node.load(), 3);
     EXPECT_EQ(r.seq->state(), sequencer::State::kFault);

@@ -66,8 +66,8 @@ std::string status_text(const OperatorLink& l, const std::string& loom_id, const
     if (rec == hal::LinkRecovery::kNodeSilent) out += " silent_node=" + std::to_string(l.silent_node.load(r));
   }
   if (d != nullptr) {
-    const std::uint32_t rows = l.rows.load(r), at_arm = p.counter_rows_at_arm.load(r);
-    const auto pos = design::position_after(*d, p.rows_at_arm.load(r) + (rows >= at_arm ? rows - at_arm : 0));
+    const auto pos = design::position_after(
+        *d, design::rows_woven(p.rows_at_arm.load(r), p.counter_rows_at_arm.load(r), l.rows.load(r)));
     std::snprintf(buf, sizeof buf, " design=%s design_row=%d/%d repeat=%d", d->name().c_str(), pos.row + 1,
                   d->height(), pos.repeat);
     out += buf;

@@ -170,8 +170,7 @@ void Publisher::publish_event(const Event& e) {
 // learns the row within a second; an unchanged row is not re-sent at STATUS's rate).
 void Publisher::publish_design(const Snapshot& s, std::int64_t utime) {
   if (!cfg_.design) return;
-  const std::uint64_t woven = s.row >= cfg_.counter_rows_at_start ? s.row - cfg_.counter_rows_at_start : 0;
-  const std::uint64_t rows = cfg_.design_rows_at_start + woven;
+  const std::uint64_t rows = design::rows_woven(cfg_.design_rows_at_start, cfg_.counter_rows_at_start, s.row);
   const auto now = std::chrono::steady_clock::now();
   if (rows == design_rows_sent_ && now - design_sent_at_ < std::chrono::seconds(1)) return;
   send(channels_.design, to_design(*cfg_.design, rows, cfg_.loom_id, utime), n_design_);

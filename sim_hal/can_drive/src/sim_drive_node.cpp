@@ -23,9 +23,9 @@ namespace nmt = slave::nmt;
 namespace {
 
 // Objects the drive reacts to or reports (CiA 301, CiA 402).
-constexpr std::uint16_t kErrorRegister = 0x1001;
-constexpr std::uint16_t kConsumerHeartbeat = 0x1016;
-constexpr std::uint16_t kProducerHeartbeat = 0x1017;
+constexpr std::uint16_t kErrorRegister = slave::kErrorRegisterObject;
+constexpr std::uint16_t kConsumerHeartbeat = slave::kConsumerHeartbeatObject;
+constexpr std::uint16_t kProducerHeartbeat = slave::kProducerHeartbeatObject;
 constexpr std::uint16_t kErrorCode = 0x603F;
 constexpr std::uint16_t kControlword = 0x6040;
 constexpr std::uint16_t kStatusword = 0x6041;
@@ -50,13 +50,7 @@ using slave::pdo_comm;
 using slave::pdo_map;
 namespace cob = slave::cob;
 
-constexpr slave::Objects<5> kCommunicationObjects{{
-    {0x1000, 0, 4, Access::kConst, Pdo::kNone, kDeviceTypeServo402},
-    {kErrorRegister, 0, 1, Access::kRo, Pdo::kNone, 0},
-    {kConsumerHeartbeat, 0, 1, Access::kConst, Pdo::kNone, 1},
-    {kConsumerHeartbeat, 1, 4, Access::kRw, Pdo::kNone, 0},  // master node << 16 | ms
-    {kProducerHeartbeat, 0, 2, Access::kRw, Pdo::kNone, 0},  // ms
-}};
+constexpr slave::Objects<5> kCommunicationObjects = slave::communication_objects(kDeviceTypeServo402);
 
 constexpr slave::Objects<13> kDriveObjects{{
     {kErrorCode, 0, 2, Access::kRo, Pdo::kTx, 0},

@@ -23,9 +23,9 @@ namespace nmt = slave::nmt;
 // Device type: profile 401, bits 16..18 = digital inputs, digital outputs, analog inputs.
 constexpr std::uint32_t kDeviceType = 0x00070191;
 
-constexpr std::uint16_t kErrorRegister = 0x1001;
-constexpr std::uint16_t kConsumerHeartbeat = 0x1016;
-constexpr std::uint16_t kProducerHeartbeat = 0x1017;
+constexpr std::uint16_t kErrorRegister = slave::kErrorRegisterObject;
+constexpr std::uint16_t kConsumerHeartbeat = slave::kConsumerHeartbeatObject;
+constexpr std::uint16_t kProducerHeartbeat = slave::kProducerHeartbeatObject;
 constexpr std::uint16_t kDigitalInputs = 0x6000;
 constexpr std::uint16_t kDigitalOutputs = 0x6200;
 constexpr std::uint16_t kOutputErrorMode = 0x6206;
@@ -37,13 +37,7 @@ constexpr int kInPistonAExt = 0, kInPistonARet = 1, kInPistonBExt = 2, kInPiston
               kInShuttleRight = 5, kInEstopOk = 6, kInStart = 8, kInPause = 9, kInAck = 10, kInKnotted = 11;
 constexpr int kOutValveA = 0, kOutValveB = 1;
 
-constexpr slave::Objects<5> kCommunicationObjects{{
-    {0x1000, 0, 4, Access::kConst, Pdo::kNone, kDeviceType},
-    {kErrorRegister, 0, 1, Access::kRo, Pdo::kNone, 0},
-    {kConsumerHeartbeat, 0, 1, Access::kConst, Pdo::kNone, 1},
-    {kConsumerHeartbeat, 1, 4, Access::kRw, Pdo::kNone, 0},  // master node << 16 | ms
-    {kProducerHeartbeat, 0, 2, Access::kRw, Pdo::kNone, 0},  // ms
-}};
+constexpr slave::Objects<5> kCommunicationObjects = slave::communication_objects(kDeviceType);
 
 // Digital inputs (8-bit groups), outputs, output error mode and value, analog inputs.
 constexpr slave::Objects<17> kIoObjects{{

@@ -73,4 +73,11 @@ struct DesignPosition {
 };
 DesignPosition position_after(const Design& d, std::uint64_t rows_done);
 
+// Design rows woven by production row `counter_rows`, given `rows_at_start` of them woven by production
+// row `counter_rows_at_start`: every production row since then was a row of this design.
+constexpr std::uint64_t rows_woven(std::uint64_t rows_at_start, std::uint32_t counter_rows_at_start,
+                                   std::uint32_t counter_rows) {
+  return rows_at_start + (counter_rows >= counter_rows_at_start ? counter_rows - counter_rows_at_start : 0);
+}
+
 }  // namespace loom::design

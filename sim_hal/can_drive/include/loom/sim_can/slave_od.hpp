@@ -134,6 +134,18 @@ constexpr Objects<1 + kMapEntries> pdo_map(std::uint16_t index,
   return o;
 }
 
+// The CiA 301 communication objects every simulated node has, the device type aside.
+inline constexpr std::uint16_t kErrorRegisterObject = 0x1001;
+inline constexpr std::uint16_t kConsumerHeartbeatObject = 0x1016;
+inline constexpr std::uint16_t kProducerHeartbeatObject = 0x1017;
+constexpr Objects<5> communication_objects(std::uint32_t device_type) {
+  return {{{0x1000, 0, 4, Access::kConst, Pdo::kNone, device_type},
+           {kErrorRegisterObject, 0, 1, Access::kRo, Pdo::kNone, 0},
+           {kConsumerHeartbeatObject, 0, 1, Access::kConst, Pdo::kNone, 1},
+           {kConsumerHeartbeatObject, 1, 4, Access::kRw, Pdo::kNone, 0},  // master node << 16 | ms
+           {kProducerHeartbeatObject, 0, 2, Access::kRw, Pdo::kNone, 0}}};  // ms
+}
+
 // One table from several blocks (kept in the order given: the caller lists objects by index).
 template <std::size_t... N>
 constexpr auto concat(const Objects<N>&... parts) {
