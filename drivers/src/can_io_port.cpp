@@ -63,17 +63,17 @@ std::vector<NamedBit> outputs_of(const IoWiring& w) {
           {"io.outputs.buzzer", &w.buzzer, false}};
 }
 
-Status check_bits(const std::vector<NamedBit>& bits) {
-  std::array<const char*, kIoMaxBits> used{};
+Status check_bits(const std::vector<NamedBit>& bits, int max_bits) {
+  std::array<const char*, kIoMaxInputBits> used{};
   for (const NamedBit& b : bits) {
     const int n = b.bit->bit;
     if (n == -1) {
       if (b.required) return Status::error(std::string(b.name) + ".bit = -1: this signal must be wired");
       continue;
     }
-    if (n < 0 || n >= kIoMaxBits) {
+    if (n < 0 || n >= max_bits) {
       return Status::error(std::string(b.name) + ".bit = " + std::to_string(n) + " is outside 0.." +
-                           std::to_string(kIoMaxBits - 1) + " (-1 = not wired)");
+                           std::to_string(max_bits - 1) + " (-1 = not wired)");
     }
     if (used[static_cast<std::size_t>(n)] != nullptr) {
       return Status::error(std::string(b.name) + ".bit = " + std::to_string(n) + " is already used by " +
@@ -106,8 +106,8 @@ bool interop_readback_code(std::uint32_t abort) {
 // Configuration
 // ---------------------------------------------------------------------------------------------------
 Status validate(const IoWiring& w) {
-  if (Status s = check_bits(inputs_of(w)); !s) return s;
-  if (Status s = check_bits(outputs_of(w)); !s) return s;
+  if (Status s = check_bits(inputs_of(w), kIoMaxInputBits); !s) return s;
+  if (Status s = check_bits(outputs_of(w), kIoMaxOutputBits); !s) return s;
   if (w.load_cell_channel < 0 || w.load_cell_channel > 254) {
     return Status::error("io.load_cell.channel = " + std::to_string(w.load_cell_channel) +
                          " is outside 0..254 (0 = no load cell, else the sub-index of 0x6401)");

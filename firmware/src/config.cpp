@@ -155,12 +155,25 @@ bool parse_io_kind(const char* s, IoKind& k) {
   return true;
 }
 
-// One wired signal of the I/O module: `io.<name>_bit` (-1 = not wired) and `io.<name>_active_low`.
-void io_signal(std::vector<Key>& v, const std::string& name, drivers::IoBit drivers::IoWiring::*member) {
-  v.push_back(integer<int>("io." + name + "_bit", Klass::kMachine, -1, drivers::kIoMaxBits - 1,
-                           [member](LoomConfig& c) -> int& { return (c.io.wiring.*member).bit; }));
+// One wired signal of the I/O module: `io.<name>_bit` (-1 = not wired, else 0..max_bits-1) and
+// `io.<name>_active_low`; `get` finds the signal in a config.
+template <class Get>
+void io_signal(std::vector<Key>& v, const std::string& name, int max_bits, Get get) {
+  v.push_back(integer<int>("io." + name + "_bit", Klass::kMachine, -1, max_bits - 1,
+                           [get](LoomConfig& c) -> int& { return get(c).bit; }));
   v.push_back(boolean("io." + name + "_active_low", Klass::kMachine,
-                      [member](LoomConfig& c) -> bool& { return (c.io.wiring.*member).active_low; }));
+                      [get](LoomConfig& c) -> bool& { return get(c).active_low; }));
+}
+void io_input(std::vector<Key>& v, const std::string& name, drivers::IoBit drivers::IoWiring::*member) {
+  io_signal(v, name, drivers::kIoMaxInputBits, [member](LoomConfig& c) -> drivers::IoBit& { return c.io.wiring.*member; });
+}
+void io_output(std::vector<Key>& v, const std::string& name, drivers::IoBit drivers::IoWiring::*member) {
+  io_signal(v, name, drivers::kIoMaxOutputBits, [member](LoomConfig& c) -> drivers::IoBit& { return c.io.wiring.*member; });
+}
+// The second channel of safety sensor `i`: `io.<sensor>_2_bit`, `io.<sensor>_2_active_low`.
+void io_second_channel(std::vector<Key>& v, std::size_t i) {
+  io_signal(v, std::string(hal::safety_sensor_name(static_cast<hal::SafetySensor>(i))) + "_2", drivers::kIoMaxInputBits,
+            [i](LoomConfig& c) -> drivers::IoBit& { return c.io.wiring.second[i]; });
 }
 
 const char* branch_name(motion::Branch b) { return b == motion::Branch::kPositive ? "positive" : "negative"; }
@@ -280,23 +293,24 @@ const std::vector<Key>& keys() {
     v.push_back(integer<std::uint32_t>("io.boot_timeout_ms", M::kMachine, 10, 60000, [](LoomConfig& c) -> std::uint32_t& { return c.io.boot_timeout_ms; }));
     v.push_back(integer<std::uint32_t>("io.operational_timeout_ms", M::kMachine, 10, 60000, [](LoomConfig& c) -> std::uint32_t& { return c.io.operational_timeout_ms; }));
     using W = drivers::IoWiring;
-    io_signal(v, "piston_a_extended", &W::piston_a_extended);
-    io_signal(v, "piston_a_retracted", &W::piston_a_retracted);
-    io_signal(v, "piston_b_extended", &W::piston_b_extended);
-    io_signal(v, "piston_b_retracted", &W::piston_b_retracted);
-    io_signal(v, "shuttle_at_left", &W::shuttle_at_left);
-    io_signal(v, "shuttle_at_right", &W::shuttle_at_right);
-    io_signal(v, "estop_ok", &W::estop_ok);
-    io_signal(v, "button_start", &W::button_start);
-    io_signal(v, "button_pause", &W::button_pause);
-    io_signal(v, "button_ack", &W::button_ack);
-    io_signal(v, "row_knotted", &W::row_knotted);
-    io_signal(v, "piston_a_extend", &W::piston_a_extend);
-    io_signal(v, "piston_b_extend", &W::piston_b_extend);
-    io_signal(v, "lamp_green", &W::lamp_green);
-    io_signal(v, "lamp_amber", &W::lamp_amber);
-    io_signal(v, "lamp_red", &W::lamp_red);
-    io_signal(v, "buzzer", &W::buzzer);
+    io_input(v, "piston_a_extended", &W::piston_a_extended);
+    io_input(v, "piston_a_retracted", &W::piston_a_retracted);
+    io_input(v, "piston_b_extended", &W::piston_b_extended);
+    io_input(v, "piston_b_retracted", &W::piston_b_retracted);
+    io_input(v, "shuttle_at_left", &W::shuttle_at_left);
+    io_input(v, "shuttle_at_right", &W::shuttle_at_right);
+    io_input(v, "estop_ok", &W::estop_ok);
+    io_input(v, "button_start", &W::button_start);
+    io_input(v, "button_pause", &W::button_pause);
+    io_input(v, "button_ack", &W::button_ack);
+    io_input(v, "row_knotted", &W::row_knotted);
+    for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) io_second_channel(v, i);
+    io_output(v, "piston_a_extend", &W::piston_a_extend);
+    io_output(v, "piston_b_extend", &W::piston_b_extend);
+    io_output(v, "lamp_green", &W::lamp_green);
+    io_output(v, "lamp_amber", &W::lamp_amber);
+    io_output(v, "lamp_red", &W::lamp_red);
+    io_output(v, "buzzer", &W::buzzer);
     v.push_back(integer<int>("io.load_cell_channel", M::kMachine, 0, 254, [](LoomConfig& c) -> int& { return c.io.wiring.load_cell_channel; }));
     v.push_back(number("io.load_cell_n_per_count", M::kMachine, -1.0e3, 1.0e3, [](LoomConfig& c) -> double& { return c.io.wiring.load_cell_n_per_count; }));
     v.push_back(number("io.load_cell_offset_n", M::kMachine, -1.0e4, 1.0e4, [](LoomConfig& c) -> double& { return c.io.wiring.load_cell_offset_n; }));

@@ -27,6 +27,18 @@ const char* drive_state_name(DriveState s) {
   return "?";
 }
 
+const char* safety_sensor_name(SafetySensor s) {
+  switch (s) {
+    case SafetySensor::kPistonAExtended: return "piston_a_extended";
+    case SafetySensor::kPistonARetracted: return "piston_a_retracted";
+    case SafetySensor::kPistonBExtended: return "piston_b_extended";
+    case SafetySensor::kPistonBRetracted: return "piston_b_retracted";
+    case SafetySensor::kShuttleAtLeft: return "shuttle_at_left";
+    case SafetySensor::kShuttleAtRight: return "shuttle_at_right";
+  }
+  return "?";
+}
+
 const char* link_recovery_name(LinkRecovery r) {
   switch (r) {
     case LinkRecovery::kHealthy: return "healthy";

@@ -57,8 +57,10 @@ struct IoBit {
   bool active_low = false;  // the signal is true when the electrical bit is 0
 };
 
-// Inputs read from 0x6000:01..02 and outputs written to 0x6200:01..02 (16 bits each way).
-inline constexpr int kIoMaxBits = 16;
+// Inputs read from 0x6000:01..04 (32 bits) and outputs written to 0x6200:01..02 (16 bits); a wiring
+// uses as many 8-bit subs as its highest bit needs.
+inline constexpr int kIoMaxInputBits = 32;
+inline constexpr int kIoMaxOutputBits = 16;
 
 struct IoWiring {
   // Inputs (0x6000). The six sensors and the e-stop chain must be wired; buttons are optional.
@@ -73,6 +75,9 @@ struct IoWiring {
   IoBit button_pause{9};
   IoBit button_ack{10};
   IoBit row_knotted{11};
+  // Second channels of the six safety sensors (hal::SafetySensor order); −1 = the machine has none for
+  // that sensor (then a stuck switch there can only be caught by the sequencer's plausibility checks).
+  std::array<IoBit, hal::kSafetySensorCount> second{IoBit{16}, IoBit{17}, IoBit{18}, IoBit{19}, IoBit{20}, IoBit{21}};
   // Outputs (0x6200). Valves must be wired; the stack light and buzzer are optional.
   IoBit piston_a_extend{0};
   IoBit piston_b_extend{1};

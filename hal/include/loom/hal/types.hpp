@@ -83,6 +83,14 @@ struct DigitalOutputs {
   bool buzzer = false;
 };
 
+// The six safety sensors — the ones whose word lets a frame move or a pick start — in a fixed order
+// (debouncing, second channels, diagnostics).
+enum class SafetySensor : std::uint8_t {
+  kPistonAExtended, kPistonARetracted, kPistonBExtended, kPistonBRetracted, kShuttleAtLeft, kShuttleAtRight
+};
+inline constexpr std::size_t kSafetySensorCount = 6;
+const char* safety_sensor_name(SafetySensor s);  // "shuttle_at_right", as in the config's io keys
+
 struct DigitalInputs {
   bool piston_a_extended = false;  // end sensors (reed switches) of piston A
   bool piston_a_retracted = false;
@@ -97,8 +105,18 @@ struct DigitalInputs {
   bool button_pause = false;
   bool button_ack = false;         // reset / acknowledge a latched fault
   bool row_knotted = false;        // the weaver's "row knotted" pedal (knotting mode)
+  // Second channels of the safety sensors, in SafetySensor order: an independent switch at the same
+  // place on its own input, where the machine has one (io.<sensor>_2_bit). One stuck switch then cannot
+  // confirm a shed or an arrival that did not happen: the two must agree. False where not wired.
+  std::array<bool, kSafetySensorCount> second_channel{};
   Tick refreshed = kNeverTick;
 };
+
+// The primary channels of the safety sensors, in SafetySensor order.
+inline std::array<bool, kSafetySensorCount> safety_sensors(const DigitalInputs& io) {
+  return {io.piston_a_extended, io.piston_a_retracted, io.piston_b_extended,
+          io.piston_b_retracted, io.shuttle_at_left,    io.shuttle_at_right};
+}
 
 // ---------------------------------------------------------------------------------------------------
 // Analog inputs: the beater's load cell (force the comb exerts on the cloth fell), when fitted.
