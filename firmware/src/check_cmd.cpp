@@ -2,6 +2,7 @@
 // from the machine description, computed by the same code the loop and the CAN master use.
 #include "check_cmd.hpp"
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include "loom/drivers/bus_load.hpp"
 #include "loom/drivers/required_objects.hpp"
 #include "loom/firmware/config.hpp"
+#include "loom/firmware/scene_config.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/profile_set.hpp"
 #include "loom/sim_hal/effects.hpp"
@@ -20,6 +22,36 @@ namespace {
 void print_keys() {
   std::printf("%-36s %-8s %s\n", "key", "class", "range");
   for (const KeyInfo& k : config_keys()) std::printf("%-36s %-8s %s\n", k.path, k.klass, k.range.c_str());
+}
+
+// Which safety sensors have a second switch, where both are wired, and what a sensor without one
+// cannot catch.
+void print_safety_sensors(const LoomConfig& c) {
+  std::printf("\nsafety sensors\n");
+  const drivers::IoWiring& w = c.io.wiring;
+  const std::array<const drivers::IoBit*, hal::kSafetySensorCount> first{
+      &w.piston_a_extended, &w.piston_a_retracted, &w.piston_b_extended,
+      &w.piston_b_retracted, &w.shuttle_at_left,    &w.shuttle_at_right};
+  std::string dual, single;
+  for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) {
+    const std::string name = hal::safety_sensor_name(static_cast<hal::SafetySensor>(i));
+    if (c.sequencer.second_channel[i]) {
+      dual += "    " + name + ": inputs " + std::to_string(first[i]->bit) + " and " + std::to_string(w.second[i].bit) + "\n";
+    } else {
+      single += (single.empty() ? "" : ", ") + name;
+    }
+  }
+  if (!dual.empty()) {
+    std::printf("  two switches each, acted on only while both agree; apart longer than %.0f ms (after the %d-tick "
+                "debounce) is the fault sensor_discrepancy:\n%s",
+                c.sequencer.sensor_discrepancy_s * 1e3, c.sequencer.debounce_ticks, dual.c_str());
+  }
+  if (!single.empty()) {
+    std::printf("  WARNING single switch (io.<sensor>_2_bit = -1): %s. A stuck switch there that meets a second "
+                "fault (a shuttle slipped off its carrier, a piston seized mid-stroke) reads as the healthy machine "
+                "would: a frame can close on the shuttle or a pick run through a half-open shed.\n",
+                single.c_str());
+  }
 }
 
 void print_plan(const LoomConfig& c) {
@@ -74,6 +106,8 @@ void print_plan(const LoomConfig& c) {
               p.crank_sweep().duration());
   std::printf("  about %.2f s per row (%.0fx faster than ~300 s by hand)\n", row, 300.0 / row);
 
+  print_safety_sensors(c);
+
   std::printf("\nCAN (for --hal socketcan)\n");
   const drivers::BusLoad load = can_bus_load(c);  // the figure the CAN master checks when it configures
   std::printf("  nodes: beat crank %u, carriage %u, helix %u, I/O module %u (%s); controller heartbeat %s\n",
@@ -121,6 +155,7 @@ int run_check(const CheckArgs& a) {
       }
     }
     const LoomConfig c = config_path.empty() ? default_loom_config() : load_loom_config(config_path);
+    if (!a.scene.empty()) check_scene_fits(scene, c);
     print_plan(c);
     if (!a.scene.empty()) print_scene(scene);
     std::printf("\ncheck: OK — nothing was moved\n");

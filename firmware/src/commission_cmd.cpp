@@ -7,9 +7,13 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "loom/firmware/config.hpp"
 #include "loom/firmware/durable_file.hpp"
@@ -43,19 +47,6 @@ const Capture* capture_named(const std::string& n) {
   return nullptr;
 }
 
-std::string inputs_line(const hal::HalInputs& in) {
-  const hal::DigitalInputs& io = in.io;
-  char buf[512];
-  std::snprintf(buf, sizeof buf,
-                "inputs: piston_a_extended=%d piston_a_retracted=%d piston_b_extended=%d piston_b_retracted=%d "
-                "shuttle_at_left=%d shuttle_at_right=%d estop_ok=%d button_start=%d button_pause=%d button_ack=%d "
-                "row_knotted=%d load_cell=%s",
-                io.piston_a_extended, io.piston_a_retracted, io.piston_b_extended, io.piston_b_retracted,
-                io.shuttle_at_left, io.shuttle_at_right, io.estop_ok, io.button_start, io.button_pause, io.button_ack,
-                io.row_knotted, in.analog.beat_force_valid ? (std::to_string(in.analog.beat_force_n) + "N").c_str() : "-");
-  return buf;
-}
-
 std::string positions_line(const hal::HalInputs& in) {
   std::string s = "positions:";
   for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
@@ -68,25 +59,42 @@ std::string positions_line(const hal::HalInputs& in) {
   return s;
 }
 
+// The I/O module's inputs as wired: name and value, the safety sensors' second switches where fitted.
+std::vector<std::pair<std::string, bool>> named_inputs(const hal::DigitalInputs& io,
+                                                        const std::array<bool, hal::kSafetySensorCount>& second) {
+  std::vector<std::pair<std::string, bool>> v{{"piston_a_extended", io.piston_a_extended},
+                                              {"piston_a_retracted", io.piston_a_retracted},
+                                              {"piston_b_extended", io.piston_b_extended},
+                                              {"piston_b_retracted", io.piston_b_retracted},
+                                              {"shuttle_at_left", io.shuttle_at_left},
+                                              {"shuttle_at_right", io.shuttle_at_right}};
+  for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) {
+    if (second[i]) v.emplace_back(std::string(hal::safety_sensor_name(static_cast<hal::SafetySensor>(i))) + "_2",
+                                  io.second_channel[i]);
+  }
+  v.insert(v.end(), {{"estop_ok", io.estop_ok},
+                     {"button_start", io.button_start},
+                     {"button_pause", io.button_pause},
+                     {"button_ack", io.button_ack},
+                     {"row_knotted", io.row_knotted}});
+  return v;
+}
+
+std::string inputs_line(const hal::HalInputs& in, const std::array<bool, hal::kSafetySensorCount>& second) {
+  std::string s = "inputs:";
+  for (const auto& [name, on] : named_inputs(in.io, second)) s += " " + name + "=" + (on ? "1" : "0");
+  return s + " load_cell=" + (in.analog.beat_force_valid ? std::to_string(in.analog.beat_force_n) + "N" : "-");
+}
+
 // Every input whose value changed since the last call, one line each: wiring is checked by working
 // each sensor by hand and watching its line appear.
-void print_input_changes(const hal::DigitalInputs& now, hal::DigitalInputs& last) {
-  const struct {
-    const char* name;
-    bool hal::DigitalInputs::*field;
-  } kInputs[] = {{"piston_a_extended", &hal::DigitalInputs::piston_a_extended},
-                 {"piston_a_retracted", &hal::DigitalInputs::piston_a_retracted},
-                 {"piston_b_extended", &hal::DigitalInputs::piston_b_extended},
-                 {"piston_b_retracted", &hal::DigitalInputs::piston_b_retracted},
-                 {"shuttle_at_left", &hal::DigitalInputs::shuttle_at_left},
-                 {"shuttle_at_right", &hal::DigitalInputs::shuttle_at_right},
-                 {"estop_ok", &hal::DigitalInputs::estop_ok},
-                 {"button_start", &hal::DigitalInputs::button_start},
-                 {"button_pause", &hal::DigitalInputs::button_pause},
-                 {"button_ack", &hal::DigitalInputs::button_ack},
-                 {"row_knotted", &hal::DigitalInputs::row_knotted}};
-  for (const auto& in : kInputs) {
-    if (now.*in.field != last.*in.field) std::printf("input %s %d -> %d\n", in.name, last.*in.field, now.*in.field);
+void print_input_changes(const hal::DigitalInputs& now, hal::DigitalInputs& last,
+                         const std::array<bool, hal::kSafetySensorCount>& second) {
+  const auto was = named_inputs(last, second), is = named_inputs(now, second);
+  for (std::size_t i = 0; i < is.size(); ++i) {
+    if (is[i].second != was[i].second) {
+      std::printf("input %s %d -> %d\n", is[i].first.c_str(), was[i].second, is[i].second);
+    }
   }
   last = now;
 }
@@ -109,7 +117,7 @@ class Commissioning {
       return kExitNotArmed;
     }
     if (a_.io_once || !a_.capture.empty()) {
-      std::printf("%s\n%s\n", positions_line(loop_->inputs()).c_str(), inputs_line(loop_->inputs()).c_str());
+      std::printf("%s\n%s\n", positions_line(loop_->inputs()).c_str(), inputs_line(loop_->inputs(), cfg_.sequencer.second_channel).c_str());
       for (const std::string& c : a_.capture) take(*capture_named(c));
       return a_.write ? write() : kExitOk;
     }
@@ -169,7 +177,7 @@ class Commissioning {
   }
 
   int interactive() {
-    std::printf("%s\n%s\n", positions_line(loop_->inputs()).c_str(), inputs_line(loop_->inputs()).c_str());
+    std::printf("%s\n%s\n", positions_line(loop_->inputs()).c_str(), inputs_line(loop_->inputs(), cfg_.sequencer.second_channel).c_str());
     std::printf("drives disabled: move each axis by hand. Type park (crank at its park pose), home (carriage at the "
                 "left selvedge), left (helix carrier at the left selvedge), write, positions, io, or quit.\n");
     hal::DigitalInputs last = loop_->inputs().io;
@@ -177,7 +185,7 @@ class Commissioning {
     std::string pending;
     for (hal::Tick t = 0;; ++t) {
       tick(per_second / 10);
-      print_input_changes(loop_->inputs().io, last);
+      print_input_changes(loop_->inputs().io, last, cfg_.sequencer.second_channel);
       if (t % 10 == 9) std::printf("%s\n", positions_line(loop_->inputs()).c_str());
       std::fflush(stdout);
       pollfd p{STDIN_FILENO, POLLIN, 0};
@@ -196,7 +204,7 @@ class Commissioning {
         } else if (cmd == "positions") {
           std::printf("%s\n", positions_line(loop_->inputs()).c_str());
         } else if (cmd == "io") {
-          std::printf("%s\n", inputs_line(loop_->inputs()).c_str());
+          std::printf("%s\n", inputs_line(loop_->inputs(), cfg_.sequencer.second_channel).c_str());
         } else if (const Capture* c = capture_named(cmd)) {
           take(*c);
         } else if (!cmd.empty()) {

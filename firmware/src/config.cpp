@@ -365,6 +365,7 @@ const std::vector<Key>& keys() {
     v.push_back(number("timing.row_save_timeout_s", M::kRun, 0.1, 600.0, [](LoomConfig& c) -> double& { return c.run.row_save_timeout_s; }));
     v.push_back(millis("timing.stale_timeout_ms", M::kRun, 0.5, 10000.0, [](LoomConfig& c) -> double& { return c.run.stale_timeout_s; }));
     v.push_back(integer<int>("timing.debounce_ticks", M::kRun, 1, 100, [](LoomConfig& c) -> int& { return c.run.debounce_ticks; }));
+    v.push_back(millis("timing.sensor_discrepancy_ms", M::kRun, 1.0, 1000.0, [](LoomConfig& c) -> double& { return c.run.sensor_discrepancy_s; }));
     v.push_back(integer<std::uint32_t>("timing.overrun_stop_after", M::kRun, 0, 1'000'000,
                                        [](LoomConfig& c) -> std::uint32_t& { return c.run.overrun_stop_after; }));
     // [telemetry] (run)
@@ -578,6 +579,8 @@ void derive(LoomConfig& c, const Fail& fail) {
   s.picks_per_row = rc.picks_per_row;
   s.knotting = rc.knotting;
   s.debounce_ticks = c.run.debounce_ticks;
+  s.sensor_discrepancy_s = c.run.sensor_discrepancy_s;
+  for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) s.second_channel[i] = c.io.wiring.second[i].bit >= 0;
   s.enable_timeout_s = c.run.enable_timeout_s;
   s.pick_timeout_margin_s = c.run.pick_timeout_margin_s;
   s.row_save_timeout_s = c.run.row_save_timeout_s;
@@ -598,6 +601,7 @@ void derive(LoomConfig& c, const Fail& fail) {
   sm.piston_travel_s = m.shed.piston_travel_s;
   sm.beatup = m.beatup;
   sm.crank_park_position_rad = m.calibration.crank_park_position_rad;
+  sm.second_channel = s.second_channel;
 }
 
 // The derived motion must be buildable, fit the sequencer's fixed capacities and end in finite time.

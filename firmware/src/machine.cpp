@@ -13,6 +13,7 @@ namespace loom::firmware {
 
 Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions& opt, sequencer::Counters resume)
     : cfg_(cfg) {
+  check_scene_fits(scene, cfg_);
   slot_ = std::make_unique<motion::ProfileSlot>(std::make_unique<const motion::ProfileSet>(cfg_.profile));
   sequencer::SequencerConfig scfg = cfg_.sequencer;
   scfg.rows_to_weave = opt.rows;

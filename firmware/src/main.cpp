@@ -333,10 +333,13 @@ int weave(const WeaveArgs& a) {
     const std::string stopped = seq.stopped_by() == f ? std::string()
                                                         : std::string(" (motion stopped on ") +
                                                               sequencer::fault_name(seq.stopped_by()) + ")";
-    std::printf("FAULT %s (code 0x%04X%s%s, device code 0x%04X) at t=%.3f s%s: %s; rows completed %u, picks %u, "
+    const int sensor = seq.fault_sensor();
+    std::printf("FAULT %s (code 0x%04X%s%s%s%s, device code 0x%04X) at t=%.3f s%s: %s; rows completed %u, picks %u, "
                 "beats %u\n",
                 sequencer::fault_name(f), sequencer::fault_code(f), seq.fault_axis() >= 0 ? ", axis " : "",
                 seq.fault_axis() >= 0 ? hal::axis_name(static_cast<hal::Axis>(seq.fault_axis())) : "",
+                sensor >= 0 ? ", sensor " : "",
+                sensor >= 0 ? hal::safety_sensor_name(static_cast<hal::SafetySensor>(sensor)) : "",
                 seq.fault_detail(), secs(seq.fault_tick()), stopped.c_str(), sequencer::fault_text(f), c.rows,
                 c.picks, c.beats);
     if (f == sequencer::Fault::kCountersNotSaved && !counters_error.empty()) {

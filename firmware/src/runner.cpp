@@ -259,6 +259,7 @@ class LoopBody {
     e.stopped_by = seq_.stopped_by();
     e.fault_axis = seq_.fault_axis();
     e.fault_detail = seq_.fault_detail();
+    e.fault_sensor = seq_.fault_sensor();
     return e;
   }
 

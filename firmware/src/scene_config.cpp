@@ -144,9 +144,11 @@ void read_fault(const TomlReader& r, const toml::table& t, std::size_t n,
         }
       }
       if (!known) {
-        r.fail_at(v, field, shown(v),
-                  "must be a sensor: piston_a_extended, piston_a_retracted, piston_b_extended, "
-                  "piston_b_retracted, shuttle_at_left, shuttle_at_right");
+        std::string names;
+        for (int i = 0; i < sim_hal::kSensorCount; ++i) {
+          names += std::string(i == 0 ? "" : ", ") + sim_hal::sensor_name(static_cast<sim_hal::Sensor>(i));
+        }
+        r.fail_at(v, field, shown(v), "must be a sensor: " + names);
       }
     } else if (k == "value") {
       const auto x = v.value<bool>();
@@ -304,11 +306,26 @@ Scene parse_scene(const std::string& text, const std::string& source) {
         }
       }
       s.spec.faults.push_back(f);
+      s.fault_where.push_back(source + ":" + std::to_string(fn.source().begin.line) + ":" +
+                              std::to_string(fn.source().begin.column));
       ++n;
     }
   }
   r.reject_unknown();
   return s;
+}
+
+void check_scene_fits(const Scene& scene, const LoomConfig& cfg) {
+  for (std::size_t n = 0; n < scene.spec.faults.size(); ++n) {
+    const sim_hal::FaultInjection& f = scene.spec.faults[n];
+    if (f.kind != InjectedFault::kStuckSensor && f.kind != InjectedFault::kIntermittentSensor) continue;
+    const auto i = static_cast<std::size_t>(f.sensor);
+    if (i < hal::kSafetySensorCount || cfg.sequencer.second_channel[i - hal::kSafetySensorCount]) continue;
+    const std::string at = n < scene.fault_where.size() ? scene.fault_where[n] : scene.source;
+    throw ConfigError(at + ": fault[" + std::to_string(n) + "].sensor = \"" + sim_hal::sensor_name(f.sensor) +
+                      "\": the loom (" + cfg.source + ") has no second switch there (io." +
+                      sim_hal::sensor_name(f.sensor) + "_bit = -1)");
+  }
 }
 
 Scene load_scene(const std::string& path) { return parse_scene(read_text(path), path); }

@@ -69,6 +69,9 @@ std::string validate(const SequencerConfig& c, const motion::ProfileSet& p) {
   }
   if (c.picks_per_row < 1) return "recipe.picks_per_row must be at least 1";
   if (c.debounce_ticks < 1) return "timing.debounce_ticks must be at least 1";
+  if (!fin(c.sensor_discrepancy_s) || c.sensor_discrepancy_s < c.period_s || c.sensor_discrepancy_s > 1.0) {
+    return "timing.sensor_discrepancy_ms must be between one period and 1000 ms";
+  }
   const struct {
     const char* key;
     double v;
@@ -112,8 +115,13 @@ Sequencer::Sequencer(const motion::ProfileSet& profiles, const SequencerConfig& 
       cfg_(cfg),
       counters_(resume),
       sensors_(cfg.debounce_ticks),
+      second_channels_(cfg.debounce_ticks),
       buttons_(cfg.debounce_ticks) {
   if (const std::string why = validate(cfg_, *profiles_); !why.empty()) throw std::invalid_argument(why);
+  // Each channel is debounced first, so two healthy channels can be that many ticks apart: the
+  // discrepancy time is never shorter than the debounce plus one tick, whatever the period.
+  dual_ = DualChannelSensors(cfg_.second_channel, std::max(static_cast<int>(ticks(cfg_.sensor_discrepancy_s)),
+                                                           cfg_.debounce_ticks + 1));
   interlock_ctx_.warp = &profiles_->beatup().warp();
   interlock_ctx_.crank_park_position = cfg_.crank_park_position_rad;
   adopt_limits();
@@ -144,10 +152,11 @@ double Sequencer::commanded_rocker_angle() const noexcept {
   return profiles_->rocker().at(commanded_crank_phase()).value;
 }
 
-void Sequencer::latch(Fault f, hal::Tick now, int axis, std::uint16_t detail) noexcept {
+void Sequencer::latch(Fault f, hal::Tick now, int axis, std::uint16_t detail, int sensor) noexcept {
   if (first_fault_ == Fault::kNone) {
     first_fault_ = stopped_by_ = f;
     fault_axis_ = axis;
+    fault_sensor_ = sensor;
     fault_detail_ = detail;
     fault_tick_ = now;
   }
@@ -208,19 +217,29 @@ void Sequencer::step(hal::Tick now, const hal::HalInputs& raw, hal::HalOutputs& 
   out = cmd_;
 }
 
+namespace {
+void set_safety_sensors(hal::DigitalInputs& io, const DualChannelSensors::Channels& v) noexcept {
+  io.piston_a_extended = v[0];
+  io.piston_a_retracted = v[1];
+  io.piston_b_extended = v[2];
+  io.piston_b_retracted = v[3];
+  io.shuttle_at_left = v[4];
+  io.shuttle_at_right = v[5];
+}
+}  // namespace
+
 void Sequencer::sense(const hal::HalInputs& raw) noexcept {
   const hal::DigitalInputs& r = raw.io;
-  sensors_.update({r.piston_a_extended, r.piston_a_retracted, r.piston_b_extended, r.piston_b_retracted,
-                   r.shuttle_at_left, r.shuttle_at_right});
+  const DualChannelSensors::Channels first = hal::safety_sensors(r);
+  sensors_.update(first);
+  second_channels_.update(r.second_channel);
+  dual_.track(sensors_.values(), second_channels_.values());
   buttons_.update({r.button_start, r.button_pause, r.button_ack, r.row_knotted});
+  // Everything below acts on the sensors as both channels agree (dual_channel.hpp), raw and debounced.
   raw_io_ = r;
+  set_safety_sensors(raw_io_, dual_.agreed(first, r.second_channel));
   io_ = r;
-  io_.piston_a_extended = sensors_[0];
-  io_.piston_a_retracted = sensors_[1];
-  io_.piston_b_extended = sensors_[2];
-  io_.piston_b_retracted = sensors_[3];
-  io_.shuttle_at_left = sensors_[4];
-  io_.shuttle_at_right = sensors_[5];
+  set_safety_sensors(io_, dual_.agreed(sensors_.values(), second_channels_.values()));
   io_.button_start = buttons_[0];
   io_.button_pause = buttons_[1];
   io_.button_ack = buttons_[2];
@@ -309,6 +328,10 @@ bool Sequencer::check_faults(hal::Tick now, const hal::HalInputs& in) noexcept {
     return true;
   }
   // Sensor pictures that no machine state can produce (once the debouncer has some history).
+  if (const int sensor = dual_.discrepant(); sensor >= 0) {
+    latch(Fault::kSensorDiscrepancy, now, -1, 0, sensor);
+    return true;
+  }
   if (sensed_ticks_ > cfg_.debounce_ticks) {
     if ((io_.piston_a_extended && io_.piston_a_retracted) || (io_.piston_b_extended && io_.piston_b_retracted)) {
       latch(Fault::kShedSensorConflict, now);
@@ -566,7 +589,7 @@ void Sequencer::fault(hal::Tick now) noexcept {
   // Acknowledged: the drives get their fault-reset edge this tick, then the machine idles disabled and
   // re-arms from measured positions on the next start, proving the sensors again.
   first_fault_ = stopped_by_ = Fault::kNone;
-  fault_axis_ = -1;
+  fault_axis_ = fault_sensor_ = -1;
   fault_detail_ = 0;
   fault_tick_ = hal::kNeverTick;
   stop_now_requested_ = false;

@@ -29,6 +29,12 @@ const char* sensor_name(Sensor s) {
     case Sensor::kPistonBRetracted: return "piston_b_retracted";
     case Sensor::kShuttleLeft: return "shuttle_at_left";
     case Sensor::kShuttleRight: return "shuttle_at_right";
+    case Sensor::kPistonAExtended2: return "piston_a_extended_2";
+    case Sensor::kPistonARetracted2: return "piston_a_retracted_2";
+    case Sensor::kPistonBExtended2: return "piston_b_extended_2";
+    case Sensor::kPistonBRetracted2: return "piston_b_retracted_2";
+    case Sensor::kShuttleLeft2: return "shuttle_at_left_2";
+    case Sensor::kShuttleRight2: return "shuttle_at_right_2";
   }
   return "?";
 }
@@ -346,13 +352,20 @@ void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::Digit
   step_shuttle(pos(hal::Axis::kHelix));
   // The load cell rides the beater, which the crank drives: real (CAN) or simulated.
   if (scene_.beat_contact) step_beat_contact(pos(hal::Axis::kBeatCrank), vel(hal::Axis::kBeatCrank));
-  std::array<bool, 6> v{piston_[0] >= 1.0,
-                        piston_[0] <= 0.0,
-                        piston_[1] >= 1.0,
-                        piston_[1] <= 0.0,
-                        shuttle_x_ <= m_.selvedge_sensor_window_m,
-                        shuttle_x_ >= m_.width_m - m_.selvedge_sensor_window_m};
+  constexpr std::size_t n = hal::kSafetySensorCount;
+  const std::array<bool, n> truth{piston_[0] >= 1.0,
+                                  piston_[0] <= 0.0,
+                                  piston_[1] >= 1.0,
+                                  piston_[1] <= 0.0,
+                                  shuttle_x_ <= m_.selvedge_sensor_window_m,
+                                  shuttle_x_ >= m_.width_m - m_.selvedge_sensor_window_m};
+  // Each switch (first channels 0..5, second channels 6..11) sees the truth, then its own faults, then
+  // its own bounce. A second switch the machine does not have reads false and draws no noise.
+  std::array<bool, kSensorCount> v{};
   for (std::size_t i = 0; i < v.size(); ++i) {
+    const bool fitted = i < n || m_.second_channel[i - n];
+    if (!fitted) continue;
+    v[i] = truth[i % n];
     if (stuck_sensor_[i]) v[i] = *stuck_sensor_[i];
     if (scene_.sensor_noise && rng_.uniform() < scene_.sensor_noise->flip_probability) v[i] = !v[i];
   }
@@ -362,6 +375,7 @@ void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::Digit
   io.piston_b_retracted = v[3];
   io.shuttle_at_left = v[4];
   io.shuttle_at_right = v[5];
+  for (std::size_t i = 0; i < n; ++i) io.second_channel[i] = v[n + i];
   io.estop_ok = estop_ok_;
   io.refreshed = now;
 }

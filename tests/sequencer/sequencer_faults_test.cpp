@@ -170,3 +170,96 @@ TEST(SequencerFaults, BeatsPerRowBeyondCapacityAreRefusedAtConfiguration) {
   nan_park.crank_park_position_rad = std::nan("");
   EXPECT_NE(sequencer::validate(nan_park, motion::ProfileSet(motion::ProfileSpec{})), "");
 }
+
+// ---- Dual-channel safety sensors (dual_channel.hpp) ----------------------------------------------
+
+TEST(DualChannelSensors, ASensorIsOnOnlyWhileBothChannelsSayOnWhereASecondIsWired) {
+  sequencer::DualChannelSensors d({true, true, true, true, false, true}, 10);
+  const auto v = d.agreed({true, true, false, false, true, true}, {true, false, true, false, false, false});
+  EXPECT_TRUE(v[0]);   // both on
+  EXPECT_FALSE(v[1]);  // second off: not confirmed
+  EXPECT_FALSE(v[2]);  // first off: not confirmed, whatever the second says
+  EXPECT_FALSE(v[3]);
+  EXPECT_TRUE(v[4]);   // no second channel: the first alone
+  EXPECT_FALSE(v[5]);
+}
+
+TEST(DualChannelSensors, ADisagreementIsAFaultOnlyOnceItLastsTheDiscrepancyTime) {
+  sequencer::DualChannelSensors d({true, true, true, true, true, false}, 4);
+  const sequencer::DualChannelSensors::Channels first{false, false, false, false, true, true};
+  sequencer::DualChannelSensors::Channels second{false, false, false, false, false, false};
+  for (int i = 0; i < 3; ++i) {
+    d.track(first, second);
+    EXPECT_EQ(d.discrepant(), -1) << "tick " << i;
+  }
+  d.track(first, {false, false, false, false, true, false});  // the channels agree again: the count restarts
+  for (int i = 0; i < 3; ++i) d.track(first, second);
+  EXPECT_EQ(d.discrepant(), -1);
+  d.track(first, second);
+  EXPECT_EQ(d.discrepant(), static_cast<int>(hal::SafetySensor::kShuttleAtLeft));
+  // Sensor 5 has no second channel: its "disagreement" is never counted.
+  sequencer::DualChannelSensors unwired({false, false, false, false, false, false}, 1);
+  for (int i = 0; i < 5; ++i) unwired.track(first, second);
+  EXPECT_EQ(unwired.discrepant(), -1);
+}
+
+namespace {
+// The rig with second switches on all six safety sensors, in the simulator and the sequencer.
+void fit_second_channels(Rig& r, sim_hal::SimMachine& m) {
+  r.cfg.second_channel.fill(true);
+  m.second_channel.fill(true);
+}
+void build_dual(Rig& r, std::uint32_t rows) {
+  sim_hal::SimMachine m;
+  fit_second_channels(r, m);
+  r.cfg.rows_to_weave = rows;
+  r.world = std::make_unique<sim_hal::SimWorld>(m, r.scene);
+  r.seq = std::make_unique<sequencer::Sequencer>(r.profiles, r.cfg);
+  r.seq->request_start();
+}
+}  // namespace
+
+TEST(SequencerFaults, HealthySecondChannelsAgreeAndTheLoomWeavesEvenWithBounce) {
+  Rig r;
+  r.scene.effects = {sim_hal::kEffectIdeal, sim_hal::kEffectSensorNoise};
+  r.scene.sensor_noise = sim_hal::SensorNoise{0.01};
+  build_dual(r, 2);
+  r.run(60000, [&] { return r.seq->finished(); });
+  EXPECT_EQ(r.seq->state(), State::kDone) << sequencer::fault_name(r.seq->first_fault());
+  EXPECT_EQ(r.seq->counters().rows, 2u);
+}
+
+TEST(SequencerFaults, AFirstChannelThatSaysArrivedAloneConfirmsNothingAndIsADiscrepancy) {
+  // The arrival switch at the right (first channel) claims the shuttle from the first tick of the first
+  // pick on, while the shuttle is still at the left and the second switch says so: no pick may be
+  // counted on its word, and the disagreement is the fault sensor_discrepancy naming shuttle_at_right.
+  Rig r;
+  hal::Tick lies_from = -1;
+  r.tamper = [&](hal::Tick t, hal::HalInputs& in) {
+    if (lies_from < 0 && r.seq && r.seq->state() == State::kPick) lies_from = t;
+    if (lies_from >= 0) in.io.shuttle_at_right = true;
+  };
+  build_dual(r, 2);
+  r.run(20000, [&] { return r.seq->state() == State::kFault; });
+  ASSERT_GE(lies_from, 0) << "the loom never reached its first pick";
+  EXPECT_EQ(r.seq->first_fault(), Fault::kSensorDiscrepancy) << sequencer::fault_name(r.seq->first_fault());
+  EXPECT_EQ(r.seq->fault_sensor(), static_cast<int>(hal::SafetySensor::kShuttleAtRight));
+  EXPECT_EQ(r.seq->counters().picks, 0u);
+  // Debounce (3 ticks) + discrepancy time (20 ms = 10 ticks at 2 ms): found within 13 ticks.
+  EXPECT_GE(r.seq->fault_tick(), lies_from);
+  EXPECT_LE(r.seq->fault_tick(), lies_from + 13);
+}
+
+TEST(SequencerFaults, ASecondChannelThatNeverSwitchesIsFoundAtTheFirstStroke) {
+  // The second switch of piston A's extended end is dead (reads off for ever): the first stroke that
+  // extends A shows the two channels apart, and the shed is never confirmed on the first alone.
+  Rig r;
+  r.tamper = [](hal::Tick, hal::HalInputs& in) {
+    in.io.second_channel[static_cast<std::size_t>(hal::SafetySensor::kPistonAExtended)] = false;
+  };
+  build_dual(r, 2);
+  r.run(20000, [&] { return r.seq->state() == State::kFault; });
+  EXPECT_EQ(r.seq->first_fault(), Fault::kSensorDiscrepancy) << sequencer::fault_name(r.seq->first_fault());
+  EXPECT_EQ(r.seq->fault_sensor(), static_cast<int>(hal::SafetySensor::kPistonAExtended));
+  EXPECT_EQ(r.seq->counters().picks, 0u);
+}

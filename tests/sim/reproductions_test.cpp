@@ -72,11 +72,22 @@ kind = "stuck_sensor"
 sensor = "piston_a_extended"
 value = true
 )", "stuck.toml");
-  const Outcome r = weave(firmware::default_loom_config(), scene, "", {}, 3, 100000, never);
-  EXPECT_EQ(r.state, State::kFault);
-  EXPECT_EQ(r.first_fault, Fault::kShedNotReleased) << sequencer::fault_name(r.first_fault);
-  EXPECT_FALSE(r.helix_moved);
-  EXPECT_EQ(r.counters.picks, 0u);
+  // With the default loom's second switch beside it, the stuck switch disagrees with its partner; on a
+  // loom without second switches the shed monitor sees piston A never leave its retracted end.
+  firmware::LoomConfig single = firmware::default_loom_config();
+  for (auto& b : single.io.wiring.second) b.bit = -1;
+  firmware::rederive_and_check(single, "single-channel variant");
+  const struct {
+    firmware::LoomConfig cfg;
+    Fault expected;
+  } looms[] = {{firmware::default_loom_config(), Fault::kSensorDiscrepancy}, {single, Fault::kShedNotReleased}};
+  for (const auto& loom : looms) {
+    const Outcome r = weave(loom.cfg, scene, "", {}, 3, 100000, never);
+    EXPECT_EQ(r.state, State::kFault);
+    EXPECT_EQ(r.first_fault, loom.expected) << sequencer::fault_name(r.first_fault);
+    EXPECT_FALSE(r.helix_moved);
+    EXPECT_EQ(r.counters.picks, 0u);
+  }
 }
 
 TEST(Reproductions, RestartWithResetCountersIsRefusedNotBeatenWithoutWeft) {

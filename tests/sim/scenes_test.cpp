@@ -23,17 +23,22 @@ struct Outcome {
   bool moved_after_fault = false;
 };
 
-// `period_ms` 0: the default loop period.
-Outcome run_scene(const std::string& name, std::uint32_t rows, double period_ms = 0.0) {
+enum class Sensing { kDualChannel, kSingleChannel };
+
+// `period_ms` 0: the default loop period. kSingleChannel: the default loom without the safety sensors'
+// second switches (io.<sensor>_2_bit = -1), so only the sequencer's plausibility checks stand guard.
+Outcome run_scene(const std::string& name, std::uint32_t rows, double period_ms = 0.0,
+                  Sensing sensing = Sensing::kDualChannel) {
   const firmware::Scene scene = firmware::load_scene(std::string(LOOM_SOURCE_DIR) + "/sim_hal/scenes/" + name + ".toml");
   firmware::MachineOptions opt;
   opt.telemetry = false;
   opt.rows = rows;
   firmware::LoomConfig cfg = firmware::default_loom_config();
-  if (period_ms > 0.0) {
-    cfg.run.period_s = period_ms * 1e-3;
-    firmware::rederive_and_check(cfg, "test period");
+  if (period_ms > 0.0) cfg.run.period_s = period_ms * 1e-3;
+  if (sensing == Sensing::kSingleChannel) {
+    for (auto& b : cfg.io.wiring.second) b.bit = -1;
   }
+  if (period_ms > 0.0 || sensing == Sensing::kSingleChannel) firmware::rederive_and_check(cfg, "test variant");
   firmware::Machine m(cfg, scene, opt, {});
   Outcome o;
   m.sim().on_power_cut([](void* cut) { *static_cast<bool*>(cut) = true; }, &o.power_cut);
@@ -120,38 +125,47 @@ TEST_P(LoopPeriods, ShuttleChecksHoldAtThisPeriod) {
 INSTANTIATE_TEST_SUITE_P(AllowedRange, LoopPeriods, ::testing::Values(2.0, 5.0, 10.0, 10.8),
                          [](const auto& period) { return std::to_string(static_cast<int>(period.param * 100)) + "0us"; });
 
+// Each fault scene on the default loom (dual-channel safety sensors) and on the same loom with single-
+// channel sensors: a stuck switch is a sensor_discrepancy with a second switch beside it, and is caught
+// by the plausibility checks (its own named fault) without one.
 struct FaultCase {
   const char* scene;
   Fault expected;
+  Fault single_channel;
 };
 
 class FaultScenes : public ::testing::TestWithParam<FaultCase> {};
 
 TEST_P(FaultScenes, EndInASafeStopWithTheExpectedFirstFault) {
-  const Outcome o = run_scene(GetParam().scene, 5);
-  EXPECT_EQ(o.state, State::kFault);
-  EXPECT_EQ(o.first_fault, GetParam().expected) << sequencer::fault_name(o.first_fault);
-  EXPECT_FALSE(o.moved_after_fault);
-  EXPECT_LT(o.counters.rows, 5u);
+  for (const Sensing sensing : {Sensing::kDualChannel, Sensing::kSingleChannel}) {
+    const bool dual = sensing == Sensing::kDualChannel;
+    const Outcome o = run_scene(GetParam().scene, 5, 0.0, sensing);
+    const Fault expected = dual ? GetParam().expected : GetParam().single_channel;
+    const char* loom = dual ? "dual-channel sensors" : "single-channel sensors";
+    EXPECT_EQ(o.state, State::kFault) << loom;
+    EXPECT_EQ(o.first_fault, expected) << loom << ": " << sequencer::fault_name(o.first_fault);
+    EXPECT_FALSE(o.moved_after_fault) << loom;
+    EXPECT_LT(o.counters.rows, 5u) << loom;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Shipped, FaultScenes,
-                         ::testing::Values(FaultCase{"drive_fault", Fault::kDriveFault},
-                                           FaultCase{"stuck_piston", Fault::kShedNotReleased},
-                                           FaultCase{"shuttle_slip", Fault::kShuttleSlipped},
-                                           FaultCase{"stuck_sensor", Fault::kShuttleLost},
-                                           FaultCase{"estop", Fault::kEStop},
-                                           FaultCase{"stuck_end_sensor", Fault::kShedNotReleased},
-                                           FaultCase{"can_frame_loss", Fault::kStaleFeedback},
-                                           FaultCase{"can_latency", Fault::kStaleFeedback},
-                                           FaultCase{"bus_off", Fault::kLinkFault},
-                                           FaultCase{"heartbeat_loss", Fault::kHeartbeatLost},
-                                           FaultCase{"emcy", Fault::kDriveEmcy},
-                                           FaultCase{"intermittent_sensor", Fault::kShedSensorConflict},
-                                           FaultCase{"encoder_glitch", Fault::kEncoderJump},
-                                           FaultCase{"load_cell", Fault::kLoadCellFault},
-                                           FaultCase{"air_loss", Fault::kAirLost},
-                                           FaultCase{"loop_stall", Fault::kLoopStall}),
+                         ::testing::Values(FaultCase{"drive_fault", Fault::kDriveFault, Fault::kDriveFault},
+                                           FaultCase{"stuck_piston", Fault::kShedNotReleased, Fault::kShedNotReleased},
+                                           FaultCase{"shuttle_slip", Fault::kShuttleSlipped, Fault::kShuttleSlipped},
+                                           FaultCase{"stuck_sensor", Fault::kSensorDiscrepancy, Fault::kShuttleLost},
+                                           FaultCase{"estop", Fault::kEStop, Fault::kEStop},
+                                           FaultCase{"stuck_end_sensor", Fault::kSensorDiscrepancy, Fault::kShedNotReleased},
+                                           FaultCase{"can_frame_loss", Fault::kStaleFeedback, Fault::kStaleFeedback},
+                                           FaultCase{"can_latency", Fault::kStaleFeedback, Fault::kStaleFeedback},
+                                           FaultCase{"bus_off", Fault::kLinkFault, Fault::kLinkFault},
+                                           FaultCase{"heartbeat_loss", Fault::kHeartbeatLost, Fault::kHeartbeatLost},
+                                           FaultCase{"emcy", Fault::kDriveEmcy, Fault::kDriveEmcy},
+                                           FaultCase{"intermittent_sensor", Fault::kSensorDiscrepancy, Fault::kShedSensorConflict},
+                                           FaultCase{"encoder_glitch", Fault::kEncoderJump, Fault::kEncoderJump},
+                                           FaultCase{"load_cell", Fault::kLoadCellFault, Fault::kLoadCellFault},
+                                           FaultCase{"air_loss", Fault::kAirLost, Fault::kAirLost},
+                                           FaultCase{"loop_stall", Fault::kLoopStall, Fault::kLoopStall}),
                          [](const auto& param_info) { return std::string(param_info.param.scene); });
 
 TEST(Scenes, SensorNoiseIsDebouncedAwayAndTheRunIsDeterministic) {

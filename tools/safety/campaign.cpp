@@ -26,14 +26,34 @@ void ensure_effect(sim_hal::SceneSpec& s, const char* effect) {
   if (std::find(s.effects.begin(), s.effects.end(), effect) == s.effects.end()) s.effects.push_back(effect);
 }
 
-sim_hal::FaultInjection random_fault(std::mt19937_64& rng, sim_hal::SceneSpec& s, std::ostringstream& d) {
+// A switch the machine has, drawn from `first` (first-channel sensors, SafetySensor order) and their
+// second channels where fitted; uniform over the candidates.
+sim_hal::Sensor random_switch(std::mt19937_64& rng, std::initializer_list<hal::SafetySensor> first,
+                              const std::array<bool, hal::kSafetySensorCount>& second_channel) {
+  std::array<sim_hal::Sensor, sim_hal::kSensorCount> candidates{};
+  std::size_t n = 0;
+  for (const hal::SafetySensor f : first) {
+    const auto i = static_cast<std::size_t>(f);
+    candidates[n++] = static_cast<sim_hal::Sensor>(i);
+    if (second_channel[i]) candidates[n++] = static_cast<sim_hal::Sensor>(hal::kSafetySensorCount + i);
+  }
+  return candidates[std::uniform_int_distribution<std::size_t>(0, n - 1)(rng)];
+}
+
+constexpr std::initializer_list<hal::SafetySensor> kAllSensors = {
+    hal::SafetySensor::kPistonAExtended, hal::SafetySensor::kPistonARetracted, hal::SafetySensor::kPistonBExtended,
+    hal::SafetySensor::kPistonBRetracted, hal::SafetySensor::kShuttleAtLeft,   hal::SafetySensor::kShuttleAtRight};
+
+sim_hal::FaultInjection random_fault(std::mt19937_64& rng, sim_hal::SceneSpec& s,
+                                     const std::array<bool, hal::kSafetySensorCount>& second_channel,
+                                     std::ostringstream& d) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   sim_hal::FaultInjection f;
   f.kind = static_cast<InjectedFault>(static_cast<int>(u(rng) * sim_hal::kInjectedFaultCount));
   f.at_s = 16.0 * u(rng);
   f.axis = static_cast<hal::Axis>(static_cast<int>(u(rng) * 3));
   f.piston = u(rng) < 0.5 ? 0 : 1;
-  f.sensor = static_cast<sim_hal::Sensor>(static_cast<int>(u(rng) * sim_hal::kSensorCount));
+  f.sensor = random_switch(rng, kAllSensors, second_channel);
   f.stuck_value = u(rng) < 0.5;
   switch (f.kind) {
     case InjectedFault::kIntermittentSensor: f.duration_s = 0.002 + 0.5 * u(rng); break;
@@ -79,7 +99,9 @@ bool shed_open(const std::array<double, 2>& p) {
 
 }  // namespace
 
-sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run, std::string& description) {
+sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run,
+                                const std::array<bool, hal::kSafetySensorCount>& second_channel,
+                                std::string& description) {
   std::mt19937_64 rng(mix(seed ^ mix(run)));
   std::uniform_real_distribution<double> u(0.0, 1.0);
   sim_hal::SceneSpec s;
@@ -128,7 +150,7 @@ sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run, std::stri
     sim_hal::FaultInjection f;
     f.kind = InjectedFault::kStuckSensor;
     f.at_s = 16.0 * u(rng);
-    f.sensor = u(rng) < 0.5 ? sim_hal::Sensor::kShuttleLeft : sim_hal::Sensor::kShuttleRight;
+    f.sensor = random_switch(rng, {hal::SafetySensor::kShuttleAtLeft, hal::SafetySensor::kShuttleAtRight}, second_channel);
     f.stuck_value = true;
     s.faults.push_back(f);
     d << "slip + stuck " << sim_hal::sensor_name(f.sensor) << " at " << f.at_s << " s";
@@ -137,14 +159,17 @@ sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run, std::stri
     sim_hal::FaultInjection f;
     f.kind = InjectedFault::kStuckSensor;
     f.at_s = (u(rng) < 0.5 ? 2.0 : 16.0) * u(rng);
-    f.sensor = static_cast<sim_hal::Sensor>(static_cast<int>(u(rng) * 4));
+    f.sensor = random_switch(rng,
+                             {hal::SafetySensor::kPistonAExtended, hal::SafetySensor::kPistonARetracted,
+                              hal::SafetySensor::kPistonBExtended, hal::SafetySensor::kPistonBRetracted},
+                             second_channel);
     f.stuck_value = u(rng) < 0.7;
     s.faults.push_back(f);
     d << "stuck " << sim_hal::sensor_name(f.sensor) << " = " << f.stuck_value << " at " << f.at_s << " s";
   } else {
     const double n = u(rng);
     const int count = n < 0.15 ? 0 : n < 0.8 ? 1 : 2;
-    for (int i = 0; i < count; ++i) s.faults.push_back(random_fault(rng, s, d));
+    for (int i = 0; i < count; ++i) s.faults.push_back(random_fault(rng, s, second_channel, d));
     // One power cut per scene.
     if (count == 2 && s.faults[0].kind == InjectedFault::kPowerCut && s.faults[1].kind == InjectedFault::kPowerCut) {
       s.faults.pop_back();
@@ -214,11 +239,15 @@ RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& sp
   o.faulted = m.sequencer().state() == sequencer::State::kFault;
   o.completed = m.sequencer().state() == sequencer::State::kDone;
   o.first_fault = sequencer::fault_name(m.sequencer().first_fault());
+  if (const int sensor = m.sequencer().fault_sensor(); sensor >= 0) {
+    o.fault_sensor = hal::safety_sensor_name(static_cast<hal::SafetySensor>(sensor));
+  }
   return o;
 }
 
 CampaignResult run_campaign(const CampaignOptions& opt) {
-  const firmware::LoomConfig cfg = firmware::default_loom_config();
+  const firmware::LoomConfig cfg =
+      opt.config_path.empty() ? firmware::default_loom_config() : firmware::load_loom_config(opt.config_path);
   std::atomic<std::uint64_t> next{0};
   std::mutex mu;
   CampaignResult result;
@@ -229,14 +258,14 @@ CampaignResult run_campaign(const CampaignOptions& opt) {
       const std::uint64_t run = next.fetch_add(1);
       if (run >= opt.runs) return;
       std::string description;
-      const sim_hal::SceneSpec scene = random_scene(opt.seed, run, description);
+      const sim_hal::SceneSpec scene = random_scene(opt.seed, run, local.sequencer.second_channel, description);
       const RunOutcome o = run_one(local, scene, opt.rows);
       const std::lock_guard<std::mutex> lock(mu);
       ++result.runs;
       result.faulted += o.faulted;
       result.completed += o.completed;
       result.power_cuts += o.power_cut;
-      if (o.violated) result.violations.push_back({run, description, o.what, firmware::scene_to_toml(scene)});
+      if (o.violated) result.violations.push_back({run, description, o.what, firmware::scene_to_toml(scene, opt.config_path)});
       if (opt.on_run) opt.on_run(result, o.violated ? &result.violations.back() : nullptr);
     }
   };

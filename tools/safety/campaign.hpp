@@ -11,6 +11,7 @@
 // catch a warp thread. Each run is deterministic for (campaign seed, run index), whatever the threads.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -28,10 +29,15 @@ struct RunOutcome {
   bool completed = false;
   bool power_cut = false;
   std::string first_fault;
+  std::string fault_sensor;  // the safety sensor the first fault names (sensor_discrepancy), or ""
 };
 
-// The scene of run `run` of the campaign seeded `seed`, and a one-line description of it.
-sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run, std::string& description);
+// The scene of run `run` of the campaign seeded `seed`, and a one-line description of it. Faults go
+// into every switch the machine has: the six safety sensors' first channels, and their second channels
+// where `second_channel` says the machine has one.
+sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run,
+                                const std::array<bool, hal::kSafetySensorCount>& second_channel,
+                                std::string& description);
 
 // Weave `rows` rows of `scene` on `cfg` and check the true state every tick.
 RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& scene, std::uint32_t rows);
@@ -46,6 +52,7 @@ struct CampaignOptions {
   std::uint64_t seed = 1;
   int threads = 1;
   std::uint32_t rows = 2;
+  std::string config_path;  // the loom description the runs weave on ("" = the embedded default loom)
   const std::atomic<bool>* stop = nullptr;  // set asynchronously: finish the runs in progress and return
   // Called (serialised) after each run with the totals so far and the run's violation, if any.
   std::function<void(const struct CampaignResult&, const struct Violation*)> on_run;

@@ -28,6 +28,9 @@ int main(int argc, char** argv) {
   app.add_option("--threads", opt.threads, "worker threads")->check(CLI::Range(1, 256));
   app.add_option("--rows", opt.rows, "rows woven per run")->check(CLI::Range(1u, 100u));
   app.add_option("--out", out, "directory for the scene files of violating runs");
+  app.add_option("--config", opt.config_path,
+                 "the loom description to weave on (default: the embedded default loom); e.g. one whose "
+                 "io.<sensor>_2_bit = -1 has single-channel safety sensors");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -39,9 +42,11 @@ int main(int argc, char** argv) {
   if (!seed_given) {
     opt.seed = static_cast<std::uint64_t>(std::chrono::system_clock::now().time_since_epoch().count()) % 1'000'000'007ull;
   }
-  std::printf("loom-safety: seed %llu, %llu runs of %u rows, %d threads (replay this campaign with --seed %llu)\n",
+  if (!opt.config_path.empty()) opt.config_path = std::filesystem::absolute(opt.config_path).string();
+  std::printf("loom-safety: seed %llu, %llu runs of %u rows, %d threads, loom %s (replay this campaign with --seed %llu)\n",
               static_cast<unsigned long long>(opt.seed), static_cast<unsigned long long>(opt.runs), opt.rows,
-              opt.threads, static_cast<unsigned long long>(opt.seed));
+              opt.threads, opt.config_path.empty() ? "embedded default" : opt.config_path.c_str(),
+              static_cast<unsigned long long>(opt.seed));
   std::fflush(stdout);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);

@@ -272,6 +272,9 @@ int serve_main(const ServeArgs& a) {
           r.picks = e.counters.picks;
           r.beats = e.counters.beats;
           r.text = sequencer::fault_text(f);
+          if (!overrun && e.fault_sensor >= 0) {
+            r.text += std::string(": ") + hal::safety_sensor_name(static_cast<hal::SafetySensor>(e.fault_sensor));
+          }
           if (!overrun && e.stopped_by != e.fault) r.text += std::string(" (motion stopped on ") +
                                                             sequencer::fault_name(e.stopped_by) + ")";
           log(Severity::kErr, "FAULT %s (0x%04X)%s%s: %s; rows %u, picks %u — acknowledge with ctl ack or the ack "

@@ -124,6 +124,7 @@ struct RunSettings {
   double stale_timeout_s = 0.05;
   double row_save_timeout_s = 5.0;  // a finished row's counters not confirmed on disk by then: a fault
   int debounce_ticks = 3;
+  double sensor_discrepancy_s = 0.02;  // the two channels of a safety sensor may disagree this long
   std::uint32_t overrun_stop_after = 10;  // on hardware: this many overruns in a row → safe stop (0 = never)
 };
 

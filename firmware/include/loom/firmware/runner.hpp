@@ -95,6 +95,7 @@ struct RunEvent {
   sequencer::Fault stopped_by = sequencer::Fault::kNone;
   int fault_axis = -1;
   std::uint16_t fault_detail = 0;
+  int fault_sensor = -1;  // hal::SafetySensor the fault names (sensor_discrepancy), or -1
 };
 // Run events waiting for the reporter. An event is at most one per row, pick, pause, resume or fault,
 // and a pick is never shorter than a shed change (hundreds of ms), so 1024 pending events cover a

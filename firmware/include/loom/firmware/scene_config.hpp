@@ -6,6 +6,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "loom/sim_hal/scene.hpp"
 
@@ -15,7 +16,14 @@ struct Scene {
   std::string source = "<embedded default scene>";
   sim_hal::SceneSpec spec;
   std::string config_path;  // loom config named by the scene ("" = embedded default)
+  std::vector<std::string> fault_where;  // "file:line:col" of each [[fault]] (spec.faults order)
 };
+
+struct LoomConfig;
+// Configure-time. A scene is written for a machine; faults it injects into switches the loom does
+// not have (a second channel its wiring leaves at -1) are refused, naming the fault's file:line:col.
+// Throws ConfigError.
+void check_scene_fits(const Scene& scene, const LoomConfig& cfg);
 
 // Parse a scene from TOML text; `source` names it in errors. Throws ConfigError.
 Scene parse_scene(const std::string& text, const std::string& source);

@@ -38,7 +38,8 @@ namespace loom::sequencer {
   X(kShuttleSlipped, 0x101C, "shuttle_slipped", "the shuttle did not leave or arrive with its carrier (slipped off the magnet)") \
   X(kShedSensorLate, 0x101D, "shed_sensor_late", "a heald frame took far longer than its learned stroke (stuck on its way)") \
   X(kLoopOverrun, 0x101E, "loop_overrun", "the control loop missed its deadline too many ticks in a row") \
-  X(kCountersNotSaved, 0x101F, "counters_not_saved", "the production counters of a finished row could not be saved")
+  X(kCountersNotSaved, 0x101F, "counters_not_saved", "the production counters of a finished row could not be saved") \
+  X(kSensorDiscrepancy, 0x1020, "sensor_discrepancy", "the two channels of a safety sensor disagree (a stuck switch or a wiring fault)")
 
 enum class Fault : std::uint8_t {
 #define LOOM_FAULT_ENUM(id, code, name, text) id,

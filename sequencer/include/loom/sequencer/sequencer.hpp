@@ -12,6 +12,7 @@
 #include "loom/motion/profile_set.hpp"
 #include "loom/motion/profile_slot.hpp"
 #include "loom/sequencer/debounce.hpp"
+#include "loom/sequencer/dual_channel.hpp"
 #include "loom/sequencer/faults.hpp"
 #include "loom/sequencer/interlocks.hpp"
 #include "loom/sequencer/row_stats.hpp"
@@ -58,6 +59,11 @@ struct SequencerConfig {
   std::uint32_t rows_to_weave = 3;       // 0 = weave until stopped (absolute row count to reach)
   std::uint32_t picks_per_row = 1;       // weft picks (each with its own shed change) before the beat sweep
   int debounce_ticks = 3;                // a sensor must read the same this many ticks to count (not e-stop)
+  // Which safety sensors have a second channel (hal::SafetySensor order; see dual_channel.hpp), and how
+  // long (after each channel's debounce) the two may disagree before that is the fault sensor_discrepancy
+  // (never less than debounce_ticks + 1 ticks).
+  std::array<bool, hal::kSafetySensorCount> second_channel{};
+  double sensor_discrepancy_s = 0.02;
   double enable_timeout_s = 2.0;
   double pick_timeout_margin_s = 0.5;    // beyond the planned pick duration
   double stale_timeout_s = 0.05;         // feedback older than this is a fault
@@ -143,6 +149,8 @@ class Sequencer {
   Fault stopped_by() const noexcept { return stopped_by_; }
   int fault_axis() const noexcept { return fault_axis_; }              // -1 when not axis-specific
   std::uint16_t fault_detail() const noexcept { return fault_detail_; }  // device code (EMCY) if any
+  // The safety sensor (hal::SafetySensor) the first fault is about, or -1 (sensor_discrepancy names one).
+  int fault_sensor() const noexcept { return fault_sensor_; }
   hal::Tick fault_tick() const noexcept { return fault_tick_; }
   const RowStats& last_row() const noexcept { return last_row_; }
   // RT-safe. Counts completed beats since construction (never reset); when it changes, last_beat() is
@@ -184,7 +192,7 @@ class Sequencer {
   hal::Tick ticks(double seconds) const noexcept;
   double seconds_since(hal::Tick now, hal::Tick t0) const noexcept;
   static bool is_symptom(Fault f) noexcept;
-  void latch(Fault f, hal::Tick now, int axis = -1, std::uint16_t detail = 0) noexcept;
+  void latch(Fault f, hal::Tick now, int axis = -1, std::uint16_t detail = 0, int sensor = -1) noexcept;
   void enter(State s, hal::Tick now) noexcept;
   bool reconcile_at_arming(hal::Tick now, const hal::HalInputs& in) noexcept;
   bool shuttle_where_counters_say(hal::Tick now) noexcept;
@@ -224,6 +232,7 @@ class Sequencer {
   Fault stopped_by_ = Fault::kNone;
   hal::Tick armed_since_ = 0;  // tick the drives were first asked to enable (staleness of never-seen data)
   int fault_axis_ = -1;
+  int fault_sensor_ = -1;
   std::uint16_t fault_detail_ = 0;
   hal::Tick fault_tick_ = hal::kNeverTick;
 
@@ -266,7 +275,9 @@ class Sequencer {
   bool sensors_proven_ = false;
 
   // Sensors and buttons as the sequencer uses them (debounced), and plausibility state.
-  Debouncer<6> sensors_;
+  Debouncer<hal::kSafetySensorCount> sensors_;          // first channels
+  Debouncer<hal::kSafetySensorCount> second_channels_;  // used where wired (cfg_.second_channel)
+  DualChannelSensors dual_;
   Debouncer<4> buttons_;  // start, pause, ack, row knotted
   RisingEdge start_edge_, pause_edge_, ack_edge_, knotted_edge_;
   bool knot_requested_ = false;  // "row knotted" since the loom last started waiting for it

@@ -95,10 +95,13 @@ enum class InjectedFault : std::uint8_t {
 inline constexpr int kInjectedFaultCount = 15;
 const char* injected_fault_name(InjectedFault f);  // the scene file's `kind`
 
+// Every switch a scene can fail: the six safety sensors' first channels, then their second channels
+// ("<sensor>_2", in the same order: second channel of sensor i is 6 + i).
 enum class Sensor : std::uint8_t {
-  kPistonAExtended, kPistonARetracted, kPistonBExtended, kPistonBRetracted, kShuttleLeft, kShuttleRight
+  kPistonAExtended, kPistonARetracted, kPistonBExtended, kPistonBRetracted, kShuttleLeft, kShuttleRight,
+  kPistonAExtended2, kPistonARetracted2, kPistonBExtended2, kPistonBRetracted2, kShuttleLeft2, kShuttleRight2
 };
-inline constexpr int kSensorCount = 6;
+inline constexpr int kSensorCount = 12;
 const char* sensor_name(Sensor s);
 
 enum class LoadCellMode : std::uint8_t { kNan, kLost };
@@ -136,6 +139,9 @@ struct SimMachine {
   double selvedge_sensor_window_m = 0.005;
   motion::BeatUpGeometry beatup = motion::default_beatup_geometry();
   double crank_park_position_rad = 0.0;   // crank axis reading at the park pose
+  // Which safety sensors have a second switch (hal::SafetySensor order): each sees the same truth as the
+  // first and fails on its own (its own stuck faults, its own noise).
+  std::array<bool, hal::kSafetySensorCount> second_channel{};
 };
 
 struct SceneSpec {

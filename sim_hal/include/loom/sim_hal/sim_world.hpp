@@ -92,7 +92,7 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   std::array<double, 2> piston_{0.0, 0.0};    // 0 retracted … 1 extended
   std::array<double, 2> pressure_{0.0, 0.0};  // net drive −1 … 1 (pneumatics)
   std::array<bool, 2> piston_stuck_{false, false};
-  std::array<std::optional<bool>, 6> stuck_sensor_{};
+  std::array<std::optional<bool>, kSensorCount> stuck_sensor_{};
   double shuttle_x_ = 0.0, shuttle_v_ = 0.0;
   bool shuttle_coupled_ = true;
   double carrier_x_prev_ = 0.0, carrier_v_prev_ = 0.0;

@@ -1,0 +1,69 @@
+// Two-channel safety sensors with discrepancy monitoring (the ISO 13849-1 category 3 pattern).
+//
+// A single switch cannot be told from the thing it watches when two faults meet: a shuttle that slipped
+// off its carrier while the arrival switch sticks on just as the carrier arrives, or a piston that seized
+// mid-stroke while its end switch sticks on in the window where the stroke would have ended. No timing
+// or plausibility check sees either — the picture is the normal one. Where the machine has a second,
+// independent switch at the same place (io.<sensor>_2_bit), the sequencer acts on a sensor only while
+// BOTH channels say "on", and two channels that disagree for longer than the discrepancy time are a
+// fault naming the sensor. One stuck channel then delays nothing that is safe and confirms nothing
+// that did not happen.
+//
+// Each channel is debounced on its own before the two are compared, so a one-tick bounce on one
+// channel is not a discrepancy; the discrepancy time covers the switching-point spread of two real
+// switches (they never switch on the same millisecond). RT-safe: fixed size, no allocation.
+#pragma once
+
+#include <array>
+#include <cstddef>
+
+#include "loom/hal/types.hpp"
+
+namespace loom::sequencer {
+
+class DualChannelSensors {
+ public:
+  using Channels = std::array<bool, hal::kSafetySensorCount>;
+
+  DualChannelSensors() noexcept = default;
+  // `wired`: which sensors have a second channel. `discrepancy_ticks` ≥ 1.
+  DualChannelSensors(const Channels& wired, int discrepancy_ticks) noexcept
+      : wired_(wired), limit_(discrepancy_ticks < 1 ? 1 : discrepancy_ticks) {}
+
+  // What the sequencer acts on: where a second channel is wired, a sensor is on only while both
+  // channels are on; elsewhere the first channel alone.
+  Channels agreed(const Channels& first, const Channels& second) const noexcept {
+    Channels v = first;
+    for (std::size_t i = 0; i < v.size(); ++i) v[i] = first[i] && (!wired_[i] || second[i]);
+    return v;
+  }
+
+  // RT-safe; once per tick with both channels debounced. Counts how long each pair has disagreed.
+  void track(const Channels& first, const Channels& second) noexcept {
+    for (std::size_t i = 0; i < first.size(); ++i) {
+      disagree_[i] = wired_[i] && first[i] != second[i] ? disagree_[i] + (disagree_[i] < limit_) : 0;
+    }
+  }
+
+  // The first sensor whose channels have disagreed for longer than the discrepancy time, or −1.
+  int discrepant() const noexcept {
+    for (std::size_t i = 0; i < disagree_.size(); ++i) {
+      if (disagree_[i] >= limit_) return static_cast<int>(i);
+    }
+    return -1;
+  }
+
+  bool any_wired() const noexcept {
+    for (bool w : wired_) {
+      if (w) return true;
+    }
+    return false;
+  }
+
+ private:
+  Channels wired_{};
+  int limit_ = 1;
+  std::array<int, hal::kSafetySensorCount> disagree_{};
+};
+
+}  // namespace loom::sequencer
