@@ -12,6 +12,7 @@
 #include "loom/drivers/cia402.hpp"
 #include "loom/drivers/emcy.hpp"
 #include "loom/drivers/nmt.hpp"
+#include "loom/drivers/required_objects.hpp"
 #include "loom/sim_can/sim_io_node.hpp"
 
 namespace loom::test {
@@ -162,6 +163,27 @@ TEST(IoWiring, FramesPerCycle) {
   EXPECT_EQ(drivers::io_frames_per_cycle(high)[1].data_bytes, 4u);
   w.load_cell_channel = 0;
   EXPECT_EQ(drivers::io_frames_per_cycle(w).size(), 2u);
+}
+
+// What a loom builder checks in a module's EDS: as many 8-bit input groups as the wiring uses.
+std::string required_line(const std::vector<drivers::RequiredObject>& objects, std::uint16_t index) {
+  for (const drivers::RequiredObject& o : objects) {
+    if (o.index == index) return drivers::describe(o);
+  }
+  return "";
+}
+
+TEST(IoWiring, RequiredObjectsCountTheInputGroupsTheWiringUses) {
+  EXPECT_EQ(required_line(drivers::io_module_objects(IoWiring{}), 0x6000),
+            "0x6000:01..03 read digital inputs, 8-bit: sensors and their second channels, e-stop chain, buttons");
+  EXPECT_EQ(required_line(drivers::io_module_objects(IoWiring{}), 0x6200),
+            "0x6200:01 write digital outputs, 8-bit: valves, stack light, buzzer");
+  EXPECT_TRUE(contains(required_line(drivers::io_module_objects(single_channel()), 0x6000), "0x6000:01..02 "));
+  IoWiring high;
+  high.second[5].bit = 30;
+  EXPECT_TRUE(contains(required_line(drivers::io_module_objects(high), 0x6000), "0x6000:01..04 "));
+  // Without a wiring: the objects only.
+  EXPECT_TRUE(contains(required_line(drivers::io_module_objects(), 0x6000), "0x6000 read digital inputs"));
 }
 
 // ---------------------------------------------------------------------------------------------------
