@@ -105,6 +105,22 @@ class SimIoNodeTest : public ::testing::Test {
     }
     return 0xFFFFFFFF;  // no answer
   }
+  // Expedited SDO download of four bytes (0x23); 0 or the abort code.
+  std::uint32_t write_u32(std::uint16_t index, std::uint8_t sub, std::uint32_t value) {
+    take();
+    send(frame(kSdoRequest, {0x23, static_cast<std::uint8_t>(index & 0xFF), static_cast<std::uint8_t>(index >> 8),
+                             sub, static_cast<std::uint8_t>(value), static_cast<std::uint8_t>(value >> 8),
+                             static_cast<std::uint8_t>(value >> 16), static_cast<std::uint8_t>(value >> 24)}));
+    for (const CanFrame& f : take()) {
+      if (f.id != kSdoReply) continue;
+      if (f.data[0] == 0x80) {
+        return static_cast<std::uint32_t>(f.data[4] | f.data[5] << 8 | f.data[6] << 16) |
+               static_cast<std::uint32_t>(f.data[7]) << 24;
+      }
+      return 0;
+    }
+    return 0xFFFFFFFF;  // no answer
+  }
   // TPDO1 synchronous (type 1), NMT start: from now on one TPDO1 per SYNC.
   void start_synchronous() {
     ASSERT_EQ(write_u8(0x1800, 2, 1), 0u);
@@ -212,6 +228,37 @@ TEST_F(SimIoNodeFixed16Test, FactoryTpdo1IsReadOnlyAndCarriesTwoBytes) {
   const std::optional<CanFrame> f = sync_tpdo1();
   ASSERT_TRUE(f);
   EXPECT_EQ(payload(*f), terminals(kAtRest, 2));
+}
+
+// A writable 16-input module (two input groups): says so in 0x6000:00, pre-defines TPDO1 with both,
+// refuses to map the third and sends only terminals 0..15.
+class SimIoNode16Test : public SimIoNodeTest {
+ protected:
+  SimIoNode16Test() : SimIoNodeTest(sixteen()) {}
+  static SimIoConfig sixteen() {
+    SimIoConfig c = config();
+    c.digital_input_groups = 2;
+    return c;
+  }
+};
+
+TEST_F(SimIoNode16Test, HasTwoInputGroupsAndRefusesToMapAThird) {
+  power_on();
+  EXPECT_EQ(read(0x6000, 0), 2u);
+  EXPECT_EQ(read(0x1A00, 0), 2u);
+  EXPECT_EQ(read(0x1A00, 2), 0x60000208u);
+  // Re-mapping as CiA 301 asks: invalidate the PDO, clear the count, write entries, set the count.
+  ASSERT_EQ(write_u32(0x1800, 1, 0x80000000u | kTpdo1), 0u);
+  ASSERT_EQ(write_u8(0x1A00, 0, 0), 0u);
+  EXPECT_EQ(write_u32(0x1A00, 1, 0x60000108), 0u);
+  EXPECT_EQ(write_u32(0x1A00, 2, 0x60000208), 0u);
+  EXPECT_EQ(write_u32(0x1A00, 3, 0x60000308), 0x06040041u);  // object cannot be mapped
+  ASSERT_EQ(write_u8(0x1A00, 0, 2), 0u);
+  ASSERT_EQ(write_u32(0x1800, 1, kTpdo1), 0u);
+  start_synchronous();
+  const std::optional<CanFrame> f = sync_tpdo1();
+  ASSERT_TRUE(f);
+  EXPECT_EQ(payload(*f), terminals({1, 3, 4, 6}, 2));  // no second switches: those terminals do not exist
 }
 
 }  // namespace

@@ -98,6 +98,13 @@ SimIoNode::SimIoNode(drivers::CanBus& bus, SimIoConfig config)
     : bus_(bus),
       config_(std::move(config)),
       od_(kTable, slave::OdOptions{config_.absent_objects, config_.fixed_mapping}) {
+  // A module with fewer than the table's three mapped input groups pre-defines TPDO1 with the ones it
+  // has (resolved here, so resets allocate nothing).
+  if (config_.tpdo1_factory_mapping.empty() && input_groups() < 3) {
+    for (int k = 1; k <= input_groups(); ++k) {
+      config_.tpdo1_factory_mapping.push_back(map_entry(kDigitalInputs, static_cast<std::uint8_t>(k), 8));
+    }
+  }
   reset_application();
 }
 
@@ -116,6 +123,10 @@ void SimIoNode::reset_communication(std::int64_t now_us) {
   boot_at_us_ = now_us + config_.boot_delay_us;
 }
 
+int SimIoNode::input_groups() const {
+  return std::clamp(config_.digital_input_groups, 1, 4);
+}
+
 // A personality's own factory mapping of TPDO `tpdo` (empty: the table's default stays).
 void SimIoNode::set_factory_mapping(int tpdo, const std::vector<std::uint32_t>& entries) {
   if (entries.empty()) return;
@@ -129,6 +140,7 @@ void SimIoNode::set_factory_mapping(int tpdo, const std::vector<std::uint32_t>& 
 
 void SimIoNode::reset_application() {
   od_.reset_application();
+  od_.set(kDigitalInputs, 0, static_cast<std::uint32_t>(input_groups()));
 }
 
 void SimIoNode::power_on(std::int64_t now_us) {
@@ -257,6 +269,15 @@ void SimIoNode::send_changed_inputs() {
   }
 }
 
+// A group the module lacks cannot be mapped (the dictionary table is shared by every personality, so
+// the rule is here rather than in it).
+std::uint32_t SimIoNode::check(std::uint16_t index, std::uint8_t sub, std::uint32_t value) const {
+  const bool map_entry_write = index >= slave::kTpdoMap && index < slave::kTpdoMap + slave::kPdos && sub >= 1;
+  const auto group = static_cast<int>((value >> 8) & 0xFF);
+  const bool missing_group = (value >> 16) == kDigitalInputs && group > input_groups();
+  return map_entry_write && missing_group ? slave::abort_code::kNotMappable : 0;
+}
+
 void SimIoNode::written(std::uint16_t index, std::uint8_t, std::uint32_t value, std::int64_t now_us) {
   if (index == kProducerHeartbeat) {
     next_hb_us_ = now_us + static_cast<std::int64_t>(value) * 1000;
@@ -295,6 +316,7 @@ void SimIoNode::update_inputs() {
   set(kInPause, plant_.button_pause);
   set(kInAck, plant_.button_ack);
   set(kInKnotted, plant_.row_knotted);
+  for (std::size_t k = static_cast<std::size_t>(input_groups()); k < in.size(); ++k) in[k] = 0;  // no terminals
   in_ = in;
   for (std::size_t k = 0; k < in.size(); ++k) od_.set(kDigitalInputs, static_cast<std::uint8_t>(k + 1), in[k]);
   // Load cell: a narrow pulse around the crank angle at which the beater meets the fell.

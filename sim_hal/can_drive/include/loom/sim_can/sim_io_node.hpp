@@ -65,6 +65,10 @@ struct SimIoConfig {
   // 16-input module's {0x60000108, 0x60000208}; empty = the defaults in sim_io_node.cpp.
   std::vector<std::uint32_t> tpdo1_factory_mapping;
   std::vector<std::uint32_t> tpdo2_factory_mapping;
+  // 8-bit input groups the module has (1..4; 2 = a 16-input module without the second channels'
+  // terminals 16..21): 0x6000:00 says so, its default TPDO1 carries them all (at most three), the missing
+  // groups read 0 and cannot be mapped (abort 0x06040041).
+  int digital_input_groups = 4;
   std::vector<std::uint16_t> absent_objects;  // e.g. 0x1016, 0x6206, 0x1802
   std::int64_t boot_delay_us = 0;             // power-on / reset → boot-up
 };
@@ -95,6 +99,7 @@ class SimIoNode : private slave::ObjectHooks {
  private:
   // The bus's writes reach the module through the ObjectHooks (timers react to them).
   void written(std::uint16_t index, std::uint8_t sub, std::uint32_t value, std::int64_t now_us) override;
+  std::uint32_t check(std::uint16_t index, std::uint8_t sub, std::uint32_t value) const override;
 
   void on_nmt(std::uint8_t command, std::int64_t now_us);
   void on_sdo(const drivers::CanFrame& f, std::int64_t now_us);
@@ -107,6 +112,7 @@ class SimIoNode : private slave::ObjectHooks {
   void send(const drivers::CanFrame& f);
   void update_inputs();
   void set_factory_mapping(int tpdo, const std::vector<std::uint32_t>& entries);
+  int input_groups() const;
   std::array<bool, hal::kSafetySensorCount> safety_sensors_truth() const;
   void move_pistons(double dt);
   void watch_master(std::int64_t now_us);
