@@ -256,7 +256,7 @@ Status CanIoPort::disable_pdo(SdoClient& sdo, bool rx, int pdo) {
 // Write `wanted` into PDO `pdo`; when the module refuses because its mapping is fixed, read back what it
 // has. Either way `actual` ends as what the module reports, which the caller checks.
 Status CanIoPort::map_pdo(SdoClient& sdo, bool rx, int pdo, const std::vector<std::uint32_t>& wanted,
-                          std::uint8_t transmission_type, PdoLayout& actual) {
+                          std::uint8_t transmission_type, PdoLayout& actual, std::uint32_t* refused) {
   const std::uint8_t id = config_.node_id;
   const auto comm = static_cast<std::uint16_t>((rx ? od::kRpdoComm : od::kTpdoComm) + pdo);
   const auto map = static_cast<std::uint16_t>((rx ? od::kRpdoMap : od::kTpdoMap) + pdo);
@@ -276,7 +276,10 @@ Status CanIoPort::map_pdo(SdoClient& sdo, bool rx, int pdo, const std::vector<st
   }
   if (!fixed) {
     for (std::size_t k = 0; k < wanted.size(); ++k) {
-      if (Status s = sdo.write(id, map, static_cast<std::uint8_t>(k + 1), wanted[k], 4); !s) return fail(s);
+      if (Status s = sdo.write(id, map, static_cast<std::uint8_t>(k + 1), wanted[k], 4); !s) {
+        if (refused != nullptr) *refused = wanted[k];  // the caller can say what needed it
+        return fail(s);
+      }
     }
     if (Status s = sdo.write(id, map, 0, static_cast<std::uint32_t>(wanted.size()), 1); !s) return fail(s);
   }
@@ -334,7 +337,11 @@ Status CanIoPort::configure_mapping(SdoClient& sdo) {
 
   tpdo_ = {};
   rpdo_ = {};
-  if (Status s = map_pdo(sdo, false, 0, inputs, 1, tpdo_[0]); !s) return s;
+  std::uint32_t refused = 0;
+  if (Status s = map_pdo(sdo, false, 0, inputs, 1, tpdo_[0], &refused); !s) {
+    if (refused == 0) return s;
+    return explain_refused_input(s, refused, in_subs);
+  }
   if (analog) {
     if (Status s = map_pdo(sdo, false, 1, {load_cell}, 1, tpdo_[1]); !s) return s;
   } else if (Status s = disable_pdo(sdo, false, 1); !s) {
@@ -384,6 +391,19 @@ Status CanIoPort::locate(const std::array<PdoLayout, 4>& layouts, std::uint32_t 
                          " bits, the master needs " + std::to_string(wanted & 0xFF) + " (" + what + ")");
   }
   return Status::ok();
+}
+
+// The module refused to map `entry` into the inputs' TPDO: most likely it has fewer inputs than the
+// wiring uses, so say which signal makes the master read that far (the highest one, in the last sub).
+Status CanIoPort::explain_refused_input(const Status& s, std::uint32_t entry, std::uint8_t subs) const {
+  const std::vector<NamedBit> bits = inputs_of(config_.wiring);
+  const NamedBit* highest = signal_in_sub(bits, subs);
+  if (highest == nullptr) return s;
+  char range[24];
+  std::snprintf(range, sizeof range, "0x%04X:01..%02X", od401::kDigitalInputs8, subs);
+  return Status::error(s.message() + "; " + object_name(entry) + " is mapped because the wiring reads " +
+                       range + " up to " + key_and_value(*highest) +
+                       " (a module with fewer digital inputs needs that signal moved or unwired, -1)");
 }
 
 // 0x6000:01..`subs`. Every sub a wired input lives in must be carried, and all of them by ONE TPDO: the

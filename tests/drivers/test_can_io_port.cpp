@@ -400,6 +400,29 @@ TEST(Interop, IoModuleWithFixedSixteenInputsIsAcceptedForSingleChannelSensing) {
   EXPECT_EQ(hal::safety_sensors(r.in.io), kAtRest);
 }
 
+// A writable 16-input module cannot map 0x6000:03: the SDO abort is explained by the signal that needs it.
+TEST(Interop, IoModuleWithSixteenInputsRefusingTheThirdGroupIsExplainedByTheSignal) {
+  sim_can::SimIoConfig ic;
+  ic.digital_input_groups = 2;
+  IoRig r(ic);
+  const drivers::Status s = r.configure();
+  ASSERT_FALSE(s);
+  EXPECT_TRUE(contains(s.message(), "node 4 (I/O node): SDO write 0x1A00:03")) << s.message();
+  EXPECT_TRUE(contains(s.message(), "0x06040041")) << s.message();
+  EXPECT_TRUE(contains(s.message(), "; 0x6000:03 is mapped because the wiring reads 0x6000:01..03 up to "
+                                    "io.shuttle_at_right_2_bit = 21 (a module with fewer digital inputs needs "
+                                    "that signal moved or unwired, -1)"))
+      << s.message();
+  // The same module serves single-channel sensing.
+  CanIoConfig pc;
+  pc.wiring = single_channel();
+  IoRig single(ic, three_drives(), {}, pc);
+  const drivers::Status ok = single.configure();
+  ASSERT_TRUE(ok) << ok.message();
+  single.enable_all();
+  EXPECT_EQ(hal::safety_sensors(single.in.io), kAtRest);
+}
+
 // The inputs are one sample: a fixed mapping that spreads them over two TPDOs is refused.
 TEST(Interop, IoModuleWithInputsSplitOverTwoTpdosIsRefused) {
   sim_can::SimIoConfig ic = fixed_16_inputs();

@@ -183,8 +183,10 @@ class CanIoPort final : public hal::IoPort, public CanNodeListener {
   Status locate(const std::array<PdoLayout, 4>& layouts, std::uint32_t wanted, const std::string& what,
                 Slot& slot) const;
   Status locate_inputs(std::uint8_t subs);
+  Status explain_refused_input(const Status& s, std::uint32_t entry, std::uint8_t subs) const;
+  // `refused` (optional): the mapping entry the module refused to take, 0 when none was.
   Status map_pdo(SdoClient& sdo, bool rx, int pdo, const std::vector<std::uint32_t>& wanted,
-                 std::uint8_t transmission_type, PdoLayout& actual);
+                 std::uint8_t transmission_type, PdoLayout& actual, std::uint32_t* refused = nullptr);
   Status disable_pdo(SdoClient& sdo, bool rx, int pdo);
   static Slot find(const std::array<PdoLayout, 4>& layouts, std::uint32_t entry_without_len);
   std::string who() const;
