@@ -3,6 +3,7 @@
 // noted), and the RT exchange decoded through the layout the module really uses.
 #include "loom/drivers/can_io_port.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -34,25 +35,43 @@ constexpr std::uint32_t entry(std::uint16_t index, std::uint8_t sub, std::uint8_
   return encode_map_entry(PdoMapEntry{index, sub, bits});
 }
 
+// "0x6000:03" for a mapping entry.
+std::string object_name(std::uint32_t map_entry) {
+  char buf[16];
+  std::snprintf(buf, sizeof(buf), "0x%04X:%02X", map_entry >> 16, (map_entry >> 8) & 0xFF);
+  return buf;
+}
+
 struct NamedBit {
   const char* name;
   const IoBit* bit;
   bool required;
 };
 
-// The wiring's signals by name, inputs then outputs, for validation and messages.
+// Names of the second channels in hal::SafetySensor order (NamedBit keeps the pointer: static storage).
+constexpr std::array<const char*, hal::kSafetySensorCount> kSecondChannelNames{
+    "io.inputs.piston_a_extended_2", "io.inputs.piston_a_retracted_2", "io.inputs.piston_b_extended_2",
+    "io.inputs.piston_b_retracted_2", "io.inputs.shuttle_at_left_2",    "io.inputs.shuttle_at_right_2"};
+
+// The wiring's signals by name, inputs then outputs, for validation and messages. The second channels
+// are inputs like any other, so a bit shared between a first and a second channel is refused.
 std::vector<NamedBit> inputs_of(const IoWiring& w) {
-  return {{"io.inputs.piston_a_extended", &w.piston_a_extended, true},
-          {"io.inputs.piston_a_retracted", &w.piston_a_retracted, true},
-          {"io.inputs.piston_b_extended", &w.piston_b_extended, true},
-          {"io.inputs.piston_b_retracted", &w.piston_b_retracted, true},
-          {"io.inputs.shuttle_at_left", &w.shuttle_at_left, true},
-          {"io.inputs.shuttle_at_right", &w.shuttle_at_right, true},
-          {"io.inputs.estop_ok", &w.estop_ok, true},
-          {"io.inputs.button_start", &w.button_start, false},
-          {"io.inputs.button_pause", &w.button_pause, false},
-          {"io.inputs.button_ack", &w.button_ack, false},
-          {"io.inputs.row_knotted", &w.row_knotted, false}};
+  std::vector<NamedBit> v{{"io.inputs.piston_a_extended", &w.piston_a_extended, true},
+                          {"io.inputs.piston_a_retracted", &w.piston_a_retracted, true},
+                          {"io.inputs.piston_b_extended", &w.piston_b_extended, true},
+                          {"io.inputs.piston_b_retracted", &w.piston_b_retracted, true},
+                          {"io.inputs.shuttle_at_left", &w.shuttle_at_left, true},
+                          {"io.inputs.shuttle_at_right", &w.shuttle_at_right, true},
+                          {"io.inputs.estop_ok", &w.estop_ok, true},
+                          {"io.inputs.button_start", &w.button_start, false},
+                          {"io.inputs.button_pause", &w.button_pause, false},
+                          {"io.inputs.button_ack", &w.button_ack, false},
+                          {"io.inputs.row_knotted", &w.row_knotted, false}};
+  // Optional: a machine may have single-channel sensing (then the sequencer's plausibility checks alone).
+  for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) {
+    v.push_back({kSecondChannelNames[i], &w.second[i], false});
+  }
+  return v;
 }
 std::vector<NamedBit> outputs_of(const IoWiring& w) {
   return {{"io.outputs.piston_a_extend", &w.piston_a_extend, true},
@@ -90,9 +109,30 @@ int highest_bit(const std::vector<NamedBit>& bits) {
   return hi;
 }
 
-// The 8-bit subs (1 or 2) a set of signals needs.
-std::uint8_t bytes_for(const std::vector<NamedBit>& bits) {
-  return highest_bit(bits) >= 8 ? 2 : 1;
+// The 8-bit subs a set of signals needs: up to the one holding the highest wired bit (at least one, so
+// the PDO exists even when nothing optional is wired).
+std::uint8_t subs_for(const std::vector<NamedBit>& bits) {
+  return static_cast<std::uint8_t>(std::max(highest_bit(bits), 0) / 8 + 1);
+}
+
+// The wired signal with the highest bit in 8-bit sub `sub` (1-based), the one named when the module
+// cannot deliver that sub; nullptr when no signal lives there (then the master can do without it).
+const NamedBit* signal_in_sub(const std::vector<NamedBit>& bits, int sub) {
+  const NamedBit* found = nullptr;
+  for (const NamedBit& b : bits) {
+    const int n = b.bit->bit;
+    if (n >= 0 && n / 8 + 1 == sub && (found == nullptr || n > found->bit->bit)) found = &b;
+  }
+  return found;
+}
+
+// The config key an operator edits for a signal ("io.inputs.shuttle_at_right_2" →
+// "io.shuttle_at_right_2_bit") and its value: a bring-up refusal points at the TOML line that asks for
+// the input the module cannot deliver.
+std::string key_and_value(const NamedBit& b) {
+  std::string name = b.name;
+  const std::string group = name.rfind("io.inputs.", 0) == 0 ? "io.inputs." : "io.outputs.";
+  return "io." + name.substr(group.size()) + "_bit = " + std::to_string(b.bit->bit);
 }
 
 bool interop_readback_code(std::uint32_t abort) {
@@ -159,10 +199,17 @@ Status validate(const CanIoConfig& c) {
   return Status::ok();
 }
 
+std::uint8_t io_input_subs(const IoWiring& w) {
+  return subs_for(inputs_of(w));
+}
+std::uint8_t io_output_subs(const IoWiring& w) {
+  return subs_for(outputs_of(w));
+}
+
 std::vector<FrameGroup> io_frames_per_cycle(const IoWiring& w) {
   std::vector<FrameGroup> g;
-  g.push_back({bytes_for(outputs_of(w)), 1});  // RPDO: digital outputs
-  g.push_back({bytes_for(inputs_of(w)), 1});   // TPDO: digital inputs
+  g.push_back({io_output_subs(w), 1});  // RPDO: digital outputs
+  g.push_back({io_input_subs(w), 1});   // TPDO: digital inputs, one 8-bit sub per byte
   if (w.load_cell_channel != 0) g.push_back({2, 1});  // TPDO: load cell
   return g;
 }
@@ -209,7 +256,7 @@ Status CanIoPort::disable_pdo(SdoClient& sdo, bool rx, int pdo) {
 // Write `wanted` into PDO `pdo`; when the module refuses because its mapping is fixed, read back what it
 // has. Either way `actual` ends as what the module reports, which the caller checks.
 Status CanIoPort::map_pdo(SdoClient& sdo, bool rx, int pdo, const std::vector<std::uint32_t>& wanted,
-                          std::uint8_t transmission_type, PdoLayout& actual) {
+                          std::uint8_t transmission_type, PdoLayout& actual, std::uint32_t* refused) {
   const std::uint8_t id = config_.node_id;
   const auto comm = static_cast<std::uint16_t>((rx ? od::kRpdoComm : od::kTpdoComm) + pdo);
   const auto map = static_cast<std::uint16_t>((rx ? od::kRpdoMap : od::kTpdoMap) + pdo);
@@ -229,7 +276,10 @@ Status CanIoPort::map_pdo(SdoClient& sdo, bool rx, int pdo, const std::vector<st
   }
   if (!fixed) {
     for (std::size_t k = 0; k < wanted.size(); ++k) {
-      if (Status s = sdo.write(id, map, static_cast<std::uint8_t>(k + 1), wanted[k], 4); !s) return fail(s);
+      if (Status s = sdo.write(id, map, static_cast<std::uint8_t>(k + 1), wanted[k], 4); !s) {
+        if (refused != nullptr) *refused = wanted[k];  // the caller can say what needed it
+        return fail(s);
+      }
     }
     if (Status s = sdo.write(id, map, 0, static_cast<std::uint32_t>(wanted.size()), 1); !s) return fail(s);
   }
@@ -274,11 +324,12 @@ Status CanIoPort::map_pdo(SdoClient& sdo, bool rx, int pdo, const std::vector<st
 
 Status CanIoPort::configure_mapping(SdoClient& sdo) {
   const IoWiring& w = config_.wiring;
-  const std::uint8_t in_bytes = bytes_for(inputs_of(w));
-  const std::uint8_t out_bytes = bytes_for(outputs_of(w));
+  const std::uint8_t in_subs = io_input_subs(w);
+  const std::uint8_t out_bytes = io_output_subs(w);
 
-  std::vector<std::uint32_t> inputs{entry(od401::kDigitalInputs8, 1, 8)};
-  if (in_bytes == 2) inputs.push_back(entry(od401::kDigitalInputs8, 2, 8));
+  // 0x6000:01..n in TPDO1, in sub order, so the inputs are one sample in one frame.
+  std::vector<std::uint32_t> inputs;
+  for (std::uint8_t k = 1; k <= in_subs; ++k) inputs.push_back(entry(od401::kDigitalInputs8, k, 8));
   std::vector<std::uint32_t> outputs{entry(od401::kDigitalOutputs8, 1, 8)};
   if (out_bytes == 2) outputs.push_back(entry(od401::kDigitalOutputs8, 2, 8));
   const bool analog = w.load_cell_channel != 0;
@@ -286,7 +337,11 @@ Status CanIoPort::configure_mapping(SdoClient& sdo) {
 
   tpdo_ = {};
   rpdo_ = {};
-  if (Status s = map_pdo(sdo, false, 0, inputs, 1, tpdo_[0]); !s) return s;
+  std::uint32_t refused = 0;
+  if (Status s = map_pdo(sdo, false, 0, inputs, 1, tpdo_[0], &refused); !s) {
+    if (refused == 0) return s;
+    return explain_refused_input(s, refused, in_subs);
+  }
   if (analog) {
     if (Status s = map_pdo(sdo, false, 1, {load_cell}, 1, tpdo_[1]); !s) return s;
   } else if (Status s = disable_pdo(sdo, false, 1); !s) {
@@ -301,32 +356,14 @@ Status CanIoPort::configure_mapping(SdoClient& sdo) {
   }
 
   // Every object the wiring needs must be in what the module reports; else refuse, naming it.
-  const auto need = [&](const std::array<PdoLayout, 4>& l, std::uint32_t e, const char* what, Slot& slot) {
-    slot = find(l, e);
-    if (slot.pdo < 0) {
-      return Status::error(who() + "no PDO carries " + hex(e >> 16, 4) + ":" + hex((e >> 8) & 0xFF, 2).substr(2) +
-                           " (" + what + "); the module's mapping (fixed or refused) lacks it");
-    }
-    if (slot.bytes != ((e & 0xFF) / 8)) {
-      return Status::error(who() + hex(e >> 16, 4) + " is mapped with " + std::to_string(slot.bytes * 8) +
-                           " bits, the master needs " + std::to_string(e & 0xFF));
-    }
-    return Status::ok();
-  };
-  input_slot_ = {};
   output_slot_ = {};
   analog_slot_ = {};
-  for (std::size_t k = 0; k < inputs.size(); ++k) {
-    if (Status s = need(tpdo_, inputs[k], "digital inputs", input_slot_[k]); !s) return s;
-  }
+  if (Status s = locate_inputs(in_subs); !s) return s;
   for (std::size_t k = 0; k < outputs.size(); ++k) {
-    if (Status s = need(rpdo_, outputs[k], "digital outputs", output_slot_[k]); !s) return s;
+    if (Status s = locate(rpdo_, outputs[k], "digital outputs", output_slot_[k]); !s) return s;
   }
   if (analog) {
-    if (Status s = need(tpdo_, load_cell, "load cell", analog_slot_); !s) return s;
-  }
-  if (input_slot_.size() == 2 && in_bytes == 2 && input_slot_[1].pdo != input_slot_[0].pdo) {
-    return Status::error(who() + "0x6000:01 and 0x6000:02 are in different TPDOs; the master needs them in one");
+    if (Status s = locate(tpdo_, load_cell, "load cell", analog_slot_); !s) return s;
   }
   output_pdo_ = output_slot_[0].pdo;
   if (out_bytes == 2 && output_slot_[1].pdo != output_pdo_) {
@@ -340,6 +377,70 @@ Status CanIoPort::configure_mapping(SdoClient& sdo) {
   return Status::ok();
 }
 
+// Where `wanted` sits in `layouts`; refused, naming the object and what needs it, when the module's
+// mapping lacks it or maps it with another length.
+Status CanIoPort::locate(const std::array<PdoLayout, 4>& layouts, std::uint32_t wanted, const std::string& what,
+                         Slot& slot) const {
+  slot = find(layouts, wanted);
+  if (slot.pdo < 0) {
+    return Status::error(who() + "no PDO carries " + object_name(wanted) + " (" + what +
+                         "); the module's mapping (fixed or refused) lacks it");
+  }
+  if (slot.bytes != (wanted & 0xFF) / 8) {
+    return Status::error(who() + object_name(wanted) + " is mapped with " + std::to_string(slot.bytes * 8) +
+                         " bits, the master needs " + std::to_string(wanted & 0xFF) + " (" + what + ")");
+  }
+  return Status::ok();
+}
+
+// The module refused to map `entry` into the inputs' TPDO: most likely it has fewer inputs than the
+// wiring uses, so say which signal makes the master read that far (the highest one, in the last sub).
+Status CanIoPort::explain_refused_input(const Status& s, std::uint32_t entry, std::uint8_t subs) const {
+  const std::vector<NamedBit> bits = inputs_of(config_.wiring);
+  const NamedBit* highest = signal_in_sub(bits, subs);
+  if (highest == nullptr) return s;
+  char range[24];
+  std::snprintf(range, sizeof range, "0x%04X:01..%02X", od401::kDigitalInputs8, subs);
+  return Status::error(s.message() + "; " + object_name(entry) + " is mapped because the wiring reads " +
+                       range + " up to " + key_and_value(*highest) +
+                       " (a module with fewer digital inputs needs that signal moved or unwired, -1)");
+}
+
+// 0x6000:01..`subs`. Every sub a wired input lives in must be carried, and all of them by ONE TPDO: the
+// inputs are one sample with one `refreshed` tick, so a sensor and its second channel (or a shed's end
+// switches) are compared as seen at the same instant, never one frame against another. A sub no signal
+// lives in is read when it comes in that TPDO and otherwise not needed.
+Status CanIoPort::locate_inputs(std::uint8_t subs) {
+  const std::vector<NamedBit> bits = inputs_of(config_.wiring);
+  input_slot_ = {};
+  input_pdo_ = -1;
+  std::uint32_t first = 0;  // the needed sub that fixed input_pdo_, for the message
+  for (std::uint8_t k = 1; k <= subs; ++k) {
+    const std::uint32_t e = entry(od401::kDigitalInputs8, k, 8);
+    Slot& slot = input_slot_[static_cast<std::size_t>(k - 1)];
+    const NamedBit* user = signal_in_sub(bits, k);
+    if (user == nullptr) {
+      slot = find(tpdo_, e);
+      continue;
+    }
+    const std::string needed_by = "digital inputs, needed by " + key_and_value(*user);
+    if (Status s = locate(tpdo_, e, needed_by, slot); !s) return s;
+    if (input_pdo_ < 0) {
+      input_pdo_ = slot.pdo;
+      first = e;
+    } else if (slot.pdo != input_pdo_) {
+      return Status::error(who() + object_name(e) + " (" + needed_by + ") is in TPDO" +
+                           std::to_string(slot.pdo + 1) + ", " + object_name(first) + " in TPDO" +
+                           std::to_string(input_pdo_ + 1) +
+                           "; the master needs every digital input in one TPDO (one sample per cycle)");
+    }
+  }
+  for (Slot& slot : input_slot_) {
+    if (slot.pdo != input_pdo_ || slot.bytes != 1) slot = {};
+  }
+  return Status::ok();
+}
+
 Status CanIoPort::configure(CanBus& bus, ConfigureClock& clock) {
   configured_ = false;
   bus_ = nullptr;
@@ -347,6 +448,7 @@ Status CanIoPort::configure(CanBus& bus, ConfigureClock& clock) {
   link_fault_ = 0;
   emcy_code_ = 0;
   inputs_refreshed_ = analog_refreshed_ = last_heartbeat_ = hal::kNeverTick;
+  inputs_ = {};  // a re-arm must not show the sensors of the last configuration before the first TPDO
   booted_ = false;
   if (Status s = validate(config_); !s) return Status::error("CAN I/O configuration: " + s.message());
   consumer_ticks_ = static_cast<std::uint32_t>(std::ceil(config_.heartbeat_consumer_s / config_.cycle_period_s - 1e-9));
@@ -428,7 +530,7 @@ Status CanIoPort::configure(CanBus& bus, ConfigureClock& clock) {
     put(w.lamp_amber, safe.lamp_amber);
     put(w.lamp_red, safe.lamp_red);
     put(w.buzzer, safe.buzzer);
-    const std::uint8_t bytes = bytes_for(outputs_of(w));
+    const std::uint8_t bytes = io_output_subs(w);
     bool absent = false;
     for (std::uint8_t k = 0; k < bytes && !absent; ++k) {
       if (Status s = sdo.write(id, od401::kOutputErrorMode, static_cast<std::uint8_t>(k + 1), mode[k], 1); !s) {
@@ -518,15 +620,18 @@ void CanIoPort::on_frame(hal::Tick now, const CanFrame& f) {
   }
   bool used = false;
   std::uint32_t v = 0;
-  if (input_slot_[0].pdo == tpdo) {
+  if (input_pdo_ == tpdo) {
+    // Every sub first, then all at once: a short frame changes nothing, so the inputs stay one sample.
+    std::array<std::uint8_t, kMaxInputSubs> sample = inputs_;
     for (std::size_t k = 0; k < input_slot_.size(); ++k) {
       if (input_slot_[k].pdo != tpdo) continue;
       if (!read_le(input_slot_[k], v)) {
         ++rx_errors_;
         return;
       }
-      inputs_[k] = static_cast<std::uint8_t>(v);
+      sample[k] = static_cast<std::uint8_t>(v);
     }
+    inputs_ = sample;
     inputs_refreshed_ = now;
     used = true;
   }
@@ -577,6 +682,8 @@ void CanIoPort::read_io(hal::Tick /*now*/, const hal::AxisFeedbacks& /*axes*/, h
   io.button_pause = input(w.button_pause);
   io.button_ack = input(w.button_ack);
   io.row_knotted = input(w.row_knotted);
+  // Each second channel from its own terminal, never derived from the first: false where not wired.
+  for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) io.second_channel[i] = input(w.second[i]);
   io.refreshed = inputs_refreshed_;
 }
 

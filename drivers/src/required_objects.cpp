@@ -41,7 +41,8 @@ std::vector<RequiredObject> io_module_objects() {
       {od::kRpdoComm, "RPDO1 communication/mapping", false, "digital outputs every SYNC"},
       {od::kTpdoComm, "TPDO1 communication/mapping", false, "digital inputs every SYNC"},
       {static_cast<std::uint16_t>(od::kTpdoComm + 1), "TPDO2 communication/mapping", true, "load cell (when wired)"},
-      {od401::kDigitalInputs8, "read digital inputs, 8-bit", false, "sensors, e-stop chain, buttons"},
+      {od401::kDigitalInputs8, "read digital inputs, 8-bit", false,
+       "sensors and their second channels, e-stop chain, buttons"},
       {od401::kDigitalOutputs8, "write digital outputs, 8-bit", false, "valves, stack light, buzzer"},
       {od401::kOutputErrorMode, "output error mode", true, "the module adopts the safe outputs by itself"},
       {od401::kOutputErrorValue, "output error value", true, "both valves de-energised on failure"},
@@ -49,9 +50,28 @@ std::vector<RequiredObject> io_module_objects() {
   };
 }
 
+std::vector<RequiredObject> io_module_objects(const IoWiring& wiring) {
+  // The group counts come from the same function configure() maps with, so a module checked against
+  // this list is one the master accepts (a module with fewer groups cannot map what the wiring asks for).
+  std::vector<RequiredObject> v = io_module_objects();
+  for (RequiredObject& o : v) {
+    if (o.index == od401::kDigitalInputs8) o.subs = io_input_subs(wiring);
+    if (o.index == od401::kDigitalOutputs8) o.subs = io_output_subs(wiring);
+  }
+  return v;
+}
+
 std::string describe(const RequiredObject& o) {
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "0x%04X %s%s: %s", o.index, o.name, o.optional ? " (optional)" : "", o.why);
+  char object[24];
+  if (o.subs > 1) {
+    std::snprintf(object, sizeof object, "0x%04X:01..%02X", o.index, o.subs);
+  } else if (o.subs == 1) {
+    std::snprintf(object, sizeof object, "0x%04X:01", o.index);
+  } else {
+    std::snprintf(object, sizeof object, "0x%04X", o.index);
+  }
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "%s %s%s: %s", object, o.name, o.optional ? " (optional)" : "", o.why);
   return buf;
 }
 

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <string>
 
 #include "drive_rig.hpp"
@@ -11,6 +12,7 @@
 #include "loom/drivers/cia402.hpp"
 #include "loom/drivers/emcy.hpp"
 #include "loom/drivers/nmt.hpp"
+#include "loom/drivers/required_objects.hpp"
 #include "loom/sim_can/sim_io_node.hpp"
 
 namespace loom::test {
@@ -27,6 +29,15 @@ bool contains(const std::string& s, const std::string& part) {
 }
 bool any_note(const std::vector<std::string>& notes, const std::string& part) {
   return std::any_of(notes.begin(), notes.end(), [&](const std::string& n) { return contains(n, part); });
+}
+
+// The DLC of the last frame on the wire with `id` (the I/O node's TPDO1 is 0x184), −1 none.
+int last_dlc(const test::FakeCanNetwork& net, std::uint32_t id) {
+  int dlc = -1;
+  for (const auto& l : net.log()) {
+    if (l.frame.id == id && !l.frame.is_error()) dlc = l.frame.dlc;
+  }
+  return dlc;
 }
 
 // Servo drives + the I/O node on one endpoint, the master's two ports on the other.
@@ -101,15 +112,78 @@ TEST(IoWiring, BitOutOfRangeAndUnwiredRequiredSignal) {
   EXPECT_TRUE(contains(drivers::validate(g).message(), "io.load_cell.n_per_count = 0"));
 }
 
+// The wiring with single-channel sensing: every second channel unwired.
+IoWiring single_channel() {
+  IoWiring w;
+  for (drivers::IoBit& b : w.second) b.bit = -1;
+  return w;
+}
+
+TEST(IoWiring, DuplicateBitBetweenAFirstAndASecondChannelNamesBoth) {
+  // Each second channel on its own sensor's first-channel bit (0..5 in SafetySensor order): refused,
+  // named with the config's sensor names.
+  for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) {
+    IoWiring w;
+    w.second[i].bit = static_cast<int>(i);
+    const std::string name = hal::safety_sensor_name(static_cast<hal::SafetySensor>(i));
+    EXPECT_EQ(drivers::validate(w).message(), "io.inputs." + name + "_2.bit = " + std::to_string(i) +
+                                                  " is already used by io.inputs." + name);
+  }
+  IoWiring w;
+  w.second[5].bit = 11;  // the knotting pedal's input
+  EXPECT_EQ(drivers::validate(w).message(), "io.inputs.shuttle_at_right_2.bit = 11 is already used by io.inputs.row_knotted");
+  IoWiring twice;
+  twice.second[1].bit = 20;  // two second channels on one input
+  EXPECT_EQ(drivers::validate(twice).message(),
+            "io.inputs.shuttle_at_left_2.bit = 20 is already used by io.inputs.piston_a_retracted_2");
+}
+
+TEST(IoWiring, InputBitsReach31AndSecondChannelsAreOptional) {
+  IoWiring w;
+  w.second[0].bit = 31;
+  EXPECT_TRUE(drivers::validate(w));
+  w.second[0].bit = 32;
+  EXPECT_EQ(drivers::validate(w).message(), "io.inputs.piston_a_extended_2.bit = 32 is outside 0..31 (-1 = not wired)");
+  EXPECT_TRUE(drivers::validate(single_channel()));
+}
+
 TEST(IoWiring, FramesPerCycle) {
   IoWiring w;
   auto g = drivers::io_frames_per_cycle(w);
-  ASSERT_EQ(g.size(), 3u);  // outputs RPDO (1 B), inputs TPDO (2 B: buttons on bits 8..11), load cell TPDO
+  ASSERT_EQ(g.size(), 3u);  // outputs RPDO (1 B), inputs TPDO, load cell TPDO
   EXPECT_EQ(g[0].data_bytes, 1u);
-  EXPECT_EQ(g[1].data_bytes, 2u);
+  EXPECT_EQ(g[1].data_bytes, 3u);  // second channels on bits 16..21: 0x6000:01..03
   EXPECT_EQ(g[2].data_bytes, 2u);
+  EXPECT_EQ(drivers::io_input_subs(w), 3u);
+  // Single-channel sensing: buttons on bits 8..11 are the highest, 0x6000:01..02.
+  EXPECT_EQ(drivers::io_frames_per_cycle(single_channel())[1].data_bytes, 2u);
+  EXPECT_EQ(drivers::io_input_subs(single_channel()), 2u);
+  IoWiring high;
+  high.second[5].bit = 30;  // 0x6000:04
+  EXPECT_EQ(drivers::io_frames_per_cycle(high)[1].data_bytes, 4u);
   w.load_cell_channel = 0;
   EXPECT_EQ(drivers::io_frames_per_cycle(w).size(), 2u);
+}
+
+// What a loom builder checks in a module's EDS: as many 8-bit input groups as the wiring uses.
+std::string required_line(const std::vector<drivers::RequiredObject>& objects, std::uint16_t index) {
+  for (const drivers::RequiredObject& o : objects) {
+    if (o.index == index) return drivers::describe(o);
+  }
+  return "";
+}
+
+TEST(IoWiring, RequiredObjectsCountTheInputGroupsTheWiringUses) {
+  EXPECT_EQ(required_line(drivers::io_module_objects(IoWiring{}), 0x6000),
+            "0x6000:01..03 read digital inputs, 8-bit: sensors and their second channels, e-stop chain, buttons");
+  EXPECT_EQ(required_line(drivers::io_module_objects(IoWiring{}), 0x6200),
+            "0x6200:01 write digital outputs, 8-bit: valves, stack light, buzzer");
+  EXPECT_TRUE(contains(required_line(drivers::io_module_objects(single_channel()), 0x6000), "0x6000:01..02 "));
+  IoWiring high;
+  high.second[5].bit = 30;
+  EXPECT_TRUE(contains(required_line(drivers::io_module_objects(high), 0x6000), "0x6000:01..04 "));
+  // Without a wiring: the objects only.
+  EXPECT_TRUE(contains(required_line(drivers::io_module_objects(), 0x6000), "0x6000 read digital inputs"));
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -156,6 +230,87 @@ TEST(CanIoPort, BringsUpTheModuleAndExchangesEverySignal) {
   r.rig.rack.io_controls().estop_open = true;
   for (int i = 0; i < 3; ++i) r.tick(AxisRequest::kEnable, out);
   EXPECT_FALSE(r.in.io.estop_ok);
+}
+
+// Second channels of the six safety sensors (hal::SafetySensor order) as the master read them.
+std::array<bool, hal::kSafetySensorCount> second(const IoRig& r) {
+  return r.in.io.second_channel;
+}
+using Channels = std::array<bool, hal::kSafetySensorCount>;
+// Pistons retracted, shuttle at the left selvedge: A retracted, B retracted, shuttle at left.
+constexpr Channels kAtRest{false, true, false, true, true, false};
+
+TEST(CanIoPort, DefaultWiringReadsBothChannelsOfEverySafetySensorFromThreeInputBytes) {
+  IoRig r;
+  const drivers::Status s = r.configure();
+  ASSERT_TRUE(s) << s.message();
+  hal::DigitalInputs before;
+  r.port.read_io(0, {}, before);
+  EXPECT_EQ(before.second_channel, Channels{});  // nothing seen yet: nothing confirmed
+  r.enable_all();
+  EXPECT_EQ(last_dlc(r.rig.net, 0x184), 3);  // 0x6000:01..03 in TPDO1
+  EXPECT_EQ(hal::safety_sensors(r.in.io), kAtRest);
+  EXPECT_EQ(second(r), kAtRest);
+  // Valve A on: both switches of "A extended" close, both of "A retracted" open.
+  hal::DigitalOutputs out;
+  out.piston_a_extend = true;
+  for (int i = 0; i < 160; ++i) r.tick(AxisRequest::kEnable, out);
+  const Channels extended{true, false, false, true, true, false};
+  EXPECT_EQ(hal::safety_sensors(r.in.io), extended);
+  EXPECT_EQ(second(r), extended);
+}
+
+// A stuck switch on one channel shows on that channel only: the master reports the two independently.
+TEST(CanIoPort, AStuckSwitchShowsOnItsOwnChannelOnly) {
+  IoRig r;
+  ASSERT_TRUE(r.configure());
+  r.enable_all();
+  // The second switch of shuttle-at-right welded closed, the shuttle at the left.
+  r.rig.rack.io_controls().stuck = {true, hal::SafetySensor::kShuttleAtRight, true, true};
+  for (int i = 0; i < 3; ++i) r.tick(AxisRequest::kEnable);
+  EXPECT_FALSE(r.in.io.shuttle_at_right);
+  EXPECT_TRUE(second(r)[5]);
+  EXPECT_EQ(hal::safety_sensors(r.in.io), kAtRest);
+  // The first switch of piston-A-retracted stuck open.
+  r.rig.rack.io_controls().stuck = {true, hal::SafetySensor::kPistonARetracted, false, false};
+  for (int i = 0; i < 3; ++i) r.tick(AxisRequest::kEnable);
+  EXPECT_FALSE(r.in.io.piston_a_retracted);
+  EXPECT_EQ(second(r), kAtRest);
+}
+
+TEST(CanIoPort, SecondChannelPolarityIsItsOwn) {
+  CanIoConfig pc;
+  pc.wiring.second[1].active_low = true;  // piston A retracted's second switch: a break contact
+  pc.wiring.second[5].active_low = true;  // shuttle at right's second switch
+  IoRig r({}, three_drives(), {}, pc);
+  ASSERT_TRUE(r.configure());
+  r.enable_all();
+  EXPECT_TRUE(r.in.io.piston_a_retracted);
+  EXPECT_FALSE(second(r)[1]);  // terminal 17 closed = not retracted, read through its polarity
+  EXPECT_TRUE(second(r)[5]);   // terminal 21 open
+  EXPECT_TRUE(second(r)[4]);   // the others as wired
+}
+
+TEST(CanIoPort, ASecondChannelOnBit30MapsTheFourthInputByte) {
+  CanIoConfig pc;
+  pc.wiring.second[5] = {30, true};  // terminal 30 is never closed on the simulated module: reads true
+  IoRig r({}, three_drives(), {}, pc);
+  const drivers::Status s = r.configure();
+  ASSERT_TRUE(s) << s.message();
+  r.enable_all();
+  EXPECT_EQ(last_dlc(r.rig.net, 0x184), 4);  // 0x6000:01..04
+  EXPECT_EQ(r.in.io.second_channel, (Channels{false, true, false, true, true, true}));
+}
+
+TEST(CanIoPort, SingleChannelSensingMapsTwoInputBytesAndLeavesSecondChannelsFalse) {
+  CanIoConfig pc;
+  pc.wiring = single_channel();
+  IoRig r({}, three_drives(), {}, pc);
+  ASSERT_TRUE(r.configure());
+  r.enable_all();
+  EXPECT_EQ(last_dlc(r.rig.net, 0x184), 2);  // the module's default 0x6000:01..03 re-mapped to :01..02
+  EXPECT_EQ(hal::safety_sensors(r.in.io), kAtRest);
+  EXPECT_EQ(second(r), Channels{});
 }
 
 TEST(CanIoPort, LoadCellScaledByTheWiringAndShuttleFollowsTheHelix) {
@@ -215,6 +370,69 @@ TEST(Interop, IoModuleWithFixedMappingLackingTheLoadCellIsRefused) {
   const drivers::Status s = r.configure();
   ASSERT_FALSE(s);
   EXPECT_TRUE(contains(s.message(), "node 4 (I/O node): no PDO carries 0x6401:02 (load cell)")) << s.message();
+}
+
+// A 16-input module with a fixed TPDO1 {0x6000:01, 0x6000:02}: the default wiring's second channels
+// (0x6000:03) cannot arrive, so it is refused naming the object and the signal that needs it.
+sim_can::SimIoConfig fixed_16_inputs() {
+  sim_can::SimIoConfig ic;
+  ic.fixed_mapping = true;
+  ic.tpdo1_factory_mapping = {0x60000108, 0x60000208};
+  return ic;
+}
+
+TEST(Interop, IoModuleWithFixedMappingLackingTheSecondChannelsIsRefusedNamingTheSignal) {
+  IoRig r(fixed_16_inputs());
+  const drivers::Status s = r.configure();
+  ASSERT_FALSE(s);
+  EXPECT_EQ(s.message(),
+            "node 4 (I/O node): no PDO carries 0x6000:03 (digital inputs, needed by io.shuttle_at_right_2_bit = 21); "
+            "the module's mapping (fixed or refused) lacks it");
+}
+
+TEST(Interop, IoModuleWithFixedSixteenInputsIsAcceptedForSingleChannelSensing) {
+  CanIoConfig pc;
+  pc.wiring = single_channel();
+  IoRig r(fixed_16_inputs(), three_drives(), {}, pc);
+  const drivers::Status s = r.configure();
+  ASSERT_TRUE(s) << s.message();
+  r.enable_all();
+  EXPECT_EQ(hal::safety_sensors(r.in.io), kAtRest);
+}
+
+// A writable 16-input module cannot map 0x6000:03: the SDO abort is explained by the signal that needs it.
+TEST(Interop, IoModuleWithSixteenInputsRefusingTheThirdGroupIsExplainedByTheSignal) {
+  sim_can::SimIoConfig ic;
+  ic.digital_input_groups = 2;
+  IoRig r(ic);
+  const drivers::Status s = r.configure();
+  ASSERT_FALSE(s);
+  EXPECT_TRUE(contains(s.message(), "node 4 (I/O node): SDO write 0x1A00:03")) << s.message();
+  EXPECT_TRUE(contains(s.message(), "0x06040041")) << s.message();
+  EXPECT_TRUE(contains(s.message(), "; 0x6000:03 is mapped because the wiring reads 0x6000:01..03 up to "
+                                    "io.shuttle_at_right_2_bit = 21 (a module with fewer digital inputs needs "
+                                    "that signal moved or unwired, -1)"))
+      << s.message();
+  // The same module serves single-channel sensing.
+  CanIoConfig pc;
+  pc.wiring = single_channel();
+  IoRig single(ic, three_drives(), {}, pc);
+  const drivers::Status ok = single.configure();
+  ASSERT_TRUE(ok) << ok.message();
+  single.enable_all();
+  EXPECT_EQ(hal::safety_sensors(single.in.io), kAtRest);
+}
+
+// The inputs are one sample: a fixed mapping that spreads them over two TPDOs is refused.
+TEST(Interop, IoModuleWithInputsSplitOverTwoTpdosIsRefused) {
+  sim_can::SimIoConfig ic = fixed_16_inputs();
+  ic.tpdo2_factory_mapping = {0x64010110, 0x60000308};  // load cell, then the third input byte
+  IoRig r(ic);
+  const drivers::Status s = r.configure();
+  ASSERT_FALSE(s);
+  EXPECT_EQ(s.message(),
+            "node 4 (I/O node): 0x6000:03 (digital inputs, needed by io.shuttle_at_right_2_bit = 21) is in TPDO2, "
+            "0x6000:01 in TPDO1; the master needs every digital input in one TPDO (one sample per cycle)");
 }
 
 // Rule 2: "object does not exist" while disabling an unused PDO is not an error.

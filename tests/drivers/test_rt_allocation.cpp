@@ -1,12 +1,15 @@
 // The CAN axis port's per-tick path allocates nothing: operator new is counted while read_axes and
 // write_axes run over 20,000 ticks against simulated drives, including a heartbeat loss, a drive fault
-// with EMCY and a fault reset. (Its own executable: tests/support's counter replaces the global operator new.)
+// with EMCY and a fault reset; likewise the I/O node's read_io/write_io. (Its own executable: tests/support's counter replaces the global operator new.)
 #include <gtest/gtest.h>
 
 
 #include "fake_can_network.hpp"
 #include "loom/drivers/can_axis_port.hpp"
+#include "loom/drivers/can_io_port.hpp"
+#include "loom/hal/hal.hpp"
 #include "loom/sim_can/sim_drive_rack.hpp"
+#include "loom/sim_can/sim_io_node.hpp"
 #include "relay_bus.hpp"
 #include "alloc_counter.hpp"
 
@@ -79,6 +82,65 @@ TEST(CanAxisPortRt, TwentyThousandTicksWithoutAllocation) {
   EXPECT_TRUE(saw_fault);
   EXPECT_TRUE(link.link_fault);  // the heartbeat loss was seen too
   EXPECT_EQ(allocations(), 0u);
+  EXPECT_EQ(worst, 0);
+}
+
+// The I/O node's per-tick path (on_frame through the axis port's drain, read_io with both channels of
+// every safety sensor, write_io) allocates nothing either, with the default wiring's three input bytes
+// and a switch sticking and freeing on the way.
+TEST(CanIoPortRt, FiveThousandTicksWithoutAllocation) {
+  FakeCanNetwork net;
+  auto& master = net.add_endpoint();
+  auto& drives = net.add_endpoint();
+  std::vector<sim_can::SimDriveConfig> nodes(3);
+  for (std::size_t i = 0; i < 3; ++i) nodes[i].node_id = static_cast<std::uint8_t>(i + 1);
+  sim_can::SimDriveRack rack(drives, nodes);
+  sim_can::SimIoConfig io_cfg;
+  sim_can::SimIoNode io(drives, io_cfg);
+  rack.attach_io(io, {0, 2, drivers::kDefaultCountsPerRad, drivers::kDefaultCountsPerRad});
+  RelayBus relay(master);
+  drivers::CanAxisPortConfig axis_cfg;
+  axis_cfg.other_frames_per_cycle = drivers::io_frames_per_cycle(drivers::IoWiring{});
+  drivers::CanAxisPort port{axis_cfg};
+  drivers::CanIoPort io_port{drivers::CanIoConfig{}};
+  port.attach(io_port);
+  std::int64_t now = 0;
+  Clock clock(net, rack, now);
+  rack.power_on(now);
+  ASSERT_TRUE(port.configure(relay, clock).is_ok());
+  ASSERT_TRUE(io_port.configure(relay, clock).is_ok());
+  relay.set_passthrough(false);
+
+  hal::PortHal hal(port, io_port);
+  hal::HalInputs in{};
+  hal::HalOutputs out{};
+  long worst = 0;
+  bool saw_disagreement = false;
+  for (hal::Tick k = 0; k < 5'000; ++k) {
+    rack.io_controls().stuck = {k >= 1'000 && k < 3'000, hal::SafetySensor::kShuttleAtRight, true, true};
+    const long before = static_cast<long>(allocations());
+    count_allocations(true);
+    hal.read(k, in);
+    for (std::size_t i = 0; i < 3; ++i) {
+      out.axes[i].request = hal::AxisRequest::kEnable;
+      out.axes[i].target_position = in.axes[i].position;
+    }
+    out.io.piston_a_extend = (k / 500) % 2 == 1;
+    hal.write(k, out);
+    count_allocations(false);
+    worst = std::max(worst, static_cast<long>(allocations()) - before);
+    saw_disagreement = saw_disagreement || in.io.second_channel[5] != in.io.shuttle_at_right;
+    relay.exchange();
+    for (int s = 0; s < 20; ++s) {
+      now += 100;
+      net.set_time(now);
+      rack.step(now);
+    }
+    relay.exchange();
+  }
+  EXPECT_TRUE(saw_disagreement);
+  EXPECT_FALSE(in.link.link_fault);
+  EXPECT_EQ(in.io.refreshed, 4'999);
   EXPECT_EQ(worst, 0);
 }
 

@@ -33,17 +33,24 @@ constexpr std::uint16_t kOutputErrorValue = 0x6207;
 constexpr std::uint16_t kAnalogInputs = 0x6401;
 
 // The node's wiring (its own terminal numbering; the master's default wiring matches it by config).
-constexpr int kInPistonAExt = 0, kInPistonARet = 1, kInPistonBExt = 2, kInPistonBRet = 3, kInShuttleLeft = 4,
-              kInShuttleRight = 5, kInEstopOk = 6, kInStart = 8, kInPause = 9, kInAck = 10, kInKnotted = 11;
+// The six safety sensors in hal::SafetySensor order: piston A extended/retracted, piston B
+// extended/retracted, shuttle at left/right; each has two switches at the same place, on terminals
+// 0..5 and 16..21.
+constexpr std::array<int, hal::kSafetySensorCount> kInSafetyFirst{0, 1, 2, 3, 4, 5};
+constexpr std::array<int, hal::kSafetySensorCount> kInSafetySecond{16, 17, 18, 19, 20, 21};
+constexpr int kInEstopOk = 6, kInStart = 8, kInPause = 9, kInAck = 10, kInKnotted = 11;
 constexpr int kOutValveA = 0, kOutValveB = 1;
 
 constexpr slave::Objects<5> kCommunicationObjects = slave::communication_objects(kDeviceType);
 
 // Digital inputs (8-bit groups), outputs, output error mode and value, analog inputs.
-constexpr slave::Objects<17> kIoObjects{{
-    {kDigitalInputs, 0, 1, Access::kConst, Pdo::kNone, 2},
+// 32 digital inputs (0x6000:01..04), of which the loom uses terminals 0..21.
+constexpr slave::Objects<19> kIoObjects{{
+    {kDigitalInputs, 0, 1, Access::kConst, Pdo::kNone, 4},
     {kDigitalInputs, 1, 1, Access::kRo, Pdo::kTx, 0},
     {kDigitalInputs, 2, 1, Access::kRo, Pdo::kTx, 0},
+    {kDigitalInputs, 3, 1, Access::kRo, Pdo::kTx, 0},
+    {kDigitalInputs, 4, 1, Access::kRo, Pdo::kTx, 0},
     {kDigitalOutputs, 0, 1, Access::kConst, Pdo::kNone, 2},
     {kDigitalOutputs, 1, 1, Access::kRw, Pdo::kRx, 0},
     {kDigitalOutputs, 2, 1, Access::kRw, Pdo::kRx, 0},
@@ -62,8 +69,8 @@ constexpr slave::Objects<17> kIoObjects{{
 }};
 
 // The object dictionary: every object the module has, once. Pre-defined PDOs of CiA 401: RPDO1 the
-// digital outputs, TPDO1 the digital inputs on change, TPDO2 the analog inputs; RPDO2 and TPDO3/4
-// present but invalid.
+// digital outputs, TPDO1 the digital inputs on change (the three groups the loom wires, terminals
+// 0..23), TPDO2 the analog inputs; RPDO2 and TPDO3/4 present but invalid.
 // One object per line, so the table reads as the dictionary it is.
 // clang-format off
 constexpr auto kTable = slave::concat(
@@ -76,7 +83,8 @@ constexpr auto kTable = slave::concat(
     pdo_comm(0x1801, cob::kTpdo2, 255),
     pdo_comm(0x1802, cob::kTpdo3 | cob::kPdoInvalid, 255),
     pdo_comm(0x1803, cob::kTpdo4 | cob::kPdoInvalid, 255),
-    pdo_map(0x1A00, {map_entry(kDigitalInputs, 1, 8), map_entry(kDigitalInputs, 2, 8)}),
+    pdo_map(0x1A00, {map_entry(kDigitalInputs, 1, 8), map_entry(kDigitalInputs, 2, 8),
+                     map_entry(kDigitalInputs, 3, 8)}),
     pdo_map(0x1A01, {map_entry(kAnalogInputs, 1, 16)}),
     pdo_map(0x1A02),
     pdo_map(0x1A03),
@@ -90,6 +98,13 @@ SimIoNode::SimIoNode(drivers::CanBus& bus, SimIoConfig config)
     : bus_(bus),
       config_(std::move(config)),
       od_(kTable, slave::OdOptions{config_.absent_objects, config_.fixed_mapping}) {
+  // A module with fewer than the table's three mapped input groups pre-defines TPDO1 with the ones it
+  // has (resolved here, so resets allocate nothing).
+  if (config_.tpdo1_factory_mapping.empty() && input_groups() < 3) {
+    for (int k = 1; k <= input_groups(); ++k) {
+      config_.tpdo1_factory_mapping.push_back(map_entry(kDigitalInputs, static_cast<std::uint8_t>(k), 8));
+    }
+  }
   reset_application();
 }
 
@@ -98,6 +113,8 @@ SimIoNode::SimIoNode(drivers::CanBus& bus, SimIoConfig config)
 // ---------------------------------------------------------------------------------------------------
 void SimIoNode::reset_communication(std::int64_t now_us) {
   od_.reset_communication(config_.node_id);
+  set_factory_mapping(0, config_.tpdo1_factory_mapping);
+  set_factory_mapping(1, config_.tpdo2_factory_mapping);
   nmt_ = nmt::kPreOperational;
   syncs_ = 0;
   rpdo_pending_.fill(false);
@@ -106,8 +123,24 @@ void SimIoNode::reset_communication(std::int64_t now_us) {
   boot_at_us_ = now_us + config_.boot_delay_us;
 }
 
+int SimIoNode::input_groups() const {
+  return std::clamp(config_.digital_input_groups, 1, 4);
+}
+
+// A personality's own factory mapping of TPDO `tpdo` (empty: the table's default stays).
+void SimIoNode::set_factory_mapping(int tpdo, const std::vector<std::uint32_t>& entries) {
+  if (entries.empty()) return;
+  const auto map = static_cast<std::uint16_t>(slave::kTpdoMap + tpdo);
+  const std::size_t n = std::min<std::size_t>(slave::kMapEntries, entries.size());
+  for (std::size_t e = 0; e < slave::kMapEntries; ++e) {
+    od_.set(map, static_cast<std::uint8_t>(e + 1), e < n ? entries[e] : 0);
+  }
+  od_.set(map, 0, static_cast<std::uint32_t>(n));
+}
+
 void SimIoNode::reset_application() {
   od_.reset_application();
+  od_.set(kDigitalInputs, 0, static_cast<std::uint32_t>(input_groups()));
 }
 
 void SimIoNode::power_on(std::int64_t now_us) {
@@ -236,6 +269,15 @@ void SimIoNode::send_changed_inputs() {
   }
 }
 
+// A group the module lacks cannot be mapped (the dictionary table is shared by every personality, so
+// the rule is here rather than in it).
+std::uint32_t SimIoNode::check(std::uint16_t index, std::uint8_t sub, std::uint32_t value) const {
+  const bool map_entry_write = index >= slave::kTpdoMap && index < slave::kTpdoMap + slave::kPdos && sub >= 1;
+  const auto group = static_cast<int>((value >> 8) & 0xFF);
+  const bool missing_group = (value >> 16) == kDigitalInputs && group > input_groups();
+  return map_entry_write && missing_group ? slave::abort_code::kNotMappable : 0;
+}
+
 void SimIoNode::written(std::uint16_t index, std::uint8_t, std::uint32_t value, std::int64_t now_us) {
   if (index == kProducerHeartbeat) {
     next_hb_us_ = now_us + static_cast<std::int64_t>(value) * 1000;
@@ -248,26 +290,35 @@ void SimIoNode::written(std::uint16_t index, std::uint8_t, std::uint32_t value, 
 // ---------------------------------------------------------------------------------------------------
 // Plant and timers
 // ---------------------------------------------------------------------------------------------------
+// What the six safety sensors should see (hal::SafetySensor order): end positions of the pistons, the
+// shuttle within its window of either selvedge.
+std::array<bool, hal::kSafetySensorCount> SimIoNode::safety_sensors_truth() const {
+  const double x = plant_.helix_rad * config_.helix_lead_m / (2.0 * 3.14159265358979323846);
+  return {piston_[0] >= 1.0, piston_[0] <= 0.0, piston_[1] >= 1.0, piston_[1] <= 0.0,
+          x <= config_.selvedge_window_m, x >= config_.width_m - config_.selvedge_window_m};
+}
+
 void SimIoNode::update_inputs() {
-  std::array<std::uint8_t, 2> in{};
+  std::array<std::uint8_t, 4> in{};
   const auto set = [&](int bit, bool on) {
     if (on) in[static_cast<std::size_t>(bit / 8)] |= static_cast<std::uint8_t>(1U << (bit % 8));
   };
-  set(kInPistonAExt, piston_[0] >= 1.0);
-  set(kInPistonARet, piston_[0] <= 0.0);
-  set(kInPistonBExt, piston_[1] >= 1.0);
-  set(kInPistonBRet, piston_[1] <= 0.0);
-  const double x = plant_.helix_rad * config_.helix_lead_m / (2.0 * 3.14159265358979323846);
-  set(kInShuttleLeft, x <= config_.selvedge_window_m);
-  set(kInShuttleRight, x >= config_.width_m - config_.selvedge_window_m);
+  // Both switches of a sensor follow the same truth; only the stuck one (test hook) departs from it.
+  const std::array<bool, hal::kSafetySensorCount> truth = safety_sensors_truth();
+  const StuckSwitch& stuck = plant_.stuck;
+  for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) {
+    const bool here = stuck.active && static_cast<std::size_t>(stuck.sensor) == i;
+    set(kInSafetyFirst[i], here && !stuck.second ? stuck.level : truth[i]);
+    set(kInSafetySecond[i], here && stuck.second ? stuck.level : truth[i]);
+  }
   set(kInEstopOk, !plant_.estop_open);
   set(kInStart, plant_.button_start);
   set(kInPause, plant_.button_pause);
   set(kInAck, plant_.button_ack);
   set(kInKnotted, plant_.row_knotted);
+  for (std::size_t k = static_cast<std::size_t>(input_groups()); k < in.size(); ++k) in[k] = 0;  // no terminals
   in_ = in;
-  od_.set(kDigitalInputs, 1, in[0]);
-  od_.set(kDigitalInputs, 2, in[1]);
+  for (std::size_t k = 0; k < in.size(); ++k) od_.set(kDigitalInputs, static_cast<std::uint8_t>(k + 1), in[k]);
   // Load cell: a narrow pulse around the crank angle at which the beater meets the fell.
   const double two_pi = 2.0 * 3.14159265358979323846;
   double d = std::fmod(plant_.crank_rad - config_.fell_crank_rad, two_pi);
@@ -303,7 +354,7 @@ void SimIoNode::step(std::int64_t now_us, const IoPlant& plant) {
     next_hb_us_ = now_us + hb_us;
   }
   if (boot_at_us_ >= 0) return;
-  const std::array<std::uint8_t, 2> before = in_;
+  const std::array<std::uint8_t, 4> before = in_;
   update_inputs();
   if (nmt_ == nmt::kOperational && in_ != before) send_changed_inputs();
   produce_heartbeat(now_us);

@@ -114,7 +114,13 @@ struct CanIoConfig {
 // Configure-time only.
 Status validate(const CanIoConfig& config);
 
-// The frames this node adds to every cycle with `wiring` (one RPDO, one or two TPDOs).
+// Configure-time only. The 8-bit subs of 0x6000 (inputs) and of 0x6200 (outputs) the wiring uses: 1 up
+// to the one holding its highest wired bit (0x6000:01..03 for the default wiring's second channels).
+std::uint8_t io_input_subs(const IoWiring& wiring);
+std::uint8_t io_output_subs(const IoWiring& wiring);
+
+// The frames this node adds to every cycle with `wiring` (one RPDO, one or two TPDOs): the inputs' TPDO
+// carries one byte per 8-bit sub up to the highest wired input (3 with the default second channels).
 std::vector<FrameGroup> io_frames_per_cycle(const IoWiring& wiring);
 
 // The output values the module is told to adopt by itself on failure (0x6206/0x6207): both valve coils
@@ -170,9 +176,17 @@ class CanIoPort final : public hal::IoPort, public CanNodeListener {
     std::array<std::uint32_t, kMaxPdoEntries> entries{};
   };
 
+  // 8-bit subs of 0x6000 the master can read (kIoMaxInputBits).
+  static constexpr std::size_t kMaxInputSubs = kIoMaxInputBits / 8;
+
   Status configure_mapping(class SdoClient& sdo);
+  Status locate(const std::array<PdoLayout, 4>& layouts, std::uint32_t wanted, const std::string& what,
+                Slot& slot) const;
+  Status locate_inputs(std::uint8_t subs);
+  Status explain_refused_input(const Status& s, std::uint32_t entry, std::uint8_t subs) const;
+  // `refused` (optional): the mapping entry the module refused to take, 0 when none was.
   Status map_pdo(SdoClient& sdo, bool rx, int pdo, const std::vector<std::uint32_t>& wanted,
-                 std::uint8_t transmission_type, PdoLayout& actual);
+                 std::uint8_t transmission_type, PdoLayout& actual, std::uint32_t* refused = nullptr);
   Status disable_pdo(SdoClient& sdo, bool rx, int pdo);
   static Slot find(const std::array<PdoLayout, 4>& layouts, std::uint32_t entry_without_len);
   std::string who() const;
@@ -186,14 +200,15 @@ class CanIoPort final : public hal::IoPort, public CanNodeListener {
 
   std::array<PdoLayout, 4> tpdo_{};
   std::array<PdoLayout, 4> rpdo_{};
-  std::array<Slot, 2> input_slot_{};   // 0x6000:01, :02
+  std::array<Slot, kMaxInputSubs> input_slot_{};  // 0x6000:01..04 (pdo −1: not read)
+  int input_pdo_ = -1;                             // the one TPDO carrying the digital inputs
   std::array<Slot, 2> output_slot_{};  // 0x6200:01, :02
   Slot analog_slot_{};
   int output_pdo_ = -1;
   std::uint8_t output_pdo_bytes_ = 0;
 
   // RT state.
-  std::array<std::uint8_t, 2> inputs_{};
+  std::array<std::uint8_t, kMaxInputSubs> inputs_{};
   hal::Tick inputs_refreshed_ = hal::kNeverTick;
   std::int16_t analog_counts_ = 0;
   hal::Tick analog_refreshed_ = hal::kNeverTick;

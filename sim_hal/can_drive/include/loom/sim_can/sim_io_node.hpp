@@ -1,7 +1,8 @@
 // A simulated CiA 401 generic I/O module as a CANopen node, with the loom's plant behind it: two
 // pneumatic pistons (valve coil → end sensors after a fill time), the shuttle-arrival sensors (the
-// shuttle rides the helix shaft's carrier), the beater's load cell (from the crank angle), the e-stop
-// chain and the operator buttons (set by the test or the executable's control file).
+// shuttle rides the helix shaft's carrier), each of these six safety sensors twice (two independent
+// switches on their own terminals), the beater's load cell (from the crank angle), the e-stop chain and
+// the operator buttons (set by the test or the executable's control file).
 //
 // Deliberately independent of the master's codec: its object dictionary is one table in
 // sim_io_node.cpp (index, sub, size, access, PDO direction, default) from which SDO read/write, PDO
@@ -15,9 +16,20 @@
 #include <vector>
 
 #include "loom/drivers/can_frame.hpp"
+#include "loom/hal/types.hpp"
 #include "loom/sim_can/slave_od.hpp"
 
 namespace loom::sim_can {
+
+// One switch of a safety sensor that reads `level` whatever the plant does (a welded reed contact, a
+// light barrier blinded by fluff): the other channel of that sensor still follows the plant, which is
+// what a two-channel master must notice.
+struct StuckSwitch {
+  bool active = false;
+  hal::SafetySensor sensor = hal::SafetySensor::kPistonAExtended;
+  bool second = false;  // false: the first switch (terminals 0..5), true: the second (terminals 16..21)
+  bool level = false;   // what its terminal reads
+};
 
 // What the module's inputs physically see, set by the caller every step (RT-safe plain data).
 struct IoPlant {
@@ -29,6 +41,7 @@ struct IoPlant {
   bool button_ack = false;
   bool row_knotted = false;
   bool silent = false;  // cable pulled: sends nothing, hears nothing
+  StuckSwitch stuck{};  // test hook: one channel of one safety sensor stuck
 };
 
 struct SimIoConfig {
@@ -48,6 +61,14 @@ struct SimIoConfig {
   double load_cell_n_per_count = 0.01;
   // Interoperability variants.
   bool fixed_mapping = false;                 // 0x16xx/0x1Axx read-only, sub 0 included
+  // A module's own factory TPDO1/TPDO2 (mapping entries index << 16 | sub << 8 | bits), e.g. a fixed
+  // 16-input module's {0x60000108, 0x60000208}; empty = the defaults in sim_io_node.cpp.
+  std::vector<std::uint32_t> tpdo1_factory_mapping;
+  std::vector<std::uint32_t> tpdo2_factory_mapping;
+  // 8-bit input groups the module has (1..4; 2 = a 16-input module without the second channels'
+  // terminals 16..21): 0x6000:00 says so, its default TPDO1 carries them all (at most three), the missing
+  // groups read 0 and cannot be mapped (abort 0x06040041).
+  int digital_input_groups = 4;
   std::vector<std::uint16_t> absent_objects;  // e.g. 0x1016, 0x6206, 0x1802
   std::int64_t boot_delay_us = 0;             // power-on / reset → boot-up
 };
@@ -69,7 +90,7 @@ class SimIoNode : private slave::ObjectHooks {
   std::uint8_t node_id() const { return config_.node_id; }
   std::uint8_t nmt_state() const { return nmt_; }  // 0x00, 0x04, 0x05, 0x7F as on the wire
   std::uint8_t outputs(int byte) const;            // what drives the valve coils now (error state applied)
-  std::uint8_t inputs(int byte) const { return in_[static_cast<std::size_t>(byte)]; }
+  std::uint8_t inputs(int byte) const { return in_[static_cast<std::size_t>(byte)]; }  // 0x6000:01..04
   std::int16_t analog_counts() const { return analog_; }
   bool comm_lost() const { return comm_lost_; }   // master heartbeat consumer expired
   double piston_a() const { return piston_[0]; }  // 0 = retracted … 1 = extended
@@ -78,6 +99,7 @@ class SimIoNode : private slave::ObjectHooks {
  private:
   // The bus's writes reach the module through the ObjectHooks (timers react to them).
   void written(std::uint16_t index, std::uint8_t sub, std::uint32_t value, std::int64_t now_us) override;
+  std::uint32_t check(std::uint16_t index, std::uint8_t sub, std::uint32_t value) const override;
 
   void on_nmt(std::uint8_t command, std::int64_t now_us);
   void on_sdo(const drivers::CanFrame& f, std::int64_t now_us);
@@ -89,6 +111,9 @@ class SimIoNode : private slave::ObjectHooks {
   void reset_application();
   void send(const drivers::CanFrame& f);
   void update_inputs();
+  void set_factory_mapping(int tpdo, const std::vector<std::uint32_t>& entries);
+  int input_groups() const;
+  std::array<bool, hal::kSafetySensorCount> safety_sensors_truth() const;
   void move_pistons(double dt);
   void watch_master(std::int64_t now_us);
   void produce_heartbeat(std::int64_t now_us);
@@ -110,7 +135,7 @@ class SimIoNode : private slave::ObjectHooks {
   IoPlant plant_{};
   std::int64_t last_step_us_ = -1;
   std::array<double, 2> piston_{0.0, 0.0};
-  std::array<std::uint8_t, 2> in_{};
+  std::array<std::uint8_t, 4> in_{};  // terminals 0..31
   std::int16_t analog_ = 0;
 };
 
