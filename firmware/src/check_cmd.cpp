@@ -126,7 +126,7 @@ void print_plan(const LoomConfig& c) {
               c.can.node_helix);
   for (const auto& o : drivers::drive_objects()) std::printf("    %s\n", drivers::describe(o).c_str());
   std::printf("  objects the I/O module (node %u) must support:\n", c.io.node);
-  for (const auto& o : drivers::io_module_objects()) std::printf("    %s\n", drivers::describe(o).c_str());
+  for (const auto& o : drivers::io_module_objects(c.io.wiring)) std::printf("    %s\n", drivers::describe(o).c_str());
 }
 
 void print_scene(const Scene& s) {

@@ -124,7 +124,7 @@ void ControlLoop::push_events(hal::Tick now) noexcept {
   // FAULT: the latched first fault, a later diagnosis of its root cause, and every device report.
   const sequencer::Fault f = seq_.first_fault();
   const auto fault_event = [&](telemetry::Event::FaultKind kind, sequencer::Fault which, int axis,
-                               std::uint16_t device_code) {
+                               std::uint16_t device_code, int sensor = -1) {
     telemetry::Event e;
     e.kind = telemetry::Event::Kind::kFault;
     fill_event_context(e, now);
@@ -132,6 +132,7 @@ void ControlLoop::push_events(hal::Tick now) noexcept {
     e.fault = static_cast<std::uint8_t>(which);
     e.axis = static_cast<std::int8_t>(axis);
     e.device_code = device_code;
+    e.sensor = static_cast<std::int8_t>(sensor);
     copy_name(e.state, sequencer::state_name(prev_state_));
     push_event(e);
   };
@@ -141,7 +142,7 @@ void ControlLoop::push_events(hal::Tick now) noexcept {
     if (f != sequencer::Fault::kNone) {
       fault_event(prev_fault_ == sequencer::Fault::kNone ? telemetry::Event::FaultKind::kFirst
                                                           : telemetry::Event::FaultKind::kDiagnosis,
-                  f, seq_.fault_axis(), seq_.fault_detail());
+                  f, seq_.fault_axis(), seq_.fault_detail(), seq_.fault_sensor());
       first_axis_reported = seq_.fault_axis();
       link_reported = f == sequencer::Fault::kLinkFault ||
                       (f == sequencer::Fault::kHeartbeatLost && seq_.fault_axis() < 0);
@@ -178,6 +179,7 @@ void ControlLoop::fill_snapshot(hal::Tick now) noexcept {
   copy_name(s.first_fault, faulted ? sequencer::fault_name(f) : "");
   s.first_fault_code = sequencer::fault_code(f);
   s.fault_axis = static_cast<std::int8_t>(faulted ? seq_.fault_axis() : -1);
+  s.fault_sensor = static_cast<std::int8_t>(faulted ? seq_.fault_sensor() : -1);
   s.fault_device_code = faulted ? seq_.fault_detail() : 0;
   s.fault_tick = faulted ? seq_.fault_tick() : hal::kNeverTick;
   copy_name(s.stopped_by, faulted ? sequencer::fault_name(seq_.stopped_by()) : "");
@@ -209,6 +211,10 @@ void ControlLoop::fill_snapshot(hal::Tick now) noexcept {
       (io.piston_a_extended ? 1 : 0) | (io.piston_a_retracted ? 2 : 0) | (io.piston_b_extended ? 4 : 0) |
       (io.piston_b_retracted ? 8 : 0) | (io.shuttle_at_left ? 16 : 0) | (io.shuttle_at_right ? 32 : 0) |
       (io.estop_ok ? 64 : 0));
+  s.inputs_2 = 0;
+  for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) {
+    if (io.second_channel[i]) s.inputs_2 = static_cast<std::uint8_t>(s.inputs_2 | (1U << i));
+  }
   s.overruns = stats_.overruns;
   s.tick_cost_ns = stats_.last_tick_cost_ns;
   s.max_tick_cost_ns = stats_.max_tick_cost_ns;

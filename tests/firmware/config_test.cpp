@@ -245,3 +245,23 @@ TEST(Config, StructDefaultsAgreeWithTheEmbeddedDefaultToml) {
   EXPECT_DOUBLE_EQ(a.max_table_error_rad, b.max_table_error_rad);
   EXPECT_EQ(built.loom_id, parsed.loom_id);
 }
+
+// The safety sensors' second switches are wiring like any other input: a bit already used is refused at
+// the second switch's own key; -1 leaves that sensor single-channel; the discrepancy time is a time.
+TEST(Config, SecondSwitchesAreWiredInputsAndDeriveTheSequencersDualChannels) {
+  const LoomConfig dual = parse_loom_config("extends = \"default\"\n", "loom.toml");
+  for (bool wired : dual.sequencer.second_channel) EXPECT_TRUE(wired);
+  for (bool fitted : dual.machine.second_channel) EXPECT_TRUE(fitted);
+  EXPECT_DOUBLE_EQ(dual.sequencer.sensor_discrepancy_s, 0.02);
+  const LoomConfig single = parse_loom_config("extends = \"default\"\n[io]\nshuttle_at_left_2_bit = -1\n", "loom.toml");
+  EXPECT_FALSE(single.sequencer.second_channel[static_cast<std::size_t>(loom::hal::SafetySensor::kShuttleAtLeft)]);
+  EXPECT_FALSE(single.machine.second_channel[static_cast<std::size_t>(loom::hal::SafetySensor::kShuttleAtLeft)]);
+  EXPECT_TRUE(single.sequencer.second_channel[static_cast<std::size_t>(loom::hal::SafetySensor::kShuttleAtRight)]);
+  const std::string e = config_error("extends = \"default\"\n[io]\nshuttle_at_right_2_bit = 5\n");
+  EXPECT_EQ(e.rfind("loom.toml:3:26: io.shuttle_at_right_2_bit = 5: the I/O module refuses it: ", 0), 0u) << e;
+  EXPECT_NE(e.find("already used by io.inputs.shuttle_at_right"), std::string::npos) << e;
+  EXPECT_EQ(config_error("extends = \"default\"\n[io]\npiston_a_extended_2_bit = 32\n"),
+            "loom.toml:3:27: io.piston_a_extended_2_bit = 32: must be in [-1, 31]");
+  EXPECT_EQ(config_error("extends = \"default\"\n[timing]\nsensor_discrepancy_ms = 0\n"),
+            "loom.toml:3:25: timing.sensor_discrepancy_ms = 0: must be in [1, 1000]");
+}

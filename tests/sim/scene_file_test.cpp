@@ -91,3 +91,21 @@ TEST(SceneFile, EveryFaultKindRoundTripsThroughTheWriter) {
   EXPECT_EQ(back.spec.faults[0].at_s, s.faults[0].at_s);  // 17 digits: exact
   EXPECT_EQ(back.spec.name, s.name);
 }
+
+TEST(SceneFile, AFaultInASecondSwitchTheLoomDoesNotHaveIsRefusedAtTheFault) {
+  const firmware::Scene scene = firmware::parse_scene(
+      "effects = [\"ideal\"]\n[[fault]]\nkind = \"stuck_sensor\"\nat_s = 1.0\nsensor = \"shuttle_at_right_2\"\nvalue = true\n",
+      "s.toml");
+  EXPECT_NO_THROW(firmware::check_scene_fits(scene, firmware::default_loom_config()));
+  firmware::LoomConfig single = firmware::default_loom_config();
+  single.io.wiring.second[static_cast<std::size_t>(hal::SafetySensor::kShuttleAtRight)].bit = -1;
+  firmware::rederive_and_check(single, "test");
+  try {
+    firmware::check_scene_fits(scene, single);
+    FAIL() << "a fault in a switch the loom does not have was accepted";
+  } catch (const firmware::ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("s.toml:2:1: fault[0].sensor = \"shuttle_at_right_2\": the loom", 0), 0u)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("io.shuttle_at_right_2_bit = -1"), std::string::npos) << e.what();
+  }
+}

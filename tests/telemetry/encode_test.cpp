@@ -50,6 +50,7 @@ Snapshot sample() {
   }
   s.outputs = 0b10;
   s.inputs = 0b1000101;
+  s.inputs_2 = 0b100001;
   s.overruns = 3;
   s.tick_cost_ns = 41'000;
   s.max_tick_cost_ns = 97'000;
@@ -87,6 +88,7 @@ TEST(Encode, StatusCarriesStateCountersAndFault) {
   EXPECT_EQ(m.stopped_by, "stale_feedback");
   EXPECT_EQ(m.outputs, 0b10);
   EXPECT_EQ(m.inputs, 0b1000101);
+  EXPECT_EQ(m.inputs_2, 0b100001);
 }
 
 TEST(Encode, AxesCarryEveryAxisWithNames) {
@@ -208,6 +210,21 @@ TEST(Encode, FaultEventNamesAxisCodeAndText) {
   e.fault_kind = Event::FaultKind::kDevice;
   EXPECT_EQ(to_fault(e, "L7", 9).axis, "");
   EXPECT_EQ(to_fault(e, "L7", 9).kind, "device");
+}
+
+TEST(Encode, ASensorDiscrepancyNamesItsSensorInTheText) {
+  Event e = event(Event::Kind::kFault);
+  e.fault = 31;  // the fault table's entry sensor_discrepancy
+  e.sensor = static_cast<std::int8_t>(loom::hal::SafetySensor::kShuttleAtRight);
+  const auto m = round_trip(to_fault(e, "L7", 9));
+  EXPECT_EQ(m.name, "sensor_discrepancy");
+  EXPECT_EQ(m.text,
+            "the two channels of a safety sensor disagree (a stuck switch or a wiring fault): shuttle_at_right");
+  Snapshot s = sample();
+  test_support::set_name(s.first_fault, "sensor_discrepancy");
+  s.fault_sensor = static_cast<std::int8_t>(loom::hal::SafetySensor::kPistonBExtended);
+  EXPECT_EQ(round_trip(to_status(s, "L7", 9)).fault_text,
+            "the two channels of a safety sensor disagree (a stuck switch or a wiring fault): piston_b_extended");
 }
 
 TEST(Encode, RowEventSplitsTimeInSeconds) {

@@ -53,6 +53,13 @@ namespace {
 sequencer::Fault fault_of(std::uint8_t v) noexcept {
   return static_cast<sequencer::Fault>(v);
 }
+// The operator text, naming the safety sensor a fault is about ("...: shuttle_at_right").
+std::string with_sensor(std::string text, std::int8_t sensor) {
+  if (sensor >= 0 && sensor < static_cast<std::int8_t>(hal::kSafetySensorCount)) {
+    text += std::string(": ") + hal::safety_sensor_name(static_cast<hal::SafetySensor>(sensor));
+  }
+  return text;
+}
 }  // namespace
 
 loomlcm::status_t to_status(const Snapshot& s, const std::string& loom_id, std::int64_t utime) {
@@ -74,11 +81,12 @@ loomlcm::status_t to_status(const Snapshot& s, const std::string& loom_id, std::
   const bool faulted = !m.first_fault.empty();
   m.fault_axis = faulted ? axis_or_empty(s.fault_axis) : std::string();
   m.fault_device_code = faulted ? s.fault_device_code : 0;
-  m.fault_text = faulted ? fault_text_of(m.first_fault) : std::string();
+  m.fault_text = faulted ? with_sensor(fault_text_of(m.first_fault), s.fault_sensor) : std::string();
   m.fault_time_s = faulted && s.fault_tick >= 0 ? seconds(s.fault_tick, s.period_ns) : 0.0;
   m.stopped_by = from_cstr(s.stopped_by);
   m.outputs = s.outputs;
   m.inputs = s.inputs;
+  m.inputs_2 = s.inputs_2;
   return m;
 }
 
@@ -171,7 +179,7 @@ loomlcm::fault_t to_fault(const Event& e, const std::string& loom_id, std::int64
   const sequencer::Fault f = fault_of(e.fault);
   m.name = sequencer::fault_name(f);
   m.code = sequencer::fault_code(f);
-  m.text = sequencer::fault_text(f);
+  m.text = with_sensor(sequencer::fault_text(f), e.sensor);
   m.axis = axis_or_empty(e.axis);
   m.device_code = e.device_code;
   m.state = from_cstr(e.state);

@@ -34,6 +34,7 @@ struct Snapshot {
   std::uint32_t rows_target = 0;       // rows this run weaves up to (0 = unknown / until stopped)
   std::uint16_t beats_per_row = 0;
   std::int8_t fault_axis = -1;         // axis of the first fault, -1 when none / not axis-specific
+  std::int8_t fault_sensor = -1;       // hal::SafetySensor the first fault names, -1 when none
   std::uint16_t fault_device_code = 0; // device (EMCY) code of the first fault
   hal::Tick fault_tick = hal::kNeverTick;
   std::array<char, 32> stopped_by{};   // the fault that stopped motion, "" when none
@@ -44,6 +45,7 @@ struct Snapshot {
   std::array<AxisSample, hal::kAxisCount> axes{};
   std::uint8_t outputs = 0;            // bit0 piston A extend, bit1 piston B extend
   std::uint8_t inputs = 0;             // bit0 A ext, 1 A ret, 2 B ext, 3 B ret, 4 shuttle L, 5 shuttle R, 6 estop ok
+  std::uint8_t inputs_2 = 0;           // second switches of the safety sensors, same bits 0..5 (0 where none)
   std::uint32_t overruns = 0;          // RT loop overruns so far
   std::int64_t tick_cost_ns = 0;       // this tick's compute time (0 in virtual time if not measured)
   std::int64_t max_tick_cost_ns = 0;
@@ -79,6 +81,7 @@ struct Event {
   FaultKind fault_kind = FaultKind::kFirst;
   std::uint8_t fault = 0;          // sequencer::Fault value
   std::int8_t axis = -1;           // -1 when not axis-specific
+  std::int8_t sensor = -1;         // hal::SafetySensor the fault names, -1 when none
   std::uint16_t device_code = 0;
   std::array<char, 24> state{};    // sequencer state just before the fault
   // kRow
