@@ -378,6 +378,32 @@ TEST(HilJudgeIo, EverySignalSeenPassesAndAMissingOneIsNamed) {
   EXPECT_EQ(r.failure, "never seen on the bus: shuttle at right");
 }
 
+TEST(HilJudgeIo, SecondSwitchesMustBeCarriedSeenAndAgreeWithTheirFirst) {
+  // Byte 2 = the second switches of bits 0..5 of byte 0.
+  const std::string ok =
+      "(1.000000) vcan0 204#01\n(1.002000) vcan0 204#02\n(1.004000) vcan0 184#4A000A\n"
+      "(1.006000) vcan0 184#550015\n(1.008000) vcan0 184#600020\n(1.010000) vcan0 284#2C01\n";
+  EXPECT_TRUE(check_io_traffic(parse_log(ok), 4, true).ok);
+  const std::string two_bytes =
+      "(1.000000) vcan0 204#01\n(1.002000) vcan0 204#02\n(1.004000) vcan0 184#4A00\n"
+      "(1.006000) vcan0 184#5500\n(1.008000) vcan0 184#6000\n(1.010000) vcan0 284#2C01\n";
+  EXPECT_TRUE(check_io_traffic(parse_log(two_bytes), 4).ok);
+  EXPECT_FALSE(check_io_traffic(parse_log(two_bytes), 4, true).ok);
+  const std::string stuck =  // the second switch of "shuttle at right" never made
+      "(1.000000) vcan0 204#01\n(1.002000) vcan0 204#02\n(1.004000) vcan0 184#4A000A\n"
+      "(1.006000) vcan0 184#550015\n(1.008000) vcan0 184#600000\n(1.010000) vcan0 284#2C01\n";
+  const CheckResult r = check_io_traffic(parse_log(stuck), 4, true);
+  ASSERT_FALSE(r.ok);
+  EXPECT_EQ(r.failure, "never seen on the bus: shuttle at right (second switch)");
+  const std::string apart =  // seen on, but once apart from its first switch
+      "(1.000000) vcan0 204#01\n(1.002000) vcan0 204#02\n(1.004000) vcan0 184#4A000A\n"
+      "(1.006000) vcan0 184#550015\n(1.008000) vcan0 184#600020\n(1.009000) vcan0 184#400020\n"
+      "(1.010000) vcan0 284#2C01\n";
+  const CheckResult a = check_io_traffic(parse_log(apart), 4, true);
+  ASSERT_FALSE(a.ok);
+  EXPECT_NE(a.failure.find("second switches 0x20 disagree with first switches 0x00"), std::string::npos) << a.failure;
+}
+
 TEST(HilJudgeEmcy, QuickStopRightAfterTheEmcyPassesAndLateOrReenabledFails) {
   const std::string ok =
       "(1.000000) vcan0 201#0F0000000000\n(1.000100) vcan0 202#0F0000000000\n(1.001000) vcan0 082#1023030000000000\n"

@@ -76,6 +76,9 @@ int main(int argc, char** argv) {
   auto* io = app.add_subcommand("io", "every valve and sensor of the CiA 401 I/O node crossed the bus");
   io->add_option("log", log, "candump -L log")->required();
   io->add_option("--node", io_node, "I/O node id")->check(CLI::Range(1, 127));
+  bool second_switches = false;
+  io->add_flag("--second-switches", second_switches,
+               "inputs 16..21 (0x6000:03) carry the safety sensors' second switches: each seen, each equal to its first");
   auto* emcy = app.add_subcommand("emcy-stop", "quick stop of every drive right after an EMCY");
   emcy->add_option("log", log, "candump -L log")->required();
   emcy->add_option("--nodes", nodes, "drive node ids")->required()->delimiter(',')->check(CLI::Range(1, 127));
@@ -101,7 +104,7 @@ int main(int argc, char** argv) {
   std::cout << log << ": " << loom::hil::describe(loom::hil::summarize(frames)) << "\n";
   if (summary->parsed()) return 0;
   if (weave->parsed()) return report("weave protocol", loom::hil::check_weave_protocol(frames, nodes));
-  if (io->parsed()) return report("I/O traffic", loom::hil::check_io_traffic(frames, io_node));
+  if (io->parsed()) return report("I/O traffic", loom::hil::check_io_traffic(frames, io_node, second_switches));
   if (emcy->parsed()) return report("EMCY stop", loom::hil::check_emcy_stop(frames, nodes, emcy_node));
   if (mloss->parsed()) {
     return report("master loss", loom::hil::check_master_loss(frames, nodes, master, consumer_ms * 1e-3, slack_ms * 1e-3));

@@ -341,14 +341,15 @@ std::string at_line(const Frame& f) {
 }
 }  // namespace
 
-CheckResult check_io_traffic(const std::vector<Frame>& frames, int io_node) {
+CheckResult check_io_traffic(const std::vector<Frame>& frames, int io_node, bool second_switches) {
   CheckResult r;
   const auto rpdo = static_cast<std::uint32_t>(0x200 + io_node);
   const auto tpdo = static_cast<std::uint32_t>(0x180 + io_node);
   const auto analog = static_cast<std::uint32_t>(0x280 + io_node);
   int n_out = 0, n_in = 0, n_an = 0;
-  std::uint8_t out_seen = 0, in_seen = 0;
+  std::uint8_t out_seen = 0, in_seen = 0, second_seen = 0;
   bool loaded = false;
+  std::string second_wrong;  // the first input TPDO whose second switches are missing or disagree
   for (const Frame& f : frames) {
     if (f.error_frame || f.rtr || f.extended) continue;
     if (f.id == rpdo && f.len >= 1) {
@@ -357,6 +358,18 @@ CheckResult check_io_traffic(const std::vector<Frame>& frames, int io_node) {
     } else if (f.id == tpdo && f.len >= 1) {
       ++n_in;
       in_seen |= f.data[0];
+      if (second_switches && second_wrong.empty()) {
+        if (f.len < 3) {
+          second_wrong = "an input TPDO of " + std::to_string(f.len) + " byte(s) at log line " +
+                         std::to_string(f.line) + ": no 0x6000:03 (second switches)";
+        } else if ((f.data[2] & 0x3F) != (f.data[0] & 0x3F)) {
+          char buf[128];
+          std::snprintf(buf, sizeof buf, "second switches 0x%02X disagree with first switches 0x%02X at log line %zu",
+                        f.data[2] & 0x3F, f.data[0] & 0x3F, f.line);
+          second_wrong = buf;
+        }
+      }
+      if (f.len >= 3) second_seen |= f.data[2];
     } else if (f.id == analog && f.len >= 2) {
       ++n_an;
       loaded = loaded || static_cast<std::int16_t>(f.u16(0)) > 0;
@@ -373,9 +386,17 @@ CheckResult check_io_traffic(const std::vector<Frame>& frames, int io_node) {
     if ((in_seen & (1 << b)) == 0) missing += std::string(", ") + in_names[b];
   }
   if (!loaded) missing += ", a load-cell force > 0";
+  if (second_switches) {
+    for (int b = 0; b < 6; ++b) {
+      if ((second_seen & (1 << b)) == 0) missing += std::string(", ") + in_names[b] + " (second switch)";
+    }
+  }
   if (!missing.empty()) {
     r.ok = false;
     r.failure = "never seen on the bus: " + missing.substr(2);
+  } else if (!second_wrong.empty()) {
+    r.ok = false;
+    r.failure = second_wrong;
   }
   return r;
 }

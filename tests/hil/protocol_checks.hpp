@@ -64,7 +64,10 @@ namespace loom::hil {
 // Every actuator and sensor of the CiA 401 I/O node `io_node` crossed the bus (pre-defined PDO ids, the
 // HIL wiring: outputs bit 0/1 = valves A/B; inputs bit 0..6 = A extended, A retracted, B extended,
 // B retracted, shuttle left, shuttle right, e-stop chain closed; TPDO2 = load cell, signed 16 bit).
-CheckResult check_io_traffic(const std::vector<Frame>& frames, int io_node);
+// With `second_switches`: every input TPDO also carries byte 2 (0x6000:03, the safety sensors' second
+// switches at inputs 16..21), each second switch is seen on, and in every input TPDO it reads as its
+// first switch (byte 0, bits 0..5) does: the simulated module's two switches see the same truth.
+CheckResult check_io_traffic(const std::vector<Frame>& frames, int io_node, bool second_switches = false);
 
 // An EMCY with a non-zero code from `emcy_node` (the first such frame in the log): the master's next
 // RPDO1 to every drive in `nodes` after it carries quick stop (controlword bits 2 and 7 clear, bit 1 set:

@@ -43,5 +43,5 @@ done
 hil_note "loomctl completed 1 row (exit 0); counters: $(tr -d '\n' <"$counters")"
 
 "$HIL_CANLOG" weave "$HIL_LOG" --nodes "$HIL_NODES" || hil_fail "bus protocol check failed (see above); log: $HIL_LOG"
-"$HIL_CANLOG" io "$HIL_LOG" --node "$HIL_IO_NODE" || hil_fail "I/O node traffic incomplete (see above); log: $HIL_LOG"
+"$HIL_CANLOG" io "$HIL_LOG" --node "$HIL_IO_NODE" --second-switches || hil_fail "I/O node traffic incomplete (see above); log: $HIL_LOG"
 hil_report_frames
