@@ -217,17 +217,6 @@ void Sequencer::step(hal::Tick now, const hal::HalInputs& raw, hal::HalOutputs& 
   out = cmd_;
 }
 
-namespace {
-void set_safety_sensors(hal::DigitalInputs& io, const DualChannelSensors::Channels& v) noexcept {
-  io.piston_a_extended = v[0];
-  io.piston_a_retracted = v[1];
-  io.piston_b_extended = v[2];
-  io.piston_b_retracted = v[3];
-  io.shuttle_at_left = v[4];
-  io.shuttle_at_right = v[5];
-}
-}  // namespace
-
 void Sequencer::sense(const hal::HalInputs& raw) noexcept {
   const hal::DigitalInputs& r = raw.io;
   const DualChannelSensors::Channels first = hal::safety_sensors(r);
@@ -237,9 +226,9 @@ void Sequencer::sense(const hal::HalInputs& raw) noexcept {
   buttons_.update({r.button_start, r.button_pause, r.button_ack, r.row_knotted});
   // Everything below acts on the sensors as both channels agree (dual_channel.hpp), raw and debounced.
   raw_io_ = r;
-  set_safety_sensors(raw_io_, dual_.agreed(first, r.second_channel));
+  hal::set_safety_sensors(raw_io_, dual_.agreed(first, r.second_channel));
   io_ = r;
-  set_safety_sensors(io_, dual_.agreed(sensors_.values(), second_channels_.values()));
+  hal::set_safety_sensors(io_, dual_.agreed(sensors_.values(), second_channels_.values()));
   io_.button_start = buttons_[0];
   io_.button_pause = buttons_[1];
   io_.button_ack = buttons_[2];

@@ -369,13 +369,9 @@ void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::Digit
     if (stuck_sensor_[i]) v[i] = *stuck_sensor_[i];
     if (scene_.sensor_noise && rng_.uniform() < scene_.sensor_noise->flip_probability) v[i] = !v[i];
   }
-  io.piston_a_extended = v[0];
-  io.piston_a_retracted = v[1];
-  io.piston_b_extended = v[2];
-  io.piston_b_retracted = v[3];
-  io.shuttle_at_left = v[4];
-  io.shuttle_at_right = v[5];
-  for (std::size_t i = 0; i < n; ++i) io.second_channel[i] = v[n + i];
+  std::array<bool, n> first{};
+  for (std::size_t i = 0; i < n; ++i) first[i] = v[i], io.second_channel[i] = v[n + i];
+  hal::set_safety_sensors(io, first);
   io.estop_ok = estop_ok_;
   io.refreshed = now;
 }

@@ -112,10 +112,18 @@ struct DigitalInputs {
   Tick refreshed = kNeverTick;
 };
 
-// The primary channels of the safety sensors, in SafetySensor order.
+// The primary channels of the safety sensors, in SafetySensor order, and back.
 inline std::array<bool, kSafetySensorCount> safety_sensors(const DigitalInputs& io) {
   return {io.piston_a_extended, io.piston_a_retracted, io.piston_b_extended,
           io.piston_b_retracted, io.shuttle_at_left,    io.shuttle_at_right};
+}
+inline void set_safety_sensors(DigitalInputs& io, const std::array<bool, kSafetySensorCount>& v) {
+  io.piston_a_extended = v[0];
+  io.piston_a_retracted = v[1];
+  io.piston_b_extended = v[2];
+  io.piston_b_retracted = v[3];
+  io.shuttle_at_left = v[4];
+  io.shuttle_at_right = v[5];
 }
 
 // ---------------------------------------------------------------------------------------------------
