@@ -618,6 +618,10 @@ void CanIoPort::on_frame(hal::Tick now, const CanFrame& f) {
     default:
       return;
   }
+  if (f.is_rtr()) {  // a remote request for this TPDO (another master, a bus tool) carries no data
+    ++rx_errors_;
+    return;
+  }
   bool used = false;
   std::uint32_t v = 0;
   if (input_pdo_ == tpdo) {
@@ -661,7 +665,9 @@ void CanIoPort::acknowledge() {
 }
 
 bool CanIoPort::input(const IoBit& b) const {
-  if (b.bit < 0) return false;
+  // Never seen reads false whatever the polarity: the cleared inputs_ of an active-low signal would
+  // otherwise read true (a break-contact sensor confirmed, a button pressed) before the first TPDO.
+  if (b.bit < 0 || inputs_refreshed_ == hal::kNeverTick) return false;
   const bool level = ((inputs_[static_cast<std::size_t>(b.bit / 8)] >> (b.bit % 8)) & 1U) != 0;
   return level != b.active_low;
 }
@@ -675,8 +681,8 @@ void CanIoPort::read_io(hal::Tick /*now*/, const hal::AxisFeedbacks& /*axes*/, h
   io.shuttle_at_left = input(w.shuttle_at_left);
   io.shuttle_at_right = input(w.shuttle_at_right);
   // Before the first TPDO there is no news, not an opened chain: `refreshed` stays kNeverTick, which the
-  // sequencer counts as old from arming (stale → fault), and every sensor reads false, so nothing can
-  // be confirmed (no shed, no pick) on inputs never seen.
+  // sequencer counts as old from arming (stale → fault), and every input reads false (active-low ones
+  // too, see input()), so nothing can be confirmed (no shed, no pick) on inputs never seen.
   io.estop_ok = inputs_refreshed_ == hal::kNeverTick || input(w.estop_ok);
   io.button_start = input(w.button_start);
   io.button_pause = input(w.button_pause);

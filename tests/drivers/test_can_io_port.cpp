@@ -291,6 +291,38 @@ TEST(CanIoPort, SecondChannelPolarityIsItsOwn) {
   EXPECT_TRUE(second(r)[4]);   // the others as wired
 }
 
+// Inputs never seen read false whatever their polarity (found by tests/fuzz/fuzz_can_io_port): the
+// cleared input bytes before the first TPDO used to read as true through an active-low wiring — a
+// break-contact sensor confirmed, a button pressed — after bring-up and again after every re-arm.
+TEST(CanIoPort, ActiveLowInputsReadFalseBeforeTheFirstTpdo) {
+  CanIoConfig pc;
+  pc.wiring.piston_a_retracted.active_low = true;
+  pc.wiring.second[1].active_low = true;
+  pc.wiring.button_start.active_low = true;
+  pc.wiring.estop_ok.active_low = true;
+  IoRig r({}, three_drives(), {}, pc);
+  ASSERT_TRUE(r.configure());
+  const auto expect_nothing_seen = [&] {
+    hal::DigitalInputs before;
+    r.port.read_io(0, {}, before);
+    EXPECT_EQ(before.refreshed, hal::kNeverTick);
+    EXPECT_TRUE(before.estop_ok);  // no news, not an opened chain
+    EXPECT_EQ(hal::safety_sensors(before), Channels{});
+    EXPECT_EQ(before.second_channel, Channels{});
+    EXPECT_FALSE(before.button_start);
+  };
+  expect_nothing_seen();
+  // Once sampled, through their polarity: terminals 1, 6 and 17 closed, 8 open.
+  r.enable_all();
+  EXPECT_FALSE(r.in.io.piston_a_retracted);
+  EXPECT_FALSE(second(r)[1]);
+  EXPECT_TRUE(r.in.io.button_start);
+  EXPECT_FALSE(r.in.io.estop_ok);
+  // Re-armed: nothing seen again until the next TPDO.
+  ASSERT_TRUE(r.port.configure(r.rig.master, r.rig.clock));
+  expect_nothing_seen();
+}
+
 TEST(CanIoPort, ASecondChannelOnBit30MapsTheFourthInputByte) {
   CanIoConfig pc;
   pc.wiring.second[5] = {30, true};  // terminal 30 is never closed on the simulated module: reads true
@@ -311,6 +343,40 @@ TEST(CanIoPort, SingleChannelSensingMapsTwoInputBytesAndLeavesSecondChannelsFals
   EXPECT_EQ(last_dlc(r.rig.net, 0x184), 2);  // the module's default 0x6000:01..03 re-mapped to :01..02
   EXPECT_EQ(hal::safety_sensors(r.in.io), kAtRest);
   EXPECT_EQ(second(r), Channels{});
+}
+
+// A remote request on the module's TPDO COB-IDs (another master, a bus analyser) carries no data: it is
+// counted as a receive error, never taken as a sample (found by tests/fuzz/fuzz_can_io_port: an RTR
+// frame on 0x184 read as all inputs 0 — e-stop opened, every active-low input true — refreshed now).
+TEST(CanIoPort, RemoteRequestsOnItsTpdosAreNotSamples) {
+  IoRig r;
+  ASSERT_TRUE(r.configure());
+  r.enable_all();
+  ASSERT_TRUE(r.in.io.estop_ok);
+  ASSERT_TRUE(r.in.io.piston_a_retracted);
+  ASSERT_TRUE(r.in.analog.beat_force_valid);
+  r.rig.rack.io_controls().silent = true;  // only the requests below on 0x184/0x284
+  for (int i = 0; i < 2; ++i) r.tick(AxisRequest::kEnable);  // the TPDOs in flight arrive
+  const hal::DigitalInputs io = r.in.io;
+  const hal::AnalogInputs analog = r.in.analog;
+  const std::uint32_t errors = r.port.rx_errors();
+  drivers::CanFrame rtr;
+  rtr.flags = drivers::CanFrame::kRtr;
+  rtr.id = 0x184;
+  rtr.dlc = 3;  // as on the wire: a length, no data (the driver's zeros)
+  r.rig.drives.send(rtr);
+  rtr.id = 0x284;
+  rtr.dlc = 2;
+  r.rig.drives.send(rtr);
+  r.rig.advance(100);
+  r.tick(AxisRequest::kEnable);
+  EXPECT_EQ(r.port.rx_errors(), errors + 2);
+  EXPECT_EQ(r.in.io.refreshed, io.refreshed);
+  EXPECT_TRUE(r.in.io.estop_ok);
+  EXPECT_TRUE(r.in.io.piston_a_retracted);
+  EXPECT_EQ(r.in.io.second_channel, io.second_channel);
+  EXPECT_EQ(r.in.analog.refreshed, analog.refreshed);
+  EXPECT_EQ(r.in.analog.beat_force_n, analog.beat_force_n);
 }
 
 TEST(CanIoPort, LoadCellScaledByTheWiringAndShuttleFollowsTheHelix) {
