@@ -33,10 +33,14 @@ CanFrame frame(std::uint32_t id, std::initializer_list<std::uint8_t> bytes) {
   return f;
 }
 
-// Terminal bits as the test computes them: bit b of the inputs is byte b / 8, bit b % 8.
+// Terminal bits as the test computes them: bit b of the inputs is byte b / 8, bit b % 8; terminals
+// beyond the `bytes` a frame carries are not in it.
 std::vector<std::uint8_t> terminals(std::initializer_list<int> on, std::size_t bytes) {
   std::vector<std::uint8_t> v(bytes, 0);
-  for (int b : on) v[static_cast<std::size_t>(b / 8)] |= static_cast<std::uint8_t>(1U << (b % 8));
+  for (int b : on) {
+    const auto byte = static_cast<std::size_t>(b / 8);
+    if (byte < bytes) v[byte] |= static_cast<std::uint8_t>(1U << (b % 8));
+  }
   return v;
 }
 
