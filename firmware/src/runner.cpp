@@ -133,7 +133,10 @@ class LoopBody {
       }
 
       if (seq_.finished() && finished_at < 0) finished_at = tick;
-      if (!opt_.hold_when_finished && finished_at >= 0 && tick - finished_at >= opt_.grace_ticks) break;
+      if (!opt_.hold_when_finished && finished_at >= 0 && tick - finished_at >= opt_.grace_ticks &&
+          !seq_.diagnosis_pending(tick)) {
+        break;
+      }
       if (exit_pending_ && quiet_state()) {
         res.end = RunResult::End::kExitRequested;
         break;

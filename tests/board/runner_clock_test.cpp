@@ -281,3 +281,28 @@ TEST(RunnerCommands, ExitWhileIdleLeavesAtOnce) {
   EXPECT_EQ(res.end, RunResult::End::kExitRequested);
   EXPECT_LE(res.ticks, 1);
 }
+
+TEST(RunnerCommands, ARunStoppedByASymptomWaitsOutTheDiagnosisWindowBeforeEnding) {
+  // weave ends a finished run after its grace ticks — but not while a symptom (here an interlock trip)
+  // stopped the machine and the root cause (a lost heartbeat arrives up to the heartbeat time later on
+  // CAN) may still replace it: the run would otherwise report the symptom as the first fault.
+  Rig r;
+  firmware::OperatorLink link;
+  r.seq->request_safe_stop(sequencer::Fault::kCarriageInWarp);
+  RunOptions o;
+  o.period_s = r.cfg.sequencer.period_s;
+  o.max_ticks = 10'000;
+  o.clock = &r.clock;
+  o.link = &link;
+  o.grace_ticks = 5;
+  const RunResult res = firmware::run_loop(*r.loop, *r.seq, o, [](const firmware::RunEvent&) {});
+  ASSERT_EQ(r.seq->first_fault(), sequencer::Fault::kCarriageInWarp);
+  const auto window = static_cast<hal::Tick>(std::ceil(r.cfg.sequencer.diagnosis_window_s / o.period_s));
+  EXPECT_GE(res.ticks, r.seq->fault_tick() + window) << "ended inside the diagnosis window";
+  EXPECT_LE(res.ticks, r.seq->fault_tick() + window + 10);
+  // A root cause (not a symptom) ends after the grace ticks alone.
+  Rig r2;
+  r2.seq->request_safe_stop(sequencer::Fault::kLoopOverrun);
+  const RunResult res2 = firmware::run_loop(*r2.loop, *r2.seq, o, [](const firmware::RunEvent&) {});
+  EXPECT_LE(res2.ticks, r2.seq->fault_tick() + 10);
+}

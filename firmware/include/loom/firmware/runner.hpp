@@ -121,7 +121,8 @@ struct RunOptions {
   bool realtime = false;         // pace at the tick rate (always true with hardware)
   double pace = 1.0;             // with realtime: run this many times faster than real time (sim only)
   hal::Tick max_ticks = 0;       // 0 = no limit
-  hal::Tick grace_ticks = 100;   // ticks run after the sequencer finishes (quick stop reaches the drives)
+  hal::Tick grace_ticks = 100;   // ticks run after the sequencer finishes (quick stop reaches the drives;
+                                 // longer while a symptom's root cause may still be diagnosed)
   const std::atomic<bool>* stop_flag = nullptr;   // set asynchronously → stop at row end
   const std::atomic<bool>* stop_now_flag = nullptr;  // set asynchronously → safe stop at once (stop_requested)
   const std::atomic<bool>* pause_flag = nullptr;  // true → pause at the next safe point, false → resume

@@ -163,6 +163,11 @@ class Sequencer {
   double commanded_crank_phase() const noexcept;
   double commanded_rocker_angle() const noexcept;
   bool finished() const noexcept { return state_ == State::kDone || state_ == State::kFault; }
+  // RT-safe. A symptom (stale feedback, an interlock trip) stopped the machine and its root cause may
+  // still be reported within the diagnosis window: a run that ends now would report the symptom.
+  bool diagnosis_pending(hal::Tick now) const noexcept {
+    return state_ == State::kFault && is_symptom(first_fault_) && now - fault_tick_ <= ticks(cfg_.diagnosis_window_s);
+  }
   // Debounced digital inputs as the sequencer last used them.
   const hal::DigitalInputs& debounced_io() const noexcept { return io_; }
 
