@@ -53,13 +53,6 @@ class DualChannelSensors {
     return -1;
   }
 
-  bool any_wired() const noexcept {
-    for (bool w : wired_) {
-      if (w) return true;
-    }
-    return false;
-  }
-
  private:
   Channels wired_{};
   int limit_ = 1;
