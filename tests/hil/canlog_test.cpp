@@ -404,17 +404,34 @@ TEST(HilJudgeIo, SecondSwitchesMustBeCarriedSeenAndAgreeWithTheirFirst) {
   EXPECT_NE(a.failure.find("second switches 0x20 disagree with first switches 0x00"), std::string::npos) << a.failure;
 }
 
-TEST(HilJudgeEmcy, QuickStopRightAfterTheEmcyPassesAndLateOrReenabledFails) {
+TEST(HilJudgeEmcy, EveryDriveStopsWithinOneCycleOfTheEmcyAndStaysStopped) {
+  // The EMCY lands after the master read the bus: SYNC and RPDO1s of the cycle in progress still enable
+  // (decided before the EMCY), the next cycle stops both drives.
   const std::string ok =
-      "(1.000000) vcan0 201#0F0000000000\n(1.000100) vcan0 202#0F0000000000\n(1.001000) vcan0 082#1023030000000000\n"
-      "(1.004000) vcan0 201#020000000000\n(1.004100) vcan0 202#020000000000\n(1.008000) vcan0 201#000000000000\n";
-  EXPECT_TRUE(check_emcy_stop(parse_log(ok), {1, 2}, 2).ok);
+      "(1.000000) vcan0 080#\n(1.000050) vcan0 201#0F0000000000\n(1.001000) vcan0 082#1023030000000000\n"
+      "(1.004000) vcan0 080#\n(1.004050) vcan0 201#0F0000000000\n(1.004100) vcan0 202#0F0000000000\n"
+      "(1.008000) vcan0 080#\n(1.008050) vcan0 201#020000000000\n(1.008100) vcan0 202#020000000000\n"
+      "(1.012000) vcan0 080#\n(1.012050) vcan0 201#000000000000\n";
+  const CheckResult pass = check_emcy_stop(parse_log(ok), {1, 2}, 2);
+  EXPECT_TRUE(pass.ok) << pass.failure;
+  // Still enabling one whole cycle after the EMCY.
   const std::string late =
-      "(1.001000) vcan0 082#1023030000000000\n(1.004000) vcan0 201#0F0000000000\n(1.004100) vcan0 202#020000000000\n";
-  EXPECT_FALSE(check_emcy_stop(parse_log(late), {1, 2}, 2).ok);
+      "(1.001000) vcan0 082#1023030000000000\n(1.004000) vcan0 080#\n(1.004050) vcan0 201#020000000000\n"
+      "(1.008000) vcan0 080#\n(1.008050) vcan0 201#0F0000000000\n(1.008100) vcan0 202#020000000000\n"
+      "(1.012000) vcan0 080#\n";
+  const CheckResult l = check_emcy_stop(parse_log(late), {1, 2}, 2);
+  ASSERT_FALSE(l.ok);
+  EXPECT_NE(l.failure.find("node 1: first RPDO1 of the next cycle"), std::string::npos) << l.failure;
+  // Stopped, then enabled again.
   const std::string again =
-      "(1.001000) vcan0 082#1023030000000000\n(1.004000) vcan0 201#020000000000\n(1.008000) vcan0 201#0F0000000000\n";
-  EXPECT_FALSE(check_emcy_stop(parse_log(again), {1}, 2).ok);
+      "(1.001000) vcan0 082#1023030000000000\n(1.004000) vcan0 080#\n(1.008000) vcan0 080#\n"
+      "(1.008050) vcan0 201#020000000000\n(1.012000) vcan0 080#\n(1.012050) vcan0 201#0F0000000000\n";
+  const CheckResult g = check_emcy_stop(parse_log(again), {1}, 2);
+  ASSERT_FALSE(g.ok);
+  EXPECT_NE(g.failure.find("re-enabled"), std::string::npos) << g.failure;
+  // A drive the master stopped talking to, and a log that ends before the next cycle.
+  EXPECT_FALSE(check_emcy_stop(parse_log(again), {1, 3}, 2).ok);
+  EXPECT_FALSE(check_emcy_stop(parse_log("(1.001000) vcan0 082#1023030000000000\n(1.004000) vcan0 080#\n"), {1}, 2).ok);
 }
 
 TEST(HilJudgeMasterLoss, EveryConsumerMustReactInTime) {

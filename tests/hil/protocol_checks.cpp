@@ -414,20 +414,42 @@ CheckResult check_emcy_stop(const std::vector<Frame>& frames, const std::vector<
     return r;
   }
   const Frame& emcy = frames[k];
-  char buf[160];
+  char buf[200];
   std::snprintf(buf, sizeof(buf), "EMCY 0x%04X from node %d at %s", emcy.u16(0), emcy_node, at_line(emcy).c_str());
+  r.notes.push_back(buf);
+  // The master reads the bus, ticks, then sends SYNC and the RPDOs. An EMCY that lands after the read is
+  // seen by the next cycle: the RPDOs of the cycle in progress (up to the second SYNC after the EMCY)
+  // were decided before it and may still enable; every RPDO1 after that SYNC must stop the drive.
+  std::size_t deadline = k + 1;
+  for (int syncs = 0; deadline < frames.size(); ++deadline) {
+    if (const Frame& f = frames[deadline]; is_sync(f) && ++syncs == 2) break;
+  }
+  if (deadline == frames.size()) {
+    r.ok = false;
+    r.failure = "the log ends less than two SYNCs after the EMCY: the reaction cannot be judged";
+    return r;
+  }
+  std::snprintf(buf, sizeof(buf), "one cycle to react: the second SYNC after the EMCY at %s (%.1f ms later)",
+                at_line(frames[deadline]).c_str(), static_cast<double>(frames[deadline].t_us - emcy.t_us) * 1e-3);
   r.notes.push_back(buf);
   for (int node : nodes) {
     bool first = true;
+    int in_progress = 0;
     for (std::size_t j = k + 1; j < frames.size(); ++j) {
       const Frame& f = frames[j];
       if (f.error_frame || f.id != static_cast<std::uint32_t>(0x200 + node) || f.len < 2) continue;
       const std::uint16_t cw = f.u16(0);
+      if (j < deadline) {
+        ++in_progress;
+        continue;
+      }
       if (first) {
         first = false;
         const bool stop = (cw & 0x0F) == 0x02 || (cw & 0x02) == 0;
-        std::snprintf(buf, sizeof(buf), "node %d: first RPDO1 after the EMCY at %s (%.1f ms later): controlword 0x%04X",
-                      node, at_line(f).c_str(), static_cast<double>(f.t_us - emcy.t_us) * 1e-3, cw);
+        std::snprintf(buf, sizeof(buf),
+                      "node %d: first RPDO1 of the next cycle at %s (%.1f ms after the EMCY, %d RPDO1 of the cycle in "
+                      "progress before it): controlword 0x%04X",
+                      node, at_line(f).c_str(), static_cast<double>(f.t_us - emcy.t_us) * 1e-3, in_progress, cw);
         r.notes.push_back(buf);
         if (!stop) {
           r.ok = false;
@@ -444,7 +466,7 @@ CheckResult check_emcy_stop(const std::vector<Frame>& frames, const std::vector<
     }
     if (first) {
       r.ok = false;
-      r.failure = "no RPDO1 to node " + std::to_string(node) + " after the EMCY";
+      r.failure = "no RPDO1 to node " + std::to_string(node) + " in the cycle after the EMCY";
       return r;
     }
   }

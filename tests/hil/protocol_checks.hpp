@@ -69,9 +69,11 @@ namespace loom::hil {
 // first switch (byte 0, bits 0..5) does: the simulated module's two switches see the same truth.
 CheckResult check_io_traffic(const std::vector<Frame>& frames, int io_node, bool second_switches = false);
 
-// An EMCY with a non-zero code from `emcy_node` (the first such frame in the log): the master's next
-// RPDO1 to every drive in `nodes` after it carries quick stop (controlword bits 2 and 7 clear, bit 1 set:
-// 0x0002) or disable voltage (0x0000), and no later RPDO1 enables operation again.
+// An EMCY with a non-zero code from `emcy_node` (the first such frame in the log): within one cycle the
+// master stops every drive in `nodes`. RPDO1s before the second SYNC after the EMCY belong to the cycle in
+// progress (decided before the EMCY could be read) and are not judged; the first RPDO1 after that SYNC
+// carries quick stop (controlword bits 2 and 7 clear, bit 1 set: 0x0002) or disable voltage (0x0000), and
+// no later RPDO1 enables operation again.
 CheckResult check_emcy_stop(const std::vector<Frame>& frames, const std::vector<int>& nodes, int emcy_node);
 
 // The master's heartbeat (0x700 + master) stops (it was killed): every node in `nodes` sends an EMCY
