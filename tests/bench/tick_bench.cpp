@@ -1,9 +1,22 @@
 // What a control tick costs, and what profile accuracy costs: the full cycle (sim HAL read, sequencer,
 // write) for the ideal scene and with servo lag named, and the rocker-table lookup against the exact
 // linkage solve, with the table's worst error reported as a counter next to its time.
+//
+// The *AfterSleep benchmarks ask why a tick costs more in real time than back to back: the same tick
+// (default scene, telemetry off) after the core slept a control period, with and without a rehearsal
+// (one tick run shortly before, then a spin to the deadline, so the measured tick finds its code and
+// data in the caches), and, as the machine's floor, touching N cache lines of one buffer after the
+// same sleep. Each reports p50/p99.9/max in ns as counters. Run them at the loop's priority:
+//   chrt -f 80 build/bin/loom_bench_tick --benchmark_filter=AfterSleep
+// LOOM_BENCH_SLEEP_ITERS sets the samples per benchmark (default 5000, 10 s each at 2 ms).
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <ctime>
+#include <vector>
 
 #include "loom/firmware/config.hpp"
 #include "loom/firmware/machine.hpp"
@@ -68,6 +81,102 @@ void BM_RockerTable(benchmark::State& state) {
   state.counters["bytes"] = static_cast<double>(table.bytes());
 }
 
+// ---------------------------------------------------------------------------------------------------
+// After a sleep
+// ---------------------------------------------------------------------------------------------------
+std::int64_t now_ns() {
+  timespec t{};
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return static_cast<std::int64_t>(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
+}
+
+void sleep_until_ns(std::int64_t deadline) {
+  const timespec ts{static_cast<time_t>(deadline / 1'000'000'000), static_cast<long>(deadline % 1'000'000'000)};
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) != 0) {
+  }
+}
+
+void spin_until_ns(std::int64_t deadline) {
+  while (now_ns() < deadline) {
+  }
+}
+
+constexpr std::int64_t kPeriodNs = 2'000'000;  // the default loom's control period
+
+std::int64_t sleep_iterations() {
+  const char* env = std::getenv("LOOM_BENCH_SLEEP_ITERS");
+  const long long n = env != nullptr ? std::atoll(env) : 5000;
+  return n > 0 ? n : 5000;
+}
+
+void report_percentiles(benchmark::State& state, std::vector<std::int64_t>& ns) {
+  if (ns.empty()) return;
+  std::sort(ns.begin(), ns.end());
+  const auto at = [&](double q) {
+    return static_cast<double>(ns[std::min(ns.size() - 1, static_cast<std::size_t>(q * static_cast<double>(ns.size())))]);
+  };
+  state.counters["p50_ns"] = at(0.5);
+  state.counters["p99.9_ns"] = at(0.999);
+  state.counters["max_ns"] = static_cast<double>(ns.back());
+}
+
+// The tick after the core slept until its deadline. rehearse_us > 0: a tick runs that many µs before the
+// deadline and the core spins until it (the machine then advances two ticks per period: a measurement
+// device, not something the loop could do, since a tick moves the machine).
+void BM_TickAfterSleep(benchmark::State& state) {
+  const std::int64_t rehearse_ns = state.range(0) * 1000;
+  firmware::LoomConfig cfg = firmware::default_loom_config();
+  firmware::MachineOptions opt;
+  opt.telemetry = false;
+  opt.rows = 1'000'000;
+  firmware::Machine m(cfg, firmware::default_scene(), opt, {});
+  m.sequencer().request_start();
+  hal::Tick t = 0;
+  for (; t < 2000; ++t) m.loop().cycle(t);  // past bring-up, into weaving
+  std::vector<std::int64_t> ns;
+  ns.reserve(static_cast<std::size_t>(state.max_iterations));
+  std::int64_t deadline = now_ns();
+  for (auto _ : state) {
+    deadline += kPeriodNs;
+    if (rehearse_ns > 0) {
+      sleep_until_ns(deadline - rehearse_ns);
+      m.loop().cycle(t++);
+      spin_until_ns(deadline);
+    } else {
+      sleep_until_ns(deadline);
+    }
+    const std::int64_t t0 = now_ns();
+    m.loop().cycle(t++);
+    const std::int64_t cost = now_ns() - t0;
+    state.SetIterationTime(static_cast<double>(cost) * 1e-9);
+    ns.push_back(cost);
+  }
+  report_percentiles(state, ns);
+  state.counters["rows"] = m.sequencer().counters().rows;
+}
+
+// The machine's floor: reading N cache lines of one 64 KB buffer after the same sleep (N = 0: the two
+// clock reads alone).
+void BM_CacheLinesAfterSleep(benchmark::State& state) {
+  static std::uint8_t buffer[64 * 1024];
+  const auto lines = static_cast<std::size_t>(state.range(0));
+  std::vector<std::int64_t> ns;
+  ns.reserve(static_cast<std::size_t>(state.max_iterations));
+  std::int64_t deadline = now_ns();
+  unsigned sum = 0;
+  for (auto _ : state) {
+    deadline += kPeriodNs;
+    sleep_until_ns(deadline);
+    const std::int64_t t0 = now_ns();
+    for (std::size_t i = 0; i < lines; ++i) sum += static_cast<const volatile std::uint8_t*>(buffer)[i * 64];
+    const std::int64_t cost = now_ns() - t0;
+    state.SetIterationTime(static_cast<double>(cost) * 1e-9);
+    ns.push_back(cost);
+  }
+  benchmark::DoNotOptimize(sum);
+  report_percentiles(state, ns);
+}
+
 }  // namespace
 
 BENCHMARK_CAPTURE(BM_Tick, ideal, std::vector<std::string>{"ideal"});
@@ -82,4 +191,6 @@ BENCHMARK_CAPTURE(BM_Tick, all, std::vector<std::string>{"servo_lag", "pneumatic
                                                          "beat_contact", "inertia", "joint_friction"});
 BENCHMARK(BM_RockerExactSolve);
 BENCHMARK(BM_RockerTable)->RangeMultiplier(4)->Range(64, 65536);
+BENCHMARK(BM_TickAfterSleep)->Arg(0)->Arg(50)->UseManualTime()->Iterations(sleep_iterations());
+BENCHMARK(BM_CacheLinesAfterSleep)->Arg(0)->Arg(64)->Arg(256)->UseManualTime()->Iterations(sleep_iterations());
 BENCHMARK_MAIN();

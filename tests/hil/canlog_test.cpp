@@ -414,6 +414,12 @@ TEST(HilJudgeEmcy, EveryDriveStopsWithinOneCycleOfTheEmcyAndStaysStopped) {
       "(1.012000) vcan0 080#\n(1.012050) vcan0 201#000000000000\n";
   const CheckResult pass = check_emcy_stop(parse_log(ok), {1, 2}, 2);
   EXPECT_TRUE(pass.ok) << pass.failure;
+  std::string reaction;  // the reaction is reported: where and in which cycle after the EMCY drive 1 stopped
+  for (const std::string& n : pass.notes) {
+    if (n.rfind("node 1:", 0) == 0) reaction = n;
+  }
+  EXPECT_EQ(reaction.rfind("node 1: quick stop at line 8,", 0), 0U) << reaction;
+  EXPECT_NE(reaction.find("in cycle 2 after it"), std::string::npos) << reaction;
   // Still enabling one whole cycle after the EMCY.
   const std::string late =
       "(1.001000) vcan0 082#1023030000000000\n(1.004000) vcan0 080#\n(1.004050) vcan0 201#020000000000\n"

@@ -5,7 +5,7 @@
 #   estop     — the I/O node's e-stop input opens → exit 3, first fault estop, counters kept;
 #   io_silent — the I/O node goes silent → exit 3, first fault heartbeat_lost, counters kept;
 #   emcy      — an EMCY 0x2310 from drive 2 while its statusword stays Operation Enabled → exit 3,
-#               drive_fault; judged from candump: the next RPDO1 to every drive is quick stop;
+#               drive_fault; judged from candump: within one cycle every drive gets quick stop;
 #   master    — loomctl is killed (SIGKILL) → every node's 0x1016 consumer reacts (EMCY 0x8130 each),
 #               judged from candump against the consumer time.
 # Reaction times are printed from candump's timestamps (the VM is not real-time: order is asserted,

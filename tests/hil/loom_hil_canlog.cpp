@@ -79,7 +79,7 @@ int main(int argc, char** argv) {
   bool second_switches = false;
   io->add_flag("--second-switches", second_switches,
                "inputs 16..21 (0x6000:03) carry the safety sensors' second switches: each seen, each equal to its first");
-  auto* emcy = app.add_subcommand("emcy-stop", "quick stop of every drive right after an EMCY");
+  auto* emcy = app.add_subcommand("emcy-stop", "quick stop of every drive within one cycle of an EMCY");
   emcy->add_option("log", log, "candump -L log")->required();
   emcy->add_option("--nodes", nodes, "drive node ids")->required()->delimiter(',')->check(CLI::Range(1, 127));
   emcy->add_option("--emcy-node", emcy_node, "node whose EMCY is checked")->required()->check(CLI::Range(1, 127));

@@ -433,27 +433,24 @@ CheckResult check_emcy_stop(const std::vector<Frame>& frames, const std::vector<
                 at_line(frames[deadline]).c_str(), static_cast<double>(frames[deadline].t_us - emcy.t_us) * 1e-3);
   r.notes.push_back(buf);
   for (int node : nodes) {
-    bool first = true;
-    int in_progress = 0;
+    const Frame* first_stop = nullptr;  // the reaction: this node's first quick stop / disable after the EMCY
+    bool judged = false;
     for (std::size_t j = k + 1; j < frames.size(); ++j) {
       const Frame& f = frames[j];
       if (f.error_frame || f.id != static_cast<std::uint32_t>(0x200 + node) || f.len < 2) continue;
       const std::uint16_t cw = f.u16(0);
-      if (j < deadline) {
-        ++in_progress;
-        continue;
-      }
-      if (first) {
-        first = false;
-        const bool stop = (cw & 0x0F) == 0x02 || (cw & 0x02) == 0;
-        std::snprintf(buf, sizeof(buf),
-                      "node %d: first RPDO1 of the next cycle at %s (%.1f ms after the EMCY, %d RPDO1 of the cycle in "
-                      "progress before it): controlword 0x%04X",
-                      node, at_line(f).c_str(), static_cast<double>(f.t_us - emcy.t_us) * 1e-3, in_progress, cw);
-        r.notes.push_back(buf);
+      const bool stop = (cw & 0x0F) == 0x02 || (cw & 0x02) == 0;
+      if (stop && first_stop == nullptr) first_stop = &f;
+      if (j < deadline) continue;  // the cycle in progress: decided before the EMCY could be read
+      if (!judged) {
+        judged = true;
         if (!stop) {
           r.ok = false;
-          r.failure = std::string(buf) + " is not quick stop (0x0002) or disable voltage";
+          std::snprintf(buf, sizeof(buf),
+                        "node %d: first RPDO1 of the next cycle at %s (%.1f ms after the EMCY): controlword 0x%04X is not "
+                        "quick stop (0x0002) or disable voltage",
+                        node, at_line(f).c_str(), static_cast<double>(f.t_us - emcy.t_us) * 1e-3, cw);
+          r.failure = buf;
           return r;
         }
       } else if ((cw & 0x0F) == 0x0F) {
@@ -464,11 +461,16 @@ CheckResult check_emcy_stop(const std::vector<Frame>& frames, const std::vector<
         return r;
       }
     }
-    if (first) {
+    if (!judged) {
       r.ok = false;
       r.failure = "no RPDO1 to node " + std::to_string(node) + " in the cycle after the EMCY";
       return r;
     }
+    int syncs = 0;  // which cycle after the EMCY stopped the drive (1 = the first SYNC after it)
+    for (const Frame* f = &emcy; f != first_stop; ++f) syncs += is_sync(*f) ? 1 : 0;
+    std::snprintf(buf, sizeof(buf), "node %d: quick stop at %s, %.1f ms after the EMCY, in cycle %d after it", node,
+                  at_line(*first_stop).c_str(), static_cast<double>(first_stop->t_us - emcy.t_us) * 1e-3, syncs);
+    r.notes.push_back(buf);
   }
   return r;
 }
