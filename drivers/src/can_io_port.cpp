@@ -674,12 +674,10 @@ bool CanIoPort::input(const IoBit& b) const {
 
 void CanIoPort::read_io(hal::Tick /*now*/, const hal::AxisFeedbacks& /*axes*/, hal::DigitalInputs& io) {
   const IoWiring& w = config_.wiring;
-  io.piston_a_extended = input(w.piston_a_extended);
-  io.piston_a_retracted = input(w.piston_a_retracted);
-  io.piston_b_extended = input(w.piston_b_extended);
-  io.piston_b_retracted = input(w.piston_b_retracted);
-  io.shuttle_at_left = input(w.shuttle_at_left);
-  io.shuttle_at_right = input(w.shuttle_at_right);
+  const auto first = first_switches(w);
+  std::array<bool, hal::kSafetySensorCount> sensors{};
+  for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) sensors[i] = input(*first[i]);
+  hal::set_safety_sensors(io, sensors);
   // Before the first TPDO there is no news, not an opened chain: `refreshed` stays kNeverTick, which the
   // sequencer counts as old from arming (stale → fault), and every input reads false (active-low ones
   // too, see input()), so nothing can be confirmed (no shed, no pick) on inputs never seen.

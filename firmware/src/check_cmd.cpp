@@ -29,9 +29,7 @@ void print_keys() {
 void print_safety_sensors(const LoomConfig& c) {
   std::printf("\nsafety sensors\n");
   const drivers::IoWiring& w = c.io.wiring;
-  const std::array<const drivers::IoBit*, hal::kSafetySensorCount> first{
-      &w.piston_a_extended, &w.piston_a_retracted, &w.piston_b_extended,
-      &w.piston_b_retracted, &w.shuttle_at_left,    &w.shuttle_at_right};
+  const auto first = drivers::first_switches(w);
   std::string dual, single;
   for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) {
     const std::string name = hal::safety_sensor_name(static_cast<hal::SafetySensor>(i));

@@ -92,6 +92,12 @@ struct IoWiring {
   double load_cell_offset_n = 0.0;
 };
 
+// The first switch of each safety sensor, in hal::SafetySensor order (the second ones are `second`).
+inline std::array<const IoBit*, hal::kSafetySensorCount> first_switches(const IoWiring& w) {
+  return {&w.piston_a_extended, &w.piston_a_retracted, &w.piston_b_extended,
+          &w.piston_b_retracted, &w.shuttle_at_left,    &w.shuttle_at_right};
+}
+
 // Configure-time only. Error naming the field ("io.inputs.estop_ok.bit = 3 is already used by
 // io.inputs.piston_b_retracted") and its value.
 Status validate(const IoWiring& wiring);
