@@ -151,12 +151,21 @@ const char* fault_kind_name(Event::FaultKind k) noexcept {
   return "unknown";
 }
 
-loomlcm::beat_t to_beat(const Event& e, const std::string& loom_id, std::int64_t utime) {
-  loomlcm::beat_t m;
+namespace {
+// The header every event message starts with: when it was sent, which loom, and the tick it happened at.
+template <class Message>
+Message event_message(const Event& e, const std::string& loom_id, std::int64_t utime) {
+  Message m;
   m.utime = utime;
   m.loom_id = loom_id;
   m.tick = e.tick;
   m.time_s = seconds(e.tick, e.period_ns);
+  return m;
+}
+}  // namespace
+
+loomlcm::beat_t to_beat(const Event& e, const std::string& loom_id, std::int64_t utime) {
+  auto m = event_message<loomlcm::beat_t>(e, loom_id, utime);
   m.row = static_cast<std::int32_t>(e.row);
   m.index = static_cast<std::int16_t>(e.beat_index);
   m.beats_per_row = static_cast<std::int16_t>(e.beats_per_row);
@@ -170,11 +179,7 @@ loomlcm::beat_t to_beat(const Event& e, const std::string& loom_id, std::int64_t
 }
 
 loomlcm::fault_t to_fault(const Event& e, const std::string& loom_id, std::int64_t utime) {
-  loomlcm::fault_t m;
-  m.utime = utime;
-  m.loom_id = loom_id;
-  m.tick = e.tick;
-  m.time_s = seconds(e.tick, e.period_ns);
+  auto m = event_message<loomlcm::fault_t>(e, loom_id, utime);
   m.kind = fault_kind_name(e.fault_kind);
   const sequencer::Fault f = fault_of(e.fault);
   m.name = sequencer::fault_name(f);
@@ -191,11 +196,7 @@ loomlcm::fault_t to_fault(const Event& e, const std::string& loom_id, std::int64
 }
 
 loomlcm::row_t to_row(const Event& e, const std::string& loom_id, std::int64_t utime) {
-  loomlcm::row_t m;
-  m.utime = utime;
-  m.loom_id = loom_id;
-  m.tick = e.tick;
-  m.time_s = seconds(e.tick, e.period_ns);
+  auto m = event_message<loomlcm::row_t>(e, loom_id, utime);
   m.row = static_cast<std::int32_t>(e.row);
   m.row_s = seconds(e.row_ticks, e.period_ns);
   m.shed_s = seconds(e.shed_ticks, e.period_ns);
