@@ -13,6 +13,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <csignal>
@@ -221,7 +222,10 @@ int main(int argc, char** argv) {
     for (const std::string& ignored : loom::sim_can::set_io_controls(words.str(), rack.io_controls())) {
       std::cerr << "loom-sim-drive: --io-control: " << ignored << "\n";
     }
-    std::cerr << "loom-sim-drive: I/O controls now: " << words.str();
+    // One line per re-read (HIL tests wait for it), also for an empty file or a last word without newline.
+    std::string applied = words.str();
+    while (!applied.empty() && std::isspace(static_cast<unsigned char>(applied.back())) != 0) applied.pop_back();
+    std::cerr << "loom-sim-drive: I/O controls now: " << applied << "\n";
   };
   rack.power_on(monotonic_us());
   std::cerr << "loom-sim-drive: " << nodes.size() << " " << personality << " drive(s) on " << iface << ", nodes";
