@@ -8,9 +8,11 @@
 #include <cstdint>
 #include <initializer_list>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "fake_can_network.hpp"
+#include "loom/sim_can/io_control.hpp"
 #include "loom/sim_can/sim_io_node.hpp"
 
 namespace loom::sim_can {
@@ -209,6 +211,85 @@ TEST_F(SimIoNodeTest, AStuckSwitchDepartsFromThePlantOnItsOwnTerminalOnly) {
   f = sync_tpdo1();
   ASSERT_TRUE(f);
   EXPECT_EQ(payload(*f), terminals(kAtRest, 3));
+}
+
+// loom-sim-drive's --io-control words (io_control.hpp): stuck=<sensor>[_2]:on|off names a switch as the
+// config's io keys do, and whatever the file does not say is inactive.
+TEST(SimIoControl, StuckWordNamesTheSensorAndItsSwitch) {
+  std::string error;
+  std::optional<StuckSwitch> sw = parse_stuck_switch("shuttle_at_right_2:on", error);
+  ASSERT_TRUE(sw) << error;
+  EXPECT_TRUE(sw->active);
+  EXPECT_EQ(sw->sensor, hal::SafetySensor::kShuttleAtRight);
+  EXPECT_TRUE(sw->second);
+  EXPECT_TRUE(sw->level);
+  sw = parse_stuck_switch("piston_a_extended:off", error);
+  ASSERT_TRUE(sw) << error;
+  EXPECT_EQ(sw->sensor, hal::SafetySensor::kPistonAExtended);
+  EXPECT_FALSE(sw->second);
+  EXPECT_FALSE(sw->level);
+  // Every sensor, both switches, by the HAL's own names.
+  for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) {
+    const std::string name = hal::safety_sensor_name(static_cast<hal::SafetySensor>(i));
+    for (const bool second : {false, true}) {
+      sw = parse_stuck_switch(name + (second ? "_2" : "") + ":on", error);
+      ASSERT_TRUE(sw) << name << ": " << error;
+      EXPECT_EQ(static_cast<std::size_t>(sw->sensor), i);
+      EXPECT_EQ(sw->second, second);
+    }
+  }
+}
+
+TEST(SimIoControl, StuckWordRefusesBadSyntaxAndUnknownSensors) {
+  std::string error;
+  EXPECT_FALSE(parse_stuck_switch("shuttle_at_right_2", error));
+  EXPECT_EQ(error, "expected stuck=<sensor>[_2]:on|off");
+  EXPECT_FALSE(parse_stuck_switch(":on", error));
+  EXPECT_EQ(error, "expected stuck=<sensor>[_2]:on|off");
+  EXPECT_FALSE(parse_stuck_switch("shuttle_at_right:1", error));
+  EXPECT_EQ(error, "level '1' is not on or off (stuck=<sensor>[_2]:on|off)");
+  EXPECT_FALSE(parse_stuck_switch("shuttle_at_right_3:on", error));
+  EXPECT_EQ(
+      error,
+      "unknown sensor 'shuttle_at_right_3' (known: piston_a_extended, piston_a_retracted, piston_b_extended, "
+      "piston_b_retracted, shuttle_at_left, shuttle_at_right; add _2 for the second switch)");
+  EXPECT_FALSE(parse_stuck_switch("shuttle_at_right_2_2:on", error));
+}
+
+TEST(SimIoControl, FileSetsWhatItNamesAndClearsTheRest) {
+  IoPlant p;
+  p.helix_rad = 3.0;  // the plant's positions are the rack's, not the file's
+  EXPECT_TRUE(set_io_controls("estop  stuck=shuttle_at_right_2:on\nack\n", p).empty());
+  EXPECT_TRUE(p.estop_open);
+  EXPECT_TRUE(p.button_ack);
+  EXPECT_FALSE(p.silent);
+  EXPECT_TRUE(p.stuck.active);
+  EXPECT_EQ(p.stuck.sensor, hal::SafetySensor::kShuttleAtRight);
+  EXPECT_TRUE(p.stuck.second);
+  EXPECT_TRUE(p.stuck.level);
+  // The word removed, the switch works again.
+  EXPECT_TRUE(set_io_controls("silent\n", p).empty());
+  EXPECT_FALSE(p.estop_open);
+  EXPECT_FALSE(p.button_ack);
+  EXPECT_TRUE(p.silent);
+  EXPECT_FALSE(p.stuck.active);
+  EXPECT_EQ(p.helix_rad, 3.0);
+}
+
+TEST(SimIoControl, FileNamesEveryWordItIgnores) {
+  IoPlant p;
+  const std::vector<std::string> ignored = set_io_controls(
+      "bogus stuck=nozzle:on stuck=shuttle_at_left:on stuck=piston_b_extended_2:off estop", p);
+  ASSERT_EQ(ignored.size(), 3u);
+  EXPECT_EQ(ignored[0], "unknown word 'bogus' ignored");
+  EXPECT_EQ(ignored[1].rfind("'stuck=nozzle:on': unknown sensor 'nozzle' (known: piston_a_extended", 0), 0u)
+      << ignored[1];
+  EXPECT_EQ(ignored[2], "'stuck=piston_b_extended_2:off': only one switch can be stuck at a time; ignored");
+  // The good words still count: the first stuck switch stays, the e-stop after the bad words opens.
+  EXPECT_TRUE(p.stuck.active);
+  EXPECT_EQ(p.stuck.sensor, hal::SafetySensor::kShuttleAtLeft);
+  EXPECT_FALSE(p.stuck.second);
+  EXPECT_TRUE(p.estop_open);
 }
 
 // A fixed-mapping 16-input personality: its TPDO1 is {0x6000:01, 0x6000:02} and cannot be changed.

@@ -6,6 +6,9 @@
 #   io_silent — the I/O node goes silent → exit 3, first fault heartbeat_lost, counters kept;
 #   emcy      — an EMCY 0x2310 from drive 2 while its statusword stays Operation Enabled → exit 3,
 #               drive_fault; judged from candump: within one cycle every drive gets quick stop;
+#   stuck     — the second switch of shuttle_at_left sticks on (loom-sim-drive's io-control word
+#               stuck=shuttle_at_left_2:on) → exit 3, first fault sensor_discrepancy naming
+#               shuttle_at_left: the two-channel check over the real CAN path (terminal 20, in TPDO1's third byte);
 #   master    — loomctl is killed (SIGKILL) → every node's 0x1016 consumer reacts (EMCY 0x8130 each),
 #               judged from candump against the consumer time.
 # Reaction times are printed from candump's timestamps (the VM is not real-time: order is asserted,
@@ -76,6 +79,17 @@ expect_fault() {
   hil_note "$1: exit 3, $line"
 }
 
+# sim_took_controls NAME WORDS — loom-sim-drive has applied the control file's WORDS (it echoes what it
+# applied and names every word it ignored): a misspelt word fails here, not as a fault that never came.
+sim_took_controls() {
+  local deadline=$((SECONDS + 5)) sim_out=$HIL_WORK/sim.out
+  until grep -qF "I/O controls now: $2" "$sim_out"; do
+    ((SECONDS < deadline)) || hil_fail "$1: loom-sim-drive did not apply '$2' within 5 s: $(tail -n 3 "$sim_out")"
+    sleep 0.02
+  done
+  ! grep -F -- '--io-control:' "$sim_out" || hil_fail "$1: loom-sim-drive ignored io-control words (above)"
+}
+
 # --- e-stop input -------------------------------------------------------------------------------------
 run_until_armed estop
 hil_io_control estop
@@ -95,6 +109,21 @@ cansend "$HIL_IFACE" 082#1023030000000000
 expect_fault emcy 'drive_fault.*0x2310|0x2310.*drive_fault'
 "$HIL_CANLOG" emcy-stop "$HIL_LOG" --nodes "$HIL_NODES" --emcy-node 2 ||
   hil_fail "emcy: the bus does not show a quick stop of every drive right after the EMCY; log: $HIL_LOG"
+
+# --- a stuck second switch ----------------------------------------------------------------------------
+# shuttle_at_left's second switch sticks on. Row 1 is shed (0.3 s machine time), one pick to the right
+# (0.7 s), then 8 beats (8.4 s) with the shuttle at the right: 2 s after arming (about 1 s machine time
+# in the VM) the shuttle has left the left selvedge, its first switch is off and the two disagree at
+# once; were it still there, they disagree as it leaves. (Stuck shuttle_at_right_2 would wait out the
+# beats, its first switch on through them.) The loom acts on the sensor only while both switches agree,
+# so nothing else trips first.
+case_start=$SECONDS
+run_until_armed stuck
+hil_io_control stuck=shuttle_at_left_2:on
+sim_took_controls stuck 'stuck=shuttle_at_left_2:on'
+expect_fault stuck '^FAULT sensor_discrepancy \(code 0x1020, sensor shuttle_at_left,'
+hil_io_control ""
+hil_note "stuck: case took $((SECONDS - case_start)) s (fresh machine, bring-up, 2 s weaving, fault)"
 
 # --- the master dies ----------------------------------------------------------------------------------
 run_until_armed master

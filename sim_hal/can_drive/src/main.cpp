@@ -5,12 +5,15 @@
 //                  [--counts-per-unit A,B,C] [--initial-position a,b,c] [--io-control FILE]
 // The I/O node's pistons follow its valve outputs, its shuttle sensors the helix drive (3rd node), its
 // load cell the crank drive (1st node). --io-control FILE is re-read when it changes: whitespace-separated
-// words estop, start, pause, ack, knotted, silent (present = active), for HIL fault tests.
+// words estop, start, pause, ack, knotted, silent, stuck=<sensor>[_2]:on|off (present = active; the last
+// sticks one switch of a safety sensor, `_2` its second, e.g. stuck=shuttle_at_right_2:on), for HIL
+// fault tests; io_control.hpp describes them.
 #include <poll.h>
 #include <time.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <csignal>
@@ -28,6 +31,7 @@
 #include "loom/drivers/can_axis_port.hpp"
 #include "loom/drivers/nmt.hpp"
 #include "loom/drivers/socket_can_bus.hpp"
+#include "loom/sim_can/io_control.hpp"
 #include "loom/sim_can/sim_drive_rack.hpp"
 
 namespace {
@@ -95,7 +99,10 @@ int main(int argc, char** argv) {
   double width_m = 0.6, helix_lead_m = 0.1;
   app.add_option("--iface", iface, "CAN interface, e.g. vcan0")->required();
   app.add_option("--io-node", io_node, "also simulate the CiA 401 I/O node with this node id (1..127)");
-  app.add_option("--io-control", io_control, "file of words estop/start/pause/ack/knotted/silent for the I/O node");
+  app.add_option("--io-control", io_control,
+                 "file of words for the I/O node, re-read when it changes: estop start pause ack knotted silent, "
+                 "stuck=<sensor>[_2]:on|off (one switch of a safety sensor stuck, _2 = its second switch, e.g. "
+                 "stuck=shuttle_at_right_2:on)");
   app.add_option("--width-m", width_m, "loom width for the I/O node's shuttle sensors (default 0.6)");
   app.add_option("--helix-lead-m", helix_lead_m, "helix lead for the I/O node's shuttle sensors (default 0.1)");
   app.add_option("--personality", personality,
@@ -212,19 +219,13 @@ int main(int argc, char** argv) {
     std::ifstream in(io_control);
     std::stringstream words;
     words << in.rdbuf();
-    loom::sim_can::IoPlant& p = rack.io_controls();
-    p.estop_open = p.button_start = p.button_pause = p.button_ack = p.row_knotted = p.silent = false;
-    std::string w;
-    while (words >> w) {
-      if (w == "estop") p.estop_open = true;
-      else if (w == "start") p.button_start = true;
-      else if (w == "pause") p.button_pause = true;
-      else if (w == "ack") p.button_ack = true;
-      else if (w == "knotted") p.row_knotted = true;
-      else if (w == "silent") p.silent = true;
-      else std::cerr << "loom-sim-drive: --io-control: unknown word '" << w << "' ignored\n";
+    for (const std::string& ignored : loom::sim_can::set_io_controls(words.str(), rack.io_controls())) {
+      std::cerr << "loom-sim-drive: --io-control: " << ignored << "\n";
     }
-    std::cerr << "loom-sim-drive: I/O controls now: " << words.str();
+    // One line per re-read (HIL tests wait for it), also for an empty file or a last word without newline.
+    std::string applied = words.str();
+    while (!applied.empty() && std::isspace(static_cast<unsigned char>(applied.back())) != 0) applied.pop_back();
+    std::cerr << "loom-sim-drive: I/O controls now: " << applied << "\n";
   };
   rack.power_on(monotonic_us());
   std::cerr << "loom-sim-drive: " << nodes.size() << " " << personality << " drive(s) on " << iface << ", nodes";

@@ -25,7 +25,8 @@ class SimDriveRack {
     double helix_counts_per_rad = 1.0;
   };
   void attach_io(SimIoNode& io, IoPlantSource source);
-  // The e-stop, buttons and "silent" switch the I/O node sees (tests and the control file set them).
+  // The e-stop, buttons, "silent" switch and stuck safety switch (IoPlant::stuck) the I/O node sees
+  // (tests and the control file set them); step() hands them to the node with the drives' positions.
   IoPlant& io_controls() { return io_controls_; }
 
   void power_on(std::int64_t now_us);  // RT-safe
