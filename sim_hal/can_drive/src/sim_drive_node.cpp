@@ -122,7 +122,7 @@ void SimDriveNode::reset_communication() {
   }
   master_seen_us_ = -1;
   master_lost_ = false;
-  rpdo_pending_.fill(false);
+  rpdos_.clear();
   syncs_ = 0;
 }
 
@@ -174,27 +174,13 @@ void SimDriveNode::send(const CanFrame& f) {
 // Frames in
 // ---------------------------------------------------------------------------------------------------
 void SimDriveNode::handle(const CanFrame& f, std::int64_t now_us) {
-  if (!powered_ || f.is_error() || f.is_rtr() || boot_at_us_ >= 0) return;
-  // The master's heartbeat, watched through 0x1016:01 (node << 16 | ms).
-  const std::uint32_t consumer = od_.get(kConsumerHeartbeat, 1);
-  if (consumer != 0 && f.id == cob::kErrorControl + ((consumer >> 16) & 0x7F)) {
-    master_seen_us_ = now_us;
-    return;
-  }
-  if (f.id == cob::kNmt) {
-    if (const auto request = slave::parse_nmt(f, config_.node_id)) on_nmt(request->command, now_us);
-    return;
-  }
-  if (f.id == cob::kSdoRx + config_.node_id) {
-    if (nmt_ != nmt::kStopped) on_sdo(f, now_us);
-    return;
-  }
-  if (nmt_ != nmt::kOperational) return;
-  if (slave::is_sync(f)) {
-    on_sync(now_us);
-    return;
-  }
-  if (const int pdo = od_.rpdo_for(f.id); pdo >= 0) on_rpdo(pdo, f, now_us);
+  if (!powered_ || boot_at_us_ >= 0) return;
+  slave::deliver(od_, config_.node_id, nmt_, f, now_us, *this);
+}
+
+// The master's heartbeat, watched through 0x1016:01.
+void SimDriveNode::on_watched_heartbeat(std::int64_t now_us) {
+  master_seen_us_ = now_us;
 }
 
 void SimDriveNode::on_nmt(std::uint8_t command, std::int64_t now_us) {
@@ -230,26 +216,14 @@ void SimDriveNode::on_sdo(const CanFrame& f, std::int64_t now_us) {
 }
 
 void SimDriveNode::on_rpdo(int pdo, const CanFrame& f, std::int64_t now_us) {
-  if (!od_.rpdo_length_ok(pdo, f.dlc)) {
+  if (!rpdos_.receive(od_, *this, pdo, f, now_us)) {
     send(slave::emcy(config_.node_id, slave::emcy_code::kPdoLength, error_register_));
-    return;
-  }
-  const auto k = static_cast<std::size_t>(pdo);
-  if (slave::rpdo_synchronous(od_.pdo_type(static_cast<std::uint16_t>(slave::kRpdoComm + pdo)))) {
-    rpdo_data_[k] = f.data;
-    rpdo_pending_[k] = true;  // applied at the next SYNC
-  } else {
-    od_.unpack_rpdo(pdo, f.data, *this, now_us);
   }
 }
 
 void SimDriveNode::on_sync(std::int64_t now_us) {
   ++syncs_;
-  for (std::size_t k = 0; k < rpdo_pending_.size(); ++k) {
-    if (!rpdo_pending_[k]) continue;
-    rpdo_pending_[k] = false;
-    od_.unpack_rpdo(static_cast<int>(k), rpdo_data_[k], *this, now_us);
-  }
+  rpdos_.apply_at_sync(od_, *this, now_us);
   previous_position_ = position_;
   track_target();
   send_tpdos();
@@ -277,13 +251,7 @@ void SimDriveNode::track_target() {
 // ---------------------------------------------------------------------------------------------------
 void SimDriveNode::send_tpdos() {
   publish();
-  for (int k = 0; k < slave::kPdos; ++k) {
-    const auto comm = static_cast<std::uint16_t>(slave::kTpdoComm + k);
-    if (!od_.pdo_valid(comm) || !slave::tpdo_due_on_sync(od_.pdo_type(comm), syncs_)) continue;
-    std::array<std::uint8_t, 8> data{};
-    const std::uint8_t dlc = od_.pack_tpdo(k, data);
-    send(slave::pdo_frame(od_.pdo_can_id(comm), dlc, data));
-  }
+  slave::send_due_tpdos(od_, syncs_, [this](const CanFrame& f) { send(f); });
 }
 
 // What the drive reports, into its objects: the dictionary is what SDO uploads and TPDOs read.

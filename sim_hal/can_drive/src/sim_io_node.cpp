@@ -117,7 +117,7 @@ void SimIoNode::reset_communication(std::int64_t now_us) {
   set_factory_mapping(1, config_.tpdo2_factory_mapping);
   nmt_ = nmt::kPreOperational;
   syncs_ = 0;
-  rpdo_pending_.fill(false);
+  rpdos_.clear();
   master_seen_us_ = -1;
   comm_lost_ = false;
   boot_at_us_ = now_us + config_.boot_delay_us;
@@ -175,27 +175,13 @@ std::uint8_t SimIoNode::outputs(int byte) const {
 // Frames in
 // ---------------------------------------------------------------------------------------------------
 void SimIoNode::handle(const drivers::CanFrame& f, std::int64_t now_us) {
-  if (!powered_ || plant_.silent || f.is_error() || f.is_rtr() || boot_at_us_ >= 0) return;
-  if (const auto request = slave::parse_nmt(f, config_.node_id)) {
-    on_nmt(request->command, now_us);
-    return;
-  }
-  // The master's heartbeat, watched through 0x1016:01.
-  const std::uint32_t consumer = od_.exists(kConsumerHeartbeat) ? od_.get(kConsumerHeartbeat, 1) : 0;
-  if (consumer != 0 && f.id == cob::kErrorControl + ((consumer >> 16) & 0x7F) && f.dlc >= 1) {
-    master_seen_us_ = now_us;
-    return;
-  }
-  if (f.id == cob::kSdoRx + config_.node_id) {
-    if (nmt_ != nmt::kStopped) on_sdo(f, now_us);
-    return;
-  }
-  if (nmt_ != nmt::kOperational) return;
-  if (slave::is_sync(f)) {
-    on_sync(now_us);
-    return;
-  }
-  if (const int pdo = od_.rpdo_for(f.id); pdo >= 0) on_rpdo(pdo, f, now_us);
+  if (!powered_ || plant_.silent || boot_at_us_ >= 0) return;
+  slave::deliver(od_, config_.node_id, nmt_, f, now_us, *this);
+}
+
+// The master's heartbeat, watched through 0x1016:01.
+void SimIoNode::on_watched_heartbeat(std::int64_t now_us) {
+  master_seen_us_ = now_us;
 }
 
 void SimIoNode::on_nmt(std::uint8_t command, std::int64_t now_us) {
@@ -227,16 +213,8 @@ void SimIoNode::on_sdo(const drivers::CanFrame& f, std::int64_t now_us) {
 }
 
 void SimIoNode::on_rpdo(int pdo, const drivers::CanFrame& f, std::int64_t now_us) {
-  if (!od_.rpdo_length_ok(pdo, f.dlc)) {
+  if (!rpdos_.receive(od_, *this, pdo, f, now_us)) {
     send(slave::emcy(config_.node_id, slave::emcy_code::kPdoLength, slave::kErrorRegisterGeneric));
-    return;
-  }
-  const auto k = static_cast<std::size_t>(pdo);
-  if (slave::rpdo_synchronous(od_.pdo_type(static_cast<std::uint16_t>(slave::kRpdoComm + pdo)))) {
-    rpdo_data_[k] = f.data;
-    rpdo_pending_[k] = true;  // applied at the next SYNC
-  } else {
-    od_.unpack_rpdo(pdo, f.data, *this, now_us);
   }
 }
 
@@ -249,16 +227,9 @@ void SimIoNode::send_tpdo(int pdo) {
 void SimIoNode::on_sync(std::int64_t now_us) {
   ++syncs_;
   ++syncs_total_;
-  for (std::size_t k = 0; k < rpdo_pending_.size(); ++k) {
-    if (!rpdo_pending_[k]) continue;
-    rpdo_pending_[k] = false;
-    od_.unpack_rpdo(static_cast<int>(k), rpdo_data_[k], *this, now_us);
-  }
+  rpdos_.apply_at_sync(od_, *this, now_us);
   update_inputs();
-  for (int k = 0; k < slave::kPdos; ++k) {
-    const auto comm = static_cast<std::uint16_t>(slave::kTpdoComm + k);
-    if (od_.pdo_valid(comm) && slave::tpdo_due_on_sync(od_.pdo_type(comm), syncs_)) send_tpdo(k);
-  }
+  slave::send_due_tpdos(od_, syncs_, [this](const drivers::CanFrame& f) { send(f); });
 }
 
 // Event-driven input TPDOs (types 254/255) go out when an input changed.
@@ -294,8 +265,12 @@ void SimIoNode::written(std::uint16_t index, std::uint8_t, std::uint32_t value, 
 // shuttle within its window of either selvedge.
 std::array<bool, hal::kSafetySensorCount> SimIoNode::safety_sensors_truth() const {
   const double x = plant_.helix_rad * config_.helix_lead_m / (2.0 * 3.14159265358979323846);
-  return {piston_[0] >= 1.0, piston_[0] <= 0.0, piston_[1] >= 1.0, piston_[1] <= 0.0,
-          x <= config_.selvedge_window_m, x >= config_.width_m - config_.selvedge_window_m};
+  return {piston_[0] >= 1.0,
+          piston_[0] <= 0.0,
+          piston_[1] >= 1.0,
+          piston_[1] <= 0.0,
+          x <= config_.selvedge_window_m,
+          x >= config_.width_m - config_.selvedge_window_m};
 }
 
 void SimIoNode::update_inputs() {
@@ -316,9 +291,11 @@ void SimIoNode::update_inputs() {
   set(kInPause, plant_.button_pause);
   set(kInAck, plant_.button_ack);
   set(kInKnotted, plant_.row_knotted);
-  for (std::size_t k = static_cast<std::size_t>(input_groups()); k < in.size(); ++k) in[k] = 0;  // no terminals
+  for (std::size_t k = static_cast<std::size_t>(input_groups()); k < in.size(); ++k)
+    in[k] = 0;  // no terminals
   in_ = in;
-  for (std::size_t k = 0; k < in.size(); ++k) od_.set(kDigitalInputs, static_cast<std::uint8_t>(k + 1), in[k]);
+  for (std::size_t k = 0; k < in.size(); ++k)
+    od_.set(kDigitalInputs, static_cast<std::uint8_t>(k + 1), in[k]);
   // Load cell: a narrow pulse around the crank angle at which the beater meets the fell.
   const double two_pi = 2.0 * 3.14159265358979323846;
   double d = std::fmod(plant_.crank_rad - config_.fell_crank_rad, two_pi);

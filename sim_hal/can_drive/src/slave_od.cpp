@@ -394,4 +394,71 @@ bool rpdo_synchronous(std::uint8_t type) {
   return type <= 240;
 }
 
+// ---------------------------------------------------------------------------------------------------
+// Shared communication
+// ---------------------------------------------------------------------------------------------------
+bool is_watched_heartbeat(const ObjectDictionary& od, const drivers::CanFrame& f) {
+  const std::uint32_t consumer =
+      od.exists(kConsumerHeartbeatObject) ? od.get(kConsumerHeartbeatObject, 1) : 0;
+  return consumer != 0 && f.id == cob::kErrorControl + ((consumer >> 16) & 0x7F) && f.dlc >= 1;
+}
+
+Route route(const ObjectDictionary& od, std::uint8_t node_id, std::uint8_t nmt_state,
+            const drivers::CanFrame& f) {
+  using To = Route::To;
+  if (f.is_error() || f.is_rtr()) return {};
+  if (const auto request = parse_nmt(f, node_id)) return {To::kNmt, request->command, -1};
+  if (is_watched_heartbeat(od, f)) return {To::kWatchedHeartbeat, 0, -1};
+  if (f.id == cob::kSdoRx + node_id) return nmt_state != nmt::kStopped ? Route{To::kSdo, 0, -1} : Route{};
+  if (nmt_state != nmt::kOperational) return {};
+  if (is_sync(f)) return {To::kSync, 0, -1};
+  if (const int pdo = od.rpdo_for(f.id); pdo >= 0) return {To::kRpdo, 0, pdo};
+  return {};
+}
+
+void deliver(const ObjectDictionary& od, std::uint8_t node_id, std::uint8_t nmt_state,
+             const drivers::CanFrame& f, std::int64_t now_us, FrameHandlers& node) {
+  const Route r = route(od, node_id, nmt_state, f);
+  switch (r.to) {
+    case Route::To::kNmt:
+      node.on_nmt(r.nmt_command, now_us);
+      break;
+    case Route::To::kWatchedHeartbeat:
+      node.on_watched_heartbeat(now_us);
+      break;
+    case Route::To::kSdo:
+      node.on_sdo(f, now_us);
+      break;
+    case Route::To::kSync:
+      node.on_sync(now_us);
+      break;
+    case Route::To::kRpdo:
+      node.on_rpdo(r.pdo, f, now_us);
+      break;
+    case Route::To::kNothing:
+      break;
+  }
+}
+
+bool RpdoInbox::receive(ObjectDictionary& od, ObjectHooks& hooks, int pdo, const drivers::CanFrame& f,
+                        std::int64_t now_us) {
+  if (!od.rpdo_length_ok(pdo, f.dlc)) return false;
+  const auto k = static_cast<std::size_t>(pdo);
+  if (rpdo_synchronous(od.pdo_type(static_cast<std::uint16_t>(kRpdoComm + pdo)))) {
+    data_[k] = f.data;
+    pending_[k] = true;  // applied at the next SYNC
+  } else {
+    od.unpack_rpdo(pdo, f.data, hooks, now_us);
+  }
+  return true;
+}
+
+void RpdoInbox::apply_at_sync(ObjectDictionary& od, ObjectHooks& hooks, std::int64_t now_us) {
+  for (std::size_t k = 0; k < pending_.size(); ++k) {
+    if (!pending_[k]) continue;
+    pending_[k] = false;
+    od.unpack_rpdo(static_cast<int>(k), data_[k], hooks, now_us);
+  }
+}
+
 }  // namespace loom::sim_can::slave

@@ -40,7 +40,7 @@ struct SimDriveConfig {
   std::int64_t operational_delay_us = 0;  // NMT start → operational
 };
 
-class SimDriveNode : private slave::ObjectHooks {
+class SimDriveNode : private slave::ObjectHooks, private slave::FrameHandlers {
  public:
   // Configure-time only. The node is powered off until power_on().
   SimDriveNode(drivers::CanBus& bus, SimDriveConfig config);
@@ -84,10 +84,12 @@ class SimDriveNode : private slave::ObjectHooks {
   void restart(std::int64_t now_us);
   void boot_up(std::int64_t now_us);
   void send(const drivers::CanFrame& f);
-  void on_nmt(std::uint8_t command, std::int64_t now_us);
-  void on_sdo(const drivers::CanFrame& f, std::int64_t now_us);
-  void on_sync(std::int64_t now_us);
-  void on_rpdo(int pdo, const drivers::CanFrame& f, std::int64_t now_us);
+  // Frames routed by slave::deliver.
+  void on_nmt(std::uint8_t command, std::int64_t now_us) override;
+  void on_watched_heartbeat(std::int64_t now_us) override;
+  void on_sdo(const drivers::CanFrame& f, std::int64_t now_us) override;
+  void on_sync(std::int64_t now_us) override;
+  void on_rpdo(int pdo, const drivers::CanFrame& f, std::int64_t now_us) override;
   void track_target();
   void send_tpdos();
   void publish();
@@ -106,8 +108,7 @@ class SimDriveNode : private slave::ObjectHooks {
 
   // Communication state.
   std::int64_t next_heartbeat_us_ = 0;
-  std::array<bool, slave::kPdos> rpdo_pending_{};
-  std::array<std::array<std::uint8_t, 8>, slave::kPdos> rpdo_data_{};
+  slave::RpdoInbox rpdos_;
   std::uint32_t syncs_ = 0;
 
   // Drive state (the physical side; published into the dictionary before the bus reads it).

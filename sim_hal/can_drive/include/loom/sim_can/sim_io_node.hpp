@@ -60,7 +60,7 @@ struct SimIoConfig {
   double fell_crank_rad = 3.14159265358979;  // crank angle (mod 2π) at which the beater meets the fell
   double load_cell_n_per_count = 0.01;
   // Interoperability variants.
-  bool fixed_mapping = false;                 // 0x16xx/0x1Axx read-only, sub 0 included
+  bool fixed_mapping = false;  // 0x16xx/0x1Axx read-only, sub 0 included
   // A module's own factory TPDO1/TPDO2 (mapping entries index << 16 | sub << 8 | bits), e.g. a fixed
   // 16-input module's {0x60000108, 0x60000208}; empty = the defaults in sim_io_node.cpp.
   std::vector<std::uint32_t> tpdo1_factory_mapping;
@@ -73,7 +73,7 @@ struct SimIoConfig {
   std::int64_t boot_delay_us = 0;             // power-on / reset → boot-up
 };
 
-class SimIoNode : private slave::ObjectHooks {
+class SimIoNode : private slave::ObjectHooks, private slave::FrameHandlers {
  public:
   // Configure-time only. Powered off until power_on().
   SimIoNode(drivers::CanBus& bus, SimIoConfig config);
@@ -101,10 +101,12 @@ class SimIoNode : private slave::ObjectHooks {
   void written(std::uint16_t index, std::uint8_t sub, std::uint32_t value, std::int64_t now_us) override;
   std::uint32_t check(std::uint16_t index, std::uint8_t sub, std::uint32_t value) const override;
 
-  void on_nmt(std::uint8_t command, std::int64_t now_us);
-  void on_sdo(const drivers::CanFrame& f, std::int64_t now_us);
-  void on_sync(std::int64_t now_us);
-  void on_rpdo(int pdo, const drivers::CanFrame& f, std::int64_t now_us);
+  // Frames routed by slave::deliver.
+  void on_nmt(std::uint8_t command, std::int64_t now_us) override;
+  void on_watched_heartbeat(std::int64_t now_us) override;
+  void on_sdo(const drivers::CanFrame& f, std::int64_t now_us) override;
+  void on_sync(std::int64_t now_us) override;
+  void on_rpdo(int pdo, const drivers::CanFrame& f, std::int64_t now_us) override;
   void send_tpdo(int pdo);
   void send_changed_inputs();
   void reset_communication(std::int64_t now_us);
@@ -129,8 +131,7 @@ class SimIoNode : private slave::ObjectHooks {
   bool comm_lost_ = false;
   std::uint32_t syncs_ = 0;
   std::uint64_t syncs_total_ = 0, syncs_at_last_step_ = 0;  // plant_cycle_s: machine time in SYNCs
-  std::array<bool, 4> rpdo_pending_{};
-  std::array<std::array<std::uint8_t, 8>, 4> rpdo_data_{};
+  slave::RpdoInbox rpdos_;
   // Plant.
   IoPlant plant_{};
   std::int64_t last_step_us_ = -1;

@@ -142,7 +142,7 @@ constexpr Objects<5> communication_objects(std::uint32_t device_type) {
   return {{{0x1000, 0, 4, Access::kConst, Pdo::kNone, device_type},
            {kErrorRegisterObject, 0, 1, Access::kRo, Pdo::kNone, 0},
            {kConsumerHeartbeatObject, 0, 1, Access::kConst, Pdo::kNone, 1},
-           {kConsumerHeartbeatObject, 1, 4, Access::kRw, Pdo::kNone, 0},  // master node << 16 | ms
+           {kConsumerHeartbeatObject, 1, 4, Access::kRw, Pdo::kNone, 0},    // master node << 16 | ms
            {kProducerHeartbeatObject, 0, 2, Access::kRw, Pdo::kNone, 0}}};  // ms
 }
 
@@ -262,5 +262,72 @@ drivers::CanFrame pdo_frame(std::uint32_t can_id, std::uint8_t dlc, const std::a
 bool tpdo_due_on_sync(std::uint8_t type, std::uint32_t syncs);
 // Synchronous RPDO (types 0..240): buffered and applied at the next SYNC.
 bool rpdo_synchronous(std::uint8_t type);
+
+// ---------------------------------------------------------------------------------------------------
+// Communication both simulated nodes share (the drive and the I/O module)
+// ---------------------------------------------------------------------------------------------------
+// `f` is the heartbeat of the node this one's 0x1016:01 consumer watches (node << 16 | ms; an absent
+// object or 0 watches nothing).
+bool is_watched_heartbeat(const ObjectDictionary& od, const drivers::CanFrame& f);
+
+// Which service of node `node_id` (in NMT state `nmt_state`) a received data frame is for: an NMT command
+// to it, the watched heartbeat, its SDO server (not while stopped), and only while operational SYNC and
+// its RPDOs. Error and remote frames, and what is for other nodes, go nowhere.
+struct Route {
+  enum class To : std::uint8_t { kNothing, kNmt, kWatchedHeartbeat, kSdo, kSync, kRpdo };
+  To to = To::kNothing;
+  std::uint8_t nmt_command = 0;  // kNmt
+  int pdo = -1;                  // kRpdo
+};
+Route route(const ObjectDictionary& od, std::uint8_t node_id, std::uint8_t nmt_state,
+            const drivers::CanFrame& f);
+
+// What a simulated node does with each service route() sends a frame to.
+class FrameHandlers {
+ public:
+  virtual void on_nmt(std::uint8_t command, std::int64_t now_us) = 0;
+  virtual void on_watched_heartbeat(std::int64_t now_us) = 0;
+  virtual void on_sdo(const drivers::CanFrame& f, std::int64_t now_us) = 0;
+  virtual void on_sync(std::int64_t now_us) = 0;
+  virtual void on_rpdo(int pdo, const drivers::CanFrame& f, std::int64_t now_us) = 0;
+
+ protected:
+  ~FrameHandlers() = default;
+};
+
+// RT-safe. Routes `f` (route()) to the handler of `node` it is for.
+void deliver(const ObjectDictionary& od, std::uint8_t node_id, std::uint8_t nmt_state,
+             const drivers::CanFrame& f, std::int64_t now_us, FrameHandlers& node);
+
+// Received RPDOs (CiA 301): a synchronous one is held and its objects written at the next SYNC, an
+// event-driven one at once. RT-safe.
+class RpdoInbox {
+ public:
+  // A frame for RPDO `pdo`. False when its length does not match the mapping (nothing written; the node
+  // answers with its own EMCY 0x8210).
+  bool receive(ObjectDictionary& od, ObjectHooks& hooks, int pdo, const drivers::CanFrame& f,
+               std::int64_t now_us);
+  // At SYNC: writes every held RPDO's objects, in PDO order.
+  void apply_at_sync(ObjectDictionary& od, ObjectHooks& hooks, std::int64_t now_us);
+  // Communication reset: nothing held.
+  void clear() { pending_.fill(false); }
+
+ private:
+  std::array<bool, kPdos> pending_{};
+  std::array<std::array<std::uint8_t, 8>, kPdos> data_{};
+};
+
+// Hands every TPDO due at this SYNC (`syncs` counted since NMT reset), packed from the dictionary, to
+// `send(frame)`. RT-safe.
+template <class Send>
+void send_due_tpdos(const ObjectDictionary& od, std::uint32_t syncs, Send&& send) {
+  for (int k = 0; k < kPdos; ++k) {
+    const auto comm = static_cast<std::uint16_t>(kTpdoComm + k);
+    if (!od.pdo_valid(comm) || !tpdo_due_on_sync(od.pdo_type(comm), syncs)) continue;
+    std::array<std::uint8_t, 8> data{};
+    const std::uint8_t dlc = od.pack_tpdo(k, data);
+    send(pdo_frame(od.pdo_can_id(comm), dlc, data));
+  }
+}
 
 }  // namespace loom::sim_can::slave
