@@ -292,5 +292,75 @@ TEST(SimSlaveOdFrames, SyncWithOrWithoutCounter) {
   EXPECT_FALSE(is_sync(frame(0x081, {})));
 }
 
+// ---- Routing a received frame, and the RPDO inbox (shared by the simulated drive and I/O module) ---
+TEST_F(SimSlaveOd, FramesAreRoutedByServiceAndNmtState) {
+  using To = Route::To;
+  const auto to = [&](std::uint8_t state, const CanFrame& f) { return route(od_, kNode, state, f).to; };
+  // NMT to this node or to all, in any state; to another node, nowhere.
+  EXPECT_EQ(to(nmt::kStopped, frame(0x000, {0x01, kNode})), To::kNmt);
+  EXPECT_EQ(route(od_, kNode, nmt::kStopped, frame(0x000, {0x81, 0x00})).nmt_command, 0x81);
+  EXPECT_EQ(to(nmt::kOperational, frame(0x000, {0x01, 0x06})), To::kNothing);
+  // The SDO server answers in every state but stopped.
+  const CanFrame upload = frame(0x605, {0x40, 0x41, 0x60, 0x00, 0, 0, 0, 0});
+  EXPECT_EQ(to(nmt::kPreOperational, upload), To::kSdo);
+  EXPECT_EQ(to(nmt::kOperational, upload), To::kSdo);
+  EXPECT_EQ(to(nmt::kStopped, upload), To::kNothing);
+  EXPECT_EQ(to(nmt::kOperational, frame(0x606, {0x40, 0x41, 0x60, 0x00, 0, 0, 0, 0})), To::kNothing);
+  // SYNC and RPDOs only while operational.
+  EXPECT_EQ(to(nmt::kOperational, frame(0x080, {})), To::kSync);
+  EXPECT_EQ(to(nmt::kPreOperational, frame(0x080, {})), To::kNothing);
+  const Route rpdo = route(od_, kNode, nmt::kOperational, frame(0x205, {0x0F, 0x00}));
+  EXPECT_EQ(rpdo.to, To::kRpdo);
+  EXPECT_EQ(rpdo.pdo, 0);
+  EXPECT_EQ(to(nmt::kPreOperational, frame(0x205, {0x0F, 0x00})), To::kNothing);
+  // Error and remote frames go nowhere, whatever their id.
+  CanFrame rtr = frame(0x080, {});
+  rtr.flags = CanFrame::kRtr;
+  EXPECT_EQ(to(nmt::kOperational, rtr), To::kNothing);
+  CanFrame error = frame(0x000, {0x01, kNode});
+  error.flags = CanFrame::kError;
+  EXPECT_EQ(to(nmt::kOperational, error), To::kNothing);
+  // This device has no 0x1016: it watches no heartbeat.
+  EXPECT_EQ(to(nmt::kOperational, frame(0x77F, {0x05})), To::kNothing);
+}
+
+TEST(SimSlaveOdRouting, OnlyTheHeartbeatThe1016ConsumerNamesIsWatched) {
+  static constexpr auto table = concat(communication_objects(0x00020192));
+  ObjectDictionary od(table, {});
+  od.reset_communication(kNode);
+  EXPECT_FALSE(is_watched_heartbeat(od, frame(0x77F, {0x05})));  // 0x1016:01 = 0: nothing watched
+  od.set(kConsumerHeartbeatObject, 1, (127U << 16) | 500U);
+  EXPECT_TRUE(is_watched_heartbeat(od, frame(0x77F, {0x05})));
+  EXPECT_EQ(route(od, kNode, nmt::kStopped, frame(0x77F, {0x05})).to, Route::To::kWatchedHeartbeat);
+  EXPECT_FALSE(is_watched_heartbeat(od, frame(0x77E, {0x05})));  // another node's
+  EXPECT_FALSE(is_watched_heartbeat(od, frame(0x77F, {})));      // no state byte: not a heartbeat
+}
+
+TEST_F(SimSlaveOd, ASynchronousRpdoIsWrittenAtTheNextSyncAnEventOneAtOnce) {
+  RpdoInbox inbox;
+  // RPDO1 is event-driven (type 255) in this table: written on receipt.
+  ASSERT_TRUE(inbox.receive(od_, hooks_, 0, frame(0x205, {0x06, 0x00}), 10));
+  EXPECT_EQ(od_.get(0x6040, 0), 0x0006U);
+  // Made synchronous (type 1): held until the SYNC, and the last frame before it wins.
+  od_.set(0x1400, 2, 1);
+  ASSERT_TRUE(inbox.receive(od_, hooks_, 0, frame(0x205, {0x07, 0x00}), 20));
+  ASSERT_TRUE(inbox.receive(od_, hooks_, 0, frame(0x205, {0x0F, 0x00}), 21));
+  EXPECT_EQ(od_.get(0x6040, 0), 0x0006U);
+  inbox.apply_at_sync(od_, hooks_, 30);
+  EXPECT_EQ(od_.get(0x6040, 0), 0x000FU);
+  EXPECT_EQ(hooks_.writes.back().now_us, 30);
+  // Applied once: a second SYNC writes nothing more; a reset drops what was held.
+  const std::size_t writes = hooks_.writes.size();
+  inbox.apply_at_sync(od_, hooks_, 40);
+  EXPECT_EQ(hooks_.writes.size(), writes);
+  ASSERT_TRUE(inbox.receive(od_, hooks_, 0, frame(0x205, {0x02, 0x00}), 50));
+  inbox.clear();
+  inbox.apply_at_sync(od_, hooks_, 60);
+  EXPECT_EQ(od_.get(0x6040, 0), 0x000FU);
+  // A frame shorter than the mapping is refused, nothing written.
+  EXPECT_FALSE(inbox.receive(od_, hooks_, 0, frame(0x205, {0x0F}), 70));
+  EXPECT_EQ(hooks_.writes.size(), writes);
+}
+
 }  // namespace
 }  // namespace loom::sim_can::slave
