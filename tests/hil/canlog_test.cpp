@@ -440,6 +440,30 @@ TEST(HilJudgeEmcy, EveryDriveStopsWithinOneCycleOfTheEmcyAndStaysStopped) {
   EXPECT_FALSE(check_emcy_stop(parse_log("(1.001000) vcan0 082#1023030000000000\n(1.004000) vcan0 080#\n"), {1}, 2).ok);
 }
 
+TEST(HilJudgeFeedbackLag, ATpdoTrailingItsSyncIsCountedAndOverTheLimitFails) {
+  // Node 1 answers every SYNC at once; node 2's answers to two SYNCs arrive together after the second.
+  const std::string log =
+      "(1.000000) vcan0 080#\n(1.001000) vcan0 181#370000000000\n(1.002000) vcan0 182#370000000000\n"
+      "(1.004000) vcan0 080#\n(1.005000) vcan0 181#370000000000\n"
+      "(1.008000) vcan0 080#\n(1.009000) vcan0 181#370000000000\n(1.010000) vcan0 182#370000000000\n"
+      "(1.011000) vcan0 182#370000000000\n";
+  const std::vector<Frame> frames = parse_log(log);
+  const CheckResult report = check_feedback_lag(frames, {1, 2}, 1000);
+  EXPECT_TRUE(report.ok);
+  ASSERT_EQ(report.notes.size(), 2U);
+  EXPECT_EQ(report.notes[0], "node 1: 3 TPDO1s, each answering the SYNC right before it");
+  EXPECT_EQ(report.notes[1], "node 2: 3 TPDO1s, 1 of them late (worst 1 cycle(s) behind, at line 8)")
+      << report.notes[1];
+  EXPECT_TRUE(check_feedback_lag(frames, {1}, 0).ok);
+  const CheckResult strict = check_feedback_lag(frames, {1, 2}, 0);
+  EXPECT_FALSE(strict.ok);
+  EXPECT_NE(strict.failure.find("more than 0 cycle(s) late"), std::string::npos) << strict.failure;
+  // A node that sent no TPDO1 cannot be judged: that is a failure, not a pass.
+  const CheckResult silent = check_feedback_lag(frames, {1, 3}, 1000);
+  EXPECT_FALSE(silent.ok);
+  EXPECT_EQ(silent.failure, "node 3: no TPDO1 in the log");
+}
+
 TEST(HilJudgeMasterLoss, EveryConsumerMustReactInTime) {
   const std::string ok =
       "(1.000000) vcan0 77F#05\n(1.160000) vcan0 081#3081100000000000\n(1.170000) vcan0 084#3081110000000000\n";

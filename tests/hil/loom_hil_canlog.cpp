@@ -90,6 +90,13 @@ int main(int argc, char** argv) {
   mloss->add_option("--consumer-ms", consumer_ms, "consumer time (ms)")->check(CLI::Range(1.0, 65535.0));
   mloss->add_option("--slack-ms", slack_ms, "allowed lateness (the VM is not real-time)")->check(CLI::Range(0.0, 10000.0));
 
+  int max_late = 1000000;
+  auto* lag = app.add_subcommand("feedback-lag", "each drive's TPDO1 answers the SYNC right before it (the rig)");
+  lag->add_option("log", log, "candump -L log")->required();
+  lag->add_option("--nodes", nodes, "drive node ids")->required()->delimiter(',')->check(CLI::Range(1, 127));
+  lag->add_option("--max-cycles-late", max_late, "fail when a TPDO1 trails its SYNC by more (default: report only)")
+      ->check(CLI::Range(0, 1000000));
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -105,6 +112,7 @@ int main(int argc, char** argv) {
   if (summary->parsed()) return 0;
   if (weave->parsed()) return report("weave protocol", loom::hil::check_weave_protocol(frames, nodes));
   if (io->parsed()) return report("I/O traffic", loom::hil::check_io_traffic(frames, io_node, second_switches));
+  if (lag->parsed()) return report("feedback lag", loom::hil::check_feedback_lag(frames, nodes, max_late));
   if (emcy->parsed()) return report("EMCY stop", loom::hil::check_emcy_stop(frames, nodes, emcy_node));
   if (mloss->parsed()) {
     return report("master loss", loom::hil::check_master_loss(frames, nodes, master, consumer_ms * 1e-3, slack_ms * 1e-3));

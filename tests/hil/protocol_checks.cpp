@@ -475,6 +475,43 @@ CheckResult check_emcy_stop(const std::vector<Frame>& frames, const std::vector<
   return r;
 }
 
+CheckResult check_feedback_lag(const std::vector<Frame>& frames, const std::vector<int>& nodes, int max_cycles_late) {
+  CheckResult r;
+  char buf[200];
+  for (int node : nodes) {
+    int outstanding = 0;  // SYNCs since this node's last TPDO1
+    std::size_t tpdos = 0, late = 0;
+    int worst = 0;
+    const Frame* worst_at = nullptr;
+    for (const Frame& f : frames) {
+      if (is_sync(f)) {
+        ++outstanding;
+      } else if (!f.error_frame && f.id == static_cast<std::uint32_t>(0x180 + node)) {
+        ++tpdos;
+        const int behind = outstanding - 1;  // cycles late: 0 when it answers the SYNC right before it
+        if (behind > 0) ++late;
+        if (behind > worst) worst = behind, worst_at = &f;
+        outstanding = 0;
+      }
+    }
+    if (tpdos == 0) {
+      std::snprintf(buf, sizeof(buf), "node %d: no TPDO1 in the log", node);
+      if (r.ok) r.ok = false, r.failure = buf;
+    } else if (late == 0) {
+      std::snprintf(buf, sizeof(buf), "node %d: %zu TPDO1s, each answering the SYNC right before it", node, tpdos);
+    } else {
+      std::snprintf(buf, sizeof(buf), "node %d: %zu TPDO1s, %zu of them late (worst %d cycle(s) behind, at %s)", node,
+                    tpdos, late, worst, at_line(*worst_at).c_str());
+    }
+    r.notes.push_back(buf);
+    if (worst > max_cycles_late && r.ok) {
+      r.ok = false;
+      r.failure = std::string(buf) + ": more than " + std::to_string(max_cycles_late) + " cycle(s) late";
+    }
+  }
+  return r;
+}
+
 CheckResult check_master_loss(const std::vector<Frame>& frames, const std::vector<int>& nodes, int master,
                               double consumer_s, double slack_s) {
   CheckResult r;

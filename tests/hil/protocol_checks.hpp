@@ -76,6 +76,13 @@ CheckResult check_io_traffic(const std::vector<Frame>& frames, int io_node, bool
 // no later RPDO1 enables operation again.
 CheckResult check_emcy_stop(const std::vector<Frame>& frames, const std::vector<int>& nodes, int emcy_node);
 
+// How late the drives' feedback reached the bus (a check of the rig, not of the master): each
+// synchronous TPDO1 of `nodes` should answer the SYNC right before it. Counts, per node, the TPDO1s that
+// trail by more (a TPDO1 with k SYNCs outstanding since that node's previous one is k − 1 cycles late;
+// the first after a silence counts from that silence). Fails when one trails by more than
+// `max_cycles_late` cycles, or a node sent no TPDO1 at all (nothing to judge).
+CheckResult check_feedback_lag(const std::vector<Frame>& frames, const std::vector<int>& nodes, int max_cycles_late);
+
 // The master's heartbeat (0x700 + master) stops (it was killed): every node in `nodes` sends an EMCY
 // 0x8130 (heartbeat consumer) within `consumer_s` + `slack_s` of the master's last heartbeat.
 CheckResult check_master_loss(const std::vector<Frame>& frames, const std::vector<int>& nodes, int master,
