@@ -22,6 +22,7 @@
 #include <memory>
 
 #include "drive_rig.hpp"
+#include "fuzzed_frame.hpp"
 #include "loom/drivers/can_error_frame.hpp"
 #include "loom/drivers/cob_id.hpp"
 #include "loom/drivers/nmt.hpp"
@@ -117,12 +118,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (int op = 0; op < kMaxOps && in.remaining_bytes() > 0; ++op) {
     switch (in.ConsumeIntegralInRange<int>(0, 5)) {
       case 0: {  // any frame
-        drivers::CanFrame f;
-        f.flags = in.ConsumeIntegral<std::uint8_t>() & (drivers::CanFrame::kError | drivers::CanFrame::kRtr);
-        f.id = f.is_error() ? in.ConsumeIntegral<std::uint32_t>()
-                            : in.ConsumeIntegral<std::uint16_t>() & drivers::kMaxStandardId;
-        f.dlc = in.ConsumeIntegralInRange<std::uint8_t>(0, 8);
-        for (auto& b : f.data) b = in.ConsumeIntegral<std::uint8_t>();
+        const drivers::CanFrame f = fuzz::any_frame(in);
         if (bus.queue(f) && f.is_error() && drivers::decode_error_frame(f).bus_off) bus_off_queued = true;
         break;
       }

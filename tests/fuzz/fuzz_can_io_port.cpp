@@ -43,6 +43,7 @@
 #include <cstdlib>
 
 #include "fake_can_network.hpp"
+#include "fuzzed_frame.hpp"
 #include "loom/drivers/can_io_port.hpp"
 #include "loom/drivers/emcy.hpp"
 #include "loom/sim_can/sim_io_node.hpp"
@@ -439,12 +440,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (int op = 0; op < kMaxOps && in.remaining_bytes() > 0; ++op) {
     switch (in.ConsumeIntegralInRange<int>(0, 9)) {
       case 0: {  // any frame
-        drivers::CanFrame f;
-        f.flags = in.ConsumeIntegral<std::uint8_t>() & (drivers::CanFrame::kError | drivers::CanFrame::kRtr);
-        f.id = f.is_error() ? in.ConsumeIntegral<std::uint32_t>()
-                            : in.ConsumeIntegral<std::uint16_t>() & drivers::kMaxStandardId;
-        f.dlc = in.ConsumeIntegralInRange<std::uint8_t>(0, 8);
-        for (auto& b : f.data) b = in.ConsumeIntegral<std::uint8_t>();
+        const drivers::CanFrame f = fuzz::any_frame(in);
         queue(f);
         break;
       }
