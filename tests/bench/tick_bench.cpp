@@ -15,11 +15,11 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
-#include <ctime>
 #include <vector>
 
 #include "loom/firmware/config.hpp"
 #include "loom/firmware/machine.hpp"
+#include "loom/firmware/runner.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/beatup.hpp"
 #include "loom/motion/phase_table.hpp"
@@ -84,17 +84,10 @@ void BM_RockerTable(benchmark::State& state) {
 // ---------------------------------------------------------------------------------------------------
 // After a sleep
 // ---------------------------------------------------------------------------------------------------
-std::int64_t now_ns() {
-  timespec t{};
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return static_cast<std::int64_t>(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
-}
-
-void sleep_until_ns(std::int64_t deadline) {
-  const timespec ts{static_cast<time_t>(deadline / 1'000'000'000), static_cast<long>(deadline % 1'000'000'000)};
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) != 0) {
-  }
-}
+// The loop's own clock: the same clock_nanosleep to absolute deadlines the runner sleeps with.
+firmware::MonotonicClock g_clock;
+std::int64_t now_ns() { return g_clock.now_ns(); }
+void sleep_until_ns(std::int64_t deadline) { g_clock.sleep_until(deadline); }
 
 void spin_until_ns(std::int64_t deadline) {
   while (now_ns() < deadline) {
