@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# The README cannot drift from the tools: every command line it shows in a code block (```sh blocks,
-# and "$ "-prompted lines in plain ones) that runs one of ours is checked against the real thing —
+# The docs cannot drift from the tools: every command line that any Markdown file of the repository
+# (tests/readme/markdown_files.sh: every *.md outside build trees and fuzz corpora) shows in a code block
+# (```sh/```bash blocks, and "$ "-prompted lines in plain ones) that runs one of ours is checked against
+# the real thing —
 #   loomctl / build/bin/<tool> [subcommand]: the subcommand exists and every --option on the line is in
 #     that (sub)command's --help;
 #   a command word after a subcommand (loomctl ctl next) is among those its --help lists;
@@ -11,13 +13,25 @@
 set -uo pipefail
 src=$1
 build=$2
-readme=$src/README.md
+md=""  # the file being read, relative to src
 fails=0 checked=0
-fail() { echo "README:$1: $2" >&2; fails=$((fails + 1)); }
+fail() { echo "$md:$1: $2" >&2; fails=$((fails + 1)); }
 
-# Subcommands of each of our binaries (first word after the program that names one).
-subcommands_of() {
-  "$1" --help 2>/dev/null | awk '/^Subcommands:/{on=1; next} on && /^  [a-z]/{print $1} on && /^$/{on=0}'
+# --help of a binary (or of one of its subcommands) into $HELP, asked once per run: the docs repeat
+# programs. (Not a $(...) function: a subshell would forget the cache.)
+declare -A help_cache=()
+HELP=""
+load_help() {  # BIN [SUBCOMMAND]
+  local key="$1 ${2:-}"
+  if [[ -z ${help_cache[$key]+set} ]]; then
+    help_cache[$key]=$("$1" ${2:+"$2"} --help 2>&1 </dev/null)
+  fi
+  HELP=${help_cache[$key]}
+}
+
+# Subcommands listed in a --help text (first word after the program that names one).
+subcommands_in() {
+  awk '/^Subcommands:/{on=1; next} on && /^  [a-z]/{print $1} on && /^$/{on=0}' <<<"$1"
 }
 
 check_binary_line() {  # LINE_NO PROGRAM ARGS...
@@ -26,7 +40,8 @@ check_binary_line() {  # LINE_NO PROGRAM ARGS...
   local bin=$build/bin/$prog
   [[ -x $bin ]] || { fail "$n" "'$prog' is not built (no $bin)"; return; }
   local subs sub="" help
-  subs=$(subcommands_of "$bin")
+  load_help "$bin"
+  subs=$(subcommands_in "$HELP")
   if [[ -n $subs && $# -gt 0 && $1 != -* ]]; then
     if grep -qx -- "$1" <<<"$subs"; then
       sub=$1
@@ -35,7 +50,8 @@ check_binary_line() {  # LINE_NO PROGRAM ARGS...
       return
     fi
   fi
-  help=$("$bin" ${sub:+"$sub"} --help 2>&1)
+  load_help "$bin" "$sub"
+  help=$HELP
   # A subcommand that takes a command word (loomctl ctl status): the word is in its help.
   if [[ -n $sub && $# -gt 1 && $2 =~ ^[a-z]+$ ]] && grep -q '^Positionals:' <<<"$help"; then
     grep -qw -- "$2" <<<"$help" || fail "$n" "'$prog $sub $2': '$2' is not among the commands its --help lists"
@@ -84,29 +100,37 @@ check_line() {  # LINE_NO TEXT
   esac
 }
 
-lang="" inblock=0 n=0 pending="" pending_at=0
-while IFS= read -r line || [[ -n $line ]]; do
-  n=$((n + 1))
-  if [[ $line =~ ^\`\`\`([a-z]*)$ ]]; then
-    if ((inblock)); then inblock=0; else inblock=1; lang=${BASH_REMATCH[1]}; fi
-    continue
-  fi
-  ((inblock)) || continue
-  [[ $lang == sh || $lang == bash || ( -z $lang && $line == '$ '* ) || -n $pending ]] || continue
-  # Join backslash continuations into one command.
-  if [[ $line == *\\ ]]; then
-    [[ -z $pending ]] && pending_at=$n
-    pending+="${line%\\} "
-    continue
-  fi
-  if [[ -n $pending ]]; then
-    check_line "$pending_at" "$pending$line"
-    pending=""
-  else
-    check_line "$n" "$line"
-  fi
-done <"$readme"
+check_file() {  # reads $src/$md
+  local lang="" inblock=0 n=0 pending="" pending_at=0 line
+  while IFS= read -r line || [[ -n $line ]]; do
+    n=$((n + 1))
+    if [[ $line =~ ^\`\`\`([a-z]*)$ ]]; then
+      if ((inblock)); then inblock=0; else inblock=1; lang=${BASH_REMATCH[1]}; fi
+      continue
+    fi
+    ((inblock)) || continue
+    [[ $lang == sh || $lang == bash || ( -z $lang && $line == '$ '* ) || -n $pending ]] || continue
+    # Join backslash continuations into one command.
+    if [[ $line == *\\ ]]; then
+      [[ -z $pending ]] && pending_at=$n
+      pending+="${line%\\} "
+      continue
+    fi
+    if [[ -n $pending ]]; then
+      check_line "$pending_at" "$pending$line"
+      pending=""
+    else
+      check_line "$n" "$line"
+    fi
+  done <"$src/$md"
+}
 
-echo "readme_commands: $checked command lines checked, $fails problems"
-((checked >= 20)) || { echo "FAIL: only $checked command lines found: is the README's format still what this script reads?" >&2; exit 1; }
+files=0
+while IFS= read -r md; do
+  check_file
+  files=$((files + 1))
+done < <("$(dirname "$0")/markdown_files.sh" "$src")
+
+echo "readme_commands: $checked command lines in $files Markdown files checked, $fails problems"
+((checked >= 20)) || { echo "FAIL: only $checked command lines found: is the docs' format still what this script reads?" >&2; exit 1; }
 ((fails == 0))
