@@ -379,6 +379,8 @@ using Fail = std::function<void(const std::string& key, const std::string& value
 // ---------------------------------------------------------------------------------------------------
 // The axes: [axes.<name>] tables, one per servo axis
 // ---------------------------------------------------------------------------------------------------
+constexpr std::int64_t kMaxBuses = 4;  // CAN interfaces one controller drives
+
 struct AxisKeyInfo {
   const char* path;
   const char* range;
@@ -387,6 +389,7 @@ const std::vector<AxisKeyInfo>& axis_keys() {
   static const std::vector<AxisKeyInfo> k{
       {"axes.<name>.role", "beat_crank | carriage | helix | knotter | selector | auxiliary"},
       {"axes.<name>.node", "[1, 127] (integer)"},
+      {"axes.<name>.bus", "[0, 3] (integer): 0 = the first CAN interface; default 0"},
       {"axes.<name>.counts_per_rev", "[16, 2147483648]"},
       {"axes.<name>.lead_m", "[0.0001, 1] (linear axes only)"},
       {"axes.<name>.max_speed", "[0.001, 1000] rad/s or m/s (added axes only)"},
@@ -409,7 +412,7 @@ std::string axes_text(const LoomConfig& c) {
   std::ostringstream os;
   for (const AxisSpec& a : c.axes) {
     os << "[" << a.name << " " << hal::axis_role_name(a.role) << " node " << int{a.node} << " " << fmt_num(a.counts_per_rev)
-       << "/rev lead " << fmt_num(a.lead_m) << " vmax " << fmt_num(a.max_speed) << " ferror " << fmt_num(a.ferror_min) << "+"
+       << "/rev bus " << int{a.bus} << " lead " << fmt_num(a.lead_m) << " vmax " << fmt_num(a.max_speed) << " ferror " << fmt_num(a.ferror_min) << "+"
        << fmt_num(a.ferror_k_s) << "s boot " << a.boot_ms << " op " << a.operational_ms;
     if (a.homing) {
       os << " homing " << a.homing_method << " at " << fmt_num(a.home_offset) << " " << fmt_num(a.homing_speed) << "/s "
@@ -539,7 +542,10 @@ void read_axes(TomlReader& r, LoomConfig& c, bool extending) {
     std::int64_t node_id = a.node;
     r.integer(p + "node", node_id, 1, 127);
     a.node = static_cast<std::uint8_t>(node_id);
-    need("counts_per_rev", "missing: encoder counts per motor revolution");
+    std::int64_t bus = a.bus;
+    r.integer(p + "bus", bus, 0, kMaxBuses - 1);
+    a.bus = static_cast<std::uint8_t>(bus);
+        need("counts_per_rev", "missing: encoder counts per motor revolution");
     r.number(p + "counts_per_rev", a.counts_per_rev, [](double v) { return in_range(v, 16.0, 2147483648.0); });
     if (linear) {
       need("lead_m", "missing: a linear axis' travel per motor revolution (m)");
@@ -598,7 +604,7 @@ void check_relations(const TomlReader& r, const LoomConfig& c) {
   // A drive's node id is used once on the bus (the I/O module's is checked with it in check_can).
   for (std::size_t i = 1; i < c.axes.size(); ++i) {
     for (std::size_t j = 0; j < i; ++j) {
-      if (c.axes[i].node != c.axes[j].node) continue;
+      if (c.axes[i].node != c.axes[j].node || c.axes[i].bus != c.axes[j].bus) continue;
       const std::string ki = "axes." + c.axes[i].name + ".node", kj = "axes." + c.axes[j].name + ".node";
       const bool i_here = present(ki), j_here = present(kj);
       const toml::node* ni = r.root().at_path(ki).node();
@@ -667,7 +673,9 @@ void check_can(const LoomConfig& c, const Fail& fail) {
   }
   if (c.io.kind == IoKind::kCan) {
     for (const AxisSpec& a : c.axes) {
-      if (a.node == c.io.node) fail("io.node", std::to_string(c.io.node), "node id already used by axes." + a.name + ".node");
+      if (a.bus == 0 && a.node == c.io.node) {
+        fail("io.node", std::to_string(c.io.node), "node id already used by axes." + a.name + ".node");
+      }
     }
     if (const drivers::Status s = drivers::validate(can_io_config(c)); !s) {
       // The driver names the signal ("io.inputs.estop_ok.bit = 3 ..."): point at that signal's key.
@@ -943,6 +951,7 @@ drivers::CanAxisPortConfig can_axis_config(const LoomConfig& c) {
   for (const AxisSpec& a : c.axes) {
     drivers::CanAxisConfig& d = cc.axes.emplace_back();
     d.name = a.name;
+    d.bus = a.bus;
     d.node_id = a.node;
     d.counts_per_unit = a.counts_per_unit();
     d.rated_effort = 0.0;

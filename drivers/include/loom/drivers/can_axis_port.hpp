@@ -32,6 +32,7 @@ inline constexpr double kDefaultCountsPerM = kCountsPerRev / kDefaultCarriageLea
 
 struct CanAxisConfig {
   std::string name = "axis";  // the machine description's name, for messages
+  std::uint8_t bus = 0;       // which bus (0 = the first interface); node ids are unique per bus
   std::uint8_t node_id = 1;
   double counts_per_unit = kDefaultCountsPerRad;  // counts per rad (rotary) or per m (carriage)
   double rated_effort = 0.0;  // N·m or N at 1000 ‰ of 0x6077; 0 = effort not reported (needs TPDO2)
@@ -48,9 +49,9 @@ struct CanAxisConfig {
 struct CanAxisPortConfig {
   // One per axis of the machine, in slot order (hal::AxisLayout); at most hal::kMaxAxes.
   std::vector<CanAxisConfig> axes{
-      {"beat_crank", 1, kDefaultCountsPerRad, 0.0},
-      {"carriage", 2, kDefaultCountsPerM, 0.0},
-      {"helix", 3, kDefaultCountsPerRad, 0.0},
+      {"beat_crank", 0, 1, kDefaultCountsPerRad, 0.0},
+      {"carriage", 0, 2, kDefaultCountsPerM, 0.0},
+      {"helix", 0, 3, kDefaultCountsPerRad, 0.0},
   };
   double cycle_period_s = 0.002;        // SYNC period = tick period; written to 0x60C2
   double heartbeat_producer_s = 0.100;  // written to each drive's 0x1017 (whole ms)

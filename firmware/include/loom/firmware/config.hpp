@@ -54,6 +54,7 @@ struct AxisSpec {
   std::string name;
   hal::AxisRole role = hal::AxisRole::kAuxiliary;
   std::uint8_t node = 0;             // CANopen node id of its drive
+  std::uint8_t bus = 0;              // which CAN bus its drive is on: 0 = the first --iface, 1 = the second, ...
   double counts_per_rev = 1048576.0; // encoder counts per motor revolution
   double lead_m = 0.0;               // linear axes: travel per motor revolution (m); rotary axes: 0
   // Added axes' top speed (rad/s or m/s; bounds the plausible feedback step). The core axes' limits are
