@@ -46,9 +46,13 @@ bool is_whole_ms(double s) {
 // ---------------------------------------------------------------------------------------------------
 Status validate(const CanAxisPortConfig& c) {
   std::array<bool, 128> used{};
+  if (c.axes.empty() || c.axes.size() > hal::kMaxAxes) {
+    return Status::error("axes: " + std::to_string(c.axes.size()) + " axes on the bus (1.." +
+                         std::to_string(hal::kMaxAxes) + ")");
+  }
   for (std::size_t i = 0; i < c.axes.size(); ++i) {
     const CanAxisConfig& a = c.axes[i];
-    const std::string field = std::string("axes.") + hal::axis_name(static_cast<hal::Axis>(i));
+    const std::string field = "axes." + a.name;
     if (a.node_id < kMinNodeId || a.node_id > kMaxNodeId) {
       return Status::error(field + ".node_id = " + std::to_string(a.node_id) + " is outside 1..127");
     }
@@ -155,7 +159,8 @@ void CanAxisPort::reset_runtime() {
   next_master_hb_ = 0;
   notes_.clear();
   axis_of_node_.fill(-1);
-  for (std::size_t i = 0; i < axes_.size(); ++i) {
+  n_axes_ = std::min(config_.axes.size(), hal::kMaxAxes);
+  for (std::size_t i = 0; i < n_axes_; ++i) {
     axes_[i] = AxisRuntime{};
     axes_[i].node = config_.axes[i].node_id;
     axes_[i].counts_per_unit = config_.axes[i].counts_per_unit;
@@ -167,8 +172,7 @@ void CanAxisPort::reset_runtime() {
 }
 
 std::string CanAxisPort::node_label(std::size_t axis) const {
-  return "node " + std::to_string(config_.axes[axis].node_id) + " (" +
-         hal::axis_name(static_cast<hal::Axis>(axis)) + ")";
+  return "node " + std::to_string(config_.axes[axis].node_id) + " (" + config_.axes[axis].name + ")";
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -357,8 +361,9 @@ Status CanAxisPort::configure_pdos(std::size_t axis, SdoClient& sdo) {
 }
 
 BusLoad planned_bus_load(const CanAxisPortConfig& c) {
-  std::vector<FrameGroup> frames{{0, 1}, {kRpdo1Bytes, hal::kAxisCount}, {kTpdo1Bytes, hal::kAxisCount}};
-  if (c.tpdo2) frames.push_back({kTpdo2Bytes, hal::kAxisCount});
+  const auto n = static_cast<std::uint32_t>(c.axes.size());
+  std::vector<FrameGroup> frames{{0, 1}, {kRpdo1Bytes, n}, {kTpdo1Bytes, n}};
+  if (c.tpdo2) frames.push_back({kTpdo2Bytes, n});
   frames.insert(frames.end(), c.other_frames_per_cycle.begin(), c.other_frames_per_cycle.end());
   // The master heartbeat (1 byte) counted as if it were sent every cycle: the worst cycle holds it.
   if (c.master_node_id != 0) frames.push_back({1, 1});
@@ -377,8 +382,8 @@ Status CanAxisPort::configure(CanBus& bus, ConfigureClock& clock) {
   state_timeout_ticks_ = ceil_ticks(config_.state_timeout_s, config_.cycle_period_s);
 
   // What the nodes said while we were busy with something else.
-  std::array<bool, hal::kAxisCount> booted{};
-  std::array<bool, hal::kAxisCount> operational{};
+  std::array<bool, hal::kMaxAxes> booted{};
+  std::array<bool, hal::kMaxAxes> operational{};
   const auto note = [&](const CanFrame& f) {
     if (f.is_error()) {
       if (decode_error_frame(f).bus_off) bus_off_ = true;
@@ -409,14 +414,14 @@ Status CanAxisPort::configure(CanBus& bus, ConfigureClock& clock) {
   };
   // Wait until `done` holds for every axis, each within its own window (per-node setting, else the
   // port-wide one), or name the first axis that did not make it.
-  const auto wait_all = [&](std::array<bool, hal::kAxisCount>& done, std::array<double, hal::kAxisCount> timeout_s,
+  const auto wait_all = [&](std::array<bool, hal::kMaxAxes>& done, std::array<double, hal::kMaxAxes> timeout_s,
                             const char* what, const char* hint) -> Status {
     const std::int64_t start = clock.now_us();
     for (;;) {
       drain();
       if (bus_off_) return Status::error("CAN bus-off while waiting for " + std::string(what));
       bool all = true;
-      for (std::size_t i = 0; i < done.size(); ++i) {
+      for (std::size_t i = 0; i < n_axes_; ++i) {
         all = all && done[i];
         if (!done[i] && clock.now_us() - start >= static_cast<std::int64_t>(timeout_s[i] * 1e6)) {
           return Status::error(node_label(i) + ": no " + what + fmt(" within %.3g s", timeout_s[i]) + hint);
@@ -426,8 +431,8 @@ Status CanAxisPort::configure(CanBus& bus, ConfigureClock& clock) {
       clock.idle();
     }
   };
-  std::array<double, hal::kAxisCount> boot_window{}, op_window{};
-  for (std::size_t i = 0; i < axes_.size(); ++i) {
+  std::array<double, hal::kMaxAxes> boot_window{}, op_window{};
+  for (std::size_t i = 0; i < n_axes_; ++i) {
     const CanAxisConfig& a = config_.axes[i];
     boot_window[i] = a.boot_timeout_s > 0.0 ? a.boot_timeout_s : config_.boot_timeout_s;
     const double op = config_.operational_timeout_s;
@@ -436,7 +441,7 @@ Status CanAxisPort::configure(CanBus& bus, ConfigureClock& clock) {
 
   drain();  // stale frames from before the reset mean nothing
   booted.fill(false);
-  for (std::size_t i = 0; i < axes_.size(); ++i) {
+  for (std::size_t i = 0; i < n_axes_; ++i) {
     if (Status s = send(make_nmt(NmtCommand::kResetNode, axes_[i].node), node_label(i) + ": NMT reset-node");
         !s) {
       return s;
@@ -449,13 +454,13 @@ Status CanAxisPort::configure(CanBus& bus, ConfigureClock& clock) {
   }
 
   SdoClient sdo(bus, clock, static_cast<std::int64_t>(config_.sdo_timeout_s * 1e6), note);
-  for (std::size_t i = 0; i < axes_.size(); ++i) {
+  for (std::size_t i = 0; i < n_axes_; ++i) {
     if (Status s = configure_node(i, sdo); !s) return s;
     if (bus_off_) return Status::error(node_label(i) + ": CAN bus-off during configuration");
   }
 
   operational.fill(false);
-  for (std::size_t i = 0; i < axes_.size(); ++i) {
+  for (std::size_t i = 0; i < n_axes_; ++i) {
     if (Status s = send(make_nmt(NmtCommand::kStart, axes_[i].node), node_label(i) + ": NMT start"); !s) {
       return s;
     }
@@ -581,7 +586,7 @@ void CanAxisPort::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkSt
   if (configured_) {
     CanFrame f;
     for (int i = 0; i < kMaxFramesPerRead && bus_->receive(f); ++i) handle_frame(now, f);
-    for (AxisRuntime& a : axes_) {
+    for (AxisRuntime& a : live()) {
       // The consumer starts counting at the first tick; heartbeats during bring-up carry no tick.
       if (a.last_heartbeat == hal::kNeverTick) a.last_heartbeat = now;
       if (a.link_fault == 0 && now - a.last_heartbeat > static_cast<hal::Tick>(consumer_ticks_)) {
@@ -600,7 +605,7 @@ hal::LinkRecovery CanAxisPort::recovery(hal::Tick now, std::uint8_t& silent) con
     return a.booted || (a.last_heartbeat != hal::kNeverTick && now - a.last_heartbeat <= static_cast<hal::Tick>(consumer_ticks_));
   };
   bool faulted = bus_off_ || !configured_ || foreign_emcy_code_ != 0;
-  for (const AxisRuntime& a : axes_) {
+  for (const AxisRuntime& a : live()) {
     if (a.link_fault == 0) continue;
     faulted = true;
     if (!heard(a)) {
@@ -622,7 +627,9 @@ hal::LinkRecovery CanAxisPort::recovery(hal::Tick now, std::uint8_t& silent) con
 void CanAxisPort::fill_feedback(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) const {
   link.link_fault = !configured_ || bus_off_;
   link.link_fault_code = link.link_fault ? fault_code::kCommunication : fault_code::kNone;
-  for (std::size_t i = 0; i < axes_.size(); ++i) {
+  link.link_fault_kind = bus_off_ ? hal::FaultKind::kBusOff
+                                  : link.link_fault ? hal::FaultKind::kCommunication : hal::FaultKind::kNone;
+  for (std::size_t i = 0; i < n_axes_; ++i) {
     const AxisRuntime& a = axes_[i];
     hal::AxisFeedback& fb = axes[i];
     fb.state = a.state;
@@ -635,22 +642,30 @@ void CanAxisPort::fill_feedback(hal::Tick now, hal::AxisFeedbacks& axes, hal::Li
     const bool drive_fault = a.state == DriveState::kFault || a.state == DriveState::kFaultReactionActive ||
                              a.emcy_code != 0 || a.ferror_fault;
     fb.fault = !configured_ || a.link_fault != 0 || drive_fault || a.tracker.timed_out || bus_off_;
+    const bool in_fault_state = a.state == DriveState::kFault || a.state == DriveState::kFaultReactionActive;
     if (a.link_fault != 0) {
       fb.fault_code = a.link_fault;
+      fb.fault_kind = hal::FaultKind::kNodeLost;
     } else if (bus_off_ || !configured_) {
       fb.fault_code = fault_code::kCommunication;
+      fb.fault_kind = bus_off_ ? hal::FaultKind::kBusOff : hal::FaultKind::kCommunication;
     } else if (a.emcy_code != 0) {
       fb.fault_code = a.emcy_code;
+      fb.fault_kind = in_fault_state ? hal::FaultKind::kDrive : hal::FaultKind::kEmcy;
     } else if (a.ferror_fault) {
       fb.fault_code = fault_code::kFollowingError;
+      fb.fault_kind = hal::FaultKind::kDrive;
     } else if (a.tracker.timed_out) {
       fb.fault_code = fault_code::kStateTimeout;
+      fb.fault_kind = hal::FaultKind::kDrive;
     } else {
       fb.fault_code = fault_code::kNone;
+      fb.fault_kind = in_fault_state ? hal::FaultKind::kDrive : hal::FaultKind::kNone;
     }
     if (a.link_fault != 0 && !link.link_fault) {
       link.link_fault = true;
       link.link_fault_code = a.link_fault;
+      link.link_fault_kind = hal::FaultKind::kNodeLost;
     }
   }
   // Other nodes: the I/O node's own faults, then an EMCY from any node that is not an axis.
@@ -658,11 +673,13 @@ void CanAxisPort::fill_feedback(hal::Tick now, hal::AxisFeedbacks& axes, hal::Li
     if (const std::uint16_t c = listeners_[k]->link_fault_code(); c != 0) {
       link.link_fault = true;
       link.link_fault_code = c;
+      link.link_fault_kind = link_fault_kind(c);
     }
   }
   if (!link.link_fault && foreign_emcy_code_ != 0) {
     link.link_fault = true;
     link.link_fault_code = foreign_emcy_code_;
+    link.link_fault_kind = hal::FaultKind::kEmcy;
   }
   link.tx_dropped = tx_dropped_;
   link.rx_errors = rx_errors_;
@@ -672,7 +689,7 @@ void CanAxisPort::fill_feedback(hal::Tick now, hal::AxisFeedbacks& axes, hal::Li
 
 bool CanAxisPort::any_fault() const {
   if (bus_off_ || foreign_emcy_code_ != 0) return true;
-  for (const AxisRuntime& a : axes_) {
+  for (const AxisRuntime& a : live()) {
     if (a.link_fault != 0 || a.emcy_code != 0 || a.ferror_fault || a.state == DriveState::kFault ||
         a.state == DriveState::kFaultReactionActive) {
       return true;
@@ -688,7 +705,7 @@ bool CanAxisPort::any_fault() const {
 // itself decided are cleared; a drive still in Fault gets its reset edge through the CiA 402 table.
 void CanAxisPort::acknowledge() {
   foreign_emcy_code_ = 0;
-  for (AxisRuntime& a : axes_) {
+  for (AxisRuntime& a : live()) {
     a.ferror_fault = false;
     a.acknowledged = true;
     if (a.state != DriveState::kFault && a.state != DriveState::kFaultReactionActive) a.emcy_code = 0;
@@ -699,7 +716,7 @@ void CanAxisPort::acknowledge() {
 void CanAxisPort::write_axes(hal::Tick now, const hal::AxisCommands& commands) {
   if (!configured_) return;
   bool reset = false;
-  for (const hal::AxisCommand& c : commands) reset = reset || c.request == AxisRequest::kFaultReset;
+  for (std::size_t i = 0; i < n_axes_; ++i) reset = reset || commands[i].request == AxisRequest::kFaultReset;
   if (reset) acknowledge();
   // Any fault anywhere on the bus (EMCY from any node, a lost node, following error) stops every axis in
   // this very tick, whatever the sequencer asked and whatever the drives' statuswords say.
@@ -709,7 +726,7 @@ void CanAxisPort::write_axes(hal::Tick now, const hal::AxisCommands& commands) {
     count_send(bus_->send(make_heartbeat(config_.master_node_id, NmtState::kOperational)));
     next_master_hb_ = now + static_cast<hal::Tick>(master_hb_ticks_);
   }
-  for (std::size_t i = 0; i < axes_.size(); ++i) {
+  for (std::size_t i = 0; i < n_axes_; ++i) {
     AxisRuntime& a = axes_[i];
     // A drive we cannot supervise (lost, rebooted, bus-off) gets quick stop, never an enable command.
     const bool lost = a.link_fault != 0 || bus_off_;

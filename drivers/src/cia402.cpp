@@ -25,6 +25,7 @@ hal::DriveState decode_statusword(std::uint16_t sw) {
 bool cia402_goal_reached(DriveState state, AxisRequest request) {
   switch (request) {
     case AxisRequest::kEnable:
+    case AxisRequest::kHome:  // homing runs in Operation Enabled (mode 6)
       return state == DriveState::kOperationEnabled;
     case AxisRequest::kQuickStop:
       return state == DriveState::kQuickStopActive || state == DriveState::kSwitchOnDisabled;
@@ -45,7 +46,7 @@ struct Command {
 // The one command that moves `state` one step toward `request` (ignoring fault-reset bookkeeping).
 Command command_for(DriveState state, AxisRequest request) {
   namespace cw = controlword;
-  const bool enable = request == AxisRequest::kEnable;
+  const bool enable = request == AxisRequest::kEnable || request == AxisRequest::kHome;
   const bool quick = request == AxisRequest::kQuickStop;
   const std::uint16_t down = quick ? cw::kQuickStop : cw::kDisableVoltage;
   switch (state) {

@@ -52,6 +52,21 @@ void print_safety_sensors(const LoomConfig& c) {
   }
 }
 
+// The configured axes: slot, name, role, drive node, scaling and supervision, one line each.
+void print_axes(const LoomConfig& c) {
+  std::printf("\naxes (%zu of at most %zu)\n", c.axes.size(), hal::kMaxAxes);
+  for (std::size_t i = 0; i < c.axes.size(); ++i) {
+    const AxisSpec& a = c.axes[i];
+    const bool linear = !hal::is_rotary(a.role);
+    const char* unit = linear ? "m" : "rad";
+    char speed[64] = "", ferror[96] = "not supervised by the controller";
+    if (a.max_speed > 0.0) std::snprintf(speed, sizeof speed, ", top speed %g %s/s", a.max_speed, unit);
+    if (a.ferror_min > 0.0) std::snprintf(ferror, sizeof ferror, "> max(%g %s, %g s x |v|)", a.ferror_min, unit, a.ferror_k_s);
+    std::printf("  %zu %-12s %-10s node %3u  %.0f counts/%s%s; following error %s\n", i, a.name.c_str(),
+                hal::axis_role_name(a.role), a.node, a.counts_per_unit(), unit, speed, ferror);
+  }
+}
+
 void print_plan(const LoomConfig& c) {
   const motion::ProfileSet p(c.profile);
   const auto& w = p.beatup().warp();
@@ -106,10 +121,11 @@ void print_plan(const LoomConfig& c) {
 
   print_safety_sensors(c);
 
+  print_axes(c);
+
   std::printf("\nCAN (for --hal socketcan)\n");
   const drivers::BusLoad load = can_bus_load(c);  // the figure the CAN master checks when it configures
-  std::printf("  nodes: beat crank %u, carriage %u, helix %u, I/O module %u (%s); controller heartbeat %s\n",
-              c.can.node_beat_crank, c.can.node_carriage, c.can.node_helix, c.io.node,
+  std::printf("  I/O module node %u (%s); controller heartbeat %s\n", c.io.node,
               c.io.kind == IoKind::kCan ? "on the bus" : "SIMULATED: needs --io simulated on hardware",
               c.can.master_node != 0 ? ("node " + std::to_string(c.can.master_node) + ", every " +
                                         std::to_string(c.can.master_heartbeat_ms) + " ms, consumers " +
@@ -118,10 +134,9 @@ void print_plan(const LoomConfig& c) {
   std::printf("  heartbeats %u ms, lost after %u ms; bit rate %u bit/s\n", c.can.heartbeat_ms, c.can.heartbeat_timeout_ms,
               c.can.bitrate);
   std::printf("  bus load: %s (budget %.0f %%)\n", drivers::describe_bus_load(load).c_str(), c.can.bus_load_budget * 100.0);
-  std::printf("  scaling: %.0f counts/rev (crank, helix), %.0f counts/m (carriage)\n", c.can.counts_per_rev,
-              c.can.carriage_counts_per_m);
-  std::printf("  objects every drive (nodes %u, %u, %u) must support:\n", c.can.node_beat_crank, c.can.node_carriage,
-              c.can.node_helix);
+  std::string nodes;
+  for (const AxisSpec& a : c.axes) nodes += (nodes.empty() ? "" : ", ") + std::to_string(a.node);
+  std::printf("  objects every drive (nodes %s) must support:\n", nodes.c_str());
   for (const auto& o : drivers::drive_objects()) std::printf("    %s\n", drivers::describe(o).c_str());
   std::printf("  objects the I/O module (node %u) must support:\n", c.io.node);
   for (const auto& o : drivers::io_module_objects(c.io.wiring)) std::printf("    %s\n", drivers::describe(o).c_str());
@@ -153,7 +168,7 @@ int run_check(const CheckArgs& a) {
       }
     }
     const LoomConfig c = config_path.empty() ? default_loom_config() : load_loom_config(config_path);
-    if (!a.scene.empty()) check_scene_fits(scene, c);
+    if (!a.scene.empty()) (void)check_scene_fits(scene, c);
     print_plan(c);
     if (!a.scene.empty()) print_scene(scene);
     std::printf("\ncheck: OK — nothing was moved\n");

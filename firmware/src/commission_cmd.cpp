@@ -29,15 +29,15 @@ constexpr int kExitOk = 0, kExitBadInput = 2, kExitNotArmed = 4;
 // What each capture name measures, and the config key it writes.
 struct Capture {
   const char* name;
-  hal::Axis axis;
+  hal::CoreAxis axis;
   const char* section;
   const char* key;
   const char* pose;
 };
 constexpr Capture kCaptures[] = {
-    {"park", hal::Axis::kBeatCrank, "beatup", "crank_park_position_rad", "the crank at its park pose, beater clear of the warp"},
-    {"home", hal::Axis::kCarriage, "carriage", "home_position_m", "the carriage at the left selvedge"},
-    {"left", hal::Axis::kHelix, "helix", "left_position_rad", "the helix carrier at the left selvedge"},
+    {"park", hal::CoreAxis::kBeatCrank, "beatup", "crank_park_position_rad", "the crank at its park pose, beater clear of the warp"},
+    {"home", hal::CoreAxis::kCarriage, "carriage", "home_position_m", "the carriage at the left selvedge"},
+    {"left", hal::CoreAxis::kHelix, "helix", "left_position_rad", "the helix carrier at the left selvedge"},
 };
 
 const Capture* capture_named(const std::string& n) {
@@ -47,13 +47,13 @@ const Capture* capture_named(const std::string& n) {
   return nullptr;
 }
 
-std::string positions_line(const hal::HalInputs& in) {
+std::string positions_line(const hal::HalInputs& in, const hal::AxisLayout& axes) {
   std::string s = "positions:";
-  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+  for (std::size_t i = 0; i < axes.count; ++i) {
     const hal::AxisFeedback& fb = in.axes[i];
     char buf[160];
-    std::snprintf(buf, sizeof buf, " %s=%.9f %s (%s)", hal::axis_name(static_cast<hal::Axis>(i)), fb.position,
-                  i == hal::index(hal::Axis::kCarriage) ? "m" : "rad", hal::drive_state_name(fb.state));
+    std::snprintf(buf, sizeof buf, " %s=%.9f %s (%s)", axes.name(i), fb.position,
+                  hal::is_rotary(axes.role(i)) ? "rad" : "m", hal::drive_state_name(fb.state));
     s += buf;
   }
   return s;
@@ -113,11 +113,11 @@ class Commissioning {
     tick(static_cast<hal::Tick>(std::ceil(a_.settle_s / cfg_.sequencer.period_s)));
     if (!all_disabled()) {
       std::fprintf(stderr, "loomctl commission: a drive is not disabled (%s); refusing to go on\n",
-                   positions_line(loop_->inputs()).c_str());
+                   positions_line(loop_->inputs(), cfg_.sequencer.axes).c_str());
       return kExitNotArmed;
     }
     if (a_.io_once || !a_.capture.empty()) {
-      std::printf("%s\n%s\n", positions_line(loop_->inputs()).c_str(), inputs_line(loop_->inputs(), cfg_.sequencer.second_channel).c_str());
+      std::printf("%s\n%s\n", positions_line(loop_->inputs(), cfg_.sequencer.axes).c_str(), inputs_line(loop_->inputs(), cfg_.sequencer.second_channel).c_str());
       for (const std::string& c : a_.capture) take(*capture_named(c));
       return a_.write ? write() : kExitOk;
     }
@@ -177,7 +177,7 @@ class Commissioning {
   }
 
   int interactive() {
-    std::printf("%s\n%s\n", positions_line(loop_->inputs()).c_str(), inputs_line(loop_->inputs(), cfg_.sequencer.second_channel).c_str());
+    std::printf("%s\n%s\n", positions_line(loop_->inputs(), cfg_.sequencer.axes).c_str(), inputs_line(loop_->inputs(), cfg_.sequencer.second_channel).c_str());
     std::printf("drives disabled: move each axis by hand. Type park (crank at its park pose), home (carriage at the "
                 "left selvedge), left (helix carrier at the left selvedge), write, positions, io, or quit.\n");
     hal::DigitalInputs last = loop_->inputs().io;
@@ -186,7 +186,7 @@ class Commissioning {
     for (hal::Tick t = 0;; ++t) {
       tick(per_second / 10);
       print_input_changes(loop_->inputs().io, last, cfg_.sequencer.second_channel);
-      if (t % 10 == 9) std::printf("%s\n", positions_line(loop_->inputs()).c_str());
+      if (t % 10 == 9) std::printf("%s\n", positions_line(loop_->inputs(), cfg_.sequencer.axes).c_str());
       std::fflush(stdout);
       pollfd p{STDIN_FILENO, POLLIN, 0};
       if (::poll(&p, 1, 0) <= 0) continue;
@@ -202,7 +202,7 @@ class Commissioning {
         if (cmd == "write") {
           if (const int rc = write(); rc != kExitOk) return rc;
         } else if (cmd == "positions") {
-          std::printf("%s\n", positions_line(loop_->inputs()).c_str());
+          std::printf("%s\n", positions_line(loop_->inputs(), cfg_.sequencer.axes).c_str());
         } else if (cmd == "io") {
           std::printf("%s\n", inputs_line(loop_->inputs(), cfg_.sequencer.second_channel).c_str());
         } else if (const Capture* c = capture_named(cmd)) {

@@ -260,32 +260,12 @@ const std::vector<Key>& keys() {
       v.push_back(bitrate);
     }
     v.push_back(number("can.bus_load_budget", M::kMachine, 0.05, 1.0, [](LoomConfig& c) -> double& { return c.can.bus_load_budget; }));
-    v.push_back(integer<std::uint8_t>("can.node_beat_crank", M::kMachine, 1, 127, [](LoomConfig& c) -> std::uint8_t& { return c.can.node_beat_crank; }));
-    v.push_back(integer<std::uint8_t>("can.node_carriage", M::kMachine, 1, 127, [](LoomConfig& c) -> std::uint8_t& { return c.can.node_carriage; }));
-    v.push_back(integer<std::uint8_t>("can.node_helix", M::kMachine, 1, 127, [](LoomConfig& c) -> std::uint8_t& { return c.can.node_helix; }));
-    v.push_back(number("can.counts_per_rev", M::kMachine, 16.0, 2147483648.0, [](LoomConfig& c) -> double& { return c.can.counts_per_rev; }));
-    v.push_back(number("can.carriage_counts_per_m", M::kMachine, 100.0, 1.0e9, [](LoomConfig& c) -> double& { return c.can.carriage_counts_per_m; }));
     v.push_back(integer<std::uint16_t>("can.heartbeat_ms", M::kMachine, 10, 10000, [](LoomConfig& c) -> std::uint16_t& { return c.can.heartbeat_ms; }));
     v.push_back(integer<std::uint16_t>("can.heartbeat_timeout_ms", M::kMachine, 10, 30000, [](LoomConfig& c) -> std::uint16_t& { return c.can.heartbeat_timeout_ms; }));
     v.push_back(integer<std::uint16_t>("can.sdo_timeout_ms", M::kMachine, 10, 10000, [](LoomConfig& c) -> std::uint16_t& { return c.can.sdo_timeout_ms; }));
     v.push_back(integer<std::uint8_t>("can.master_node", M::kMachine, 0, 127, [](LoomConfig& c) -> std::uint8_t& { return c.can.master_node; }));
     v.push_back(integer<std::uint16_t>("can.master_heartbeat_ms", M::kMachine, 10, 10000, [](LoomConfig& c) -> std::uint16_t& { return c.can.master_heartbeat_ms; }));
     v.push_back(integer<std::uint16_t>("can.master_consumer_ms", M::kMachine, 20, 30000, [](LoomConfig& c) -> std::uint16_t& { return c.can.master_consumer_ms; }));
-    {
-      static const char* const axes[] = {"beat_crank", "carriage", "helix"};
-      static const char* const units[] = {"rad", "m", "rad"};
-      for (std::size_t i = 0; i < 3; ++i) {
-        const std::string a = axes[i];
-        v.push_back(integer<std::uint32_t>("can." + a + "_boot_ms", M::kMachine, 0, 60000,
-                                           [i](LoomConfig& c) -> std::uint32_t& { return c.can.boot_timeout_ms[i]; }));
-        v.push_back(integer<std::uint32_t>("can." + a + "_operational_ms", M::kMachine, 0, 60000,
-                                           [i](LoomConfig& c) -> std::uint32_t& { return c.can.operational_timeout_ms[i]; }));
-        v.push_back(number("can." + a + "_ferror_min_" + units[i], M::kMachine, 0.0, i == 1 ? 1.0 : 100.0,
-                           [i](LoomConfig& c) -> double& { return c.can.ferror_min[i]; }));
-        v.push_back(number("can." + a + "_ferror_k_s", M::kMachine, 0.0, 10.0,
-                           [i](LoomConfig& c) -> double& { return c.can.ferror_k_s[i]; }));
-      }
-    }
     // [io] — the CiA 401 module: where each signal is wired
     v.push_back(choice<IoKind>("io.kind", M::kMachine, {"can", "simulated"}, [](LoomConfig& c) -> IoKind& { return c.io.kind; },
                                io_kind_name, parse_io_kind));
@@ -387,6 +367,7 @@ const std::set<std::string>& known_sections() {
   static const std::set<std::string> s = [] {
     std::set<std::string> out;
     for (const Key& k : keys()) out.insert(k.path.substr(0, k.path.find('.')));
+    out.insert("axes");  // [axes.<name>] tables, read by read_axes()
     return out;
   }();
   return s;
@@ -396,29 +377,241 @@ const std::set<std::string>& known_sections() {
 using Fail = std::function<void(const std::string& key, const std::string& value, const std::string& why)>;
 
 // ---------------------------------------------------------------------------------------------------
+// The axes: [axes.<name>] tables, one per servo axis
+// ---------------------------------------------------------------------------------------------------
+constexpr std::int64_t kMaxBuses = 4;  // CAN interfaces one controller drives
+
+struct AxisKeyInfo {
+  const char* path;
+  const char* range;
+};
+const std::vector<AxisKeyInfo>& axis_keys() {
+  static const std::vector<AxisKeyInfo> k{
+      {"axes.<name>.role", "beat_crank | carriage | helix | knotter | selector | auxiliary"},
+      {"axes.<name>.node", "[1, 127] (integer)"},
+      {"axes.<name>.bus", "[0, 3] (integer): 0 = the first CAN interface; default 0"},
+      {"axes.<name>.counts_per_rev", "[16, 2147483648]"},
+      {"axes.<name>.lead_m", "[0.0001, 1] (linear axes only)"},
+      {"axes.<name>.max_speed", "[0.001, 1000] rad/s or m/s (added axes only)"},
+      {"axes.<name>.ferror_min", "[0, 100] rad, [0, 1] m; 0 = off"},
+      {"axes.<name>.ferror_k_s", "[0, 10]"},
+      {"axes.<name>.boot_ms", "[0, 60000] (integer); 0 = 2000 ms"},
+      {"axes.<name>.operational_ms", "[0, 60000] (integer); 0 = can.heartbeat_timeout_ms"},
+      {"axes.<name>.referencing", "absolute | homing"},
+      {"axes.<name>.homing_method", "19 | 21 (home switch) | 33 | 34 (index pulse) | 37 (where it stands)"},
+      {"axes.<name>.home_offset", "[-1e5, 1e5] rad or m: the reading at the home point"},
+      {"axes.<name>.homing_speed", "[1e-4, 100] rad/s or m/s"},
+      {"axes.<name>.homing_accel", "[1e-3, 1e5] rad/s^2 or m/s^2"},
+      {"axes.<name>.homing_timeout_s", "[0.1, 600]"},
+  };
+  return k;
+}
+
+// The canonical text of the axes, to tell a restart-only change.
+std::string axes_text(const LoomConfig& c) {
+  std::ostringstream os;
+  for (const AxisSpec& a : c.axes) {
+    os << "[" << a.name << " " << hal::axis_role_name(a.role) << " node " << int{a.node} << " " << fmt_num(a.counts_per_rev)
+       << "/rev bus " << int{a.bus} << " lead " << fmt_num(a.lead_m) << " vmax " << fmt_num(a.max_speed) << " ferror " << fmt_num(a.ferror_min) << "+"
+       << fmt_num(a.ferror_k_s) << "s boot " << a.boot_ms << " op " << a.operational_ms;
+    if (a.homing) {
+      os << " homing " << a.homing_method << " at " << fmt_num(a.home_offset) << " " << fmt_num(a.homing_speed) << "/s "
+         << fmt_num(a.homing_accel) << "/s2 " << fmt_num(a.homing_timeout_s) << "s";
+    }
+    os << "]";
+  }
+  return os.str();
+}
+
+// Keys of the three-axis layout that became [axes.<name>] tables: a file that still says them is refused
+// with the line and where the fact lives now (a typo-proof migration: nothing is silently ignored).
+void refuse_moved_keys(TomlReader& r) {
+  static const struct {
+    const char* old_key;
+    const char* now;
+  } moved[] = {
+      {"can.node_beat_crank", "axes.beat_crank.node"},           {"can.node_carriage", "axes.carriage.node"},
+      {"can.node_helix", "axes.helix.node"},                     {"can.counts_per_rev", "axes.<name>.counts_per_rev of each rotary axis"},
+      {"can.carriage_counts_per_m", "axes.carriage.counts_per_rev and axes.carriage.lead_m (counts per m = counts_per_rev / lead_m)"},
+      {"can.beat_crank_boot_ms", "axes.beat_crank.boot_ms"},     {"can.beat_crank_operational_ms", "axes.beat_crank.operational_ms"},
+      {"can.beat_crank_ferror_min_rad", "axes.beat_crank.ferror_min"}, {"can.beat_crank_ferror_k_s", "axes.beat_crank.ferror_k_s"},
+      {"can.carriage_boot_ms", "axes.carriage.boot_ms"},         {"can.carriage_operational_ms", "axes.carriage.operational_ms"},
+      {"can.carriage_ferror_min_m", "axes.carriage.ferror_min"}, {"can.carriage_ferror_k_s", "axes.carriage.ferror_k_s"},
+      {"can.helix_boot_ms", "axes.helix.boot_ms"},               {"can.helix_operational_ms", "axes.helix.operational_ms"},
+      {"can.helix_ferror_min_rad", "axes.helix.ferror_min"},     {"can.helix_ferror_k_s", "axes.helix.ferror_k_s"},
+  };
+  for (const auto& m : moved) {
+    if (const toml::node* n = r.root().at_path(m.old_key).node()) {
+      const auto i = n->value<std::int64_t>();
+      const auto d = n->value<double>();
+      const std::string shown = i ? std::to_string(*i) : d ? fmt_num(*d) : "...";
+      r.fail_at(*n, m.old_key, shown, std::string("the axes are [axes.<name>] tables now: this fact is ") + m.now +
+                                       " (loomctl check --keys lists every key)");
+    }
+  }
+}
+
+bool valid_axis_name(const std::string& n) {
+  if (n.empty() || n.size() > hal::AxisLayout::kNameMax) return false;
+  return std::all_of(n.begin(), n.end(), [](char ch) { return (ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') || ch == '_'; });
+}
+
+// An axis' referencing: "absolute", or "homing" with its CiA 402 method and parameters (all required
+// then, and refused on an absolute axis so a half-changed table never passes).
+void read_referencing(TomlReader& r, const toml::node& table, const std::string& p, AxisSpec& a, bool is_new) {
+  const auto has = [&](const char* k) { return table.as_table()->get(k) != nullptr; };
+  std::string kind = a.homing ? "homing" : "absolute";
+  if (is_new && !has("referencing")) r.fail_at(table, p + "referencing", "(missing)", "missing: absolute | homing");
+  r.string(p + "referencing", kind, {"absolute", "homing"});
+  a.homing = kind == "homing";
+  static const char* const keys[] = {"homing_method", "home_offset", "homing_speed", "homing_accel", "homing_timeout_s"};
+  if (!a.homing) {
+    for (const char* k : keys) {
+      if (has(k)) r.fail(p + k, "", "only an axis with referencing = \"homing\" has homing parameters");
+    }
+    a.homing_method = 0;
+    return;
+  }
+  // Switching an absolute axis to homing must say every parameter (there are no defaults to inherit).
+  const bool was_absolute = a.homing_method == 0;
+  for (const char* k : keys) {
+    if (was_absolute && !has(k)) r.fail_at(table, p + k, "(missing)", "missing: referencing = \"homing\" needs it");
+  }
+  std::int64_t method = a.homing_method;
+  r.integer(p + "homing_method", method, 1, 37);
+  if (method != 19 && method != 21 && method != 33 && method != 34 && method != 37) {
+    r.fail(p + "homing_method", std::to_string(method),
+           "supported CiA 402 methods: 19, 21 (home switch), 33, 34 (index pulse), 37 (current position)");
+  }
+  a.homing_method = static_cast<int>(method);
+  r.number(p + "home_offset", a.home_offset, [](double v) { return in_range(v, -1e5, 1e5); });
+  r.number(p + "homing_speed", a.homing_speed, [](double v) { return in_range(v, 1e-4, 100.0); });
+  r.number(p + "homing_accel", a.homing_accel, [](double v) { return in_range(v, 1e-3, 1e5); });
+  r.number(p + "homing_timeout_s", a.homing_timeout_s, [](double v) { return in_range(v, 0.1, 600.0); });
+  if (a.role == hal::AxisRole::kHelix) {
+    r.fail(p + "referencing", "\"homing\"",
+           "the helix cannot home: a homing run would drag the shuttle's carrier through a shed that may be closed; "
+           "give the helix an absolute (multi-turn) encoder");
+  }
+}
+
+// Reads every [axes.<name>] table over what `c` already holds (the embedded default's axes when the
+// file extends it), then puts the axes in slot order and checks the set: each core role exactly once,
+// at most hal::kMaxAxes axes.
+void read_axes(TomlReader& r, LoomConfig& c, bool extending) {
+  r.consume("axes");
+  const toml::node* root = r.root().get("axes");
+  if (root == nullptr) {
+    if (!extending) r.fail_missing("axes", "missing: every loom has [axes.beat_crank], [axes.carriage] and [axes.helix] tables");
+    return;
+  }
+  const toml::table* tables = root->as_table();
+  if (tables == nullptr) r.fail_at(*root, "axes", "", "must be tables [axes.<name>]");
+  std::vector<std::string> added;
+  for (auto&& [key, node] : *tables) {
+    const std::string name(key.str());
+    const std::string p = "axes." + name + ".";
+    if (!valid_axis_name(name)) {
+      r.fail_at(node, "axes." + name, "", "an axis name is 1.." + std::to_string(hal::AxisLayout::kNameMax) +
+                                            " characters of a-z, 0-9 and _");
+    }
+    if (!node.is_table()) r.fail_at(node, "axes." + name, "", "must be a table [axes." + name + "]");
+    r.consume("axes." + name);
+    auto it = std::find_if(c.axes.begin(), c.axes.end(), [&](const AxisSpec& a) { return a.name == name; });
+    const bool is_new = it == c.axes.end();
+    if (is_new) {
+      c.axes.push_back(AxisSpec{});
+      c.axes.back().name = name;
+      it = c.axes.end() - 1;
+      added.push_back(name);
+    }
+    AxisSpec& a = *it;
+    const auto has = [&](const char* k) { return node.as_table()->get(k) != nullptr; };
+    const auto need = [&](const char* k, const std::string& why) {
+      if (is_new && !has(k)) r.fail_at(node, p + k, "(missing)", why);
+    };
+    need("role", "missing: what the axis is for (" + std::string(axis_keys()[0].range) + ")");
+    if (has("role")) {
+      std::string role = hal::axis_role_name(a.role);
+      r.string(p + "role", role, {"beat_crank", "carriage", "helix", "knotter", "selector", "auxiliary"});
+      hal::parse_axis_role(role.c_str(), a.role);
+    }
+    const bool core = a.role == hal::AxisRole::kBeatCrank || a.role == hal::AxisRole::kCarriage || a.role == hal::AxisRole::kHelix;
+    const bool linear = !hal::is_rotary(a.role);
+    need("node", "missing: the CANopen node id of its drive");
+    std::int64_t node_id = a.node;
+    r.integer(p + "node", node_id, 1, 127);
+    a.node = static_cast<std::uint8_t>(node_id);
+    std::int64_t bus = a.bus;
+    r.integer(p + "bus", bus, 0, kMaxBuses - 1);
+    a.bus = static_cast<std::uint8_t>(bus);
+        need("counts_per_rev", "missing: encoder counts per motor revolution");
+    r.number(p + "counts_per_rev", a.counts_per_rev, [](double v) { return in_range(v, 16.0, 2147483648.0); });
+    if (linear) {
+      need("lead_m", "missing: a linear axis' travel per motor revolution (m)");
+      r.number(p + "lead_m", a.lead_m, [](double v) { return in_range(v, 1e-4, 1.0); });
+    } else if (has("lead_m")) {
+      r.fail(p + "lead_m", "", "only a linear axis (role carriage) has a lead; a rotary axis is scaled per revolution");
+    } else {
+      a.lead_m = 0.0;
+    }
+    if (core && has("max_speed")) {
+      r.fail(p + "max_speed", "", "the core axes' speed limits are facts of their mechanisms: [carriage] max_speed_m_s, "
+                                  "[helix] max_speed_rad_s, the recipe's crank speed");
+    }
+    if (!core) {
+      need("max_speed", std::string("missing: the axis' top speed (") + (linear ? "m/s" : "rad/s") + ")");
+      r.number(p + "max_speed", a.max_speed, [](double v) { return in_range(v, 1e-3, 1e3); });
+    } else {
+      a.max_speed = 0.0;
+    }
+    need("ferror_min", std::string("missing: the following-error limit (") + (linear ? "m" : "rad") + "; 0 = off)");
+    r.number(p + "ferror_min", a.ferror_min, [linear](double v) { return in_range(v, 0.0, linear ? 1.0 : 100.0); });
+    r.number(p + "ferror_k_s", a.ferror_k_s, [](double v) { return in_range(v, 0.0, 10.0); });
+    std::int64_t boot = a.boot_ms, op = a.operational_ms;
+    r.integer(p + "boot_ms", boot, 0, 60000);
+    r.integer(p + "operational_ms", op, 0, 60000);
+    a.boot_ms = static_cast<std::uint32_t>(boot);
+    a.operational_ms = static_cast<std::uint32_t>(op);
+    read_referencing(r, node, p, a, is_new);
+  }
+  // Slot order: the core roles first (slots 0..2), then the others by name (toml++ keeps keys sorted).
+  std::stable_sort(c.axes.begin(), c.axes.end(), [](const AxisSpec& x, const AxisSpec& y) {
+    const auto rank = [](const AxisSpec& a) { return std::min(static_cast<int>(a.role), 3); };
+    return rank(x) != rank(y) ? rank(x) < rank(y) : (rank(x) == 3 && x.name < y.name);
+  });
+  for (std::size_t role = 0; role < hal::kCoreAxisCount; ++role) {
+    const auto r_ = static_cast<hal::AxisRole>(role);
+    const auto n = std::count_if(c.axes.begin(), c.axes.end(), [&](const AxisSpec& a) { return a.role == r_; });
+    if (n == 0) r.fail_at(*root, "axes", "", std::string("no axis has role = \"") + hal::axis_role_name(r_) + "\": every loom has one");
+    if (n > 1) {
+      const AxisSpec& second = c.axes[role + 1];
+      r.fail("axes." + second.name + ".role", std::string("\"") + hal::axis_role_name(r_) + "\"",
+             "the loom has one " + std::string(hal::axis_role_name(r_)) + " axis (axes." + c.axes[role].name + ")");
+    }
+  }
+  if (c.axes.size() > hal::kMaxAxes) {
+    r.fail("axes." + (added.empty() ? c.axes.back().name : added.back()), "",
+           std::to_string(c.axes.size()) + " axes; the controller holds at most " + std::to_string(hal::kMaxAxes));
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------
 // Cross-field checks (each at the line that is wrong)
 // ---------------------------------------------------------------------------------------------------
 void check_relations(const TomlReader& r, const LoomConfig& c) {
   const auto present = [&](const std::string& path) { return r.root().at_path(path).node() != nullptr; };
-  // A duplicated node id is reported at its second use (in file order, whichever key repeats it).
-  {
-    struct Use { const char* key; std::uint8_t id; };
-    std::vector<Use> uses{{"can.node_beat_crank", c.can.node_beat_crank}, {"can.node_carriage", c.can.node_carriage},
-                          {"can.node_helix", c.can.node_helix}};
-    std::stable_sort(uses.begin(), uses.end(), [&](const Use& a, const Use& b) {
-      const toml::node* na = r.root().at_path(a.key).node();
-      const toml::node* nb = r.root().at_path(b.key).node();
-      const auto line = [](const toml::node* n) { return n ? n->source().begin.line : 0u; };
-      return line(na) < line(nb);
-    });
-    for (std::size_t i = 1; i < uses.size(); ++i) {
-      for (std::size_t j = 0; j < i; ++j) {
-        if (uses[i].id == uses[j].id) {
-          const char* at = present(uses[i].key) ? uses[i].key : uses[j].key;
-          r.fail(at, std::to_string(uses[i].id),
-                 std::string("node id already used by ") + (at == uses[i].key ? uses[j].key : uses[i].key));
-        }
-      }
+  // A drive's node id is used once on the bus (the I/O module's is checked with it in check_can).
+  for (std::size_t i = 1; i < c.axes.size(); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      if (c.axes[i].node != c.axes[j].node || c.axes[i].bus != c.axes[j].bus) continue;
+      const std::string ki = "axes." + c.axes[i].name + ".node", kj = "axes." + c.axes[j].name + ".node";
+      const bool i_here = present(ki), j_here = present(kj);
+      const toml::node* ni = r.root().at_path(ki).node();
+      const toml::node* nj = r.root().at_path(kj).node();
+      // At the later of the two lines the file writes (the one the file repeats).
+      const bool at_i = i_here && (!j_here || ni->source().begin.line >= nj->source().begin.line);
+      r.fail(at_i ? ki : kj, std::to_string(c.axes[i].node), "node id already used by " + (at_i ? kj : ki));
     }
   }
   const auto& m = c.machine_spec;
@@ -469,17 +662,19 @@ void check_can(const LoomConfig& c, const Fail& fail) {
     if (msg.find("master_heartbeat") == 0) key = "can.master_heartbeat_ms", value = std::to_string(c.can.master_heartbeat_ms);
     if (msg.find("master_consumer") == 0) key = "can.master_consumer_ms", value = std::to_string(c.can.master_consumer_ms);
     if (msg.find("sdo") == 0) key = "can.sdo_timeout_ms", value = std::to_string(c.can.sdo_timeout_ms);
-    if (msg.find("counts_per_unit") != std::string::npos) key = "can.counts_per_rev", value = fmt_num(c.can.counts_per_rev);
+    for (const AxisSpec& a : c.axes) {
+      if (msg.rfind("axes." + a.name + ".counts_per_unit", 0) == 0) key = "axes." + a.name + ".counts_per_rev", value = fmt_num(a.counts_per_rev);
+      if (msg.rfind("axes." + a.name + ".ferror", 0) == 0) key = "axes." + a.name + ".ferror_min", value = fmt_num(a.ferror_min);
+    }
     if (msg.find("bus") != std::string::npos || msg.find("bit") != std::string::npos) {
       key = "can.bus_load_budget", value = fmt_num(c.can.bus_load_budget);
     }
     fail(key, value, "the CAN master refuses it: " + msg);
   }
   if (c.io.kind == IoKind::kCan) {
-    for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
-      if (cc.axes[i].node_id == c.io.node) {
-        fail("io.node", std::to_string(c.io.node),
-             std::string("node id already used by the ") + hal::axis_name(static_cast<hal::Axis>(i)) + " drive");
+    for (const AxisSpec& a : c.axes) {
+      if (a.bus == 0 && a.node == c.io.node) {
+        fail("io.node", std::to_string(c.io.node), "node id already used by axes." + a.name + ".node");
       }
     }
     if (const drivers::Status s = drivers::validate(can_io_config(c)); !s) {
@@ -576,6 +771,9 @@ void derive(LoomConfig& c, const Fail& fail) {
   sequencer::SequencerConfig& s = c.sequencer;
   s = sequencer::SequencerConfig{};
   s.period_s = c.run.period_s;
+  s.axes = axis_layout(c);
+  for (std::size_t i = hal::kCoreAxisCount; i < c.axes.size(); ++i) s.axis_max_speed[i] = c.axes[i].max_speed;
+  for (std::size_t i = 0; i < c.axes.size(); ++i) s.homing_timeout_s[i] = c.axes[i].homing ? c.axes[i].homing_timeout_s : 0.0;
   s.picks_per_row = rc.picks_per_row;
   s.knotting = rc.knotting;
   s.debounce_ticks = c.run.debounce_ticks;
@@ -596,6 +794,13 @@ void derive(LoomConfig& c, const Fail& fail) {
   sim_hal::SimMachine& sm = c.machine;
   sm = sim_hal::SimMachine{};
   sm.period_s = c.run.period_s;
+  sm.axis_count = c.axes.size();
+  for (std::size_t i = 0; i < c.axes.size(); ++i) {
+    const AxisSpec& a = c.axes[i];
+    if (!a.homing) continue;
+    sm.referencing[i] = {.method = a.homing_method, .home_offset = a.home_offset, .speed = a.homing_speed,
+                         .index_pitch = hal::is_rotary(a.role) ? 2.0 * M_PI : a.lead_m};
+  }
   sm.width_m = m.width_m;
   sm.helix_lead_m = m.helix_lead_m;
   sm.piston_travel_s = m.shed.piston_travel_s;
@@ -621,6 +826,19 @@ void check_motion(const LoomConfig& c, const Fail& fail) {
     fail("recipe.beats_per_position", std::to_string(c.recipe.beats_per_position),
          "gives " + std::to_string(set->beats_per_row()) + " beats per row on a " + fmt_num(c.machine_spec.width_m) +
              " m loom; the sequencer holds at most " + std::to_string(sequencer::kMaxBeatsPerRow));
+  }
+  // A homed crank comes to rest at its home point before anything else moves: the beater must be clear
+  // of the warp there, or the carriage could never home or move after it.
+  const AxisSpec& crank = c.axes[hal::index(hal::CoreAxis::kBeatCrank)];
+  if (crank.homing) {
+    const motion::WarpWindow& w = set->beatup().warp();
+    const double phase = motion::wrap_two_pi(crank.home_offset - c.machine_spec.calibration.crank_park_position_rad);
+    if (phase > w.enter && phase < w.exit) {
+      fail("axes." + crank.name + ".home_offset", fmt_num(crank.home_offset),
+           "the beater is inside the warp at the crank's home point (" + fmt_num(motion::deg(phase)) +
+               " deg from park; the warp spans " + fmt_num(motion::deg(w.enter)) + ".." + fmt_num(motion::deg(w.exit)) +
+               " deg): put the home switch where the beater is clear");
+    }
   }
   const double pick_s = set->pick().duration(), sweep_s = set->crank_sweep().duration();
   if (!std::isfinite(pick_s) || pick_s <= 0.0 || pick_s > 600.0) {
@@ -691,6 +909,8 @@ LoomConfig parse_complete(const std::string& text, const std::string& source, co
   if (!speed && !force && !base) {
     r.fail_missing("recipe.beat_force_target_n", "missing: give beat_force_target_n (N) or crank_speed_rad_s (rad/s)");
   }
+  refuse_moved_keys(r);
+  read_axes(r, c, base != nullptr);
   r.reject_unknown(known_sections());
   check_relations(r, c);
   const Fail fail = [&](const std::string& key, const std::string& value, const std::string& why) {
@@ -727,18 +947,18 @@ void rederive_and_check(LoomConfig& c, const std::string& origin) {
 
 drivers::CanAxisPortConfig can_axis_config(const LoomConfig& c) {
   drivers::CanAxisPortConfig cc;
-  const double counts_per_rad = c.can.counts_per_rev / (2.0 * M_PI);
-  const std::array<std::uint8_t, 3> nodes{c.can.node_beat_crank, c.can.node_carriage, c.can.node_helix};
-  const std::array<double, 3> counts{counts_per_rad, c.can.carriage_counts_per_m, counts_per_rad};
-  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
-    drivers::CanAxisConfig& a = cc.axes[i];
-    a.node_id = nodes[i];
-    a.counts_per_unit = counts[i];
-    a.rated_effort = 0.0;
-    a.ferror_min = c.can.ferror_min[i];
-    a.ferror_k_s = c.can.ferror_k_s[i];
-    a.boot_timeout_s = c.can.boot_timeout_ms[i] * 1e-3;
-    a.operational_timeout_s = c.can.operational_timeout_ms[i] * 1e-3;
+  cc.axes.clear();
+  for (const AxisSpec& a : c.axes) {
+    drivers::CanAxisConfig& d = cc.axes.emplace_back();
+    d.name = a.name;
+    d.bus = a.bus;
+    d.node_id = a.node;
+    d.counts_per_unit = a.counts_per_unit();
+    d.rated_effort = 0.0;
+    d.ferror_min = a.ferror_min;
+    d.ferror_k_s = a.ferror_k_s;
+    d.boot_timeout_s = a.boot_ms * 1e-3;
+    d.operational_timeout_s = a.operational_ms * 1e-3;
   }
   cc.cycle_period_s = c.run.period_s;
   cc.heartbeat_producer_s = c.can.heartbeat_ms * 1e-3;
@@ -797,13 +1017,31 @@ std::string restart_only_changes(const LoomConfig& running, const LoomConfig& ne
     const std::string a = k.value(running), b = k.value(next);
     if (a != b) out += (out.empty() ? "" : ", ") + k.path + " " + a + " -> " + b;
   }
+  if (const std::string a = axes_text(running), b = axes_text(next); a != b) {
+    out += (out.empty() ? "" : ", ") + std::string("axes ") + a + " -> " + b;
+  }
   return out;
 }
 
 std::vector<KeyInfo> config_keys() {
   std::vector<KeyInfo> out;
-  for (const Key& k : keys()) out.push_back({k.path.c_str(), klass_name(k.klass), k.range});
+  for (const Key& k : keys()) {
+    out.push_back({k.path.c_str(), klass_name(k.klass), k.range});
+    if (k.path == "can.master_consumer_ms") {
+      for (const AxisKeyInfo& a : axis_keys()) out.push_back({a.path, "machine", a.range});
+    }
+  }
   return out;
+}
+
+double AxisSpec::counts_per_unit() const {
+  return lead_m > 0.0 ? counts_per_rev / lead_m : counts_per_rev / (2.0 * M_PI);
+}
+
+hal::AxisLayout axis_layout(const LoomConfig& c) {
+  hal::AxisLayout l;
+  for (const AxisSpec& a : c.axes) l.add(a.name.c_str(), a.role);
+  return l;
 }
 
 }  // namespace loom::firmware

@@ -24,6 +24,7 @@ ControlLoop::ControlLoop(hal::Hal& hal, sequencer::Sequencer& seq, telemetry::Te
                          double period_s, bool lossless_telemetry)
     : hal_(hal),
       seq_(seq),
+      n_axes_(seq.axes().count),
       telemetry_(telemetry),
       period_ns_(static_cast<std::int64_t>(std::llround(period_s * 1e9))),
       lossless_(lossless_telemetry) {}
@@ -151,7 +152,7 @@ void ControlLoop::push_events(hal::Tick now) noexcept {
     prev_fault_axis_ = seq_.fault_axis();
     prev_fault_detail_ = seq_.fault_detail();
   }
-  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+  for (std::size_t i = 0; i < n_axes_; ++i) {
     const hal::AxisFeedback& a = in_.axes[i];
     const bool faulted = axis_faulted(a);
     const bool report = faulted && (!prev_axis_fault_[i] || a.fault_code != prev_axis_fault_code_[i]);
@@ -193,7 +194,8 @@ void ControlLoop::fill_snapshot(hal::Tick now) noexcept {
   s.beater_angle_rad = seq_.commanded_rocker_angle();
   s.beat_force_valid = in_.analog.beat_force_valid;
   s.beat_force_n = in_.analog.beat_force_valid ? in_.analog.beat_force_n : 0.0;
-  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+  s.axis_count = static_cast<std::uint8_t>(n_axes_);
+  for (std::size_t i = 0; i < n_axes_; ++i) {
     telemetry::AxisSample& a = s.axes[i];
     a.position = in_.axes[i].position;
     a.velocity = in_.axes[i].velocity;

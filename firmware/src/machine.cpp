@@ -13,7 +13,7 @@ namespace loom::firmware {
 
 Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions& opt, sequencer::Counters resume)
     : cfg_(cfg) {
-  check_scene_fits(scene, cfg_);
+  const Scene fitted = check_scene_fits(scene, cfg_);
   slot_ = std::make_unique<motion::ProfileSlot>(std::make_unique<const motion::ProfileSet>(cfg_.profile));
   sequencer::SequencerConfig scfg = cfg_.sequencer;
   scfg.rows_to_weave = opt.rows;
@@ -23,7 +23,7 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
     scfg.diagnosis_window_s = cfg_.can.heartbeat_timeout_ms * 1e-3 + 10.0 * cfg_.sequencer.period_s;
   }
   sequencer_ = std::make_unique<sequencer::Sequencer>(*slot_, scfg, resume);
-  sim_ = std::make_unique<sim_hal::SimWorld>(cfg_.machine, scene.spec);
+  sim_ = std::make_unique<sim_hal::SimWorld>(cfg_.machine, fitted.spec);
   if (!opt.sim_state_path.empty()) {
     try {
       sim_state_ = std::make_unique<sim_hal::SimStateFile>(opt.sim_state_path);
@@ -43,6 +43,7 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
     telemetry::PublisherConfig pc;
     pc.lcm_url = cfg_.telemetry.lcm_url;
     pc.loom_id = cfg_.loom_id;
+    pc.axes = axis_layout(cfg_);
     pc.decimation.status_every_n_ticks = cfg_.telemetry.status_every;
     pc.decimation.axes_every_n_ticks = cfg_.telemetry.axes_every;
     pc.decimation.rt_every_n_ticks = cfg_.telemetry.rt_every;
@@ -74,6 +75,15 @@ void Machine::build_can_hal(const MachineOptions& opt) {
     throw ConfigError(cfg_.source +
                       ": io.kind = \"simulated\" with the CAN HAL: the servos would move while the e-stop chain, "
                       "sensors and valves are imaginary; give --io simulated to do this on purpose");
+  }
+  // Homing over CAN needs the drive profile's homing mode in the cyclic exchange (not built yet): refuse
+  // before the bus is opened rather than arm axes whose position nobody has referenced.
+  for (const AxisSpec& a : cfg_.axes) {
+    if (a.homing) {
+      throw ConfigError(cfg_.source + ": axes." + a.name + ".referencing = \"homing\": the CAN master does not run "
+                        "CiA 402 homing yet; use an absolute encoder (referencing = \"absolute\") on CAN, or the "
+                        "simulated HAL");
+    }
   }
   // Derived from the machine description (and validated when it was read).
   const drivers::CanIoConfig ic = can_io_config(cfg_);

@@ -317,7 +317,7 @@ int weave(const WeaveArgs& a) {
     const sequencer::Fault f = seq.first_fault();
     summary.fault = report::FaultSummary{
         sequencer::fault_name(f), sequencer::fault_code(f),
-        seq.fault_axis() >= 0 ? hal::axis_name(static_cast<hal::Axis>(seq.fault_axis())) : "", seq.fault_detail(),
+        seq.fault_axis() >= 0 ? seq.axes().name(static_cast<std::size_t>(seq.fault_axis())) : "", seq.fault_detail(),
         secs(seq.fault_tick()), sequencer::fault_name(seq.stopped_by()), sequencer::fault_text(f)};
   }
   if (report_writer) {
@@ -337,7 +337,7 @@ int weave(const WeaveArgs& a) {
     std::printf("FAULT %s (code 0x%04X%s%s%s%s, device code 0x%04X) at t=%.3f s%s: %s; rows completed %u, picks %u, "
                 "beats %u\n",
                 sequencer::fault_name(f), sequencer::fault_code(f), seq.fault_axis() >= 0 ? ", axis " : "",
-                seq.fault_axis() >= 0 ? hal::axis_name(static_cast<hal::Axis>(seq.fault_axis())) : "",
+                seq.fault_axis() >= 0 ? seq.axes().name(static_cast<std::size_t>(seq.fault_axis())) : "",
                 sensor >= 0 ? ", sensor " : "",
                 sensor >= 0 ? hal::safety_sensor_name(static_cast<hal::SafetySensor>(sensor)) : "",
                 seq.fault_detail(), secs(seq.fault_tick()), stopped.c_str(), sequencer::fault_text(f), c.rows,

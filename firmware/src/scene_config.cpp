@@ -155,16 +155,13 @@ void read_fault(const TomlReader& r, const toml::table& t, std::size_t n,
       if (!x || !v.is_boolean()) r.fail_at(v, field, shown(v), "must be true or false");
       f.stuck_value = *x;
     } else if (k == "axis") {
+      // Any axis of the machine by its name ([axes.<name>]); the core axes' slots are known now, the
+      // others' once the scene meets its loom (check_scene_fits).
       const std::string x = text();
-      if (x == "beat_crank") {
-        f.axis = hal::Axis::kBeatCrank;
-      } else if (x == "carriage") {
-        f.axis = hal::Axis::kCarriage;
-      } else if (x == "helix") {
-        f.axis = hal::Axis::kHelix;
-      } else {
-        r.fail_at(v, field, shown(v), "must be one of: beat_crank, carriage, helix");
-      }
+      const int core = hal::core_axis_layout().find(x.c_str());
+      if (x.empty() || x.size() > hal::AxisLayout::kNameMax) r.fail_at(v, field, shown(v), "must name an axis of the loom");
+      f.axis_name = x;
+      f.axis = core >= 0 ? static_cast<std::size_t>(core) : hal::kMaxAxes;
     } else if (k == "code") {
       f.code = static_cast<std::uint16_t>(integer(f.kind == InjectedFault::kEmcy ? 1 : 0, 0xFFFF));
     } else if (k == "duration_s") {
@@ -196,7 +193,7 @@ void read_fault(const TomlReader& r, const toml::table& t, std::size_t n,
 }
 
 bool same_fault(const sim_hal::FaultInjection& a, const sim_hal::FaultInjection& b) {
-  return a.kind == b.kind && a.at_s == b.at_s && a.at_tick == b.at_tick && a.axis == b.axis && a.piston == b.piston &&
+  return a.kind == b.kind && a.at_s == b.at_s && a.at_tick == b.at_tick && a.axis_name == b.axis_name && a.piston == b.piston &&
          a.sensor == b.sensor;
 }
 
@@ -315,17 +312,30 @@ Scene parse_scene(const std::string& text, const std::string& source) {
   return s;
 }
 
-void check_scene_fits(const Scene& scene, const LoomConfig& cfg) {
+Scene check_scene_fits(Scene scene, const LoomConfig& cfg) {
   for (std::size_t n = 0; n < scene.spec.faults.size(); ++n) {
-    const sim_hal::FaultInjection& f = scene.spec.faults[n];
+    sim_hal::FaultInjection& f = scene.spec.faults[n];
+    const std::string at = n < scene.fault_where.size() ? scene.fault_where[n] : scene.source;
+    const bool names_axis = f.kind == InjectedFault::kDriveFault || f.kind == InjectedFault::kHeartbeatLoss ||
+                            f.kind == InjectedFault::kEmcy || f.kind == InjectedFault::kEncoderGlitch;
+    if (names_axis) {
+      const int slot = cfg.sequencer.axes.find(f.axis_name.c_str());
+      if (slot < 0) {
+        std::string names;
+        for (std::size_t i = 0; i < cfg.sequencer.axes.count; ++i) names += std::string(i ? ", " : "") + cfg.sequencer.axes.name(i);
+        throw ConfigError(at + ": fault[" + std::to_string(n) + "].axis = \"" + f.axis_name + "\": the loom (" +
+                          cfg.source + ") has no such axis (its axes: " + names + ")");
+      }
+      f.axis = static_cast<std::size_t>(slot);
+    }
     if (f.kind != InjectedFault::kStuckSensor && f.kind != InjectedFault::kIntermittentSensor) continue;
     const auto i = static_cast<std::size_t>(f.sensor);
     if (i < hal::kSafetySensorCount || cfg.sequencer.second_channel[i - hal::kSafetySensorCount]) continue;
-    const std::string at = n < scene.fault_where.size() ? scene.fault_where[n] : scene.source;
     throw ConfigError(at + ": fault[" + std::to_string(n) + "].sensor = \"" + sim_hal::sensor_name(f.sensor) +
                       "\": the loom (" + cfg.source + ") has no second switch there (io." +
                       sim_hal::sensor_name(f.sensor) + "_bit = -1)");
   }
+  return scene;
 }
 
 Scene load_scene(const std::string& path) { return parse_scene(read_text(path), path); }
@@ -379,7 +389,7 @@ std::string scene_to_toml(const sim_hal::SceneSpec& s, const std::string& config
     }
     const KindFields& fields = kind_fields().at(f.kind);
     const auto has = [&](const char* k) { return fields.required.count(k) || fields.optional.count(k); };
-    if (has("axis")) os << "axis = " << quoted(hal::axis_name(f.axis)) << "\n";
+    if (has("axis")) os << "axis = " << quoted(f.axis_name) << "\n";
     if (has("code")) os << "code = " << f.code << "\n";
     if (has("piston")) os << "piston = " << (f.piston == 0 ? "\"a\"" : "\"b\"") << "\n";
     if (has("sensor")) os << "sensor = " << quoted(sim_hal::sensor_name(f.sensor)) << "\n";

@@ -23,14 +23,14 @@ bool beater_in_warp(const InterlockContext& ctx, double crank_position) {
 
 Fault check_interlocks(const InterlockContext& ctx, const hal::HalInputs& measured, const hal::HalOutputs& prev,
                        const hal::HalOutputs& next) {
-  const auto moved = [&](hal::Axis a) {
+  const auto moved = [&](hal::CoreAxis a) {
     return next.axes[hal::index(a)].target_position != prev.axes[hal::index(a)].target_position;
   };
-  if (moved(hal::Axis::kCarriage) &&
-      beater_in_warp(ctx, measured.axes[hal::index(hal::Axis::kBeatCrank)].position)) {
+  if (moved(hal::CoreAxis::kCarriage) &&
+      beater_in_warp(ctx, measured.axes[hal::index(hal::CoreAxis::kBeatCrank)].position)) {
     return Fault::kCarriageInWarp;
   }
-  if (moved(hal::Axis::kHelix) && !shed_confirmed(measured.io)) return Fault::kPickWithoutShed;
+  if (moved(hal::CoreAxis::kHelix) && !shed_confirmed(measured.io)) return Fault::kPickWithoutShed;
   const bool valves_change =
       next.io.piston_a_extend != prev.io.piston_a_extend || next.io.piston_b_extend != prev.io.piston_b_extend;
   if (valves_change && !shuttle_at_selvedge(measured.io)) return Fault::kShedWithShuttle;

@@ -16,6 +16,7 @@
 // A fault found in step 2 wins over any plan: the state functions then only hold.
 #include "loom/sequencer/sequencer.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -23,19 +24,27 @@
 
 namespace loom::sequencer {
 namespace {
-using hal::Axis;
+using hal::CoreAxis;
 using hal::AxisRequest;
 using hal::DriveState;
 using hal::index;
-constexpr std::uint16_t kHeartbeatCode = 0x8130;  // CiA 301 EMCY "life guard / heartbeat error"
 constexpr double kArrivalMarginM = 0.002;         // carrier position uncertainty at the arrival sensor
 constexpr double kStepPlausibility = 4.0;         // an axis may move at most this × its top speed per tick
 constexpr int kShedTestStrokes = 4;               // arming shed test: A up, B up, A up, B up
 
-void request_all(hal::HalOutputs& o, AxisRequest r) {
-  for (auto& a : o.axes) a.request = r;
+void request_all(hal::HalOutputs& o, std::size_t n_axes, AxisRequest r) {
+  for (std::size_t i = 0; i < n_axes; ++i) o.axes[i].request = r;
 }
 bool finite(double x) { return std::isfinite(x); }
+}  // namespace
+
+// The configured axes and the I/O (the arrays are sized for the capacity; the rest is never used).
+void Sequencer::copy_outputs(const hal::HalOutputs& from, hal::HalOutputs& to) const noexcept {
+  std::copy_n(from.axes.begin(), n_axes_, to.axes.begin());
+  to.io = from.io;
+}
+
+namespace {
 bool drive_in_fault(const hal::AxisFeedback& a) {
   return a.fault || a.state == DriveState::kFault || a.state == DriveState::kFaultReactionActive;
 }
@@ -45,6 +54,7 @@ const char* state_name(State s) {
   switch (s) {
     case State::kIdle: return "idle";
     case State::kEnabling: return "enabling";
+    case State::kHoming: return "homing";
     case State::kPositioning: return "positioning";
     case State::kShedTest: return "shed_test";
     case State::kShed: return "shed";
@@ -68,6 +78,21 @@ std::string validate(const SequencerConfig& c, const motion::ProfileSet& p) {
            std::to_string(kMaxBeatsPerRow) + " (narrow the loom or beat each position fewer times)";
   }
   if (c.picks_per_row < 1) return "recipe.picks_per_row must be at least 1";
+  if (c.axes.count < hal::kCoreAxisCount || c.axes.count > hal::kMaxAxes) {
+    return "axes: the loom has " + std::to_string(c.axes.count) + " axes; it needs the three core axes and holds at most " +
+           std::to_string(hal::kMaxAxes);
+  }
+  for (std::size_t i = 0; i < hal::kCoreAxisCount; ++i) {
+    if (c.axes.role(i) != static_cast<hal::AxisRole>(i)) {
+      return std::string("axes: slot ") + std::to_string(i) + " must hold the " +
+             hal::axis_role_name(static_cast<hal::AxisRole>(i)) + " axis";
+    }
+  }
+  for (std::size_t i = hal::kCoreAxisCount; i < c.axes.count; ++i) {
+    if (!std::isfinite(c.axis_max_speed[i]) || !(c.axis_max_speed[i] > 0.0)) {
+      return std::string("axes.") + c.axes.name(i) + ".max_speed must be positive and finite";
+    }
+  }
   if (c.debounce_ticks < 1) return "timing.debounce_ticks must be at least 1";
   if (!fin(c.sensor_discrepancy_s) || c.sensor_discrepancy_s < c.period_s || c.sensor_discrepancy_s > 1.0) {
     return "timing.sensor_discrepancy_ms must be between one period and 1000 ms";
@@ -116,7 +141,8 @@ Sequencer::Sequencer(const motion::ProfileSet& profiles, const SequencerConfig& 
       counters_(resume),
       sensors_(cfg.debounce_ticks),
       second_channels_(cfg.debounce_ticks),
-      buttons_(cfg.debounce_ticks) {
+      buttons_(cfg.debounce_ticks),
+      n_axes_(cfg.axes.count) {
   if (const std::string why = validate(cfg_, *profiles_); !why.empty()) throw std::invalid_argument(why);
   // Each channel is debounced first, so two healthy channels can be that many ticks apart: the
   // discrepancy time is never shorter than the debounce plus one tick, whatever the period.
@@ -130,10 +156,13 @@ Sequencer::Sequencer(const motion::ProfileSet& profiles, const SequencerConfig& 
 void Sequencer::adopt_limits() noexcept {
   const motion::ProfileSpec& s = profiles_->spec();
   const double dt = cfg_.period_s;
-  max_step_[index(Axis::kBeatCrank)] = kStepPlausibility * s.crank.velocity * dt + 1e-3;
-  max_step_[index(Axis::kCarriage)] =
+  max_step_[index(CoreAxis::kBeatCrank)] = kStepPlausibility * s.crank.velocity * dt + 1e-3;
+  max_step_[index(CoreAxis::kCarriage)] =
       kStepPlausibility * std::max(s.carriage_max_speed_m_s, cfg_.carriage.velocity) * dt + 1e-4;
-  max_step_[index(Axis::kHelix)] = kStepPlausibility * profiles_->helix_limits().velocity * dt + 1e-3;
+  max_step_[index(CoreAxis::kHelix)] = kStepPlausibility * profiles_->helix_limits().velocity * dt + 1e-3;
+  for (std::size_t i = hal::kCoreAxisCount; i < n_axes_; ++i) {
+    max_step_[i] = kStepPlausibility * cfg_.axis_max_speed[i] * dt + 1e-3;
+  }
 }
 
 hal::Tick Sequencer::ticks(double seconds) const noexcept {
@@ -145,7 +174,7 @@ double Sequencer::seconds_since(hal::Tick now, hal::Tick t0) const noexcept {
 }
 
 double Sequencer::commanded_crank_phase() const noexcept {
-  return motion::wrap_two_pi(cmd_.axes[index(Axis::kBeatCrank)].target_position - cfg_.crank_park_position_rad);
+  return motion::wrap_two_pi(cmd_.axes[index(CoreAxis::kBeatCrank)].target_position - cfg_.crank_park_position_rad);
 }
 
 double Sequencer::commanded_rocker_angle() const noexcept {
@@ -176,8 +205,13 @@ void Sequencer::enter(State s, hal::Tick now) noexcept {
 
 void Sequencer::step(hal::Tick now, const hal::HalInputs& raw, hal::HalOutputs& out) noexcept {
   sense(raw);
-  hal::HalInputs in = raw;  // the sequencer and its interlocks see debounced sensors
+  // The sequencer and its interlocks see debounced sensors: a copy of the inputs with them, of the
+  // configured axes only (the arrays are sized for the capacity).
+  hal::HalInputs& in = in_;
+  std::copy_n(raw.axes.begin(), n_axes_, in.axes.begin());
   in.io = io_;
+  in.analog = raw.analog;
+  in.link = raw.link;
   if (state_ != State::kIdle && state_ != State::kFault) check_faults(now, in);
   if (external_fault_ != Fault::kNone) {  // the runner's overrun policy: latched once, like any fault
     if (state_ != State::kFault) latch(external_fault_, now);
@@ -193,9 +227,9 @@ void Sequencer::step(hal::Tick now, const hal::HalInputs& raw, hal::HalOutputs& 
   run_state(now, in);
   if (state_ == State::kFault) {
     // Quick stop, hold the last targets, valves keep their state (a stopped shuttle is never clamped).
-    request_all(cmd_, AxisRequest::kQuickStop);
+    request_all(cmd_, n_axes_, AxisRequest::kQuickStop);
   } else {
-    if (acknowledged_this_tick_) request_all(cmd_, AxisRequest::kFaultReset);
+    if (acknowledged_this_tick_) request_all(cmd_, n_axes_, AxisRequest::kFaultReset);
     play_moves(now);
     track_beat_force(in);
     if (enabled_outputs_) {
@@ -203,18 +237,19 @@ void Sequencer::step(hal::Tick now, const hal::HalInputs& raw, hal::HalOutputs& 
       if (f != Fault::kNone) {
         cmd_ = prev_cmd_;
         latch(f, now);
-        request_all(cmd_, AxisRequest::kQuickStop);
+        request_all(cmd_, n_axes_, AxisRequest::kQuickStop);
       }
     }
   }
   signal();
-  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+  for (std::size_t i = 0; i < n_axes_; ++i) {
     last_position_[i] = in.axes[i].position;
     last_refreshed_[i] = in.axes[i].refreshed;
+    last_referenced_[i] = in.axes[i].referenced;
   }
   positions_primed_ = state_ != State::kIdle;
-  prev_cmd_ = cmd_;
-  out = cmd_;
+  copy_outputs(cmd_, prev_cmd_);
+  copy_outputs(cmd_, out);
 }
 
 void Sequencer::sense(const hal::HalInputs& raw) noexcept {
@@ -246,21 +281,26 @@ bool Sequencer::check_faults(hal::Tick now, const hal::HalInputs& in) noexcept {
     latch(Fault::kStopRequested, now);
     return true;
   }
-  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+  for (std::size_t i = 0; i < n_axes_; ++i) {
     const hal::AxisFeedback& a = in.axes[i];
     const int axis = static_cast<int>(i);
     if (drive_in_fault(a)) {
-      latch(a.fault_code == kHeartbeatCode ? Fault::kHeartbeatLost : Fault::kDriveFault, now, axis, a.fault_code);
+      latch(a.fault_kind == hal::FaultKind::kNodeLost ? Fault::kHeartbeatLost : Fault::kDriveFault, now, axis, a.fault_code);
       return true;
     }
-    // CiA 402: any EMCY with a non-zero code stops motion in the same tick, even if the drive stays enabled.
-    if (a.fault_code != 0) {
-      latch(a.fault_code == kHeartbeatCode ? Fault::kHeartbeatLost : Fault::kDriveEmcy, now, axis, a.fault_code);
+    // A drive that powered up again has no reference: it must not move until homed at the next arming.
+    if (enabled_outputs_ && !a.referenced) {
+      latch(Fault::kAxisUnreferenced, now, axis, a.fault_code);
+      return true;
+    }
+    // Any device fault stops motion in the same tick, even if the drive stays enabled (an EMCY).
+    if (a.fault_kind != hal::FaultKind::kNone) {
+      latch(a.fault_kind == hal::FaultKind::kNodeLost ? Fault::kHeartbeatLost : Fault::kDriveEmcy, now, axis, a.fault_code);
       return true;
     }
   }
   if (in.link.link_fault) {
-    latch(in.link.link_fault_code == kHeartbeatCode ? Fault::kHeartbeatLost : Fault::kLinkFault, now, -1,
+    latch(in.link.link_fault_kind == hal::FaultKind::kNodeLost ? Fault::kHeartbeatLost : Fault::kLinkFault, now, -1,
           in.link.link_fault_code);
     return true;
   }
@@ -272,14 +312,14 @@ bool Sequencer::check_faults(hal::Tick now, const hal::HalInputs& in) noexcept {
     return now - (refreshed == hal::kNeverTick ? armed_since_ : refreshed) > stale;
   };
   int stale_axis = -1, stale_count = 0;
-  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+  for (std::size_t i = 0; i < n_axes_; ++i) {
     if (too_old(in.axes[i].refreshed)) {
       if (stale_axis < 0) stale_axis = static_cast<int>(i);
       ++stale_count;
     }
   }
   const bool io_stale = too_old(in.io.refreshed);
-  if (stale_count == static_cast<int>(hal::kAxisCount) && io_stale) {
+  if (stale_count == static_cast<int>(n_axes_) && io_stale) {
     latch(Fault::kLoopStall, now);
     return true;
   }
@@ -288,7 +328,7 @@ bool Sequencer::check_faults(hal::Tick now, const hal::HalInputs& in) noexcept {
     return true;
   }
   // Feedback that cannot be true (fresh, but NaN/inf, or moved farther in one tick than the axis can).
-  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+  for (std::size_t i = 0; i < n_axes_; ++i) {
     const hal::AxisFeedback& a = in.axes[i];
     if (!finite(a.position) || !finite(a.velocity) || !finite(a.effort)) {
       latch(Fault::kNonFiniteFeedback, now, static_cast<int>(i));
@@ -299,7 +339,10 @@ bool Sequencer::check_faults(hal::Tick now, const hal::HalInputs& in) noexcept {
     const hal::Tick apart = a.refreshed != hal::kNeverTick && last_refreshed_[i] != hal::kNeverTick
                                 ? std::max<hal::Tick>(1, a.refreshed - last_refreshed_[i])
                                 : 1;
-    if (positions_primed_ && std::abs(a.position - last_position_[i]) > max_step_[i] * static_cast<double>(apart)) {
+    // A homing run that references the axis re-bases its reading once: that step is the reference, not a jump.
+    const bool rebased = a.referenced != last_referenced_[i];
+    if (positions_primed_ && !rebased &&
+        std::abs(a.position - last_position_[i]) > max_step_[i] * static_cast<double>(apart)) {
       latch(Fault::kEncoderJump, now, static_cast<int>(i));
       return true;
     }
@@ -341,17 +384,17 @@ bool Sequencer::is_symptom(Fault f) noexcept {
 
 void Sequencer::refine_diagnosis(hal::Tick now, const hal::HalInputs& in) noexcept {
   if (!is_symptom(first_fault_) || now - fault_tick_ > ticks(cfg_.diagnosis_window_s)) return;
-  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+  for (std::size_t i = 0; i < n_axes_; ++i) {
     const hal::AxisFeedback& a = in.axes[i];
     if (drive_in_fault(a)) {
-      first_fault_ = a.fault_code == kHeartbeatCode ? Fault::kHeartbeatLost : Fault::kDriveFault;
+      first_fault_ = a.fault_kind == hal::FaultKind::kNodeLost ? Fault::kHeartbeatLost : Fault::kDriveFault;
       fault_axis_ = static_cast<int>(i);
       fault_detail_ = a.fault_code;
       return;
     }
   }
   if (in.link.link_fault) {
-    first_fault_ = in.link.link_fault_code == kHeartbeatCode ? Fault::kHeartbeatLost : Fault::kLinkFault;
+    first_fault_ = in.link.link_fault_kind == hal::FaultKind::kNodeLost ? Fault::kHeartbeatLost : Fault::kLinkFault;
     fault_axis_ = -1;
     fault_detail_ = in.link.link_fault_code;
   }
@@ -371,6 +414,7 @@ void Sequencer::run_state(hal::Tick now, const hal::HalInputs& in) noexcept {
   switch (state_) {
     case State::kIdle: idle(now, in); break;
     case State::kEnabling: enabling(now, in); break;
+    case State::kHoming: homing(now, in); break;
     case State::kPositioning: positioning(now, in); break;
     case State::kShedTest: shed_test(now); break;
     case State::kShed: shed(now); break;
@@ -389,8 +433,8 @@ void Sequencer::run_state(hal::Tick now, const hal::HalInputs& in) noexcept {
 // ---------------------------------------------------------------------------------------------------
 
 void Sequencer::idle(hal::Tick now, const hal::HalInputs& in) noexcept {
-  request_all(cmd_, AxisRequest::kDisable);
-  for (std::size_t i = 0; i < hal::kAxisCount; ++i) cmd_.axes[i].target_position = in.axes[i].position;
+  request_all(cmd_, n_axes_, AxisRequest::kDisable);
+  for (std::size_t i = 0; i < n_axes_; ++i) cmd_.axes[i].target_position = in.axes[i].position;
   // Valves hold the frames where the end sensors see them: starting up (or restarting after a power
   // loss) never moves a frame, so a shuttle left in the shed is never clamped.
   cmd_.io.piston_a_extend = io_.piston_a_extended;
@@ -403,10 +447,10 @@ void Sequencer::idle(hal::Tick now, const hal::HalInputs& in) noexcept {
 }
 
 void Sequencer::enabling(hal::Tick now, const hal::HalInputs& in) noexcept {
-  request_all(cmd_, AxisRequest::kEnable);
+  request_all(cmd_, n_axes_, AxisRequest::kEnable);
   // Until every drive is enabled the targets follow the measured positions: enabling never jumps.
   bool all = true;
-  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+  for (std::size_t i = 0; i < n_axes_; ++i) {
     cmd_.axes[i].target_position = in.axes[i].position;
     all = all && in.axes[i].state == DriveState::kOperationEnabled;
   }
@@ -414,13 +458,57 @@ void Sequencer::enabling(hal::Tick now, const hal::HalInputs& in) noexcept {
     if (now - state_since_ > ticks(cfg_.enable_timeout_s)) latch(Fault::kEnableTimeout, now);
     return;
   }
+  begin_homing(now, in);
+}
+
+void Sequencer::begin_homing(hal::Tick now, const hal::HalInputs& in) noexcept {
+  // Slot order is the machine's order: the beat crank first (its home point is clear of the warp), the
+  // carriage once the beater is clear, then the added axes. The helix is never homed (absolute only).
+  for (std::size_t i = 0; i < n_axes_; ++i) {
+    if (in.axes[i].referenced) continue;
+    if (cfg_.homing_timeout_s[i] <= 0.0) {  // unreferenced, and no homing run configured for it
+      latch(Fault::kAxisUnreferenced, now, static_cast<int>(i));
+      return;
+    }
+    if (i == index(CoreAxis::kCarriage) &&
+        beater_in_warp(interlock_ctx_, in.axes[index(CoreAxis::kBeatCrank)].position)) {
+      latch(Fault::kCarriageInWarp, now, static_cast<int>(i));
+      return;
+    }
+    homing_axis_ = static_cast<int>(i);
+    enter(State::kHoming, now);
+    return;
+  }
+  homing_axis_ = -1;
+  finish_arming(now, in);
+}
+
+void Sequencer::homing(hal::Tick now, const hal::HalInputs& in) noexcept {
+  // The drive runs the homing by itself; every target follows its measured position so that nothing
+  // jumps when an axis goes back to following targets.
+  request_all(cmd_, n_axes_, AxisRequest::kEnable);
+  for (std::size_t i = 0; i < n_axes_; ++i) cmd_.axes[i].target_position = in.axes[i].position;
+  const auto k = static_cast<std::size_t>(homing_axis_);
+  const hal::AxisFeedback& a = in.axes[k];
+  if (a.referenced) {
+    begin_homing(now, in);
+    return;
+  }
+  if (a.homing_error || now - state_since_ > ticks(cfg_.homing_timeout_s[k])) {
+    latch(Fault::kHomingFailed, now, homing_axis_);
+    return;
+  }
+  cmd_.axes[k].request = AxisRequest::kHome;
+}
+
+void Sequencer::finish_arming(hal::Tick now, const hal::HalInputs& in) noexcept {
   // The counters are checked against the machine before anything moves: what they say was done must
   // be what the machine shows.
   if (!reconcile_at_arming(now, in)) return;
   enabled_outputs_ = true;
   // Re-arm from measured positions: crank to the nearest park, then the carriage to the row's start side.
-  const double phase = motion::wrap_pi(in.axes[index(Axis::kBeatCrank)].position - cfg_.crank_park_position_rad);
-  crank_move_ = {true, now, cmd_.axes[index(Axis::kBeatCrank)].target_position,
+  const double phase = motion::wrap_pi(in.axes[index(CoreAxis::kBeatCrank)].position - cfg_.crank_park_position_rad);
+  crank_move_ = {true, now, cmd_.axes[index(CoreAxis::kBeatCrank)].target_position,
                  motion::JerkMove::plan(-phase, profiles_->spec().crank)};
   // Valves hold whatever the frames show now, so re-arming never moves a frame over the shuttle.
   cmd_.io.piston_a_extend = io_.piston_a_extended;
@@ -432,10 +520,10 @@ void Sequencer::positioning(hal::Tick now, const hal::HalInputs& in) noexcept {
   if (crank_move_.active || carriage_move_.active) return;
   // Rows sweep in alternating directions: row n+1 starts at the left when n is even. The carriage goes
   // there (a row cut mid-sweep is swept again from its start).
-  const double rel = in.axes[index(Axis::kCarriage)].position - cfg_.carriage_home_m;
+  const double rel = in.axes[index(CoreAxis::kCarriage)].position - cfg_.carriage_home_m;
   const double goal = row_starts_left() ? 0.0 : profiles_->carriage_travel_m();
   if (std::abs(rel - goal) > cfg_.selvedge_tolerance_m) {
-    carriage_move_ = {true, now, cmd_.axes[index(Axis::kCarriage)].target_position,
+    carriage_move_ = {true, now, cmd_.axes[index(CoreAxis::kCarriage)].target_position,
                       motion::JerkMove::plan(goal - rel, cfg_.carriage)};
     return;
   }
@@ -500,7 +588,7 @@ void Sequencer::pick(hal::Tick now, const hal::HalInputs& in) noexcept {
   // leaves its reach, the arrival sensor see the shuttle when the carrier enters its reach — not before
   // (a stuck or miswired sensor), not after (the shuttle slipped off and a sensor lies or sticks).
   const double lead = profiles_->spec().helix_lead_m;
-  const double helix = in.axes[index(Axis::kHelix)].position;
+  const double helix = in.axes[index(CoreAxis::kHelix)].position;
   const double to_goal_m = std::abs(helix - pick_goal_rad_) * lead / motion::kTwoPi;
   const double from_start_m = std::abs(helix - pick_start_rad_) * lead / motion::kTwoPi;
   const double reach = cfg_.selvedge_sensor_window_m, tol = cfg_.shuttle_follow_tolerance_m;
@@ -512,7 +600,7 @@ void Sequencer::pick(hal::Tick now, const hal::HalInputs& in) noexcept {
   carrier_prev_step_m_ = carrier_step_m_;
   carrier_step_m_ = std::abs(helix - prev_helix_rad_) * lead / motion::kTwoPi;
   prev_helix_rad_ = helix;
-  const hal::Tick io_at = in.io.refreshed, helix_at = in.axes[index(Axis::kHelix)].refreshed;
+  const hal::Tick io_at = in.io.refreshed, helix_at = in.axes[index(CoreAxis::kHelix)].refreshed;
   const hal::Tick skew_ticks =
       io_at == hal::kNeverTick || helix_at == hal::kNeverTick ? 0 : (io_at > helix_at ? io_at - helix_at : helix_at - io_at);
   const double skew_m = static_cast<double>(std::min<hal::Tick>(skew_ticks, cfg_.debounce_ticks + 1)) *
@@ -607,7 +695,7 @@ bool Sequencer::reconcile_at_arming(hal::Tick now, const hal::HalInputs& in) noe
   // the next beat a beat without weft: refuse, the operator checks the cloth and the counters.
   const bool a_up = counters_.picks % 2 == 0;
   const bool shed_of_pick_n = shed_confirmed(io_) && io_.piston_a_extended == a_up;
-  const double rel = in.axes[index(Axis::kCarriage)].position - cfg_.carriage_home_m;
+  const double rel = in.axes[index(CoreAxis::kCarriage)].position - cfg_.carriage_home_m;
   const double start = row_starts_left() ? 0.0 : profiles_->carriage_travel_m();
   const bool before_sweep = std::abs(rel - start) <= cfg_.selvedge_tolerance_m;
   if (counters_.picks_in_row < cfg_.picks_per_row && shed_of_pick_n && before_sweep) {
@@ -679,7 +767,7 @@ void Sequencer::begin_pick(hal::Tick now, bool resumed) noexcept {
   row_.begin(counters_.rows + 1, now);
   // The shuttle goes away from the side the counters say it started at.
   pick_to_right_ = expect_shuttle_left();
-  const double from = cmd_.axes[index(Axis::kHelix)].target_position;
+  const double from = cmd_.axes[index(CoreAxis::kHelix)].target_position;
   if (resumed) {
     // A pick cut by a power loss: the carrier is somewhere in the shed; finish at the far selvedge.
     pick_goal_rad_ = cfg_.helix_left_position_rad + (pick_to_right_ ? profiles_->pick().distance() : 0.0);
@@ -705,8 +793,8 @@ void Sequencer::begin_sweep(hal::Tick now) noexcept {
   // The crank turns `beats` full turns from park; the carriage rides the cam on it from the row's start
   // selvedge, so successive rows sweep in alternating directions.
   carriage_sweep_dir_ = row_starts_left() ? 1.0 : -1.0;
-  carriage_sweep_origin_ = cmd_.axes[index(Axis::kCarriage)].target_position;
-  crank_sweep_origin_ = cmd_.axes[index(Axis::kBeatCrank)].target_position;
+  carriage_sweep_origin_ = cmd_.axes[index(CoreAxis::kCarriage)].target_position;
+  crank_sweep_origin_ = cmd_.axes[index(CoreAxis::kBeatCrank)].target_position;
   crank_move_ = {true, now, crank_sweep_origin_, profiles_->crank_sweep()};
   sweeping_ = true;
   row_beats_ = 0;
@@ -794,27 +882,27 @@ Fault Sequencer::shed_fault(ShedVerdict v) const noexcept {
 // ---------------------------------------------------------------------------------------------------
 
 void Sequencer::play_moves(hal::Tick now) noexcept {
-  const auto play = [&](ActiveMove& m, Axis axis) {
+  const auto play = [&](ActiveMove& m, CoreAxis axis) {
     if (!m.active) return;
     const double t = seconds_since(now, m.t0);
     cmd_.axes[index(axis)].target_position = m.origin + m.move.at(t).position;
     if (t >= m.move.duration()) m.active = false;
   };
   const double sweep_t = seconds_since(now, crank_move_.t0);  // before play() may end the move
-  play(crank_move_, Axis::kBeatCrank);
-  play(carriage_move_, Axis::kCarriage);
-  play(helix_move_, Axis::kHelix);
+  play(crank_move_, CoreAxis::kBeatCrank);
+  play(carriage_move_, CoreAxis::kCarriage);
+  play(helix_move_, CoreAxis::kHelix);
   if (!sweeping_) return;
   // The sweep move is the master phase; the crank follows the speed law (constant: the same).
   const motion::Phase master = motion::Phase::from_rad(crank_move_.move.at(sweep_t).position);
   const double phi = profiles_->crank_at(master).phase;
-  cmd_.axes[index(Axis::kBeatCrank)].target_position = crank_sweep_origin_ + phi;
-  cmd_.axes[index(Axis::kCarriage)].target_position =
+  cmd_.axes[index(CoreAxis::kBeatCrank)].target_position = crank_sweep_origin_ + phi;
+  cmd_.axes[index(CoreAxis::kCarriage)].target_position =
       carriage_sweep_origin_ + carriage_sweep_dir_ * profiles_->cam().at(phi).position;
   // A beat is delivered when the commanded crank passes the fell of turn k.
   const double fell = profiles_->beatup().warp().fell;
   while (row_beats_ < profiles_->beats_per_row() && phi >= motion::kTwoPi * row_beats_ + fell) {
-    row_.beat_at(row_beats_, cmd_.axes[index(Axis::kCarriage)].target_position - cfg_.carriage_home_m);
+    row_.beat_at(row_beats_, cmd_.axes[index(CoreAxis::kCarriage)].target_position - cfg_.carriage_home_m);
     ++row_beats_;
     ++counters_.beats;
   }
@@ -828,7 +916,7 @@ void Sequencer::play_moves(hal::Tick now) noexcept {
 void Sequencer::track_beat_force(const hal::HalInputs& in) noexcept {
   if (!sweeping_ || !in.analog.beat_force_valid) return;
   // Beat k is the k-th passage through the warp; its peak is recorded while the beater is in the warp.
-  const double crank = in.axes[index(Axis::kBeatCrank)].position;
+  const double crank = in.axes[index(CoreAxis::kBeatCrank)].position;
   const double phi = crank - crank_sweep_origin_;
   const int k = static_cast<int>(std::floor(phi / motion::kTwoPi));
   if (k < 0 || k >= profiles_->beats_per_row()) return;
@@ -856,7 +944,7 @@ void Sequencer::publish_beat(int k) noexcept {
 void Sequencer::signal() noexcept {
   // Stack light: red = a fault waits for acknowledgement; green = weaving; amber = waiting for the
   // operator (idle, arming, paused, done).
-  const bool weaving = state_ == State::kPositioning || state_ == State::kShedTest || state_ == State::kShed ||
+  const bool weaving = state_ == State::kHoming || state_ == State::kPositioning || state_ == State::kShedTest || state_ == State::kShed ||
                        state_ == State::kPick || state_ == State::kBeatSweep || state_ == State::kRowEnd;
   cmd_.io.lamp_red = state_ == State::kFault;
   cmd_.io.lamp_green = weaving;

@@ -72,11 +72,38 @@ double SimRandom::uniform() noexcept {
 
 SimWorld::SimWorld(const SimMachine& machine, const SceneSpec& scene)
     : m_(machine), scene_(scene), rng_(scene.seed) {
+  if (m_.axis_count < hal::kCoreAxisCount || m_.axis_count > hal::kMaxAxes) {
+    throw std::invalid_argument("simulated machine: " + std::to_string(m_.axis_count) + " axes (3.." +
+                                std::to_string(hal::kMaxAxes) + ")");
+  }
+  n_axes_ = m_.axis_count;
+  silent_since_.fill(-1);
+  const bool latency = std::any_of(scene_.faults.begin(), scene_.faults.end(),
+                                   [](const FaultInjection& f) { return f.kind == InjectedFault::kCanLatency; });
+  history_ticks_ = latency ? kHistory : 1;
+  // Power-up: a homed axis' incremental encoder starts at an arbitrary count (drawn from the scene's
+  // seed, so a run replays), an absolute one reads the machine position.
+  SimRandom power_up(scene_.seed ^ 0x5EEDF00Dull);
+  for (std::size_t i = 0; i < n_axes_; ++i) {
+    const SimReferencing& ref = m_.referencing[i];
+    if (ref.method == 0) continue;
+    const double span = ref.index_pitch > 0.0 ? 40.0 * ref.index_pitch : 100.0;
+    axes_[i].offset = (power_up.uniform() - 0.5) * span;
+    axes_[i].referenced = false;
+  }
+  for (const FaultInjection& f : scene_.faults) {
+    const bool names_axis = f.kind == InjectedFault::kDriveFault || f.kind == InjectedFault::kHeartbeatLoss ||
+                            f.kind == InjectedFault::kEmcy || f.kind == InjectedFault::kEncoderGlitch;
+    if (names_axis && f.axis >= n_axes_) {
+      throw std::invalid_argument("fault on axis '" + f.axis_name + "': the simulated machine has no such axis");
+    }
+  }
+  history_.resize(history_ticks_ * n_axes_);
   for (const std::string& e : scene_.effects) {
     if (e == kEffectIdeal) continue;  // ideal tracking is the absence of axis effects
     if (e == kEffectServoLag) {
       const ServoLag lag = scene_.servo_lag.value_or(ServoLag{});
-      for (auto& ax : axes_) ax.effects.push_back(make_servo_lag(lag));
+      for (std::size_t i = 0; i < n_axes_; ++i) axes_[i].effects.push_back(make_servo_lag(lag));
       continue;
     }
     // Device effects: their parameter blocks are what switches them on; default them if absent.
@@ -93,7 +120,7 @@ SimWorld::SimWorld(const SimMachine& machine, const SceneSpec& scene)
       const bool friction = std::find(scene_.effects.begin(), scene_.effects.end(), kEffectJointFriction) !=
                             scene_.effects.end();
       if (friction && !scene_.joint_friction) scene_.joint_friction = JointFriction{};
-      axes_[hal::index(hal::Axis::kBeatCrank)].effects.push_back(
+      axes_[hal::index(hal::CoreAxis::kBeatCrank)].effects.push_back(
           make_crank_inertia(m_, *scene_.inertia, friction ? &*scene_.joint_friction : nullptr));
     } else if (e == kEffectJointFriction) {
       if (std::find(scene_.effects.begin(), scene_.effects.end(), kEffectInertia) == scene_.effects.end()) {
@@ -118,17 +145,17 @@ SimWorld::~SimWorld() = default;
 
 std::size_t SimWorld::effect_count() const {
   std::size_t n = 0;
-  for (const auto& ax : axes_) n += ax.effects.size();
+  for (std::size_t i = 0; i < n_axes_; ++i) n += axes_[i].effects.size();
   n += scene_.pneumatics.has_value() + scene_.shuttle_slip.has_value() + scene_.sensor_noise.has_value() +
        scene_.beat_contact.has_value() + scene_.joint_friction.has_value();
   return n;
 }
 
 void SimWorld::set_initial_state(const hal::AxisFeedbacks& axes, std::array<double, 2> pistons) {
-  for (std::size_t i = 0; i < hal::kAxisCount; ++i) axes_[i].position = axes_[i].target = axes[i].position;
+  for (std::size_t i = 0; i < n_axes_; ++i) axes_[i].position = axes_[i].target = axes[i].position;
   piston_ = pistons;
   for (std::size_t i = 0; i < 2; ++i) pressure_[i] = pistons[i] > 0.5 ? 1.0 : -1.0;
-  const double helix = axes_[hal::index(hal::Axis::kHelix)].position;
+  const double helix = axes_[hal::index(hal::CoreAxis::kHelix)].position;
   shuttle_x_ = carrier_x_prev_ = helix * m_.helix_lead_m / motion::kTwoPi;
 }
 
@@ -136,7 +163,7 @@ void SimWorld::attach_state_file(SimStateFile& file) {
   PersistedMachine pm;
   if (file.load(pm)) {
     hal::AxisFeedbacks axes{};
-    for (std::size_t i = 0; i < hal::kAxisCount; ++i) axes[i].position = pm.axis_position[i];
+    for (std::size_t i = 0; i < pm.axis_position.size(); ++i) axes[i].position = pm.axis_position[i];
     set_initial_state(axes, pm.piston);
     shuttle_x_ = pm.shuttle_x;
   }
@@ -144,7 +171,7 @@ void SimWorld::attach_state_file(SimStateFile& file) {
 }
 
 bool SimWorld::beater_in_warp() const {
-  const double phase = axes_[hal::index(hal::Axis::kBeatCrank)].position - m_.crank_park_position_rad;
+  const double phase = axes_[hal::index(hal::CoreAxis::kBeatCrank)].position - m_.crank_park_position_rad;
   const motion::WarpWindow& w = beatup_->warp();
   const double p = motion::wrap_two_pi(phase);
   return p > w.enter && p < w.exit;
@@ -157,7 +184,7 @@ void SimWorld::apply_injected_faults(hal::Tick now) noexcept {
   };
   while (next_fault_ < scene_.faults.size() && fault_tick_[next_fault_] <= now) {
     const FaultInjection& f = scene_.faults[next_fault_++];
-    const std::size_t ax = hal::index(f.axis);
+    const std::size_t ax = f.axis;  // checked in the constructor
     switch (f.kind) {
       case InjectedFault::kEStop: estop_ok_ = false; break;
       case InjectedFault::kDriveFault:
@@ -179,7 +206,7 @@ void SimWorld::apply_injected_faults(hal::Tick now) noexcept {
         break;
       case InjectedFault::kCanLatency:
         latency_ticks_ = std::min(static_cast<hal::Tick>(std::llround(f.latency_s / m_.period_s)),
-                                  static_cast<hal::Tick>(kHistory - 1));
+                                  static_cast<hal::Tick>(history_ticks_ - 1));
         latency_until_ = ticks(f.duration_s);
         break;
       case InjectedFault::kBusOff: bus_off_ = true; break;
@@ -212,36 +239,41 @@ void SimWorld::apply_injected_faults(hal::Tick now) noexcept {
 void SimWorld::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) {
   apply_injected_faults(now);
   if (powered_off_ || stalled(now)) return;  // nothing refreshed: the values keep their old ticks
-  hal::AxisFeedbacks& truth = history_[static_cast<std::size_t>(now) % kHistory];
-  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+  hal::AxisFeedback* truth = &history_[static_cast<std::size_t>(now) % history_ticks_ * n_axes_];
+  for (std::size_t i = 0; i < n_axes_; ++i) {
     const SimAxis& s = axes_[i];
     hal::AxisFeedback& fb = truth[i];
     fb.state = s.state;
-    fb.position = s.position + (glitch_left_[i] > 0 ? glitch_jump_[i] : 0.0);
+    fb.position = s.position + s.offset + (glitch_left_[i] > 0 ? glitch_jump_[i] : 0.0);
     fb.velocity = s.velocity;
     fb.effort = 0.0;
     fb.fault = s.state == hal::DriveState::kFault;
     fb.fault_code = s.fault_code;
+    fb.fault_kind = fb.fault ? hal::FaultKind::kDrive : s.fault_code != 0 ? hal::FaultKind::kEmcy : hal::FaultKind::kNone;
     fb.following_error = false;
+    fb.referenced = s.referenced;
+    fb.homing_error = false;
     fb.refreshed = now;
     if (glitch_left_[i] > 0) --glitch_left_[i];
   }
   link = hal::LinkStatus{};
   if (bus_off_) {  // no frame gets through any more, and the simulated controller never restarts
     link.link_fault = true;
+    link.link_fault_kind = hal::FaultKind::kBusOff;
     link.link_fault_code = kEmcyBusOff;
     link.recovery = hal::LinkRecovery::kBusOff;
     return;
   }
   // Latency: what arrives now was sampled `latency_ticks_` ago and carries that sample's tick.
   const hal::Tick delay = std::min<hal::Tick>(latency_ticks_, now);
-  const hal::AxisFeedbacks& arrived = history_[static_cast<std::size_t>(now - delay) % kHistory];
-  for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+  const hal::AxisFeedback* arrived = &history_[static_cast<std::size_t>(now - delay) % history_ticks_ * n_axes_];
+  for (std::size_t i = 0; i < n_axes_; ++i) {
     if (silent_since_[i] >= 0) {
       // A silent node sends nothing; its heartbeat consumer reports it after the heartbeat time.
       if (now - silent_since_[i] >= static_cast<hal::Tick>(std::ceil(kSimHeartbeatTimeoutS / m_.period_s))) {
         axes[i].fault = true;
         axes[i].fault_code = kEmcyHeartbeat;
+        axes[i].fault_kind = hal::FaultKind::kNodeLost;
       }
       continue;
     }
@@ -250,9 +282,10 @@ void SimWorld::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatu
   }
 }
 
-void SimWorld::step_axis(SimAxis& ax, const hal::AxisCommand& cmd) noexcept {
+void SimWorld::step_axis(std::size_t slot, const hal::AxisCommand& cmd) noexcept {
   using hal::AxisRequest;
   using hal::DriveState;
+  SimAxis& ax = axes_[slot];
   if (ax.state == DriveState::kFault) {
     if (cmd.request == AxisRequest::kFaultReset) {
       ax.state = DriveState::kSwitchOnDisabled;
@@ -262,6 +295,7 @@ void SimWorld::step_axis(SimAxis& ax, const hal::AxisCommand& cmd) noexcept {
     switch (cmd.request) {
       case AxisRequest::kDisable: ax.state = DriveState::kSwitchOnDisabled; break;
       case AxisRequest::kEnable:
+      case AxisRequest::kHome:
         if (ax.state != DriveState::kQuickStopActive) ax.state = DriveState::kOperationEnabled;
         break;
       case AxisRequest::kQuickStop:
@@ -271,8 +305,15 @@ void SimWorld::step_axis(SimAxis& ax, const hal::AxisCommand& cmd) noexcept {
     }
   }
   const double before = ax.position;
-  if (ax.state == DriveState::kOperationEnabled) {
-    ax.target = cmd.target_position;
+  // A homing run moves the axis by itself (the drive's mode 6) until its reference point; anything but
+  // kHome while enabled ends it, referenced or not.
+  const bool homing = ax.state == DriveState::kOperationEnabled && cmd.request == AxisRequest::kHome &&
+                      m_.referencing[slot].method != 0 && !ax.referenced;
+  if (!homing) ax.homing = false;
+  if (homing) {
+    step_homing(slot);
+  } else if (ax.state == DriveState::kOperationEnabled) {
+    ax.target = cmd.target_position - ax.offset;  // commands are in the drive's reading
     double actual = ax.target;
     if (!ax.effects.empty()) {
       actual = ax.position;
@@ -283,10 +324,39 @@ void SimWorld::step_axis(SimAxis& ax, const hal::AxisCommand& cmd) noexcept {
   ax.velocity = (ax.position - before) / m_.period_s;
 }
 
+void SimWorld::step_homing(std::size_t slot) noexcept {
+  SimAxis& ax = axes_[slot];
+  const SimReferencing& ref = m_.referencing[slot];
+  if (!ax.homing) {  // the run starts: where is the reference point from here?
+    const double home = ref.home_offset;
+    const double pitch = ref.index_pitch;
+    switch (ref.method) {
+      case 19:  // switch active on the positive side: its edge, approached from either side
+      case 21: ax.homing_goal = home; break;
+      case 33: ax.homing_goal = home + std::floor((ax.position - home) / pitch) * pitch; break;
+      case 34: ax.homing_goal = home + std::ceil((ax.position - home) / pitch) * pitch; break;
+      default: ax.homing_goal = ax.position; break;  // 37: here
+    }
+    ax.homing = true;
+  }
+  const double step = ref.speed * m_.period_s;
+  const double to_go = ax.homing_goal - ax.position;
+  if (std::abs(to_go) > step) {
+    ax.position += std::copysign(step, to_go);
+    return;
+  }
+  // At the reference point: the drive sets its reading to the home offset there.
+  ax.position = ax.homing_goal;
+  ax.offset = ref.home_offset - ax.homing_goal;
+  ax.target = ax.position;
+  ax.referenced = true;
+  ax.homing = false;
+}
+
 void SimWorld::write_axes(hal::Tick, const hal::AxisCommands& axes) {
   if (powered_off_) return;
   drives_simulated_ = true;
-  for (std::size_t i = 0; i < hal::kAxisCount; ++i) step_axis(axes_[i], axes[i]);
+  for (std::size_t i = 0; i < n_axes_; ++i) step_axis(i, axes[i]);
 }
 
 void SimWorld::step_beat_contact(double crank_position, double omega) noexcept {
@@ -347,11 +417,11 @@ void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::Digit
   // HAL's fresh helix feedback, so this I/O node also works beside real (CAN) drives.
   // When this world also simulates the drives, the shuttle and the beater follow the true axes, not
   // what the (possibly delayed or glitched) feedback says.
-  const auto pos = [&](hal::Axis a) { return drives_simulated_ ? axes_[hal::index(a)].position : axes[hal::index(a)].position; };
-  const auto vel = [&](hal::Axis a) { return drives_simulated_ ? axes_[hal::index(a)].velocity : axes[hal::index(a)].velocity; };
-  step_shuttle(pos(hal::Axis::kHelix));
+  const auto pos = [&](hal::CoreAxis a) { return drives_simulated_ ? axes_[hal::index(a)].position : axes[hal::index(a)].position; };
+  const auto vel = [&](hal::CoreAxis a) { return drives_simulated_ ? axes_[hal::index(a)].velocity : axes[hal::index(a)].velocity; };
+  step_shuttle(pos(hal::CoreAxis::kHelix));
   // The load cell rides the beater, which the crank drives: real (CAN) or simulated.
-  if (scene_.beat_contact) step_beat_contact(pos(hal::Axis::kBeatCrank), vel(hal::Axis::kBeatCrank));
+  if (scene_.beat_contact) step_beat_contact(pos(hal::CoreAxis::kBeatCrank), vel(hal::CoreAxis::kBeatCrank));
   constexpr std::size_t n = hal::kSafetySensorCount;
   const std::array<bool, n> truth{piston_[0] >= 1.0,
                                   piston_[0] <= 0.0,
@@ -395,7 +465,7 @@ void SimWorld::write_io(hal::Tick, const hal::DigitalOutputs& io) {
   if (state_file_ != nullptr) {
     PersistedMachine pm;
     pm.magic = PersistedMachine::kMagic;
-    for (std::size_t i = 0; i < hal::kAxisCount; ++i) pm.axis_position[i] = axes_[i].position;
+    for (std::size_t i = 0; i < pm.axis_position.size(); ++i) pm.axis_position[i] = axes_[i].position;
     pm.piston = piston_;
     pm.shuttle_x = shuttle_x_;
     state_file_->store(pm);

@@ -74,8 +74,8 @@ class DriveRig {
     };
   }
   bool all_in(hal::DriveState s) const {
-    for (const auto& f : feedback) {
-      if (f.state != s) return false;
+    for (std::size_t i = 0; i < port.axis_count(); ++i) {
+      if (feedback[i].state != s) return false;
     }
     return true;
   }

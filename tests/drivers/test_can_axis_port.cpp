@@ -4,6 +4,8 @@
 // configuration errors that name the node, the object and the step.
 #include <gtest/gtest.h>
 
+#include <span>
+
 #include <cmath>
 #include <numbers>
 
@@ -133,7 +135,7 @@ TEST(CanAxisPort, ReachesOperationEnabledAndTracksWithTwoTickLatency) {
       ASSERT_NEAR(measured[k + 2][i], commanded[k][i], 0.5 * count + 1e-15) << "k=" << k << " axis " << i;
     }
   }
-  for (const auto& f : rig.feedback) {
+  for (const auto& f : std::span(rig.feedback.data(), rig.port.axis_count())) {
     EXPECT_FALSE(f.fault);
     EXPECT_EQ(f.refreshed, rig.tick_index - 1);  // fresh every tick
   }
@@ -177,13 +179,13 @@ TEST(CanAxisPort, HeartbeatLossFaultsWithinThreeProducerPeriodsAndStopsEnabling)
   enable_all(rig);
   // Steady operation for 4 producer periods: heartbeats keep every axis healthy.
   for (int i = 0; i < 200; ++i) rig.tick(DriveRig::hold(kEnable));
-  for (const auto& f : rig.feedback) ASSERT_FALSE(f.fault);
+  for (const auto& f : std::span(rig.feedback.data(), rig.port.axis_count())) ASSERT_FALSE(f.fault);
   ASSERT_FALSE(rig.link.link_fault);
   EXPECT_EQ(rig.link.recovery, hal::LinkRecovery::kHealthy);
 
   const std::int64_t t_off = rig.now_us;
   rig.rack.node(1).power_off();  // carriage drive disappears
-  const auto& carriage = rig.feedback[hal::index(hal::Axis::kCarriage)];
+  const auto& carriage = rig.feedback[hal::index(hal::CoreAxis::kCarriage)];
   rig.run_until(
       DriveRig::hold(kEnable), [&] { return carriage.fault; }, 1000);
   const std::int64_t detected_after_us = rig.now_us - t_off;
@@ -308,7 +310,7 @@ TEST(CanAxisPort, UnconfirmedTransitionTimesOutIntoAFault) {
   EXPECT_EQ(more, 2);
   EXPECT_TRUE(helix.fault);
   EXPECT_EQ(helix.fault_code, drivers::fault_code::kStateTimeout);
-  EXPECT_EQ(rig.port.last_controlword(hal::Axis::kHelix), drivers::controlword::kDisableVoltage);
+  EXPECT_EQ(rig.port.last_controlword(hal::index(hal::CoreAxis::kHelix)), drivers::controlword::kDisableVoltage);
   EXPECT_TRUE(rig.feedback[0].state == DriveState::kOperationEnabled);
 
   // The bus heals; a fault-reset request clears the latch and the axis enables.
@@ -328,7 +330,7 @@ TEST(CanAxisPort, BusOffLatchesALinkFaultAndCountsDroppedFrames) {
   EXPECT_TRUE(rig.link.link_fault);
   EXPECT_EQ(rig.link.link_fault_code, drivers::fault_code::kCommunication);
   EXPECT_EQ(rig.link.rx_errors, 1u);
-  for (const auto& f : rig.feedback) EXPECT_TRUE(f.fault);
+  for (const auto& f : std::span(rig.feedback.data(), rig.port.axis_count())) EXPECT_TRUE(f.fault);
   EXPECT_EQ(rig.link.tx_dropped, 0u);
   rig.tick(DriveRig::hold(kEnable));
   EXPECT_EQ(rig.link.tx_dropped, 4u);  // the previous tick's SYNC + 3 RPDO were refused by the bus
@@ -337,7 +339,7 @@ TEST(CanAxisPort, BusOffLatchesALinkFaultAndCountsDroppedFrames) {
   for (int i = 0; i < 5; ++i) rig.tick(DriveRig::hold(kEnable));
   EXPECT_TRUE(rig.link.link_fault);  // latched until configure()
   EXPECT_EQ(rig.link.recovery, hal::LinkRecovery::kReady);  // the controller is back: re-arming can work
-  EXPECT_EQ(rig.port.last_controlword(hal::Axis::kBeatCrank), drivers::controlword::kQuickStop);
+  EXPECT_EQ(rig.port.last_controlword(hal::index(hal::CoreAxis::kBeatCrank)), drivers::controlword::kQuickStop);
 }
 
 TEST(CanAxisPort, FullTransmitQueueDropsAndCountsWithoutFault) {
@@ -518,7 +520,7 @@ TEST(CanAxisPortConfigure, UnconfiguredPortSendsNothingAndReportsALinkFault) {
   DriveRig rig(three_drives());
   rig.tick(DriveRig::hold(kEnable));
   EXPECT_TRUE(rig.link.link_fault);
-  for (const auto& f : rig.feedback) EXPECT_TRUE(f.fault);
+  for (const auto& f : std::span(rig.feedback.data(), rig.port.axis_count())) EXPECT_TRUE(f.fault);
   for (const auto& l : rig.net.log()) EXPECT_NE(l.from, 0u);
 }
 

@@ -62,7 +62,7 @@ struct IoRig {
     hal.read(rig.tick_index, in);
     rig.feedback = in.axes;
     hal::HalOutputs o;
-    for (std::size_t i = 0; i < hal::kAxisCount; ++i) {
+    for (std::size_t i = 0; i < hal::kCoreAxisCount; ++i) {
       o.axes[i].request = r;
       o.axes[i].target_position = in.axes[i].position;
     }
@@ -549,8 +549,8 @@ TEST(Interop, FixedPersonalityDriveIsAcceptedWithNotes) {
   EXPECT_TRUE(any_note(notes, "node 1 (beat_crank): 0x1016 (consumer heartbeat time) absent"));
   EXPECT_TRUE(any_note(notes, "0x1600:00 (RPDO1 mapping) is fixed (read-only); read back and accepted") ||
               any_note(notes, "0x1600:00") );
-  EXPECT_TRUE(r.rig.port.has_tpdo2(hal::Axis::kCarriage));
-  EXPECT_FALSE(r.rig.port.has_consumer(hal::Axis::kCarriage));
+  EXPECT_TRUE(r.rig.port.has_tpdo2(hal::index(hal::CoreAxis::kCarriage)));
+  EXPECT_FALSE(r.rig.port.has_consumer(hal::index(hal::CoreAxis::kCarriage)));
   r.enable_all();
 }
 
@@ -590,8 +590,8 @@ TEST(FaultReaction, EmcyFromAnEnabledDriveQuickStopsEveryAxisInTheSameTick) {
   r.tick(AxisRequest::kEnable);
   EXPECT_TRUE(r.in.axes[1].fault);
   EXPECT_EQ(r.in.axes[1].fault_code, 0x2310);
-  for (hal::Axis a : {hal::Axis::kBeatCrank, hal::Axis::kCarriage, hal::Axis::kHelix}) {
-    EXPECT_EQ(r.rig.port.last_controlword(a), drivers::controlword::kQuickStop) << hal::axis_name(a);
+  for (hal::CoreAxis a : {hal::CoreAxis::kBeatCrank, hal::CoreAxis::kCarriage, hal::CoreAxis::kHelix}) {
+    EXPECT_EQ(r.rig.port.last_controlword(hal::index(a)), drivers::controlword::kQuickStop) << hal::axis_name(a);
   }
 }
 
@@ -604,7 +604,7 @@ TEST(FaultReaction, EmcyFromTheIoNodeStopsEveryAxisAndIsALinkFault) {
   r.tick(AxisRequest::kEnable);
   EXPECT_TRUE(r.in.link.link_fault);
   EXPECT_EQ(r.in.link.link_fault_code, 0x5000);
-  EXPECT_EQ(r.rig.port.last_controlword(hal::Axis::kHelix), drivers::controlword::kQuickStop);
+  EXPECT_EQ(r.rig.port.last_controlword(hal::index(hal::CoreAxis::kHelix)), drivers::controlword::kQuickStop);
   // Latched until the operator acknowledges (fault reset request).
   for (int i = 0; i < 5; ++i) r.tick(AxisRequest::kEnable);
   EXPECT_TRUE(r.in.link.link_fault);
@@ -634,7 +634,7 @@ TEST(FaultReaction, SilentIoNodeIsLostWithinItsConsumerTimeAndStopsEveryAxis) {
   // The last heartbeat came up to one producer period (100 ms) before the cut; consumer 250 ms.
   EXPECT_LE(static_cast<double>(r.rig.tick_index - cut) * 0.002, 0.250 + 0.004);
   EXPECT_LE(r.in.io.refreshed, cut + 1);  // stale inputs keep their old tick (one frame was in flight)
-  EXPECT_EQ(r.rig.port.last_controlword(hal::Axis::kCarriage), drivers::controlword::kQuickStop);
+  EXPECT_EQ(r.rig.port.last_controlword(hal::index(hal::CoreAxis::kCarriage)), drivers::controlword::kQuickStop);
   // Until it is heard again, acknowledging cannot re-arm: the link names the silent node.
   EXPECT_EQ(r.in.link.recovery, hal::LinkRecovery::kNodeSilent);
   EXPECT_EQ(r.in.link.silent_node, 4);
@@ -654,7 +654,7 @@ TEST(FaultReaction, MasterSilenceTripsTheNodesConsumers) {
   out.piston_b_extend = true;
   for (int i = 0; i < 5; ++i) r.tick(AxisRequest::kEnable, out);
   EXPECT_EQ(r.io.outputs(0) & 0x03, 0x02);
-  EXPECT_TRUE(r.rig.port.has_consumer(hal::Axis::kBeatCrank));
+  EXPECT_TRUE(r.rig.port.has_consumer(hal::index(hal::CoreAxis::kBeatCrank)));
   // The host dies: no more ticks, time goes on.
   r.rig.advance(400'000);
   EXPECT_FALSE(r.io.comm_lost());
@@ -692,7 +692,7 @@ TEST(FaultReaction, FollowingErrorScalesWithCommandedSpeedAndKeepsAHighWaterMark
     r.rig.advance(r.rig.period_us());
   }
   EXPECT_FALSE(r.in.axes[2].fault);
-  const double hw = r.rig.port.ferror_high_water(hal::Axis::kHelix);
+  const double hw = r.rig.port.ferror_high_water(hal::index(hal::CoreAxis::kHelix));
   EXPECT_GT(hw, 0.15);
   EXPECT_LT(hw, 0.5);
   // The drive stops receiving its targets (RPDOs lost): the error grows 0.2 rad per cycle and trips
@@ -712,8 +712,8 @@ TEST(FaultReaction, FollowingErrorScalesWithCommandedSpeedAndKeepsAHighWaterMark
   EXPECT_EQ(r.in.axes[2].fault_code, drivers::fault_code::kFollowingError);
   EXPECT_GE(n, 4);
   EXPECT_LE(n, 8);
-  EXPECT_EQ(r.rig.port.last_controlword(hal::Axis::kBeatCrank), drivers::controlword::kQuickStop);
-  EXPECT_GT(r.rig.port.ferror_high_water(hal::Axis::kHelix), 0.99);
+  EXPECT_EQ(r.rig.port.last_controlword(hal::index(hal::CoreAxis::kBeatCrank)), drivers::controlword::kQuickStop);
+  EXPECT_GT(r.rig.port.ferror_high_water(hal::index(hal::CoreAxis::kHelix)), 0.99);
 }
 
 }  // namespace

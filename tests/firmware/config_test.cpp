@@ -219,8 +219,10 @@ TEST(Config, StructDefaultsAgreeWithTheEmbeddedDefaultToml) {
   const LoomConfig built;
   // Every machine, CAN, I/O, timing and telemetry key, compared as loomctl prints them.
   EXPECT_EQ(restart_only_changes(built, parsed), "");
-  EXPECT_DOUBLE_EQ(built.can.carriage_counts_per_m, 104857600.0);  // 2^20 counts per 10 mm, as the drives assume
-  EXPECT_DOUBLE_EQ(built.can.carriage_counts_per_m, loom::drivers::kDefaultCountsPerM);
+  ASSERT_EQ(built.axes.size(), 3u);
+  EXPECT_DOUBLE_EQ(built.axes[1].counts_per_unit(), 104857600.0);  // 2^20 counts per 10 mm, as the drives assume
+  EXPECT_DOUBLE_EQ(built.axes[1].counts_per_unit(), loom::drivers::kDefaultCountsPerM);
+  EXPECT_DOUBLE_EQ(built.axes[0].counts_per_unit(), loom::drivers::kDefaultCountsPerRad);
   // The recipe's numeric keys (restart_only_changes leaves the recipe out).
   const Recipe& a = built.recipe;
   const Recipe& b = parsed.recipe;

@@ -54,6 +54,12 @@ TEST(MachineDescription, TheDefaultFileIsCompleteAndExtendingItChangesNothing) {
   EXPECT_EQ(a.profile.crank.velocity, b.profile.crank.velocity);
   // Every key the parser knows is written in the shipped file (so a copy of it is complete).
   for (const KeyInfo& k : config_keys()) {
+    if (std::string(k.path).rfind("axes.<name>.", 0) == 0) {  // per-axis keys: in the axis tables
+      const std::string key = std::string(k.path).substr(12);
+      if (key == "max_speed" || key.rfind("hom", 0) == 0) continue;  // added axes / homed axes only
+      EXPECT_NE(std::string(kDefaultLoomToml).find("\n" + key + " "), std::string::npos) << k.path;
+      continue;
+    }
     const std::string key = std::string(k.path).substr(std::string(k.path).find('.') + 1);
     const std::string section = std::string(k.path).substr(0, std::string(k.path).find('.'));
     if (std::string(k.path) == "recipe.crank_speed_rad_s") continue;  // the alternative to the force target
@@ -117,8 +123,8 @@ TEST(MachineDescription, AbsurdPositiveValuesAreRefusedByPlausibleRanges) {
 
 TEST(MachineDescription, EachCrossFieldErrorPointsAtTheLineThatIsWrong) {
   // A duplicated node id at its second use, whichever key that is.
-  EXPECT_EQ(config_error(ext("[can]\nnode_helix = 7\nnode_carriage = 7\n")),
-            "loom.toml:4:17: can.node_carriage = 7: node id already used by can.node_helix");
+  EXPECT_EQ(config_error(ext("[axes.helix]\nnode = 7\n[axes.carriage]\nnode = 7\n")),
+            "loom.toml:5:8: axes.carriage.node = 7: node id already used by axes.helix.node");
   // A non-Grashof linkage at the link lengths.
   EXPECT_NE(config_error(ext("[beatup]\ncrank_m = 0.3\n")).find("loom.toml:3:11: beatup.crank_m = 0.3: the linkage"),
             std::string::npos);
@@ -177,4 +183,85 @@ TEST(MachineDescription, EveryKeyHasAClassAndARange) {
   EXPECT_GT(machine, 30);
   EXPECT_GT(recipe, 10);
   EXPECT_GT(run, 5);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Axes are the machine's: [axes.<name>] tables, the core three in every loom, more up to the capacity.
+// ---------------------------------------------------------------------------------------------------
+namespace {
+// An auxiliary take-up roller on node 5, added to the default loom.
+const char* const kTakeUp = "[axes.take_up]\nrole = \"auxiliary\"\nnode = 5\ncounts_per_rev = 4096\nmax_speed = 2.0\n"
+                            "ferror_min = 0.1\nreferencing = \"absolute\"\n";
+}  // namespace
+
+TEST(MachineAxes, TheDefaultLoomHasTheThreeCoreAxesInSlotOrder) {
+  const LoomConfig c = default_loom_config();
+  ASSERT_EQ(c.axes.size(), 3u);
+  const loom::hal::AxisLayout l = axis_layout(c);
+  EXPECT_EQ(std::string(l.name(0)), "beat_crank");
+  EXPECT_EQ(std::string(l.name(1)), "carriage");
+  EXPECT_EQ(std::string(l.name(2)), "helix");
+  EXPECT_EQ(c.sequencer.axes.count, 3u);
+  EXPECT_EQ(c.machine.axis_count, 3u);
+  EXPECT_EQ(can_axis_config(c).axes.size(), 3u);
+  EXPECT_EQ(can_axis_config(c).axes[2].node_id, 3);
+}
+
+TEST(MachineAxes, AnAddedAxisIsDerivedIntoEveryModule) {
+  const LoomConfig c = parse_loom_config(ext(std::string("[can]\nbus_load_budget = 0.8\n") + kTakeUp), "loom.toml");
+  ASSERT_EQ(c.axes.size(), 4u);
+  EXPECT_EQ(c.axes[3].name, "take_up");
+  EXPECT_EQ(c.sequencer.axes.count, 4u);
+  EXPECT_EQ(std::string(c.sequencer.axes.name(3)), "take_up");
+  EXPECT_DOUBLE_EQ(c.sequencer.axis_max_speed[3], 2.0);
+  EXPECT_EQ(c.machine.axis_count, 4u);
+  const auto can = can_axis_config(c);
+  ASSERT_EQ(can.axes.size(), 4u);
+  EXPECT_EQ(can.axes[3].node_id, 5);
+  EXPECT_NEAR(can.axes[3].counts_per_unit, 4096.0 / (2.0 * M_PI), 1e-9);
+  // One more drive on the bus: one more RPDO1 and TPDO1 per cycle than the default loom.
+  EXPECT_EQ(can_bus_load(c).frames, can_bus_load(default_loom_config()).frames + 2);
+  // An added axis is a restart-only change.
+  EXPECT_NE(restart_only_changes(default_loom_config(), c).find("axes"), std::string::npos);
+  // Slot order does not follow the file: the core axes come first, the others by name.
+  const LoomConfig d = parse_loom_config(ext(std::string("[can]\nbus_load_budget = 1.0\n") + kTakeUp + "[axes.a_roll]\nrole = \"auxiliary\"\nnode = 6\n"
+                                             "counts_per_rev = 4096\nmax_speed = 1\nferror_min = 0\nreferencing = \"absolute\"\n"), "loom.toml");
+  ASSERT_EQ(d.axes.size(), 5u);
+  EXPECT_EQ(d.axes[0].name, "beat_crank");
+  EXPECT_EQ(d.axes[3].name, "a_roll");
+  EXPECT_EQ(d.axes[4].name, "take_up");
+}
+
+TEST(MachineAxes, BadAxisTablesAreRefusedAtTheirLine) {
+  // The old three-axis keys name where the fact lives now.
+  EXPECT_EQ(config_error(ext("[can]\nnode_helix = 7\n")),
+            "loom.toml:3:14: can.node_helix = 7: the axes are [axes.<name>] tables now: this fact is axes.helix.node "
+            "(loomctl check --keys lists every key)");
+  EXPECT_NE(config_error(ext("[can]\ncarriage_counts_per_m = 1e6\n")).find("axes.carriage.lead_m"), std::string::npos);
+  // A new axis says what it is, which drive moves it and how fast it may go.
+  EXPECT_NE(config_error(ext("[axes.x]\nnode = 5\n")).find("axes.x.role = (missing): missing"), std::string::npos)
+      << config_error(ext("[axes.x]\nnode = 5\n"));
+  EXPECT_NE(config_error(ext("[axes.x]\nrole = \"auxiliary\"\nnode = 5\ncounts_per_rev = 4096\nferror_min = 0\n"))
+                .find("axes.x.max_speed = (missing)"),
+            std::string::npos);
+  EXPECT_NE(config_error(ext("[axes.x]\nrole = \"spindle\"\n")).find("axes.x.role = \"spindle\""), std::string::npos);
+  // Facts that belong elsewhere are refused where they are written.
+  EXPECT_NE(config_error(ext("[axes.helix]\nmax_speed = 5\n")).find("[helix] max_speed_rad_s"), std::string::npos);
+  EXPECT_NE(config_error(ext("[axes.helix]\nlead_m = 0.01\n")).find("only a linear axis"), std::string::npos);
+  // Names are identifiers; the set holds one axis per core role and at most the capacity.
+  EXPECT_NE(config_error(ext("[axes.Take-Up]\nrole = \"auxiliary\"\n")).find("a-z, 0-9 and _"), std::string::npos);
+  EXPECT_NE(config_error(ext("[axes.second_crank]\nrole = \"beat_crank\"\nnode = 9\ncounts_per_rev = 4096\nferror_min = 0\nreferencing = \"absolute\"\n"))
+                .find("the loom has one beat_crank axis (axes.beat_crank)"),
+            std::string::npos);
+  EXPECT_NE(config_error(ext("[axes.helix]\nrole = \"auxiliary\"\nmax_speed = 1\n")).find("no axis has role = \"helix\""),
+            std::string::npos);
+  std::string many;
+  for (int i = 0; i < 30; ++i) {
+    many += "[axes.k" + std::to_string(10 + i) + "]\nrole = \"knotter\"\nnode = " + std::to_string(10 + i) +
+            "\ncounts_per_rev = 4096\nmax_speed = 10\nferror_min = 0\nreferencing = \"absolute\"\n";
+  }
+  EXPECT_NE(config_error(ext(many)).find("33 axes; the controller holds at most 32"), std::string::npos)
+      << config_error(ext(many));
+  // A duplicated node id between an axis and the I/O module.
+  EXPECT_NE(config_error(ext("[io]\nnode = 2\n")).find("node id already used by axes.carriage.node"), std::string::npos);
 }

@@ -25,19 +25,19 @@ struct Fixture {
 
 TEST(Interlocks, CarriageMayNotMoveWhileTheBeaterIsInTheWarp) {
   Fixture f;
-  f.in.axes[hal::index(hal::Axis::kBeatCrank)].position = f.beatup.warp().fell;  // beater at the fell
-  f.next.axes[hal::index(hal::Axis::kCarriage)].target_position = 0.001;
+  f.in.axes[hal::index(hal::CoreAxis::kBeatCrank)].position = f.beatup.warp().fell;  // beater at the fell
+  f.next.axes[hal::index(hal::CoreAxis::kCarriage)].target_position = 0.001;
   EXPECT_EQ(check_interlocks(f.ctx, f.in, f.prev, f.next), Fault::kCarriageInWarp);
-  f.in.axes[hal::index(hal::Axis::kBeatCrank)].position = 0.0;  // park: clear
+  f.in.axes[hal::index(hal::CoreAxis::kBeatCrank)].position = 0.0;  // park: clear
   EXPECT_EQ(check_interlocks(f.ctx, f.in, f.prev, f.next), Fault::kNone);
   // Several turns later at the fell again: still in the warp (phase is taken modulo a turn).
-  f.in.axes[hal::index(hal::Axis::kBeatCrank)].position = f.beatup.warp().fell + 40 * motion::kTwoPi;
+  f.in.axes[hal::index(hal::CoreAxis::kBeatCrank)].position = f.beatup.warp().fell + 40 * motion::kTwoPi;
   EXPECT_EQ(check_interlocks(f.ctx, f.in, f.prev, f.next), Fault::kCarriageInWarp);
 }
 
 TEST(Interlocks, NoPickUnlessTheShedIsConfirmedOpen) {
   Fixture f;
-  f.next.axes[hal::index(hal::Axis::kHelix)].target_position = 0.1;
+  f.next.axes[hal::index(hal::CoreAxis::kHelix)].target_position = 0.1;
   EXPECT_EQ(check_interlocks(f.ctx, f.in, f.prev, f.next), Fault::kNone);
   f.in.io.piston_b_retracted = false;  // frame B between end sensors
   EXPECT_EQ(check_interlocks(f.ctx, f.in, f.prev, f.next), Fault::kPickWithoutShed);

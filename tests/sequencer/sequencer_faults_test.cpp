@@ -52,26 +52,29 @@ struct Rig {
 TEST(SequencerFaults, NonFiniteAxisFeedbackIsAFaultOnThatAxis) {
   Rig r;
   r.tamper = [](hal::Tick t, hal::HalInputs& in) {
-    if (t >= 3000) in.axes[hal::index(hal::Axis::kCarriage)].velocity = std::numeric_limits<double>::quiet_NaN();
+    if (t >= 3000) in.axes[hal::index(hal::CoreAxis::kCarriage)].velocity = std::numeric_limits<double>::quiet_NaN();
   };
   r.build(3);
   r.run(5000);
   EXPECT_EQ(r.seq->first_fault(), Fault::kNonFiniteFeedback);
-  EXPECT_EQ(r.seq->fault_axis(), static_cast<int>(hal::Axis::kCarriage));
+  EXPECT_EQ(r.seq->fault_axis(), static_cast<int>(hal::CoreAxis::kCarriage));
   EXPECT_EQ(r.seq->fault_tick(), 3000);
 }
 
 TEST(SequencerFaults, EmcyFromAnEnabledDriveStopsInTheSameTick) {
   Rig r;
   r.tamper = [](hal::Tick t, hal::HalInputs& in) {
-    if (t >= 3000) in.axes[hal::index(hal::Axis::kHelix)].fault_code = 0x2310;
+    if (t >= 3000) {
+      in.axes[hal::index(hal::CoreAxis::kHelix)].fault_code = 0x2310;
+      in.axes[hal::index(hal::CoreAxis::kHelix)].fault_kind = hal::FaultKind::kEmcy;
+    }
   };
   r.build(3);
   r.run(5000);
   EXPECT_EQ(r.seq->first_fault(), Fault::kDriveEmcy);
   EXPECT_EQ(r.seq->fault_detail(), 0x2310);
   EXPECT_EQ(r.seq->fault_tick(), 3000);
-  for (const auto& a : r.out.axes) EXPECT_EQ(a.request, hal::AxisRequest::kQuickStop);
+  for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k) EXPECT_EQ(r.out.axes[k].request, hal::AxisRequest::kQuickStop);
 }
 
 TEST(SequencerFaults, ALoadCellThatVanishesOrReadsNaNIsAFault) {
@@ -110,7 +113,7 @@ TEST(SequencerFaults, StopNowStopsAtOnceKeepsTheCountersAndAcknowledgeRearms) {
   r.run(1);
   EXPECT_EQ(r.seq->state(), State::kIdle);
   EXPECT_EQ(r.seq->first_fault(), Fault::kNone);
-  for (const auto& a : r.out.axes) EXPECT_EQ(a.request, hal::AxisRequest::kFaultReset);
+  for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k) EXPECT_EQ(r.out.axes[k].request, hal::AxisRequest::kFaultReset);
   EXPECT_TRUE(r.out.io.lamp_amber);
   r.seq->request_start();
   r.run(200000, [&] { return r.seq->finished(); });

@@ -53,7 +53,7 @@ TEST(SequencerSim, WeavesThreeRowsWithEveryBeatAndFullCarriageTravel) {
   double carriage_min = 1e9, carriage_max = -1e9;
   std::uint32_t rows_seen = 0;
   r.run(200000, [&] {
-    const double x = r.world->axis(hal::Axis::kCarriage).position;
+    const double x = r.world->axis(hal::CoreAxis::kCarriage).position;
     carriage_min = std::min(carriage_min, x);
     carriage_max = std::max(carriage_max, x);
     if (r.seq->counters().rows != rows_seen) {
@@ -88,24 +88,24 @@ TEST(SequencerSim, ServoLagStillWeavesWithoutInterlockTrips) {
 TEST(SequencerSim, DriveFaultStopsEveryAxisAndKeepsCounters) {
   Rig r;
   r.scene.faults.push_back({.at_s = 12.0, .kind = sim_hal::InjectedFault::kDriveFault,
-                            .axis = hal::Axis::kCarriage, .code = 0x8611});
+                            .axis_name = "carriage", .axis = hal::index(hal::CoreAxis::kCarriage), .code = 0x8611});
   r.build(5);
   r.run(200000, [] {});
   ASSERT_EQ(r.seq->state(), State::kFault);
   EXPECT_EQ(r.seq->first_fault(), Fault::kDriveFault);
-  EXPECT_EQ(r.seq->fault_axis(), static_cast<int>(hal::Axis::kCarriage));
+  EXPECT_EQ(r.seq->fault_axis(), static_cast<int>(hal::CoreAxis::kCarriage));
   EXPECT_EQ(r.seq->fault_detail(), 0x8611);
   const auto counters = r.seq->counters();
   EXPECT_GE(counters.rows, 1u);
   // After the fault: every axis is asked to quick-stop and no target moves any more.
   const hal::HalOutputs at_fault = r.out;
-  for (const auto& a : at_fault.axes) EXPECT_EQ(a.request, hal::AxisRequest::kQuickStop);
+  for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k) EXPECT_EQ(at_fault.axes[k].request, hal::AxisRequest::kQuickStop);
   hal::PortHal hal(*r.world, *r.world);
   for (int i = 0; i < 1000; ++i, ++r.now) {
     hal.read(r.now, r.in);
     r.seq->step(r.now, r.in, r.out);
     hal.write(r.now, r.out);
-    for (std::size_t k = 0; k < hal::kAxisCount; ++k)
+    for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k)
       EXPECT_EQ(r.out.axes[k].target_position, at_fault.axes[k].target_position);
   }
   EXPECT_EQ(r.seq->counters().rows, counters.rows);
@@ -126,9 +126,9 @@ TEST(SequencerSim, EveryBeatHappensAtFullCrankSpeed) {
   const double fell = r.profiles.beatup().warp().fell;
   int beats = 0;
   double prev_phase = 0.0;
-  double prev_pos = r.world->axis(hal::Axis::kBeatCrank).position;
+  double prev_pos = r.world->axis(hal::CoreAxis::kBeatCrank).position;
   r.run(200000, [&] {
-    const double pos = r.world->axis(hal::Axis::kBeatCrank).position;
+    const double pos = r.world->axis(hal::CoreAxis::kBeatCrank).position;
     const double phase = motion::wrap_two_pi(pos);
     if (r.seq->state() == State::kBeatSweep && prev_phase < fell && phase >= fell && pos > prev_pos) {
       ++beats;
@@ -168,8 +168,9 @@ TEST(SequencerSim, DeadDriveStopsOnStaleFeedbackAndIsReportedAsHeartbeatLoss) {
     if (r.now == dead_at) frozen = r.in.axes;
     if (r.now >= dead_at) r.in.axes = frozen;  // no more PDOs from any drive
     if (r.now >= heartbeat_seen_at) {
-      r.in.axes[hal::index(hal::Axis::kHelix)].fault = true;
-      r.in.axes[hal::index(hal::Axis::kHelix)].fault_code = 0x8130;
+      r.in.axes[hal::index(hal::CoreAxis::kHelix)].fault = true;
+      r.in.axes[hal::index(hal::CoreAxis::kHelix)].fault_code = 0x8130;
+      r.in.axes[hal::index(hal::CoreAxis::kHelix)].fault_kind = hal::FaultKind::kNodeLost;
     }
     r.seq->step(r.now, r.in, r.out);
     hal.write(r.now, r.out);
@@ -180,7 +181,7 @@ TEST(SequencerSim, DeadDriveStopsOnStaleFeedbackAndIsReportedAsHeartbeatLoss) {
   }
   EXPECT_EQ(r.seq->first_fault(), Fault::kHeartbeatLost);
   EXPECT_EQ(r.seq->stopped_by(), Fault::kStaleFeedback);
-  EXPECT_EQ(r.seq->fault_axis(), static_cast<int>(hal::Axis::kHelix));
+  EXPECT_EQ(r.seq->fault_axis(), static_cast<int>(hal::CoreAxis::kHelix));
 }
 
 TEST(SequencerSim, RootCauseOutsideTheWindowDoesNotRewriteHistory) {
@@ -217,7 +218,7 @@ TEST(SequencerSim, PauseHoldsAtTheNextSafePointAndResumeContinues) {
     hal.read(r.now, r.in);
     r.seq->step(r.now, r.in, r.out);
     hal.write(r.now, r.out);
-    for (std::size_t k = 0; k < hal::kAxisCount; ++k)
+    for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k)
       EXPECT_EQ(r.out.axes[k].target_position, held.axes[k].target_position);
   }
   r.seq->request_resume();
@@ -293,7 +294,7 @@ TEST(SequencerSim, EachRowWaitsUntilTheOneBeforeIsOnDisk) {
       parked = r.out;
       if (row_end_at < 0) row_end_at = r.now;
     }
-    for (std::size_t k = 0; k < hal::kAxisCount; ++k) {
+    for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k) {
       moved_while_waiting = moved_while_waiting || r.out.axes[k].target_position != parked.axes[k].target_position;
     }
     // The reporter confirms row 1 one second (500 ticks) after it ended.
@@ -361,7 +362,7 @@ TEST(SequencerSim, KnottingModeWaitsBeforeEveryRowForTheWeaver) {
         pedal_ticks = 0;
         ++waits;
       }
-      for (std::size_t k = 0; k < hal::kAxisCount; ++k) {
+      for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k) {
         moved_while_waiting = moved_while_waiting || r.out.axes[k].target_position != parked.axes[k].target_position;
       }
       EXPECT_TRUE(r.out.io.lamp_amber);

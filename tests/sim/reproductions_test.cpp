@@ -34,12 +34,12 @@ Outcome weave(const firmware::LoomConfig& cfg, const firmware::Scene& scene, con
   opt.sim_state_path = state_file;
   firmware::Machine m(cfg, scene, opt, resume);
   m.sequencer().request_start();
-  const double helix0 = m.sim().axis(hal::Axis::kHelix).position, crank0 = m.sim().axis(hal::Axis::kBeatCrank).position;
+  const double helix0 = m.sim().axis(hal::CoreAxis::kHelix).position, crank0 = m.sim().axis(hal::CoreAxis::kBeatCrank).position;
   Outcome r;
   for (hal::Tick t = 0; t < max_ticks && !m.sequencer().finished(); ++t) {
     m.loop().cycle(t);
-    r.helix_moved = r.helix_moved || std::abs(m.sim().axis(hal::Axis::kHelix).position - helix0) > 1e-6;
-    r.crank_moved = r.crank_moved || std::abs(m.sim().axis(hal::Axis::kBeatCrank).position - crank0) > 1e-3;
+    r.helix_moved = r.helix_moved || std::abs(m.sim().axis(hal::CoreAxis::kHelix).position - helix0) > 1e-6;
+    r.crank_moved = r.crank_moved || std::abs(m.sim().axis(hal::CoreAxis::kBeatCrank).position - crank0) > 1e-3;
     if (stop_when(m.sequencer())) break;
   }
   r.state = m.sequencer().state();

@@ -72,7 +72,8 @@ TEST(SceneFile, EveryFaultKindRoundTripsThroughTheWriter) {
     f.kind = static_cast<sim_hal::InjectedFault>(k);
     f.at_s = 0.1 * k + 1.0 / 3.0;
     f.at_tick = 1234;
-    f.axis = hal::Axis::kHelix;
+    f.axis_name = "helix";
+    f.axis = hal::index(hal::CoreAxis::kHelix);
     f.code = 0x2310;
     f.sensor = sim_hal::Sensor::kPistonBExtended;
     f.stuck_value = true;

@@ -55,12 +55,12 @@ Outcome run_scene(const std::string& name, std::uint32_t rows, double period_ms 
   o.state = m.sequencer().state();
   if (o.power_cut) {
     // The machine lost its power: whatever the controller (were it alive) commands, nothing moves.
-    std::array<double, hal::kAxisCount> at_cut{};
-    for (std::size_t k = 0; k < hal::kAxisCount; ++k) at_cut[k] = m.sim().axis(static_cast<hal::Axis>(k)).position;
+    std::array<double, hal::kCoreAxisCount> at_cut{};
+    for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k) at_cut[k] = m.sim().axis(static_cast<hal::CoreAxis>(k)).position;
     for (int i = 0; i < 500; ++i, ++t) {
       m.loop().cycle(t);
-      for (std::size_t k = 0; k < hal::kAxisCount; ++k) {
-        if (m.sim().axis(static_cast<hal::Axis>(k)).position != at_cut[k]) o.moved_after_fault = true;
+      for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k) {
+        if (m.sim().axis(static_cast<hal::CoreAxis>(k)).position != at_cut[k]) o.moved_after_fault = true;
       }
     }
     return o;
@@ -69,7 +69,7 @@ Outcome run_scene(const std::string& name, std::uint32_t rows, double period_ms 
   const hal::HalOutputs at_end = m.loop().outputs();
   for (int i = 0; i < 500; ++i, ++t) {
     m.loop().cycle(t);
-    for (std::size_t k = 0; k < hal::kAxisCount; ++k) {
+    for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k) {
       if (m.loop().outputs().axes[k].target_position != at_end.axes[k].target_position) o.moved_after_fault = true;
       if (m.sequencer().state() == State::kFault &&
           m.loop().outputs().axes[k].request != hal::AxisRequest::kQuickStop) {

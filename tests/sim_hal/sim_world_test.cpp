@@ -20,14 +20,14 @@ SceneSpec scene(std::vector<std::string> effects) {
 }
 
 // Drives one axis to `target` every tick for `ticks` ticks with the drive enabled.
-void drive(SimWorld& w, hal::Axis axis, double target, int ticks, hal::Tick& now) {
+void drive(SimWorld& w, hal::CoreAxis axis, double target, int ticks, hal::Tick& now) {
   hal::AxisCommands cmd{};
   for (auto& c : cmd) c.request = hal::AxisRequest::kEnable;
   hal::AxisFeedbacks fb{};
   hal::LinkStatus link{};
   for (int i = 0; i < ticks; ++i, ++now) {
     w.read_axes(now, fb, link);
-    for (std::size_t k = 0; k < hal::kAxisCount; ++k) cmd[k].target_position = fb[k].position;
+    for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k) cmd[k].target_position = fb[k].position;
     cmd[hal::index(axis)].target_position = target;
     w.write_axes(now, cmd);
   }
@@ -49,9 +49,9 @@ TEST(SimWorld, ServoLagIsTheExactFirstOrderStepResponse) {
   s.servo_lag = ServoLag{0.01};
   SimWorld w(SimMachine{}, s);
   hal::Tick now = 0;
-  drive(w, hal::Axis::kCarriage, 0.0, 1, now);  // enable
-  drive(w, hal::Axis::kCarriage, 0.1, 10, now);  // step of 0.1 m held 10 ticks = 20 ms = 2 τ
-  EXPECT_NEAR(w.axis(hal::Axis::kCarriage).position, 0.1 * (1.0 - std::exp(-2.0)), 1e-12);
+  drive(w, hal::CoreAxis::kCarriage, 0.0, 1, now);  // enable
+  drive(w, hal::CoreAxis::kCarriage, 0.1, 10, now);  // step of 0.1 m held 10 ticks = 20 ms = 2 τ
+  EXPECT_NEAR(w.axis(hal::CoreAxis::kCarriage).position, 0.1 * (1.0 - std::exp(-2.0)), 1e-12);
 }
 
 TEST(SimWorld, PneumaticsDelayTheStrokeByFillAndBreakaway) {
@@ -89,7 +89,7 @@ TEST(SimWorld, ShuttleSlipsOnlyAboveTheCouplingForce) {
     const double a_lin = 50.0, lead = 0.1, dt = 0.002;
     for (int t = 0; t < 100; ++t) {
       const double time = t * dt;
-      fb[hal::index(hal::Axis::kHelix)].position = 0.5 * a_lin * time * time / lead * motion::kTwoPi;
+      fb[hal::index(hal::CoreAxis::kHelix)].position = 0.5 * a_lin * time * time / lead * motion::kTwoPi;
       w.read_io(t, fb, io);
     }
     return w.shuttle_coupled();
@@ -129,7 +129,7 @@ TEST(SimWorld, MachineStateSurvivesInItsFile) {
     SimStateFile file(path);
     SimWorld w(SimMachine{}, scene({"ideal"}));
     w.attach_state_file(file);
-    drive(w, hal::Axis::kHelix, 3.0, 5, now);
+    drive(w, hal::CoreAxis::kHelix, 3.0, 5, now);
     hal::AxisFeedbacks fb{};
     hal::LinkStatus link{};
     hal::DigitalInputs io{};
@@ -142,7 +142,7 @@ TEST(SimWorld, MachineStateSurvivesInItsFile) {
   SimStateFile again(path);
   SimWorld w2(SimMachine{}, scene({"ideal"}));
   w2.attach_state_file(again);
-  EXPECT_DOUBLE_EQ(w2.axis(hal::Axis::kHelix).position, 3.0);
+  EXPECT_DOUBLE_EQ(w2.axis(hal::CoreAxis::kHelix).position, 3.0);
   EXPECT_DOUBLE_EQ(w2.pistons()[1], 1.0);
   EXPECT_NEAR(w2.shuttle_x(), 3.0 * 0.1 / motion::kTwoPi, 1e-15);
 }

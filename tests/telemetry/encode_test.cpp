@@ -36,7 +36,8 @@ Snapshot sample() {
   s.can_tx_dropped = 6;
   s.can_rx_errors = 9;
   s.wake_latency_p99_ns = 12'000;
-  for (std::size_t i = 0; i < s.axes.size(); ++i) {
+  s.axis_count = 3;  // the default loom's axes (names from the core layout)
+  for (std::size_t i = 0; i < s.axis_count; ++i) {
     const double k = static_cast<double>(i + 1);
     s.axes[i] = {.position = 1.0 * k,
                  .velocity = 2.0 * k,

@@ -77,7 +77,8 @@ inline Snapshot script_snapshot(const WeaveScript& w, std::int64_t tick) {
       in_row < beat_start ? 0.0
                           : static_cast<double>(in_row - beat_start) / static_cast<double>(w.ticks_per_beat);
   s.crank_phase_rad = std::fmod(beat_progress, 1.0) * 2.0 * std::numbers::pi;
-  for (std::size_t i = 0; i < s.axes.size(); ++i) {
+  s.axis_count = 3;  // the default loom's axes
+  for (std::size_t i = 0; i < s.axis_count; ++i) {
     AxisSample& a = s.axes[i];
     a.position = static_cast<double>(tick) * 1e-3 * static_cast<double>(i + 1);
     a.target = a.position + 1e-4;

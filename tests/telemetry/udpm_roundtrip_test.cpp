@@ -35,7 +35,7 @@ class StatusCollector {
   static void on_axes(const lcm::ReceiveBuffer*, const std::string&, const loomlcm::axes_t* m,
                       StatusCollector* self) {
     std::lock_guard lock(self->mu_);
-    if (m->axes.size() == loom::hal::kAxisCount) ++self->axes_;
+    if (m->axes.size() == loom::hal::kCoreAxisCount) ++self->axes_;
   }
   std::vector<Key> got() {
     std::lock_guard lock(mu_);

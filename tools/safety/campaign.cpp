@@ -51,7 +51,8 @@ sim_hal::FaultInjection random_fault(std::mt19937_64& rng, sim_hal::SceneSpec& s
   sim_hal::FaultInjection f;
   f.kind = static_cast<InjectedFault>(static_cast<int>(u(rng) * sim_hal::kInjectedFaultCount));
   f.at_s = 16.0 * u(rng);
-  f.axis = static_cast<hal::Axis>(static_cast<int>(u(rng) * 3));
+  f.axis = static_cast<std::size_t>(u(rng) * 3);
+  f.axis_name = hal::axis_name(static_cast<hal::CoreAxis>(f.axis));
   f.piston = u(rng) < 0.5 ? 0 : 1;
   f.sensor = random_switch(rng, kAllSensors, second_channel);
   f.stuck_value = u(rng) < 0.5;
@@ -67,7 +68,7 @@ sim_hal::FaultInjection random_fault(std::mt19937_64& rng, sim_hal::SceneSpec& s
       break;
     case InjectedFault::kEmcy: f.code = static_cast<std::uint16_t>(0x1000 + static_cast<int>(u(rng) * 0xE000)); break;
     case InjectedFault::kEncoderGlitch: {
-      const double scale = f.axis == hal::Axis::kCarriage ? 0.1 : 2.0;
+      const double scale = f.axis == hal::index(hal::CoreAxis::kCarriage) ? 0.1 : 2.0;
       f.jump = (u(rng) < 0.5 ? -1.0 : 1.0) * scale * (0.005 + u(rng));
       f.ticks = 1 + static_cast<int>(u(rng) * 5);
       break;
@@ -198,8 +199,8 @@ RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& sp
   const double window = cfg.machine.selvedge_sensor_window_m;
   RunOutcome o;
   std::ostringstream why;
-  double carriage = sim.axis(hal::Axis::kCarriage).position, helix = sim.axis(hal::Axis::kHelix).position;
-  double crank = sim.axis(hal::Axis::kBeatCrank).position;
+  double carriage = sim.axis(hal::CoreAxis::kCarriage).position, helix = sim.axis(hal::CoreAxis::kHelix).position;
+  double crank = sim.axis(hal::CoreAxis::kBeatCrank).position;
   std::array<double, 2> pistons = sim.pistons();
   hal::Tick fault_at = -1;
   hal::Tick t = 0;
@@ -214,8 +215,8 @@ RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& sp
       o.power_cut = true;
       break;
     }
-    const double c2 = sim.axis(hal::Axis::kCarriage).position, h2 = sim.axis(hal::Axis::kHelix).position;
-    const double k2 = sim.axis(hal::Axis::kBeatCrank).position;
+    const double c2 = sim.axis(hal::CoreAxis::kCarriage).position, h2 = sim.axis(hal::CoreAxis::kHelix).position;
+    const double k2 = sim.axis(hal::CoreAxis::kBeatCrank).position;
     const auto p2 = sim.pistons();
     if (moved(c2, carriage) && warp_before && sim.beater_in_warp()) {
       why << "carriage moved " << (c2 - carriage) << " m while the beater was in the warp at tick " << t;

@@ -37,8 +37,8 @@ extern "C" void on_terminate(int) {
   if (g_link != nullptr) g_link->post(Command::kExit);  // lock-free fetch_or: async-signal-safe
 }
 
-std::string axis_label(int axis) {
-  return axis >= 0 ? hal::axis_name(static_cast<hal::Axis>(axis)) : "";
+std::string axis_label(const hal::AxisLayout& axes, int axis) {
+  return axis >= 0 ? axes.name(static_cast<std::size_t>(axis)) : "";
 }
 
 // Where the session's design stands: rows of it woven when the session was armed, against the
@@ -266,7 +266,7 @@ int serve_main(const ServeArgs& a) {
           r.kind = overrun ? "overrun_stop" : "fault";
           r.name = sequencer::fault_name(f);
           r.code = sequencer::fault_code(f);
-          r.axis = overrun ? "" : axis_label(e.fault_axis);
+          r.axis = overrun ? "" : axis_label(cfg.sequencer.axes, e.fault_axis);
           r.device_code = overrun ? 0 : e.fault_detail;
           r.rows = e.counters.rows;
           r.picks = e.counters.picks;

@@ -27,9 +27,8 @@ double seconds(hal::Tick ticks, std::int64_t period_ns) noexcept {
   return static_cast<double>(ticks) * static_cast<double>(period_ns) * 1e-9;
 }
 
-std::string axis_or_empty(int axis) {
-  return axis >= 0 && axis < static_cast<int>(hal::kAxisCount) ? hal::axis_name(static_cast<hal::Axis>(axis))
-                                                                : std::string();
+std::string axis_or_empty(const hal::AxisLayout& axes, int axis) {
+  return axis >= 0 && static_cast<std::size_t>(axis) < axes.count ? axes.name(static_cast<std::size_t>(axis)) : std::string();
 }
 
 // The operator text of a fault named in a snapshot (the snapshot carries the name, not the enum).
@@ -62,7 +61,8 @@ std::string with_sensor(std::string text, std::int8_t sensor) {
 }
 }  // namespace
 
-loomlcm::status_t to_status(const Snapshot& s, const std::string& loom_id, std::int64_t utime) {
+loomlcm::status_t to_status(const Snapshot& s, const std::string& loom_id, std::int64_t utime,
+                            const hal::AxisLayout& axes) {
   loomlcm::status_t m;
   m.utime = utime;
   m.loom_id = loom_id;
@@ -79,7 +79,7 @@ loomlcm::status_t to_status(const Snapshot& s, const std::string& loom_id, std::
   m.first_fault = from_cstr(s.first_fault);
   m.first_fault_code = s.first_fault_code;
   const bool faulted = !m.first_fault.empty();
-  m.fault_axis = faulted ? axis_or_empty(s.fault_axis) : std::string();
+  m.fault_axis = faulted ? axis_or_empty(axes, s.fault_axis) : std::string();
   m.fault_device_code = faulted ? s.fault_device_code : 0;
   m.fault_text = faulted ? with_sensor(fault_text_of(m.first_fault), s.fault_sensor) : std::string();
   m.fault_time_s = faulted && s.fault_tick >= 0 ? seconds(s.fault_tick, s.period_ns) : 0.0;
@@ -90,7 +90,8 @@ loomlcm::status_t to_status(const Snapshot& s, const std::string& loom_id, std::
   return m;
 }
 
-loomlcm::axes_t to_axes(const Snapshot& s, const std::string& loom_id, std::int64_t utime) {
+loomlcm::axes_t to_axes(const Snapshot& s, const std::string& loom_id, std::int64_t utime,
+                        const hal::AxisLayout& axes) {
   loomlcm::axes_t m;
   m.utime = utime;
   m.loom_id = loom_id;
@@ -100,12 +101,13 @@ loomlcm::axes_t to_axes(const Snapshot& s, const std::string& loom_id, std::int6
   m.beater_angle_rad = s.beater_angle_rad;
   m.beat_force_n = s.beat_force_valid ? s.beat_force_n : 0.0;
   m.beat_force_valid = s.beat_force_valid;
-  m.num_axes = static_cast<std::int8_t>(s.axes.size());
-  m.axes.resize(s.axes.size());
-  for (std::size_t i = 0; i < s.axes.size(); ++i) {
+  const std::size_t n = std::min<std::size_t>(s.axis_count, hal::kMaxAxes);
+  m.num_axes = static_cast<std::int8_t>(n);
+  m.axes.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
     const AxisSample& a = s.axes[i];
     loomlcm::axis_t& o = m.axes[i];
-    o.name = hal::axis_name(static_cast<hal::Axis>(i));
+    o.name = i < axes.count ? axes.name(i) : "axis" + std::to_string(i);
     o.position = a.position;
     o.velocity = a.velocity;
     o.target = a.target;
@@ -178,14 +180,15 @@ loomlcm::beat_t to_beat(const Event& e, const std::string& loom_id, std::int64_t
   return m;
 }
 
-loomlcm::fault_t to_fault(const Event& e, const std::string& loom_id, std::int64_t utime) {
+loomlcm::fault_t to_fault(const Event& e, const std::string& loom_id, std::int64_t utime,
+                          const hal::AxisLayout& axes) {
   auto m = event_message<loomlcm::fault_t>(e, loom_id, utime);
   m.kind = fault_kind_name(e.fault_kind);
   const sequencer::Fault f = fault_of(e.fault);
   m.name = sequencer::fault_name(f);
   m.code = sequencer::fault_code(f);
   m.text = with_sensor(sequencer::fault_text(f), e.sensor);
-  m.axis = axis_or_empty(e.axis);
+  m.axis = axis_or_empty(axes, e.axis);
   m.device_code = e.device_code;
   m.state = from_cstr(e.state);
   m.row = static_cast<std::int32_t>(e.row);

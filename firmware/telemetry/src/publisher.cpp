@@ -158,7 +158,7 @@ void Publisher::publish_event(const Event& e) {
   try {
     switch (e.kind) {
       case Event::Kind::kBeat: send(channels_.beat, to_beat(e, cfg_.loom_id, utime), n_beat_); break;
-      case Event::Kind::kFault: send(channels_.fault, to_fault(e, cfg_.loom_id, utime), n_fault_); break;
+      case Event::Kind::kFault: send(channels_.fault, to_fault(e, cfg_.loom_id, utime, cfg_.axes), n_fault_); break;
       case Event::Kind::kRow: send(channels_.row, to_row(e, cfg_.loom_id, utime), n_row_); break;
     }
   } catch (const std::exception&) {
@@ -184,10 +184,10 @@ void Publisher::publish(const Snapshot& s) {
   const std::int64_t utime = wall_utime();
   try {
     if (due.status) {
-      send(channels_.status, to_status(s, cfg_.loom_id, utime), n_status_);
+      send(channels_.status, to_status(s, cfg_.loom_id, utime, cfg_.axes), n_status_);
       publish_design(s, utime);
     }
-    if (due.axes) send(channels_.axes, to_axes(s, cfg_.loom_id, utime), n_axes_);
+    if (due.axes) send(channels_.axes, to_axes(s, cfg_.loom_id, utime, cfg_.axes), n_axes_);
     if (due.rt) {
       send(channels_.rt, to_rt_stats(s, cfg_.loom_id, utime, ring_.dropped(), ring_.size_approx(), events_.dropped()), n_rt_);
     }

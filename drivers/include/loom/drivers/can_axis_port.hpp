@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <numbers>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,8 @@ inline constexpr double kDefaultCarriageLeadM = 0.010;
 inline constexpr double kDefaultCountsPerM = kCountsPerRev / kDefaultCarriageLeadM;
 
 struct CanAxisConfig {
+  std::string name = "axis";  // the machine description's name, for messages
+  std::uint8_t bus = 0;       // which bus (0 = the first interface); node ids are unique per bus
   std::uint8_t node_id = 1;
   double counts_per_unit = kDefaultCountsPerRad;  // counts per rad (rotary) or per m (carriage)
   double rated_effort = 0.0;  // N·m or N at 1000 ‰ of 0x6077; 0 = effort not reported (needs TPDO2)
@@ -44,12 +47,12 @@ struct CanAxisConfig {
 };
 
 struct CanAxisPortConfig {
-  // Indexed by hal::index(hal::Axis).
-  std::array<CanAxisConfig, hal::kAxisCount> axes{{
-      {1, kDefaultCountsPerRad, 0.0},  // beat crank
-      {2, kDefaultCountsPerM, 0.0},    // carriage
-      {3, kDefaultCountsPerRad, 0.0},  // helix shaft
-  }};
+  // One per axis of the machine, in slot order (hal::AxisLayout); at most hal::kMaxAxes.
+  std::vector<CanAxisConfig> axes{
+      {"beat_crank", 0, 1, kDefaultCountsPerRad, 0.0},
+      {"carriage", 0, 2, kDefaultCountsPerM, 0.0},
+      {"helix", 0, 3, kDefaultCountsPerRad, 0.0},
+  };
   double cycle_period_s = 0.002;        // SYNC period = tick period; written to 0x60C2
   double heartbeat_producer_s = 0.100;  // written to each drive's 0x1017 (whole ms)
   // A drive is lost when no heartbeat arrived for longer than this. Must exceed the producer time and
@@ -108,7 +111,7 @@ class CanAxisPort final : public hal::AxisPort {
 
   // RT-safe. Drains at most kMaxFramesPerRead frames, then reports every axis and the link.
   void read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) override;
-  // RT-safe. SYNC, then one RPDO1 per axis (4 frames).
+  // RT-safe. SYNC, then one RPDO1 per axis.
   void write_axes(hal::Tick now, const hal::AxisCommands& axes) override;
 
   // Diagnostics; RT-safe to read.
@@ -116,13 +119,14 @@ class CanAxisPort final : public hal::AxisPort {
   // What configure() found optional and absent (0x1016, TPDO2) or accepted as read back; one line each.
   const std::vector<std::string>& notes() const { return notes_; }
   // Largest following error seen per axis since configure(), in SI units (telemetry high-water mark).
-  double ferror_high_water(hal::Axis a) const { return axes_[hal::index(a)].ferror_high_water; }
-  bool has_consumer(hal::Axis a) const { return axes_[hal::index(a)].has_consumer; }
-  bool has_tpdo2(hal::Axis a) const { return axes_[hal::index(a)].has_tpdo2; }
+  double ferror_high_water(std::size_t slot) const { return axes_[slot].ferror_high_water; }
+  bool has_consumer(std::size_t slot) const { return axes_[slot].has_consumer; }
+  bool has_tpdo2(std::size_t slot) const { return axes_[slot].has_tpdo2; }
+  std::size_t axis_count() const { return n_axes_; }
   const BusLoad& bus_load() const { return bus_load_; }
   const CanAxisPortConfig& config() const { return config_; }
-  std::uint16_t last_controlword(hal::Axis a) const { return axes_[hal::index(a)].tracker.last_controlword; }
-  std::int64_t last_target_counts(hal::Axis a) const { return axes_[hal::index(a)].last_target_counts; }
+  std::uint16_t last_controlword(std::size_t slot) const { return axes_[slot].tracker.last_controlword; }
+  std::int64_t last_target_counts(std::size_t slot) const { return axes_[slot].last_target_counts; }
   std::uint32_t heartbeat_consumer_ticks() const { return consumer_ticks_; }
 
  private:
@@ -173,7 +177,10 @@ class CanAxisPort final : public hal::AxisPort {
   BusLoad bus_load_{};
   std::uint32_t consumer_ticks_ = 0;
   std::uint32_t state_timeout_ticks_ = 0;
-  std::array<AxisRuntime, hal::kAxisCount> axes_{};
+  std::array<AxisRuntime, hal::kMaxAxes> axes_{};
+  std::size_t n_axes_ = 0;  // config_.axes.size()
+  std::span<AxisRuntime> live() { return {axes_.data(), n_axes_}; }
+  std::span<const AxisRuntime> live() const { return {axes_.data(), n_axes_}; }
   std::array<std::int8_t, 128> axis_of_node_{};  // −1 = not ours
   bool bus_off_ = false;                         // latched until configure()
   bool restarted_ = false;                       // the controller restarted after the bus-off

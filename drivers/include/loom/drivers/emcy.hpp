@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "loom/drivers/can_frame.hpp"
+#include "loom/hal/types.hpp"
 
 namespace loom::drivers {
 
@@ -36,6 +37,10 @@ inline constexpr std::uint16_t kStateTimeout = 0xFF01;        // CiA 402 transit
 inline constexpr std::uint16_t kNodeRebooted = 0xFF02;        // boot-up seen while operating: mapping lost
 inline constexpr std::uint16_t kNodeNotOperational = 0xFF03;  // heartbeat says stopped/pre-operational
 }  // namespace fault_code
+
+// RT-safe. The kind of a fault the master reports with `code` on a node's link: its own detections of
+// a lost node (heartbeat lost, rebooted, not operational) and of the bus, else an EMCY the node sent.
+hal::FaultKind link_fault_kind(std::uint16_t code);
 
 // RT-safe (returns a static string). The specific text for codes in the table above and the common
 // drive codes, else the CiA 301 error class of the code ("current", "voltage", ...).

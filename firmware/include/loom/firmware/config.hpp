@@ -37,9 +37,6 @@ class ConfigError : public std::runtime_error {
 struct CanSettings {
   std::uint32_t bitrate = 1'000'000;
   double bus_load_budget = 0.7;
-  std::uint8_t node_beat_crank = 1, node_carriage = 2, node_helix = 3;
-  double counts_per_rev = 1048576.0;
-  double carriage_counts_per_m = 104857600.0;  // 2^20 counts per 10 mm
   std::uint16_t heartbeat_ms = 100;
   std::uint16_t heartbeat_timeout_ms = 250;
   std::uint16_t sdo_timeout_ms = 500;
@@ -48,18 +45,51 @@ struct CanSettings {
   std::uint8_t master_node = 0x7F;
   std::uint16_t master_heartbeat_ms = 100;
   std::uint16_t master_consumer_ms = 500;
-  // Per-drive bring-up windows, indexed beat_crank, carriage, helix; 0 = boot 2000 ms / operational
-  // = heartbeat_timeout_ms. Commercial drives may need hundreds of ms for either.
-  std::array<std::uint32_t, 3> boot_timeout_ms{0, 0, 0};
-  std::array<std::uint32_t, 3> operational_timeout_ms{0, 0, 0};
-  // Following-error supervision per axis (LinuxCNC rule): fault when |commanded − actual| >
-  // max(ferror_min, ferror_k_s · |commanded velocity|). Units: rad (crank, helix) or m (carriage); s.
-  // ferror_min = 0 disables it for that axis.
-  // The same defaults as firmware/config/default_loom.toml (a test holds them equal): the embedded TOML is
-  // what every loomctl run starts from.
-  std::array<double, 3> ferror_min{0.2, 0.002, 0.5};
-  std::array<double, 3> ferror_k_s{0.05, 0.05, 0.05};
 };
+
+// One servo axis of the machine, a table [axes.<name>]: what it is for, which drive moves it and how
+// that drive's counts map to SI. Every loom has the three core axes (roles beat_crank, carriage,
+// helix); a machine adds its own (knotting servos, colour selectors, auxiliaries) up to hal::kMaxAxes.
+struct AxisSpec {
+  std::string name;
+  hal::AxisRole role = hal::AxisRole::kAuxiliary;
+  std::uint8_t node = 0;             // CANopen node id of its drive
+  std::uint8_t bus = 0;              // which CAN bus its drive is on: 0 = the first --iface, 1 = the second, ...
+  double counts_per_rev = 1048576.0; // encoder counts per motor revolution
+  double lead_m = 0.0;               // linear axes: travel per motor revolution (m); rotary axes: 0
+  // Added axes' top speed (rad/s or m/s; bounds the plausible feedback step). The core axes' limits are
+  // facts of their mechanisms ([beatup] via the recipe, [carriage], [helix]) and are not repeated here.
+  double max_speed = 0.0;
+  // Following-error supervision (LinuxCNC rule): fault when |commanded − actual| >
+  // max(ferror_min, ferror_k_s · |commanded velocity|); rad or m, and s. ferror_min = 0 turns it off.
+  double ferror_min = 0.0;
+  double ferror_k_s = 0.05;
+  // Bring-up windows of its drive; 0 = 2000 ms to boot, can.heartbeat_timeout_ms to go operational.
+  std::uint32_t boot_ms = 0;
+  std::uint32_t operational_ms = 0;
+  // Referencing: "absolute" (the encoder reads the machine position from power-up; commissioning
+  // captures the references once) or "homing" (an incremental encoder: a CiA 402 homing run after every
+  // power-up of the drive, before the axis may move in production).
+  bool homing = false;
+  int homing_method = 0;          // 19 / 21 home switch (positive / negative side), 33 / 34 index pulse, 37 here
+  double home_offset = 0.0;       // the reading at the home point (0x607C), SI
+  double homing_speed = 0.0;      // SI/s (0x6099)
+  double homing_accel = 0.0;      // SI/s^2 (0x609A)
+  double homing_timeout_s = 0.0;  // a run not referenced by then is the fault homing_failed
+
+  // Drive counts per SI unit (per rad, or per m on a linear axis).
+  double counts_per_unit() const;
+};
+
+// The default loom's three axes, as firmware/config/default_loom.toml states them (a test holds the two
+// equal): 20-bit encoders, a 10 mm ball screw on the carriage.
+inline std::vector<AxisSpec> default_axes() {
+  return {
+      {.name = "beat_crank", .role = hal::AxisRole::kBeatCrank, .node = 1, .ferror_min = 0.2},
+      {.name = "carriage", .role = hal::AxisRole::kCarriage, .node = 2, .lead_m = 0.010, .ferror_min = 0.002},
+      {.name = "helix", .role = hal::AxisRole::kHelix, .node = 3, .ferror_min = 0.5},
+  };
+}
 
 // Where the valves, sensors, e-stop chain, buttons and load cell come from on the CAN HAL.
 enum class IoKind { kCan, kSimulated };
@@ -138,6 +168,8 @@ struct LoomConfig {
   // What the file says, each fact once.
   std::string loom_id = "loom1";
   MachineSpec machine_spec;
+  // The axes in slot order (hal::AxisLayout): beat crank, carriage, helix, then the others by name.
+  std::vector<AxisSpec> axes = default_axes();
   CanSettings can;
   IoSettings io;
   Recipe recipe;
@@ -158,7 +190,9 @@ void derive_module_configs(LoomConfig& c);
 // Configure-time only. After a command-line override of a fact (`origin` names it, e.g.
 // "--period-ms = 4"): derive again and run every module's validation, as parsing does.
 void rederive_and_check(LoomConfig& c, const std::string& origin);
-// Configure-time only. The CAN master's config for the three servo axes, from the same facts.
+// The machine's axes as the runtime sees them (names and roles in slot order).
+hal::AxisLayout axis_layout(const LoomConfig& c);
+// Configure-time only. The CAN master's config for the machine's servo axes, from the same facts.
 drivers::CanAxisPortConfig can_axis_config(const LoomConfig& c);
 // Configure-time only. The CAN I/O module's config, from the same facts.
 drivers::CanIoConfig can_io_config(const LoomConfig& c);

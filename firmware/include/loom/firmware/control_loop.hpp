@@ -37,7 +37,7 @@ struct TelemetryContext {
   double beat_force_min_n = 80.0;
   double beat_force_max_n = 100.0;
   std::uint32_t rows_target = 0;  // 0 = until stopped / unknown
-  std::array<double, hal::kAxisCount> following_error_limit{};  // SI per axis; 0 = not checked
+  std::array<double, hal::kMaxAxes> following_error_limit{};  // SI per axis; 0 = not checked
 };
 
 class ControlLoop {
@@ -67,6 +67,7 @@ class ControlLoop {
 
   hal::Hal& hal_;
   sequencer::Sequencer& seq_;
+  std::size_t n_axes_;  // the machine's axes (seq_.axes().count)
   telemetry::Telemetry* telemetry_;
   std::int64_t period_ns_;
   bool lossless_;
@@ -83,8 +84,8 @@ class ControlLoop {
   sequencer::Fault prev_fault_ = sequencer::Fault::kNone;
   int prev_fault_axis_ = -1;
   std::uint16_t prev_fault_detail_ = 0;
-  std::array<std::uint16_t, hal::kAxisCount> prev_axis_fault_code_{};
-  std::array<bool, hal::kAxisCount> prev_axis_fault_{};
+  std::array<std::uint16_t, hal::kMaxAxes> prev_axis_fault_code_{};
+  std::array<bool, hal::kMaxAxes> prev_axis_fault_{};
   bool prev_link_fault_ = false;
 };
 

@@ -20,10 +20,11 @@ struct Scene {
 };
 
 struct LoomConfig;
-// Configure-time. A scene is written for a machine; faults it injects into switches the loom does
-// not have (a second channel its wiring leaves at -1) are refused, naming the fault's file:line:col.
-// Throws ConfigError.
-void check_scene_fits(const Scene& scene, const LoomConfig& cfg);
+// Configure-time. A scene is written for a machine: the scene as it runs on `cfg`'s loom, each fault's
+// axis resolved to its slot by name. Faults on axes the loom does not have, or injected into switches it
+// does not have (a second channel its wiring leaves at -1), are refused, naming the fault's
+// file:line:col. Throws ConfigError.
+Scene check_scene_fits(Scene scene, const LoomConfig& cfg);
 
 // Parse a scene from TOML text; `source` names it in errors. Throws ConfigError.
 Scene parse_scene(const std::string& text, const std::string& source);

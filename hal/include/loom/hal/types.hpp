@@ -14,16 +14,50 @@ using Tick = std::int64_t;
 inline constexpr Tick kNeverTick = -1;
 
 // ---------------------------------------------------------------------------------------------------
-// Axes
+// Axes: a configured set (the machine description's [axes.<name>] tables), bounded by kMaxAxes.
+// Every loom has the three core axes, always at slots 0..2 in this order; the axes a machine adds
+// (knotting servos, colour selectors, auxiliaries) follow from slot 3 on. Arrays are sized for the
+// capacity and only the first `AxisLayout::count` entries are used.
 // ---------------------------------------------------------------------------------------------------
-enum class Axis : std::uint8_t {
+inline constexpr std::size_t kMaxAxes = 32;  // 12 knotting heads x 2 servos + 3 core axes, with room
+enum class CoreAxis : std::uint8_t {
   kBeatCrank = 0,  // crank of the beat-up crank-rocker, position in rad (unwrapped)
   kCarriage = 1,   // carriage slider across the width, position in m
   kHelix = 2,      // helix shaft carrying the shuttle's magnetic carrier, position in rad (unwrapped)
 };
-inline constexpr std::size_t kAxisCount = 3;
-inline constexpr std::size_t index(Axis a) { return static_cast<std::size_t>(a); }
-const char* axis_name(Axis a);
+inline constexpr std::size_t kCoreAxisCount = 3;
+inline constexpr std::size_t index(CoreAxis a) { return static_cast<std::size_t>(a); }
+const char* axis_name(CoreAxis a);  // the core axes' default names: "beat_crank", "carriage", "helix"
+
+// What an axis is for. The core roles are held by exactly one axis each (slots 0..2).
+enum class AxisRole : std::uint8_t { kBeatCrank, kCarriage, kHelix, kKnotter, kSelector, kAuxiliary };
+inline constexpr std::size_t kAxisRoleCount = 6;
+const char* axis_role_name(AxisRole r);                     // "beat_crank", ..., "auxiliary"
+bool parse_axis_role(const char* text, AxisRole& role);     // false for an unknown name
+bool is_rotary(AxisRole r);                                 // rad (true) or m (the carriage)
+
+// The machine's axes: names and roles, in slot order. Plain fixed-size data, built at configure time
+// and shared by the sequencer, the simulator, the drivers and telemetry.
+struct AxisLayout {
+  static constexpr std::size_t kNameMax = 31;
+  struct Entry {
+    std::array<char, kNameMax + 1> name{};  // NUL-terminated
+    AxisRole role = AxisRole::kAuxiliary;
+  };
+  std::array<Entry, kMaxAxes> axis{};
+  std::size_t count = 0;
+
+  // The three core axes, named after their roles: today's loom, and every test's default.
+  static AxisLayout core();
+  // Configure-time. Appends an axis; false when full or the name is empty or too long.
+  bool add(const char* name, AxisRole role);
+  const char* name(std::size_t i) const { return i < count ? axis[i].name.data() : "?"; }
+  AxisRole role(std::size_t i) const { return axis[i].role; }
+  // The slot of the axis called `name`, or -1.
+  int find(const char* name) const;
+};
+// The core layout as a shared constant (for defaults).
+const AxisLayout& core_axis_layout();
 
 // CiA 402 power-state machine states, as decoded from the statusword (0x6041).
 enum class DriveState : std::uint8_t {
@@ -46,16 +80,34 @@ enum class AxisRequest : std::uint8_t {
   kEnable = 1,      // reach Operation Enabled and follow target_position
   kQuickStop = 2,   // decelerate on the drive's quick-stop ramp, hold
   kFaultReset = 3,  // rising edge of fault reset, then back to Switch On Disabled
+  kHome = 4,        // enabled, run the axis' referencing (CiA 402 homing) until referenced or failed
 };
+
+// What kind of fault a HAL found on a device or the link. The sequencer decides by kind; the raw code
+// (a CiA 301 EMCY code on CAN) travels beside it for display and logs only.
+enum class FaultKind : std::uint8_t {
+  kNone = 0,
+  kDrive,          // the drive reports Fault / fault reaction, or the master's own supervision of it tripped
+  kEmcy,           // the device sent an emergency message but may still be enabled
+  kNodeLost,       // heartbeat lost, unexpected boot-up, or not operational: the node cannot be supervised
+  kBusOff,         // the controller left the bus
+  kCommunication,  // the link itself failed (socket error, not configured)
+};
+const char* fault_kind_name(FaultKind k);
 
 struct AxisFeedback {
   DriveState state = DriveState::kUnknown;
   double position = 0.0;        // SI: rad (crank, helix) or m (carriage)
   double velocity = 0.0;        // SI per second
   double effort = 0.0;          // N·m (rotary) or N (linear); 0 when the drive does not report it
-  std::uint16_t fault_code = 0; // last CiA 301 EMCY / local error code (0 = none)
+  std::uint16_t fault_code = 0; // raw device code for display (a CiA 301 EMCY code on CAN; 0 = none)
+  FaultKind fault_kind = FaultKind::kNone;  // what the fault is; kNone while healthy
   bool fault = false;           // drive reports Fault / Fault reaction, or the HAL lost the node
   bool following_error = false; // statusword bit 13 in CSP
+  // The axis' position is referenced to the machine: always for an absolute axis; for a homed axis only
+  // after a homing run since its drive powered up (kHome). An unreferenced axis never moves in production.
+  bool referenced = true;
+  bool homing_error = false;    // the last homing run failed (the drive's homing error, or its time-out)
   Tick refreshed = kNeverTick;  // tick this feedback was last received
 };
 
@@ -64,8 +116,9 @@ struct AxisCommand {
   double target_position = 0.0;  // SI; in CSP the drive interpolates to it within one cycle
 };
 
-using AxisFeedbacks = std::array<AxisFeedback, kAxisCount>;
-using AxisCommands = std::array<AxisCommand, kAxisCount>;
+// Indexed by slot; entries at and beyond the layout's count are unused.
+using AxisFeedbacks = std::array<AxisFeedback, kMaxAxes>;
+using AxisCommands = std::array<AxisCommand, kMaxAxes>;
 
 // ---------------------------------------------------------------------------------------------------
 // Digital I/O (the I/O node): two piston valves for the heald frames, their end sensors, the shuttle
@@ -151,7 +204,8 @@ const char* link_recovery_name(LinkRecovery r);
 
 struct LinkStatus {
   bool link_fault = false;          // bus-off, heartbeat lost, socket error: motion must stop
-  std::uint16_t link_fault_code = 0;
+  FaultKind link_fault_kind = FaultKind::kNone;
+  std::uint16_t link_fault_code = 0;  // raw code for display
   LinkRecovery recovery = LinkRecovery::kHealthy;
   std::uint8_t silent_node = 0;     // kNodeSilent: the first node still missing
   std::uint32_t tx_dropped = 0;     // frames not sent (ENOBUFS/EAGAIN), cumulative

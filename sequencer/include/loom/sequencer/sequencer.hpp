@@ -23,6 +23,7 @@ namespace loom::sequencer {
 enum class State : std::uint8_t {
   kIdle,         // drives disabled, waiting for start
   kEnabling,     // walking the drives to Operation Enabled
+  kHoming,       // referencing the axes whose drives powered up unreferenced, one at a time, in machine order
   kPositioning,  // re-arm: crank to park, carriage to the row's start selvedge, from measured positions
   kShedTest,     // proving the end sensors: each frame stroked both ways twice before the first pick
   kShed,         // swapping the heald frames, waiting for a consistent end-sensor picture
@@ -56,6 +57,16 @@ struct BeatEvent {
 
 struct SequencerConfig {
   double period_s = 0.002;
+  // The machine's axes (the core three at slots 0..2, then what the machine adds); every axis is enabled,
+  // supervised (drive fault, EMCY, staleness, non-finite or jumping feedback) and stopped with the loom.
+  hal::AxisLayout axes = hal::AxisLayout::core();
+  // Top speed of each added axis (slot 3 on; SI/s): bounds the feedback's plausible step per tick. The
+  // core axes' come from the profiles.
+  std::array<double, hal::kMaxAxes> axis_max_speed{};
+  // Per axis: how long a homing run may take (s); 0 for an absolute axis (never homed). An axis the HAL
+  // reports unreferenced is homed when the loom arms, beat crank first (its home point is clear of the
+  // warp), then the carriage, then the added axes; it never moves in production unreferenced.
+  std::array<double, hal::kMaxAxes> homing_timeout_s{};
   std::uint32_t rows_to_weave = 3;       // 0 = weave until stopped (absolute row count to reach)
   std::uint32_t picks_per_row = 1;       // weft picks (each with its own shed change) before the beat sweep
   int debounce_ticks = 3;                // a sensor must read the same this many ticks to count (not e-stop)
@@ -142,6 +153,8 @@ class Sequencer {
   void step(hal::Tick now, const hal::HalInputs& in, hal::HalOutputs& out) noexcept;
 
   State state() const noexcept { return state_; }
+  // The machine's axes (slot order); the HAL's arrays are used up to axes().count.
+  const hal::AxisLayout& axes() const noexcept { return cfg_.axes; }
   const Counters& counters() const noexcept { return counters_; }
   Fault first_fault() const noexcept { return first_fault_; }
   // The fault that actually stopped motion; differs from first_fault() when a symptom (stale feedback,
@@ -184,6 +197,7 @@ class Sequencer {
   // ---- one function per state ----
   void idle(hal::Tick now, const hal::HalInputs& in) noexcept;
   void enabling(hal::Tick now, const hal::HalInputs& in) noexcept;
+  void homing(hal::Tick now, const hal::HalInputs& in) noexcept;
   void positioning(hal::Tick now, const hal::HalInputs& in) noexcept;
   void shed_test(hal::Tick now) noexcept;
   void shed(hal::Tick now) noexcept;
@@ -195,11 +209,14 @@ class Sequencer {
   void fault(hal::Tick now) noexcept;
   // ---- transitions and helpers ----
   hal::Tick ticks(double seconds) const noexcept;
+  void copy_outputs(const hal::HalOutputs& from, hal::HalOutputs& to) const noexcept;
   double seconds_since(hal::Tick now, hal::Tick t0) const noexcept;
   static bool is_symptom(Fault f) noexcept;
   void latch(Fault f, hal::Tick now, int axis = -1, std::uint16_t detail = 0, int sensor = -1) noexcept;
   void enter(State s, hal::Tick now) noexcept;
   bool reconcile_at_arming(hal::Tick now, const hal::HalInputs& in) noexcept;
+  void finish_arming(hal::Tick now, const hal::HalInputs& in) noexcept;  // every axis enabled and referenced
+  void begin_homing(hal::Tick now, const hal::HalInputs& in) noexcept;   // the next unreferenced axis, or finish
   bool shuttle_where_counters_say(hal::Tick now) noexcept;
   void begin_row(hal::Tick now) noexcept;  // a row boundary: adopt a published recipe, else shed
   void begin_shed(hal::Tick now) noexcept;
@@ -235,7 +252,8 @@ class Sequencer {
 
   Fault first_fault_ = Fault::kNone;
   Fault stopped_by_ = Fault::kNone;
-  hal::Tick armed_since_ = 0;  // tick the drives were first asked to enable (staleness of never-seen data)
+  hal::Tick armed_since_ = 0;
+  int homing_axis_ = -1;  // the axis being homed (kHoming)  // tick the drives were first asked to enable (staleness of never-seen data)
   int fault_axis_ = -1;
   int fault_sensor_ = -1;
   std::uint16_t fault_detail_ = 0;
@@ -291,12 +309,15 @@ class Sequencer {
   hal::DigitalInputs io_{};
   hal::DigitalInputs raw_io_{};
   int sensed_ticks_ = 0;                       // picture checks wait until the debouncer has history
-  std::array<double, hal::kAxisCount> last_position_{};
-  std::array<hal::Tick, hal::kAxisCount> last_refreshed_{};  // tick each last_position_ sample arrived
+  std::size_t n_axes_ = hal::kCoreAxisCount;  // cfg_.axes.count
+  hal::HalInputs in_{};                        // this tick's inputs with debounced sensors (step)
+  std::array<double, hal::kMaxAxes> last_position_{};
+  std::array<hal::Tick, hal::kMaxAxes> last_refreshed_{};  // tick each last_position_ sample arrived
+  std::array<bool, hal::kMaxAxes> last_referenced_{};      // each axis' referenced flag with that sample
   std::uint32_t rows_on_disk_ = 0;   // the row-boundary handshake (note_rows_saved)
   bool last_save_failed_ = false;
   bool positions_primed_ = false;
-  std::array<double, hal::kAxisCount> max_step_{};  // the most an axis can move in one tick (m or rad)
+  std::array<double, hal::kMaxAxes> max_step_{};  // the most an axis can move in one tick (m or rad)
   bool load_cell_seen_ = false;
 
   // Row bookkeeping.

@@ -116,7 +116,10 @@ inline constexpr std::uint16_t kEmcyBusOff = 0x8140;     // CiA 301 recovered fr
 struct FaultInjection {
   double at_s = 0.0;                       // virtual time from start
   InjectedFault kind = InjectedFault::kDriveFault;
-  hal::Axis axis = hal::Axis::kBeatCrank;  // drive faults, heartbeat loss, EMCY, encoder glitch
+  // Drive faults, heartbeat loss, EMCY, encoder glitch: the axis by its machine name, and its slot
+  // (the core axes' at parse time; others once the scene is checked against the loom's axes).
+  std::string axis_name = "beat_crank";
+  std::size_t axis = 0;
   std::uint16_t code = 0x8611;             // EMCY code reported (default: following error)
   int piston = 0;                          // stuck piston: 0 = A, 1 = B
   Sensor sensor = Sensor::kShuttleRight;   // stuck / intermittent sensor
@@ -131,8 +134,24 @@ struct FaultInjection {
 };
 
 // Physical facts of the simulated machine that are not effects (they come from the loom config).
+// How a simulated axis' reading is referenced to the machine. An absolute encoder reads the machine's
+// position from power-up. A homed axis (incremental encoder) powers up at a random count and is
+// referenced by a homing run (hal::AxisRequest::kHome), by CiA 402 method: 19 / 21 the edge of a home
+// switch whose active region lies on the positive / negative side, 33 / 34 the next index pulse in the
+// negative / positive direction (one per motor revolution), 37 where it stands. The home switch and the
+// index pulses sit where the machine's own coordinate reads `home_offset` (+ whole pitches), so a
+// correctly homed axis reads the machine position again.
+struct SimReferencing {
+  int method = 0;             // 0 = absolute encoder
+  double home_offset = 0.0;   // reading at the home point once homed (SI)
+  double speed = 0.0;         // homing speed (SI/s)
+  double index_pitch = 0.0;   // axis travel per index pulse (2 pi rad, or a linear axis' lead)
+};
+
 struct SimMachine {
   double period_s = 0.002;
+  std::size_t axis_count = hal::kCoreAxisCount;  // the machine's axes (hal::AxisLayout::count)
+  std::array<SimReferencing, hal::kMaxAxes> referencing{};  // per axis; default absolute
   double width_m = 1.2;
   double helix_lead_m = 0.10;
   double piston_travel_s = 0.25;          // heald frame stroke time with the nominal air supply

@@ -1,4 +1,4 @@
-// The simulated loom behind the HAL: three servo axes, two pistons with end sensors, the shuttle on its
+// The simulated loom behind the HAL: its servo axes (the three core axes and any the machine adds), two pistons with end sensors, the shuttle on its
 // magnetic carrier with arrival sensors, the e-stop chain, and (when named) the beater's load cell.
 // Stepped in virtual time by the loop's own tick (write() integrates one period), so it runs as fast as
 // the machine allows. Every effect is built only if the scene names it.
@@ -26,10 +26,16 @@ class AxisEffect {
 
 struct SimAxis {
   hal::DriveState state = hal::DriveState::kSwitchOnDisabled;
-  double position = 0.0;
+  double position = 0.0;  // the machine's true position (SI)
   double velocity = 0.0;
-  double target = 0.0;
+  double target = 0.0;    // true position commanded
   std::uint16_t fault_code = 0;
+  // The drive's reading is position + offset: 0 for an absolute encoder; for a homed axis a random
+  // count from power-up until a homing run references it.
+  double offset = 0.0;
+  bool referenced = true;
+  bool homing = false;        // a homing run is under way
+  double homing_goal = 0.0;   // the true position of its reference point
   std::vector<std::unique_ptr<AxisEffect>> effects;  // built once from the scene
 };
 
@@ -63,7 +69,8 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   void attach_state_file(SimStateFile& file);
 
   // Ground truth for tests and reports (not what the controller sees).
-  const SimAxis& axis(hal::Axis a) const { return axes_[hal::index(a)]; }
+  const SimAxis& axis(hal::CoreAxis a) const { return axes_[hal::index(a)]; }
+  const SimAxis& axis(std::size_t slot) const { return axes_[slot]; }
   double shuttle_x() const { return shuttle_x_; }
   bool shuttle_coupled() const { return shuttle_coupled_; }
   std::array<double, 2> pistons() const { return piston_; }
@@ -82,13 +89,15 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
  private:
   void apply_injected_faults(hal::Tick now) noexcept;
   bool stalled(hal::Tick now) const noexcept { return now < stall_until_; }
-  void step_axis(SimAxis& ax, const hal::AxisCommand& cmd) noexcept;
+  void step_axis(std::size_t slot, const hal::AxisCommand& cmd) noexcept;
+  void step_homing(std::size_t slot) noexcept;
   void step_shuttle(double helix_position) noexcept;
   void step_beat_contact(double crank_position, double crank_velocity) noexcept;
 
   SimMachine m_;
   SceneSpec scene_;
-  std::array<SimAxis, hal::kAxisCount> axes_{};
+  std::array<SimAxis, hal::kMaxAxes> axes_{};
+  std::size_t n_axes_ = hal::kCoreAxisCount;  // m_.axis_count
   std::array<double, 2> piston_{0.0, 0.0};    // 0 retracted … 1 extended
   std::array<double, 2> pressure_{0.0, 0.0};  // net drive −1 … 1 (pneumatics)
   std::array<bool, 2> piston_stuck_{false, false};
@@ -105,12 +114,15 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   double frame_loss_p_ = 0.0;
   hal::Tick frame_loss_until_ = 0;
   hal::Tick latency_ticks_ = 0, latency_until_ = 0;
-  static constexpr std::size_t kHistory = 512;           // axis feedback kept for the latency fault
-  std::array<hal::AxisFeedbacks, kHistory> history_{};
+  // Axis feedback as sampled, the last kHistory ticks of it when the scene injects CAN latency (slot
+  // t % kHistory, n_axes_ entries each), else only this tick's: what a scene does not name costs nothing.
+  static constexpr std::size_t kHistory = 512;
+  std::size_t history_ticks_ = 1;
+  std::vector<hal::AxisFeedback> history_;
   bool bus_off_ = false;
-  std::array<hal::Tick, hal::kAxisCount> silent_since_{-1, -1, -1};  // heartbeat loss
-  std::array<int, hal::kAxisCount> glitch_left_{};
-  std::array<double, hal::kAxisCount> glitch_jump_{};
+  std::array<hal::Tick, hal::kMaxAxes> silent_since_{};  // heartbeat loss (-1: heard; set in the constructor)
+  std::array<int, hal::kMaxAxes> glitch_left_{};
+  std::array<double, hal::kMaxAxes> glitch_jump_{};
   std::optional<LoadCellMode> load_cell_failed_;
   bool air_lost_ = false;
   hal::Tick stall_until_ = 0;

@@ -21,15 +21,19 @@ namespace loom::telemetry {
 double loop_time_s(const Snapshot& s) noexcept;
 
 // Not RT-safe (allocates strings): publisher thread only. Each fills every field of its message.
-loomlcm::status_t to_status(const Snapshot& s, const std::string& loom_id, std::int64_t utime);
-loomlcm::axes_t to_axes(const Snapshot& s, const std::string& loom_id, std::int64_t utime);
+// Axis names come from the machine's layout (the snapshot carries slots).
+loomlcm::status_t to_status(const Snapshot& s, const std::string& loom_id, std::int64_t utime,
+                            const hal::AxisLayout& axes = hal::core_axis_layout());
+loomlcm::axes_t to_axes(const Snapshot& s, const std::string& loom_id, std::int64_t utime,
+                        const hal::AxisLayout& axes = hal::core_axis_layout());
 // `dropped` and `backlog` come from the ring, which knows about snapshots the loop never got to send.
 loomlcm::rt_stats_t to_rt_stats(const Snapshot& s, const std::string& loom_id, std::int64_t utime,
                                 std::uint64_t dropped, std::uint64_t backlog, std::uint64_t dropped_events = 0);
 
 // Not RT-safe (allocates strings): publisher thread only. One message per event of that kind.
 loomlcm::beat_t to_beat(const Event& e, const std::string& loom_id, std::int64_t utime);
-loomlcm::fault_t to_fault(const Event& e, const std::string& loom_id, std::int64_t utime);
+loomlcm::fault_t to_fault(const Event& e, const std::string& loom_id, std::int64_t utime,
+                          const hal::AxisLayout& axes = hal::core_axis_layout());
 loomlcm::row_t to_row(const Event& e, const std::string& loom_id, std::int64_t utime);
 // Not RT-safe: publisher thread only. The design's row to knot after `rows_done` design rows, with the
 // row knotted last (when any) and the two after it.

@@ -25,7 +25,9 @@ class LCM;
 namespace loom::telemetry {
 
 // 4096 snapshots: 8 s of buffer at the 2 ms CAN cycle, about 1.3 MB.
-inline constexpr std::size_t kSnapshotRingCapacity = 4096;
+// 2 s of ticks at the default 2 ms period: a snapshot holds every axis the controller can have (a
+// few KB), so the ring is sized in seconds of publisher lag it absorbs, not in thousands of ticks.
+inline constexpr std::size_t kSnapshotRingCapacity = 1024;
 using SnapshotRing = SpscRing<Snapshot, kSnapshotRingCapacity>;
 // 1024 events: a beat every 0.4 s at the default loom is minutes of slack for a stalled publisher.
 inline constexpr std::size_t kEventRingCapacity = 1024;
@@ -35,6 +37,7 @@ struct PublisherConfig {
   // "" = LCM's default: $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0 (host only).
   std::string lcm_url;
   std::string loom_id = "loom1";
+  hal::AxisLayout axes = hal::AxisLayout::core();  // names for the AXES, STATUS and FAULT messages
   std::string channel_prefix = std::string(kDefaultChannelPrefix);
   Decimation decimation;
   // How long the thread naps when the ring is empty: bounds the added latency, costs a wake-up each.

@@ -42,7 +42,8 @@ struct Snapshot {
   double beater_angle_rad = 0.0;       // rocker angle from the profile
   double beat_force_n = 0.0;           // load-cell force at this tick (0 when not measured)
   bool beat_force_valid = false;
-  std::array<AxisSample, hal::kAxisCount> axes{};
+  std::uint8_t axis_count = 0;         // the machine's axes: axes[0 .. axis_count)
+  std::array<AxisSample, hal::kMaxAxes> axes{};
   std::uint8_t outputs = 0;            // bit0 piston A extend, bit1 piston B extend
   std::uint8_t inputs = 0;             // bit0 A ext, 1 A ret, 2 B ext, 3 B ret, 4 shuttle L, 5 shuttle R, 6 estop ok
   std::uint8_t inputs_2 = 0;           // second switches of the safety sensors, same bits 0..5 (0 where none)
