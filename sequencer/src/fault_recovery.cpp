@@ -51,6 +51,12 @@ const char* fault_recovery(Fault f) {
              "`weave` (exit 3): write its FAULT line's counts into the counters file before the next run";
     case Fault::kLoopOverrun:
       return "find what starves the loop thread (CPU isolation, other real-time load); ack";
+    case Fault::kHomingFailed:
+      return "check the named axis' home switch or index pulse, its cabling and that nothing blocks its travel; "
+             "`axes.<name>.homing_timeout_s` must cover the run; ack, start (homing runs again at arming)";
+    case Fault::kAxisUnreferenced:
+      return "ack, start: an axis with a homing run homes again at arming; an absolute axis "
+             "(`referencing = \"absolute\"`) that lost its reference needs its encoder and calibration checked";
     case Fault::kCarriageInWarp:
     case Fault::kPickWithoutShed:
     case Fault::kShedWithShuttle:
