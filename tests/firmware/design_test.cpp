@@ -213,13 +213,13 @@ TEST_F(DesignBookTest, WhatCannotBeExplainedIsRefused) {
 
 TEST_F(DesignBookTest, ConfigLoadsTheDesignBesideItAndReportsItsLine) {
   std::ofstream(dir_ / "rug.csv") << "palette,R,#ff0000\nR,R\nR,Q\n";
-  std::ofstream(dir_ / "loom.toml") << "extends = \"default\"\n[recipe]\nknotting = true\ndesign = \"rug.csv\"\n";
+  std::ofstream(dir_ / "loom.toml") << "extends = \"default\"\n[knotting]\nmode = \"weaver\"\n[recipe]\ndesign = \"rug.csv\"\n";
   try {
     loom::firmware::load_loom_config((dir_ / "loom.toml").string());
     FAIL() << "accepted";
   } catch (const loom::firmware::ConfigError& e) {
     const std::string msg = e.what();
-    EXPECT_NE(msg.find((dir_ / "loom.toml").string() + ":4:"), std::string::npos) << msg;
+    EXPECT_NE(msg.find((dir_ / "loom.toml").string() + ":5:"), std::string::npos) << msg;
     EXPECT_NE(msg.find("recipe.design = \"rug.csv\""), std::string::npos) << msg;
     EXPECT_NE(msg.find((dir_ / "rug.csv").string() + ":3:3: colour code 'Q'"), std::string::npos) << msg;
   }

@@ -159,7 +159,7 @@ int serve_main(const ServeArgs& a) {
         return out.empty() ? "no faults recorded in " + history.path() + "\n" : out;
       } else if (req == "next") {
         if (!cfg.sequencer.knotting) {
-          return "error: next: this loom's recipe has no knotting mode (recipe.knotting = false)\n";
+          return "error: next: this loom has no weaver's knotting (knotting.mode is not \"weaver\")\n";
         }
         link.post(Command::kNext);
       } else {

@@ -22,6 +22,7 @@
 #include "loom/drivers/can_axis_port.hpp"
 #include "loom/drivers/can_io_port.hpp"
 #include "loom/motion/profile_set.hpp"
+#include "loom/sequencer/knot_plan.hpp"
 #include "loom/sequencer/sequencer.hpp"
 #include "loom/firmware/scene_config.hpp"  // the scene file (kept here so callers of config.hpp see it)
 #include "loom/sim_hal/scene.hpp"
@@ -131,7 +132,6 @@ struct Recipe {
   double crank_accel_rad_s2 = 400.0, crank_jerk_rad_s3 = 2.0e4;
   motion::CrankLawSpec crank_law{};
   std::uint32_t picks_per_row = 1;
-  bool knotting = false;  // park before every row until the weaver's "row knotted" (handmade carpets)
   // The carpet's knot map, shown to the weaver row by row: the file as written (relative to the config
   // file's folder) and what was loaded from it (null when the recipe names none).
   std::string design_file;
@@ -170,6 +170,8 @@ struct LoomConfig {
   MachineSpec machine_spec;
   // The axes in slot order (hal::AxisLayout): beat crank, carriage, helix, then the others by name.
   std::vector<AxisSpec> axes = default_axes();
+  // The pile: none (a flat weave), knotted by the weaver while the loom waits, or by the heads.
+  sequencer::KnottingSpec knotting;
   CanSettings can;
   IoSettings io;
   Recipe recipe;
