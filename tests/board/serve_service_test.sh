@@ -6,7 +6,10 @@
 #      while the loop ticks; the loop thread alone is stalled (ptrace-stopped, the rest of the process
 #      runs): the pings stop; the stalled serve is killed and restarted as systemd would, and comes back
 #      armed and waiting (state idle) at the same counts — never into motion;
-#   3. a full disk (a tiny tmpfs, in a private mount namespace): a fresh sim-state file is refused with
+#   3. one publisher per loom id: a serve with another state directory but the same loom id hears the
+#      first one's IDENTITY on the LCM group and refuses to arm, exit 4, naming its host and pid; a serve
+#      with another id arms beside it;
+#   4. a full disk (a tiny tmpfs, in a private mount namespace): a fresh sim-state file is refused with
 #      the reason (no SIGBUS); and when the disk fills while weaving, the row stops with
 #      counters_not_saved, `ctl ack` is refused while the save still fails (the fault stays), and once
 #      the disk has room the retried save lets the ack through, re-arming at the woven count — never the
@@ -34,9 +37,11 @@ wait_for() {  # wait_for SOCKET FIELD VALUE SECONDS
   for _ in $(seq 1 $(($4 * 20))); do [[ $(field "$1" "$2" 2>/dev/null) == "$3" ]] && return 0; sleep 0.05; done
   fail "waited $4 s for $2=$3: $(ctl "$1" status 2>&1)"
 }
-serve() {  # serve LOG STATE SOCKET [extra]: starts serve in the background, sets $last
-  local log=$1 state=$2 sock=$3; shift 3
-  "$loomctl" serve --state-dir "$state" --socket "$sock" --group "" --no-telemetry --pace 25 "$@" >"$work/$log" 2>&1 &
+serve() {  # serve LOG STATE SOCKET [extra]: starts serve in the background, sets $last (telemetry off
+  local log=$1 state=$2 sock=$3; shift 3  # unless the extra arguments give --lcm-url)
+  local tm=(--no-telemetry)
+  [[ " $* " == *" --lcm-url "* ]] && tm=()
+  "$loomctl" serve --state-dir "$state" --socket "$sock" --group "" "${tm[@]}" --pace 25 "$@" >"$work/$log" 2>&1 &
   last=$!
   pids+=("$last")
 }
@@ -118,7 +123,25 @@ sleep 1
 kill -TERM "$last"; wait "$last" || true
 echo "watchdog: $pings_before pings while running, none in 2.5 s with the loop stopped, restart waits at row $rows_at_stall: ok"
 
-# ---- 3. full disk ----
+# ---- 3. one publisher per loom id (an LCM group of this test's own: host-only, a port per run) ----
+url="udpm://239.255.76.93:$((7000 + $$ % 2000))?ttl=0"
+serve i1.log "$work/i1" "$work/i1.sock" --lcm-url "$url" --loom-id same
+i1=$last
+wait_socket "$work/i1.sock"
+rc=0
+timeout 20 "$loomctl" serve --state-dir "$work/i2" --socket "$work/i2.sock" --group "" --lcm-url "$url" \
+  --loom-id same >"$work/i2.log" 2>&1 || rc=$?
+[[ $rc == 4 ]] || fail "a second serve with the same loom id exited $rc, not 4"
+grep -q "loom id 'same' is already published .* by host $(hostname) (pid $i1," "$work/i2.log" ||
+  fail "the refusal does not name the other publisher: $(cat "$work/i2.log")"
+serve i3.log "$work/i3" "$work/i3.sock" --lcm-url "$url" --loom-id other
+i3=$last
+wait_socket "$work/i3.sock"
+[[ $(field "$work/i3.sock" state) == idle ]] || fail "a loom with its own id did not arm beside the first"
+kill -TERM "$i1" "$i3"; wait "$i1" "$i3" || true
+echo "one publisher per loom id: $(grep -o "refusing to arm: loom id.*by host [^;]*" "$work/i2.log"): ok"
+
+# ---- 4. full disk ----
 mkdir "$work/disk"
 mount -t tmpfs -o size=256k tmpfs "$work/disk"
 fill() { dd if=/dev/zero of="$work/disk/fill" bs=4k status=none 2>/dev/null || true; }

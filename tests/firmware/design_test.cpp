@@ -202,6 +202,12 @@ TEST_F(DesignBookTest, WhatCannotBeExplainedIsRefused) {
             std::string::npos);
   EXPECT_NE(refusal("{\"active\":\"a.csv\",\"at_rows\":1,\"designs\":{\"a.csv\":-4}}").find("\"designs\".\"a.csv\" = -4: not a row count"),
             std::string::npos);
+  // Row counts are bounded like the production counters they come from: 2^64-1 used to be accepted and wrap.
+  EXPECT_NE(refusal("{\"active\":\"a.csv\",\"at_rows\":1,\"designs\":{\"a.csv\":18446744073709551615}}")
+                .find("= 18446744073709551615: not a row count in 0..4294967295"),
+            std::string::npos);
+  EXPECT_NE(refusal("{\"active\":\"a.csv\",\"at_rows\":1,\"designs\":{\"a.csv\":4294967295}}").find("would pass 4294967295"),
+            std::string::npos);
   EXPECT_NE(refusal("{\"active\":\"a.csv\",\"at_rows\":1.5,\"designs\":{}}").find("\"at_rows\" = 1.5"), std::string::npos);
   EXPECT_NE(refusal("{\"active\":\"z.csv\",\"at_rows\":1,\"designs\":{}}").find("active design 'z.csv' has no entry"),
             std::string::npos);

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -28,6 +29,7 @@
 #include "loom/firmware/serve/journal.hpp"
 #include "loom/firmware/serve/sd_notify.hpp"
 #include "loom/firmware/serve/state_lock.hpp"
+#include "loom/telemetry/identity.hpp"
 
 namespace loom::firmware::serve {
 namespace {
@@ -37,6 +39,8 @@ constexpr const char* kEtcConfig = "/etc/loomctl/loom.toml";
 // The id every board's embedded default loom has: two boards left on it are one loom on the LCM group.
 constexpr const char* kDefaultLoomId = "loom1";
 constexpr std::int64_t kSaveRetryNs = 1'000'000'000;  // a failed counters save is retried once a second
+// How long a loom listens for another publisher of its id before arming: IDENTITY comes once a second.
+constexpr std::chrono::milliseconds kIdentityListen{1300};
 
 OperatorLink* g_link = nullptr;
 extern "C" void on_terminate(int) {
@@ -234,6 +238,25 @@ int serve_main(const ServeArgs& a) {
       log(Severity::kNotice, "design %s (%d x %d knots): row %d to knot next%s", cfg.recipe.design->name().c_str(),
           cfg.recipe.design->width(), cfg.recipe.design->height(), pos.row + 1,
           pos.repeat > 1 ? (", repeat " + std::to_string(pos.repeat)).c_str() : "");
+    }
+    if (!a.no_telemetry) {
+      // One loom id, one publisher: another loom (or a recording replayed onto the live group) with this
+      // id would mix with ours on every subscriber.
+      std::string other;
+      try {
+        other = telemetry::other_publisher(cfg.telemetry.lcm_url, std::string(telemetry::kDefaultChannelPrefix),
+                                           cfg.loom_id, kIdentityListen);
+      } catch (const std::exception& e) {
+        log(Severity::kErr, "loomctl serve: %s: telemetry: %s", cfg.source.c_str(), e.what());
+        return kExitBadInput;
+      }
+      if (!other.empty()) {
+        log(Severity::kErr, "loomctl serve: refusing to arm: loom id '%s' is already published on the LCM group "
+            "(%s) by %s; two looms with one id mix on every monitor and panel: give this loom its own id, or "
+            "replay recordings onto another group", cfg.loom_id.c_str(),
+            cfg.telemetry.lcm_url.empty() ? "LCM's default URL" : cfg.telemetry.lcm_url.c_str(), other.c_str());
+        return kExitNotArmed;
+      }
     }
     MachineOptions mo;
     mo.design_rows_done = design_rows;
