@@ -128,6 +128,10 @@ TEST(DesignPosition, RepeatsAfterTheLastRow) {
   EXPECT_EQ(loom::design::position_after(d, 2).row, 2);
   EXPECT_EQ(loom::design::position_after(d, 3).row, 0);
   EXPECT_EQ(loom::design::position_after(d, 3).repeat, 2);
+  // The repeat saturates, never wraps: one row and 2^64-1 rows done used to give repeat 0 (fuzz_design).
+  const Design one = parse_design_csv("palette,R,#ff0000\nR\n", "one.csv");
+  EXPECT_EQ(loom::design::position_after(one, UINT64_MAX).repeat, INT32_MAX);
+  EXPECT_EQ(loom::design::position_after(one, UINT64_MAX).row, 0);
 }
 
 TEST(DesignTelemetry, CarriesTheRowKnottedLastTheNextAndTwoAfter) {
