@@ -1,6 +1,6 @@
 # Install rules and the Debian package (CPack DEB). `cmake --install` lays out what a board needs:
 #   /usr/bin/loomctl, loom-panel, loom-spy (+ the technician's and builder's tools built in this tree)
-#   /usr/share/java/loomlcm.jar             the telemetry's LCM types for Java (loom-spy, lcm-spy)
+#   /usr/share/loomctl/loomlcm.jar          the telemetry's LCM types for Java (loom-spy; a private jar)
 #   /etc/loomctl/loom.toml                   the embedded default loom, as a conffile (upgrades keep edits)
 #   /lib/systemd/system/loomctl.service      runs `loomctl serve`; /etc/default/loomctl its arguments
 #   /lib/systemd/system/loom-panel.service   the web panel (not enabled); /etc/default/loom-panel
@@ -55,7 +55,7 @@ endif()
 get_property(LOOM_TYPES_JAR_FILE GLOBAL PROPERTY LOOM_TYPES_JAR)
 if(TARGET loom-spy AND LOOM_TYPES_JAR_FILE)
   install(PROGRAMS ${CMAKE_RUNTIME_OUTPUT_DIRECTORY}/loom-spy DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT loomctl)
-  install(FILES ${LOOM_TYPES_JAR_FILE} DESTINATION ${CMAKE_INSTALL_DATADIR}/java COMPONENT loomctl)
+  install(FILES ${LOOM_TYPES_JAR_FILE} DESTINATION ${CMAKE_INSTALL_DATADIR}/loomctl COMPONENT loomctl)
   add_custom_command(OUTPUT ${man_out}/loom-spy.1.gz
                      COMMAND ${CMAKE_COMMAND} -E make_directory ${man_out}
                      COMMAND ${CMAKE_COMMAND} -E copy ${pkg}/loom-spy.1 ${man_out}/loom-spy.1
@@ -96,11 +96,12 @@ set(LOOM_DEB_MAINTAINER "loomctl maintainers <maintainers@users.noreply.h-seed-3
     CACHE STRING "Maintainer field of the .deb (a real, reachable address)")
 set(CPACK_PACKAGE_CONTACT "${LOOM_DEB_MAINTAINER}")
 set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "controller for a mechanised handmade-carpet loom")
-set(CPACK_PACKAGE_DESCRIPTION "loomctl drives the shedding, picking, beat-up and carriage mechanisms of a
-mechanised handmade-carpet loom over CANopen (SocketCAN), or a simulated loom, in a fixed-rate real-time
-loop. The loomctl service arms the loom and waits for the operator's commands (loomctl ctl, the I/O
-node's buttons); telemetry is published over LCM and shown by loom-monitor, loom-panel (a web page)
-and loom-spy.")
+set(CPACK_PACKAGE_DESCRIPTION "loomctl drives the shedding, picking, beat-up and carriage
+mechanisms of a mechanised handmade-carpet loom over CANopen (SocketCAN),
+or a simulated loom, in a fixed-rate real-time loop. The loomctl service
+arms the loom and waits for the operator's commands (loomctl ctl, the I/O
+node's buttons); telemetry is published over LCM and shown by
+loom-monitor, loom-panel (a web page) and loom-spy.")
 set(CPACK_DEBIAN_PACKAGE_ARCHITECTURE ${LOOM_DEB_ARCH})
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION misc)
@@ -111,7 +112,11 @@ set(CPACK_STRIP_FILES ON)
 # Google Benchmark (loom-profile's lookup timings), libpng (designs), cpp-httplib (loom-panel), and
 # adduser for the postinst. Names are the same on amd64 and arm64.
 set(CPACK_DEBIAN_PACKAGE_DEPENDS
-    "libc6 (>= 2.36), libstdc++6 (>= 12), libgcc-s1, liblcm1 (>= 1.3.1), libtomlplusplus3 (>= 3.3.0), libnlopt0 (>= 2.7.1), libbenchmark1debian (>= 1.7.1), libpng16-16 (>= 1.6.39), libcpp-httplib0.11 (>= 0.11.4), adduser")
+    "libc6 (>= 2.36), libstdc++6 (>= 12), libgcc-s1, liblcm1 (>= 1.3.1), libtomlplusplus3 (>= 3.3.0), libnlopt0 (>= 2.7.1), libbenchmark1debian (>= 1.7.1), libpng16-16 (>= 1.6.39)")
+if(TARGET loom-panel)
+  string(APPEND CPACK_DEBIAN_PACKAGE_DEPENDS ", libcpp-httplib0.11 (>= 0.11.4)")
+endif()
+string(APPEND CPACK_DEBIAN_PACKAGE_DEPENDS ", adduser")
 # loom-spy's Java side (a viewer: boards without a display do without it).
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "can-utils, iproute2, default-jre-headless | java11-runtime-headless, liblcm-java, libjchart2d-java")
 set(CPACK_DEBIAN_PACKAGE_SUGGESTS "rt-tests, liblcm-bin, xvfb")
