@@ -153,6 +153,18 @@ int serve_main(const ServeArgs& a) {
 
   OperatorLink link;
   g_link = &link;
+  // `ctl status` answers from the link, which the loop fills from its first tick on; until then (config,
+  // the LCM identity check, arming) it shows the counters on disk, never zeros that look like a reset.
+  const auto show_counters = [&link](const sequencer::Counters& c) {
+    link.rows.store(c.rows, std::memory_order_relaxed);
+    link.picks.store(c.picks, std::memory_order_relaxed);
+    link.beats.store(c.beats, std::memory_order_relaxed);
+  };
+  try {
+    if (auto c = store.load()) show_counters(*c);
+  } catch (const ConfigError&) {
+    // Reported (and refused) when the first session loads them.
+  }
   std::signal(SIGTERM, on_terminate);
   std::signal(SIGINT, on_terminate);
 
@@ -221,6 +233,7 @@ int serve_main(const ServeArgs& a) {
       resume = *unsaved;
       unsaved.reset();
     }
+    show_counters(resume);
     std::uint64_t design_rows = 0;
     if (book) {
       try {
