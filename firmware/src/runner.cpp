@@ -235,6 +235,12 @@ class LoopBody {
         ++res.acks_refused;
         return false;
       }
+      // Re-arming reads the counters back from disk: while the last save failed the file lags what was
+      // woven, and re-arming from it would weave those rows again. The fault stays until a save succeeds.
+      if (opt_.row_saves != nullptr && opt_.row_saves->last_save_failed.load(std::memory_order_acquire)) {
+        ++res.acks_refused_unsaved;
+        return false;
+      }
       res.end = RunResult::End::kAckRequested;
       return true;
     }
@@ -449,6 +455,7 @@ RunResult run_loop(ControlLoop& loop, sequencer::Sequencer& seq, const RunOption
     // The caller's thread (SCHED_OTHER) is the reporter.
     while (!rt->loop_done.load(std::memory_order_acquire)) {
       drain_events(*rt);
+      if (opt.reporter_poll) opt.reporter_poll();
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
     pthread_join(th, nullptr);
@@ -498,6 +505,9 @@ std::string describe_run(const RunResult& r, const RunOptions& opt) {
   if (r.events_dropped > 0) s += "; run events dropped " + std::to_string(r.events_dropped);
   if (r.acks_refused > 0) {
     s += "; acknowledgements refused while the link could not be re-armed " + std::to_string(r.acks_refused);
+  }
+  if (r.acks_refused_unsaved > 0) {
+    s += "; acknowledgements refused while the counters could not be saved " + std::to_string(r.acks_refused_unsaved);
   }
   if (r.fifo_refused) s += "\nloomctl: WARNING: SCHED_FIFO was refused; the loop ran at SCHED_OTHER";
   if (r.fell_behind) {

@@ -143,6 +143,9 @@ struct RunOptions {
   OperatorLink* link = nullptr;
   bool operator_buttons = false;   // the I/O node's start/pause/ack buttons act like the commands
   bool hold_when_finished = false;
+  // Real time only: called on the reporter thread every few milliseconds (the service's watchdog and
+  // retries live here, off the loop thread). Never called from the loop.
+  std::function<void()> reporter_poll;
 
   LoopClock* clock = nullptr;      // nullptr = MonotonicClock
 };
@@ -163,6 +166,7 @@ struct RunResult {
   std::int64_t wake_latency_p50_ns = 0, wake_latency_p99_ns = 0, wake_latency_max_ns = 0;
   std::uint64_t events_dropped = 0;
   std::uint32_t acks_refused = 0;  // acknowledgements while the link could not be re-armed yet
+  std::uint32_t acks_refused_unsaved = 0;  // acknowledgements while the counters still could not be saved
   // What the loop thread actually ran at (realtime only; read back with pthread_getschedparam inside it).
   int loop_policy = -1;            // SCHED_FIFO, SCHED_OTHER, ...; -1 = ran on the caller (virtual time)
   int loop_priority = 0;
