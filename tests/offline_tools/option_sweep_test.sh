@@ -132,14 +132,14 @@ for t in loom-kin loom-synth loom-dynamics loom-profile; do
       expect_stdout=0
       check_run "$key ${alt//@OUT@/OUT} (baseline)" "$exe" "$sub" "${args[@]}"
       ((last_rc == 0)) || fail "$key baseline '${alt//@OUT@/OUT}' did not succeed: $(head -c 300 "$work/stderr")"
-      [[ -s $work/stdout ]] && stdout_of["$alt"]=1 || stdout_of["$alt"]=0
+      [[ -s $work/stdout ]] && stdout_of["k$alt"]=1 || stdout_of["k$alt"]=0
     done
     while read -r opt kind; do
       [[ -z $opt ]] && continue
       [[ $kind == text && -z ${numeric_text[$opt]:-} ]] && continue
       for alt in "${alternatives[@]}"; do
         read -r -a args <<<"${alt//@OUT@/$out}"
-        expect_stdout=${stdout_of["$alt"]}
+        expect_stdout=${stdout_of["k$alt"]}
         for v in "${values[@]}"; do
           mapfile -t argv < <(with_value "$opt" "$v" "${args[@]}")
           check_run "$key $opt=$v (baseline: ${alt//@OUT@/OUT})" "$exe" "$sub" "${argv[@]}"
