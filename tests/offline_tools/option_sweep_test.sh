@@ -114,8 +114,9 @@ check_run() {  # check_run LABEL TOOL ARGS...
   esac
 }
 
-for t in loom-kin loom-synth loom-dynamics loom-profile; do
-  exe=${tool[$t]}
+sweep_tool() {  # sweep_tool TOOL: every subcommand and numeric option of one tool
+  local t=$1 exe=${tool[$1]} sub key alt opt kind v
+  local -a subs alternatives args argv
   mapfile -t subs < <(subcommands "$exe")
   ((${#subs[@]} > 0)) || fail "$t: no subcommands found in --help"
   for sub in "${subs[@]}"; do
@@ -147,7 +148,23 @@ for t in loom-kin loom-synth loom-dynamics loom-profile; do
       done
     done < <(numeric_options "$exe" "$sub")
   done
-done
+}
 
-echo "option sweep: $runs runs, $failures failures"
-((failures == 0))
+# Two tools at a time (the machine has two cores), each in its own scratch directory.
+run_group() {  # run_group NAME TOOL...
+  local name=$1
+  shift
+  work=$work_root/$name
+  out=$work/out
+  mkdir -p "$work"
+  for t in "$@"; do sweep_tool "$t"; done
+  echo "$runs $failures" >"$work_root/$name.count"
+}
+work_root=$work
+run_group a loom-dynamics loom-synth &
+run_group b loom-kin loom-profile &
+wait
+read -r runs_a failures_a <"$work_root/a.count" || failures_a=1
+read -r runs_b failures_b <"$work_root/b.count" || failures_b=1
+echo "option sweep: $((runs_a + runs_b)) runs, $((failures_a + failures_b)) failures"
+((failures_a + failures_b == 0))
