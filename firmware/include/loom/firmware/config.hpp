@@ -140,7 +140,7 @@ struct Recipe {
   double overlap_m = 0.02;
   double cam_margin_rad = 20.0 * 3.141592653589793 / 180.0;  // cam_margin_deg = 20
   double beat_force_min_n = 80.0, beat_force_max_n = 100.0;  // the band every beat must hit
-  std::size_t table_size = 256;
+  std::size_t table_size = motion::ProfileSpec{}.table_size;  // one default, motion's
   motion::Interp table_interp = motion::Interp::kCubic;
   motion::Precision table_precision = motion::Precision::kDouble;
   double max_table_error_rad = 1e-7;
