@@ -62,9 +62,81 @@ void print_axes(const LoomConfig& c) {
     char speed[64] = "", ferror[96] = "not supervised by the controller";
     if (a.max_speed > 0.0) std::snprintf(speed, sizeof speed, ", top speed %g %s/s", a.max_speed, unit);
     if (a.ferror_min > 0.0) std::snprintf(ferror, sizeof ferror, "> max(%g %s, %g s x |v|)", a.ferror_min, unit, a.ferror_k_s);
-    std::printf("  %zu %-12s %-10s node %3u  %.0f counts/%s%s; following error %s\n", i, a.name.c_str(),
-                hal::axis_role_name(a.role), a.node, a.counts_per_unit(), unit, speed, ferror);
+    std::printf("  %zu %-12s %-10s bus %u node %3u  %.0f counts/%s%s; following error %s\n", i, a.name.c_str(),
+                hal::axis_role_name(a.role), a.bus, a.node, a.counts_per_unit(), unit, speed, ferror);
   }
+  // Referencing: what the loom does with each axis after its drive powers up, in the order it arms.
+  std::printf("  referencing (at every arming, in this order; an unreferenced axis never moves in production):\n");
+  int step = 0;
+  for (const AxisSpec& a : c.axes) {
+    const char* unit = hal::is_rotary(a.role) ? "rad" : "m";
+    if (!a.homing) continue;
+    const char* how = a.homing_method == 19   ? "home switch, active on its positive side"
+                      : a.homing_method == 21 ? "home switch, active on its negative side"
+                      : a.homing_method == 33 ? "index pulse, negative direction"
+                      : a.homing_method == 34 ? "index pulse, positive direction"
+                                              : "where it stands";
+    std::printf("    %d. %s: CiA 402 homing method %d (%s) at %g %s/s, reads %g %s at the home point; fault "
+                "homing_failed after %g s%s\n",
+                ++step, a.name.c_str(), a.homing_method, how, a.homing_speed, unit, a.home_offset, unit,
+                a.homing_timeout_s,
+                a.role == hal::AxisRole::kCarriage ? " (only once the beater is clear of the warp)" : "");
+  }
+  std::string absolute;
+  for (const AxisSpec& a : c.axes) {
+    if (!a.homing) absolute += (absolute.empty() ? "" : ", ") + a.name;
+  }
+  if (!absolute.empty()) {
+    std::printf("    absolute (positions known from power-up; references set by loomctl commission): %s\n",
+                absolute.c_str());
+  }
+}
+
+// The knot plan: density and carpet class, and with knotting heads how a row is tied — knots per head,
+// knot cycles and carriage steps per row, and the design's selector moves.
+void print_knotting(const LoomConfig& c) {
+  const sequencer::KnottingSpec& k = c.knotting;
+  const double density = k.knots_per_dm * k.rows_per_dm;
+  std::printf("\nknotting: %s", sequencer::knotting_mode_name(k.mode));
+  if (k.mode == sequencer::KnottingMode::kNone) {
+    std::printf(" (a flat weave: no pile knots)\n");
+    return;
+  }
+  std::printf(", %s knot, %g knots/dm x %g rows/dm = %g knots/dm^2 (%s)\n", sequencer::knot_type_name(k.knot),
+              k.knots_per_dm, k.rows_per_dm, density, sequencer::carpet_class_name(sequencer::carpet_class(density)));
+  const int per_row = sequencer::knots_per_row(k, c.machine_spec.width_m);
+  std::printf("  %d knots per row over %.3f m (pitch %.2f mm)\n", per_row, c.machine_spec.width_m,
+              sequencer::knot_pitch_m(k) * 1e3);
+  if (k.mode == sequencer::KnottingMode::kWeaver) {
+    std::printf("  the weaver knots each row by hand while the loom waits (pedal or ctl next)\n");
+    return;
+  }
+  const int stripe = sequencer::knots_per_stripe(k);
+  std::printf("  %d heads %.3f m apart, each tying a stripe of up to %d knots: %d knot cycles and %d carriage steps "
+              "of one pitch per row\n",
+              k.heads, k.head_spacing_m, stripe, std::min(stripe, per_row), std::max(0, std::min(stripe, per_row) - 1));
+  std::string slots;
+  for (std::size_t i = 0; i < k.slot_colours.size(); ++i) slots += (i ? ", " : "") + std::to_string(i) + "=" + k.slot_colours[i];
+  std::printf("  magazine (every head alike): %zu slots [%s], %d knots of yarn per full slot\n", k.slot_colours.size(),
+              slots.c_str(), k.knots_per_slot);
+  if (!c.recipe.design) return;
+  const design::Design& d = *c.recipe.design;
+  std::vector<std::string> codes;
+  for (const auto& colour : d.palette()) codes.push_back(colour.code);
+  std::array<int, sequencer::kMaxKnottingHeads> at{};
+  at.fill(-1);
+  long moves = 0;
+  int worst = 0;
+  for (int r = 0; r < d.height(); ++r) {  // checked when the config was read: every colour has a slot
+    const sequencer::RowKnotPlan p = sequencer::plan_row(k, c.machine_spec.width_m, d.row(r), codes, at);
+    int row_moves = 0;
+    for (int h = 0; h < k.heads; ++h) row_moves = std::max(row_moves, p.selector_moves[static_cast<std::size_t>(h)]);
+    moves += row_moves;
+    worst = std::max(worst, row_moves);
+  }
+  std::printf("  design '%s': %d rows of %d knots; selector moves per row (the busiest head): mean %.1f, most %d\n",
+              d.name().c_str(), d.height(), d.width(), d.height() > 0 ? static_cast<double>(moves) / d.height() : 0.0,
+              worst);
 }
 
 void print_plan(const LoomConfig& c) {
@@ -122,6 +194,7 @@ void print_plan(const LoomConfig& c) {
   print_safety_sensors(c);
 
   print_axes(c);
+  print_knotting(c);
 
   std::printf("\nCAN (for --hal socketcan)\n");
   const drivers::BusLoad load = can_bus_load(c);  // the figure the CAN master checks when it configures

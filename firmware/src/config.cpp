@@ -294,9 +294,33 @@ const std::vector<Key>& keys() {
     v.push_back(integer<int>("io.load_cell_channel", M::kMachine, 0, 254, [](LoomConfig& c) -> int& { return c.io.wiring.load_cell_channel; }));
     v.push_back(number("io.load_cell_n_per_count", M::kMachine, -1.0e3, 1.0e3, [](LoomConfig& c) -> double& { return c.io.wiring.load_cell_n_per_count; }));
     v.push_back(number("io.load_cell_offset_n", M::kMachine, -1.0e4, 1.0e4, [](LoomConfig& c) -> double& { return c.io.wiring.load_cell_offset_n; }));
+    // [knotting] — the pile (machine: the heads are hardware)
+    v.push_back(choice<sequencer::KnottingMode>("knotting.mode", M::kMachine, {"none", "weaver", "heads"},
+                                                [](LoomConfig& c) -> sequencer::KnottingMode& { return c.knotting.mode; },
+                                                sequencer::knotting_mode_name, sequencer::parse_knotting_mode));
+    v.push_back(choice<sequencer::KnotType>("knotting.knot", M::kMachine, {"turkish", "persian_left", "persian_right"},
+                                            [](LoomConfig& c) -> sequencer::KnotType& { return c.knotting.knot; },
+                                            sequencer::knot_type_name, sequencer::parse_knot_type));
+    v.push_back(number("knotting.knots_per_dm", M::kMachine, 5.0, 200.0, [](LoomConfig& c) -> double& { return c.knotting.knots_per_dm; }));
+    v.push_back(number("knotting.rows_per_dm", M::kMachine, 5.0, 200.0, [](LoomConfig& c) -> double& { return c.knotting.rows_per_dm; }));
+    v.push_back(integer<int>("knotting.heads", M::kMachine, 1, sequencer::kMaxKnottingHeads,
+                             [](LoomConfig& c) -> int& { return c.knotting.heads; }));
+    v.push_back(number("knotting.head_spacing_m", M::kMachine, 0.005, 10.0, [](LoomConfig& c) -> double& { return c.knotting.head_spacing_m; }));
+    {
+      Key slots{"knotting.slot_colours", M::kMachine, "design palette codes, one per magazine slot (at most 16)", true,
+                nullptr, nullptr};
+      slots.read = [](TomlReader& r, LoomConfig& c) { r.string_list("knotting.slot_colours", c.knotting.slot_colours); };
+      slots.value = [](const LoomConfig& c) {
+        std::string out;
+        for (const auto& code : c.knotting.slot_colours) out += (out.empty() ? "" : ",") + code;
+        return out;
+      };
+      v.push_back(slots);
+    }
+    v.push_back(integer<int>("knotting.knots_per_slot", M::kMachine, 1, 1'000'000,
+                             [](LoomConfig& c) -> int& { return c.knotting.knots_per_slot; }));
     // [recipe]
     v.push_back(integer<std::uint32_t>("recipe.picks_per_row", M::kRecipe, 1, 16, [](LoomConfig& c) -> std::uint32_t& { return c.recipe.picks_per_row; }));
-    v.push_back(boolean("recipe.knotting", M::kRecipe, [](LoomConfig& c) -> bool& { return c.recipe.knotting; }));
     {
       Key design{"recipe.design", M::kRecipe, "file: .csv grid of colour codes or .png, one pixel per knot; \"\" = none",
                  false, nullptr, nullptr};
@@ -439,13 +463,17 @@ void refuse_moved_keys(TomlReader& r) {
       {"can.carriage_ferror_min_m", "axes.carriage.ferror_min"}, {"can.carriage_ferror_k_s", "axes.carriage.ferror_k_s"},
       {"can.helix_boot_ms", "axes.helix.boot_ms"},               {"can.helix_operational_ms", "axes.helix.operational_ms"},
       {"can.helix_ferror_min_rad", "axes.helix.ferror_min"},     {"can.helix_ferror_k_s", "axes.helix.ferror_k_s"},
+      {"recipe.knotting", "knotting.mode (\"none\", \"weaver\" or \"heads\")"},
   };
   for (const auto& m : moved) {
     if (const toml::node* n = r.root().at_path(m.old_key).node()) {
       const auto i = n->value<std::int64_t>();
       const auto d = n->value<double>();
-      const std::string shown = i ? std::to_string(*i) : d ? fmt_num(*d) : "...";
-      r.fail_at(*n, m.old_key, shown, std::string("the axes are [axes.<name>] tables now: this fact is ") + m.now +
+      const std::string shown = n->is_boolean() ? (n->value<bool>().value_or(false) ? "true" : "false")
+                                : i             ? std::to_string(*i)
+                                : d             ? fmt_num(*d)
+                                                : "...";
+      r.fail_at(*n, m.old_key, shown, std::string("moved: this fact is ") + m.now +
                                        " (loomctl check --keys lists every key)");
     }
   }
@@ -599,6 +627,24 @@ void read_axes(TomlReader& r, LoomConfig& c, bool extending) {
 // ---------------------------------------------------------------------------------------------------
 // Cross-field checks (each at the line that is wrong)
 // ---------------------------------------------------------------------------------------------------
+// With knotting heads, every row of the recipe's design must be tied by them: its width is the loom's
+// knots per row and every colour sits in a magazine slot (refused naming the colour and the first knot).
+void check_design_fits_heads(const TomlReader& r, const LoomConfig& c) {
+  if (c.knotting.mode != sequencer::KnottingMode::kHeads || !c.recipe.design) return;
+  const design::Design& d = *c.recipe.design;
+  std::vector<std::string> codes;
+  for (const auto& colour : d.palette()) codes.push_back(colour.code);
+  std::array<int, sequencer::kMaxKnottingHeads> slots{};
+  slots.fill(-1);
+  for (int row = 0; row < d.height(); ++row) {
+    try {
+      (void)sequencer::plan_row(c.knotting, c.machine_spec.width_m, d.row(row), codes, slots);
+    } catch (const std::invalid_argument& e) {
+      r.fail("recipe.design", '"' + c.recipe.design_file + '"', "design row " + std::to_string(row + 1) + ": " + e.what());
+    }
+  }
+}
+
 void check_relations(const TomlReader& r, const LoomConfig& c) {
   const auto present = [&](const std::string& path) { return r.root().at_path(path).node() != nullptr; };
   // A drive's node id is used once on the bus (the I/O module's is checked with it in check_can).
@@ -645,6 +691,16 @@ void check_relations(const TomlReader& r, const LoomConfig& c) {
     r.fail("timing.stale_timeout_ms", fmt_num(c.run.stale_timeout_s * 1e3),
            "must be at least two periods (timing.period_ms = " + fmt_num(c.run.period_s * 1e3) + ")");
   }
+  if (const std::string why = sequencer::validate(c.knotting, m.width_m); !why.empty()) {
+    const std::string named = why.substr(0, why.find_first_of(" :["));
+    const std::string key = present(named) ? named : "knotting.mode";
+    std::string value;
+    for (const Key& k : keys()) {
+      if (k.path == key) value = k.value(c);
+    }
+    r.fail(key, value, why);
+  }
+  check_design_fits_heads(r, c);
   if (m.shed.release_timeout_s >= m.shed.timeout_s) {
     r.fail("shedding.release_timeout_s", fmt_num(m.shed.release_timeout_s),
            "must be shorter than shedding.timeout_s = " + fmt_num(m.shed.timeout_s));
@@ -775,7 +831,7 @@ void derive(LoomConfig& c, const Fail& fail) {
   for (std::size_t i = hal::kCoreAxisCount; i < c.axes.size(); ++i) s.axis_max_speed[i] = c.axes[i].max_speed;
   for (std::size_t i = 0; i < c.axes.size(); ++i) s.homing_timeout_s[i] = c.axes[i].homing ? c.axes[i].homing_timeout_s : 0.0;
   s.picks_per_row = rc.picks_per_row;
-  s.knotting = rc.knotting;
+  s.knotting = c.knotting.mode == sequencer::KnottingMode::kWeaver;
   s.debounce_ticks = c.run.debounce_ticks;
   s.sensor_discrepancy_s = c.run.sensor_discrepancy_s;
   for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) s.second_channel[i] = c.io.wiring.second[i].bit >= 0;

@@ -44,7 +44,11 @@ void DesignBook::load() {
   if (!j["designs"].is_object()) throw bad("\"designs\" = " + j["designs"].dump().substr(0, 60) + ": not an object");
   for (const auto& [name, rows] : j["designs"].items()) {
     if (name.empty() || name.size() > 255) throw bad("design name '" + name.substr(0, 60) + "': want 1..255 characters");
-    if (!rows.is_number_unsigned()) throw bad("\"designs\".\"" + name + "\" = " + rows.dump() + ": not a row count");
+    // Every row a design has is a row the production counters counted, and those are 32-bit: a larger
+    // count was not written by loomctl (and would wrap when credited).
+    if (!rows.is_number_unsigned() || rows.get<std::uint64_t>() > UINT32_MAX) {
+      throw bad("\"designs\".\"" + name + "\" = " + rows.dump() + ": not a row count in 0..4294967295");
+    }
     designs_[name] = rows.get<std::uint64_t>();
   }
   active_ = j["active"].get<std::string>();
@@ -57,7 +61,14 @@ void DesignBook::credit(std::uint32_t counter_rows) {
     throw ConfigError(path_ + ": written at production row " + std::to_string(at_rows_) + " but the counters say " +
                       std::to_string(counter_rows) + " (production counts never go back; refusing to guess)");
   }
-  if (!active_.empty()) designs_[active_] += counter_rows - at_rows_;
+  if (!active_.empty()) {
+    std::uint64_t& rows = designs_[active_];
+    if (rows > UINT32_MAX - static_cast<std::uint64_t>(counter_rows - at_rows_)) {
+      throw ConfigError(path_ + ": design '" + active_ + "' at " + std::to_string(rows) + " rows plus " +
+                        std::to_string(counter_rows - at_rows_) + " would pass 4294967295 (never wrapped)");
+    }
+    rows += counter_rows - at_rows_;
+  }
   at_rows_ = counter_rows;
 }
 

@@ -13,6 +13,11 @@ namespace loom::firmware {
 
 Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions& opt, sequencer::Counters resume)
     : cfg_(cfg) {
+  if (cfg_.knotting.mode == sequencer::KnottingMode::kHeads) {
+    // `loomctl check` plans the heads' rows; weaving with them needs their sequence, simulation and drives.
+    throw ConfigError(cfg_.source + ": knotting.mode = \"heads\": this loomctl plans the heads' knots (loomctl check) "
+                      "but cannot tie them yet; use \"weaver\" to weave with the weaver knotting each row");
+  }
   const Scene fitted = check_scene_fits(scene, cfg_);
   slot_ = std::make_unique<motion::ProfileSlot>(std::make_unique<const motion::ProfileSet>(cfg_.profile));
   sequencer::SequencerConfig scfg = cfg_.sequencer;
@@ -141,7 +146,6 @@ void Machine::publish_recipe(const LoomConfig& next) {
     if (d) fixed += (fixed.empty() ? "" : ", ") + std::string(key);
   };
   differs(next.sequencer.picks_per_row != cfg_.sequencer.picks_per_row, "recipe.picks_per_row");
-  differs(next.sequencer.knotting != cfg_.sequencer.knotting, "recipe.knotting");
   // The design's remembered row and the panel's view are bound to the carpet on the loom.
   differs(next.recipe.design_file != cfg_.recipe.design_file, "recipe.design");
   differs(next.sequencer.beat_force_min_n != cfg_.sequencer.beat_force_min_n ||

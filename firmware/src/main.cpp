@@ -135,7 +135,7 @@ int weave(const WeaveArgs& a) {
   if (a.knotting_s > 0.0 && (hardware || !cfg.sequencer.knotting)) {
     std::fprintf(stderr, "loomctl: --knotting-s = %g: %s\n", a.knotting_s,
                  hardware ? "the simulated weaver exists in simulation only (on a loom the weaver presses the pedal)"
-                          : "the recipe has no knotting mode (set recipe.knotting = true)");
+                          : "the loom has no weaver's knotting (set knotting.mode = \"weaver\")");
     return kExitBadInput;
   }
   if (hardware) {

@@ -20,6 +20,7 @@
 
 #include "loom/firmware/latency_histogram.hpp"
 #include "loom/telemetry/spsc_ring.hpp"
+#include "loom/telemetry/telemetry.hpp"
 
 namespace loom::firmware {
 
@@ -64,26 +65,40 @@ int make_attrs(pthread_attr_t& attr, int policy, int priority, std::size_t stack
 }
 
 // ---------------------------------------------------------------------------------------------------
-// Everything the loop touches, allocated (and its pages touched) before the first tick.
+// Everything the loop touches, allocated (and its pages touched) before the first tick. What only real
+// time needs — the reporter's event ring (~2 MB) and the wake-up histogram — is allocated only then:
+// in virtual time the handler runs in place and nobody sleeps.
 // ---------------------------------------------------------------------------------------------------
+using EventRing = telemetry::SpscRing<RunEvent, kEventRingCapacity>;
+
+struct RealTimeParts {
+  LatencyHistogram wake;
+  EventRing events;
+};
+
 struct Runtime {
   Runtime(ControlLoop& l, sequencer::Sequencer& s, const RunOptions& o, LoopClock& c, const EventHandler& h)
-      : loop(l), seq(s), opt(o), clock(c), on_event(h) {}
+      : loop(l), seq(s), opt(o), clock(c), on_event(h),
+        rt_parts(o.realtime ? std::make_unique<RealTimeParts>() : nullptr) {}
   ControlLoop& loop;
   sequencer::Sequencer& seq;
   const RunOptions& opt;
   LoopClock& clock;
   const EventHandler& on_event;
   LatencyHistogram cost;
-  LatencyHistogram wake;
-  telemetry::SpscRing<RunEvent, kEventRingCapacity> events;
+  std::unique_ptr<RealTimeParts> rt_parts;  // real time only (value-initialised: pages touched)
   std::atomic<bool> loop_done{false};
   RunResult result;
 };
 
+// A tick pushes at most one snapshot and this many events (a beat, a row, a first fault or diagnosis,
+// a device fault per axis, a link fault): the room the runner waits for before a virtual-time tick.
+constexpr std::size_t kMaxEventsPerTick = 3 + hal::kAxisCount;
+
 class LoopBody {
  public:
-  explicit LoopBody(Runtime& rt) : rt_(rt), seq_(rt.seq), opt_(rt.opt), stats_(rt.loop.stats()) {}
+  explicit LoopBody(Runtime& rt)
+      : rt_(rt), seq_(rt.seq), opt_(rt.opt), stats_(rt.loop.stats()), telemetry_(rt.loop.lossless_telemetry()) {}
 
   // The loop. RT-safe after its first statement: no allocation, no locks, no syscalls but the clock's.
   void run() noexcept {
@@ -107,11 +122,12 @@ class LoopBody {
       if (opt_.realtime) {
         rt_.clock.sleep_until(deadline);
         const std::int64_t late = rt_.clock.now_ns() - deadline;
-        rt_.wake.add(late);
+        rt_.rt_parts->wake.add(late);
         stats_.last_wake_latency_ns = late;
         stats_.max_wake_latency_ns = std::max(stats_.max_wake_latency_ns, late);
       }
       if (take_commands()) break;  // a command ended the session
+      if (telemetry_ != nullptr) wait_for_telemetry_room();
 
       const std::int64_t t0 = rt_.clock.now_ns();
       rt_.loop.cycle(tick);
@@ -125,11 +141,13 @@ class LoopBody {
       publish_status(tick);
       if (tick % refresh_every == 0) {
         // Bounded (two scans of a fixed histogram), once a second, in the tick's slack.
-        stats_.wake_latency_p50_ns = rt_.wake.percentile(0.5);
-        stats_.wake_latency_p99_ns = rt_.wake.percentile(0.99);
+        if (rt_.rt_parts) {
+          stats_.wake_latency_p50_ns = rt_.rt_parts->wake.percentile(0.5);
+          stats_.wake_latency_p99_ns = rt_.rt_parts->wake.percentile(0.99);
+          stats_.events_dropped = static_cast<std::uint32_t>(rt_.rt_parts->events.dropped());
+        }
         stats_.wake_latency_max_ns = stats_.max_wake_latency_ns;
         stats_.tick_cost_p999_ns = rt_.cost.percentile(0.999);
-        stats_.events_dropped = static_cast<std::uint32_t>(rt_.events.dropped());
       }
 
       if (seq_.finished() && finished_at < 0) finished_at = tick;
@@ -172,6 +190,23 @@ class LoopBody {
   }
 
  private:
+  // Virtual time, lossless telemetry: wait (yielding to the publisher) until this tick's snapshot and
+  // events fit, so the tick itself never waits; the wait is timed and counted apart from the tick.
+  // The clock is read only when the ring is actually full.
+  void wait_for_telemetry_room() noexcept {
+    if (telemetry_->has_room(kMaxEventsPerTick) || !telemetry_->publishing()) return;
+    RunResult& res = rt_.result;
+    const std::int64_t w0 = rt_.clock.now_ns();
+    while (!telemetry_->has_room(kMaxEventsPerTick) && telemetry_->publishing()) {
+      std::this_thread::yield();
+      ++res.telemetry_wait_yields;
+    }
+    const std::int64_t waited = rt_.clock.now_ns() - w0;
+    ++res.telemetry_wait_ticks;
+    res.telemetry_wait_total_ns += waited;
+    res.telemetry_wait_max_ns = std::max(res.telemetry_wait_max_ns, waited);
+  }
+
   // Applies operator commands (and button edges). True when the session ends here.
   bool take_commands() noexcept {
     std::uint32_t cmds = 0;
@@ -235,6 +270,12 @@ class LoopBody {
         ++res.acks_refused;
         return false;
       }
+      // Re-arming reads the counters back from disk: while the last save failed the file lags what was
+      // woven, and re-arming from it would weave those rows again. The fault stays until a save succeeds.
+      if (opt_.row_saves != nullptr && opt_.row_saves->last_save_failed.load(std::memory_order_acquire)) {
+        ++res.acks_refused_unsaved;
+        return false;
+      }
       res.end = RunResult::End::kAckRequested;
       return true;
     }
@@ -268,7 +309,7 @@ class LoopBody {
 
   void emit(const RunEvent& e) noexcept {
     if (opt_.realtime) {
-      rt_.events.push_or_drop(e);
+      rt_.rt_parts->events.push_or_drop(e);
     } else {
       // Virtual time: the loop runs on the caller's thread, so the handler is called in place.
       try {
@@ -320,6 +361,7 @@ class LoopBody {
   sequencer::Sequencer& seq_;
   const RunOptions& opt_;
   LoopStats& stats_;
+  telemetry::Telemetry* telemetry_;  // non-null: virtual time, lossless telemetry (wait before the tick)
   std::uint32_t rows_seen_ = 0, picks_seen_ = 0;
   bool was_paused_ = false, was_fault_ = false;
   bool stop_sent_ = false, stop_now_sent_ = false, exit_pending_ = false;
@@ -364,7 +406,7 @@ void* loop_thread_main(void* arg) {
 
 void drain_events(Runtime& rt) {
   RunEvent e;
-  while (rt.events.try_pop(e)) {
+  while (rt.rt_parts->events.try_pop(e)) {
     try {
       rt.on_event(e);
     } catch (...) {
@@ -417,8 +459,8 @@ RtSetup setup_realtime(int fifo_priority, std::size_t heap_prefault_bytes) {
 RunResult run_loop(ControlLoop& loop, sequencer::Sequencer& seq, const RunOptions& opt, const EventHandler& on_event) {
   MonotonicClock monotonic;
   LoopClock& clock = opt.clock != nullptr ? *opt.clock : monotonic;
-  // Configure-time: the ring and the histograms live on the heap (the ring is ~2 MB), value-initialised,
-  // which touches every page before the loop starts.
+  // Configure-time: the histograms (and in real time the ~2 MB event ring) live on the heap,
+  // value-initialised, which touches every page before the loop starts.
   auto rt = std::make_unique<Runtime>(loop, seq, opt, clock, on_event);
 
   if (!opt.realtime) {
@@ -449,6 +491,7 @@ RunResult run_loop(ControlLoop& loop, sequencer::Sequencer& seq, const RunOption
     // The caller's thread (SCHED_OTHER) is the reporter.
     while (!rt->loop_done.load(std::memory_order_acquire)) {
       drain_events(*rt);
+      if (opt.reporter_poll) opt.reporter_poll();
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
     pthread_join(th, nullptr);
@@ -461,12 +504,12 @@ RunResult run_loop(ControlLoop& loop, sequencer::Sequencer& seq, const RunOption
   res.max_tick_cost_ns = stats.max_tick_cost_ns;
   res.median_tick_cost_ns = rt->cost.percentile(0.5);
   res.p999_tick_cost_ns = rt->cost.percentile(0.999);
-  if (opt.realtime) {
-    res.wake_latency_p50_ns = rt->wake.percentile(0.5);
-    res.wake_latency_p99_ns = rt->wake.percentile(0.99);
-    res.wake_latency_max_ns = rt->wake.max();
+  if (rt->rt_parts) {
+    res.wake_latency_p50_ns = rt->rt_parts->wake.percentile(0.5);
+    res.wake_latency_p99_ns = rt->rt_parts->wake.percentile(0.99);
+    res.wake_latency_max_ns = rt->rt_parts->wake.max();
+    res.events_dropped = rt->rt_parts->events.dropped();
   }
-  res.events_dropped = rt->events.dropped();
   loop.stats().events_dropped = static_cast<std::uint32_t>(res.events_dropped);
   const double machine_s = static_cast<double>(res.ticks) * opt.period_s;
   res.achieved_ratio = machine_s / std::max(res.wall_s, 1e-9);
@@ -480,13 +523,21 @@ std::string describe_run(const RunResult& r, const RunOptions& opt) {
   const char* ratio_fmt = r.achieved_ratio < 10.0 ? "%.2f" : "%.0f";
   char ratio[32];
   std::snprintf(ratio, sizeof ratio, ratio_fmt, r.achieved_ratio);
+  const auto us = [](std::int64_t ns) { return static_cast<double>(ns) * 1e-3; };
   int n = std::snprintf(buf, sizeof buf,
-                        "loop: %lld ticks (%.2f s machine time) in %.3f s wall (%sx real time); tick cost median %lld "
-                        "ns, p99.9 %lld ns, max %lld ns; overruns %u",
-                        static_cast<long long>(r.ticks), machine_s, r.wall_s, ratio,
-                        static_cast<long long>(r.median_tick_cost_ns), static_cast<long long>(r.p999_tick_cost_ns),
-                        static_cast<long long>(r.max_tick_cost_ns), r.overruns);
+                        "loop: %lld ticks (%.2f s machine time) in %.3f s wall (%sx real time); tick cost (the tick's "
+                        "own work) median %.1f \u00b5s, p99.9 %.1f \u00b5s, max %.1f \u00b5s; overruns %u",
+                        static_cast<long long>(r.ticks), machine_s, r.wall_s, ratio, us(r.median_tick_cost_ns),
+                        us(r.p999_tick_cost_ns), us(r.max_tick_cost_ns), r.overruns);
   std::string s(buf, static_cast<std::size_t>(std::max(n, 0)));
+  if (r.telemetry_wait_ticks > 0) {
+    n = std::snprintf(buf, sizeof buf,
+                      "; telemetry wait (virtual time: the loop waited between ticks for the LCM publisher to free "
+                      "ring space, not part of the tick) %llu ticks, total %.1f \u00b5s, max %.1f \u00b5s, %llu yields",
+                      static_cast<unsigned long long>(r.telemetry_wait_ticks), us(r.telemetry_wait_total_ns),
+                      us(r.telemetry_wait_max_ns), static_cast<unsigned long long>(r.telemetry_wait_yields));
+    s.append(buf, static_cast<std::size_t>(std::max(n, 0)));
+  }
   if (opt.realtime) {
     n = std::snprintf(buf, sizeof buf, "; wake-up latency p50 %lld ns, p99 %lld ns, max %lld ns; loop thread %s",
                       static_cast<long long>(r.wake_latency_p50_ns), static_cast<long long>(r.wake_latency_p99_ns),
@@ -498,6 +549,9 @@ std::string describe_run(const RunResult& r, const RunOptions& opt) {
   if (r.events_dropped > 0) s += "; run events dropped " + std::to_string(r.events_dropped);
   if (r.acks_refused > 0) {
     s += "; acknowledgements refused while the link could not be re-armed " + std::to_string(r.acks_refused);
+  }
+  if (r.acks_refused_unsaved > 0) {
+    s += "; acknowledgements refused while the counters could not be saved " + std::to_string(r.acks_refused_unsaved);
   }
   if (r.fifo_refused) s += "\nloomctl: WARNING: SCHED_FIFO was refused; the loop ran at SCHED_OTHER";
   if (r.fell_behind) {

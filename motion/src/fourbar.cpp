@@ -267,6 +267,51 @@ void fourbar_sweep(const FourBar& m, Branch branch, int samples, double theta2_s
   }
 }
 
+ReachableSweep fourbar_sweep_reachable(const FourBar& m, Branch branch, int samples, double theta2_start,
+                                       const std::function<void(int, const FourBarPose&)>& sink) {
+  detail::require_samples("four-bar sweep", samples);
+  detail::require_finite("four-bar sweep", "theta2_start", theta2_start, " rad");
+  check_lengths(m);
+  if (classify(m) == GrashofClass::kChangePoint) {
+    std::ostringstream os;
+    os << "four-bar sweep: change-point linkage " << describe(m)
+       << ": both branches meet where it folds flat, so the motion beyond is not determined";
+    throw MotionError(ErrorCode::kSingular, os.str());
+  }
+  ReachableSweep cover;
+  FourBarPose prev{};
+  bool have_prev = false;
+  for (int i = 0; i < samples; ++i) {
+    const double theta2 = theta2_start + kTwoPi * static_cast<double>(i) / static_cast<double>(samples);
+    const FourBarPosition pos = [&]() -> FourBarPosition {
+      try {
+        return solve_position(m, theta2, branch);
+      } catch (const MotionError& e) {
+        if (e.code() != ErrorCode::kNotAssemblable && e.code() != ErrorCode::kSingular) throw;
+        FourBarPosition none;
+        none.at_toggle = e.code() == ErrorCode::kSingular;
+        none.theta2 = NAN;  // marks "did not close"
+        return none;
+      }
+    }();
+    if (std::isnan(pos.theta2) || pos.at_toggle) {
+      ++(pos.at_toggle ? cover.at_toggle : cover.unreachable);
+      have_prev = false;
+      continue;
+    }
+    FourBarPose p = solve(m, theta2, branch);
+    if (have_prev) {
+      p.theta3 = prev.theta3 + wrap_pi(p.theta3 - prev.theta3);
+      p.theta4 = prev.theta4 + wrap_pi(p.theta4 - prev.theta4);
+    }
+    sink(i, p);
+    prev = p;
+    have_prev = true;
+    ++cover.solved;
+  }
+  return cover;
+}
+
 FourBarNewtonResult solve_newton(const FourBar& m, double theta2, Branch branch, double theta3_guess,
                                  double theta4_guess, const NewtonOptions& opt) {
   check_lengths(m);

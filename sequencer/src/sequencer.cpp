@@ -29,6 +29,7 @@ using hal::AxisRequest;
 using hal::DriveState;
 using hal::index;
 constexpr double kArrivalMarginM = 0.002;         // carrier position uncertainty at the arrival sensor
+constexpr double kCarrierAtSelvedgeM = 1e-6;      // a pick starting farther off its selvedge (a cut pick) is re-planned
 constexpr double kStepPlausibility = 4.0;         // an axis may move at most this × its top speed per tick
 constexpr int kShedTestStrokes = 4;               // arming shed test: A up, B up, A up, B up
 
@@ -773,8 +774,18 @@ void Sequencer::begin_pick(hal::Tick now, bool resumed) noexcept {
     pick_goal_rad_ = cfg_.helix_left_position_rad + (pick_to_right_ ? profiles_->pick().distance() : 0.0);
     helix_move_ = {true, now, from, motion::JerkMove::plan(pick_goal_rad_ - from, profiles_->helix_limits())};
   } else {
-    pick_goal_rad_ = from + (pick_to_right_ ? 1.0 : -1.0) * profiles_->pick().distance();
-    helix_move_ = {true, now, from, pick_to_right_ ? profiles_->pick() : profiles_->pick_back()};
+    // The goal is the far selvedge's own position, not `from` + the pick's distance: after a power cut in
+    // the first or last ticks of a pick the shuttle is still (or already) at a selvedge while the carrier
+    // stands a few millimetres off it, and a relative goal would carry that offset into the arrival check
+    // (a false shuttle_slipped). Off the selvedge, the carrier goes straight to the goal (bounded move).
+    const double start_rad = cfg_.helix_left_position_rad + (pick_to_right_ ? 0.0 : profiles_->pick().distance());
+    pick_goal_rad_ = cfg_.helix_left_position_rad + (pick_to_right_ ? profiles_->pick().distance() : 0.0);
+    const double off_m = std::abs(from - start_rad) * profiles_->spec().helix_lead_m / motion::kTwoPi;
+    if (off_m <= kCarrierAtSelvedgeM) {
+      helix_move_ = {true, now, from, pick_to_right_ ? profiles_->pick() : profiles_->pick_back()};
+    } else {
+      helix_move_ = {true, now, from, motion::JerkMove::plan(pick_goal_rad_ - from, profiles_->helix_limits())};
+    }
   }
   carrier_at_selvedge_ = hal::kNeverTick;
   carrier_left_ = hal::kNeverTick;

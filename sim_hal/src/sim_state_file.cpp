@@ -29,9 +29,18 @@ SimStateFile::SimStateFile(const std::string& path) {
     refuse("not a loomctl sim-state file (" + std::to_string(st.st_size) + " bytes, expected " +
            std::to_string(sizeof(PersistedMachine)) + "); not touched");
   }
-  if (st.st_size == 0 && ::ftruncate(fd_, sizeof(PersistedMachine)) != 0) {
-    ::close(fd_);
-    throw std::runtime_error("cannot size sim state file " + path + ": " + std::strerror(errno));
+  // The file's blocks are allocated now (posix_fallocate; a no-op where they exist), never left a sparse
+  // hole (ftruncate): a store into a mapped hole on a full disk is a SIGBUS in the loop; here it is a
+  // refusal before anything is armed.
+  {
+    const int rc = ::posix_fallocate(fd_, 0, sizeof(PersistedMachine));
+    if (rc != 0) {
+      ::close(fd_);
+      fd_ = -1;
+      if (st.st_size == 0) ::unlink(path.c_str());  // ours and empty: leave no file a later run would adopt
+      throw std::runtime_error("cannot allocate sim state file " + path + " (" +
+                               std::to_string(sizeof(PersistedMachine)) + " bytes): " + std::strerror(rc));
+    }
   }
   void* p = ::mmap(nullptr, sizeof(PersistedMachine), PROT_READ | PROT_WRITE, MAP_SHARED, fd_, 0);
   if (p == MAP_FAILED) {

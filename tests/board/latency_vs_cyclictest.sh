@@ -19,8 +19,8 @@ ticks=$(sed -n 's/^loop: \([0-9]*\) ticks.*/\1/p' <<<"$line")
 l50=$(sed -n 's/.*wake-up latency p50 \([0-9]*\) ns.*/\1/p' <<<"$line")
 l99=$(sed -n 's/.*wake-up latency p50 [0-9]* ns, p99 \([0-9]*\) ns.*/\1/p' <<<"$line")
 lmax=$(sed -n 's/.*wake-up latency .* max \([0-9]*\) ns; loop thread.*/\1/p' <<<"$line")
-c50=$(sed -n 's/.*tick cost median \([0-9]*\) ns.*/\1/p' <<<"$line")
-c999=$(sed -n 's/.*tick cost median [0-9]* ns, p99.9 \([0-9]*\) ns.*/\1/p' <<<"$line")
+c50=$(sed -n 's/.*tick cost (the tick.s own work) median \([0-9.]*\) µs.*/\1/p' <<<"$line")
+c999=$(sed -n 's/.*tick cost (the tick.s own work) median [0-9.]* µs, p99.9 \([0-9.]*\) µs.*/\1/p' <<<"$line")
 policy=$(sed -n 's/.*loop thread \(SCHED_[A-Z]*\( [0-9]*\)\{0,1\}\).*/\1/p' <<<"$line")
 [[ -n $l50 && -n $l99 && -n $lmax && -n $c50 && -n $c999 ]] || { echo "cannot parse: $line" >&2; exit 1; }
 
@@ -42,4 +42,4 @@ us() { awk -v n="$1" 'BEGIN { printf "%.1f", n / 1000 }'; }
 printf '%-34s %8s µs %7s µs %7s µs\n' "loomctl loop ($policy)" "$(us "$l50")" "$(us "$l99")" "$(us "$lmax")"
 printf '%-34s %8d µs %7d µs %7d µs\n' "cyclictest -m -p 80 -i $period_us" "$c_p50" "$c_p99" "$c_max"
 printf '%-34s %10s %10s\n' "tick cost, telemetry on" p50 p99.9
-printf '%-34s %7d ns %7d ns\n' "loomctl loop" "$c50" "$c999"
+printf '%-34s %7s µs %7s µs\n' "loomctl loop" "$c50" "$c999"

@@ -167,6 +167,27 @@ TEST(RunnerClock, ReportsTheScriptedWakeLatencyAndTickCost) {
   EXPECT_EQ(r.loop->stats().max_wake_latency_ns, 7'000);
 }
 
+// The summary tells the tick's own cost and the virtual-time telemetry wait apart, both in µs.
+TEST(RunnerClock, SummaryReportsTickCostAndTelemetryWaitApart) {
+  firmware::RunResult r;
+  r.ticks = 3000;
+  r.median_tick_cost_ns = 4'100;
+  r.p999_tick_cost_ns = 12'300;
+  r.max_tick_cost_ns = 40'200;
+  r.telemetry_wait_ticks = 1'203;
+  r.telemetry_wait_total_ns = 512'300'000;
+  r.telemetry_wait_max_ns = 6'356'992;
+  r.telemetry_wait_yields = 18'056;
+  const std::string text = firmware::describe_run(r, RunOptions{});
+  EXPECT_NE(text.find("tick cost (the tick's own work) median 4.1 \u00b5s, p99.9 12.3 \u00b5s, max 40.2 \u00b5s"),
+            std::string::npos) << text;
+  EXPECT_NE(text.find("telemetry wait"), std::string::npos) << text;
+  EXPECT_NE(text.find("1203 ticks, total 512300.0 \u00b5s, max 6357.0 \u00b5s, 18056 yields"), std::string::npos) << text;
+  // No wait: nothing about it.
+  r.telemetry_wait_ticks = 0;
+  EXPECT_EQ(firmware::describe_run(r, RunOptions{}).find("telemetry wait"), std::string::npos);
+}
+
 TEST(RunnerClock, FallingBehindThePaceIsReportedHonestly) {
   Rig r;
   r.slow->default_cost_ns = 3 * kPeriodNs;  // every tick takes three periods

@@ -115,7 +115,7 @@ stop_serve
 #    knotted"); status says which design row to knot; the row reached is kept per design across restarts
 rm -rf "$work/state"
 cp "$src/tests/firmware/designs/border.csv" "$work/border.csv"
-printf 'extends = "default"\n[recipe]\nknotting = true\ndesign = "border.csv"\n' >"$work/knotting.toml"
+printf 'extends = "default"\n[knotting]\nmode = "weaver"\n[recipe]\ndesign = "border.csv"\n' >"$work/knotting.toml"
 start_serve serve5.log --config "$work/knotting.toml"
 ctl start >/dev/null
 wait_for state await_knotting 30

@@ -231,7 +231,6 @@ TEST(Config, StructDefaultsAgreeWithTheEmbeddedDefaultToml) {
   EXPECT_DOUBLE_EQ(a.crank_accel_rad_s2, b.crank_accel_rad_s2);
   EXPECT_DOUBLE_EQ(a.crank_jerk_rad_s3, b.crank_jerk_rad_s3);
   EXPECT_EQ(a.picks_per_row, b.picks_per_row);
-  EXPECT_EQ(a.knotting, b.knotting);
   EXPECT_EQ(a.beats_per_position, b.beats_per_position);
   EXPECT_DOUBLE_EQ(a.overlap_m, b.overlap_m);
   EXPECT_DOUBLE_EQ(a.cam_margin_rad, b.cam_margin_rad);

@@ -128,6 +128,10 @@ TEST(DesignPosition, RepeatsAfterTheLastRow) {
   EXPECT_EQ(loom::design::position_after(d, 2).row, 2);
   EXPECT_EQ(loom::design::position_after(d, 3).row, 0);
   EXPECT_EQ(loom::design::position_after(d, 3).repeat, 2);
+  // The repeat saturates, never wraps: one row and 2^64-1 rows done used to give repeat 0 (fuzz_design).
+  const Design one = parse_design_csv("palette,R,#ff0000\nR\n", "one.csv");
+  EXPECT_EQ(loom::design::position_after(one, UINT64_MAX).repeat, INT32_MAX);
+  EXPECT_EQ(loom::design::position_after(one, UINT64_MAX).row, 0);
 }
 
 TEST(DesignTelemetry, CarriesTheRowKnottedLastTheNextAndTwoAfter) {
@@ -202,6 +206,12 @@ TEST_F(DesignBookTest, WhatCannotBeExplainedIsRefused) {
             std::string::npos);
   EXPECT_NE(refusal("{\"active\":\"a.csv\",\"at_rows\":1,\"designs\":{\"a.csv\":-4}}").find("\"designs\".\"a.csv\" = -4: not a row count"),
             std::string::npos);
+  // Row counts are bounded like the production counters they come from: 2^64-1 used to be accepted and wrap.
+  EXPECT_NE(refusal("{\"active\":\"a.csv\",\"at_rows\":1,\"designs\":{\"a.csv\":18446744073709551615}}")
+                .find("= 18446744073709551615: not a row count in 0..4294967295"),
+            std::string::npos);
+  EXPECT_NE(refusal("{\"active\":\"a.csv\",\"at_rows\":1,\"designs\":{\"a.csv\":4294967295}}").find("would pass 4294967295"),
+            std::string::npos);
   EXPECT_NE(refusal("{\"active\":\"a.csv\",\"at_rows\":1.5,\"designs\":{}}").find("\"at_rows\" = 1.5"), std::string::npos);
   EXPECT_NE(refusal("{\"active\":\"z.csv\",\"at_rows\":1,\"designs\":{}}").find("active design 'z.csv' has no entry"),
             std::string::npos);
@@ -213,13 +223,13 @@ TEST_F(DesignBookTest, WhatCannotBeExplainedIsRefused) {
 
 TEST_F(DesignBookTest, ConfigLoadsTheDesignBesideItAndReportsItsLine) {
   std::ofstream(dir_ / "rug.csv") << "palette,R,#ff0000\nR,R\nR,Q\n";
-  std::ofstream(dir_ / "loom.toml") << "extends = \"default\"\n[recipe]\nknotting = true\ndesign = \"rug.csv\"\n";
+  std::ofstream(dir_ / "loom.toml") << "extends = \"default\"\n[knotting]\nmode = \"weaver\"\n[recipe]\ndesign = \"rug.csv\"\n";
   try {
     loom::firmware::load_loom_config((dir_ / "loom.toml").string());
     FAIL() << "accepted";
   } catch (const loom::firmware::ConfigError& e) {
     const std::string msg = e.what();
-    EXPECT_NE(msg.find((dir_ / "loom.toml").string() + ":4:"), std::string::npos) << msg;
+    EXPECT_NE(msg.find((dir_ / "loom.toml").string() + ":5:"), std::string::npos) << msg;
     EXPECT_NE(msg.find("recipe.design = \"rug.csv\""), std::string::npos) << msg;
     EXPECT_NE(msg.find((dir_ / "rug.csv").string() + ":3:3: colour code 'Q'"), std::string::npos) << msg;
   }

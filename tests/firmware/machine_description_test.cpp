@@ -235,7 +235,7 @@ TEST(MachineAxes, AnAddedAxisIsDerivedIntoEveryModule) {
 TEST(MachineAxes, BadAxisTablesAreRefusedAtTheirLine) {
   // The old three-axis keys name where the fact lives now.
   EXPECT_EQ(config_error(ext("[can]\nnode_helix = 7\n")),
-            "loom.toml:3:14: can.node_helix = 7: the axes are [axes.<name>] tables now: this fact is axes.helix.node "
+            "loom.toml:3:14: can.node_helix = 7: moved: this fact is axes.helix.node "
             "(loomctl check --keys lists every key)");
   EXPECT_NE(config_error(ext("[can]\ncarriage_counts_per_m = 1e6\n")).find("axes.carriage.lead_m"), std::string::npos);
   // A new axis says what it is, which drive moves it and how fast it may go.
@@ -264,4 +264,43 @@ TEST(MachineAxes, BadAxisTablesAreRefusedAtTheirLine) {
       << config_error(ext(many));
   // A duplicated node id between an axis and the I/O module.
   EXPECT_NE(config_error(ext("[io]\nnode = 2\n")).find("node id already used by axes.carriage.node"), std::string::npos);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// [knotting]: the pile, as the machine ties it
+// ---------------------------------------------------------------------------------------------------
+TEST(MachineKnotting, TheOldRecipeFlagNamesItsNewHome) {
+  EXPECT_NE(config_error(ext("[recipe]\nknotting = true\n")).find("loom.toml:3:12: recipe.knotting = true: moved: this fact is knotting.mode"),
+            std::string::npos)
+      << config_error(ext("[recipe]\nknotting = true\n"));
+  EXPECT_TRUE(parse_loom_config(ext("[knotting]\nmode = \"weaver\"\n"), "x.toml").sequencer.knotting);
+  EXPECT_FALSE(default_loom_config().sequencer.knotting);
+}
+
+TEST(MachineKnotting, HeadsNeedAMagazineThatHoldsEveryColourOfTheDesign) {
+  const std::string dir = temp_path("knots");
+  std::filesystem::create_directories(dir);
+  // 1.2 m at 10 knots/dm: 120 knots per row; the design uses R and B, the magazine holds R and W.
+  std::ofstream design(dir + "/rug.csv");
+  design << "palette,R,#aa0000\npalette,B,#0000aa\npalette,W,#ffffff\n";
+  for (int row = 0; row < 2; ++row) {
+    for (int k = 0; k < 120; ++k) design << (k ? "," : "") << (row == 1 && k == 70 ? "B" : "R");
+    design << "\n";
+  }
+  design.close();
+  const std::string heads = "[knotting]\nmode = \"heads\"\nknots_per_dm = 10\nheads = 2\nhead_spacing_m = 0.6\n";
+  std::ofstream(dir + "/bad.toml") << ext(heads + "slot_colours = [\"R\", \"W\"]\n[recipe]\ndesign = \"rug.csv\"\n");
+  // Design row 1 is the file's last line (woven bottom up): its knot 71 is the blue one, head 2's.
+  EXPECT_NE(load_error(dir + "/bad.toml")
+                .find("recipe.design = \"rug.csv\": design row 1: colour \"B\" (knot 71, head 2) is in no magazine slot"),
+            std::string::npos)
+      << load_error(dir + "/bad.toml");
+  std::ofstream(dir + "/good.toml") << ext(heads + "slot_colours = [\"R\", \"W\", \"B\"]\n[recipe]\ndesign = \"rug.csv\"\n");
+  EXPECT_EQ(load_error(dir + "/good.toml"), "");
+  // Stripes that do not reach the right selvedge, at the spacing's line.
+  EXPECT_NE(config_error(ext("[knotting]\nmode = \"heads\"\nhead_spacing_m = 0.5\nslot_colours = [\"R\"]\n"))
+                .find("knotting.head_spacing_m = 0.5: knotting.head_spacing_m: 2 heads x 150 knots per stripe cover 300"),
+            std::string::npos)
+      << config_error(ext("[knotting]\nmode = \"heads\"\nhead_spacing_m = 0.5\nslot_colours = [\"R\"]\n"));
+  std::filesystem::remove_all(dir);
 }

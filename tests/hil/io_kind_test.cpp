@@ -72,7 +72,7 @@ TEST(IoKind, BadWiringIsAConfigErrorAtTheLineThatIsWrong) {
   EXPECT_EQ(e.rfind("loom.toml:3:18: io.button_ack_bit = 6:", 0), 0u) << e;
   EXPECT_NE(e.find("io.inputs.button_ack.bit = 6 is already used by io.inputs.estop_ok"), std::string::npos) << e;
   EXPECT_EQ(error_of("extends = \"default\"\n[io]\nnode = 2\n"),
-            "loom.toml:3:8: io.node = 2: node id already used by the carriage drive");
+            "loom.toml:3:8: io.node = 2: node id already used by axes.carriage.node");
 }
 
 }  // namespace

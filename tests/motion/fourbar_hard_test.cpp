@@ -365,5 +365,54 @@ TEST(SliderCrankHard, ScaleFreeAtOneE155) {
   }
 }
 
+
+// A double-rocker (Grashof, the coupler shortest): the knotting-chain example with links r0 = 78.105
+// (ground), r1 = 82.345 (input), r2 = 15.688 (coupler), r3 = 65.426 (output) mm at the pose θ1 = 135°,
+// θ2 = 10° in the drawing's frame. Independent values in long double, written out here: the diagonal
+// s = r1 + r2, the output angle θ3 = θs + acos((s² + r3² − r0²)/(2 s r3)), the ground direction
+// r1 + r2 − r3, and the output rate ω3/ω1 = (r1/r3)·sin(θ1 − θ2)/sin(θ3 − θ2) (−22.851).
+TEST(FourBarDoubleRocker, AnalysedAtThePosesItReaches) {
+  const FourBar m{78.105, 82.345, 15.688, 65.426};
+  ASSERT_EQ(classify(m), GrashofClass::kDoubleRocker);
+  const long double d2r = 3.141592653589793238462643383279502884L / 180.0L;
+  const long double r0 = 78.105L, r1 = 82.345L, r2 = 15.688L, r3 = 65.426L;
+  const long double t1 = 135.0L * d2r, t2 = 10.0L * d2r;
+  const long double sx = r1 * std::cos(t1) + r2 * std::cos(t2), sy = r1 * std::sin(t1) + r2 * std::sin(t2);
+  const long double s = std::hypot(sx, sy), ts = std::atan2(sy, sx);
+  const long double t3 = ts + std::acos((s * s + r3 * r3 - r0 * r0) / (2.0L * s * r3));
+  const long double ground = std::atan2(sy - r3 * std::sin(t3), sx - r3 * std::cos(t3));
+  const long double w3 = r1 / r3 * std::sin(t1 - t2) / std::sin(t3 - t2);
+  const long double w2 = -r1 / r2 * std::sin(t1 - t3) / std::sin(t2 - t3);
+  EXPECT_NEAR(static_cast<double>(w3), -22.851, 5e-4);  // the value the chain's example should print
+  const double crank = static_cast<double>(t1 - ground);
+  const Branch branch = branch_of(static_cast<double>(t2 - ground), static_cast<double>(t3 - ground));
+  const FourBarPose p = solve(m, crank, branch);
+  EXPECT_NEAR(p.k4, static_cast<double>(w3), 1e-11 * std::fabs(static_cast<double>(w3)));
+  EXPECT_NEAR(p.k3, static_cast<double>(w2), 1e-11 * std::fabs(static_cast<double>(w2)));
+  EXPECT_NEAR(wrap_pi(p.theta4 - static_cast<double>(t3 - ground)), 0.0, 1e-12);
+
+  // A whole turn: the reachable poses come out, the rest are counted, never thrown.
+  std::vector<FourBarPose> poses;
+  std::vector<int> index;
+  const ReachableSweep cover =
+      fourbar_sweep_reachable(m, branch, 360, 0.0, [&](int i, const FourBarPose& q) {
+        index.push_back(i);
+        poses.push_back(q);
+      });
+  EXPECT_EQ(cover.solved + cover.unreachable + cover.at_toggle, 360);
+  EXPECT_GT(cover.solved, 0);
+  EXPECT_GT(cover.unreachable, 0);
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    const FourBarPose q = solve(m, kTwoPi * index[k] / 360.0, branch);
+    EXPECT_NEAR(poses[k].k4, q.k4, 1e-12 * std::max(1.0, std::fabs(q.k4)));
+    // Reachable: A within the annulus |b − c| ≤ |A − B0| ≤ b + c around the output pivot.
+    const double ax = m.crank * std::cos(q.theta2) - m.ground, ay = m.crank * std::sin(q.theta2);
+    EXPECT_LE(std::hypot(ax, ay), m.coupler + m.rocker + 1e-9);
+  }
+  // The fully turning classes lose nothing.
+  const ReachableSweep full = fourbar_sweep_reachable(FourBar{1.0, 0.3, 1.0, 0.8}, Branch::kPositive, 64, 0.0,
+                                                      [](int, const FourBarPose&) {});
+  EXPECT_EQ(full.solved, 64);
+}
 }  // namespace
 }  // namespace loom::motion

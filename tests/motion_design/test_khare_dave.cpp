@@ -449,3 +449,32 @@ TEST(KhareDave, TinyAndHugeGroundsAndSwings) {
 }
 
 }  // namespace
+
+// φ → 180°: the designs depend on the supplement s = 180° − φ, which a degree input gives exactly
+// (Sterbenz) but π − rad(φ) only to ulp(π)/s (2.5e-8 relative at 179.999999°, 2.5 % at 180° − 1e-12°).
+// Independent values in long double from the degree difference: the β lower bound is s itself, and
+// the change-point design at β = s has a = sin(ψ/2)·sin(s/2)/cos(s/2 + ψ/2) (the crank folds back on
+// the coupler: relative error of a = that of s).
+TEST(KhareDaveNear180, SupplementFromDegreesKeepsFullRelativePrecision) {
+  using loom::motion::CrankRotation;
+  using loom::motion::khare_dave_beta_bounds;
+  using loom::motion::khare_dave_crank_rocker;
+  const long double pi_l = 3.141592653589793238462643383279502884L;
+  const double psi_deg = 45.0;
+  for (const double phi_deg : {179.999999, 180.0 - 1e-12, 179.9}) {
+    const long double s = (180.0L - static_cast<long double>(phi_deg)) * pi_l / 180.0L;
+    const long double half_psi = static_cast<long double>(psi_deg) * pi_l / 360.0L;
+    const CrankRotation phi = CrankRotation::degrees(phi_deg);
+    const auto bounds = khare_dave_beta_bounds(loom::motion::rad(psi_deg), phi);
+    EXPECT_NEAR(bounds.lower_rad, static_cast<double>(s), 4e-16 * static_cast<double>(s)) << phi_deg;
+    const CrankRockerDesign d = khare_dave_crank_rocker(loom::motion::rad(psi_deg), phi, bounds.lower_rad);
+    const long double a = std::sin(half_psi) * std::sin(s / 2.0L) / std::cos(s / 2.0L + half_psi);
+    EXPECT_NEAR(d.crank, static_cast<double>(a), 1e-14 * static_cast<double>(a)) << phi_deg;
+    EXPECT_TRUE(d.flags & kDesignChangePoint);
+  }
+  // The radian entry point keeps its documented precision: π − φ_rad (worse than the degree path).
+  const double phi_rad = loom::motion::rad(179.999999);
+  const auto coarse = khare_dave_beta_bounds(loom::motion::rad(psi_deg), phi_rad);
+  const double s = static_cast<double>((180.0L - static_cast<long double>(179.999999)) * pi_l / 180.0L);
+  EXPECT_NEAR(coarse.lower_rad, s, 1e-7 * s);
+}

@@ -92,11 +92,39 @@ expect_bad --config beatup --config "$TMP/missing.toml" --crank-rad-s 10
 # No NaN/inf with exit 0: an overflowing crank speed is refused, not printed and not a crash.
 expect_bad "not finite" balance --crank-rad-s 1e100 --samples 12
 expect_bad "non-finite" beatup --target-force-n 1e300
+# The optimiser's trace file: evaluations it probed outside the model (a 1e300 kg counterweight bound
+# drives the masses out of range) are left out and counted on stderr, never written as NaN/inf.
+"$BIN" balance --samples 12 --max-evaluations 200 --max-counterweight-kg 1e300 --trace "$TMP/trace.csv" > "$TMP/bal.csv" 2> "$TMP/err" ||
+  fail "balance with a huge bound exit: $(cat "$TMP/err")"
+grep -Eiq '(^|[^a-z])[-+]?(nan|inf)([^a-z]|$)' "$TMP/trace.csv" "$TMP/bal.csv" && fail "balance --trace wrote NaN/inf"
+grep -q "note: --trace: [1-9][0-9]* evaluations with a non-finite objective" "$TMP/err" ||
+  fail "balance --trace did not count the left-out evaluations: $(cat "$TMP/err")"
+# Equimomental point masses of the scraping machine's links (003 Table 1). Link 4 by hand: m = 1.706 kg,
+# d = 0.1714 m, I_O = 0.06824 kg m^2: l = sqrt(I_O/m) = 0.2 m; facing the centre, m1 = (m/3)(1 + 2d/l)
+# = 1.5433613 kg and m2 = m3 = (m/3)(1 - d/l) = 0.0813193 kg; every row rebuilds its own link.
+"$BIN" equimomental > "$TMP/eq.csv" 2> "$TMP/err" || fail "equimomental exit: $(cat "$TMP/err")"
+[ "$(wc -l < "$TMP/eq.csv")" -eq 8 ] || fail "equimomental rows: $(cat "$TMP/eq.csv")"
+awk -F, 'NR == 5 {
+  m = 1.706; d = 0.1714; l = 0.2
+  if ($1 != "4" || ($6 - l)^2 > 1e-24 || ($7 - m / 3 * (1 + 2 * d / l))^2 > 1e-22 || ($8 - m / 3 * (1 - d / l))^2 > 1e-22) bad = 1 }
+  NR > 1 && (($12 - $2)^2 > 1e-24 * $2^2 || ($13 - $3)^2 > 1e-24 || ($15 - $5)^2 > 1e-24 * $5^2 || $11 != "yes") { bad = 1 }
+  END { exit bad }' "$TMP/eq.csv" || fail "equimomental values: $(cat "$TMP/eq.csv")"
+"$BIN" equimomental --table balanced > /dev/null 2> "$TMP/err" || fail "equimomental balanced exit"
+grep -q "link 5: inertia about the origin 0.0525 kg m^2 is below m d^2" "$TMP/err" ||
+  fail "equimomental balanced: link 5 at the m d^2 <= I bound not flagged: $(cat "$TMP/err")"
+expect_bad "--inertia" equimomental --mass 1
 # e -> 1: the extreme-ratio flag.
 "$BIN" batten --e 0.999999 --search --scan-points 8 --samples 64 > /dev/null 2> "$TMP/err" || fail "batten e near 1 exit"
 grep -q "extreme ratio" "$TMP/err" || fail "batten --e 0.999999 --search not flagged: $(cat "$TMP/err")"
 "$BIN" beatup --crank-rad-s 15.5 --cam-e 0.999999 --samples 12 > /dev/null 2> "$TMP/err" || fail "beatup cam-e near 1 exit"
 grep -q "extreme ratio" "$TMP/err" || fail "beatup --cam-e 0.999999 not flagged: $(cat "$TMP/err")"
+# ... already at e = 0.99: speed ratio (1+e)/(1-e) = 199 > 100 (gain 39601); e = 0.98 (ratio 99) is not flagged.
+"$BIN" batten --e 0.99 --phi02-rad 0 --samples 64 > /dev/null 2> "$TMP/err" || fail "batten e 0.99 exit"
+grep -q "extreme ratio" "$TMP/err" || fail "batten --e 0.99 not flagged: $(cat "$TMP/err")"
+"$BIN" beatup --crank-rad-s 15.5 --cam-e 0.99 --samples 12 > /dev/null 2> "$TMP/err" || fail "beatup cam-e 0.99 exit"
+grep -q "extreme ratio" "$TMP/err" || fail "beatup --cam-e 0.99 not flagged: $(cat "$TMP/err")"
+"$BIN" batten --e 0.98 --phi02-rad 0 --samples 64 > /dev/null 2> "$TMP/err" || fail "batten e 0.98 exit"
+grep -q "extreme ratio" "$TMP/err" && fail "batten --e 0.98 flagged: $(cat "$TMP/err")"
 # Seed 004 per visit: two visits of the beat side per turn, each with its own gain; the beat's gain
 # is one of them and none exceeds ((1+e)/(1-e))^2 = 2.25 at e = 0.2.
 "$BIN" batten --e 0.2 --search --scan-points 60 > "$TMP/v.csv" || fail "batten per visit"

@@ -158,7 +158,8 @@ expect_rejected "--crank" fourbar --crank -1 --coupler 1 --rocker 1
 expect_rejected "--coupler" fourbar --crank 0.2 --coupler nan --rocker 1
 expect_rejected "--rocker" fourbar --crank 0.2 --coupler 1
 expect_rejected "--branch" fourbar --crank 0.2 --coupler 0.9 --rocker 0.8 --branch up
-expect_rejected "--ground/--crank/--coupler/--rocker" fourbar --ground 3 --crank 3.5 --coupler 1 --rocker 3.2
+# A double-rocker whose input cannot turn fully: one pose it cannot reach is refused, naming the options.
+expect_rejected "--start-deg" fourbar --ground 3 --crank 3.5 --coupler 1 --rocker 3.2 --samples 1 --start-deg 0
 expect_rejected "--ground/--crank/--coupler/--rocker" fourbar --ground 2 --crank 1 --coupler 2 --rocker 1
 expect_rejected "--point-link" fourbar --crank 0.2 --coupler 0.9 --rocker 0.8 --point-x 1
 expect_rejected "--samples" fourbar --crank 0.2 --coupler 0.9 --rocker 0.8 --samples 0
@@ -208,6 +209,43 @@ cmp -s <("$KIN" fourbar --ground 2.13e79 --crank 5.8e78 --coupler 1.89e79 --rock
 # e -> 1 keeps the extreme-ratio flag.
 "$KIN" batten-phase --e 0.999999 --step-deg 90 --samples 64 >/dev/null 2>"$TMP/err" || fail "batten-phase e near 1 exited $?"
 grep -q "near 1" "$TMP/err" || fail "batten-phase e near 1 not flagged"
+
+# ---- a double-rocker at the poses it reaches: the knotting chain's example -------------------------
+# Links r0 = 78.105 (ground), r1 = 82.345 (input), r2 = 15.688 (coupler), r3 = 65.426 (output) mm, drawn
+# at theta1 = 135 deg, theta2 = 10 deg. The pose and the rates from the example's own closed forms
+# (diagonal s = r1 + r2, theta3 = theta_s + acos((s^2 + r3^2 - r0^2)/(2 s r3)), omega3/omega1 =
+# (r1/r3) sin(theta1 - theta2)/sin(theta3 - theta2)), then the same pose through loom-kin.
+read -r crank_deg branch w3 w2 < <(awk 'BEGIN {
+  pi = atan2(0, -1); r = pi / 180
+  r0 = 78.105; r1 = 82.345; r2 = 15.688; r3 = 65.426; t1 = 135 * r; t2 = 10 * r
+  sx = r1 * cos(t1) + r2 * cos(t2); sy = r1 * sin(t1) + r2 * sin(t2); s = sqrt(sx * sx + sy * sy)
+  c = (s * s + r3 * r3 - r0 * r0) / (2 * s * r3); t3 = atan2(sy, sx) + atan2(sqrt(1 - c * c), c)
+  g = atan2(sy - r3 * sin(t3), sx - r3 * cos(t3))
+  printf "%.15f %s %.15g %.15g\n", (t1 - g) / r, (sin(t2 - t3) > 0 ? "positive" : "negative"),
+    r1 / r3 * sin(t1 - t2) / sin(t3 - t2), -r1 / r2 * sin(t1 - t3) / sin(t2 - t3) }')
+"$KIN" fourbar --ground 78.105 --crank 82.345 --coupler 15.688 --rocker 65.426 --samples 1 \
+  --start-deg "$crank_deg" --branch "$branch" >"$TMP/dr.csv" 2>"$TMP/err" || fail "double-rocker pose exited $?: $(cat "$TMP/err")"
+awk -F, -v w3="$w3" -v w2="$w2" 'NR == 2 {
+  if (w3 > -22.8505 || w3 < -22.8515) { print "closed form omega3/omega1 " w3 " is not -22.851"; bad = 1 }
+  d3 = $5 - w3; d2 = $4 - w2
+  if (d3 * d3 > 1e-14 || d2 * d2 > 1e-10) { print "k4 " $5 " vs " w3 ", k3 " $4 " vs " w2; bad = 1 }
+  n = NR } END { exit bad || n != 2 }' "$TMP/dr.csv" || fail "double-rocker example: $(cat "$TMP/dr.csv")"
+# Over a whole turn it prints the poses it reaches and says how many it left out (exit 0).
+"$KIN" fourbar --ground 78.105 --crank 82.345 --coupler 15.688 --rocker 65.426 --samples 360 >"$TMP/dr.csv" 2>"$TMP/err" ||
+  fail "double-rocker sweep exited $?: $(cat "$TMP/err")"
+rows=$(($(wc -l <"$TMP/dr.csv") - 1))
+grep -q "double-rocker's crank cannot reach every angle: $((360 - rows)) of 360 samples left out" "$TMP/err" ||
+  fail "double-rocker sweep note ($rows rows): $(cat "$TMP/err")"
+[ "$rows" -gt 0 ] && [ "$rows" -lt 360 ] || fail "double-rocker sweep rows: $rows"
+
+# ---- slider-crank near a toggle: mu_min = acos((a + e)/b) = 0.0018 deg is warned about ----------
+b=$(awk 'BEGIN { printf "%.17g", 2 / cos(0.0018 * atan2(0, -1) / 180) }')
+"$KIN" slider-crank --crank 1 --coupler "$b" --offset 1 --summary >"$TMP/sc.csv" 2>"$TMP/err" || fail "slider-crank near toggle exit"
+grep -q "warning: near toggle: the transmission angle reaches 0.0018 deg" "$TMP/err" ||
+  fail "slider-crank near toggle not warned: $(cat "$TMP/err")"
+awk -F, 'NR == 2 { d = $9 - 0.0018; exit (d * d > 1e-16) }' "$TMP/sc.csv" || fail "slider-crank mu_min: $(cat "$TMP/sc.csv")"
+"$KIN" slider-crank --crank 1 --coupler 3 --summary >/dev/null 2>"$TMP/err"
+[ -s "$TMP/err" ] && fail "slider-crank far from toggle warned: $(cat "$TMP/err")"
 
 [ "$FAILS" -eq 0 ] && echo "loom-kin CLI contract: all checks passed"
 [ "$FAILS" -eq 0 ]

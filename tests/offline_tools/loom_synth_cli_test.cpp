@@ -302,4 +302,43 @@ TEST_F(LoomSynthCli, ThreePointRefusesPointsThatDoNotDetermineTheChain) {
   EXPECT_TRUE(same.out.empty());
 }
 
+
+// The λ quadratic's root λ = 0 (an infinite link) is named, not dropped silently; a negative signed
+// length is explained. Points (0,0), (10,0), (0,10) with θ2 = 0 and θ0 = 90°: by hand, A = rows
+// [1, 2y, 2x], F = 0, ρ² = (0, 100, 100) give M = (0, 5, 5), p = 25, q = −1, r = 0, so λ ∈ {0, 1/25}
+// and λ = 1/25 gives a0 = a2 = 5, a1 = √50. With θ0 = 270° the ground column flips sign: λ = −1/25,
+// a0 = −5 (the same link pointing along 90°).
+TEST_F(LoomSynthCli, ThreePointNamesTheInfiniteRootAndNegativeLengths) {
+  const CliRun r = run("three-point --theta0-deg 90 --point 0,0,0 --point 10,0,0 --point 0,10,0 --full-precision");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto rows = csv(r.out);
+  ASSERT_EQ(rows.size(), 2u) << r.out;
+  EXPECT_NEAR(std::stod(rows[1][0]), 0.04, 1e-15);
+  EXPECT_NEAR(std::stod(rows[1][1]), 5.0, 1e-12);
+  EXPECT_NEAR(std::stod(rows[1][2]), std::sqrt(50.0), 1e-12);
+  EXPECT_NEAR(std::stod(rows[1][3]), 5.0, 1e-12);
+  EXPECT_NE(r.err.find("1 real root of the lambda quadratic left out"), std::string::npos) << r.err;
+  const CliRun n = run("three-point --theta0-deg 270 --point 0,0,0 --point 10,0,0 --point 0,10,0 --full-precision");
+  ASSERT_EQ(n.exit_code, 0) << n.err;
+  rows = csv(n.out);
+  ASSERT_EQ(rows.size(), 2u) << n.out;
+  EXPECT_NEAR(std::stod(rows[1][0]), -0.04, 1e-15);
+  EXPECT_NEAR(std::stod(rows[1][1]), -5.0, 1e-12);
+  EXPECT_NE(n.err.find("a0 = -5 < 0: that link points the other way"), std::string::npos) << n.err;
+}
+
+// φ → 180° through the CLI: the supplement is taken in degrees, so the change-point design at β = the
+// lower bound 180° − φ has a = sin(ψ/2)·sin(s/2)/cos(s/2 + ψ/2) to full precision (s = 1e-6° here;
+// computed in long double).
+TEST_F(LoomSynthCli, CrankRockerNear180KeepsItsDigits) {
+  const CliRun r = run("design --swing 45 --phi 179.999999 --beta 0.000001 --full-precision");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto rows = csv(r.out);
+  ASSERT_EQ(rows.size(), 2u) << r.out;
+  const long double d2r = 3.141592653589793238462643383279502884L / 180.0L;
+  const long double s = (180.0L - static_cast<long double>(179.999999)) * d2r;
+  const long double hp = 22.5L * d2r;
+  const long double a = std::sin(hp) * std::sin(s / 2.0L) / std::cos(s / 2.0L + hp);
+  EXPECT_NEAR(std::stod(rows[1][4]), static_cast<double>(a), 1e-13 * static_cast<double>(a)) << r.out;
+}
 }  // namespace

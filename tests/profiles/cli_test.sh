@@ -31,6 +31,10 @@ expect_exit 2 "--out" report
 expect_exit 2 "--config" dump --out "$work/x"
 expect_exit 2 "cannot open" dump --config "$work/none.toml" --out "$work/x"
 expect_exit 2 "--ellipse-e" dump --config firmware/config/default_loom.toml --out "$work/x" --ellipse-e 1.5
+# NaN is refused, never read as "not given" (the config's value) nor passed on to Google Benchmark.
+expect_exit 2 "--ellipse-e" dump --config firmware/config/default_loom.toml --out "$work/x" --ellipse-e nan
+expect_exit 2 "--ellipse-phi02-deg" dump --config firmware/config/default_loom.toml --out "$work/x" --ellipse-phi02-deg nan
+expect_exit 2 "--min-time" report --out "$work/x" --min-time nan
 expect_exit 2 "--interp" dump --config firmware/config/default_loom.toml --out "$work/x" --interp cubicle
 expect_exit 2 "profiles.max_table_error_rad" dump --config firmware/config/default_loom.toml --out "$work/x" \
   --table-size 16 --interp linear

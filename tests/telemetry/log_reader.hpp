@@ -9,6 +9,7 @@
 #include "loomlcm/axes_t.hpp"
 #include "loomlcm/beat_t.hpp"
 #include "loomlcm/fault_t.hpp"
+#include "loomlcm/identity_t.hpp"
 #include "loomlcm/row_t.hpp"
 #include "loomlcm/rt_stats_t.hpp"
 #include "loomlcm/status_t.hpp"
@@ -22,6 +23,7 @@ struct LoggedMessages {
   std::vector<loomlcm::beat_t> beat;
   std::vector<loomlcm::fault_t> fault;
   std::vector<loomlcm::row_t> row;
+  std::vector<loomlcm::identity_t> identity;  // who publishes: once a second with STATUS
   std::vector<std::string> other_channels;
   int decode_errors = 0;
 };
@@ -55,6 +57,8 @@ inline LoggedMessages read_log(const std::string& path, const std::string& prefi
       ok = decode_into(*ev, out.fault);
     else if (ev->channel == prefix_and_id + ".ROW")
       ok = decode_into(*ev, out.row);
+    else if (ev->channel == prefix_and_id + ".IDENTITY")
+      ok = decode_into(*ev, out.identity);
     else
       out.other_channels.push_back(ev->channel);
     if (!ok) ++out.decode_errors;

@@ -66,6 +66,12 @@ TEST_F(PublisherLog, DecimatedCountsMatchTheIntervals) {
   const auto log = test_support::read_log(log_path(), "LOOM.T1");
   ASSERT_EQ(log.decode_errors, 0);
   EXPECT_TRUE(log.other_channels.empty());
+  // IDENTITY: at least the first STATUS carries who publishes (then at most once a second).
+  ASSERT_FALSE(log.identity.empty());
+  EXPECT_EQ(log.identity.front().loom_id, "T1");
+  EXPECT_EQ(log.identity.front().pid, static_cast<std::int32_t>(::getpid()));
+  EXPECT_FALSE(log.identity.front().host.empty());
+  EXPECT_NE(log.identity.front().instance, 0);
   // Ticks 0..K-1, one message per whole interval started: ceil(K / n).
   const auto ceil_div = [](std::int64_t a, std::int64_t b) { return (a + b - 1) / b; };
   EXPECT_EQ(static_cast<std::int64_t>(log.status.size()), ceil_div(kTicks, 100));

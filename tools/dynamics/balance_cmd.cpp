@@ -2,6 +2,7 @@
 // the crank and rocker, and/or redistribution of every link's mass — with RMS shaking force and moment
 // before and after, the optimiser's stop reason, and optionally its convergence trace and SVG plots.
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -30,7 +31,7 @@ CLI::App* add_balance(CLI::App& app, BalanceArgs& a) {
       ->check(positive_number())->capture_default_str();
   c->add_option("--counterweight-thickness-m", a.counterweight_thickness_m, "Thickness of the cast-iron counterweight discs")
       ->check(positive_number())->capture_default_str();
-  c->add_option("--xtol", a.xtol_rel, "SLSQP relative tolerance on the design variables")->check(CLI::Range(1e-15, 0.5))->capture_default_str();
+  c->add_option("--xtol", a.xtol_rel, "SLSQP relative tolerance on the design variables")->check(cli::finite_range(1e-15, 0.5))->capture_default_str();
   c->add_option("--max-evaluations", a.max_evaluations, "SLSQP evaluation budget per start")->check(CLI::Range(1, 10000000))->capture_default_str();
   c->add_option("--trace", a.trace, "Write every objective evaluation (convergence) as CSV to this file");
   c->add_option("--svg-force", a.svg_force, "Plot shaking force magnitude vs crank angle, before/after, to this SVG");
@@ -109,14 +110,27 @@ void run_balance(const CLI::App& cmd, const BalanceArgs& a) {
     std::ofstream f(a.trace, std::ios::binary);
     if (!f) throw UsageError("--trace: cannot write '" + a.trace + "'");
     std::string t = "method,evaluation,objective,rms_force_n,rms_moment_nm\n";
+    std::size_t non_finite = 0;
     for (const BalanceResult& r : results) {
       for (const OptimiserStep& st : r.trace) {
+        // The optimiser probes designs the model cannot evaluate (a link mass or inertia driven out of
+        // its domain gives NaN/inf): those evaluations are left out of the file and counted, never written.
+        if (!std::isfinite(st.objective) || !std::isfinite(st.rms.force_n) || !std::isfinite(st.rms.moment_nm)) {
+          ++non_finite;
+          continue;
+        }
         t += r.method + "," + std::to_string(st.evaluation) + "," + cli::format_number(st.objective) + "," +
              cli::format_number(st.rms.force_n) + "," + cli::format_number(st.rms.moment_nm) + "\n";
       }
     }
     f << t;
     if (!f.flush()) throw UsageError("--trace: cannot write '" + a.trace + "'");
+    if (non_finite > 0) {
+      std::fprintf(stderr,
+                   "loom-dynamics: note: --trace: %zu evaluations with a non-finite objective (the optimiser probing "
+                   "outside the model's domain) left out of %s; their numbers are gaps in the evaluation column\n",
+                   non_finite, a.trace.c_str());
+    }
   }
   if (!a.svg_force.empty() || !a.svg_moment.empty()) {
     std::vector<PlanarInertia> original;

@@ -72,4 +72,12 @@ void run_balance(const CLI::App& cmd, const BalanceArgs& a);
 CLI::App* add_mass(CLI::App& app);
 void run_mass();
 
+struct EquimomentalArgs {
+  double mass_kg = 0.0, centre_d_m = 0.0, centre_theta_deg = 0.0, inertia_kg_m2 = 0.0;
+  double offset_deg = 0.0;  // used when given; otherwise the points face the mass centre
+  std::string table = "original";
+};
+CLI::App* add_equimomental(CLI::App& app, EquimomentalArgs& a);
+void run_equimomental(const CLI::App& cmd, const EquimomentalArgs& a);
+
 }  // namespace loom::dyncli

@@ -54,7 +54,7 @@ loom::motion::BattenDrive make_drive(const BattenArgs& a, double phi02) {
 void warn_about_gear(const loom::motion::EllipticGearPair& g) {
   if (g.near_degenerate()) {
     std::fprintf(stderr,
-                 "loom-kin: warning: --e %.17g is near 1: the crank speed swings by %.3g:1, results "
+                 "loom-kin: warning: extreme ratio: --e %.17g is near 1: the crank acceleration swings by %.3g:1, results "
                  "are finite but ill-conditioned\n",
                  g.eccentricity(), g.max_speed_ratio() * g.max_speed_ratio());
   }
@@ -75,7 +75,7 @@ CLI::App* add_batten_command(CLI::App& app, BattenArgs& a) {
       ->check(finite_number())->capture_default_str();
   c->add_option("--solver", a.solver, "Position solver")->check(CLI::IsMember({"closed", "newton"}))->capture_default_str();
   c->add_option("--newton-tol", a.newton_tol, "Newton tolerance on |F|, relative to the largest link")
-      ->check(CLI::Range(1e-15, 1e-2))->capture_default_str();
+      ->check(cli::finite_range(1e-15, 1e-2))->capture_default_str();
   c->add_flag("--pose", a.pose, "Append gamma2_rad,gamma3_rad,gamma4_rad");
   return c;
 }
@@ -84,7 +84,7 @@ CLI::App* add_batten_phase_command(CLI::App& app, BattenArgs& a) {
   CLI::App* c = app.add_subcommand(
       "batten-phase", "Scan the crank phase phi02: batten acceleration at its turning points and gain over e = 0");
   add_common(c, a);
-  c->add_option("--step-deg", a.step_deg, "phi02 step over [0, 360)")->check(CLI::Range(0.01, 90.0))->capture_default_str();
+  c->add_option("--step-deg", a.step_deg, "phi02 step over [0, 360)")->check(cli::finite_range(0.01, 90.0))->capture_default_str();
   return c;
 }
 

@@ -77,9 +77,11 @@ void write_sweep(const FourBarArgs& a, const loom::motion::FourBar& m, loom::mot
   std::string header = "theta2_deg,theta3_deg,theta4_deg,k3,k4,k3p,k4p,transmission_deg";
   if (point) header += ",point_x,point_y,point_vx,point_vy,point_ax,point_ay";
   cli::CsvWriter out(header);
-  long i = 0;
-  fourbar_sweep(m, branch, a.samples, rad(a.start_deg), [&](const FourBarPose& p) {
-    out.num(a.start_deg + 360.0 * static_cast<double>(i++) / static_cast<double>(a.samples));
+  // Every class but the change point: a linkage whose crank cannot turn fully (double-rocker,
+  // rocker-crank, triple-rocker) is analysed at the crank angles it reaches; the others are left out
+  // and counted. The crank angle column is the pose's own, so a gap shows where they were.
+  const ReachableSweep cover = fourbar_sweep_reachable(m, branch, a.samples, rad(a.start_deg), [&](int i, const FourBarPose& p) {
+    out.num(a.start_deg + 360.0 * static_cast<double>(i) / static_cast<double>(a.samples));
     out.num(deg(p.theta3)).num(deg(p.theta4)).num(p.k3).num(p.k4).num(p.k3p).num(p.k4p);
     out.num(deg(p.transmission));
     if (point) {
@@ -90,7 +92,20 @@ void write_sweep(const FourBarArgs& a, const loom::motion::FourBar& m, loom::mot
     }
     out.end_row();
   });
+  if (cover.solved == 0) {
+    throw MotionError(ErrorCode::kNotAssemblable,
+                      std::string("the ") + grashof_class_name(classify(m)) + " cannot be assembled at any of the " +
+                          std::to_string(a.samples) + " crank angles asked for (--start-deg " +
+                          cli::format_number(a.start_deg) + ", --samples " + std::to_string(a.samples) + ")");
+  }
   out.finish();
+  if (cover.unreachable + cover.at_toggle > 0) {
+    std::fprintf(stderr,
+                 "loom-kin: note: the %s's crank cannot reach every angle: %d of %d samples left out (%d beyond its "
+                 "reach, %d at a toggle)\n",
+                 grashof_class_name(classify(m)), cover.unreachable + cover.at_toggle, a.samples, cover.unreachable,
+                 cover.at_toggle);
+  }
 }
 
 }  // namespace
@@ -98,7 +113,8 @@ void write_sweep(const FourBarArgs& a, const loom::motion::FourBar& m, loom::mot
 CLI::App* add_fourbar_command(CLI::App& app, FourBarArgs& a) {
   CLI::App* c = app.add_subcommand(
       "fourbar",
-      "Any four-bar (crank input) over one crank turn: angles, kinematic coefficients, transmission");
+      "Any four-bar (crank input) over one crank turn: angles, kinematic coefficients, transmission; a "
+      "linkage whose input cannot turn fully (double-rocker, ...) at the crank angles it reaches");
   c->add_option("--ground", a.ground, "Ground link A0B0 (lengths in its unit)")
       ->check(positive_number())
       ->capture_default_str();

@@ -3,6 +3,7 @@
 // the length options they come from.
 #include "slider_crank_cmd.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <string>
 
@@ -10,6 +11,7 @@
 #include "loom/cli/numbers.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/errors.hpp"
+#include "loom/motion/fourbar.hpp"
 #include "loom/motion/slider_crank.hpp"
 
 namespace loom::kin {
@@ -38,10 +40,28 @@ CLI::App* add_slider_crank_command(CLI::App& app, SliderCrankArgs& a) {
   return c;
 }
 
+namespace {
+
+// The same warning as loom-kin fourbar's: a transmission angle this close to 0 amplifies rates and
+// length errors by 1/sin μ (μ_min = acos((a + |e|)/b) for the slider-crank).
+void warn_near_toggle(const loom::motion::SliderCrank& m) {
+  using namespace loom::motion;
+  const double mu_min = slider_dead_centres(m).mu_min_rad;
+  if (std::sin(mu_min) < kNearToggleSine) {
+    std::fprintf(stderr,
+                 "loom-kin: warning: near toggle: the transmission angle reaches %.6g deg (|sin mu| = %.3g < %g); "
+                 "rates there are amplified by 1/|sin mu| and small length errors move the linkage a long way\n",
+                 deg(mu_min), std::sin(mu_min), kNearToggleSine);
+  }
+}
+
+}  // namespace
+
 void run_slider_crank(const SliderCrankArgs& a) {
   using namespace loom::motion;
   const SliderCrank m{a.crank, a.coupler, a.offset};
   try {
+    warn_near_toggle(m);
     if (a.summary) {
       const SliderDeadCentres dc = slider_dead_centres(m);
       cli::CsvWriter out(

@@ -4,6 +4,11 @@
 //                       fault with axis, hex codes and text) and a compact status at most once per
 //                       second of loop time
 //   --channel KIND,...  one key=value line per message of those channels (status axes rt beat fault row)
+// Replayed data is marked, never mixed with a live loom's: a message stamped (utime, the publisher's wall
+// clock) more than --replay-after-s before now was recorded earlier and is being replayed (lcm-logplayer
+// onto this group, or a log read through file://). Its lines say so ("REPLAY recorded N s ago" in the event
+// view, " replayed=1 recorded_s_ago=N" at the end of key=value lines) and the event view keeps a separate
+// state per loom for replayed messages, so a recording never invents state changes of the live loom.
 // Exit 0 after --count lines (or, without --count, on Ctrl-C / end of log once something was printed),
 // 1 when the timeout or the log ends without them, 2 on bad arguments.
 #include <CLI/CLI.hpp>
@@ -39,7 +44,13 @@ struct Options {
   double timeout_s = 0.0;
   double status_every_s = 1.0;
   bool no_beats = false;
+  double replay_after_s = 10.0;
 };
+
+std::int64_t wall_utime() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
 
 // Handlers are static functions with a context pointer (subscribeFunction) rather than member
 // functions: LCM 1.3.1's member-function subscribe() crashes when built with -fsanitize=undefined.
@@ -47,8 +58,12 @@ class Printer {
   using View = loom::monitor::EventView;
 
  public:
-  Printer(bool event_view, std::set<std::string> raw, double status_every_s, bool show_beats)
-      : event_view_(event_view), raw_(std::move(raw)), view_(status_every_s, show_beats) {}
+  Printer(bool event_view, std::set<std::string> raw, double status_every_s, bool show_beats, double replay_after_s)
+      : event_view_(event_view),
+        raw_(std::move(raw)),
+        view_(status_every_s, show_beats),
+        replay_view_(status_every_s, show_beats),
+        replay_after_us_(static_cast<std::int64_t>(replay_after_s * 1e6)) {}
 
   template <typename Msg>
   static void on(const lcm::ReceiveBuffer*, const std::string&, const Msg* m, Printer* self) {
@@ -70,13 +85,27 @@ class Printer {
   template <typename Msg>
   void dispatch(const char* kind, const Msg& m, std::string (*raw_line)(const Msg&),
                 std::vector<std::string> (View::*view_lines)(const Msg&)) {
+    const std::int64_t age_us = wall_utime() - m.utime;
+    const bool replayed = age_us > replay_after_us_;
+    const std::string ago = std::to_string(age_us / 1'000'000);
+    if (replayed) note_replay(m.loom_id, ago);
     if (event_view_) {
       if (view_lines != nullptr) {
-        for (const auto& line : (view_.*view_lines)(m)) print(line);
+        View& v = replayed ? replay_view_ : view_;
+        for (const auto& line : (v.*view_lines)(m)) print(replayed ? "REPLAY recorded " + ago + " s ago: " + line : line);
       }
     } else if (raw_.count(kind) != 0) {
-      print(raw_line(m));
+      print(replayed ? raw_line(m) + " replayed=1 recorded_s_ago=" + ago : raw_line(m));
     }
+  }
+  // Once per loom: say on stderr that replayed messages are arriving (on a live group they would
+  // otherwise look like the loom itself).
+  void note_replay(const std::string& loom_id, const std::string& ago) {
+    if (!replay_noted_.insert(loom_id).second) return;
+    std::fprintf(stderr,
+                 "loom-monitor: %s: replayed messages (recorded %s s ago) on this group; marked REPLAY and kept "
+                 "apart from the live loom (replay recordings onto their own group: tools/README.md)\n",
+                 loom::monitor::printable_field(loom_id).c_str(), ago.c_str());
   }
   // Flushed per line so `loom-monitor | grep` and scripts see each message as it arrives.
   void print(const std::string& line) {
@@ -88,7 +117,10 @@ class Printer {
 
   bool event_view_;
   std::set<std::string> raw_;
-  View view_;
+  View view_;         // live messages
+  View replay_view_;  // replayed ones: their own per-loom state
+  std::int64_t replay_after_us_;
+  std::set<std::string> replay_noted_;
 };
 
 int usage_error(const std::string& msg) {
@@ -124,6 +156,10 @@ int main(int argc, char** argv) {
                  "Event view: a compact status line at most this often, in seconds of loop time")
       ->capture_default_str();
   app.add_flag("--no-beats", o.no_beats, "Event view: leave out the per-beat lines");
+  app.add_option("--replay-after-s", o.replay_after_s,
+                 "Messages stamped more than this many seconds ago are replayed recordings: marked REPLAY and "
+                 "kept apart from the live loom")
+      ->capture_default_str();
   app.add_option("--channel-prefix", o.channel_prefix, "First field of the channel names")
       ->capture_default_str();
   try {
@@ -139,6 +175,9 @@ int main(int argc, char** argv) {
   }
   if (!std::isfinite(o.status_every_s) || o.status_every_s < 0.0 || o.status_every_s > kMaxTimeoutS) {
     return usage_error("--status-every-s " + std::to_string(o.status_every_s) + " must be a number of seconds >= 0");
+  }
+  if (!std::isfinite(o.replay_after_s) || o.replay_after_s < 0.0 || o.replay_after_s > kMaxTimeoutS) {
+    return usage_error("--replay-after-s " + std::to_string(o.replay_after_s) + " must be a number of seconds >= 0");
   }
   if (!o.loom_id.empty()) {
     if (auto e = loom::telemetry::loom_id_error(o.loom_id); !e.empty()) return usage_error("--loom-id: " + e);
@@ -161,7 +200,7 @@ int main(int argc, char** argv) {
     return usage_error("--lcm-url '" + o.lcm_url + "' could not be opened by LCM");
   }
 
-  Printer printer(event_view, raw, o.status_every_s, !o.no_beats);
+  Printer printer(event_view, raw, o.status_every_s, !o.no_beats, o.replay_after_s);
   // LCM keeps 30 unhandled messages per subscription by default; a log replayed fast or a burst of
   // row-end changes can exceed that, so allow a generous queue.
   constexpr int kQueue = 10000;

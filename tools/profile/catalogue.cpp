@@ -28,7 +28,7 @@ Catalogue default_catalogue() {
   c.profiles.push_back({.name = "rocker",
                         .unit = "rad",
                         .what = "beater (rocker) angle vs crank phase",
-                        .requirement = 1e-7,
+                        .requirement = 1e-9,
                         .phase_rate = omega,
                         .rise = 0.0,
                         .exact = [p](double phi) {
@@ -40,7 +40,7 @@ Catalogue default_catalogue() {
   c.profiles.push_back({.name = "crank_elliptic",
                         .unit = "rad",
                         .what = "crank vs master phase, elliptic law e = 0.2",
-                        .requirement = 1e-7,
+                        .requirement = 1e-9,
                         .phase_rate = omega,
                         .rise = 0.0,
                         .exact = [p](double phi) {

@@ -14,6 +14,7 @@
 #include "catalogue.hpp"
 #include "chart.hpp"
 #include "dump.hpp"
+#include "loom/cli/numbers.hpp"
 #include "loom/firmware/config.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/errors.hpp"
@@ -136,7 +137,7 @@ int main(int argc, char** argv) {
   report->add_option("--out", rep.out, "Output directory (created)")->required();
   report->add_option("--sizes", rep.sizes, "Table sizes (default 64 128 ... 65536)")->check(CLI::Range(4, 1 << 24));
   report->add_option("--min-time", rep.min_time_s, "Google Benchmark minimum time per repetition, s")
-      ->check(CLI::Range(1e-4, 10.0))->capture_default_str();
+      ->check(loom::cli::finite_range(1e-4, 10.0))->capture_default_str();
   report->add_option("--repetitions", rep.repetitions, "Benchmark repetitions (the fastest counts)")
       ->check(CLI::Range(1, 100))->capture_default_str();
   report->add_option("--check-points", rep.check_points, "Phases at which errors are measured")
@@ -148,11 +149,11 @@ int main(int argc, char** argv) {
   dump_cmd->add_option("--out", dump.out, "Output directory (created)")->required();
   dump_cmd->add_option("--crank-law", dump.crank_law, "Override: crank speed law")->check(CLI::IsMember({"constant", "elliptic"}));
   dump_cmd->add_option("--ellipse-e", dump.ellipse_e, "Override: eccentricity of the elliptic law, [0, 1)")
-      ->check(CLI::Range(0.0, 0.999999));
+      ->check(loom::cli::finite_range(0.0, 0.999999));
   dump_cmd->add_option("--ellipse-lobes", dump.ellipse_lobes, "Override: lobes of the elliptic pitch curves")
       ->check(CLI::Range(1, 16));
   dump_cmd->add_option("--ellipse-phi02-deg", dump.ellipse_phi02_deg, "Override: driven-pinion angle at the fell, deg")
-      ->check(CLI::Range(-360.0, 360.0));
+      ->check(loom::cli::finite_range(-360.0, 360.0));
   dump_cmd->add_option("--table-size", dump.table_size, "Override: knots per turn")->check(CLI::Range(4, 1 << 24));
   dump_cmd->add_option("--interp", dump.interp, "Override: interpolation")->check(CLI::IsMember({"linear", "cubic", "quintic"}));
   dump_cmd->add_option("--precision", dump.precision, "Override: knot precision")->check(CLI::IsMember({"double", "float32"}));

@@ -68,7 +68,7 @@ void design_crank_rocker(const DesignArgs& args, std::ostream& out, std::ostream
   require_positive_length("--ground", args.ground);
   if (args.has_beta && args.has_lambda) throw ArgError("--beta / --lambda: give at most one of them");
   const double psi = rad(args.swing_deg);
-  const double phi = rad(args.phi_deg);
+  const motion::CrankRotation phi = motion::CrankRotation::degrees(args.phi_deg);
   blame("--swing " + input_value(args.swing_deg) + " --phi " + input_value(args.phi_deg),
         [&] { return motion::khare_dave_beta_bounds(psi, phi); });
   motion::CrankRockerDesign d;

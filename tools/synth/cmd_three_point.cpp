@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "commands.hpp"
@@ -19,8 +20,11 @@ namespace loom::synth {
 
 namespace {
 
-// Links longer than this many times the points' extent are the λ → 0 branch running off to infinity.
-constexpr double kInfiniteLinkRatio = 1e9;
+// Links longer than this many times the points' extent are the λ → 0 branch running off to infinity:
+// dropped with a note (their digits are the roots' rounding, not a mechanism).
+constexpr double kInfiniteLinkRatio = 1e6;
+// Longer than this many times the extent: printed, flagged as a near-infinite link (ill-conditioned).
+constexpr double kLongLinkRatio = 1e3;
 
 motion::PrecisionPoint parse_point(const std::string& text, int index) {
   const std::string arg = "--point " + text;
@@ -79,13 +83,29 @@ void run_three_point(const ThreePointArgs& args, std::ostream& out, std::ostream
     }
     throw ArgError(std::string("--point/--theta0-deg: ") + e.what());
   }
+  if (r.rejected_roots > 0) {
+    err << "loom-synth: note: " << r.rejected_roots << " real root" << (r.rejected_roots > 1 ? "s" : "")
+        << " of the lambda quadratic left out: lambda = 1/(a0 a2) = 0 (or a1^2 <= 0) is a chain with an "
+           "infinite link, not a mechanism\n";
+  }
   std::vector<motion::ThreePointSolution> finite;
+  const double reach = std::max(extent, 1e-300);
   for (const motion::ThreePointSolution& s : r.solutions) {
     const double longest = std::max({std::fabs(s.a0), std::fabs(s.a1), std::fabs(s.a2)});
-    if (!(longest <= kInfiniteLinkRatio * std::max(extent, 1e-300))) {
+    if (!(longest <= kInfiniteLinkRatio * reach)) {
       err << "loom-synth: note: solution lambda = " << s.lambda << " dropped: a link of " << longest
-          << " mm is " << longest / extent << " times the points' extent (infinite link)\n";
+          << " mm is " << longest / reach << " times the points' extent (infinite link)\n";
       continue;
+    }
+    if (longest > kLongLinkRatio * reach) {
+      err << "loom-synth: warning: solution lambda = " << s.lambda << ": a link of " << longest << " mm is "
+          << longest / reach << " times the points' extent: near the infinite-link root, ill-conditioned\n";
+    }
+    for (const auto& [name, len] : {std::pair{"a0", s.a0}, std::pair{"a2", s.a2}}) {
+      if (len < 0.0) {
+        err << "loom-synth: note: solution lambda = " << s.lambda << ": " << name << " = " << len
+            << " < 0: that link points the other way (along its angle + 180 deg), length " << -len << " mm\n";
+      }
     }
     finite.push_back(s);
   }

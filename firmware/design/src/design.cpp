@@ -220,7 +220,9 @@ Design parse_design(const std::string& bytes, const std::string& source) {
 
 DesignPosition position_after(const Design& d, std::uint64_t rows_done) {
   const auto h = static_cast<std::uint64_t>(d.height());
-  return {static_cast<int>(rows_done % h), static_cast<int>(std::min<std::uint64_t>(rows_done / h + 1, INT32_MAX))};
+  // Clamped before the +1: with one row and 2^64-1 rows done, rows_done / h + 1 wraps to repeat 0
+  // (found by tests/fuzz/fuzz_design).
+  return {static_cast<int>(rows_done % h), static_cast<int>(std::min<std::uint64_t>(rows_done / h, INT32_MAX - 1) + 1)};
 }
 
 }  // namespace loom::design

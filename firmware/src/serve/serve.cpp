@@ -11,10 +11,12 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include "loom/firmware/config.hpp"
 #include "loom/firmware/counter_store.hpp"
@@ -25,12 +27,20 @@
 #include "loom/firmware/serve/control_socket.hpp"
 #include "loom/firmware/serve/fault_history.hpp"
 #include "loom/firmware/serve/journal.hpp"
+#include "loom/firmware/serve/sd_notify.hpp"
+#include "loom/firmware/serve/state_lock.hpp"
+#include "loom/telemetry/identity.hpp"
 
 namespace loom::firmware::serve {
 namespace {
 
 constexpr int kExitOk = 0, kExitBadInput = 2, kExitNotArmed = 4;
 constexpr const char* kEtcConfig = "/etc/loomctl/loom.toml";
+// The id every board's embedded default loom has: two boards left on it are one loom on the LCM group.
+constexpr const char* kDefaultLoomId = "loom1";
+constexpr std::int64_t kSaveRetryNs = 1'000'000'000;  // a failed counters save is retried once a second
+// How long a loom listens for another publisher of its id before arming: IDENTITY comes once a second.
+constexpr std::chrono::milliseconds kIdentityListen{1300};
 
 OperatorLink* g_link = nullptr;
 extern "C" void on_terminate(int) {
@@ -92,6 +102,10 @@ int serve_main(const ServeArgs& a) {
     if (!a.lcm_url.empty()) cfg.telemetry.lcm_url = a.lcm_url;
     if (hardware && a.pace != 1.0) throw ConfigError("--pace = " + std::to_string(a.pace) + ": simulation only");
     if (hardware && a.iface.empty()) throw ConfigError("--hal socketcan needs --iface NAME");
+    if (hardware && cfg.loom_id == kDefaultLoomId) {
+      throw ConfigError(std::string("loom id '") + kDefaultLoomId + "' is the default every installed board has: give this "
+                        "loom its own (LOOMCTL_LOOM_ID in /etc/loomctl/loom-id, loom.id in the config, or --loom-id)");
+    }
   } catch (const ConfigError& e) {
     log(Severity::kErr, "loomctl serve: %s", e.what());
     return kExitBadInput;
@@ -104,13 +118,24 @@ int serve_main(const ServeArgs& a) {
     return kExitBadInput;
   }
   const std::string state = std::filesystem::path(a.state_dir).string();
+  const std::string socket_path = a.socket.empty() ? "/run/loomctl/" + cfg.loom_id + ".sock" : a.socket;
+  // One serve per state directory (the socket alone does not say so: another --socket would share
+  // these counters). Held until this process ends.
+  std::unique_ptr<StateDirLock> state_lock;
+  try {
+    state_lock = std::make_unique<StateDirLock>(state, cfg.loom_id, socket_path);
+  } catch (const std::exception& e) {
+    log(Severity::kErr, "loomctl serve: refusing to arm: %s", e.what());
+    return kExitNotArmed;
+  }
   CounterStore store(state + "/counters.json");
   FaultHistory history(state + "/faults.log");
   // The row each design has reached, beside the counters (only when the recipe names a design).
   std::unique_ptr<DesignBook> book;
   if (cfg.recipe.design) book = std::make_unique<DesignBook>(state + "/designs.json");
   DesignProgress design_progress;
-  const std::string socket_path = a.socket.empty() ? "/run/loomctl/" + cfg.loom_id + ".sock" : a.socket;
+  const SystemdNotifier systemd;
+  LoopWatchdog watchdog(systemd);
 
   // Real time: memory locked and SCHED_FIFO probed for the loop thread only (this thread, the control
   // thread and the telemetry publisher stay SCHED_OTHER).
@@ -128,6 +153,18 @@ int serve_main(const ServeArgs& a) {
 
   OperatorLink link;
   g_link = &link;
+  // `ctl status` answers from the link, which the loop fills from its first tick on; until then (config,
+  // the LCM identity check, arming) it shows the counters on disk, never zeros that look like a reset.
+  const auto show_counters = [&link](const sequencer::Counters& c) {
+    link.rows.store(c.rows, std::memory_order_relaxed);
+    link.picks.store(c.picks, std::memory_order_relaxed);
+    link.beats.store(c.beats, std::memory_order_relaxed);
+  };
+  try {
+    if (auto c = store.load()) show_counters(*c);
+  } catch (const ConfigError&) {
+    // Reported (and refused) when the first session loads them.
+  }
   std::signal(SIGTERM, on_terminate);
   std::signal(SIGINT, on_terminate);
 
@@ -159,7 +196,7 @@ int serve_main(const ServeArgs& a) {
         return out.empty() ? "no faults recorded in " + history.path() + "\n" : out;
       } else if (req == "next") {
         if (!cfg.sequencer.knotting) {
-          return "error: next: this loom's recipe has no knotting mode (recipe.knotting = false)\n";
+          return "error: next: this loom has no weaver's knotting (knotting.mode is not \"weaver\")\n";
         }
         link.post(Command::kNext);
       } else {
@@ -177,8 +214,12 @@ int serve_main(const ServeArgs& a) {
       cfg.loom_id.c_str(), cfg.source.c_str(), a.hal.c_str(), hardware ? " " : "", hardware ? a.iface.c_str() : "",
       state.c_str(), socket_path.c_str());
 
-  bool start_at_once = false;
+  bool start_at_once = false, ready_sent = false;
+  // Counters woven but not on disk when a session ended: the next session arms from these, never from
+  // the file's older counts (which would weave those rows again).
+  std::optional<sequencer::Counters> unsaved;
   for (;;) {
+    watchdog.ping_outside_loop();  // re-arming: no loop runs, this thread is the proof of life
     // ---- arm one session from what is on disk ----
     sequencer::Counters resume{};
     try {
@@ -187,6 +228,12 @@ int serve_main(const ServeArgs& a) {
       log(Severity::kErr, "loomctl serve: %s", e.what());
       return kExitBadInput;
     }
+    const std::optional<sequencer::Counters> arm_unsaved = unsaved;
+    if (unsaved) {
+      resume = *unsaved;
+      unsaved.reset();
+    }
+    show_counters(resume);
     std::uint64_t design_rows = 0;
     if (book) {
       try {
@@ -204,6 +251,25 @@ int serve_main(const ServeArgs& a) {
       log(Severity::kNotice, "design %s (%d x %d knots): row %d to knot next%s", cfg.recipe.design->name().c_str(),
           cfg.recipe.design->width(), cfg.recipe.design->height(), pos.row + 1,
           pos.repeat > 1 ? (", repeat " + std::to_string(pos.repeat)).c_str() : "");
+    }
+    if (!a.no_telemetry) {
+      // One loom id, one publisher: another loom (or a recording replayed onto the live group) with this
+      // id would mix with ours on every subscriber.
+      std::string other;
+      try {
+        other = telemetry::other_publisher(cfg.telemetry.lcm_url, std::string(telemetry::kDefaultChannelPrefix),
+                                           cfg.loom_id, kIdentityListen);
+      } catch (const std::exception& e) {
+        log(Severity::kErr, "loomctl serve: %s: telemetry: %s", cfg.source.c_str(), e.what());
+        return kExitBadInput;
+      }
+      if (!other.empty()) {
+        log(Severity::kErr, "loomctl serve: refusing to arm: loom id '%s' is already published on the LCM group "
+            "(%s) by %s; two looms with one id mix on every monitor and panel: give this loom its own id, or "
+            "replay recordings onto another group", cfg.loom_id.c_str(),
+            cfg.telemetry.lcm_url.empty() ? "LCM's default URL" : cfg.telemetry.lcm_url.c_str(), other.c_str());
+        return kExitNotArmed;
+      }
     }
     MachineOptions mo;
     mo.design_rows_done = design_rows;
@@ -234,9 +300,25 @@ int serve_main(const ServeArgs& a) {
                                                : "weaving",
         resume.rows, resume.picks, resume.picks_in_row, resume.beats);
 
+    if (!ready_sent) {
+      systemd.notify("READY=1\nSTATUS=armed, waiting for the operator");
+      ready_sent = true;
+    }
     const double period = cfg.sequencer.period_s;
     RowSaves row_saves;
     row_saves.saved(resume.rows);
+    std::optional<sequencer::Counters> failed_save;  // the latest counters a save failed for (reporter thread)
+    std::int64_t last_retry_ns = 0;
+    const auto save_counters = [&](const sequencer::Counters& c) {
+      store.save(c);
+      if (book) book->record(c.rows);  // after the counters: a cut between lags, never leads
+      row_saves.saved(c.rows);
+      failed_save.reset();
+    };
+    if (arm_unsaved) {  // armed from memory: the disk still lags until a retry succeeds
+      failed_save = arm_unsaved;
+      row_saves.failed();
+    }
     const auto on_event = [&](const RunEvent& e) {
       machine->collect_retired_recipes();
       switch (e.kind) {
@@ -292,13 +374,29 @@ int serve_main(const ServeArgs& a) {
           break;
       }
       try {
-        store.save(e.counters);
-        if (book) book->record(e.counters.rows);  // after the counters: a cut between lags, never leads
-        row_saves.saved(e.counters.rows);
+        save_counters(e.counters);
       } catch (const std::exception& ex) {
-        // The sequencer stops at the row boundary with counters_not_saved (a fault like any other).
+        // The sequencer stops at the row boundary with counters_not_saved (a fault like any other); an
+        // acknowledgement is refused until a retry (below) has saved these counts.
         log(Severity::kErr, "counters not saved: %s", ex.what());
+        failed_save = e.counters;
         row_saves.failed();
+      }
+    };
+    // The reporter thread's poll: the watchdog is fed only while the loop's tick moves, and a failed
+    // save is retried, so freeing the disk lets the acknowledgement through.
+    const auto reporter_poll = [&] {
+      const std::int64_t now = MonotonicClock{}.now_ns();
+      watchdog.poll(link.tick.load(std::memory_order_acquire), now);
+      if (failed_save && now - last_retry_ns >= kSaveRetryNs) {
+        last_retry_ns = now;
+        try {
+          save_counters(*failed_save);
+          log(Severity::kNotice, "counters saved again (rows %u, picks %u): the fault can be acknowledged",
+              row_saves.rows_on_disk.load(), link.picks.load());
+        } catch (const std::exception&) {
+          // Still failing: the fault stays and the ack is refused; the first failure was logged.
+        }
       }
     };
 
@@ -314,6 +412,7 @@ int serve_main(const ServeArgs& a) {
     ro.link = &link;
     ro.operator_buttons = true;
     ro.hold_when_finished = true;
+    ro.reporter_poll = reporter_poll;
     const RunResult res = run_loop(machine->loop(), seq, ro, on_event);
     if (auto* tm = machine->telemetry()) tm->stop();
     const std::string summary = describe_run(res, ro);
@@ -347,10 +446,13 @@ int serve_main(const ServeArgs& a) {
         // The counters in memory are the truth (a fault keeps them; counters_not_saved means the disk
         // lags them): write them before re-arming, which reads them back.
         try {
-          store.save(seq.counters());
-          if (book) book->record(seq.counters().rows);
+          save_counters(seq.counters());
         } catch (const std::exception& ex) {
-          log(Severity::kErr, "counters still not saved (%s): re-arming from the file's older counts", ex.what());
+          // Never re-arm from the file's older counts: the next session starts from what was woven, and
+          // its first row end stops again with counters_not_saved while the disk still refuses.
+          log(Severity::kErr, "counters still not saved (%s): re-arming from the counts in memory (rows %u, picks %u)",
+              ex.what(), seq.counters().rows, seq.counters().picks);
+          unsaved = seq.counters();
         }
         continue;
       }
@@ -359,10 +461,19 @@ int serve_main(const ServeArgs& a) {
       case RunResult::End::kMaxTicks:
         break;
     }
+    if (failed_save) {
+      try {
+        save_counters(seq.counters());
+      } catch (const std::exception& ex) {
+        log(Severity::kErr, "counters not saved at exit (%s): %s lags rows %u, picks %u", ex.what(),
+            store.path().c_str(), seq.counters().rows, seq.counters().picks);
+      }
+    }
     log(Severity::kNotice, "loomctl serve: stopped (rows %u, picks %u, beats %u kept in %s)", seq.counters().rows,
         seq.counters().picks, seq.counters().beats, store.path().c_str());
     break;
   }
+  systemd.notify("STOPPING=1");
   g_link = nullptr;
   return kExitOk;
 }

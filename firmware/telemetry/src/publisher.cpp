@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "loom/telemetry/encode.hpp"
+#include "loom/telemetry/identity.hpp"
 
 namespace loom::telemetry {
 
@@ -186,6 +187,11 @@ void Publisher::publish(const Snapshot& s) {
     if (due.status) {
       send(channels_.status, to_status(s, cfg_.loom_id, utime, cfg_.axes), n_status_);
       publish_design(s, utime);
+      const auto now = std::chrono::steady_clock::now();
+      if (now - identity_sent_at_ >= std::chrono::seconds(1)) {
+        send(channels_.identity, this_process_identity(cfg_.loom_id, utime), n_identity_);
+        identity_sent_at_ = now;
+      }
     }
     if (due.axes) send(channels_.axes, to_axes(s, cfg_.loom_id, utime, cfg_.axes), n_axes_);
     if (due.rt) {

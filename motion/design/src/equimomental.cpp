@@ -21,17 +21,17 @@ std::array<PointMass, 3> equimomental_points(double m1, double m2, double m3, do
   return p;
 }
 
-EquimomentalSystem equimomental_three(const PlanarInertia& body, double offset) {
-  if (!(body.mass_kg > 0.0) || !std::isfinite(body.mass_kg) || !body.centre_m.allFinite() ||
-      !(body.inertia_kg_m2 >= 0.0) || !std::isfinite(body.inertia_kg_m2) || !std::isfinite(offset)) {
+EquimomentalSystem equimomental_three_origin(double m, const Eigen::Vector2d& centre, double inertia_origin,
+                                             double offset) {
+  if (!(m > 0.0) || !std::isfinite(m) || !centre.allFinite() || !(inertia_origin >= 0.0) ||
+      !std::isfinite(inertia_origin) || !std::isfinite(offset)) {
     std::ostringstream os;
-    os << "equimomental system: link mass " << body.mass_kg << " kg, inertia " << body.inertia_kg_m2
-       << " kg m^2, angle offset " << offset << " rad: mass must be > 0, all finite";
+    os << "equimomental system: link mass " << m << " kg, inertia about the link origin " << inertia_origin
+       << " kg m^2, angle offset " << offset << " rad: mass must be > 0, inertia >= 0, all finite";
     throw MotionError(ErrorCode::kInvalidInput, os.str());
   }
   EquimomentalSystem s;
-  const double m = body.mass_kg;
-  s.radius_m = std::sqrt(body.inertia_about(Eigen::Vector2d::Zero()) / m);
+  s.radius_m = std::sqrt(inertia_origin / m);
   const double l = s.radius_m;
   // m_j = (m/3)(1 + 2 (c·u_j)/l), u_j the unit vector of point j; l > 0 whenever the body has
   // inertia or an off-origin centre. A point body at the origin (l = 0) takes equal thirds.
@@ -40,12 +40,23 @@ EquimomentalSystem equimomental_three(const PlanarInertia& body, double offset) 
     for (int j = 0; j < 3; ++j) {
       const double th = offset + kTwoPi * j / 3.0;
       const Eigen::Vector2d u(std::cos(th), std::sin(th));
-      mj[j] = m / 3.0 * (1.0 + 2.0 * body.centre_m.dot(u) / l);
+      mj[j] = m / 3.0 * (1.0 + 2.0 * centre.dot(u) / l);
     }
   }
   s.points = equimomental_points(mj[0], mj[1], mj[2], l, offset);
   s.all_positive = mj[0] >= 0.0 && mj[1] >= 0.0 && mj[2] >= 0.0;
   return s;
+}
+
+EquimomentalSystem equimomental_three(const PlanarInertia& body, double offset) {
+  if (!(body.mass_kg > 0.0) || !std::isfinite(body.mass_kg) || !body.centre_m.allFinite() ||
+      !(body.inertia_kg_m2 >= 0.0) || !std::isfinite(body.inertia_kg_m2) || !std::isfinite(offset)) {
+    std::ostringstream os;
+    os << "equimomental system: link mass " << body.mass_kg << " kg, inertia " << body.inertia_kg_m2
+       << " kg m^2, angle offset " << offset << " rad: mass must be > 0, all finite";
+    throw MotionError(ErrorCode::kInvalidInput, os.str());
+  }
+  return equimomental_three_origin(body.mass_kg, body.centre_m, body.inertia_about(Eigen::Vector2d::Zero()), offset);
 }
 
 PlanarInertia from_point_masses(std::span<const PointMass> points) {

@@ -22,7 +22,8 @@ namespace {
 
 struct Problem {
   double psi;
-  double phi;  // snapped to π or π + ψ when within kSynthesisSnap_rad
+  double phi;         // snapped to π or π + ψ when within kSynthesisSnap_rad
+  double supplement;  // π − φ to full relative precision (snapped with φ)
   CrankRockerCase design_case;
   double lower;
   double upper;
@@ -34,13 +35,15 @@ std::string describe(double psi, double phi) {
   return s.str();
 }
 
-Problem classify(double psi, double phi) {
+Problem classify(double psi, const CrankRotation& rotation) {
+  const double phi = rotation.phi_rad;
+  const double sup = rotation.supplement_rad;
   if (!std::isfinite(psi) || !(psi > 0.0) || !(psi < kPi)) {
     std::ostringstream msg;
     msg << "crank-rocker synthesis: psi = " << deg(psi) << " deg must lie in (0, 180) deg";
     throw MotionError(ErrorCode::kInvalidInput, msg.str());
   }
-  if (!std::isfinite(phi)) {
+  if (!std::isfinite(phi) || !std::isfinite(sup)) {
     throw MotionError(ErrorCode::kInvalidInput, "crank-rocker synthesis: phi must be finite");
   }
   const double phi_min = 0.5 * kPi + 0.5 * psi;
@@ -52,22 +55,24 @@ Problem classify(double psi, double phi) {
         << deg(phi_max) << ") deg";
     throw MotionError(ErrorCode::kInvalidInput, msg.str());
   }
-  Problem p{psi, phi, CrankRockerCase::kPhi180, 0.0, 0.5 * kPi - 0.5 * psi};
+  Problem p{psi, phi, sup, CrankRockerCase::kPhi180, 0.0, 0.5 * kPi - 0.5 * psi};
   const double beta_rocker_limit = 0.5 * kPi - 0.5 * psi;  // coupler as short as the crank
-  if (std::fabs(phi - (kPi + psi)) <= kSynthesisSnap_rad) {
+  if (std::fabs(sup + psi) <= kSynthesisSnap_rad) {
     p.phi = kPi + psi;
+    p.supplement = -psi;
     p.design_case = CrankRockerCase::kPhi180PlusPsi;
     p.lower = p.upper = beta_rocker_limit;
-  } else if (std::fabs(phi - kPi) <= kSynthesisSnap_rad) {
+  } else if (std::fabs(sup) <= kSynthesisSnap_rad) {
     p.phi = kPi;
+    p.supplement = 0.0;
     p.design_case = CrankRockerCase::kPhi180;
     p.lower = 0.0;
     p.upper = beta_rocker_limit;
-  } else if (phi < kPi) {
+  } else if (sup > 0.0) {
     p.design_case = CrankRockerCase::kPhiBelow180;
-    p.lower = kPi - phi;
+    p.lower = sup;
     p.upper = beta_rocker_limit;
-  } else if (phi < kPi + psi) {
+  } else if (sup + psi > 0.0) {
     p.design_case = CrankRockerCase::kPhiAbove180;
     p.lower = 0.0;
     p.upper = beta_rocker_limit;
@@ -104,7 +109,7 @@ struct UnitLinkage {
 
 UnitLinkage general_linkage(const Problem& p, double beta) {
   const double sp = std::sin(0.5 * p.psi);
-  const double delta = 0.5 * (kPi - p.phi);
+  const double delta = 0.5 * p.supplement;
   const double h = delta + 0.5 * p.psi;
   const double gamma = beta - delta;
   UnitLinkage u{};
@@ -198,7 +203,7 @@ CrankRockerDesign design_for_beta(const Problem& p, double beta, double ground) 
     throw MotionError(ErrorCode::kOutOfBounds, msg.str());
   }
   if (b == p.lower || b == p.upper) flags |= kDesignChangePoint;
-  if (std::fabs(p.phi - (kPi + p.psi)) <= kNearSpecialCase_rad) flags |= kDesignNearSpecialCase;
+  if (std::fabs(p.supplement + p.psi) <= kNearSpecialCase_rad) flags |= kDesignNearSpecialCase;
   return finish(p, b, general_linkage(p, b), ground, flags);
 }
 
@@ -215,18 +220,34 @@ const char* crank_rocker_case_name(CrankRockerCase c) {
   return "?";
 }
 
+CrankRotation CrankRotation::degrees(double phi_deg) { return {rad(phi_deg), rad(180.0 - phi_deg)}; }
+CrankRotation CrankRotation::radians(double phi_rad) { return {phi_rad, kPi - phi_rad}; }
+
 BetaBounds khare_dave_beta_bounds(double psi_rad, double phi_rad) {
+  return khare_dave_beta_bounds(psi_rad, CrankRotation::radians(phi_rad));
+}
+CrankRockerDesign khare_dave_crank_rocker(double psi_rad, double phi_rad, double beta_rad, double ground) {
+  return khare_dave_crank_rocker(psi_rad, CrankRotation::radians(phi_rad), beta_rad, ground);
+}
+CrankRockerDesign khare_dave_best_beta(double psi_rad, double phi_rad, double ground) {
+  return khare_dave_best_beta(psi_rad, CrankRotation::radians(phi_rad), ground);
+}
+CrankRockerDesign khare_dave_for_ratio(double psi_rad, double phi_rad, double lambda, double ground) {
+  return khare_dave_for_ratio(psi_rad, CrankRotation::radians(phi_rad), lambda, ground);
+}
+
+BetaBounds khare_dave_beta_bounds(double psi_rad, const CrankRotation& phi_rad) {
   const Problem p = classify(psi_rad, phi_rad);
   return BetaBounds{p.lower, p.upper, p.design_case};
 }
 
-CrankRockerDesign khare_dave_crank_rocker(double psi_rad, double phi_rad, double beta_rad,
+CrankRockerDesign khare_dave_crank_rocker(double psi_rad, const CrankRotation& phi_rad, double beta_rad,
                                           double ground) {
   check_ground(ground);
   return design_for_beta(classify(psi_rad, phi_rad), beta_rad, ground);
 }
 
-CrankRockerDesign khare_dave_best_beta(double psi_rad, double phi_rad, double ground) {
+CrankRockerDesign khare_dave_best_beta(double psi_rad, const CrankRotation& phi_rad, double ground) {
   check_ground(ground);
   const Problem p = classify(psi_rad, phi_rad);
   if (p.design_case == CrankRockerCase::kPhi180PlusPsi) return design_for_beta(p, p.lower, ground);
@@ -277,7 +298,7 @@ CrankRockerDesign khare_dave_best_beta(double psi_rad, double phi_rad, double gr
   return design_for_beta(p, 0.5 * (lo + hi), ground);
 }
 
-CrankRockerDesign khare_dave_for_ratio(double psi_rad, double phi_rad, double lambda,
+CrankRockerDesign khare_dave_for_ratio(double psi_rad, const CrankRotation& phi_rad, double lambda,
                                        double ground) {
   check_ground(ground);
   const Problem p = classify(psi_rad, phi_rad);
@@ -300,7 +321,7 @@ CrankRockerDesign khare_dave_for_ratio(double psi_rad, double phi_rad, double la
                   change_point ? kDesignChangePoint : 0u);
   }
   // a/b = tan γ · tan h is monotonic in β; γ lies in (0, π/2) when h > 0 and in (π/2, π) when h < 0.
-  const double delta = 0.5 * (kPi - p.phi);
+  const double delta = 0.5 * p.supplement;
   const double h = delta + 0.5 * p.psi;
   const double gamma = std::atan2(lambda * std::cos(h), std::sin(h));
   const double beta = gamma + delta;

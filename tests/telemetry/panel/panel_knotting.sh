@@ -28,7 +28,7 @@ URL="udpm://239.255.76.67:${PORT}?ttl=0"
 ID="knot$$"
 mkdir -p "$WORK/run"
 cp "$DESIGN" "$WORK/$(basename "$DESIGN")"
-printf 'extends = "default"\n[recipe]\nknotting = true\ndesign = "%s"\n' "$(basename "$DESIGN")" >"$WORK/loom.toml"
+printf 'extends = "default"\n[knotting]\nmode = "weaver"\n[recipe]\ndesign = "%s"\n' "$(basename "$DESIGN")" >"$WORK/loom.toml"
 
 # What the page must show: design row 1 is the file's last grid line, row 2 the one above it.
 rows_json=$(grep -v '^[[:space:]]*#' "$DESIGN" | grep -v '^palette,' | grep -v '^[[:space:]]*$' | tac | head -2 |

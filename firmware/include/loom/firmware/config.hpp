@@ -22,6 +22,7 @@
 #include "loom/drivers/can_axis_port.hpp"
 #include "loom/drivers/can_io_port.hpp"
 #include "loom/motion/profile_set.hpp"
+#include "loom/sequencer/knot_plan.hpp"
 #include "loom/sequencer/sequencer.hpp"
 #include "loom/firmware/scene_config.hpp"  // the scene file (kept here so callers of config.hpp see it)
 #include "loom/sim_hal/scene.hpp"
@@ -131,7 +132,6 @@ struct Recipe {
   double crank_accel_rad_s2 = 400.0, crank_jerk_rad_s3 = 2.0e4;
   motion::CrankLawSpec crank_law{};
   std::uint32_t picks_per_row = 1;
-  bool knotting = false;  // park before every row until the weaver's "row knotted" (handmade carpets)
   // The carpet's knot map, shown to the weaver row by row: the file as written (relative to the config
   // file's folder) and what was loaded from it (null when the recipe names none).
   std::string design_file;
@@ -140,7 +140,7 @@ struct Recipe {
   double overlap_m = 0.02;
   double cam_margin_rad = 20.0 * 3.141592653589793 / 180.0;  // cam_margin_deg = 20
   double beat_force_min_n = 80.0, beat_force_max_n = 100.0;  // the band every beat must hit
-  std::size_t table_size = 256;
+  std::size_t table_size = motion::ProfileSpec{}.table_size;  // one default, motion's
   motion::Interp table_interp = motion::Interp::kCubic;
   motion::Precision table_precision = motion::Precision::kDouble;
   double max_table_error_rad = 1e-7;
@@ -170,6 +170,8 @@ struct LoomConfig {
   MachineSpec machine_spec;
   // The axes in slot order (hal::AxisLayout): beat crank, carriage, helix, then the others by name.
   std::vector<AxisSpec> axes = default_axes();
+  // The pile: none (a flat weave), knotted by the weaver while the loom waits, or by the heads.
+  sequencer::KnottingSpec knotting;
   CanSettings can;
   IoSettings io;
   Recipe recipe;

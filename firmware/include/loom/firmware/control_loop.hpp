@@ -54,6 +54,9 @@ class ControlLoop {
   void cycle(hal::Tick now) noexcept;
 
   LoopStats& stats() noexcept { return stats_; }
+  // The telemetry the cycle waits on for ring space (lossless, virtual time only), else nullptr: a
+  // runner waits for room before the cycle so the wait is reported apart from the tick's cost.
+  telemetry::Telemetry* lossless_telemetry() const noexcept { return lossless_ ? telemetry_ : nullptr; }
   const hal::HalInputs& inputs() const noexcept { return in_; }
   const hal::HalOutputs& outputs() const noexcept { return out_; }
   const telemetry::Snapshot& snapshot() const noexcept { return snap_; }

@@ -97,7 +97,8 @@ struct RunEvent {
   std::uint16_t fault_detail = 0;
   int fault_sensor = -1;  // hal::SafetySensor the fault names (sensor_discrepancy), or -1
 };
-// Run events waiting for the reporter. An event is at most one per row, pick, pause, resume or fault,
+// Run events waiting for the reporter (real time only: in virtual time the handler runs in place and no
+// ring is allocated). An event is at most one per row, pick, pause, resume or fault,
 // and a pick is never shorter than a shed change (hundreds of ms), so 1024 pending events cover a
 // reporter stalled for minutes (e.g. an fsync on a slow SD card). Overflow is counted, never waited on;
 // the next event carries the full counters again, so a counter save is never lost for long.
@@ -143,6 +144,9 @@ struct RunOptions {
   OperatorLink* link = nullptr;
   bool operator_buttons = false;   // the I/O node's start/pause/ack buttons act like the commands
   bool hold_when_finished = false;
+  // Real time only: called on the reporter thread every few milliseconds (the service's watchdog and
+  // retries live here, off the loop thread). Never called from the loop.
+  std::function<void()> reporter_poll;
 
   LoopClock* clock = nullptr;      // nullptr = MonotonicClock
 };
@@ -156,13 +160,22 @@ struct RunResult {
   std::uint32_t overruns = 0;
   std::uint32_t max_consecutive_overruns = 0;
   bool overrun_stop = false;       // the overrun policy latched loop_overrun
+  // The tick's own work (read inputs, sequencer, write outputs, queue telemetry), never a wait.
   std::int64_t max_tick_cost_ns = 0;
   std::int64_t median_tick_cost_ns = 0;  // from a fixed-size histogram, no allocation while running
   std::int64_t p999_tick_cost_ns = 0;
+  // Virtual time with lossless telemetry only: before a tick whose snapshot or events would not fit,
+  // the loop waits (yielding) for the LCM publisher to free ring space. That wait is the publisher's
+  // pace, not the tick's cost, so it is measured and reported apart. Real time never waits (drops).
+  std::uint64_t telemetry_wait_ticks = 0;    // ticks that had to wait
+  std::int64_t telemetry_wait_total_ns = 0;
+  std::int64_t telemetry_wait_max_ns = 0;
+  std::uint64_t telemetry_wait_yields = 0;   // sched_yield calls while waiting
   // Real time only: how late the loop woke after each deadline.
   std::int64_t wake_latency_p50_ns = 0, wake_latency_p99_ns = 0, wake_latency_max_ns = 0;
   std::uint64_t events_dropped = 0;
   std::uint32_t acks_refused = 0;  // acknowledgements while the link could not be re-armed yet
+  std::uint32_t acks_refused_unsaved = 0;  // acknowledgements while the counters still could not be saved
   // What the loop thread actually ran at (realtime only; read back with pthread_getschedparam inside it).
   int loop_policy = -1;            // SCHED_FIFO, SCHED_OTHER, ...; -1 = ran on the caller (virtual time)
   int loop_priority = 0;
@@ -180,8 +193,9 @@ using EventHandler = std::function<void(const RunEvent&)>;
 // the session. In real time the caller's thread becomes the reporter while a new thread runs the loop.
 RunResult run_loop(ControlLoop& loop, sequencer::Sequencer& seq, const RunOptions& opt, const EventHandler& on_event);
 
-// One line for the end of a run: ticks, wall time, achieved ratio, tick cost p50/p99.9/max, wake-up
-// latency p50/p99/max, overruns, dropped events; and a WARNING line when it fell behind.
+// One line for the end of a run: ticks, wall time, achieved ratio, tick cost p50/p99.9/max in µs, the
+// telemetry wait apart (virtual time), wake-up latency p50/p99/max, overruns, dropped events; and a
+// WARNING line when it fell behind.
 std::string describe_run(const RunResult& r, const RunOptions& opt);
 
 }  // namespace loom::firmware

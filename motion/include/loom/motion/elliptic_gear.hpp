@@ -15,9 +15,11 @@ struct GearPhase {
 
 class EllipticGearPair {
  public:
-  // Above this speed-ratio spread max(dφ2/dφ1) = (1+e)/(1-e), a crank-angle error is amplified a
-  // thousand-fold: the results stay finite but the gear is flagged as near-degenerate (e -> 1).
-  static constexpr double kNearDegenerateSpeedRatio = 1.0e3;
+  // Above this speed-ratio spread max(dφ2/dφ1) = (1+e)/(1-e) — e > 99/101 ≈ 0.980 — a crank-angle
+  // error is amplified a hundred-fold and accelerations and forces (which go with the ratio's square)
+  // ten-thousand-fold: the results stay finite but the gear is flagged as near-degenerate (e -> 1).
+  // e = 0.99 (ratio 199, squared 39 601) is flagged; no cut gear comes near it.
+  static constexpr double kNearDegenerateSpeedRatio = 1.0e2;
 
   // Configure-time only. half_centre_distance_m = a (centre distance 2a), eccentricity e in [0, 1),
   // lobes k >= 1 (004 uses k = 2). Throws MotionError(kInvalidInput) naming the bad field.

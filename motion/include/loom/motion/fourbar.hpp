@@ -144,6 +144,22 @@ std::vector<FourBarPose> fourbar_sweep(const FourBar& m, Branch branch, int samp
 void fourbar_sweep(const FourBar& m, Branch branch, int samples, double theta2_start,
                    const std::function<void(const FourBarPose&)>& sink);
 
+// What a sweep over the crank angles a linkage can reach covered.
+struct ReachableSweep {
+  int solved = 0;       // poses handed to the sink
+  int unreachable = 0;  // crank angles where the loop does not close (outside the input link's range)
+  int at_toggle = 0;    // crank angles at a toggle (coefficients unbounded), within rounding
+};
+// configure-time only. The same samples as fourbar_sweep for a linkage whose input link cannot turn
+// fully (double-rocker, rocker-crank, triple-rocker) as well as for one that can: each pose is solved
+// on `branch` independently, and crank angles it cannot reach or where it is at a toggle are skipped
+// and counted instead of ending the sweep. Angles are unwrapped only across consecutive solved poses.
+// Throws kInvalidInput (samples < 1, non-finite start, bad lengths) and kSingular for a change-point
+// linkage, before the first pose.
+// The sink gets the sample's index i (θ2 = θ2_start + 2π·i/samples) with the pose.
+ReachableSweep fourbar_sweep_reachable(const FourBar& m, Branch branch, int samples, double theta2_start,
+                                       const std::function<void(int, const FourBarPose&)>& sink);
+
 struct FourBarNewtonResult {
   FourBarPose pose;  // coefficients from the converged angles
   int iterations;    // Newton steps taken (0 when the guess already met the tolerance)

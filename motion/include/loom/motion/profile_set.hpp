@@ -36,8 +36,10 @@ struct ProfileSpec {
   double shuttle_mass_kg = 0.40;
   ShedSpec shed{};
   // Every phase table (rocker, crank law): knots per turn, interpolation order, knot precision.
-  // Chosen from `loom-profile report` (tools/profile): see the README's profile table.
-  std::size_t table_size = 256;
+  // Chosen by `loom-profile report`'s own rule (tools/profile) for the 1e-9 rad target: 1024 cubic
+  // double knots are the smallest with 10x margin for the rocker (6.6e-12 rad; 512 gives 1.06e-10,
+  // no margin), 512 would do for the crank law; one size serves both. See motion/README.md.
+  std::size_t table_size = 1024;
   Interp table_interp = Interp::kCubic;
   Precision table_precision = Precision::kDouble;
   // Each table's error is measured against the exact kinematics at every segment's midpoint (where

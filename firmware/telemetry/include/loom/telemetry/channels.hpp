@@ -28,6 +28,7 @@ struct ChannelNames {
   std::string fault;
   std::string row;
   std::string design;  // the weaver's next row, from the publisher (looms with a design only)
+  std::string identity;  // who publishes (host, pid, instance): one loom id, one publisher
 };
 
 // Every channel kind, in the order a reader lists them.

@@ -124,6 +124,8 @@ class Publisher {
   std::atomic<std::uint64_t> n_beat_{0}, n_fault_{0}, n_row_{0}, n_design_{0};
   std::uint64_t design_rows_sent_ = UINT64_MAX;  // design rows done in the last DESIGN sent
   std::chrono::steady_clock::time_point design_sent_at_{};
+  std::chrono::steady_clock::time_point identity_sent_at_{};
+  std::atomic<std::uint64_t> n_identity_{0};
 };
 
 }  // namespace loom::telemetry

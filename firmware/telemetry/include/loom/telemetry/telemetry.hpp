@@ -41,6 +41,14 @@ class Telemetry {
   bool push_event_waiting(const Event& e) noexcept;
   std::uint64_t dropped_events() const noexcept { return events_->dropped(); }
 
+  // RT-safe (producer thread). Whether a snapshot and `events` more events fit without waiting: a
+  // virtual-time runner waits for this between ticks, so the wait is measured apart from the tick.
+  bool has_room(std::size_t events) const noexcept {
+    return ring_->size_approx() < SnapshotRing::capacity() && events_->size_approx() + events <= EventRing::capacity();
+  }
+  // RT-safe, any thread. Whether the publisher is draining the rings (nobody makes room otherwise).
+  bool publishing() const noexcept { return publisher_.running(); }
+
   // RT-safe, any thread.
   std::uint64_t dropped() const noexcept { return ring_->dropped(); }
   PublisherStats stats() const noexcept { return publisher_.stats(); }

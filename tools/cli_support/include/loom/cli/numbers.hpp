@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 #include <cmath>
+#include <sstream>
 #include <string>
 
 namespace loom::cli {
@@ -35,6 +36,14 @@ inline CLI::Validator positive_number() {
 // A finite number >= 0 (weights, contact forces).
 inline CLI::Validator non_negative_number() {
   return number_check([](double v) { return v >= 0.0; }, "must be a finite number >= 0", "NONNEGATIVE");
+}
+
+// A finite number in [lo, hi] (CLI::Range lets NaN through: every comparison with NaN is false).
+inline CLI::Validator finite_range(double lo, double hi) {
+  std::ostringstream bounds;
+  bounds << "[" << lo << ", " << hi << "]";
+  return number_check([lo, hi](double v) { return v >= lo && v <= hi; }, "must be a finite number in " + bounds.str(),
+                      "FLOAT in " + bounds.str());
 }
 
 // Eccentricity of the elliptic pitch curves: [0, 1).

@@ -31,6 +31,13 @@ struct EquimomentalSystem {
 // MotionError(kInvalidInput) for a non-positive or non-finite mass, or a non-finite centre/inertia.
 EquimomentalSystem equimomental_three(const PlanarInertia& body, double offset_rad = 0.0);
 
+// Configure-time only. The same system from 003's own data: mass, centre in the link frame and the
+// inertia about the link origin I_O (eqn 4's right-hand side). I_O below m·|c|² belongs to no rigid body
+// (a rounded table at constraint 20e's bound): the masses still satisfy eqns 1–4, one of them negative
+// (all_positive false). Throws kInvalidInput for a non-positive mass, negative I_O or non-finite input.
+EquimomentalSystem equimomental_three_origin(double mass_kg, const Eigen::Vector2d& centre_m,
+                                             double inertia_origin_kg_m2, double offset_rad = 0.0);
+
 // RT-safe. 003's design-variable form (eqn 16 with eqns 18a–b): masses m1, m2, m3 at distance l and
 // angles offset + 0, 2π/3, 4π/3 in the link frame.
 std::array<PointMass, 3> equimomental_points(double m1_kg, double m2_kg, double m3_kg, double l_m,

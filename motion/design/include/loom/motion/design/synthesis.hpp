@@ -99,6 +99,16 @@ struct CrankRockerDesign {
   unsigned flags = 0;
 };
 
+// The crank rotation φ together with its supplement π − φ, each to full relative precision. Near
+// φ = 180° the designs depend on π − φ, which `π − φ_rad` gets only to ulp(π)/|π − φ| (9.5e-9 relative at
+// 179.999999°, 1 % at 180° − 1e-12°); from degrees the supplement is exact (Sterbenz) before conversion.
+struct CrankRotation {
+  double phi_rad = 0.0;         // φ
+  double supplement_rad = 0.0;  // π − φ
+  static CrankRotation degrees(double phi_deg);  // supplement from 180 − φ_deg, converted after
+  static CrankRotation radians(double phi_rad);  // supplement from π − φ_rad (as accurate as φ_rad is)
+};
+
 // configure-time only. Feasible β for (ψ, φ); for φ = π + ψ lower = upper. Throws kInvalidInput
 // unless 0 < ψ < π and π/2 + ψ/2 < φ < 3π/2 + ψ/2 (no crank-rocker exists outside).
 BetaBounds khare_dave_beta_bounds(double psi_rad, double phi_rad);
@@ -121,6 +131,14 @@ CrankRockerDesign khare_dave_best_beta(double psi_rad, double phi_rad, double gr
 // criterion, a/b ≤ 0.3). For φ = π + ψ, λ selects the member of the family (b = a/λ).
 // kOutOfBounds when no feasible β gives that ratio.
 CrankRockerDesign khare_dave_for_ratio(double psi_rad, double phi_rad, double lambda,
+                                       double ground = 1.0);
+
+// The same four with φ and its supplement given apart (CrankRotation::degrees for degree input).
+BetaBounds khare_dave_beta_bounds(double psi_rad, const CrankRotation& phi);
+CrankRockerDesign khare_dave_crank_rocker(double psi_rad, const CrankRotation& phi, double beta_rad,
+                                          double ground = 1.0);
+CrankRockerDesign khare_dave_best_beta(double psi_rad, const CrankRotation& phi, double ground = 1.0);
+CrankRockerDesign khare_dave_for_ratio(double psi_rad, const CrankRotation& phi, double lambda,
                                        double ground = 1.0);
 
 }  // namespace loom::motion

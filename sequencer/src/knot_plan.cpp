@@ -1,0 +1,156 @@
+// The knot plan (see knot_plan.hpp): stripes, counts and selector moves, from the [knotting] facts.
+#include "loom/sequencer/knot_plan.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+
+namespace loom::sequencer {
+
+const char* knotting_mode_name(KnottingMode m) {
+  switch (m) {
+    case KnottingMode::kNone: return "none";
+    case KnottingMode::kWeaver: return "weaver";
+    case KnottingMode::kHeads: return "heads";
+  }
+  return "?";
+}
+
+bool parse_knotting_mode(const char* text, KnottingMode& m) {
+  for (KnottingMode k : {KnottingMode::kNone, KnottingMode::kWeaver, KnottingMode::kHeads}) {
+    if (std::strcmp(text, knotting_mode_name(k)) == 0) {
+      m = k;
+      return true;
+    }
+  }
+  return false;
+}
+
+const char* knot_type_name(KnotType k) {
+  switch (k) {
+    case KnotType::kTurkish: return "turkish";
+    case KnotType::kPersianLeft: return "persian_left";
+    case KnotType::kPersianRight: return "persian_right";
+  }
+  return "?";
+}
+
+bool parse_knot_type(const char* text, KnotType& k) {
+  for (KnotType t : {KnotType::kTurkish, KnotType::kPersianLeft, KnotType::kPersianRight}) {
+    if (std::strcmp(text, knot_type_name(t)) == 0) {
+      k = t;
+      return true;
+    }
+  }
+  return false;
+}
+
+CarpetClass carpet_class(double n) {
+  if (!(n >= 215.0) || n > 10000.0) return CarpetClass::kOutside;
+  if (n <= 700.0) return CarpetClass::kCoarse;
+  if (n <= 1400.0) return CarpetClass::kMedium;
+  if (n <= 1850.0) return CarpetClass::kFine;
+  if (n <= 2400.0) return CarpetClass::kExtraFine;
+  return CarpetClass::kExtraExtraFine;
+}
+
+const char* carpet_class_name(CarpetClass c) {
+  switch (c) {
+    case CarpetClass::kOutside: return "outside the thesis' classes (215..10000 knots/dm^2)";
+    case CarpetClass::kCoarse: return "coarse";
+    case CarpetClass::kMedium: return "medium";
+    case CarpetClass::kFine: return "fine";
+    case CarpetClass::kExtraFine: return "extra fine";
+    case CarpetClass::kExtraExtraFine: return "extra extra fine";
+  }
+  return "?";
+}
+
+double knot_pitch_m(const KnottingSpec& s) { return 0.1 / s.knots_per_dm; }
+
+// A hair of tolerance, so that 1.2 m at 30 knots/dm is 360 knots, not 359.999… → 359.
+int knots_per_row(const KnottingSpec& s, double width_m) {
+  return static_cast<int>(std::floor(width_m / knot_pitch_m(s) + 1e-9));
+}
+
+int knots_per_stripe(const KnottingSpec& s) {
+  return static_cast<int>(std::floor(s.head_spacing_m / knot_pitch_m(s) + 1e-9));
+}
+
+std::string validate(const KnottingSpec& s, double width_m) {
+  const auto fin = [](double v) { return std::isfinite(v); };
+  if (!fin(s.knots_per_dm) || s.knots_per_dm < 5.0 || s.knots_per_dm > 200.0) {
+    return "knotting.knots_per_dm must be in [5, 200]";
+  }
+  if (!fin(s.rows_per_dm) || s.rows_per_dm < 5.0 || s.rows_per_dm > 200.0) return "knotting.rows_per_dm must be in [5, 200]";
+  if (s.mode != KnottingMode::kHeads) return "";
+  if (s.heads < 1 || s.heads > kMaxKnottingHeads) {
+    return "knotting.heads must be 1.." + std::to_string(kMaxKnottingHeads);
+  }
+  if (!fin(s.head_spacing_m) || knots_per_stripe(s) < 1) return "knotting.head_spacing_m must hold at least one knot pitch";
+  // The heads' stripes together must reach the right selvedge: head h ties [h·n, (h+1)·n).
+  const int n = knots_per_stripe(s), k = knots_per_row(s, width_m);
+  if (s.heads * n < k) {
+    return "knotting.head_spacing_m: " + std::to_string(s.heads) + " heads x " + std::to_string(n) +
+           " knots per stripe cover " + std::to_string(s.heads * n) + " of the row's " + std::to_string(k) +
+           " knots (loom.width_m / knotting.heads is the spacing that covers the width)";
+  }
+  if ((s.heads - 1) * n >= k) {
+    return "knotting.heads: the last head's stripe starts beyond the row's " + std::to_string(k) +
+           " knots (fewer heads, or a narrower spacing)";
+  }
+  if (s.slot_colours.empty() || s.slot_colours.size() > static_cast<std::size_t>(kMaxMagazineSlots)) {
+    return "knotting.slot_colours must name 1.." + std::to_string(kMaxMagazineSlots) + " colours (one per magazine slot)";
+  }
+  for (std::size_t i = 0; i < s.slot_colours.size(); ++i) {
+    if (s.slot_colours[i].empty()) return "knotting.slot_colours[" + std::to_string(i) + "] is empty";
+    for (std::size_t j = 0; j < i; ++j) {
+      if (s.slot_colours[i] == s.slot_colours[j]) {
+        return "knotting.slot_colours: \"" + s.slot_colours[i] + "\" is in slots " + std::to_string(j) + " and " +
+               std::to_string(i);
+      }
+    }
+  }
+  if (s.knots_per_slot < 1) return "knotting.knots_per_slot must be at least 1";
+  return "";
+}
+
+int slot_of(const KnottingSpec& s, const std::string& code) {
+  for (std::size_t i = 0; i < s.slot_colours.size(); ++i) {
+    if (s.slot_colours[i] == code) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+RowKnotPlan plan_row(const KnottingSpec& s, double width_m, std::span<const std::uint16_t> row,
+                     std::span<const std::string> palette, std::array<int, kMaxKnottingHeads>& slot_before) {
+  RowKnotPlan p;
+  p.knots = knots_per_row(s, width_m);
+  if (static_cast<int>(row.size()) != p.knots) {
+    throw std::invalid_argument("the design row is " + std::to_string(row.size()) + " knots wide; the loom ties " +
+                                std::to_string(p.knots) + " per row (loom.width_m at knotting.knots_per_dm)");
+  }
+  const int n = knots_per_stripe(s);
+  for (int h = 0; h < s.heads; ++h) {
+    const int first = h * n, last = std::min(p.knots, first + n);
+    const auto hh = static_cast<std::size_t>(h);
+    p.head_knots[hh] = std::max(0, last - first);
+    for (int k = first; k < last; ++k) {
+      const std::uint16_t colour = row[static_cast<std::size_t>(k)];
+      const std::string& code = colour < palette.size() ? palette[colour] : std::string();
+      const int slot = slot_of(s, code);
+      if (slot < 0) {
+        throw std::invalid_argument("colour \"" + code + "\" (knot " + std::to_string(k + 1) + ", head " +
+                                    std::to_string(h + 1) + ") is in no magazine slot (knotting.slot_colours)");
+      }
+      if (slot != slot_before[hh]) ++p.selector_moves[hh];
+      slot_before[hh] = slot;
+    }
+    p.knot_cycles = std::max(p.knot_cycles, p.head_knots[hh]);
+  }
+  p.carriage_steps = std::max(0, p.knot_cycles - 1);
+  return p;
+}
+
+}  // namespace loom::sequencer

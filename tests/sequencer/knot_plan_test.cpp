@@ -1,0 +1,122 @@
+// The knot plan against numbers worked out by hand: the thesis' carpet classes (Table 2.1), knots per
+// row and stripe, carriage steps and selector moves, and the refusals that name what is wrong.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "loom/sequencer/knot_plan.hpp"
+
+using namespace loom::sequencer;
+
+namespace {
+KnottingSpec heads_spec() {
+  KnottingSpec s;
+  s.mode = KnottingMode::kHeads;
+  s.knots_per_dm = 30.0;
+  s.rows_per_dm = 30.0;
+  s.heads = 2;
+  s.head_spacing_m = 0.6;
+  s.slot_colours = {"R", "B", "W"};
+  return s;
+}
+std::array<int, kMaxKnottingHeads> unknown_slots() {
+  std::array<int, kMaxKnottingHeads> a{};
+  a.fill(-1);
+  return a;
+}
+const std::vector<std::string> kPalette{"R", "B", "W", "G"};  // G is in no slot
+}  // namespace
+
+TEST(KnotPlan, CarpetClassesFollowTheThesisTable) {
+  EXPECT_EQ(carpet_class(214.0), CarpetClass::kOutside);
+  EXPECT_EQ(carpet_class(215.0), CarpetClass::kCoarse);
+  EXPECT_EQ(carpet_class(700.0), CarpetClass::kCoarse);
+  EXPECT_EQ(carpet_class(701.0), CarpetClass::kMedium);
+  EXPECT_EQ(carpet_class(900.0), CarpetClass::kMedium);  // 30 x 30: the issue's "medium class, about 30 knots/dm"
+  EXPECT_EQ(carpet_class(1400.0), CarpetClass::kMedium);
+  EXPECT_EQ(carpet_class(1401.0), CarpetClass::kFine);
+  EXPECT_EQ(carpet_class(1850.0), CarpetClass::kFine);
+  EXPECT_EQ(carpet_class(1851.0), CarpetClass::kExtraFine);
+  EXPECT_EQ(carpet_class(2400.0), CarpetClass::kExtraFine);
+  EXPECT_EQ(carpet_class(2401.0), CarpetClass::kExtraExtraFine);
+  EXPECT_EQ(carpet_class(10000.0), CarpetClass::kExtraExtraFine);
+  EXPECT_EQ(carpet_class(10001.0), CarpetClass::kOutside);
+  EXPECT_EQ(carpet_class(0.0 / 0.0), CarpetClass::kOutside);
+}
+
+TEST(KnotPlan, TheDefaultLoomsRowAtThirtyKnotsPerDecimetre) {
+  const KnottingSpec s = heads_spec();
+  // 1.2 m / (0.1 m / 30) = 360 knots at 3.333 mm; 0.6 m holds 180 of them per head.
+  EXPECT_EQ(knots_per_row(s, 1.2), 360);
+  EXPECT_NEAR(knot_pitch_m(s), 0.1 / 30.0, 1e-15);
+  EXPECT_EQ(knots_per_stripe(s), 180);
+  EXPECT_EQ(validate(s, 1.2), "");
+  std::vector<std::uint16_t> row(360, 0);  // all red
+  auto slots = unknown_slots();
+  const RowKnotPlan p = plan_row(s, 1.2, row, kPalette, slots);
+  EXPECT_EQ(p.knots, 360);
+  EXPECT_EQ(p.head_knots[0], 180);
+  EXPECT_EQ(p.head_knots[1], 180);
+  EXPECT_EQ(p.knot_cycles, 180);    // both heads at once
+  EXPECT_EQ(p.carriage_steps, 179);  // one pitch between consecutive knots
+  EXPECT_EQ(p.selector_moves[0], 1);  // from "unknown" to red once
+  EXPECT_EQ(p.selector_moves[1], 1);
+  EXPECT_EQ(slots[0], 0);
+  // The next row in the same colour needs no selector move at all.
+  EXPECT_EQ(plan_row(s, 1.2, row, kPalette, slots).selector_moves[0], 0);
+}
+
+TEST(KnotPlan, SelectorMovesCountColourChangesInEachStripe) {
+  KnottingSpec s = heads_spec();
+  s.knots_per_dm = 10.0;  // 1.2 m: 120 knots, 60 per head
+  std::vector<std::uint16_t> row(120, 0);
+  // Head 0: R R ... then B for knots 10..19, then R again: 3 moves from unknown (R, B, R).
+  for (int k = 10; k < 20; ++k) row[static_cast<std::size_t>(k)] = 1;
+  // Head 1 (knots 60..119): alternating W/B every knot: 60 moves.
+  for (int k = 60; k < 120; ++k) row[static_cast<std::size_t>(k)] = k % 2 ? 1 : 2;
+  auto slots = unknown_slots();
+  const RowKnotPlan p = plan_row(s, 1.2, row, kPalette, slots);
+  EXPECT_EQ(p.selector_moves[0], 3);
+  EXPECT_EQ(p.selector_moves[1], 60);
+  EXPECT_EQ(slots[0], 0);  // left at red
+  EXPECT_EQ(slots[1], 1);  // knot 119 is odd: blue
+}
+
+TEST(KnotPlan, AnUnevenLastStripe) {
+  KnottingSpec s = heads_spec();
+  s.heads = 3;
+  s.head_spacing_m = 0.45;  // 135 knots per stripe: 135 + 135 + 90 = 360
+  EXPECT_EQ(validate(s, 1.2), "");
+  std::vector<std::uint16_t> row(360, 2);
+  auto slots = unknown_slots();
+  const RowKnotPlan p = plan_row(s, 1.2, row, kPalette, slots);
+  EXPECT_EQ(p.head_knots[0], 135);
+  EXPECT_EQ(p.head_knots[1], 135);
+  EXPECT_EQ(p.head_knots[2], 90);
+  EXPECT_EQ(p.knot_cycles, 135);
+}
+
+TEST(KnotPlan, RefusalsNameWhatIsWrong) {
+  KnottingSpec s = heads_spec();
+  std::vector<std::uint16_t> row(360, 0);
+  row[250] = 3;  // G: knot 251, head 2
+  auto slots = unknown_slots();
+  try {
+    (void)plan_row(s, 1.2, row, kPalette, slots);
+    FAIL() << "a colour without a slot was planned";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "colour \"G\" (knot 251, head 2) is in no magazine slot (knotting.slot_colours)");
+  }
+  EXPECT_THROW((void)plan_row(s, 1.2, std::vector<std::uint16_t>(359, 0), kPalette, slots), std::invalid_argument);
+  s.head_spacing_m = 0.5;  // 2 x 150 knots cover 300 of 360
+  EXPECT_NE(validate(s, 1.2).find("cover 300 of the row's 360 knots"), std::string::npos) << validate(s, 1.2);
+  s = heads_spec();
+  s.slot_colours = {"R", "R"};
+  EXPECT_NE(validate(s, 1.2).find("\"R\" is in slots 0 and 1"), std::string::npos);
+  s.slot_colours = {};
+  EXPECT_NE(validate(s, 1.2).find("knotting.slot_colours must name"), std::string::npos);
+  s.mode = KnottingMode::kWeaver;  // the weaver needs no magazine
+  EXPECT_EQ(validate(s, 1.2), "");
+}
