@@ -230,8 +230,11 @@ class LoopBody {
     if (has(Command::kAck) && s == sequencer::State::kFault && opt_.hold_when_finished) {
       // Re-arming reconfigures the link: pointless (and the operator would think it done) while the
       // controller is still off the bus or a lost node is still silent. The status says which.
+      // Likewise while the e-stop chain is still open: the fault stays latched (re-arming would show no
+      // fault until the next start re-latched it).
       const hal::LinkRecovery rec = rt_.loop.inputs().link.recovery;
-      if (rec == hal::LinkRecovery::kBusOff || rec == hal::LinkRecovery::kNodeSilent) {
+      if (rec == hal::LinkRecovery::kBusOff || rec == hal::LinkRecovery::kNodeSilent ||
+          !rt_.loop.inputs().io.estop_ok) {
         ++res.acks_refused;
         return false;
       }
@@ -313,6 +316,7 @@ class LoopBody {
     l->max_wake_latency_ns.store(stats_.max_wake_latency_ns, r);
     l->link_recovery.store(static_cast<std::uint8_t>(rt_.loop.inputs().link.recovery), r);
     l->silent_node.store(rt_.loop.inputs().link.silent_node, r);
+    l->estop_ok.store(rt_.loop.inputs().io.estop_ok, r);
     l->tick.store(tick, std::memory_order_release);
   }
 

@@ -78,6 +78,7 @@ struct OperatorLink {
   std::atomic<std::int64_t> max_wake_latency_ns{0};
   std::atomic<std::uint8_t> link_recovery{0};  // hal::LinkRecovery: whether an acknowledgement can re-arm
   std::atomic<std::uint8_t> silent_node{0};    // the lost node still silent (kNodeSilent)
+  std::atomic<bool> estop_ok{true};            // the e-stop chain is closed (an acknowledgement can re-arm)
   std::atomic<std::int64_t> tick{0};
 };
 
