@@ -85,9 +85,11 @@ std::string status_text(const OperatorLink& l, const std::string& loom_id, const
 void audit(FaultHistory& history, const std::string& loom_id, const std::string& line, const Decision& d) {
   std::string verdict = d.reply;
   if (!verdict.empty() && verdict.back() == '\n') verdict.pop_back();
-  // Tokens never reach a log.
-  const auto tok = verdict.find(" token=");
-  if (tok != std::string::npos) verdict.erase(tok, verdict.find(' ', tok + 1) - tok);
+  // Tokens and pairing codes never reach a log.
+  for (const char* secret : {" token=", " code="}) {
+    const auto at = verdict.find(secret);
+    if (at != std::string::npos) verdict.erase(at, verdict.find(' ', at + 1) - at);
+  }
   std::string word = line.substr(0, line.find(' '));
   log(d.accepted() ? Severity::kNotice : Severity::kWarning, "operator: %s by %s: %s", word.c_str(), d.who.c_str(),
       verdict.c_str());
