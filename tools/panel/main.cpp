@@ -300,6 +300,9 @@ int main(int argc, char** argv) {
         return refuse(403, why);
       }
       if (req.get_header_value("X-Loom-Panel") != "1") return refuse(403, "missing X-Loom-Panel header");
+      // A body without a length is read until the connection's timeout: the command would be carried out
+      // after the client gave up. Refused instead.
+      if (!req.has_header("Content-Length")) return refuse(411, "a POST needs Content-Length");
     }
     return httplib::Server::HandlerResponse::Unhandled;
   });
