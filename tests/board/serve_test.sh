@@ -151,6 +151,12 @@ set +e
 [[ $rc -eq 2 ]] || fail "unknown ctl command exit $rc, want 2"
 "$loomctl" ctl --socket "$work/none.sock" status 2>/dev/null; rc=$?
 [[ $rc -eq 1 ]] || fail "ctl without a server exit $rc, want 1"
+# An interface without the SocketCAN HAL would weave the simulated loom: refused, exit 2.
+"$loomctl" weave --iface can0 --rows 1 --no-telemetry --quiet 2>/dev/null; rc=$?
+[[ $rc -eq 2 ]] || fail "weave --iface without --hal socketcan exit $rc, want 2"
+"$loomctl" serve --iface can0 --state-dir "$work/state" --socket "$work/iface.sock" --group "" --no-telemetry \
+  >/dev/null 2>&1; rc=$?
+[[ $rc -eq 2 ]] || fail "serve --iface without --hal socketcan exit $rc, want 2"
 set -e
 
 # 7. every reply is true: expect STATE COMMAND VERDICT (ok → exit 0, refused → exit 1 and "refused: ")

@@ -123,6 +123,9 @@ int serve_main(const ServeArgs& a) {
     if (!a.lcm_url.empty()) cfg.telemetry.lcm_url = a.lcm_url;
     if (hardware && a.pace != 1.0) throw ConfigError("--pace = " + std::to_string(a.pace) + ": simulation only");
     if (hardware && a.iface.empty()) throw ConfigError("--hal socketcan needs --iface NAME");
+    if (!hardware && !a.iface.empty()) {
+      throw ConfigError("--iface " + a.iface + " needs --hal socketcan (without it the simulated loom would run)");
+    }
   } catch (const ConfigError& e) {
     log(Severity::kErr, "loomctl serve: %s", e.what());
     return kExitBadInput;
