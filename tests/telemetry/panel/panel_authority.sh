@@ -12,7 +12,8 @@
 #      panel's log and `ctl faults` name the client's address and pairing; a wrong code is refused;
 #      `ctl unpair` revokes the token;
 #   4. bounded: a 1 MiB body is refused (413); event streams beyond 4 per client get 503 while the
-#      buttons still answer; a design whose palette name is cp1252 (not UTF-8) keeps the panel up.
+#      buttons still answer, and so they do behind 40 idle connections; a design whose palette name is
+#      cp1252 (not UTF-8) keeps the panel up.
 # Usage: panel_authority.sh <loomctl> <loom-panel> <design csv>
 set -euo pipefail
 LOOMCTL=$1
@@ -151,6 +152,9 @@ grep -q "$ID resume by $CLIENT (token) -> ok resume" "$WORK/panel.log" || fail "
 ctl faults | grep -q " command $ID resume .*panel client $CLIENT paired as tablet-1" || fail "ctl faults lacks the audit: $(ctl faults)"
 grep -q "$code" "$WORK/serve.log" && fail "the pairing code reached the journal"
 ctl pairs | grep -q "paired tablet-1 client $CLIENT" || fail "ctl pairs: $(ctl pairs)"
+# An acknowledgement with no fault latched is refused by the loom (never kept for a later fault).
+[[ $(cmd ack -b "$WORK/jar") == 403 ]] || fail "paired ack while weaving: $(cat "$WORK/body")"
+grep -q 'refused: ack: no fault is latched' "$WORK/body" || fail "ack refusal: $(cat "$WORK/body")"
 [[ $(cmd pause -b "$WORK/jar") == 200 ]] || fail "paired pause"
 wait_for state paused 30
 ctl unpair tablet-1 | grep -q '^ok unpair' || fail "unpair"
@@ -172,6 +176,19 @@ done
 [[ $(cmd stop) == 200 ]] || fail "buttons locked out by open event streams: $(cat "$WORK/body")"
 [[ $(cat "$WORK"/stream*.code 2>/dev/null | grep -c 200 || true) == 0 ]] || fail "an admitted event stream ended early"
 [[ $refused -ge 2 ]] || fail "event streams beyond 4 per client were not refused ($refused refused; codes $(cat "$WORK"/stream*.code | tr '\n' ' '))"
+# 40 idle connections (connected, sending nothing) do not lock the buttons out.
+remote python3 - "$SERVER" "$HPORT" <<'PY' &
+import socket, sys, time
+idle = [socket.create_connection((sys.argv[1], int(sys.argv[2]))) for _ in range(40)]
+time.sleep(6)
+PY
+PIDS+=($!)
+sleep 1
+t0=$(date +%s%N)
+[[ $(cmd pause) == 200 || $(cat "$WORK/body") == *"refused: pause: not weaving"* ]] ||
+  fail "buttons locked out by 40 idle connections: $(cat "$WORK/body")"
+t1=$(date +%s%N)
+echo "a button behind 4 event streams and 40 idle connections answered in $(((t1 - t0) / 1000000)) ms"
 remote curl -s -m 5 "$BASE/api/loom/$ID" | grep -q 'rouge garanc' || fail "the cp1252 palette name is not shown"
 kill -0 "$PANEL_PID" 2>/dev/null || fail "loom-panel died"
 echo "panel_authority: ok ($([[ $netns == 1 ]] && echo "client in network namespace $NS" || echo "client on loopback"))"
