@@ -111,7 +111,7 @@ class LoopBody {
         stats_.last_wake_latency_ns = late;
         stats_.max_wake_latency_ns = std::max(stats_.max_wake_latency_ns, late);
       }
-      if (take_commands()) break;  // a command ended the session
+      if (take_commands(tick)) break;  // a command ended the session
 
       const std::int64_t t0 = rt_.clock.now_ns();
       rt_.loop.cycle(tick);
@@ -173,16 +173,24 @@ class LoopBody {
 
  private:
   // Applies operator commands (and button edges). True when the session ends here.
-  bool take_commands() noexcept {
+  bool take_commands(hal::Tick tick) noexcept {
     std::uint32_t cmds = 0;
     if (opt_.link != nullptr && opt_.link->pending.load(std::memory_order_relaxed) != 0) {
       cmds = opt_.link->pending.exchange(0, std::memory_order_acquire);
     }
     if (opt_.operator_buttons) {
       const hal::DigitalInputs& io = rt_.loop.inputs().io;
-      if (io.button_start && !prev_start_) cmds |= static_cast<std::uint32_t>(Command::kStart);
-      if (io.button_pause && !prev_pause_) cmds |= static_cast<std::uint32_t>(Command::kPause);
-      if (io.button_ack && !prev_ack_) cmds |= static_cast<std::uint32_t>(Command::kAck);
+      // Each press is audited (the reporter logs who gave the command: the I/O module's button).
+      const auto press = [&](bool now, bool before, Command c) {
+        if (!now || before) return;
+        cmds |= static_cast<std::uint32_t>(c);
+        RunEvent e = base_event(RunEvent::Kind::kButton, tick);
+        e.button = c;
+        emit(e);
+      };
+      press(io.button_start, prev_start_, Command::kStart);
+      press(io.button_pause, prev_pause_, Command::kPause);
+      press(io.button_ack, prev_ack_, Command::kAck);
       prev_start_ = io.button_start;
       prev_pause_ = io.button_pause;
       prev_ack_ = io.button_ack;

@@ -309,6 +309,13 @@ int serve_main(const ServeArgs& a) {
           }
           break;
         }
+        case RunEvent::Kind::kButton:
+          // Audit only: a press changes no counters, so nothing is saved for it.
+          log(Severity::kNotice, "operator: %s by the I/O module's %s button (state %s)",
+              e.button == Command::kStart ? "start" : e.button == Command::kPause ? "pause" : "ack",
+              e.button == Command::kStart ? "start" : e.button == Command::kPause ? "pause" : "reset/acknowledge",
+              sequencer::state_name(e.state));
+          return;
         case RunEvent::Kind::kPickDone:
         case RunEvent::Kind::kFinished:
           break;

@@ -86,7 +86,7 @@ struct OperatorLink {
 // Events for the non-RT side.
 // ---------------------------------------------------------------------------------------------------
 struct RunEvent {
-  enum class Kind : std::uint8_t { kRowDone, kPickDone, kPaused, kResumed, kFault, kOverrunStop, kFinished };
+  enum class Kind : std::uint8_t { kRowDone, kPickDone, kPaused, kResumed, kFault, kOverrunStop, kFinished, kButton };
   Kind kind = Kind::kRowDone;
   hal::Tick tick = 0;
   sequencer::RowStats row{};
@@ -97,6 +97,7 @@ struct RunEvent {
   int fault_axis = -1;
   std::uint16_t fault_detail = 0;
   int fault_sensor = -1;  // hal::SafetySensor the fault names (sensor_discrepancy), or -1
+  Command button = Command::kStart;  // kButton: the I/O module's button pressed (operator_buttons)
 };
 // Run events waiting for the reporter. An event is at most one per row, pick, pause, resume or fault,
 // and a pick is never shorter than a shed change (hundreds of ms), so 1024 pending events cover a
