@@ -114,6 +114,10 @@ TEST(OperatorDesk, RefusalsSayWhy) {
   EXPECT_NE(desk.decide(local("next"), plain, kNow).reply.find("no knotting mode"), std::string::npos);
   EXPECT_EQ(desk.decide(local("dance"), idle, kNow).reply.rfind("error: unknown command 'dance'", 0), 0u);
   EXPECT_EQ(desk.decide(local("start now"), idle, kNow).reply, "error: start takes no argument (got 'now')\n");
+  EXPECT_EQ(desk.decide(local("start hours=3"), idle, kNow).reply, "error: hours= is for pair only\n");
+  EXPECT_EQ(desk.decide(local("start via=lan client=x"), idle, kNow).reply, "error: via=lan: only via=panel\n");
+  EXPECT_EQ(desk.decide(local("start via=panel"), idle, kNow).reply, "error: via=panel needs client=ADDR\n");
+  EXPECT_EQ(desk.decide(local(std::string("start\x01")), idle, kNow).reply.rfind("error: request has a character", 0), 0u);
 }
 
 TEST(OperatorDesk, WhoGaveTheCommandIsTheKernelsWordAndThePanelsClient) {

@@ -116,6 +116,14 @@ std::optional<ParsedRequest> parse_request(std::string_view line, std::string& e
       return std::nullopt;
     }
   }
+  if (r.fields.count("hours") != 0 && r.word != "pair") {
+    error = "hours= is for pair only";
+    return std::nullopt;
+  }
+  if (r.fields.count("code") != 0 && r.word != "redeem") {
+    error = "code= is for redeem only";
+    return std::nullopt;
+  }
   if (r.fields.count("via") != 0 && r.field("via") != "panel") {
     error = "via=" + shown(r.field("via")) + ": only via=panel";
     return std::nullopt;

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -165,9 +166,11 @@ int serve_main(const ServeArgs& a) {
   std::signal(SIGTERM, on_terminate);
   std::signal(SIGINT, on_terminate);
 
-  // Who gave the latest accepted `ack` (the loop reports the acknowledgement itself; none → the I/O button).
+  // Who gave the latest accepted `ack`, and when (the loop reports the acknowledgement itself; none in
+  // the last second → the I/O module's button).
   std::mutex ack_mu;
   std::string ack_by;
+  std::chrono::steady_clock::time_point ack_at{};
   Pairings pairings;
   OperatorDesk desk(pairings, a.iface);
   std::unique_ptr<ControlServer> server;
@@ -184,6 +187,7 @@ int serve_main(const ServeArgs& a) {
         if (*d.post == Command::kAck) {
           std::lock_guard<std::mutex> lock(ack_mu);
           ack_by = d.who;
+          ack_at = std::chrono::steady_clock::now();
         }
         link.post(*d.post);
       }
@@ -368,7 +372,8 @@ int serve_main(const ServeArgs& a) {
         r.beats = seq.counters().beats;
         {
           std::lock_guard<std::mutex> lock(ack_mu);
-          r.text = "acknowledged by " + (ack_by.empty() ? std::string("the I/O module's ack button") : ack_by) +
+          const bool by_command = !ack_by.empty() && std::chrono::steady_clock::now() - ack_at < std::chrono::seconds(1);
+          r.text = "acknowledged by " + (by_command ? ack_by : std::string("the I/O module's ack button")) +
                    "; re-arming from the measured positions";
           ack_by.clear();
         }
