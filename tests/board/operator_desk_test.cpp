@@ -29,6 +29,7 @@ struct Row {
 const Row kTable[] = {
     {State::kIdle, "idle", "start"},
     {State::kEnabling, "enabling", "pause stop"},
+    {State::kHoming, "homing", "pause stop"},
     {State::kPositioning, "positioning", "pause stop"},
     {State::kShedTest, "shed_test", "pause stop"},
     {State::kShed, "shed", "pause stop"},

@@ -10,6 +10,7 @@ using sequencer::State;
 bool weaving(State s) {
   switch (s) {
     case State::kEnabling:
+    case State::kHoming:
     case State::kPositioning:
     case State::kShedTest:
     case State::kShed:
