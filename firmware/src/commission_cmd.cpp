@@ -40,6 +40,16 @@ constexpr Capture kCaptures[] = {
     {"left", hal::CoreAxis::kHelix, "helix", "left_position_rad", "the helix carrier at the left selvedge"},
 };
 
+// "" when the inputs agree with the pose `c` captures, else the contradiction. Only the helix carrier's
+// pose has sensors that confirm it: at the left selvedge the shuttle rides it into the left sensor's reach
+// and out of the right one's. (The crank's park and the carriage's home have no sensor on this loom.)
+std::string pose_contradiction(const Capture& c, const hal::DigitalInputs& io) {
+  if (c.axis != hal::CoreAxis::kHelix) return "";
+  if (io.shuttle_at_right) return "shuttle_at_right=1: the shuttle (and its carrier) is at the right selvedge";
+  if (!io.shuttle_at_left) return "shuttle_at_left=0: no shuttle seen at the left selvedge (is it on its carrier?)";
+  return "";
+}
+
 const Capture* capture_named(const std::string& n) {
   for (const Capture& c : kCaptures) {
     if (n == c.name) return &c;
@@ -118,7 +128,9 @@ class Commissioning {
     }
     if (a_.io_once || !a_.capture.empty()) {
       std::printf("%s\n%s\n", positions_line(loop_->inputs(), cfg_.sequencer.axes).c_str(), inputs_line(loop_->inputs(), cfg_.sequencer.second_channel).c_str());
-      for (const std::string& c : a_.capture) take(*capture_named(c));
+      for (const std::string& c : a_.capture) {
+        if (!take(*capture_named(c))) return kExitBadInput;  // nothing written
+      }
       return a_.write ? write() : kExitOk;
     }
     return interactive();
@@ -147,12 +159,18 @@ class Commissioning {
     return seq_->state() == sequencer::State::kIdle || seq_->state() == sequencer::State::kFault;
   }
 
-  void take(const Capture& c) {
+  // Captures `c` unless the sensors contradict the pose; false (and why, on stderr) when refused.
+  bool take(const Capture& c) {
+    if (const std::string why = pose_contradiction(c, loop_->inputs().io); !why.empty()) {
+      std::fprintf(stderr, "loomctl commission: %s refused: %s, but %s\n", c.name, c.pose, why.c_str());
+      return false;
+    }
     const double v = loop_->inputs().axes[hal::index(c.axis)].position;
     char buf[64];
     std::snprintf(buf, sizeof buf, "%.9f", v);
     captured_.push_back({c.section, c.key, buf});
     std::printf("captured %s: %s.%s = %s (%s)\n", c.name, c.section, c.key, buf, c.pose);
+    return true;
   }
 
   int write() {
@@ -206,7 +224,7 @@ class Commissioning {
         } else if (cmd == "io") {
           std::printf("%s\n", inputs_line(loop_->inputs(), cfg_.sequencer.second_channel).c_str());
         } else if (const Capture* c = capture_named(cmd)) {
-          take(*c);
+          (void)take(*c);  // a refusal says why; the operator moves the axis and tries again
         } else if (!cmd.empty()) {
           std::printf("unknown command '%s' (park, home, left, write, positions, io, quit)\n", cmd.c_str());
         }

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <tuple>
 
 #include "loom/drivers/bus_load.hpp"
 #include "loom/firmware/config.hpp"
@@ -440,6 +441,14 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "loomctl: %s\n", e.what());
     return kExitBadInput;
+  }
+  // An interface without the SocketCAN HAL would silently run the simulated loom: refused.
+  for (const auto& [cmd, hal_kind, iface] : {std::tuple{weave_cmd, &a.hal, &a.iface}, std::tuple{com_cmd, &com.hal, &com.iface}}) {
+    if (cmd->parsed() && !iface->empty() && *hal_kind != "socketcan") {
+      std::fprintf(stderr, "loomctl %s: --iface %s needs --hal socketcan (without it the simulated loom would run)\n",
+                   cmd->get_name().c_str(), iface->c_str());
+      return kExitBadInput;
+    }
   }
   if (check_cmd->parsed()) return firmware::run_check(check);
   if (com_cmd->parsed()) return firmware::run_commission(com);

@@ -93,7 +93,7 @@ struct Runtime {
 
 // A tick pushes at most one snapshot and this many events (a beat, a row, a first fault or diagnosis,
 // a device fault per axis, a link fault): the room the runner waits for before a virtual-time tick.
-constexpr std::size_t kMaxEventsPerTick = 3 + hal::kAxisCount;
+constexpr std::size_t kMaxEventsPerTick = 3 + hal::kMaxAxes;
 
 class LoopBody {
  public:
@@ -126,7 +126,7 @@ class LoopBody {
         stats_.last_wake_latency_ns = late;
         stats_.max_wake_latency_ns = std::max(stats_.max_wake_latency_ns, late);
       }
-      if (take_commands()) break;  // a command ended the session
+      if (take_commands(tick)) break;  // a command ended the session
       if (telemetry_ != nullptr) wait_for_telemetry_room();
 
       const std::int64_t t0 = rt_.clock.now_ns();
@@ -208,16 +208,24 @@ class LoopBody {
   }
 
   // Applies operator commands (and button edges). True when the session ends here.
-  bool take_commands() noexcept {
+  bool take_commands(hal::Tick tick) noexcept {
     std::uint32_t cmds = 0;
     if (opt_.link != nullptr && opt_.link->pending.load(std::memory_order_relaxed) != 0) {
       cmds = opt_.link->pending.exchange(0, std::memory_order_acquire);
     }
     if (opt_.operator_buttons) {
       const hal::DigitalInputs& io = rt_.loop.inputs().io;
-      if (io.button_start && !prev_start_) cmds |= static_cast<std::uint32_t>(Command::kStart);
-      if (io.button_pause && !prev_pause_) cmds |= static_cast<std::uint32_t>(Command::kPause);
-      if (io.button_ack && !prev_ack_) cmds |= static_cast<std::uint32_t>(Command::kAck);
+      // Each press is audited (the reporter logs who gave the command: the I/O module's button).
+      const auto press = [&](bool now, bool before, Command c) {
+        if (!now || before) return;
+        cmds |= static_cast<std::uint32_t>(c);
+        RunEvent e = base_event(RunEvent::Kind::kButton, tick);
+        e.button = c;
+        emit(e);
+      };
+      press(io.button_start, prev_start_, Command::kStart);
+      press(io.button_pause, prev_pause_, Command::kPause);
+      press(io.button_ack, prev_ack_, Command::kAck);
       prev_start_ = io.button_start;
       prev_pause_ = io.button_pause;
       prev_ack_ = io.button_ack;
@@ -265,8 +273,11 @@ class LoopBody {
     if (has(Command::kAck) && s == sequencer::State::kFault && opt_.hold_when_finished) {
       // Re-arming reconfigures the link: pointless (and the operator would think it done) while the
       // controller is still off the bus or a lost node is still silent. The status says which.
+      // Likewise while the e-stop chain is still open: the fault stays latched (re-arming would show no
+      // fault until the next start re-latched it).
       const hal::LinkRecovery rec = rt_.loop.inputs().link.recovery;
-      if (rec == hal::LinkRecovery::kBusOff || rec == hal::LinkRecovery::kNodeSilent) {
+      if (rec == hal::LinkRecovery::kBusOff || rec == hal::LinkRecovery::kNodeSilent ||
+          !rt_.loop.inputs().io.estop_ok) {
         ++res.acks_refused;
         return false;
       }
@@ -354,6 +365,7 @@ class LoopBody {
     l->max_wake_latency_ns.store(stats_.max_wake_latency_ns, r);
     l->link_recovery.store(static_cast<std::uint8_t>(rt_.loop.inputs().link.recovery), r);
     l->silent_node.store(rt_.loop.inputs().link.silent_node, r);
+    l->estop_ok.store(rt_.loop.inputs().io.estop_ok, r);
     l->tick.store(tick, std::memory_order_release);
   }
 

@@ -190,6 +190,9 @@ void Sequencer::latch(Fault f, hal::Tick now, int axis, std::uint16_t detail, in
     fault_detail_ = detail;
     fault_tick_ = now;
   }
+  // An acknowledgement counts only as a deliberate act after the fault: one given before (a press while
+  // weaving, a command racing the fault) is discarded here, whatever its source.
+  ack_requested_ = false;
   crank_move_.active = carriage_move_.active = helix_move_.active = false;
   sweeping_ = false;
   enter(State::kFault, now);
@@ -219,7 +222,7 @@ void Sequencer::step(hal::Tick now, const hal::HalInputs& raw, hal::HalOutputs& 
     external_fault_ = Fault::kNone;
   }
   if (state_ == State::kFault) refine_diagnosis(now, in);
-  operator_requests();
+  operator_requests(now);
   if (state_ == State::kIdle && start_requested_ && !in.io.estop_ok) {
     start_requested_ = false;
     latch(Fault::kEStop, now);
@@ -401,13 +404,15 @@ void Sequencer::refine_diagnosis(hal::Tick now, const hal::HalInputs& in) noexce
   }
 }
 
-void Sequencer::operator_requests() noexcept {
+void Sequencer::operator_requests(hal::Tick now) noexcept {
   if (start_edge_.update(io_.button_start)) {
     if (state_ == State::kIdle) start_requested_ = true;
     if (state_ == State::kPaused || pause_requested_) pause_requested_ = false;  // start also resumes
   }
   if (pause_edge_.update(io_.button_pause) && state_ != State::kIdle) pause_requested_ = true;
-  if (ack_edge_.update(io_.button_ack)) ack_requested_ = true;
+  // The ack button counts only when pressed after the fault latched (not in the tick that latched it: its
+  // debounced edge means it was pressed before).
+  if (ack_edge_.update(io_.button_ack) && state_ == State::kFault && now != fault_tick_) ack_requested_ = true;
   if (knotted_edge_.update(io_.row_knotted)) knot_requested_ = true;
 }
 
@@ -664,6 +669,9 @@ void Sequencer::paused(hal::Tick now) noexcept {
 void Sequencer::fault(hal::Tick now) noexcept {
   if (!ack_requested_) return;
   ack_requested_ = false;
+  // Refused while the cause persists: an open e-stop chain keeps the fault latched (red lamp, quick stop)
+  // instead of going idle and re-latching at the next start. (Link causes: the runner refuses those.)
+  if (!io_.estop_ok) return;
   // Acknowledged: the drives get their fault-reset edge this tick, then the machine idles disabled and
   // re-arms from measured positions on the next start, proving the sensors again.
   first_fault_ = stopped_by_ = Fault::kNone;

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# loomctl serve end to end on the simulated loom (paced 25x real time, no telemetry), with a temporary
+# loomctl serve end to end on the simulated loom (paced 10x real time, no telemetry), with a temporary
 # state directory and control socket:
 #   1. serve arms and waits: nothing moves until `ctl start`;
 #   2. `ctl start` weaves; a row completes; `ctl stop` stops at the end of the row (state done);
@@ -9,7 +9,14 @@
 #      and `ctl ack` re-arms (state idle again, the ack recorded);
 #   5. knotting mode with a design: parked before every row until `ctl next`, the knotting time logged
 #      with the row, the design row to knot in `ctl status` and remembered across a restart;
-#   6. bad commands are refused (exit 2 from the CLI, exit 1 from the service).
+#   6. bad commands are refused (exit 2 from the CLI, exit 1 from the service);
+#   7. every reply is true (issue 22): a table of each command in each state — `ok` (exit 0) only when it
+#      changed something, else `refused: why` (exit 1), and the journal names who gave it;
+#   8. an acknowledgement before the fault is discarded: `ctl ack` while weaving is refused, the fault that
+#      follows is latched, logged and recorded, and stays latched until a new ack after it;
+#   9. a client that trickles its request and one that never reads a ~300 KB `faults` reply hold nobody:
+#      `ctl status` answers at once, SIGTERM stops the service; `--socket` on a regular file is refused
+#      and the file kept.
 # Usage: serve_test.sh LOOMCTL SOURCE_DIR
 set -euo pipefail
 loomctl=$1
@@ -28,7 +35,7 @@ field() { ctl status | tr ' ' '\n' | sed -n "s/^$1=//p"; }
 start_serve() {  # start_serve LOG [extra args]
   local log=$1; shift
   JOURNAL_STREAM=8:1 "$loomctl" serve --state-dir "$work/state" --socket "$sock" --group "" --no-telemetry \
-    --pace 25 "$@" >"$work/$log" 2>&1 &
+    --pace "${PACE:-10}" "$@" >"$work/$log" 2>&1 &
   pid=$!
   for _ in $(seq 1 200); do
     [[ -S $sock ]] && ctl status >/dev/null 2>&1 && return 0
@@ -69,8 +76,10 @@ wait_for state done 30
 rows=$(field rows)
 [[ $rows -ge 1 ]] || fail "no row woven"
 grep -q '^<6>row 1 done' "$work/serve1.log" || fail "no <6> row line"
-ctl faults | grep -q 'no faults recorded' || fail "a fault recorded on a clean run"
+ctl faults | grep -q ' fault loom1 ' && fail "a fault recorded on a clean run: $(ctl faults)"
+ctl faults | grep -q ' command loom1 start .*by local user' || fail "the start command is not in the history: $(ctl faults)"
 ctl next 2>/dev/null && fail "next accepted without a knotting mode"
+ctl faults | grep -q ' command loom1 next' && fail "a refused command went into the history"
 
 # 3. restart on the same state: armed at the same row, idle
 stop_serve
@@ -142,5 +151,98 @@ set +e
 [[ $rc -eq 2 ]] || fail "unknown ctl command exit $rc, want 2"
 "$loomctl" ctl --socket "$work/none.sock" status 2>/dev/null; rc=$?
 [[ $rc -eq 1 ]] || fail "ctl without a server exit $rc, want 1"
+# An interface without the SocketCAN HAL would weave the simulated loom: refused, exit 2.
+"$loomctl" weave --iface can0 --rows 1 --no-telemetry --quiet 2>/dev/null; rc=$?
+[[ $rc -eq 2 ]] || fail "weave --iface without --hal socketcan exit $rc, want 2"
+"$loomctl" serve --iface can0 --state-dir "$work/state" --socket "$work/iface.sock" --group "" --no-telemetry \
+  >/dev/null 2>&1; rc=$?
+[[ $rc -eq 2 ]] || fail "serve --iface without --hal socketcan exit $rc, want 2"
 set -e
+
+# 7. every reply is true: expect STATE COMMAND VERDICT (ok → exit 0, refused → exit 1 and "refused: ")
+expect() {
+  local out rc=0
+  out=$(ctl "$2" 2>&1) || rc=$?
+  case $3 in
+    ok) [[ $rc -eq 0 && $out == "ok $2"* ]] || fail "in $1: ctl $2 answered '$out' (exit $rc), want ok" ;;
+    refused) [[ $rc -eq 1 && $out == "refused: $2: "* ]] || fail "in $1: ctl $2 answered '$out' (exit $rc), want refused" ;;
+  esac
+}
+rm -rf "$work/state"
+start_serve serve7.log
+for c in pause resume stop ack next; do expect idle $c refused; done
+expect idle start ok
+wait_for state pick 30
+for c in start resume ack next; do expect weaving $c refused; done
+expect weaving pause ok
+wait_for state paused 30
+for c in start pause ack next; do expect paused $c refused; done
+expect paused resume ok
+wait_for state pick 30
+expect weaving stop ok
+wait_for state done 60
+for c in stop pause resume ack next; do expect done $c refused; done
+grep -q '^<4>operator: resume by local user .*: refused: resume: not paused' "$work/serve7.log" ||
+  fail "a refusal is not in the journal with who gave it"
+ctl start | grep -q '^ok start' || fail "start after done (a new session) not accepted"
+wait_for state pick 30
+stop_serve
+
+# 8. a stale acknowledgement: ack while weaving is refused; the fault after it is latched and recorded and
+#    stays latched until an ack given after it
+rm -rf "$work/state"
+# (2x real time: the scene's fault comes 6 s after start, well after the stale ack)
+PACE=2 start_serve serve8.log --scene "$src/sim_hal/scenes/drive_fault.toml"
+ctl start >/dev/null
+ctl ack >/dev/null 2>&1 && fail "ack accepted while weaving without a fault: $(ctl status)"
+wait_for state fault 60
+grep -q '^<3>FAULT drive_fault' "$work/serve8.log" || fail "the fault after a stale ack was not logged"
+ctl faults | grep -q ' fault loom1 drive_fault' || fail "the fault after a stale ack was not recorded"
+for c in start resume pause stop next; do expect fault $c refused; done
+sleep 0.5
+[[ $(field state) == fault ]] || fail "the fault did not stay latched: $(ctl status)"
+expect fault ack ok
+wait_for state idle 30
+ctl faults | grep -q ' ack loom1 drive_fault .*acknowledged by local user' || fail "the ack does not name who: $(ctl faults)"
+stop_serve
+
+# 9. slow clients hold nobody; SIGTERM is honoured; --socket never deletes a non-socket
+rm -rf "$work/state"
+mkdir -p "$work/state"
+for i in $(seq 1 3000); do
+  printf '2026-11-23T20:15:03Z fault loom1 drive_fault 0x1002 axis=carriage device=0x7310 rows=3 picks=3 beats=45: filler line %05d\n' "$i"
+done >"$work/state/faults.log"
+start_serve serve9.log
+python3 - "$sock" <<'PY' &
+import socket, sys, time
+trickler = socket.socket(socket.AF_UNIX); trickler.connect(sys.argv[1])
+hoarder = socket.socket(socket.AF_UNIX); hoarder.connect(sys.argv[1])
+hoarder.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+hoarder.sendall(b"faults\n")                 # and never reads the reply
+for c in b"stat":                             # a byte every 0.3 s, never a newline
+    trickler.send(bytes([c])); time.sleep(0.3)
+time.sleep(30)
+PY
+slow=$!
+sleep 0.3
+t0=$(date +%s%N)
+ctl status >/dev/null || fail "status not answered while slow clients are connected"
+ctl pause >/dev/null 2>&1 || true
+t1=$(date +%s%N)
+(( (t1 - t0) / 1000000 < 1000 )) || fail "status and pause took $(( (t1 - t0) / 1000000 )) ms behind slow clients"
+t0=$(date +%s%N)
+stop_serve
+t1=$(date +%s%N)
+(( (t1 - t0) / 1000000 < 5000 )) || fail "SIGTERM took $(( (t1 - t0) / 1000000 )) ms with slow clients connected"
+kill "$slow" 2>/dev/null || true
+wait "$slow" 2>/dev/null || true
+echo keep >"$work/not-a-socket"
+set +e
+"$loomctl" serve --state-dir "$work/state" --socket "$work/not-a-socket" --group "" --no-telemetry \
+  >"$work/serve9b.log" 2>&1; rc=$?
+set -e
+[[ $rc -eq 2 ]] || fail "serve --socket on a regular file exit $rc, want 2"
+[[ $(cat "$work/not-a-socket") == keep ]] || fail "serve --socket deleted a regular file"
+grep -q 'is not a socket' "$work/serve9b.log" || fail "no reason given for refusing --socket on a file"
+
 echo "serve_test: ok"

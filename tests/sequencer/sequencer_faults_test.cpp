@@ -160,6 +160,58 @@ TEST(SequencerFaults, ButtonsAreDebouncedEdgesAndAButtonHeldAtPowerOnIsNoPress) 
   EXPECT_EQ(r.seq->counters().rows, 2u);
 }
 
+// Issue 22: an acknowledgement given before a fault acknowledged it (the drives got "disable voltage"
+// while moving, no red lamp, no fault). From both sources — the I/O module's button and a command — an
+// ack before the fault is discarded: the e-stop that follows is latched, quick-stops, lights red and stays
+// latched; an ack while the chain is still open is refused; only a press after the chain closed re-arms.
+TEST(SequencerFaults, AnAcknowledgementBeforeTheFaultIsDiscardedAndOneWhileTheChainIsOpenRefused) {
+  for (const bool by_button : {true, false}) {
+    SCOPED_TRACE(by_button ? "ack button" : "request_acknowledge");
+    Rig r;
+    bool ack = false, chain_open = false;
+    r.tamper = [&](hal::Tick, hal::HalInputs& in) {
+      in.io.button_ack = ack;
+      if (chain_open) in.io.estop_ok = false;
+    };
+    const auto press = [&] {
+      if (by_button) {
+        ack = true;
+        r.run(150);  // 0.3 s at 2 ms
+        ack = false;
+        r.run(10);
+      } else {
+        r.seq->request_acknowledge();
+        r.run(1);
+      }
+    };
+    r.build(3);
+    r.run(1500);
+    ASSERT_NE(r.seq->state(), State::kFault) << sequencer::fault_name(r.seq->first_fault());
+    ASSERT_NE(r.seq->state(), State::kIdle);
+    press();  // while weaving, no fault: not an acknowledgement
+    EXPECT_NE(r.seq->state(), State::kFault);
+    r.run(800);  // 1.6 s later the e-stop chain opens
+    chain_open = true;
+    r.run(1);
+    EXPECT_EQ(r.seq->state(), State::kFault);
+    EXPECT_EQ(r.seq->first_fault(), Fault::kEStop);
+    for (const auto& a : r.out.axes) EXPECT_EQ(a.request, hal::AxisRequest::kQuickStop);
+    r.run(300);
+    EXPECT_EQ(r.seq->state(), State::kFault) << "the stale acknowledgement was taken";
+    EXPECT_TRUE(r.out.io.lamp_red);
+    EXPECT_FALSE(r.out.io.lamp_amber);
+    press();  // the chain is still open: refused, still latched
+    EXPECT_EQ(r.seq->state(), State::kFault);
+    EXPECT_EQ(r.seq->first_fault(), Fault::kEStop);
+    chain_open = false;
+    r.run(50);
+    EXPECT_EQ(r.seq->state(), State::kFault);  // closing the chain acknowledges nothing
+    press();
+    EXPECT_EQ(r.seq->state(), State::kIdle);
+    EXPECT_EQ(r.seq->first_fault(), Fault::kNone);
+  }
+}
+
 TEST(SequencerFaults, BeatsPerRowBeyondCapacityAreRefusedAtConfiguration) {
   motion::ProfileSpec wide;
   wide.width_m = 3.0;

@@ -135,6 +135,28 @@ TEST(PanelHall, DesignShowsTheNextRowAndOnlyANewRowIsAChange) {
   EXPECT_GT(hall.version(), v);
 }
 
+// Issue 22: one FAULT packet or palette name that is not UTF-8 aborted the panel (type_error 316).
+TEST(PanelHall, TextThatIsNotUtf8IsReplacedNeverThrown) {
+  Hall hall;
+  auto d = loom::telemetry::test_support::design_message("L1", {{0, 1}});
+  d.colour_name[0] = "rot\xe9 (cp1252)";
+  d.name = "teppich\xfc.csv";
+  hall.on_design(d);
+  loomlcm::fault_t f{};
+  f.loom_id = "L1";
+  f.kind = "fault";
+  f.name = "drive_fault";
+  f.text = "spoofed \xff\xfe\xc3";
+  hall.on_fault(f);
+  std::string loom, all;
+  ASSERT_NO_THROW(loom = loom::panel::json_text(*hall.loom_json("L1")));
+  ASSERT_NO_THROW(all = loom::panel::json_text(hall.hall_json()));
+  EXPECT_NE(loom.find("rot\xef\xbf\xbd (cp1252)"), std::string::npos) << loom;  // U+FFFD for the bad byte
+  EXPECT_NE(loom.find("spoofed \xef\xbf\xbd"), std::string::npos);
+  EXPECT_TRUE(nlohmann::json::accept(loom));  // what a browser gets parses
+  EXPECT_TRUE(nlohmann::json::accept(all));
+}
+
 TEST(PanelHall, RowsCarryTheKnottingTime) {
   Hall hall;
   loomlcm::row_t r{};

@@ -4,6 +4,11 @@
 #include <cmath>
 
 namespace loom::panel {
+
+std::string json_text(const nlohmann::json& j) {
+  return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
 namespace {
 
 using nlohmann::json;

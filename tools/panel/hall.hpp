@@ -32,6 +32,11 @@ struct HallLimits {
   std::size_t beats_per_row = 512;  // beats kept per row (the firmware caps a row at 256)
 };
 
+// The only way the panel turns JSON into text: any string that is not valid UTF-8 (a design palette
+// name saved in cp1252, a spoofed LCM packet) has its bad bytes replaced by U+FFFD instead of throwing
+// (nlohmann's type_error 316 would end the HTTP handler's thread and, uncaught, the panel).
+std::string json_text(const nlohmann::json& j);
+
 class Hall {
  public:
   using Clock = std::chrono::steady_clock;

@@ -6,19 +6,26 @@
 //   GET /api/hall         the hall as JSON                    GET /api/loom/<id>  one loom as JSON
 //   GET /events[?loom=ID] server-sent events: the same JSON, pushed on change (at most 4 per second)
 //   POST /api/loom/<id>/ctl/<pause|resume|stop|ack|next>   operator buttons, only with --control-dir
+//   POST /api/loom/<id>/pair  (body: the code from `loomctl ctl pair NAME`)  pair this client
+//   GET  /api/loom/<id>/authority   whether this client is paired (may give starting commands)
 // Read-only by default: nothing it receives over HTTP reaches the loom. With --control-dir DIR the
-// page offers pause / resume / stop at row end / acknowledge and "row knotted", each sent to that
-// loom's local control socket DIR/<id>.sock (loomctl serve's), never published on LCM. Binds to
-// 127.0.0.1 unless --bind says otherwise (a hall network). Exit 2 on bad arguments, 1 when it cannot
-// listen or open LCM.
+// page offers pause / stop at row end to every client, and resume / acknowledge / "row knotted" only to
+// a client paired with that loom (request_gate.hpp), each sent to that loom's local control socket
+// DIR/<id>.sock (loomctl serve's) tagged with the client's address and token, so the loom decides and
+// audits who pressed; never published on LCM. Host and Origin are checked, bodies, connections and
+// event streams bounded (README.md). Binds to 127.0.0.1 unless --bind says otherwise (a hall network).
+// Exit 2 on bad arguments, 1 when it cannot listen or open LCM.
 #include <httplib.h>
 #include <sys/stat.h>
 
 #include <CLI/CLI.hpp>
 #include <atomic>
 #include <chrono>
+#include <algorithm>
 #include <map>
 #include <memory>
+#include <mutex>
+#include <vector>
 #include <csignal>
 #include <cstdio>
 #include <lcm/lcm-cpp.hpp>
@@ -26,6 +33,7 @@
 #include <thread>
 
 #include "hall.hpp"
+#include "request_gate.hpp"
 #include "udpm_receiver.hpp"
 #include "loom/firmware/serve/control_socket.hpp"
 #include "loom/telemetry/channels.hpp"
@@ -50,17 +58,74 @@ struct PanelOptions {
   std::string lcm_url;
   std::string channel_prefix = std::string(loom::telemetry::kDefaultChannelPrefix);
   double min_push_interval_s = 0.25;  // live updates are coalesced to at most this often per client
-  int http_threads = 32;              // each open page holds one for its event stream
+  int http_threads = 64;              // each open page holds one for its event stream
+  int max_streams = 16;               // event streams at once (each holds a thread); more get 503
+  int max_streams_per_client = 4;     // per client address
+  std::vector<std::string> hosts;     // --host: names the hall uses for this panel (Host header check)
   // Operator buttons act through the board's local control sockets, <control_dir>/<loom id>.sock,
   // never over LCM. Empty = read-only. The page shows buttons only when the JSON says "controls": true
   // (the option is set and that loom's socket exists).
   std::string control_dir;
 };
 
-// The commands the page's buttons may send: no `start` (a loom is set going by the person beside it).
-bool panel_command(const std::string& c) {
-  return c == "pause" || c == "resume" || c == "stop" || c == "ack" || c == "next";
+// The client's pairing token for `loom`, from its cookie loom_token_<id> ("" when none or malformed).
+std::string token_of(const httplib::Request& req, const std::string& loom) {
+  const std::string cookies = req.get_header_value("Cookie");
+  const std::string key = "loom_token_" + loom + "=";
+  std::size_t at = 0;
+  while ((at = cookies.find(key, at)) != std::string::npos) {
+    if (at == 0 || cookies[at - 1] == ' ' || cookies[at - 1] == ';') {
+      const std::size_t v = at + key.size();
+      const std::string tok = cookies.substr(v, cookies.find(';', v) - v);
+      return loom::panel::token_shape(tok) ? tok : std::string();
+    }
+    at += key.size();
+  }
+  return "";
 }
+
+// A request line for the loom's control socket on behalf of this HTTP client.
+std::string on_behalf(const std::string& word, const httplib::Request& req, const std::string& token) {
+  std::string client;
+  for (char c : req.remote_addr) client += (c > ' ' && c < 0x7F) ? c : '?';
+  return word + " via=panel client=" + (client.empty() ? "unknown" : client) + (token.empty() ? "" : " token=" + token);
+}
+
+std::string trimmed(std::string s) {
+  while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
+  return s;
+}
+
+// The words of a reply line "ok redeem NAME token=T expires=E": the value of `key`, or "".
+std::string reply_field(const std::string& reply, const std::string& key) {
+  const auto at = reply.find(" " + key + "=");
+  if (at == std::string::npos) return "";
+  const auto v = at + key.size() + 2;
+  return reply.substr(v, reply.find_first_of(" \n", v) - v);
+}
+
+// Counts the event streams open, in all and per client; a stream is admitted only under both limits.
+class StreamSlots {
+ public:
+  StreamSlots(int total, int per_client) : total_(total), per_client_(per_client) {}
+  bool take(const std::string& client) {
+    std::lock_guard<std::mutex> lock(mu_);
+    if (open_ >= total_ || by_client_[client] >= per_client_) return false;
+    ++open_;
+    ++by_client_[client];
+    return true;
+  }
+  void give(const std::string& client) {
+    std::lock_guard<std::mutex> lock(mu_);
+    --open_;
+    if (--by_client_[client] <= 0) by_client_.erase(client);
+  }
+
+ private:
+  std::mutex mu_;
+  int total_, per_client_, open_ = 0;
+  std::map<std::string, int> by_client_;
+};
 
 std::string control_socket_of(const PanelOptions& o, const std::string& loom) {
   return o.control_dir + "/" + loom + ".sock";
@@ -141,9 +206,9 @@ std::optional<nlohmann::json> loom_json(const Hall& hall, const PanelOptions& o,
 }
 
 std::string json_for(const Hall& hall, const PanelOptions& o, const std::string& loom) {
-  if (loom.empty()) return hall.hall_json().dump();
+  if (loom.empty()) return loom::panel::json_text(hall.hall_json());
   const auto j = loom_json(hall, o, loom);
-  return j ? j->dump() : nlohmann::json{{"id", loom}, {"heard", false}}.dump();
+  return loom::panel::json_text(j ? *j : nlohmann::json{{"id", loom}, {"heard", false}});
 }
 
 }  // namespace
@@ -160,6 +225,12 @@ int main(int argc, char** argv) {
   app.add_option("--control-dir", o.control_dir,
                  "operator buttons: send them to the looms' control sockets DIR/<loom id>.sock (loomctl serve; "
                  "on a board /run/loomctl). Without it the panel is read-only");
+  app.add_option("--host", o.hosts,
+                 "a name the hall uses for this panel (repeatable); requests naming any other host are refused")
+      ->check([](const std::string& h) { return h.empty() || h.size() > 253 ? std::string("bad host name") : std::string(); });
+  app.add_option("--max-streams", o.max_streams, "live pages (event streams) served at once")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
   app.add_option("--min-push-interval-s", o.min_push_interval_s, "shortest gap between two live updates of a page")
       ->check(CLI::Range(0.01, 60.0))
       ->capture_default_str();
@@ -202,6 +273,39 @@ int main(int argc, char** argv) {
 
   httplib::Server svr;
   svr.new_task_queue = [&] { return new httplib::ThreadPool(static_cast<std::size_t>(o.http_threads)); };
+  // Bounded: bodies (a pairing code is a few bytes), idle and slow connections, keep-alive reuse.
+  svr.set_payload_max_length(4096);
+  svr.set_read_timeout(5, 0);
+  svr.set_write_timeout(5, 0);
+  svr.set_keep_alive_timeout(5);
+  svr.set_keep_alive_max_count(100);
+  for (std::string& h : o.hosts) {
+    std::transform(h.begin(), h.end(), h.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  }
+  loom::panel::GateConfig gate{o.bind, o.port, o.hosts};
+  // Every request: its Host must name this panel (DNS rebinding); a POST must come from this panel's own
+  // page (Origin) and carry X-Loom-Panel (a cross-site form cannot).
+  svr.set_pre_routing_handler([&](const httplib::Request& req, httplib::Response& res) {
+    const auto refuse = [&](int status, const std::string& why) {
+      res.status = status;
+      res.set_content(loom::panel::json_text({{"error", why}}), "application/json");
+      std::fprintf(stderr, "loom-panel: refused %s %s from %s: %s\n", req.method.c_str(), req.path.substr(0, 80).c_str(),
+                   req.remote_addr.c_str(), why.c_str());
+      return httplib::Server::HandlerResponse::Handled;
+    };
+    if (auto why = loom::panel::host_refusal(gate, req.get_header_value("Host")); !why.empty()) return refuse(421, why);
+    if (req.method != "GET" && req.method != "HEAD") {
+      if (auto why = loom::panel::origin_refusal(req.get_header_value("Origin"), req.get_header_value("Host"));
+          !why.empty()) {
+        return refuse(403, why);
+      }
+      if (req.get_header_value("X-Loom-Panel") != "1") return refuse(403, "missing X-Loom-Panel header");
+      // A body without a length is read until the connection's timeout: the command would be carried out
+      // after the client gave up. Refused instead.
+      if (!req.has_header("Content-Length")) return refuse(411, "a POST needs Content-Length");
+    }
+    return httplib::Server::HandlerResponse::Unhandled;
+  });
   const auto page = [](const httplib::Request&, httplib::Response& res) {
     res.set_header("Cache-Control", "no-store");
     res.set_content(loom::panel::kPanelHtml, "text/html; charset=utf-8");
@@ -209,40 +313,93 @@ int main(int argc, char** argv) {
   svr.Get("/", page);
   svr.Get(R"(/loom/([A-Za-z0-9_-]{1,32}))", page);
   svr.Get("/api/hall", [&](const httplib::Request&, httplib::Response& res) {
-    res.set_content(hall.hall_json().dump(), "application/json");
+    res.set_content(loom::panel::json_text(hall.hall_json()), "application/json");
   });
   svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32}))", [&](const httplib::Request& req, httplib::Response& res) {
     const auto j = loom_json(hall, o, req.matches[1]);
     if (!j) {
       res.status = 404;
-      res.set_content(nlohmann::json{{"error", "loom not heard"}, {"id", std::string(req.matches[1])}}.dump(),
+      res.set_content(loom::panel::json_text({{"error", "loom not heard"}, {"id", std::string(req.matches[1])}}),
                       "application/json");
       return;
     }
-    res.set_content(j->dump(), "application/json");
+    res.set_content(loom::panel::json_text(*j), "application/json");
   });
- // An operator button. A custom header is required so a page on another site cannot fire it with a
-  // plain form post (browsers send custom headers cross-origin only after a preflight we never grant).
+  // An operator button, forwarded to the loom on behalf of this client (its address and pairing token):
+  // the loom decides and audits. A starting command without a token is refused here and never forwarded.
   svr.Post(R"(/api/loom/([A-Za-z0-9_-]{1,32})/ctl/([a-z]{1,16}))", [&](const httplib::Request& req,
                                                                        httplib::Response& res) {
     const std::string loom = req.matches[1], cmd = req.matches[2];
     const auto reply = [&](int status, const std::string& text) {
       res.status = status;
-      res.set_content(nlohmann::json{{"loom", loom}, {"command", cmd}, {"reply", text}}.dump(), "application/json");
+      res.set_content(loom::panel::json_text({{"loom", loom}, {"command", cmd}, {"reply", text}}), "application/json");
+      std::fprintf(stderr, "loom-panel: %s %s by %s%s -> %s\n", loom.c_str(), cmd.c_str(), req.remote_addr.c_str(),
+                   token_of(req, loom).empty() ? " (not paired)" : " (token)", text.c_str());
     };
-    if (req.get_header_value("X-Loom-Panel") != "1") return reply(403, "missing X-Loom-Panel header");
     if (o.control_dir.empty()) return reply(403, "read-only panel (start it with --control-dir to offer buttons)");
-    if (!panel_command(cmd)) return reply(400, "unknown command (pause, resume, stop, ack, next)");
+    const auto cls = loom::panel::panel_command(cmd);
+    if (cls == loom::panel::PanelCommand::kUnknown) return reply(400, "unknown command (pause, stop, resume, ack, next)");
+    const std::string token = token_of(req, loom);
+    if (cls == loom::panel::PanelCommand::kStarting && token.empty()) {
+      return reply(403, "refused: " + cmd + ": this device is not paired with loom " + loom +
+                            " (a command that starts motion or resets a fault needs pairing: ctl pair NAME at the loom)");
+    }
     std::string text;
     try {
-      text = loom::firmware::serve::control_request(control_socket_of(o, loom), cmd, 3000);
+      text = trimmed(loom::firmware::serve::control_request(control_socket_of(o, loom), on_behalf(cmd, req, token), 3000));
     } catch (const std::exception& e) {
       return reply(503, e.what());
     }
-    while (!text.empty() && text.back() == '\n') text.pop_back();
-    std::fprintf(stderr, "loom-panel: %s %s -> %s\n", loom.c_str(), cmd.c_str(), text.c_str());
-    reply(text.rfind("ok", 0) == 0 ? 200 : 409, text);
+    reply(text.rfind("ok", 0) == 0 ? 200 : text.rfind("refused:", 0) == 0 ? 403 : 409, text);
   });
+  // Pairing: the code shown at the loom (`loomctl ctl pair NAME`) becomes this client's token, kept in an
+  // HttpOnly, SameSite=Strict cookie for that loom only.
+  svr.Post(R"(/api/loom/([A-Za-z0-9_-]{1,32})/pair)", [&](const httplib::Request& req, httplib::Response& res) {
+    const std::string loom = req.matches[1];
+    std::string code = req.has_param("code") ? req.get_param_value("code") : req.body;
+    code = trimmed(code);
+    const auto reply = [&](int status, const std::string& text) {
+      res.status = status;
+      res.set_content(loom::panel::json_text({{"loom", loom}, {"reply", text}}), "application/json");
+      std::fprintf(stderr, "loom-panel: %s pair by %s -> %s\n", loom.c_str(), req.remote_addr.c_str(), text.c_str());
+    };
+    if (o.control_dir.empty()) return reply(403, "read-only panel");
+    if (code.empty() || code.size() > 8 || code.find_first_not_of("0123456789") != std::string::npos) {
+      return reply(400, "a pairing code is the digits `loomctl ctl pair NAME` printed at the loom");
+    }
+    std::string text;
+    try {
+      text = trimmed(loom::firmware::serve::control_request(control_socket_of(o, loom),
+                                                            on_behalf("redeem", req, "") + " code=" + code, 3000));
+    } catch (const std::exception& e) {
+      return reply(503, e.what());
+    }
+    if (text.rfind("ok redeem ", 0) != 0) return reply(403, text);
+    const std::string token = reply_field(text, "token");
+    if (!loom::panel::token_shape(token)) return reply(502, "the loom's reply carried no token");
+    res.set_header("Set-Cookie", "loom_token_" + loom + "=" + token + "; Path=/; HttpOnly; SameSite=Strict; Max-Age=" +
+                                     std::to_string(24 * 7 * 3600));
+    const std::string name = text.substr(10, text.find(' ', 10) - 10);
+    reply(200, "paired as " + name + " until " + reply_field(text, "expires"));
+  });
+  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32})/authority)", [&](const httplib::Request& req, httplib::Response& res) {
+    const std::string loom = req.matches[1];
+    res.set_header("Cache-Control", "no-store");
+    const std::string token = token_of(req, loom);
+    std::string text = "not paired";
+    bool may_start = false;
+    if (!o.control_dir.empty() && !token.empty()) {
+      try {
+        text = trimmed(loom::firmware::serve::control_request(control_socket_of(o, loom), on_behalf("whoami", req, token), 3000));
+        may_start = text.rfind("ok whoami paired ", 0) == 0;
+      } catch (const std::exception& e) {
+        text = e.what();
+      }
+    }
+    res.set_content(loom::panel::json_text({{"loom", loom}, {"may_start", may_start}, {"client", req.remote_addr}, {"reply", text}}),
+                    "application/json");
+  });
+  StreamSlots slots(o.max_streams, o.max_streams_per_client);
   svr.Get("/events", [&](const httplib::Request& req, httplib::Response& res) {
     const std::string loom = req.has_param("loom") ? req.get_param_value("loom") : std::string();
     if (!loom.empty() && !loom::telemetry::loom_id_error(loom).empty()) {
@@ -251,10 +408,17 @@ int main(int argc, char** argv) {
       return;
     }
     res.set_header("Cache-Control", "no-store");
+    if (!slots.take(req.remote_addr)) {
+      res.status = 503;
+      res.set_header("Retry-After", "10");
+      res.set_content("too many live pages open\n", "text/plain");
+      return;
+    }
     const auto gap = std::chrono::duration_cast<std::chrono::milliseconds>(
         std::chrono::duration<double>(o.min_push_interval_s));
     // Each call of the provider sends one event: the current JSON, once it differs from the last sent.
     auto seen = std::make_shared<std::uint64_t>(~std::uint64_t{0});
+    const std::string client = req.remote_addr;
     res.set_chunked_content_provider("text/event-stream", [&hall, &o, loom, gap, seen](std::size_t, httplib::DataSink& sink) {
       const auto t0 = std::chrono::steady_clock::now();
       // Wake every second to notice a closed page or a stopping server; a comment keeps proxies awake.
@@ -272,7 +436,7 @@ int main(int argc, char** argv) {
       if (!sink.write(msg.data(), msg.size())) return false;
       std::this_thread::sleep_for(gap);  // coalesce: a busy loom costs at most one update per gap
       return true;
-    });
+    }, [&slots, client](bool) { slots.give(client); });
   });
 
   int port = o.port;
@@ -285,6 +449,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "loom-panel: cannot listen on %s:%d\n", o.bind.c_str(), o.port);
     return 1;
   }
+  gate.port = port;  // the port actually listened on (--port 0 picks one)
   g_server = &svr;
   struct sigaction sa {};
   sa.sa_handler = on_signal;

@@ -11,14 +11,18 @@ const char* version() { return LOOM_VERSION; }
 
 int ctl_main(const CtlArgs& a) {
   const std::string path = a.socket.empty() ? "/run/loomctl/" + a.loom_id + ".sock" : a.socket;
+  std::string request = a.command;
+  if (!a.name.empty()) request += " " + a.name;
+  if (a.hours > 0) request += " hours=" + std::to_string(a.hours);
   std::string reply;
   try {
-    reply = control_request(path, a.command, a.timeout_ms);
+    reply = control_request(path, request, a.timeout_ms);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "loomctl ctl: %s\n", e.what());
     return 1;
   }
-  const bool error = reply.rfind("error:", 0) == 0;
+  // Only `ok ...` (and the reading commands' text) means done: a refusal says why and exits 1.
+  const bool error = reply.empty() || reply.rfind("error:", 0) == 0 || reply.rfind("refused:", 0) == 0;
   std::fputs(reply.c_str(), error ? stderr : stdout);
   return error ? 1 : 0;
 }
@@ -28,7 +32,7 @@ constexpr const char* kFooter = R"(
 EXIT STATUS
   weave: 0 rows woven, 2 bad input (nothing started), 3 ended in a fault, 4 hardware not armed.
   serve: 0 stopped by the service manager, 2 bad input, 4 could not arm (real-time or CAN set-up).
-  ctl:   0 done, 1 the service refused the command or did not answer, 2 bad usage.
+  ctl:   0 done (the reply is "ok ..."), 1 refused ("refused: why"), failed or no answer, 2 bad usage.
 
 FILES
   /etc/loomctl/loom.toml        the loom's configuration (serve's default --config; a conffile)
@@ -75,9 +79,13 @@ BoardCommands::BoardCommands(CLI::App& app) {
   CtlArgs& c = *ctl_args_;
   ctl_ = app.add_subcommand("ctl", "send an operator command to a running `loomctl serve`");
   ctl_->add_option("command", c.command,
-                   "start | pause | resume | stop (at row end) | ack (a fault) | status | faults (history) | next")
+                   "start | pause | resume | stop (at row end) | ack (a fault) | status | faults (history and "
+                   "commands) | next | pair NAME (a code for a panel client) | unpair NAME | pairs")
       ->required()
-      ->check(CLI::IsMember({"start", "pause", "resume", "stop", "ack", "status", "faults", "next"}));
+      ->check(CLI::IsMember({"start", "pause", "resume", "stop", "ack", "status", "faults", "next", "pair", "unpair",
+                             "pairs"}));
+  ctl_->add_option("name", c.name, "pair/unpair: the client's name (letters, digits, _ - .)");
+  ctl_->add_option("--hours", c.hours, "pair: how long the pairing lasts (default 12)")->check(CLI::Range(1, 168));
   ctl_->add_option("--socket", c.socket, "control socket (default /run/loomctl/<loom-id>.sock)");
   ctl_->add_option("--loom-id", c.loom_id, "loom id (default loom1)");
   ctl_->add_option("--timeout-ms", c.timeout_ms, "how long to wait for the reply")->check(CLI::Range(1, 600000));

@@ -15,8 +15,10 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <ctime>
 #include <memory>
 #include <optional>
+#include <mutex>
 
 #include "loom/firmware/config.hpp"
 #include "loom/firmware/counter_store.hpp"
@@ -30,6 +32,8 @@
 #include "loom/firmware/serve/sd_notify.hpp"
 #include "loom/firmware/serve/state_lock.hpp"
 #include "loom/telemetry/identity.hpp"
+#include "loom/firmware/serve/operator_desk.hpp"
+#include "loom/firmware/serve/pairings.hpp"
 
 namespace loom::firmware::serve {
 namespace {
@@ -85,6 +89,33 @@ std::string status_text(const OperatorLink& l, const std::string& loom_id, const
   return out + "\n";
 }
 
+// The audit of one command: a journal line naming who gave it and the verdict; accepted ones also go
+// to the fault history (`ctl faults`). Refused ones stay in the journal only, so a flood of refusals
+// cannot rotate the faults out of the history.
+void audit(FaultHistory& history, const std::string& loom_id, const std::string& line, const Decision& d) {
+  std::string verdict = d.reply;
+  if (!verdict.empty() && verdict.back() == '\n') verdict.pop_back();
+  // Tokens and pairing codes never reach a log.
+  for (const char* secret : {" token=", " code="}) {
+    const auto at = verdict.find(secret);
+    if (at != std::string::npos) verdict.erase(at, verdict.find(' ', at + 1) - at);
+  }
+  std::string word = line.substr(0, line.find(' '));
+  log(d.accepted() ? Severity::kNotice : Severity::kWarning, "operator: %s by %s: %s", word.c_str(), d.who.c_str(),
+      verdict.c_str());
+  if (!d.accepted()) return;
+  FaultRecord r;
+  r.loom_id = loom_id;
+  r.kind = "command";
+  r.name = word;
+  r.text = "by " + d.who + ": " + verdict;
+  try {
+    history.append(r);
+  } catch (const std::exception& ex) {
+    log(Severity::kErr, "%s", ex.what());
+  }
+}
+
 }  // namespace
 
 int serve_main(const ServeArgs& a) {
@@ -105,6 +136,9 @@ int serve_main(const ServeArgs& a) {
     if (hardware && cfg.loom_id == kDefaultLoomId) {
       throw ConfigError(std::string("loom id '") + kDefaultLoomId + "' is the default every installed board has: give this "
                         "loom its own (LOOMCTL_LOOM_ID in /etc/loomctl/loom-id, loom.id in the config, or --loom-id)");
+    }
+    if (!hardware && !a.iface.empty()) {
+      throw ConfigError("--iface " + a.iface + " needs --hal socketcan (without it the simulated loom would run)");
     }
   } catch (const ConfigError& e) {
     log(Severity::kErr, "loomctl serve: %s", e.what());
@@ -168,42 +202,33 @@ int serve_main(const ServeArgs& a) {
   std::signal(SIGTERM, on_terminate);
   std::signal(SIGINT, on_terminate);
 
+  // Who gave the latest accepted `ack`, and when (the loop reports the acknowledgement itself; none in
+  // the last second → the I/O module's button).
+  std::mutex ack_mu;
+  std::string ack_by;
+  std::chrono::steady_clock::time_point ack_at{};
+  Pairings pairings;
+  OperatorDesk desk(pairings, a.iface);
   std::unique_ptr<ControlServer> server;
   try {
-    server = std::make_unique<ControlServer>(socket_path, a.group, [&](const std::string& req) -> std::string {
-      if (req == "start") link.post(Command::kStart);
-      else if (req == "pause") link.post(Command::kPause);
-      else if (req == "resume") link.post(Command::kResume);
-      else if (req == "stop") link.post(Command::kStop);
-      else if (req == "ack") {
-        // The loop refuses it too (the I/O node's button goes there directly); saying why here spares
-        // the operator an acknowledgement that silently does nothing.
-        const auto rec = static_cast<hal::LinkRecovery>(link.link_recovery.load(std::memory_order_relaxed));
-        if (rec == hal::LinkRecovery::kBusOff) {
-          return std::string("error: ack: the CAN controller is still bus-off; it must restart first (ip link set ") +
-                 (a.iface.empty() ? "can0" : a.iface) + " type can restart-ms 100, or ip link set ... type can restart)\n";
-        }
-        if (rec == hal::LinkRecovery::kNodeSilent) {
-          return "error: ack: node " + std::to_string(link.silent_node.load(std::memory_order_relaxed)) +
-                 " is still silent (no heartbeat, no boot-up): check its power and cable, then acknowledge\n";
-        }
-        link.post(Command::kAck);
-      }
-      else if (req == "status") return status_text(link, cfg.loom_id, cfg.recipe.design.get(), design_progress);
-      else if (req == "faults") {
+    server = std::make_unique<ControlServer>(socket_path, a.group, [&](const ControlRequest& req) -> std::string {
+      const Decision d = desk.decide(req, view_of(link, cfg.sequencer.knotting), static_cast<std::int64_t>(std::time(nullptr)));
+      if (d.read == Decision::Read::kStatus) return status_text(link, cfg.loom_id, cfg.recipe.design.get(), design_progress);
+      if (d.read == Decision::Read::kFaults) {
         std::string out;
         for (const std::string& line : history.read_all()) out += line + "\n";
         return out.empty() ? "no faults recorded in " + history.path() + "\n" : out;
-      } else if (req == "next") {
-        if (!cfg.sequencer.knotting) {
-          return "error: next: this loom has no weaver's knotting (knotting.mode is not \"weaver\")\n";
-        }
-        link.post(Command::kNext);
-      } else {
-        return "error: unknown command '" + req + "' (start, pause, resume, stop, ack, status, faults, next)\n";
       }
-      log(Severity::kNotice, "operator: %s (control socket)", req.c_str());
-      return "ok " + req + "\n";
+      if (d.post) {
+        if (*d.post == Command::kAck) {
+          std::lock_guard<std::mutex> lock(ack_mu);
+          ack_by = d.who;
+          ack_at = std::chrono::steady_clock::now();
+        }
+        link.post(*d.post);
+      }
+      if (d.audit) audit(history, cfg.loom_id, req.line, d);
+      return d.reply;
     });
   } catch (const std::exception& e) {
     log(Severity::kErr, "loomctl serve: %s", e.what());
@@ -369,6 +394,13 @@ int serve_main(const ServeArgs& a) {
           }
           break;
         }
+        case RunEvent::Kind::kButton:
+          // Audit only: a press changes no counters, so nothing is saved for it.
+          log(Severity::kNotice, "operator: %s by the I/O module's %s button (state %s)",
+              e.button == Command::kStart ? "start" : e.button == Command::kPause ? "pause" : "ack",
+              e.button == Command::kStart ? "start" : e.button == Command::kPause ? "pause" : "reset/acknowledge",
+              sequencer::state_name(e.state));
+          return;
         case RunEvent::Kind::kPickDone:
         case RunEvent::Kind::kFinished:
           break;
@@ -436,13 +468,19 @@ int serve_main(const ServeArgs& a) {
         r.rows = seq.counters().rows;
         r.picks = seq.counters().picks;
         r.beats = seq.counters().beats;
-        r.text = "acknowledged by the operator; re-arming from the measured positions";
+        {
+          std::lock_guard<std::mutex> lock(ack_mu);
+          const bool by_command = !ack_by.empty() && std::chrono::steady_clock::now() - ack_at < std::chrono::seconds(1);
+          r.text = "acknowledged by " + (by_command ? ack_by : std::string("the I/O module's ack button")) +
+                   "; re-arming from the measured positions";
+          ack_by.clear();
+        }
         try {
           history.append(r);
         } catch (const std::exception& ex) {
           log(Severity::kErr, "%s", ex.what());
         }
-        log(Severity::kNotice, "fault %s acknowledged: re-arming from the measured positions", r.name.c_str());
+        log(Severity::kNotice, "fault %s %s", r.name.c_str(), r.text.c_str());
         // The counters in memory are the truth (a fault keeps them; counters_not_saved means the disk
         // lags them): write them before re-arming, which reads them back.
         try {

@@ -4,10 +4,11 @@
 // the loom weaves that row and parks again with the panel showing the next design row.
 // Usage: node --experimental-websocket panel_knotting.mjs <chromium> <panel base url> <loom id> <png>
 //        <timeout s> <design rows JSON: [[codes of design row 1], [codes of design row 2]]> <height>
+//        <pairing code from `loomctl ctl pair`: "Row knotted" is offered only to a paired device>
 import { writeFileSync } from "node:fs";
 import { launch, sleep } from "./cdp.mjs";
 
-const [chromiumBin, base, loomId, pngPath, timeoutArg, rowsJson, heightArg] = process.argv.slice(2);
+const [chromiumBin, base, loomId, pngPath, timeoutArg, rowsJson, heightArg, pairCode] = process.argv.slice(2);
 const expected = JSON.parse(rowsJson);
 const height = Number(heightArg);
 const timeoutMs = Number(timeoutArg || 60) * 1000;
@@ -38,6 +39,12 @@ const waitFor = async (what, ok, seconds) => {
 };
 const same = (a, b) => JSON.stringify(a) === JSON.stringify(b);
 
+// 0. Unpaired, the page offers no "Row knotted" (a starting command); the weaver pairs the device.
+const unpaired = await waitFor("the pairing field of an unpaired device",
+  v => v.state === "await_knotting", 40);
+if (unpaired.button) fail("an unpaired device was offered \"Row knotted\"");
+await evaluate(page, `(() => { document.getElementById("pair-code").value = "${pairCode}";
+  document.querySelector('button[data-pair]').click(); })()`);
 // 1. Parked before row 1, showing design row 1 (the bottom line of the picture) with its codes.
 const first = await waitFor("the loom waiting for the weaver with design row 1 shown",
   v => v.state === "await_knotting" && v.nextRow === 1 && v.knots.length > 0 && v.button, 40);

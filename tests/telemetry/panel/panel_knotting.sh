@@ -53,10 +53,14 @@ for _ in $(seq 1 200); do
   sleep 0.05
 done
 "$LOOMCTL" ctl --socket "$SOCK" start >/dev/null || fail "serve did not take start"
+# "Row knotted" starts motion: the panel offers it only to a device paired at the loom.
+CODE=$("$LOOMCTL" ctl --socket "$SOCK" pair knot-test | sed -n 's/.*code=\([0-9]*\).*/\1/p')
+[ -n "$CODE" ] || fail "ctl pair printed no code"
 
 node --experimental-websocket "$here/panel_knotting.mjs" "$CHROMIUM" "$BASE" "$ID" "$OUT/loom_panel_knotting.png" 80 \
-  "$rows_json" "$height" 2>&1 | grep -v ExperimentalWarning | grep -v "node --trace-warnings" ||
+  "$rows_json" "$height" "$CODE" 2>&1 | grep -v ExperimentalWarning | grep -v "node --trace-warnings" ||
   fail "browser check failed"
-grep -q "$ID next -> ok next" "$WORK/panel.log" || fail "the panel did not log the button it sent"
-grep -q 'operator: next (control socket)' "$WORK/serve.log" || fail "serve did not receive the panel's next"
+grep -q "$ID next by 127.0.0.1 (token) -> ok next" "$WORK/panel.log" || fail "the panel did not log the button it sent"
+grep -q 'operator: next by panel client 127.0.0.1 paired as knot-test' "$WORK/serve.log" ||
+  fail "serve did not receive the panel's next naming the paired client"
 [ -s "$OUT/loom_panel_knotting.png" ] || fail "no screenshot written"

@@ -78,6 +78,7 @@ struct OperatorLink {
   std::atomic<std::int64_t> max_wake_latency_ns{0};
   std::atomic<std::uint8_t> link_recovery{0};  // hal::LinkRecovery: whether an acknowledgement can re-arm
   std::atomic<std::uint8_t> silent_node{0};    // the lost node still silent (kNodeSilent)
+  std::atomic<bool> estop_ok{true};            // the e-stop chain is closed (an acknowledgement can re-arm)
   std::atomic<std::int64_t> tick{0};
 };
 
@@ -85,7 +86,7 @@ struct OperatorLink {
 // Events for the non-RT side.
 // ---------------------------------------------------------------------------------------------------
 struct RunEvent {
-  enum class Kind : std::uint8_t { kRowDone, kPickDone, kPaused, kResumed, kFault, kOverrunStop, kFinished };
+  enum class Kind : std::uint8_t { kRowDone, kPickDone, kPaused, kResumed, kFault, kOverrunStop, kFinished, kButton };
   Kind kind = Kind::kRowDone;
   hal::Tick tick = 0;
   sequencer::RowStats row{};
@@ -96,6 +97,7 @@ struct RunEvent {
   int fault_axis = -1;
   std::uint16_t fault_detail = 0;
   int fault_sensor = -1;  // hal::SafetySensor the fault names (sensor_discrepancy), or -1
+  Command button = Command::kStart;  // kButton: the I/O module's button pressed (operator_buttons)
 };
 // Run events waiting for the reporter (real time only: in virtual time the handler runs in place and no
 // ring is allocated). An event is at most one per row, pick, pause, resume or fault,

@@ -135,7 +135,11 @@ class Sequencer {
   void request_stop_now() noexcept { stop_now_requested_ = true; }
   // RT-safe. Acknowledge a latched fault: the drives get their fault-reset edge, the machine goes idle
   // and re-arms from measured positions on the next start. (The operator's ack button does the same.)
-  void request_acknowledge() noexcept { ack_requested_ = true; }
+  // Only after the fault: a request while no fault is latched is discarded, never kept for the next one;
+  // refused (the fault stays latched) while the e-stop chain is open.
+  void request_acknowledge() noexcept {
+    if (state_ == State::kFault) ack_requested_ = true;
+  }
   // RT-safe. The weaver has knotted the row (knotting mode): weave it. Ignored unless waiting for it.
   void request_row_knotted() noexcept { knot_requested_ = true; }
   // RT-safe. A fault found outside the sequencer (the runner's overrun policy): latched at the next step
@@ -189,7 +193,7 @@ class Sequencer {
   void sense(const hal::HalInputs& raw) noexcept;
   bool check_faults(hal::Tick now, const hal::HalInputs& in) noexcept;
   void refine_diagnosis(hal::Tick now, const hal::HalInputs& in) noexcept;
-  void operator_requests() noexcept;
+  void operator_requests(hal::Tick now) noexcept;
   void run_state(hal::Tick now, const hal::HalInputs& in) noexcept;
   void play_moves(hal::Tick now) noexcept;
   void track_beat_force(const hal::HalInputs& in) noexcept;

@@ -34,6 +34,8 @@ int serve_main(const ServeArgs& a);
 
 struct CtlArgs {
   std::string command;
+  std::string name;  // pair/unpair NAME
+  int hours = 0;     // pair: 0 → the service's default
   std::string socket;
   std::string loom_id = "loom1";
   int timeout_ms = 5000;

@@ -1,0 +1,46 @@
+// The control socket's request line, parsed without trusting it: `WORD [ARG] [key=value ...]`, printable
+// ASCII only, bounded. The words and their classes (operator authority, IEC 60204-1 / ISO 12100 practice:
+// a command that starts motion or resets a fault is given where the hazard zone can be seen):
+//   stopping  stop, pause                     — from anyone allowed on the socket, paired or not
+//   starting  start, resume, next, ack        — only from a trusted station: a local socket user, or a
+//                                                panel client paired with this loom
+//   reading   status, faults, pairs, whoami
+//   pairing   pair NAME [hours=H], unpair NAME — local socket users only (never through the panel)
+//             redeem code=CODE                — a panel client turns a pairing code into its token
+// A panel forwarding for one of its clients adds `via=panel client=ADDR [token=TOKEN]`: the command then
+// carries that client's authority, not the panel process's own.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace loom::firmware::serve {
+
+enum class CommandClass { kStopping, kStarting, kReading, kPairing };
+
+struct ParsedRequest {
+  std::string word;                          // "start", "pair", ...
+  std::string arg;                           // the positional argument (pair/unpair NAME), else ""
+  std::map<std::string, std::string> fields; // key=value pairs (via, client, token, code, hours)
+  CommandClass cls = CommandClass::kReading;
+  bool via_panel() const { return fields.count("via") != 0 && fields.at("via") == "panel"; }
+  std::string field(const std::string& k) const {
+    const auto it = fields.find(k);
+    return it == fields.end() ? std::string() : it->second;
+  }
+};
+
+// The command words, in the order help lists them.
+inline constexpr const char* kCommandWords[] = {"start", "pause", "resume", "stop",   "ack",    "next",  "status",
+                                                "faults", "pair", "unpair", "pairs", "redeem", "whoami"};
+
+// Parses one request line. nullopt and `error` set ("unknown command 'x' (start, ...)", "bad field ...")
+// when the line is not a request; never throws on any input.
+std::optional<ParsedRequest> parse_request(std::string_view line, std::string& error);
+
+// Whether `s` is a name a pairing may carry (1..32 of [A-Za-z0-9_.-]); "" when it is, else why not.
+std::string pairing_name_error(std::string_view s);
+
+}  // namespace loom::firmware::serve

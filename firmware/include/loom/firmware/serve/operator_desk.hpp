@@ -1,0 +1,58 @@
+// The service's decision on each control-socket request: who gave it (the kernel's word on the local
+// user; a panel client's address and pairing), whether that station may give it (control_protocol.hpp:
+// stopping from anyone allowed, starting only from a trusted station), and whether it would change
+// anything in the loom's present state. A reply is `ok WORD ...` only when the command is carried out;
+// otherwise `refused: WORD: why` (the CLI exits 1). Non-RT, on the control socket's thread; pure apart
+// from the pairings it keeps, so every command is tested in every state without a loom.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "loom/firmware/runner.hpp"
+#include "loom/firmware/serve/control_protocol.hpp"
+#include "loom/firmware/serve/control_socket.hpp"
+#include "loom/firmware/serve/pairings.hpp"
+#include "loom/hal/types.hpp"
+#include "loom/sequencer/sequencer.hpp"
+
+namespace loom::firmware::serve {
+
+// What the desk needs to know of the loom (a snapshot of the OperatorLink's status).
+struct LoomView {
+  sequencer::State state = sequencer::State::kIdle;
+  sequencer::Fault fault = sequencer::Fault::kNone;
+  hal::LinkRecovery recovery = hal::LinkRecovery::kHealthy;
+  int silent_node = 0;
+  bool estop_ok = true;
+  bool knotting = false;  // the recipe has a knotting mode (`next` exists)
+};
+LoomView view_of(const OperatorLink& link, bool knotting);
+
+struct Decision {
+  enum class Read { kNone, kStatus, kFaults };
+  std::string reply;                 // complete unless read != kNone (then the caller answers)
+  std::optional<Command> post;       // the command to hand to the loop
+  Read read = Read::kNone;
+  std::string who;                   // "local user anna (uid 1000, pid 42)", "panel client 10.0.0.5 paired as tab1 ..."
+  bool audit = false;                // a command that changes or would change the loom: log and record it
+  bool accepted() const { return reply.rfind("ok", 0) == 0; }
+};
+
+class OperatorDesk {
+ public:
+  // `iface`: the CAN interface named in the bus-off advice.
+  OperatorDesk(Pairings& pairings, std::string iface) : pairings_(pairings), iface_(std::move(iface)) {}
+  Decision decide(const ControlRequest& req, const LoomView& v, std::int64_t now_s);
+
+ private:
+  std::string refuse_for_state(const ParsedRequest& r, const LoomView& v) const;
+  Pairings& pairings_;
+  std::string iface_;
+};
+
+// Whether the loom is weaving (in a state that `stop`/`pause` act on).
+bool weaving(sequencer::State s);
+
+}  // namespace loom::firmware::serve

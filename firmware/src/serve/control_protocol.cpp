@@ -1,0 +1,138 @@
+// Request-line parsing for the control socket: strict, bounded, total (every input gets a verdict).
+#include "loom/firmware/serve/control_protocol.hpp"
+
+namespace loom::firmware::serve {
+namespace {
+
+constexpr std::size_t kMaxLine = 512, kMaxToken = 128, kMaxFields = 8;
+
+bool printable(char c) { return c > ' ' && c < 0x7F; }
+
+std::optional<CommandClass> class_of(std::string_view w) {
+  if (w == "stop" || w == "pause") return CommandClass::kStopping;
+  if (w == "start" || w == "resume" || w == "next" || w == "ack") return CommandClass::kStarting;
+  if (w == "status" || w == "faults" || w == "pairs" || w == "whoami") return CommandClass::kReading;
+  if (w == "pair" || w == "unpair" || w == "redeem") return CommandClass::kPairing;
+  return std::nullopt;
+}
+
+bool known_field(std::string_view k) {
+  return k == "via" || k == "client" || k == "token" || k == "code" || k == "hours";
+}
+
+std::string word_list() {
+  std::string s;
+  for (const char* w : kCommandWords) s += (s.empty() ? "" : ", ") + std::string(w);
+  return s;
+}
+
+// For error messages: at most 40 characters, anything unprintable as '?'.
+std::string shown(std::string_view s) {
+  std::string out;
+  for (char c : s.substr(0, 40)) out += printable(c) ? c : '?';
+  return out + (s.size() > 40 ? "..." : "");
+}
+
+}  // namespace
+
+std::string pairing_name_error(std::string_view s) {
+  if (s.empty() || s.size() > 32) return "a pairing name is 1 to 32 characters";
+  for (char c : s) {
+    const bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' ||
+                    c == '-' || c == '.';
+    if (!ok) return "a pairing name has only letters, digits, '_', '-' and '.'";
+  }
+  return "";
+}
+
+std::optional<ParsedRequest> parse_request(std::string_view line, std::string& error) {
+  if (line.size() > kMaxLine) {
+    error = "request longer than " + std::to_string(kMaxLine) + " bytes";
+    return std::nullopt;
+  }
+  ParsedRequest r;
+  std::size_t i = 0, n = 0;
+  while (i < line.size()) {
+    if (line[i] == ' ') {
+      ++i;
+      continue;
+    }
+    std::size_t j = i;
+    while (j < line.size() && line[j] != ' ') {
+      if (!printable(line[j])) {
+        error = "request has a character that is not printable ASCII";
+        return std::nullopt;
+      }
+      ++j;
+    }
+    const std::string_view tok = line.substr(i, j - i);
+    i = j;
+    if (tok.size() > kMaxToken) {
+      error = "request word longer than " + std::to_string(kMaxToken) + " bytes";
+      return std::nullopt;
+    }
+    if (n++ == 0) {
+      r.word = tok;
+      continue;
+    }
+    const auto eq = tok.find('=');
+    if (eq == std::string_view::npos) {
+      if (!r.arg.empty() || !r.fields.empty()) {
+        error = "unexpected '" + shown(tok) + "' (one argument, then key=value fields)";
+        return std::nullopt;
+      }
+      r.arg = tok;
+      continue;
+    }
+    const std::string key(tok.substr(0, eq));
+    if (!known_field(key)) {
+      error = "unknown field '" + shown(key) + "' (via, client, token, code, hours)";
+      return std::nullopt;
+    }
+    if (r.fields.size() >= kMaxFields || r.fields.count(key) != 0) {
+      error = "field '" + key + "' given twice";
+      return std::nullopt;
+    }
+    r.fields[key] = std::string(tok.substr(eq + 1));
+  }
+  const auto cls = class_of(r.word);
+  if (!cls) {
+    error = "unknown command '" + shown(r.word) + "' (" + word_list() + ")";
+    return std::nullopt;
+  }
+  r.cls = *cls;
+  const bool takes_arg = r.word == "pair" || r.word == "unpair";
+  if (takes_arg && r.arg.empty()) {
+    error = r.word + " needs a NAME (e.g. " + r.word + " phone-anna)";
+    return std::nullopt;
+  }
+  if (!takes_arg && !r.arg.empty()) {
+    error = r.word + " takes no argument (got '" + shown(r.arg) + "')";
+    return std::nullopt;
+  }
+  if (takes_arg) {
+    if (auto e = pairing_name_error(r.arg); !e.empty()) {
+      error = e;
+      return std::nullopt;
+    }
+  }
+  if (r.fields.count("hours") != 0 && r.word != "pair") {
+    error = "hours= is for pair only";
+    return std::nullopt;
+  }
+  if (r.fields.count("code") != 0 && r.word != "redeem") {
+    error = "code= is for redeem only";
+    return std::nullopt;
+  }
+  if (r.fields.count("via") != 0 && r.field("via") != "panel") {
+    error = "via=" + shown(r.field("via")) + ": only via=panel";
+    return std::nullopt;
+  }
+  if (r.via_panel() && r.field("client").empty()) {
+    error = "via=panel needs client=ADDR";
+    return std::nullopt;
+  }
+  return r;
+}
+
+}  // namespace loom::firmware::serve

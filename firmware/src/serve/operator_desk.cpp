@@ -1,0 +1,187 @@
+// Authority and truthful replies for the control socket's commands (see operator_desk.hpp).
+#include "loom/firmware/serve/operator_desk.hpp"
+
+#include <ctime>
+
+namespace loom::firmware::serve {
+
+using sequencer::State;
+
+bool weaving(State s) {
+  switch (s) {
+    case State::kEnabling:
+    case State::kHoming:
+    case State::kPositioning:
+    case State::kShedTest:
+    case State::kShed:
+    case State::kPick:
+    case State::kBeatSweep:
+    case State::kRowEnd:
+    case State::kAwaitKnotting:
+      return true;
+    default:
+      return false;
+  }
+}
+
+LoomView view_of(const OperatorLink& l, bool knotting) {
+  constexpr auto r = std::memory_order_relaxed;
+  LoomView v;
+  v.state = static_cast<State>(l.state.load(r));
+  v.fault = static_cast<sequencer::Fault>(l.first_fault.load(r));
+  v.recovery = static_cast<hal::LinkRecovery>(l.link_recovery.load(r));
+  v.silent_node = l.silent_node.load(r);
+  v.estop_ok = l.estop_ok.load(r);
+  v.knotting = knotting;
+  return v;
+}
+
+namespace {
+
+std::string fault_of(const LoomView& v) {
+  return v.fault == sequencer::Fault::kNone ? std::string("a fault") : sequencer::fault_name(v.fault);
+}
+
+std::string utc(std::int64_t s) {
+  std::tm tm{};
+  const std::time_t t = static_cast<std::time_t>(s);
+  gmtime_r(&t, &tm);
+  char b[32];
+  std::strftime(b, sizeof b, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return b;
+}
+
+}  // namespace
+
+// "" when the command would change something now, else why not.
+std::string OperatorDesk::refuse_for_state(const ParsedRequest& r, const LoomView& v) const {
+  const std::string& w = r.word;
+  const std::string state = sequencer::state_name(v.state);
+  if (v.state == State::kFault && w != "ack") {
+    return fault_of(v) + " is latched: acknowledge it first (ctl ack)";
+  }
+  if (w == "start") {
+    if (v.state == State::kPaused) return "paused: resume it (ctl resume)";
+    if (v.state != State::kIdle && v.state != State::kDone) return "already weaving (state " + state + ")";
+    if (!v.estop_ok) return "the e-stop chain is open: close it first";
+    return "";
+  }
+  if (w == "pause") return weaving(v.state) ? "" : "not weaving (state " + state + ")";
+  if (w == "resume") return v.state == State::kPaused ? "" : "not paused (state " + state + ")";
+  if (w == "stop") {
+    return weaving(v.state) || v.state == State::kPaused ? "" : "not weaving (state " + state + "): nothing to stop";
+  }
+  if (w == "next") {
+    if (!v.knotting) return "this loom has no weaver's knotting (knotting.mode is not \"weaver\")";
+    return v.state == State::kAwaitKnotting ? "" : "not waiting for the weaver (state " + state + ")";
+  }
+  if (w == "ack") {
+    if (v.state != State::kFault) return "no fault is latched (state " + state + ")";
+    if (!v.estop_ok) return "the e-stop chain is still open: close it (release the e-stop), then acknowledge";
+    if (v.recovery == hal::LinkRecovery::kBusOff) {
+      return "the CAN controller is still bus-off; it must restart first (ip link set " +
+             (iface_.empty() ? std::string("can0") : iface_) +
+             " type can restart-ms 100, or ip link set ... type can restart)";
+    }
+    if (v.recovery == hal::LinkRecovery::kNodeSilent) {
+      return "node " + std::to_string(v.silent_node) +
+             " is still silent (no heartbeat, no boot-up): check its power and cable, then acknowledge";
+    }
+    return "";
+  }
+  return "";
+}
+
+Decision OperatorDesk::decide(const ControlRequest& req, const LoomView& v, std::int64_t now_s) {
+  Decision d;
+  std::string error;
+  const auto parsed = parse_request(req.line, error);
+  d.who = describe(req.peer);
+  if (!parsed) {
+    d.reply = "error: " + error + "\n";
+    return d;
+  }
+  const ParsedRequest& r = *parsed;
+  // Who: the kernel's word on the local user; a panel adds its client's address and pairing.
+  std::optional<Pairing> paired;
+  if (r.via_panel()) {
+    if (!r.field("token").empty()) paired = pairings_.find(r.field("token"), now_s);
+    d.who = "panel client " + r.field("client") +
+            (paired ? " paired as " + paired->name : std::string(r.field("token").empty() ? " (not paired)"
+                                                                                          : " (token unknown or expired)")) +
+            " via " + describe(req.peer);
+  }
+  const auto refuse = [&](const std::string& why) {
+    d.reply = "refused: " + r.word + ": " + why + "\n";
+    return d;
+  };
+  switch (r.cls) {
+    case CommandClass::kReading:
+      if (r.word == "status") d.read = Decision::Read::kStatus;
+      else if (r.word == "faults") d.read = Decision::Read::kFaults;
+      else if (r.word == "whoami") {
+        if (!r.via_panel()) d.reply = "ok whoami local " + d.who + " may_start=1\n";
+        else if (paired) d.reply = "ok whoami paired " + paired->name + " expires=" + utc(paired->expires_s) + " may_start=1\n";
+        else return refuse("not paired: stopping commands only");
+      } else {  // pairs
+        std::string out;
+        for (const Pairing& p : pairings_.list(now_s)) {
+          out += "paired " + p.name + " client " + p.client + " until " + utc(p.expires_s) + "\n";
+        }
+        d.reply = out.empty() ? "no panel clients paired\n" : out;
+      }
+      return d;
+    case CommandClass::kPairing:
+      d.audit = true;
+      if (r.word == "redeem") {
+        if (!r.via_panel()) return refuse("only a panel redeems a pairing code for its client");
+        auto p = pairings_.redeem(r.field("code"), r.field("client"), now_s, error);
+        if (!p) return refuse(error);
+        d.who = "panel client " + r.field("client") + " paired as " + p->name + " via " + describe(req.peer);
+        d.reply = "ok redeem " + p->name + " token=" + p->token + " expires=" + utc(p->expires_s) + "\n";
+        return d;
+      }
+      if (r.via_panel()) return refuse("pairing is done at the loom (its local socket), never through a panel");
+      if (r.word == "pair") {
+        int hours = Pairings::kDefaultHours;
+        if (!r.field("hours").empty()) {
+          const std::string& h = r.field("hours");
+          if (h.size() > 3 || h.find_first_not_of("0123456789") != std::string::npos || std::stoi(h) < 1 ||
+              std::stoi(h) > Pairings::kMaxHours) {
+            return refuse("hours=" + h + ": 1 to " + std::to_string(Pairings::kMaxHours));
+          }
+          hours = std::stoi(h);
+        }
+        const std::string code = pairings_.new_code(r.arg, hours, now_s);
+        d.reply = "ok pair " + r.arg + " code=" + code + " valid=" + std::to_string(Pairings::kCodeLifetimeS) +
+                  "s hours=" + std::to_string(hours) + " (enter the code on the panel's pairing field)\n";
+        return d;
+      }
+      {  // unpair
+        const int n = pairings_.revoke(r.arg);
+        if (n == 0) return refuse("no pairing named " + r.arg);
+        d.reply = "ok unpair " + r.arg + " (" + std::to_string(n) + " revoked)\n";
+        return d;
+      }
+    case CommandClass::kStarting:
+    case CommandClass::kStopping:
+      break;
+  }
+  d.audit = true;
+  if (r.cls == CommandClass::kStarting && r.via_panel() && !paired) {
+    return refuse("a command that starts motion or resets a fault needs a paired panel client (this one is " +
+                  std::string(r.field("token").empty() ? "not paired" : "not paired: token unknown or expired") +
+                  "; pair it with `loomctl ctl pair NAME` at the loom)");
+  }
+  if (auto why = refuse_for_state(r, v); !why.empty()) return refuse(why);
+  if (r.word == "start") d.post = Command::kStart;
+  else if (r.word == "pause") d.post = Command::kPause;
+  else if (r.word == "resume") d.post = Command::kResume;
+  else if (r.word == "stop") d.post = Command::kStop;
+  else if (r.word == "ack") d.post = Command::kAck;
+  else d.post = Command::kNext;
+  d.reply = "ok " + r.word + "\n";
+  return d;
+}
+
+}  // namespace loom::firmware::serve

@@ -1,0 +1,166 @@
+// The control socket's decisions (issue 22): every command in every loom state, from each kind of
+// station — a local socket user, an unpaired panel client, a paired one — answers `ok` (and hands the
+// command to the loop) only when it changes something and the station may give it; else `refused: why`.
+// The expected table is written out here by hand from the rules (operator_desk.hpp), not computed.
+#include <gtest/gtest.h>
+
+#include <map>
+#include <string>
+
+#include "loom/firmware/serve/operator_desk.hpp"
+
+using namespace loom;
+using namespace loom::firmware::serve;
+using sequencer::State;
+
+namespace {
+
+constexpr std::int64_t kNow = 1'800'000'000;
+
+struct Row {
+  State state;
+  const char* name;
+  // Which of start pause resume stop ack next change something here (knotting recipe, chain closed).
+  const char* ok;
+};
+
+// By hand: start from idle or done; pause while weaving; resume while paused; stop while weaving or
+// paused; ack only in a fault; next only while waiting for the weaver; nothing but ack in a fault.
+const Row kTable[] = {
+    {State::kIdle, "idle", "start"},
+    {State::kEnabling, "enabling", "pause stop"},
+    {State::kHoming, "homing", "pause stop"},
+    {State::kPositioning, "positioning", "pause stop"},
+    {State::kShedTest, "shed_test", "pause stop"},
+    {State::kShed, "shed", "pause stop"},
+    {State::kPick, "pick", "pause stop"},
+    {State::kBeatSweep, "beat_sweep", "pause stop"},
+    {State::kRowEnd, "row_end", "pause stop"},
+    {State::kAwaitKnotting, "await_knotting", "pause stop next"},
+    {State::kPaused, "paused", "resume stop"},
+    {State::kDone, "done", "start"},
+    {State::kFault, "fault", "ack"},
+};
+const char* const kCommands[] = {"start", "pause", "resume", "stop", "ack", "next"};
+
+bool listed(const std::string& list, const std::string& w) { return (" " + list + " ").find(" " + w + " ") != std::string::npos; }
+
+LoomView view(State s) {
+  LoomView v;
+  v.state = s;
+  v.fault = s == State::kFault ? sequencer::Fault::kDriveFault : sequencer::Fault::kNone;
+  v.knotting = true;
+  return v;
+}
+
+ControlRequest local(const std::string& line) { return {line, Peer{4242, 1000, 1000, "anna"}}; }
+
+}  // namespace
+
+TEST(OperatorDesk, EveryCommandInEveryStateFromEveryStationIsTrue) {
+  Pairings pairings;
+  OperatorDesk desk(pairings, "can0");
+  std::string error;
+  const std::string token = pairings.redeem(pairings.new_code("tab1", 1, kNow), "10.0.0.7", kNow, error)->token;
+  for (const Row& row : kTable) {
+    for (const char* cmd : kCommands) {
+      const bool starting = std::string(cmd) != "pause" && std::string(cmd) != "stop";
+      const bool changes = listed(row.ok, cmd);
+      struct Station {
+        std::string suffix;
+        bool may;
+      } stations[] = {{"", true},
+                      {" via=panel client=10.0.0.7", !starting},
+                      {" via=panel client=10.0.0.7 token=" + token, true},
+                      {" via=panel client=10.0.0.7 token=00000000000000000000000000000000", !starting}};
+      for (const Station& st : stations) {
+        SCOPED_TRACE(std::string(row.name) + ": " + cmd + st.suffix);
+        const Decision d = desk.decide(local(cmd + st.suffix), view(row.state), kNow);
+        const bool ok = changes && st.may;
+        EXPECT_EQ(d.accepted(), ok) << d.reply;
+        EXPECT_EQ(d.post.has_value(), ok) << d.reply;
+        EXPECT_TRUE(d.audit);
+        if (!ok) {
+          EXPECT_EQ(d.reply.rfind(std::string("refused: ") + cmd + ": ", 0), 0u) << d.reply;
+        }
+        if (!st.may) {
+          EXPECT_NE(d.reply.find("paired panel client"), std::string::npos) << d.reply;
+        }
+      }
+    }
+  }
+}
+
+TEST(OperatorDesk, RefusalsSayWhy) {
+  Pairings pairings;
+  OperatorDesk desk(pairings, "can1");
+  LoomView fault = view(State::kFault);
+  fault.estop_ok = false;
+  EXPECT_EQ(desk.decide(local("ack"), fault, kNow).reply,
+            "refused: ack: the e-stop chain is still open: close it (release the e-stop), then acknowledge\n");
+  fault.estop_ok = true;
+  fault.recovery = hal::LinkRecovery::kNodeSilent;
+  fault.silent_node = 3;
+  EXPECT_NE(desk.decide(local("ack"), fault, kNow).reply.find("node 3 is still silent"), std::string::npos);
+  fault.recovery = hal::LinkRecovery::kBusOff;
+  EXPECT_NE(desk.decide(local("ack"), fault, kNow).reply.find("ip link set can1"), std::string::npos);
+  EXPECT_EQ(desk.decide(local("start"), fault, kNow).reply,
+            "refused: start: drive_fault is latched: acknowledge it first (ctl ack)\n");
+  EXPECT_EQ(desk.decide(local("ack"), view(State::kPick), kNow).reply, "refused: ack: no fault is latched (state pick)\n");
+  LoomView idle = view(State::kIdle);
+  idle.estop_ok = false;
+  EXPECT_EQ(desk.decide(local("start"), idle, kNow).reply, "refused: start: the e-stop chain is open: close it first\n");
+  LoomView plain = view(State::kAwaitKnotting);
+  plain.knotting = false;
+  EXPECT_NE(desk.decide(local("next"), plain, kNow).reply.find("no knotting mode"), std::string::npos);
+  EXPECT_EQ(desk.decide(local("dance"), idle, kNow).reply.rfind("error: unknown command 'dance'", 0), 0u);
+  EXPECT_EQ(desk.decide(local("start now"), idle, kNow).reply, "error: start takes no argument (got 'now')\n");
+  EXPECT_EQ(desk.decide(local("start hours=3"), idle, kNow).reply, "error: hours= is for pair only\n");
+  EXPECT_EQ(desk.decide(local("start via=lan client=x"), idle, kNow).reply, "error: via=lan: only via=panel\n");
+  EXPECT_EQ(desk.decide(local("start via=panel"), idle, kNow).reply, "error: via=panel needs client=ADDR\n");
+  EXPECT_EQ(desk.decide(local(std::string("start\x01")), idle, kNow).reply.rfind("error: request has a character", 0), 0u);
+}
+
+TEST(OperatorDesk, WhoGaveTheCommandIsTheKernelsWordAndThePanelsClient) {
+  Pairings pairings;
+  OperatorDesk desk(pairings, "");
+  EXPECT_EQ(desk.decide(local("pause"), view(State::kPick), kNow).who, "local user anna (uid 1000, pid 4242)");
+  EXPECT_EQ(desk.decide(local("pause via=panel client=10.0.0.7"), view(State::kPick), kNow).who,
+            "panel client 10.0.0.7 (not paired) via local user anna (uid 1000, pid 4242)");
+}
+
+TEST(OperatorDesk, PairingIsDoneAtTheLoomCodesExpireAndTokensAreRevocable) {
+  Pairings pairings;
+  OperatorDesk desk(pairings, "");
+  const LoomView paused = view(State::kPaused);
+  // Never through a panel: a panel client cannot pair itself or others.
+  EXPECT_EQ(desk.decide(local("pair x via=panel client=1.2.3.4"), paused, kNow).reply.rfind("refused: pair:", 0), 0u);
+  const std::string reply = desk.decide(local("pair tab2 hours=2"), paused, kNow).reply;
+  ASSERT_EQ(reply.rfind("ok pair tab2 code=", 0), 0u) << reply;
+  const std::string code = reply.substr(18, 6);
+  // Five tries, then void.
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_NE(desk.decide(local("redeem via=panel client=1.2.3.4 code=x"), paused, kNow).reply.find("tries left"),
+              std::string::npos);
+  }
+  EXPECT_NE(desk.decide(local("redeem via=panel client=1.2.3.4 code=x"), paused, kNow).reply.find("now void"),
+            std::string::npos);
+  EXPECT_NE(desk.decide(local("redeem via=panel client=1.2.3.4 code=" + code), paused, kNow).reply.find("no pairing code"),
+            std::string::npos);
+  // A fresh code, redeemed in time: a token valid 2 h.
+  const std::string code2 = desk.decide(local("pair tab2 hours=2"), paused, kNow).reply.substr(18, 6);
+  EXPECT_NE(desk.decide(local("redeem via=panel client=1.2.3.4 code=" + code2), paused, kNow + Pairings::kCodeLifetimeS)
+                .reply.find("expired"),
+            std::string::npos);
+  const std::string code3 = desk.decide(local("pair tab2 hours=2"), paused, kNow).reply.substr(18, 6);
+  const std::string ok = desk.decide(local("redeem via=panel client=1.2.3.4 code=" + code3), paused, kNow + 10).reply;
+  ASSERT_EQ(ok.rfind("ok redeem tab2 token=", 0), 0u) << ok;
+  const std::string token = ok.substr(21, 32);
+  const std::string resume = "resume via=panel client=1.2.3.4 token=" + token;
+  EXPECT_TRUE(desk.decide(local(resume), paused, kNow + 7199).accepted());
+  EXPECT_FALSE(desk.decide(local(resume), paused, kNow + 7210).accepted());  // expired after 2 h
+  EXPECT_TRUE(desk.decide(local(resume), paused, kNow + 100).accepted());
+  EXPECT_EQ(desk.decide(local("unpair tab2"), paused, kNow).reply, "ok unpair tab2 (1 revoked)\n");
+  EXPECT_FALSE(desk.decide(local(resume), paused, kNow + 100).accepted());
+  EXPECT_EQ(desk.decide(local("unpair tab2"), paused, kNow).reply.rfind("refused:", 0), 0u);
+}

@@ -1,0 +1,194 @@
+#!/usr/bin/env bash
+# Operator authority through loom-panel, from another host (issue 22). The panel is bound to every
+# address with --control-dir, as a hall with phones runs it; the client is curl in a second network
+# namespace joined by a veth pair (iproute2, as root). Where namespaces cannot be made (not root, no
+# veth) the client is curl on 127.0.0.1 instead and the test says so: the panel trusts no address, so
+# the authority checks are the same; only the audited address differs.
+#   1. unpaired: pause (stopping) is carried out; resume (starting) is refused by the panel and never
+#      reaches the loom; /authority says may_start=false (the page offers no starting buttons);
+#   2. a forged Host (DNS rebinding), a foreign Origin, a POST without X-Loom-Panel and a GET on a
+#      command's URL change nothing;
+#   3. paired with the code from `loomctl ctl pair`: resume is carried out, and serve's journal, the
+#      panel's log and `ctl faults` name the client's address and pairing; a wrong code is refused;
+#      `ctl unpair` revokes the token;
+#   4. bounded: a 1 MiB body is refused (413); event streams beyond 4 per client get 503 while the
+#      buttons still answer, and so they do behind 40 idle connections; a design whose palette name is
+#      cp1252 (not UTF-8) keeps the panel up.
+# Usage: panel_authority.sh <loomctl> <loom-panel> <design csv>
+set -euo pipefail
+LOOMCTL=$1
+PANEL=$2
+DESIGN=$3
+WORK=$(mktemp -d "${TMPDIR:-/tmp}/loom_panel_authority.XXXXXX")
+PIDS=()
+NS=lpa$$
+VA=lpa$$a
+VB=lpa$$b
+netns=0
+fail() { echo "FAIL: $*" >&2; for f in "$WORK"/*.log; do echo "--- $f" >&2; tail -25 "$f" >&2; done; exit 1; }
+cleanup() {
+  for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null || true; done
+  for p in "${PIDS[@]}"; do wait "$p" 2>/dev/null || true; done
+  if [[ $netns == 1 ]]; then
+    ip link del "$VA" 2>/dev/null || true
+    ip netns del "$NS" 2>/dev/null || true
+  fi
+  rm -rf "$WORK" || true
+}
+trap cleanup EXIT
+
+# The second host.
+SUB=$((($$ % 250) + 1))
+if [[ $(id -u) == 0 ]] && ip netns add "$NS" 2>/dev/null; then
+  netns=1
+  if ip link add "$VA" type veth peer name "$VB" 2>/dev/null && ip link set "$VB" netns "$NS" &&
+    ip addr add "10.231.$SUB.1/24" dev "$VA" && ip link set "$VA" up &&
+    ip netns exec "$NS" ip addr add "10.231.$SUB.2/24" dev "$VB" && ip netns exec "$NS" ip link set "$VB" up; then
+    SERVER=10.231.$SUB.1
+    CLIENT=10.231.$SUB.2
+    remote() { ip netns exec "$NS" "$@"; }
+    echo "client: curl in network namespace $NS ($CLIENT), panel at $SERVER"
+  else
+    netns=2
+  fi
+fi
+if [[ $netns != 1 ]]; then
+  SERVER=127.0.0.1
+  CLIENT=127.0.0.1
+  remote() { "$@"; }
+  echo "client: curl on 127.0.0.1 (no network namespace here; the panel trusts no address either way)"
+fi
+
+PORT=$((20000 + ($$ * 13) % 20000))
+URL="udpm://239.255.76.67:${PORT}?ttl=0"
+ID="auth$$"
+mkdir -p "$WORK/run"
+# A palette name in cp1252 (0xE9 = é): loomctl accepts the file; the panel must stay up.
+sed 's/^palette,R,#9b1b30,madder red$/palette,R,#9b1b30,rouge garanc\xe9/' "$DESIGN" >"$WORK/border.csv"
+grep -q $'garanc\xe9' "$WORK/border.csv" || fail "could not write the cp1252 palette name"
+printf 'extends = "default"\n[recipe]\ndesign = "border.csv"\n' >"$WORK/loom.toml"
+
+"$PANEL" --port 0 --bind 0.0.0.0 --lcm-url "$URL" --control-dir "$WORK/run" 2>"$WORK/panel.log" &
+PIDS+=($!)
+PANEL_PID=$!
+for _ in $(seq 1 100); do
+  grep -q "serving http" "$WORK/panel.log" 2>/dev/null && break
+  sleep 0.05
+done
+HPORT=$(sed -n 's|.*serving http://[0-9.]*:\([0-9]*\)/.*|\1|p' "$WORK/panel.log")
+[[ -n $HPORT ]] || fail "loom-panel did not start"
+BASE="http://$SERVER:$HPORT"
+
+SOCK="$WORK/run/$ID.sock"
+"$LOOMCTL" serve --config "$WORK/loom.toml" --state-dir "$WORK/state" --socket "$SOCK" --group "" \
+  --loom-id "$ID" --lcm-url "$URL" --pace 10 >"$WORK/serve.log" 2>&1 &
+PIDS+=($!)
+ctl() { "$LOOMCTL" ctl --socket "$SOCK" "$@"; }
+for _ in $(seq 1 200); do
+  [[ -S $SOCK ]] && ctl status >/dev/null 2>&1 && break
+  sleep 0.05
+done
+field() { ctl status | tr ' ' '\n' | sed -n "s/^$1=//p"; }
+wait_for() {
+  for _ in $(seq 1 $(($3 * 20))); do
+    [[ $(field "$1") == "$2" ]] && return 0
+    sleep 0.05
+  done
+  fail "waited $3 s for $1=$2: $(ctl status)"
+}
+# post PATH BODY [curl args...] → the HTTP status (the reply in $WORK/body)
+post() {
+  local path=$1 body=$2; shift 2
+  remote curl -s -m 5 -o "$WORK/body" -w '%{http_code}' -X POST -H 'X-Loom-Panel: 1' -H 'Content-Type: text/plain' \
+    --data-binary "$body" "$@" "$BASE$path" || true
+}
+cmd() { post "/api/loom/$ID/ctl/$1" "" "${@:2}"; }
+
+ctl start | grep -q '^ok start' || fail "local start refused"
+wait_for state pick 30
+
+# 1. unpaired: stopping works, starting is refused and not offered
+[[ $(cmd pause) == 200 ]] || fail "unpaired pause: $(cat "$WORK/body")"
+wait_for state paused 30
+[[ $(cmd resume) == 403 ]] || fail "unpaired resume not refused: $(cat "$WORK/body")"
+grep -q 'not paired' "$WORK/body" || fail "refusal does not say why: $(cat "$WORK/body")"
+sleep 0.3
+[[ $(field state) == paused ]] || fail "an unpaired resume set the loom going: $(ctl status)"
+grep -q 'operator: resume' "$WORK/serve.log" && fail "the panel forwarded a starting command of an unpaired client"
+grep -q "operator: pause by panel client $CLIENT (not paired) via local user" "$WORK/serve.log" ||
+  fail "serve's journal does not name the panel client of the pause"
+remote curl -s -m 5 "$BASE/api/loom/$ID/authority" | grep -q '"may_start":false' || fail "unpaired client offered starting commands"
+
+# 2. forged Host / Origin, no header, GET: nothing changes
+[[ $(cmd resume -H 'Host: evil.example.com') == 421 ]] || fail "forged Host not refused"
+[[ $(cmd stop -H 'Host: evil.example.com') == 421 ]] || fail "forged Host not refused for stop"
+[[ $(cmd stop -H "Origin: http://evil.example.com") == 403 ]] || fail "foreign Origin not refused"
+[[ $(remote curl -s -m 5 -o /dev/null -w '%{http_code}' -X POST -d '' "$BASE/api/loom/$ID/ctl/stop") == 403 ]] ||
+  fail "POST without X-Loom-Panel not refused"
+[[ $(remote curl -s -m 8 -o /dev/null -w '%{http_code}' -X POST -H 'X-Loom-Panel: 1' "$BASE/api/loom/$ID/ctl/stop") == 411 ]] ||
+  fail "POST without Content-Length not refused at once"
+[[ $(remote curl -s -m 5 -o /dev/null -w '%{http_code}' "$BASE/api/loom/$ID/ctl/stop") == 404 ]] || fail "GET on a command URL"
+[[ $(remote curl -s -m 5 -o /dev/null -w '%{http_code}' -H 'Host: evil.example.com' "$BASE/api/hall") == 421 ]] ||
+  fail "GET with a forged Host served (DNS rebinding reads the hall)"
+[[ $(field state) == paused ]] || fail "a refused request changed the loom: $(ctl status)"
+grep -q 'operator: stop' "$WORK/serve.log" && fail "a refused stop reached the loom"
+
+# 3. paired
+[[ $(post "/api/loom/$ID/pair" 000000) == 403 ]] || fail "a pairing without a code accepted"
+code=$(ctl pair tablet-1 | sed -n 's/.*code=\([0-9]*\).*/\1/p')
+[[ -n $code ]] || fail "ctl pair printed no code"
+wrong=$(printf '%06d' $(((10#$code + 1) % 1000000)))
+[[ $(post "/api/loom/$ID/pair" "$wrong") == 403 ]] || fail "a wrong code paired"
+[[ $(post "/api/loom/$ID/pair" "$code" -c "$WORK/jar") == 200 ]] ||
+  fail "pairing with the right code: $(cat "$WORK/body")"
+grep -q "loom_token_$ID" "$WORK/jar" || fail "no token cookie set"
+grep -q '#HttpOnly_' "$WORK/jar" || fail "the token cookie is not HttpOnly"
+remote curl -s -m 5 -b "$WORK/jar" "$BASE/api/loom/$ID/authority" | grep -q '"may_start":true' || fail "a paired client may not start"
+[[ $(cmd resume -b "$WORK/jar") == 200 ]] || fail "paired resume: $(cat "$WORK/body")"
+wait_for state pick 30
+grep -q "operator: resume by panel client $CLIENT paired as tablet-1 via local user" "$WORK/serve.log" ||
+  fail "the audit line does not name the paired client"
+grep -q "$ID resume by $CLIENT (token) -> ok resume" "$WORK/panel.log" || fail "the panel's log does not name the client"
+ctl faults | grep -q " command $ID resume .*panel client $CLIENT paired as tablet-1" || fail "ctl faults lacks the audit: $(ctl faults)"
+grep -q "$code" "$WORK/serve.log" && fail "the pairing code reached the journal"
+ctl pairs | grep -q "paired tablet-1 client $CLIENT" || fail "ctl pairs: $(ctl pairs)"
+# An acknowledgement with no fault latched is refused by the loom (never kept for a later fault).
+[[ $(cmd ack -b "$WORK/jar") == 403 ]] || fail "paired ack while weaving: $(cat "$WORK/body")"
+grep -q 'refused: ack: no fault is latched' "$WORK/body" || fail "ack refusal: $(cat "$WORK/body")"
+[[ $(cmd pause -b "$WORK/jar") == 200 ]] || fail "paired pause"
+wait_for state paused 30
+ctl unpair tablet-1 | grep -q '^ok unpair' || fail "unpair"
+[[ $(cmd resume -b "$WORK/jar") == 403 ]] || fail "a revoked token still resumes: $(cat "$WORK/body")"
+[[ $(field state) == paused ]] || fail "a revoked token set the loom going"
+
+# 4. bounds
+head -c 1048576 /dev/zero >"$WORK/big"
+[[ $(post "/api/loom/$ID/pair" @"$WORK/big") == 413 ]] || fail "a 1 MiB body was not refused"
+for i in 1 2 3 4 5 6; do
+  remote curl -s -N -m 8 -o "$WORK/stream$i" -w '%{http_code}\n' "$BASE/events?loom=$ID" >"$WORK/stream$i.code" 2>/dev/null &
+  PIDS+=($!)
+done
+for _ in $(seq 1 50); do  # the refused ones answer at once; the admitted ones stay open (-m 8)
+  refused=$(cat "$WORK"/stream*.code 2>/dev/null | grep -c 503 || true)
+  [[ $refused -ge 2 ]] && break
+  sleep 0.1
+done
+[[ $(cmd stop) == 200 ]] || fail "buttons locked out by open event streams: $(cat "$WORK/body")"
+[[ $(cat "$WORK"/stream*.code 2>/dev/null | grep -c 200 || true) == 0 ]] || fail "an admitted event stream ended early"
+[[ $refused -ge 2 ]] || fail "event streams beyond 4 per client were not refused ($refused refused; codes $(cat "$WORK"/stream*.code | tr '\n' ' '))"
+# 40 idle connections (connected, sending nothing) do not lock the buttons out.
+remote python3 - "$SERVER" "$HPORT" <<'PY' &
+import socket, sys, time
+idle = [socket.create_connection((sys.argv[1], int(sys.argv[2]))) for _ in range(40)]
+time.sleep(6)
+PY
+PIDS+=($!)
+sleep 1
+t0=$(date +%s%N)
+[[ $(cmd pause) == 200 || $(cat "$WORK/body") == *"refused: pause: not weaving"* ]] ||
+  fail "buttons locked out by 40 idle connections: $(cat "$WORK/body")"
+t1=$(date +%s%N)
+echo "a button behind 4 event streams and 40 idle connections answered in $(((t1 - t0) / 1000000)) ms"
+remote curl -s -m 5 "$BASE/api/loom/$ID" | grep -q 'rouge garanc' || fail "the cp1252 palette name is not shown"
+kill -0 "$PANEL_PID" 2>/dev/null || fail "loom-panel died"
+echo "panel_authority: ok ($([[ $netns == 1 ]] && echo "client in network namespace $NS" || echo "client on loopback"))"
