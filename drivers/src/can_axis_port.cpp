@@ -90,6 +90,20 @@ Status validate(const CanAxisPortConfig& c) {
       return Status::error(field + fmt(".boot_timeout_s = %g s / .operational_timeout_s = %g s must be ≥ 0",
                                        a.boot_timeout_s, a.operational_timeout_s));
     }
+    if (a.homing_method != 0) {
+      if (a.homing_method < 1 || a.homing_method > 37) {
+        return Status::error(field + ".homing_method = " + std::to_string(a.homing_method) +
+                             " is not a CiA 402 homing method (1..37)");
+      }
+      if (a.homing_method != 37 && (!(a.homing_speed > 0.0) || !(a.homing_accel > 0.0) ||
+                                    !std::isfinite(a.homing_speed) || !std::isfinite(a.homing_accel))) {
+        return Status::error(field + fmt(".homing_speed = %g / .homing_accel = %g must be > 0 for a homing run",
+                                         a.homing_speed, a.homing_accel));
+      }
+      if (!std::isfinite(a.home_offset) || std::abs(a.home_offset * a.counts_per_unit) > 2147483647.0) {
+        return Status::error(field + fmt(".home_offset = %g does not fit 0x607C (32-bit counts)", a.home_offset));
+      }
+    }
     if (c.master_node_id == a.node_id) {
       return Status::error(field + ".node_id = " + std::to_string(a.node_id) + " is the master's own node id");
     }
@@ -163,9 +177,17 @@ std::size_t bus_count(const CanAxisPortConfig& c) {
 }
 
 BusLoad planned_bus_load(const CanAxisPortConfig& c, std::size_t bus) {
-  std::uint32_t n = 0;
-  for (const CanAxisConfig& a : c.axes) n += a.bus == bus ? 1U : 0U;
+  std::uint32_t n = 0, homed = 0;  // homed axes carry the mode in RPDO1/TPDO1 (7 bytes instead of 6)
+  for (const CanAxisConfig& a : c.axes) {
+    n += a.bus == bus && a.homing_method == 0 ? 1U : 0U;
+    homed += a.bus == bus && a.homing_method != 0 ? 1U : 0U;
+  }
   std::vector<FrameGroup> frames{{0, 1}, {kRpdo1Bytes, n}, {kTpdo1Bytes, n}};
+  if (homed != 0) {
+    frames.push_back({kRpdo1HomingBytes, homed});
+    frames.push_back({kTpdo1HomingBytes, homed});
+  }
+  n += homed;
   if (c.tpdo2) frames.push_back({kTpdo2Bytes, n});
   if (bus == 0) frames.insert(frames.end(), c.other_frames_per_cycle.begin(), c.other_frames_per_cycle.end());
   // The master heartbeat (1 byte) counted as if it were sent every cycle: the worst cycle holds it.

@@ -38,6 +38,10 @@ void Cia402Axis::setup(const CanAxisConfig& a, const CanAxisPortConfig& port) {
   rated_effort_ = a.rated_effort;
   ferror_min_ = a.ferror_min;
   ferror_k_s_ = a.ferror_k_s;
+  homing_method_ = a.homing_method;
+  home_offset_counts_ = static_cast<std::int32_t>(std::llround(a.home_offset * a.counts_per_unit));
+  homing_speed_ = a.homing_speed;
+  homing_accel_ = a.homing_accel;
   bring_up_started();
 }
 
@@ -55,6 +59,10 @@ void Cia402Axis::bring_up_started() {
   cmd_valid_ = ferror_fault_ = false;
   ferror_high_water_ = 0.0;
   has_consumer_ = has_tpdo2_ = false;
+  // After every bring-up (a reset-node, a boot-up) an incremental encoder's count means nothing.
+  referenced_ = homing_method_ == 0;
+  homing_error_ = homing_commanded_ = false;
+  mode_display_ = od::kModeCsp;
 }
 
 void Cia402Axis::brought_up(CanBus& /*bus*/) { up_ = true; }
@@ -76,6 +84,9 @@ Status Cia402Axis::configure_profile(SdoClient& sdo) {
                   "the drive does not support cyclic synchronous position (0x6502 = 0x%08X, bit 7 clear)",
                   modes.value());
     return Status::error(who + buf);
+  }
+  if (homing_method_ != 0) {
+    if (Status s = configure_homing(sdo, modes.value()); !s) return s;
   }
   if (Status s = sdo.write(node, od::kModesOfOperation, 0, static_cast<std::uint8_t>(od::kModeCsp), 1); !s) {
     return fail(s);
@@ -127,6 +138,7 @@ Status Cia402Axis::configure_profile(SdoClient& sdo) {
 
 
 Status Cia402Axis::configure_pdos(SdoClient& sdo) {
+  const bool homed = homing_method_ != 0;
   const std::uint8_t node = node_;
   const std::string who = label_ + ": ";
   const auto fail = [&](const Status& s) { return Status::error(who + s.message()); };
@@ -158,8 +170,10 @@ Status Cia402Axis::configure_pdos(SdoClient& sdo) {
     bool optional;  // used when the drive has it, noted when absent (TPDO2: velocity and torque)
   };
   const PdoPlan plans[] = {
-      {od::kRpdoComm, od::kRpdoMap, cob::rpdo(1, node), kRpdo1Mapping.data(), 2, 1, false},
-      {od::kTpdoComm, od::kTpdoMap, cob::tpdo(1, node), kTpdo1Mapping.data(), 2, 1, false},
+      {od::kRpdoComm, od::kRpdoMap, cob::rpdo(1, node), homed ? kRpdo1HomingMapping.data() : kRpdo1Mapping.data(),
+       static_cast<std::uint8_t>(homed ? 3 : 2), 1, false},
+      {od::kTpdoComm, od::kTpdoMap, cob::tpdo(1, node), homed ? kTpdo1HomingMapping.data() : kTpdo1Mapping.data(),
+       static_cast<std::uint8_t>(homed ? 3 : 2), 1, false},
       {static_cast<std::uint16_t>(od::kTpdoComm + 1), static_cast<std::uint16_t>(od::kTpdoMap + 1),
        cob::tpdo(2, node), sdo_cfg_.tpdo2 ? kTpdo2Mapping.data() : nullptr,
        static_cast<std::uint8_t>(sdo_cfg_.tpdo2 ? 2 : 0), sdo_cfg_.tpdo2_every_n_sync, true},
@@ -240,27 +254,78 @@ Status Cia402Axis::configure_pdos(SdoClient& sdo) {
 }
 
 
+// The homing run's parameters, in drive units, so the RT path only switches the mode and starts it.
+Status Cia402Axis::configure_homing(SdoClient& sdo, std::uint32_t supported_modes) {
+  const std::string who = label_ + ": ";
+  const auto fail = [&](const Status& s) { return Status::error(who + s.message()); };
+  if ((supported_modes & od::kSupportsHomingBit) == 0) {
+    char buf[160];
+    std::snprintf(buf, sizeof(buf),
+                  "referencing = \"homing\" but the drive does not offer homing mode (0x6502 = 0x%08X, bit 5 clear)",
+                  supported_modes);
+    return Status::error(who + buf);
+  }
+  const auto counts = [&](double si) { return static_cast<std::uint32_t>(std::llround(si * counts_per_unit_)); };
+  if (Status s = sdo.write(node_, od::kHomingMethod, 0, static_cast<std::uint8_t>(homing_method_), 1); !s) return fail(s);
+  if (Status s = sdo.write(node_, od::kHomeOffset, 0, static_cast<std::uint32_t>(home_offset_counts_), 4); !s) {
+    return fail(s);
+  }
+  if (homing_method_ != 37) {  // 37 sets the current position: no travel, no speeds
+    const std::uint32_t fast = std::max<std::uint32_t>(1, counts(homing_speed_));
+    if (Status s = sdo.write(node_, od::kHomingSpeeds, 1, fast, 4); !s) return fail(s);
+    if (Status s = sdo.write(node_, od::kHomingSpeeds, 2, std::max<std::uint32_t>(1, fast / 4), 4); !s) return fail(s);
+    if (Status s = sdo.write(node_, od::kHomingAcceleration, 0, std::max<std::uint32_t>(1, counts(homing_accel_)), 4);
+        !s) {
+      return fail(s);
+    }
+  }
+  return Status::ok();
+}
+
 // ---------------------------------------------------------------------------------------------------
 // Per tick (RT-safe)
 // ---------------------------------------------------------------------------------------------------
 void Cia402Axis::on_profile_frame(hal::Tick now, const CanFrame& f) {
   switch (decode_cob_id(f.id).function) {
     case CobFunction::kTpdo1: {
-      const auto p = unpack_tpdo1(f, node_);
-      if (!p) {
-        ++rx_errors_;
-        return;
+      Tpdo1Mode p{};
+      if (homing_method_ == 0) {
+        const auto q = unpack_tpdo1(f, node_);
+        if (q) p = Tpdo1Mode{q->statusword, q->position_actual, od::kModeCsp};
+        if (!q) {
+          ++rx_errors_;
+          return;
+        }
+      } else {
+        const auto q = unpack_tpdo1_mode(f, node_);
+        if (!q) {
+          ++rx_errors_;
+          return;
+        }
+        p = *q;
       }
-      statusword_ = p->statusword;
-      state_ = decode_statusword(p->statusword);
-      const double pos = counts_to_si(position_.update(p->position_actual), counts_per_unit_);
+      statusword_ = p.statusword;
+      state_ = decode_statusword(p.statusword);
+      mode_display_ = p.mode_display;
+      if (homing_method_ != 0 && mode_display_ == od::kModeHoming && homing_commanded_) {
+        // CiA 402 homing mode: bit 12 homing attained (with bit 10, target reached), bit 13 homing error.
+        if ((statusword_ & statusword::kHomingError) != 0) homing_error_ = true;
+        if (!referenced_ && (statusword_ & statusword::kHomingAttained) != 0 &&
+            (statusword_ & statusword::kTargetReached) != 0) {
+          referenced_ = true;
+          position_.reset(p.position_actual);  // the count jumped to the home offset: a new origin
+          last_position_si_ = counts_to_si(position_.value(), counts_per_unit_);
+          refreshed_ = hal::kNeverTick;      // no velocity across the jump
+        }
+      }
+      const double pos = counts_to_si(position_.update(p.position_actual), counts_per_unit_);
       if (!tpdo2_wanted_ && refreshed_ != hal::kNeverTick && now > refreshed_) {
         velocity_ = (pos - last_position_si_) / (static_cast<double>(now - refreshed_) * cycle_period_s_);
       }
       last_position_si_ = pos;
       refreshed_ = now;
       // Following error against the target commanded before this feedback (LinuxCNC's velocity-scaled rule).
-      if (ferror_min_ > 0.0 && cmd_valid_ && state_ == DriveState::kOperationEnabled) {
+      if (ferror_min_ > 0.0 && cmd_valid_ && state_ == DriveState::kOperationEnabled && mode_display_ == od::kModeCsp) {
         const double err = std::abs(last_cmd_si_ - pos);
         if (err > ferror_high_water_) ferror_high_water_ = err;
         if (err > std::max(ferror_min_, ferror_k_s_ * std::abs(cmd_velocity_))) ferror_fault_ = true;
@@ -296,7 +361,9 @@ void Cia402Axis::fill_feedback(hal::AxisFeedback& fb, bool bus_off, bool bus_con
   fb.velocity = velocity_;
   fb.effort = effort_;
   fb.refreshed = refreshed_;
-  fb.following_error = state_ == DriveState::kOperationEnabled && (statusword_ & statusword::kCspFollowingError) != 0;
+  fb.referenced = referenced_;
+  fb.homing_error = homing_error_;
+  fb.following_error = state_ == DriveState::kOperationEnabled && mode_display_ == od::kModeCsp && (statusword_ & statusword::kCspFollowingError) != 0;
   const bool in_fault_state = state_ == DriveState::kFault || state_ == DriveState::kFaultReactionActive;
   const bool drive_fault = in_fault_state || emcy != 0 || ferror_fault_;
   fb.fault = link_down || link_fault != 0 || drive_fault || tracker_.timed_out;
@@ -325,6 +392,7 @@ void Cia402Axis::fill_feedback(hal::AxisFeedback& fb, bool bus_off, bool bus_con
 // itself decided are cleared; a drive still in Fault gets its reset edge through the CiA 402 table.
 void Cia402Axis::acknowledge() {
   ferror_fault_ = false;
+  homing_error_ = false;
   supervisor_.acknowledge(state_ == DriveState::kFault || state_ == DriveState::kFaultReactionActive);
 }
 
@@ -332,19 +400,31 @@ CanFrame Cia402Axis::command(const hal::AxisCommand& cmd, bool stop_all, bool bu
                              std::uint32_t state_timeout_ticks) {
   // A drive we cannot supervise (lost, rebooted, bus-off) gets quick stop, never an enable command.
   const bool lost = supervisor_.link_fault() != 0 || bus_down;
-  const AxisRequest wanted_request = cmd.request;
+  // A homing run is an enabled drive in homing mode (6) with controlword bit 4 set; an absolute axis has
+  // nothing to run and is simply enabled.
+  const bool homing = cmd.request == AxisRequest::kHome && homing_method_ != 0 && !referenced_;
+  const AxisRequest wanted_request = cmd.request == AxisRequest::kHome ? AxisRequest::kEnable : cmd.request;
   const AxisRequest request =
       lost || (stop_all && wanted_request != AxisRequest::kFaultReset && wanted_request != AxisRequest::kDisable)
           ? AxisRequest::kQuickStop
           : wanted_request;
   const Cia402Step step = cia402_step(state_, request, tracker_, state_timeout_ticks);
   tracker_ = step.next;
+  std::uint16_t controlword = step.controlword;
+  const std::int8_t mode = homing && request == AxisRequest::kEnable ? od::kModeHoming : od::kModeCsp;
+  if (mode == od::kModeHoming && state_ == DriveState::kOperationEnabled && mode_display_ == od::kModeHoming &&
+      controlword == controlword::kEnableOperation && !homing_error_) {
+    controlword |= controlword::kHomingStart;  // the drive starts on its rising edge and runs while it is held
+    homing_commanded_ = true;
+  }
+  if (mode != od::kModeHoming) homing_commanded_ = false;
 
-  // Outside Operation Enabled the target follows the actual position, so enabling never jumps.
+  // Outside Operation Enabled in CSP the target follows the actual position, so enabling never jumps;
+  // an unreferenced axis is never moved (its count means nothing yet).
   std::int64_t target = position_.value();
   const double wanted = cmd.target_position;
   if (state_ == DriveState::kOperationEnabled && step.controlword == controlword::kEnableOperation &&
-      std::isfinite(wanted)) {
+      mode == od::kModeCsp && mode_display_ == od::kModeCsp && referenced_ && std::isfinite(wanted)) {
     target = si_to_counts(wanted, counts_per_unit_);
   }
   const double cmd_si = counts_to_si(target, counts_per_unit_);
@@ -352,7 +432,8 @@ CanFrame Cia402Axis::command(const hal::AxisCommand& cmd, bool stop_all, bool bu
   last_cmd_si_ = cmd_si;
   cmd_valid_ = true;
   last_target_counts_ = target;
-  return pack_rpdo1(node_, Rpdo1{step.controlword, wire_counts(target)});
+  if (homing_method_ == 0) return pack_rpdo1(node_, Rpdo1{controlword, wire_counts(target)});
+  return pack_rpdo1_mode(node_, Rpdo1Mode{controlword, wire_counts(target), mode});
 }
 
 }  // namespace loom::drivers

@@ -45,6 +45,13 @@ struct CanAxisConfig {
   // 0 = the port-wide boot_timeout_s / operational_timeout_s.
   double boot_timeout_s = 0.0;
   double operational_timeout_s = 0.0;
+  // Referencing. 0 = an absolute encoder: always referenced. Else a CiA 402 homing method (19/21 home
+  // switch, 33/34 index pulse, 37 current position, or any other 1..35 the drive offers): the axis is
+  // unreferenced after every bring-up or boot-up until a homing run (hal::AxisRequest::kHome) attains.
+  std::int8_t homing_method = 0;
+  double home_offset = 0.0;   // SI: the reading at the home point (0x607C)
+  double homing_speed = 0.0;  // SI/s: 0x6099:01; 0x6099:02 (search for zero) a quarter of it
+  double homing_accel = 0.0;  // SI/s² (0x609A)
 };
 
 struct CanAxisPortConfig {

@@ -53,6 +53,7 @@ class Cia402Axis final : public CanNode {
 
  private:
   Status configure_pdos(SdoClient& sdo);
+  Status configure_homing(SdoClient& sdo, std::uint32_t supported_modes);
 
   // Configuration (configure-time).
   // What configure_profile() writes (from CanAxisPortConfig).
@@ -75,6 +76,10 @@ class Cia402Axis final : public CanNode {
   double rated_effort_ = 0.0;
   double ferror_min_ = 0.0;
   double ferror_k_s_ = 0.0;
+  std::int8_t homing_method_ = 0;  // 0 = absolute encoder
+  std::int32_t home_offset_counts_ = 0;
+  double homing_speed_ = 0.0;
+  double homing_accel_ = 0.0;
   std::vector<std::string> notes_;
 
   // RT state.
@@ -95,6 +100,10 @@ class Cia402Axis final : public CanNode {
   double ferror_high_water_ = 0.0;
   bool has_consumer_ = false;  // the drive watches our heartbeat (0x1016)
   bool has_tpdo2_ = false;     // velocity/torque PDO configured
+  std::int8_t mode_display_ = 8;   // 0x6061 from TPDO1 (always CSP for an absolute axis)
+  bool referenced_ = true;         // absolute, or homed since the last bring-up
+  bool homing_error_ = false;      // the drive said homing error (latched until acknowledged)
+  bool homing_commanded_ = false;  // bit 4 sent in this homing run: attained/error bits are ours
 };
 
 }  // namespace loom::drivers
