@@ -33,11 +33,8 @@ counters=$HIL_WORK/counters.json
 HIL_CONFIG=$HIL_SRC/hil_four_axis_loom.toml
 HIL_IFACES=$HIL_IFACE,$HIL_IFACE2
 hil_weave_cmd 1 "$counters"
-hil_note "running: ${HIL_CMD[*]}"
-status=0
-timeout -k 5 "${LOOM_HIL_WEAVE_TIMEOUT_S:-150}" "${HIL_CMD[@]}" >"$HIL_WORK/loomctl.out" 2>&1 || status=$?
-sed 's/^/  loomctl| /' "$HIL_WORK/loomctl.out"
-cp "$HIL_WORK/loomctl.out" "$HIL_LOGDIR/$HIL_NAME.loomctl.out"
+hil_run_weave "${LOOM_HIL_WEAVE_TIMEOUT_S:-150}"
+status=$HIL_STATUS
 hil_stop_candump
 sleep 0.2
 cp "$log2" "$HIL_LOGDIR/$HIL_NAME.bus1.candump.log"
