@@ -49,7 +49,6 @@ constexpr std::uint32_t kModesPpPv = 0x05;          // 0x6502 bits 0 (pp) and 2 
 constexpr std::uint32_t kModeCspBit = 1U << 7;      // 0x6502 bit 7 (csp)
 constexpr std::uint32_t kModeHomingBit = 1U << 5;   // 0x6502 bit 5 (hm)
 constexpr std::uint16_t kCwHomingStart = 1U << 4;   // controlword bit 4 in homing mode
-constexpr std::uint16_t kSwTargetReached = 1U << 10;
 constexpr std::uint16_t kSwHomingAttained = 1U << 12;
 constexpr std::uint16_t kSwHomingError = 1U << 13;
 constexpr std::int8_t kInterpolationIndexMin = -6;  // 0x60C2:02, 10^index s: µs … s
