@@ -12,7 +12,8 @@ hil_init homing "${1:-}"
 hil_require_vcan
 hil_find_binaries
 hil_start_candump
-HIL_SIM_EXTRA=(--homing-nodes 1,2)
+# The crank 0.5 rad past its home switch and the carriage 5 cm right of its own: the runs travel.
+HIL_SIM_EXTRA=(--homing-nodes 1,2 --initial-position 0.5,0.05,0)
 hil_start_sim_drives
 grep -m1 'power-up seed' "$HIL_WORK/sim.out" 2>/dev/null | sed 's/^/  sim| /' || true
 
