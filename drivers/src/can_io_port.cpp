@@ -223,7 +223,7 @@ hal::DigitalOutputs io_safe_outputs() {
 CanIoPort::CanIoPort(CanIoConfig config) : config_(std::move(config)) {}
 
 std::string CanIoPort::who() const {
-  return "node " + std::to_string(config_.node_id) + " (I/O node): ";
+  return label() + ": ";
 }
 
 CanIoPort::Slot CanIoPort::find(const std::array<PdoLayout, 4>& layouts, std::uint32_t wanted) {
@@ -441,66 +441,40 @@ Status CanIoPort::locate_inputs(std::uint8_t subs) {
   return Status::ok();
 }
 
+std::string CanIoPort::label() const {
+  return "node " + std::to_string(config_.node_id) + " (I/O node)";
+}
+
+NodeTiming CanIoPort::timing() const {
+  return NodeTiming{config_.boot_timeout_s, config_.operational_timeout_s, config_.heartbeat_consumer_s};
+}
+
 Status CanIoPort::configure(CanBus& bus, ConfigureClock& clock) {
+  if (Status s = validate(config_); !s) return Status::error("CAN I/O configuration: " + s.message());
+  // The module alone on its bus: a master of its own (no SYNC or heartbeat of its own until a port uses
+  // the bus), the same one NMT sequence every bus is brought up with.
+  CanMaster master(CanMasterConfig{config_.cycle_period_s, config_.sdo_timeout_s, config_.boot_timeout_s,
+                                   config_.operational_timeout_s, 0, 0.0});
+  master.add(*this);
+  return master.bring_up(bus, clock);
+}
+
+void CanIoPort::bring_up_started() {
   configured_ = false;
   bus_ = nullptr;
   notes_.clear();
-  link_fault_ = 0;
-  emcy_code_ = 0;
-  inputs_refreshed_ = analog_refreshed_ = last_heartbeat_ = hal::kNeverTick;
+  inputs_refreshed_ = analog_refreshed_ = hal::kNeverTick;
   inputs_ = {};  // a re-arm must not show the sensors of the last configuration before the first TPDO
-  booted_ = false;
+}
+
+void CanIoPort::brought_up(CanBus& bus) {
+  bus_ = &bus;
+  configured_ = true;
+}
+
+Status CanIoPort::configure_profile(SdoClient& sdo) {
   if (Status s = validate(config_); !s) return Status::error("CAN I/O configuration: " + s.message());
-  consumer_ticks_ = static_cast<std::uint32_t>(std::ceil(config_.heartbeat_consumer_s / config_.cycle_period_s - 1e-9));
   const std::uint8_t id = config_.node_id;
-
-  bool booted = false, operational = false, bus_off = false;
-  const auto note = [&](const CanFrame& f) {
-    if (f.is_error()) {
-      bus_off = bus_off || decode_error_frame(f).bus_off;
-      return;
-    }
-    if (auto hb = parse_heartbeat(f); hb && hb->node == id) {
-      if (hb->state == NmtState::kBootUp) booted = true;
-      operational = hb->state == NmtState::kOperational;
-    }
-  };
-  const auto wait = [&](const bool& flag, double timeout_s, const std::string& what) -> Status {
-    const std::int64_t deadline = clock.now_us() + static_cast<std::int64_t>(timeout_s * 1e6);
-    for (;;) {
-      CanFrame f;
-      for (int i = 0; i < 4096 && bus.receive(f); ++i) note(f);
-      if (bus_off) return Status::error(who() + "CAN bus-off while waiting for " + what);
-      if (flag) return Status::ok();
-      if (clock.now_us() >= deadline) return Status::error(who() + "no " + what + " within " + seconds(timeout_s));
-      clock.idle();
-    }
-  };
-  const auto send = [&](const CanFrame& f, const char* what) -> Status {
-    const std::int64_t deadline = clock.now_us() + static_cast<std::int64_t>(config_.sdo_timeout_s * 1e6);
-    for (;;) {
-      const SendResult r = bus.send(f);
-      if (r == SendResult::kOk) return Status::ok();
-      if (r == SendResult::kError || clock.now_us() >= deadline) {
-        return Status::error(who() + what + ": the CAN bus refused the frame");
-      }
-      clock.idle();
-    }
-  };
-
-  {
-    CanFrame f;
-    for (int i = 0; i < 4096 && bus.receive(f); ++i) {
-    }
-  }
-  if (Status s = send(make_nmt(NmtCommand::kResetNode, id), "NMT reset-node"); !s) return s;
-  if (Status s = wait(booted, config_.boot_timeout_s,
-                      "boot-up after NMT reset-node (is the I/O module powered, on this bus, with this node id?)");
-      !s) {
-    return s;
-  }
-
-  SdoClient sdo(bus, clock, static_cast<std::int64_t>(config_.sdo_timeout_s * 1e6), note);
   const auto fail = [&](const Status& s) { return Status::error(who() + s.message()); };
 
   Result<std::uint32_t> type = sdo.read(id, od::kDeviceType, 0);
@@ -559,27 +533,14 @@ Status CanIoPort::configure(CanBus& bus, ConfigureClock& clock) {
     }
   }
 
-  if (Status s = configure_mapping(sdo); !s) return s;
-
-  operational = false;
-  if (Status s = send(make_nmt(NmtCommand::kStart, id), "NMT start"); !s) return s;
-  if (Status s = wait(operational, config_.operational_timeout_s,
-                      "operational heartbeat after NMT start (heartbeat producer time 0x1017 not honoured?)");
-      !s) {
-    return s;
-  }
-  bus_ = &bus;
-  configured_ = true;
-  return Status::ok();
+  return configure_mapping(sdo);
 }
 
 // ---------------------------------------------------------------------------------------------------
 // Per tick (RT-safe)
 // ---------------------------------------------------------------------------------------------------
-void CanIoPort::on_frame(hal::Tick now, const CanFrame& f) {
-  if (!configured_ || f.is_error()) return;
+void CanIoPort::on_profile_frame(hal::Tick now, const CanFrame& f) {
   const CobDecoded d = decode_cob_id(f.id);
-  if (d.node != config_.node_id) return;
   const auto read_le = [&](const Slot& s, std::uint32_t& v) {
     if (s.offset + s.bytes > f.dlc) return false;
     v = 0;
@@ -592,29 +553,6 @@ void CanIoPort::on_frame(hal::Tick now, const CanFrame& f) {
     case CobFunction::kTpdo2: tpdo = 1; break;
     case CobFunction::kTpdo3: tpdo = 2; break;
     case CobFunction::kTpdo4: tpdo = 3; break;
-    case CobFunction::kHeartbeat: {
-      const auto hb = parse_heartbeat(f);
-      if (!hb) {
-        ++rx_errors_;
-        return;
-      }
-      last_heartbeat_ = now;
-      if (hb->state == NmtState::kBootUp) booted_ = true;
-      if (link_fault_ == 0 && hb->state == NmtState::kBootUp) link_fault_ = fault_code::kNodeRebooted;
-      if (link_fault_ == 0 && hb->state != NmtState::kOperational && hb->state != NmtState::kBootUp) {
-        link_fault_ = fault_code::kNodeNotOperational;
-      }
-      return;
-    }
-    case CobFunction::kEmcy: {
-      const auto e = parse_emcy(f);
-      if (!e) {
-        ++rx_errors_;
-        return;
-      }
-      if (e->code != 0) emcy_code_ = e->code;
-      return;
-    }
     default:
       return;
   }
@@ -649,19 +587,6 @@ void CanIoPort::on_frame(hal::Tick now, const CanFrame& f) {
     used = true;
   }
   if (!used) ++rx_errors_;  // a TPDO we disabled: the module ignores its configuration
-}
-
-void CanIoPort::supervise(hal::Tick now) {
-  if (!configured_) return;
-  // The consumer starts counting at the first tick; heartbeats during bring-up carry no tick.
-  if (last_heartbeat_ == hal::kNeverTick) last_heartbeat_ = now;
-  if (link_fault_ == 0 && now - last_heartbeat_ > static_cast<hal::Tick>(consumer_ticks_)) {
-    link_fault_ = fault_code::kHeartbeatLost;
-  }
-}
-
-void CanIoPort::acknowledge() {
-  emcy_code_ = 0;  // the module's own fault clears with its error reset; ours with the operator's ack
 }
 
 bool CanIoPort::input(const IoBit& b) const {
@@ -703,7 +628,7 @@ void CanIoPort::read_analog(hal::Tick /*now*/, hal::AnalogInputs& analog) {
 void CanIoPort::write_io(hal::Tick /*now*/, const hal::DigitalOutputs& requested) {
   if (!configured_) return;
   // A node we cannot supervise gets its safe outputs (it may still hear us).
-  const hal::DigitalOutputs& o = link_fault_ != 0 ? io_safe_outputs() : requested;
+  const hal::DigitalOutputs& o = supervisor_.link_fault() != 0 ? io_safe_outputs() : requested;
   const IoWiring& w = config_.wiring;
   std::array<std::uint8_t, 2> bytes{};
   const auto put = [&](const IoBit& b, bool on) {
@@ -723,10 +648,6 @@ void CanIoPort::write_io(hal::Tick /*now*/, const hal::DigitalOutputs& requested
     if (output_slot_[k].pdo == output_pdo_ && output_slot_[k].bytes == 1) f.data[output_slot_[k].offset] = bytes[k];
   }
   if (bus_->send(f) != SendResult::kOk) ++tx_dropped_;
-}
-
-bool CanIoPort::heard_again(hal::Tick now) const {
-  return booted_ || (last_heartbeat_ != hal::kNeverTick && now - last_heartbeat_ <= static_cast<hal::Tick>(consumer_ticks_));
 }
 
 }  // namespace loom::drivers

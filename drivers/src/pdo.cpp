@@ -78,6 +78,30 @@ std::optional<Tpdo1> unpack_tpdo1(const CanFrame& frame, std::uint8_t node) {
   return Tpdo1{get_u16(&frame.data[0]), get_i32(&frame.data[2])};
 }
 
+CanFrame pack_rpdo1_mode(std::uint8_t node, const Rpdo1Mode& p) {
+  CanFrame f = pack_rpdo1(node, Rpdo1{p.controlword, p.target_position});
+  f.dlc = kRpdo1HomingBytes;
+  f.data[6] = static_cast<std::uint8_t>(p.mode);
+  return f;
+}
+
+std::optional<Rpdo1Mode> unpack_rpdo1_mode(const CanFrame& frame, std::uint8_t node) {
+  if (!is_data_frame(frame, cob::rpdo(1, node), kRpdo1HomingBytes)) return std::nullopt;
+  return Rpdo1Mode{get_u16(&frame.data[0]), get_i32(&frame.data[2]), static_cast<std::int8_t>(frame.data[6])};
+}
+
+CanFrame pack_tpdo1_mode(std::uint8_t node, const Tpdo1Mode& p) {
+  CanFrame f = pack_tpdo1(node, Tpdo1{p.statusword, p.position_actual});
+  f.dlc = kTpdo1HomingBytes;
+  f.data[6] = static_cast<std::uint8_t>(p.mode_display);
+  return f;
+}
+
+std::optional<Tpdo1Mode> unpack_tpdo1_mode(const CanFrame& frame, std::uint8_t node) {
+  if (!is_data_frame(frame, cob::tpdo(1, node), kTpdo1HomingBytes)) return std::nullopt;
+  return Tpdo1Mode{get_u16(&frame.data[0]), get_i32(&frame.data[2]), static_cast<std::int8_t>(frame.data[6])};
+}
+
 CanFrame pack_tpdo2(std::uint8_t node, const Tpdo2& p) {
   CanFrame f;
   f.id = cob::tpdo(2, node);

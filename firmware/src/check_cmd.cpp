@@ -197,7 +197,6 @@ void print_plan(const LoomConfig& c) {
   print_knotting(c);
 
   std::printf("\nCAN (for --hal socketcan)\n");
-  const drivers::BusLoad load = can_bus_load(c);  // the figure the CAN master checks when it configures
   std::printf("  I/O module node %u (%s); controller heartbeat %s\n", c.io.node,
               c.io.kind == IoKind::kCan ? "on the bus" : "SIMULATED: needs --io simulated on hardware",
               c.can.master_node != 0 ? ("node " + std::to_string(c.can.master_node) + ", every " +
@@ -206,9 +205,21 @@ void print_plan(const LoomConfig& c) {
                                      : "off");
   std::printf("  heartbeats %u ms, lost after %u ms; bit rate %u bit/s\n", c.can.heartbeat_ms, c.can.heartbeat_timeout_ms,
               c.can.bitrate);
-  std::printf("  bus load: %s (budget %.0f %%)\n", drivers::describe_bus_load(load).c_str(), c.can.bus_load_budget * 100.0);
+  // Per bus: the figure that bus' CAN master checks when it configures (bus i = the i-th --iface name).
+  const std::size_t buses = drivers::bus_count(can_axis_config(c));
+  for (std::size_t b = 0; b < buses; ++b) {
+    std::string on_bus;
+    for (const AxisSpec& a : c.axes) {
+      if (a.bus == b) on_bus += (on_bus.empty() ? "" : ", ") + a.name + " " + std::to_string(a.node);
+    }
+    if (b == 0 && c.io.kind == IoKind::kCan) on_bus += ", I/O " + std::to_string(c.io.node);
+    std::printf("  bus %zu (nodes %s) load: %s (budget %.0f %%)\n", b, on_bus.c_str(),
+                drivers::describe_bus_load(can_bus_load(c, b)).c_str(), c.can.bus_load_budget * 100.0);
+  }
   std::string nodes;
-  for (const AxisSpec& a : c.axes) nodes += (nodes.empty() ? "" : ", ") + std::to_string(a.node);
+  for (const AxisSpec& a : c.axes) {
+    nodes += (nodes.empty() ? "" : ", ") + std::to_string(a.node) + (buses > 1 ? "@bus" + std::to_string(a.bus) : "");
+  }
   std::printf("  objects every drive (nodes %s) must support:\n", nodes.c_str());
   for (const auto& o : drivers::drive_objects()) std::printf("    %s\n", drivers::describe(o).c_str());
   std::printf("  objects the I/O module (node %u) must support:\n", c.io.node);

@@ -721,6 +721,7 @@ void check_can(const LoomConfig& c, const Fail& fail) {
     for (const AxisSpec& a : c.axes) {
       if (msg.rfind("axes." + a.name + ".counts_per_unit", 0) == 0) key = "axes." + a.name + ".counts_per_rev", value = fmt_num(a.counts_per_rev);
       if (msg.rfind("axes." + a.name + ".ferror", 0) == 0) key = "axes." + a.name + ".ferror_min", value = fmt_num(a.ferror_min);
+      if (msg.rfind("axes." + a.name + ".hom", 0) == 0) key = "axes." + a.name + ".homing_method", value = std::to_string(a.homing_method);
     }
     if (msg.find("bus") != std::string::npos || msg.find("bit") != std::string::npos) {
       key = "can.bus_load_budget", value = fmt_num(c.can.bus_load_budget);
@@ -748,8 +749,13 @@ void check_can(const LoomConfig& c, const Fail& fail) {
       fail(key, value, "the I/O module refuses it: " + msg);
     }
   }
-  if (const drivers::Status s = drivers::check_bus_load(can_bus_load(c), c.can.bus_load_budget); !s) {
-    fail("can.bus_load_budget", fmt_num(c.can.bus_load_budget), s.message());
+  // Each bus has its own master, SYNC and budget: a bus is judged by its own nodes' frames.
+  const std::size_t buses = drivers::bus_count(cc);
+  for (std::size_t b = 0; b < buses; ++b) {
+    if (const drivers::Status s = drivers::check_bus_load(can_bus_load(c, b), c.can.bus_load_budget); !s) {
+      fail("can.bus_load_budget", fmt_num(c.can.bus_load_budget),
+           buses == 1 ? s.message() : "bus " + std::to_string(b) + ": " + s.message());
+    }
   }
 }
 
@@ -1015,6 +1021,12 @@ drivers::CanAxisPortConfig can_axis_config(const LoomConfig& c) {
     d.ferror_k_s = a.ferror_k_s;
     d.boot_timeout_s = a.boot_ms * 1e-3;
     d.operational_timeout_s = a.operational_ms * 1e-3;
+    if (a.homing) {  // CiA 402 homing run over CAN (0x6098, 0x607C, 0x6099, 0x609A)
+      d.homing_method = static_cast<std::int8_t>(a.homing_method);
+      d.home_offset = a.home_offset;
+      d.homing_speed = a.homing_speed;
+      d.homing_accel = a.homing_accel;
+    }
   }
   cc.cycle_period_s = c.run.period_s;
   cc.heartbeat_producer_s = c.can.heartbeat_ms * 1e-3;
@@ -1044,9 +1056,9 @@ drivers::CanIoConfig can_io_config(const LoomConfig& c) {
   return ic;
 }
 
-drivers::BusLoad can_bus_load(const LoomConfig& c) {
+drivers::BusLoad can_bus_load(const LoomConfig& c, std::size_t bus) {
   const drivers::CanAxisPortConfig cc = can_axis_config(c);
-  return drivers::planned_bus_load(cc);
+  return drivers::planned_bus_load(cc, bus);
 }
 
 LoomConfig parse_loom_config(const std::string& text, const std::string& source) {

@@ -71,8 +71,8 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
   loop_->set_telemetry_context(tc);
 }
 
-// The CAN HAL: three CiA 402 drives and the CiA 401 I/O node on one bus (or, only when asked for on
-// the command line, the drives beside the simulated I/O node). Every refusal that needs no bus comes
+// The CAN HAL: the CiA 402 drives on their buses and the CiA 401 I/O node on bus 0 (or, only when asked
+// for on the command line, the drives beside the simulated I/O node). Every refusal that needs no bus comes
 // before the bus is opened.
 void Machine::build_can_hal(const MachineOptions& opt) {
   const IoKind io_kind = opt.io.value_or(cfg_.io.kind);
@@ -80,15 +80,6 @@ void Machine::build_can_hal(const MachineOptions& opt) {
     throw ConfigError(cfg_.source +
                       ": io.kind = \"simulated\" with the CAN HAL: the servos would move while the e-stop chain, "
                       "sensors and valves are imaginary; give --io simulated to do this on purpose");
-  }
-  // Homing over CAN needs the drive profile's homing mode in the cyclic exchange (not built yet): refuse
-  // before the bus is opened rather than arm axes whose position nobody has referenced.
-  for (const AxisSpec& a : cfg_.axes) {
-    if (a.homing) {
-      throw ConfigError(cfg_.source + ": axes." + a.name + ".referencing = \"homing\": the CAN master does not run "
-                        "CiA 402 homing yet; use an absolute encoder (referencing = \"absolute\") on CAN, or the "
-                        "simulated HAL");
-    }
   }
   // Derived from the machine description (and validated when it was read).
   const drivers::CanIoConfig ic = can_io_config(cfg_);
@@ -99,29 +90,57 @@ void Machine::build_can_hal(const MachineOptions& opt) {
     cc.other_frames_per_cycle = drivers::io_frames_per_cycle(ic.wiring);
   }
 
-  // The interface's real bitrate, from the kernel, before anything is sent.
-  auto link = drivers::read_can_link_info(opt.iface);
-  if (!link) throw std::runtime_error(link.error());
-  std::string note;
-  if (drivers::Status s = drivers::check_can_bitrate(opt.iface, link.value(), cfg_.can.bitrate, note); !s) {
-    throw ConfigError(cfg_.source + ": can.bitrate: " + s.message());
+  // One interface per bus, in bus order: "can0,can1" puts the axes with bus = 1 on can1.
+  std::vector<std::string> ifaces;
+  for (std::size_t at = 0;;) {
+    const std::size_t comma = opt.iface.find(',', at);
+    ifaces.push_back(opt.iface.substr(at, comma == std::string::npos ? std::string::npos : comma - at));
+    if (comma == std::string::npos) break;
+    at = comma + 1;
   }
-  if (!note.empty()) notes_.push_back(note);
-
-  auto bus = drivers::SocketCanBus::open(opt.iface);
-  if (!bus) throw std::runtime_error(bus.error());
-  bus_ = std::move(bus.value());
+  const std::size_t buses = drivers::bus_count(cc);
+  for (std::size_t i = 0; i < ifaces.size(); ++i) {
+    if (ifaces[i].empty()) throw ConfigError("--iface \"" + opt.iface + "\": interface " + std::to_string(i) + " has no name");
+    for (std::size_t j = 0; j < i; ++j) {
+      if (ifaces[j] == ifaces[i]) {
+        throw ConfigError("--iface \"" + opt.iface + "\": " + ifaces[i] + " is named twice (one bus per interface)");
+      }
+    }
+  }
+  if (ifaces.size() != buses) {
+    throw ConfigError("--iface \"" + opt.iface + "\" names " + std::to_string(ifaces.size()) + " interface(s), but " +
+                      cfg_.source + " puts its axes on " + std::to_string(buses) +
+                      " CAN bus(es) (axes.<name>.bus 0.." + std::to_string(buses - 1) +
+                      "): give one interface per bus, comma-separated, bus 0 first");
+  }
+  buses_.clear();
+  std::vector<drivers::CanBus*> bus_ptrs;
+  for (const std::string& iface : ifaces) {
+    // The interface's real bitrate, from the kernel, before anything is sent.
+    auto link = drivers::read_can_link_info(iface);
+    if (!link) throw std::runtime_error(link.error());
+    std::string note;
+    if (drivers::Status s = drivers::check_can_bitrate(iface, link.value(), cfg_.can.bitrate, note); !s) {
+      throw ConfigError(cfg_.source + ": can.bitrate: " + s.message());
+    }
+    if (!note.empty()) notes_.push_back(note);
+    auto bus = drivers::SocketCanBus::open(iface);
+    if (!bus) throw std::runtime_error(bus.error());
+    buses_.push_back(std::move(bus.value()));
+    bus_ptrs.push_back(buses_.back().get());
+  }
   can_port_ = std::make_unique<drivers::CanAxisPort>(cc);
   if (io_kind == IoKind::kCan) {
     io_port_ = std::make_unique<drivers::CanIoPort>(ic);
     can_port_->attach(*io_port_);
   }
-  if (const drivers::Status st = can_port_->configure(*bus_); !st) throw std::runtime_error(st.message());
-  notes_.push_back("CAN bus load: " + drivers::describe_bus_load(can_port_->bus_load()));
+  drivers::MonotonicConfigureClock clock;
+  if (const drivers::Status st = can_port_->configure(bus_ptrs, clock); !st) throw std::runtime_error(st.message());
+  for (std::size_t b = 0; b < buses; ++b) {
+    notes_.push_back("CAN bus load (" + ifaces[b] + "): " + drivers::describe_bus_load(can_port_->bus_load(b)));
+  }
   notes_.insert(notes_.end(), can_port_->notes().begin(), can_port_->notes().end());
-  if (io_port_) {
-    drivers::MonotonicConfigureClock clock;
-    if (const drivers::Status st = io_port_->configure(*bus_, clock); !st) throw std::runtime_error(st.message());
+  if (io_port_) {  // brought up by bus 0's master in the same NMT sequence as the drives
     notes_.insert(notes_.end(), io_port_->notes().begin(), io_port_->notes().end());
     hal_ = std::make_unique<hal::PortHal>(*can_port_, *io_port_);
   } else {

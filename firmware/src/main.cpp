@@ -388,7 +388,7 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   weave_cmd->add_option("--rows", a.rows, "rows to weave")->check(CLI::Range(1u, 1000000u));
   weave_cmd->add_option("--hal", a.hal, "sim | socketcan")->check(CLI::IsMember({"sim", "socketcan"}));
-  weave_cmd->add_option("--iface", a.iface, "SocketCAN interface (with --hal socketcan), e.g. can0, vcan0");
+  weave_cmd->add_option("--iface", a.iface, "SocketCAN interface(s) (with --hal socketcan), e.g. can0, or can0,can1 for a loom with axes on two buses");
   weave_cmd->add_option("--io", a.io,
                         "with --hal socketcan: can (the CiA 401 I/O node) | simulated (refused unless given here)")
       ->check(CLI::IsMember({"can", "simulated"}));
@@ -421,7 +421,7 @@ int main(int argc, char** argv) {
       "commission", "drives disabled: show live axis positions and I/O inputs, capture the calibration into the config");
   com_cmd->add_option("--config", com.config, "the loom config file the calibration is written into")->required();
   com_cmd->add_option("--hal", com.hal, "sim | socketcan")->check(CLI::IsMember({"sim", "socketcan"}));
-  com_cmd->add_option("--iface", com.iface, "SocketCAN interface (with --hal socketcan)");
+  com_cmd->add_option("--iface", com.iface, "SocketCAN interface(s) (with --hal socketcan): one per bus, comma-separated");
   com_cmd->add_option("--io", com.io, "can | simulated (overrides io.kind; simulated I/O beside real drives only so)")
       ->check(CLI::IsMember({"can", "simulated"}));
   com_cmd->add_option("--sim-state", com.sim_state, "sim HAL: the simulated machine's physical state file");

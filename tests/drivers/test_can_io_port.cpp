@@ -52,10 +52,8 @@ struct IoRig {
     c.other_frames_per_cycle = drivers::io_frames_per_cycle(io.wiring);
     return c;
   }
-  drivers::Status configure() {
-    if (drivers::Status s = rig.configure(); !s) return s;
-    return port.configure(rig.master, rig.clock);
-  }
+  // The axis port's master brings the I/O node up in the same NMT sequence as the drives.
+  drivers::Status configure() { return rig.configure(); }
   // One RT cycle through the joined HAL, as the control loop runs it.
   void tick(AxisRequest r, const hal::DigitalOutputs& out = {}) {
     hal::PortHal hal(rig.port, port);

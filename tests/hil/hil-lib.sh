@@ -216,8 +216,20 @@ hil_start_sim_drives() {
 hil_io_control() { printf '%s\n' "$*" >"$HIL_IO_CONTROL.tmp" && mv "$HIL_IO_CONTROL.tmp" "$HIL_IO_CONTROL"; }
 
 
-# hil_weave_cmd ROWS COUNTERS_FILE — the loomctl command line under test, into HIL_CMD.
+# hil_run_weave TIMEOUT_S — run HIL_CMD (hil_weave_cmd) with a time limit, show its output and keep it
+# as HIL_LOGDIR/NAME.loomctl.out; its exit status in HIL_STATUS (124/137 = timed out).
+hil_run_weave() {
+  hil_note "running: ${HIL_CMD[*]}"
+  HIL_STATUS=0
+  timeout -k 5 "$1" "${HIL_CMD[@]}" >"$HIL_WORK/loomctl.out" 2>&1 || HIL_STATUS=$?
+  sed 's/^/  loomctl| /' "$HIL_WORK/loomctl.out"
+  cp "$HIL_WORK/loomctl.out" "$HIL_LOGDIR/$HIL_NAME.loomctl.out"
+}
+
+# hil_weave_cmd ROWS COUNTERS_FILE — the loomctl command line under test, into HIL_CMD. HIL_CONFIG (a
+# loom file) and HIL_IFACES ("vcan0,vcan1" for a loom on two buses) change what it weaves.
 hil_weave_cmd() {
-  HIL_CMD=("$HIL_LOOMCTL" weave --hal socketcan --iface "$HIL_IFACE" --rows "$1" --period-ms "$HIL_PERIOD_MS"
-           --allow-degraded --counters "$2" --config "$HIL_SRC/hil_loom.toml" --io can)
+  HIL_CMD=("$HIL_LOOMCTL" weave --hal socketcan --iface "${HIL_IFACES:-$HIL_IFACE}" --rows "$1"
+           --period-ms "$HIL_PERIOD_MS" --allow-degraded --counters "$2" --config "${HIL_CONFIG:-$HIL_SRC/hil_loom.toml}"
+           --io can)
 }

@@ -58,6 +58,35 @@ TEST(IoKind, ExplicitSimulatedIoGetsPastTheRefusal) {
   EXPECT_NE(std::string(kSimulatedIoBanner).find("interlocks are not protecting anything"), std::string::npos);
 }
 
+// --iface names one interface per bus, bus 0 first; a count that does not match the machine's buses is
+// refused before any interface is opened, and the second name is the one opened for bus 1.
+TEST(Iface, OneInterfacePerBusCommaSeparated) {
+  const LoomConfig four = parse_loom_config(
+      "extends = \"default\"\n[axes.take_up]\nrole = \"auxiliary\"\nbus = 1\nnode = 5\ncounts_per_rev = 4096\n"
+      "max_speed = 2.0\nferror_min = 0.1\nreferencing = \"absolute\"\n",
+      "four.toml");
+  const auto error_of = [&](const std::string& iface) -> std::string {
+    MachineOptions o = can_options(IoKind::kCan);
+    o.iface = iface;
+    try {
+      Machine m(four, default_scene(), o, {});
+    } catch (const std::exception& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  std::string e = error_of("nosuchcan7");
+  EXPECT_NE(e.find("--iface \"nosuchcan7\" names 1 interface(s), but four.toml puts its axes on 2 CAN bus(es)"),
+            std::string::npos)
+      << e;
+  e = error_of("nosuchcan7,nosuchcan7");
+  EXPECT_NE(e.find("nosuchcan7 is named twice"), std::string::npos) << e;
+  e = error_of("nosuchcan7,");
+  EXPECT_NE(e.find("interface 1 has no name"), std::string::npos) << e;
+  e = error_of("nosuchcan7,nosuchcan8");  // the right count: assembly goes on to the first interface
+  EXPECT_EQ(e, "CAN interface 'nosuchcan7' does not exist");
+}
+
 TEST(IoKind, BadWiringIsAConfigErrorAtTheLineThatIsWrong) {
   // Checked when the file is read (exit 2), not when the bus is opened.
   const auto error_of = [](const std::string& text) {

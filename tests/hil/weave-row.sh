@@ -16,11 +16,8 @@ hil_start_sim_drives
 
 counters=$HIL_WORK/counters.json
 hil_weave_cmd 1 "$counters"
-hil_note "running: ${HIL_CMD[*]}"
-status=0
-timeout -k 5 "${LOOM_HIL_WEAVE_TIMEOUT_S:-150}" "${HIL_CMD[@]}" >"$HIL_WORK/loomctl.out" 2>&1 || status=$?
-sed 's/^/  loomctl| /' "$HIL_WORK/loomctl.out"
-cp "$HIL_WORK/loomctl.out" "$HIL_LOGDIR/$HIL_NAME.loomctl.out"
+hil_run_weave "${LOOM_HIL_WEAVE_TIMEOUT_S:-150}"
+status=$HIL_STATUS
 kill -0 "$HIL_SIM_PID" 2>/dev/null || hil_fail "loom-sim-drive died during the row: $(tail -n 5 "$HIL_WORK/sim.out")"
 hil_stop_candump
 

@@ -3,6 +3,10 @@
 // SIGINT/SIGTERM; bad arguments exit 2.
 //   loom-sim-drive --iface vcan0 --nodes 1,2,3 [--io-node 4] [--personality standard|fixed]
 //                  [--counts-per-unit A,B,C] [--initial-position a,b,c] [--io-control FILE]
+//                  [--homing-nodes 1,2 [--power-up-seed N]]
+// --homing-nodes: those drives have incremental encoders: they offer CiA 402 homing (mode 6; methods 19/21
+// on a home switch at physical 0, 33/34 on an index pulse every 4096 counts, 37 where they stand) and
+// power up at a random count (the seed is printed; give it back to reproduce a run).
 // The I/O node's pistons follow its valve outputs, its shuttle sensors the helix drive (3rd node), its
 // load cell the crank drive (1st node). --io-control FILE is re-read when it changes: whitespace-separated
 // words estop, start, pause, ack, knotted, silent, stuck=<sensor>[_2]:on|off (present = active; the last
@@ -20,6 +24,7 @@
 #include <cstdio>
 #include <iostream>
 #include <limits>
+#include <random>
 #include <deque>
 #include <fstream>
 #include <set>
@@ -97,6 +102,8 @@ int main(int argc, char** argv) {
   std::string io_control;
   double boot_delay_ms = -1.0, operational_delay_ms = -1.0;
   double width_m = 0.6, helix_lead_m = 0.1;
+  std::vector<int> homing_nodes;
+  std::uint64_t power_up_seed = 0;
   app.add_option("--iface", iface, "CAN interface, e.g. vcan0")->required();
   app.add_option("--io-node", io_node, "also simulate the CiA 401 I/O node with this node id (1..127)");
   app.add_option("--io-control", io_control,
@@ -122,6 +129,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 100.0));
   app.add_option("--max-step-counts", max_step_counts,
                  "largest target step per SYNC before a following-error fault (0 = off)");
+  app.add_option("--homing-nodes", homing_nodes,
+                 "drives with an incremental encoder: CiA 402 homing offered, a random count at every power-up")
+      ->delimiter(',');
+  app.add_option("--power-up-seed", power_up_seed, "seed of the random power-up counts (default: chosen, printed)");
   app.add_flag("--verbose", verbose, "print NMT and drive state changes");
   try {
     app.parse(argc, argv);
@@ -158,6 +169,14 @@ int main(int argc, char** argv) {
     return usage_error("--initial-position: " + std::to_string(initial_position.size()) + " values for " +
                        std::to_string(nodes.size()) + " nodes");
   }
+  for (int n : homing_nodes) {
+    if (seen.count(n) == 0) return usage_error("--homing-nodes: node id " + std::to_string(n) + " is not in --nodes");
+  }
+  if (!homing_nodes.empty()) {
+    if (power_up_seed == 0) power_up_seed = (static_cast<std::uint64_t>(std::random_device{}()) << 1) | 1U;
+    std::fprintf(stderr, "loom-sim-drive: power-up seed %llu (--power-up-seed to repeat)\n",
+                 static_cast<unsigned long long>(power_up_seed));
+  }
   std::vector<loom::sim_can::SimDriveConfig> configs;
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     const double cpu = counts_per_unit.empty() ? default_counts_per_unit(i) : counts_per_unit[i];
@@ -176,6 +195,10 @@ int main(int argc, char** argv) {
     c.max_step_counts = max_step_counts;
     c.boot_delay_us = static_cast<std::int64_t>(boot_delay_ms * 1000.0);
     c.operational_delay_us = static_cast<std::int64_t>(operational_delay_ms * 1000.0);
+    if (std::find(homing_nodes.begin(), homing_nodes.end(), nodes[i]) != homing_nodes.end()) {
+      c.supports_homing = true;
+      c.power_up_seed = power_up_seed + 2 * i;  // odd seeds stay non-zero
+    }
     if (fixed) {
       c.fixed_mapping = true;
       c.missing_objects = {0x1802, 0x1803, 0x1A02, 0x1A03, 0x1016};

@@ -35,13 +35,22 @@ constexpr std::uint16_t kPositionActual = 0x6064;
 constexpr std::uint16_t kVelocityActual = 0x606C;
 constexpr std::uint16_t kTorqueActual = 0x6077;
 constexpr std::uint16_t kTargetPosition = 0x607A;
+constexpr std::uint16_t kHomeOffset = 0x607C;
+constexpr std::uint16_t kHomingMethod = 0x6098;
+constexpr std::uint16_t kHomingSpeeds = 0x6099;
+constexpr std::uint16_t kHomingAcceleration = 0x609A;
 constexpr std::uint16_t kInterpolationPeriod = 0x60C2;
 constexpr std::uint16_t kSupportedModes = 0x6502;
 
 constexpr std::uint32_t kDeviceTypeServo402 = 0x00020192;  // profile 402, servo drive
 constexpr std::int8_t kModeCsp = 8;
+constexpr std::int8_t kModeHoming = 6;
 constexpr std::uint32_t kModesPpPv = 0x05;          // 0x6502 bits 0 (pp) and 2 (pv)
 constexpr std::uint32_t kModeCspBit = 1U << 7;      // 0x6502 bit 7 (csp)
+constexpr std::uint32_t kModeHomingBit = 1U << 5;   // 0x6502 bit 5 (hm)
+constexpr std::uint16_t kCwHomingStart = 1U << 4;   // controlword bit 4 in homing mode
+constexpr std::uint16_t kSwHomingAttained = 1U << 12;
+constexpr std::uint16_t kSwHomingError = 1U << 13;
 constexpr std::int8_t kInterpolationIndexMin = -6;  // 0x60C2:02, 10^index s: µs … s
 constexpr std::int8_t kInterpolationIndexMax = 0;
 
@@ -52,7 +61,7 @@ namespace cob = slave::cob;
 
 constexpr slave::Objects<5> kCommunicationObjects = slave::communication_objects(kDeviceTypeServo402);
 
-constexpr slave::Objects<13> kDriveObjects{{
+constexpr slave::Objects<19> kDriveObjects{{
     {kErrorCode, 0, 2, Access::kRo, Pdo::kTx, 0},
     {kControlword, 0, 2, Access::kRw, Pdo::kRx, 0},
     {kStatusword, 0, 2, Access::kRo, Pdo::kTx, 0},
@@ -62,6 +71,12 @@ constexpr slave::Objects<13> kDriveObjects{{
     {kVelocityActual, 0, 4, Access::kRo, Pdo::kTx, 0},
     {kTorqueActual, 0, 2, Access::kRo, Pdo::kTx, 0},  // ideal tracking needs no torque: always 0
     {kTargetPosition, 0, 4, Access::kRw, Pdo::kRx, 0},
+    {kHomeOffset, 0, 4, Access::kRw, Pdo::kNone, 0},
+    {kHomingMethod, 0, 1, Access::kRw, Pdo::kNone, 37},
+    {kHomingSpeeds, 0, 1, Access::kConst, Pdo::kNone, 2},
+    {kHomingSpeeds, 1, 4, Access::kRw, Pdo::kNone, 10000},  // search for switch, counts/s
+    {kHomingSpeeds, 2, 4, Access::kRw, Pdo::kNone, 2500},   // search for zero, counts/s
+    {kHomingAcceleration, 0, 4, Access::kRw, Pdo::kNone, 100000},
     {kInterpolationPeriod, 0, 1, Access::kConst, Pdo::kNone, 2},
     {kInterpolationPeriod, 1, 1, Access::kRw, Pdo::kNone, 1},     // value …
     {kInterpolationPeriod, 2, 1, Access::kRw, Pdo::kNone, 0xFD},  // … × 10^−3 s: 1 ms
@@ -100,7 +115,8 @@ static_assert(slave::sorted(kTable), "the dictionary is binary-searched: list ob
 SimDriveNode::SimDriveNode(drivers::CanBus& bus, SimDriveConfig config)
     : bus_(bus),
       config_(std::move(config)),
-      od_(kTable, slave::OdOptions{config_.missing_objects, config_.fixed_mapping}) {
+      od_(kTable, slave::OdOptions{config_.missing_objects, config_.fixed_mapping}),
+      rng_(config_.power_up_seed) {
   position_ = config_.initial_position;
   previous_position_ = position_;
   od_.set(kTargetPosition, 0, static_cast<std::uint32_t>(position_));
@@ -128,7 +144,9 @@ void SimDriveNode::reset_communication() {
 
 void SimDriveNode::reset_application() {
   od_.reset_application();
-  od_.set(kSupportedModes, 0, config_.supports_csp ? kModesPpPv | kModeCspBit : kModesPpPv);
+  od_.set(kSupportedModes, 0,
+          kModesPpPv | (config_.supports_csp ? kModeCspBit : 0U) | (config_.supports_homing ? kModeHomingBit : 0U));
+  homing_running_ = homing_attained_ = homing_error_ = false;
   state_ = drive_settle(DriveState::kNotReadyToSwitchOn);
   controlword_ = 0;
   od_.set(kTargetPosition, 0, static_cast<std::uint32_t>(position_));  // no jump when first enabled
@@ -148,6 +166,14 @@ void SimDriveNode::restart(std::int64_t now_us) {
 
 void SimDriveNode::power_on(std::int64_t now_us) {
   powered_ = true;
+  if (config_.power_up_seed != 0) {
+    // An incremental encoder: the same physical position, a count that means nothing.
+    const std::int64_t physical = physical_position();
+    const std::int64_t range = std::max<std::int32_t>(1, config_.power_up_range);
+    count_offset_ = std::uniform_int_distribution<std::int64_t>(-range, range)(rng_);
+    position_ = static_cast<std::int32_t>(physical + count_offset_);
+    previous_position_ = position_;
+  }
   reset_application();
   restart(now_us);
 }
@@ -226,6 +252,7 @@ void SimDriveNode::on_sync(std::int64_t now_us) {
   rpdos_.apply_at_sync(od_, *this, now_us);
   previous_position_ = position_;
   track_target();
+  run_homing();
   send_tpdos();
   // The fault reaction (a ramp in a real drive) completes before the next SYNC.
   if (state_ == DriveState::kFaultReactionActive) state_ = drive_settle(state_);
@@ -265,7 +292,68 @@ void SimDriveNode::publish() {
 }
 
 std::uint16_t SimDriveNode::statusword() const {
+  if (mode() == kModeHoming) {
+    // CiA 402 homing mode: bit 10 = the run is over (or none runs), bit 12 attained, bit 13 error.
+    std::uint16_t sw = drive_statusword(state_, false, !homing_running_, false);
+    if (homing_attained_) sw |= kSwHomingAttained;
+    if (homing_error_) sw = static_cast<std::uint16_t>(sw | kSwHomingError);
+    return sw;
+  }
   return drive_statusword(state_, mode() == kModeCsp, position_ == target(), following_error_);
+}
+
+// The home point is found: the count becomes the home offset there (0x607C); the physical axis stays.
+void SimDriveNode::set_home() {
+  const auto home = static_cast<std::int32_t>(od_.get(kHomeOffset, 0));
+  count_offset_ += static_cast<std::int64_t>(home) - position_;
+  position_ = home;
+  previous_position_ = position_;
+  od_.set(kTargetPosition, 0, static_cast<std::uint32_t>(position_));
+  homing_running_ = false;
+  homing_attained_ = true;
+}
+
+// One SYNC of a homing run: travel at the search speed toward the home point of the method.
+void SimDriveNode::run_homing() {
+  if (!homing_running_) return;
+  if (state_ != DriveState::kOperationEnabled || mode() != kModeHoming || (controlword_ & kCwHomingStart) == 0) {
+    homing_running_ = false;  // interrupted (bit 4 dropped, mode changed, power stage off)
+    return;
+  }
+  const auto method = static_cast<std::int8_t>(od_.get(kHomingMethod, 0));
+  if (method == 37) {
+    set_home();
+    return;
+  }
+  ++homing_syncs_;
+  const double period_s = static_cast<double>(od_.get(kInterpolationPeriod, 1)) *
+                          std::pow(10.0, static_cast<std::int8_t>(od_.get(kInterpolationPeriod, 2)));
+  const auto step = std::max<std::int64_t>(1, std::llround(static_cast<double>(od_.get(kHomingSpeeds, 1)) * period_s));
+  const std::int64_t here = physical_position();
+  std::int64_t goal = here;
+  if (method == 19 || method == 21) {
+    if (config_.home_switch_missing) {
+      if (homing_syncs_ > 200) {  // travelled far enough without seeing a switch
+        homing_running_ = false;
+        homing_error_ = true;
+      } else {
+        position_ += static_cast<std::int32_t>(method == 19 ? step : -step);
+      }
+      return;
+    }
+    goal = config_.home_switch_at;
+  } else {  // 33: the next index pulse below, 34: above
+    const std::int64_t n = std::max<std::int32_t>(1, config_.index_every);
+    const std::int64_t below = (here >= 0 ? here / n : -((-here + n - 1) / n)) * n;
+    goal = method == 33 ? (below == here ? here - n : below) : below + n;
+  }
+  const std::int64_t d = goal - here;
+  if (std::llabs(d) <= step) {
+    position_ = static_cast<std::int32_t>(goal + count_offset_);
+    set_home();
+    return;
+  }
+  position_ += static_cast<std::int32_t>(d > 0 ? step : -step);
 }
 
 std::int32_t SimDriveNode::target() const {
@@ -291,6 +379,13 @@ std::int32_t SimDriveNode::velocity() const {
 
 void SimDriveNode::set_controlword(std::uint16_t cw) {
   const DriveState before = state_;
+  // Homing starts on the rising edge of bit 4 in homing mode with the power stage enabled.
+  if (mode() == kModeHoming && before == DriveState::kOperationEnabled && (cw & kCwHomingStart) != 0 &&
+      (controlword_ & kCwHomingStart) == 0) {
+    homing_running_ = true;
+    homing_attained_ = homing_error_ = false;
+    homing_syncs_ = 0;
+  }
   state_ = drive_apply_controlword(state_, cw, controlword_);
   controlword_ = cw;
   if (before == DriveState::kFault && state_ != DriveState::kFault) {
@@ -323,10 +418,17 @@ void SimDriveNode::inject_fault(std::uint16_t code) {
 // ---------------------------------------------------------------------------------------------------
 std::uint32_t SimDriveNode::check(std::uint16_t index, std::uint8_t sub, std::uint32_t value) const {
   if (index == kModes) {
-    // Only "no mode" and the modes 0x6502 announces; of those the simulation implements CSP.
+    // Only "no mode" and the modes 0x6502 announces; of those the simulation implements CSP and homing.
     const auto mode = static_cast<std::int8_t>(value);
     const bool csp_offered = (od_.get(kSupportedModes, 0) & kModeCspBit) != 0;
-    return (mode == 0 || (mode == kModeCsp && csp_offered)) ? 0 : slave::abort_code::kValueRange;
+    const bool homing_offered = (od_.get(kSupportedModes, 0) & kModeHomingBit) != 0;
+    return (mode == 0 || (mode == kModeCsp && csp_offered) || (mode == kModeHoming && homing_offered))
+               ? 0
+               : slave::abort_code::kValueRange;
+  }
+  if (index == kHomingMethod) {
+    const auto m = static_cast<std::int8_t>(value);
+    return (m == 19 || m == 21 || m == 33 || m == 34 || m == 37) ? 0 : slave::abort_code::kValueRange;
   }
   if (index == kInterpolationPeriod && sub == 1) {
     return value == 0 ? slave::abort_code::kValueRange : 0;  // a zero period has no SYNC rate

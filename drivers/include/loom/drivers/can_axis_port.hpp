@@ -1,7 +1,7 @@
-// The three servo axes (beat crank, carriage, helix shaft) as CiA 402 drives in cyclic synchronous
-// position mode behind hal::AxisPort. configure() brings the drives up by NMT and SDO (may block, with
-// timeouts); read_axes()/write_axes() are the per-tick RT path: SYNC + one RPDO per axis out, TPDOs,
-// heartbeats, EMCYs and error frames in, fixed arrays only, bounded work.
+// The machine's servo axes (the core three and any added ones, on one or more CAN buses) as CiA 402
+// drives in cyclic synchronous position mode behind hal::AxisPort. configure() brings every bus up by
+// NMT and SDO (may block, with timeouts); read_axes()/write_axes() are the per-tick RT path: per bus
+// SYNC + one RPDO per axis out, TPDOs, heartbeats, EMCYs and error frames in, fixed arrays only.
 #pragma once
 
 #include <array>
@@ -14,7 +14,8 @@
 #include "loom/drivers/bus_load.hpp"
 #include "loom/drivers/can_frame.hpp"
 #include "loom/drivers/can_io_port.hpp"
-#include "loom/drivers/cia402.hpp"
+#include "loom/drivers/can_master.hpp"
+#include "loom/drivers/cia402_axis.hpp"
 #include "loom/drivers/configure_clock.hpp"
 #include "loom/drivers/position_scaling.hpp"
 #include "loom/drivers/status.hpp"
@@ -44,6 +45,13 @@ struct CanAxisConfig {
   // 0 = the port-wide boot_timeout_s / operational_timeout_s.
   double boot_timeout_s = 0.0;
   double operational_timeout_s = 0.0;
+  // Referencing. 0 = an absolute encoder: always referenced. Else a CiA 402 homing method (19/21 home
+  // switch, 33/34 index pulse, 37 current position, or any other 1..35 the drive offers): the axis is
+  // unreferenced after every bring-up or boot-up until a homing run (hal::AxisRequest::kHome) attains.
+  std::int8_t homing_method = 0;
+  double home_offset = 0.0;   // SI: the reading at the home point (0x607C)
+  double homing_speed = 0.0;  // SI/s: 0x6099:01; 0x6099:02 (search for zero) a quarter of it
+  double homing_accel = 0.0;  // SI/s² (0x609A)
 };
 
 struct CanAxisPortConfig {
@@ -75,123 +83,95 @@ struct CanAxisPortConfig {
   bool tpdo2 = false;                   // velocity + torque PDO (adds 3 frames per cycle)
   std::uint8_t tpdo2_every_n_sync = 1;  // 1..240
   std::uint32_t bitrate_bps = 1'000'000;
-  double bus_load_budget = 0.70;                   // worst-case utilisation allowed
-  std::vector<FrameGroup> other_frames_per_cycle;  // other nodes sharing the bus (e.g. the I/O node)
+  double bus_load_budget = 0.70;                   // worst-case utilisation allowed, per bus
+  std::vector<FrameGroup> other_frames_per_cycle;  // other nodes on bus 0 (e.g. the I/O node)
 };
+
+// Buses a port can drive (can0..can3): CanAxisConfig::bus is 0..kMaxBuses-1.
+inline constexpr std::size_t kMaxBuses = 4;
 
 // Configure-time only. Error naming the field and its value.
 Status validate(const CanAxisPortConfig& config);
-// Configure-time only. The worst cycle this configuration puts on the bus: SYNC, each drive's RPDO1
-// and TPDO1 (and TPDO2), the other nodes' frames and the master heartbeat. The same figure the port
-// checks against its budget when it configures, and `loomctl check` prints.
-BusLoad planned_bus_load(const CanAxisPortConfig& config);
+// Configure-time only. The buses the configuration uses: 1 + the highest CanAxisConfig::bus.
+std::size_t bus_count(const CanAxisPortConfig& config);
+// Configure-time only. The worst cycle this configuration puts on bus `bus`: SYNC, each of its drives'
+// RPDO1 and TPDO1 (and TPDO2), the other nodes' frames (bus 0 only: the I/O node) and the master
+// heartbeat. The same figure the port checks against its budget when it configures, and `loomctl check`
+// prints per bus.
+BusLoad planned_bus_load(const CanAxisPortConfig& config, std::size_t bus = 0);
 
+// The hal::AxisPort of the CAN servo axes: one CanMaster per bus (bus owner: drain, dispatch, SYNC,
+// master heartbeat, bus-off, NMT bring-up of its nodes in one sequence), one Cia402Axis per axis (the
+// CiA 402 profile), and the other nodes of bus 0 (the I/O node) attached to bus 0's master. A fault of
+// any node on any bus stops every axis in the same tick.
 class CanAxisPort final : public hal::AxisPort {
  public:
-  // Bounds of the RT path.
-  static constexpr int kMaxFramesPerRead = 64;
+  // Bounds of the RT path (per bus).
+  static constexpr int kMaxFramesPerRead = CanMaster::kMaxFramesPerPoll;
 
   // Configure-time only.
   explicit CanAxisPort(CanAxisPortConfig config);
+  // Copies rebind the masters to the copy's own axes (the fuzz harness copies a configured port).
+  CanAxisPort(const CanAxisPort& other);
+  CanAxisPort& operator=(const CanAxisPort& other);
 
-  // Configure-time only. Another node on this bus (the I/O node): every frame it sends is handed to it
-  // in read_axes(), its faults stop every axis, its fault code is reported as a link fault. At most 4.
-  void attach(CanNodeListener& node);
+  // Configure-time only. Another node on bus 0 (the I/O node): brought up in the same NMT sequence as
+  // the drives, its frames handed to it, its faults stop every axis and are reported as link faults. At
+  // most 4.
+  void attach(CanNode& node);
 
-  // Configure-time only; blocks with timeouts. Validates the configuration and the bus load, then:
-  // NMT reset-node → every boot-up → per drive by SDO: 0x6502 has CSP, 0x6060 = 8 confirmed by 0x6061,
-  // 0x1017, 0x60C2, PDO mapping (pdo.hpp), 0x6041 and 0x6064 to seed state and the first target →
-  // NMT start → an operational heartbeat from every drive. Errors name node, axis and step. Calling it
-  // again (from the non-RT side, after the loop has stopped using the port, on a fresh bus) is how a lost
-  // drive or a bus-off is recovered; read_axes() reports in LinkStatus::recovery whether that can work
-  // yet (the controller restarted, every lost node heard again), and the loop honours the operator's
-  // acknowledgement only then.
-  Status configure(CanBus& bus, ConfigureClock& clock);
-  Status configure(CanBus& bus);  // with MonotonicConfigureClock
+  // Configure-time only; blocks with timeouts. Validates the configuration and every bus' load, then
+  // brings each bus up in one NMT sequence (can_master.hpp): reset-node → every boot-up → per drive by
+  // SDO: 0x6502 has CSP, 0x6060 = 8 confirmed by 0x6061, 0x1017, 0x60C2, PDO mapping (pdo.hpp), 0x6041
+  // and 0x6064 to seed state and the first target; the attached nodes' own configuration → NMT start →
+  // an operational heartbeat from every node. Errors name node, axis and step. Calling it again (from
+  // the non-RT side, after the loop has stopped using the port, on fresh buses) is how a lost node or a
+  // bus-off is recovered; read_axes() reports in LinkStatus::recovery whether that can work yet.
+  // `buses[i]` is bus i; there must be bus_count(config) of them.
+  Status configure(std::span<CanBus* const> buses, ConfigureClock& clock);
+  Status configure(CanBus& bus, ConfigureClock& clock);  // one bus
+  Status configure(CanBus& bus);                         // with MonotonicConfigureClock
 
-  // RT-safe. Drains at most kMaxFramesPerRead frames, then reports every axis and the link.
+  // RT-safe. Per bus: drains at most kMaxFramesPerRead frames; then reports every axis and the link.
   void read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) override;
-  // RT-safe. SYNC, then one RPDO1 per axis.
+  // RT-safe. Per bus: SYNC, then one RPDO1 per axis.
   void write_axes(hal::Tick now, const hal::AxisCommands& axes) override;
 
   // Diagnostics; RT-safe to read.
-  bool configured() const { return configured_; }
+  bool configured() const { return d_.configured; }
   // What configure() found optional and absent (0x1016, TPDO2) or accepted as read back; one line each.
-  const std::vector<std::string>& notes() const { return notes_; }
+  const std::vector<std::string>& notes() const { return d_.notes; }
   // Largest following error seen per axis since configure(), in SI units (telemetry high-water mark).
-  double ferror_high_water(std::size_t slot) const { return axes_[slot].ferror_high_water; }
-  bool has_consumer(std::size_t slot) const { return axes_[slot].has_consumer; }
-  bool has_tpdo2(std::size_t slot) const { return axes_[slot].has_tpdo2; }
-  std::size_t axis_count() const { return n_axes_; }
-  const BusLoad& bus_load() const { return bus_load_; }
-  const CanAxisPortConfig& config() const { return config_; }
-  std::uint16_t last_controlword(std::size_t slot) const { return axes_[slot].tracker.last_controlword; }
-  std::int64_t last_target_counts(std::size_t slot) const { return axes_[slot].last_target_counts; }
-  std::uint32_t heartbeat_consumer_ticks() const { return consumer_ticks_; }
+  double ferror_high_water(std::size_t slot) const { return d_.axes[slot].ferror_high_water(); }
+  bool has_consumer(std::size_t slot) const { return d_.axes[slot].has_consumer(); }
+  bool has_tpdo2(std::size_t slot) const { return d_.axes[slot].has_tpdo2(); }
+  std::size_t axis_count() const { return d_.n_axes; }
+  std::size_t bus_count() const { return d_.n_buses; }
+  const BusLoad& bus_load(std::size_t bus = 0) const { return d_.bus_loads[bus]; }
+  const CanAxisPortConfig& config() const { return d_.config; }
+  std::uint16_t last_controlword(std::size_t slot) const { return d_.axes[slot].last_controlword(); }
+  std::int64_t last_target_counts(std::size_t slot) const { return d_.axes[slot].last_target_counts(); }
+  std::uint32_t heartbeat_consumer_ticks() const { return d_.consumer_ticks; }
 
  private:
-  struct AxisRuntime {
-    std::uint8_t node = 0;
-    double counts_per_unit = 1.0;
-    double rated_effort = 0.0;
-    PositionUnwrapper position;
-    std::int64_t last_target_counts = 0;
-    std::uint16_t statusword = 0;
-    hal::DriveState state = hal::DriveState::kUnknown;
-    Cia402Tracker tracker;
-    hal::Tick refreshed = hal::kNeverTick;
-    double last_position_si = 0.0;
-    double velocity = 0.0;
-    double effort = 0.0;
-    hal::Tick last_heartbeat = hal::kNeverTick;
-    bool booted = false;           // a boot-up since configure(): back on the bus, needing configuration
-    std::uint16_t emcy_code = 0;
-    std::uint16_t link_fault = 0;  // latched: heartbeat lost / rebooted / not operational
-    double ferror_min = 0.0;
-    double ferror_k_s = 0.0;
-    double last_cmd_si = 0.0;       // last commanded target (SI), for following-error supervision
-    double cmd_velocity = 0.0;      // SI/s, from successive commanded targets
-    bool cmd_valid = false;
-    bool ferror_fault = false;      // latched until acknowledged
-    bool acknowledged = false;      // operator acked while the drive was in Fault: its EMCY 0x0000 clears
-    double ferror_high_water = 0.0;
-    bool has_consumer = false;      // the drive watches our heartbeat (0x1016)
-    bool has_tpdo2 = false;         // velocity/torque PDO configured
-  };
-
-  void reset_runtime();
-  void handle_frame(hal::Tick now, const CanFrame& frame);
-  void fill_feedback(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) const;
-  // The recovery state of a link fault (see hal::LinkRecovery); `silent` names the node still missing.
-  hal::LinkRecovery recovery(hal::Tick now, std::uint8_t& silent) const;
-  void count_send(SendResult r);
-  std::string node_label(std::size_t axis) const;
-  Status configure_node(std::size_t axis, SdoClient& sdo);
-  Status configure_pdos(std::size_t axis, SdoClient& sdo);
+  void relink();  // the masters' node tables from the axes and the attached nodes
   bool any_fault() const;
-  void acknowledge();
 
-  CanAxisPortConfig config_;
-  CanBus* bus_ = nullptr;
-  bool configured_ = false;
-  BusLoad bus_load_{};
-  std::uint32_t consumer_ticks_ = 0;
-  std::uint32_t state_timeout_ticks_ = 0;
-  std::array<AxisRuntime, hal::kMaxAxes> axes_{};
-  std::size_t n_axes_ = 0;  // config_.axes.size()
-  std::span<AxisRuntime> live() { return {axes_.data(), n_axes_}; }
-  std::span<const AxisRuntime> live() const { return {axes_.data(), n_axes_}; }
-  std::array<std::int8_t, 128> axis_of_node_{};  // −1 = not ours
-  bool bus_off_ = false;                         // latched until configure()
-  bool restarted_ = false;                       // the controller restarted after the bus-off
-  std::array<CanNodeListener*, 4> listeners_{};
-  std::size_t n_listeners_ = 0;
-  std::uint16_t foreign_emcy_code_ = 0;  // EMCY from a node that is not an axis (latched until ack)
-  std::uint32_t master_hb_ticks_ = 0;
-  hal::Tick next_master_hb_ = 0;
-  std::vector<std::string> notes_;
-  std::uint32_t tx_dropped_ = 0;
-  std::uint32_t rx_errors_ = 0;
+  struct Data {
+    CanAxisPortConfig config;
+    bool configured = false;
+    std::array<BusLoad, kMaxBuses> bus_loads{};
+    std::uint32_t consumer_ticks = 0;
+    std::uint32_t state_timeout_ticks = 0;
+    std::array<Cia402Axis, hal::kMaxAxes> axes{};
+    std::size_t n_axes = 0;
+    std::array<CanMaster, kMaxBuses> masters{};
+    std::size_t n_buses = 0;
+    std::array<CanNode*, 4> attached{};  // on bus 0; not owned
+    std::size_t n_attached = 0;
+    std::vector<std::string> notes;
+  };
+  Data d_;
 };
 
 }  // namespace loom::drivers

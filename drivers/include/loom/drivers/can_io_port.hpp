@@ -3,9 +3,10 @@
 // buttons through 0x6000 in a TPDO, the beater's load cell through 0x6401 in a TPDO. Which bit is which
 // signal, its polarity and the load-cell scaling are wiring (config), so any module can be used.
 //
-// The module shares the bus with the servo drives: CanAxisPort owns the receive side and hands every
-// frame of this node to it (CanNodeListener), so one drain per tick serves all nodes and a fault of this
-// node stops every axis in the same tick. configure() may block (NMT, SDO); the rest is RT-safe.
+// The module is a CanNode of bus 0's CanMaster (can_master.hpp): the master brings it up in the same NMT
+// sequence as the drives, drains the bus once per tick and hands this node's frames here, and supervises
+// it (heartbeat, boot-up, EMCY), so a fault of this node stops every axis in the same tick. This class
+// only does the CiA 401 profile. configure_profile() may block (SDO); the rest is RT-safe.
 #pragma once
 
 #include <array>
@@ -15,6 +16,7 @@
 
 #include "loom/drivers/bus_load.hpp"
 #include "loom/drivers/can_frame.hpp"
+#include "loom/drivers/can_master.hpp"
 #include "loom/drivers/configure_clock.hpp"
 #include "loom/drivers/status.hpp"
 #include "loom/hal/hal.hpp"
@@ -31,24 +33,6 @@ inline constexpr std::uint16_t kAnalogInput16 = 0x6401;    // read analog input 
 inline constexpr std::uint16_t kConsumerHeartbeat = 0x1016;
 inline constexpr std::uint16_t kDeviceProfile401 = 0x0191;  // low word of 0x1000
 }  // namespace od401
-
-// One node on the shared bus that is not a servo axis. CanAxisPort drains the bus once per tick and
-// hands this node's frames here, then asks for its health. All RT-safe.
-class CanNodeListener {
- public:
-  virtual ~CanNodeListener() = default;
-  virtual std::uint8_t node_id() const = 0;
-  virtual void on_frame(hal::Tick now, const CanFrame& frame) = 0;
-  // After the tick's frames: run timers (heartbeat consumer).
-  virtual void supervise(hal::Tick now) = 0;
-  // 0 = healthy; else a fault code (emcy.hpp) that stops every axis and is reported as a link fault.
-  virtual std::uint16_t link_fault_code() const = 0;
-  // The operator acknowledged (fault reset requested): clear latches whose cause is gone.
-  virtual void acknowledge() = 0;
-  // RT-safe. After a link fault of its own: the node is on the bus again (heard within its consumer
-  // time, or booted since), so re-arming can reconfigure it.
-  virtual bool heard_again(hal::Tick now) const = 0;
-};
 
 // One signal on a digital input or output: bit number across the 8-bit objects (bit b lives in
 // sub-index b/8 + 1, bit b%8), and polarity. bit = −1: not wired.
@@ -134,17 +118,16 @@ std::vector<FrameGroup> io_frames_per_cycle(const IoWiring& wiring);
 // green/amber off, red on, buzzer off.
 hal::DigitalOutputs io_safe_outputs();
 
-class CanIoPort final : public hal::IoPort, public CanNodeListener {
+class CanIoPort final : public hal::IoPort, public CanNode {
  public:
   static constexpr int kMaxPdoEntries = 8;
 
   // Configure-time only.
   explicit CanIoPort(CanIoConfig config);
 
-  // Configure-time only; blocks with timeouts. NMT reset-node → boot-up → device type 0x1000 is CiA 401
-  // → 0x1017 → 0x6206/0x6207 (safe outputs) → 0x1016 consumer of the master heartbeat → PDO mapping
-  // (written, or read back when the module's mapping is fixed, and accepted only when it carries every
-  // object the wiring needs) → NMT start → operational heartbeat. Errors name node, object and step.
+  // Configure-time only; blocks with timeouts. The module alone on a master of its own (a bus without
+  // drives; with drives, CanAxisPort::attach() brings it up with them): NMT reset-node → boot-up →
+  // configure_profile() → NMT start → operational heartbeat. Errors name node, object and step.
   Status configure(CanBus& bus, ConfigureClock& clock);
 
   // What configure() found optional and absent, or accepted instead of what it asked for (one line each).
@@ -155,19 +138,21 @@ class CanIoPort final : public hal::IoPort, public CanNodeListener {
   void read_analog(hal::Tick now, hal::AnalogInputs& analog) override;
   void write_io(hal::Tick now, const hal::DigitalOutputs& io) override;
 
-  // CanNodeListener (RT-safe).
+  // CanNode. configure_profile(): device type 0x1000 is CiA 401 → 0x1017 → 0x6206/0x6207 (safe outputs)
+  // → 0x1016 consumer of the master heartbeat → PDO mapping (written, or read back when the module's
+  // mapping is fixed, and accepted only when it carries every object the wiring needs).
   std::uint8_t node_id() const override { return config_.node_id; }
-  void on_frame(hal::Tick now, const CanFrame& frame) override;
-  void supervise(hal::Tick now) override;
-  std::uint16_t link_fault_code() const override { return link_fault_; }
-  void acknowledge() override;
-  bool heard_again(hal::Tick now) const override;
+  std::string label() const override;
+  NodeTiming timing() const override;
+  void bring_up_started() override;
+  Status configure_profile(SdoClient& sdo) override;
+  void brought_up(CanBus& bus) override;
+  void on_profile_frame(hal::Tick now, const CanFrame& frame) override;  // RT-safe
 
   // Diagnostics; RT-safe.
   bool configured() const { return configured_; }
   const CanIoConfig& config() const { return config_; }
-  std::uint16_t last_emcy_code() const { return emcy_code_; }
-  std::uint32_t rx_errors() const { return rx_errors_; }
+  std::uint16_t last_emcy_code() const { return supervisor_.emcy_code(); }
   std::uint32_t tx_dropped() const { return tx_dropped_; }
 
  private:
@@ -202,7 +187,6 @@ class CanIoPort final : public hal::IoPort, public CanNodeListener {
   CanBus* bus_ = nullptr;
   bool configured_ = false;
   std::vector<std::string> notes_;
-  std::uint32_t consumer_ticks_ = 0;
 
   std::array<PdoLayout, 4> tpdo_{};
   std::array<PdoLayout, 4> rpdo_{};
@@ -218,11 +202,6 @@ class CanIoPort final : public hal::IoPort, public CanNodeListener {
   hal::Tick inputs_refreshed_ = hal::kNeverTick;
   std::int16_t analog_counts_ = 0;
   hal::Tick analog_refreshed_ = hal::kNeverTick;
-  hal::Tick last_heartbeat_ = hal::kNeverTick;
-  bool booted_ = false;  // a boot-up since configure(): the node is back, needing its configuration
-  std::uint16_t link_fault_ = 0;
-  std::uint16_t emcy_code_ = 0;
-  std::uint32_t rx_errors_ = 0;
   std::uint32_t tx_dropped_ = 0;
 };
 

@@ -52,7 +52,13 @@ inline constexpr std::uint16_t kRpdoMap = 0x1600;
 inline constexpr std::uint16_t kTpdoComm = 0x1800;
 inline constexpr std::uint16_t kTpdoMap = 0x1A00;
 inline constexpr std::int8_t kModeCsp = 8;                 // cyclic synchronous position
+inline constexpr std::int8_t kModeHoming = 6;              // homing mode
 inline constexpr std::uint32_t kSupportsCspBit = 1U << 7;  // in 0x6502
+inline constexpr std::uint32_t kSupportsHomingBit = 1U << 5;  // in 0x6502
+inline constexpr std::uint16_t kHomeOffset = 0x607C;       // i32, counts: the reading at the home point
+inline constexpr std::uint16_t kHomingMethod = 0x6098;     // i8
+inline constexpr std::uint16_t kHomingSpeeds = 0x6099;     // :01 search for switch, :02 search for zero, counts/s
+inline constexpr std::uint16_t kHomingAcceleration = 0x609A;  // u32, counts/s²
 inline constexpr std::uint32_t kPdoInvalidBit = 1U << 31;  // in 0x14xx/0x18xx:01
 }  // namespace od
 
@@ -68,6 +74,15 @@ inline constexpr std::array<PdoMapEntry, 2> kTpdo2Mapping{
 inline constexpr std::uint8_t kRpdo1Bytes = 6;
 inline constexpr std::uint8_t kTpdo1Bytes = 6;
 inline constexpr std::uint8_t kTpdo2Bytes = 6;
+// A homed axis switches between homing (6) and CSP (8) in the RT path, so the mode travels in the PDOs
+// beside the controlword and the statusword (the layout of CiA 402's "modes of operation" PDO sets):
+// RPDO1 {controlword, target, 0x6060}, TPDO1 {statusword, position actual, 0x6061}; 7 bytes each.
+inline constexpr std::array<PdoMapEntry, 3> kRpdo1HomingMapping{
+    {{od::kControlword, 0, 16}, {od::kTargetPosition, 0, 32}, {od::kModesOfOperation, 0, 8}}};
+inline constexpr std::array<PdoMapEntry, 3> kTpdo1HomingMapping{
+    {{od::kStatusword, 0, 16}, {od::kPositionActual, 0, 32}, {od::kModesOfOperationDisplay, 0, 8}}};
+inline constexpr std::uint8_t kRpdo1HomingBytes = 7;
+inline constexpr std::uint8_t kTpdo1HomingBytes = 7;
 
 struct Rpdo1 {
   std::uint16_t controlword = 0;
@@ -76,6 +91,17 @@ struct Rpdo1 {
 struct Tpdo1 {
   std::uint16_t statusword = 0;
   std::int32_t position_actual = 0;  // counts
+};
+// The homed axes' 7-byte layouts (kRpdo1HomingMapping, kTpdo1HomingMapping).
+struct Rpdo1Mode {
+  std::uint16_t controlword = 0;
+  std::int32_t target_position = 0;  // counts
+  std::int8_t mode = 8;              // 0x6060
+};
+struct Tpdo1Mode {
+  std::uint16_t statusword = 0;
+  std::int32_t position_actual = 0;  // counts
+  std::int8_t mode_display = 0;      // 0x6061
 };
 struct Tpdo2 {
   std::int32_t velocity_actual = 0;  // counts/s
@@ -87,6 +113,10 @@ CanFrame pack_rpdo1(std::uint8_t node, const Rpdo1& p);
 std::optional<Rpdo1> unpack_rpdo1(const CanFrame& frame, std::uint8_t node);
 CanFrame pack_tpdo1(std::uint8_t node, const Tpdo1& p);
 std::optional<Tpdo1> unpack_tpdo1(const CanFrame& frame, std::uint8_t node);
+CanFrame pack_rpdo1_mode(std::uint8_t node, const Rpdo1Mode& p);
+std::optional<Rpdo1Mode> unpack_rpdo1_mode(const CanFrame& frame, std::uint8_t node);
+CanFrame pack_tpdo1_mode(std::uint8_t node, const Tpdo1Mode& p);
+std::optional<Tpdo1Mode> unpack_tpdo1_mode(const CanFrame& frame, std::uint8_t node);
 CanFrame pack_tpdo2(std::uint8_t node, const Tpdo2& p);
 std::optional<Tpdo2> unpack_tpdo2(const CanFrame& frame, std::uint8_t node);
 

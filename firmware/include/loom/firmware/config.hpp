@@ -198,9 +198,10 @@ hal::AxisLayout axis_layout(const LoomConfig& c);
 drivers::CanAxisPortConfig can_axis_config(const LoomConfig& c);
 // Configure-time only. The CAN I/O module's config, from the same facts.
 drivers::CanIoConfig can_io_config(const LoomConfig& c);
-// Configure-time only. The worst-case bus load of the whole machine (drives, I/O module, master
-// heartbeat) — the figure the CAN master checks when it configures.
-drivers::BusLoad can_bus_load(const LoomConfig& c);
+// Configure-time only. The worst-case load of CAN bus `bus` (its drives; on bus 0 also the I/O module;
+// the master heartbeat) — the figure that bus' CAN master checks when it configures. The machine uses
+// drivers::bus_count(can_axis_config(c)) buses.
+drivers::BusLoad can_bus_load(const LoomConfig& c, std::size_t bus = 0);
 
 // Configure-time only. Parse a loom config from TOML text; `source` names it in errors. The file must
 // be complete, or start with `extends = "default"` to take what it does not say from the embedded

@@ -25,7 +25,7 @@ enum class HalKind { kSim, kSocketCan };
 
 struct MachineOptions {
   HalKind hal = HalKind::kSim;
-  std::string iface;             // SocketCAN interface for kSocketCan
+  std::string iface;             // SocketCAN interface(s) for kSocketCan: "can0" or "can0,can1" (bus i = i-th)
   bool telemetry = true;
   bool lossless_telemetry = true;  // virtual time only: wait for ring space instead of dropping
   std::uint32_t rows = 3;
@@ -83,7 +83,7 @@ class Machine {
   std::unique_ptr<sequencer::Sequencer> sequencer_;
   std::unique_ptr<sim_hal::SimStateFile> sim_state_;
   std::unique_ptr<sim_hal::SimWorld> sim_;
-  std::unique_ptr<drivers::SocketCanBus> bus_;
+  std::vector<std::unique_ptr<drivers::SocketCanBus>> buses_;  // bus i = the i-th --iface name
   std::unique_ptr<drivers::CanAxisPort> can_port_;
   std::unique_ptr<drivers::CanIoPort> io_port_;
   std::string banner_;

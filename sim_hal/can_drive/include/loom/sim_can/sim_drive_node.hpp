@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdint>
+#include <random>
 #include <vector>
 
 #include "loom/drivers/can_frame.hpp"
@@ -38,6 +39,16 @@ struct SimDriveConfig {
   std::vector<std::uint32_t> tpdo1_factory_mapping;
   std::int64_t boot_delay_us = 0;         // power-on / NMT reset → boot-up frame
   std::int64_t operational_delay_us = 0;  // NMT start → operational
+  // CiA 402 homing (mode 6, 0x6502 bit 5; methods 19/21 home switch, 33/34 index pulse, 37 current
+  // position). The axis has a physical position the count is an image of: with power_up_seed != 0 every
+  // power-on draws a random count in ±power_up_range for the same physical position (an incremental
+  // encoder), so only a homing run gives the count a meaning again.
+  bool supports_homing = false;  // 0x6502 bit 5 (off: the drive announces what it always did)
+  std::uint64_t power_up_seed = 0;
+  std::int32_t power_up_range = 1 << 20;
+  std::int32_t home_switch_at = 0;  // physical position (counts) of the home switch's edge
+  std::int32_t index_every = 4096;  // an index pulse at every multiple of this (physical counts)
+  bool home_switch_missing = false; // methods 19/21 never see the switch: homing error after a while
 };
 
 class SimDriveNode : private slave::ObjectHooks, private slave::FrameHandlers {
@@ -72,6 +83,9 @@ class SimDriveNode : private slave::ObjectHooks, private slave::FrameHandlers {
   std::uint16_t controlword() const { return controlword_; }
   std::uint16_t statusword() const;
   std::uint32_t syncs_seen() const { return syncs_; }
+  // The axis' physical position (counts): what the count would read without the power-up offset.
+  std::int64_t physical_position() const { return static_cast<std::int64_t>(position_) - count_offset_; }
+  bool homing_attained() const { return homing_attained_; }
   bool master_lost() const { return master_lost_; }  // 0x1016 consumer expired (the drive quick-stopped)
 
  private:
@@ -91,6 +105,8 @@ class SimDriveNode : private slave::ObjectHooks, private slave::FrameHandlers {
   void on_sync(std::int64_t now_us) override;
   void on_rpdo(int pdo, const drivers::CanFrame& f, std::int64_t now_us) override;
   void track_target();
+  void run_homing();
+  void set_home();
   void send_tpdos();
   void publish();
   void set_controlword(std::uint16_t cw);
@@ -124,6 +140,13 @@ class SimDriveNode : private slave::ObjectHooks, private slave::FrameHandlers {
   std::int64_t operational_at_us_ = -1;
   std::int64_t master_seen_us_ = -1;
   bool master_lost_ = false;
+  // Homing: count = physical + count_offset_ (random per power-on with power_up_seed).
+  std::mt19937_64 rng_;
+  std::int64_t count_offset_ = 0;
+  bool homing_running_ = false;
+  bool homing_attained_ = false;
+  bool homing_error_ = false;
+  std::uint32_t homing_syncs_ = 0;
 };
 
 }  // namespace loom::sim_can
