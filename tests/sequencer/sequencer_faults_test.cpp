@@ -195,7 +195,7 @@ TEST(SequencerFaults, AnAcknowledgementBeforeTheFaultIsDiscardedAndOneWhileTheCh
     r.run(1);
     EXPECT_EQ(r.seq->state(), State::kFault);
     EXPECT_EQ(r.seq->first_fault(), Fault::kEStop);
-    for (const auto& a : r.out.axes) EXPECT_EQ(a.request, hal::AxisRequest::kQuickStop);
+    for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k) EXPECT_EQ(r.out.axes[k].request, hal::AxisRequest::kQuickStop);
     r.run(300);
     EXPECT_EQ(r.seq->state(), State::kFault) << "the stale acknowledgement was taken";
     EXPECT_TRUE(r.out.io.lamp_red);
