@@ -112,7 +112,7 @@ TEST(OperatorDesk, RefusalsSayWhy) {
   EXPECT_EQ(desk.decide(local("start"), idle, kNow).reply, "refused: start: the e-stop chain is open: close it first\n");
   LoomView plain = view(State::kAwaitKnotting);
   plain.knotting = false;
-  EXPECT_NE(desk.decide(local("next"), plain, kNow).reply.find("no knotting mode"), std::string::npos);
+  EXPECT_NE(desk.decide(local("next"), plain, kNow).reply.find("no weaver's knotting"), std::string::npos);
   EXPECT_EQ(desk.decide(local("dance"), idle, kNow).reply.rfind("error: unknown command 'dance'", 0), 0u);
   EXPECT_EQ(desk.decide(local("start now"), idle, kNow).reply, "error: start takes no argument (got 'now')\n");
   EXPECT_EQ(desk.decide(local("start hours=3"), idle, kNow).reply, "error: hours= is for pair only\n");
