@@ -9,7 +9,7 @@
 #                            multi-arch: installing liblcm-dev:arm64 would remove the host's LCM) in
 #                            ~/.cache/loomctl/arm64-sysroot (LOOM_ARM64_SYSROOT), extracted, not installed.
 # The vcan VM's packages are not installed here: tools/vcan/vm-deps installs them only when the host
-# cannot make a vcan itself (see README, "HIL on vcan").
+# cannot make a vcan itself (see tests/README.md, "HIL on vcan").
 set -euo pipefail
 
 packages=(
