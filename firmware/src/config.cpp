@@ -536,8 +536,11 @@ void read_axes(TomlReader& r, LoomConfig& c, bool extending) {
   const toml::table* tables = root->as_table();
   if (tables == nullptr) r.fail_at(*root, "axes", "", "must be tables [axes.<name>]");
   std::vector<std::string> added;
-  for (auto&& [key, node] : *tables) {
-    const std::string name(key.str());
+  for (auto&& entry : *tables) {
+    // Named references, not a structured binding: lambdas below capture them (clang 14 cannot capture
+    // structured bindings).
+    const toml::node& node = entry.second;
+    const std::string name(entry.first.str());
     const std::string p = "axes." + name + ".";
     if (!valid_axis_name(name)) {
       r.fail_at(node, "axes." + name, "", "an axis name is 1.." + std::to_string(hal::AxisLayout::kNameMax) +
