@@ -43,8 +43,9 @@ constexpr const char* kEtcConfig = "/etc/loomctl/loom.toml";
 // The id every board's embedded default loom has: two boards left on it are one loom on the LCM group.
 constexpr const char* kDefaultLoomId = "loom1";
 constexpr std::int64_t kSaveRetryNs = 1'000'000'000;  // a failed counters save is retried once a second
-// How long a loom listens for another publisher of its id before arming: IDENTITY comes once a second.
-constexpr std::chrono::milliseconds kIdentityListen{1300};
+// How long a loom listens for another publisher of its id before arming: IDENTITY comes once a second,
+// so two and a half periods let one late message (a loaded host) go by without letting a twin through.
+constexpr std::chrono::milliseconds kIdentityListen{2500};
 
 OperatorLink* g_link = nullptr;
 extern "C" void on_terminate(int) {
