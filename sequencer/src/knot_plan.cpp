@@ -4,9 +4,23 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <initializer_list>
 #include <stdexcept>
 
 namespace loom::sequencer {
+namespace {
+// The value among `values` whose name is `text` (false, `out` untouched, when none is).
+template <class E>
+bool parse_named(const char* text, std::initializer_list<E> values, const char* (*name)(E), E& out) {
+  for (E v : values) {
+    if (std::strcmp(text, name(v)) == 0) {
+      out = v;
+      return true;
+    }
+  }
+  return false;
+}
+}  // namespace
 
 const char* knotting_mode_name(KnottingMode m) {
   switch (m) {
@@ -18,13 +32,7 @@ const char* knotting_mode_name(KnottingMode m) {
 }
 
 bool parse_knotting_mode(const char* text, KnottingMode& m) {
-  for (KnottingMode k : {KnottingMode::kNone, KnottingMode::kWeaver, KnottingMode::kHeads}) {
-    if (std::strcmp(text, knotting_mode_name(k)) == 0) {
-      m = k;
-      return true;
-    }
-  }
-  return false;
+  return parse_named(text, {KnottingMode::kNone, KnottingMode::kWeaver, KnottingMode::kHeads}, knotting_mode_name, m);
 }
 
 const char* knot_type_name(KnotType k) {
@@ -37,13 +45,7 @@ const char* knot_type_name(KnotType k) {
 }
 
 bool parse_knot_type(const char* text, KnotType& k) {
-  for (KnotType t : {KnotType::kTurkish, KnotType::kPersianLeft, KnotType::kPersianRight}) {
-    if (std::strcmp(text, knot_type_name(t)) == 0) {
-      k = t;
-      return true;
-    }
-  }
-  return false;
+  return parse_named(text, {KnotType::kTurkish, KnotType::kPersianLeft, KnotType::kPersianRight}, knot_type_name, k);
 }
 
 CarpetClass carpet_class(double n) {
