@@ -1,0 +1,192 @@
+// One knot of a knotting head: the servo-driven four-bar that carries the gripper through the three
+// precision positions of the knot (TAKE the yarn at the colour selector, WRAP it round the warp pair,
+// PULL it down to the fell), and the timed cycle around it — close the gripper, TAKE→WRAP, WRAP→PULL,
+// cut, release, back to TAKE. Each move is jerk-limited and then slowed, by time-scaling, until the
+// servo torque the linkage needs (its configuration-dependent inertia reflected to the servo, the
+// velocity-squared term of the equation of motion, gravity) fits the servo: the cycle time follows
+// from the servo's limits and the links' mass properties, it is not a constant.
+//
+// The linkage is given explicitly (what `loom-synth knotter` prints) and checked against the
+// precision positions at configure time: the gripper must pass through every point with the coupler
+// at the prescribed gripper-link angle, on one assembly branch, reached in the order TAKE, WRAP, PULL
+// turning one way, with no toggle within the stroke. build() is configure-time and throws MotionError
+// naming what is wrong; sample() is an O(1) phase-table lookup, RT-safe.
+//
+// Frames: the knot frame is the precision points' frame (x towards the fell side, y up: gravity acts
+// along −y). Servo angles are crank angles in the knot frame (from +x, counter-clockwise).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "loom/motion/fourbar.hpp"
+#include "loom/motion/jerk_move.hpp"
+#include "loom/motion/phase_table.hpp"
+
+namespace loom::motion {
+
+// One precision position of the gripper (knot frame): where it is, and the angle of the gripper link
+// (the coupler line through both moving pivots, on which the synthesis puts the gripper).
+struct KnotPoint {
+  double x_m = 0.0;
+  double y_m = 0.0;
+  double gripper_rad = 0.0;
+};
+
+struct KnotLinkSpec {
+  double length_m = 0.0;       // pivot to pivot
+  double mass_kg = 0.0;
+  double cg_m = 0.0;           // from its first pivot, along the link (may be negative: overhang)
+  double inertia_kg_m2 = 0.0;  // about its cg
+};
+
+struct KnotCycleSpec {
+  // The three precision positions: take, wrap, pull.
+  std::array<KnotPoint, 3> points{};
+  double theta0_rad = 0.0;  // the synthesis' fixed-link direction (kept for the record and the tools)
+
+  // The linkage (knot frame). The crank is the side link the servo drives; it need not turn fully.
+  double crank_pivot_x_m = 0.0, crank_pivot_y_m = 0.0;
+  double rocker_pivot_x_m = 0.0, rocker_pivot_y_m = 0.0;
+  KnotLinkSpec crank, coupler, rocker;
+  // The gripper point in the coupler frame: origin the crank-coupler joint, x towards the
+  // coupler-rocker joint, y 90° counter-clockwise from x.
+  double gripper_along_m = 0.0, gripper_normal_m = 0.0;
+  Branch branch = Branch::kPositive;
+  double warp_entry_x_m = 0.0;  // the gripper is inside the warp while its x >= this
+  // Least transmission angle (min(μ, π − μ)) allowed within the stroke TAKE→PULL.
+  double min_transmission_rad = 0.0;
+  double gravity_m_s2 = 9.81;   // along −y of the knot frame; 0 for a horizontal head
+
+  // The knotting servo (output shaft).
+  double max_speed_rad_s = 0.0, max_accel_rad_s2 = 0.0, jerk_rad_s3 = 0.0;
+  double max_torque_nm = 0.0;
+  double rotor_inertia_kg_m2 = 0.0;  // motor rotor and gears, reflected to the output shaft
+
+  // Dwells (s): the gripper closing at TAKE, the cutter at PULL, the gripper opening after the cut.
+  double grip_s = 0.0, cut_s = 0.0, release_s = 0.0;
+
+  int table_size = 0;  // phase-table knots over the cycle (quintic Hermite)
+};
+
+// Seed 001's knotting design, synthesised right (see motion/README.md "Knot cycle"): the two
+// three-point chains through (0, 0, 10°), (25, 15, 3°), (30, 1, −25°) mm with θ0 = 275° share the
+// coupler; the servo drives the shorter side link. Delrin links 6 × 5 mm; the coupler with its
+// holder and gripper keeps the seed's 1.641 g and I_G = 208.94e-9 kg m²; crank and rocker use the
+// seed's V·ρ and I_G = m(6² + L²)/12 formulas on the correct lengths. A micro servo's limits.
+KnotCycleSpec seed001_knot_cycle_spec();
+
+// What bounds a segment of the cycle.
+enum class KnotLimit : std::uint8_t {
+  kDwell,         // a timed dwell (gripper, cutter)
+  kSpeed,         // the move cruises at the servo's speed limit
+  kAcceleration,  // it reaches the acceleration limit, too short to cruise
+  kJerk,          // too short to reach either: the jerk limit alone
+  kTorque,        // slowed below the servo's kinematic limits until its torque fits
+};
+// RT-safe. "dwell", "speed", "acceleration", "jerk", "torque".
+const char* knot_limit_name(KnotLimit l);
+
+struct KnotCycleReport {
+  struct Segment {
+    const char* name = "";     // "grip", "take_to_wrap", "wrap_to_pull", "cut", "release", "return"
+    double begin_s = 0.0, end_s = 0.0;
+    double distance_rad = 0.0;    // signed servo travel (0 for a dwell)
+    double peak_speed_rad_s = 0.0;
+    double time_scale = 1.0;      // > 1: slowed by the torque limit by this factor
+    KnotLimit bound = KnotLimit::kDwell;
+  };
+  std::array<Segment, 6> segments{};
+  std::array<double, 3> crank_angles_rad{};  // absolute crank angle at take, wrap, pull
+  double closure_residual_m = 0.0;           // max over the points of the linkage's miss
+  GrashofClass grashof = GrashofClass::kTripleRocker;
+  bool full_turn = false;                    // the crank turns on through the turn to return
+  double stroke_rad = 0.0;                   // signed TAKE→PULL travel
+  double min_transmission_rad = 0.0;         // min over the stroke of min(μ, π − μ)
+  double min_transmission_at_rad = 0.0;      // absolute crank angle where it is least
+  double min_transmission_return_rad = 0.0;  // the same over the return (differs when turning on)
+  double peak_torque_nm = 0.0;               // max |τ| over the cycle (signed value at that instant)
+  double peak_torque_t_s = 0.0;
+  double peak_torque_angle_rad = 0.0;        // relative to TAKE
+  double max_inertia_kg_m2 = 0.0;            // largest effective inertia at the servo over the stroke
+  double min_inertia_kg_m2 = 0.0;
+  // The phase table against the exact piecewise evaluation, on a grid off the knots.
+  double table_angle_error_rad = 0.0;
+  double table_velocity_error_rad_s = 0.0;
+  double table_accel_error_rad_s2 = 0.0;
+  struct PathSample {
+    double t_s = 0.0, servo_rad = 0.0, x_m = 0.0, y_m = 0.0;  // servo relative to TAKE
+  };
+  std::vector<PathSample> path;  // the gripper over the cycle, for plots (256 samples)
+};
+
+class KnotCycle {
+ public:
+  // Configure-time only. Checks the spec and the linkage against the points and plans the cycle.
+  // Throws MotionError:
+  //   kInvalidInput    a field non-finite, negative or zero where it must be positive (names it);
+  //                    the warp entry not between TAKE and WRAP along x
+  //   kNotAssemblable  the linkage misses a precision point, or the gripper angle there
+  //   kWrongBranch     branch defect: a point lies on the other assembly branch
+  //   kOutOfBounds     order defect (PULL before WRAP turning one way), or the servo cannot hold
+  //                    the linkage against gravity
+  //   kSingular        a toggle / dead centre, or a transmission angle below the minimum, within
+  //                    the stroke (or a toggle on a full-turn return)
+  static KnotCycle build(const KnotCycleSpec& spec);
+
+  struct Sample {
+    double angle_rad = 0.0, velocity_rad_s = 0.0, accel_rad_s2 = 0.0;
+  };
+  // RT-safe, O(1), no allocation. Servo angle relative to TAKE at t into the cycle; t is clamped to
+  // [0, duration]; a NaN t reads t = 0 (the rest pose), +inf the end.
+  Sample sample(double t_s) const noexcept;
+  // Configure-time reference (and the tests'): the same from the piecewise jerk moves, not the table.
+  Sample exact(double t_s) const noexcept;
+
+  double duration_s() const noexcept { return duration_; }
+  // Angle at the end relative to the start: 0 when it swings back, ±2π when it turns on.
+  double end_offset_rad() const noexcept { return end_offset_; }
+  double take_angle_rad() const noexcept { return take_angle_; }  // absolute crank angle at TAKE
+
+  struct Window {
+    double begin_s = 0, end_s = 0;
+    bool contains(double t) const noexcept { return t >= begin_s && t < end_s; }
+  };
+  Window gripper_closed() const noexcept { return gripper_closed_; }  // closing at TAKE .. cut done
+  Window cutter() const noexcept { return cutter_; }                  // the cut dwell at PULL
+  Window yarn_sample() const noexcept { return yarn_sample_; }        // at PULL, cut and release
+  Window in_warp() const noexcept { return in_warp_; }                // carriage must not move
+
+  const KnotCycleReport& report() const noexcept { return report_; }
+  const KnotCycleSpec& spec() const noexcept { return spec_; }
+
+  // Configure-time: the dynamics the planner uses, for checks and tools. At absolute crank angle θ
+  // (throws MotionError off the linkage's range or at a toggle).
+  struct Dynamics {
+    double inertia_kg_m2 = 0.0;   // J(θ): rotor + links reflected to the servo
+    double dinertia = 0.0;        // dJ/dθ
+    double gravity_nm = 0.0;      // dV/dθ: torque that holds the links against gravity
+    double gripper_x_m = 0.0, gripper_y_m = 0.0;
+    double transmission_rad = 0.0;  // μ
+  };
+  Dynamics dynamics_at(double crank_abs_rad) const;
+  // τ = J α + ½ J' ω² + dV/dθ.
+  double torque_at(double crank_abs_rad, double omega, double alpha) const;
+
+ private:
+  struct Piece {
+    double t0 = 0.0, t1 = 0.0, start_rad = 0.0;  // relative to TAKE
+    JerkMove move;                                // zero-length for a dwell
+  };
+  KnotCycleSpec spec_{};
+  FourBar fourbar_{};
+  double ground_angle_ = 0.0;  // direction crank pivot → rocker pivot (knot frame)
+  std::array<Piece, 6> pieces_{};
+  PhaseTable table_{};
+  double duration_ = 0.0, inv_duration_ = 0.0, end_offset_ = 0.0, take_angle_ = 0.0;
+  Window gripper_closed_{}, cutter_{}, yarn_sample_{}, in_warp_{};
+  KnotCycleReport report_{};
+};
+
+}  // namespace loom::motion

@@ -1,0 +1,593 @@
+// The knot cycle: check the linkage against the precision points, plan the jerk-limited moves slowed
+// to the servo's torque, and tabulate the servo angle over the cycle. Everything here but sample()
+// is configure-time; sample() reads the phase table.
+#include "loom/motion/knot_cycle.hpp"
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <utility>
+
+#include "checks.hpp"
+#include "loom/motion/angles.hpp"
+#include "loom/motion/errors.hpp"
+
+namespace loom::motion {
+
+namespace {
+
+constexpr const char* kWho = "knot cycle";
+// A precision point counts as reached when the linkage misses it by no more than this (1 µm: far
+// below the yarn's diameter, far above the printed config's rounding).
+constexpr double kPointTolerance_m = 1e-6;
+// The gripper-link angle at a point must match to this (rad).
+constexpr double kAngleTolerance_rad = 1e-6;
+// Dense checks along the stroke and the return: crank-angle step (rad).
+constexpr double kSweepStep_rad = 1e-3;
+// Samples per move for the torque check; the planned move is re-checked and nudged slower if a
+// sample still exceeds the limit.
+constexpr int kTorqueSamples = 2048;
+// Moves slowed by the torque limit are planned to this share of it: the peak between samples and
+// the table's interpolation stay below the limit itself.
+constexpr double kTorquePlanShare = 0.998;
+// The in-warp window is widened by this much gripper travel in x (m) each side: the jaws have width.
+constexpr double kWarpMargin_m = 1e-3;
+constexpr int kPathSamples = 256;
+constexpr int kAccuracySamples = 20011;  // prime: off the table's knots
+
+using Eigen::Vector2d;
+
+Vector2d unit(double a) { return {std::cos(a), std::sin(a)}; }
+
+[[noreturn]] void fail(ErrorCode code, const std::string& what) { detail::fail(kWho, code, what); }
+
+std::string num(double v) {
+  std::ostringstream os;
+  os.precision(6);
+  os << v;
+  return os.str();
+}
+
+void require_finite(const char* field, double v) { detail::require_finite(kWho, field, v, ""); }
+void require_positive(const char* field, double v) {
+  if (!std::isfinite(v) || !(v > 0.0)) fail(ErrorCode::kInvalidInput, std::string(field) + " = " + num(v) + ": must be finite and > 0");
+}
+void require_non_negative(const char* field, double v) {
+  if (!std::isfinite(v) || !(v >= 0.0)) fail(ErrorCode::kInvalidInput, std::string(field) + " = " + num(v) + ": must be finite and >= 0");
+}
+
+void check_link(const char* name, const KnotLinkSpec& l) {
+  const std::string n(name);
+  require_positive((n + ".length_m").c_str(), l.length_m);
+  require_non_negative((n + ".mass_kg").c_str(), l.mass_kg);
+  require_finite((n + ".cg_m").c_str(), l.cg_m);
+  require_non_negative((n + ".inertia_kg_m2").c_str(), l.inertia_kg_m2);
+}
+
+void check_spec(const KnotCycleSpec& s) {
+  static constexpr std::array<const char*, 3> kNames{"points[take]", "points[wrap]", "points[pull]"};
+  for (std::size_t i = 0; i < 3; ++i) {
+    const std::string n(kNames[i]);
+    require_finite((n + ".x_m").c_str(), s.points[i].x_m);
+    require_finite((n + ".y_m").c_str(), s.points[i].y_m);
+    require_finite((n + ".gripper_rad").c_str(), s.points[i].gripper_rad);
+  }
+  require_finite("theta0_rad", s.theta0_rad);
+  require_finite("crank_pivot_x_m", s.crank_pivot_x_m);
+  require_finite("crank_pivot_y_m", s.crank_pivot_y_m);
+  require_finite("rocker_pivot_x_m", s.rocker_pivot_x_m);
+  require_finite("rocker_pivot_y_m", s.rocker_pivot_y_m);
+  check_link("crank", s.crank);
+  check_link("coupler", s.coupler);
+  check_link("rocker", s.rocker);
+  require_finite("gripper_along_m", s.gripper_along_m);
+  require_finite("gripper_normal_m", s.gripper_normal_m);
+  if (s.branch != Branch::kPositive && s.branch != Branch::kNegative) {
+    fail(ErrorCode::kInvalidInput, "branch = " + std::to_string(static_cast<int>(s.branch)) + ": must be positive or negative");
+  }
+  require_finite("warp_entry_x_m", s.warp_entry_x_m);
+  if (!std::isfinite(s.min_transmission_rad) || s.min_transmission_rad < 0.0 || s.min_transmission_rad >= kPi / 2) {
+    fail(ErrorCode::kInvalidInput, "min_transmission_rad = " + num(s.min_transmission_rad) + ": must be in [0, pi/2)");
+  }
+  require_non_negative("gravity_m_s2", s.gravity_m_s2);
+  require_positive("max_speed_rad_s", s.max_speed_rad_s);
+  require_positive("max_accel_rad_s2", s.max_accel_rad_s2);
+  require_positive("jerk_rad_s3", s.jerk_rad_s3);
+  require_positive("max_torque_nm", s.max_torque_nm);
+  require_non_negative("rotor_inertia_kg_m2", s.rotor_inertia_kg_m2);
+  require_non_negative("grip_s", s.grip_s);
+  require_non_negative("cut_s", s.cut_s);
+  require_non_negative("release_s", s.release_s);
+  if (s.table_size < 16 || static_cast<std::size_t>(s.table_size) > PhaseTable::kMaxSize) {
+    fail(ErrorCode::kInvalidInput, "table_size = " + std::to_string(s.table_size) + ": must be in [16, 2^24]");
+  }
+  const double pivots = std::hypot(s.rocker_pivot_x_m - s.crank_pivot_x_m, s.rocker_pivot_y_m - s.crank_pivot_y_m);
+  if (!(pivots > 0.0)) fail(ErrorCode::kInvalidInput, "crank and rocker pivots coincide: the ground link has no length");
+  if (std::hypot(s.gripper_along_m, s.gripper_normal_m) > 1e3 * std::max({pivots, s.crank.length_m, s.coupler.length_m, s.rocker.length_m})) {
+    fail(ErrorCode::kInvalidInput, "gripper_along_m/gripper_normal_m: the gripper is over 1000 link lengths off the coupler");
+  }
+}
+
+const char* point_name(std::size_t i) {
+  static constexpr std::array<const char*, 3> kPoint{"TAKE", "WRAP", "PULL"};
+  return kPoint[i];
+}
+
+const char* branch_name(Branch b) { return b == Branch::kPositive ? "positive" : "negative"; }
+
+}  // namespace
+
+const char* knot_limit_name(KnotLimit l) {
+  switch (l) {
+    case KnotLimit::kDwell: return "dwell";
+    case KnotLimit::kSpeed: return "speed";
+    case KnotLimit::kAcceleration: return "acceleration";
+    case KnotLimit::kJerk: return "jerk";
+    case KnotLimit::kTorque: return "torque";
+  }
+  return "?";
+}
+
+KnotCycleSpec seed001_knot_cycle_spec() {
+  KnotCycleSpec s;
+  // Seed 001's precision points (mm → m) and θ0 = 275°.
+  s.points = {KnotPoint{0.0, 0.0, rad(10.0)}, KnotPoint{0.025, 0.015, rad(3.0)}, KnotPoint{0.030, 0.001, rad(-25.0)}};
+  s.theta0_rad = rad(275.0);
+  // The two real chains of the three-point synthesis: (a0, a1, a2) = (1.255712, 17.165528, 17.229329)
+  // and (23.285522, 37.525177, 31.525943) mm. Ground pivots a0·u(θ0); the servo drives the 17.17 mm
+  // side link (the 37.5 mm one would rest 0.08° from its limit at TAKE, μ = 175.8°).
+  s.crank_pivot_x_m = 0.000109442513498;
+  s.crank_pivot_y_m = -0.00125093365343;
+  s.rocker_pivot_x_m = 0.00202946697058;
+  s.rocker_pivot_y_m = -0.0231969136205;
+  // Delrin (ρ = 1.4159 g/cm³), 6 × 5 mm section: m = 30 mm² · L · ρ, I_G = m (6² + L²)/12 (the seed's
+  // formulas, on the correct lengths).
+  s.crank = {0.0171655277145, 0.00072914, 0.0171655277145 / 2, 2.00912e-08};
+  s.rocker = {0.0375251765985, 0.00159396, 0.0375251765985 / 2, 1.91825e-07};
+  // The coupler carries both moving pivots and the gripper on one line (B — A — gripper, 31.53 mm end
+  // to end, the long chain's last link). The seed's link with holder and gripper: 1.641 g,
+  // I_G = 208.94e-9 kg m², cg 19.30 mm from the far end of its 32.637 mm link, i.e. 13.337 mm from the
+  // gripper: at −17.229 + 13.337 mm along the coupler.
+  s.coupler = {0.0142966138382, 0.001641, -0.0172293288072 + 0.013337, 208.94e-9};
+  s.gripper_along_m = -0.0172293288072;
+  s.gripper_normal_m = 0.0;
+  s.branch = Branch::kPositive;
+  // The warp pair is wrapped at x = 25 mm; the gripper's 5 mm jaws are in the warp sheet from 20 mm.
+  s.warp_entry_x_m = 0.020;
+  // 30°: below it the joint forces grow as 1/sin μ past twice their best; the design has 38.2° at TAKE.
+  s.min_transmission_rad = rad(30.0);
+  s.gravity_m_s2 = 9.81;
+  // A metal-gear micro servo (MG90S class) at 5 V: no-load 0.1 s/60° (10.5 rad/s) and stall
+  // 1.8 kg·cm (0.18 N·m). Derated: 7 rad/s is its speed under load, 0.06 N·m a third of stall (what it
+  // gives continuously without overheating). Its internal position loop settles a step in ~30 ms:
+  // 400 rad/s² and a 20 ms acceleration ramp (2e4 rad/s³) keep the commanded profile trackable.
+  // Rotor: a 7 mm coreless motor, ~1e-9 kg m², behind a ~1:130 gear train: 1.7e-5 kg m² at the output.
+  s.max_speed_rad_s = 7.0;
+  s.max_accel_rad_s2 = 400.0;
+  s.jerk_rad_s3 = 2.0e4;
+  s.max_torque_nm = 0.06;
+  s.rotor_inertia_kg_m2 = 1.7e-5;
+  // Gripper jaws (a second micro servo or a solenoid) close in 150 ms; the hot-wire/blade cut 100 ms;
+  // the jaws open in 100 ms.
+  s.grip_s = 0.15;
+  s.cut_s = 0.10;
+  s.release_s = 0.10;
+  s.table_size = 1024;
+  return s;
+}
+
+KnotCycle::Dynamics KnotCycle::dynamics_at(double crank_abs_rad) const {
+  const double t2 = crank_abs_rad - ground_angle_;
+  const FourBarPose pose = solve(fourbar_, t2, spec_.branch);
+  const double cg = std::cos(ground_angle_), sg = std::sin(ground_angle_);
+  auto to_knot = [&](const Vector2d& v) { return Vector2d(cg * v.x() - sg * v.y(), sg * v.x() + cg * v.y()); };
+  Dynamics d;
+  const KnotLinkSpec& cr = spec_.crank;
+  const KnotLinkSpec& cp = spec_.coupler;
+  const KnotLinkSpec& rk = spec_.rocker;
+  const double g = spec_.gravity_m_s2;
+  // Crank: pure rotation about its pivot at the servo's own speed.
+  d.inertia_kg_m2 = spec_.rotor_inertia_kg_m2 + cr.inertia_kg_m2 + cr.mass_kg * cr.cg_m * cr.cg_m;
+  d.gravity_nm = cr.mass_kg * g * cr.cg_m * std::cos(crank_abs_rad);
+  // Coupler and rocker: m|P'|² + I k² (kinetic energy per ω²·2), its θ-derivative, and m g P'_y.
+  auto add_body = [&](FourBarLink link, const KnotLinkSpec& l, double k, double kp) {
+    const PointCoefficients c = point_coefficients(fourbar_, pose, link, Vector2d(l.cg_m, 0.0));
+    d.inertia_kg_m2 += l.mass_kg * c.d1.squaredNorm() + l.inertia_kg_m2 * k * k;
+    d.dinertia += 2.0 * (l.mass_kg * c.d1.dot(c.d2) + l.inertia_kg_m2 * k * kp);
+    d.gravity_nm += l.mass_kg * g * to_knot(c.d1).y();
+  };
+  add_body(FourBarLink::kCoupler, cp, pose.k3, pose.k3p);
+  add_body(FourBarLink::kRocker, rk, pose.k4, pose.k4p);
+  const PointCoefficients grip =
+      point_coefficients(fourbar_, pose, FourBarLink::kCoupler, Vector2d(spec_.gripper_along_m, spec_.gripper_normal_m));
+  const Vector2d p = to_knot(grip.position);
+  d.gripper_x_m = spec_.crank_pivot_x_m + p.x();
+  d.gripper_y_m = spec_.crank_pivot_y_m + p.y();
+  d.transmission_rad = pose.transmission;
+  return d;
+}
+
+double KnotCycle::torque_at(double crank_abs_rad, double omega, double alpha) const {
+  const Dynamics d = dynamics_at(crank_abs_rad);
+  return d.inertia_kg_m2 * alpha + 0.5 * d.dinertia * omega * omega + d.gravity_nm;
+}
+
+KnotCycle::Sample KnotCycle::exact(double t_s) const noexcept {
+  double t = std::isnan(t_s) ? 0.0 : std::clamp(t_s, 0.0, duration_);
+  for (const Piece& p : pieces_) {
+    if (t <= p.t1 || &p == &pieces_.back()) {
+      const MoveSample m = p.move.at(t - p.t0);
+      return {p.start_rad + m.position, m.velocity, m.acceleration};
+    }
+  }
+  return {};
+}
+
+KnotCycle::Sample KnotCycle::sample(double t_s) const noexcept {
+  // NaN → the rest pose; clamping keeps the phase within one turn (the end reads f(0) + rise).
+  const double t = std::isnan(t_s) ? 0.0 : std::clamp(t_s, 0.0, duration_);
+  const PhaseSample s = table_.at(Phase::from_turns(t * inv_duration_));
+  const double rate = kTwoPi * inv_duration_;  // phase per second
+  return {s.value, s.d1 * rate, s.d2 * rate * rate};
+}
+
+namespace {
+
+// Where a sweep from `from` over `distance` (signed) stops being usable, if it does.
+struct SweepResult {
+  bool ok = true;
+  double stopped_at = 0.0;       // absolute crank angle of the first bad sample
+  bool unreachable = false;      // the loop does not close there (beyond the crank's range)
+  double min_transmission = kPi; // min over the sweep of min(μ, π − μ)
+  double min_at = 0.0;
+};
+
+}  // namespace
+
+KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
+  check_spec(spec);
+  KnotCycle kc;
+  kc.spec_ = spec;
+  const Vector2d a0(spec.crank_pivot_x_m, spec.crank_pivot_y_m);
+  const Vector2d b0(spec.rocker_pivot_x_m, spec.rocker_pivot_y_m);
+  kc.fourbar_ = FourBar{(b0 - a0).norm(), spec.crank.length_m, spec.coupler.length_m, spec.rocker.length_m};
+  kc.ground_angle_ = std::atan2(b0.y() - a0.y(), b0.x() - a0.x());
+  const FourBar& fb = kc.fourbar_;
+  KnotCycleReport& rep = kc.report_;
+  rep.grashof = classify(fb);
+  if (rep.grashof == GrashofClass::kChangePoint) {
+    fail(ErrorCode::kSingular, "the linkage is a change-point four-bar (s + l = p + q): its branches meet at the flat pose");
+  }
+
+  // --- The precision points: the linkage must put the gripper there with the coupler line at the
+  // gripper angle (mod π: the synthesis' last links lie along θ2 either way round, but the same way
+  // at all three points, since the coupler is one rigid body).
+  const Vector2d grip_local(spec.gripper_along_m, spec.gripper_normal_m);
+  std::array<double, 3> crank_abs{};
+  std::array<Branch, 3> branch_at{};
+  int flip = -1;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const KnotPoint& pt = spec.points[i];
+    double best = std::numeric_limits<double>::infinity();
+    int best_flip = 0;
+    Vector2d best_a, best_b;
+    for (int f = 0; f < 2; ++f) {
+      const double th3 = pt.gripper_rad + f * kPi;
+      const Vector2d u = unit(th3), n(-u.y(), u.x());
+      const Vector2d a = Vector2d(pt.x_m, pt.y_m) - grip_local.x() * u - grip_local.y() * n;
+      const Vector2d b = a + spec.coupler.length_m * u;
+      const double miss = std::max(std::fabs((a - a0).norm() - spec.crank.length_m), std::fabs((b - b0).norm() - spec.rocker.length_m));
+      if (miss < best) {
+        best = miss;
+        best_flip = f;
+        best_a = a;
+        best_b = b;
+      }
+    }
+    if (!(best <= kPointTolerance_m)) {
+      std::ostringstream os;
+      os << "the linkage misses " << point_name(i) << " (" << pt.x_m << ", " << pt.y_m << ") m with the gripper link at "
+         << deg(pt.gripper_rad) << " deg by " << best << " m (more than " << kPointTolerance_m
+         << " m): crank/rocker pivots, link lengths or gripper offset do not belong to these points";
+      fail(ErrorCode::kNotAssemblable, os.str());
+    }
+    if (flip >= 0 && best_flip != flip) {
+      std::ostringstream os;
+      os << "at " << point_name(i) << " the coupler would have to be turned half a turn against the other points to hold the "
+         << "gripper link at " << deg(pt.gripper_rad) << " deg: no rigid coupler passes all three points";
+      fail(ErrorCode::kNotAssemblable, os.str());
+    }
+    flip = best_flip;
+    rep.closure_residual_m = std::max(rep.closure_residual_m, best);
+    crank_abs[i] = std::atan2(best_a.y() - a0.y(), best_a.x() - a0.x());
+    const double th3 = std::atan2(best_b.y() - best_a.y(), best_b.x() - best_a.x());
+    const double th4 = std::atan2(best_b.y() - b0.y(), best_b.x() - b0.x());
+    branch_at[i] = branch_of(th3, th4);
+  }
+  // Cross-check with the position solution itself: the coupler angle it gives matches the gripper angle.
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (branch_at[i] != spec.branch) {
+      std::ostringstream os;
+      os << "branch defect: " << point_name(i) << " lies on the " << branch_name(branch_at[i]) << " assembly branch, the spec says "
+         << branch_name(spec.branch) << " (TAKE " << branch_name(branch_at[0]) << ", WRAP " << branch_name(branch_at[1])
+         << ", PULL " << branch_name(branch_at[2]) << "): the linkage would have to be taken apart between the points";
+      fail(ErrorCode::kWrongBranch, os.str());
+    }
+    const FourBarPosition pos = solve_position(fb, crank_abs[i] - kc.ground_angle_, spec.branch);
+    const double th3_knot = pos.theta3 + kc.ground_angle_;
+    const double err = std::fabs(wrap_pi(th3_knot - (spec.points[i].gripper_rad + flip * kPi)));
+    if (!(err <= kAngleTolerance_rad)) {
+      std::ostringstream os;
+      os << "at " << point_name(i) << " the coupler stands at " << deg(th3_knot) << " deg, not along the gripper angle "
+         << deg(spec.points[i].gripper_rad) << " deg";
+      fail(ErrorCode::kNotAssemblable, os.str());
+    }
+  }
+  rep.crank_angles_rad = crank_abs;
+  kc.take_angle_ = crank_abs[0];
+
+  // --- Order: the direction in which WRAP comes before PULL, turning one way from TAKE.
+  auto ahead = [&](double s, std::size_t i) { return wrap_two_pi(s * (crank_abs[i] - crank_abs[0])); };
+  double dir = ahead(1.0, 1) < ahead(1.0, 2) ? 1.0 : -1.0;
+  const double to_wrap = ahead(dir, 1), to_pull = ahead(dir, 2);
+  if (!(to_wrap > 0.0) || !(to_pull > to_wrap)) {
+    fail(ErrorCode::kOutOfBounds, "order defect: two precision points share a crank angle (TAKE " + num(deg(crank_abs[0])) + ", WRAP " +
+                                      num(deg(crank_abs[1])) + ", PULL " + num(deg(crank_abs[2])) + " deg)");
+  }
+
+  auto sweep = [&](double from, double distance, double min_transmission) {
+    SweepResult r;
+    const int n = std::max(8, static_cast<int>(std::ceil(std::fabs(distance) / kSweepStep_rad)));
+    for (int k = 0; k <= n; ++k) {
+      const double th = from + distance * k / n;
+      FourBarPosition pos;
+      try {
+        pos = solve_position(fb, th - kc.ground_angle_, spec.branch);
+      } catch (const MotionError&) {
+        r.ok = false;
+        r.unreachable = true;
+        r.stopped_at = th;
+        return r;
+      }
+      const double dev = std::min(pos.transmission, kPi - pos.transmission);
+      if (dev < r.min_transmission) {
+        r.min_transmission = dev;
+        r.min_at = th;
+      }
+      if (pos.at_toggle || dev < min_transmission) {
+        r.ok = false;
+        r.stopped_at = th;
+        return r;
+      }
+    }
+    return r;
+  };
+
+  const SweepResult stroke = sweep(crank_abs[0], dir * to_pull, spec.min_transmission_rad);
+  if (!stroke.ok) {
+    // The other way round: would the points be reachable there (order defect) or not at all?
+    const SweepResult other = sweep(crank_abs[0], -dir * ahead(-dir, 1), spec.min_transmission_rad);
+    std::ostringstream os;
+    if (other.ok && other.min_transmission >= spec.min_transmission_rad) {
+      os << "order defect: turning from TAKE (" << deg(crank_abs[0]) << " deg) towards WRAP the crank meets "
+         << (stroke.unreachable ? "the end of its range" : "a toggle") << " at " << deg(stroke.stopped_at)
+         << " deg; the other way it reaches PULL (" << deg(crank_abs[2]) << " deg) before WRAP (" << deg(crank_abs[1]) << " deg)";
+      fail(ErrorCode::kOutOfBounds, os.str());
+    }
+    if (stroke.unreachable) {
+      os << "the stroke TAKE→WRAP→PULL (" << deg(crank_abs[0]) << " → " << deg(crank_abs[1]) << " → " << deg(crank_abs[2])
+         << " deg) passes a dead centre: the loop cannot close at crank angle " << deg(stroke.stopped_at) << " deg";
+    } else {
+      os << "toggle within the stroke: the transmission angle falls to " << deg(std::min(stroke.min_transmission, kPi / 2))
+         << " deg at crank angle " << deg(stroke.stopped_at) << " deg (min_transmission_rad = " << deg(spec.min_transmission_rad)
+         << " deg)";
+    }
+    fail(ErrorCode::kSingular, os.str());
+  }
+  rep.stroke_rad = dir * to_pull;
+  rep.min_transmission_rad = stroke.min_transmission;
+  rep.min_transmission_at_rad = stroke.min_at;
+
+  // --- The return: on through the turn when the crank turns fully, else back along the stroke.
+  rep.full_turn = rep.grashof == GrashofClass::kCrankRocker || rep.grashof == GrashofClass::kDoubleCrank;
+  double back = -rep.stroke_rad;
+  if (rep.full_turn) {
+    back = dir * (kTwoPi - to_pull);
+    const SweepResult ret = sweep(crank_abs[2], back, std::asin(kNearToggleSine));
+    if (!ret.ok) {
+      fail(ErrorCode::kSingular, "the full-turn return from PULL passes a toggle at crank angle " + num(deg(ret.stopped_at)) + " deg");
+    }
+    rep.min_transmission_return_rad = ret.min_transmission;
+  } else {
+    rep.min_transmission_return_rad = stroke.min_transmission;
+  }
+  kc.end_offset_ = rep.stroke_rad + back;
+
+  // --- Can the servo hold the links at all? (gravity alone, at the points)
+  for (std::size_t i = 0; i < 3; ++i) {
+    const double hold = std::fabs(kc.dynamics_at(crank_abs[i]).gravity_nm);
+    if (!(hold < spec.max_torque_nm)) {
+      fail(ErrorCode::kOutOfBounds, "max_torque_nm = " + num(spec.max_torque_nm) + ": holding the links against gravity at " +
+                                        point_name(i) + " takes " + num(hold) + " N m");
+    }
+  }
+
+  // --- The moves, each slowed until the torque fits.
+  const JerkLimits limits{spec.max_speed_rad_s, spec.max_accel_rad_s2, spec.jerk_rad_s3};
+  struct Planned {
+    JerkMove move;
+    double scale = 1.0;
+  };
+  auto plan = [&](double start_rel, double distance) {
+    const double start_abs = kc.take_angle_ + start_rel;
+    const JerkMove fast = JerkMove::plan(distance, limits);
+    const double T = fast.duration();
+    // τ(t) = τ_in(t) + τ_g(θ): stretching time by s scales τ_in by 1/s² at the same pose, so each
+    // sample needs s² ≥ τ_in / (±τ_max − τ_g); the largest is the move's scale.
+    const double limit = kTorquePlanShare * spec.max_torque_nm;
+    double s2 = 1.0;
+    for (int k = 0; k <= kTorqueSamples; ++k) {
+      const MoveSample m = fast.at(T * k / kTorqueSamples);
+      const Dynamics d = kc.dynamics_at(start_abs + m.position);
+      const double in = d.inertia_kg_m2 * m.acceleration + 0.5 * d.dinertia * m.velocity * m.velocity;
+      const double total = in + d.gravity_nm;
+      if (std::fabs(total) > limit) {
+        const double room = std::copysign(limit, in) - d.gravity_nm;
+        if (!(room * in > 0.0)) {
+          fail(ErrorCode::kOutOfBounds, "max_torque_nm = " + num(spec.max_torque_nm) + ": gravity alone needs " +
+                                            num(d.gravity_nm) + " N m at servo angle " + num(deg(start_rel + m.position)) +
+                                            " deg from TAKE");
+        }
+        s2 = std::max(s2, in / room);
+      }
+    }
+    Planned p;
+    p.scale = std::sqrt(s2);
+    for (int attempt = 0; attempt < 8; ++attempt) {
+      const double s = p.scale;
+      p.move = JerkMove::plan(distance, JerkLimits{limits.velocity / s, limits.acceleration / (s * s), limits.jerk / (s * s * s)});
+      if (s == 1.0) break;
+      double peak = 0.0;
+      const double Ts = p.move.duration();
+      for (int k = 0; k <= 4 * kTorqueSamples; ++k) {
+        const double t = Ts * (k + 0.5) / (4 * kTorqueSamples + 1);  // between the first pass's samples
+        const MoveSample m = p.move.at(t);
+        peak = std::max(peak, std::fabs(kc.torque_at(start_abs + m.position, m.velocity, m.acceleration)));
+      }
+      if (peak <= spec.max_torque_nm) break;
+      p.scale *= 1.01;
+    }
+    return p;
+  };
+
+  auto bound_of = [&](const Planned& p) {
+    if (p.scale > 1.0) return KnotLimit::kTorque;
+    if (std::fabs(p.move.peak_velocity()) >= spec.max_speed_rad_s * (1.0 - 1e-9)) return KnotLimit::kSpeed;
+    double peak_acc = 0.0;
+    for (int k = 0; k <= 256; ++k) peak_acc = std::max(peak_acc, std::fabs(p.move.at(p.move.duration() * k / 256).acceleration));
+    // The acceleration plateau is flat: a sample on it reads the limit to rounding.
+    return peak_acc >= spec.max_accel_rad_s2 * (1.0 - 1e-9) ? KnotLimit::kAcceleration : KnotLimit::kJerk;
+  };
+
+  const double d1 = dir * to_wrap, d2 = dir * (to_pull - to_wrap);
+  const Planned m1 = plan(0.0, d1);
+  const Planned m2 = plan(d1, d2);
+  const Planned m3 = plan(rep.stroke_rad, back);
+
+  struct Seg {
+    const char* name;
+    double dt;
+    double start;
+    const Planned* move;
+  };
+  const std::array<Seg, 6> segs{{{"grip", spec.grip_s, 0.0, nullptr},
+                                  {"take_to_wrap", m1.move.duration(), 0.0, &m1},
+                                  {"wrap_to_pull", m2.move.duration(), d1, &m2},
+                                  {"cut", spec.cut_s, rep.stroke_rad, nullptr},
+                                  {"release", spec.release_s, rep.stroke_rad, nullptr},
+                                  {"return", m3.move.duration(), rep.stroke_rad, &m3}}};
+  double t = 0.0;
+  for (std::size_t i = 0; i < segs.size(); ++i) {
+    Piece& pc = kc.pieces_[i];
+    pc.t0 = t;
+    pc.t1 = t + segs[i].dt;
+    pc.start_rad = segs[i].start;
+    KnotCycleReport::Segment& rs = rep.segments[i];
+    rs.name = segs[i].name;
+    rs.begin_s = pc.t0;
+    rs.end_s = pc.t1;
+    if (segs[i].move != nullptr) {
+      pc.move = segs[i].move->move;
+      rs.distance_rad = pc.move.distance();
+      rs.peak_speed_rad_s = std::fabs(pc.move.peak_velocity());
+      rs.time_scale = segs[i].move->scale;
+      rs.bound = bound_of(*segs[i].move);
+    }
+    t = pc.t1;
+  }
+  kc.duration_ = t;
+  if (!(kc.duration_ > 0.0)) fail(ErrorCode::kInvalidInput, "the cycle has no duration");
+  kc.inv_duration_ = 1.0 / kc.duration_;
+
+  // --- Windows.
+  const double t_pull = kc.pieces_[3].t0, t_cut_end = kc.pieces_[3].t1, t_release_end = kc.pieces_[4].t1;
+  kc.gripper_closed_ = {0.0, t_cut_end};
+  kc.cutter_ = {t_pull, t_cut_end};
+  kc.yarn_sample_ = {t_pull, t_release_end};
+
+  // In the warp: from the geometry along the exact motion, x ≥ entry − margin, crossings by bisection.
+  const double entry = spec.warp_entry_x_m - kWarpMargin_m;
+  auto grip_x = [&](double tt) { return kc.dynamics_at(kc.take_angle_ + kc.exact(tt).angle_rad).gripper_x_m; };
+  if (!(spec.points[1].x_m >= spec.warp_entry_x_m) || !(spec.points[0].x_m < entry)) {
+    fail(ErrorCode::kInvalidInput, "warp_entry_x_m = " + num(spec.warp_entry_x_m) + ": must lie between TAKE x (" +
+                                       num(spec.points[0].x_m) + " m, outside the warp by " + num(kWarpMargin_m) +
+                                       " m) and WRAP x (" + num(spec.points[1].x_m) + " m, inside)");
+  }
+  {
+    const int n = 4096;
+    int first = -1, last = -1;
+    for (int k = 0; k <= n; ++k) {
+      if (grip_x(kc.duration_ * k / n) >= entry) {
+        if (first < 0) first = k;
+        last = k;
+      }
+    }
+    auto crossing = [&](double lo, double hi, bool rising) {  // grip_x(lo) < entry ≤ grip_x(hi) if rising
+      for (int it = 0; it < 60; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        const bool in = grip_x(mid) >= entry;
+        if (in == rising) hi = mid; else lo = mid;
+      }
+      return rising ? lo : hi;  // the outer bound: the window errs on the safe side
+    };
+    const double h = kc.duration_ / n;
+    const double begin = first > 0 ? crossing((first - 1) * h, first * h, true) : 0.0;
+    const double end = last < n ? crossing(last * h, (last + 1) * h, false) : kc.duration_;
+    kc.in_warp_ = {begin, end};
+  }
+
+  // --- The table and its accuracy.
+  const double T = kc.duration_;
+  kc.table_ = PhaseTable(TableSpec{static_cast<std::size_t>(spec.table_size), Interp::kQuintic, Precision::kDouble, kc.end_offset_},
+                         [&](double phi) {
+                           const Sample e = kc.exact(phi / kTwoPi * T);
+                           const double sc = T / kTwoPi;
+                           return PhaseExact{e.angle_rad, e.velocity_rad_s * sc, e.accel_rad_s2 * sc * sc};
+                         });
+  for (int k = 0; k < kAccuracySamples; ++k) {
+    const double tt = T * (k + 0.5) / kAccuracySamples;
+    const Sample a = kc.sample(tt), e = kc.exact(tt);
+    rep.table_angle_error_rad = std::max(rep.table_angle_error_rad, std::fabs(a.angle_rad - e.angle_rad));
+    rep.table_velocity_error_rad_s = std::max(rep.table_velocity_error_rad_s, std::fabs(a.velocity_rad_s - e.velocity_rad_s));
+    rep.table_accel_error_rad_s2 = std::max(rep.table_accel_error_rad_s2, std::fabs(a.accel_rad_s2 - e.accel_rad_s2));
+  }
+
+  // --- Peak torque, inertia range and the gripper path along the exact motion.
+  rep.min_inertia_kg_m2 = std::numeric_limits<double>::infinity();
+  for (int k = 0; k <= 4 * kTorqueSamples; ++k) {
+    const double tt = T * k / (4 * kTorqueSamples);
+    const Sample e = kc.exact(tt);
+    const Dynamics d = kc.dynamics_at(kc.take_angle_ + e.angle_rad);
+    const double tau = d.inertia_kg_m2 * e.accel_rad_s2 + 0.5 * d.dinertia * e.velocity_rad_s * e.velocity_rad_s + d.gravity_nm;
+    if (std::fabs(tau) > std::fabs(rep.peak_torque_nm)) {
+      rep.peak_torque_nm = tau;
+      rep.peak_torque_t_s = tt;
+      rep.peak_torque_angle_rad = e.angle_rad;
+    }
+    rep.max_inertia_kg_m2 = std::max(rep.max_inertia_kg_m2, d.inertia_kg_m2);
+    rep.min_inertia_kg_m2 = std::min(rep.min_inertia_kg_m2, d.inertia_kg_m2);
+  }
+  rep.path.reserve(kPathSamples);
+  for (int k = 0; k < kPathSamples; ++k) {
+    const double tt = T * k / (kPathSamples - 1);
+    const double a = kc.exact(tt).angle_rad;
+    const Dynamics d = kc.dynamics_at(kc.take_angle_ + a);
+    rep.path.push_back({tt, a, d.gripper_x_m, d.gripper_y_m});
+  }
+  return kc;
+}
+
+}  // namespace loom::motion
