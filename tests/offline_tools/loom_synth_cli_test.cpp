@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -342,3 +343,89 @@ TEST_F(LoomSynthCli, CrankRockerNear180KeepsItsDigits) {
   EXPECT_NEAR(std::stod(rows[1][4]), static_cast<double>(a), 1e-13 * static_cast<double>(a)) << r.out;
 }
 }  // namespace
+
+namespace {
+
+// The [knotting.linkage] lines of `loom-synth knotter` as key → value text (comments dropped).
+std::map<std::string, std::string> config_lines(const std::string& text) {
+  std::map<std::string, std::string> kv;
+  std::istringstream lines(text);
+  std::string line;
+  bool in_section = false;
+  while (std::getline(lines, line)) {
+    if (line == "[knotting.linkage]") {
+      in_section = true;
+      continue;
+    }
+    if (!in_section || line.empty() || line[0] == '#') continue;
+    const auto eq = line.find(" = ");
+    const auto hash = line.find("  # ");
+    EXPECT_NE(eq, std::string::npos) << line;
+    EXPECT_NE(hash, std::string::npos) << "every key has a comment: " << line;
+    std::string v = line.substr(eq + 3, hash - eq - 3);
+    while (!v.empty() && v.back() == ' ') v.pop_back();
+    kv[line.substr(0, eq)] = v;
+  }
+  return kv;
+}
+
+}  // namespace
+
+TEST_F(LoomSynthCli, KnotterPrintsTheSeedLinkageAsConfig) {
+  const CliRun r = run("knotter");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto kv = config_lines(r.out);
+  for (const char* k : {"take_x_m", "take_y_m", "take_gripper_deg", "wrap_x_m", "wrap_y_m", "wrap_gripper_deg", "pull_x_m",
+                        "pull_y_m", "pull_gripper_deg", "theta0_deg", "crank_pivot_x_m", "crank_pivot_y_m", "rocker_pivot_x_m",
+                        "rocker_pivot_y_m", "crank_m", "coupler_m", "rocker_m", "gripper_along_m", "gripper_normal_m", "branch",
+                        "crank_mass_kg", "crank_cg_m", "crank_inertia_kg_m2", "coupler_mass_kg", "coupler_cg_m",
+                        "coupler_inertia_kg_m2", "rocker_mass_kg", "rocker_cg_m", "rocker_inertia_kg_m2", "warp_entry_x_m"}) {
+    EXPECT_EQ(kv.count(k), 1u) << k;
+  }
+  EXPECT_EQ(kv.size(), 30u);
+  auto num = [&](const char* k) { return std::stod(kv.at(k)); };
+  // The two chains through seed 001's points (mm, solved by elimination): (1.255712, 17.165528,
+  // 17.229329) and (23.285522, 37.525177, 31.525943); the servo drives the short side link.
+  EXPECT_NEAR(num("crank_m"), 0.017165528, 1e-9);
+  EXPECT_NEAR(num("rocker_m"), 0.037525177, 1e-9);
+  EXPECT_NEAR(num("coupler_m"), 0.031525943 - 0.017229329, 1e-9);
+  EXPECT_NEAR(num("gripper_along_m"), -0.017229329, 1e-9);
+  EXPECT_EQ(kv.at("branch"), "\"positive\"");
+  EXPECT_EQ(kv.at("theta0_deg"), "275");
+  // The printed linkage closes at the three points: the crank joint A and rocker joint B, placed back
+  // from the gripper along the gripper-link angle, sit on their circles about the ground pivots.
+  const double a0x = num("crank_pivot_x_m"), a0y = num("crank_pivot_y_m"), b0x = num("rocker_pivot_x_m"), b0y = num("rocker_pivot_y_m");
+  for (const char* p : {"take", "wrap", "pull"}) {
+    const std::string s(p);
+    const double th = (num((s + "_gripper_deg").c_str()) + 180.0) * M_PI / 180.0;  // coupler x axis
+    const double px = num((s + "_x_m").c_str()), py = num((s + "_y_m").c_str());
+    const double ax = px - num("gripper_along_m") * std::cos(th), ay = py - num("gripper_along_m") * std::sin(th);
+    const double bx = ax + num("coupler_m") * std::cos(th), by = ay + num("coupler_m") * std::sin(th);
+    EXPECT_NEAR(std::hypot(ax - a0x, ay - a0y), num("crank_m"), 1e-9) << p;
+    EXPECT_NEAR(std::hypot(bx - b0x, by - b0y), num("rocker_m"), 1e-9) << p;
+  }
+  EXPECT_NE(r.out.find("# loom-synth knotter"), std::string::npos);
+  EXPECT_NE(r.out.find("cycle "), std::string::npos);  // the cycle time as a comment
+  for (const char* bad : {"nan", "inf"}) EXPECT_EQ(r.out.find(bad), std::string::npos) << bad;
+  // The other side link would start at a toggle: noted, not chosen.
+  EXPECT_NE(r.err.find("toggle"), std::string::npos) << r.err;
+}
+
+TEST_F(LoomSynthCli, KnotterRefusesNamingTheOption) {
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"knotter --warp-entry-mm 50", "--warp-entry-mm 50"},
+      {"knotter --min-transmission-deg 45", "transmission"},
+      {"knotter --min-transmission-deg 95", "--min-transmission-deg 95"},
+      {"knotter --drive second", "toggle"},
+      {"knotter --drive sideways", "--drive sideways"},
+      {"knotter --point 0,0,10 --point 25,15,3", "three precision points"},
+      {"knotter --point 0,0,10 --point 30,1,-25 --point 25,15,3", "order defect"},
+      {"knotter --max-torque-nm 1e-6", "--max-torque-nm"},
+  };
+  for (const auto& [args, expect] : cases) {
+    const CliRun r = run(args);
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.out;
+    EXPECT_NE(r.err.find(expect), std::string::npos) << args << ": " << r.err;
+    EXPECT_EQ(r.out.find("[knotting.linkage]"), std::string::npos) << args;
+  }
+}

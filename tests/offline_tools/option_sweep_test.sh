@@ -34,6 +34,7 @@ declare -A base=(
   ["loom-synth crank-rocker"]="--psi 45 --phi 190 --beta 20"
   ["loom-synth design"]="--stroke 1 --phi 120;--swing 45 --phi 190 --beta 20"
   ["loom-synth three-point"]="--theta0-deg 275 --point 0,0,10 --point 25,15,3 --point 30,1,-25"
+  ["loom-synth knotter"]=""
   ["loom-dynamics beatup"]="--crank-rad-s 15.5 --samples 8 --extra --svg @OUT@/b.svg;--target-force-n 90 --samples 8"
   ["loom-dynamics needle"]="--samples 8 --svg @OUT@/n.svg"
   ["loom-dynamics batten"]="--phi02-rad 0 --samples 32;--search --scan-points 6 --samples 32"

@@ -26,7 +26,9 @@ constexpr double kInfiniteLinkRatio = 1e6;
 // Longer than this many times the extent: printed, flagged as a near-infinite link (ill-conditioned).
 constexpr double kLongLinkRatio = 1e3;
 
-motion::PrecisionPoint parse_point(const std::string& text, int index) {
+}  // namespace
+
+motion::PrecisionPoint parse_precision_point(const std::string& text, int index) {
   const std::string arg = "--point " + text;
   std::array<double, 3> v{};
   std::stringstream ss(text);
@@ -50,15 +52,13 @@ motion::PrecisionPoint parse_point(const std::string& text, int index) {
   return motion::PrecisionPoint{v[0], v[1], motion::rad(v[2])};
 }
 
-}  // namespace
-
 void run_three_point(const ThreePointArgs& args, std::ostream& out, std::ostream& err) {
   if (args.points.size() != 3) {
     throw ArgError("--point: give exactly three precision points (got " + std::to_string(args.points.size()) + ")");
   }
   if (!std::isfinite(args.theta0_deg)) throw ArgError("--theta0-deg: must be a finite angle in degrees");
   std::array<motion::PrecisionPoint, 3> pts{};
-  for (int i = 0; i < 3; ++i) pts[static_cast<std::size_t>(i)] = parse_point(args.points[static_cast<std::size_t>(i)], i);
+  for (int i = 0; i < 3; ++i) pts[static_cast<std::size_t>(i)] = parse_precision_point(args.points[static_cast<std::size_t>(i)], i);
   double extent = 0.0;
   for (int i = 0; i < 3; ++i) {
     const auto& p = pts[static_cast<std::size_t>(i)];

@@ -10,6 +10,7 @@
 
 #include "loom/cli/run.hpp"
 #include "loom/cli/table_format.hpp"
+#include "loom/motion/design/three_point.hpp"
 #include "loom/motion/errors.hpp"
 
 namespace loom::synth {
@@ -91,5 +92,22 @@ struct ThreePointArgs {
 // configure-time only (offline tool). Seed 001's three-precision-point synthesis:
 // lambda,a0,a1,a2,theta1_1_deg,theta1_2_deg,theta1_3_deg,closure_residual — one row per real solution.
 void run_three_point(const ThreePointArgs& args, std::ostream& out, std::ostream& err);
+
+// configure-time only. "RX,RY,THETA2" (mm, mm, degrees) → a precision point in mm and radians;
+// throws ArgError naming `--point <text>` (index: the point's 0-based position, for the message).
+motion::PrecisionPoint parse_precision_point(const std::string& text, int index);
+
+struct KnotterArgs {
+  double theta0_deg = 275.0;
+  std::vector<std::string> points{"0,0,10", "25,15,3", "30,1,-25"};  // seed 001's (mm, mm, deg)
+  double warp_entry_mm = 20.0;
+  double min_transmission_deg = 30.0;
+  std::string drive = "auto";  // "auto", "first", "second": which chain's side link the servo drives
+  // Servo limits for the cycle-time comment (defaults: loom::motion::seed001_knot_cycle_spec()).
+  double max_speed_rad_s = 0.0, max_accel_rad_s2 = 0.0, jerk_rad_s3 = 0.0, max_torque_nm = 0.0;
+};
+// configure-time only (offline tool). The knotting four-bar from the two three-point chains, checked
+// (branch, order, transmission, toggle) by the knot cycle, as [knotting.linkage] config lines.
+void run_knotter(const KnotterArgs& args, std::ostream& out, std::ostream& err);
 
 }  // namespace loom::synth

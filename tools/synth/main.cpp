@@ -65,6 +65,21 @@ int main(int argc, char** argv) {
       ->required();
   tp_cmd->add_flag("--full-precision", tp.full_precision, "Print %.17g instead of 6 decimals");
 
+  KnotterArgs kn;
+  CLI::App* kn_cmd = app.add_subcommand(
+      "knotter", "Seed 001's knotting four-bar from the two three-point chains (shared coupler), checked "
+                 "for branch, order, transmission and toggles, as [knotting.linkage] config lines (SI)");
+  kn_cmd->add_option("--theta0-deg", kn.theta0_deg, "Fixed-link direction of the synthesis, degrees")->capture_default_str();
+  kn_cmd->add_option("--point", kn.points, "Precision point RX,RY,THETA2 (mm, mm, deg): TAKE, WRAP, PULL (default seed 001's)");
+  kn_cmd->add_option("--warp-entry-mm", kn.warp_entry_mm, "Gripper inside the warp while its x >= this (mm)")->capture_default_str();
+  kn_cmd->add_option("--min-transmission-deg", kn.min_transmission_deg, "Least transmission angle allowed in the stroke")
+      ->capture_default_str();
+  kn_cmd->add_option("--drive", kn.drive, "Which chain's side link the servo drives: auto, first, second")->capture_default_str();
+  kn_cmd->add_option("--max-speed-rad-s", kn.max_speed_rad_s, "Servo speed limit for the cycle-time comment (default: micro servo)");
+  kn_cmd->add_option("--max-accel-rad-s2", kn.max_accel_rad_s2, "Servo acceleration limit");
+  kn_cmd->add_option("--jerk-rad-s3", kn.jerk_rad_s3, "Servo jerk limit");
+  kn_cmd->add_option("--max-torque-nm", kn.max_torque_nm, "Servo torque limit");
+
   return loom::cli::run_cli("loom-synth", app, argc, argv, [&] {
     if (*sc_cmd) {
       sc.has_phi = sc_phi->count() > 0;
@@ -81,6 +96,8 @@ int main(int argc, char** argv) {
       run_design(ds, std::cout, std::cerr);
     } else if (*tp_cmd) {
       run_three_point(tp, std::cout, std::cerr);
+    } else if (*kn_cmd) {
+      run_knotter(kn, std::cout, std::cerr);
     }
     std::cout.flush();
     if (!std::cout) throw std::runtime_error("cannot write the CSV output");
