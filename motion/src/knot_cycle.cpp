@@ -241,6 +241,7 @@ struct SweepResult {
   bool ok = true;
   double stopped_at = 0.0;       // absolute crank angle of the first bad sample
   bool unreachable = false;      // the loop does not close there (beyond the crank's range)
+  bool toggle = false;           // coupler and rocker in line there
   double min_transmission = kPi; // min over the sweep of min(μ, π − μ)
   double min_at = 0.0;
 };
@@ -359,6 +360,7 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
       }
       if (pos.at_toggle || dev < min_transmission) {
         r.ok = false;
+        r.toggle = pos.at_toggle || dev < std::asin(kNearToggleSine);
         r.stopped_at = th;
         return r;
       }
@@ -367,24 +369,24 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
   };
 
   const SweepResult stroke = sweep(crank_abs[0], dir * to_pull, spec.min_transmission_rad);
+  auto what_stops = [&](const SweepResult& r) {
+    if (r.unreachable) return std::string("the end of its range (a dead centre: the loop cannot close)");
+    if (r.toggle) return std::string("a toggle (coupler and rocker in line)");
+    return "a transmission angle of " + num(deg(r.min_transmission)) + " deg (below min_transmission_rad = " +
+           num(deg(spec.min_transmission_rad)) + " deg)";
+  };
   if (!stroke.ok) {
     // The other way round: would the points be reachable there (order defect) or not at all?
     const SweepResult other = sweep(crank_abs[0], -dir * ahead(-dir, 1), spec.min_transmission_rad);
     std::ostringstream os;
     if (other.ok && other.min_transmission >= spec.min_transmission_rad) {
       os << "order defect: turning from TAKE (" << deg(crank_abs[0]) << " deg) towards WRAP the crank meets "
-         << (stroke.unreachable ? "the end of its range" : "a toggle") << " at " << deg(stroke.stopped_at)
+         << what_stops(stroke) << " at " << deg(stroke.stopped_at)
          << " deg; the other way it reaches PULL (" << deg(crank_abs[2]) << " deg) before WRAP (" << deg(crank_abs[1]) << " deg)";
       fail(ErrorCode::kOutOfBounds, os.str());
     }
-    if (stroke.unreachable) {
-      os << "the stroke TAKE→WRAP→PULL (" << deg(crank_abs[0]) << " → " << deg(crank_abs[1]) << " → " << deg(crank_abs[2])
-         << " deg) passes a dead centre: the loop cannot close at crank angle " << deg(stroke.stopped_at) << " deg";
-    } else {
-      os << "toggle within the stroke: the transmission angle falls to " << deg(std::min(stroke.min_transmission, kPi / 2))
-         << " deg at crank angle " << deg(stroke.stopped_at) << " deg (min_transmission_rad = " << deg(spec.min_transmission_rad)
-         << " deg)";
-    }
+    os << "the stroke TAKE→WRAP→PULL (" << deg(crank_abs[0]) << " → " << deg(crank_abs[1]) << " → " << deg(crank_abs[2])
+       << " deg) meets " << what_stops(stroke) << " at crank angle " << deg(stroke.stopped_at) << " deg";
     fail(ErrorCode::kSingular, os.str());
   }
   rep.stroke_rad = dir * to_pull;

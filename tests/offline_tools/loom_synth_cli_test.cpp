@@ -408,15 +408,15 @@ TEST_F(LoomSynthCli, KnotterPrintsTheSeedLinkageAsConfig) {
   EXPECT_NE(r.out.find("cycle "), std::string::npos);  // the cycle time as a comment
   for (const char* bad : {"nan", "inf"}) EXPECT_EQ(r.out.find(bad), std::string::npos) << bad;
   // The other side link would start at a toggle: noted, not chosen.
-  EXPECT_NE(r.err.find("toggle"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("transmission angle of 4.1"), std::string::npos) << r.err;
 }
 
 TEST_F(LoomSynthCli, KnotterRefusesNamingTheOption) {
   const std::vector<std::pair<std::string, std::string>> cases{
       {"knotter --warp-entry-mm 50", "--warp-entry-mm 50"},
-      {"knotter --min-transmission-deg 45", "transmission"},
+      {"knotter --min-transmission-deg 45", "--min-transmission-deg 45"},
       {"knotter --min-transmission-deg 95", "--min-transmission-deg 95"},
-      {"knotter --drive second", "toggle"},
+      {"knotter --drive second", "transmission angle of 4.1"},
       {"knotter --drive sideways", "--drive sideways"},
       {"knotter --point 0,0,10 --point 25,15,3", "three precision points"},
       {"knotter --point 0,0,10 --point 30,1,-25 --point 25,15,3", "order defect"},

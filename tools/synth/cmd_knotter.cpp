@@ -156,7 +156,9 @@ void run_knotter(const KnotterArgs& args, std::ostream& out, std::ostream& err) 
     for (const Candidate& c : cands) why += std::string(why.empty() ? "" : "; ") + "driving the " + chain_name(c.driven) + " chain's side link: " + c.refusal;
     if (why.find("warp_entry_x_m") != std::string::npos) throw ArgError("--warp-entry-mm " + input_value(args.warp_entry_mm) + ": " + why);
     if (why.find("max_torque_nm") != std::string::npos) throw ArgError("--max-torque-nm " + input_value(args.max_torque_nm) + ": " + why);
-    throw ArgError(point_args + " --theta0-deg " + input_value(args.theta0_deg) + ": no usable knotting linkage: " + why);
+    std::string blamed = point_args + " --theta0-deg " + input_value(args.theta0_deg);
+    if (why.find("min_transmission_rad") != std::string::npos) blamed += " --min-transmission-deg " + input_value(args.min_transmission_deg);
+    throw ArgError(blamed + ": no usable knotting linkage: " + why);
   }
   for (const Candidate& c : cands) {
     if (&c != best && !c.cycle) err << "loom-synth: note: driving the " << chain_name(c.driven) << " chain's side link refused: " << c.refusal << "\n";
