@@ -75,6 +75,23 @@ Catalogue default_catalogue() {
                           return motion::PhaseExact{m.position, m.velocity * scale, m.acceleration * scale * scale};
                         },
                         .closed_form = [&pick, scale](double phi) { return pick.at(phi * scale).position; }});
+  // The knotting servo over one knot (seed 001's head, default micro servo): the cycle's exact
+  // piecewise jerk moves with time mapped onto one turn of phase, as the knot cycle tabulates it.
+  c.knot = std::make_shared<const motion::KnotCycle>(motion::KnotCycle::build(motion::seed001_knot_cycle_spec()));
+  const motion::KnotCycle* knot = c.knot.get();
+  const double knot_scale = knot->duration_s() / kTwoPi;
+  c.profiles.push_back({.name = "knot_cycle",
+                        .unit = "rad",
+                        .what = "knotting servo angle over one knot (phase = time share)",
+                        .requirement = 1e-7,
+                        .phase_rate = 1.0 / knot_scale,
+                        .rise = knot->end_offset_rad(),
+                        .exact = [knot, knot_scale](double phi) {
+                          const motion::KnotCycle::Sample m = knot->exact(phi * knot_scale);
+                          return motion::PhaseExact{m.angle_rad, m.velocity_rad_s * knot_scale,
+                                                    m.accel_rad_s2 * knot_scale * knot_scale};
+                        },
+                        .closed_form = [knot, knot_scale](double phi) { return knot->exact(phi * knot_scale).angle_rad; }});
   for (ReportProfile& prof : c.profiles) {
     for (int i = 0; i < 8192; ++i) {
       const motion::PhaseExact e = prof.exact(kTwoPi * i / 8192.0);

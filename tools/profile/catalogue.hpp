@@ -1,6 +1,6 @@
 // The profiles the accuracy report measures, each with its exact kinematics: the rocker (beater
 // angle) on crank phase, the elliptic crank law, the carriage cam over one turn, and the helix pick
-// over its duration. Built from the default loom so the numbers are the ones the machine plays.
+// over its duration, and the knotting servo over one knot cycle. Built from the default loom so the numbers are the ones the machine plays.
 #pragma once
 
 #include <functional>
@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "loom/motion/knot_cycle.hpp"
 #include "loom/motion/phase_table.hpp"
 #include "loom/motion/profile_set.hpp"
 
@@ -35,6 +36,7 @@ struct ReportProfile {
 
 struct Catalogue {
   std::shared_ptr<const motion::ProfileSet> set;  // owns what the profiles' functions refer to
+  std::shared_ptr<const motion::KnotCycle> knot;  // seed 001's knot cycle (the knotting servo)
   std::vector<ReportProfile> profiles;
 };
 
