@@ -2,6 +2,8 @@
 // from the machine description, computed by the same code the loop and the CAN master use.
 #include "check_cmd.hpp"
 
+#include "loom/motion/knot_cycle.hpp"
+
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -115,6 +117,27 @@ void print_knotting(const LoomConfig& c) {
   std::printf("  %d heads %.3f m apart, each tying a stripe of up to %d knots: %d knot cycles and %d carriage steps "
               "of one pitch per row\n",
               k.heads, k.head_spacing_m, stripe, std::min(stripe, per_row), std::max(0, std::min(stripe, per_row) - 1));
+  // The knot cycle: built (and checked) from the linkage and the servo's limits.
+  const motion::KnotCycle cycle = motion::KnotCycle::build(c.knot_cycle);
+  const motion::KnotCycleReport& rep = cycle.report();
+  std::printf("  knot cycle %.3f s through seed 001's linkage (%s, servo %s): TAKE %.1f deg, WRAP %.1f deg, PULL %.1f deg "
+              "(crank); least transmission angle %.1f deg\n",
+              cycle.duration_s(), motion::grashof_class_name(rep.grashof), rep.full_turn ? "turns on round" : "swings back",
+              motion::deg(rep.crank_angles_rad[0]), motion::deg(rep.crank_angles_rad[1]), motion::deg(rep.crank_angles_rad[2]),
+              motion::deg(rep.min_transmission_rad));
+  std::printf("   ");
+  for (const auto& seg : rep.segments) {
+    std::printf(" %s %.3f s (%s)", seg.name, seg.end_s - seg.begin_s, motion::knot_limit_name(seg.bound));
+  }
+  std::printf("\n    servo %.3g rad/s (the knotter axes' max_speed), %.3g rad/s^2, %.3g N m: peak torque %.3g N m at %.3f s; "
+              "gripper in the warp %.3f..%.3f s, cutter %.3f..%.3f s, yarn-present sampled %.3f..%.3f s\n",
+              c.knot_cycle.max_speed_rad_s, c.knot_cycle.max_accel_rad_s2, c.knot_cycle.max_torque_nm,
+              std::abs(rep.peak_torque_nm), rep.peak_torque_t_s, cycle.in_warp().begin_s, cycle.in_warp().end_s,
+              cycle.cutter().begin_s, cycle.cutter().end_s, cycle.yarn_sample().begin_s, cycle.yarn_sample().end_s);
+  const int cycles = std::min(stripe, per_row);
+  std::printf("  knotting about %.1f s per row (%d cycles; the carriage steps and the selectors index while the grippers "
+              "return)\n",
+              cycles * cycle.duration_s(), cycles);
   std::string slots;
   for (std::size_t i = 0; i < k.slot_colours.size(); ++i) slots += (i ? ", " : "") + std::to_string(i) + "=" + k.slot_colours[i];
   std::printf("  magazine (every head alike): %zu slots [%s], %d knots of yarn per full slot\n", k.slot_colours.size(),
@@ -189,7 +212,17 @@ void print_plan(const LoomConfig& c) {
   std::printf("  %u pick(s) per row: shed %.2f s (sensors must confirm within %.2f s) + pick %.2f s each; beat sweep %.2f s\n",
               c.sequencer.picks_per_row, shed_nominal, c.profile.shed.timeout_s, p.pick().duration(),
               p.crank_sweep().duration());
-  std::printf("  about %.2f s per row (%.0fx faster than ~300 s by hand)\n", row, 300.0 / row);
+  if (c.knotting.mode == sequencer::KnottingMode::kHeads) {
+    // A knotted row compares whole with the weaver's whole row (~5 min knotting + 2 shed and pick + 3 beat).
+    const motion::KnotCycle cycle = motion::KnotCycle::build(c.knot_cycle);
+    const int cycles = std::min(sequencer::knots_per_stripe(c.knotting), sequencer::knots_per_row(c.knotting, c.machine_spec.width_m));
+    const double knot = cycles * cycle.duration_s();
+    std::printf("  about %.2f s per whole row: knotting %.2f s by %d heads + shed, pick and beat %.2f s (%.0fx faster than "
+                "~600 s for the weaver's whole row)\n",
+                knot + row, knot, c.knotting.heads, row, 600.0 / (knot + row));
+  } else {
+    std::printf("  about %.2f s per row (%.0fx faster than ~300 s by hand)\n", row, 300.0 / row);
+  }
 
   print_safety_sensors(c);
 

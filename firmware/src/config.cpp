@@ -319,6 +319,58 @@ const std::vector<Key>& keys() {
     }
     v.push_back(integer<int>("knotting.knots_per_slot", M::kMachine, 1, 1'000'000,
                              [](LoomConfig& c) -> int& { return c.knotting.knots_per_slot; }));
+    v.push_back(number("knotting.take_position_rad", M::kMachine, -1e6, 1e6, [](LoomConfig& c) -> double& { return c.knotting.take_position_rad; }));
+    v.push_back(number("knotting.selector_zero_rad", M::kMachine, -1e6, 1e6, [](LoomConfig& c) -> double& { return c.knotting.selector_zero_rad; }));
+    v.push_back(number("knotting.selector_accel_rad_s2", M::kMachine, 1.0, 1e6, [](LoomConfig& c) -> double& { return c.knotting.selector_accel_rad_s2; }));
+    v.push_back(number("knotting.selector_jerk_rad_s3", M::kMachine, 10.0, 1e9, [](LoomConfig& c) -> double& { return c.knotting.selector_jerk_rad_s3; }));
+    // The knotting servo (its top speed is the knotter axes' max_speed) and the gripper's dwells.
+    using KC = motion::KnotCycleSpec;
+    const auto kc = [](double KC::*f) { return [f](LoomConfig& c) -> double& { return c.knot_cycle.*f; }; };
+    v.push_back(number("knotting.servo_accel_rad_s2", M::kMachine, 1.0, 1e6, kc(&KC::max_accel_rad_s2)));
+    v.push_back(number("knotting.servo_jerk_rad_s3", M::kMachine, 10.0, 1e9, kc(&KC::jerk_rad_s3)));
+    v.push_back(number("knotting.servo_torque_nm", M::kMachine, 1e-5, 100.0, kc(&KC::max_torque_nm)));
+    v.push_back(number("knotting.servo_rotor_inertia_kg_m2", M::kMachine, 0.0, 1.0, kc(&KC::rotor_inertia_kg_m2)));
+    v.push_back(millis("knotting.grip_ms", M::kMachine, 1.0, 5000.0, kc(&KC::grip_s)));
+    v.push_back(millis("knotting.cut_ms", M::kMachine, 1.0, 5000.0, kc(&KC::cut_s)));
+    v.push_back(millis("knotting.release_ms", M::kMachine, 1.0, 5000.0, kc(&KC::release_s)));
+    v.push_back(degrees("knotting.min_transmission_deg", M::kMachine, 1.0, 89.0, kc(&KC::min_transmission_rad)));
+    // [knotting.linkage] — seed 001's four-bar as `loom-synth knotter` prints it (checked when the cycle is built).
+    const char* point_names[] = {"take", "wrap", "pull"};
+    for (std::size_t i = 0; i < 3; ++i) {
+      const std::string p = std::string("knotting.linkage.") + point_names[i];
+      v.push_back(number(p + "_x_m", M::kMachine, -1.0, 1.0, [i](LoomConfig& c) -> double& { return c.knot_cycle.points[i].x_m; }));
+      v.push_back(number(p + "_y_m", M::kMachine, -1.0, 1.0, [i](LoomConfig& c) -> double& { return c.knot_cycle.points[i].y_m; }));
+      v.push_back(degrees(p + "_gripper_deg", M::kMachine, -360.0, 360.0,
+                          [i](LoomConfig& c) -> double& { return c.knot_cycle.points[i].gripper_rad; }));
+    }
+    v.push_back(degrees("knotting.linkage.theta0_deg", M::kMachine, -360.0, 360.0, kc(&KC::theta0_rad)));
+    v.push_back(number("knotting.linkage.crank_pivot_x_m", M::kMachine, -1.0, 1.0, kc(&KC::crank_pivot_x_m)));
+    v.push_back(number("knotting.linkage.crank_pivot_y_m", M::kMachine, -1.0, 1.0, kc(&KC::crank_pivot_y_m)));
+    v.push_back(number("knotting.linkage.rocker_pivot_x_m", M::kMachine, -1.0, 1.0, kc(&KC::rocker_pivot_x_m)));
+    v.push_back(number("knotting.linkage.rocker_pivot_y_m", M::kMachine, -1.0, 1.0, kc(&KC::rocker_pivot_y_m)));
+    const auto link = [](motion::KnotLinkSpec KC::*l, double motion::KnotLinkSpec::*f) {
+      return [l, f](LoomConfig& c) -> double& { return (c.knot_cycle.*l).*f; };
+    };
+    const struct {
+      const char* name;
+      motion::KnotLinkSpec KC::*link;
+    } links[] = {{"crank", &KC::crank}, {"coupler", &KC::coupler}, {"rocker", &KC::rocker}};
+    for (const auto& l : links) {
+      const std::string p = std::string("knotting.linkage.") + l.name;
+      v.push_back(number(p + "_m", M::kMachine, 1e-4, 1.0, link(l.link, &motion::KnotLinkSpec::length_m)));
+    }
+    v.push_back(number("knotting.linkage.gripper_along_m", M::kMachine, -1.0, 1.0, kc(&KC::gripper_along_m)));
+    v.push_back(number("knotting.linkage.gripper_normal_m", M::kMachine, -1.0, 1.0, kc(&KC::gripper_normal_m)));
+    v.push_back(choice<motion::Branch>("knotting.linkage.branch", M::kMachine, {"positive", "negative"},
+                                       [](LoomConfig& c) -> motion::Branch& { return c.knot_cycle.branch; },
+                                       branch_name, parse_branch));
+    for (const auto& l : links) {
+      const std::string p = std::string("knotting.linkage.") + l.name;
+      v.push_back(number(p + "_mass_kg", M::kMachine, 0.0, 10.0, link(l.link, &motion::KnotLinkSpec::mass_kg)));
+      v.push_back(number(p + "_cg_m", M::kMachine, -1.0, 1.0, link(l.link, &motion::KnotLinkSpec::cg_m)));
+      v.push_back(number(p + "_inertia_kg_m2", M::kMachine, 0.0, 1.0, link(l.link, &motion::KnotLinkSpec::inertia_kg_m2)));
+    }
+    v.push_back(number("knotting.linkage.warp_entry_x_m", M::kMachine, -1.0, 1.0, kc(&KC::warp_entry_x_m)));
     // [recipe]
     v.push_back(integer<std::uint32_t>("recipe.picks_per_row", M::kRecipe, 1, 16, [](LoomConfig& c) -> std::uint32_t& { return c.recipe.picks_per_row; }));
     {
@@ -704,6 +756,27 @@ void check_relations(const TomlReader& r, const LoomConfig& c) {
     r.fail(key, value, why);
   }
   check_design_fits_heads(r, c);
+  if (c.knotting.mode == sequencer::KnottingMode::kHeads) {
+    // The knotting linkage must reach its three precision points on one branch, in order, with a usable
+    // transmission angle and no dead centre in the stroke, and the servo must move it (the knot cycle's checks).
+    try {
+      (void)motion::KnotCycle::build(c.knot_cycle);
+    } catch (const motion::MotionError& e) {
+      r.fail("knotting.linkage.crank_m", fmt_num(c.knot_cycle.crank.length_m), std::string("the knotting linkage: ") + e.what());
+    }
+  }
+  if (c.knotting.mode == sequencer::KnottingMode::kHeads) {
+    // One knotting servo and one colour selector per head, in the axes table.
+    for (const hal::AxisRole role : {hal::AxisRole::kKnotter, hal::AxisRole::kSelector}) {
+      const auto n = std::count_if(c.axes.begin(), c.axes.end(), [&](const AxisSpec& a) { return a.role == role; });
+      if (n != c.knotting.heads) {
+        r.fail("knotting.heads", std::to_string(c.knotting.heads),
+               "the loom has " + std::to_string(n) + " axes with role = \"" + hal::axis_role_name(role) +
+                   "\": every head needs its knotting servo and its colour selector ([axes.<name>] role = \"knotter\" "
+                   "and role = \"selector\", one of each per head)");
+      }
+    }
+  }
   if (m.shed.release_timeout_s >= m.shed.timeout_s) {
     r.fail("shedding.release_timeout_s", fmt_num(m.shed.release_timeout_s),
            "must be shorter than shedding.timeout_s = " + fmt_num(m.shed.timeout_s));
@@ -841,6 +914,31 @@ void derive(LoomConfig& c, const Fail& fail) {
   for (std::size_t i = 0; i < c.axes.size(); ++i) s.homing_timeout_s[i] = c.axes[i].homing ? c.axes[i].homing_timeout_s : 0.0;
   s.picks_per_row = rc.picks_per_row;
   s.knotting = c.knotting.mode == sequencer::KnottingMode::kWeaver;
+  if (c.knotting.mode == sequencer::KnottingMode::kHeads) {
+    // Head h drives with the h-th knotter and the h-th selector axis in slot order (names sort: knotter_1,
+    // knotter_2, ...). The design program and the knot cycle are built with the machine (they need the
+    // design's progress); the selectors' top speed is their axes' max_speed.
+    sequencer::KnottingConfig& k = s.heads;
+    int knotters = 0, selectors = 0;
+    double selector_speed = 1e300;
+    for (std::size_t i = hal::kCoreAxisCount; i < c.axes.size(); ++i) {
+      if (c.axes[i].role == hal::AxisRole::kKnotter && knotters < sequencer::kMaxKnottingHeads) {
+        k.knotter_axis[static_cast<std::size_t>(knotters++)] = static_cast<int>(i);
+      } else if (c.axes[i].role == hal::AxisRole::kSelector && selectors < sequencer::kMaxKnottingHeads) {
+        k.selector_axis[static_cast<std::size_t>(selectors++)] = static_cast<int>(i);
+        selector_speed = std::min(selector_speed, c.axes[i].max_speed);
+      }
+    }
+    double knotter_speed = 1e300;
+    for (int h = 0; h < knotters; ++h) knotter_speed = std::min(knotter_speed, c.axes[static_cast<std::size_t>(k.knotter_axis[static_cast<std::size_t>(h)])].max_speed);
+    if (knotters > 0) c.knot_cycle.max_speed_rad_s = knotter_speed;
+    k.take_position_rad = c.knotting.take_position_rad;
+    k.selector_zero_rad = c.knotting.selector_zero_rad;
+    if (selectors > 0) {
+      k.selector = {.velocity = selector_speed, .acceleration = c.knotting.selector_accel_rad_s2,
+                    .jerk = c.knotting.selector_jerk_rad_s3};
+    }
+  }
   s.debounce_ticks = c.run.debounce_ticks;
   s.sensor_discrepancy_s = c.run.sensor_discrepancy_s;
   for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) s.second_channel[i] = c.io.wiring.second[i].bit >= 0;

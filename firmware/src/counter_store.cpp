@@ -1,4 +1,6 @@
-// Atomic counter persistence as a tiny JSON object {"rows":R,"picks":P,"beats":B,"picks_in_row":K}.
+// Atomic counter persistence as a tiny JSON object {"rows":R,"picks":P,"beats":B,"picks_in_row":K}, plus the
+// knotting heads' counts ("knots", "knots_retried", "knots_by_hand", "knot_cycles_started",
+// "knot_cycles_done"); a file written before the heads existed lacks them, and they were zero then.
 // The parser accepts exactly that shape (whitespace aside): four distinct keys, each a whole number
 // in the 32-bit range; 1.5, -1, 1e3, 4294967296 and duplicates are refused, never rounded or wrapped.
 #include "loom/firmware/counter_store.hpp"
@@ -11,7 +13,10 @@
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
+#include <algorithm>
+#include <iterator>
 #include <map>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -78,7 +83,13 @@ struct Cursor {
 std::string CounterStore::format(const sequencer::Counters& c) {
   std::ostringstream os;
   os << "{\"rows\":" << c.rows << ",\"picks\":" << c.picks << ",\"beats\":" << c.beats
-     << ",\"picks_in_row\":" << c.picks_in_row << "}\n";
+     << ",\"picks_in_row\":" << c.picks_in_row;
+  const sequencer::KnotCounters& k = c.knot;
+  if (k.tied != 0 || k.retried != 0 || k.by_hand != 0 || k.cycles_started != 0 || k.cycles_done != 0) {
+    os << ",\"knots\":" << k.tied << ",\"knots_retried\":" << k.retried << ",\"knots_by_hand\":" << k.by_hand
+       << ",\"knot_cycles_started\":" << k.cycles_started << ",\"knot_cycles_done\":" << k.cycles_done;
+  }
+  os << "}\n";
   return os.str();
 }
 
@@ -89,7 +100,10 @@ sequencer::Counters CounterStore::parse(const std::string& text, const std::stri
   if (!cur.peek('}')) {
     for (;;) {
       const std::string k = cur.key();
-      if (k != "rows" && k != "picks" && k != "beats" && k != "picks_in_row") cur.fail("unknown field \"" + k + "\"");
+      static const std::set<std::string> known{"rows",          "picks",         "beats",
+                                               "picks_in_row",  "knots",         "knots_retried",
+                                               "knots_by_hand", "knot_cycles_started", "knot_cycles_done"};
+      if (!known.count(k)) cur.fail("unknown field \"" + k + "\"");
       if (fields.count(k)) cur.fail("field \"" + k + "\" given twice");
       cur.expect(':');
       fields[k] = cur.count(k);
@@ -106,13 +120,22 @@ sequencer::Counters CounterStore::parse(const std::string& text, const std::stri
   for (const char* k : {"rows", "picks", "beats", "picks_in_row"}) {
     if (!fields.count(k)) cur.fail(std::string("lacks \"") + k + "\"");
   }
-  sequencer::Counters c{fields["rows"], fields["picks"], fields["beats"], fields["picks_in_row"]};
+  sequencer::Counters c{fields["rows"], fields["picks"], fields["beats"], fields["picks_in_row"], {}};
+  // The knot counts come together or not at all (a file from before the heads has none).
+  const char* knot_fields[] = {"knots", "knots_retried", "knots_by_hand", "knot_cycles_started", "knot_cycles_done"};
+  const auto knot_given = std::count_if(std::begin(knot_fields), std::end(knot_fields), [&](const char* k) { return fields.count(k) > 0; });
+  if (knot_given != 0 && knot_given != 5) cur.fail("the knot counts come together: some of knots, knots_retried, knots_by_hand, knot_cycles_started, knot_cycles_done are missing");
+  c.knot = {fields["knots"], fields["knots_retried"], fields["knots_by_hand"], fields["knot_cycles_started"], fields["knot_cycles_done"]};
   // Every completed row had at least one pick and one beat; the picks of the row in progress are
   // picks too. Counts that say otherwise were not written by loomctl.
   const auto contradict = [&](const std::string& why) { throw ConfigError(source + ": counters contradict each other: " + why); };
   if (static_cast<std::uint64_t>(c.rows) + c.picks_in_row > c.picks) {
     contradict("picks = " + std::to_string(c.picks) + " is less than rows + picks_in_row = " +
                std::to_string(static_cast<std::uint64_t>(c.rows) + c.picks_in_row));
+  }
+  if (c.knot.cycles_done > c.knot.cycles_started) {
+    contradict("knot_cycles_done = " + std::to_string(c.knot.cycles_done) + " exceeds knot_cycles_started = " +
+               std::to_string(c.knot.cycles_started));
   }
   if (c.beats < c.rows) {
     contradict("beats = " + std::to_string(c.beats) + " is less than rows = " + std::to_string(c.rows));

@@ -13,14 +13,10 @@ namespace loom::firmware {
 
 Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions& opt, sequencer::Counters resume)
     : cfg_(cfg) {
-  if (cfg_.knotting.mode == sequencer::KnottingMode::kHeads) {
-    // `loomctl check` plans the heads' rows; weaving with them needs their sequence, simulation and drives.
-    throw ConfigError(cfg_.source + ": knotting.mode = \"heads\": this loomctl plans the heads' knots (loomctl check) "
-                      "but cannot tie them yet; use \"weaver\" to weave with the weaver knotting each row");
-  }
   const Scene fitted = check_scene_fits(scene, cfg_);
   slot_ = std::make_unique<motion::ProfileSlot>(std::make_unique<const motion::ProfileSet>(cfg_.profile));
   sequencer::SequencerConfig scfg = cfg_.sequencer;
+  if (cfg_.knotting.mode == sequencer::KnottingMode::kHeads) build_knotting(opt, resume.rows, scfg);
   scfg.rows_to_weave = opt.rows;
   scfg.await_row_saved = opt.await_row_saved;
   if (opt.hal == HalKind::kSocketCan) {
@@ -28,6 +24,29 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
     scfg.diagnosis_window_s = cfg_.can.heartbeat_timeout_ms * 1e-3 + 10.0 * cfg_.sequencer.period_s;
   }
   sequencer_ = std::make_unique<sequencer::Sequencer>(*slot_, scfg, resume);
+  if (knot_program_) {
+    // The simulated heads see the same machine: the knot geometry, the heads' axes and where the gripper
+    // is in the warp (the sequencer's interlock derived it from the knot cycle).
+    sim_hal::SimKnotting& k = cfg_.machine.knotting;
+    const sequencer::KnotGuard& g = sequencer_->knot_guard();
+    k.heads = knot_program_->heads();
+    k.knots_per_row = knot_program_->knots_per_row();
+    k.stripe = knot_program_->stripe();
+    k.slots = knot_program_->slots();
+    k.knots_per_slot = knot_program_->knots_per_slot();
+    k.pitch_m = knot_program_->pitch_m();
+    k.carriage_home_m = scfg.carriage_home_m;
+    for (int h = 0; h < k.heads; ++h) {
+      const auto hh = static_cast<std::size_t>(h);
+      k.knotter_axis[hh] = static_cast<std::size_t>(scfg.heads.knotter_axis[hh]);
+      k.selector_axis[hh] = static_cast<std::size_t>(scfg.heads.selector_axis[hh]);
+    }
+    k.take_position_rad = g.take_position_rad;
+    k.selector_zero_rad = scfg.heads.selector_zero_rad;
+    k.in_warp_from_rad = g.in_warp_from_rad;
+    k.in_warp_to_rad = g.in_warp_to_rad;
+    k.full_turn = g.full_turn;
+  }
   sim_ = std::make_unique<sim_hal::SimWorld>(cfg_.machine, fitted.spec);
   if (!opt.sim_state_path.empty()) {
     try {
@@ -69,6 +88,51 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
   tc.beat_force_max_n = cfg_.sequencer.beat_force_max_n;
   tc.rows_target = opt.rows;
   loop_->set_telemetry_context(tc);
+}
+
+// The knotting heads: the knot cycle from the linkage and the design as magazine slots, both built once
+// here (the design's progress says which row comes next) and read by the tick.
+void Machine::build_knotting(const MachineOptions& opt, std::uint32_t counter_rows, sequencer::SequencerConfig& scfg) {
+  if (opt.hal == HalKind::kSocketCan) {
+    throw ConfigError(cfg_.source + ": knotting.mode = \"heads\": the heads' grippers, cutters and yarn-present switches "
+                      "are not wired to a CAN I/O module yet; weave with the simulated HAL (--hal sim)");
+  }
+  if (!cfg_.recipe.design) {
+    throw ConfigError(cfg_.source + ": knotting.mode = \"heads\": the heads tie the design's knots; set recipe.design");
+  }
+  try {
+    knot_cycle_ = std::make_unique<const motion::KnotCycle>(motion::KnotCycle::build(cfg_.knot_cycle));
+  } catch (const motion::MotionError& e) {
+    throw ConfigError(cfg_.source + ": [knotting.linkage]: " + e.what());
+  }
+  const design::Design& d = *cfg_.recipe.design;
+  std::vector<std::string> codes;
+  for (const auto& colour : d.palette()) codes.push_back(colour.code);
+  std::vector<std::uint16_t> knots;
+  knots.reserve(static_cast<std::size_t>(d.width()) * static_cast<std::size_t>(d.height()));
+  for (int r = 0; r < d.height(); ++r) {
+    const auto row = d.row(r);
+    knots.insert(knots.end(), row.begin(), row.end());
+  }
+  try {
+    knot_program_ = std::make_unique<const sequencer::KnotProgram>(sequencer::KnotProgram::build(
+        cfg_.knotting, cfg_.machine_spec.width_m, d.width(), d.height(), knots, codes, opt.design_rows_done, counter_rows));
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(cfg_.source + ": recipe.design = \"" + cfg_.recipe.design_file + "\": " + e.what());
+  }
+  scfg.heads.program = knot_program_.get();
+  scfg.heads.cycle = knot_cycle_.get();
+}
+
+void Machine::simulated_weaver_sink(void* machine, const sequencer::WeaverRequest& r) noexcept {
+  sim_hal::WeaverTask t;
+  t.kind = r.ask == sequencer::WeaverAsk::kReload      ? sim_hal::WeaverTask::Kind::kReload
+           : r.ask == sequencer::WeaverAsk::kCheckKnot ? sim_hal::WeaverTask::Kind::kCheckKnot
+                                                       : sim_hal::WeaverTask::Kind::kTieByHand;
+  t.head = r.head;
+  t.knot = r.knot;
+  t.slot = r.slot;
+  static_cast<Machine*>(machine)->sim().ask_weaver(t);
 }
 
 // The CAN HAL: the CiA 402 drives on their buses and the CiA 401 I/O node on bus 0 (or, only when asked

@@ -11,6 +11,7 @@
 #include <tuple>
 
 #include "loom/drivers/bus_load.hpp"
+#include "loom/firmware/carpet_png.hpp"
 #include "loom/firmware/config.hpp"
 #include "loom/firmware/counter_store.hpp"
 #include "loom/firmware/design_book.hpp"
@@ -186,7 +187,10 @@ int weave(const WeaveArgs& a) {
   const double period = cfg.sequencer.period_s;
   const std::uint32_t target_rows = resume.rows + a.rows;
   double machine_s_rows = 0.0;
+  double knot_s_rows = 0.0, weaver_s_rows = 0.0;  // the heads' knotting, and the weaver's hands, in those rows
+  double weaver_outside_s_rows = 0.0;
   std::uint32_t rows_this_run = 0;
+  std::uint32_t weaver_requests = 0;
   const auto secs = [&](hal::Tick t) { return static_cast<double>(t) * period; };
   // A progress bar on long runs (a terminal only; logs get the per-row lines).
   const bool progress_bar = isatty(STDOUT_FILENO) && a.rows >= 20 && !a.quiet;
@@ -228,6 +232,11 @@ int weave(const WeaveArgs& a) {
         std::fprintf(stderr, "loomctl: recipe not reloaded, weaving on with the current one: %s\n", ex.what());
       }
     }
+    if (e.kind == firmware::RunEvent::Kind::kWeaverRequest && machine->knot_program() != nullptr) {
+      ++weaver_requests;
+      std::printf("weaver asked: %s\n", sequencer::describe(e.request, *machine->knot_program()).c_str());
+      std::fflush(stdout);
+    }
     if (e.kind == firmware::RunEvent::Kind::kPaused || e.kind == firmware::RunEvent::Kind::kResumed) {
       std::printf("%s after row %u, pick %u\n", e.kind == firmware::RunEvent::Kind::kPaused ? "paused" : "resumed",
                   e.counters.rows, e.counters.picks);
@@ -237,6 +246,9 @@ int weave(const WeaveArgs& a) {
       const auto& r = e.row;
       ++rows_this_run;
       machine_s_rows += secs(r.total_ticks);
+      knot_s_rows += secs(r.knot_ticks);
+      weaver_s_rows += secs(r.knotting_ticks + r.weaver_ticks);
+      weaver_outside_s_rows += secs(r.knotting_ticks);  // the weaver's own knotting is not in the row's time
       if (report_writer) {
         try {
           report_writer->add_row(r, e.counters.picks - picks_at_row_start, secs(e.tick));
@@ -256,6 +268,12 @@ int weave(const WeaveArgs& a) {
                     target_rows, secs(r.total_ticks), secs(r.shed_ticks), secs(r.pick_ticks), secs(r.beat_ticks),
                     r.beats, r.carriage_steps);
         if (r.knotting_ticks > 0) std::printf(", knotted in %.2f s before it", secs(r.knotting_ticks));
+        if (r.knots_tied + r.knots_by_hand > 0) {
+          std::printf(", %d knots tied in %.2f s (%d retried, %d by hand", r.knots_tied, secs(r.knot_ticks), r.knots_retried,
+                      r.knots_by_hand);
+          if (r.weaver_ticks > 0) std::printf(", %.2f s waiting for the weaver", secs(r.weaver_ticks));
+          std::printf(")");
+        }
         if (r.force_measured) {
           std::printf(", peak beat force min/mean/max %.1f/%.1f/%.1f N", r.force_min_n, r.force_mean_n, r.force_max_n);
         }
@@ -269,6 +287,7 @@ int weave(const WeaveArgs& a) {
         store->save(e.counters);
         if (book) book->record(e.counters.rows);  // after the counters: a cut between lags, never leads
         row_saves.saved(e.counters.rows);
+        row_saves.saved_knots(e.counters.rows, e.counters.knot.cycles_started);
       } catch (const std::exception& ex) {
         // Weaving on without a durable count would lose work at the next power cut: the sequencer
         // stops at the row boundary (a safe point) with counters_not_saved, keeping its counters.
@@ -296,6 +315,10 @@ int weave(const WeaveArgs& a) {
   ro.stop_now_flag = &g_stop_now;
   ro.row_saves = store ? &row_saves : nullptr;
   ro.simulated_knotting_s = a.knotting_s;
+  if (machine->knot_program() != nullptr && !hardware) {
+    ro.weaver_sink = firmware::Machine::simulated_weaver_sink;
+    ro.weaver_sink_ctx = machine.get();
+  }
   ro.pause_flag = &g_pause;
   ro.require_fifo = hardware && !a.allow_degraded;
   ro.overrun_stop_after = hardware ? cfg.run.overrun_stop_after : 0;
@@ -320,6 +343,20 @@ int weave(const WeaveArgs& a) {
         sequencer::fault_name(f), sequencer::fault_code(f),
         seq.fault_axis() >= 0 ? seq.axes().name(static_cast<std::size_t>(seq.fault_axis())) : "", seq.fault_detail(),
         secs(seq.fault_tick()), sequencer::fault_name(seq.stopped_by()), sequencer::fault_text(f)};
+  }
+  // The carpet the simulated heads knotted, beside the report, compared with the design knot for knot.
+  if (const sim_hal::SimKnotter* k = machine->sim().knotter(); k != nullptr && !hardware && !a.report.empty()) {
+    const std::string png = a.report + "/carpet.png";
+    try {
+      const firmware::CarpetCheck cc = firmware::write_carpet_png(*k, *machine->knot_program(), *cfg.recipe.design, resume.rows, png);
+      std::printf("carpet: %s: %d rows, %d knots (%d by hand); %s\n", png.c_str(), cc.rows, cc.knots, cc.by_hand,
+                  cc.equal() ? "equals the design knot for knot"
+                             : ("DIFFERS from the design: " + std::to_string(cc.missing) + " missing, " +
+                                std::to_string(cc.wrong) + " wrong colour, " + std::to_string(cc.doubled) + " tied twice")
+                                   .c_str());
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "loomctl: %s\n", e.what());
+    }
   }
   if (report_writer) {
     try {
@@ -354,9 +391,22 @@ int weave(const WeaveArgs& a) {
     return kExitFault;
   }
   if (rows_this_run > 0) {
+    // By hand a row is ~5 min knotting + 2 shedding and picking + 3 beating (the thesis, ch. 6). A flat weave
+    // has no knots: its rows compare with the 5 min of shed, pick and beat. A knotted row compares whole:
+    // the machine's time plus whatever the weaver's hands took (knotting every row, or helping the heads).
     const double per_row = machine_s_rows / rows_this_run;
-    std::printf("woven %u rows (total %u): %.2f s per row vs ~300 s by hand (%.0fx faster); picks %u, beats %u\n",
-                rows_this_run, c.rows, per_row, 300.0 / per_row, c.picks, c.beats);
+    if (cfg.knotting.mode == sequencer::KnottingMode::kNone) {
+      std::printf("woven %u rows (total %u): %.2f s per row vs ~300 s by hand (shed, pick, beat: %.0fx faster); picks %u, "
+                  "beats %u\n",
+                  rows_this_run, c.rows, per_row, 300.0 / per_row, c.picks, c.beats);
+    } else {
+      const double whole = per_row + weaver_outside_s_rows / rows_this_run;
+      std::printf("woven %u knotted rows (total %u): %.2f s per whole row (knotting %.2f s by the heads, %.2f s by the "
+                  "weaver's hands) vs ~600 s for the weaver's whole row (%.1fx faster); picks %u, beats %u, knots %u tied "
+                  "by the heads, %u retried, %u by hand, %u requests to the weaver\n",
+                  rows_this_run, c.rows, whole, knot_s_rows / rows_this_run, weaver_s_rows / rows_this_run, 600.0 / whole,
+                  c.picks, c.beats, c.knot.tied, c.knot.retried, c.knot.by_hand, weaver_requests);
+    }
   }
   return kExitOk;
 }

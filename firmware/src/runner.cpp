@@ -93,7 +93,7 @@ struct Runtime {
 
 // A tick pushes at most one snapshot and this many events (a beat, a row, a first fault or diagnosis,
 // a device fault per axis, a link fault): the room the runner waits for before a virtual-time tick.
-constexpr std::size_t kMaxEventsPerTick = 3 + hal::kMaxAxes;
+constexpr std::size_t kMaxEventsPerTick = 5 + hal::kMaxAxes;
 
 class LoopBody {
  public:
@@ -107,6 +107,8 @@ class LoopBody {
         std::max<std::int64_t>(1, std::llround(opt_.period_s * 1e9 / (opt_.realtime ? opt_.pace : 1.0)));
     rows_seen_ = seq_.counters().rows;
     picks_seen_ = seq_.counters().picks;
+    knots_seen_ = seq_.counters().knot;
+    requests_seen_ = seq_.weaver_requests();
     const hal::Tick refresh_every = std::max<hal::Tick>(1, static_cast<hal::Tick>(1.0 / opt_.period_s));
     const std::int64_t begin = rt_.clock.now_ns();
     std::int64_t deadline = begin + period_ns;
@@ -248,6 +250,8 @@ class LoopBody {
     if (opt_.row_saves != nullptr) {
       const std::uint32_t on_disk = opt_.row_saves->rows_on_disk.load(std::memory_order_acquire);
       seq_.note_rows_saved(on_disk, opt_.row_saves->last_save_failed.load(std::memory_order_acquire));
+      const std::uint64_t knots = opt_.row_saves->knots_on_disk.load(std::memory_order_acquire);
+      seq_.note_knots_saved(static_cast<std::uint32_t>(knots >> 32), static_cast<std::uint32_t>(knots & 0xFFFFFFFFu));
     }
     if (cmds == 0) return false;
     const auto has = [&](Command c) { return (cmds & static_cast<std::uint32_t>(c)) != 0; };
@@ -341,6 +345,22 @@ class LoopBody {
       if (row_done) e.row = seq_.last_row();
       emit(e);
     }
+    const sequencer::KnotCounters& k = c.knot;
+    if (k.tied != knots_seen_.tied || k.retried != knots_seen_.retried || k.by_hand != knots_seen_.by_hand ||
+        k.cycles_started != knots_seen_.cycles_started || k.cycles_done != knots_seen_.cycles_done) {
+      knots_seen_ = k;
+      emit(base_event(RunEvent::Kind::kKnotProgress, tick));
+    }
+    if (seq_.weaver_requests() != requests_seen_) {
+      requests_seen_ = seq_.weaver_requests();
+      const sequencer::WeaverRequest& r = seq_.weaver_request();
+      if (r.ask != sequencer::WeaverAsk::kNone) {
+        RunEvent e = base_event(RunEvent::Kind::kWeaverRequest, tick);
+        e.request = r;
+        emit(e);
+        if (opt_.weaver_sink != nullptr) opt_.weaver_sink(opt_.weaver_sink_ctx, r);
+      }
+    }
     const sequencer::State s = seq_.state();
     const bool paused = s == sequencer::State::kPaused;
     if (paused != was_paused_) {
@@ -375,6 +395,8 @@ class LoopBody {
   LoopStats& stats_;
   telemetry::Telemetry* telemetry_;  // non-null: virtual time, lossless telemetry (wait before the tick)
   std::uint32_t rows_seen_ = 0, picks_seen_ = 0;
+  sequencer::KnotCounters knots_seen_{};
+  std::uint32_t requests_seen_ = 0;
   bool was_paused_ = false, was_fault_ = false;
   bool stop_sent_ = false, stop_now_sent_ = false, exit_pending_ = false;
   bool prev_start_ = false, prev_pause_ = false, prev_ack_ = false;

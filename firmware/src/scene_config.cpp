@@ -59,6 +59,8 @@ const std::map<InjectedFault, KindFields>& kind_fields() {
       {InjectedFault::kAirLoss, {{}, {}}},
       {InjectedFault::kLoopStall, {{"ticks"}, {}}},
       {InjectedFault::kPowerCut, {{}, {}}},
+      {InjectedFault::kSelectorJam, {{"head"}, {}}},
+      {InjectedFault::kYarnOut, {{"head", "slot"}, {}}},
   };
   return m;
 }
@@ -173,6 +175,10 @@ void read_fault(const TomlReader& r, const toml::table& t, std::size_t n,
     } else if (k == "jump") {
       f.jump = number(-1e3, 1e3);
       if (f.jump == 0.0) r.fail_at(v, field, shown(v), "an encoder glitch must jump (non-zero)");
+    } else if (k == "head") {
+      f.head = static_cast<int>(integer(1, static_cast<std::int64_t>(hal::kMaxKnottingHeads))) - 1;  // 1-based in the file
+    } else if (k == "slot") {
+      f.slot = static_cast<int>(integer(0, 15));
     } else if (k == "ticks") {
       f.ticks = static_cast<int>(integer(1, 1'000'000));
     } else if (k == "mode") {
@@ -194,7 +200,7 @@ void read_fault(const TomlReader& r, const toml::table& t, std::size_t n,
 
 bool same_fault(const sim_hal::FaultInjection& a, const sim_hal::FaultInjection& b) {
   return a.kind == b.kind && a.at_s == b.at_s && a.at_tick == b.at_tick && a.axis_name == b.axis_name && a.piston == b.piston &&
-         a.sensor == b.sensor;
+         a.sensor == b.sensor && a.head == b.head && a.slot == b.slot;
 }
 
 }  // namespace
@@ -230,7 +236,7 @@ Scene parse_scene(const std::string& text, const std::string& source) {
   };
   for (const char* effect : {sim_hal::kEffectServoLag, sim_hal::kEffectPneumatics, sim_hal::kEffectShuttleSlip,
                              sim_hal::kEffectSensorNoise, sim_hal::kEffectBeatContact, sim_hal::kEffectInertia,
-                             sim_hal::kEffectJointFriction}) {
+                             sim_hal::kEffectJointFriction, sim_hal::kEffectKnotter}) {
     if (r.root().contains(effect) && !named(effect)) {
       r.fail(effect, "{...}", "parameters given for an effect the scene does not name");
     }
@@ -278,6 +284,15 @@ Scene parse_scene(const std::string& text, const std::string& source) {
     r.number("joint_friction.coulomb_nm", p.coulomb_nm, [](double v) { return in_range(v, 0.0, 1e6); });
     s.spec.joint_friction = p;
   }
+  if (named(sim_hal::kEffectKnotter)) {
+    sim_hal::Knotter p;
+    r.number("knotter.miss_probability", p.miss_probability, [](double v) { return in_range(v, 0.0, 1.0); });
+    r.number("knotter.weaver_s", p.weaver_s, [](double v) { return in_range(v, 1e-3, 3600.0); });
+    std::int64_t rows = p.carpet_rows;
+    r.integer("knotter.carpet_rows", rows, 1, 20000);
+    p.carpet_rows = static_cast<int>(rows);
+    s.spec.knotter = p;
+  }
   if (named(sim_hal::kEffectBeatContact)) {
     sim_hal::BeatContact p;
     r.number("beat_contact.beater_mass_kg", p.beater_mass_kg, [](double v) { return in_range(v, 1e-3, 1e3); });
@@ -313,6 +328,16 @@ Scene parse_scene(const std::string& text, const std::string& source) {
 }
 
 Scene check_scene_fits(Scene scene, const LoomConfig& cfg) {
+  const bool heads = cfg.knotting.mode == sequencer::KnottingMode::kHeads;
+  if (scene.spec.knotter && !heads) {
+    throw ConfigError(scene.source + ": effects: \"knotter\" simulates knotting heads; the loom (" + cfg.source +
+                      ") has none (knotting.mode = \"" + sequencer::knotting_mode_name(cfg.knotting.mode) + "\")");
+  }
+  if (heads && !scene.spec.knotter) {
+    throw ConfigError(scene.source + ": effects: the loom (" + cfg.source +
+                      ") ties its knots with heads (knotting.mode = \"heads\"): the scene must name the effect \"knotter\" "
+                      "(the heads' yarn, knots and the weaver are simulated only when named)");
+  }
   for (std::size_t n = 0; n < scene.spec.faults.size(); ++n) {
     sim_hal::FaultInjection& f = scene.spec.faults[n];
     const std::string at = n < scene.fault_where.size() ? scene.fault_where[n] : scene.source;
@@ -327,6 +352,21 @@ Scene check_scene_fits(Scene scene, const LoomConfig& cfg) {
                           cfg.source + ") has no such axis (its axes: " + names + ")");
       }
       f.axis = static_cast<std::size_t>(slot);
+    }
+    if (f.kind == InjectedFault::kSelectorJam || f.kind == InjectedFault::kYarnOut) {
+      if (!scene.spec.knotter) {
+        throw ConfigError(at + ": fault[" + std::to_string(n) + "].kind = \"" + sim_hal::injected_fault_name(f.kind) +
+                          "\": a knotting head's fault needs the effect \"knotter\"");
+      }
+      if (f.head >= cfg.knotting.heads) {
+        throw ConfigError(at + ": fault[" + std::to_string(n) + "].head = " + std::to_string(f.head + 1) + ": the loom (" +
+                          cfg.source + ") has " + std::to_string(cfg.knotting.heads) + " knotting heads");
+      }
+      if (f.kind == InjectedFault::kYarnOut && f.slot >= static_cast<int>(cfg.knotting.slot_colours.size())) {
+        throw ConfigError(at + ": fault[" + std::to_string(n) + "].slot = " + std::to_string(f.slot) + ": the heads' magazines have " +
+                          std::to_string(cfg.knotting.slot_colours.size()) + " slots (0.." +
+                          std::to_string(cfg.knotting.slot_colours.size() - 1) + ")");
+      }
     }
     if (f.kind != InjectedFault::kStuckSensor && f.kind != InjectedFault::kIntermittentSensor) continue;
     const auto i = static_cast<std::size_t>(f.sensor);
@@ -376,6 +416,10 @@ std::string scene_to_toml(const sim_hal::SceneSpec& s, const std::string& config
        << "\ndrive_inertia_kg_m2 = " << s.inertia->drive_inertia_kg_m2 << "\nbandwidth_hz = " << s.inertia->bandwidth_hz
        << "\nsubsteps = " << s.inertia->substeps << "\nbeater_mass_kg = " << s.inertia->beater_mass_kg << "\n";
   }
+  if (s.knotter) {
+    os << "\n[knotter]\nmiss_probability = " << s.knotter->miss_probability << "\nweaver_s = " << s.knotter->weaver_s
+       << "\ncarpet_rows = " << s.knotter->carpet_rows << "\n";
+  }
   if (s.joint_friction) {
     os << "\n[joint_friction]\nviscous_nm_s = " << s.joint_friction->viscous_nm_s
        << "\ncoulomb_nm = " << s.joint_friction->coulomb_nm << "\n";
@@ -400,6 +444,8 @@ std::string scene_to_toml(const sim_hal::SceneSpec& s, const std::string& config
     if (has("jump")) os << "jump = " << f.jump << "\n";
     if (has("ticks")) os << "ticks = " << f.ticks << "\n";
     if (has("mode")) os << "mode = " << quoted(sim_hal::load_cell_mode_name(f.load_cell)) << "\n";
+    if (has("head")) os << "head = " << f.head + 1 << "\n";
+    if (has("slot")) os << "slot = " << f.slot << "\n";
   }
   return os.str();
 }

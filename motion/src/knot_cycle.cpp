@@ -131,6 +131,12 @@ const char* knot_limit_name(KnotLimit l) {
   return "?";
 }
 
+KnotLinkSpec delrin_link(double length_m) {
+  constexpr double kDelrinKgM3 = 1415.9, kW = 0.006, kH = 0.005;
+  const double m = kW * kH * length_m * kDelrinKgM3;
+  return {length_m, m, 0.5 * length_m, m * (kW * kW + length_m * length_m) / 12.0};
+}
+
 KnotCycleSpec seed001_knot_cycle_spec() {
   KnotCycleSpec s;
   // Seed 001's precision points (mm → m) and θ0 = 275°.
@@ -145,8 +151,8 @@ KnotCycleSpec seed001_knot_cycle_spec() {
   s.rocker_pivot_y_m = -0.0231969136205;
   // Delrin (ρ = 1.4159 g/cm³), 6 × 5 mm section: m = 30 mm² · L · ρ, I_G = m (6² + L²)/12 (the seed's
   // formulas, on the correct lengths).
-  s.crank = {0.0171655277145, 0.00072914, 0.0171655277145 / 2, 2.00912e-08};
-  s.rocker = {0.0375251765985, 0.00159396, 0.0375251765985 / 2, 1.91825e-07};
+  s.crank = delrin_link(0.0171655277145);
+  s.rocker = delrin_link(0.0375251765985);
   // The coupler carries both moving pivots and the gripper on one line (B — A — gripper, 31.53 mm end
   // to end, the long chain's last link). The seed's link with holder and gripper: 1.641 g,
   // I_G = 208.94e-9 kg m², cg 19.30 mm from the far end of its 32.637 mm link, i.e. 13.337 mm from the

@@ -51,6 +51,17 @@ const char* fault_recovery(Fault f) {
              "`weave` (exit 3): write its FAULT line's counts into the counters file before the next run";
     case Fault::kLoopOverrun:
       return "find what starves the loop thread (CPU isolation, other real-time load); ack";
+    case Fault::kKnotServoLag:
+      return "look at the head's linkage and gripper for yarn or a jam, turn it freely by hand with the drive off; ack "
+             "(the knot being tied is asked of the weaver, never tied twice)";
+    case Fault::kShedLost:
+      return "check the air supply, the valves and both frames' end sensors (a switch that lets go reads like a frame "
+             "that moved); ack (the knot being tied is asked of the weaver)";
+    case Fault::kSelectorJam:
+      return "clear the head's colour magazine (a yarn end caught between slots), check it indexes freely; ack";
+    case Fault::kYarnSensorStuck:
+      return "look at the knot position: a knot already there was tied before (leave it, the counters are wrong: check "
+             "them); no knot there: the head's yarn-present switch is stuck or miswired; ack";
     case Fault::kHomingFailed:
       return "check the named axis' home switch or index pulse, its cabling and that nothing blocks its travel; "
              "`axes.<name>.homing_timeout_s` must cover the run; ack, start (homing runs again at arming)";
@@ -60,6 +71,9 @@ const char* fault_recovery(Fault f) {
     case Fault::kCarriageInWarp:
     case Fault::kPickWithoutShed:
     case Fault::kShedWithShuttle:
+    case Fault::kGripperInWarp:
+    case Fault::kKnotNotClear:
+    case Fault::kSelectorWithYarn:
       return "the interlocks refused a motion (a sequencer bug would end here): report it with the run's report; ack";
   }
   return "?";

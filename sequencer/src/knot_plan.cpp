@@ -91,6 +91,12 @@ std::string validate(const KnottingSpec& s, double width_m) {
     return "knotting.heads must be 1.." + std::to_string(kMaxKnottingHeads);
   }
   if (!fin(s.head_spacing_m) || knots_per_stripe(s) < 1) return "knotting.head_spacing_m must hold at least one knot pitch";
+  // Every head sits over a knot when head 1 does: the spacing is a whole number of knot pitches.
+  if (const double p = knot_pitch_m(s), whole = knots_per_stripe(s) * p; std::abs(s.head_spacing_m - whole) > 0.01 * p) {
+    return "knotting.head_spacing_m = " + std::to_string(s.head_spacing_m) + " is not a whole number of knot pitches (" +
+           std::to_string(p) + " m at knotting.knots_per_dm): the heads would miss their knots; " +
+           std::to_string(whole) + " m puts each over its knot";
+  }
   // The heads' stripes together must reach the right selvedge: head h ties [h·n, (h+1)·n).
   const int n = knots_per_stripe(s), k = knots_per_row(s, width_m);
   if (s.heads * n < k) {

@@ -7,8 +7,8 @@
 //   4. operator_requests() buttons → start, pause/resume, acknowledge (requests, acted on when safe)
 //   5. run_state()         the current state's own function; the states, in cycle order:
 //        idle → enabling → positioning → shed_test → shed → pick → (shed → pick …) → beat_sweep
-//        → row_end (only when the row's counters must be on disk first) → await_knotting (knotting
-//        mode only) → shed …;   paused, done, fault
+//        → row_end (only when the row's counters must be on disk first) → await_knotting (the weaver
+//        knots) or knotting (the heads tie the row: RowKnotter) → shed …;   paused, done, fault
 //   6. play_moves()        sample the active moves and profiles into targets; count beats
 //   7. track_beat_force()  the load cell's peak per beat
 //   8. interlocks          judge the proposed outputs against the measured inputs; a trip latches
@@ -63,6 +63,7 @@ const char* state_name(State s) {
     case State::kBeatSweep: return "beat_sweep";
     case State::kRowEnd: return "row_end";
     case State::kAwaitKnotting: return "await_knotting";
+    case State::kKnotting: return "knotting";
     case State::kPaused: return "paused";
     case State::kDone: return "done";
     case State::kFault: return "fault";
@@ -128,6 +129,31 @@ std::string validate(const SequencerConfig& c, const motion::ProfileSet& p) {
   if (!(c.shuttle_follow_tolerance_m > 0.0) || !(c.shuttle_follow_tolerance_m < c.selvedge_sensor_window_m)) {
     return "shuttle follow tolerance must be positive and below the selvedge sensor window";
   }
+  if ((c.heads.program == nullptr) != (c.heads.cycle == nullptr)) return "knotting heads: a knot program needs its knot cycle";
+  if (c.heads.program != nullptr) {
+    if (c.knotting) return "knotting.mode: the weaver's knotting and the knotting heads exclude each other";
+    const int heads = c.heads.program->heads();
+    if (c.heads.program->slots() < 1 || c.heads.program->slots() > kMaxMagazineSlots) return "knotting.slot_colours: 1..16 slots";
+    for (int h = 0; h < heads; ++h) {
+      const auto hh = static_cast<std::size_t>(h);
+      const int kn = c.heads.knotter_axis[hh], sel = c.heads.selector_axis[hh];
+      const auto slot_ok = [&](int a, hal::AxisRole role) {
+        return a >= static_cast<int>(hal::kCoreAxisCount) && a < static_cast<int>(c.axes.count) &&
+               c.axes.role(static_cast<std::size_t>(a)) == role;
+      };
+      if (!slot_ok(kn, hal::AxisRole::kKnotter) || !slot_ok(sel, hal::AxisRole::kSelector)) {
+        return "knotting heads: head " + std::to_string(h + 1) + " needs a knotter and a selector axis";
+      }
+    }
+    const auto fin_pos = [&](double v) { return std::isfinite(v) && v > 0.0; };
+    if (!fin_pos(c.heads.selector.velocity) || !fin_pos(c.heads.selector.acceleration) || !fin_pos(c.heads.selector.jerk)) {
+      return "knotting.selector limits must be positive and finite";
+    }
+    if (!fin_pos(c.heads.servo_tolerance_rad) || !std::isfinite(c.heads.settle_s) || c.heads.settle_s < 0.0 ||
+        !std::isfinite(c.heads.take_position_rad) || !std::isfinite(c.heads.selector_zero_rad)) {
+      return "knotting: servo tolerance, settle time and commissioning offsets must be finite";
+    }
+  }
   return "";
 }
 
@@ -151,7 +177,37 @@ Sequencer::Sequencer(const motion::ProfileSet& profiles, const SequencerConfig& 
                                                            cfg_.debounce_ticks + 1));
   interlock_ctx_.warp = &profiles_->beatup().warp();
   interlock_ctx_.crank_park_position = cfg_.crank_park_position_rad;
+  if (cfg_.heads.program != nullptr && cfg_.heads.cycle != nullptr) configure_knot_guard();
+  knotter_.configure(cfg_.heads, &interlock_ctx_.knot, cfg_.period_s, cfg_.carriage_home_m, cfg_.carriage);
   adopt_limits();
+}
+
+void Sequencer::configure_knot_guard() {
+  // Where the gripper is inside the warp, as knotting-servo angles: the cycle's in-warp window, sampled
+  // (a one-degree-of-freedom linkage puts its gripper in the same place at the same servo angle).
+  const motion::KnotCycle& c = *cfg_.heads.cycle;
+  KnotGuard& g = interlock_ctx_.knot;
+  g.heads = cfg_.heads.program->heads();
+  for (int h = 0; h < g.heads; ++h) {
+    g.knotter[static_cast<std::size_t>(h)] = static_cast<std::int8_t>(cfg_.heads.knotter_axis[static_cast<std::size_t>(h)]);
+    g.selector[static_cast<std::size_t>(h)] = static_cast<std::int8_t>(cfg_.heads.selector_axis[static_cast<std::size_t>(h)]);
+  }
+  g.take_position_rad = cfg_.heads.take_position_rad;
+  g.full_turn = c.end_offset_rad() != 0.0;
+  double lo = 1e300, hi = -1e300;
+  const motion::KnotCycle::Window w = c.in_warp();
+  constexpr int kSamples = 256;
+  for (int i = 0; i <= kSamples; ++i) {
+    double a = c.sample(w.begin_s + (w.end_s - w.begin_s) * i / kSamples).angle_rad;
+    if (g.full_turn) a = motion::wrap_two_pi(a);
+    lo = std::min(lo, a);
+    hi = std::max(hi, a);
+  }
+  // Closed at the ends (the stroke turns round inside the warp, at PULL) and a milliradian wider: the guard
+  // errs on the side of "in the warp".
+  constexpr double kMarginRad = 1e-3;
+  g.in_warp_from_rad = lo - kMarginRad;
+  g.in_warp_to_rad = hi + kMarginRad;
 }
 
 void Sequencer::adopt_limits() noexcept {
@@ -230,8 +286,10 @@ void Sequencer::step(hal::Tick now, const hal::HalInputs& raw, hal::HalOutputs& 
   acknowledged_this_tick_ = false;
   run_state(now, in);
   if (state_ == State::kFault) {
-    // Quick stop, hold the last targets, valves keep their state (a stopped shuttle is never clamped).
+    // Quick stop, hold the last targets, valves keep their state (a stopped shuttle is never clamped),
+    // grippers keep their yarn, no cutter fires.
     request_all(cmd_, n_axes_, AxisRequest::kQuickStop);
+    cmd_.io.cutter.fill(false);
   } else {
     if (acknowledged_this_tick_) request_all(cmd_, n_axes_, AxisRequest::kFaultReset);
     play_moves(now);
@@ -428,6 +486,7 @@ void Sequencer::run_state(hal::Tick now, const hal::HalInputs& in) noexcept {
     case State::kBeatSweep: beat_sweep(now); break;
     case State::kRowEnd: row_end(now); break;
     case State::kAwaitKnotting: await_knotting(now); break;
+    case State::kKnotting: knotting(now, in); break;
     case State::kPaused: paused(now); break;
     case State::kDone: break;
     case State::kFault: fault(now); break;
@@ -512,6 +571,7 @@ void Sequencer::finish_arming(hal::Tick now, const hal::HalInputs& in) noexcept 
   // be what the machine shows.
   if (!reconcile_at_arming(now, in)) return;
   enabled_outputs_ = true;
+  knotters_parked_ = false;
   // Re-arm from measured positions: crank to the nearest park, then the carriage to the row's start side.
   const double phase = motion::wrap_pi(in.axes[index(CoreAxis::kBeatCrank)].position - cfg_.crank_park_position_rad);
   crank_move_ = {true, now, cmd_.axes[index(CoreAxis::kBeatCrank)].target_position,
@@ -523,6 +583,7 @@ void Sequencer::finish_arming(hal::Tick now, const hal::HalInputs& in) noexcept 
 }
 
 void Sequencer::positioning(hal::Tick now, const hal::HalInputs& in) noexcept {
+  if (!knotters_at_rest(now, in)) return;
   if (crank_move_.active || carriage_move_.active) return;
   // Rows sweep in alternating directions: row n+1 starts at the left when n is even. The carriage goes
   // there (a row cut mid-sweep is swept again from its start).
@@ -550,6 +611,34 @@ void Sequencer::positioning(hal::Tick now, const hal::HalInputs& in) noexcept {
   } else {
     begin_shed(now);
   }
+}
+
+bool Sequencer::knotters_at_rest(hal::Tick now, const hal::HalInputs& in) noexcept {
+  // A knotting servo stopped inside its cycle (a power cut, a fault) goes back to the TAKE pose behind it
+  // the way it came, grippers open, before the crank or the carriage moves: nothing crosses a gripper
+  // left in the warp. Each servo moves on its own plan; the positioning waits for them all.
+  if (!knotter_.fitted() || knotters_parked_) return true;
+  bool moving = false;
+  for (int h = 0; h < cfg_.heads.program->heads(); ++h) {
+    const auto a = static_cast<std::size_t>(cfg_.heads.knotter_axis[static_cast<std::size_t>(h)]);
+    ActiveMove& m = knot_park_[static_cast<std::size_t>(h)];
+    if (!m.active && seconds_since(now, state_since_) == 0.0) {
+      // (A servo that trails its rest pose by a hair is at it, not a turn past the one behind.)
+      const double rest = knotter_.rest_behind(in.axes[a].position + cfg_.heads.servo_tolerance_rad);
+      const double from = cmd_.axes[a].target_position;
+      if (std::abs(rest - from) > 1e-9) {
+        m = {true, now, from, motion::JerkMove::plan(rest - from, knot_park_limits_)};
+      }
+    }
+    if (!m.active) continue;
+    const double t = seconds_since(now, m.t0);
+    cmd_.axes[a].target_position = m.origin + m.move.at(t).position;
+    if (t >= m.move.duration()) m.active = false;
+    moving |= m.active;
+  }
+  if (moving) return false;
+  knotters_parked_ = true;
+  return true;
 }
 
 void Sequencer::shed_test(hal::Tick now) noexcept {
@@ -692,7 +781,10 @@ void Sequencer::fault(hal::Tick now) noexcept {
 // ---------------------------------------------------------------------------------------------------
 
 bool Sequencer::reconcile_at_arming(hal::Tick now, const hal::HalInputs& in) noexcept {
-  if (counters_.picks_in_row > cfg_.picks_per_row || counters_.picks_in_row > counters_.picks) {
+  const KnotCounters& k = counters_.knot;
+  const bool knots_impossible = k.cycles_done > k.cycles_started ||
+                                (knotter_.fitted() && k.cycles_started > static_cast<std::uint32_t>(cfg_.heads.program->stripe()));
+  if (counters_.picks_in_row > cfg_.picks_per_row || counters_.picks_in_row > counters_.picks || knots_impossible) {
     latch(Fault::kCountersInconsistent, now);
     return false;
   }
@@ -827,6 +919,7 @@ void Sequencer::end_row(hal::Tick now) noexcept {
   while (beats_published_ < row_beats_) publish_beat(beats_published_);
   ++counters_.rows;
   counters_.picks_in_row = 0;
+  counters_.knot.cycles_started = counters_.knot.cycles_done = 0;
   last_row_ = row_.finish(now, now - sweep_start_, row_beats_, profiles_->cam().steps());
   if (cfg_.await_row_saved) {
     enter(State::kRowEnd, now);
@@ -859,6 +952,16 @@ void Sequencer::after_row(hal::Tick now) noexcept {
 }
 
 void Sequencer::next_row(hal::Tick now) noexcept {
+  if (knotter_.fitted() && !row_knotted_) {
+    // The heads tie the row (from the counters' progress: a row cut by a power loss resumes at its first
+    // knot not known to be tied); the carriage comes back to the row's start selvedge afterwards.
+    row_.begin(counters_.rows + 1, now);
+    knotter_requests_seen_ = knotter_.requests();
+    knot_requested_ = false;
+    knotter_.begin(counters_.rows, counters_.knot, row_starts_left() ? 0.0 : profiles_->carriage_travel_m(), now, cmd_);
+    enter(State::kKnotting, now);
+    return;
+  }
   if (cfg_.knotting && !row_knotted_) {
     knot_requested_ = false;  // a pedal press from before the row was woven does not count for the next
     enter(State::kAwaitKnotting, now);
@@ -879,6 +982,39 @@ void Sequencer::await_knotting(hal::Tick now) noexcept {
   row_knotted_ = true;
   knotting_ticks_ = now - state_since_;
   next_row(now);
+}
+
+void Sequencer::knotting(hal::Tick now, const hal::HalInputs& in) noexcept {
+  // The heads work between the warp threads: the shed must stay where it is the whole time (the interlock
+  // would refuse the next knot; this names the cause first).
+  if (!shed_still(io_)) {
+    latch(Fault::kShedLost, now);
+    return;
+  }
+  // A new request of the weaver: a pedal press from before it does not answer it.
+  if (knotter_.requests() != knotter_requests_seen_) {
+    knotter_requests_seen_ = knotter_.requests();
+    knot_requested_ = false;
+  }
+  const bool await_disk = cfg_.await_row_saved;
+  const std::uint32_t on_disk = knots_on_disk_rows_ == counters_.rows ? knots_on_disk_started_ : 0;
+  const RowKnotter::Status st = knotter_.step(now, in, cmd_, counters_.knot, knot_requested_, await_disk, on_disk);
+  knot_requested_ = false;  // answered the request, or came when none was open
+  switch (st) {
+    case RowKnotter::Status::kRunning:
+    case RowKnotter::Status::kAwaitingWeaver:
+      return;
+    case RowKnotter::Status::kFault:
+      latch(knotter_.fault(), now, knotter_.fault_axis());
+      return;
+    case RowKnotter::Status::kDone: {
+      const RowKnots& k = knotter_.row();
+      row_.set_knots(k.ticks, k.weaver_ticks, k.tied, k.retried, k.by_hand);
+      row_knotted_ = true;
+      next_row(now);
+      return;
+    }
+  }
 }
 
 Fault Sequencer::shed_fault(ShedVerdict v) const noexcept {
@@ -963,12 +1099,14 @@ void Sequencer::publish_beat(int k) noexcept {
 void Sequencer::signal() noexcept {
   // Stack light: red = a fault waits for acknowledgement; green = weaving; amber = waiting for the
   // operator (idle, arming, paused, done).
+  const bool asking = state_ == State::kKnotting && knotter_.request().ask != WeaverAsk::kNone;
   const bool weaving = state_ == State::kHoming || state_ == State::kPositioning || state_ == State::kShedTest || state_ == State::kShed ||
-                       state_ == State::kPick || state_ == State::kBeatSweep || state_ == State::kRowEnd;
+                       state_ == State::kPick || state_ == State::kBeatSweep || state_ == State::kRowEnd ||
+                       (state_ == State::kKnotting && !asking);
   cmd_.io.lamp_red = state_ == State::kFault;
   cmd_.io.lamp_green = weaving;
   cmd_.io.lamp_amber = !weaving && state_ != State::kFault;
-  cmd_.io.buzzer = false;
+  cmd_.io.buzzer = asking;  // the weaver is needed at the machine (a knot to tie by hand, a slot to reload)
 }
 
 }  // namespace loom::sequencer

@@ -17,7 +17,7 @@ namespace loom::sim_hal {
 const std::vector<std::string>& known_effects() {
   static const std::vector<std::string> names{kEffectIdeal,       kEffectServoLag,    kEffectPneumatics,
                                               kEffectShuttleSlip,  kEffectSensorNoise, kEffectBeatContact,
-                                              kEffectInertia,      kEffectJointFriction};
+                                              kEffectInertia,      kEffectJointFriction, kEffectKnotter};
   return names;
 }
 
@@ -56,6 +56,8 @@ const char* injected_fault_name(InjectedFault f) {
     case InjectedFault::kAirLoss: return "air_loss";
     case InjectedFault::kLoopStall: return "loop_stall";
     case InjectedFault::kPowerCut: return "power_cut";
+    case InjectedFault::kSelectorJam: return "selector_jam";
+    case InjectedFault::kYarnOut: return "yarn_out";
   }
   return "?";
 }
@@ -122,6 +124,12 @@ SimWorld::SimWorld(const SimMachine& machine, const SceneSpec& scene)
       if (friction && !scene_.joint_friction) scene_.joint_friction = JointFriction{};
       axes_[hal::index(hal::CoreAxis::kBeatCrank)].effects.push_back(
           make_crank_inertia(m_, *scene_.inertia, friction ? &*scene_.joint_friction : nullptr));
+    } else if (e == kEffectKnotter) {
+      if (m_.knotting.heads < 1) {
+        throw std::invalid_argument("effect 'knotter' simulates the knotting heads: the loom has none (knotting.mode = \"heads\")");
+      }
+      if (!scene_.knotter) scene_.knotter = Knotter{};
+      knotter_ = std::make_unique<SimKnotter>(m_.knotting, *scene_.knotter, m_.period_s);
     } else if (e == kEffectJointFriction) {
       if (std::find(scene_.effects.begin(), scene_.effects.end(), kEffectInertia) == scene_.effects.end()) {
         throw std::invalid_argument("effect 'joint_friction' acts on the crank's dynamics: name 'inertia' too");
@@ -222,6 +230,12 @@ void SimWorld::apply_injected_faults(hal::Tick now) noexcept {
         stall_until_ = now + std::max(1, f.ticks);
         injected_overruns_ += static_cast<std::uint32_t>(std::max(1, f.ticks));
         break;
+      case InjectedFault::kSelectorJam:
+        if (knotter_ && f.head >= 0 && f.head < m_.knotting.heads) jammed_[m_.knotting.selector_axis[static_cast<std::size_t>(f.head)]] = true;
+        break;
+      case InjectedFault::kYarnOut:
+        if (knotter_) knotter_->yarn_out(f.head, f.slot);
+        break;
       case InjectedFault::kPowerCut:
         powered_off_ = true;
         if (power_cut_handler_ == nullptr) std::raise(SIGKILL);  // as if killed: nothing more is written
@@ -312,7 +326,7 @@ void SimWorld::step_axis(std::size_t slot, const hal::AxisCommand& cmd) noexcept
   if (!homing) ax.homing = false;
   if (homing) {
     step_homing(slot);
-  } else if (ax.state == DriveState::kOperationEnabled) {
+  } else if (ax.state == DriveState::kOperationEnabled && !jammed_[slot]) {
     ax.target = cmd.target_position - ax.offset;  // commands are in the drive's reading
     double actual = ax.target;
     if (!ax.effects.empty()) {
@@ -420,6 +434,15 @@ void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::Digit
   const auto pos = [&](hal::CoreAxis a) { return drives_simulated_ ? axes_[hal::index(a)].position : axes[hal::index(a)].position; };
   const auto vel = [&](hal::CoreAxis a) { return drives_simulated_ ? axes_[hal::index(a)].velocity : axes[hal::index(a)].velocity; };
   step_shuttle(pos(hal::CoreAxis::kHelix));
+  if (knotter_) {
+    // A weft locks the knots tied so far into their row: the shuttle arrived at the other selvedge.
+    const int side = shuttle_x_ <= m_.selvedge_sensor_window_m ? -1 : shuttle_x_ >= m_.width_m - m_.selvedge_sensor_window_m ? 1 : 0;
+    if (side != 0 && shuttle_side_ != 0 && side != shuttle_side_) knotter_->on_weft();
+    if (side != 0) shuttle_side_ = side;
+    std::array<double, hal::kMaxAxes> at{};
+    readings(at);
+    knotter_->inputs(at, io);
+  }
   // The load cell rides the beater, which the crank drives: real (CAN) or simulated.
   if (scene_.beat_contact) step_beat_contact(pos(hal::CoreAxis::kBeatCrank), vel(hal::CoreAxis::kBeatCrank));
   constexpr std::size_t n = hal::kSafetySensorCount;
@@ -446,8 +469,17 @@ void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::Digit
   io.refreshed = now;
 }
 
+void SimWorld::readings(std::array<double, hal::kMaxAxes>& out) const noexcept {
+  for (std::size_t i = 0; i < n_axes_; ++i) out[i] = axes_[i].position + axes_[i].offset;
+}
+
 void SimWorld::write_io(hal::Tick, const hal::DigitalOutputs& io) {
   if (powered_off_) return;
+  if (knotter_) {
+    std::array<double, hal::kMaxAxes> at{};
+    readings(at);
+    knotter_->on_outputs(io, at, rng_);
+  }
   const std::array<bool, 2> valve{io.piston_a_extend, io.piston_b_extend};
   const double dt = m_.period_s;
   const double full_speed = dt / m_.piston_travel_s;  // fraction of stroke per tick at full pressure

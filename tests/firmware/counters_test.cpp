@@ -59,6 +59,31 @@ TEST(Counters, RoundTripAndStrictShape) {
             4294967295u);
 }
 
+TEST(Counters, TheKnottingHeadsCountsComeTogetherAndAgree) {
+  loom::sequencer::Counters c{4, 8, 60, 0, {}};
+  // A loom without heads writes what it always wrote.
+  EXPECT_EQ(CounterStore::format(c), "{\"rows\":4,\"picks\":8,\"beats\":60,\"picks_in_row\":0}\n");
+  c.knot = {1400, 12, 3, 17, 16};
+  const std::string text = CounterStore::format(c);
+  EXPECT_NE(text.find("\"knots\":1400,\"knots_retried\":12,\"knots_by_hand\":3,\"knot_cycles_started\":17,"
+                      "\"knot_cycles_done\":16"),
+            std::string::npos)
+      << text;
+  const loom::sequencer::Counters back = CounterStore::parse(text, "c.json");
+  EXPECT_EQ(back.knot.tied, 1400u);
+  EXPECT_EQ(back.knot.retried, 12u);
+  EXPECT_EQ(back.knot.by_hand, 3u);
+  EXPECT_EQ(back.knot.cycles_started, 17u);
+  EXPECT_EQ(back.knot.cycles_done, 16u);
+  // All five or none; a cycle done that never started is not loomctl's.
+  EXPECT_NE(parse_error("{\"rows\":4,\"picks\":8,\"beats\":60,\"picks_in_row\":0,\"knots\":5}").find("the knot counts come together"),
+            std::string::npos);
+  EXPECT_NE(parse_error("{\"rows\":4,\"picks\":8,\"beats\":60,\"picks_in_row\":0,\"knots\":5,\"knots_retried\":0,"
+                        "\"knots_by_hand\":0,\"knot_cycles_started\":2,\"knot_cycles_done\":3}")
+                .find("knot_cycles_done = 3 exceeds knot_cycles_started = 2"),
+            std::string::npos);
+}
+
 TEST(Counters, ValuesAreWholeCountsNeverRoundedOrWrapped) {
   const auto bad = [](const std::string& rows) {
     return parse_error("{\"rows\":" + rows + ",\"picks\":5,\"beats\":5,\"picks_in_row\":0}");

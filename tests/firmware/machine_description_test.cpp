@@ -60,8 +60,9 @@ TEST(MachineDescription, TheDefaultFileIsCompleteAndExtendingItChangesNothing) {
       EXPECT_NE(std::string(kDefaultLoomToml).find("\n" + key + " "), std::string::npos) << k.path;
       continue;
     }
-    const std::string key = std::string(k.path).substr(std::string(k.path).find('.') + 1);
-    const std::string section = std::string(k.path).substr(0, std::string(k.path).find('.'));
+    // The key is the last part of the path, its table the rest ([knotting.linkage] holds take_x_m).
+    const std::string key = std::string(k.path).substr(std::string(k.path).rfind('.') + 1);
+    const std::string section = std::string(k.path).substr(0, std::string(k.path).rfind('.'));
     if (std::string(k.path) == "recipe.crank_speed_rad_s") continue;  // the alternative to the force target
     EXPECT_NE(std::string(kDefaultLoomToml).find("\n" + key + " "), std::string::npos) << k.path;
     EXPECT_NE(std::string(kDefaultLoomToml).find("[" + section + "]"), std::string::npos) << k.path;
@@ -289,18 +290,34 @@ TEST(MachineKnotting, HeadsNeedAMagazineThatHoldsEveryColourOfTheDesign) {
   }
   design.close();
   const std::string heads = "[knotting]\nmode = \"heads\"\nknots_per_dm = 10\nheads = 2\nhead_spacing_m = 0.6\n";
-  std::ofstream(dir + "/bad.toml") << ext(heads + "slot_colours = [\"R\", \"W\"]\n[recipe]\ndesign = \"rug.csv\"\n");
+  // Each head's knotting servo and colour selector, on a bus of their own.
+  std::string head_axes;
+  for (const char* a : {"knotter_1", "knotter_2", "selector_1", "selector_2"}) {
+    static int node = 10;
+    head_axes += std::string("[axes.") + a + "]\nrole = \"" + (a[0] == 'k' ? "knotter" : "selector") +
+                 "\"\nbus = 1\nnode = " + std::to_string(++node) +
+                 "\ncounts_per_rev = 4096\nmax_speed = 20.0\nferror_min = 0.2\nreferencing = \"absolute\"\n";
+  }
+  std::ofstream(dir + "/bad.toml") << ext(heads + "slot_colours = [\"R\", \"W\"]\n" + head_axes + "[recipe]\ndesign = \"rug.csv\"\n");
   // Design row 1 is the file's last line (woven bottom up): its knot 71 is the blue one, head 2's.
   EXPECT_NE(load_error(dir + "/bad.toml")
                 .find("recipe.design = \"rug.csv\": design row 1: colour \"B\" (knot 71, head 2) is in no magazine slot"),
             std::string::npos)
       << load_error(dir + "/bad.toml");
-  std::ofstream(dir + "/good.toml") << ext(heads + "slot_colours = [\"R\", \"W\", \"B\"]\n[recipe]\ndesign = \"rug.csv\"\n");
+  std::ofstream(dir + "/good.toml") << ext(heads + "slot_colours = [\"R\", \"W\", \"B\"]\n" + head_axes + "[recipe]\ndesign = \"rug.csv\"\n");
   EXPECT_EQ(load_error(dir + "/good.toml"), "");
+  // Without its axes a head cannot tie: refused at the head count, naming the role.
+  std::ofstream(dir + "/no_axes.toml") << ext(heads + "slot_colours = [\"R\", \"W\", \"B\"]\n[recipe]\ndesign = \"rug.csv\"\n");
+  EXPECT_NE(load_error(dir + "/no_axes.toml").find("knotting.heads = 2: the loom has 0 axes with role = \"knotter\""), std::string::npos)
+      << load_error(dir + "/no_axes.toml");
   // Stripes that do not reach the right selvedge, at the spacing's line.
-  EXPECT_NE(config_error(ext("[knotting]\nmode = \"heads\"\nhead_spacing_m = 0.5\nslot_colours = [\"R\"]\n"))
+  EXPECT_NE(config_error(ext("[knotting]\nmode = \"heads\"\nheads = 2\nhead_spacing_m = 0.5\nslot_colours = [\"R\"]\n"))
                 .find("knotting.head_spacing_m = 0.5: knotting.head_spacing_m: 2 heads x 150 knots per stripe cover 300"),
             std::string::npos)
-      << config_error(ext("[knotting]\nmode = \"heads\"\nhead_spacing_m = 0.5\nslot_colours = [\"R\"]\n"));
+      << config_error(ext("[knotting]\nmode = \"heads\"\nheads = 2\nhead_spacing_m = 0.5\nslot_colours = [\"R\"]\n"));
+  // A spacing that is not a whole number of knot pitches would put head 2 between two knots.
+  EXPECT_NE(config_error(ext("[knotting]\nmode = \"heads\"\nheads = 2\nhead_spacing_m = 0.6015\nslot_colours = [\"R\"]\n"))
+                .find("is not a whole number of knot pitches"),
+            std::string::npos);
   std::filesystem::remove_all(dir);
 }

@@ -50,9 +50,9 @@ if [[ $header != "$want" ]]; then
   echo "FAIL: accuracy.csv header is '$header'"
   fail=1
 fi
-# 4 profiles x (1 closed form + 2 sizes x 3 orders x 2 precisions) rows after the header.
+# 5 profiles (rocker, crank law, carriage cam, pick, knot cycle) x (1 exact + 2 sizes x 3 orders x 2 precisions) rows.
 rows=$(($(wc -l <"$work/report/accuracy.csv") - 1))
-[[ $rows -eq 52 ]] || { echo "FAIL: $rows rows, expected 52"; fail=1; }
+[[ $rows -eq 65 ]] || { echo "FAIL: $rows rows, expected 65"; fail=1; }
 grep -q "<svg" "$work/report/pareto.svg" || { echo "FAIL: no SVG chart"; fail=1; }
 grep -q "| rocker |" "$work/report/summary.md" || { echo "FAIL: summary lacks the rocker row"; fail=1; }
 exit $fail

@@ -120,3 +120,48 @@ TEST(KnotPlan, RefusalsNameWhatIsWrong) {
   s.mode = KnottingMode::kWeaver;  // the weaver needs no magazine
   EXPECT_EQ(validate(s, 1.2), "");
 }
+
+// ---------------------------------------------------------------------------------------------------
+// The knot program: the design as magazine slots, read by the tick.
+// ---------------------------------------------------------------------------------------------------
+#include "loom/sequencer/knot_program.hpp"
+
+TEST(KnotProgram, ProductionRowsMapToDesignRowsInTheDesignsOrderAndRepeat) {
+  KnottingSpec s = heads_spec();
+  s.knots_per_dm = 10.0;  // 120 knots, 60 per head
+  // Three design rows (bottom first): all red, all blue, all white; palette index = slot here.
+  std::vector<std::uint16_t> knots;
+  for (const int colour : {0, 1, 2}) knots.insert(knots.end(), 120, static_cast<std::uint16_t>(colour));
+  // Four design rows were woven by production row 10: production row 10 ties design row 4 % 3 = 1 (blue).
+  const KnotProgram p = KnotProgram::build(s, 1.2, 120, 3, knots, kPalette, 4, 10);
+  EXPECT_EQ(p.knots_per_row(), 120);
+  EXPECT_EQ(p.stripe(), 60);
+  EXPECT_EQ(p.design_row(10), 1);
+  EXPECT_EQ(p.design_row(11), 2);
+  EXPECT_EQ(p.design_row(12), 0);  // the design repeats
+  EXPECT_EQ(p.slot(10, 0), 1);
+  EXPECT_EQ(p.slot(11, 119), 2);
+  EXPECT_EQ(p.slot(12, 60), 0);
+  EXPECT_EQ(p.slot(10, 120), -1);  // beyond the row
+  // Head h ties knot h * 60 + j in cycle j, with head 0 over the middle of knot j's pitch.
+  EXPECT_EQ(p.knot_of(0, 0), 0);
+  EXPECT_EQ(p.knot_of(1, 59), 119);
+  EXPECT_EQ(p.knot_of(1, 60), -1);
+  EXPECT_NEAR(p.carriage_at(0), 0.005, 1e-15);
+  EXPECT_NEAR(p.carriage_at(59), 0.595, 1e-12);
+  EXPECT_EQ(p.slot_colour(2), "W");
+}
+
+TEST(KnotProgram, ADesignTheMagazinesCannotHoldIsRefusedNamingTheRowAndColour) {
+  KnottingSpec s = heads_spec();
+  s.knots_per_dm = 10.0;
+  std::vector<std::uint16_t> knots(240, 0);
+  knots[120 + 70] = 3;  // design row 2, knot 71: G is in no slot
+  try {
+    (void)KnotProgram::build(s, 1.2, 120, 2, knots, kPalette, 0, 0);
+    FAIL() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("design row 2: colour \"G\" (knot 71, head 2) is in no magazine slot"), std::string::npos)
+        << e.what();
+  }
+}

@@ -44,12 +44,18 @@ constexpr std::initializer_list<hal::SafetySensor> kAllSensors = {
     hal::SafetySensor::kPistonAExtended, hal::SafetySensor::kPistonARetracted, hal::SafetySensor::kPistonBExtended,
     hal::SafetySensor::kPistonBRetracted, hal::SafetySensor::kShuttleAtLeft,   hal::SafetySensor::kShuttleAtRight};
 
+// The kinds a loom without knotting heads can suffer (the heads' own faults come last in the enum).
+constexpr int kFaultKindsWithoutHeads = static_cast<int>(InjectedFault::kSelectorJam);
+
 sim_hal::FaultInjection random_fault(std::mt19937_64& rng, sim_hal::SceneSpec& s,
-                                     const std::array<bool, hal::kSafetySensorCount>& second_channel,
+                                     const std::array<bool, hal::kSafetySensorCount>& second_channel, int heads, int slots,
                                      std::ostringstream& d) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   sim_hal::FaultInjection f;
-  f.kind = static_cast<InjectedFault>(static_cast<int>(u(rng) * sim_hal::kInjectedFaultCount));
+  const int kinds = heads > 0 ? sim_hal::kInjectedFaultCount : kFaultKindsWithoutHeads;
+  f.kind = static_cast<InjectedFault>(static_cast<int>(u(rng) * kinds));
+  f.head = heads > 0 ? static_cast<int>(u(rng) * heads) : 0;
+  f.slot = slots > 0 ? static_cast<int>(u(rng) * slots) : 0;
   f.at_s = 16.0 * u(rng);
   f.axis = static_cast<std::size_t>(u(rng) * 3);
   f.axis_name = hal::axis_name(static_cast<hal::CoreAxis>(f.axis));
@@ -79,7 +85,9 @@ sim_hal::FaultInjection random_fault(std::mt19937_64& rng, sim_hal::SceneSpec& s
       f.load_cell = u(rng) < 0.5 ? sim_hal::LoadCellMode::kNan : sim_hal::LoadCellMode::kLost;
       break;
     case InjectedFault::kLoopStall: f.ticks = 1 + static_cast<int>(u(rng) * 100); break;
-    case InjectedFault::kPowerCut: f.at_tick = static_cast<hal::Tick>(u(rng) * 8000.0); break;
+    case InjectedFault::kPowerCut: f.at_tick = static_cast<hal::Tick>(u(rng) * (heads > 0 ? 30000.0 : 8000.0)); break;
+    case InjectedFault::kSelectorJam:
+    case InjectedFault::kYarnOut: f.at_s = 40.0 * u(rng); break;  // anywhere in the knotting of the first row
     default: break;
   }
   d << sim_hal::injected_fault_name(f.kind);
@@ -101,7 +109,7 @@ bool shed_open(const std::array<double, 2>& p) {
 }  // namespace
 
 sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run,
-                                const std::array<bool, hal::kSafetySensorCount>& second_channel,
+                                const std::array<bool, hal::kSafetySensorCount>& second_channel, int heads, int slots,
                                 std::string& description) {
   std::mt19937_64 rng(mix(seed ^ mix(run)));
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -140,6 +148,13 @@ sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run,
     s.inertia = sim_hal::Inertia{};
     d << "inertia ";
   }
+  if (heads > 0) {
+    // The heads are always simulated on a loom that has them: knots slip now and then, the weaver answers
+    // after a while.
+    s.effects.push_back(sim_hal::kEffectKnotter);
+    s.knotter = sim_hal::Knotter{u(rng) < 0.5 ? 0.0 : 0.2 * u(rng), 0.05 + 3.0 * u(rng), 8};
+    d << "knotter(miss " << s.knotter->miss_probability << ", weaver " << s.knotter->weaver_s << " s) ";
+  }
   d << "| ";
   const double pick = u(rng);
   if (pick < 0.08) {
@@ -170,7 +185,7 @@ sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run,
   } else {
     const double n = u(rng);
     const int count = n < 0.15 ? 0 : n < 0.8 ? 1 : 2;
-    for (int i = 0; i < count; ++i) s.faults.push_back(random_fault(rng, s, second_channel, d));
+    for (int i = 0; i < count; ++i) s.faults.push_back(random_fault(rng, s, second_channel, heads, slots, d));
     // One power cut per scene.
     if (count == 2 && s.faults[0].kind == InjectedFault::kPowerCut && s.faults[1].kind == InjectedFault::kPowerCut) {
       s.faults.pop_back();
@@ -202,15 +217,38 @@ RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& sp
   double carriage = sim.axis(hal::CoreAxis::kCarriage).position, helix = sim.axis(hal::CoreAxis::kHelix).position;
   double crank = sim.axis(hal::CoreAxis::kBeatCrank).position;
   std::array<double, 2> pistons = sim.pistons();
+  // The heads' servos (true positions) and where a gripper is in the warp (the machine's geometry).
+  const sim_hal::SimKnotting& kn = cfg.machine.knotting;
+  const auto heads_axes = [&](std::array<double, 2 * hal::kMaxKnottingHeads>& at) {
+    for (int h = 0; h < kn.heads; ++h) {
+      at[static_cast<std::size_t>(2 * h)] = sim.axis(kn.knotter_axis[static_cast<std::size_t>(h)]).position;
+      at[static_cast<std::size_t>(2 * h + 1)] = sim.axis(kn.selector_axis[static_cast<std::size_t>(h)]).position;
+    }
+  };
+  std::array<double, 2 * hal::kMaxKnottingHeads> head_at{};
+  heads_axes(head_at);
+  const sim_hal::SimKnotter* knotter = sim.knotter();
+  std::uint32_t requests_seen = m.sequencer().weaver_requests();
   hal::Tick fault_at = -1;
   hal::Tick t = 0;
-  for (; t < 60000; ++t) {
+  const hal::Tick max_ticks = kn.heads > 0 ? 200000 : 60000;
+  for (; t < max_ticks; ++t) {
     if (m.sequencer().finished() && (fault_at < 0 || t > fault_at + 300)) break;
     const bool warp_before = sim.beater_in_warp();
+    bool gripper_before = false;
+    for (int h = 0; h < kn.heads; ++h) gripper_before |= knotter->gripper_in_warp(h, head_at[static_cast<std::size_t>(2 * h)]);
+    std::array<bool, hal::kMaxKnottingHeads> holding{};
+    for (int h = 0; h < kn.heads; ++h) holding[static_cast<std::size_t>(h)] = knotter->gripper_closed(h);
     const bool shed_before = shed_open(pistons);
     const double x = sim.shuttle_x();
     const bool shuttle_in_shed = x > window && x < cfg.machine.width_m - window;
     m.loop().cycle(t);
+    if (m.sequencer().weaver_requests() != requests_seen) {  // the simulated weaver answers, as in a weave
+      requests_seen = m.sequencer().weaver_requests();
+      if (m.sequencer().weaver_request().ask != sequencer::WeaverAsk::kNone) {
+        firmware::Machine::simulated_weaver_sink(&m, m.sequencer().weaver_request());
+      }
+    }
     if (cut) {
       o.power_cut = true;
       break;
@@ -218,7 +256,29 @@ RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& sp
     const double c2 = sim.axis(hal::CoreAxis::kCarriage).position, h2 = sim.axis(hal::CoreAxis::kHelix).position;
     const double k2 = sim.axis(hal::CoreAxis::kBeatCrank).position;
     const auto p2 = sim.pistons();
-    if (moved(c2, carriage) && warp_before && sim.beater_in_warp()) {
+    std::array<double, 2 * hal::kMaxKnottingHeads> head2{};
+    heads_axes(head2);
+    bool gripper_now = false, knotter_moved = false, head_moved = false;
+    int selector_with_yarn = -1;
+    for (int h = 0; h < kn.heads; ++h) {
+      const auto k = static_cast<std::size_t>(2 * h), sel = k + 1;
+      gripper_now |= knotter->gripper_in_warp(h, head2[k]);
+      knotter_moved |= moved(head2[k], head_at[k]);
+      head_moved |= moved(head2[k], head_at[k]) || moved(head2[sel], head_at[sel]);
+      if (moved(head2[sel], head_at[sel]) && (holding[static_cast<std::size_t>(h)] || knotter->gripper_closed(h))) selector_with_yarn = h;
+    }
+    const bool frames_moved = moved(p2[0], pistons[0]) || moved(p2[1], pistons[1]);
+    if (gripper_before && gripper_now && (moved(c2, carriage) || moved(k2, crank) || frames_moved)) {
+      why << (moved(c2, carriage) ? "carriage" : moved(k2, crank) ? "beater crank" : "heald frame")
+          << " moved while a knotting gripper was in the warp at tick " << t;
+    } else if (knotter_moved && warp_before && sim.beater_in_warp()) {
+      why << "a knotting servo moved while the beater was in the warp at tick " << t;
+    } else if (selector_with_yarn >= 0) {
+      why << "the selector of head " << selector_with_yarn + 1 << " turned while its gripper held yarn at tick " << t;
+    } else if (fault_at >= 0 && t > fault_at + 1 && head_moved) {
+      why << "a knotting head's axis moved after the fault (" << sequencer::fault_name(m.sequencer().first_fault())
+          << ") at tick " << t;
+    } else if (moved(c2, carriage) && warp_before && sim.beater_in_warp()) {
       why << "carriage moved " << (c2 - carriage) << " m while the beater was in the warp at tick " << t;
     } else if (moved(h2, helix) && !(shed_before && shed_open(p2))) {
       why << "pick motion (helix " << (h2 - helix) << " rad) without an open shed (frames " << p2[0] << ", " << p2[1]
@@ -236,6 +296,24 @@ RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& sp
     }
     if (fault_at < 0 && m.sequencer().state() == sequencer::State::kFault) fault_at = t;
     carriage = c2, helix = h2, crank = k2, pistons = p2;
+    head_at = head2;
+  }
+  // The carpet: no knot tied twice, and every row the counters say is woven fully knotted (nothing skipped
+  // in silence). A power cut ends the run where it struck; what was tied until then must still hold.
+  if (!o.violated && knotter != nullptr) {
+    const std::uint32_t woven = m.sequencer().counters().rows;
+    for (int r = 0; r < knotter->rows() && !o.violated; ++r) {
+      for (int k = 0; k < knotter->knots_per_row(); ++k) {
+        const sim_hal::KnotCell& c = knotter->cell(r, k);
+        if (c.ties > 1 || (static_cast<std::uint32_t>(r) < woven && c.ties == 0)) {
+          o.violated = true;
+          o.what = "knot " + std::to_string(k + 1) + " of carpet row " + std::to_string(r + 1) +
+                   (c.ties > 1 ? " tied " + std::to_string(c.ties) + " times" : " never tied in a woven row") +
+                   " (first fault " + sequencer::fault_name(m.sequencer().first_fault()) + ")";
+          break;
+        }
+      }
+    }
   }
   o.faulted = m.sequencer().state() == sequencer::State::kFault;
   o.completed = m.sequencer().state() == sequencer::State::kDone;
@@ -259,7 +337,10 @@ CampaignResult run_campaign(const CampaignOptions& opt) {
       const std::uint64_t run = next.fetch_add(1);
       if (run >= opt.runs) return;
       std::string description;
-      const sim_hal::SceneSpec scene = random_scene(opt.seed, run, local.sequencer.second_channel, description);
+      const bool with_heads = local.knotting.mode == sequencer::KnottingMode::kHeads;
+      const sim_hal::SceneSpec scene =
+          random_scene(opt.seed, run, local.sequencer.second_channel, with_heads ? local.knotting.heads : 0,
+                       with_heads ? static_cast<int>(local.knotting.slot_colours.size()) : 0, description);
       const RunOutcome o = run_one(local, scene, opt.rows);
       const std::lock_guard<std::mutex> lock(mu);
       ++result.runs;

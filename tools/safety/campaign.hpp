@@ -6,7 +6,13 @@
 //   - the carriage never moves while the beater is in the warp;
 //   - the helix shaft (a pick) never moves unless the shed is truly open (both frames at their ends);
 //   - no heald frame moves while the shuttle is in the shed;
-//   - once a fault is latched no axis moves any more.
+//   - once a fault is latched no axis moves any more;
+// and on a loom with knotting heads (the scene then simulates them: misses, jammed selectors, empty slots,
+// a weaver who answers):
+//   - the carriage, the beater's crank and the heald frames never move while a gripper is in the warp;
+//   - no knotting servo leaves its rest while the beater is in the warp;
+//   - no selector turns while its gripper holds yarn;
+//   - no knot is tied twice, and every row the counters call woven has every knot tied (none skipped).
 // "Moves" means more than 1 µm (or µrad) in a tick: a servo's settling tail is not motion that can
 // catch a warp thread. Each run is deterministic for (campaign seed, run index), whatever the threads.
 #pragma once
@@ -35,8 +41,10 @@ struct RunOutcome {
 // The scene of run `run` of the campaign seeded `seed`, and a one-line description of it. Faults go
 // into every switch the machine has: the six safety sensors' first channels, and their second channels
 // where `second_channel` says the machine has one.
+// `heads` and `slots`: the loom's knotting heads and their magazine slots (0 without heads): the scene then
+// simulates them and draws their faults too.
 sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run,
-                                const std::array<bool, hal::kSafetySensorCount>& second_channel,
+                                const std::array<bool, hal::kSafetySensorCount>& second_channel, int heads, int slots,
                                 std::string& description);
 
 // Weave `rows` rows of `scene` on `cfg` and check the true state every tick.

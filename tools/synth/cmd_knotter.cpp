@@ -8,6 +8,7 @@
 // is the [knotting.linkage] config section, SI, with comments.
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -27,16 +28,10 @@ namespace {
 using motion::KnotCycleSpec;
 using motion::ThreePointSolution;
 
-// Seed 001's Delrin and section, for the side links' mass properties: m = w·h·L·ρ, I_G = m(w² + L²)/12.
-constexpr double kDelrinKgM3 = 1415.9;
-constexpr double kSectionW_m = 0.006, kSectionH_m = 0.005;
 // The seed's coupler (link 2 with holder and gripper): mass, I_G, cg 13.337 mm from the gripper.
 constexpr double kCouplerMassKg = 1.641e-3, kCouplerInertia = 208.94e-9, kCouplerCgFromGripper_m = 0.013337;
 
-motion::KnotLinkSpec side_link(double length_m) {
-  const double m = kSectionW_m * kSectionH_m * length_m * kDelrinKgM3;
-  return {length_m, m, 0.5 * length_m, m * (kSectionW_m * kSectionW_m + length_m * length_m) / 12.0};
-}
+motion::KnotLinkSpec side_link(double length_m) { return motion::delrin_link(length_m); }  // seed 001's Delrin links
 
 // The four-bar from the driven chain d and the other chain o (lengths in mm from the synthesis).
 KnotCycleSpec linkage_from(const std::array<motion::PrecisionPoint, 3>& pts, double theta0, const ThreePointSolution& d,
@@ -69,10 +64,11 @@ KnotCycleSpec linkage_from(const std::array<motion::PrecisionPoint, 3>& pts, dou
   return s;
 }
 
+// The shortest text that reads back as the same double: pasted config lines rebuild exactly this linkage.
 std::string g(double v) {
   char b[64];
-  std::snprintf(b, sizeof b, "%.10g", v == 0.0 ? 0.0 : v);  // no "-0"
-  return b;
+  const auto r = std::to_chars(b, b + sizeof b, v == 0.0 ? 0.0 : v);  // no "-0"
+  return std::string(b, r.ptr);
 }
 
 void key(std::ostream& out, const std::string& k, const std::string& v, const std::string& comment) {

@@ -339,6 +339,7 @@ int serve_main(const ServeArgs& a) {
       store.save(c);
       if (book) book->record(c.rows);  // after the counters: a cut between lags, never leads
       row_saves.saved(c.rows);
+      row_saves.saved_knots(c.rows, c.knot.cycles_started);
       failed_save.reset();
     };
     if (arm_unsaved) {  // armed from memory: the disk still lags until a retry succeeds
@@ -402,7 +403,15 @@ int serve_main(const ServeArgs& a) {
               e.button == Command::kStart ? "start" : e.button == Command::kPause ? "pause" : "reset/acknowledge",
               sequencer::state_name(e.state));
           return;
+        case RunEvent::Kind::kWeaverRequest:
+          // The loom waits for the weaver (lamp amber, buzzer): logged for the shift's record; the panel and
+          // `ctl status` show it. Nothing changed in the counters.
+          if (const sequencer::KnotProgram* p = machine->knot_program()) {
+            log(Severity::kNotice, "weaver asked: %s", sequencer::describe(e.request, *p).c_str());
+          }
+          return;
         case RunEvent::Kind::kPickDone:
+        case RunEvent::Kind::kKnotProgress:
         case RunEvent::Kind::kFinished:
           break;
       }

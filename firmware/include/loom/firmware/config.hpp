@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "loom/design/design.hpp"
+#include "loom/motion/knot_cycle.hpp"
 #include "loom/drivers/can_axis_port.hpp"
 #include "loom/drivers/can_io_port.hpp"
 #include "loom/motion/profile_set.hpp"
@@ -172,6 +173,9 @@ struct LoomConfig {
   std::vector<AxisSpec> axes = default_axes();
   // The pile: none (a flat weave), knotted by the weaver while the loom waits, or by the heads.
   sequencer::KnottingSpec knotting;
+  // The knotting servo's cycle through seed 001's linkage: its precision points, dimensions, masses and the
+  // servo's limits ([knotting.linkage], [knotting] servo keys).
+  motion::KnotCycleSpec knot_cycle = motion::seed001_knot_cycle_spec();
   CanSettings can;
   IoSettings io;
   Recipe recipe;

@@ -74,12 +74,20 @@ class Machine {
   const sim_hal::SimWorld& sim() const { return *sim_; }
   sim_hal::SimWorld& sim() { return *sim_; }  // configure-time: e.g. a power-cut handler for in-process runs
   const LoomConfig& config() const { return cfg_; }
+  // RT-safe. The loom asks the weaver: with the simulated machine's knotter the simulated weaver answers
+  // (`machine` is this Machine; the shape fits RunOptions::weaver_sink).
+  static void simulated_weaver_sink(void* machine, const sequencer::WeaverRequest& r) noexcept;
+  // The design as the knotting heads tie it (null without heads).
+  const sequencer::KnotProgram* knot_program() const { return knot_program_.get(); }
 
  private:
+  void build_knotting(const MachineOptions& opt, std::uint32_t counter_rows, sequencer::SequencerConfig& scfg);
   void build_can_hal(const MachineOptions& opt);
 
   LoomConfig cfg_;
   std::unique_ptr<motion::ProfileSlot> slot_;
+  std::unique_ptr<const sequencer::KnotProgram> knot_program_;  // the design as magazine slots (heads)
+  std::unique_ptr<const motion::KnotCycle> knot_cycle_;          // the knotting servo's cycle (heads)
   std::unique_ptr<sequencer::Sequencer> sequencer_;
   std::unique_ptr<sim_hal::SimStateFile> sim_state_;
   std::unique_ptr<sim_hal::SimWorld> sim_;

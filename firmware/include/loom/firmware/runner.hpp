@@ -86,7 +86,11 @@ struct OperatorLink {
 // Events for the non-RT side.
 // ---------------------------------------------------------------------------------------------------
 struct RunEvent {
-  enum class Kind : std::uint8_t { kRowDone, kPickDone, kPaused, kResumed, kFault, kOverrunStop, kFinished, kButton };
+  // kKnotProgress: the knotting heads' counters moved (a knot cycle started or done, knots tied): saved like
+  // a pick. kWeaverRequest: the loom asks the weaver (`request`).
+  enum class Kind : std::uint8_t {
+    kRowDone, kPickDone, kPaused, kResumed, kFault, kOverrunStop, kFinished, kButton, kKnotProgress, kWeaverRequest
+  };
   Kind kind = Kind::kRowDone;
   hal::Tick tick = 0;
   sequencer::RowStats row{};
@@ -98,6 +102,7 @@ struct RunEvent {
   std::uint16_t fault_detail = 0;
   int fault_sensor = -1;  // hal::SafetySensor the fault names (sensor_discrepancy), or -1
   Command button = Command::kStart;  // kButton: the I/O module's button pressed (operator_buttons)
+  sequencer::WeaverRequest request{};  // kWeaverRequest
 };
 // Run events waiting for the reporter (real time only: in virtual time the handler runs in place and no
 // ring is allocated). An event is at most one per row, pick, pause, resume or fault,
@@ -117,6 +122,12 @@ struct RowSaves {
     rows_on_disk.store(rows, std::memory_order_release);
   }
   void failed() noexcept { last_save_failed.store(true, std::memory_order_release); }
+  // The knotting heads' write-ahead: the counters on disk say `started` knot cycles of the row after `rows`
+  // production rows were begun (no cycle starts before its start is on disk).
+  std::atomic<std::uint64_t> knots_on_disk{0};
+  void saved_knots(std::uint32_t rows, std::uint32_t started) noexcept {
+    knots_on_disk.store(static_cast<std::uint64_t>(rows) << 32 | started, std::memory_order_release);
+  }
 };
 
 struct RunOptions {
@@ -132,6 +143,10 @@ struct RunOptions {
   RowSaves* row_saves = nullptr;                  // the counters-file handshake, when one is kept
   // Simulation: a weaver who says "row knotted" this long after the loom starts waiting (knotting mode).
   double simulated_knotting_s = 0.0;
+  // Knotting heads: called (on the loop's thread, RT-safe) with every request the loom makes of the weaver;
+  // the simulated machine's weaver answers them. Null: the weaver is a person at the panel.
+  void (*weaver_sink)(void* ctx, const sequencer::WeaverRequest& r) = nullptr;
+  void* weaver_sink_ctx = nullptr;
 
   // Real-time thread (realtime only).
   int fifo_priority = 80;        // SCHED_FIFO priority of the loop thread; 0 = SCHED_OTHER

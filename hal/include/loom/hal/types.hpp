@@ -20,6 +20,9 @@ inline constexpr Tick kNeverTick = -1;
 // capacity and only the first `AxisLayout::count` entries are used.
 // ---------------------------------------------------------------------------------------------------
 inline constexpr std::size_t kMaxAxes = 32;  // 12 knotting heads x 2 servos + 3 core axes, with room
+// Knotting heads on the carriage (the machine description's [knotting] section): each has a knotting
+// servo and a colour-selector servo (axes with roles knotter / selector) and the digital I/O below.
+inline constexpr std::size_t kMaxKnottingHeads = 12;
 enum class CoreAxis : std::uint8_t {
   kBeatCrank = 0,  // crank of the beat-up crank-rocker, position in rad (unwrapped)
   kCarriage = 1,   // carriage slider across the width, position in m
@@ -134,6 +137,10 @@ struct DigitalOutputs {
   bool lamp_amber = false;   // waiting for the operator (armed, paused, waiting for the knotter)
   bool lamp_red = false;     // fault latched, waiting for acknowledgement
   bool buzzer = false;
+  // Knotting heads (the first `heads` entries): gripper closed on the yarn, cutter blade firing. Safe state
+  // (false) opens the grippers and retracts the cutters.
+  std::array<bool, kMaxKnottingHeads> gripper_close{};
+  std::array<bool, kMaxKnottingHeads> cutter{};
 };
 
 // The six safety sensors — the ones whose word lets a frame move or a pick start — in a fixed order
@@ -162,6 +169,9 @@ struct DigitalInputs {
   // place on its own input, where the machine has one (io.<sensor>_2_bit). One stuck switch then cannot
   // confirm a shed or an arrival that did not happen: the two must agree. False where not wired.
   std::array<bool, kSafetySensorCount> second_channel{};
+  // Knotting heads: the yarn-present switch behind each gripper's knot position, true when a knot was
+  // tied and pulled down to the fell (sampled in the knot cycle's window). False where no head is fitted.
+  std::array<bool, kMaxKnottingHeads> yarn_present{};
   Tick refreshed = kNeverTick;
 };
 

@@ -75,6 +75,9 @@ struct KnotCycleSpec {
 // coupler; the servo drives the shorter side link. Delrin links 6 × 5 mm; the coupler with its
 // holder and gripper keeps the seed's 1.641 g and I_G = 208.94e-9 kg m²; crank and rocker use the
 // seed's V·ρ and I_G = m(6² + L²)/12 formulas on the correct lengths. A micro servo's limits.
+// Configure-time. A side link of seed 001's Delrin (ρ = 1415.9 kg/m³), 6 × 5 mm section, `length_m` pivot to
+// pivot: m = w·h·L·ρ, cg at mid-length, I_G = m (w² + L²)/12 (the seed's formulas).
+KnotLinkSpec delrin_link(double length_m);
 KnotCycleSpec seed001_knot_cycle_spec();
 
 // What bounds a segment of the cycle.

@@ -41,7 +41,14 @@ namespace loom::sequencer {
   X(kCountersNotSaved, 0x101F, "counters_not_saved", "the production counters of a finished row could not be saved") \
   X(kSensorDiscrepancy, 0x1020, "sensor_discrepancy", "the two channels of a safety sensor disagree (a stuck switch or a wiring fault)") \
   X(kHomingFailed, 0x1021, "homing_failed", "an axis' homing run failed or did not find its reference in time") \
-  X(kAxisUnreferenced, 0x1022, "axis_unreferenced", "an axis lost its reference (drive power cycle) or cannot be homed")
+  X(kAxisUnreferenced, 0x1022, "axis_unreferenced", "an axis lost its reference (drive power cycle) or cannot be homed") \
+  X(kKnotServoLag, 0x1023, "knot_servo_lag", "a knotting servo did not follow its knot cycle (jammed linkage or drive limit)") \
+  X(kSelectorJam, 0x1024, "selector_jam", "a colour selector did not reach its magazine slot (jammed magazine or drive limit)") \
+  X(kYarnSensorStuck, 0x1025, "yarn_sensor_stuck", "a head's yarn-present switch saw a knot before the head tied one (stuck switch, or a knot already there)") \
+  X(kGripperInWarp, 0x1026, "interlock_gripper_in_warp", "carriage, beater or shed commanded while a knotting gripper is in the warp") \
+  X(kKnotNotClear, 0x1027, "interlock_knot_not_clear", "knot cycle commanded while the beater is in the warp or the shed is not still") \
+  X(kSelectorWithYarn, 0x1028, "interlock_selector_with_yarn", "colour selector commanded while its gripper holds yarn") \
+  X(kShedLost, 0x1029, "shed_lost", "a heald frame left its end position while the shed was held for knotting (air, valve or end sensor)")
 
 enum class Fault : std::uint8_t {
 #define LOOM_FAULT_ENUM(id, code, name, text) id,

@@ -14,9 +14,11 @@
 #include <string>
 #include <vector>
 
+#include "loom/hal/types.hpp"
+
 namespace loom::sequencer {
 
-inline constexpr int kMaxKnottingHeads = 12;
+inline constexpr int kMaxKnottingHeads = static_cast<int>(hal::kMaxKnottingHeads);
 inline constexpr int kMaxMagazineSlots = 16;
 
 // What the loom does about the pile: nothing (a flat weave), the weaver knots each row by hand while the
@@ -42,11 +44,17 @@ struct KnottingSpec {
   KnotType knot = KnotType::kTurkish;
   double knots_per_dm = 30.0;  // across the width
   double rows_per_dm = 30.0;   // along the carpet
-  int heads = 2;
-  double head_spacing_m = 0.6;
+  int heads = 6;
+  double head_spacing_m = 0.2;
   // Every head's colour selector holds the same magazine: slot s carries palette code slot_colours[s].
   std::vector<std::string> slot_colours;
   int knots_per_slot = 2000;  // yarn in a full slot, counted in knots
+  // Commissioning and the selector's motion (the knotting servo's limits are in the knot cycle's spec; each
+  // axis' top speed is its [axes.<name>] max_speed).
+  double take_position_rad = 0.0;  // knotting servo reading with the gripper at TAKE
+  double selector_zero_rad = 0.0;  // selector reading with slot 0 at the TAKE point
+  double selector_accel_rad_s2 = 400.0;
+  double selector_jerk_rad_s3 = 20000.0;
 };
 
 // Configure-time. "" when the spec is usable on a loom `width_m` wide, else why not (naming the

@@ -23,6 +23,10 @@ struct RowStats {
   std::uint32_t row = 0;     // 1-based number of the row just completed
   hal::Tick shed_ticks = 0, pick_ticks = 0, beat_ticks = 0, total_ticks = 0;  // shed/pick summed over picks
   hal::Tick knotting_ticks = 0;  // knotting mode: how long the weaver knotted before this row (not in total)
+  // Knotting heads: the machine's knotting time (in total), the time waiting for the weaver's hand (in
+  // total), and the row's knots tied by the heads, retried, and tied by the weaver.
+  hal::Tick knot_ticks = 0, weaver_ticks = 0;
+  int knots_tied = 0, knots_retried = 0, knots_by_hand = 0;
   int beats = 0;
   int carriage_steps = 0;
   bool force_measured = false;
@@ -45,6 +49,13 @@ class RowRecorder {
   }
   void add_shed(hal::Tick ticks) noexcept { stats_.shed_ticks += ticks; }
   void set_knotting(hal::Tick ticks) noexcept { stats_.knotting_ticks = ticks; }
+  void set_knots(hal::Tick knot_ticks, hal::Tick weaver_ticks, int tied, int retried, int by_hand) noexcept {
+    stats_.knot_ticks = knot_ticks;
+    stats_.weaver_ticks = weaver_ticks;
+    stats_.knots_tied = tied;
+    stats_.knots_retried = retried;
+    stats_.knots_by_hand = by_hand;
+  }
   void add_pick(hal::Tick ticks) noexcept { stats_.pick_ticks += ticks; }
   void beat_at(int k, double x_m) noexcept {
     if (k >= 0 && k < kMaxBeatsPerRow) stats_.beat[static_cast<std::size_t>(k)].x_m = static_cast<float>(x_m);

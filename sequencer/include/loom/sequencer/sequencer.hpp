@@ -15,6 +15,7 @@
 #include "loom/sequencer/dual_channel.hpp"
 #include "loom/sequencer/faults.hpp"
 #include "loom/sequencer/interlocks.hpp"
+#include "loom/sequencer/row_knotter.hpp"
 #include "loom/sequencer/row_stats.hpp"
 #include "loom/sequencer/shed_monitor.hpp"
 
@@ -31,6 +32,7 @@ enum class State : std::uint8_t {
   kBeatSweep,    // crank beats while the carriage steps across the width
   kRowEnd,       // row woven, beater parked: waiting until its counters are on disk (when asked to)
   kAwaitKnotting,  // knotting mode: parked before a new row until the weaver says the row is knotted
+  kKnotting,     // knotting heads: tying the row knot by knot before its shed change (or asking the weaver)
   kPaused,       // holding at a safe point (before a shed change), drives enabled, until resumed
   kDone,         // all requested rows woven (or stop at row end): holding, enabled
   kFault,        // latched fault: quick stop, valves hold, counters kept
@@ -42,6 +44,7 @@ struct Counters {
   std::uint32_t picks = 0;         // completed picks (shuttle arrived)
   std::uint32_t beats = 0;         // beats delivered (beater passed the fell)
   std::uint32_t picks_in_row = 0;  // picks of the row in progress (restart resumes here)
+  KnotCounters knot{};             // knotting heads: knots tied/retried/by hand, the row's cycles
 };
 
 // One beat as the technician sees it: published once per beat, when the beater has left the warp
@@ -109,6 +112,9 @@ struct SequencerConfig {
   // Knotting mode (handmade carpets: knot a row, pass the weft, beat): before every new row the loom
   // parks and waits for "row knotted" — the pedal/button input row_knotted, or request_row_knotted().
   bool knotting = false;
+  // Knotting heads (knotting.mode = "heads"): the design as magazine slots, the knot cycle and the heads'
+  // axes. Before every new row the heads tie it (RowKnotter) while the beater is parked and the shed still.
+  KnottingConfig heads{};
 };
 
 // Configure-time only. "" when the sequencer can run `profiles` with `cfg`, else why not, naming the
@@ -151,6 +157,23 @@ class Sequencer {
     rows_on_disk_ = rows_on_disk;
     last_save_failed_ = last_save_failed;
   }
+  // RT-safe. The knot cycles of row `rows` (production rows before it) the counters file says were started:
+  // with await_row_saved, no knot cycle starts before its start is on disk.
+  void note_knots_saved(std::uint32_t rows, std::uint32_t cycles_started) noexcept {
+    knots_on_disk_rows_ = rows;
+    knots_on_disk_started_ = cycles_started;
+  }
+  // RT-safe. What the loom asks of the weaver now (kNone when nothing); requests() counts every request
+  // made (a reader polling it sees each one).
+  const WeaverRequest& weaver_request() const noexcept {
+    static constexpr WeaverRequest kNothing{};
+    return state_ == State::kKnotting ? knotter_.request() : kNothing;
+  }
+  std::uint32_t weaver_requests() const noexcept { return knotter_.requests(); }
+  // The knotting heads as the interlocks see them (heads = 0 without).
+  const KnotGuard& knot_guard() const noexcept { return interlock_ctx_.knot; }
+  // RT-safe. The knot cycle the heads are on (0-based) while knotting.
+  int knot_cycle() const noexcept { return knotter_.cycle(); }
 
   // RT-safe. One tick: check faults → advance the row cycle → sample profiles → check interlocks →
   // write every field of `out`.
@@ -209,6 +232,8 @@ class Sequencer {
   void beat_sweep(hal::Tick now) noexcept;
   void row_end(hal::Tick now) noexcept;
   void await_knotting(hal::Tick now) noexcept;
+  void knotting(hal::Tick now, const hal::HalInputs& in) noexcept;
+  bool knotters_at_rest(hal::Tick now, const hal::HalInputs& in) noexcept;  // positioning: back to TAKE first
   void paused(hal::Tick now) noexcept;
   void fault(hal::Tick now) noexcept;
   // ---- transitions and helpers ----
@@ -231,6 +256,7 @@ class Sequencer {
   void after_row(hal::Tick now) noexcept;  // done, paused or the next row, once the boundary is passed
   void next_row(hal::Tick now) noexcept;   // a new row: first knotted by the weaver in knotting mode
   void adopt_limits() noexcept;
+  void configure_knot_guard();
   Fault shed_fault(ShedVerdict v) const noexcept;
   void publish_beat(int k) noexcept;
   bool expect_shuttle_left() const noexcept { return counters_.picks % 2 == 0; }  // it starts at the left
@@ -276,6 +302,8 @@ class Sequencer {
     motion::JerkMove move;
   };
   ActiveMove crank_move_, carriage_move_, helix_move_;
+  std::array<ActiveMove, hal::kMaxKnottingHeads> knot_park_{};  // knotting servos back to rest (positioning)
+  motion::JerkLimits knot_park_limits_{.velocity = 2.0, .acceleration = 20.0, .jerk = 1000.0};  // slow: a gripper may hold yarn
   bool sweeping_ = false;          // carriage follows the cam on the crank move
   double carriage_sweep_origin_ = 0.0;
   double carriage_sweep_dir_ = 1.0;
@@ -310,6 +338,10 @@ class Sequencer {
   bool knot_requested_ = false;  // "row knotted" since the loom last started waiting for it
   bool row_knotted_ = false;     // the row about to start has been knotted
   hal::Tick knotting_ticks_ = 0;
+  RowKnotter knotter_;                     // the knotting heads (fitted() when the machine has them)
+  std::uint32_t knotter_requests_seen_ = 0;  // a new weaver request clears an earlier pedal press
+  std::uint32_t knots_on_disk_rows_ = 0, knots_on_disk_started_ = 0;
+  bool knotters_parked_ = false;           // positioning brought every knotting servo to rest
   hal::DigitalInputs io_{};
   hal::DigitalInputs raw_io_{};
   int sensed_ticks_ = 0;                       // picture checks wait until the debouncer has history

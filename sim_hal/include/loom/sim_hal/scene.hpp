@@ -9,6 +9,7 @@
 
 #include "loom/hal/types.hpp"
 #include "loom/motion/beatup.hpp"
+#include "loom/sim_hal/knotter.hpp"
 
 namespace loom::sim_hal {
 
@@ -21,6 +22,7 @@ inline constexpr const char* kEffectSensorNoise = "sensor_noise";   // end/arriv
 inline constexpr const char* kEffectBeatContact = "beat_contact";   // beater load cell at the cloth fell
 inline constexpr const char* kEffectInertia = "inertia";             // rigid-body beat-up behind a torque-limited servo
 inline constexpr const char* kEffectJointFriction = "joint_friction"; // crank bearing friction (needs inertia)
+inline constexpr const char* kEffectKnotter = "knotter";             // the knotting heads, their yarn and the weaver
 const std::vector<std::string>& known_effects();
 
 struct ServoLag {
@@ -91,8 +93,10 @@ enum class InjectedFault : std::uint8_t {
   kAirLoss,             // the air supply fails: neither piston moves any more
   kLoopStall,           // the loop stalls for `ticks` ticks: no input refreshed, `ticks` overruns counted
   kPowerCut,            // the power fails at tick `at_tick`: the run ends as if the process were killed
+  kSelectorJam,         // the colour selector of `head` jams where it stands (needs the knotter effect)
+  kYarnOut,             // slot `slot` of `head`'s magazine runs out of yarn early (needs the knotter effect)
 };
-inline constexpr int kInjectedFaultCount = 15;
+inline constexpr int kInjectedFaultCount = 17;
 const char* injected_fault_name(InjectedFault f);  // the scene file's `kind`
 
 // Every switch a scene can fail: the six safety sensors' first channels, then their second channels
@@ -131,6 +135,8 @@ struct FaultInjection {
   int ticks = 1;                           // encoder glitch, loop stall
   LoadCellMode load_cell = LoadCellMode::kNan;
   hal::Tick at_tick = -1;                  // power cut: the tick it strikes (at_s is ignored)
+  int head = 0;                            // selector jam, yarn out: 0-based head
+  int slot = 0;                            // yarn out: magazine slot
 };
 
 // Physical facts of the simulated machine that are not effects (they come from the loom config).
@@ -161,6 +167,7 @@ struct SimMachine {
   // Which safety sensors have a second switch (hal::SafetySensor order): each sees the same truth as the
   // first and fails on its own (its own stuck faults, its own noise).
   std::array<bool, hal::kSafetySensorCount> second_channel{};
+  SimKnotting knotting;  // the knotting heads (heads = 0: none)
 };
 
 struct SceneSpec {
@@ -174,6 +181,7 @@ struct SceneSpec {
   std::optional<BeatContact> beat_contact;
   std::optional<Inertia> inertia;
   std::optional<JointFriction> joint_friction;
+  std::optional<Knotter> knotter;
   std::vector<FaultInjection> faults;
 };
 

@@ -11,6 +11,8 @@
 
 #include "loom/hal/hal.hpp"
 #include "loom/motion/beatup.hpp"
+#include "loom/sim_hal/knotter.hpp"
+#include "loom/sim_hal/random.hpp"
 #include "loom/sim_hal/scene.hpp"
 #include "loom/sim_hal/sim_state_file.hpp"
 
@@ -37,16 +39,6 @@ struct SimAxis {
   bool homing = false;        // a homing run is under way
   double homing_goal = 0.0;   // the true position of its reference point
   std::vector<std::unique_ptr<AxisEffect>> effects;  // built once from the scene
-};
-
-// Deterministic, allocation-free random numbers for noise effects (splitmix64).
-class SimRandom {
- public:
-  explicit SimRandom(std::uint64_t seed) : state_(seed) {}
-  double uniform() noexcept;  // [0, 1)
-
- private:
-  std::uint64_t state_;
 };
 
 class SimWorld final : public hal::AxisPort, public hal::IoPort {
@@ -85,6 +77,13 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   bool power_cut() const { return powered_off_; }
   // Overruns injected by loop_stall faults (the ticks the loop was stalled), for the loop's statistics.
   std::uint32_t injected_overruns() const { return injected_overruns_; }
+  // The knotting heads (scene effect "knotter"; null without it): the carpet as knotted, for reports and tests.
+  const SimKnotter* knotter() const { return knotter_.get(); }
+  // RT-safe. The loom asks the weaver (the panel's request): the simulated weaver does it after a while and
+  // presses the pedal. Ignored without the knotter effect.
+  void ask_weaver(const WeaverTask& t) noexcept {
+    if (knotter_) knotter_->ask(t);
+  }
 
  private:
   void apply_injected_faults(hal::Tick now) noexcept;
@@ -93,6 +92,7 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   void step_homing(std::size_t slot) noexcept;
   void step_shuttle(double helix_position) noexcept;
   void step_beat_contact(double crank_position, double crank_velocity) noexcept;
+  void readings(std::array<double, hal::kMaxAxes>& out) const noexcept;  // every axis as its drive reads it
 
   SimMachine m_;
   SceneSpec scene_;
@@ -128,6 +128,9 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   hal::Tick stall_until_ = 0;
   std::uint32_t injected_overruns_ = 0;
   bool powered_off_ = false;
+  std::unique_ptr<SimKnotter> knotter_;         // scene effect "knotter"
+  std::array<bool, hal::kMaxAxes> jammed_{};    // a jammed axis no longer follows its target
+  int shuttle_side_ = 0;                        // -1 at the left selvedge, +1 at the right, 0 between
   bool drives_simulated_ = false;  // this world's axes are the drives (not real ones beside it)
   void (*power_cut_handler_)(void*) = nullptr;
   void* power_cut_ctx_ = nullptr;

@@ -1,0 +1,358 @@
+// The knotting heads tying a row (see row_knotter.hpp).
+#include "loom/sequencer/row_knotter.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "loom/motion/angles.hpp"
+
+namespace loom::sequencer {
+
+const char* weaver_ask_name(WeaverAsk a) {
+  switch (a) {
+    case WeaverAsk::kNone: return "none";
+    case WeaverAsk::kTieByHand: return "tie_by_hand";
+    case WeaverAsk::kReload: return "reload";
+    case WeaverAsk::kCheckKnot: return "check_knot";
+  }
+  return "?";
+}
+
+std::string describe(const WeaverRequest& r, const KnotProgram& p) {
+  const std::string colour = r.slot >= 0 && r.slot < p.slots() ? p.slot_colour(r.slot) : "?";
+  const std::string head = "head " + std::to_string(r.head + 1);
+  const std::string where = "row " + std::to_string(r.row) + " (design row " + std::to_string(r.design_row + 1) + "): ";
+  const std::string knot = "knot " + std::to_string(r.knot + 1) + " (" + head + ")";
+  switch (r.ask) {
+    case WeaverAsk::kNone: return "nothing";
+    case WeaverAsk::kTieByHand:
+      return where + "tie " + knot + " by hand in colour " + colour + " (the head missed it twice: look at slot " +
+             std::to_string(r.slot) + "'s yarn and the gripper)";
+    case WeaverAsk::kReload: return where + "reload colour " + colour + " into slot " + std::to_string(r.slot) + " of " + head;
+    case WeaverAsk::kCheckKnot:
+      return where + "check " + knot + " (the power failed while it was tied): finish or tie it by hand in colour " + colour;
+  }
+  return "?";
+}
+
+void RowKnotter::configure(const KnottingConfig& k, const KnotGuard* guard, double period_s, double carriage_home_m,
+                           const motion::JerkLimits& carriage) {
+  k_ = k;
+  guard_ = guard;
+  period_s_ = period_s;
+  carriage_home_m_ = carriage_home_m;
+  carriage_ = carriage;
+  heads_ = fitted() ? k_.program->heads() : 0;
+  stripe_ = fitted() ? k_.program->stripe() : 0;
+  slot_.fill(-1);
+  stock_known_ = false;
+  phase_ = Phase::kDone;
+}
+
+double RowKnotter::rest_behind(double position) const noexcept {
+  if (!fitted()) return position;
+  const double turn = k_.cycle->end_offset_rad();
+  if (turn == 0.0) return k_.take_position_rad;  // the cycle swings back: one rest pose
+  // A servo that turns on by `turn` per knot rests at take + n·turn; back to the one behind it.
+  const double n = std::floor((position - k_.take_position_rad) / turn + 1e-9);
+  return k_.take_position_rad + n * turn;
+}
+
+double RowKnotter::selector_goal(int /*head*/, int slot, double from) const noexcept {
+  // Slot s sits at zero + s·pitch; the selector turns the short way round to it.
+  const double pitch = motion::kTwoPi / k_.program->slots();
+  return from + motion::wrap_pi(k_.selector_zero_rad + slot * pitch - from);
+}
+
+void RowKnotter::begin(std::uint32_t row0, const KnotCounters& progress, double return_to_m, hal::Tick now,
+                       const hal::HalOutputs& cmd) noexcept {
+  row0_ = row0;
+  return_to_m_ = return_to_m;
+  fault_ = Fault::kNone;
+  fault_axis_ = -1;
+  row_ = RowKnots{};
+  row_since_ = now;
+  request_ = WeaverRequest{};
+  if (!stock_known_) {
+    // Full magazines are loaded before weaving starts; from then on every knot cycle counts its yarn down.
+    for (int h = 0; h < heads_; ++h) stock_[static_cast<std::size_t>(h)].fill(k_.program->knots_per_slot());
+    stock_known_ = true;
+  }
+  for (int h = 0; h < heads_; ++h) {
+    const auto hh = static_cast<std::size_t>(h);
+    knotter_origin_[hh] = cmd.axes[static_cast<std::size_t>(k_.knotter_axis[hh])].target_position;
+    selector_move_[hh].active = false;
+    slot_[hh] = -1;  // where a selector stands is read back from its command when it is next sent
+  }
+  next_started_ = false;
+  // A cycle started and not finished: the power failed while its knots were being tied. Whether they are
+  // is not known; tying again could tie one twice, so the weaver checks them (kCheck asks).
+  interrupted_ = progress.cycles_started > progress.cycles_done && progress.cycles_done < static_cast<std::uint32_t>(stripe_);
+  enter_cycle(static_cast<int>(progress.cycles_done), now, cmd);
+}
+
+void RowKnotter::plan_travel(int j, hal::Tick now, const hal::HalOutputs& cmd) noexcept {
+  const double from = cmd.axes[hal::index(hal::CoreAxis::kCarriage)].target_position;
+  const double goal = carriage_home_m_ + k_.program->carriage_at(j);
+  carriage_move_ = {true, false, now, from, motion::JerkMove::plan(goal - from, carriage_)};
+  for (int h = 0; h < heads_; ++h) {
+    const auto hh = static_cast<std::size_t>(h);
+    const int k = k_.program->knot_of(h, j);
+    if (k < 0) continue;
+    const int s = k_.program->slot(row0_, k);
+    if (s == slot_[hh]) continue;
+    const double at = cmd.axes[static_cast<std::size_t>(k_.selector_axis[hh])].target_position;
+    selector_move_[hh] = {true, true, now, at, motion::JerkMove::plan(selector_goal(h, s, at) - at, k_.selector)};
+    slot_[hh] = s;
+  }
+}
+
+void RowKnotter::enter_cycle(int j, hal::Tick now, const hal::HalOutputs& cmd) noexcept {
+  j_ = j;
+  attempt_ = 0;
+  if (j_ >= stripe_) {  // the row is knotted: the carriage goes back to the row's start selvedge
+    const double from = cmd.axes[hal::index(hal::CoreAxis::kCarriage)].target_position;
+    carriage_move_ = {true, false, now, from, motion::JerkMove::plan(carriage_home_m_ + return_to_m_ - from, carriage_)};
+    phase_ = Phase::kReturn;
+    phase_since_ = now;
+    return;
+  }
+  if (!next_started_) plan_travel(j_, now, cmd);
+  next_started_ = false;
+  for (int h = 0; h < heads_; ++h) {
+    const auto hh = static_cast<std::size_t>(h);
+    active_[hh] = k_.program->knot_of(h, j_) >= 0;
+    seen_[hh] = false;
+    missed_[hh] = false;
+  }
+  phase_ = Phase::kTravel;
+  phase_since_ = now;
+}
+
+bool RowKnotter::play(Move& m, hal::Tick now, double& target) const noexcept {
+  if (!m.active) return false;
+  const double t = seconds(now - m.t0);
+  target = m.origin + m.move.at(t).position;
+  if (t >= m.move.duration()) m.active = false;
+  return true;  // it wrote a target this tick (its last one, perhaps): nothing else may start in this tick
+}
+
+bool RowKnotter::fail(Fault f, int axis) noexcept {
+  fault_ = f;
+  fault_axis_ = axis;
+  return false;
+}
+
+void RowKnotter::ask(WeaverAsk a, int head, int knot, int slot, hal::Tick now) noexcept {
+  request_.ask = a;
+  request_.row = row0_ + 1;
+  request_.design_row = k_.program->design_row(row0_);
+  request_.knot = knot;
+  request_.head = head;
+  request_.slot = slot;
+  weaver_since_ = now;
+  ++requests_;
+}
+
+void RowKnotter::start_cycle(hal::Tick now) noexcept {
+  for (int h = 0; h < heads_; ++h) {
+    const auto hh = static_cast<std::size_t>(h);
+    if (active_[hh]) --stock_[hh][static_cast<std::size_t>(slot_[hh])];  // the gripper takes yarn at TAKE
+    seen_[hh] = false;
+  }
+  cycle_t0_ = now;
+  phase_ = Phase::kCycle;
+  phase_since_ = now;
+}
+
+RowKnotter::Status RowKnotter::check(hal::Tick now, const hal::HalInputs& in, const hal::HalOutputs& cmd,
+                                     KnotCounters& counters, bool await_disk, std::uint32_t on_disk_started) noexcept {
+  // Every servo where it was sent (a drive trails its command by a few ticks: settle_s).
+  const bool settled = seconds(now - phase_since_) >= k_.settle_s;
+  for (int h = 0; h < heads_; ++h) {
+    const auto hh = static_cast<std::size_t>(h);
+    const auto sel = static_cast<std::size_t>(k_.selector_axis[hh]);
+    const auto kn = static_cast<std::size_t>(k_.knotter_axis[hh]);
+    const bool sel_off = std::abs(in.axes[sel].position - cmd.axes[sel].target_position) > k_.servo_tolerance_rad;
+    const bool kn_off = std::abs(in.axes[kn].position - cmd.axes[kn].target_position) > k_.servo_tolerance_rad;
+    if (!sel_off && !kn_off) continue;
+    if (!settled) return Status::kRunning;
+    fail(sel_off ? Fault::kSelectorJam : Fault::kKnotServoLag, static_cast<int>(sel_off ? sel : kn));
+    return Status::kFault;
+  }
+  if (interrupted_) {  // the power failed inside this cycle: the weaver checks its knots first
+    interrupted_ = false;
+    missed_ = active_;
+    hand_ask_ = WeaverAsk::kCheckKnot;
+    ask_head_ = 0;
+    phase_ = Phase::kWeaver;
+    return Status::kAwaitingWeaver;
+  }
+  for (int h = 0; h < heads_; ++h) {
+    const auto hh = static_cast<std::size_t>(h);
+    if (!active_[hh]) continue;
+    // Yarn for the knot: an empty slot is reloaded before the knot that needs it.
+    if (stock_[hh][static_cast<std::size_t>(slot_[hh])] <= 0) {
+      ask(WeaverAsk::kReload, h, -1, slot_[hh], now);
+      phase_ = Phase::kWeaver;
+      return Status::kAwaitingWeaver;
+    }
+    // The knot position must be empty: a switch already on is stuck, or a knot is already there.
+    if (in.io.yarn_present[hh]) {
+      fail(Fault::kYarnSensorStuck, k_.knotter_axis[hh]);
+      return Status::kFault;
+    }
+  }
+  // Write-ahead: "cycle j started" is on disk before the cycle starts, so a power cut inside it is known
+  // after the restart and its knots are never tied a second time.
+  counters.cycles_started = std::max(counters.cycles_started, static_cast<std::uint32_t>(j_ + 1));
+  if (await_disk && on_disk_started < counters.cycles_started) return Status::kRunning;
+  start_cycle(now);
+  return Status::kRunning;
+}
+
+void RowKnotter::run_cycle(hal::Tick now, const hal::HalInputs& in, hal::HalOutputs& cmd, KnotCounters& counters) noexcept {
+  const motion::KnotCycle& c = *k_.cycle;
+  const double t = seconds(now - cycle_t0_);
+  const motion::KnotCycle::Sample s = c.sample(t);
+  bool all_seen = true;
+  for (int h = 0; h < heads_; ++h) {
+    const auto hh = static_cast<std::size_t>(h);
+    if (!active_[hh]) continue;
+    cmd.axes[static_cast<std::size_t>(k_.knotter_axis[hh])].target_position = knotter_origin_[hh] + s.angle_rad;
+    cmd.io.gripper_close[hh] = c.gripper_closed().contains(t);
+    cmd.io.cutter[hh] = c.cutter().contains(t);
+    if (c.yarn_sample().contains(t) && in.io.yarn_present[hh]) seen_[hh] = true;
+    all_seen &= seen_[hh];
+  }
+  // The next knot's travel starts inside this cycle once this position cannot be needed again: every knot
+  // verified (no retry), the yarn released (selectors) and every gripper out of the warp (carriage).
+  if (all_seen && !next_started_ && j_ + 1 < stripe_ && t >= c.yarn_sample().end_s && t >= c.gripper_closed().end_s &&
+      t >= c.in_warp().end_s) {
+    plan_travel(j_ + 1, now, cmd);
+    next_started_ = true;
+  }
+  if (t >= c.duration_s()) finish_cycle(now, cmd, counters);
+}
+
+void RowKnotter::finish_cycle(hal::Tick now, const hal::HalOutputs& cmd, KnotCounters& counters) noexcept {
+  bool retry = false, missed = false;
+  for (int h = 0; h < heads_; ++h) {
+    const auto hh = static_cast<std::size_t>(h);
+    if (!active_[hh]) continue;
+    knotter_origin_[hh] += k_.cycle->end_offset_rad();  // the servo is at rest again, a cycle on
+    if (seen_[hh]) {
+      ++counters.tied;
+      ++row_.tied;
+      active_[hh] = false;
+    } else if (attempt_ == 0) {
+      ++counters.retried;
+      ++row_.retried;
+      retry = true;  // stays active: ties again
+    } else {
+      missed_[hh] = true;
+      active_[hh] = false;
+      missed = true;
+    }
+  }
+  if (retry) {
+    attempt_ = 1;
+    start_cycle(now);
+    return;
+  }
+  if (missed) {
+    hand_ask_ = WeaverAsk::kTieByHand;
+    ask_head_ = 0;
+    phase_ = Phase::kWeaver;
+    return;
+  }
+  cycle_done(now, cmd, counters);
+}
+
+void RowKnotter::cycle_done(hal::Tick now, const hal::HalOutputs& cmd, KnotCounters& counters) noexcept {
+  counters.cycles_done = static_cast<std::uint32_t>(j_ + 1);
+  counters.cycles_started = std::max(counters.cycles_started, counters.cycles_done);
+  enter_cycle(j_ + 1, now, cmd);
+}
+
+RowKnotter::Status RowKnotter::weaver(hal::Tick now, const hal::HalOutputs& cmd, KnotCounters& counters,
+                                      bool weaver_done) noexcept {
+  if (request_.ask != WeaverAsk::kNone) {
+    if (!weaver_done) return Status::kAwaitingWeaver;
+    row_.weaver_ticks += now - weaver_since_;
+    const WeaverAsk done = request_.ask;
+    request_.ask = WeaverAsk::kNone;
+    if (done == WeaverAsk::kReload) {  // the slot is full again: check the cycle again
+      stock_[static_cast<std::size_t>(request_.head)][static_cast<std::size_t>(request_.slot)] = k_.program->knots_per_slot();
+      phase_ = Phase::kCheck;
+      phase_since_ = now;
+      return Status::kRunning;
+    }
+    ++counters.by_hand;  // tied (or checked and finished) by the weaver
+    ++row_.by_hand;
+    missed_[static_cast<std::size_t>(request_.head)] = false;
+  }
+  for (; ask_head_ < heads_; ++ask_head_) {  // one request at a time, head by head
+    if (!missed_[static_cast<std::size_t>(ask_head_)]) continue;
+    const int k = k_.program->knot_of(ask_head_, j_);
+    ask(hand_ask_, ask_head_, k, k_.program->slot(row0_, k), now);
+    return Status::kAwaitingWeaver;
+  }
+  cycle_done(now, cmd, counters);  // every knot of the cycle is tied, by the heads or by hand
+  return Status::kRunning;
+}
+
+RowKnotter::Status RowKnotter::step(hal::Tick now, const hal::HalInputs& in, hal::HalOutputs& cmd,
+                                    KnotCounters& counters, bool weaver_done, bool await_disk,
+                                    std::uint32_t on_disk_started) noexcept {
+  if (!fitted()) return Status::kDone;
+  // Every tick: the moves in flight write their targets; grippers and cutters are open unless a running
+  // cycle closes them. A carriage move waits at its origin while any gripper is measured in the warp (the
+  // servo trails its command by a tick or two when the cycle leaves the warp).
+  if (carriage_move_.active && !carriage_move_.started) {
+    bool inside = false;
+    for (int h = 0; h < heads_ && guard_ != nullptr; ++h) {
+      inside |= gripper_in_warp(*guard_, in.axes[static_cast<std::size_t>(k_.knotter_axis[static_cast<std::size_t>(h)])].position);
+    }
+    if (inside) {
+      carriage_move_.t0 = now;
+    } else {
+      carriage_move_.started = true;
+    }
+  }
+  const bool carriage_moving = play(carriage_move_, now, cmd.axes[hal::index(hal::CoreAxis::kCarriage)].target_position);
+  bool selectors_moving = false;
+  for (int h = 0; h < heads_; ++h) {
+    const auto hh = static_cast<std::size_t>(h);
+    selectors_moving |= play(selector_move_[hh], now, cmd.axes[static_cast<std::size_t>(k_.selector_axis[hh])].target_position);
+    cmd.io.gripper_close[hh] = false;
+    cmd.io.cutter[hh] = false;
+  }
+  switch (phase_) {
+    case Phase::kTravel:
+      if (carriage_moving || selectors_moving) return Status::kRunning;
+      phase_ = Phase::kCheck;
+      phase_since_ = now;
+      [[fallthrough]];
+    case Phase::kCheck: {
+      const Status st = check(now, in, cmd, counters, await_disk, on_disk_started);
+      if (st != Status::kRunning || phase_ != Phase::kCycle) return st;
+      [[fallthrough]];
+    }
+    case Phase::kCycle:
+      run_cycle(now, in, cmd, counters);
+      break;
+    case Phase::kWeaver:
+      return weaver(now, cmd, counters, weaver_done);
+    case Phase::kReturn:
+      if (carriage_moving) return Status::kRunning;
+      phase_ = Phase::kDone;
+      row_.ticks = now - row_since_ - row_.weaver_ticks;
+      return Status::kDone;
+    case Phase::kDone:
+      return Status::kDone;
+  }
+  return phase_ == Phase::kWeaver ? Status::kAwaitingWeaver : Status::kRunning;
+}
+
+}  // namespace loom::sequencer

@@ -1,0 +1,186 @@
+// The loom ties its own knots: the knotting heads tie the design on the narrow knotting loom
+// (tests/sim/knotting_sample_loom.toml), through misses, an empty slot and the weaver's hand, and the
+// carpet the simulated machine actually knotted — read back from its PNG with libpng, compared with the
+// design file read here on its own — equals the design knot for knot.
+#include <gtest/gtest.h>
+#include <png.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "loom/firmware/carpet_png.hpp"
+#include "loom/firmware/config.hpp"
+#include "loom/firmware/machine.hpp"
+#include "loom/firmware/runner.hpp"
+
+using namespace loom;
+
+namespace {
+const std::string kDir = std::string(LOOM_SOURCE_DIR) + "/tests/sim/";
+
+firmware::LoomConfig knotting_loom() { return firmware::load_loom_config(kDir + "knotting_sample_loom.toml"); }
+
+firmware::Scene scene(const std::string& knotter, const std::string& faults = "") {
+  return firmware::parse_scene("name = \"knots\"\nseed = 3\neffects = [\"ideal\", \"knotter\"]\n[knotter]\n" + knotter + faults,
+                               "knots.toml");
+}
+
+// The design file as a weaver reads it: palette codes to colours, rows top line first.
+struct Picture {
+  std::vector<std::vector<std::uint32_t>> rows_top_down;
+};
+Picture read_design_csv(const std::string& path) {
+  std::ifstream in(path);
+  std::map<std::string, std::uint32_t> palette;
+  Picture p;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+    if (cells[0] == "palette") {
+      palette[cells[1]] = static_cast<std::uint32_t>(std::stoul(cells[2].substr(1), nullptr, 16));
+      continue;
+    }
+    std::vector<std::uint32_t> row;
+    for (const auto& c : cells) row.push_back(palette.at(c));
+    p.rows_top_down.push_back(row);
+  }
+  return p;
+}
+
+struct Rgba {
+  int w = 0, h = 0;
+  std::vector<png_byte> px;
+};
+Rgba read_png(const std::string& path) {
+  png_image img{};
+  img.version = PNG_IMAGE_VERSION;
+  Rgba r;
+  if (png_image_begin_read_from_file(&img, path.c_str()) == 0) return r;
+  img.format = PNG_FORMAT_RGBA;
+  r.w = static_cast<int>(img.width);
+  r.h = static_cast<int>(img.height);
+  r.px.resize(PNG_IMAGE_SIZE(img));
+  if (png_image_finish_read(&img, nullptr, r.px.data(), 0, nullptr) == 0) r.w = r.h = 0;
+  return r;
+}
+
+struct Woven {
+  sequencer::State state{};
+  sequencer::Fault fault{};
+  int fault_axis = -1;
+  sequencer::Counters counters{};
+  std::vector<sequencer::WeaverRequest> requests;
+  firmware::CarpetCheck check{};
+  Rgba png;
+};
+
+Woven weave(const firmware::LoomConfig& cfg, const firmware::Scene& sc, std::uint32_t rows) {
+  firmware::MachineOptions opt;
+  opt.telemetry = false;
+  opt.rows = rows;
+  firmware::Machine m(cfg, sc, opt, {});
+  m.sequencer().request_start();
+  firmware::RunOptions ro;
+  ro.period_s = cfg.sequencer.period_s;
+  ro.max_ticks = 400000;
+  ro.weaver_sink = firmware::Machine::simulated_weaver_sink;
+  ro.weaver_sink_ctx = &m;
+  Woven w;
+  firmware::run_loop(m.loop(), m.sequencer(), ro, [&](const firmware::RunEvent& e) {
+    if (e.kind == firmware::RunEvent::Kind::kWeaverRequest) w.requests.push_back(e.request);
+  });
+  w.state = m.sequencer().state();
+  w.fault = m.sequencer().first_fault();
+  w.fault_axis = m.sequencer().fault_axis();
+  w.counters = m.sequencer().counters();
+  const std::string png = testing::TempDir() + "/carpet_" + std::to_string(::getpid()) + ".png";
+  w.check = firmware::write_carpet_png(*m.sim().knotter(), *m.knot_program(), *cfg.recipe.design, 0, png);
+  w.png = read_png(png);
+  std::filesystem::remove(png);
+  return w;
+}
+
+// Every knot of the first `rows` rows has the design's colour; returns the knots whose alpha says "by hand".
+int expect_equals_design(const Woven& w, int rows) {
+  const Picture d = read_design_csv(kDir + "knot_sample.csv");
+  const int h = static_cast<int>(d.rows_top_down.size());
+  EXPECT_EQ(w.png.w, 90);
+  EXPECT_EQ(w.png.h, rows);
+  int by_hand = 0;
+  for (int r = 0; r < rows && w.png.w == 90 && w.png.h == rows; ++r) {
+    // Carpet row r (woven r-th) is design row r from the bottom; both pictures draw it from the bottom.
+    const auto& want = d.rows_top_down[static_cast<std::size_t>(h - 1 - r)];
+    for (int k = 0; k < 90; ++k) {
+      const png_byte* p = &w.png.px[(static_cast<std::size_t>(rows - 1 - r) * 90 + static_cast<std::size_t>(k)) * 4];
+      const std::uint32_t rgb = static_cast<std::uint32_t>(p[0]) << 16 | static_cast<std::uint32_t>(p[1]) << 8 | p[2];
+      EXPECT_EQ(rgb, want[static_cast<std::size_t>(k)]) << "row " << r + 1 << " knot " << k + 1;
+      EXPECT_NE(p[3], 0) << "row " << r + 1 << " knot " << k + 1 << " not tied";
+      by_hand += p[3] == 128;
+    }
+  }
+  return by_hand;
+}
+}  // namespace
+
+TEST(Knotting, TheHeadsTieTheDesignKnotForKnot) {
+  const Woven w = weave(knotting_loom(), scene("miss_probability = 0.0\nweaver_s = 1.0\n"), 2);
+  EXPECT_EQ(w.state, sequencer::State::kDone) << sequencer::fault_name(w.fault);
+  EXPECT_EQ(w.counters.rows, 2u);
+  EXPECT_EQ(w.counters.knot.tied, 180u);
+  EXPECT_EQ(w.counters.knot.by_hand, 0u);
+  EXPECT_TRUE(w.requests.empty() || w.requests[0].ask == sequencer::WeaverAsk::kReload);  // 40-knot slots: reloads only
+  EXPECT_TRUE(w.check.equal());
+  EXPECT_EQ(expect_equals_design(w, 2), 0);
+}
+
+TEST(Knotting, MissedKnotsAndAnEmptySlotEndWithTheDesignAndTheWeaversKnotsMarked) {
+  // Knots slip off one time in six; slot 2 (indigo) of head 1 runs dry early.
+  const Woven w = weave(knotting_loom(),
+                        scene("miss_probability = 0.17\nweaver_s = 2.0\n", "[[fault]]\nkind = \"yarn_out\"\nat_s = 5.0\nhead = 1\nslot = 2\n"), 3);
+  EXPECT_EQ(w.state, sequencer::State::kDone) << sequencer::fault_name(w.fault);
+  EXPECT_GT(w.counters.knot.retried, 0u);
+  EXPECT_GT(w.counters.knot.by_hand, 0u);
+  EXPECT_EQ(w.counters.knot.tied + w.counters.knot.by_hand, 270u);  // every knot once: none skipped, none twice
+  int asked_by_hand = 0, reloads = 0;
+  for (const auto& r : w.requests) {
+    asked_by_hand += r.ask == sequencer::WeaverAsk::kTieByHand;
+    reloads += r.ask == sequencer::WeaverAsk::kReload;
+    EXPECT_GE(r.slot, 0);
+  }
+  EXPECT_EQ(static_cast<std::uint32_t>(asked_by_hand), w.counters.knot.by_hand);
+  EXPECT_GT(reloads, 0);
+  EXPECT_TRUE(w.check.equal()) << w.check.missing << " missing, " << w.check.wrong << " wrong, " << w.check.doubled << " doubled";
+  EXPECT_EQ(expect_equals_design(w, 3), static_cast<int>(w.counters.knot.by_hand));
+}
+
+TEST(Knotting, AJammedSelectorIsANamedFault) {
+  const firmware::LoomConfig cfg = knotting_loom();
+  const Woven w = weave(cfg, scene("weaver_s = 1.0\n", "[[fault]]\nkind = \"selector_jam\"\nat_s = 3.0\nhead = 2\n"), 2);
+  EXPECT_EQ(w.state, sequencer::State::kFault);
+  EXPECT_EQ(w.fault, sequencer::Fault::kSelectorJam);
+  EXPECT_EQ(w.fault_axis, cfg.sequencer.heads.selector_axis[1]);
+}
+
+TEST(Knotting, AScenelessHeadsLoomAndAHeadlessKnotterAreRefused) {
+  firmware::MachineOptions opt;
+  opt.telemetry = false;
+  const auto error = [&](const firmware::LoomConfig& cfg, const firmware::Scene& sc) -> std::string {
+    try {
+      firmware::Machine m(cfg, sc, opt, {});
+    } catch (const firmware::ConfigError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_NE(error(knotting_loom(), firmware::parse_scene("name = \"t\"\neffects = [\"ideal\"]\n", "t.toml"))
+                .find("the scene must name the effect \"knotter\""),
+            std::string::npos);
+  EXPECT_NE(error(firmware::default_loom_config(), scene("weaver_s = 1.0\n")).find("has none (knotting.mode = \"none\")"),
+            std::string::npos);
+}
