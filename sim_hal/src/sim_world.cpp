@@ -229,6 +229,8 @@ void SimWorld::apply_injected_faults(hal::Tick now) noexcept {
         return;
     }
   }
+  // Until a fault strikes, nothing below has anything to recover (the per-tick cost of an unfaulted scene).
+  if (next_fault_ == 0) return;
   for (std::size_t i = 0; i < sensor_until_.size(); ++i) {
     if (stuck_sensor_[i] && now >= sensor_until_[i]) stuck_sensor_[i].reset();  // an intermittent fault recovers
   }
@@ -239,7 +241,11 @@ void SimWorld::apply_injected_faults(hal::Tick now) noexcept {
 void SimWorld::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) {
   apply_injected_faults(now);
   if (powered_off_ || stalled(now)) return;  // nothing refreshed: the values keep their old ticks
-  hal::AxisFeedback* truth = &history_[static_cast<std::size_t>(now) % history_ticks_ * n_axes_];
+  // Until a fault strikes (no frame lost, no node silent, no bus-off) and without CAN latency, every
+  // frame arrives as sampled: sample straight into `axes`, not into the history and then across.
+  const bool direct = history_ticks_ == 1 && next_fault_ == 0;
+  hal::AxisFeedback* truth =
+      direct ? axes.data() : &history_[static_cast<std::size_t>(now) % history_ticks_ * n_axes_];
   for (std::size_t i = 0; i < n_axes_; ++i) {
     const SimAxis& s = axes_[i];
     hal::AxisFeedback& fb = truth[i];
@@ -257,6 +263,7 @@ void SimWorld::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatu
     if (glitch_left_[i] > 0) --glitch_left_[i];
   }
   link = hal::LinkStatus{};
+  if (direct) return;
   if (bus_off_) {  // no frame gets through any more, and the simulated controller never restarts
     link.link_fault = true;
     link.link_fault_kind = hal::FaultKind::kBusOff;
@@ -429,6 +436,15 @@ void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::Digit
                                   piston_[1] <= 0.0,
                                   shuttle_x_ <= m_.selvedge_sensor_window_m,
                                   shuttle_x_ >= m_.width_m - m_.selvedge_sensor_window_m};
+  if (next_fault_ == 0 && !scene_.sensor_noise) {
+    // No sensor fault has struck and no bounce is simulated: every switch reads the truth (the loop
+    // below, without its per-switch checks). A second switch the machine does not have reads false.
+    for (std::size_t i = 0; i < n; ++i) io.second_channel[i] = m_.second_channel[i] && truth[i];
+    hal::set_safety_sensors(io, truth);
+    io.estop_ok = estop_ok_;
+    io.refreshed = now;
+    return;
+  }
   // Each switch (first channels 0..5, second channels 6..11) sees the truth, then its own faults, then
   // its own bounce. A second switch the machine does not have reads false and draws no noise.
   std::array<bool, kSensorCount> v{};
