@@ -15,6 +15,15 @@ void copy_name(std::array<char, N>& dst, const char* src) noexcept {
   for (; i < N; ++i) dst[i] = '\0';
 }
 
+// The snapshot keeps its names from tick to tick and they are string literals (state_name,
+// fault_name): copy one only when it changed, not three 24–32 byte loops every tick.
+template <std::size_t N>
+void set_name(std::array<char, N>& dst, const char* src, const char*& shown) noexcept {
+  if (src == shown) return;
+  copy_name(dst, src);
+  shown = src;
+}
+
 bool axis_faulted(const hal::AxisFeedback& a) noexcept {
   return a.fault || a.state == hal::DriveState::kFault || a.state == hal::DriveState::kFaultReactionActive;
 }
@@ -174,24 +183,26 @@ void ControlLoop::fill_snapshot(hal::Tick now) noexcept {
   telemetry::Snapshot& s = snap_;
   s.tick = now;
   s.period_ns = period_ns_;
-  copy_name(s.state, sequencer::state_name(seq_.state()));
+  set_name(s.state, sequencer::state_name(seq_.state()), shown_state_);
   const sequencer::Fault f = seq_.first_fault();
   const bool faulted = f != sequencer::Fault::kNone;
-  copy_name(s.first_fault, faulted ? sequencer::fault_name(f) : "");
+  set_name(s.first_fault, faulted ? sequencer::fault_name(f) : "", shown_first_fault_);
   s.first_fault_code = sequencer::fault_code(f);
   s.fault_axis = static_cast<std::int8_t>(faulted ? seq_.fault_axis() : -1);
   s.fault_sensor = static_cast<std::int8_t>(faulted ? seq_.fault_sensor() : -1);
   s.fault_device_code = faulted ? seq_.fault_detail() : 0;
   s.fault_tick = faulted ? seq_.fault_tick() : hal::kNeverTick;
-  copy_name(s.stopped_by, faulted ? sequencer::fault_name(seq_.stopped_by()) : "");
+  set_name(s.stopped_by, faulted ? sequencer::fault_name(seq_.stopped_by()) : "", shown_stopped_by_);
   s.row = seq_.counters().rows;
   s.pick = seq_.counters().picks;
   s.beat = seq_.counters().beats;
   s.row_in_progress = row_in_progress();
   s.rows_target = ctx_.rows_target;
   s.beats_per_row = static_cast<std::uint16_t>(seq_.profiles().beats_per_row());
+  // commanded_rocker_angle() is the rocker table at commanded_crank_phase(): the phase is wrapped
+  // (an fmod of the unwrapped crank, ~100 instructions) once here instead of twice.
   s.crank_phase_rad = seq_.commanded_crank_phase();
-  s.beater_angle_rad = seq_.commanded_rocker_angle();
+  s.beater_angle_rad = seq_.profiles().rocker().at(s.crank_phase_rad).value;
   s.beat_force_valid = in_.analog.beat_force_valid;
   s.beat_force_n = in_.analog.beat_force_valid ? in_.analog.beat_force_n : 0.0;
   s.axis_count = static_cast<std::uint8_t>(n_axes_);

@@ -77,6 +77,10 @@ class ControlLoop {
   hal::HalInputs in_{};
   hal::HalOutputs out_{};
   telemetry::Snapshot snap_{};
+  // The names snap_ holds (string literals; nullptr: none yet), so fill_snapshot copies only changes.
+  const char* shown_state_ = nullptr;
+  const char* shown_first_fault_ = nullptr;
+  const char* shown_stopped_by_ = nullptr;
   LoopStats stats_{};
   TelemetryContext ctx_{};
   // What the previous tick showed, so each event is pushed exactly once.
