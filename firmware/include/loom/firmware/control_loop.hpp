@@ -81,6 +81,10 @@ class ControlLoop {
   const char* shown_state_ = nullptr;
   const char* shown_first_fault_ = nullptr;
   const char* shown_stopped_by_ = nullptr;
+  // The crank target and recipe snap_'s crank phase and beater angle were computed for.
+  bool crank_shown_ = false;
+  double shown_crank_target_ = 0.0;
+  std::uint32_t shown_recipe_ = 0;
   LoopStats stats_{};
   TelemetryContext ctx_{};
   // What the previous tick showed, so each event is pushed exactly once.
