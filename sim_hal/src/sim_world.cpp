@@ -130,6 +130,8 @@ SimWorld::SimWorld(const SimMachine& machine, const SceneSpec& scene)
       throw std::invalid_argument("unknown simulation effect '" + e + "'");
     }
   }
+  // The valves' fill per tick depends only on the period and the time constant: one exp here, not two a tick.
+  if (scene_.pneumatics) pressure_fill_ = 1.0 - std::exp(-m_.period_s / scene_.pneumatics->fill_tau_s);
   beatup_ = std::make_unique<motion::BeatUp>(m_.beatup);
   // Each fault strikes at the first tick whose time reaches at_s (a power cut: at its own tick).
   const auto strike = [&](const FaultInjection& f) {
@@ -472,7 +474,7 @@ void SimWorld::write_io(hal::Tick, const hal::DigitalOutputs& io) {
     double step = goal * full_speed;
     if (scene_.pneumatics) {
       const Pneumatics& p = *scene_.pneumatics;
-      pressure_[i] += (goal - pressure_[i]) * (1.0 - std::exp(-dt / p.fill_tau_s));
+      pressure_[i] += (goal - pressure_[i]) * pressure_fill_;  // 1 - exp(-dt / p.fill_tau_s)
       const double margin = (std::abs(pressure_[i]) - p.breakaway) / (1.0 - p.breakaway);
       step = margin > 0.0 ? std::copysign(margin * full_speed, pressure_[i]) : 0.0;
     }
