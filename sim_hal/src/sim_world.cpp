@@ -295,6 +295,24 @@ void SimWorld::step_axis(std::size_t slot, const hal::AxisCommand& cmd) noexcept
   using hal::AxisRequest;
   using hal::DriveState;
   SimAxis& ax = axes_[slot];
+  const double before = ax.position;
+  // The drive follows its target in Operation Enabled (commands are in the drive's reading).
+  const auto follow = [&] {
+    ax.target = cmd.target_position - ax.offset;
+    double actual = ax.target;
+    if (!ax.effects.empty()) {
+      actual = ax.position;
+      for (auto& e : ax.effects) actual = e->step(ax.target, actual, m_.period_s);
+    }
+    ax.position = actual;
+  };
+  if (ax.state == DriveState::kOperationEnabled && cmd.request == AxisRequest::kEnable) {
+    // The usual tick: enabled and asked to stay so. No power-state change, no homing run.
+    ax.homing = false;
+    follow();
+    ax.velocity = (ax.position - before) / m_.period_s;
+    return;
+  }
   if (ax.state == DriveState::kFault) {
     if (cmd.request == AxisRequest::kFaultReset) {
       ax.state = DriveState::kSwitchOnDisabled;
@@ -313,7 +331,6 @@ void SimWorld::step_axis(std::size_t slot, const hal::AxisCommand& cmd) noexcept
       case AxisRequest::kFaultReset: break;
     }
   }
-  const double before = ax.position;
   // A homing run moves the axis by itself (the drive's mode 6) until its reference point; anything but
   // kHome while enabled ends it, referenced or not.
   const bool homing = ax.state == DriveState::kOperationEnabled && cmd.request == AxisRequest::kHome &&
@@ -322,13 +339,7 @@ void SimWorld::step_axis(std::size_t slot, const hal::AxisCommand& cmd) noexcept
   if (homing) {
     step_homing(slot);
   } else if (ax.state == DriveState::kOperationEnabled) {
-    ax.target = cmd.target_position - ax.offset;  // commands are in the drive's reading
-    double actual = ax.target;
-    if (!ax.effects.empty()) {
-      actual = ax.position;
-      for (auto& e : ax.effects) actual = e->step(ax.target, actual, m_.period_s);
-    }
-    ax.position = actual;
+    follow();
   }
   ax.velocity = (ax.position - before) / m_.period_s;
 }
@@ -441,7 +452,7 @@ void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::Digit
   if (next_fault_ == 0 && !scene_.sensor_noise) {
     // No sensor fault has struck and no bounce is simulated: every switch reads the truth (the loop
     // below, without its per-switch checks). A second switch the machine does not have reads false.
-    for (std::size_t i = 0; i < n; ++i) io.second_channel[i] = m_.second_channel[i] && truth[i];
+    for (std::size_t i = 0; i < n; ++i) io.second_channel[i] = m_.second_channel[i] & truth[i];
     hal::set_safety_sensors(io, truth);
     io.estop_ok = estop_ok_;
     io.refreshed = now;
