@@ -15,6 +15,7 @@
 #pragma once
 
 #include <array>
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -59,7 +60,12 @@ class DualChannelSensors {
   // The six channels as the bytes of one word (a bool is one byte, 0 or 1), so the per-sensor logic
   // is three word operations instead of a loop of branches.
   static_assert(sizeof(bool) == 1 && hal::kSafetySensorCount <= sizeof(std::uint64_t));
-  static constexpr std::uint64_t kOnes = 0x0000'0101'0101'0101ull;  // one 1 per sensor byte
+  // A 1 in each sensor's byte (in memory order, so whatever the byte order).
+  static constexpr std::uint64_t kOnes = [] {
+    std::array<unsigned char, sizeof(std::uint64_t)> b{};
+    for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) b[i] = 1;
+    return std::bit_cast<std::uint64_t>(b);
+  }();
   static std::uint64_t bits(const Channels& c) noexcept {
     std::uint64_t b = 0;
     std::memcpy(&b, c.data(), c.size());
