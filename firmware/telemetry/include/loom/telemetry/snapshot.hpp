@@ -63,7 +63,7 @@ struct Snapshot {
 
 // Copies the part of a snapshot that is in use into a ring slot: everything but the axis slots at and
 // beyond axis_count, which nobody reads (the publisher encodes axes[0 .. axis_count)). The record is
-// sized for hal::kMaxAxes (32 axes, ~2 KB); a three-axis loom uses 170 bytes of its axes. RT-safe.
+// sized for hal::kMaxAxes (32 axes, ~2 KB); a three-axis loom uses 168 bytes of its axes. RT-safe.
 inline void copy_in_use(Snapshot& to, const Snapshot& from) noexcept {
   constexpr std::size_t head = offsetof(Snapshot, axes);
   constexpr std::size_t tail = offsetof(Snapshot, outputs);

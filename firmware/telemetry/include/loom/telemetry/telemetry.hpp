@@ -22,8 +22,8 @@ class Telemetry {
   // Non-RT. Publishes what is left in the ring, then joins the publishing thread.
   void stop() { publisher_.stop(); }
 
-  // RT-safe. Copies the snapshot (the part in use: copy_in_use) into the ring; when the ring is full the snapshot is dropped,
-  // counted in dropped(), and false is returned. Never blocks, never allocates.
+  // RT-safe. Copies the snapshot (the part in use: copy_in_use) into the ring; when the ring is full
+  // the snapshot is dropped, counted in dropped(), and false is returned. Never blocks, never allocates.
   bool push(const Snapshot& s) noexcept { return ring_->push_or_drop(s, copy_in_use); }
 
   // RT-safe. Like push() but a full ring is not counted as a drop: for a caller that will retry
