@@ -34,7 +34,7 @@ while [[ $# -gt 0 ]]; do
     --ceiling) ceiling=$2; shift 2 ;;
     --split) split=1; shift ;;
     --out) out=$2; shift 2 ;;
-    -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "tick_instructions.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done
