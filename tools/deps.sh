@@ -30,6 +30,7 @@ packages=(
   default-jdk-headless liblcm-java libjchart2d-java  # loomlcm.jar and loom-spy (lcm-spy)
   chromium xvfb xauth imagemagick nodejs  # browser and Xvfb tests of loom-panel and loom-spy
   rt-tests                      # cyclictest: the latency floor the loop is compared with
+  valgrind                      # callgrind: the tick's cost in instructions (tests/bench/tick_instructions.sh)
   help2man lintian debootstrap  # the .deb: manual pages from --help, its lint, a clean root to install it in
 )
 

@@ -15,6 +15,15 @@ void copy_name(std::array<char, N>& dst, const char* src) noexcept {
   for (; i < N; ++i) dst[i] = '\0';
 }
 
+// The snapshot keeps its names from tick to tick and they are string literals (state_name,
+// fault_name): copy one only when it changed, not three 24–32 byte loops every tick.
+template <std::size_t N>
+void set_name(std::array<char, N>& dst, const char* src, const char*& shown) noexcept {
+  if (src == shown) return;
+  copy_name(dst, src);
+  shown = src;
+}
+
 bool axis_faulted(const hal::AxisFeedback& a) noexcept {
   return a.fault || a.state == hal::DriveState::kFault || a.state == hal::DriveState::kFaultReactionActive;
 }
@@ -155,6 +164,7 @@ void ControlLoop::push_events(hal::Tick now) noexcept {
   for (std::size_t i = 0; i < n_axes_; ++i) {
     const hal::AxisFeedback& a = in_.axes[i];
     const bool faulted = axis_faulted(a);
+    if (!faulted && !prev_axis_fault_[i]) continue;  // the usual tick: nothing to report or forget (code is 0)
     const bool report = faulted && (!prev_axis_fault_[i] || a.fault_code != prev_axis_fault_code_[i]);
     if (report && static_cast<int>(i) != first_axis_reported) {
       fault_event(telemetry::Event::FaultKind::kDevice, sequencer::Fault::kDriveFault, static_cast<int>(i),
@@ -174,24 +184,33 @@ void ControlLoop::fill_snapshot(hal::Tick now) noexcept {
   telemetry::Snapshot& s = snap_;
   s.tick = now;
   s.period_ns = period_ns_;
-  copy_name(s.state, sequencer::state_name(seq_.state()));
+  set_name(s.state, sequencer::state_name(seq_.state()), shown_state_);
   const sequencer::Fault f = seq_.first_fault();
   const bool faulted = f != sequencer::Fault::kNone;
-  copy_name(s.first_fault, faulted ? sequencer::fault_name(f) : "");
+  set_name(s.first_fault, faulted ? sequencer::fault_name(f) : "", shown_first_fault_);
   s.first_fault_code = sequencer::fault_code(f);
   s.fault_axis = static_cast<std::int8_t>(faulted ? seq_.fault_axis() : -1);
   s.fault_sensor = static_cast<std::int8_t>(faulted ? seq_.fault_sensor() : -1);
   s.fault_device_code = faulted ? seq_.fault_detail() : 0;
   s.fault_tick = faulted ? seq_.fault_tick() : hal::kNeverTick;
-  copy_name(s.stopped_by, faulted ? sequencer::fault_name(seq_.stopped_by()) : "");
+  set_name(s.stopped_by, faulted ? sequencer::fault_name(seq_.stopped_by()) : "", shown_stopped_by_);
   s.row = seq_.counters().rows;
   s.pick = seq_.counters().picks;
   s.beat = seq_.counters().beats;
   s.row_in_progress = row_in_progress();
   s.rows_target = ctx_.rows_target;
   s.beats_per_row = static_cast<std::uint16_t>(seq_.profiles().beats_per_row());
-  s.crank_phase_rad = seq_.commanded_crank_phase();
-  s.beater_angle_rad = seq_.commanded_rocker_angle();
+  // commanded_rocker_angle() is the rocker table at commanded_crank_phase(): the phase is wrapped (an
+  // fmod of the unwrapped crank, ~100 instructions) once here instead of twice, and both are kept
+  // while the crank's target and the recipe stay the same (shed, pick, idle).
+  const double crank_target = out_.axes[hal::index(hal::CoreAxis::kBeatCrank)].target_position;
+  if (!crank_shown_ || crank_target != shown_crank_target_ || seq_.recipe_changes() != shown_recipe_) {
+    s.crank_phase_rad = seq_.commanded_crank_phase();
+    s.beater_angle_rad = seq_.profiles().rocker().at(s.crank_phase_rad).value;
+    crank_shown_ = true;
+    shown_crank_target_ = crank_target;
+    shown_recipe_ = seq_.recipe_changes();
+  }
   s.beat_force_valid = in_.analog.beat_force_valid;
   s.beat_force_n = in_.analog.beat_force_valid ? in_.analog.beat_force_n : 0.0;
   s.axis_count = static_cast<std::uint8_t>(n_axes_);
@@ -213,10 +232,10 @@ void ControlLoop::fill_snapshot(hal::Tick now) noexcept {
       (io.piston_a_extended ? 1 : 0) | (io.piston_a_retracted ? 2 : 0) | (io.piston_b_extended ? 4 : 0) |
       (io.piston_b_retracted ? 8 : 0) | (io.shuttle_at_left ? 16 : 0) | (io.shuttle_at_right ? 32 : 0) |
       (io.estop_ok ? 64 : 0));
-  s.inputs_2 = 0;
-  for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) {
-    if (io.second_channel[i]) s.inputs_2 = static_cast<std::uint8_t>(s.inputs_2 | (1U << i));
-  }
+  const auto& c2 = io.second_channel;
+  s.inputs_2 = static_cast<std::uint8_t>((c2[0] ? 1 : 0) | (c2[1] ? 2 : 0) | (c2[2] ? 4 : 0) | (c2[3] ? 8 : 0) |
+                                         (c2[4] ? 16 : 0) | (c2[5] ? 32 : 0));
+  static_assert(hal::kSafetySensorCount == 6, "inputs_2 packs six second channels");
   s.overruns = stats_.overruns;
   s.tick_cost_ns = stats_.last_tick_cost_ns;
   s.max_tick_cost_ns = stats_.max_tick_cost_ns;

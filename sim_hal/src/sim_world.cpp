@@ -138,6 +138,8 @@ SimWorld::SimWorld(const SimMachine& machine, const SceneSpec& scene)
       throw std::invalid_argument("unknown simulation effect '" + e + "'");
     }
   }
+  // The valves' fill per tick depends only on the period and the time constant: one exp here, not two a tick.
+  if (scene_.pneumatics) pressure_fill_ = 1.0 - std::exp(-m_.period_s / scene_.pneumatics->fill_tau_s);
   beatup_ = std::make_unique<motion::BeatUp>(m_.beatup);
   // Each fault strikes at the first tick whose time reaches at_s (a power cut: at its own tick).
   const auto strike = [&](const FaultInjection& f) {
@@ -243,6 +245,8 @@ void SimWorld::apply_injected_faults(hal::Tick now) noexcept {
         return;
     }
   }
+  // Until a fault strikes, nothing below has anything to recover (the per-tick cost of an unfaulted scene).
+  if (next_fault_ == 0) return;
   for (std::size_t i = 0; i < sensor_until_.size(); ++i) {
     if (stuck_sensor_[i] && now >= sensor_until_[i]) stuck_sensor_[i].reset();  // an intermittent fault recovers
   }
@@ -253,7 +257,11 @@ void SimWorld::apply_injected_faults(hal::Tick now) noexcept {
 void SimWorld::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) {
   apply_injected_faults(now);
   if (powered_off_ || stalled(now)) return;  // nothing refreshed: the values keep their old ticks
-  hal::AxisFeedback* truth = &history_[static_cast<std::size_t>(now) % history_ticks_ * n_axes_];
+  // Until a fault strikes (no frame lost, no node silent, no bus-off) and without CAN latency, every
+  // frame arrives as sampled: sample straight into `axes`, not into the history and then across.
+  const bool direct = history_ticks_ == 1 && next_fault_ == 0;
+  hal::AxisFeedback* truth =
+      direct ? axes.data() : &history_[static_cast<std::size_t>(now) % history_ticks_ * n_axes_];
   for (std::size_t i = 0; i < n_axes_; ++i) {
     const SimAxis& s = axes_[i];
     hal::AxisFeedback& fb = truth[i];
@@ -271,6 +279,7 @@ void SimWorld::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatu
     if (glitch_left_[i] > 0) --glitch_left_[i];
   }
   link = hal::LinkStatus{};
+  if (direct) return;
   if (bus_off_) {  // no frame gets through any more, and the simulated controller never restarts
     link.link_fault = true;
     link.link_fault_kind = hal::FaultKind::kBusOff;
@@ -300,6 +309,26 @@ void SimWorld::step_axis(std::size_t slot, const hal::AxisCommand& cmd) noexcept
   using hal::AxisRequest;
   using hal::DriveState;
   SimAxis& ax = axes_[slot];
+  const double before = ax.position;
+  // The drive follows its target in Operation Enabled (commands are in the drive's reading); a jammed axis
+  // (scene fault selector_jam) stays where it is.
+  const auto follow = [&] {
+    if (jammed_[slot]) return;
+    ax.target = cmd.target_position - ax.offset;
+    double actual = ax.target;
+    if (!ax.effects.empty()) {
+      actual = ax.position;
+      for (auto& e : ax.effects) actual = e->step(ax.target, actual, m_.period_s);
+    }
+    ax.position = actual;
+  };
+  if (ax.state == DriveState::kOperationEnabled && cmd.request == AxisRequest::kEnable) {
+    // The usual tick: enabled and asked to stay so. No power-state change, no homing run.
+    ax.homing = false;
+    follow();
+    ax.velocity = (ax.position - before) / m_.period_s;
+    return;
+  }
   if (ax.state == DriveState::kFault) {
     if (cmd.request == AxisRequest::kFaultReset) {
       ax.state = DriveState::kSwitchOnDisabled;
@@ -318,7 +347,6 @@ void SimWorld::step_axis(std::size_t slot, const hal::AxisCommand& cmd) noexcept
       case AxisRequest::kFaultReset: break;
     }
   }
-  const double before = ax.position;
   // A homing run moves the axis by itself (the drive's mode 6) until its reference point; anything but
   // kHome while enabled ends it, referenced or not.
   const bool homing = ax.state == DriveState::kOperationEnabled && cmd.request == AxisRequest::kHome &&
@@ -326,14 +354,8 @@ void SimWorld::step_axis(std::size_t slot, const hal::AxisCommand& cmd) noexcept
   if (!homing) ax.homing = false;
   if (homing) {
     step_homing(slot);
-  } else if (ax.state == DriveState::kOperationEnabled && !jammed_[slot]) {
-    ax.target = cmd.target_position - ax.offset;  // commands are in the drive's reading
-    double actual = ax.target;
-    if (!ax.effects.empty()) {
-      actual = ax.position;
-      for (auto& e : ax.effects) actual = e->step(ax.target, actual, m_.period_s);
-    }
-    ax.position = actual;
+  } else if (ax.state == DriveState::kOperationEnabled) {
+    follow();
   }
   ax.velocity = (ax.position - before) / m_.period_s;
 }
@@ -452,6 +474,15 @@ void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::Digit
                                   piston_[1] <= 0.0,
                                   shuttle_x_ <= m_.selvedge_sensor_window_m,
                                   shuttle_x_ >= m_.width_m - m_.selvedge_sensor_window_m};
+  if (next_fault_ == 0 && !scene_.sensor_noise) {
+    // No sensor fault has struck and no bounce is simulated: every switch reads the truth (the loop
+    // below, without its per-switch checks). A second switch the machine does not have reads false.
+    for (std::size_t i = 0; i < n; ++i) io.second_channel[i] = m_.second_channel[i] & truth[i];
+    hal::set_safety_sensors(io, truth);
+    io.estop_ok = estop_ok_;
+    io.refreshed = now;
+    return;
+  }
   // Each switch (first channels 0..5, second channels 6..11) sees the truth, then its own faults, then
   // its own bounce. A second switch the machine does not have reads false and draws no noise.
   std::array<bool, kSensorCount> v{};
@@ -488,7 +519,7 @@ void SimWorld::write_io(hal::Tick, const hal::DigitalOutputs& io) {
     double step = goal * full_speed;
     if (scene_.pneumatics) {
       const Pneumatics& p = *scene_.pneumatics;
-      pressure_[i] += (goal - pressure_[i]) * (1.0 - std::exp(-dt / p.fill_tau_s));
+      pressure_[i] += (goal - pressure_[i]) * pressure_fill_;  // 1 - exp(-dt / p.fill_tau_s)
       const double margin = (std::abs(pressure_[i]) - p.breakaway) / (1.0 - p.breakaway);
       step = margin > 0.0 ? std::copysign(margin * full_speed, pressure_[i]) : 0.0;
     }

@@ -226,6 +226,31 @@ TEST(SequencerFaults, BeatsPerRowBeyondCapacityAreRefusedAtConfiguration) {
   EXPECT_NE(sequencer::validate(nan_park, motion::ProfileSet(motion::ProfileSpec{})), "");
 }
 
+// ---- Debouncing (debounce.hpp) ------------------------------------------------------------------
+
+TEST(Debouncer, AChangeCountsOnlyWhileItLastsAndStartsOverWhenTheInputGoesBack) {
+  sequencer::Debouncer<2> d(3);
+  d.update({false, true});  // the first update adopts the inputs as they are
+  EXPECT_FALSE(d[0]);
+  EXPECT_TRUE(d[1]);
+  // Input 0 reads on for two ticks, off for one, on for two: never three in a row, never adopted.
+  const bool seq[] = {true, true, false, true, true};
+  for (bool raw : seq) {
+    d.update({raw, true});
+    EXPECT_FALSE(d[0]);
+  }
+  d.update({true, true});  // the third tick on in a row
+  EXPECT_TRUE(d[0]);
+  EXPECT_TRUE(d[1]) << "the other input never changed";
+  // Unchanged inputs for many ticks change nothing, and a later change again needs three ticks.
+  for (int i = 0; i < 10; ++i) d.update({true, true});
+  d.update({true, false});
+  d.update({true, false});
+  EXPECT_TRUE(d[1]);
+  d.update({true, false});
+  EXPECT_FALSE(d[1]);
+}
+
 // ---- Dual-channel safety sensors (dual_channel.hpp) ----------------------------------------------
 
 TEST(DualChannelSensors, ASensorIsOnOnlyWhileBothChannelsSayOnWhereASecondIsWired) {
@@ -237,6 +262,31 @@ TEST(DualChannelSensors, ASensorIsOnOnlyWhileBothChannelsSayOnWhereASecondIsWire
   EXPECT_FALSE(v[3]);
   EXPECT_TRUE(v[4]);   // no second channel: the first alone
   EXPECT_FALSE(v[5]);
+}
+
+TEST(DualChannelSensors, EveryPictureOfBothChannelsAgreesSensorBySensor) {
+  // All 2^18 combinations of wiring and the two channels' six sensors, against the rule written out
+  // per sensor: on only while the first says on and, where a second is wired, the second too.
+  using Channels = sequencer::DualChannelSensors::Channels;
+  const auto picture = [](unsigned bits) {
+    Channels c{};
+    for (std::size_t i = 0; i < c.size(); ++i) c[i] = (bits >> i) & 1U;
+    return c;
+  };
+  for (unsigned w = 0; w < 64; ++w) {
+    const Channels wired = picture(w);
+    const sequencer::DualChannelSensors d(wired, 3);
+    for (unsigned f = 0; f < 64; ++f) {
+      for (unsigned s = 0; s < 64; ++s) {
+        const Channels first = picture(f), second = picture(s);
+        const Channels v = d.agreed(first, second);
+        for (std::size_t i = 0; i < v.size(); ++i) {
+          const bool expected = wired[i] ? (first[i] && second[i]) : first[i];
+          ASSERT_EQ(v[i], expected) << "wired " << w << " first " << f << " second " << s << " sensor " << i;
+        }
+      }
+    }
+  }
 }
 
 TEST(DualChannelSensors, ADisagreementIsAFaultOnlyOnceItLastsTheDiscrepancyTime) {

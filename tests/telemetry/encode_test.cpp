@@ -264,4 +264,66 @@ TEST(Encode, UnterminatedNamesStopAtTheArrayEnd) {
   EXPECT_EQ(m.first_fault, std::string(s.first_fault.size(), 'F'));
 }
 
+// copy_in_use (snapshot.hpp): what the loop puts into a ring slot. Every field arrives; of the axes only
+// the machine's, so a slot's other axis entries keep what they held (value-initialised: zero).
+TEST(Snapshot, CopyInUseCopiesEveryFieldAndOnlyTheMachinesAxes) {
+  Snapshot from;
+  from.tick = 123456;
+  from.period_ns = 2'000'000;
+  std::strcpy(from.state.data(), "beat_sweep");
+  std::strcpy(from.first_fault.data(), "drive_fault");
+  std::strcpy(from.stopped_by.data(), "estop");
+  from.first_fault_code = 7;
+  from.row = 11, from.pick = 22, from.beat = 33, from.row_in_progress = 12, from.rows_target = 40;
+  from.crank_phase_rad = 1.25, from.beater_angle_rad = -0.5, from.beat_force_n = 91.0, from.beat_force_valid = true;
+  from.axis_count = 3;
+  for (std::size_t i = 0; i < from.axes.size(); ++i) {
+    from.axes[i].position = 1.0 + static_cast<double>(i);
+    from.axes[i].fault_code = static_cast<std::uint16_t>(100 + i);
+  }
+  from.outputs = 3, from.inputs = 0x55, from.inputs_2 = 0x2a;
+  from.overruns = 4, from.tick_cost_ns = 5, from.max_tick_cost_ns = 6;
+  from.wake_latency_p50_ns = 7, from.wake_latency_p99_ns = 8, from.wake_latency_max_ns = 9;
+  from.telemetry_dropped = 10, from.can_tx_dropped = 11, from.can_rx_errors = 12;
+
+  Snapshot to{};
+  copy_in_use(to, from);
+  EXPECT_EQ(to.tick, 123456);
+  EXPECT_EQ(to.period_ns, 2'000'000);
+  EXPECT_STREQ(to.state.data(), "beat_sweep");
+  EXPECT_STREQ(to.first_fault.data(), "drive_fault");
+  EXPECT_STREQ(to.stopped_by.data(), "estop");
+  EXPECT_EQ(to.first_fault_code, 7);
+  EXPECT_EQ(to.row, 11u);
+  EXPECT_EQ(to.pick, 22u);
+  EXPECT_EQ(to.beat, 33u);
+  EXPECT_EQ(to.row_in_progress, 12u);
+  EXPECT_EQ(to.rows_target, 40u);
+  EXPECT_EQ(to.crank_phase_rad, 1.25);
+  EXPECT_EQ(to.beater_angle_rad, -0.5);
+  EXPECT_EQ(to.beat_force_n, 91.0);
+  EXPECT_TRUE(to.beat_force_valid);
+  EXPECT_EQ(to.axis_count, 3);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(to.axes[i].position, 1.0 + static_cast<double>(i)) << "axis " << i;
+    EXPECT_EQ(to.axes[i].fault_code, 100 + i) << "axis " << i;
+  }
+  for (std::size_t i = 3; i < to.axes.size(); ++i) {
+    EXPECT_EQ(to.axes[i].position, 0.0) << "axis " << i << " is not the machine's: not copied";
+    EXPECT_EQ(to.axes[i].fault_code, 0) << "axis " << i;
+  }
+  EXPECT_EQ(to.outputs, 3);
+  EXPECT_EQ(to.inputs, 0x55);
+  EXPECT_EQ(to.inputs_2, 0x2a);
+  EXPECT_EQ(to.overruns, 4u);
+  EXPECT_EQ(to.tick_cost_ns, 5);
+  EXPECT_EQ(to.max_tick_cost_ns, 6);
+  EXPECT_EQ(to.wake_latency_p50_ns, 7);
+  EXPECT_EQ(to.wake_latency_p99_ns, 8);
+  EXPECT_EQ(to.wake_latency_max_ns, 9);
+  EXPECT_EQ(to.telemetry_dropped, 10u);
+  EXPECT_EQ(to.can_tx_dropped, 11u);
+  EXPECT_EQ(to.can_rx_errors, 12u);
+}
+
 }  // namespace

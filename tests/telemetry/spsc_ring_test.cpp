@@ -68,6 +68,22 @@ TEST(SpscRing, PushOrDropCountsOnlyRefusals) {
   EXPECT_EQ(ring.dropped(), 6u);
 }
 
+TEST(SpscRing, APushWithACopyFunctionFillsTheSlotItsWay) {
+  // The copy writes only the first two of four values: the rest of the slot keeps what it held.
+  using Rec = std::array<int, 4>;
+  SpscRing<Rec, 2> ring;
+  const auto first_two = [](Rec& slot, const Rec& v) { slot[0] = v[0], slot[1] = v[1]; };
+  ASSERT_TRUE(ring.try_push(Rec{1, 2, 3, 4}, first_two));
+  ASSERT_TRUE(ring.push_or_drop(Rec{5, 6, 7, 8}, first_two));
+  EXPECT_FALSE(ring.push_or_drop(Rec{9, 9, 9, 9}, first_two));
+  EXPECT_EQ(ring.dropped(), 1u);
+  Rec out{};
+  ASSERT_TRUE(ring.try_pop(out));
+  EXPECT_EQ(out, (Rec{1, 2, 0, 0}));
+  ASSERT_TRUE(ring.try_pop(out));
+  EXPECT_EQ(out, (Rec{5, 6, 0, 0}));
+}
+
 TEST(SpscRing, PopManyTakesAtMostWhatIsThereInOrder) {
   SpscRing<int, 16> ring;
   std::array<int, 8> out{};

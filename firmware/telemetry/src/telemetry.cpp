@@ -11,8 +11,8 @@ Telemetry::Telemetry(const PublisherConfig& cfg)
       publisher_(cfg, *ring_, *events_) {}
 
 bool Telemetry::push_waiting(const Snapshot& s) noexcept {
-  while (!ring_->try_push(s)) {
-    if (!publisher_.running()) return ring_->push_or_drop(s);
+  while (!ring_->try_push(s, copy_in_use)) {
+    if (!publisher_.running()) return ring_->push_or_drop(s, copy_in_use);
     std::this_thread::yield();
   }
   return true;

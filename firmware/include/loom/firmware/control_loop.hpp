@@ -77,6 +77,14 @@ class ControlLoop {
   hal::HalInputs in_{};
   hal::HalOutputs out_{};
   telemetry::Snapshot snap_{};
+  // The names snap_ holds (string literals; nullptr: none yet), so fill_snapshot copies only changes.
+  const char* shown_state_ = nullptr;
+  const char* shown_first_fault_ = nullptr;
+  const char* shown_stopped_by_ = nullptr;
+  // The crank target and recipe snap_'s crank phase and beater angle were computed for.
+  bool crank_shown_ = false;
+  double shown_crank_target_ = 0.0;
+  std::uint32_t shown_recipe_ = 0;
   LoopStats stats_{};
   TelemetryContext ctx_{};
   // What the previous tick showed, so each event is pushed exactly once.

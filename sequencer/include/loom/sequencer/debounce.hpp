@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstring>
 
 namespace loom::sequencer {
 
@@ -16,6 +17,9 @@ class Debouncer {
 
   // RT-safe. The first update adopts the raw values as they are (there is no history to filter with).
   void update(const std::array<bool, N>& raw) noexcept {
+    // Almost every tick: every input reads what is in use and none is changing. Nothing to do.
+    if (primed_ && !changing_ && std::memcmp(raw.data(), value_.data(), N) == 0) return;
+    changing_ = false;
     for (std::size_t i = 0; i < N; ++i) {
       if (!primed_ || raw[i] == value_[i]) {
         value_[i] = raw[i];
@@ -24,6 +28,7 @@ class Debouncer {
         value_[i] = raw[i];
         disagree_[i] = 0;
       }
+      changing_ = changing_ || disagree_[i] != 0;
     }
     primed_ = true;
   }
@@ -33,6 +38,7 @@ class Debouncer {
  private:
   int ticks_;
   bool primed_ = false;
+  bool changing_ = false;  // some disagree_[i] != 0
   std::array<bool, N> value_{};
   std::array<int, N> disagree_{};
 };

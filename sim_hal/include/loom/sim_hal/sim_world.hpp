@@ -100,6 +100,7 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   std::size_t n_axes_ = hal::kCoreAxisCount;  // m_.axis_count
   std::array<double, 2> piston_{0.0, 0.0};    // 0 retracted … 1 extended
   std::array<double, 2> pressure_{0.0, 0.0};  // net drive −1 … 1 (pneumatics)
+  double pressure_fill_ = 0.0;                // pneumatics: 1 - exp(-period / fill_tau_s), the fill per tick
   std::array<bool, 2> piston_stuck_{false, false};
   std::array<std::optional<bool>, kSensorCount> stuck_sensor_{};
   double shuttle_x_ = 0.0, shuttle_v_ = 0.0;

@@ -3,7 +3,10 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <cstring>
+#include <type_traits>
 
 #include "loom/hal/types.hpp"
 
@@ -57,6 +60,22 @@ struct Snapshot {
   std::uint32_t can_tx_dropped = 0;    // link counters from the HAL (cumulative)
   std::uint32_t can_rx_errors = 0;
 };
+
+// Copies the part of a snapshot that is in use into a ring slot: everything but the axis slots at and
+// beyond axis_count, which nobody reads (the publisher encodes axes[0 .. axis_count)). The record is
+// sized for hal::kMaxAxes (32 axes, ~2 KB); a three-axis loom uses 168 bytes of its axes. RT-safe.
+inline void copy_in_use(Snapshot& to, const Snapshot& from) noexcept {
+  constexpr std::size_t head = offsetof(Snapshot, axes);
+  constexpr std::size_t tail = offsetof(Snapshot, outputs);
+  std::memcpy(static_cast<void*>(&to), &from, head);
+  const std::size_t n = from.axis_count < hal::kMaxAxes ? from.axis_count : hal::kMaxAxes;
+  for (std::size_t i = 0; i < n; ++i) to.axes[i] = from.axes[i];
+  std::memcpy(reinterpret_cast<unsigned char*>(&to) + tail, reinterpret_cast<const unsigned char*>(&from) + tail,
+              sizeof(Snapshot) - tail);
+}
+
+static_assert(std::is_standard_layout_v<Snapshot> && std::is_trivially_copyable_v<Snapshot>,
+              "copy_in_use copies a snapshot by its layout");
 
 // An event the loop reports once, never decimated (BEAT, FAULT, ROW). One plain struct for all kinds
 // so one ring carries them in order; `kind` says which part is meaningful.

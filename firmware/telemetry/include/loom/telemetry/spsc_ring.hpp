@@ -33,19 +33,30 @@ class SpscRing {
 
   // RT-safe (producer thread only). Copies `value` in; false when full, and nothing is changed.
   bool try_push(const T& value) noexcept {
+    return try_push(value, [](T& slot, const T& v) { slot = v; });
+  }
+
+  // RT-safe (producer thread only). Like try_push, but `copy(slot, value)` fills the slot: for a record
+  // only part of which is in use (a telemetry snapshot's axis slots beyond the machine's axes).
+  template <typename Copy>
+  bool try_push(const T& value, Copy&& copy) noexcept {
     const std::uint64_t head = head_.load(std::memory_order_relaxed);
     if (head - tail_seen_ == N) {
       tail_seen_ = tail_.load(std::memory_order_acquire);
       if (head - tail_seen_ == N) return false;
     }
-    slots_[head & kMask] = value;
+    copy(slots_[head & kMask], value);
     head_.store(head + 1, std::memory_order_release);
     return true;
   }
 
   // RT-safe (producer thread only). try_push, and when the ring is full count the loss in dropped().
   bool push_or_drop(const T& value) noexcept {
-    if (try_push(value)) return true;
+    return push_or_drop(value, [](T& slot, const T& v) { slot = v; });
+  }
+  template <typename Copy>
+  bool push_or_drop(const T& value, Copy&& copy) noexcept {
+    if (try_push(value, copy)) return true;
     // Only the producer writes the counter, so a relaxed read-modify-store cannot lose increments.
     dropped_.store(dropped_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
     return false;

@@ -22,13 +22,13 @@ class Telemetry {
   // Non-RT. Publishes what is left in the ring, then joins the publishing thread.
   void stop() { publisher_.stop(); }
 
-  // RT-safe. Copies the snapshot into the ring; when the ring is full the snapshot is dropped,
-  // counted in dropped(), and false is returned. Never blocks, never allocates.
-  bool push(const Snapshot& s) noexcept { return ring_->push_or_drop(s); }
+  // RT-safe. Copies the snapshot (the part in use: copy_in_use) into the ring; when the ring is full
+  // the snapshot is dropped, counted in dropped(), and false is returned. Never blocks, never allocates.
+  bool push(const Snapshot& s) noexcept { return ring_->push_or_drop(s, copy_in_use); }
 
   // RT-safe. Like push() but a full ring is not counted as a drop: for a caller that will retry
   // (virtual-time simulation, where the loop may wait for the publisher so nothing is lost).
-  bool try_push(const Snapshot& s) noexcept { return ring_->try_push(s); }
+  bool try_push(const Snapshot& s) noexcept { return ring_->try_push(s, copy_in_use); }
 
   // NOT RT-safe: virtual time only. Retries (yielding the CPU) until the ring takes the snapshot;
   // gives up and counts a drop if the publisher is not running, since then nobody would make room.
