@@ -109,6 +109,12 @@ class RowKnotter {
   std::uint32_t requests() const noexcept { return requests_; }  // counts requests made (never reset)
   const RowKnots& row() const noexcept { return row_; }
   int cycle() const noexcept { return j_; }  // the knot cycle in progress (0-based)
+  // RT-safe. Yarn left in slot `slot` of head `head`'s magazine, in knots, as the loom counts it (-1 when
+  // unknown: before the first row or out of range).
+  std::int32_t stock(int head, int slot) const noexcept {
+    if (!stock_known_ || head < 0 || head >= heads_ || slot < 0 || slot >= kMaxMagazineSlots) return -1;
+    return stock_[static_cast<std::size_t>(head)][static_cast<std::size_t>(slot)];
+  }
 
   // RT-safe. The servo angle of a knotting servo at rest (TAKE) nearest behind `position`: where a
   // servo stopped inside a cycle goes back to (the way it came).

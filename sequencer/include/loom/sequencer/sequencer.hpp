@@ -172,6 +172,8 @@ class Sequencer {
   std::uint32_t weaver_requests() const noexcept { return knotter_.requests(); }
   // The knotting heads as the interlocks see them (heads = 0 without).
   const KnotGuard& knot_guard() const noexcept { return interlock_ctx_.knot; }
+  // The knotting heads' progress in the row (cycle, requests, magazines).
+  const RowKnotter& knotter() const noexcept { return knotter_; }
   // RT-safe. The knot cycle the heads are on (0-based) while knotting.
   int knot_cycle() const noexcept { return knotter_.cycle(); }
 
