@@ -84,17 +84,20 @@ void RowKnotter::begin(std::uint32_t row0, const KnotCounters& progress, double 
     selector_move_[hh].active = false;
     slot_[hh] = -1;  // where a selector stands is read back from its command when it is next sent
   }
-  next_started_ = false;
+  next_carriage_ = next_selectors_ = false;
   // A cycle started and not finished: the power failed while its knots were being tied. Whether they are
   // is not known; tying again could tie one twice, so the weaver checks them (kCheck asks).
   interrupted_ = progress.cycles_started > progress.cycles_done && progress.cycles_done < static_cast<std::uint32_t>(stripe_);
   enter_cycle(static_cast<int>(progress.cycles_done), now, cmd);
 }
 
-void RowKnotter::plan_travel(int j, hal::Tick now, const hal::HalOutputs& cmd) noexcept {
+void RowKnotter::plan_carriage(int j, hal::Tick now, const hal::HalOutputs& cmd) noexcept {
   const double from = cmd.axes[hal::index(hal::CoreAxis::kCarriage)].target_position;
   const double goal = carriage_home_m_ + k_.program->carriage_at(j);
   carriage_move_ = {true, false, now, from, motion::JerkMove::plan(goal - from, carriage_)};
+}
+
+void RowKnotter::plan_selectors(int j, hal::Tick now, const hal::HalOutputs& cmd) noexcept {
   for (int h = 0; h < heads_; ++h) {
     const auto hh = static_cast<std::size_t>(h);
     const int k = k_.program->knot_of(h, j);
@@ -107,6 +110,12 @@ void RowKnotter::plan_travel(int j, hal::Tick now, const hal::HalOutputs& cmd) n
   }
 }
 
+void RowKnotter::plan_travel(int j, hal::Tick now, const hal::HalOutputs& cmd) noexcept {
+  if (!next_carriage_) plan_carriage(j, now, cmd);
+  if (!next_selectors_) plan_selectors(j, now, cmd);
+  next_carriage_ = next_selectors_ = false;
+}
+
 void RowKnotter::enter_cycle(int j, hal::Tick now, const hal::HalOutputs& cmd) noexcept {
   j_ = j;
   attempt_ = 0;
@@ -117,8 +126,7 @@ void RowKnotter::enter_cycle(int j, hal::Tick now, const hal::HalOutputs& cmd) n
     phase_since_ = now;
     return;
   }
-  if (!next_started_) plan_travel(j_, now, cmd);
-  next_started_ = false;
+  plan_travel(j_, now, cmd);  // what did not start inside the cycle before
   for (int h = 0; h < heads_; ++h) {
     const auto hh = static_cast<std::size_t>(h);
     active_[hh] = k_.program->knot_of(h, j_) >= 0;
@@ -225,12 +233,17 @@ void RowKnotter::run_cycle(hal::Tick now, const hal::HalInputs& in, hal::HalOutp
     if (c.yarn_sample().contains(t) && in.io.yarn_present[hh]) seen_[hh] = true;
     all_seen &= seen_[hh];
   }
-  // The next knot's travel starts inside this cycle once this position cannot be needed again: every knot
-  // verified (no retry), the yarn released (selectors) and every gripper out of the warp (carriage).
-  if (all_seen && !next_started_ && j_ + 1 < stripe_ && t >= c.yarn_sample().end_s && t >= c.gripper_closed().end_s &&
-      t >= c.in_warp().end_s) {
-    plan_travel(j_ + 1, now, cmd);
-    next_started_ = true;
+  // The next knot's moves start inside this cycle once this position cannot be needed again (every knot
+  // verified: no retry): the selectors as soon as the yarn is released (they never turn under a closed
+  // gripper), the carriage once every gripper is out of the warp.
+  const bool verified = all_seen && j_ + 1 < stripe_ && t >= c.yarn_sample().end_s;
+  if (verified && !next_selectors_ && t >= c.gripper_closed().end_s) {
+    plan_selectors(j_ + 1, now, cmd);
+    next_selectors_ = true;
+  }
+  if (verified && !next_carriage_ && t >= c.in_warp().end_s) {
+    plan_carriage(j_ + 1, now, cmd);
+    next_carriage_ = true;
   }
   if (t >= c.duration_s()) finish_cycle(now, cmd, counters);
 }

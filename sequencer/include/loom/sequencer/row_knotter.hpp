@@ -130,6 +130,8 @@ class RowKnotter {
     motion::JerkMove move;
   };
   void plan_travel(int j, hal::Tick now, const hal::HalOutputs& cmd) noexcept;  // carriage and selectors to cycle j
+  void plan_selectors(int j, hal::Tick now, const hal::HalOutputs& cmd) noexcept;
+  void plan_carriage(int j, hal::Tick now, const hal::HalOutputs& cmd) noexcept;
   void enter_cycle(int j, hal::Tick now, const hal::HalOutputs& cmd) noexcept;  // cycle j: travel (if not begun), check
   void start_cycle(hal::Tick now) noexcept;
   void finish_cycle(hal::Tick now, const hal::HalOutputs& cmd, KnotCounters& counters) noexcept;
@@ -167,7 +169,8 @@ class RowKnotter {
   std::array<bool, hal::kMaxKnottingHeads> missed_{};    // needs the weaver's hand after the second miss
   std::array<std::array<std::int32_t, kMaxMagazineSlots>, hal::kMaxKnottingHeads> stock_{};  // knots left per slot
   bool stock_known_ = false;
-  bool next_started_ = false;  // the next cycle's travel began inside this one
+  bool next_selectors_ = false;  // the next cycle's selector moves began inside this one
+  bool next_carriage_ = false;   // and its carriage step
   hal::Tick cycle_t0_ = 0;
   Fault fault_ = Fault::kNone;
   int fault_axis_ = -1;
