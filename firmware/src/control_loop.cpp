@@ -24,6 +24,8 @@ void set_name(std::array<char, N>& dst, const char* src, const char*& shown) noe
   shown = src;
 }
 
+static_assert(telemetry::kMaxKnotSlots == static_cast<std::size_t>(sequencer::kMaxMagazineSlots), "the snapshot holds every magazine slot");
+
 bool axis_faulted(const hal::AxisFeedback& a) noexcept {
   return a.fault || a.state == hal::DriveState::kFault || a.state == hal::DriveState::kFaultReactionActive;
 }
@@ -86,6 +88,7 @@ void ControlLoop::push_events(hal::Tick now) noexcept {
     // Counters resumed from disk are not events of this run.
     beat_events_seen_ = seq_.beat_events();
     rows_seen_ = seq_.counters().rows;
+    weaver_requests_seen_ = seq_.weaver_requests();
     primed_ = true;
   }
   // BEAT: the sequencer completes at most one beat per tick, so polling every tick sees each once.
@@ -122,6 +125,11 @@ void ControlLoop::push_events(hal::Tick now) noexcept {
     e.force_min_n = r.force_min_n;
     e.force_mean_n = r.force_mean_n;
     e.force_max_n = r.force_max_n;
+    e.knot_ticks = r.knot_ticks;
+    e.weaver_ticks = r.weaver_ticks;
+    e.knots_tied = static_cast<std::uint16_t>(r.knots_tied);
+    e.knots_retried = static_cast<std::uint16_t>(r.knots_retried);
+    e.knots_by_hand = static_cast<std::uint16_t>(r.knots_by_hand);
     std::uint16_t in_band = 0;
     const int n = r.beats < sequencer::kMaxBeatsPerRow ? r.beats : sequencer::kMaxBeatsPerRow;
     for (int k = 0; r.force_measured && k < n; ++k) {  // bounded: kMaxBeatsPerRow
@@ -129,6 +137,23 @@ void ControlLoop::push_events(hal::Tick now) noexcept {
       if (f >= ctx_.beat_force_min_n && f <= ctx_.beat_force_max_n) ++in_band;
     }
     e.beats_in_band = in_band;
+    push_event(e);
+  }
+  // WEAVER: each request the knotting heads make of the weaver (at most one per tick), once; the
+  // publisher words it. A loom without heads never counts one.
+  if (seq_.weaver_requests() != weaver_requests_seen_) {
+    weaver_requests_seen_ = seq_.weaver_requests();
+    const sequencer::WeaverRequest& q = seq_.knotter().request();
+    telemetry::Event e;
+    e.kind = telemetry::Event::Kind::kWeaver;
+    fill_event_context(e, now);
+    e.row = q.row;
+    e.ask = static_cast<std::uint8_t>(q.ask);
+    e.request = weaver_requests_seen_;
+    e.design_row = q.design_row;
+    e.knot = static_cast<std::int16_t>(q.knot);
+    e.head = static_cast<std::int16_t>(q.head);
+    e.slot = static_cast<std::int16_t>(q.slot);
     push_event(e);
   }
   // FAULT: the latched first fault, a later diagnosis of its root cause, and every device report.
@@ -245,6 +270,45 @@ void ControlLoop::fill_snapshot(hal::Tick now) noexcept {
   s.telemetry_dropped = static_cast<std::uint32_t>(telemetry_->dropped());
   s.can_tx_dropped = in_.link.tx_dropped;
   s.can_rx_errors = in_.link.rx_errors;
+  if (ctx_.knot_program != nullptr) fill_knots();
+}
+
+// The heads' progress changes only while they tie: outside the knotting state (and after the tick that
+// left it) the previous values stand and nothing is copied.
+void ControlLoop::fill_knots() noexcept {
+  telemetry::KnotSample& k = snap_.knots;
+  const bool knotting = seq_.state() == sequencer::State::kKnotting;
+  if (knots_shown_ && !knotting && !k.knotting) return;
+  const sequencer::KnotProgram& p = *ctx_.knot_program;
+  const sequencer::RowKnotter& r = seq_.knotter();
+  const int heads = p.heads() < static_cast<int>(hal::kMaxKnottingHeads) ? p.heads() : static_cast<int>(hal::kMaxKnottingHeads);
+  const int slots = p.slots() < sequencer::kMaxMagazineSlots ? p.slots() : sequencer::kMaxMagazineSlots;
+  k.heads = static_cast<std::uint8_t>(heads > 0 ? heads : 0);
+  k.slots = static_cast<std::uint8_t>(slots > 0 ? slots : 0);
+  k.knotting = knotting;
+  k.cycle = static_cast<std::int16_t>(knotting ? r.cycle() : -1);
+  const sequencer::KnotCounters& c = seq_.counters().knot;
+  k.cycles_started = static_cast<std::uint16_t>(c.cycles_started);
+  k.cycles_done = static_cast<std::uint16_t>(c.cycles_done);
+  k.tied = c.tied;
+  k.retried = c.retried;
+  k.by_hand = c.by_hand;
+  k.row_tied = static_cast<std::uint16_t>(r.row().tied);
+  k.row_retried = static_cast<std::uint16_t>(r.row().retried);
+  k.row_by_hand = static_cast<std::uint16_t>(r.row().by_hand);
+  k.requests = seq_.weaver_requests();
+  const sequencer::WeaverRequest& q = seq_.weaver_request();  // kNone unless knotting
+  k.ask = static_cast<std::uint8_t>(q.ask);
+  k.ask_knot = static_cast<std::int16_t>(q.knot);
+  k.ask_head = static_cast<std::int16_t>(q.head);
+  k.ask_slot = static_cast<std::int16_t>(q.slot);
+  k.ask_row = q.row;
+  for (int h = 0; h < heads; ++h) {  // bounded: 12 heads × 16 slots
+    for (int sl = 0; sl < slots; ++sl) {
+      k.stock[static_cast<std::size_t>(h)][static_cast<std::size_t>(sl)] = r.stock(h, sl);
+    }
+  }
+  knots_shown_ = true;
 }
 
 }  // namespace loom::firmware

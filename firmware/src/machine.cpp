@@ -74,6 +74,7 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
     pc.design = cfg_.recipe.design;
     pc.design_rows_at_start = opt.design_rows_done;
     pc.counter_rows_at_start = resume.rows;
+    pc.knot_program = knot_program_.get();  // KNOTS and WEAVER (null without heads); outlives telemetry_
     try {
       telemetry_ = std::make_unique<telemetry::Telemetry>(pc);
     } catch (const std::invalid_argument& e) {
@@ -87,6 +88,7 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
   tc.beat_force_min_n = cfg_.sequencer.beat_force_min_n;
   tc.beat_force_max_n = cfg_.sequencer.beat_force_max_n;
   tc.rows_target = opt.rows;
+  tc.knot_program = knot_program_.get();  // the snapshot's knot progress (null without heads)
   loop_->set_telemetry_context(tc);
 }
 

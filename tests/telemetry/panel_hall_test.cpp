@@ -167,6 +167,69 @@ TEST(PanelHall, RowsCarryTheKnottingTime) {
   EXPECT_EQ((*hall.loom_json("L1"))["rows"][0]["knotting_s"], 42.5);
 }
 
+// The knotting heads: the latest KNOTS as the page draws it (each head's knot and magazine, the row's
+// slots, the open request), every WEAVER request kept up to the limit; counts a corrupt message claims
+// beyond its arrays are never trusted.
+TEST(PanelHall, KnotsShowTheRowPerHeadAndTheOpenRequest) {
+  HallLimits lim;
+  lim.weaver_requests_kept = 2;
+  lim.knots_per_row = 4;
+  Hall hall(lim);
+  loomlcm::knots_t k{};
+  k.loom_id = "L1";
+  k.state = "knotting";
+  k.knotting = 1;
+  k.row = 3;
+  k.heads = 2;
+  k.stripe = 3;
+  k.knots_per_row = 6;
+  k.slots = 2;
+  k.knots_per_slot = 100;
+  k.cycle = 1;
+  k.head_knot = {1, 4};
+  k.head_slot = {0, 1};
+  k.head_colour = {"R", "B"};
+  k.slot_colour = {"R", "B"};
+  k.knot_slot = {0, 0, 1, 1, 1, 7};  // 7: no such slot
+  k.stock = {{90, -1}, {100, 5}};
+  k.ask = "tie_by_hand";
+  k.ask_knot = 4;
+  k.ask_head = 1;
+  k.ask_text = "tie knot 5";
+  hall.on_knots(k);
+  for (int n = 1; n <= 3; ++n) {
+    loomlcm::weaver_request_t w{};
+    w.loom_id = "L1";
+    w.number = n;
+    w.ask = "reload";
+    w.text = "request " + std::to_string(n);
+    hall.on_weaver(w);
+  }
+  const auto j = *hall.loom_json("L1");
+  const auto& kj = j["knots"];
+  ASSERT_EQ(kj["heads"].size(), 2u);
+  EXPECT_EQ(kj["heads"][1]["knot"], 4);
+  EXPECT_EQ(kj["heads"][1]["colour"], "B");
+  EXPECT_EQ(kj["heads"][0]["stock"], nlohmann::json({90, -1}));
+  EXPECT_EQ(kj["row_slots"], nlohmann::json({0, 0, 1, 1}));  // cut at the limit of 4
+  EXPECT_TRUE(kj["cut"]);
+  EXPECT_EQ(kj["request"]["text"], "tie knot 5");
+  EXPECT_EQ(kj["request"]["knot"], 4);
+  ASSERT_EQ(j["weaver_requests"].size(), 2u);
+  EXPECT_EQ(j["weaver_requests"][0]["number"], 2);
+  EXPECT_EQ(j["weaver_requests"][1]["text"], "request 3");
+
+  k.heads = 12;  // claims more heads than it carries
+  k.ask = "";
+  k.knot_slot = {0, 9};
+  k.knots_per_row = 2;
+  hall.on_knots(k);
+  const auto j2 = *hall.loom_json("L1");
+  EXPECT_EQ(j2["knots"]["heads"].size(), 2u);
+  EXPECT_TRUE(j2["knots"]["request"].is_null());
+  EXPECT_EQ(j2["knots"]["row_slots"], nlohmann::json({0, nullptr}));  // slot 9 is not a slot
+}
+
 TEST(PanelUdpm, UrlsAndPackets) {
   const auto a = parse_udpm_url("udpm://239.255.76.67:7771?ttl=0");
   ASSERT_TRUE(a.has_value());

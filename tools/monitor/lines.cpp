@@ -1,6 +1,7 @@
 // Formatting of telemetry messages as lines (see lines.hpp).
 #include "lines.hpp"
 
+#include <algorithm>
 #include <cstdio>
 
 namespace loom::monitor {
@@ -33,6 +34,11 @@ long long ll(std::int64_t v) {
 // "loom1 t=12.345s" — the start of every event-view line.
 std::string who(const std::string& loom_id, double t_s) {
   return printable_field(loom_id) + fmt(" t=%.3fs", t_s);
+}
+
+// A row the knotting heads tied (knotting mode by hand and plain weaving have no knot counts).
+bool knotted_by_heads(const loomlcm::row_t& m) {
+  return m.knot_s > 0.0 || m.knots_tied > 0 || m.knots_retried > 0 || m.knots_by_hand > 0;
 }
 
 std::string row_of(const loomlcm::status_t& m) {
@@ -125,7 +131,37 @@ std::string row_line(const loomlcm::row_t& m) {
   } else {
     line += " force_min=- force_mean=- force_max=- in_band=-";
   }
-  return line + fmt(" knotting=%.2fs", m.knotting_s);
+  line += fmt(" knotting=%.2fs", m.knotting_s);
+  if (knotted_by_heads(m)) {
+    line += fmt(" knots_tied=%d knots_retried=%d knots_by_hand=%d knot_time=%.2fs weaver_time=%.2fs", m.knots_tied,
+                m.knots_retried, m.knots_by_hand, m.knot_s, m.weaver_s);
+  }
+  return line;
+}
+
+std::string weaver_line(const loomlcm::weaver_request_t& m) {
+  return "weaver loom=" + printable_field(m.loom_id) + fmt(" t=%.3fs n=%d ask=", m.time_s, m.number) +
+         printable_field(m.ask) +
+         fmt(" row=%d design_row=%d knot=%d head=%d slot=%d colour=", m.row, m.design_row, m.knot, m.head, m.slot) +
+         printable_field(m.colour) + " text=\"" + printable_text(m.text) + "\"";
+}
+
+std::string knots_line(const loomlcm::knots_t& m) {
+  std::string line = head("knots ", m.loom_id, m.tick, m.time_s) + " state=" + printable_field(m.state) +
+                     fmt(" row=%d design_row=%d cycle=%d/%d cycles_done=%d tied=%lld retried=%lld by_hand=%lld", m.row,
+                         m.design_row, m.cycle, m.stripe, m.cycles_done, ll(m.tied), ll(m.retried), ll(m.by_hand)) +
+                     fmt(" row_tied=%d row_retried=%d row_by_hand=%d requests=%d ask=", m.row_tied, m.row_retried,
+                         m.row_by_hand, m.requests) +
+                     printable_field(m.ask);
+  for (std::size_t h = 0; h < static_cast<std::size_t>(std::max<int>(m.heads, 0)); ++h) {
+    const int knot = h < m.head_knot.size() ? m.head_knot[h] : -1;
+    line += fmt(" | head%d knot=%d colour=", static_cast<int>(h), knot) +
+            printable_field(h < m.head_colour.size() ? m.head_colour[h] : std::string()) + " stock=";
+    if (h < m.stock.size()) {
+      for (std::size_t sl = 0; sl < m.stock[h].size(); ++sl) line += (sl == 0 ? "" : ",") + fmt("%d", m.stock[h][sl]);
+    }
+  }
+  return line;
 }
 
 // The next row's knots as runs of one colour, left to right ("B×2 R×2 B×4 ..."): what a weaver counts.
@@ -212,7 +248,16 @@ std::vector<std::string> EventView::on_row(const loomlcm::row_t& m) {
                 m.force_max_n, m.beats_in_band, m.beats);
   }
   if (m.knotting_s > 0.0) line += fmt(", knotted in %.1f s before it", m.knotting_s);
+  if (knotted_by_heads(m)) {
+    line += fmt(", knots %d tied, %d retried, %d by hand (heads %.1f s", m.knots_tied, m.knots_retried,
+                m.knots_by_hand, m.knot_s);
+    line += m.weaver_s > 0.0 ? fmt(", weaver %.1f s)", m.weaver_s) : std::string(")");
+  }
   return {line};
+}
+
+std::vector<std::string> EventView::on_weaver(const loomlcm::weaver_request_t& m) {
+  return {who(m.loom_id, m.time_s) + " WEAVER " + printable_field(m.ask) + ": " + printable_text(m.text)};
 }
 
 std::vector<std::string> EventView::on_fault(const loomlcm::fault_t& m) {

@@ -16,9 +16,11 @@
 #include "loomlcm/beat_t.hpp"
 #include "loomlcm/design_t.hpp"
 #include "loomlcm/fault_t.hpp"
+#include "loomlcm/knots_t.hpp"
 #include "loomlcm/row_t.hpp"
 #include "loomlcm/rt_stats_t.hpp"
 #include "loomlcm/status_t.hpp"
+#include "loomlcm/weaver_request_t.hpp"
 
 namespace loom::monitor {
 
@@ -38,7 +40,16 @@ std::string beat_line(const loomlcm::beat_t& m);
 std::string fault_line(const loomlcm::fault_t& m);
 // row loom=<id> t=<s>s row=<n> time=<s>s shed=<s>s pick=<s>s beat=<s>s beats=<n> steps=<n>
 //   force_min=<N>N force_mean=<N>N force_max=<N>N in_band=<k>/<n>   (force fields "-" when unmeasured)
+//   knotting=<s>s, then for a row the knotting heads tied:
+//   knots_tied=<n> knots_retried=<n> knots_by_hand=<n> knot_time=<s>s weaver_time=<s>s
 std::string row_line(const loomlcm::row_t& m);
+// weaver loom=<id> t=<s>s n=<request number> ask=<tie_by_hand|reload|check_knot> row=<n> design_row=<0-based>
+//   knot=<0-based|-1> head=<0-based> slot=<n> colour=<code|-> text="<the request in the weaver's words>"
+std::string weaver_line(const loomlcm::weaver_request_t& m);
+// knots loom=<id> tick=<n> t=<s>s state=<name> row=<n> design_row=<0-based> cycle=<j|-1>/<stripe>
+//   cycles_done=<n> tied=<n> retried=<n> by_hand=<n> row_tied=<n> row_retried=<n> row_by_hand=<n> requests=<n>
+//   ask=<name|-> then per head " | head<h> knot=<k|-1> colour=<code|-> stock=<slot0>,<slot1>,..."
+std::string knots_line(const loomlcm::knots_t& m);
 std::string design_line(const loomlcm::design_t& m);
 
 // Received text is printed only after replacing spaces and non-printable bytes with '?', so a
@@ -58,6 +69,8 @@ class EventView {
   std::vector<std::string> on_fault(const loomlcm::fault_t& m);
   std::vector<std::string> on_row(const loomlcm::row_t& m);
   std::vector<std::string> on_rt(const loomlcm::rt_stats_t& m);
+  // One line per request the knotting heads make of the weaver.
+  std::vector<std::string> on_weaver(const loomlcm::weaver_request_t& m);
   // A line only when the row to knot next changes (DESIGN repeats every second).
   std::vector<std::string> on_design(const loomlcm::design_t& m);
 

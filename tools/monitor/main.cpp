@@ -2,8 +2,9 @@
 // straight from a log (file://…?mode=r).
 //   default             one line per event (state change, beat, row done with its force summary,
 //                       fault with axis, hex codes and text) and a compact status at most once per
-//                       second of loop time
-//   --channel KIND,...  one key=value line per message of those channels (status axes rt beat fault row)
+//                       second of loop time, a line per weaver request (knotting heads)
+//   --channel KIND,...  one key=value line per message of those channels (status axes rt beat fault row
+//                       design weaver knots)
 // Replayed data is marked, never mixed with a live loom's: a message stamped (utime, the publisher's wall
 // clock) more than --replay-after-s before now was recorded earlier and is being replayed (lcm-logplayer
 // onto this group, or a log read through file://). Its lines say so ("REPLAY recorded N s ago" in the event
@@ -81,6 +82,11 @@ class Printer {
   void handle(const loomlcm::fault_t& m) { dispatch("fault", m, &loom::monitor::fault_line, &View::on_fault); }
   void handle(const loomlcm::row_t& m) { dispatch("row", m, &loom::monitor::row_line, &View::on_row); }
   void handle(const loomlcm::design_t& m) { dispatch("design", m, &loom::monitor::design_line, &View::on_design); }
+  void handle(const loomlcm::weaver_request_t& m) { dispatch("weaver", m, &loom::monitor::weaver_line, &View::on_weaver); }
+  void handle(const loomlcm::knots_t& m) {
+    dispatch("knots", m, &loom::monitor::knots_line,
+             static_cast<std::vector<std::string> (View::*)(const loomlcm::knots_t&)>(nullptr));
+  }
 
   template <typename Msg>
   void dispatch(const char* kind, const Msg& m, std::string (*raw_line)(const Msg&),
@@ -145,8 +151,8 @@ int main(int argc, char** argv) {
                  "$LCM_DEFAULT_URL or LCM's own default)");
   app.add_option("--loom-id", o.loom_id, "Only this loom (default: every loom on the URL)");
   app.add_option("--channel", o.channels,
-                 "Print every message of these channels as key=value lines: status, axes, rt, beat, fault, row "
-                 "(repeat or comma-separate)")
+                 "Print every message of these channels as key=value lines: status, axes, rt, beat, fault, row, "
+                 "design, weaver, knots (repeat or comma-separate)")
       ->delimiter(',');
   app.add_option("--count", o.count, "Exit 0 after printing this many lines (0: no limit)");
   app.add_option("--timeout-s", o.timeout_s,
@@ -187,9 +193,9 @@ int main(int argc, char** argv) {
   }
   std::set<std::string> raw;
   for (const auto& c : o.channels) {
-    static const std::set<std::string> kKnown = {"status", "axes", "rt", "beat", "fault", "row", "design"};
+    static const std::set<std::string> kKnown = {"status", "axes", "rt", "beat", "fault", "row", "design", "weaver", "knots"};
     if (kKnown.count(c) == 0) {
-      return usage_error("--channel '" + c + "' is not one of status, axes, rt, beat, fault, row, design");
+      return usage_error("--channel '" + c + "' is not one of status, axes, rt, beat, fault, row, design, weaver, knots");
     }
     raw.insert(c);
   }
@@ -220,6 +226,8 @@ int main(int argc, char** argv) {
   if (wanted("fault", true)) sub("fault", &Printer::on<loomlcm::fault_t>);
   if (wanted("row", true)) sub("row", &Printer::on<loomlcm::row_t>);
   if (wanted("design", true)) sub("design", &Printer::on<loomlcm::design_t>);
+  if (wanted("weaver", true)) sub("weaver", &Printer::on<loomlcm::weaver_request_t>);
+  if (wanted("knots", false)) sub("knots", &Printer::on<loomlcm::knots_t>);
 
   struct sigaction sa {};
   sa.sa_handler = on_signal;

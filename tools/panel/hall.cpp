@@ -1,6 +1,7 @@
 // The panel's bounded model of the hall (see hall.hpp).
 #include "hall.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace loom::panel {
@@ -81,7 +82,9 @@ json rt_json(const loomlcm::rt_stats_t& m) {
 
 json row_json(const loomlcm::row_t& m) {
   json j = {{"row", m.row},       {"time_s", num(m.row_s)}, {"shed_s", num(m.shed_s)}, {"pick_s", num(m.pick_s)},
-            {"beat_s", num(m.beat_s)}, {"knotting_s", num(m.knotting_s)}, {"beats", m.beats},
+            {"beat_s", num(m.beat_s)}, {"knotting_s", num(m.knotting_s)}, {"knot_s", num(m.knot_s)},
+            {"weaver_s", num(m.weaver_s)}, {"knots_tied", m.knots_tied}, {"knots_retried", m.knots_retried},
+            {"knots_by_hand", m.knots_by_hand}, {"beats", m.beats},
             {"carriage_steps", m.carriage_steps},
             {"beats_in_band", m.beats_in_band}};
   if (m.force_measured) {
@@ -114,6 +117,12 @@ json design_json(const loomlcm::design_t& m) {
   }
   return {{"name", m.name},           {"width", m.width},   {"height", m.height}, {"rows_done", m.rows_done},
           {"next_row", m.next_row},   {"repeat", m.repeat}, {"palette", palette}, {"rows", rows}};
+}
+
+json weaver_json(const loomlcm::weaver_request_t& m) {
+  return {{"time_s", num(m.time_s)}, {"number", m.number}, {"ask", m.ask},   {"row", m.row},
+          {"design_row", m.design_row}, {"knot", m.knot}, {"head", m.head}, {"slot", m.slot},
+          {"colour", m.colour}, {"text", m.text}};
 }
 
 json fault_json(const loomlcm::fault_t& m) {
@@ -218,6 +227,59 @@ void Hall::on_design(const loomlcm::design_t& m) {
   }
 }
 
+void Hall::on_knots(const loomlcm::knots_t& m) {
+  std::lock_guard lock(mu_);
+  if (Loom* l = loom(m.loom_id)) {
+    l->knots = m;
+    changed();
+  }
+}
+
+void Hall::on_weaver(const loomlcm::weaver_request_t& m) {
+  std::lock_guard lock(mu_);
+  if (Loom* l = loom(m.loom_id)) {
+    l->weaver.push_back(m);
+    while (l->weaver.size() > limits_.weaver_requests_kept) l->weaver.pop_front();
+    changed();
+  }
+}
+
+// The row the heads tie, knot by knot, as the page draws it. The message's counts are not trusted
+// beyond its arrays (a spoofed or corrupt KNOTS): heads at most 12, slots 16, knots the limit.
+json Hall::knots_json(const loomlcm::knots_t& m) const {
+  const auto count = [](std::int64_t n, std::size_t have, std::size_t cap) {
+    return std::min<std::size_t>({n > 0 ? static_cast<std::size_t>(n) : 0, have, cap});
+  };
+  const std::size_t heads = count(m.heads, std::min({m.head_knot.size(), m.head_slot.size(), m.head_colour.size(),
+                                                     m.stock.size()}), 12);
+  const std::size_t slots = count(m.slots, m.slot_colour.size(), 16);
+  const std::size_t knots = count(m.knots_per_row, m.knot_slot.size(), limits_.knots_per_row);
+  json slot_colours = json::array();
+  for (std::size_t s = 0; s < slots; ++s) slot_colours.push_back(m.slot_colour[s]);
+  json row = json::array();
+  for (std::size_t k = 0; k < knots; ++k) {
+    const int s = m.knot_slot[k];
+    row.push_back(s >= 0 && static_cast<std::size_t>(s) < slots ? json(s) : json(nullptr));
+  }
+  json hs = json::array();
+  for (std::size_t h = 0; h < heads; ++h) {
+    json stock = json::array();
+    for (std::size_t s = 0; s < slots && s < m.stock[h].size(); ++s) stock.push_back(m.stock[h][s]);
+    hs.push_back({{"head", h}, {"knot", m.head_knot[h]}, {"slot", m.head_slot[h]}, {"colour", m.head_colour[h]},
+                  {"stock", stock}});
+  }
+  json ask = m.ask.empty() ? json(nullptr)
+                           : json{{"ask", m.ask}, {"knot", m.ask_knot}, {"head", m.ask_head}, {"slot", m.ask_slot},
+                                  {"text", m.ask_text}};
+  return {{"time_s", num(m.time_s)},     {"state", m.state},           {"knotting", m.knotting != 0},
+          {"row", m.row},                {"design_row", m.design_row}, {"heads", hs},
+          {"stripe", m.stripe},          {"knots_per_row", m.knots_per_row}, {"cut", knots < static_cast<std::size_t>(std::max<int>(m.knots_per_row, 0))},
+          {"knots_per_slot", m.knots_per_slot}, {"cycle", m.cycle}, {"cycles_done", m.cycles_done},
+          {"tied", m.tied},              {"retried", m.retried},       {"by_hand", m.by_hand},
+          {"row_tied", m.row_tied},      {"row_retried", m.row_retried}, {"row_by_hand", m.row_by_hand},
+          {"requests", m.requests},      {"slot_colours", slot_colours}, {"row_slots", row}, {"request", ask}};
+}
+
 json Hall::summary(const std::string& id, const Loom& l, Clock::time_point now) {
   json j = {{"id", id},
             {"heard_s_ago", std::chrono::duration<double>(now - l.heard).count()},
@@ -267,6 +329,10 @@ std::optional<json> Hall::loom_json(const std::string& id) const {
   for (const auto& f : l.faults) faults.push_back(fault_json(f));
   j["faults"] = faults;
   j["design"] = l.design ? design_json(*l.design) : json(nullptr);
+  j["knots"] = l.knots ? knots_json(*l.knots) : json(nullptr);
+  json weaver = json::array();
+  for (const auto& w : l.weaver) weaver.push_back(weaver_json(w));
+  j["weaver_requests"] = weaver;
   j["controls"] = false;  // the HTTP side says whether it may act on this loom (main.cpp)
   return j;
 }

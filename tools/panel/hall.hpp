@@ -19,9 +19,11 @@
 #include "loomlcm/beat_t.hpp"
 #include "loomlcm/design_t.hpp"
 #include "loomlcm/fault_t.hpp"
+#include "loomlcm/knots_t.hpp"
 #include "loomlcm/row_t.hpp"
 #include "loomlcm/rt_stats_t.hpp"
 #include "loomlcm/status_t.hpp"
+#include "loomlcm/weaver_request_t.hpp"
 
 namespace loom::panel {
 
@@ -30,6 +32,8 @@ struct HallLimits {
   std::size_t rows_kept = 20;     // row summaries per loom
   std::size_t faults_kept = 50;   // faults per loom
   std::size_t beats_per_row = 512;  // beats kept per row (the firmware caps a row at 256)
+  std::size_t weaver_requests_kept = 20;  // weaver requests per loom (knotting heads)
+  std::size_t knots_per_row = 4096;       // knots of a row shown (a wider one is cut, and says so)
 };
 
 // The only way the panel turns JSON into text: any string that is not valid UTF-8 (a design palette
@@ -50,6 +54,8 @@ class Hall {
   void on_fault(const loomlcm::fault_t& m);
   void on_row(const loomlcm::row_t& m);
   void on_design(const loomlcm::design_t& m);
+  void on_knots(const loomlcm::knots_t& m);
+  void on_weaver(const loomlcm::weaver_request_t& m);
 
   // HTTP threads. The hall: every loom heard, one summary object each. A loom: everything kept, or
   // nullopt when that id was never heard.
@@ -80,11 +86,14 @@ class Hall {
     std::deque<loomlcm::row_t> rows;
     std::deque<loomlcm::fault_t> faults;
     std::optional<loomlcm::design_t> design;  // the weaver's next row (looms weaving a design)
+    std::optional<loomlcm::knots_t> knots;    // the knotting heads' progress (looms with heads)
+    std::deque<loomlcm::weaver_request_t> weaver;  // the last requests made of the weaver
     std::uint64_t beats_seen = 0, beats_in_band = 0, faults_seen = 0;
   };
   Loom* loom(const std::string& id);  // nullptr when over the loom limit; caller holds mu_
   void changed();                      // caller holds mu_
   static nlohmann::json summary(const std::string& id, const Loom& l, Clock::time_point now);
+  nlohmann::json knots_json(const loomlcm::knots_t& m) const;
 
   HallLimits limits_;
   mutable std::mutex mu_;

@@ -172,6 +172,10 @@ class Router {
       decode<loomlcm::row_t>(data, len, [&](const auto& m) { hall_.on_row(m); });
     } else if (kind == "DESIGN") {
       decode<loomlcm::design_t>(data, len, [&](const auto& m) { hall_.on_design(m); });
+    } else if (kind == "KNOTS") {
+      decode<loomlcm::knots_t>(data, len, [&](const auto& m) { hall_.on_knots(m); });
+    } else if (kind == "WEAVER") {
+      decode<loomlcm::weaver_request_t>(data, len, [&](const auto& m) { hall_.on_weaver(m); });
     }
   }
   std::uint64_t decode_errors() const { return decode_errors_; }

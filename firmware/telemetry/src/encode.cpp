@@ -6,6 +6,8 @@
 
 #include "loom/hal/types.hpp"
 #include "loom/sequencer/faults.hpp"
+#include "loom/sequencer/knot_program.hpp"
+#include "loom/sequencer/row_knotter.hpp"
 
 namespace loom::telemetry {
 
@@ -215,7 +217,117 @@ loomlcm::row_t to_row(const Event& e, const std::string& loom_id, std::int64_t u
   m.band_min_n = e.band_min_n;
   m.band_max_n = e.band_max_n;
   m.knotting_s = seconds(e.knotting_ticks, e.period_ns);
-  m.knotting_s = seconds(e.knotting_ticks, e.period_ns);
+  m.knot_s = seconds(e.knot_ticks, e.period_ns);
+  m.weaver_s = seconds(e.weaver_ticks, e.period_ns);
+  m.knots_tied = e.knots_tied;
+  m.knots_retried = e.knots_retried;
+  m.knots_by_hand = e.knots_by_hand;
+  return m;
+}
+
+namespace {
+sequencer::WeaverAsk ask_of(std::uint8_t v) noexcept {
+  return v <= static_cast<std::uint8_t>(sequencer::WeaverAsk::kCheckKnot) ? static_cast<sequencer::WeaverAsk>(v)
+                                                                          : sequencer::WeaverAsk::kNone;
+}
+std::string slot_colour_or_empty(const sequencer::KnotProgram* p, int slot) {
+  return p != nullptr && slot >= 0 && slot < p->slots() ? p->slot_colour(slot) : std::string();
+}
+}  // namespace
+
+loomlcm::knots_t to_knots(const Snapshot& s, const sequencer::KnotProgram& p, const std::string& loom_id,
+                          std::int64_t utime) {
+  const KnotSample& k = s.knots;
+  loomlcm::knots_t m;
+  m.utime = utime;
+  m.loom_id = loom_id;
+  m.tick = s.tick;
+  m.time_s = loop_time_s(s);
+  m.state = from_cstr(s.state);
+  m.knotting = k.knotting;
+  m.row = static_cast<std::int32_t>(s.row + 1);  // the row knotted is the one after the completed rows
+  m.design_row = p.design_row(s.row);
+  // The sample's counts bound every array (the program is the same machine's, but a ring slot is read
+  // only as far as it was written).
+  const int heads = std::min<int>({p.heads(), k.heads, static_cast<int>(hal::kMaxKnottingHeads)});
+  const int slots = std::min<int>({p.slots(), k.slots, static_cast<int>(kMaxKnotSlots)});
+  m.heads = static_cast<std::int16_t>(std::max(heads, 0));
+  m.stripe = static_cast<std::int16_t>(p.stripe());
+  m.knots_per_row = static_cast<std::int16_t>(p.knots_per_row());
+  m.slots = static_cast<std::int16_t>(std::max(slots, 0));
+  m.knots_per_slot = p.knots_per_slot();
+  m.cycle = k.cycle;
+  m.cycles_started = static_cast<std::int16_t>(k.cycles_started);
+  m.cycles_done = static_cast<std::int16_t>(k.cycles_done);
+  m.tied = k.tied;
+  m.retried = k.retried;
+  m.by_hand = k.by_hand;
+  m.row_tied = k.row_tied;
+  m.row_retried = k.row_retried;
+  m.row_by_hand = k.row_by_hand;
+  m.head_knot.resize(static_cast<std::size_t>(m.heads));
+  m.head_slot.resize(static_cast<std::size_t>(m.heads));
+  m.head_colour.resize(static_cast<std::size_t>(m.heads));
+  m.stock.assign(static_cast<std::size_t>(m.heads), std::vector<std::int32_t>(static_cast<std::size_t>(m.slots)));
+  for (int h = 0; h < m.heads; ++h) {
+    const auto hh = static_cast<std::size_t>(h);
+    const int knot = k.cycle >= 0 ? p.knot_of(h, k.cycle) : -1;
+    const int slot = knot >= 0 ? p.slot(s.row, knot) : -1;
+    m.head_knot[hh] = static_cast<std::int16_t>(knot);
+    m.head_slot[hh] = static_cast<std::int16_t>(slot);
+    m.head_colour[hh] = slot_colour_or_empty(&p, slot);
+    for (int sl = 0; sl < m.slots; ++sl) m.stock[hh][static_cast<std::size_t>(sl)] = k.stock[hh][static_cast<std::size_t>(sl)];
+  }
+  m.slot_colour.resize(static_cast<std::size_t>(m.slots));
+  for (int sl = 0; sl < m.slots; ++sl) m.slot_colour[static_cast<std::size_t>(sl)] = p.slot_colour(sl);
+  m.knot_slot.resize(static_cast<std::size_t>(std::max(p.knots_per_row(), 0)));
+  for (std::size_t i = 0; i < m.knot_slot.size(); ++i) {
+    m.knot_slot[i] = static_cast<std::int16_t>(p.slot(s.row, static_cast<int>(i)));
+  }
+  m.requests = static_cast<std::int32_t>(k.requests);
+  const sequencer::WeaverAsk ask = ask_of(k.ask);
+  m.ask = ask == sequencer::WeaverAsk::kNone ? std::string() : sequencer::weaver_ask_name(ask);
+  m.ask_knot = k.ask_knot;
+  m.ask_head = k.ask_head;
+  m.ask_slot = k.ask_slot;
+  if (ask != sequencer::WeaverAsk::kNone) {
+    sequencer::WeaverRequest q;
+    q.ask = ask;
+    q.row = k.ask_row;
+    q.design_row = p.design_row(k.ask_row > 0 ? k.ask_row - 1 : 0);
+    q.knot = k.ask_knot;
+    q.head = k.ask_head;
+    q.slot = k.ask_slot;
+    m.ask_text = sequencer::describe(q, p);
+  }
+  return m;
+}
+
+loomlcm::weaver_request_t to_weaver_request(const Event& e, const sequencer::KnotProgram* p,
+                                            const std::string& loom_id, std::int64_t utime) {
+  auto m = event_message<loomlcm::weaver_request_t>(e, loom_id, utime);
+  const sequencer::WeaverAsk ask = ask_of(e.ask);
+  m.number = static_cast<std::int32_t>(e.request);
+  m.ask = sequencer::weaver_ask_name(ask);
+  m.row = static_cast<std::int32_t>(e.row);
+  m.design_row = e.design_row;
+  m.knot = e.knot;
+  m.head = e.head;
+  m.slot = e.slot;
+  m.colour = slot_colour_or_empty(p, e.slot);
+  sequencer::WeaverRequest q;
+  q.ask = ask;
+  q.row = e.row;
+  q.design_row = e.design_row;
+  q.knot = e.knot;
+  q.head = e.head;
+  q.slot = e.slot;
+  if (p != nullptr) {
+    m.text = sequencer::describe(q, *p);
+  } else {
+    m.text = "row " + std::to_string(e.row) + ": " + m.ask + " knot " + std::to_string(e.knot + 1) + " head " +
+             std::to_string(e.head + 1) + " slot " + std::to_string(e.slot);
+  }
   return m;
 }
 

@@ -10,6 +10,7 @@
 
 #include "loom/telemetry/encode.hpp"
 #include "loom/telemetry/identity.hpp"
+#include "loom/sequencer/knot_program.hpp"
 
 namespace loom::telemetry {
 
@@ -87,7 +88,9 @@ PublisherStats Publisher::stats() const noexcept {
   s.fault = n_fault_.load(std::memory_order_relaxed);
   s.row = n_row_.load(std::memory_order_relaxed);
   s.design = n_design_.load(std::memory_order_relaxed);
-  s.events = s.beat + s.fault + s.row;
+  s.weaver = n_weaver_.load(std::memory_order_relaxed);
+  s.knots = n_knots_.load(std::memory_order_relaxed);
+  s.events = s.beat + s.fault + s.row + s.weaver;
   s.publish_errors = n_errors_.load(std::memory_order_relaxed);
   return s;
 }
@@ -161,6 +164,9 @@ void Publisher::publish_event(const Event& e) {
       case Event::Kind::kBeat: send(channels_.beat, to_beat(e, cfg_.loom_id, utime), n_beat_); break;
       case Event::Kind::kFault: send(channels_.fault, to_fault(e, cfg_.loom_id, utime, cfg_.axes), n_fault_); break;
       case Event::Kind::kRow: send(channels_.row, to_row(e, cfg_.loom_id, utime), n_row_); break;
+      case Event::Kind::kWeaver:
+        send(channels_.weaver, to_weaver_request(e, cfg_.knot_program, cfg_.loom_id, utime), n_weaver_);
+        break;
     }
   } catch (const std::exception&) {
     n_errors_.fetch_add(1, std::memory_order_relaxed);
@@ -187,6 +193,9 @@ void Publisher::publish(const Snapshot& s) {
     if (due.status) {
       send(channels_.status, to_status(s, cfg_.loom_id, utime, cfg_.axes), n_status_);
       publish_design(s, utime);
+      if (cfg_.knot_program != nullptr && cfg_.knot_program->heads() > 0 && s.knots.heads > 0) {
+        send(channels_.knots, to_knots(s, *cfg_.knot_program, cfg_.loom_id, utime), n_knots_);
+      }
       const auto now = std::chrono::steady_clock::now();
       if (now - identity_sent_at_ >= std::chrono::seconds(1)) {
         send(channels_.identity, this_process_identity(cfg_.loom_id, utime), n_identity_);

@@ -34,6 +34,10 @@ ChannelSchedule::StatusKey ChannelSchedule::key_of(const Snapshot& s) noexcept {
   k.row = s.row;
   k.pick = s.pick;
   k.beat = s.beat;
+  k.knot_cycle = s.knots.cycle;
+  k.knot_cycles_done = s.knots.cycles_done;
+  k.knot_ask = s.knots.ask;
+  k.knot_requests = s.knots.requests;
   return k;
 }
 

@@ -38,6 +38,9 @@ struct TelemetryContext {
   double beat_force_max_n = 100.0;
   std::uint32_t rows_target = 0;  // 0 = until stopped / unknown
   std::array<double, hal::kMaxAxes> following_error_limit{};  // SI per axis; 0 = not checked
+  // The knotting heads' design as magazine slots (Machine::knot_program(); null: no heads, and the
+  // snapshot's knots stay empty at no cost per tick). Must outlive the loop.
+  const sequencer::KnotProgram* knot_program = nullptr;
 };
 
 class ControlLoop {
@@ -63,6 +66,7 @@ class ControlLoop {
 
  private:
   void fill_snapshot(hal::Tick now) noexcept;
+  void fill_knots() noexcept;
   void push_events(hal::Tick now) noexcept;
   void push_event(const telemetry::Event& e) noexcept;
   void fill_event_context(telemetry::Event& e, hal::Tick now) const noexcept;
@@ -90,6 +94,8 @@ class ControlLoop {
   // What the previous tick showed, so each event is pushed exactly once.
   std::uint32_t beat_events_seen_ = 0;
   std::uint32_t rows_seen_ = 0;
+  std::uint32_t weaver_requests_seen_ = 0;
+  bool knots_shown_ = false;  // snap_.knots was filled at least once
   bool primed_ = false;
   sequencer::State prev_state_ = sequencer::State::kIdle;
   sequencer::Fault prev_fault_ = sequencer::Fault::kNone;

@@ -1,6 +1,6 @@
 // LCM channel names for one loom: <prefix>.<loom id>.STATUS / .AXES / .RT (samples, decimated) and
-// .BEAT / .FAULT / .ROW (events, each sent once), and .DESIGN (the weaver's next row, when the recipe
-// names a design). The loom id is in the name
+// .BEAT / .FAULT / .ROW / .WEAVER (events, each sent once), .DESIGN (the weaver's next row, when the
+// recipe names a design) and .KNOTS (the knotting heads' progress, looms with heads). The loom id is in the name
 // so a hall of looms can share one multicast group and a technician can subscribe to one loom or all.
 #pragma once
 
@@ -29,10 +29,12 @@ struct ChannelNames {
   std::string row;
   std::string design;  // the weaver's next row, from the publisher (looms with a design only)
   std::string identity;  // who publishes (host, pid, instance): one loom id, one publisher
+  std::string knots;   // the knotting heads' progress, with STATUS (looms with heads only)
+  std::string weaver;  // each request the knotting heads make of the weaver (event)
 };
 
 // Every channel kind, in the order a reader lists them.
-inline constexpr std::string_view kChannelKinds[] = {"STATUS", "AXES", "RT", "BEAT", "FAULT", "ROW", "DESIGN"};
+inline constexpr std::string_view kChannelKinds[] = {"STATUS", "AXES", "RT", "BEAT", "FAULT", "ROW", "DESIGN", "KNOTS", "WEAVER"};
 
 // Configure-time only (allocates). Assumes both parts passed the checks above.
 ChannelNames channel_names(std::string_view prefix, std::string_view loom_id);

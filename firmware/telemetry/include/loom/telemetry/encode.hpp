@@ -11,9 +11,15 @@
 #include "loomlcm/axes_t.hpp"
 #include "loomlcm/beat_t.hpp"
 #include "loomlcm/fault_t.hpp"
+#include "loomlcm/knots_t.hpp"
 #include "loomlcm/row_t.hpp"
 #include "loomlcm/rt_stats_t.hpp"
 #include "loomlcm/status_t.hpp"
+#include "loomlcm/weaver_request_t.hpp"
+
+namespace loom::sequencer {
+class KnotProgram;
+}
 
 namespace loom::telemetry {
 
@@ -39,6 +45,14 @@ loomlcm::row_t to_row(const Event& e, const std::string& loom_id, std::int64_t u
 // row knotted last (when any) and the two after it.
 loomlcm::design_t to_design(const design::Design& d, std::uint64_t rows_done, const std::string& loom_id,
                             std::int64_t utime);
+// Not RT-safe: publisher thread only. The knotting heads' progress in `s` (KNOTS), the knots and colours
+// from `program` (the machine's design as magazine slots).
+loomlcm::knots_t to_knots(const Snapshot& s, const sequencer::KnotProgram& program, const std::string& loom_id,
+                          std::int64_t utime);
+// Not RT-safe: publisher thread only. A weaver request event (WEAVER), worded with `program`'s colours
+// (null: colour "" and the text without them).
+loomlcm::weaver_request_t to_weaver_request(const Event& e, const sequencer::KnotProgram* program,
+                                            const std::string& loom_id, std::int64_t utime);
 // The FAULT message's kind field for an event's fault kind: "first", "diagnosis", "device".
 const char* fault_kind_name(Event::FaultKind k) noexcept;
 

@@ -21,6 +21,9 @@
 namespace lcm {
 class LCM;
 }
+namespace loom::sequencer {
+class KnotProgram;
+}
 
 namespace loom::telemetry {
 
@@ -54,6 +57,9 @@ struct PublisherConfig {
   std::shared_ptr<const design::Design> design;
   std::uint64_t design_rows_at_start = 0;
   std::uint32_t counter_rows_at_start = 0;
+  // The knotting heads' design as magazine slots (the machine's; must outlive the publisher). Non-null
+  // with heads: KNOTS goes out with every STATUS and WEAVER requests name their colours. Null: no KNOTS.
+  const sequencer::KnotProgram* knot_program = nullptr;
 };
 
 struct PublisherStats {
@@ -61,11 +67,13 @@ struct PublisherStats {
   std::uint64_t status = 0;     // messages published per channel
   std::uint64_t axes = 0;
   std::uint64_t rt = 0;
-  std::uint64_t events = 0;  // BEAT + FAULT + ROW messages published
+  std::uint64_t events = 0;  // BEAT + FAULT + ROW + WEAVER messages published
   std::uint64_t beat = 0;
   std::uint64_t fault = 0;
   std::uint64_t row = 0;
-  std::uint64_t design = 0;  // DESIGN messages (not events: sent by the publisher)
+  std::uint64_t weaver = 0;
+  std::uint64_t design = 0;
+  std::uint64_t knots = 0;   // KNOTS messages (with STATUS, looms with knotting heads)  // DESIGN messages (not events: sent by the publisher)
   std::uint64_t publish_errors = 0;  // lcm publish() failures (e.g. no multicast route)
 };
 
@@ -121,7 +129,7 @@ class Publisher {
   std::atomic<bool> running_{false};
   std::atomic<bool> stop_requested_{false};
   std::atomic<std::uint64_t> n_snapshots_{0}, n_status_{0}, n_axes_{0}, n_rt_{0}, n_errors_{0};
-  std::atomic<std::uint64_t> n_beat_{0}, n_fault_{0}, n_row_{0}, n_design_{0};
+  std::atomic<std::uint64_t> n_beat_{0}, n_fault_{0}, n_row_{0}, n_design_{0}, n_weaver_{0}, n_knots_{0};
   std::uint64_t design_rows_sent_ = UINT64_MAX;  // design rows done in the last DESIGN sent
   std::chrono::steady_clock::time_point design_sent_at_{};
   std::chrono::steady_clock::time_point identity_sent_at_{};

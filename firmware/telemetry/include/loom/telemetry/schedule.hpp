@@ -48,6 +48,12 @@ class ChannelSchedule {
     std::uint32_t row = 0;
     std::uint32_t pick = 0;
     std::uint32_t beat = 0;
+    // Knotting heads: a new knot cycle, one done, or a weaver request opened or answered (STATUS carries
+    // KNOTS, so the panel follows the row knot by knot).
+    std::int16_t knot_cycle = -1;
+    std::uint16_t knot_cycles_done = 0;
+    std::uint8_t knot_ask = 0;
+    std::uint32_t knot_requests = 0;
     bool operator==(const StatusKey&) const = default;
   };
   static StatusKey key_of(const Snapshot& s) noexcept;

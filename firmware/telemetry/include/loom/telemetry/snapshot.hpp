@@ -24,6 +24,28 @@ struct AxisSample {
   std::uint8_t request = 0;      // hal::AxisRequest
 };
 
+// Magazine slots a head can have (sequencer::kMaxMagazineSlots; telemetry does not include the sequencer
+// in its public headers, so the bound is restated and checked where both are seen: control_loop.cpp).
+inline constexpr std::size_t kMaxKnotSlots = 16;
+
+// The knotting heads' progress (looms with knotting.mode = "heads"; heads = 0 otherwise, and then nothing
+// else here is read). Numbers only: the publisher turns knots into colours with the machine's KnotProgram.
+struct KnotSample {
+  std::uint8_t heads = 0;            // stock[0 .. heads) is in use
+  std::uint8_t slots = 0;            // stock[h][0 .. slots) is in use
+  bool knotting = false;             // the sequencer is in its knotting state
+  std::int16_t cycle = -1;           // knot cycle in progress (0-based), -1 when not knotting
+  std::uint16_t cycles_started = 0;  // of the row in progress
+  std::uint16_t cycles_done = 0;
+  std::uint32_t tied = 0, retried = 0, by_hand = 0;              // production totals
+  std::uint16_t row_tied = 0, row_retried = 0, row_by_hand = 0;  // the row in progress
+  std::uint32_t requests = 0;        // weaver requests made so far
+  std::uint8_t ask = 0;              // sequencer::WeaverAsk of the open request (0 = none)
+  std::int16_t ask_knot = -1, ask_head = -1, ask_slot = -1;
+  std::uint32_t ask_row = 0;         // its 1-based production row
+  std::array<std::array<std::int32_t, kMaxKnotSlots>, hal::kMaxKnottingHeads> stock{};  // knots left, -1 unknown
+};
+
 struct Snapshot {
   hal::Tick tick = 0;
   std::int64_t period_ns = 0;
@@ -59,28 +81,34 @@ struct Snapshot {
   std::uint32_t telemetry_dropped = 0; // snapshots dropped because the ring was full
   std::uint32_t can_tx_dropped = 0;    // link counters from the HAL (cumulative)
   std::uint32_t can_rx_errors = 0;
+  KnotSample knots;                    // last: its magazines are copied for the heads in use only
 };
 
 // Copies the part of a snapshot that is in use into a ring slot: everything but the axis slots at and
-// beyond axis_count, which nobody reads (the publisher encodes axes[0 .. axis_count)). The record is
-// sized for hal::kMaxAxes (32 axes, ~2 KB); a three-axis loom uses 168 bytes of its axes. RT-safe.
+// beyond axis_count and the magazine rows at and beyond knots.heads, which nobody reads (the publisher
+// encodes axes[0 .. axis_count) and stock[0 .. heads)). The record is sized for hal::kMaxAxes (32 axes,
+// ~2 KB) and 12 heads of 16 slots (768 bytes); a three-axis loom without heads uses 168 bytes of its axes
+// and none of the magazines. RT-safe.
 inline void copy_in_use(Snapshot& to, const Snapshot& from) noexcept {
   constexpr std::size_t head = offsetof(Snapshot, axes);
   constexpr std::size_t tail = offsetof(Snapshot, outputs);
+  constexpr std::size_t stock = offsetof(Snapshot, knots) + offsetof(KnotSample, stock);
   std::memcpy(static_cast<void*>(&to), &from, head);
   const std::size_t n = from.axis_count < hal::kMaxAxes ? from.axis_count : hal::kMaxAxes;
   for (std::size_t i = 0; i < n; ++i) to.axes[i] = from.axes[i];
   std::memcpy(reinterpret_cast<unsigned char*>(&to) + tail, reinterpret_cast<const unsigned char*>(&from) + tail,
-              sizeof(Snapshot) - tail);
+              stock - tail);
+  const std::size_t h = from.knots.heads < hal::kMaxKnottingHeads ? from.knots.heads : hal::kMaxKnottingHeads;
+  for (std::size_t i = 0; i < h; ++i) to.knots.stock[i] = from.knots.stock[i];
 }
 
 static_assert(std::is_standard_layout_v<Snapshot> && std::is_trivially_copyable_v<Snapshot>,
               "copy_in_use copies a snapshot by its layout");
 
-// An event the loop reports once, never decimated (BEAT, FAULT, ROW). One plain struct for all kinds
+// An event the loop reports once, never decimated (BEAT, FAULT, ROW, WEAVER). One plain struct for all kinds
 // so one ring carries them in order; `kind` says which part is meaningful.
 struct Event {
-  enum class Kind : std::uint8_t { kBeat, kFault, kRow };
+  enum class Kind : std::uint8_t { kBeat, kFault, kRow, kWeaver };
   Kind kind = Kind::kBeat;
   hal::Tick tick = 0;
   std::int64_t period_ns = 0;
@@ -109,6 +137,13 @@ struct Event {
   hal::Tick knotting_ticks = 0;  // knotting mode: the weaver's time before the row
   std::uint16_t beats = 0, carriage_steps = 0, beats_in_band = 0;
   double force_min_n = 0.0, force_mean_n = 0.0, force_max_n = 0.0;
+  hal::Tick knot_ticks = 0, weaver_ticks = 0;  // knotting heads: machine knotting, waiting for the weaver
+  std::uint16_t knots_tied = 0, knots_retried = 0, knots_by_hand = 0;
+  // kWeaver (the row is `row`): what the loom asks of the weaver; the publisher words it
+  std::uint8_t ask = 0;          // sequencer::WeaverAsk
+  std::uint32_t request = 0;     // requests made so far, this one included
+  std::int32_t design_row = 0;   // 0-based
+  std::int16_t knot = -1, head = -1, slot = -1;
 };
 
 }  // namespace loom::telemetry
