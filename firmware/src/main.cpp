@@ -348,8 +348,9 @@ int weave(const WeaveArgs& a) {
   if (const sim_hal::SimKnotter* k = machine->sim().knotter(); k != nullptr && !hardware && !a.report.empty()) {
     const std::string png = a.report + "/carpet.png";
     try {
-      const firmware::CarpetCheck cc = firmware::write_carpet_png(*k, *machine->knot_program(), *cfg.recipe.design, resume.rows, png);
-      std::printf("carpet: %s: %d rows, %d knots (%d by hand); %s\n", png.c_str(), cc.rows, cc.knots, cc.by_hand,
+      const firmware::CarpetCheck cc = firmware::write_carpet_png(*k, *machine->knot_program(), *cfg.recipe.design, k->first_row(), png);
+      std::printf("carpet: %s: %d rows from production row %u (design row %d), %d knots (%d by hand); %s\n", png.c_str(),
+                  cc.rows, k->first_row(), machine->knot_program()->design_row(k->first_row()) + 1, cc.knots, cc.by_hand,
                   cc.equal() ? "equals the design knot for knot"
                              : ("DIFFERS from the design: " + std::to_string(cc.missing) + " missing, " +
                                 std::to_string(cc.wrong) + " wrong colour, " + std::to_string(cc.doubled) + " tied twice")

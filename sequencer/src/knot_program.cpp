@@ -43,8 +43,11 @@ KnotProgram KnotProgram::build(const KnottingSpec& spec, double width_m, int des
 
 int KnotProgram::design_row(std::uint32_t counter_row) const noexcept {
   if (design_rows_ == 0) return 0;
-  const std::uint64_t since = counter_row >= counter_rows_at_start_ ? counter_row - counter_rows_at_start_ : 0;
-  return static_cast<int>((design_rows_done_ + since) % static_cast<std::uint64_t>(design_rows_));
+  // Rows before the start map back too (a carpet compared from its first row after restarts).
+  const auto h = static_cast<std::int64_t>(design_rows_);
+  const std::int64_t d = static_cast<std::int64_t>(design_rows_done_ % static_cast<std::uint64_t>(h)) +
+                         (static_cast<std::int64_t>(counter_row) - static_cast<std::int64_t>(counter_rows_at_start_)) % h;
+  return static_cast<int>(((d % h) + h) % h);
 }
 
 int KnotProgram::slot(std::uint32_t counter_row, int k) const noexcept {

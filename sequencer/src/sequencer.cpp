@@ -572,10 +572,8 @@ void Sequencer::finish_arming(hal::Tick now, const hal::HalInputs& in) noexcept 
   if (!reconcile_at_arming(now, in)) return;
   enabled_outputs_ = true;
   knotters_parked_ = false;
-  // Re-arm from measured positions: crank to the nearest park, then the carriage to the row's start side.
-  const double phase = motion::wrap_pi(in.axes[index(CoreAxis::kBeatCrank)].position - cfg_.crank_park_position_rad);
-  crank_move_ = {true, now, cmd_.axes[index(CoreAxis::kBeatCrank)].target_position,
-                 motion::JerkMove::plan(-phase, profiles_->spec().crank)};
+  knot_park_planned_ = false;
+  crank_parking_planned_ = false;  // positioning plans it once the knotting servos are at rest
   // Valves hold whatever the frames show now, so re-arming never moves a frame over the shuttle.
   cmd_.io.piston_a_extend = io_.piston_a_extended;
   cmd_.io.piston_b_extend = io_.piston_b_extended;
@@ -583,7 +581,16 @@ void Sequencer::finish_arming(hal::Tick now, const hal::HalInputs& in) noexcept 
 }
 
 void Sequencer::positioning(hal::Tick now, const hal::HalInputs& in) noexcept {
+  // Re-arm from measured positions: the knotting servos to rest (nothing may cross a gripper left in the
+  // warp), then the crank to the nearest park, then the carriage to the row's start side.
   if (!knotters_at_rest(now, in)) return;
+  if (!crank_parking_planned_) {
+    crank_parking_planned_ = true;
+    const double phase = motion::wrap_pi(in.axes[index(CoreAxis::kBeatCrank)].position - cfg_.crank_park_position_rad);
+    crank_move_ = {true, now, cmd_.axes[index(CoreAxis::kBeatCrank)].target_position,
+                   motion::JerkMove::plan(-phase, profiles_->spec().crank)};
+    return;
+  }
   if (crank_move_.active || carriage_move_.active) return;
   // Rows sweep in alternating directions: row n+1 starts at the left when n is even. The carriage goes
   // there (a row cut mid-sweep is swept again from its start).
@@ -622,7 +629,7 @@ bool Sequencer::knotters_at_rest(hal::Tick now, const hal::HalInputs& in) noexce
   for (int h = 0; h < cfg_.heads.program->heads(); ++h) {
     const auto a = static_cast<std::size_t>(cfg_.heads.knotter_axis[static_cast<std::size_t>(h)]);
     ActiveMove& m = knot_park_[static_cast<std::size_t>(h)];
-    if (!m.active && seconds_since(now, state_since_) == 0.0) {
+    if (!m.active && !knot_park_planned_) {
       // (A servo that trails its rest pose by a hair is at it, not a turn past the one behind.)
       const double rest = knotter_.rest_behind(in.axes[a].position + cfg_.heads.servo_tolerance_rad);
       const double from = cmd_.axes[a].target_position;
@@ -636,6 +643,7 @@ bool Sequencer::knotters_at_rest(hal::Tick now, const hal::HalInputs& in) noexce
     if (t >= m.move.duration()) m.active = false;
     moving |= m.active;
   }
+  knot_park_planned_ = true;
   if (moving) return false;
   knotters_parked_ = true;
   return true;
@@ -952,6 +960,11 @@ void Sequencer::after_row(hal::Tick now) noexcept {
 }
 
 void Sequencer::next_row(hal::Tick now) noexcept {
+  const KnotCounters& kc = counters_.knot;
+  if (knotter_.fitted() && !row_knotted_ && kc.cycles_done >= static_cast<std::uint32_t>(cfg_.heads.program->stripe()) &&
+      kc.cycles_started == kc.cycles_done) {
+    row_knotted_ = true;  // every knot of this row was tied before a restart: on to its shed
+  }
   if (knotter_.fitted() && !row_knotted_) {
     // The heads tie the row (from the counters' progress: a row cut by a power loss resumes at its first
     // knot not known to be tied); the carriage comes back to the row's start selvedge afterwards.

@@ -12,19 +12,38 @@ constexpr double kPoseTolerance = 0.05;  // rad: a servo this close to a pose is
 constexpr int kPedalTicks = 10;          // the weaver's pedal press (longer than any debounce)
 }  // namespace
 
+namespace {
+void fresh(PersistedCarpet& c, const SimKnotting& m, std::uint32_t first_row) {
+  c.magic = PersistedCarpet::kMagic;
+  c.first_row = first_row;
+  c.knots_per_row = m.knots_per_row;
+  c.row = 0;
+  c.row_has_knots = 0;
+  for (auto& head : c.stock) head.fill(m.knots_per_slot);
+  c.cells.fill(KnotCell{});
+}
+}  // namespace
+
 SimKnotter::SimKnotter(const SimKnotting& m, const Knotter& k, double period_s)
-    : m_(m), k_(k), period_s_(period_s),
-      carpet_(static_cast<std::size_t>(std::max(1, k.carpet_rows)) * static_cast<std::size_t>(std::max(1, m.knots_per_row))) {
-  for (int h = 0; h < m_.heads; ++h) {
-    stock_[static_cast<std::size_t>(h)].fill(m_.knots_per_slot);
-    holding_[static_cast<std::size_t>(h)] = -1;
-  }
+    : m_(m), k_(k), period_s_(period_s), own_(std::make_unique<PersistedCarpet>()), st_(own_.get()) {
+  capacity_rows_ = std::min(std::max(1, k.carpet_rows),
+                            static_cast<int>(PersistedCarpet::kCells / static_cast<std::size_t>(std::max(1, m.knots_per_row))));
+  fresh(*st_, m_, 0);
+  holding_.fill(-1);
+}
+
+void SimKnotter::persist_in(PersistedCarpet& persisted, std::uint32_t counter_rows) {
+  const bool ours = persisted.magic == PersistedCarpet::kMagic && persisted.knots_per_row == m_.knots_per_row &&
+                    persisted.row >= 0 && persisted.row <= capacity_rows_;
+  if (!ours) fresh(persisted, m_, counter_rows);
+  st_ = &persisted;
+  own_.reset();
 }
 
 const KnotCell& SimKnotter::cell(int row, int knot) const noexcept {
   static const KnotCell kNone{};
-  if (row < 0 || row >= k_.carpet_rows || knot < 0 || knot >= m_.knots_per_row) return kNone;
-  return carpet_[static_cast<std::size_t>(row) * static_cast<std::size_t>(m_.knots_per_row) + static_cast<std::size_t>(knot)];
+  if (row < 0 || row >= capacity_rows_ || knot < 0 || knot >= m_.knots_per_row) return kNone;
+  return st_->cells[static_cast<std::size_t>(row) * static_cast<std::size_t>(m_.knots_per_row) + static_cast<std::size_t>(knot)];
 }
 
 int SimKnotter::knot_under(int head, double carriage) const noexcept {
@@ -44,15 +63,15 @@ bool SimKnotter::in_warp(double knotter) const noexcept {
 }
 
 void SimKnotter::tie(int row, int knot, int slot, bool by_hand) noexcept {
-  if (row >= k_.carpet_rows) {
+  if (row >= capacity_rows_) {
     ++overflow_;
     return;
   }
-  KnotCell& c = carpet_[static_cast<std::size_t>(row) * static_cast<std::size_t>(m_.knots_per_row) + static_cast<std::size_t>(knot)];
+  KnotCell& c = st_->cells[static_cast<std::size_t>(row) * static_cast<std::size_t>(m_.knots_per_row) + static_cast<std::size_t>(knot)];
   if (c.ties < 255) ++c.ties;
   c.slot = static_cast<std::int8_t>(slot);
   c.by_hand = by_hand;
-  row_has_knots_ = true;
+  st_->row_has_knots = 1;
 }
 
 void SimKnotter::on_outputs(const hal::DigitalOutputs& out, const std::array<double, hal::kMaxAxes>& position,
@@ -71,8 +90,8 @@ void SimKnotter::on_outputs(const hal::DigitalOutputs& out, const std::array<dou
       const int s = static_cast<int>(std::lround(u)) % m_.slots;
       const bool at_slot = std::abs(u - std::round(u)) * pitch <= kPoseTolerance;
       holding_[hh] = -1;
-      if (std::abs(rel) <= kPoseTolerance && at_slot && stock_[hh][static_cast<std::size_t>(s)] > 0) {
-        --stock_[hh][static_cast<std::size_t>(s)];
+      if (std::abs(rel) <= kPoseTolerance && at_slot && st_->stock[hh][static_cast<std::size_t>(s)] > 0) {
+        --st_->stock[hh][static_cast<std::size_t>(s)];
         holding_[hh] = s;
       }
     }
@@ -80,7 +99,7 @@ void SimKnotter::on_outputs(const hal::DigitalOutputs& out, const std::array<dou
     // the knot is tied at the knot under the head, unless it slips off.
     if (out.cutter[hh] && !cutter_[hh] && holding_[hh] >= 0) {
       const int k = knot_under(h, carriage);
-      if (in_warp(knotter) && k >= 0 && rng.uniform() >= k_.miss_probability) tie(row_, k, holding_[hh], false);
+      if (in_warp(knotter) && k >= 0 && rng.uniform() >= k_.miss_probability) tie(st_->row, k, holding_[hh], false);
       holding_[hh] = -1;  // cut: the rest of the yarn stays in the magazine's feed
     }
     if (!out.gripper_close[hh]) holding_[hh] = -1;  // opened: whatever it held drops
@@ -94,19 +113,19 @@ void SimKnotter::on_outputs(const hal::DigitalOutputs& out, const std::array<dou
     switch (task_.kind) {
       case WeaverTask::Kind::kReload:
         if (task_.head >= 0 && task_.head < m_.heads && task_.slot >= 0 && task_.slot < m_.slots) {
-          stock_[static_cast<std::size_t>(task_.head)][static_cast<std::size_t>(task_.slot)] = m_.knots_per_slot;
+          st_->stock[static_cast<std::size_t>(task_.head)][static_cast<std::size_t>(task_.slot)] = m_.knots_per_slot;
         }
         break;
       case WeaverTask::Kind::kCheckKnot:
         // A knot that is there is left alone (it was tied before the power failed); a missing one is tied.
-        if (task_.knot >= 0 && task_.knot < m_.knots_per_row && cell(row_, task_.knot).ties > 0) break;
+        if (task_.knot >= 0 && task_.knot < m_.knots_per_row && cell(st_->row, task_.knot).ties > 0) break;
         [[fallthrough]];
       case WeaverTask::Kind::kTieByHand:
-        if (task_.knot >= 0 && task_.knot < m_.knots_per_row) tie(row_, task_.knot, task_.slot, true);
+        if (task_.knot >= 0 && task_.knot < m_.knots_per_row) tie(st_->row, task_.knot, task_.slot, true);
         // At the head the weaver sees an empty slot (why it missed) and fills it.
         if (task_.head >= 0 && task_.head < m_.heads && task_.slot >= 0 && task_.slot < m_.slots &&
-            stock_[static_cast<std::size_t>(task_.head)][static_cast<std::size_t>(task_.slot)] <= 0) {
-          stock_[static_cast<std::size_t>(task_.head)][static_cast<std::size_t>(task_.slot)] = m_.knots_per_slot;
+            st_->stock[static_cast<std::size_t>(task_.head)][static_cast<std::size_t>(task_.slot)] <= 0) {
+          st_->stock[static_cast<std::size_t>(task_.head)][static_cast<std::size_t>(task_.slot)] = m_.knots_per_slot;
         }
         break;
     }
@@ -119,15 +138,15 @@ void SimKnotter::inputs(const std::array<double, hal::kMaxAxes>& position, hal::
   const double carriage = position[hal::index(hal::CoreAxis::kCarriage)];
   for (int h = 0; h < m_.heads; ++h) {
     const int k = knot_under(h, carriage);
-    io.yarn_present[static_cast<std::size_t>(h)] = k >= 0 && cell(row_, k).ties > 0;
+    io.yarn_present[static_cast<std::size_t>(h)] = k >= 0 && cell(st_->row, k).ties > 0;
   }
   io.row_knotted = pedal_left_ > 0;
 }
 
 void SimKnotter::on_weft() noexcept {
-  if (!row_has_knots_) return;
-  row_has_knots_ = false;
-  ++row_;
+  if (st_->row_has_knots == 0) return;
+  st_->row_has_knots = 0;
+  ++st_->row;
 }
 
 void SimKnotter::ask(const WeaverTask& t) noexcept {
@@ -138,7 +157,7 @@ void SimKnotter::ask(const WeaverTask& t) noexcept {
 
 void SimKnotter::yarn_out(int head, int slot) noexcept {
   if (head < 0 || head >= m_.heads || slot < 0 || slot >= m_.slots) return;
-  stock_[static_cast<std::size_t>(head)][static_cast<std::size_t>(slot)] = 0;
+  st_->stock[static_cast<std::size_t>(head)][static_cast<std::size_t>(slot)] = 0;
 }
 
 }  // namespace loom::sim_hal

@@ -174,10 +174,22 @@ void SimWorld::attach_state_file(SimStateFile& file) {
   if (file.load(pm)) {
     hal::AxisFeedbacks axes{};
     for (std::size_t i = 0; i < pm.axis_position.size(); ++i) axes[i].position = pm.axis_position[i];
+    for (std::size_t i = 0; i < pm.added_axis_position.size(); ++i) axes[hal::kCoreAxisCount + i].position = pm.added_axis_position[i];
     set_initial_state(axes, pm.piston);
     shuttle_x_ = pm.shuttle_x;
+    // A shuttle cut mid-pick is still carrying its weft: its arrival at either selvedge locks the knots.
+    const double win = m_.selvedge_sensor_window_m;
+    shuttle_side_ = shuttle_x_ <= win ? -1 : shuttle_x_ >= m_.width_m - win ? 1 : kMidPick;
   }
   state_file_ = &file;
+}
+
+void SimWorld::persist_carpet(std::uint32_t counter_rows) {
+  if (knotter_ && state_file_ != nullptr && state_file_->carpet() != nullptr) {
+    knotter_->persist_in(*state_file_->carpet(), counter_rows);
+  } else if (knotter_) {
+    knotter_->start_at_row(counter_rows);
+  }
 }
 
 bool SimWorld::beater_in_warp() const {
@@ -529,6 +541,7 @@ void SimWorld::write_io(hal::Tick, const hal::DigitalOutputs& io) {
     PersistedMachine pm;
     pm.magic = PersistedMachine::kMagic;
     for (std::size_t i = 0; i < pm.axis_position.size(); ++i) pm.axis_position[i] = axes_[i].position;
+    for (std::size_t i = hal::kCoreAxisCount; i < n_axes_; ++i) pm.added_axis_position[i - hal::kCoreAxisCount] = axes_[i].position;
     pm.piston = piston_;
     pm.shuttle_x = shuttle_x_;
     state_file_->store(pm);

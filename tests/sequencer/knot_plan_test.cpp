@@ -139,6 +139,8 @@ TEST(KnotProgram, ProductionRowsMapToDesignRowsInTheDesignsOrderAndRepeat) {
   EXPECT_EQ(p.design_row(10), 1);
   EXPECT_EQ(p.design_row(11), 2);
   EXPECT_EQ(p.design_row(12), 0);  // the design repeats
+  EXPECT_EQ(p.design_row(9), 0);   // and rows before the start map back: row 9 tied design row 3 % 3
+  EXPECT_EQ(p.design_row(8), 2);
   EXPECT_EQ(p.slot(10, 0), 1);
   EXPECT_EQ(p.slot(11, 119), 2);
   EXPECT_EQ(p.slot(12, 60), 0);

@@ -34,7 +34,8 @@ class KnotProgram {
   int knots_per_slot() const noexcept { return knots_per_slot_; }
   int design_rows() const noexcept { return design_rows_; }
 
-  // RT-safe. The design row production row `counter_row` (0-based: counters.rows before the row) ties.
+  // RT-safe. The design row production row `counter_row` (0-based: counters.rows before the row) ties (rows
+  // before the one the program started at map back the same way).
   int design_row(std::uint32_t counter_row) const noexcept;
   // RT-safe. Knot `k` (0 = left selvedge) of production row `counter_row`: its magazine slot.
   int slot(std::uint32_t counter_row, int k) const noexcept;

@@ -344,6 +344,8 @@ class Sequencer {
   std::uint32_t knotter_requests_seen_ = 0;  // a new weaver request clears an earlier pedal press
   std::uint32_t knots_on_disk_rows_ = 0, knots_on_disk_started_ = 0;
   bool knotters_parked_ = false;           // positioning brought every knotting servo to rest
+  bool knot_park_planned_ = false;         // their moves back to rest are planned
+  bool crank_parking_planned_ = false;     // positioning planned the crank's move to park
   hal::DigitalInputs io_{};
   hal::DigitalInputs raw_io_{};
   int sensed_ticks_ = 0;                       // picture checks wait until the debouncer has history

@@ -9,7 +9,7 @@
 
 #include <array>
 #include <cstdint>
-#include <vector>
+#include <memory>
 
 #include "loom/hal/types.hpp"
 #include "loom/sim_hal/random.hpp"
@@ -48,6 +48,20 @@ struct KnotCell {
   bool by_hand = false;     // tied by the weaver
 };
 
+// The knotter's whole state as it persists across a power cut (in the sim-state file, or owned): the carpet
+// with its first production row, the row being knotted, and the yarn in every slot. Plain data.
+struct PersistedCarpet {
+  static constexpr std::size_t kCells = 1u << 16;  // knots recorded: 64 rows of 1024, 182 rows of 360
+  static constexpr std::uint64_t kMagic = 0x4b4e4f5453494d31ull;  // "KNOTSIM1"
+  std::uint64_t magic = 0;
+  std::uint32_t first_row = 0;       // production row (counters) of carpet row 0
+  std::int32_t knots_per_row = 0;    // the carpet's width (a different loom starts a new carpet)
+  std::int32_t row = 0;              // the row being knotted
+  std::int32_t row_has_knots = 0;
+  std::array<std::array<std::int32_t, 16>, hal::kMaxKnottingHeads> stock{};
+  std::array<KnotCell, kCells> cells{};
+};
+
 // What the weaver is asked (the loom's request, as the panel shows it).
 struct WeaverTask {
   enum class Kind : std::uint8_t { kTieByHand, kCheckKnot, kReload };
@@ -59,8 +73,17 @@ struct WeaverTask {
 
 class SimKnotter {
  public:
-  // Configure-time (allocates the carpet).
+  // Configure-time (allocates the carpet: a fresh one at production row 0).
   SimKnotter(const SimKnotting& m, const Knotter& k, double period_s);
+  // Configure-time. Keep the carpet and the magazines in `persisted` (a sim-state file's): a carpet found
+  // there for this loom's width is adopted (the run after a power cut carries on knotting it), otherwise a
+  // fresh one is started there at production row `counter_rows`.
+  void persist_in(PersistedCarpet& persisted, std::uint32_t counter_rows);
+  // Configure-time, fresh carpets only: the production row carpet row 0 is.
+  void start_at_row(std::uint32_t counter_rows) noexcept {
+    if (st_ == own_.get()) st_->first_row = counter_rows;
+  }
+  std::uint32_t first_row() const noexcept { return st_->first_row; }
 
   // RT-safe. One tick of outputs with the axes' true positions (carriage and every head's servos).
   void on_outputs(const hal::DigitalOutputs& out, const std::array<double, hal::kMaxAxes>& position,
@@ -75,7 +98,7 @@ class SimKnotter {
   void yarn_out(int head, int slot) noexcept;
 
   // The carpet as knotted: rows() complete or in progress (the last may be partial), knots_per_row() each.
-  int rows() const noexcept { return row_ + (row_has_knots_ ? 1 : 0); }
+  int rows() const noexcept { return st_->row + (st_->row_has_knots ? 1 : 0); }
   int knots_per_row() const noexcept { return m_.knots_per_row; }
   const KnotCell& cell(int row, int knot) const noexcept;
   int overflow_knots() const noexcept { return overflow_; }  // knots beyond the recorded rows
@@ -92,11 +115,10 @@ class SimKnotter {
   SimKnotting m_;
   Knotter k_;
   double period_s_;
-  std::vector<KnotCell> carpet_;  // carpet_rows x knots_per_row
-  int row_ = 0;
-  bool row_has_knots_ = false;
+  std::unique_ptr<PersistedCarpet> own_;  // the carpet when no sim-state file keeps it
+  PersistedCarpet* st_;                   // where it is kept
+  int capacity_rows_ = 0;                 // rows of carpet recorded (the scene's carpet_rows, bounded by kCells)
   int overflow_ = 0;
-  std::array<std::array<std::int32_t, 16>, hal::kMaxKnottingHeads> stock_{};
   std::array<int, hal::kMaxKnottingHeads> holding_{};  // slot of the yarn in the gripper, -1 none
   std::array<bool, hal::kMaxKnottingHeads> gripper_{}, cutter_{};
   // The weaver: one task at a time.

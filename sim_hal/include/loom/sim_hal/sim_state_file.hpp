@@ -8,15 +8,19 @@
 #include <cstdint>
 #include <string>
 
+#include "loom/hal/types.hpp"
+#include "loom/sim_hal/knotter.hpp"
+
 namespace loom::sim_hal {
 
 struct PersistedMachine {
   std::uint64_t magic = 0;  // kMagic once written
-  std::array<double, 3> axis_position{};
+  std::array<double, 3> axis_position{};  // the core axes (this layout first: tools read it with od)
   std::array<double, 2> piston{};
   double shuttle_x = 0.0;
   std::uint64_t tick = 0;
-  static constexpr std::uint64_t kMagic = 0x4c4f4f4d53494d31ull;  // "LOOMSIM1"
+  std::array<double, hal::kMaxAxes - hal::kCoreAxisCount> added_axis_position{};  // slots 3.. (knotting heads)
+  static constexpr std::uint64_t kMagic = 0x4c4f4f4d53494d32ull;  // "LOOMSIM2"
 };
 
 class SimStateFile {
@@ -34,10 +38,14 @@ class SimStateFile {
   bool load(PersistedMachine& out) const;
   // RT-safe.
   void store(const PersistedMachine& s) noexcept;
+  // The knotting heads' persisted carpet and magazines, in the same file after the machine (the knotter
+  // effect keeps them there directly: the carpet survives the power cut as the real one would).
+  PersistedCarpet* carpet() noexcept { return carpet_; }
 
  private:
   int fd_ = -1;
   PersistedMachine* map_ = nullptr;
+  PersistedCarpet* carpet_ = nullptr;
 };
 
 }  // namespace loom::sim_hal

@@ -59,6 +59,9 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   void set_initial_state(const hal::AxisFeedbacks& axes, std::array<double, 2> pistons);
   // Configure-time. Start from the state in `file` if it holds one, and keep it updated every tick.
   void attach_state_file(SimStateFile& file);
+  // Configure-time, after attach_state_file (if any). The knotting heads' carpet begins (or, kept in the
+  // state file from before a power cut, carries on) at production row `counter_rows`.
+  void persist_carpet(std::uint32_t counter_rows);
 
   // Ground truth for tests and reports (not what the controller sees).
   const SimAxis& axis(hal::CoreAxis a) const { return axes_[hal::index(a)]; }
@@ -131,7 +134,8 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   bool powered_off_ = false;
   std::unique_ptr<SimKnotter> knotter_;         // scene effect "knotter"
   std::array<bool, hal::kMaxAxes> jammed_{};    // a jammed axis no longer follows its target
-  int shuttle_side_ = 0;                        // -1 at the left selvedge, +1 at the right, 0 between
+  int shuttle_side_ = 0;                        // the selvedge it last arrived at: -1 left, +1 right, 0 none yet
+  static constexpr int kMidPick = 2;            // restarted with the shuttle in the shed: any arrival is a weft
   bool drives_simulated_ = false;  // this world's axes are the drives (not real ones beside it)
   void (*power_cut_handler_)(void*) = nullptr;
   void* power_cut_ctx_ = nullptr;
