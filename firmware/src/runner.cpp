@@ -386,6 +386,7 @@ class LoopBody {
     l->link_recovery.store(static_cast<std::uint8_t>(rt_.loop.inputs().link.recovery), r);
     l->silent_node.store(rt_.loop.inputs().link.silent_node, r);
     l->estop_ok.store(rt_.loop.inputs().io.estop_ok, r);
+    l->weaver_ask.store(static_cast<std::uint8_t>(seq_.weaver_request().ask), r);
     l->tick.store(tick, std::memory_order_release);
   }
 

@@ -37,6 +37,7 @@ const Row kTable[] = {
     {State::kBeatSweep, "beat_sweep", "pause stop"},
     {State::kRowEnd, "row_end", "pause stop"},
     {State::kAwaitKnotting, "await_knotting", "pause stop next"},
+    {State::kKnotting, "knotting", "pause stop"},  // next only while the heads ask the weaver (below)
     {State::kPaused, "paused", "resume stop"},
     {State::kDone, "done", "start"},
     {State::kFault, "fault", "ack"},
@@ -113,6 +114,13 @@ TEST(OperatorDesk, RefusalsSayWhy) {
   LoomView plain = view(State::kAwaitKnotting);
   plain.knotting = false;
   EXPECT_NE(desk.decide(local("next"), plain, kNow).reply.find("no weaver's knotting"), std::string::npos);
+  // The knotting heads asking the weaver (a knot to tie by hand, a slot to reload): next answers them.
+  LoomView heads = view(State::kKnotting);
+  heads.knotting = false;
+  EXPECT_NE(desk.decide(local("next"), heads, kNow).reply.find("not waiting for the weaver"), std::string::npos);
+  heads.weaver_ask = sequencer::WeaverAsk::kTieByHand;
+  EXPECT_EQ(desk.decide(local("next"), heads, kNow).reply.rfind("refused", 0), std::string::npos)
+      << desk.decide(local("next"), heads, kNow).reply;
   EXPECT_EQ(desk.decide(local("dance"), idle, kNow).reply.rfind("error: unknown command 'dance'", 0), 0u);
   EXPECT_EQ(desk.decide(local("start now"), idle, kNow).reply, "error: start takes no argument (got 'now')\n");
   EXPECT_EQ(desk.decide(local("start hours=3"), idle, kNow).reply, "error: hours= is for pair only\n");

@@ -18,6 +18,7 @@ bool weaving(State s) {
     case State::kBeatSweep:
     case State::kRowEnd:
     case State::kAwaitKnotting:
+    case State::kKnotting:
       return true;
     default:
       return false;
@@ -33,6 +34,7 @@ LoomView view_of(const OperatorLink& l, bool knotting) {
   v.silent_node = l.silent_node.load(r);
   v.estop_ok = l.estop_ok.load(r);
   v.knotting = knotting;
+  v.weaver_ask = static_cast<sequencer::WeaverAsk>(l.weaver_ask.load(r));
   return v;
 }
 
@@ -72,6 +74,10 @@ std::string OperatorDesk::refuse_for_state(const ParsedRequest& r, const LoomVie
     return weaving(v.state) || v.state == State::kPaused ? "" : "not weaving (state " + state + "): nothing to stop";
   }
   if (w == "next") {
+    // The knotting heads' request (a knot to tie by hand, a slot to reload) is answered the same way.
+    if (v.state == State::kKnotting) {
+      return v.weaver_ask != sequencer::WeaverAsk::kNone ? "" : "the knotting heads are not waiting for the weaver";
+    }
     if (!v.knotting) return "this loom has no weaver's knotting (knotting.mode is not \"weaver\")";
     return v.state == State::kAwaitKnotting ? "" : "not waiting for the weaver (state " + state + ")";
   }

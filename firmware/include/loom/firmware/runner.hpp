@@ -79,6 +79,7 @@ struct OperatorLink {
   std::atomic<std::uint8_t> link_recovery{0};  // hal::LinkRecovery: whether an acknowledgement can re-arm
   std::atomic<std::uint8_t> silent_node{0};    // the lost node still silent (kNodeSilent)
   std::atomic<bool> estop_ok{true};            // the e-stop chain is closed (an acknowledgement can re-arm)
+  std::atomic<std::uint8_t> weaver_ask{0};     // sequencer::WeaverAsk: the knotting heads' open request (next answers it)
   std::atomic<std::int64_t> tick{0};
 };
 

@@ -27,6 +27,7 @@ struct LoomView {
   int silent_node = 0;
   bool estop_ok = true;
   bool knotting = false;  // the recipe has a knotting mode (`next` exists)
+  sequencer::WeaverAsk weaver_ask = sequencer::WeaverAsk::kNone;  // the knotting heads wait for the weaver
 };
 LoomView view_of(const OperatorLink& link, bool knotting);
 
