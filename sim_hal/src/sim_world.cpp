@@ -489,7 +489,7 @@ void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::Digit
   if (next_fault_ == 0 && !scene_.sensor_noise) {
     // No sensor fault has struck and no bounce is simulated: every switch reads the truth (the loop
     // below, without its per-switch checks). A second switch the machine does not have reads false.
-    for (std::size_t i = 0; i < n; ++i) io.second_channel[i] = m_.second_channel[i] & truth[i];
+    for (std::size_t i = 0; i < n; ++i) io.second_channel[i] = m_.second_channel[i] && truth[i];
     hal::set_safety_sensors(io, truth);
     io.estop_ok = estop_ok_;
     io.refreshed = now;
