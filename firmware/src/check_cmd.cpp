@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "loom/drivers/bus_load.hpp"
@@ -96,7 +97,7 @@ void print_axes(const LoomConfig& c) {
 
 // The knot plan: density and carpet class, and with knotting heads how a row is tied — knots per head,
 // knot cycles and carriage steps per row, and the design's selector moves.
-void print_knotting(const LoomConfig& c) {
+void print_knotting(const LoomConfig& c, const std::optional<motion::KnotCycle>& knot_cycle) {
   const sequencer::KnottingSpec& k = c.knotting;
   const double density = k.knots_per_dm * k.rows_per_dm;
   std::printf("\nknotting: %s", sequencer::knotting_mode_name(k.mode));
@@ -118,7 +119,7 @@ void print_knotting(const LoomConfig& c) {
               "of one pitch per row\n",
               k.heads, k.head_spacing_m, stripe, std::min(stripe, per_row), std::max(0, std::min(stripe, per_row) - 1));
   // The knot cycle: built (and checked) from the linkage and the servo's limits.
-  const motion::KnotCycle cycle = motion::KnotCycle::build(c.knot_cycle);
+  const motion::KnotCycle& cycle = *knot_cycle;  // built (and checked) once, in print_plan
   const motion::KnotCycleReport& rep = cycle.report();
   std::printf("  knot cycle %.3f s through seed 001's linkage (%s, servo %s): TAKE %.1f deg, WRAP %.1f deg, PULL %.1f deg "
               "(crank); least transmission angle %.1f deg\n",
@@ -212,9 +213,12 @@ void print_plan(const LoomConfig& c) {
   std::printf("  %u pick(s) per row: shed %.2f s (sensors must confirm within %.2f s) + pick %.2f s each; beat sweep %.2f s\n",
               c.sequencer.picks_per_row, shed_nominal, c.profile.shed.timeout_s, p.pick().duration(),
               p.crank_sweep().duration());
-  if (c.knotting.mode == sequencer::KnottingMode::kHeads) {
+  // The knot cycle from the linkage and the servo's limits (checked when the config was read).
+  std::optional<motion::KnotCycle> knot_cycle;
+  if (c.knotting.mode == sequencer::KnottingMode::kHeads) knot_cycle = motion::KnotCycle::build(c.knot_cycle);
+  if (knot_cycle) {
     // A knotted row compares whole with the weaver's whole row (~5 min knotting + 2 shed and pick + 3 beat).
-    const motion::KnotCycle cycle = motion::KnotCycle::build(c.knot_cycle);
+    const motion::KnotCycle& cycle = *knot_cycle;
     const int cycles = std::min(sequencer::knots_per_stripe(c.knotting), sequencer::knots_per_row(c.knotting, c.machine_spec.width_m));
     const double knot = cycles * cycle.duration_s();
     std::printf("  about %.2f s per whole row: knotting %.2f s by %d heads + shed, pick and beat %.2f s (%.0fx faster than "
@@ -227,7 +231,7 @@ void print_plan(const LoomConfig& c) {
   print_safety_sensors(c);
 
   print_axes(c);
-  print_knotting(c);
+  print_knotting(c, knot_cycle);
 
   std::printf("\nCAN (for --hal socketcan)\n");
   std::printf("  I/O module node %u (%s); controller heartbeat %s\n", c.io.node,

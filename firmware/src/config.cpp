@@ -686,17 +686,10 @@ void read_axes(TomlReader& r, LoomConfig& c, bool extending) {
 // knots per row and every colour sits in a magazine slot (refused naming the colour and the first knot).
 void check_design_fits_heads(const TomlReader& r, const LoomConfig& c) {
   if (c.knotting.mode != sequencer::KnottingMode::kHeads || !c.recipe.design) return;
-  const design::Design& d = *c.recipe.design;
-  std::vector<std::string> codes;
-  for (const auto& colour : d.palette()) codes.push_back(colour.code);
-  std::array<int, sequencer::kMaxKnottingHeads> slots{};
-  slots.fill(-1);
-  for (int row = 0; row < d.height(); ++row) {
-    try {
-      (void)sequencer::plan_row(c.knotting, c.machine_spec.width_m, d.row(row), codes, slots);
-    } catch (const std::invalid_argument& e) {
-      r.fail("recipe.design", '"' + c.recipe.design_file + '"', "design row " + std::to_string(row + 1) + ": " + e.what());
-    }
+  try {
+    (void)knot_program(c, 0, 0);
+  } catch (const std::invalid_argument& e) {
+    r.fail("recipe.design", '"' + c.recipe.design_file + '"', e.what());
   }
 }
 
@@ -1177,6 +1170,20 @@ LoomConfig parse_loom_config(const std::string& text, const std::string& source)
 }
 
 LoomConfig load_loom_config(const std::string& path) { return parse_loom_config(read_file(path), path); }
+sequencer::KnotProgram knot_program(const LoomConfig& c, std::uint64_t design_rows_done, std::uint32_t counter_rows) {
+  const design::Design& d = *c.recipe.design;
+  std::vector<std::string> codes;
+  for (const auto& colour : d.palette()) codes.push_back(colour.code);
+  std::vector<std::uint16_t> knots;
+  knots.reserve(static_cast<std::size_t>(d.width()) * static_cast<std::size_t>(d.height()));
+  for (int r = 0; r < d.height(); ++r) {
+    const auto row = d.row(r);
+    knots.insert(knots.end(), row.begin(), row.end());
+  }
+  return sequencer::KnotProgram::build(c.knotting, c.machine_spec.width_m, d.width(), d.height(), knots, codes,
+                                       design_rows_done, counter_rows);
+}
+
 LoomConfig default_loom_config() { return parse_loom_config(kDefaultLoomToml, "<embedded default_loom.toml>"); }
 
 std::string restart_only_changes(const LoomConfig& running, const LoomConfig& next) {

@@ -108,18 +108,8 @@ void Machine::build_knotting(const MachineOptions& opt, std::uint32_t counter_ro
   } catch (const motion::MotionError& e) {
     throw ConfigError(cfg_.source + ": [knotting.linkage]: " + e.what());
   }
-  const design::Design& d = *cfg_.recipe.design;
-  std::vector<std::string> codes;
-  for (const auto& colour : d.palette()) codes.push_back(colour.code);
-  std::vector<std::uint16_t> knots;
-  knots.reserve(static_cast<std::size_t>(d.width()) * static_cast<std::size_t>(d.height()));
-  for (int r = 0; r < d.height(); ++r) {
-    const auto row = d.row(r);
-    knots.insert(knots.end(), row.begin(), row.end());
-  }
   try {
-    knot_program_ = std::make_unique<const sequencer::KnotProgram>(sequencer::KnotProgram::build(
-        cfg_.knotting, cfg_.machine_spec.width_m, d.width(), d.height(), knots, codes, opt.design_rows_done, counter_rows));
+    knot_program_ = std::make_unique<const sequencer::KnotProgram>(firmware::knot_program(cfg_, opt.design_rows_done, counter_rows));
   } catch (const std::invalid_argument& e) {
     throw ConfigError(cfg_.source + ": recipe.design = \"" + cfg_.recipe.design_file + "\": " + e.what());
   }

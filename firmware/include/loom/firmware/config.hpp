@@ -20,6 +20,7 @@
 
 #include "loom/design/design.hpp"
 #include "loom/motion/knot_cycle.hpp"
+#include "loom/sequencer/knot_program.hpp"
 #include "loom/drivers/can_axis_port.hpp"
 #include "loom/drivers/can_io_port.hpp"
 #include "loom/motion/profile_set.hpp"
@@ -198,6 +199,10 @@ void derive_module_configs(LoomConfig& c);
 void rederive_and_check(LoomConfig& c, const std::string& origin);
 // The machine's axes as the runtime sees them (names and roles in slot order).
 hal::AxisLayout axis_layout(const LoomConfig& c);
+// Configure-time only. The recipe's design as the knotting heads tie it (`c.recipe.design` must be set):
+// `design_rows_done` of its rows woven by production row `counter_rows`. Throws std::invalid_argument naming
+// the design row, colour and knot when the loom's magazines or width cannot tie it.
+sequencer::KnotProgram knot_program(const LoomConfig& c, std::uint64_t design_rows_done, std::uint32_t counter_rows);
 // Configure-time only. The CAN master's config for the machine's servo axes, from the same facts.
 drivers::CanAxisPortConfig can_axis_config(const LoomConfig& c);
 // Configure-time only. The CAN I/O module's config, from the same facts.
