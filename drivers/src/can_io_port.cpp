@@ -43,15 +43,23 @@ std::string object_name(std::uint32_t map_entry) {
 }
 
 struct NamedBit {
-  const char* name;
+  std::string name;  // "io.inputs.estop_ok", "io.outputs.gripper_close.head2"
   const IoBit* bit;
   bool required;
 };
 
-// Names of the second channels in hal::SafetySensor order (NamedBit keeps the pointer: static storage).
+// Names of the second channels in hal::SafetySensor order.
 constexpr std::array<const char*, hal::kSafetySensorCount> kSecondChannelNames{
     "io.inputs.piston_a_extended_2", "io.inputs.piston_a_retracted_2", "io.inputs.piston_b_extended_2",
     "io.inputs.piston_b_retracted_2", "io.inputs.shuttle_at_left_2",    "io.inputs.shuttle_at_right_2"};
+
+// Head h's (0-based) signal of one kind, named with the head's number as the operator counts it (1-based).
+NamedBit head_signal(const char* group_and_kind, int h, const IoBit& bit) {
+  return {std::string(group_and_kind) + ".head" + std::to_string(h + 1), &bit, true};
+}
+int used_heads(const IoWiring& w) {
+  return std::clamp(w.heads, 0, static_cast<int>(hal::kMaxKnottingHeads));
+}
 
 // The wiring's signals by name, inputs then outputs, for validation and messages. The second channels
 // are inputs like any other, so a bit shared between a first and a second channel is refused.
@@ -71,34 +79,43 @@ std::vector<NamedBit> inputs_of(const IoWiring& w) {
   for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) {
     v.push_back({kSecondChannelNames[i], &w.second[i], false});
   }
+  for (int h = 0; h < used_heads(w); ++h) {
+    v.push_back(head_signal("io.inputs.yarn_present", h, w.yarn_present[static_cast<std::size_t>(h)]));
+  }
   return v;
 }
 std::vector<NamedBit> outputs_of(const IoWiring& w) {
-  return {{"io.outputs.piston_a_extend", &w.piston_a_extend, true},
-          {"io.outputs.piston_b_extend", &w.piston_b_extend, true},
-          {"io.outputs.lamp_green", &w.lamp_green, false},
-          {"io.outputs.lamp_amber", &w.lamp_amber, false},
-          {"io.outputs.lamp_red", &w.lamp_red, false},
-          {"io.outputs.buzzer", &w.buzzer, false}};
+  std::vector<NamedBit> v{{"io.outputs.piston_a_extend", &w.piston_a_extend, true},
+                          {"io.outputs.piston_b_extend", &w.piston_b_extend, true},
+                          {"io.outputs.lamp_green", &w.lamp_green, false},
+                          {"io.outputs.lamp_amber", &w.lamp_amber, false},
+                          {"io.outputs.lamp_red", &w.lamp_red, false},
+                          {"io.outputs.buzzer", &w.buzzer, false}};
+  for (int h = 0; h < used_heads(w); ++h) {
+    v.push_back(head_signal("io.outputs.gripper_close", h, w.gripper_close[static_cast<std::size_t>(h)]));
+    v.push_back(head_signal("io.outputs.cutter", h, w.cutter[static_cast<std::size_t>(h)]));
+  }
+  return v;
 }
 
 Status check_bits(const std::vector<NamedBit>& bits, int max_bits) {
-  std::array<const char*, kIoMaxInputBits> used{};
+  static_assert(kIoMaxInputBits >= kIoMaxOutputBits);
+  std::array<const std::string*, kIoMaxInputBits> used{};
   for (const NamedBit& b : bits) {
     const int n = b.bit->bit;
     if (n == -1) {
-      if (b.required) return Status::error(std::string(b.name) + ".bit = -1: this signal must be wired");
+      if (b.required) return Status::error(b.name + ".bit = -1: this signal must be wired");
       continue;
     }
     if (n < 0 || n >= max_bits) {
-      return Status::error(std::string(b.name) + ".bit = " + std::to_string(n) + " is outside 0.." +
+      return Status::error(b.name + ".bit = " + std::to_string(n) + " is outside 0.." +
                            std::to_string(max_bits - 1) + " (-1 = not wired)");
     }
     if (used[static_cast<std::size_t>(n)] != nullptr) {
-      return Status::error(std::string(b.name) + ".bit = " + std::to_string(n) + " is already used by " +
-                           used[static_cast<std::size_t>(n)]);
+      return Status::error(b.name + ".bit = " + std::to_string(n) + " is already used by " +
+                           *used[static_cast<std::size_t>(n)]);
     }
-    used[static_cast<std::size_t>(n)] = b.name;
+    used[static_cast<std::size_t>(n)] = &b.name;
   }
   return Status::ok();
 }
@@ -127,12 +144,16 @@ const NamedBit* signal_in_sub(const std::vector<NamedBit>& bits, int sub) {
 }
 
 // The config key an operator edits for a signal ("io.inputs.shuttle_at_right_2" →
-// "io.shuttle_at_right_2_bit") and its value: a bring-up refusal points at the TOML line that asks for
-// the input the module cannot deliver.
+// "io.shuttle_at_right_2_bit", "io.inputs.yarn_present.head2" → "io.yarn_present_bits (head 2)") and its
+// value: a bring-up refusal points at the TOML line that asks for the input the module cannot deliver.
 std::string key_and_value(const NamedBit& b) {
-  std::string name = b.name;
+  const std::string& name = b.name;
   const std::string group = name.rfind("io.inputs.", 0) == 0 ? "io.inputs." : "io.outputs.";
-  return "io." + name.substr(group.size()) + "_bit = " + std::to_string(b.bit->bit);
+  const std::string signal = name.substr(group.size());
+  const std::size_t head = signal.find(".head");
+  const std::string value = " = " + std::to_string(b.bit->bit);
+  if (head == std::string::npos) return "io." + signal + "_bit" + value;
+  return "io." + signal.substr(0, head) + "_bits (head " + signal.substr(head + 5) + ")" + value;
 }
 
 bool interop_readback_code(std::uint32_t abort) {
@@ -146,6 +167,10 @@ bool interop_readback_code(std::uint32_t abort) {
 // Configuration
 // ---------------------------------------------------------------------------------------------------
 Status validate(const IoWiring& w) {
+  if (w.heads < 0 || w.heads > static_cast<int>(hal::kMaxKnottingHeads)) {
+    return Status::error("io: " + std::to_string(w.heads) + " knotting heads wired; at most " +
+                         std::to_string(hal::kMaxKnottingHeads));
+  }
   if (Status s = check_bits(inputs_of(w), kIoMaxInputBits); !s) return s;
   if (Status s = check_bits(outputs_of(w), kIoMaxOutputBits); !s) return s;
   if (w.load_cell_channel < 0 || w.load_cell_channel > 254) {
@@ -215,7 +240,7 @@ std::vector<FrameGroup> io_frames_per_cycle(const IoWiring& w) {
 }
 
 hal::DigitalOutputs io_safe_outputs() {
-  hal::DigitalOutputs o;
+  hal::DigitalOutputs o;  // grippers open, cutters retracted: every head's outputs false
   o.lamp_red = true;
   return o;
 }
@@ -330,8 +355,8 @@ Status CanIoPort::configure_mapping(SdoClient& sdo) {
   // 0x6000:01..n in TPDO1, in sub order, so the inputs are one sample in one frame.
   std::vector<std::uint32_t> inputs;
   for (std::uint8_t k = 1; k <= in_subs; ++k) inputs.push_back(entry(od401::kDigitalInputs8, k, 8));
-  std::vector<std::uint32_t> outputs{entry(od401::kDigitalOutputs8, 1, 8)};
-  if (out_bytes == 2) outputs.push_back(entry(od401::kDigitalOutputs8, 2, 8));
+  std::vector<std::uint32_t> outputs;
+  for (std::uint8_t k = 1; k <= out_bytes; ++k) outputs.push_back(entry(od401::kDigitalOutputs8, k, 8));
   const bool analog = w.load_cell_channel != 0;
   const std::uint32_t load_cell = entry(od401::kAnalogInput16, static_cast<std::uint8_t>(w.load_cell_channel), 16);
 
@@ -366,8 +391,11 @@ Status CanIoPort::configure_mapping(SdoClient& sdo) {
     if (Status s = locate(tpdo_, load_cell, "load cell", analog_slot_); !s) return s;
   }
   output_pdo_ = output_slot_[0].pdo;
-  if (out_bytes == 2 && output_slot_[1].pdo != output_pdo_) {
-    return Status::error(who() + "0x6200:01 and 0x6200:02 are in different RPDOs; the master needs them in one");
+  for (std::size_t k = 1; k < outputs.size(); ++k) {
+    if (output_slot_[k].pdo != output_pdo_) {
+      return Status::error(who() + "0x6200:01 and " + object_name(outputs[k]) +
+                           " are in different RPDOs; the master needs every digital output in one");
+    }
   }
   std::uint32_t bits = 0;
   const PdoLayout& out = rpdo_[static_cast<std::size_t>(output_pdo_)];
@@ -490,7 +518,7 @@ Status CanIoPort::configure_profile(SdoClient& sdo) {
   {
     const IoWiring& w = config_.wiring;
     const hal::DigitalOutputs safe = io_safe_outputs();
-    std::array<std::uint8_t, 2> mode{}, value{};
+    std::array<std::uint8_t, kMaxOutputSubs> mode{}, value{};
     const auto put = [&](const IoBit& b, bool on) {
       if (b.bit < 0) return;
       const auto byte = static_cast<std::size_t>(b.bit / 8);
@@ -504,6 +532,11 @@ Status CanIoPort::configure_profile(SdoClient& sdo) {
     put(w.lamp_amber, safe.lamp_amber);
     put(w.lamp_red, safe.lamp_red);
     put(w.buzzer, safe.buzzer);
+    for (int h = 0; h < used_heads(w); ++h) {
+      const auto hh = static_cast<std::size_t>(h);
+      put(w.gripper_close[hh], safe.gripper_close[hh]);
+      put(w.cutter[hh], safe.cutter[hh]);
+    }
     const std::uint8_t bytes = io_output_subs(w);
     bool absent = false;
     for (std::uint8_t k = 0; k < bytes && !absent; ++k) {
@@ -613,6 +646,7 @@ void CanIoPort::read_io(hal::Tick /*now*/, const hal::AxisFeedbacks& /*axes*/, h
   io.row_knotted = input(w.row_knotted);
   // Each second channel from its own terminal, never derived from the first: false where not wired.
   for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) io.second_channel[i] = input(w.second[i]);
+  for (std::size_t h = 0; h < static_cast<std::size_t>(w.heads); ++h) io.yarn_present[h] = input(w.yarn_present[h]);
   io.refreshed = inputs_refreshed_;
 }
 
@@ -630,7 +664,7 @@ void CanIoPort::write_io(hal::Tick /*now*/, const hal::DigitalOutputs& requested
   // A node we cannot supervise gets its safe outputs (it may still hear us).
   const hal::DigitalOutputs& o = supervisor_.link_fault() != 0 ? io_safe_outputs() : requested;
   const IoWiring& w = config_.wiring;
-  std::array<std::uint8_t, 2> bytes{};
+  std::array<std::uint8_t, kMaxOutputSubs> bytes{};
   const auto put = [&](const IoBit& b, bool on) {
     if (b.bit < 0) return;
     if (on != b.active_low) bytes[static_cast<std::size_t>(b.bit / 8)] |= static_cast<std::uint8_t>(1U << (b.bit % 8));
@@ -641,6 +675,10 @@ void CanIoPort::write_io(hal::Tick /*now*/, const hal::DigitalOutputs& requested
   put(w.lamp_amber, o.lamp_amber);
   put(w.lamp_red, o.lamp_red);
   put(w.buzzer, o.buzzer);
+  for (std::size_t h = 0; h < static_cast<std::size_t>(w.heads); ++h) {
+    put(w.gripper_close[h], o.gripper_close[h]);
+    put(w.cutter[h], o.cutter[h]);
+  }
   CanFrame f;
   f.id = cob::rpdo(output_pdo_ + 1, config_.node_id);
   f.dlc = output_pdo_bytes_;

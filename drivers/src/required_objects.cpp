@@ -57,6 +57,15 @@ std::vector<RequiredObject> io_module_objects(const IoWiring& wiring) {
   for (RequiredObject& o : v) {
     if (o.index == od401::kDigitalInputs8) o.subs = io_input_subs(wiring);
     if (o.index == od401::kDigitalOutputs8) o.subs = io_output_subs(wiring);
+    if (wiring.heads <= 0) continue;
+    // The knotting heads' signals on the same module.
+    if (o.index == od401::kDigitalInputs8) {
+      o.why = "sensors and their second channels, e-stop chain, buttons, the heads' yarn-present switches";
+    } else if (o.index == od401::kDigitalOutputs8) {
+      o.why = "valves, stack light, buzzer, the heads' grippers and cutters";
+    } else if (o.index == od401::kOutputErrorValue) {
+      o.why = "both valves de-energised, grippers open, cutters retracted on failure";
+    }
   }
   return v;
 }

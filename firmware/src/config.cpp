@@ -176,6 +176,27 @@ void io_second_channel(std::vector<Key>& v, std::size_t i) {
             [i](LoomConfig& c) -> drivers::IoBit& { return c.io.wiring.second[i]; });
 }
 
+// A knotting-head signal of one kind: `io.<name>_bits` (one bit per head, head 1 first) and
+// `io.<name>_active_low` (the same part on every head, so one polarity).
+void io_head_signals(std::vector<Key>& v, const std::string& name, IoSettings::HeadSignals IoSettings::*member,
+                     int max_bits) {
+  const std::string path = "io." + name + "_bits";
+  Key bits{path, Klass::kMachine,
+           "one bit per knotting head, each in [0, " + std::to_string(max_bits - 1) + "] (integer)", true, nullptr,
+           nullptr};
+  bits.read = [=](TomlReader& r, LoomConfig& c) {
+    r.integer_list(path, (c.io.*member).bits, 0, max_bits - 1, hal::kMaxKnottingHeads);
+  };
+  bits.value = [=](const LoomConfig& c) {
+    std::string out;
+    for (int b : (c.io.*member).bits) out += (out.empty() ? "" : ",") + std::to_string(b);
+    return out;
+  };
+  v.push_back(bits);
+  v.push_back(boolean("io." + name + "_active_low", Klass::kMachine,
+                      [member](LoomConfig& c) -> bool& { return (c.io.*member).active_low; }));
+}
+
 const char* branch_name(motion::Branch b) { return b == motion::Branch::kPositive ? "positive" : "negative"; }
 bool parse_branch(const char* s, motion::Branch& b) {
   b = std::string(s) == "positive" ? motion::Branch::kPositive : motion::Branch::kNegative;
@@ -294,6 +315,9 @@ const std::vector<Key>& keys() {
     v.push_back(integer<int>("io.load_cell_channel", M::kMachine, 0, 254, [](LoomConfig& c) -> int& { return c.io.wiring.load_cell_channel; }));
     v.push_back(number("io.load_cell_n_per_count", M::kMachine, -1.0e3, 1.0e3, [](LoomConfig& c) -> double& { return c.io.wiring.load_cell_n_per_count; }));
     v.push_back(number("io.load_cell_offset_n", M::kMachine, -1.0e4, 1.0e4, [](LoomConfig& c) -> double& { return c.io.wiring.load_cell_offset_n; }));
+    io_head_signals(v, "gripper_close", &IoSettings::gripper_close, drivers::kIoMaxOutputBits);
+    io_head_signals(v, "cutter", &IoSettings::cutter, drivers::kIoMaxOutputBits);
+    io_head_signals(v, "yarn_present", &IoSettings::yarn_present, drivers::kIoMaxInputBits);
     // [knotting] — the pile (machine: the heads are hardware)
     v.push_back(choice<sequencer::KnottingMode>("knotting.mode", M::kMachine, {"none", "weaver", "heads"},
                                                 [](LoomConfig& c) -> sequencer::KnottingMode& { return c.knotting.mode; },
@@ -803,14 +827,34 @@ void check_can(const LoomConfig& c, const Fail& fail) {
         fail("io.node", std::to_string(c.io.node), "node id already used by axes." + a.name + ".node");
       }
     }
+    if (c.knotting.mode == sequencer::KnottingMode::kHeads) {
+      // One bit per head: a list of another length is a wiring that does not match the heads fitted.
+      for (const auto& [name, signals] : {std::pair{"io.gripper_close_bits", &c.io.gripper_close},
+                                          std::pair{"io.cutter_bits", &c.io.cutter},
+                                          std::pair{"io.yarn_present_bits", &c.io.yarn_present}}) {
+        if (signals->bits.size() != static_cast<std::size_t>(c.knotting.heads)) {
+          std::string list;
+          for (int b : signals->bits) list += (list.empty() ? "" : ", ") + std::to_string(b);
+          fail(name, "[" + list + "]",
+               std::to_string(signals->bits.size()) + " bits for knotting.heads = " + std::to_string(c.knotting.heads) +
+                   ": one per head, head 1 first");
+        }
+      }
+    }
     if (const drivers::Status s = drivers::validate(can_io_config(c)); !s) {
-      // The driver names the signal ("io.inputs.estop_ok.bit = 3 ..."): point at that signal's key.
+      // The driver names the signal first ("io.inputs.estop_ok.bit = 3 ...", "io.outputs.cutter.head2.bit
+      // = 9 ..."): point at that signal's key (not at another signal the message names after it).
       std::string key = "io.node", value = std::to_string(c.io.node);
       const std::string& msg = s.message();
+      const std::size_t group_end = msg.find('.', 3);
+      const std::string subject =
+          group_end == std::string::npos ? std::string() : msg.substr(group_end + 1, msg.find(".bit") - group_end - 1);
       for (const Key& k : keys()) {
         if (k.path.rfind("io.", 0) != 0 || k.path.size() < 4) continue;
         const std::string name = k.path.substr(3, k.path.rfind('_') - 3);
-        if (k.path.size() > 4 && k.path.substr(k.path.size() - 4) == "_bit" && msg.find("." + name + ".") != std::string::npos) {
+        const bool bit_key = k.path.size() > 4 && k.path.substr(k.path.size() - 4) == "_bit";
+        const bool head_key = k.path.size() > 5 && k.path.substr(k.path.size() - 5) == "_bits";
+        if ((bit_key && subject == name) || (head_key && subject.rfind(name + ".head", 0) == 0)) {
           key = k.path, value = k.value(c);
           break;
         }
@@ -1131,7 +1175,7 @@ drivers::CanAxisPortConfig can_axis_config(const LoomConfig& c) {
   cc.master_node_id = c.can.master_node;
   cc.master_heartbeat_s = c.can.master_heartbeat_ms * 1e-3;
   cc.master_consumer_s = c.can.master_consumer_ms * 1e-3;
-  if (c.io.kind == IoKind::kCan) cc.other_frames_per_cycle = drivers::io_frames_per_cycle(c.io.wiring);
+  if (c.io.kind == IoKind::kCan) cc.other_frames_per_cycle = drivers::io_frames_per_cycle(can_io_config(c).wiring);
   return cc;
 }
 
@@ -1139,6 +1183,20 @@ drivers::CanIoConfig can_io_config(const LoomConfig& c) {
   drivers::CanIoConfig ic;
   ic.node_id = c.io.node;
   ic.wiring = c.io.wiring;
+  // The heads' signals are on the module only when the heads are fitted (a loom without them keeps its
+  // frames as they were).
+  if (c.knotting.mode == sequencer::KnottingMode::kHeads) {
+    drivers::IoWiring& w = ic.wiring;
+    w.heads = std::clamp(c.knotting.heads, 0, static_cast<int>(hal::kMaxKnottingHeads));
+    const auto fill = [&](const IoSettings::HeadSignals& from, std::array<drivers::IoBit, hal::kMaxKnottingHeads>& to) {
+      for (std::size_t h = 0; h < to.size(); ++h) {
+        to[h] = drivers::IoBit{h < from.bits.size() ? from.bits[h] : -1, from.active_low};
+      }
+    };
+    fill(c.io.gripper_close, w.gripper_close);
+    fill(c.io.cutter, w.cutter);
+    fill(c.io.yarn_present, w.yarn_present);
+  }
   ic.cycle_period_s = c.run.period_s;
   ic.heartbeat_producer_s = c.can.heartbeat_ms * 1e-3;
   ic.heartbeat_consumer_s = c.can.heartbeat_timeout_ms * 1e-3;

@@ -7,13 +7,15 @@
 
 #include "loom/drivers/can_link_info.hpp"
 #include "loom/drivers/configure_clock.hpp"
+#include "loom/firmware/sim_heads.hpp"
 #include "loom/motion/errors.hpp"
 
 namespace loom::firmware {
 
 Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions& opt, sequencer::Counters resume)
     : cfg_(cfg) {
-  const Scene fitted = check_scene_fits(scene, cfg_);
+  const bool simulated_io = opt.hal == HalKind::kSim || opt.io.value_or(cfg_.io.kind) == IoKind::kSimulated;
+  const Scene fitted = check_scene_fits(scene, cfg_, simulated_io);
   slot_ = std::make_unique<motion::ProfileSlot>(std::make_unique<const motion::ProfileSet>(cfg_.profile));
   sequencer::SequencerConfig scfg = cfg_.sequencer;
   if (cfg_.knotting.mode == sequencer::KnottingMode::kHeads) build_knotting(opt, resume.rows, scfg);
@@ -26,26 +28,8 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
   sequencer_ = std::make_unique<sequencer::Sequencer>(*slot_, scfg, resume);
   if (knot_program_) {
     // The simulated heads see the same machine: the knot geometry, the heads' axes and where the gripper
-    // is in the warp (the sequencer's interlock derived it from the knot cycle).
-    sim_hal::SimKnotting& k = cfg_.machine.knotting;
-    const sequencer::KnotGuard& g = sequencer_->knot_guard();
-    k.heads = knot_program_->heads();
-    k.knots_per_row = knot_program_->knots_per_row();
-    k.stripe = knot_program_->stripe();
-    k.slots = knot_program_->slots();
-    k.knots_per_slot = knot_program_->knots_per_slot();
-    k.pitch_m = knot_program_->pitch_m();
-    k.carriage_home_m = scfg.carriage_home_m;
-    for (int h = 0; h < k.heads; ++h) {
-      const auto hh = static_cast<std::size_t>(h);
-      k.knotter_axis[hh] = static_cast<std::size_t>(scfg.heads.knotter_axis[hh]);
-      k.selector_axis[hh] = static_cast<std::size_t>(scfg.heads.selector_axis[hh]);
-    }
-    k.take_position_rad = g.take_position_rad;
-    k.selector_zero_rad = scfg.heads.selector_zero_rad;
-    k.in_warp_from_rad = g.in_warp_from_rad;
-    k.in_warp_to_rad = g.in_warp_to_rad;
-    k.full_turn = g.full_turn;
+    // is in the warp (as the sequencer's interlock derives it from the knot cycle).
+    cfg_.machine.knotting = sim_knotting(scfg);
   }
   sim_ = std::make_unique<sim_hal::SimWorld>(cfg_.machine, fitted.spec);
   if (!opt.sim_state_path.empty()) {
@@ -96,23 +80,9 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
 // The knotting heads: the knot cycle from the linkage and the design as magazine slots, both built once
 // here (the design's progress says which row comes next) and read by the tick.
 void Machine::build_knotting(const MachineOptions& opt, std::uint32_t counter_rows, sequencer::SequencerConfig& scfg) {
-  if (opt.hal == HalKind::kSocketCan) {
-    throw ConfigError(cfg_.source + ": knotting.mode = \"heads\": the heads' grippers, cutters and yarn-present switches "
-                      "are not wired to a CAN I/O module yet; weave with the simulated HAL (--hal sim)");
-  }
-  if (!cfg_.recipe.design) {
-    throw ConfigError(cfg_.source + ": knotting.mode = \"heads\": the heads tie the design's knots; set recipe.design");
-  }
-  try {
-    knot_cycle_ = std::make_unique<const motion::KnotCycle>(motion::KnotCycle::build(cfg_.knot_cycle));
-  } catch (const motion::MotionError& e) {
-    throw ConfigError(cfg_.source + ": [knotting.linkage]: " + e.what());
-  }
-  try {
-    knot_program_ = std::make_unique<const sequencer::KnotProgram>(firmware::knot_program(cfg_, opt.design_rows_done, counter_rows));
-  } catch (const std::invalid_argument& e) {
-    throw ConfigError(cfg_.source + ": recipe.design = \"" + cfg_.recipe.design_file + "\": " + e.what());
-  }
+  KnottingHeads heads = build_heads(cfg_, opt.design_rows_done, counter_rows);
+  knot_cycle_ = std::move(heads.cycle);
+  knot_program_ = std::move(heads.program);
   scfg.heads.program = knot_program_.get();
   scfg.heads.cycle = knot_cycle_.get();
 }

@@ -327,13 +327,13 @@ Scene parse_scene(const std::string& text, const std::string& source) {
   return s;
 }
 
-Scene check_scene_fits(Scene scene, const LoomConfig& cfg) {
+Scene check_scene_fits(Scene scene, const LoomConfig& cfg, bool simulated_io) {
   const bool heads = cfg.knotting.mode == sequencer::KnottingMode::kHeads;
   if (scene.spec.knotter && !heads) {
     throw ConfigError(scene.source + ": effects: \"knotter\" simulates knotting heads; the loom (" + cfg.source +
                       ") has none (knotting.mode = \"" + sequencer::knotting_mode_name(cfg.knotting.mode) + "\")");
   }
-  if (heads && !scene.spec.knotter) {
+  if (heads && simulated_io && !scene.spec.knotter) {
     throw ConfigError(scene.source + ": effects: the loom (" + cfg.source +
                       ") ties its knots with heads (knotting.mode = \"heads\"): the scene must name the effect \"knotter\" "
                       "(the heads' yarn, knots and the weaver are simulated only when named)");

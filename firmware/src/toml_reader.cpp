@@ -507,6 +507,26 @@ void TomlReader::string_list(const std::string& path, std::vector<std::string>& 
   }
 }
 
+void TomlReader::integer_list(const std::string& path, std::vector<int>& out, int lo, int hi, std::size_t max_size) {
+  used_.insert(path);
+  const toml::node* n = find(path);
+  if (!n) return;
+  const toml::array* arr = n->as_array();
+  if (!arr) fail_at(*n, path, show(*n), "expected an array of integers");
+  if (arr->size() > max_size) {
+    fail_at(*n, path, show(*n), "at most " + std::to_string(max_size) + " entries (" + std::to_string(arr->size()) + " given)");
+  }
+  out.clear();
+  for (const auto& e : *arr) {
+    const auto v = e.value_exact<std::int64_t>();
+    if (!v) fail_at(e, path, show(e), "expected an integer");
+    if (*v < lo || *v > hi) {
+      fail_at(e, path, show(e), "outside " + std::to_string(lo) + ".." + std::to_string(hi));
+    }
+    out.push_back(static_cast<int>(*v));
+  }
+}
+
 void TomlReader::reject_unknown(const std::set<std::string>& sections) const {
   for (const auto& [k, v] : root_) {
     const std::string name(k.str());

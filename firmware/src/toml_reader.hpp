@@ -26,6 +26,8 @@ class TomlReader {
   void boolean(const std::string& path, bool& out);
   void string(const std::string& path, std::string& out, const std::set<std::string>& allowed = {});
   void string_list(const std::string& path, std::vector<std::string>& out);
+  // Every entry an integer in lo..hi; at most max_size of them.
+  void integer_list(const std::string& path, std::vector<int>& out, int lo, int hi, std::size_t max_size);
 
   // Error at the node for `path` (or the file start when absent).
   [[noreturn]] void fail(const std::string& path, const std::string& value, const std::string& why) const;

@@ -183,31 +183,7 @@ Sequencer::Sequencer(const motion::ProfileSet& profiles, const SequencerConfig& 
 }
 
 void Sequencer::configure_knot_guard() {
-  // Where the gripper is inside the warp, as knotting-servo angles: the cycle's in-warp window, sampled
-  // (a one-degree-of-freedom linkage puts its gripper in the same place at the same servo angle).
-  const motion::KnotCycle& c = *cfg_.heads.cycle;
-  KnotGuard& g = interlock_ctx_.knot;
-  g.heads = cfg_.heads.program->heads();
-  for (int h = 0; h < g.heads; ++h) {
-    g.knotter[static_cast<std::size_t>(h)] = static_cast<std::int8_t>(cfg_.heads.knotter_axis[static_cast<std::size_t>(h)]);
-    g.selector[static_cast<std::size_t>(h)] = static_cast<std::int8_t>(cfg_.heads.selector_axis[static_cast<std::size_t>(h)]);
-  }
-  g.take_position_rad = cfg_.heads.take_position_rad;
-  g.full_turn = c.end_offset_rad() != 0.0;
-  double lo = 1e300, hi = -1e300;
-  const motion::KnotCycle::Window w = c.in_warp();
-  constexpr int kSamples = 256;
-  for (int i = 0; i <= kSamples; ++i) {
-    double a = c.sample(w.begin_s + (w.end_s - w.begin_s) * i / kSamples).angle_rad;
-    if (g.full_turn) a = motion::wrap_two_pi(a);
-    lo = std::min(lo, a);
-    hi = std::max(hi, a);
-  }
-  // Closed at the ends (the stroke turns round inside the warp, at PULL) and a milliradian wider: the guard
-  // errs on the side of "in the warp".
-  constexpr double kMarginRad = 1e-3;
-  g.in_warp_from_rad = lo - kMarginRad;
-  g.in_warp_to_rad = hi + kMarginRad;
+  interlock_ctx_.knot = sequencer::knot_guard(cfg_.heads);
 }
 
 void Sequencer::adopt_limits() noexcept {

@@ -97,8 +97,8 @@ TEST(IoWiring, DuplicateBitNamesBothSignals) {
 
 TEST(IoWiring, BitOutOfRangeAndUnwiredRequiredSignal) {
   IoWiring w;
-  w.lamp_red.bit = 16;
-  EXPECT_EQ(drivers::validate(w).message(), "io.outputs.lamp_red.bit = 16 is outside 0..15 (-1 = not wired)");
+  w.lamp_red.bit = 64;
+  EXPECT_EQ(drivers::validate(w).message(), "io.outputs.lamp_red.bit = 64 is outside 0..63 (-1 = not wired)");
   IoWiring u;
   u.piston_b_extend.bit = -1;
   EXPECT_EQ(drivers::validate(u).message(), "io.outputs.piston_b_extend.bit = -1: this signal must be wired");
@@ -136,14 +136,48 @@ TEST(IoWiring, DuplicateBitBetweenAFirstAndASecondChannelNamesBoth) {
             "io.inputs.shuttle_at_left_2.bit = 20 is already used by io.inputs.piston_a_retracted_2");
 }
 
-TEST(IoWiring, InputBitsReach31AndSecondChannelsAreOptional) {
+TEST(IoWiring, InputBitsReach63AndSecondChannelsAreOptional) {
   IoWiring w;
-  w.second[0].bit = 31;
+  w.second[0].bit = 63;
   EXPECT_TRUE(drivers::validate(w));
-  w.second[0].bit = 32;
-  EXPECT_EQ(drivers::validate(w).message(), "io.inputs.piston_a_extended_2.bit = 32 is outside 0..31 (-1 = not wired)");
+  w.second[0].bit = 64;
+  EXPECT_EQ(drivers::validate(w).message(), "io.inputs.piston_a_extended_2.bit = 64 is outside 0..63 (-1 = not wired)");
   EXPECT_TRUE(drivers::validate(single_channel()));
 }
+
+// Two knotting heads on the module: grippers on outputs 8, 9, cutters on 20, 21, yarn-present on inputs
+// 24, 25 (the simulated module's terminals).
+IoWiring two_heads() {
+  IoWiring w;
+  w.heads = 2;
+  w.gripper_close = {drivers::IoBit{8}, drivers::IoBit{9}};
+  w.cutter = {drivers::IoBit{20}, drivers::IoBit{21}};
+  w.yarn_present = {drivers::IoBit{24}, drivers::IoBit{25}};
+  return w;
+}
+
+TEST(IoWiring, EveryHeadUsedIsWiredAndNamedByItsNumber) {
+  EXPECT_TRUE(drivers::validate(two_heads()));
+  IoWiring unwired = two_heads();
+  unwired.cutter[1].bit = -1;
+  EXPECT_EQ(drivers::validate(unwired).message(), "io.outputs.cutter.head2.bit = -1: this signal must be wired");
+  IoWiring clash = two_heads();
+  clash.gripper_close[1].bit = 5;  // the amber lamp's output
+  EXPECT_EQ(drivers::validate(clash).message(), "io.outputs.gripper_close.head2.bit = 5 is already used by io.outputs.lamp_amber");
+  IoWiring input_clash = two_heads();
+  input_clash.yarn_present[0].bit = 11;  // the weaver's pedal
+  EXPECT_EQ(drivers::validate(input_clash).message(),
+            "io.inputs.yarn_present.head1.bit = 11 is already used by io.inputs.row_knotted");
+  // Heads not used (0: the loom has none) are not looked at, whatever their bits say.
+  IoWiring unused = two_heads();
+  unused.heads = 0;
+  unused.cutter[0].bit = 0;
+  EXPECT_TRUE(drivers::validate(unused));
+  IoWiring too_many = two_heads();
+  too_many.heads = 13;
+  EXPECT_EQ(drivers::validate(too_many).message(), "io: 13 knotting heads wired; at most 12");
+}
+
 
 TEST(IoWiring, FramesPerCycle) {
   IoWiring w;
@@ -169,6 +203,18 @@ std::string required_line(const std::vector<drivers::RequiredObject>& objects, s
     if (o.index == index) return drivers::describe(o);
   }
   return "";
+}
+
+TEST(IoWiring, HeadsWidenTheFramesAndTheObjectsAModuleMustHave) {
+  const IoWiring w = two_heads();
+  const auto g = drivers::io_frames_per_cycle(w);
+  EXPECT_EQ(g[0].data_bytes, 3u);  // outputs up to the cutters on 20, 21: 0x6200:01..03
+  EXPECT_EQ(g[1].data_bytes, 4u);  // inputs up to yarn-present on 24, 25: 0x6000:01..04
+  EXPECT_EQ(required_line(drivers::io_module_objects(w), 0x6000),
+            "0x6000:01..04 read digital inputs, 8-bit: sensors and their second channels, e-stop chain, buttons, "
+            "the heads' yarn-present switches");
+  EXPECT_EQ(required_line(drivers::io_module_objects(w), 0x6200),
+            "0x6200:01..03 write digital outputs, 8-bit: valves, stack light, buzzer, the heads' grippers and cutters");
 }
 
 TEST(IoWiring, RequiredObjectsCountTheInputGroupsTheWiringUses) {
@@ -259,6 +305,64 @@ TEST(CanIoPort, DefaultWiringReadsBothChannelsOfEverySafetySensorFromThreeInputB
 }
 
 // A stuck switch on one channel shows on that channel only: the master reports the two independently.
+// The heads' signals through the bus, against the module's own plant: head 1's gripper closes at TAKE with
+// its selector at slot 0 and its cutter fires in the warp over knot 0; the module's yarn-present switch
+// then sees the knot, and the master reads it. On the wire: the outputs' RPDO grows to three bytes, the
+// inputs' TPDO to four. When the master dies the module opens the grippers by itself (0x6206/0x6207).
+TEST(CanIoPort, KnottingHeadsSignalsTravelBothWaysAndFailSafe) {
+  sim_can::SimIoConfig io_cfg;
+  sim_hal::SimKnotting& k = io_cfg.knotting;
+  k.heads = 2;
+  k.knots_per_row = 20;
+  k.stripe = 10;
+  k.slots = 3;
+  k.knots_per_slot = 5;
+  k.pitch_m = 0.01;
+  k.carriage_home_m = -0.005;  // the carriage drive at 0 stands over the middle of knot 0's pitch
+  k.knotter_axis = {3, 5};
+  k.selector_axis = {4, 6};
+  k.in_warp_from_rad = -1.0;   // the knotting servo at 0 is both at TAKE and in the warp: a plant test only
+  k.in_warp_to_rad = 1.0;
+  k.full_turn = false;
+  CanIoConfig port_cfg;
+  port_cfg.wiring = two_heads();
+  IoRig r(io_cfg, three_drives(), {}, port_cfg);
+  // The three drives stand for the carriage (slot 1), head 1's knotting servo (slot 3) and selector (slot 4);
+  // head 2's servos read 0 as well (unmapped slots).
+  sim_can::SimDriveRack::IoPlantSource src{0, 2, drivers::kDefaultCountsPerRad, drivers::kDefaultCountsPerRad, {}};
+  src.axes = {{1, 1, drivers::kDefaultCountsPerM}, {0, 3, drivers::kDefaultCountsPerRad}, {2, 4, drivers::kDefaultCountsPerRad}};
+  r.rig.rack.attach_io(r.io, src);
+  const drivers::Status s = r.configure();
+  ASSERT_TRUE(s) << s.message();
+  r.enable_all();
+  EXPECT_EQ(last_dlc(r.rig.net, 0x204), 3);  // RPDO1: 0x6200:01..03
+  EXPECT_EQ(last_dlc(r.rig.net, 0x184), 4);  // TPDO1: 0x6000:01..04
+  EXPECT_FALSE(r.in.io.yarn_present[0]);
+
+  hal::DigitalOutputs out;
+  out.gripper_close[0] = true;
+  for (int i = 0; i < 5; ++i) r.tick(AxisRequest::kEnable, out);
+  EXPECT_EQ(r.io.outputs(1) & 0x03, 0x01);  // head 1's gripper (terminal 8), not head 2's
+  EXPECT_FALSE(r.in.io.yarn_present[0]);    // holding yarn is not a knot
+  out.cutter[0] = true;
+  for (int i = 0; i < 5; ++i) r.tick(AxisRequest::kEnable, out);
+  EXPECT_EQ(r.io.outputs(2) & 0x30, 0x10);  // head 1's cutter (terminal 20)
+  EXPECT_TRUE(r.in.io.yarn_present[0]);     // the knot, seen by the module's switch and read by the master
+  EXPECT_FALSE(r.in.io.yarn_present[1]);
+  ASSERT_NE(r.io.knotter(), nullptr);
+  EXPECT_EQ(r.io.knotter()->cell(0, 0).ties, 1);
+  EXPECT_EQ(r.io.knotter()->cell(0, 0).slot, 0);
+
+  // The host dies with the gripper closed and the cutter firing: the module opens and retracts them.
+  out.cutter[0] = false;
+  for (int i = 0; i < 3; ++i) r.tick(AxisRequest::kEnable, out);
+  EXPECT_EQ(r.io.outputs(1) & 0x01, 0x01);
+  r.rig.advance(700'000);
+  ASSERT_TRUE(r.io.comm_lost());
+  EXPECT_EQ(r.io.outputs(1), 0x00);  // grippers open
+  EXPECT_EQ(r.io.outputs(2), 0x00);  // cutters retracted
+}
+
 TEST(CanIoPort, AStuckSwitchShowsOnItsOwnChannelOnly) {
   IoRig r;
   ASSERT_TRUE(r.configure());

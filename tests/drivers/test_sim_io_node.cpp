@@ -155,9 +155,10 @@ class SimIoNodeTest : public ::testing::Test {
 // (1), piston B retracted (3), shuttle at left (4), e-stop (6); their second switches on 17, 19, 20.
 const std::initializer_list<int> kAtRest = {1, 3, 4, 6, 17, 19, 20};
 
-TEST_F(SimIoNodeTest, DictionaryHasFourInputGroupsAndAnswersSdoReadsOf6000Sub3) {
+TEST_F(SimIoNodeTest, DictionaryHasEightInputGroupsAndAnswersSdoReadsOf6000Sub3) {
   power_on();
-  EXPECT_EQ(read(0x6000, 0), 4u);  // highest sub-index: 32 inputs
+  EXPECT_EQ(read(0x6000, 0), 8u);  // highest sub-index: 64 inputs (the knotting heads' from terminal 24)
+  EXPECT_EQ(read(0x6200, 0), 4u);  // 32 outputs (the heads' grippers from 8, cutters from 20)
   const std::vector<std::uint8_t> in = terminals(kAtRest, 4);
   EXPECT_EQ(read(0x6000, 1), in[0]);
   EXPECT_EQ(read(0x6000, 2), in[1]);

@@ -261,8 +261,8 @@ TEST(Config, SecondSwitchesAreWiredInputsAndDeriveTheSequencersDualChannels) {
   const std::string e = config_error("extends = \"default\"\n[io]\nshuttle_at_right_2_bit = 5\n");
   EXPECT_EQ(e.rfind("loom.toml:3:26: io.shuttle_at_right_2_bit = 5: the I/O module refuses it: ", 0), 0u) << e;
   EXPECT_NE(e.find("already used by io.inputs.shuttle_at_right"), std::string::npos) << e;
-  EXPECT_EQ(config_error("extends = \"default\"\n[io]\npiston_a_extended_2_bit = 32\n"),
-            "loom.toml:3:27: io.piston_a_extended_2_bit = 32: must be in [-1, 31]");
+  EXPECT_EQ(config_error("extends = \"default\"\n[io]\npiston_a_extended_2_bit = 64\n"),
+            "loom.toml:3:27: io.piston_a_extended_2_bit = 64: must be in [-1, 63]");
   EXPECT_EQ(config_error("extends = \"default\"\n[timing]\nsensor_discrepancy_ms = 0\n"),
             "loom.toml:3:25: timing.sensor_discrepancy_ms = 0: must be in [1, 1000]");
 }

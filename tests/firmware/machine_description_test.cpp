@@ -291,7 +291,7 @@ TEST(MachineKnotting, HeadsNeedAMagazineThatHoldsEveryColourOfTheDesign) {
   design.close();
   const std::string heads = "[knotting]\nmode = \"heads\"\nknots_per_dm = 10\nheads = 2\nhead_spacing_m = 0.6\n";
   // Each head's knotting servo and colour selector, on a bus of their own.
-  std::string head_axes;
+  std::string head_axes = "[io]\ngripper_close_bits = [8, 9]\ncutter_bits = [20, 21]\nyarn_present_bits = [24, 25]\n";
   for (const char* a : {"knotter_1", "knotter_2", "selector_1", "selector_2"}) {
     static int node = 10;
     head_axes += std::string("[axes.") + a + "]\nrole = \"" + (a[0] == 'k' ? "knotter" : "selector") +
@@ -306,6 +306,26 @@ TEST(MachineKnotting, HeadsNeedAMagazineThatHoldsEveryColourOfTheDesign) {
       << load_error(dir + "/bad.toml");
   std::ofstream(dir + "/good.toml") << ext(heads + "slot_colours = [\"R\", \"W\", \"B\"]\n" + head_axes + "[recipe]\ndesign = \"rug.csv\"\n");
   EXPECT_EQ(load_error(dir + "/good.toml"), "");
+  // The heads' signals on the I/O module: one bit per head, refused at the list's own line otherwise.
+  const auto with_io = [&](const std::string& from, const std::string& to) {
+    std::string axes = head_axes;
+    axes.replace(axes.find(from), from.size(), to);
+    return ext(heads + "slot_colours = [\"R\", \"W\", \"B\"]\n" + axes + "[recipe]\ndesign = \"rug.csv\"\n");
+  };
+  std::ofstream(dir + "/short.toml") << with_io("yarn_present_bits = [24, 25]", "yarn_present_bits = [24]");
+  EXPECT_NE(load_error(dir + "/short.toml").find("short.toml:"), std::string::npos) << load_error(dir + "/short.toml");
+  EXPECT_NE(load_error(dir + "/short.toml").find("io.yarn_present_bits = [24]: 1 bits for knotting.heads = 2: one per head"),
+            std::string::npos)
+      << load_error(dir + "/short.toml");
+  std::ofstream(dir + "/clash.toml") << with_io("cutter_bits = [20, 21]", "cutter_bits = [20, 5]");
+  EXPECT_NE(load_error(dir + "/clash.toml")
+                .find("io.cutter_bits = 20,5: the I/O module refuses it: io.outputs.cutter.head2.bit = 5 is already used by "
+                      "io.outputs.lamp_amber"),
+            std::string::npos)
+      << load_error(dir + "/clash.toml");
+  std::ofstream(dir + "/range.toml") << with_io("gripper_close_bits = [8, 9]", "gripper_close_bits = [8, 64]");
+  EXPECT_NE(load_error(dir + "/range.toml").find("io.gripper_close_bits"), std::string::npos) << load_error(dir + "/range.toml");
+  EXPECT_NE(load_error(dir + "/range.toml").find("outside 0..63"), std::string::npos) << load_error(dir + "/range.toml");
   // Without its axes a head cannot tie: refused at the head count, naming the role.
   std::ofstream(dir + "/no_axes.toml") << ext(heads + "slot_colours = [\"R\", \"W\", \"B\"]\n[recipe]\ndesign = \"rug.csv\"\n");
   EXPECT_NE(load_error(dir + "/no_axes.toml").find("knotting.heads = 2: the loom has 0 axes with role = \"knotter\""), std::string::npos)

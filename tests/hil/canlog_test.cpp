@@ -404,6 +404,60 @@ TEST(HilJudgeIo, SecondSwitchesMustBeCarriedSeenAndAgreeWithTheirFirst) {
   EXPECT_NE(a.failure.find("second switches 0x20 disagree with first switches 0x00"), std::string::npos) << a.failure;
 }
 
+// One head (gripper bit 8, cutter bit 20 in the I/O node's RPDO 0x204; yarn-present bit 24 in its TPDO
+// 0x184; selector node 21, carriage node 2), two knots: select, grip, cut, knot seen, open, carriage on.
+std::string knot_log(const std::string& middle = "") {
+  return "(1.000000) vcan0 215#0F0000000000\n"        // selector at slot 0
+         "(1.001000) vcan0 202#0F0000000000\n"        // carriage at knot 0
+         "(1.002000) vcan0 204#000100\n"              // gripper closes
+         "(1.003000) vcan0 204#000110\n"              // cutter fires
+         "(1.004000) vcan0 184#00000001\n"            // knot seen
+         "(1.005000) vcan0 204#000000\n"              // gripper opens, cutter back
+         + middle +
+         "(1.006000) vcan0 202#0F0010000000\n"        // carriage one pitch on
+         "(1.007000) vcan0 184#00000000\n"
+         "(1.008000) vcan0 215#0F0000080000\n"        // selector to slot 1
+         "(1.009000) vcan0 204#000100\n"
+         "(1.010000) vcan0 204#000110\n"
+         "(1.011000) vcan0 184#00000001\n"
+         "(1.012000) vcan0 204#000000\n";
+}
+KnottingWiring one_head() {
+  KnottingWiring w;
+  w.gripper_bits = {8};
+  w.cutter_bits = {20};
+  w.yarn_bits = {24};
+  w.selector_nodes = {21};
+  w.carriage_node = 2;
+  w.knots_per_head = 2;
+  return w;
+}
+
+TEST(HilJudgeKnotting, EveryCutIsAKnotSeenAndNothingMovesUnderAClosedGripper) {
+  const CheckResult ok = check_knotting(parse_log(knot_log()), 4, one_head());
+  EXPECT_TRUE(ok.ok) << ok.failure;
+  KnottingWiring three = one_head();
+  three.knots_per_head = 3;
+  EXPECT_EQ(check_knotting(parse_log(knot_log()), 4, three).failure, "head 1: 2 cuts and 2 knots seen, expected 3 of each");
+  // The carriage moved with the gripper closed.
+  const CheckResult dragged =
+      check_knotting(parse_log("(0.998000) vcan0 202#0F0030000000\n(0.999000) vcan0 204#000100\n"
+                               "(0.999500) vcan0 202#0F0000000000\n" + knot_log()),
+                     4, one_head());
+  EXPECT_NE(dragged.failure.find("the carriage moved while a gripper was closed"), std::string::npos) << dragged.failure;
+  // The selector turned under held yarn.
+  const CheckResult turned = check_knotting(
+      parse_log(knot_log("(1.005500) vcan0 204#000100\n(1.005600) vcan0 215#0F0000040000\n(1.005700) vcan0 204#000000\n")), 4,
+      one_head());
+  EXPECT_NE(turned.failure.find("head 1's selector turned under its closed gripper"), std::string::npos) << turned.failure;
+  // A cut with the gripper open, and a cut whose knot was never seen.
+  const CheckResult open_cut = check_knotting(parse_log("(0.500000) vcan0 204#000010\n(0.600000) vcan0 204#000000\n" + knot_log()), 4, one_head());
+  EXPECT_NE(open_cut.failure.find("head 1's cutter fired with its gripper open"), std::string::npos) << open_cut.failure;
+  std::string missed = knot_log();
+  missed.replace(missed.find("(1.011000) vcan0 184#00000001\n"), 30, "(1.011000) vcan0 184#00000000\n");
+  EXPECT_EQ(check_knotting(parse_log(missed), 4, one_head()).failure, "head 1: 2 cuts and 1 knots seen, expected 2 of each");
+}
+
 TEST(HilJudgeEmcy, EveryDriveStopsWithinOneCycleOfTheEmcyAndStaysStopped) {
   // The EMCY lands after the master read the bus: SYNC and RPDO1s of the cycle in progress still enable
   // (decided before the EMCY), the next cycle stops both drives.

@@ -90,6 +90,22 @@ int main(int argc, char** argv) {
   mloss->add_option("--consumer-ms", consumer_ms, "consumer time (ms)")->check(CLI::Range(1.0, 65535.0));
   mloss->add_option("--slack-ms", slack_ms, "allowed lateness (the VM is not real-time)")->check(CLI::Range(0.0, 10000.0));
 
+  loom::hil::KnottingWiring knots;
+  auto* knotting = app.add_subcommand("knotting", "the heads tied every knot of the row, safely, seen on the wire");
+  knotting->add_option("log", log, "candump -L log")->required();
+  knotting->add_option("--node", io_node, "I/O node id")->check(CLI::Range(1, 127));
+  knotting->add_option("--gripper-bits", knots.gripper_bits, "output bit of each head's gripper")->required()->delimiter(',');
+  knotting->add_option("--cutter-bits", knots.cutter_bits, "output bit of each head's cutter")->required()->delimiter(',');
+  knotting->add_option("--yarn-bits", knots.yarn_bits, "input bit of each head's yarn-present switch")->required()->delimiter(',');
+  knotting->add_option("--selector-nodes", knots.selector_nodes, "each head's colour-selector drive")
+      ->required()
+      ->delimiter(',')
+      ->check(CLI::Range(1, 127));
+  knotting->add_option("--carriage-node", knots.carriage_node, "the carriage drive")->check(CLI::Range(1, 127));
+  knotting->add_option("--knots-per-head", knots.knots_per_head, "knots each head ties in the log")
+      ->required()
+      ->check(CLI::Range(1, 100000));
+
   int max_late = 1000000;
   auto* lag = app.add_subcommand("feedback-lag", "each drive's TPDO1 answers the SYNC right before it (the rig)");
   lag->add_option("log", log, "candump -L log")->required();
@@ -112,6 +128,7 @@ int main(int argc, char** argv) {
   if (summary->parsed()) return 0;
   if (weave->parsed()) return report("weave protocol", loom::hil::check_weave_protocol(frames, nodes));
   if (io->parsed()) return report("I/O traffic", loom::hil::check_io_traffic(frames, io_node, second_switches));
+  if (knotting->parsed()) return report("knotting", loom::hil::check_knotting(frames, io_node, knots));
   if (lag->parsed()) return report("feedback lag", loom::hil::check_feedback_lag(frames, nodes, max_late));
   if (emcy->parsed()) return report("EMCY stop", loom::hil::check_emcy_stop(frames, nodes, emcy_node));
   if (mloss->parsed()) {

@@ -401,6 +401,110 @@ CheckResult check_io_traffic(const std::vector<Frame>& frames, int io_node, bool
   return r;
 }
 
+namespace {
+bool pdo_bit(const Frame& f, int bit) {
+  const auto byte = static_cast<std::size_t>(bit / 8);
+  return bit >= 0 && byte < f.len && ((f.data[byte] >> (bit % 8)) & 1U) != 0;
+}
+}  // namespace
+
+CheckResult check_knotting(const std::vector<Frame>& frames, int io_node, const KnottingWiring& w) {
+  CheckResult r;
+  const std::size_t heads = w.gripper_bits.size();
+  if (heads == 0 || w.cutter_bits.size() != heads || w.yarn_bits.size() != heads || w.selector_nodes.size() != heads) {
+    r.ok = false;
+    r.failure = "the wiring needs one gripper, cutter and yarn-present bit and one selector node per head";
+    return r;
+  }
+  const auto rpdo = static_cast<std::uint32_t>(0x200 + io_node);
+  const auto tpdo = static_cast<std::uint32_t>(0x180 + io_node);
+  const auto carriage = static_cast<std::uint32_t>(0x200 + w.carriage_node);
+  struct Head {
+    bool gripper = false, cutter = false, yarn = false, selector_known = false;
+    bool awaiting_knot = false;  // a cut whose knot the switch has not shown yet
+    int cuts = 0, knots = 0, selector_moves = 0;
+    std::int32_t selector_target = 0;
+  };
+  std::vector<Head> h(heads);
+  bool carriage_known = false;
+  std::int32_t carriage_target = 0;
+  int carriage_steps = 0;
+  const auto fail = [&](const Frame& f, const std::string& what) {
+    if (!r.ok) return;
+    r.ok = false;
+    r.failure = what + " (log line " + std::to_string(f.line) + ")";
+  };
+  const auto any_gripper = [&] {
+    for (const Head& x : h) {
+      if (x.gripper) return true;
+    }
+    return false;
+  };
+  for (const Frame& f : frames) {
+    if (f.error_frame || f.rtr || f.extended) continue;
+    if (f.id == rpdo && f.len >= 1) {
+      for (std::size_t k = 0; k < heads; ++k) {
+        const bool gripper = pdo_bit(f, w.gripper_bits[k]);
+        const bool cutter = pdo_bit(f, w.cutter_bits[k]);
+        const std::string head = "head " + std::to_string(k + 1);
+        if (cutter && !h[k].cutter) {
+          if (!gripper) fail(f, head + "'s cutter fired with its gripper open");
+          if (h[k].awaiting_knot) fail(f, head + " cut again before the yarn-present switch showed its last knot");
+          ++h[k].cuts;
+          h[k].awaiting_knot = true;
+        }
+        h[k].gripper = gripper;
+        h[k].cutter = cutter;
+      }
+    } else if (f.id == tpdo && f.len >= 1) {
+      for (std::size_t k = 0; k < heads; ++k) {
+        const bool yarn = pdo_bit(f, w.yarn_bits[k]);
+        if (yarn && !h[k].yarn && h[k].awaiting_knot) {
+          ++h[k].knots;
+          h[k].awaiting_knot = false;
+        }
+        h[k].yarn = yarn;
+      }
+    } else if (f.id == carriage && f.len >= 6) {
+      const auto target = static_cast<std::int32_t>(f.u32(2));
+      if (carriage_known && target != carriage_target) {
+        if (any_gripper()) fail(f, "the carriage moved while a gripper was closed");
+        ++carriage_steps;
+      }
+      carriage_known = true;
+      carriage_target = target;
+    } else if (f.len >= 6) {
+      for (std::size_t k = 0; k < heads; ++k) {
+        if (f.id != static_cast<std::uint32_t>(0x200 + w.selector_nodes[k])) continue;
+        const auto target = static_cast<std::int32_t>(f.u32(2));
+        if (h[k].selector_known && target != h[k].selector_target) {
+          if (h[k].gripper) fail(f, "head " + std::to_string(k + 1) + "'s selector turned under its closed gripper");
+          ++h[k].selector_moves;
+        }
+        h[k].selector_known = true;
+        h[k].selector_target = target;
+      }
+    }
+  }
+  for (std::size_t k = 0; k < heads; ++k) {
+    const std::string head = "head " + std::to_string(k + 1);
+    r.notes.push_back(head + ": " + std::to_string(h[k].cuts) + " cuts, " + std::to_string(h[k].knots) +
+                      " knots seen by its yarn-present switch, selector target changed in " +
+                      std::to_string(h[k].selector_moves) + " RPDOs");
+    if (!r.ok) continue;
+    if (h[k].cuts != w.knots_per_head || h[k].knots != w.knots_per_head) {
+      r.ok = false;
+      r.failure = head + ": " + std::to_string(h[k].cuts) + " cuts and " + std::to_string(h[k].knots) +
+                  " knots seen, expected " + std::to_string(w.knots_per_head) + " of each";
+    } else if (h[k].selector_moves == 0) {
+      r.ok = false;
+      r.failure = head + "'s selector never turned (the stripe has more than one colour)";
+    }
+  }
+  r.notes.push_back("carriage target changed in " + std::to_string(carriage_steps) + " RPDOs, none with a gripper closed");
+  return r;
+}
+
 CheckResult check_emcy_stop(const std::vector<Frame>& frames, const std::vector<int>& nodes, int emcy_node) {
   CheckResult r;
   std::size_t k = 0;

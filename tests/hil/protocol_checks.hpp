@@ -69,6 +69,22 @@ namespace loom::hil {
 // first switch (byte 0, bits 0..5) does: the simulated module's two switches see the same truth.
 CheckResult check_io_traffic(const std::vector<Frame>& frames, int io_node, bool second_switches = false);
 
+// The knotting heads' row, judged from the wire alone. Per head h (its gripper and cutter bits in the I/O
+// node's output RPDO, its yarn-present bit in the input TPDO, its colour selector drive `selector_nodes[h]`):
+// the cutter fired exactly `knots_per_head` times, each time with its gripper closed; after every cut the
+// yarn-present switch rose before the next cut (a knot seen for every cut, `knots_per_head` in all); the
+// selector's target never changed while its gripper was closed (no turn under held yarn) and changed at
+// least once (the stripe has more than one colour). The carriage drive's target never changed while any
+// gripper was closed (the carriage does not drag a gripper through the warp). Bits count across the PDO's
+// bytes (bit b in byte b / 8); drive RPDO1 layout as PdoLayout.
+struct KnottingWiring {
+  std::vector<int> gripper_bits, cutter_bits, yarn_bits;  // one per head
+  std::vector<int> selector_nodes;                         // one per head
+  int carriage_node = 2;
+  int knots_per_head = 0;
+};
+CheckResult check_knotting(const std::vector<Frame>& frames, int io_node, const KnottingWiring& w);
+
 // An EMCY with a non-zero code from `emcy_node` (the first such frame in the log): within one cycle the
 // master stops every drive in `nodes`. RPDO1s before the second SYNC after the EMCY belong to the cycle in
 // progress (decided before the EMCY could be read) and are not judged; the first RPDO1 after that SYNC

@@ -93,6 +93,18 @@ TEST(SceneFile, EveryFaultKindRoundTripsThroughTheWriter) {
   EXPECT_EQ(back.spec.name, s.name);
 }
 
+// Knotting heads are simulated only where the simulator is the loom's I/O: there a scene must name the
+// effect "knotter"; with a real I/O module carrying the heads' signals (over CAN) it need not.
+TEST(SceneFile, HeadsNeedTheKnotterEffectOnlyWhenTheirIoIsSimulated) {
+  firmware::LoomConfig heads = firmware::default_loom_config();
+  heads.knotting.mode = sequencer::KnottingMode::kHeads;
+  const firmware::Scene plain = firmware::parse_scene("effects = [\"ideal\"]\n", "s.toml");
+  EXPECT_THROW((void)firmware::check_scene_fits(plain, heads, true), firmware::ConfigError);
+  EXPECT_NO_THROW((void)firmware::check_scene_fits(plain, heads, false));
+  const firmware::Scene knotter = firmware::parse_scene("effects = [\"ideal\", \"knotter\"]\n", "s.toml");
+  EXPECT_NO_THROW((void)firmware::check_scene_fits(knotter, heads, true));
+}
+
 TEST(SceneFile, AFaultInASecondSwitchTheLoomDoesNotHaveIsRefusedAtTheFault) {
   const firmware::Scene scene = firmware::parse_scene(
       "effects = [\"ideal\"]\n[[fault]]\nkind = \"stuck_sensor\"\nat_s = 1.0\nsensor = \"shuttle_at_right_2\"\nvalue = true\n",

@@ -4,6 +4,11 @@
 //   loom-sim-drive --iface vcan0 --nodes 1,2,3 [--io-node 4] [--personality standard|fixed]
 //                  [--counts-per-unit A,B,C] [--initial-position a,b,c] [--io-control FILE]
 //                  [--homing-nodes 1,2 [--power-up-seed N]]
+//   loom-sim-drive --iface vcan0 --loom LOOM.toml [--bus N] [--io-control FILE] ...
+// --loom: the nodes of bus N (default 0) as the machine description has them — drives in axis-slot order
+// with their scaling and referencing, the I/O node (bus 0, io.kind = "can") with the loom's width and helix
+// lead — and, for a loom with knotting heads, the heads behind the I/O node (grippers, cutters, yarn-present
+// switches, each head's magazine; the carriage and every head's servos must then be on this bus).
 // --homing-nodes: those drives have incremental encoders: they offer CiA 402 homing (mode 6; methods 19/21
 // on a home switch at physical 0, 33/34 on an index pulse every 4096 counts, 37 where they stand) and
 // power up at a random count (the seed is printed; give it back to reproduce a run).
@@ -34,6 +39,8 @@
 #include <vector>
 
 #include "loom/drivers/can_axis_port.hpp"
+#include "loom/firmware/config.hpp"
+#include "loom/firmware/sim_heads.hpp"
 #include "loom/drivers/nmt.hpp"
 #include "loom/drivers/socket_can_bus.hpp"
 #include "loom/sim_can/io_control.hpp"
@@ -86,6 +93,19 @@ double default_counts_per_unit(std::size_t i) {
   return i == 1 ? loom::drivers::kDefaultCountsPerM : loom::drivers::kDefaultCountsPerRad;
 }
 
+// The carpet the simulated heads knotted, one line per row (the magazine slot of each knot, '.' none, a
+// digit per knot tied more than once: a defect), for the HIL test to compare with the design.
+void print_carpet(const loom::sim_hal::SimKnotter& k) {
+  for (int r = 0; r < k.rows(); ++r) {
+    std::string line;
+    for (int j = 0; j < k.knots_per_row(); ++j) {
+      const loom::sim_hal::KnotCell& c = k.cell(r, j);
+      line += c.ties == 0 ? '.' : c.ties > 1 ? static_cast<char>('0' + std::min<int>(c.ties, 9)) : static_cast<char>('A' + c.slot);
+    }
+    std::cerr << "loom-sim-drive: knotted row " << r << ": " << line << "\n";
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -104,24 +124,34 @@ int main(int argc, char** argv) {
   double width_m = 0.6, helix_lead_m = 0.1;
   std::vector<int> homing_nodes;
   std::uint64_t power_up_seed = 0;
+  std::string loom_file;
+  int loom_bus = 0;
   app.add_option("--iface", iface, "CAN interface, e.g. vcan0")->required();
-  app.add_option("--io-node", io_node, "also simulate the CiA 401 I/O node with this node id (1..127)");
+  auto* loom_opt = app.add_option("--loom", loom_file,
+                                  "the machine description: simulate bus --bus's drives and (bus 0) its I/O node with "
+                                  "the loom's facts, knotting heads included");
+  app.add_option("--bus", loom_bus, "with --loom: which of the loom's buses this interface is (default 0)")
+      ->check(CLI::Range(0, 15))
+      ->needs(loom_opt);
+  auto* io_node_opt =
+      app.add_option("--io-node", io_node, "also simulate the CiA 401 I/O node with this node id (1..127)");
   app.add_option("--io-control", io_control,
                  "file of words for the I/O node, re-read when it changes: estop start pause ack knotted silent, "
                  "stuck=<sensor>[_2]:on|off (one switch of a safety sensor stuck, _2 = its second switch, e.g. "
                  "stuck=shuttle_at_right_2:on)");
-  app.add_option("--width-m", width_m, "loom width for the I/O node's shuttle sensors (default 0.6)");
-  app.add_option("--helix-lead-m", helix_lead_m, "helix lead for the I/O node's shuttle sensors (default 0.1)");
+  auto* width_opt = app.add_option("--width-m", width_m, "loom width for the I/O node's shuttle sensors (default 0.6)");
+  auto* lead_opt =
+      app.add_option("--helix-lead-m", helix_lead_m, "helix lead for the I/O node's shuttle sensors (default 0.1)");
   app.add_option("--personality", personality,
                  "standard | fixed (read-only PDO mappings, no TPDO3/4, no 0x1016, slow boot and start)")
       ->check(CLI::IsMember({"standard", "fixed"}));
   app.add_option("--boot-delay-ms", boot_delay_ms, "boot-up delay (default 0; fixed personality 300)");
   app.add_option("--operational-delay-ms", operational_delay_ms,
                  "NMT start → operational delay (default 0; fixed personality 400)");
-  app.add_option("--nodes", nodes, "node ids, comma separated (1..127)")->delimiter(',');
-  app.add_option("--counts-per-unit", counts_per_unit,
-                 "counts per SI unit per node (rad or m); default 2^20/2π, 2^20/0.01 m, 2^20/2π")
-      ->delimiter(',');
+  auto* nodes_opt = app.add_option("--nodes", nodes, "node ids, comma separated (1..127)")->delimiter(',');
+  auto* cpu_opt = app.add_option("--counts-per-unit", counts_per_unit,
+                                 "counts per SI unit per node (rad or m); default 2^20/2π, 2^20/0.01 m, 2^20/2π")
+                      ->delimiter(',');
   app.add_option("--initial-position", initial_position, "initial position per node in SI units")
       ->delimiter(',');
   app.add_option("--plant-cycle-ms", plant_cycle_ms,
@@ -129,9 +159,12 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 100.0));
   app.add_option("--max-step-counts", max_step_counts,
                  "largest target step per SYNC before a following-error fault (0 = off)");
-  app.add_option("--homing-nodes", homing_nodes,
-                 "drives with an incremental encoder: CiA 402 homing offered, a random count at every power-up")
-      ->delimiter(',');
+  auto* homing_opt =
+      app.add_option("--homing-nodes", homing_nodes,
+                     "drives with an incremental encoder: CiA 402 homing offered, a random count at every power-up")
+          ->delimiter(',');
+  // The machine description says these; giving both would be two sources for one fact.
+  for (CLI::Option* o : {nodes_opt, cpu_opt, io_node_opt, width_opt, lead_opt, homing_opt}) o->excludes(loom_opt);
   app.add_option("--power-up-seed", power_up_seed, "seed of the random power-up counts (default: chosen, printed)");
   app.add_flag("--verbose", verbose, "print NMT and drive state changes");
   try {
@@ -140,6 +173,48 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     return usage_error(e.what());
+  }
+
+  // --loom: the bus's nodes and the plant's facts from the machine description.
+  std::vector<std::size_t> slot_of_node;  // loom axis slot of each simulated drive (--loom only)
+  std::unique_ptr<loom::firmware::SimHeads> heads;
+  if (!loom_file.empty()) {
+    try {
+      const loom::firmware::LoomConfig cfg = loom::firmware::load_loom_config(loom_file);
+      nodes.clear();
+      for (std::size_t slot = 0; slot < cfg.axes.size(); ++slot) {
+        const loom::firmware::AxisSpec& a = cfg.axes[slot];
+        if (a.bus != loom_bus) continue;
+        nodes.push_back(a.node);
+        counts_per_unit.push_back(a.counts_per_unit());
+        slot_of_node.push_back(slot);
+        if (a.homing) homing_nodes.push_back(a.node);
+      }
+      io_node = loom_bus == 0 && cfg.io.kind == loom::firmware::IoKind::kCan ? cfg.io.node : 0;
+      width_m = cfg.machine_spec.width_m;
+      helix_lead_m = cfg.machine_spec.helix_lead_m;
+      if (io_node != 0 && cfg.knotting.mode == loom::sequencer::KnottingMode::kHeads) {
+        heads = std::make_unique<loom::firmware::SimHeads>(loom::firmware::sim_heads(cfg));
+        const loom::sim_hal::SimKnotting& k = heads->knotting;
+        std::vector<std::size_t> needed{static_cast<std::size_t>(loom::hal::index(loom::hal::CoreAxis::kCarriage))};
+        for (int h = 0; h < k.heads; ++h) {
+          needed.push_back(k.knotter_axis[static_cast<std::size_t>(h)]);
+          needed.push_back(k.selector_axis[static_cast<std::size_t>(h)]);
+        }
+        for (std::size_t slot : needed) {
+          if (cfg.axes[slot].bus != loom_bus) {
+            return usage_error("--loom " + loom_file + ": axes." + cfg.axes[slot].name + " is on bus " +
+                               std::to_string(cfg.axes[slot].bus) + "; the simulated knotting heads behind the I/O "
+                               "node follow the carriage and every head's servos, so they must be on bus " +
+                               std::to_string(loom_bus) + " with it");
+          }
+        }
+      }
+    } catch (const std::exception& e) {
+      std::cerr << "loom-sim-drive: " << e.what() << "\n";
+      return 2;
+    }
+    if (nodes.empty()) return usage_error("--loom " + loom_file + ": no axis is on bus " + std::to_string(loom_bus));
   }
 
   std::set<int> seen;
@@ -225,11 +300,16 @@ int main(int argc, char** argv) {
     ic.width_m = width_m;
     ic.helix_lead_m = helix_lead_m;
     ic.plant_cycle_s = plant_cycle_ms * 1e-3;
+    if (heads) ic.knotting = heads->knotting;
     io = std::make_unique<loom::sim_can::SimIoNode>(bus, ic);
     const double crank_cpr = counts_per_unit.empty() ? default_counts_per_unit(0) : counts_per_unit[0];
     const double helix_cpr =
         counts_per_unit.size() > 2 ? counts_per_unit[2] : default_counts_per_unit(2);
-    rack.attach_io(*io, {0, 2, crank_cpr, helix_cpr});
+    loom::sim_can::SimDriveRack::IoPlantSource source{0, 2, crank_cpr, helix_cpr, {}};
+    for (std::size_t i = 0; i < slot_of_node.size(); ++i) {  // every drive's position, by the loom's slot
+      source.axes.push_back({i, slot_of_node[i], counts_per_unit[i]});
+    }
+    rack.attach_io(*io, source);
   }
   // The control file (HIL fault tests): re-read when its modification time changes.
   timespec control_mtime{};
@@ -289,6 +369,7 @@ int main(int argc, char** argv) {
       }
     }
   }
+  if (io && io->knotter() != nullptr) print_carpet(*io->knotter());
   std::cerr << "loom-sim-drive: stopped\n";
   return 0;
 }

@@ -39,6 +39,11 @@ void SimDriveRack::step(std::int64_t now_us, int max_frames) {
     if (io_source_.helix < nodes_.size()) {
       p.helix_rad = static_cast<double>(nodes_[io_source_.helix]->position()) / io_source_.helix_counts_per_rad;
     }
+    for (const IoPlantSource::Axis& a : io_source_.axes) {
+      if (a.node < nodes_.size() && a.slot < p.axis_position.size()) {
+        p.axis_position[a.slot] = static_cast<double>(nodes_[a.node]->position()) / a.counts_per_unit;
+      }
+    }
     io_->step(now_us, p);
   }
 }

@@ -40,38 +40,56 @@ constexpr std::array<int, hal::kSafetySensorCount> kInSafetyFirst{0, 1, 2, 3, 4,
 constexpr std::array<int, hal::kSafetySensorCount> kInSafetySecond{16, 17, 18, 19, 20, 21};
 constexpr int kInEstopOk = 6, kInStart = 8, kInPause = 9, kInAck = 10, kInKnotted = 11;
 constexpr int kOutValveA = 0, kOutValveB = 1;
+// The knotting heads' terminals: head h's gripper and cutter outputs, its yarn-present input.
+constexpr int kOutGripperFirst = 8, kOutCutterFirst = 20, kInYarnPresentFirst = 24;
+static_assert(kOutCutterFirst + static_cast<int>(hal::kMaxKnottingHeads) <= 32, "four 8-bit output groups");
+static_assert(kInYarnPresentFirst + static_cast<int>(hal::kMaxKnottingHeads) <= 64, "eight 8-bit input groups");
 
 constexpr slave::Objects<5> kCommunicationObjects = slave::communication_objects(kDeviceType);
 
 // Digital inputs (8-bit groups), outputs, output error mode and value, analog inputs.
-// 32 digital inputs (0x6000:01..04), of which the loom uses terminals 0..21.
-constexpr slave::Objects<19> kIoObjects{{
-    {kDigitalInputs, 0, 1, Access::kConst, Pdo::kNone, 4},
+// 64 digital inputs (0x6000:01..08): the loom's sensors and buttons on terminals 0..21, the knotting heads'
+// yarn-present switches from 24. 32 digital outputs (0x6200:01..04): valves and stack light on 0..7, the
+// heads' grippers from 8 and cutters from 20.
+// One object per line, so the table reads as the dictionary it is.
+// clang-format off
+constexpr slave::Objects<29> kIoObjects{{
+    {kDigitalInputs, 0, 1, Access::kConst, Pdo::kNone, 8},
     {kDigitalInputs, 1, 1, Access::kRo, Pdo::kTx, 0},
     {kDigitalInputs, 2, 1, Access::kRo, Pdo::kTx, 0},
     {kDigitalInputs, 3, 1, Access::kRo, Pdo::kTx, 0},
     {kDigitalInputs, 4, 1, Access::kRo, Pdo::kTx, 0},
-    {kDigitalOutputs, 0, 1, Access::kConst, Pdo::kNone, 2},
+    {kDigitalInputs, 5, 1, Access::kRo, Pdo::kTx, 0},
+    {kDigitalInputs, 6, 1, Access::kRo, Pdo::kTx, 0},
+    {kDigitalInputs, 7, 1, Access::kRo, Pdo::kTx, 0},
+    {kDigitalInputs, 8, 1, Access::kRo, Pdo::kTx, 0},
+    {kDigitalOutputs, 0, 1, Access::kConst, Pdo::kNone, 4},
     {kDigitalOutputs, 1, 1, Access::kRw, Pdo::kRx, 0},
     {kDigitalOutputs, 2, 1, Access::kRw, Pdo::kRx, 0},
-    {kOutputErrorMode, 0, 1, Access::kConst, Pdo::kNone, 2},
-    {kOutputErrorMode, 1, 1, Access::kRw, Pdo::kNone,
-     0xFF},  // CiA 401 default: every output to its error value
+    {kDigitalOutputs, 3, 1, Access::kRw, Pdo::kRx, 0},
+    {kDigitalOutputs, 4, 1, Access::kRw, Pdo::kRx, 0},
+    {kOutputErrorMode, 0, 1, Access::kConst, Pdo::kNone, 4},
+    {kOutputErrorMode, 1, 1, Access::kRw, Pdo::kNone, 0xFF},  // CiA 401 default: every output to its error value
     {kOutputErrorMode, 2, 1, Access::kRw, Pdo::kNone, 0xFF},
-    {kOutputErrorValue, 0, 1, Access::kConst, Pdo::kNone, 2},
+    {kOutputErrorMode, 3, 1, Access::kRw, Pdo::kNone, 0xFF},
+    {kOutputErrorMode, 4, 1, Access::kRw, Pdo::kNone, 0xFF},
+    {kOutputErrorValue, 0, 1, Access::kConst, Pdo::kNone, 4},
     {kOutputErrorValue, 1, 1, Access::kRw, Pdo::kNone, 0},
     {kOutputErrorValue, 2, 1, Access::kRw, Pdo::kNone, 0},
+    {kOutputErrorValue, 3, 1, Access::kRw, Pdo::kNone, 0},
+    {kOutputErrorValue, 4, 1, Access::kRw, Pdo::kNone, 0},
     {kAnalogInputs, 0, 1, Access::kConst, Pdo::kNone, 4},
     {kAnalogInputs, 1, 2, Access::kRo, Pdo::kTx, 0},
     {kAnalogInputs, 2, 2, Access::kRo, Pdo::kTx, 0},
     {kAnalogInputs, 3, 2, Access::kRo, Pdo::kTx, 0},
     {kAnalogInputs, 4, 2, Access::kRo, Pdo::kTx, 0},
 }};
+// clang-format on
 
 // The object dictionary: every object the module has, once. Pre-defined PDOs of CiA 401: RPDO1 the
-// digital outputs, TPDO1 the digital inputs on change (the three groups the loom wires, terminals
-// 0..23), TPDO2 the analog inputs; RPDO2 and TPDO3/4 present but invalid.
-// One object per line, so the table reads as the dictionary it is.
+// digital outputs (the first group; a master that wires more maps more), TPDO1 the digital inputs on
+// change (the three groups the loom's sensors use, terminals 0..23), TPDO2 the analog inputs; RPDO2 and
+// TPDO3/4 present but invalid.
 // clang-format off
 constexpr auto kTable = slave::concat(
     kCommunicationObjects,
@@ -106,7 +124,15 @@ SimIoNode::SimIoNode(drivers::CanBus& bus, SimIoConfig config)
     }
   }
   reset_application();
+  if (config_.knotting.heads > 0) {
+    sim_hal::Knotter k;
+    k.miss_probability = 0.0;
+    k.weaver_s = config_.weaver_s;
+    knotter_ = std::make_unique<sim_hal::SimKnotter>(config_.knotting, k, kKnotterPeriodS);
+  }
 }
+
+SimIoNode::~SimIoNode() = default;
 
 // ---------------------------------------------------------------------------------------------------
 // Resets and power
@@ -124,7 +150,7 @@ void SimIoNode::reset_communication(std::int64_t now_us) {
 }
 
 int SimIoNode::input_groups() const {
-  return std::clamp(config_.digital_input_groups, 1, 4);
+  return std::clamp(config_.digital_input_groups, 1, static_cast<int>(kInputGroups));
 }
 
 // A personality's own factory mapping of TPDO `tpdo` (empty: the table's default stays).
@@ -274,7 +300,7 @@ std::array<bool, hal::kSafetySensorCount> SimIoNode::safety_sensors_truth() cons
 }
 
 void SimIoNode::update_inputs() {
-  std::array<std::uint8_t, 4> in{};
+  std::array<std::uint8_t, kInputGroups> in{};
   const auto set = [&](int bit, bool on) {
     if (on) in[static_cast<std::size_t>(bit / 8)] |= static_cast<std::uint8_t>(1U << (bit % 8));
   };
@@ -291,6 +317,13 @@ void SimIoNode::update_inputs() {
   set(kInPause, plant_.button_pause);
   set(kInAck, plant_.button_ack);
   set(kInKnotted, plant_.row_knotted);
+  if (knotter_) {
+    hal::DigitalInputs seen;
+    knotter_->inputs(plant_.axis_position, seen);
+    for (int h = 0; h < config_.knotting.heads; ++h) {
+      set(kInYarnPresentFirst + h, seen.yarn_present[static_cast<std::size_t>(h)]);
+    }
+  }
   for (std::size_t k = static_cast<std::size_t>(input_groups()); k < in.size(); ++k)
     in[k] = 0;  // no terminals
   in_ = in;
@@ -318,6 +351,7 @@ void SimIoNode::step(std::int64_t now_us, const IoPlant& plant) {
   }
   if (!powered_) return;
   move_pistons(dt);
+  if (knotter_) step_knotter();
   const std::int64_t hb_us = static_cast<std::int64_t>(od_.get(kProducerHeartbeat, 0)) * 1000;
   if (plant_.silent) {
     // A silenced node (HIL: the I/O node dies) sends nothing, but its heartbeat timer runs on: a deadline
@@ -331,7 +365,7 @@ void SimIoNode::step(std::int64_t now_us, const IoPlant& plant) {
     next_hb_us_ = now_us + hb_us;
   }
   if (boot_at_us_ >= 0) return;
-  const std::array<std::uint8_t, 4> before = in_;
+  const std::array<std::uint8_t, kInputGroups> before = in_;
   update_inputs();
   if (nmt_ == nmt::kOperational && in_ != before) send_changed_inputs();
   produce_heartbeat(now_us);
@@ -346,6 +380,25 @@ void SimIoNode::move_pistons(double dt) {
     const double step = dt / config_.piston_travel_s;
     piston_[i] = std::clamp(piston_[i] + (valve[i] ? step : -step), 0.0, 1.0);
   }
+}
+
+// The heads act on their outputs as they really are (error state included): a gripper closing at TAKE
+// takes yarn, a cutter firing with the gripper in the warp ties the knot under the head. A weft (the
+// shuttle arriving at the other selvedge) locks the row of knots in.
+void SimIoNode::step_knotter() {
+  hal::DigitalOutputs out;
+  const auto bit = [this](int terminal) { return ((outputs(terminal / 8) >> (terminal % 8)) & 1U) != 0; };
+  for (int h = 0; h < config_.knotting.heads; ++h) {
+    out.gripper_close[static_cast<std::size_t>(h)] = bit(kOutGripperFirst + h);
+    out.cutter[static_cast<std::size_t>(h)] = bit(kOutCutterFirst + h);
+  }
+  knotter_->on_outputs(out, plant_.axis_position, rng_);
+  const std::array<bool, hal::kSafetySensorCount> truth = safety_sensors_truth();
+  const int side = truth[static_cast<std::size_t>(hal::SafetySensor::kShuttleAtLeft)]    ? -1
+                   : truth[static_cast<std::size_t>(hal::SafetySensor::kShuttleAtRight)] ? 1
+                                                                                         : 0;
+  if (side != 0 && shuttle_side_ != 0 && side != shuttle_side_) knotter_->on_weft();
+  if (side != 0) shuttle_side_ = side;
 }
 
 void SimIoNode::produce_heartbeat(std::int64_t now_us) {

@@ -41,10 +41,11 @@ struct IoBit {
   bool active_low = false;  // the signal is true when the electrical bit is 0
 };
 
-// Inputs read from 0x6000:01..04 (32 bits) and outputs written to 0x6200:01..02 (16 bits); a wiring
-// uses as many 8-bit subs as its highest bit needs.
-inline constexpr int kIoMaxInputBits = 32;
-inline constexpr int kIoMaxOutputBits = 16;
+// Inputs read from 0x6000:01..08 (64 bits) and outputs written to 0x6200:01..08 (64 bits), each in one
+// PDO of at most 8 bytes; a wiring uses as many 8-bit subs as its highest bit needs (the default loom
+// without knotting heads: three input subs, one output sub).
+inline constexpr int kIoMaxInputBits = 64;
+inline constexpr int kIoMaxOutputBits = 64;
 
 struct IoWiring {
   // Inputs (0x6000). The six sensors and the e-stop chain must be wired; buttons are optional.
@@ -69,6 +70,13 @@ struct IoWiring {
   IoBit lamp_amber{5};
   IoBit lamp_red{6};
   IoBit buzzer{7};
+  // Knotting heads (the first `heads` entries are used; 0 = the loom has no heads, or they are not on this
+  // module): each head's gripper and cutter outputs and its yarn-present (knot tied) input. All three are
+  // wired for every head that is used.
+  int heads = 0;
+  std::array<IoBit, hal::kMaxKnottingHeads> gripper_close{};
+  std::array<IoBit, hal::kMaxKnottingHeads> cutter{};
+  std::array<IoBit, hal::kMaxKnottingHeads> yarn_present{};
   // Beater load cell on analog input 0x6401:load_cell_channel (0 = no load cell fitted):
   // force_n = gain · counts + offset.
   int load_cell_channel = 1;
@@ -115,7 +123,7 @@ std::vector<FrameGroup> io_frames_per_cycle(const IoWiring& wiring);
 
 // The output values the module is told to adopt by itself on failure (0x6206/0x6207): both valve coils
 // de-energised (frames retracted and vented; no shed, so no pick can start and nothing is trapped),
-// green/amber off, red on, buzzer off.
+// green/amber off, red on, buzzer off, every knotting head's gripper open and cutter retracted.
 hal::DigitalOutputs io_safe_outputs();
 
 class CanIoPort final : public hal::IoPort, public CanNode {
@@ -190,9 +198,12 @@ class CanIoPort final : public hal::IoPort, public CanNode {
 
   std::array<PdoLayout, 4> tpdo_{};
   std::array<PdoLayout, 4> rpdo_{};
-  std::array<Slot, kMaxInputSubs> input_slot_{};  // 0x6000:01..04 (pdo −1: not read)
+  // 8-bit subs of 0x6200 the master can write (kIoMaxOutputBits).
+  static constexpr std::size_t kMaxOutputSubs = kIoMaxOutputBits / 8;
+
+  std::array<Slot, kMaxInputSubs> input_slot_{};  // 0x6000:01..08 (pdo −1: not read)
   int input_pdo_ = -1;                             // the one TPDO carrying the digital inputs
-  std::array<Slot, 2> output_slot_{};  // 0x6200:01, :02
+  std::array<Slot, kMaxOutputSubs> output_slot_{};  // 0x6200:01..08
   Slot analog_slot_{};
   int output_pdo_ = -1;
   std::uint8_t output_pdo_bytes_ = 0;

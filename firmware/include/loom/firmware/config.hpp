@@ -103,6 +103,15 @@ struct IoSettings {
   std::uint32_t boot_timeout_ms = 2000;
   std::uint32_t operational_timeout_ms = 500;
   drivers::IoWiring wiring;  // bit per signal, polarity, load-cell channel and scaling
+  // The knotting heads' signals on the same module, head 1 first (used when knotting.mode = "heads": one
+  // bit per head, knotting.heads of them; the wiring above gets them then, see can_io_config()).
+  struct HeadSignals {
+    std::vector<int> bits;
+    bool active_low = false;
+  };
+  HeadSignals gripper_close{{8, 9, 10, 11, 12, 13}};
+  HeadSignals cutter{{20, 21, 22, 23, 24, 25}};
+  HeadSignals yarn_present{{24, 25, 26, 27, 28, 29}};
 };
 
 // Axis readings at the mechanical references, found when commissioning.

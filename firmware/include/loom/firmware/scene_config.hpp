@@ -24,7 +24,9 @@ struct LoomConfig;
 // axis resolved to its slot by name. Faults on axes the loom does not have, or injected into switches it
 // does not have (a second channel its wiring leaves at -1), are refused, naming the fault's
 // file:line:col. Throws ConfigError.
-Scene check_scene_fits(Scene scene, const LoomConfig& cfg);
+// `simulated_io`: the loom's I/O is the simulator's (a loom with knotting heads then needs the scene's
+// "knotter"); false when a real I/O module carries the heads' signals.
+Scene check_scene_fits(Scene scene, const LoomConfig& cfg, bool simulated_io = true);
 
 // Parse a scene from TOML text; `source` names it in errors. Throws ConfigError.
 Scene parse_scene(const std::string& text, const std::string& source);

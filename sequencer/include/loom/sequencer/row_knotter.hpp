@@ -67,6 +67,10 @@ struct KnottingConfig {
   double settle_s = 0.05;             // after a move's plan ends, how long it may take to get within tolerance
 };
 
+// Configure-time. The interlocks' picture of the heads (which axes, where the gripper is in the warp as
+// knotting-servo angles), derived from `heads`' knot cycle; also what the simulated heads are told.
+KnotGuard knot_guard(const KnottingConfig& heads);
+
 // Knot counts of one row, for its RowStats.
 struct RowKnots {
   int tied = 0, retried = 0, by_hand = 0;

@@ -23,6 +23,14 @@ class SimDriveRack {
     std::size_t helix = 2;
     double crank_counts_per_rad = 1.0;
     double helix_counts_per_rad = 1.0;
+    // The drives whose positions the knotting heads' plant reads (IoPlant::axis_position): rack position
+    // `node`, loom axis slot `slot`, counts per SI unit.
+    struct Axis {
+      std::size_t node = 0;
+      std::size_t slot = 0;
+      double counts_per_unit = 1.0;
+    };
+    std::vector<Axis> axes{};
   };
   void attach_io(SimIoNode& io, IoPlantSource source);
   // The e-stop, buttons, "silent" switch and stuck safety switch (IoPlant::stuck) the I/O node sees

@@ -13,11 +13,14 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "loom/drivers/can_frame.hpp"
 #include "loom/hal/types.hpp"
 #include "loom/sim_can/slave_od.hpp"
+#include "loom/sim_hal/knotter.hpp"
+#include "loom/sim_hal/random.hpp"
 
 namespace loom::sim_can {
 
@@ -42,6 +45,9 @@ struct IoPlant {
   bool row_knotted = false;
   bool silent = false;  // cable pulled: sends nothing, hears nothing
   StuckSwitch stuck{};  // test hook: one channel of one safety sensor stuck
+  // The knotting heads' servos and the carriage (SI, by the loom's axis slot; read only when the module
+  // has heads behind it: SimIoConfig::knotting).
+  std::array<double, hal::kMaxAxes> axis_position{};
 };
 
 struct SimIoConfig {
@@ -59,16 +65,22 @@ struct SimIoConfig {
   double beat_peak_n = 90.0;                 // load-cell force at the fell
   double fell_crank_rad = 3.14159265358979;  // crank angle (mod 2π) at which the beater meets the fell
   double load_cell_n_per_count = 0.01;
+  // The knotting heads behind the module (heads = 0: none), as the in-process simulator models them
+  // (sim_hal::SimKnotter, no misses): head h's gripper on output terminal 8 + h, its cutter on 20 + h, its
+  // yarn-present switch on input terminal 24 + h. Their servos and the carriage come in
+  // IoPlant::axis_position. A weaver asked for a hand tie is the person at the HIL bench (ctl next).
+  sim_hal::SimKnotting knotting{};
+  double weaver_s = 5.0;
   // Interoperability variants.
   bool fixed_mapping = false;  // 0x16xx/0x1Axx read-only, sub 0 included
   // A module's own factory TPDO1/TPDO2 (mapping entries index << 16 | sub << 8 | bits), e.g. a fixed
   // 16-input module's {0x60000108, 0x60000208}; empty = the defaults in sim_io_node.cpp.
   std::vector<std::uint32_t> tpdo1_factory_mapping;
   std::vector<std::uint32_t> tpdo2_factory_mapping;
-  // 8-bit input groups the module has (1..4; 2 = a 16-input module without the second channels'
+  // 8-bit input groups the module has (1..8; 2 = a 16-input module without the second channels'
   // terminals 16..21): 0x6000:00 says so, its default TPDO1 carries them all (at most three), the missing
   // groups read 0 and cannot be mapped (abort 0x06040041).
-  int digital_input_groups = 4;
+  int digital_input_groups = 8;
   std::vector<std::uint16_t> absent_objects;  // e.g. 0x1016, 0x6206, 0x1802
   std::int64_t boot_delay_us = 0;             // power-on / reset → boot-up
 };
@@ -77,6 +89,7 @@ class SimIoNode : private slave::ObjectHooks, private slave::FrameHandlers {
  public:
   // Configure-time only. Powered off until power_on().
   SimIoNode(drivers::CanBus& bus, SimIoConfig config);
+  ~SimIoNode();
 
   void power_on(std::int64_t now_us);  // RT-safe
   void power_off();                    // RT-safe
@@ -90,11 +103,13 @@ class SimIoNode : private slave::ObjectHooks, private slave::FrameHandlers {
   std::uint8_t node_id() const { return config_.node_id; }
   std::uint8_t nmt_state() const { return nmt_; }  // 0x00, 0x04, 0x05, 0x7F as on the wire
   std::uint8_t outputs(int byte) const;            // what drives the valve coils now (error state applied)
-  std::uint8_t inputs(int byte) const { return in_[static_cast<std::size_t>(byte)]; }  // 0x6000:01..04
+  std::uint8_t inputs(int byte) const { return in_[static_cast<std::size_t>(byte)]; }  // 0x6000:01..08
   std::int16_t analog_counts() const { return analog_; }
   bool comm_lost() const { return comm_lost_; }   // master heartbeat consumer expired
   double piston_a() const { return piston_[0]; }  // 0 = retracted … 1 = extended
   double piston_b() const { return piston_[1]; }
+  // The heads' carpet as knotted (null without heads).
+  const sim_hal::SimKnotter* knotter() const { return knotter_.get(); }
 
  private:
   // The bus's writes reach the module through the ObjectHooks (timers react to them).
@@ -117,6 +132,7 @@ class SimIoNode : private slave::ObjectHooks, private slave::FrameHandlers {
   int input_groups() const;
   std::array<bool, hal::kSafetySensorCount> safety_sensors_truth() const;
   void move_pistons(double dt);
+  void step_knotter();
   void watch_master(std::int64_t now_us);
   void produce_heartbeat(std::int64_t now_us);
 
@@ -136,7 +152,12 @@ class SimIoNode : private slave::ObjectHooks, private slave::FrameHandlers {
   IoPlant plant_{};
   std::int64_t last_step_us_ = -1;
   std::array<double, 2> piston_{0.0, 0.0};
-  std::array<std::uint8_t, 4> in_{};  // terminals 0..31
+  static constexpr std::size_t kInputGroups = 8;
+  static constexpr double kKnotterPeriodS = 0.01;  // the plant steps at least every 10 ms (weaver timing)
+  std::array<std::uint8_t, kInputGroups> in_{};  // terminals 0..63
+  std::unique_ptr<sim_hal::SimKnotter> knotter_;
+  sim_hal::SimRandom rng_{1};
+  int shuttle_side_ = 0;  // -1 left, +1 right, 0 not yet seen at a selvedge
   std::int16_t analog_ = 0;
 };
 
