@@ -14,6 +14,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config
+  clang-format                  # the format check (tests/style)
   ccache                        # rebuilds in fresh clones and worktrees
   libeigen3-dev                 # motion/ linear algebra
   liblcm-dev liblcm-bin         # telemetry (lcm-gen, lcm-logger, lcm-logplayer)

@@ -33,6 +33,17 @@ std::vector<RequiredObject> drive_objects() {
   };
 }
 
+std::vector<RequiredObject> homing_drive_objects() {
+  return {
+      {od::kModesOfOperation, "modes of operation", false, "set to 6 (homing) for the referencing run, then 8"},
+      {od::kHomeOffset, "home offset", false, "the axis' reading at the home point"},
+      {od::kHomingMethod, "homing method", false, "the configured method (switch, index pulse or here)"},
+      {od::kHomingSpeeds, "homing speeds", false, ":01 search for the switch, :02 search for zero"},
+      {od::kHomingAcceleration, "homing acceleration", false, "the referencing run's acceleration"},
+      {od::kStatusword, "statusword", false, "bits 12/13 homing attained / homing error in mode 6"},
+  };
+}
+
 std::vector<RequiredObject> io_module_objects() {
   return {
       {od::kDeviceType, "device type", false, "must be CiA 401"},

@@ -259,8 +259,16 @@ void print_plan(const LoomConfig& c) {
   }
   std::printf("  objects every drive (nodes %s) must support:\n", nodes.c_str());
   for (const auto& o : drivers::drive_objects()) std::printf("    %s\n", drivers::describe(o).c_str());
+  std::string homing;
+  for (const AxisSpec& a : c.axes) {
+    if (a.homing) homing += (homing.empty() ? "" : ", ") + std::to_string(a.node) + (buses > 1 ? "@bus" + std::to_string(a.bus) : "");
+  }
+  if (!homing.empty()) {
+    std::printf("  objects the homing drives (nodes %s) must support as well:\n", homing.c_str());
+    for (const auto& o : drivers::homing_drive_objects()) std::printf("    %s\n", drivers::describe(o).c_str());
+  }
   std::printf("  objects the I/O module (node %u) must support:\n", c.io.node);
-  for (const auto& o : drivers::io_module_objects(c.io.wiring)) std::printf("    %s\n", drivers::describe(o).c_str());
+  for (const auto& o : drivers::io_module_objects(can_io_config(c).wiring)) std::printf("    %s\n", drivers::describe(o).c_str());
 }
 
 void print_scene(const Scene& s) {

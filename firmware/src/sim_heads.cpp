@@ -40,7 +40,8 @@ KnottingHeads build_heads(const LoomConfig& c, std::uint64_t design_rows_done, s
                       "\": the loom has no knotting heads");
   }
   if (!c.recipe.design) {
-    throw ConfigError(c.source + ": knotting.mode = \"heads\": the heads tie the design's knots; set recipe.design");
+    throw ConfigError(c.source +
+                      ": knotting.mode = \"heads\": the heads tie the design's knots; set recipe.design");
   }
   KnottingHeads out;
   try {
@@ -49,7 +50,8 @@ KnottingHeads build_heads(const LoomConfig& c, std::uint64_t design_rows_done, s
     throw ConfigError(c.source + ": [knotting.linkage]: " + e.what());
   }
   try {
-    out.program = std::make_unique<const sequencer::KnotProgram>(knot_program(c, design_rows_done, counter_rows));
+    out.program =
+        std::make_unique<const sequencer::KnotProgram>(knot_program(c, design_rows_done, counter_rows));
   } catch (const std::invalid_argument& e) {
     throw ConfigError(c.source + ": recipe.design = \"" + c.recipe.design_file + "\": " + e.what());
   }

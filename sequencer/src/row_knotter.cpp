@@ -87,7 +87,7 @@ double RowKnotter::rest_behind(double position) const noexcept {
   return k_.take_position_rad + n * turn;
 }
 
-double RowKnotter::selector_goal(int /*head*/, int slot, double from) const noexcept {
+double RowKnotter::selector_goal(int slot, double from) const noexcept {
   // Slot s sits at zero + s·pitch; the selector turns the short way round to it.
   const double pitch = motion::kTwoPi / k_.program->slots();
   return from + motion::wrap_pi(k_.selector_zero_rad + slot * pitch - from);
@@ -134,7 +134,7 @@ void RowKnotter::plan_selectors(int j, hal::Tick now, const hal::HalOutputs& cmd
     const int s = k_.program->slot(row0_, k);
     if (s == slot_[hh]) continue;
     const double at = cmd.axes[static_cast<std::size_t>(k_.selector_axis[hh])].target_position;
-    selector_move_[hh] = {true, true, now, at, motion::JerkMove::plan(selector_goal(h, s, at) - at, k_.selector)};
+    selector_move_[hh] = {true, true, now, at, motion::JerkMove::plan(selector_goal(s, at) - at, k_.selector)};
     slot_[hh] = s;
   }
 }

@@ -7,10 +7,13 @@
 // simulated drives are gone), and plays operations read from the input:
 //   any frame (any COB-ID, data, error or RTR frame, DLC 0..8);
 //   a well-formed TPDO1 or heartbeat of one of the three drives with fuzzed contents (reaches deep states);
-//   a tick (read_axes → hold the measured position with a fuzzed request → write_axes);
+//   a tick (read_axes → hold the measured position with a fuzzed request, homing included → write_axes);
 //   a gap of several ticks; a full transmit queue for a few sends.
-// Besides crashes and sanitizer reports it checks what the sequencer relies on: feedback is always
-// finite, and a bus-off error frame, once read, latches the link fault.
+// The helix (node 3) is referenced by CiA 402 homing (an incremental encoder, index-pulse method 34): its
+// PDOs carry the mode (0x6060 / 0x6061) as a seventh byte, and a fuzzed TPDO1 of it may claim any mode
+// and any homing status bits. Besides crashes and sanitizer reports it checks what the sequencer relies
+// on: feedback is always finite, a bus-off error frame, once read, latches the link fault, and an axis
+// never reads referenced and in homing error at once.
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include <array>
@@ -77,8 +80,24 @@ class FuzzBus final : public drivers::CanBus {
   std::size_t head_ = 0, tail_ = 0;
 };
 
+std::vector<sim_can::SimDriveConfig> drives() {
+  std::vector<sim_can::SimDriveConfig> v = test::three_drives(1000, -2000, 3000);
+  v[2].supports_homing = true;
+  v[2].index_every = 65536;
+  v[2].power_up_seed = 12345;  // fixed: the template is the same in every run
+  return v;
+}
+drivers::CanAxisPortConfig config() {
+  drivers::CanAxisPortConfig c;
+  c.axes[2].homing_method = 34;
+  c.axes[2].home_offset = 0.5;
+  c.axes[2].homing_speed = 20.0;
+  c.axes[2].homing_accel = 200.0;
+  return c;
+}
+
 struct Template {
-  test::DriveRig rig{test::three_drives(1000, -2000, 3000)};
+  test::DriveRig rig{drives(), config()};
   FuzzBus bus;
   hal::Tick tick = 0;
 
@@ -122,12 +141,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         if (bus.queue(f) && f.is_error() && drivers::decode_error_frame(f).bus_off) bus_off_queued = true;
         break;
       }
-      case 1: {  // a TPDO1 of one of the drives
+      case 1: {  // a TPDO1 of one of the drives (the homing drive's with its mode display byte)
         const auto node = in.ConsumeIntegralInRange<std::uint8_t>(1, 3);
         drivers::Tpdo1 p;
         p.statusword = in.ConsumeIntegral<std::uint16_t>();
         p.position_actual = in.ConsumeIntegral<std::int32_t>();
-        (void)bus.queue(drivers::pack_tpdo1(node, p));
+        drivers::CanFrame f = drivers::pack_tpdo1(node, p);
+        if (node == 3) {
+          f.dlc = 7;
+          f.data[6] = in.ConsumeBool() ? std::uint8_t{6} : in.ConsumeIntegral<std::uint8_t>();
+        }
+        (void)bus.queue(f);
         break;
       }
       case 2: {  // a heartbeat / boot-up of one of the drives, any state byte
@@ -138,13 +162,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         break;
       }
       case 3: {  // one RT cycle
-        const auto request = static_cast<hal::AxisRequest>(in.ConsumeIntegralInRange<int>(0, 3));
+        const auto request = static_cast<hal::AxisRequest>(in.ConsumeIntegralInRange<int>(0, 4));
         port.read_axes(now, feedback, link);
         for (std::size_t i = 0; i < feedback.size(); ++i) {
           const auto& fb = feedback[i];
           if (!std::isfinite(fb.position)) fail("position not finite", i, fb.position);
           if (!std::isfinite(fb.velocity)) fail("velocity not finite", i, fb.velocity);
           if (!std::isfinite(fb.effort)) fail("effort not finite", i, fb.effort);
+          if (fb.referenced && fb.homing_error) fail("referenced and in homing error at once", i, fb.position);
         }
         if (bus_off_queued && bus.pending() == 0 && !link.link_fault) fail("bus-off read but no link fault", 0, 0.0);
         test::DriveRig::hold(request)(feedback, commands);

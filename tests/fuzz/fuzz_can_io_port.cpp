@@ -7,7 +7,9 @@
 //      the load cell 0x6401:01, RPDO1 = 0x6200:01;
 //   1  a 32-input wiring with mixed polarities, unwired optional inputs (a button, a second channel), a
 //      second channel on bit 30 and one on bit 31: TPDO1 = 0x6000:01..04, no load cell (TPDO2
-//      disabled), outputs on 0x6200:01..02.
+//      disabled), outputs on 0x6200:01..02;
+//   2  the default wiring with two knotting heads: grippers on outputs 8, 9, cutters on 20, 21, yarn-present
+//      on inputs 24 (active low) and 25: TPDO1 = 0x6000:01..04, RPDO1 = 0x6200:01..03.
 // The first input byte picks the template; each input starts from a copy of it, now on a bus the input
 // alone feeds (the simulated node is gone), and plays operations read from the rest with
 // FuzzedDataProvider:
@@ -124,6 +126,16 @@ drivers::CanIoConfig wiring_32_bits() {
   return c;
 }
 
+drivers::CanIoConfig two_heads() {
+  drivers::CanIoConfig c;
+  drivers::IoWiring& w = c.wiring;
+  w.heads = 2;
+  w.gripper_close = {drivers::IoBit{8, false}, drivers::IoBit{9, false}};
+  w.cutter = {drivers::IoBit{20, false}, drivers::IoBit{21, false}};
+  w.yarn_present = {drivers::IoBit{24, true}, drivers::IoBit{25, false}};
+  return c;
+}
+
 struct Template {
   test::FakeCanNetwork net;
   test::FakeCanNetwork::Endpoint& master;
@@ -199,7 +211,7 @@ struct Template {
 struct Model {
   const drivers::IoWiring* wiring = nullptr;
   Layout layout{};
-  std::uint32_t input_word = 0;  // the last accepted TPDO1, little-endian (bit b = sub b/8+1, bit b%8)
+  std::uint64_t input_word = 0;  // the last accepted TPDO1, little-endian (bit b = sub b/8+1, bit b%8)
   hal::Tick inputs_refreshed = hal::kNeverTick;
   std::int16_t counts = 0;
   hal::Tick analog_refreshed = hal::kNeverTick;
@@ -218,7 +230,7 @@ struct Model {
         if (data && f.dlc >= layout.input_bytes) {
           input_word = 0;
           for (std::size_t k = 0; k < layout.input_bytes; ++k)
-            input_word |= std::uint32_t{f.data[k]} << (8 * k);
+            input_word |= std::uint64_t{f.data[k]} << (8 * k);
           inputs_refreshed = now;
         } else {
           ++rx_errors;  // too short, or a remote request carrying no data
@@ -273,7 +285,7 @@ struct Model {
   bool input(const drivers::IoBit& b) const {
     if (b.bit < 0) return false;
     if (inputs_refreshed == hal::kNeverTick) return false;
-    const bool level = ((input_word >> b.bit) & 1U) != 0;
+    const bool level = ((input_word >> b.bit) & 1U) != 0;  // b.bit < 64 (validated wiring)
     return b.active_low ? !level : level;
   }
 };
@@ -286,8 +298,8 @@ struct Checker {
 
   void expect_input(const char* name, bool got, bool want, const Model& m) const {
     if (got != want) {
-      fail("%s = %d, but the TPDO1 of tick %lld (0x%08X) says %d", name, got,
-           static_cast<long long>(m.inputs_refreshed), m.input_word, want);
+      fail("%s = %d, but the TPDO1 of tick %lld (0x%016llX) says %d", name, got,
+           static_cast<long long>(m.inputs_refreshed), static_cast<unsigned long long>(m.input_word), want);
     }
   }
 
@@ -322,6 +334,14 @@ struct Checker {
     for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) {
       if (w.second[i].bit < 0 && io.second_channel[i]) fail("%s is true but not wired", kSecond[i]);
       expect_input(kSecond[i], io.second_channel[i], m.input(w.second[i]), m);
+    }
+    static constexpr std::array<const char*, hal::kMaxKnottingHeads> kYarn{
+        "yarn_present[0]", "yarn_present[1]", "yarn_present[2]", "yarn_present[3]", "yarn_present[4]",  "yarn_present[5]",
+        "yarn_present[6]", "yarn_present[7]", "yarn_present[8]", "yarn_present[9]", "yarn_present[10]", "yarn_present[11]"};
+    for (std::size_t h = 0; h < hal::kMaxKnottingHeads; ++h) {
+      // A head the wiring does not use (or the loom lacks) never reads a knot.
+      const bool want = static_cast<int>(h) < w.heads && m.input(w.yarn_present[h]);
+      expect_input(kYarn[h], io.yarn_present[h], want, m);
     }
 
     hal::AnalogInputs a;
@@ -360,11 +380,11 @@ struct Checker {
   }
 };
 
-// By hand: the RPDO1 bytes for `o` on wiring `w` (bit b of 0x6200:01..02 = byte b/8, bit b%8).
+// By hand: the RPDO1 bytes for `o` on wiring `w` (bit b of 0x6200:01..08 = byte b/8, bit b%8).
 std::array<std::uint8_t, 8> rpdo_bytes(const drivers::IoWiring& w, const hal::DigitalOutputs& o) {
-  std::uint16_t word = 0;
+  std::uint64_t word = 0;
   const auto put = [&](const drivers::IoBit& b, bool on) {
-    if (b.bit >= 0 && (b.active_low ? !on : on)) word = static_cast<std::uint16_t>(word | (1U << b.bit));
+    if (b.bit >= 0 && (b.active_low ? !on : on)) word |= std::uint64_t{1} << b.bit;
   };
   put(w.piston_a_extend, o.piston_a_extend);
   put(w.piston_b_extend, o.piston_b_extend);
@@ -372,7 +392,13 @@ std::array<std::uint8_t, 8> rpdo_bytes(const drivers::IoWiring& w, const hal::Di
   put(w.lamp_amber, o.lamp_amber);
   put(w.lamp_red, o.lamp_red);
   put(w.buzzer, o.buzzer);
-  return {static_cast<std::uint8_t>(word & 0xFF), static_cast<std::uint8_t>(word >> 8), 0, 0, 0, 0, 0, 0};
+  for (std::size_t h = 0; h < static_cast<std::size_t>(w.heads); ++h) {
+    put(w.gripper_close[h], o.gripper_close[h]);
+    put(w.cutter[h], o.cutter[h]);
+  }
+  std::array<std::uint8_t, 8> bytes{};
+  for (std::size_t k = 0; k < bytes.size(); ++k) bytes[k] = static_cast<std::uint8_t>(word >> (8 * k));
+  return bytes;
 }
 
 drivers::CanFrame node_frame(FuzzedDataProvider& in, std::uint32_t id, std::uint8_t nominal_dlc) {
@@ -388,10 +414,11 @@ drivers::CanFrame node_frame(FuzzedDataProvider& in, std::uint32_t id, std::uint
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   // Process lifetime; never freed (libFuzzer exits).
-  static Template* const templates[2] = {new Template(drivers::CanIoConfig{}, Layout{3, true, 1}),
-                                         new Template(wiring_32_bits(), Layout{4, false, 2})};
+  static Template* const templates[3] = {new Template(drivers::CanIoConfig{}, Layout{3, true, 1}),
+                                         new Template(wiring_32_bits(), Layout{4, false, 2}),
+                                         new Template(two_heads(), Layout{4, true, 3})};
   if (size == 0) return 0;
-  Template& t = *templates[data[0] & 1];
+  Template& t = *templates[data[0] % 3];
   FuzzBus& bus = t.bus;
   bus.reset();
   drivers::CanIoPort port = t.port;  // configured, bound to `bus`
@@ -430,8 +457,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const std::array<std::uint8_t, 8> want =
         rpdo_bytes(wiring, m.link_fault != 0 ? drivers::io_safe_outputs() : out);
     if (f.id != kRpdo1Id || f.dlc != t.layout.output_bytes || f.flags != 0 || f.data != want) {
-      fail("write_io sent 0x%03X [%u] %02X %02X (link fault 0x%04X), expected 0x%03X [%u] %02X %02X", f.id,
-           f.dlc, f.data[0], f.data[1], m.link_fault, kRpdo1Id, t.layout.output_bytes, want[0], want[1]);
+      fail("write_io sent 0x%03X [%u] %02X %02X %02X (link fault 0x%04X), expected 0x%03X [%u] %02X %02X %02X", f.id,
+           f.dlc, f.data[0], f.data[1], f.data[2], m.link_fault, kRpdo1Id, t.layout.output_bytes, want[0], want[1],
+           want[2]);
     }
     ++now;
   };
@@ -472,6 +500,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         out.lamp_amber = (bits & 0x08) != 0;
         out.lamp_red = (bits & 0x10) != 0;
         out.buzzer = (bits & 0x20) != 0;
+        const auto heads = in.ConsumeIntegral<std::uint8_t>();  // every head's signals, used or not
+        for (std::size_t h = 0; h < 2; ++h) {
+          out.gripper_close[h] = ((heads >> (2 * h)) & 1U) != 0;
+          out.cutter[h] = ((heads >> (2 * h + 1)) & 1U) != 0;
+        }
+        out.gripper_close[5] = (heads & 0x10) != 0;
+        out.cutter[11] = (heads & 0x20) != 0;
         cycle(out);
         break;
       }

@@ -9,6 +9,8 @@
 #include <thread>
 
 #include "loom/firmware/machine.hpp"
+#include "loom/motion/errors.hpp"
+#include "loom/motion/knot_cycle.hpp"
 
 namespace loom::safety {
 namespace {
@@ -228,6 +230,18 @@ RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& sp
   std::array<double, 2 * hal::kMaxKnottingHeads> head_at{};
   heads_axes(head_at);
   const sim_hal::SimKnotter* knotter = sim.knotter();
+  // Whether a gripper is in the warp, judged independently of the interlock (whose angle interval is
+  // sampled from the cycle's time window): the linkage's forward kinematics at the servo's true angle,
+  // against the warp's entry line.
+  const motion::KnotCycle* cycle = m.knot_cycle();
+  const auto in_warp = [&](int h, double servo) {
+    try {
+      const double crank_abs = cycle->take_angle_rad() + (servo - kn.take_position_rad);
+      return cycle->dynamics_at(crank_abs).gripper_x_m >= cycle->spec().warp_entry_x_m;
+    } catch (const motion::MotionError&) {
+      return knotter->gripper_in_warp(h, servo);  // off the linkage's range: the simulator's own reading
+    }
+  };
   std::uint32_t requests_seen = m.sequencer().weaver_requests();
   hal::Tick fault_at = -1;
   hal::Tick t = 0;
@@ -236,7 +250,7 @@ RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& sp
     if (m.sequencer().finished() && (fault_at < 0 || t > fault_at + 300)) break;
     const bool warp_before = sim.beater_in_warp();
     bool gripper_before = false;
-    for (int h = 0; h < kn.heads; ++h) gripper_before |= knotter->gripper_in_warp(h, head_at[static_cast<std::size_t>(2 * h)]);
+    for (int h = 0; h < kn.heads; ++h) gripper_before |= in_warp(h, head_at[static_cast<std::size_t>(2 * h)]);
     std::array<bool, hal::kMaxKnottingHeads> holding{};
     for (int h = 0; h < kn.heads; ++h) holding[static_cast<std::size_t>(h)] = knotter->gripper_closed(h);
     const bool shed_before = shed_open(pistons);
@@ -262,7 +276,7 @@ RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& sp
     int selector_with_yarn = -1;
     for (int h = 0; h < kn.heads; ++h) {
       const auto k = static_cast<std::size_t>(2 * h), sel = k + 1;
-      gripper_now |= knotter->gripper_in_warp(h, head2[k]);
+      gripper_now |= in_warp(h, head2[k]);
       knotter_moved |= moved(head2[k], head_at[k]);
       head_moved |= moved(head2[k], head_at[k]) || moved(head2[sel], head_at[sel]);
       if (moved(head2[sel], head_at[sel]) && (holding[static_cast<std::size_t>(h)] || knotter->gripper_closed(h))) selector_with_yarn = h;

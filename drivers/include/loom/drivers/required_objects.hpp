@@ -23,6 +23,9 @@ struct IoWiring;
 
 // Configure-time only. A CiA 402 servo drive in cyclic synchronous position.
 std::vector<RequiredObject> drive_objects();
+// Configure-time only. What a drive whose axis is referenced by a CiA 402 homing run (an incremental
+// encoder) must support besides drive_objects().
+std::vector<RequiredObject> homing_drive_objects();
 // Configure-time only. The CiA 401 generic I/O module, objects only (no wiring: sub-indices not counted).
 std::vector<RequiredObject> io_module_objects();
 // Configure-time only. The same for `wiring`: how many 8-bit input and output groups (0x6000:01..n,

@@ -79,6 +79,7 @@ class Machine {
   static void simulated_weaver_sink(void* machine, const sequencer::WeaverRequest& r) noexcept;
   // The design as the knotting heads tie it (null without heads).
   const sequencer::KnotProgram* knot_program() const { return knot_program_.get(); }
+  const motion::KnotCycle* knot_cycle() const { return knot_cycle_.get(); }  // null without heads
 
  private:
   void build_knotting(const MachineOptions& opt, std::uint32_t counter_rows, sequencer::SequencerConfig& scfg);

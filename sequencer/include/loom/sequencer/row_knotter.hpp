@@ -148,7 +148,7 @@ class RowKnotter {
   bool play(Move& m, hal::Tick now, double& target) const noexcept;  // true when it moved the target this tick
   bool fail(Fault f, int axis) noexcept;
   double seconds(hal::Tick dt) const noexcept { return static_cast<double>(dt) * period_s_; }
-  double selector_goal(int head, int slot, double from) const noexcept;
+  double selector_goal(int slot, double from) const noexcept;
 
   KnottingConfig k_{};
   const KnotGuard* guard_ = nullptr;
