@@ -141,6 +141,7 @@ SimWorld::SimWorld(const SimMachine& machine, const SceneSpec& scene)
   // The valves' fill per tick depends only on the period and the time constant: one exp here, not two a tick.
   if (scene_.pneumatics) pressure_fill_ = 1.0 - std::exp(-m_.period_s / scene_.pneumatics->fill_tau_s);
   beatup_ = std::make_unique<motion::BeatUp>(m_.beatup);
+  if (scene_.beat_contact) bracket_contact();
   // Each fault strikes at the first tick whose time reaches at_s (a power cut: at its own tick).
   const auto strike = [&](const FaultInjection& f) {
     if (f.kind == InjectedFault::kPowerCut) return f.at_tick;
@@ -407,6 +408,29 @@ void SimWorld::write_axes(hal::Tick, const hal::AxisCommands& axes) {
   for (std::size_t i = 0; i < n_axes_; ++i) step_axis(i, axes[i]);
 }
 
+void SimWorld::bracket_contact() {
+  // The tip's distance from the fell falls monotonically from the warp's entry to the fell and grows again
+  // to its exit (beatup.cpp). Bisect each side for the last phase still farther than the contact depth,
+  // then widen by a margin far above the solve's rounding (1e-6 rad moves the tip by ~1e-8 m where the
+  // bracket lies, by ≥ 1e-13 m even at the fell itself; the solve rounds at ~1e-16 m), so that no phase
+  // outside the bracket can be in contact. Its own test sweeps the warp window to check exactly that.
+  const motion::WarpWindow& w = beatup_->warp();
+  const double depth = scene_.beat_contact->contact_depth_m;
+  const auto away = [&](double phase) { return beatup_->at(phase).from_fell_m > depth; };
+  // far: an end at which the tip is farther than the depth; near: the fell. Returns the last far phase found.
+  const auto last_far = [&](double far, double near) {
+    if (!away(far)) return far;  // the contact reaches the warp's edge: no narrowing on this side
+    for (int i = 0; i < 200; ++i) {
+      const double mid = 0.5 * (far + near);
+      if (mid == far || mid == near) break;
+      (away(mid) ? far : near) = mid;
+    }
+    return far;
+  };
+  contact_from_ = std::max(w.enter, last_far(w.enter, w.fell) - kContactMarginRad);
+  contact_to_ = std::min(w.exit, last_far(w.exit, w.fell) + kContactMarginRad);
+}
+
 void SimWorld::step_beat_contact(double crank_position, double omega) noexcept {
   const double alpha = (omega - crank_v_prev_) / m_.period_s;
   crank_v_prev_ = omega;
@@ -414,6 +438,7 @@ void SimWorld::step_beat_contact(double crank_position, double omega) noexcept {
   const double phase = motion::wrap_two_pi(crank_position - m_.crank_park_position_rad);
   const motion::WarpWindow& w = beatup_->warp();
   if (!(phase > w.enter && phase < w.exit)) return;  // the exact solve is only needed near the fell
+  if (!(phase >= contact_from_ && phase <= contact_to_)) return;  // and only where contact is possible
   const motion::BeaterState s = beatup_->at(phase);
   if (s.from_fell_m > scene_.beat_contact->contact_depth_m) return;
   // Tangential tip acceleration from the kinematic coefficients: L·(θ4'' ω² + θ4' α).
