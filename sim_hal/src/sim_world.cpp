@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <csignal>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 
@@ -273,6 +275,28 @@ void SimWorld::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatu
   // Until a fault strikes (no frame lost, no node silent, no bus-off) and without CAN latency, every
   // frame arrives as sampled: sample straight into `axes`, not into the history and then across.
   const bool direct = history_ticks_ == 1 && next_fault_ == 0;
+  if (direct) {
+    // No fault has struck, so no encoder glitch either (glitch_left_ is all 0): the loop below, on `axes`,
+    // without the glitch's test and count ("+ 0.0" kept: it turns a -0.0 sum into +0.0 as there).
+    for (std::size_t i = 0; i < n_axes_; ++i) {
+      const SimAxis& s = axes_[i];
+      hal::AxisFeedback fb;
+      fb.state = s.state;
+      fb.position = s.position + s.offset + 0.0;
+      fb.velocity = s.velocity;
+      fb.effort = 0.0;
+      fb.fault = s.state == hal::DriveState::kFault;
+      fb.fault_code = s.fault_code;
+      fb.fault_kind = fb.fault ? hal::FaultKind::kDrive : s.fault_code != 0 ? hal::FaultKind::kEmcy : hal::FaultKind::kNone;
+      fb.following_error = false;
+      fb.referenced = s.referenced;
+      fb.homing_error = false;
+      fb.refreshed = now;
+      axes[i] = fb;
+    }
+    link = hal::LinkStatus{};
+    return;
+  }
   hal::AxisFeedback* truth =
       direct ? axes.data() : &history_[static_cast<std::size_t>(now) % history_ticks_ * n_axes_];
   for (std::size_t i = 0; i < n_axes_; ++i) {
@@ -405,7 +429,26 @@ void SimWorld::step_homing(std::size_t slot) noexcept {
 void SimWorld::write_axes(hal::Tick, const hal::AxisCommands& axes) {
   if (powered_off_) return;
   drives_simulated_ = true;
-  for (std::size_t i = 0; i < n_axes_; ++i) step_axis(i, axes[i]);
+  for (std::size_t i = 0; i < n_axes_; ++i) {
+    SimAxis& ax = axes_[i];
+    const hal::AxisCommand& cmd = axes[i];
+    if (ax.state == hal::DriveState::kOperationEnabled && cmd.request == hal::AxisRequest::kEnable && !jammed_[i]) {
+      // The usual tick, here rather than through step_axis (its power-state and homing decisions cost
+      // more than this): enabled, asked to stay so, following its target. The same steps as there.
+      const double before = ax.position;
+      ax.homing = false;
+      ax.target = cmd.target_position - ax.offset;
+      double actual = ax.target;
+      if (!ax.effects.empty()) {
+        actual = ax.position;
+        for (auto& e : ax.effects) actual = e->step(ax.target, actual, m_.period_s);
+      }
+      ax.position = actual;
+      ax.velocity = (ax.position - before) / m_.period_s;
+      continue;
+    }
+    step_axis(i, cmd);
+  }
 }
 
 void SimWorld::bracket_contact() {
@@ -514,7 +557,13 @@ void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::Digit
   if (next_fault_ == 0 && !scene_.sensor_noise) {
     // No sensor fault has struck and no bounce is simulated: every switch reads the truth (the loop
     // below, without its per-switch checks). A second switch the machine does not have reads false.
-    for (std::size_t i = 0; i < n; ++i) io.second_channel[i] = m_.second_channel[i] && truth[i];
+    // (bools are bytes 0 or 1: one AND of the six bytes is the six &&)
+    static_assert(sizeof(bool) == 1 && n <= sizeof(std::uint64_t));
+    std::uint64_t fitted = 0, seen = 0;
+    std::memcpy(&fitted, m_.second_channel.data(), n);
+    std::memcpy(&seen, truth.data(), n);
+    const std::uint64_t second = fitted & seen;
+    std::memcpy(io.second_channel.data(), &second, n);
     hal::set_safety_sensors(io, truth);
     io.estop_ok = estop_ok_;
     io.refreshed = now;
