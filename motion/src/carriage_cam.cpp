@@ -10,6 +10,13 @@
 
 namespace loom::motion {
 
+static double smooth_step_position(double u) noexcept {  // smooth_step(u).position alone
+  if (!(u > 0.0)) return 0.0;
+  if (u >= 1.0) return 1.0;
+  const double u2 = u * u, u3 = u2 * u, u4 = u3 * u;
+  return u4 * (35.0 - 84.0 * u + 70.0 * u2 - 20.0 * u3);
+}
+
 CamSample smooth_step(double u) noexcept {
   if (!(u > 0.0)) return {0.0, 0.0, 0.0, 0.0};
   if (u >= 1.0) return {1.0, 0.0, 0.0, 0.0};
@@ -77,6 +84,23 @@ CamSample CarriageCam::at(double phase) const noexcept {
   const CamSample s = smooth_step(u);
   const double c = 1.0 / length_;
   return {pitch_ * (started - 1.0 + s.position), pitch_ * s.d1 * c, pitch_ * s.d2 * c * c, pitch_ * s.d3 * c * c * c};
+}
+
+double CarriageCam::position_at(double phase) const noexcept {
+  if (!(phase > start_) || steps_ == 0) return 0.0;
+  const double rel = phase - start_;
+  // Window k follows turn k's beat; the carriage moves only in every beats_per_position-th window.
+  const double k = floor_nonneg(rel / kTwoPi);  // rel > 0
+  const double n = static_cast<double>(beats_per_position_);
+  const double started = floor_nonneg((k + 1.0) / n);  // moves whose window has begun
+  const double total = static_cast<double>(steps_);
+  if (started > total) return pitch_ * total;
+  // (from here started <= total: k is finite)
+  const bool between = not_multiple(k + 1.0, beats_per_position_);
+  if (started == total && between) return pitch_ * total;
+  if (between) return pitch_ * started;  // dwelling between beats
+  const double u = (rel - k * kTwoPi) / length_;
+  return pitch_ * (started - 1.0 + smooth_step_position(u));
 }
 
 }  // namespace loom::motion

@@ -266,7 +266,8 @@ void Sequencer::step(hal::Tick now, const hal::HalInputs& raw, hal::HalOutputs& 
   sense(raw);
   // The sequencer and its interlocks see debounced sensors: a copy of the inputs with them, of the
   // configured axes only (the arrays are sized for the capacity).
-  hal::HalInputs& in = in_;
+  cur_ ^= 1;  // the last tick's inputs become last(i)
+  hal::HalInputs& in = in_[cur_];
   for (std::size_t i = 0; i < n_axes_; ++i) in.axes[i] = raw.axes[i];  // (std::copy_n: a memcpy call)
   in.io = io_;
   in.analog = raw.analog;
@@ -303,11 +304,6 @@ void Sequencer::step(hal::Tick now, const hal::HalInputs& raw, hal::HalOutputs& 
     }
   }
   signal();
-  for (std::size_t i = 0; i < n_axes_; ++i) {
-    last_position_[i] = in.axes[i].position;
-    last_refreshed_[i] = in.axes[i].refreshed;
-    last_referenced_[i] = in.axes[i].referenced;
-  }
   positions_primed_ = state_ != State::kIdle;
   // The configured axes and the I/O to the HAL and kept for the interlocks (the arrays are sized for the
   // capacity; the rest is never used), in one pass: two library memcpy calls cost more than the copying.
@@ -361,7 +357,7 @@ bool Sequencer::all_quiet(hal::Tick now, const hal::HalInputs& in) const noexcep
             (enabled_outputs_ & !a.referenced) | (a.fault_kind != hal::FaultKind::kNone) | (now - a.refreshed > stale);
     // x - x is 0 for a finite x and NaN for inf or NaN; the sum is 0 only when both are finite.
     const bool finite_rest = (a.velocity - a.velocity) + (a.effort - a.effort) == 0.0;
-    const bool small_step = std::abs(a.position - last_position_[i]) <= max_step_[i];
+    const bool small_step = std::abs(a.position - last(i).position) <= max_step_[i];
     flag |= !finite_rest | !small_step;
   }
   const double f = in.analog.beat_force_n;
@@ -439,13 +435,14 @@ bool Sequencer::check_faults_in_order(hal::Tick now, const hal::HalInputs& in) n
     }
     // Compared sample to sample: feedback that arrived late comes in bursts (two samples in one tick
     // after none in the tick before), so the allowance is per tick between the samples' refresh ticks.
-    const hal::Tick apart = a.refreshed != hal::kNeverTick && last_refreshed_[i] != hal::kNeverTick
-                                ? std::max<hal::Tick>(1, a.refreshed - last_refreshed_[i])
+    const hal::AxisFeedback& was = last(i);
+    const hal::Tick apart = a.refreshed != hal::kNeverTick && was.refreshed != hal::kNeverTick
+                                ? std::max<hal::Tick>(1, a.refreshed - was.refreshed)
                                 : 1;
     // A homing run that references the axis re-bases its reading once: that step is the reference, not a jump.
-    const bool rebased = a.referenced != last_referenced_[i];
+    const bool rebased = a.referenced != was.referenced;
     if (positions_primed_ && !rebased &&
-        std::abs(a.position - last_position_[i]) > max_step_[i] * static_cast<double>(apart)) {
+        std::abs(a.position - was.position) > max_step_[i] * static_cast<double>(apart)) {
       latch(Fault::kEncoderJump, now, static_cast<int>(i));
       return true;
     }
@@ -1113,7 +1110,7 @@ void Sequencer::play_moves(hal::Tick now) noexcept {
   const double phi = profiles_->crank_phase_at(master);
   cmd_.axes[index(CoreAxis::kBeatCrank)].target_position = crank_sweep_origin_ + phi;
   cmd_.axes[index(CoreAxis::kCarriage)].target_position =
-      carriage_sweep_origin_ + carriage_sweep_dir_ * profiles_->cam().at(phi).position;
+      carriage_sweep_origin_ + carriage_sweep_dir_ * profiles_->cam().position_at(phi);
   // A beat is delivered when the commanded crank passes the fell of turn k.
   const double fell = profiles_->beatup().warp().fell;
   while (row_beats_ < profiles_->beats_per_row() && phi >= motion::kTwoPi * row_beats_ + fell) {

@@ -270,7 +270,8 @@ void SimWorld::apply_injected_faults(hal::Tick now) noexcept {
 }
 
 void SimWorld::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) {
-  apply_injected_faults(now);
+  // (the call only when a fault strikes now or has struck: before, it would do nothing)
+  if (next_fault_ != 0 || (!fault_tick_.empty() && fault_tick_[0] <= now)) apply_injected_faults(now);
   if (powered_off_ || stalled(now)) return;  // nothing refreshed: the values keep their old ticks
   // Until a fault strikes (no frame lost, no node silent, no bus-off) and without CAN latency, every
   // frame arrives as sampled: sample straight into `axes`, not into the history and then across.

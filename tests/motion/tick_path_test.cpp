@@ -1,5 +1,5 @@
 // The tick's motion calls without libm (Phase::from_turns, CarriageCam::at) and their sampling
-// shortcuts (JerkMove::position_at, CrankLaw::phase_at) give the same bits as the formulas they replace:
+// shortcuts (JerkMove::position_at, CarriageCam::position_at, CrankLaw::phase_at) give the same bits as the formulas they replace:
 // each reference below is the former formula written out with libm's floor, nearbyint, fmin, fmax and
 // fmod, or the full sample the shortcut is a part of.
 #include <gtest/gtest.h>
@@ -95,6 +95,7 @@ TEST(TickPath, CarriageCamIsTheFloorAndFmodFormulaBitForBit) {
       }
       for (const double p : phases) {
         const CamSample got = cam.at(p), want = cam_libm(cam, p);
+        ASSERT_EQ(bits(cam.position_at(p)), bits(want.position)) << "position_at, phase " << p;
         ASSERT_EQ(bits(got.position), bits(want.position)) << "per " << per << " steps " << steps << " phase " << p;
         ASSERT_EQ(bits(got.d1), bits(want.d1)) << p;
         ASSERT_EQ(bits(got.d2), bits(want.d2)) << p;

@@ -351,10 +351,12 @@ class Sequencer {
   hal::DigitalInputs raw_io_{};
   int sensed_ticks_ = 0;                       // picture checks wait until the debouncer has history
   std::size_t n_axes_ = hal::kCoreAxisCount;  // cfg_.axes.count
-  hal::HalInputs in_{};                        // this tick's inputs with debounced sensors (step)
-  std::array<double, hal::kMaxAxes> last_position_{};
-  std::array<hal::Tick, hal::kMaxAxes> last_refreshed_{};  // tick each last_position_ sample arrived
-  std::array<bool, hal::kMaxAxes> last_referenced_{};      // each axis' referenced flag with that sample
+  // This tick's inputs with debounced sensors (in_[cur_], step) and the last tick's (in_[cur_ ^ 1]): the
+  // fault checks compare each axis' position, refresh tick and referenced flag with the last sample's
+  // (last(i)). Alternating the two saves copying those out every tick.
+  std::array<hal::HalInputs, 2> in_{};
+  std::size_t cur_ = 0;
+  const hal::AxisFeedback& last(std::size_t i) const noexcept { return in_[cur_ ^ 1].axes[i]; }
   std::uint32_t rows_on_disk_ = 0;   // the row-boundary handshake (note_rows_saved)
   bool last_save_failed_ = false;
   bool positions_primed_ = false;
