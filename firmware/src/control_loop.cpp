@@ -1,7 +1,10 @@
 // The control cycle, its events and its telemetry snapshot.
 #include "loom/firmware/control_loop.hpp"
 
+#include <bit>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <cstring>
 
 #include "loom/telemetry/telemetry.hpp"
@@ -25,6 +28,16 @@ void set_name(std::array<char, N>& dst, const char* src, const char*& shown) noe
 }
 
 static_assert(telemetry::kMaxKnotSlots == static_cast<std::size_t>(sequencer::kMaxMagazineSlots), "the snapshot holds every magazine slot");
+
+// Bits 0..n-1 from n (<= 8) consecutive bools (little-endian words): with byte i at bit 8i, the multiply
+// puts it at bit 56 + i (the 2^(7(8-i)) term) and every other term at a distinct lower bit or past bit 63,
+// so nothing carries into the top byte.
+static_assert(sizeof(bool) == 1);
+std::uint8_t pack_flags(const unsigned char* first, std::size_t n) noexcept {
+  std::uint64_t w = 0;
+  std::memcpy(&w, first, n);
+  return static_cast<std::uint8_t>((w * 0x0102040810204080ull) >> 56);
+}
 
 bool axis_faulted(const hal::AxisFeedback& a) noexcept {
   return a.fault || a.state == hal::DriveState::kFault || a.state == hal::DriveState::kFaultReactionActive;
@@ -253,14 +266,30 @@ void ControlLoop::fill_snapshot(hal::Tick now) noexcept {
   }
   s.outputs = static_cast<std::uint8_t>((out_.io.piston_a_extend ? 1 : 0) | (out_.io.piston_b_extend ? 2 : 0));
   const auto& io = in_.io;
-  s.inputs = static_cast<std::uint8_t>(
-      (io.piston_a_extended ? 1 : 0) | (io.piston_a_retracted ? 2 : 0) | (io.piston_b_extended ? 4 : 0) |
-      (io.piston_b_retracted ? 8 : 0) | (io.shuttle_at_left ? 16 : 0) | (io.shuttle_at_right ? 32 : 0) |
-      (io.estop_ok ? 64 : 0));
-  const auto& c2 = io.second_channel;
-  s.inputs_2 = static_cast<std::uint8_t>((c2[0] ? 1 : 0) | (c2[1] ? 2 : 0) | (c2[2] ? 4 : 0) | (c2[3] ? 8 : 0) |
-                                         (c2[4] ? 16 : 0) | (c2[5] ? 32 : 0));
   static_assert(hal::kSafetySensorCount == 6, "inputs_2 packs six second channels");
+  if constexpr (std::endian::native == std::endian::little) {
+    // The seven flags (A ext … estop_ok, declared in bit order) and the six second channels are runs of
+    // bools, bytes of 0 or 1: one multiply gathers byte i of a word into bit i of its top byte.
+    using hal::DigitalInputs;
+    static_assert(offsetof(DigitalInputs, piston_a_retracted) == offsetof(DigitalInputs, piston_a_extended) + 1 &&
+                  offsetof(DigitalInputs, piston_b_extended) == offsetof(DigitalInputs, piston_a_extended) + 2 &&
+                  offsetof(DigitalInputs, piston_b_retracted) == offsetof(DigitalInputs, piston_a_extended) + 3 &&
+                  offsetof(DigitalInputs, shuttle_at_left) == offsetof(DigitalInputs, piston_a_extended) + 4 &&
+                  offsetof(DigitalInputs, shuttle_at_right) == offsetof(DigitalInputs, piston_a_extended) + 5 &&
+                  offsetof(DigitalInputs, estop_ok) == offsetof(DigitalInputs, piston_a_extended) + 6,
+                  "the seven input flags are consecutive bytes in bit order");
+    const auto* bytes = reinterpret_cast<const unsigned char*>(&io);
+    s.inputs = pack_flags(bytes + offsetof(DigitalInputs, piston_a_extended), 7);
+    s.inputs_2 = pack_flags(bytes + offsetof(DigitalInputs, second_channel), hal::kSafetySensorCount);
+  } else {
+    s.inputs = static_cast<std::uint8_t>(
+        (io.piston_a_extended ? 1 : 0) | (io.piston_a_retracted ? 2 : 0) | (io.piston_b_extended ? 4 : 0) |
+        (io.piston_b_retracted ? 8 : 0) | (io.shuttle_at_left ? 16 : 0) | (io.shuttle_at_right ? 32 : 0) |
+        (io.estop_ok ? 64 : 0));
+    const auto& c2 = io.second_channel;
+    s.inputs_2 = static_cast<std::uint8_t>((c2[0] ? 1 : 0) | (c2[1] ? 2 : 0) | (c2[2] ? 4 : 0) | (c2[3] ? 8 : 0) |
+                                           (c2[4] ? 16 : 0) | (c2[5] ? 32 : 0));
+  }
   s.overruns = stats_.overruns;
   s.tick_cost_ns = stats_.last_tick_cost_ns;
   s.max_tick_cost_ns = stats_.max_tick_cost_ns;

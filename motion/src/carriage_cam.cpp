@@ -2,12 +2,20 @@
 #include "loom/motion/carriage_cam.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <sstream>
 
 #include "loom/motion/angles.hpp"
 #include "loom/motion/errors.hpp"
 
 namespace loom::motion {
+
+static double smooth_step_position(double u) noexcept {  // smooth_step(u).position alone
+  if (!(u > 0.0)) return 0.0;
+  if (u >= 1.0) return 1.0;
+  const double u2 = u * u, u3 = u2 * u, u4 = u3 * u;
+  return u4 * (35.0 - 84.0 * u + 70.0 * u2 - 20.0 * u3);
+}
 
 CamSample smooth_step(double u) noexcept {
   if (!(u > 0.0)) return {0.0, 0.0, 0.0, 0.0};
@@ -44,20 +52,55 @@ CarriageCam::CarriageCam(const WarpWindow& warp, double margin_rad, double pitch
   }
 }
 
+namespace {
+// floor(x) for x >= 0 (or NaN), bit for bit, without libm's call on the tick's path: below 2^63 the
+// truncating conversion is the floor; at and above 2^52 every double is whole already.
+double floor_nonneg(double x) noexcept {
+  return x < 0x1p52 ? static_cast<double>(static_cast<std::int64_t>(x)) : std::floor(x);
+}
+// fmod(m, n) != 0 for a whole m >= 1 and n >= 1: whether m is not a multiple of n, in integers (exact,
+// as fmod is) while m fits them.
+bool not_multiple(double m, int n) noexcept {
+  if (n == 1) return false;
+  if (m < 0x1p63) return static_cast<std::uint64_t>(m) % static_cast<std::uint64_t>(n) != 0;
+  return std::fmod(m, static_cast<double>(n)) != 0.0;
+}
+}  // namespace
+
 CamSample CarriageCam::at(double phase) const noexcept {
   if (!(phase > start_) || steps_ == 0) return {};
   const double rel = phase - start_;
   // Window k follows turn k's beat; the carriage moves only in every beats_per_position-th window.
-  const double k = std::floor(rel / kTwoPi);
+  const double k = floor_nonneg(rel / kTwoPi);  // rel > 0
   const double n = static_cast<double>(beats_per_position_);
-  const double started = std::floor((k + 1.0) / n);  // moves whose window has begun
+  const double started = floor_nonneg((k + 1.0) / n);  // moves whose window has begun
   const double total = static_cast<double>(steps_);
-  if (started > total || (started == total && std::fmod(k + 1.0, n) != 0.0)) return {pitch_ * total, 0.0, 0.0, 0.0};
-  if (std::fmod(k + 1.0, n) != 0.0) return {pitch_ * started, 0.0, 0.0, 0.0};  // dwelling between beats
+  if (started > total) return {pitch_ * total, 0.0, 0.0, 0.0};
+  // (from here started <= total: k is finite)
+  const bool between = not_multiple(k + 1.0, beats_per_position_);
+  if (started == total && between) return {pitch_ * total, 0.0, 0.0, 0.0};
+  if (between) return {pitch_ * started, 0.0, 0.0, 0.0};  // dwelling between beats
   const double u = (rel - k * kTwoPi) / length_;
   const CamSample s = smooth_step(u);
   const double c = 1.0 / length_;
   return {pitch_ * (started - 1.0 + s.position), pitch_ * s.d1 * c, pitch_ * s.d2 * c * c, pitch_ * s.d3 * c * c * c};
+}
+
+double CarriageCam::position_at(double phase) const noexcept {
+  if (!(phase > start_) || steps_ == 0) return 0.0;
+  const double rel = phase - start_;
+  // Window k follows turn k's beat; the carriage moves only in every beats_per_position-th window.
+  const double k = floor_nonneg(rel / kTwoPi);  // rel > 0
+  const double n = static_cast<double>(beats_per_position_);
+  const double started = floor_nonneg((k + 1.0) / n);  // moves whose window has begun
+  const double total = static_cast<double>(steps_);
+  if (started > total) return pitch_ * total;
+  // (from here started <= total: k is finite)
+  const bool between = not_multiple(k + 1.0, beats_per_position_);
+  if (started == total && between) return pitch_ * total;
+  if (between) return pitch_ * started;  // dwelling between beats
+  const double u = (rel - k * kTwoPi) / length_;
+  return pitch_ * (started - 1.0 + smooth_step_position(u));
 }
 
 }  // namespace loom::motion

@@ -80,4 +80,14 @@ MoveSample JerkMove::at(double t) const noexcept {
   return out;
 }
 
+double JerkMove::position_at(double t) const noexcept {
+  if (t <= 0.0 || duration_ <= 0.0) return t <= 0.0 ? 0.0 : distance_;
+  if (t >= duration_) return distance_;
+  std::size_t i = 6;
+  while (i > 0 && seg_[i].t0 > t) --i;
+  const Segment& s = seg_[i];
+  const double h = t - s.t0;
+  return sign_ * (s.p0 + s.v0 * h + s.a0 * h * h / 2.0 + s.jerk * h * h * h / 6.0);
+}
+
 }  // namespace loom::motion

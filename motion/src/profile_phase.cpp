@@ -28,10 +28,17 @@ Phase Phase::times(std::int64_t n) const noexcept {
 
 Phase Phase::from_turns(double x) noexcept {
   if (!std::isfinite(x)) return {};
-  x = std::fmin(std::fmax(x, -kSaturateTurns), kSaturateTurns);
-  double whole = std::floor(x);
+  // The clamp, floor and round-to-nearest below are fmax/fmin, floor and nearbyint bit for bit (for
+  // finite x; the whole turns and units they produce are the same), without libm calls on the tick's
+  // path (x86-64 without SSE4.1 has no rounding instruction).
+  x = x < -kSaturateTurns ? -kSaturateTurns : x > kSaturateTurns ? kSaturateTurns : x;
+  double whole = static_cast<double>(static_cast<std::int64_t>(x));  // |x| <= 2^62: truncation is exact
+  if (whole > x) whole -= 1.0;                                        // floor for negative x
   double rest = x - whole;  // exact for |x| < 2^62; in [0, 1] after rounding
-  double units = std::nearbyint(rest * kUnitsPerTurn);
+  const double scaled = rest * kUnitsPerTurn;  // >= 0
+  // Adding and taking away 2^52 rounds a value below 2^52 to a whole number in the current rounding mode,
+  // as nearbyint does; from 2^52 up every double is whole.
+  double units = scaled < 0x1p52 ? (scaled + 0x1p52) - 0x1p52 : scaled;
   if (units >= kUnitsPerTurn) {  // rounds up to a whole turn
     whole += 1.0;
     units = 0.0;

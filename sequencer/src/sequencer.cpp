@@ -39,11 +39,6 @@ void request_all(hal::HalOutputs& o, std::size_t n_axes, AxisRequest r) {
 bool finite(double x) { return std::isfinite(x); }
 }  // namespace
 
-// The configured axes and the I/O (the arrays are sized for the capacity; the rest is never used).
-void Sequencer::copy_outputs(const hal::HalOutputs& from, hal::HalOutputs& to) const noexcept {
-  std::copy_n(from.axes.begin(), n_axes_, to.axes.begin());
-  to.io = from.io;
-}
 
 namespace {
 bool drive_in_fault(const hal::AxisFeedback& a) {
@@ -175,6 +170,10 @@ Sequencer::Sequencer(const motion::ProfileSet& profiles, const SequencerConfig& 
   // discrepancy time is never shorter than the debounce plus one tick, whatever the period.
   dual_ = DualChannelSensors(cfg_.second_channel, std::max(static_cast<int>(ticks(cfg_.sensor_discrepancy_s)),
                                                            cfg_.debounce_ticks + 1));
+  stale_ticks_ = ticks(cfg_.stale_timeout_s);
+  diagnosis_ticks_ = ticks(cfg_.diagnosis_window_s);
+  arrival_grace_ticks_ = ticks(cfg_.arrival_grace_s);
+  enable_timeout_ticks_ = ticks(cfg_.enable_timeout_s);
   interlock_ctx_.warp = &profiles_->beatup().warp();
   interlock_ctx_.crank_park_position = cfg_.crank_park_position_rad;
   if (cfg_.heads.program != nullptr && cfg_.heads.cycle != nullptr) configure_knot_guard();
@@ -243,8 +242,9 @@ void Sequencer::step(hal::Tick now, const hal::HalInputs& raw, hal::HalOutputs& 
   sense(raw);
   // The sequencer and its interlocks see debounced sensors: a copy of the inputs with them, of the
   // configured axes only (the arrays are sized for the capacity).
-  hal::HalInputs& in = in_;
-  std::copy_n(raw.axes.begin(), n_axes_, in.axes.begin());
+  cur_ ^= 1;  // the last tick's inputs become last(i)
+  hal::HalInputs& in = in_[cur_];
+  for (std::size_t i = 0; i < n_axes_; ++i) in.axes[i] = raw.axes[i];  // (std::copy_n: a memcpy call)
   in.io = io_;
   in.analog = raw.analog;
   in.link = raw.link;
@@ -280,14 +280,11 @@ void Sequencer::step(hal::Tick now, const hal::HalInputs& raw, hal::HalOutputs& 
     }
   }
   signal();
-  for (std::size_t i = 0; i < n_axes_; ++i) {
-    last_position_[i] = in.axes[i].position;
-    last_refreshed_[i] = in.axes[i].refreshed;
-    last_referenced_[i] = in.axes[i].referenced;
-  }
   positions_primed_ = state_ != State::kIdle;
-  copy_outputs(cmd_, prev_cmd_);
-  copy_outputs(cmd_, out);
+  // The configured axes and the I/O to the HAL and kept for the interlocks (the arrays are sized for the
+  // capacity; the rest is never used), in one pass: two library memcpy calls cost more than the copying.
+  for (std::size_t i = 0; i < n_axes_; ++i) out.axes[i] = prev_cmd_.axes[i] = cmd_.axes[i];
+  out.io = prev_cmd_.io = cmd_.io;
 }
 
 void Sequencer::sense(const hal::HalInputs& raw) noexcept {
@@ -311,6 +308,46 @@ void Sequencer::sense(const hal::HalInputs& raw) noexcept {
 }
 
 bool Sequencer::check_faults(hal::Tick now, const hal::HalInputs& in) noexcept {
+  if (all_quiet(now, in)) {
+    load_cell_seen_ = load_cell_seen_ || in.analog.beat_force_valid;  // as the checks in order would note it
+    return false;
+  }
+  return check_faults_in_order(now, in);
+}
+
+// Every condition check_faults_in_order() tests, or a wider one, in one pass and without a branch per
+// condition (the flags are ORed): true only when none holds, so that the checks in order would latch
+// nothing. On any flag the checks run in order, which decide the fault, its axis and its detail exactly as
+// before; a wider condition only sends a tick there that finds nothing. The wider ones:
+//  - staleness counts from the sample's tick alone: data never seen (kNeverTick, -1) looks older than
+//    anything (now + 1), where the checks in order count it from arming (never older than that);
+//  - a step is judged against one tick's allowance, with no exception for a re-based (homed) axis or the
+//    first tick after idle, where the checks in order allow one per tick between samples (>= 1) and make
+//    those exceptions; !(|step| <= limit) also flags a non-finite position (NaN or inf steps).
+bool Sequencer::all_quiet(hal::Tick now, const hal::HalInputs& in) const noexcept {
+  const hal::Tick stale = stale_ticks_;
+  bool flag = !in.io.estop_ok | stop_now_requested_ | in.link.link_fault | (now - in.io.refreshed > stale);
+  for (std::size_t i = 0; i < n_axes_; ++i) {
+    const hal::AxisFeedback& a = in.axes[i];
+    flag |= a.fault | (a.state == DriveState::kFault) | (a.state == DriveState::kFaultReactionActive) |
+            (enabled_outputs_ & !a.referenced) | (a.fault_kind != hal::FaultKind::kNone) | (now - a.refreshed > stale);
+    // x - x is 0 for a finite x and NaN for inf or NaN; the sum is 0 only when both are finite.
+    const bool finite_rest = (a.velocity - a.velocity) + (a.effort - a.effort) == 0.0;
+    const bool small_step = std::abs(a.position - last(i).position) <= max_step_[i];
+    flag |= !finite_rest | !small_step;
+  }
+  const double f = in.analog.beat_force_n;
+  flag |= in.analog.beat_force_valid
+              ? !(f - f == 0.0 && f >= -0.05 * cfg_.load_cell_max_n && f <= cfg_.load_cell_max_n)
+              : load_cell_seen_;
+  flag |= dual_.discrepant() >= 0;
+  flag |= (sensed_ticks_ > cfg_.debounce_ticks) &
+          ((io_.piston_a_extended & io_.piston_a_retracted) | (io_.piston_b_extended & io_.piston_b_retracted) |
+           (io_.shuttle_at_left & io_.shuttle_at_right));
+  return !flag;
+}
+
+bool Sequencer::check_faults_in_order(hal::Tick now, const hal::HalInputs& in) noexcept {
   if (!in.io.estop_ok) {
     latch(Fault::kEStop, now);
     return true;
@@ -345,7 +382,7 @@ bool Sequencer::check_faults(hal::Tick now, const hal::HalInputs& in) noexcept {
   // Data never seen counts as old as the time since arming: the first PDOs of a freshly started bus
   // legitimately arrive a few cycles after the first SYNC. Everything stale at once is the loop (or the
   // whole bus) stalling, not one device going quiet.
-  const hal::Tick stale = ticks(cfg_.stale_timeout_s);
+  const hal::Tick stale = stale_ticks_;
   const auto too_old = [&](hal::Tick refreshed) {
     return now - (refreshed == hal::kNeverTick ? armed_since_ : refreshed) > stale;
   };
@@ -374,13 +411,14 @@ bool Sequencer::check_faults(hal::Tick now, const hal::HalInputs& in) noexcept {
     }
     // Compared sample to sample: feedback that arrived late comes in bursts (two samples in one tick
     // after none in the tick before), so the allowance is per tick between the samples' refresh ticks.
-    const hal::Tick apart = a.refreshed != hal::kNeverTick && last_refreshed_[i] != hal::kNeverTick
-                                ? std::max<hal::Tick>(1, a.refreshed - last_refreshed_[i])
+    const hal::AxisFeedback& was = last(i);
+    const hal::Tick apart = a.refreshed != hal::kNeverTick && was.refreshed != hal::kNeverTick
+                                ? std::max<hal::Tick>(1, a.refreshed - was.refreshed)
                                 : 1;
     // A homing run that references the axis re-bases its reading once: that step is the reference, not a jump.
-    const bool rebased = a.referenced != last_referenced_[i];
+    const bool rebased = a.referenced != was.referenced;
     if (positions_primed_ && !rebased &&
-        std::abs(a.position - last_position_[i]) > max_step_[i] * static_cast<double>(apart)) {
+        std::abs(a.position - was.position) > max_step_[i] * static_cast<double>(apart)) {
       latch(Fault::kEncoderJump, now, static_cast<int>(i));
       return true;
     }
@@ -421,7 +459,7 @@ bool Sequencer::is_symptom(Fault f) noexcept {
 }
 
 void Sequencer::refine_diagnosis(hal::Tick now, const hal::HalInputs& in) noexcept {
-  if (!is_symptom(first_fault_) || now - fault_tick_ > ticks(cfg_.diagnosis_window_s)) return;
+  if (!is_symptom(first_fault_) || now - fault_tick_ > diagnosis_ticks_) return;
   for (std::size_t i = 0; i < n_axes_; ++i) {
     const hal::AxisFeedback& a = in.axes[i];
     if (drive_in_fault(a)) {
@@ -496,7 +534,7 @@ void Sequencer::enabling(hal::Tick now, const hal::HalInputs& in) noexcept {
     all = all && in.axes[i].state == DriveState::kOperationEnabled;
   }
   if (!all) {
-    if (now - state_since_ > ticks(cfg_.enable_timeout_s)) latch(Fault::kEnableTimeout, now);
+    if (now - state_since_ > enable_timeout_ticks_) latch(Fault::kEnableTimeout, now);
     return;
   }
   begin_homing(now, in);
@@ -615,7 +653,7 @@ bool Sequencer::knotters_at_rest(hal::Tick now, const hal::HalInputs& in) noexce
     }
     if (!m.active) continue;
     const double t = seconds_since(now, m.t0);
-    cmd_.axes[a].target_position = m.origin + m.move.at(t).position;
+    cmd_.axes[a].target_position = m.origin + m.move.position_at(t);
     if (t >= m.move.duration()) m.active = false;
     moving |= m.active;
   }
@@ -724,7 +762,7 @@ void Sequencer::pick(hal::Tick now, const hal::HalInputs& in) noexcept {
     return;
   }
   const bool missed = !arrived && carrier_at_selvedge_ != hal::kNeverTick &&
-                      now - carrier_at_selvedge_ > cfg_.debounce_ticks + ticks(cfg_.arrival_grace_s);
+                      now - carrier_at_selvedge_ > cfg_.debounce_ticks + arrival_grace_ticks_;
   if (missed || seconds_since(now, state_since_) > profiles_->pick().duration() + cfg_.pick_timeout_margin_s) {
     latch(Fault::kShuttleNotArrived, now);
   }
@@ -1029,20 +1067,26 @@ void Sequencer::play_moves(hal::Tick now) noexcept {
   const auto play = [&](ActiveMove& m, CoreAxis axis) {
     if (!m.active) return;
     const double t = seconds_since(now, m.t0);
-    cmd_.axes[index(axis)].target_position = m.origin + m.move.at(t).position;
+    cmd_.axes[index(axis)].target_position = m.origin + m.move.position_at(t);
     if (t >= m.move.duration()) m.active = false;
   };
-  const double sweep_t = seconds_since(now, crank_move_.t0);  // before play() may end the move
-  play(crank_move_, CoreAxis::kBeatCrank);
+  // The crank's move is sampled once: as a move of its own and, in the sweep, as the master phase.
+  const double sweep_t = seconds_since(now, crank_move_.t0);  // before the move may end
+  const bool crank_played = crank_move_.active;
+  const double crank_offset = crank_played || sweeping_ ? crank_move_.move.position_at(sweep_t) : 0.0;
+  if (crank_played) {
+    cmd_.axes[index(CoreAxis::kBeatCrank)].target_position = crank_move_.origin + crank_offset;
+    if (sweep_t >= crank_move_.move.duration()) crank_move_.active = false;
+  }
   play(carriage_move_, CoreAxis::kCarriage);
   play(helix_move_, CoreAxis::kHelix);
   if (!sweeping_) return;
   // The sweep move is the master phase; the crank follows the speed law (constant: the same).
-  const motion::Phase master = motion::Phase::from_rad(crank_move_.move.at(sweep_t).position);
-  const double phi = profiles_->crank_at(master).phase;
+  const motion::Phase master = motion::Phase::from_rad(crank_offset);
+  const double phi = profiles_->crank_phase_at(master);
   cmd_.axes[index(CoreAxis::kBeatCrank)].target_position = crank_sweep_origin_ + phi;
   cmd_.axes[index(CoreAxis::kCarriage)].target_position =
-      carriage_sweep_origin_ + carriage_sweep_dir_ * profiles_->cam().at(phi).position;
+      carriage_sweep_origin_ + carriage_sweep_dir_ * profiles_->cam().position_at(phi);
   // A beat is delivered when the commanded crank passes the fell of turn k.
   const double fell = profiles_->beatup().warp().fell;
   while (row_beats_ < profiles_->beats_per_row() && phi >= motion::kTwoPi * row_beats_ + fell) {

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <csignal>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 
@@ -141,6 +143,7 @@ SimWorld::SimWorld(const SimMachine& machine, const SceneSpec& scene)
   // The valves' fill per tick depends only on the period and the time constant: one exp here, not two a tick.
   if (scene_.pneumatics) pressure_fill_ = 1.0 - std::exp(-m_.period_s / scene_.pneumatics->fill_tau_s);
   beatup_ = std::make_unique<motion::BeatUp>(m_.beatup);
+  if (scene_.beat_contact) bracket_contact();
   // Each fault strikes at the first tick whose time reaches at_s (a power cut: at its own tick).
   const auto strike = [&](const FaultInjection& f) {
     if (f.kind == InjectedFault::kPowerCut) return f.at_tick;
@@ -267,11 +270,34 @@ void SimWorld::apply_injected_faults(hal::Tick now) noexcept {
 }
 
 void SimWorld::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) {
-  apply_injected_faults(now);
+  // (the call only when a fault strikes now or has struck: before, it would do nothing)
+  if (next_fault_ != 0 || (!fault_tick_.empty() && fault_tick_[0] <= now)) apply_injected_faults(now);
   if (powered_off_ || stalled(now)) return;  // nothing refreshed: the values keep their old ticks
   // Until a fault strikes (no frame lost, no node silent, no bus-off) and without CAN latency, every
   // frame arrives as sampled: sample straight into `axes`, not into the history and then across.
   const bool direct = history_ticks_ == 1 && next_fault_ == 0;
+  if (direct) {
+    // No fault has struck, so no encoder glitch either (glitch_left_ is all 0): the loop below, on `axes`,
+    // without the glitch's test and count ("+ 0.0" kept: it turns a -0.0 sum into +0.0 as there).
+    for (std::size_t i = 0; i < n_axes_; ++i) {
+      const SimAxis& s = axes_[i];
+      hal::AxisFeedback fb;
+      fb.state = s.state;
+      fb.position = s.position + s.offset + 0.0;
+      fb.velocity = s.velocity;
+      fb.effort = 0.0;
+      fb.fault = s.state == hal::DriveState::kFault;
+      fb.fault_code = s.fault_code;
+      fb.fault_kind = fb.fault ? hal::FaultKind::kDrive : s.fault_code != 0 ? hal::FaultKind::kEmcy : hal::FaultKind::kNone;
+      fb.following_error = false;
+      fb.referenced = s.referenced;
+      fb.homing_error = false;
+      fb.refreshed = now;
+      axes[i] = fb;
+    }
+    link = hal::LinkStatus{};
+    return;
+  }
   hal::AxisFeedback* truth =
       direct ? axes.data() : &history_[static_cast<std::size_t>(now) % history_ticks_ * n_axes_];
   for (std::size_t i = 0; i < n_axes_; ++i) {
@@ -404,7 +430,49 @@ void SimWorld::step_homing(std::size_t slot) noexcept {
 void SimWorld::write_axes(hal::Tick, const hal::AxisCommands& axes) {
   if (powered_off_) return;
   drives_simulated_ = true;
-  for (std::size_t i = 0; i < n_axes_; ++i) step_axis(i, axes[i]);
+  for (std::size_t i = 0; i < n_axes_; ++i) {
+    SimAxis& ax = axes_[i];
+    const hal::AxisCommand& cmd = axes[i];
+    if (ax.state == hal::DriveState::kOperationEnabled && cmd.request == hal::AxisRequest::kEnable && !jammed_[i]) {
+      // The usual tick, here rather than through step_axis (its power-state and homing decisions cost
+      // more than this): enabled, asked to stay so, following its target. The same steps as there.
+      const double before = ax.position;
+      ax.homing = false;
+      ax.target = cmd.target_position - ax.offset;
+      double actual = ax.target;
+      if (!ax.effects.empty()) {
+        actual = ax.position;
+        for (auto& e : ax.effects) actual = e->step(ax.target, actual, m_.period_s);
+      }
+      ax.position = actual;
+      ax.velocity = (ax.position - before) / m_.period_s;
+      continue;
+    }
+    step_axis(i, cmd);
+  }
+}
+
+void SimWorld::bracket_contact() {
+  // The tip's distance from the fell falls monotonically from the warp's entry to the fell and grows again
+  // to its exit (beatup.cpp). Bisect each side for the last phase still farther than the contact depth,
+  // then widen by a margin far above the solve's rounding (1e-6 rad moves the tip by ~1e-8 m where the
+  // bracket lies, by ≥ 1e-13 m even at the fell itself; the solve rounds at ~1e-16 m), so that no phase
+  // outside the bracket can be in contact. Its own test sweeps the warp window to check exactly that.
+  const motion::WarpWindow& w = beatup_->warp();
+  const double depth = scene_.beat_contact->contact_depth_m;
+  const auto away = [&](double phase) { return beatup_->at(phase).from_fell_m > depth; };
+  // far: an end at which the tip is farther than the depth; near: the fell. Returns the last far phase found.
+  const auto last_far = [&](double far, double near) {
+    if (!away(far)) return far;  // the contact reaches the warp's edge: no narrowing on this side
+    for (int i = 0; i < 200; ++i) {
+      const double mid = 0.5 * (far + near);
+      if (mid == far || mid == near) break;
+      (away(mid) ? far : near) = mid;
+    }
+    return far;
+  };
+  contact_from_ = std::max(w.enter, last_far(w.enter, w.fell) - kContactMarginRad);
+  contact_to_ = std::min(w.exit, last_far(w.exit, w.fell) + kContactMarginRad);
 }
 
 void SimWorld::step_beat_contact(double crank_position, double omega) noexcept {
@@ -414,6 +482,7 @@ void SimWorld::step_beat_contact(double crank_position, double omega) noexcept {
   const double phase = motion::wrap_two_pi(crank_position - m_.crank_park_position_rad);
   const motion::WarpWindow& w = beatup_->warp();
   if (!(phase > w.enter && phase < w.exit)) return;  // the exact solve is only needed near the fell
+  if (!(phase >= contact_from_ && phase <= contact_to_)) return;  // and only where contact is possible
   const motion::BeaterState s = beatup_->at(phase);
   if (s.from_fell_m > scene_.beat_contact->contact_depth_m) return;
   // Tangential tip acceleration from the kinematic coefficients: L·(θ4'' ω² + θ4' α).
@@ -489,7 +558,13 @@ void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::Digit
   if (next_fault_ == 0 && !scene_.sensor_noise) {
     // No sensor fault has struck and no bounce is simulated: every switch reads the truth (the loop
     // below, without its per-switch checks). A second switch the machine does not have reads false.
-    for (std::size_t i = 0; i < n; ++i) io.second_channel[i] = m_.second_channel[i] && truth[i];
+    // (bools are bytes 0 or 1: one AND of the six bytes is the six &&)
+    static_assert(sizeof(bool) == 1 && n <= sizeof(std::uint64_t));
+    std::uint64_t fitted = 0, seen = 0;
+    std::memcpy(&fitted, m_.second_channel.data(), n);
+    std::memcpy(&seen, truth.data(), n);
+    const std::uint64_t second = fitted & seen;
+    std::memcpy(io.second_channel.data(), &second, n);
     hal::set_safety_sensors(io, truth);
     io.estop_ok = estop_ok_;
     io.refreshed = now;

@@ -61,6 +61,9 @@ else
   done
   cases+=("default, 4 axes|$scenes/default.toml|$root/tests/sim/four_axis_loom.toml|0")
   cases+=("default, 8 axes|$scenes/default.toml|$here/eight_axis_loom.toml|0")
+  # Knotting heads, in the knotting state (the knotting scene: ideal + knotter).
+  cases+=("6 heads|$scenes/knotting.toml|$root/firmware/config/knotting_loom.toml|0")
+  cases+=("12 heads|$scenes/knotting.toml|$here/twelve_head_loom.toml|0")
 fi
 
 # Inclusive instructions of a function, from callgrind_annotate --inclusive=yes: the largest entry whose

@@ -146,3 +146,38 @@ TEST(SimWorld, MachineStateSurvivesInItsFile) {
   EXPECT_DOUBLE_EQ(w2.pistons()[1], 1.0);
   EXPECT_NEAR(w2.shuttle_x(), 3.0 * 0.1 / motion::kTwoPi, 1e-15);
 }
+
+// beat_contact solves the linkage only inside a bracket of crank phases found at configure time. The
+// bracket must hold every phase at which the exact solve (motion::BeatUp, not the simulator) puts the tip
+// within the contact depth of the fell: swept finely over the whole warp window and around its ends.
+TEST(SimWorld, BeatContactBracketHoldsEveryPhaseInContact) {
+  const SimMachine m;
+  const motion::BeatUp exact(m.beatup);
+  const motion::WarpWindow& w = exact.warp();
+  for (const double depth : {0.005, 1e-9, 0.02, 0.049, 0.2}) {
+    SceneSpec s = scene({"beat_contact"});
+    s.beat_contact = BeatContact{2.5, depth};
+    const SimWorld world(m, s);
+    const auto [from, to] = world.contact_bracket();
+    ASSERT_LE(w.enter, from);
+    ASSERT_LE(from, to);
+    ASSERT_LE(to, w.exit);
+    const auto check = [&](double phase) {  // (outside the warp window the simulator never solves)
+      if (phase > w.enter && phase < w.exit && exact.at(phase).from_fell_m <= depth) {
+        ASSERT_TRUE(phase >= from && phase <= to) << "depth " << depth << " phase " << phase;
+      }
+    };
+    constexpr int kSweep = 200000;
+    for (int i = 0; i <= kSweep; ++i) check(w.enter + (w.exit - w.enter) * i / kSweep);
+    for (const double end : {from, to}) {
+      for (int i = -2000; i <= 2000; ++i) check(end + i * 1e-9);
+    }
+    // At 5 mm of a 50 mm warp depth the bracket is a small part of the window (else it saves nothing).
+    if (depth == 0.005) {
+      EXPECT_LT(to - from, 0.5 * (w.exit - w.enter));
+    }
+    if (depth >= m.beatup.warp_depth_m) {
+      EXPECT_TRUE(from == w.enter && to == w.exit);
+    }
+  }
+}

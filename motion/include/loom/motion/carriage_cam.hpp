@@ -26,6 +26,8 @@ class CarriageCam {
 
   // RT-safe. Φ = unwrapped crank phase since the sweep began.
   CamSample at(double crank_phase) const noexcept;
+  // RT-safe. at(crank_phase).position alone (the same arithmetic, so the same bits).
+  double position_at(double crank_phase) const noexcept;
 
   double window_start() const { return start_; }  // phase of the first step's start
   double window_length() const { return length_; }

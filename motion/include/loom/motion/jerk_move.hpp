@@ -30,6 +30,8 @@ class JerkMove {
   // RT-safe. Offset from the start position at time t (s) after the move began; clamped outside
   // [0, duration] (before: at rest at 0, after: at rest at `distance` exactly).
   MoveSample at(double t) const noexcept;
+  // RT-safe. at(t).position alone (the same arithmetic, so the same bits), for a loop that needs no more.
+  double position_at(double t) const noexcept;
 
   double duration() const noexcept { return duration_; }
   double distance() const noexcept { return distance_; }

@@ -80,6 +80,7 @@ class ProfileSet {
   // RT-safe. Where the crank and the beater are at a master phase (sweep position from park);
   // the rocker's derivatives are with respect to the master phase (chain rule through the law).
   CrankSample crank_at(const Phase& master) const noexcept { return crank_law_.at(master); }
+  double crank_phase_at(const Phase& master) const noexcept { return crank_law_.phase_at(master); }  // crank_at().phase
   PhaseSample rocker_at(const Phase& master) const noexcept;
 
  private:

@@ -208,7 +208,7 @@ class Sequencer {
   // RT-safe. A symptom (stale feedback, an interlock trip) stopped the machine and its root cause may
   // still be reported within the diagnosis window: a run that ends now would report the symptom.
   bool diagnosis_pending(hal::Tick now) const noexcept {
-    return state_ == State::kFault && is_symptom(first_fault_) && now - fault_tick_ <= ticks(cfg_.diagnosis_window_s);
+    return state_ == State::kFault && is_symptom(first_fault_) && now - fault_tick_ <= diagnosis_ticks_;
   }
   // Debounced digital inputs as the sequencer last used them.
   const hal::DigitalInputs& debounced_io() const noexcept { return io_; }
@@ -217,6 +217,8 @@ class Sequencer {
   // ---- the tick, in order (see sequencer.cpp) ----
   void sense(const hal::HalInputs& raw) noexcept;
   bool check_faults(hal::Tick now, const hal::HalInputs& in) noexcept;
+  bool all_quiet(hal::Tick now, const hal::HalInputs& in) const noexcept;  // check_faults' usual tick
+  bool check_faults_in_order(hal::Tick now, const hal::HalInputs& in) noexcept;
   void refine_diagnosis(hal::Tick now, const hal::HalInputs& in) noexcept;
   void operator_requests(hal::Tick now) noexcept;
   void run_state(hal::Tick now, const hal::HalInputs& in) noexcept;
@@ -240,7 +242,6 @@ class Sequencer {
   void fault(hal::Tick now) noexcept;
   // ---- transitions and helpers ----
   hal::Tick ticks(double seconds) const noexcept;
-  void copy_outputs(const hal::HalOutputs& from, hal::HalOutputs& to) const noexcept;
   double seconds_since(hal::Tick now, hal::Tick t0) const noexcept;
   static bool is_symptom(Fault f) noexcept;
   void latch(Fault f, hal::Tick now, int axis = -1, std::uint16_t detail = 0, int sensor = -1) noexcept;
@@ -350,14 +351,18 @@ class Sequencer {
   hal::DigitalInputs raw_io_{};
   int sensed_ticks_ = 0;                       // picture checks wait until the debouncer has history
   std::size_t n_axes_ = hal::kCoreAxisCount;  // cfg_.axes.count
-  hal::HalInputs in_{};                        // this tick's inputs with debounced sensors (step)
-  std::array<double, hal::kMaxAxes> last_position_{};
-  std::array<hal::Tick, hal::kMaxAxes> last_refreshed_{};  // tick each last_position_ sample arrived
-  std::array<bool, hal::kMaxAxes> last_referenced_{};      // each axis' referenced flag with that sample
+  // This tick's inputs with debounced sensors (in_[cur_], step) and the last tick's (in_[cur_ ^ 1]): the
+  // fault checks compare each axis' position, refresh tick and referenced flag with the last sample's
+  // (last(i)). Alternating the two saves copying those out every tick.
+  std::array<hal::HalInputs, 2> in_{};
+  std::size_t cur_ = 0;
+  const hal::AxisFeedback& last(std::size_t i) const noexcept { return in_[cur_ ^ 1].axes[i]; }
   std::uint32_t rows_on_disk_ = 0;   // the row-boundary handshake (note_rows_saved)
   bool last_save_failed_ = false;
   bool positions_primed_ = false;
   std::array<double, hal::kMaxAxes> max_step_{};  // the most an axis can move in one tick (m or rad)
+  // The configured times the tick compares against, in ticks (ticks() of cfg_'s seconds, once).
+  hal::Tick stale_ticks_ = 0, diagnosis_ticks_ = 0, arrival_grace_ticks_ = 0, enable_timeout_ticks_ = 0;
   bool load_cell_seen_ = false;
 
   // Row bookkeeping.

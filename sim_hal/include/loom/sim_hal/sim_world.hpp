@@ -7,6 +7,7 @@
 #include <array>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "loom/hal/hal.hpp"
@@ -88,6 +89,10 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
     if (knotter_) knotter_->ask(t);
   }
 
+  // The crank phases (from park) inside which beat_contact solves the linkage for the load cell (both
+  // 0 without beat_contact). Outside them the tip is never within the contact depth of the fell.
+  std::pair<double, double> contact_bracket() const noexcept { return {contact_from_, contact_to_}; }
+
  private:
   void apply_injected_faults(hal::Tick now) noexcept;
   bool stalled(hal::Tick now) const noexcept { return now < stall_until_; }
@@ -95,6 +100,7 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   void step_homing(std::size_t slot) noexcept;
   void step_shuttle(double helix_position) noexcept;
   void step_beat_contact(double crank_position, double crank_velocity) noexcept;
+  void bracket_contact();  // configure time: contact_from_, contact_to_
   void readings(std::array<double, hal::kMaxAxes>& out) const noexcept;  // every axis as its drive reads it
 
   SimMachine m_;
@@ -143,6 +149,11 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   std::unique_ptr<motion::BeatUp> beatup_;  // built for beat_contact and for the ground-truth warp test
   double beat_force_n_ = 0.0;
   double crank_v_prev_ = 0.0;
+  // beat_contact: the crank phases (from park) outside which the tip is surely farther from the fell than
+  // the contact depth (a configure-time bracket, widened by kContactMarginRad): there the exact solve,
+  // ~1,300 instructions, would only find "no contact". Inside, the solve decides, as everywhere before.
+  static constexpr double kContactMarginRad = 1e-6;
+  double contact_from_ = 0.0, contact_to_ = 0.0;
   SimStateFile* state_file_ = nullptr;
 };
 
