@@ -108,6 +108,19 @@ TEST(OperatorDesk, RefusalsSayWhy) {
   EXPECT_EQ(desk.decide(local("start"), fault, kNow).reply,
             "refused: start: drive_fault is latched: acknowledge it first (ctl ack)\n");
   EXPECT_EQ(desk.decide(local("ack"), view(State::kPick), kNow).reply, "refused: ack: no fault is latched (state pick)\n");
+  // The counters woven are not yet on disk (full disk): an ack would re-arm from the file's older counts,
+  // so the loop refuses it; the reply must say so, not `ok ack` (issue 22, item 6).
+  LoomView unsaved = view(State::kFault);
+  unsaved.fault = sequencer::Fault::kCountersNotSaved;
+  unsaved.counters_unsaved = true;
+  const Decision ack_unsaved = desk.decide(local("ack"), unsaved, kNow);
+  EXPECT_EQ(ack_unsaved.reply,
+            "refused: ack: the counters woven are not on disk yet (the last save failed): free space in the state "
+            "directory; the save is retried every second, then acknowledge\n");
+  EXPECT_FALSE(ack_unsaved.post.has_value());
+  EXPECT_TRUE(ack_unsaved.audit);
+  unsaved.counters_unsaved = false;  // the retried save went through
+  EXPECT_EQ(desk.decide(local("ack"), unsaved, kNow).reply, "ok ack\n");
   LoomView idle = view(State::kIdle);
   idle.estop_ok = false;
   EXPECT_EQ(desk.decide(local("start"), idle, kNow).reply, "refused: start: the e-stop chain is open: close it first\n");

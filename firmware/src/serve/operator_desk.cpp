@@ -84,6 +84,10 @@ std::string OperatorDesk::refuse_for_state(const ParsedRequest& r, const LoomVie
   if (w == "ack") {
     if (v.state != State::kFault) return "no fault is latched (state " + state + ")";
     if (!v.estop_ok) return "the e-stop chain is still open: close it (release the e-stop), then acknowledge";
+    if (v.counters_unsaved) {
+      return "the counters woven are not on disk yet (the last save failed): free space in the state directory; "
+             "the save is retried every second, then acknowledge";
+    }
     if (v.recovery == hal::LinkRecovery::kBusOff) {
       return "the CAN controller is still bus-off; it must restart first (ip link set " +
              (iface_.empty() ? std::string("can0") : iface_) +

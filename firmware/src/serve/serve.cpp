@@ -208,12 +208,17 @@ int serve_main(const ServeArgs& a) {
   std::mutex ack_mu;
   std::string ack_by;
   std::chrono::steady_clock::time_point ack_at{};
+  // Whether the counters on disk lag what was woven (the last save failed; the loop refuses an ack until a
+  // retried save succeeds): the desk refuses `ctl ack` with the reason instead of answering `ok`.
+  std::atomic<bool> counters_unsaved{false};
   Pairings pairings;
   OperatorDesk desk(pairings, a.iface);
   std::unique_ptr<ControlServer> server;
   try {
     server = std::make_unique<ControlServer>(socket_path, a.group, [&](const ControlRequest& req) -> std::string {
-      const Decision d = desk.decide(req, view_of(link, cfg.sequencer.knotting), static_cast<std::int64_t>(std::time(nullptr)));
+      LoomView view = view_of(link, cfg.sequencer.knotting);
+      view.counters_unsaved = counters_unsaved.load(std::memory_order_acquire);
+      const Decision d = desk.decide(req, view, static_cast<std::int64_t>(std::time(nullptr)));
       if (d.read == Decision::Read::kStatus) return status_text(link, cfg.loom_id, cfg.recipe.design.get(), design_progress);
       if (d.read == Decision::Read::kFaults) {
         std::string out;
@@ -341,11 +346,15 @@ int serve_main(const ServeArgs& a) {
       row_saves.saved(c.rows);
       row_saves.saved_knots(c.rows, c.knot.cycles_started);
       failed_save.reset();
+      counters_unsaved.store(false, std::memory_order_release);
     };
-    if (arm_unsaved) {  // armed from memory: the disk still lags until a retry succeeds
-      failed_save = arm_unsaved;
+    // Every failed save goes through here: the loop (row_saves) and the desk (counters_unsaved) both learn it.
+    const auto save_failed = [&](const sequencer::Counters& c) {
+      failed_save = c;
       row_saves.failed();
-    }
+      counters_unsaved.store(true, std::memory_order_release);
+    };
+    if (arm_unsaved) save_failed(*arm_unsaved);  // armed from memory: the disk still lags until a retry succeeds
     const auto on_event = [&](const RunEvent& e) {
       machine->collect_retired_recipes();
       switch (e.kind) {
@@ -421,8 +430,7 @@ int serve_main(const ServeArgs& a) {
         // The sequencer stops at the row boundary with counters_not_saved (a fault like any other); an
         // acknowledgement is refused until a retry (below) has saved these counts.
         log(Severity::kErr, "counters not saved: %s", ex.what());
-        failed_save = e.counters;
-        row_saves.failed();
+        save_failed(e.counters);
       }
     };
     // The reporter thread's poll: the watchdog is fed only while the loop's tick moves, and a failed

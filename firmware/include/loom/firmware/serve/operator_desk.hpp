@@ -28,6 +28,10 @@ struct LoomView {
   bool estop_ok = true;
   bool knotting = false;  // the recipe has a knotting mode (`next` exists)
   sequencer::WeaverAsk weaver_ask = sequencer::WeaverAsk::kNone;  // the knotting heads wait for the weaver
+  // The last counters save failed: the file lags what was woven, and the loop refuses an ack until a
+  // retried save succeeds (an ack would re-arm from the older counts and weave those rows again). Not in
+  // the OperatorLink: serve sets it from its own save bookkeeping.
+  bool counters_unsaved = false;
 };
 LoomView view_of(const OperatorLink& link, bool knotting);
 
