@@ -148,6 +148,25 @@ TEST(OperatorDesk, WhoGaveTheCommandIsTheKernelsWordAndThePanelsClient) {
   EXPECT_EQ(desk.decide(local("pause"), view(State::kPick), kNow).who, "local user anna (uid 1000, pid 4242)");
   EXPECT_EQ(desk.decide(local("pause via=panel client=10.0.0.7"), view(State::kPick), kNow).who,
             "panel client 10.0.0.7 (not paired) via local user anna (uid 1000, pid 4242)");
+  // The COMMAND event's station.
+  EXPECT_EQ(desk.decide(local("pause"), view(State::kPick), kNow).station, "local");
+  EXPECT_EQ(desk.decide(local("pause via=panel client=10.0.0.7"), view(State::kPick), kNow).station, "panel");
+}
+
+// The I/O module's buttons go to the loop directly; their audit carries what the same command from the
+// socket would have answered in the state of the press.
+TEST(OperatorDesk, AButtonPressIsAnsweredAsTheSameCommandWouldBe) {
+  Pairings pairings;
+  OperatorDesk desk(pairings, "");
+  EXPECT_EQ(desk.answer_in_state("start", view(State::kIdle)), "ok start");
+  EXPECT_EQ(desk.answer_in_state("start", view(State::kPick)), "refused: start: already weaving (state pick)");
+  EXPECT_EQ(desk.answer_in_state("pause", view(State::kPick)), "ok pause");
+  EXPECT_EQ(desk.answer_in_state("ack", view(State::kPick)), "refused: ack: no fault is latched (state pick)");
+  LoomView open = view(State::kFault);
+  open.estop_ok = false;
+  EXPECT_EQ(desk.answer_in_state("ack", open),
+            "refused: ack: the e-stop chain is still open: close it (release the e-stop), then acknowledge");
+  EXPECT_EQ(desk.answer_in_state("ack", view(State::kFault)), "ok ack");
 }
 
 TEST(OperatorDesk, PairingIsDoneAtTheLoomCodesExpireAndTokensAreRevocable) {

@@ -55,6 +55,13 @@ std::string utc(std::int64_t s) {
 
 }  // namespace
 
+std::string OperatorDesk::answer_in_state(const std::string& word, const LoomView& v) const {
+  ParsedRequest r;
+  r.word = word;
+  const std::string why = refuse_for_state(r, v);
+  return why.empty() ? "ok " + word : "refused: " + word + ": " + why;
+}
+
 // "" when the command would change something now, else why not.
 std::string OperatorDesk::refuse_for_state(const ParsedRequest& r, const LoomView& v) const {
   const std::string& w = r.word;
@@ -107,6 +114,7 @@ Decision OperatorDesk::decide(const ControlRequest& req, const LoomView& v, std:
   std::string error;
   const auto parsed = parse_request(req.line, error);
   d.who = describe(req.peer);
+  d.station = "local";
   if (!parsed) {
     d.reply = "error: " + error + "\n";
     return d;
@@ -115,6 +123,7 @@ Decision OperatorDesk::decide(const ControlRequest& req, const LoomView& v, std:
   // Who: the kernel's word on the local user; a panel adds its client's address and pairing.
   std::optional<Pairing> paired;
   if (r.via_panel()) {
+    d.station = "panel";
     if (!r.field("token").empty()) paired = pairings_.find(r.field("token"), now_s);
     d.who = "panel client " + r.field("client") +
             (paired ? " paired as " + paired->name : std::string(r.field("token").empty() ? " (not paired)"

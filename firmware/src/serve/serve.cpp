@@ -31,6 +31,7 @@
 #include "loom/firmware/serve/journal.hpp"
 #include "loom/firmware/serve/sd_notify.hpp"
 #include "loom/firmware/serve/state_lock.hpp"
+#include "loom/telemetry/command_events.hpp"
 #include "loom/telemetry/identity.hpp"
 #include "loom/firmware/serve/operator_desk.hpp"
 #include "loom/firmware/serve/pairings.hpp"
@@ -93,7 +94,9 @@ std::string status_text(const OperatorLink& l, const std::string& loom_id, const
 // The audit of one command: a journal line naming who gave it and the verdict; accepted ones also go
 // to the fault history (`ctl faults`). Refused ones stay in the journal only, so a flood of refusals
 // cannot rotate the faults out of the history.
-void audit(FaultHistory& history, const std::string& loom_id, const std::string& line, const Decision& d) {
+// The COMMAND event (when telemetry is on) carries the same: word, station, who, verdict, state.
+void audit(FaultHistory& history, const std::string& loom_id, const std::string& line, const Decision& d,
+           telemetry::CommandEvents* events, sequencer::State state) {
   std::string verdict = d.reply;
   if (!verdict.empty() && verdict.back() == '\n') verdict.pop_back();
   // Tokens and pairing codes never reach a log.
@@ -104,6 +107,9 @@ void audit(FaultHistory& history, const std::string& loom_id, const std::string&
   std::string word = line.substr(0, line.find(' '));
   log(d.accepted() ? Severity::kNotice : Severity::kWarning, "operator: %s by %s: %s", word.c_str(), d.who.c_str(),
       verdict.c_str());
+  if (events != nullptr) {
+    events->publish({word, d.station, d.who, d.accepted(), verdict, sequencer::state_name(state)});
+  }
   if (!d.accepted()) return;
   FaultRecord r;
   r.loom_id = loom_id;
@@ -213,6 +219,17 @@ int serve_main(const ServeArgs& a) {
   std::atomic<bool> counters_unsaved{false};
   Pairings pairings;
   OperatorDesk desk(pairings, a.iface);
+  // The audit as LCM events (COMMAND), for the service's whole life: sessions' publishers come and go.
+  std::unique_ptr<telemetry::CommandEvents> command_events;
+  if (!a.no_telemetry) {
+    try {
+      command_events = std::make_unique<telemetry::CommandEvents>(
+          cfg.telemetry.lcm_url, std::string(telemetry::kDefaultChannelPrefix), cfg.loom_id);
+    } catch (const std::exception& e) {
+      log(Severity::kErr, "loomctl serve: %s: telemetry: %s", cfg.source.c_str(), e.what());
+      return kExitBadInput;
+    }
+  }
   std::unique_ptr<ControlServer> server;
   try {
     server = std::make_unique<ControlServer>(socket_path, a.group, [&](const ControlRequest& req) -> std::string {
@@ -233,7 +250,7 @@ int serve_main(const ServeArgs& a) {
         }
         link.post(*d.post);
       }
-      if (d.audit) audit(history, cfg.loom_id, req.line, d);
+      if (d.audit) audit(history, cfg.loom_id, req.line, d, command_events.get(), view.state);
       return d.reply;
     });
   } catch (const std::exception& e) {
@@ -407,11 +424,25 @@ int serve_main(const ServeArgs& a) {
         }
         case RunEvent::Kind::kButton:
           // Audit only: a press changes no counters, so nothing is saved for it.
-          log(Severity::kNotice, "operator: %s by the I/O module's %s button (state %s)",
-              e.button == Command::kStart ? "start" : e.button == Command::kPause ? "pause" : "ack",
-              e.button == Command::kStart ? "start" : e.button == Command::kPause ? "pause" : "reset/acknowledge",
-              sequencer::state_name(e.state));
+        {
+          const char* word = e.button == Command::kStart ? "start" : e.button == Command::kPause ? "pause" : "ack";
+          const std::string who = std::string("the I/O module's ") +
+                                  (e.button == Command::kStart   ? "start"
+                                   : e.button == Command::kPause ? "pause"
+                                                                 : "reset/acknowledge") +
+                                  " button";
+          log(Severity::kNotice, "operator: %s by %s (state %s)", word, who.c_str(), sequencer::state_name(e.state));
+          if (command_events) {
+            // The loop takes the press itself; the event says what the same command would have answered.
+            LoomView v = view_of(link, cfg.sequencer.knotting);
+            v.state = e.state;
+            v.counters_unsaved = counters_unsaved.load(std::memory_order_acquire);
+            const std::string verdict = desk.answer_in_state(word, v);
+            command_events->publish({word, "button", who, verdict.rfind("ok", 0) == 0, verdict,
+                                     sequencer::state_name(e.state)});
+          }
           return;
+        }
         case RunEvent::Kind::kWeaverRequest:
           // The loom waits for the weaver (lamp amber, buzzer): logged for the shift's record; the panel and
           // `ctl status` show it. Nothing changed in the counters.
