@@ -271,3 +271,47 @@ TEST(PanelUdpm, ReceivesWhatLcmPublishes) {
   }
   EXPECT_EQ(got, 1);
 }
+
+// Issue 22: a recording replayed onto the live group never mixes with the live loom of the same id.
+// A message stamped longer ago than replay_after_s is a replay: it is kept apart under "<id>~replay"
+// (which no live loom id can be) and marked; the live loom's picture is untouched by it.
+TEST(PanelHall, AReplayedRecordingIsKeptApartFromTheLiveLoomAndMarked) {
+  HallLimits lim;
+  lim.replay_after_s = 10.0;
+  const std::int64_t now_us = 1'800'000'000'000'000;
+  Hall h(lim, [now_us] { return now_us; });
+  loomlcm::status_t live = status("A", 5000, 7);
+  live.utime = now_us - 200'000;  // 0.2 s old: live
+  h.on_status(live);
+  loomlcm::status_t old = status("A", 100, 2);  // an earlier run: a lower tick would reset the live loom
+  old.utime = now_us - 3'600'000'000;           // recorded an hour ago
+  old.state = "paused";
+  h.on_status(old);
+  loomlcm::beat_t b = beat("A", 2, 0, 90.0);
+  b.utime = now_us - 3'599'000'000;
+  h.on_beat(b);
+  const auto a = h.loom_json("A").value();
+  EXPECT_EQ(a["status"]["row"], 7);
+  EXPECT_EQ(a["status"]["state"], "beat_sweep");
+  EXPECT_EQ(a["beats_seen"], 0);
+  EXPECT_FALSE(a["replay"].get<bool>());
+  EXPECT_TRUE(a["recorded_s_ago"].is_null());
+  EXPECT_EQ(a["loom"], "A");
+  const auto r = h.loom_json("A~replay").value();
+  EXPECT_TRUE(r["replay"].get<bool>());
+  EXPECT_EQ(r["loom"], "A");
+  EXPECT_EQ(r["status"]["row"], 2);
+  EXPECT_EQ(r["status"]["state"], "paused");
+  EXPECT_EQ(r["beats_seen"], 1);
+  EXPECT_NEAR(r["recorded_s_ago"].get<double>(), 3599.0, 1e-9);  // the latest replayed message's age
+  const auto hall = h.hall_json();
+  ASSERT_EQ(hall["looms"].size(), 2u);
+  EXPECT_EQ(hall["looms"][0]["id"], "A");
+  EXPECT_EQ(hall["looms"][1]["id"], "A~replay");
+  EXPECT_TRUE(hall["looms"][1]["replay"].get<bool>());
+  // Off (0): every message is taken as live, whatever its stamp (a log read through file://).
+  Hall off;
+  off.on_status(old);
+  EXPECT_FALSE(off.loom_json("A~replay").has_value());
+  EXPECT_FALSE(off.loom_json("A").value()["replay"].get<bool>());
+}

@@ -133,6 +133,28 @@ json fault_json(const loomlcm::fault_t& m) {
 
 }  // namespace
 
+Hall::Hall(HallLimits limits, std::function<std::int64_t()> wall_now_us)
+    : limits_(limits), wall_now_us_(std::move(wall_now_us)) {
+  if (!wall_now_us_) {
+    wall_now_us_ = [] {
+      return std::chrono::duration_cast<std::chrono::microseconds>(
+                 std::chrono::system_clock::now().time_since_epoch()).count();
+    };
+  }
+}
+
+Hall::Loom* Hall::loom(const std::string& id, std::int64_t utime) {
+  if (limits_.replay_after_s <= 0.0) return loom(id);
+  const double age_s = static_cast<double>(wall_now_us_() - utime) * 1e-6;
+  if (!(age_s > limits_.replay_after_s)) return loom(id);
+  Loom* l = loom(id + kReplaySuffix);
+  if (l != nullptr) {
+    l->replay = true;
+    l->recorded_s_ago = age_s;
+  }
+  return l;
+}
+
 Hall::Loom* Hall::loom(const std::string& id) {
   auto it = looms_.find(id);
   if (it == looms_.end()) {
@@ -153,10 +175,13 @@ void Hall::changed() {
 
 void Hall::on_status(const loomlcm::status_t& m) {
   std::lock_guard lock(mu_);
-  if (Loom* l = loom(m.loom_id)) {
+  if (Loom* l = loom(m.loom_id, m.utime)) {
     if (l->status && m.tick < l->status->tick) {  // the loop restarted: what was kept belongs to the previous run
+      const Loom keep = *l;
       *l = Loom{};
-      l->heard = Clock::now();
+      l->heard = keep.heard;
+      l->replay = keep.replay;
+      l->recorded_s_ago = keep.recorded_s_ago;
     }
     l->status = m;
     changed();
@@ -165,7 +190,7 @@ void Hall::on_status(const loomlcm::status_t& m) {
 
 void Hall::on_axes(const loomlcm::axes_t& m) {
   std::lock_guard lock(mu_);
-  if (Loom* l = loom(m.loom_id)) {
+  if (Loom* l = loom(m.loom_id, m.utime)) {
     l->axes = m;
     changed();
   }
@@ -173,7 +198,7 @@ void Hall::on_axes(const loomlcm::axes_t& m) {
 
 void Hall::on_rt(const loomlcm::rt_stats_t& m) {
   std::lock_guard lock(mu_);
-  if (Loom* l = loom(m.loom_id)) {
+  if (Loom* l = loom(m.loom_id, m.utime)) {
     l->rt = m;
     changed();
   }
@@ -181,7 +206,7 @@ void Hall::on_rt(const loomlcm::rt_stats_t& m) {
 
 void Hall::on_beat(const loomlcm::beat_t& m) {
   std::lock_guard lock(mu_);
-  Loom* l = loom(m.loom_id);
+  Loom* l = loom(m.loom_id, m.utime);
   if (l == nullptr) return;
   if (m.row != l->current.row) {
     // A new row: the one before becomes "previous" (only if it is the row just before).
@@ -200,7 +225,7 @@ void Hall::on_beat(const loomlcm::beat_t& m) {
 
 void Hall::on_fault(const loomlcm::fault_t& m) {
   std::lock_guard lock(mu_);
-  if (Loom* l = loom(m.loom_id)) {
+  if (Loom* l = loom(m.loom_id, m.utime)) {
     l->faults.push_back(m);
     while (l->faults.size() > limits_.faults_kept) l->faults.pop_front();
     ++l->faults_seen;
@@ -210,7 +235,7 @@ void Hall::on_fault(const loomlcm::fault_t& m) {
 
 void Hall::on_row(const loomlcm::row_t& m) {
   std::lock_guard lock(mu_);
-  if (Loom* l = loom(m.loom_id)) {
+  if (Loom* l = loom(m.loom_id, m.utime)) {
     l->rows.push_back(m);
     while (l->rows.size() > limits_.rows_kept) l->rows.pop_front();
     changed();
@@ -219,7 +244,7 @@ void Hall::on_row(const loomlcm::row_t& m) {
 
 void Hall::on_design(const loomlcm::design_t& m) {
   std::lock_guard lock(mu_);
-  if (Loom* l = loom(m.loom_id)) {
+  if (Loom* l = loom(m.loom_id, m.utime)) {
     // Only a new row is a change worth pushing to every page; the periodic repeat just refreshes it.
     const bool moved = !l->design || l->design->rows_done != m.rows_done || l->design->name != m.name;
     l->design = m;
@@ -229,7 +254,7 @@ void Hall::on_design(const loomlcm::design_t& m) {
 
 void Hall::on_knots(const loomlcm::knots_t& m) {
   std::lock_guard lock(mu_);
-  if (Loom* l = loom(m.loom_id)) {
+  if (Loom* l = loom(m.loom_id, m.utime)) {
     l->knots = m;
     changed();
   }
@@ -237,7 +262,7 @@ void Hall::on_knots(const loomlcm::knots_t& m) {
 
 void Hall::on_weaver(const loomlcm::weaver_request_t& m) {
   std::lock_guard lock(mu_);
-  if (Loom* l = loom(m.loom_id)) {
+  if (Loom* l = loom(m.loom_id, m.utime)) {
     l->weaver.push_back(m);
     while (l->weaver.size() > limits_.weaver_requests_kept) l->weaver.pop_front();
     changed();
@@ -282,6 +307,9 @@ json Hall::knots_json(const loomlcm::knots_t& m) const {
 
 json Hall::summary(const std::string& id, const Loom& l, Clock::time_point now) {
   json j = {{"id", id},
+            {"loom", l.replay ? id.substr(0, id.size() - std::char_traits<char>::length(kReplaySuffix)) : id},
+            {"replay", l.replay},
+            {"recorded_s_ago", l.replay ? num(l.recorded_s_ago) : json(nullptr)},
             {"heard_s_ago", std::chrono::duration<double>(now - l.heard).count()},
             {"beats_seen", l.beats_seen},
             {"beats_in_band", l.beats_in_band},

@@ -8,6 +8,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -34,7 +35,14 @@ struct HallLimits {
   std::size_t beats_per_row = 512;  // beats kept per row (the firmware caps a row at 256)
   std::size_t weaver_requests_kept = 20;  // weaver requests per loom (knotting heads)
   std::size_t knots_per_row = 4096;       // knots of a row shown (a wider one is cut, and says so)
+  // > 0: a message stamped (utime, the publisher's wall clock) longer ago than this is a recording being
+  // replayed onto this group (lcm-logplayer); it is kept apart under "<id>~replay" and marked, never mixed
+  // into the live loom of that id. 0: every message is live (a log read through file://).
+  double replay_after_s = 0.0;
 };
+
+// The suffix that keeps a replayed loom apart: '~' is not a loom id character, so no live loom has it.
+inline constexpr const char* kReplaySuffix = "~replay";
 
 // The only way the panel turns JSON into text: any string that is not valid UTF-8 (a design palette
 // name saved in cp1252, a spoofed LCM packet) has its bad bytes replaced by U+FFFD instead of throwing
@@ -44,7 +52,8 @@ std::string json_text(const nlohmann::json& j);
 class Hall {
  public:
   using Clock = std::chrono::steady_clock;
-  explicit Hall(HallLimits limits = {}) : limits_(limits) {}
+  // `wall_now_us`: the wall clock, microseconds since the epoch (tests give their own); null = the system's.
+  explicit Hall(HallLimits limits = {}, std::function<std::int64_t()> wall_now_us = nullptr);
 
   // LCM thread. Each records the message under its loom id and bumps the version.
   void on_status(const loomlcm::status_t& m);
@@ -78,6 +87,8 @@ class Hall {
   };
   struct Loom {
     Clock::time_point heard{};
+    bool replay = false;          // kept under "<id>~replay": stamped older than replay_after_s
+    double recorded_s_ago = 0.0;  // a replay: the latest message's age
     std::optional<loomlcm::status_t> status;
     std::optional<loomlcm::axes_t> axes;
     std::optional<loomlcm::rt_stats_t> rt;
@@ -91,11 +102,14 @@ class Hall {
     std::uint64_t beats_seen = 0, beats_in_band = 0, faults_seen = 0;
   };
   Loom* loom(const std::string& id);  // nullptr when over the loom limit; caller holds mu_
+  // The live loom `id`, or its replay when `utime` is older than the limit; caller holds mu_.
+  Loom* loom(const std::string& id, std::int64_t utime);
   void changed();                      // caller holds mu_
   static nlohmann::json summary(const std::string& id, const Loom& l, Clock::time_point now);
   nlohmann::json knots_json(const loomlcm::knots_t& m) const;
 
   HallLimits limits_;
+  std::function<std::int64_t()> wall_now_us_;
   mutable std::mutex mu_;
   mutable std::condition_variable cv_;
   std::map<std::string, Loom> looms_;

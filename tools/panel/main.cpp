@@ -14,6 +14,8 @@
 // DIR/<id>.sock (loomctl serve's) tagged with the client's address and token, so the loom decides and
 // audits who pressed; never published on LCM. Host and Origin are checked, bodies, connections and
 // event streams bounded (README.md). Binds to 127.0.0.1 unless --bind says otherwise (a hall network).
+// A recording replayed onto the group (stamped older than --replay-after-s) is shown apart as
+// <id>~replay, marked, without buttons; it never mixes into the live loom of that id.
 // Exit 2 on bad arguments, 1 when it cannot listen or open LCM.
 #include <httplib.h>
 #include <sys/stat.h>
@@ -61,6 +63,7 @@ struct PanelOptions {
   int http_threads = 64;              // each open page holds one for its event stream
   int max_streams = 16;               // event streams at once (each holds a thread); more get 503
   int max_streams_per_client = 4;     // per client address
+  double replay_after_s = 10.0;       // older stamps are a replayed recording: shown apart, marked (hall.hpp)
   std::vector<std::string> hosts;     // --host: names the hall uses for this panel (Host header check)
   // Operator buttons act through the board's local control sockets, <control_dir>/<loom id>.sock,
   // never over LCM. Empty = read-only. The page shows buttons only when the JSON says "controls": true
@@ -132,6 +135,8 @@ std::string control_socket_of(const PanelOptions& o, const std::string& loom) {
 }
 
 bool controls_for(const PanelOptions& o, const std::string& loom) {
+  // A replayed recording has no loom behind it to command.
+  if (loom.find('~') != std::string::npos) return false;
   struct stat st {};
   return !o.control_dir.empty() && ::stat(control_socket_of(o, loom).c_str(), &st) == 0 && S_ISSOCK(st.st_mode);
 }
@@ -238,6 +243,11 @@ int main(int argc, char** argv) {
   app.add_option("--min-push-interval-s", o.min_push_interval_s, "shortest gap between two live updates of a page")
       ->check(CLI::Range(0.01, 60.0))
       ->capture_default_str();
+  app.add_option("--replay-after-s", o.replay_after_s,
+                 "a message stamped longer ago than this is a replayed recording: shown apart as <id>~replay and "
+                 "marked REPLAY (0: every message is live)")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -251,7 +261,9 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  Hall hall;
+  loom::panel::HallLimits limits;
+  limits.replay_after_s = o.replay_after_s;
+  Hall hall(limits);
   Router router(hall, o.channel_prefix);
   // udpm (the normal case): the lean batched receiver. Anything else: LCM's own provider.
   std::unique_ptr<loom::panel::UdpmReceiver> udpm;
@@ -315,11 +327,12 @@ int main(int argc, char** argv) {
     res.set_content(loom::panel::kPanelHtml, "text/html; charset=utf-8");
   };
   svr.Get("/", page);
-  svr.Get(R"(/loom/([A-Za-z0-9_-]{1,32}))", page);
+  // A loom's page and JSON also for a replayed recording (<id>~replay); commands never (POST routes below).
+  svr.Get(R"(/loom/([A-Za-z0-9_-]{1,32}(?:~replay)?))", page);
   svr.Get("/api/hall", [&](const httplib::Request&, httplib::Response& res) {
     res.set_content(loom::panel::json_text(hall.hall_json()), "application/json");
   });
-  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32}))", [&](const httplib::Request& req, httplib::Response& res) {
+  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32}(?:~replay)?))", [&](const httplib::Request& req, httplib::Response& res) {
     const auto j = loom_json(hall, o, req.matches[1]);
     if (!j) {
       res.status = 404;
@@ -406,7 +419,10 @@ int main(int argc, char** argv) {
   StreamSlots slots(o.max_streams, o.max_streams_per_client);
   svr.Get("/events", [&](const httplib::Request& req, httplib::Response& res) {
     const std::string loom = req.has_param("loom") ? req.get_param_value("loom") : std::string();
-    if (!loom.empty() && !loom::telemetry::loom_id_error(loom).empty()) {
+    const std::string live_id = loom.size() > 7 && loom.compare(loom.size() - 7, 7, loom::panel::kReplaySuffix) == 0
+                                    ? loom.substr(0, loom.size() - 7)
+                                    : loom;
+    if (!loom.empty() && !loom::telemetry::loom_id_error(live_id).empty()) {
       res.status = 400;
       res.set_content("bad loom id\n", "text/plain");
       return;
