@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "fault_history.hpp"
 #include "hall.hpp"
 #include "udpm_receiver.hpp"
 #include "synthetic_loom.hpp"
@@ -314,4 +315,31 @@ TEST(PanelHall, AReplayedRecordingIsKeptApartFromTheLiveLoomAndMarked) {
   off.on_status(old);
   EXPECT_FALSE(off.loom_json("A~replay").has_value());
   EXPECT_FALSE(off.loom_json("A").value()["replay"].get<bool>());
+}
+
+// Item 7: the persisted fault history (serve's `faults` reply) as the panel's JSON, newest lines kept.
+// The lines are written out here as FaultHistory's documented format, not produced by it.
+TEST(PanelFaultHistory, LinesAreSplitAndTheNewestKept) {
+  const std::string reply =
+      "2026-11-23T20:15:03Z fault loom1 drive_fault 0x1002 axis=carriage device=0x7310 rows=3 picks=3 beats=45: "
+      "a servo drive reported a fault\n"
+      "2026-11-23T20:16:10Z ack loom1 drive_fault 0x1002 device=0x0000 rows=3 picks=3 beats=45: acknowledged by local "
+      "user anna (uid 1000, pid 42); re-arming from the measured positions\n"
+      "2026-11-23T20:17:00Z command loom1 start 0x0000 device=0x0000 rows=0 picks=0 beats=0: by local user anna: ok start\n"
+      "garbage \xff\xfe line\n";
+  const auto j = fault_history_json(reply, 3);
+  EXPECT_EQ(j["total"], 4);
+  EXPECT_EQ(j["shown"], 3);
+  ASSERT_EQ(j["lines"].size(), 3u);
+  EXPECT_EQ(j["lines"][0]["time"], "2026-11-23T20:16:10Z");
+  EXPECT_EQ(j["lines"][0]["kind"], "ack");
+  EXPECT_EQ(j["lines"][0]["name"], "drive_fault");
+  EXPECT_EQ(j["lines"][1]["kind"], "command");
+  EXPECT_EQ(j["lines"][1]["name"], "start");
+  EXPECT_EQ(j["lines"][1]["detail"], "0x0000 device=0x0000 rows=0 picks=0 beats=0: by local user anna: ok start");
+  EXPECT_FALSE(j["lines"][2].contains("kind"));  // not a history line: kept whole, not trusted
+  EXPECT_EQ(json_text(j["lines"][2]["line"]), "\"garbage \xEF\xBF\xBD\xEF\xBF\xBD line\"");  // U+FFFD, never thrown
+  const auto none = fault_history_json("no faults recorded in /var/lib/loomctl/faults.log\n", 50);
+  EXPECT_EQ(none["total"], 0);
+  EXPECT_EQ(none["note"], "no faults recorded in /var/lib/loomctl/faults.log");
 }

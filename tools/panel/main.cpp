@@ -8,6 +8,7 @@
 //   POST /api/loom/<id>/ctl/<pause|resume|stop|ack|next>   operator buttons, only with --control-dir
 //   POST /api/loom/<id>/pair  (body: the code from `loomctl ctl pair NAME`)  pair this client
 //   GET  /api/loom/<id>/authority   whether this client is paired (may give starting commands)
+//   GET  /api/loom/<id>/history     the loom's persisted fault history (faults.log), with --control-dir
 // Read-only by default: nothing it receives over HTTP reaches the loom. With --control-dir DIR the
 // page offers pause / stop at row end to every client, and resume / acknowledge / "row knotted" only to
 // a client paired with that loom (request_gate.hpp), each sent to that loom's local control socket
@@ -34,6 +35,7 @@
 #include <string>
 #include <thread>
 
+#include "fault_history.hpp"
 #include "hall.hpp"
 #include "request_gate.hpp"
 #include "udpm_receiver.hpp"
@@ -47,6 +49,9 @@ extern const char* const kPanelHtml;
 namespace {
 
 using loom::panel::Hall;
+
+// Lines of the persisted fault history a page shows (the newest; serve keeps 256-512 KiB of them).
+constexpr std::size_t kHistoryShown = 50;
 
 std::atomic<bool> g_stop{false};
 httplib::Server* g_server = nullptr;
@@ -415,6 +420,29 @@ int main(int argc, char** argv) {
     }
     res.set_content(loom::panel::json_text({{"loom", loom}, {"may_start", may_start}, {"client", req.remote_addr}, {"reply", text}}),
                     "application/json");
+  });
+  // The loom's persisted fault history (faults.log, through serve's `faults` request): it survives a
+  // restart of the panel, serve or the board, unlike what the panel heard on LCM. A GET: reading only.
+  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32})/history)", [&](const httplib::Request& req, httplib::Response& res) {
+    const std::string loom = req.matches[1];
+    res.set_header("Cache-Control", "no-store");
+    const auto error = [&](int status, const std::string& why) {
+      res.status = status;
+      res.set_content(loom::panel::json_text({{"loom", loom}, {"error", why}}), "application/json");
+    };
+    if (o.control_dir.empty()) {
+      return error(404, "read-only panel: the loom's fault history is read through its control socket (--control-dir)");
+    }
+    std::string text;
+    try {
+      text = loom::firmware::serve::control_request(control_socket_of(o, loom), on_behalf("faults", req, ""), 3000);
+    } catch (const std::exception& e) {
+      return error(503, e.what());
+    }
+    if (text.rfind("error:", 0) == 0 || text.rfind("refused:", 0) == 0) return error(502, trimmed(text));
+    auto j = loom::panel::fault_history_json(text, kHistoryShown);
+    j["loom"] = loom;
+    res.set_content(loom::panel::json_text(j), "application/json");
   });
   StreamSlots slots(o.max_streams, o.max_streams_per_client);
   svr.Get("/events", [&](const httplib::Request& req, httplib::Response& res) {
