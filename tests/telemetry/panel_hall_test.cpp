@@ -343,3 +343,60 @@ TEST(PanelFaultHistory, LinesAreSplitAndTheNewestKept) {
   EXPECT_EQ(none["total"], 0);
   EXPECT_EQ(none["note"], "no faults recorded in /var/lib/loomctl/faults.log");
 }
+
+namespace {
+loomlcm::axes_t axes_at(const std::string& id, double t, const std::vector<std::string>& names) {
+  loomlcm::axes_t m{};
+  m.loom_id = id;
+  m.time_s = t;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    loomlcm::axis_t a{};
+    a.name = names[i];
+    // Written out so the test knows each value: position = t + i, velocity = 1, following error = 1e-4 * (i + 1).
+    a.position = t + static_cast<double>(i);
+    a.velocity = 1.0;
+    a.following_error = 1e-4 * static_cast<double>(i + 1);
+    m.axes.push_back(a);
+  }
+  m.num_axes = static_cast<decltype(m.num_axes)>(m.axes.size());
+  return m;
+}
+}  // namespace
+
+// Item 7: a scope strip of any axis over the last N seconds of loop time, bounded in samples and time.
+TEST(PanelScope, EachAxisKeepsTheLastWindowOfSamples) {
+  HallLimits lim;
+  lim.scope_window_s = 2.0;
+  lim.scope_samples = 15;
+  Hall h(lim);
+  const std::vector<std::string> names{"beat_crank", "carriage", "helix"};
+  for (int k = 0; k <= 40; ++k) h.on_axes(axes_at("A", 0.1 * k, names));  // 0.0 .. 4.0 s at 10 Hz
+  const auto c = h.scope_json("A", "carriage").value();
+  EXPECT_EQ(c["axes"], nlohmann::json(names));
+  // The window is 2 s (21 samples at 10 Hz), the count 15: the count binds — t = 2.6 .. 4.0 s.
+  ASSERT_EQ(c["t"].size(), 15u);
+  EXPECT_NEAR(c["t"][0].get<double>(), 2.6, 1e-12);
+  EXPECT_NEAR(c["t"][14].get<double>(), 4.0, 1e-12);
+  EXPECT_NEAR(c["position"][14].get<double>(), 5.0, 1e-6);          // t + 1 (float storage)
+  EXPECT_NEAR(c["following_error"][0].get<double>(), 2e-4, 1e-10);  // axis 1
+  EXPECT_NEAR(c["velocity"][7].get<double>(), 1.0, 0.0);
+  // A looser count: the 2 s window binds — 4.0 - 2.0 .. 4.0 s.
+  HallLimits wide = lim;
+  wide.scope_samples = 1000;
+  Hall w(wide);
+  for (int k = 0; k <= 40; ++k) w.on_axes(axes_at("A", 0.1 * k, names));
+  const auto hw = w.scope_json("A", "helix").value();
+  EXPECT_EQ(hw["t"].size(), 21u);
+  EXPECT_NEAR(hw["t"][0].get<double>(), 2.0, 1e-12);
+  // The loop restarted (time went back): the strip starts afresh.
+  w.on_axes(axes_at("A", 0.5, names));
+  EXPECT_EQ(w.scope_json("A", "helix").value()["t"].size(), 1u);
+  // An unknown axis: empty traces; an unknown loom: nothing.
+  EXPECT_EQ(w.scope_json("A", "nosuch").value()["t"].size(), 0u);
+  EXPECT_FALSE(w.scope_json("B", "helix").has_value());
+  // NaN from the wire is sent as null, never as invalid JSON.
+  auto bad = axes_at("A", 0.6, names);
+  bad.axes[2].position = std::numeric_limits<double>::quiet_NaN();
+  w.on_axes(bad);
+  EXPECT_TRUE(w.scope_json("A", "helix").value()["position"][1].is_null());
+}

@@ -192,7 +192,34 @@ void Hall::on_axes(const loomlcm::axes_t& m) {
   std::lock_guard lock(mu_);
   if (Loom* l = loom(m.loom_id, m.utime)) {
     l->axes = m;
+    add_scope_sample(*l, m);
     changed();
+  }
+}
+
+void Hall::add_scope_sample(Loom& l, const loomlcm::axes_t& m) const {
+  if (!std::isfinite(m.time_s)) return;
+  const std::size_t n = std::min<std::size_t>(m.axes.size(), 32);
+  bool same = l.scope_names.size() == n;
+  for (std::size_t i = 0; same && i < n; ++i) same = l.scope_names[i] == m.axes[i].name;
+  // Another set of axes, or loop time going back (the loop restarted): the strip starts afresh.
+  if (!same || (!l.scope.empty() && m.time_s < l.scope.back().time_s)) {
+    l.scope.clear();
+    l.scope_names.clear();
+    for (std::size_t i = 0; i < n; ++i) l.scope_names.push_back(m.axes[i].name);
+  }
+  ScopeSample s;
+  s.time_s = m.time_s;
+  s.axes.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& a = m.axes[i];
+    s.axes.push_back({static_cast<float>(a.position), static_cast<float>(a.velocity),
+                      static_cast<float>(a.following_error)});
+  }
+  l.scope.push_back(std::move(s));
+  while (l.scope.size() > limits_.scope_samples ||
+         (l.scope.size() > 1 && l.scope.back().time_s - l.scope.front().time_s > limits_.scope_window_s)) {
+    l.scope.pop_front();
   }
 }
 
@@ -363,6 +390,27 @@ std::optional<json> Hall::loom_json(const std::string& id) const {
   j["weaver_requests"] = weaver;
   j["controls"] = false;  // the HTTP side says whether it may act on this loom (main.cpp)
   return j;
+}
+
+std::optional<json> Hall::scope_json(const std::string& id, const std::string& axis) const {
+  std::lock_guard lock(mu_);
+  const auto it = looms_.find(id);
+  if (it == looms_.end()) return std::nullopt;
+  const Loom& l = it->second;
+  const auto at = std::find(l.scope_names.begin(), l.scope_names.end(), axis);
+  json t = json::array(), pos = json::array(), vel = json::array(), fe = json::array();
+  if (at != l.scope_names.end()) {
+    const auto i = static_cast<std::size_t>(at - l.scope_names.begin());
+    for (const ScopeSample& s : l.scope) {
+      t.push_back(num(s.time_s));
+      pos.push_back(num(static_cast<double>(s.axes[i][0])));
+      vel.push_back(num(static_cast<double>(s.axes[i][1])));
+      fe.push_back(num(static_cast<double>(s.axes[i][2])));
+    }
+  }
+  return json{{"loom", id},           {"axis", axis},     {"axes", l.scope_names},
+              {"window_s", num(limits_.scope_window_s)}, {"t", t}, {"position", pos},
+              {"velocity", vel},      {"following_error", fe}};
 }
 
 std::uint64_t Hall::version() const {

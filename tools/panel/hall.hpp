@@ -4,6 +4,7 @@
 // HTTP threads as JSON; one mutex guards it (nothing here is real-time).
 #pragma once
 
+#include <array>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -39,6 +40,10 @@ struct HallLimits {
   // replayed onto this group (lcm-logplayer); it is kept apart under "<id>~replay" and marked, never mixed
   // into the live loom of that id. 0: every message is live (a log read through file://).
   double replay_after_s = 0.0;
+  // The scope strip: each loom's AXES samples (the panel decodes at most 10 a second of a live loom) over
+  // the last scope_window_s of loop time, at most scope_samples of them, 32 axes each.
+  double scope_window_s = 30.0;
+  std::size_t scope_samples = 300;
 };
 
 // The suffix that keeps a replayed loom apart: '~' is not a loom id character, so no live loom has it.
@@ -70,6 +75,10 @@ class Hall {
   // nullopt when that id was never heard.
   nlohmann::json hall_json() const;
   std::optional<nlohmann::json> loom_json(const std::string& id) const;
+  // The scope strip of one axis: loop times and that axis' position, velocity and following error (SI,
+  // as sent), oldest first, with every axis name; nullopt when the loom was never heard. An unknown axis
+  // gives empty traces.
+  std::optional<nlohmann::json> scope_json(const std::string& id, const std::string& axis) const;
   // Changes so far; wait_for_change returns the version once it differs from `seen` (or at timeout).
   std::uint64_t version() const;
   std::uint64_t wait_for_change(std::uint64_t seen, std::chrono::milliseconds timeout) const;
@@ -85,8 +94,14 @@ class Hall {
     int row = 0;
     std::vector<Beat> beats;
   };
+  struct ScopeSample {
+    double time_s = 0.0;
+    std::vector<std::array<float, 3>> axes;  // position, velocity, following error, in `scope_names` order
+  };
   struct Loom {
     Clock::time_point heard{};
+    std::vector<std::string> scope_names;  // the axes of the samples kept (a new set starts the strip afresh)
+    std::deque<ScopeSample> scope;
     bool replay = false;          // kept under "<id>~replay": stamped older than replay_after_s
     double recorded_s_ago = 0.0;  // a replay: the latest message's age
     std::optional<loomlcm::status_t> status;
@@ -105,6 +120,7 @@ class Hall {
   // The live loom `id`, or its replay when `utime` is older than the limit; caller holds mu_.
   Loom* loom(const std::string& id, std::int64_t utime);
   void changed();                      // caller holds mu_
+  void add_scope_sample(Loom& l, const loomlcm::axes_t& m) const;  // caller holds mu_
   static nlohmann::json summary(const std::string& id, const Loom& l, Clock::time_point now);
   nlohmann::json knots_json(const loomlcm::knots_t& m) const;
 

@@ -9,6 +9,7 @@
 //   POST /api/loom/<id>/pair  (body: the code from `loomctl ctl pair NAME`)  pair this client
 //   GET  /api/loom/<id>/authority   whether this client is paired (may give starting commands)
 //   GET  /api/loom/<id>/history     the loom's persisted fault history (faults.log), with --control-dir
+//   GET  /api/loom/<id>/scope?axis=NAME   the last 30 s of one axis' position, velocity, following error
 // Read-only by default: nothing it receives over HTTP reaches the loom. With --control-dir DIR the
 // page offers pause / stop at row end to every client, and resume / acknowledge / "row knotted" only to
 // a client paired with that loom (request_gate.hpp), each sent to that loom's local control socket
@@ -343,6 +344,22 @@ int main(int argc, char** argv) {
       res.status = 404;
       res.set_content(loom::panel::json_text({{"error", "loom not heard"}, {"id", std::string(req.matches[1])}}),
                       "application/json");
+      return;
+    }
+    res.set_content(loom::panel::json_text(*j), "application/json");
+  });
+  // The scope strip of one axis (?axis=NAME; the first axis when none): the last seconds of its position,
+  // velocity and following error. The page polls it once a second for the axis the technician picked.
+  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32}(?:~replay)?)/scope)", [&](const httplib::Request& req, httplib::Response& res) {
+    const std::string loom = req.matches[1];
+    res.set_header("Cache-Control", "no-store");
+    std::string axis = req.has_param("axis") ? req.get_param_value("axis") : std::string();
+    if (axis.size() > 64) axis.clear();
+    auto j = hall.scope_json(loom, axis);
+    if (j && axis.empty() && !(*j)["axes"].empty()) j = hall.scope_json(loom, (*j)["axes"][0].get<std::string>());
+    if (!j) {
+      res.status = 404;
+      res.set_content(loom::panel::json_text({{"error", "loom not heard"}, {"id", loom}}), "application/json");
       return;
     }
     res.set_content(loom::panel::json_text(*j), "application/json");

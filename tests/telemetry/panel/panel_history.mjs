@@ -26,6 +26,28 @@ const i = v.kinds.indexOf("fault");
 if (v.names[i] !== "drive_fault") fail(`history row ${JSON.stringify(v)}`);
 if (!/\(\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ\)/.test(v.when[i])) fail(`no wall-clock time: ${v.when[i]}`);
 if (v.live !== 0) fail("the panel's own fault list is not empty: it heard the fault (the test's premise)");
+// The scope strip: the first axis plotted, then the carriage picked from the list and plotted; the axes
+// table and the strips carry units and no scientific notation.
+const scopeRead = () => evaluate(page, `(() => {
+  const sc = document.getElementById("scope"), p = document.getElementById("scope-position");
+  const v = document.getElementById("scope-velocity"), e = document.getElementById("scope-following-error");
+  return { axis: sc ? sc.dataset.axis : null, points: p ? Number(p.dataset.points) : 0,
+           strips: [p, v, e].filter(x => x).length, text: (sc ? sc.textContent : "") + " " +
+           (document.getElementById("axes")?.textContent || ""), units: [...document.querySelectorAll("#axes tr td:nth-child(6)")].map(td => td.textContent) };
+})()`);
+const waitScope = async (what, ok) => {
+  for (let i = 0; i < 100; ++i) { const s = await scopeRead(); if (ok(s)) return s; await sleep(200); }
+  fail(`${what}: ${JSON.stringify(await scopeRead())}`);
+};
+const first = await waitScope("the first axis plotted", s => s.points >= 10 && s.strips === 3);
+await evaluate(page, `(() => { const s = document.getElementById("scope-axis"); s.value = "carriage";
+  s.dispatchEvent(new Event("change", { bubbles: true })); })()`);
+const carriage = await waitScope("the carriage plotted", s => s.axis === "carriage" && s.points >= 10 && s.strips === 3);
+if (/\d[eE][+-]\d/.test(carriage.text)) fail(`scientific notation on the page: ${carriage.text}`);
+if (!carriage.text.includes("velocity m/s") || !carriage.units.includes("m") || !carriage.units.includes("rad")) {
+  fail(`units missing: ${JSON.stringify(carriage)}`);
+}
+console.log(`scope: ${first.axis} then carriage plotted (${carriage.points} samples each of position, velocity, following error)`);
 const shot = await send("Page.captureScreenshot", { format: "png", captureBeyondViewport: true }, page);
 writeFileSync(pngPath, Buffer.from(shot.data, "base64"));
 console.log(`history shown in the browser: ${v.kinds.length} lines (${v.kinds.join(" ")})`);

@@ -4,7 +4,8 @@
 # the fault on LCM — and GET /api/loom/<id>/history (serve's faults.log through its control socket)
 # holds the fault, the start command and who gave it, with UTC times; headless Chromium shows them in the
 # page's "Fault history" table with wall-clock times (skipped without chromium/node). A read-only panel
-# (no --control-dir) answers 404 saying why. Writes <out>/loom_panel_history.png.
+# (no --control-dir) answers 404 saying why. The same page plots the scope strip of the first axis and,
+# picked from its list, of the carriage (units, no scientific notation). Writes <out>/loom_panel_history.png.
 # Usage: panel_history.sh <loomctl> <loom-panel> <drive_fault scene> <out dir>
 set -euo pipefail
 LOOMCTL=$1
@@ -69,6 +70,7 @@ json "/api/loom/$ID/history" 'd["lines"][0]["detail"]' | grep -q "by local user 
   fail "the start line does not say who gave it"
 json "/api/loom/$ID/history" 'd["lines"][1]["detail"]' | grep -q "axis=carriage" || fail "the fault line lacks its axis"
 
+ctl start >/dev/null  # the axes move while the browser looks at the scope strip
 if (. "$(dirname "$0")/browser_lib.sh" >/dev/null); then
   . "$(dirname "$0")/browser_lib.sh"
   for _ in $(seq 1 100); do curl -s -m 2 "$BASE/api/loom/$ID" | grep -q '"status":{' && break; sleep 0.1; done
