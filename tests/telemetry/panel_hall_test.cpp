@@ -158,6 +158,22 @@ TEST(PanelHall, TextThatIsNotUtf8IsReplacedNeverThrown) {
   EXPECT_TRUE(nlohmann::json::accept(all));
 }
 
+// Item 7: a fault the panel heard carries its wall-clock stamp (the page shows it beside loop time).
+TEST(PanelHall, FaultsCarryTheirWallClockStamp) {
+  Hall hall;
+  loomlcm::fault_t f{};
+  f.loom_id = "L1";
+  f.kind = "first";
+  f.name = "drive_fault";
+  f.utime = 1'790'000'000'123'456;
+  f.time_s = 12.5;
+  hall.on_fault(f);
+  const auto j = hall.loom_json("L1").value();
+  ASSERT_EQ(j["faults"].size(), 1u);
+  EXPECT_EQ(j["faults"][0]["utime"].get<std::int64_t>(), 1'790'000'000'123'456);
+  EXPECT_EQ(j["faults"][0]["time_s"].get<double>(), 12.5);
+}
+
 TEST(PanelHall, RowsCarryTheKnottingTime) {
   Hall hall;
   loomlcm::row_t r{};

@@ -126,7 +126,7 @@ json weaver_json(const loomlcm::weaver_request_t& m) {
 }
 
 json fault_json(const loomlcm::fault_t& m) {
-  return {{"time_s", num(m.time_s)}, {"kind", m.kind},   {"name", m.name},   {"code", hex(m.code)},
+  return {{"time_s", num(m.time_s)}, {"utime", m.utime}, {"kind", m.kind},   {"name", m.name},   {"code", hex(m.code)},
           {"text", m.text},          {"axis", m.axis},   {"device_code", hex(m.device_code)},
           {"state", m.state},        {"row", m.row},     {"picks", m.pick},  {"beats", m.beat}};
 }

@@ -9,6 +9,7 @@
 //   POST /api/loom/<id>/pair  (body: the code from `loomctl ctl pair NAME`)  pair this client
 //   GET  /api/loom/<id>/authority   whether this client is paired (may give starting commands)
 //   GET  /api/loom/<id>/history     the loom's persisted fault history (faults.log), with --control-dir
+//   GET  /api/loom/<id>/faults.log  all of it, as a file to download
 //   GET  /api/loom/<id>/scope?axis=NAME   the last 30 s of one axis' position, velocity, following error
 // Read-only by default: nothing it receives over HTTP reaches the loom. With --control-dir DIR the
 // page offers pause / stop at row end to every client, and resume / acknowledge / "row knotted" only to
@@ -460,6 +461,33 @@ int main(int argc, char** argv) {
     auto j = loom::panel::fault_history_json(text, kHistoryShown);
     j["loom"] = loom;
     res.set_content(loom::panel::json_text(j), "application/json");
+  });
+  // The whole faults.log as a file for the technician's report (the page offers the link): the same
+  // text as `loomctl ctl faults`, through serve's socket.
+  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32})/faults\.log)", [&](const httplib::Request& req, httplib::Response& res) {
+    const std::string loom = req.matches[1];
+    res.set_header("Cache-Control", "no-store");
+    if (o.control_dir.empty()) {
+      res.status = 404;
+      res.set_content("read-only panel: the loom's faults.log is read through its control socket (--control-dir)\n",
+                      "text/plain; charset=utf-8");
+      return;
+    }
+    std::string text;
+    try {
+      text = loom::firmware::serve::control_request(control_socket_of(o, loom), on_behalf("faults", req, ""), 3000);
+    } catch (const std::exception& e) {
+      res.status = 503;
+      res.set_content(std::string(e.what()) + "\n", "text/plain; charset=utf-8");
+      return;
+    }
+    if (text.rfind("error:", 0) == 0 || text.rfind("refused:", 0) == 0) {
+      res.status = 502;
+      res.set_content(text, "text/plain; charset=utf-8");
+      return;
+    }
+    res.set_header("Content-Disposition", "attachment; filename=\"" + loom + "-faults.log\"");
+    res.set_content(text, "text/plain; charset=utf-8");
   });
   StreamSlots slots(o.max_streams, o.max_streams_per_client);
   svr.Get("/events", [&](const httplib::Request& req, httplib::Response& res) {

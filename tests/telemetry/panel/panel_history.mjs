@@ -16,7 +16,7 @@ let v = null;
 for (;;) {
   v = await evaluate(page, `(() => {
     const rows = [...document.querySelectorAll("#history tr[data-kind]")];
-    return { kinds: rows.map(r => r.dataset.kind), names: rows.map(r => r.children[2].textContent),
+    return { download: document.getElementById("faults-log")?.getAttribute("href") || null, kinds: rows.map(r => r.dataset.kind), names: rows.map(r => r.children[2].textContent),
              when: rows.map(r => r.children[0].textContent), live: document.querySelectorAll("#faults tr").length };
   })()`);
   if (v.kinds.includes("fault")) break;
@@ -25,6 +25,7 @@ for (;;) {
 const i = v.kinds.indexOf("fault");
 if (v.names[i] !== "drive_fault") fail(`history row ${JSON.stringify(v)}`);
 if (!/\(\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ\)/.test(v.when[i])) fail(`no wall-clock time: ${v.when[i]}`);
+if (v.download !== `/api/loom/${loomId}/faults.log`) fail(`no faults.log download link: ${v.download}`);
 if (v.live !== 0) fail("the panel's own fault list is not empty: it heard the fault (the test's premise)");
 // The scope strip: the first axis plotted, then the carriage picked from the list and plotted; the axes
 // table and the strips carry units and no scientific notation.

@@ -70,6 +70,10 @@ json "/api/loom/$ID/history" 'd["lines"][0]["detail"]' | grep -q "by local user 
   fail "the start line does not say who gave it"
 json "/api/loom/$ID/history" 'd["lines"][1]["detail"]' | grep -q "axis=carriage" || fail "the fault line lacks its axis"
 
+# The download: the whole faults.log, as `ctl faults` gives it, as an attachment.
+curl -s -m 5 -D "$WORK/dl.headers" -o "$WORK/dl.log" "$BASE/api/loom/$ID/faults.log"
+grep -qi "^content-disposition: attachment; filename=\"$ID-faults.log\"" "$WORK/dl.headers" || fail "faults.log is not offered as a file"
+cmp -s "$WORK/dl.log" <(ctl faults) || fail "the download differs from ctl faults"
 ctl start >/dev/null  # the axes move while the browser looks at the scope strip
 if (. "$(dirname "$0")/browser_lib.sh" >/dev/null); then
   . "$(dirname "$0")/browser_lib.sh"
@@ -84,5 +88,6 @@ fi
 
 start_panel panel_ro.log
 [[ $(curl -s -m 5 -o "$WORK/ro" -w '%{http_code}' "$BASE/api/loom/$ID/history") == 404 ]] || fail "a read-only panel read the history"
+[[ $(curl -s -m 5 -o /dev/null -w '%{http_code}' "$BASE/api/loom/$ID/faults.log") == 404 ]] || fail "a read-only panel gave faults.log"
 grep -q "control socket" "$WORK/ro" || fail "the read-only refusal does not say why: $(cat "$WORK/ro")"
 echo "panel_history: ok (the fault and the start command from before the restart, shown by a fresh panel)"
