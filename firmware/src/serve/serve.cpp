@@ -217,6 +217,10 @@ int serve_main(const ServeArgs& a) {
   // Whether the counters on disk lag what was woven (the last save failed; the loop refuses an ack until a
   // retried save succeeds): the desk refuses `ctl ack` with the reason instead of answering `ok`.
   std::atomic<bool> counters_unsaved{false};
+  // The knotting heads' open request of the weaver, in words (the reporter sets it when the loop reports
+  // it): the `next` that answers it says which, in its reply and its audit (journal, faults.log, COMMAND).
+  std::mutex weaver_mu;
+  std::string weaver_request;
   Pairings pairings;
   OperatorDesk desk(pairings, a.iface);
   // The audit as LCM events (COMMAND), for the service's whole life: sessions' publishers come and go.
@@ -235,7 +239,14 @@ int serve_main(const ServeArgs& a) {
     server = std::make_unique<ControlServer>(socket_path, a.group, [&](const ControlRequest& req) -> std::string {
       LoomView view = view_of(link, cfg.sequencer.knotting);
       view.counters_unsaved = counters_unsaved.load(std::memory_order_acquire);
-      const Decision d = desk.decide(req, view, static_cast<std::int64_t>(std::time(nullptr)));
+      Decision d = desk.decide(req, view, static_cast<std::int64_t>(std::time(nullptr)));
+      if (d.post == Command::kNext && view.state == sequencer::State::kKnotting) {
+        std::lock_guard<std::mutex> lock(weaver_mu);
+        // Taken once: a later `next` before the reporter has heard the next request says plain `ok next`,
+        // never the words of a request already answered.
+        if (!weaver_request.empty()) d.reply = "ok next: answered " + weaver_request + "\n";
+        weaver_request.clear();
+      }
       if (d.read == Decision::Read::kStatus) return status_text(link, cfg.loom_id, cfg.recipe.design.get(), design_progress);
       if (d.read == Decision::Read::kFaults) {
         std::string out;
@@ -447,7 +458,10 @@ int serve_main(const ServeArgs& a) {
           // The loom waits for the weaver (lamp amber, buzzer): logged for the shift's record; the panel and
           // `ctl status` show it. Nothing changed in the counters.
           if (const sequencer::KnotProgram* p = machine->knot_program()) {
-            log(Severity::kNotice, "weaver asked: %s", sequencer::describe(e.request, *p).c_str());
+            const std::string asked = sequencer::describe(e.request, *p);
+            log(Severity::kNotice, "weaver asked: %s", asked.c_str());
+            std::lock_guard<std::mutex> lock(weaver_mu);
+            weaver_request = asked;
           }
           return;
         case RunEvent::Kind::kPickDone:
