@@ -221,6 +221,7 @@ int serve_main(const ServeArgs& a) {
   // it): the `next` that answers it says which, in its reply and its audit (journal, faults.log, COMMAND).
   std::mutex weaver_mu;
   std::string weaver_request;
+  bool weaver_answered_unheard = false;  // a `next` answered a request whose words had not come yet
   Pairings pairings;
   OperatorDesk desk(pairings, a.iface);
   // The audit as LCM events (COMMAND), for the service's whole life: sessions' publishers come and go.
@@ -242,9 +243,10 @@ int serve_main(const ServeArgs& a) {
       Decision d = desk.decide(req, view, static_cast<std::int64_t>(std::time(nullptr)));
       if (d.post == Command::kNext && view.state == sequencer::State::kKnotting) {
         std::lock_guard<std::mutex> lock(weaver_mu);
-        // Taken once: a later `next` before the reporter has heard the next request says plain `ok next`,
-        // never the words of a request already answered.
+        // Taken once: a `next` before the reporter has heard the request it answers says plain `ok next`,
+        // and that request's words, when they come, are dropped: never named by a later `next`.
         if (!weaver_request.empty()) d.reply = "ok next: answered " + weaver_request + "\n";
+        weaver_answered_unheard = weaver_request.empty();
         weaver_request.clear();
       }
       if (d.read == Decision::Read::kStatus) return status_text(link, cfg.loom_id, cfg.recipe.design.get(), design_progress);
@@ -461,7 +463,8 @@ int serve_main(const ServeArgs& a) {
             const std::string asked = sequencer::describe(e.request, *p);
             log(Severity::kNotice, "weaver asked: %s", asked.c_str());
             std::lock_guard<std::mutex> lock(weaver_mu);
-            weaver_request = asked;
+            if (weaver_answered_unheard) weaver_answered_unheard = false;  // already answered
+            else weaver_request = asked;
           }
           return;
         case RunEvent::Kind::kPickDone:
