@@ -416,3 +416,46 @@ TEST(PanelScope, EachAxisKeepsTheLastWindowOfSamples) {
   w.on_axes(bad);
   EXPECT_TRUE(w.scope_json("A", "helix").value()["position"][1].is_null());
 }
+
+// Item 7: the row report as a download — every row kept (more than the page's table), CSV, wall-clock
+// time and loop time, fixed notation. The expected lines are written out here.
+TEST(PanelHall, TheRowReportIsCsvOfEveryRowKept) {
+  HallLimits lim;
+  lim.rows_kept = 2;
+  lim.rows_report = 3;
+  Hall h(lim);
+  for (int r = 1; r <= 4; ++r) {
+    loomlcm::row_t m{};
+    m.loom_id = "A";
+    m.row = r;
+    m.utime = 1'790'000'000'000'000 + r * 1'000'000;  // 2026-09-21T14:13:2{1..4}Z (date -u -d @1790000001)
+    m.time_s = 10.0 * r;
+    m.row_s = 9.5;
+    m.shed_s = 0.5;
+    m.pick_s = 1.25;
+    m.beat_s = 7.75;
+    m.beats = 15;
+    m.carriage_steps = 14;
+    m.force_measured = r != 3;
+    m.force_min_n = 0.00001;  // printed fixed, never 1e-05
+    m.force_mean_n = 89.5;
+    m.force_max_n = 91;
+    m.beats_in_band = 15;
+    m.band_min_n = 80;
+    m.band_max_n = 100;
+    h.on_row(m);
+  }
+  EXPECT_EQ(h.loom_json("A").value()["rows"].size(), 2u);  // the page's table
+  const std::string csv = h.rows_csv("A").value();
+  const std::string want =
+      "utc,loop_time_s,row,row_s,shed_s,pick_s,beat_s,beats,carriage_steps,force_min_n,force_mean_n,force_max_n,"
+      "beats_in_band,band_min_n,band_max_n,knotting_s,knot_s,weaver_s,knots_tied,knots_retried,knots_by_hand\n"
+      "2026-09-21T14:13:22Z,20.000000,2,9.500000,0.500000,1.250000,7.750000,15,14,0.000010,89.500000,91.000000,15,"
+      "80.000000,100.000000,0.000000,0.000000,0.000000,0,0,0\n"
+      "2026-09-21T14:13:23Z,30.000000,3,9.500000,0.500000,1.250000,7.750000,15,14,,,,15,"
+      "80.000000,100.000000,0.000000,0.000000,0.000000,0,0,0\n"
+      "2026-09-21T14:13:24Z,40.000000,4,9.500000,0.500000,1.250000,7.750000,15,14,0.000010,89.500000,91.000000,15,"
+      "80.000000,100.000000,0.000000,0.000000,0.000000,0,0,0\n";
+  EXPECT_EQ(csv, want);
+  EXPECT_FALSE(h.rows_csv("B").has_value());
+}

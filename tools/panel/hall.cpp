@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <ctime>
 
 namespace loom::panel {
 
@@ -264,7 +266,7 @@ void Hall::on_row(const loomlcm::row_t& m) {
   std::lock_guard lock(mu_);
   if (Loom* l = loom(m.loom_id, m.utime)) {
     l->rows.push_back(m);
-    while (l->rows.size() > limits_.rows_kept) l->rows.pop_front();
+    while (l->rows.size() > std::max(limits_.rows_kept, limits_.rows_report)) l->rows.pop_front();
     changed();
   }
 }
@@ -378,7 +380,8 @@ std::optional<json> Hall::loom_json(const std::string& id) const {
   j["current_row"] = beats(l.current);
   j["previous_row"] = beats(l.previous);
   json rows = json::array();
-  for (const auto& r : l.rows) rows.push_back(row_json(r));
+  const std::size_t first = l.rows.size() > limits_.rows_kept ? l.rows.size() - limits_.rows_kept : 0;
+  for (std::size_t i = first; i < l.rows.size(); ++i) rows.push_back(row_json(l.rows[i]));
   j["rows"] = rows;
   json faults = json::array();
   for (const auto& f : l.faults) faults.push_back(fault_json(f));
@@ -390,6 +393,46 @@ std::optional<json> Hall::loom_json(const std::string& id) const {
   j["weaver_requests"] = weaver;
   j["controls"] = false;  // the HTTP side says whether it may act on this loom (main.cpp)
   return j;
+}
+
+namespace {
+// A number for the CSV: fixed notation with 6 decimals (a spreadsheet reads it; no 1e-05), empty when not finite.
+std::string csv_num(double v) {
+  if (!std::isfinite(v)) return "";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.6f", v);
+  return buf;
+}
+std::string utc_of(std::int64_t utime) {
+  if (utime <= 0) return "";
+  const std::time_t t = static_cast<std::time_t>(utime / 1'000'000);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+}  // namespace
+
+std::optional<std::string> Hall::rows_csv(const std::string& id) const {
+  std::lock_guard lock(mu_);
+  const auto it = looms_.find(id);
+  if (it == looms_.end()) return std::nullopt;
+  std::string out =
+      "utc,loop_time_s,row,row_s,shed_s,pick_s,beat_s,beats,carriage_steps,force_min_n,force_mean_n,force_max_n,"
+      "beats_in_band,band_min_n,band_max_n,knotting_s,knot_s,weaver_s,knots_tied,knots_retried,knots_by_hand\n";
+  for (const loomlcm::row_t& r : it->second.rows) {
+    const bool f = r.force_measured;
+    out += utc_of(r.utime) + "," + csv_num(r.time_s) + "," + std::to_string(r.row) + "," + csv_num(r.row_s) + "," +
+           csv_num(r.shed_s) + "," + csv_num(r.pick_s) + "," + csv_num(r.beat_s) + "," + std::to_string(r.beats) + "," +
+           std::to_string(r.carriage_steps) + "," + (f ? csv_num(r.force_min_n) : "") + "," +
+           (f ? csv_num(r.force_mean_n) : "") + "," + (f ? csv_num(r.force_max_n) : "") + "," +
+           std::to_string(r.beats_in_band) + "," + csv_num(r.band_min_n) + "," + csv_num(r.band_max_n) + "," +
+           csv_num(r.knotting_s) + "," + csv_num(r.knot_s) + "," + csv_num(r.weaver_s) + "," +
+           std::to_string(r.knots_tied) + "," + std::to_string(r.knots_retried) + "," + std::to_string(r.knots_by_hand) +
+           "\n";
+  }
+  return out;
 }
 
 std::optional<json> Hall::scope_json(const std::string& id, const std::string& axis) const {

@@ -31,7 +31,8 @@ namespace loom::panel {
 
 struct HallLimits {
   std::size_t looms = 256;        // loom ids kept; more are counted as ignored
-  std::size_t rows_kept = 20;     // row summaries per loom
+  std::size_t rows_kept = 20;     // row summaries per loom in its JSON (the page's table)
+  std::size_t rows_report = 500;  // row summaries per loom for the row report download (rows.csv)
   std::size_t faults_kept = 50;   // faults per loom
   std::size_t beats_per_row = 512;  // beats kept per row (the firmware caps a row at 256)
   std::size_t weaver_requests_kept = 20;  // weaver requests per loom (knotting heads)
@@ -78,6 +79,9 @@ class Hall {
   // The scope strip of one axis: loop times and that axis' position, velocity and following error (SI,
   // as sent), oldest first, with every axis name; nullopt when the loom was never heard. An unknown axis
   // gives empty traces.
+  // The row report: every row summary kept (the newest rows_report) as CSV with a header line, wall-clock
+  // time (UTC) and loop time first, SI units in the column names; nullopt when the loom was never heard.
+  std::optional<std::string> rows_csv(const std::string& id) const;
   std::optional<nlohmann::json> scope_json(const std::string& id, const std::string& axis) const;
   // Changes so far; wait_for_change returns the version once it differs from `seen` (or at timeout).
   std::uint64_t version() const;

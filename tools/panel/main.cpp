@@ -10,6 +10,7 @@
 //   GET  /api/loom/<id>/authority   whether this client is paired (may give starting commands)
 //   GET  /api/loom/<id>/history     the loom's persisted fault history (faults.log), with --control-dir
 //   GET  /api/loom/<id>/faults.log  all of it, as a file to download
+//   GET  /api/loom/<id>/rows.csv    the row report: every row the panel kept (newest 500), as CSV
 //   GET  /api/loom/<id>/scope?axis=NAME   the last 30 s of one axis' position, velocity, following error
 // Read-only by default: nothing it receives over HTTP reaches the loom. With --control-dir DIR the
 // page offers pause / stop at row end to every client, and resume / acknowledge / "row knotted" only to
@@ -438,6 +439,19 @@ int main(int argc, char** argv) {
     }
     res.set_content(loom::panel::json_text({{"loom", loom}, {"may_start", may_start}, {"client", req.remote_addr}, {"reply", text}}),
                     "application/json");
+  });
+  // The row report: every row summary the panel kept for this loom (the newest 500) as CSV to download.
+  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32}(?:~replay)?)/rows\.csv)", [&](const httplib::Request& req, httplib::Response& res) {
+    const std::string loom = req.matches[1];
+    res.set_header("Cache-Control", "no-store");
+    const auto csv = hall.rows_csv(loom);
+    if (!csv) {
+      res.status = 404;
+      res.set_content("loom " + loom + " not heard\n", "text/plain; charset=utf-8");
+      return;
+    }
+    res.set_header("Content-Disposition", "attachment; filename=\"" + loom + "-rows.csv\"");
+    res.set_content(*csv, "text/csv; charset=utf-8");
   });
   // The loom's persisted fault history (faults.log, through serve's `faults` request): it survives a
   // restart of the panel, serve or the board, unlike what the panel heard on LCM. A GET: reading only.

@@ -75,6 +75,13 @@ curl -s -m 5 -D "$WORK/dl.headers" -o "$WORK/dl.log" "$BASE/api/loom/$ID/faults.
 grep -qi "^content-disposition: attachment; filename=\"$ID-faults.log\"" "$WORK/dl.headers" || fail "faults.log is not offered as a file"
 cmp -s "$WORK/dl.log" <(ctl faults) || fail "the download differs from ctl faults"
 ctl start >/dev/null  # the axes move while the browser looks at the scope strip
+# The row report: once a row is woven (heard by this panel), it is in rows.csv, offered as a file.
+for _ in $(seq 1 200); do (( $(curl -s -m 2 "$BASE/api/loom/$ID/rows.csv" | wc -l) >= 2 )) && break; sleep 0.1; done
+curl -s -m 5 -D "$WORK/rows.headers" -o "$WORK/rows.csv" "$BASE/api/loom/$ID/rows.csv"
+grep -qi "^content-disposition: attachment; filename=\"$ID-rows.csv\"" "$WORK/rows.headers" || fail "rows.csv is not offered as a file"
+head -1 "$WORK/rows.csv" | grep -q '^utc,loop_time_s,row,row_s,' || fail "rows.csv header: $(head -1 "$WORK/rows.csv")"
+sed -n 2p "$WORK/rows.csv" | grep -Eq '^[0-9]{4}-[0-9]{2}-[0-9]{2}T[0-9:]{8}Z,[0-9.]+,[0-9]+,' || fail "rows.csv line: $(sed -n 2p "$WORK/rows.csv")"
+grep -Eq '[0-9][eE][-+][0-9]' "$WORK/rows.csv" && fail "scientific notation in rows.csv"
 if (. "$(dirname "$0")/browser_lib.sh" >/dev/null); then
   . "$(dirname "$0")/browser_lib.sh"
   for _ in $(seq 1 100); do curl -s -m 2 "$BASE/api/loom/$ID" | grep -q '"status":{' && break; sleep 0.1; done
