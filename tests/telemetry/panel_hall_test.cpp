@@ -5,9 +5,13 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <unistd.h>
 #include <limits>
 
 #include "fault_history.hpp"
+#include "recorder.hpp"
 #include "hall.hpp"
 #include "udpm_receiver.hpp"
 #include "synthetic_loom.hpp"
@@ -458,4 +462,53 @@ TEST(PanelHall, TheRowReportIsCsvOfEveryRowKept) {
       "80.000000,100.000000,0.000000,0.000000,0.000000,0,0,0\n";
   EXPECT_EQ(csv, want);
   EXPECT_FALSE(h.rows_csv("B").has_value());
+}
+
+// Item 7: an lcmlog of the last minutes. What the recorder writes is read back by LCM's own log reader;
+// the window and the byte budget bound it.
+TEST(PanelRecorder, TheLastMinutesAreAnLcmLogLcmReads) {
+  Recorder rec(60.0, 1 << 20);
+  const std::int64_t t0 = 1'790'000'000'000'000;
+  for (int k = 0; k < 130; ++k) {  // one message a second for 130 s, payload "m<k>"
+    const std::string payload = "m" + std::to_string(k);
+    rec.add("A", k % 2 ? "LOOM.A.STATUS" : "LOOM.A.AXES", payload.data(), payload.size(), t0 + k * 1'000'000LL);
+  }
+  rec.add("B", "LOOM.B.STATUS", "b", 1, t0);
+  const auto bytes = rec.lcmlog("A", t0 + 129 * 1'000'000LL);
+  ASSERT_TRUE(bytes.has_value());
+  const std::string path = (std::filesystem::temp_directory_path() / ("panel_rec_" + std::to_string(::getpid()))).string();
+  {
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    std::fwrite(bytes->data(), 1, bytes->size(), f);
+    std::fclose(f);
+  }
+  lcm::LogFile log(path, "r");
+  ASSERT_TRUE(log.good());
+  std::vector<std::string> got;
+  std::int64_t first_us = 0, last_us = 0;
+  while (const lcm::LogEvent* ev = log.readNextEvent()) {
+    got.push_back(ev->channel + "=" + std::string(static_cast<const char*>(ev->data), static_cast<std::size_t>(ev->datalen)));
+    if (got.size() == 1) first_us = ev->timestamp;
+    last_us = ev->timestamp;
+  }
+  std::remove(path.c_str());
+  // The last 60 s before t = 129 s: messages 69..129 (61 of them).
+  ASSERT_EQ(got.size(), 61u);
+  EXPECT_EQ(got.front(), "LOOM.A.STATUS=m69");
+  EXPECT_EQ(got.back(), "LOOM.A.STATUS=m129");
+  EXPECT_EQ(got[1], "LOOM.A.AXES=m70");
+  EXPECT_EQ(first_us, t0 + 69'000'000);
+  EXPECT_EQ(last_us, t0 + 129'000'000);
+  EXPECT_FALSE(rec.lcmlog("C", t0).has_value());
+  // The byte budget for all looms: the loom holding the most gives up its oldest messages.
+  Recorder small(600.0, 10 * (64 + 16));
+  for (int k = 0; k < 20; ++k) small.add("A", "LOOM.A.AXES", "0123456789abcdef", 0, t0 + k);  // 11 + 0 + 64 each
+  EXPECT_LE(small.bytes(), 10u * (64 + 16));
+  small.add("B", "LOOM.B.AXES", "x", 1, t0 + 30);
+  EXPECT_TRUE(small.lcmlog("B", t0 + 30).has_value());  // B kept: A, the largest, gave way
+  EXPECT_LE(small.bytes(), 10u * (64 + 16));
+  Recorder off(0.0, 1 << 20);
+  off.add("A", "LOOM.A.AXES", "x", 1, t0);
+  EXPECT_FALSE(off.lcmlog("A", t0).has_value());
 }

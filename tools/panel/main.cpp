@@ -11,6 +11,7 @@
 //   GET  /api/loom/<id>/history     the loom's persisted fault history (faults.log), with --control-dir
 //   GET  /api/loom/<id>/faults.log  all of it, as a file to download
 //   GET  /api/loom/<id>/rows.csv    the row report: every row the panel kept (newest 500), as CSV
+//   GET  /api/loom/<id>/last.lcmlog every message of that loom heard in the last 5 minutes (--lcmlog-minutes)
 //   GET  /api/loom/<id>/scope?axis=NAME   the last 30 s of one axis' position, velocity, following error
 // Read-only by default: nothing it receives over HTTP reaches the loom. With --control-dir DIR the
 // page offers pause / stop at row end to every client, and resume / acknowledge / "row knotted" only to
@@ -40,6 +41,7 @@
 
 #include "fault_history.hpp"
 #include "hall.hpp"
+#include "recorder.hpp"
 #include "request_gate.hpp"
 #include "udpm_receiver.hpp"
 #include "loom/firmware/serve/control_socket.hpp"
@@ -72,6 +74,8 @@ struct PanelOptions {
   int max_streams = 16;               // event streams at once (each holds a thread); more get 503
   int max_streams_per_client = 4;     // per client address
   double replay_after_s = 10.0;       // older stamps are a replayed recording: shown apart, marked (hall.hpp)
+  double lcmlog_minutes = 5.0;        // the flight recorder's window (0: off)
+  double lcmlog_mib = 64.0;           // its memory for all looms together
   std::vector<std::string> hosts;     // --host: names the hall uses for this panel (Host header check)
   // Operator buttons act through the board's local control sockets, <control_dir>/<loom id>.sock,
   // never over LCM. Empty = read-only. The page shows buttons only when the JSON says "controls": true
@@ -154,7 +158,8 @@ bool controls_for(const PanelOptions& o, const std::string& loom) {
 // 100 ms and the rest are skipped before decoding.
 class Router {
  public:
-  Router(Hall& hall, std::string prefix) : hall_(hall), prefix_(std::move(prefix) + ".") {}
+  Router(Hall& hall, loom::panel::Recorder& recorder, std::string prefix)
+      : hall_(hall), recorder_(recorder), prefix_(std::move(prefix) + ".") {}
   // Live traffic only: a log replayed at full speed would otherwise keep just its first AXES.
   void throttle_axes(bool on) { throttle_axes_ = on; }
 
@@ -165,6 +170,12 @@ class Router {
     if (dot == std::string_view::npos) return;
     const std::string_view id = rest.substr(0, dot), kind = rest.substr(dot + 1);
     if (!loom::telemetry::loom_id_error(id).empty()) return;
+    // Every message as received (before throttling) into the flight recorder: the lcmlog download.
+    if (recorder_.enabled()) {
+      recorder_.add(id, channel, data, size,
+                    std::chrono::duration_cast<std::chrono::microseconds>(
+                        std::chrono::system_clock::now().time_since_epoch()).count());
+    }
     const int len = static_cast<int>(size);
     if (kind == "STATUS") {
       decode<loomlcm::status_t>(data, len, [&](const auto& m) { hall_.on_status(m); });
@@ -210,6 +221,7 @@ class Router {
     use(m);
   }
   Hall& hall_;
+  loom::panel::Recorder& recorder_;
   std::string prefix_;
   std::map<std::string, std::chrono::steady_clock::time_point, std::less<>> last_axes_;
   std::uint64_t decode_errors_ = 0;
@@ -251,6 +263,13 @@ int main(int argc, char** argv) {
   app.add_option("--min-push-interval-s", o.min_push_interval_s, "shortest gap between two live updates of a page")
       ->check(CLI::Range(0.01, 60.0))
       ->capture_default_str();
+  app.add_option("--lcmlog-minutes", o.lcmlog_minutes,
+                 "keep every message of the last this many minutes per loom, downloadable as an lcmlog (0: off)")
+      ->check(CLI::Range(0.0, 60.0))
+      ->capture_default_str();
+  app.add_option("--lcmlog-mib", o.lcmlog_mib, "memory for those messages, all looms together (MiB)")
+      ->check(CLI::Range(1.0, 4096.0))
+      ->capture_default_str();
   app.add_option("--replay-after-s", o.replay_after_s,
                  "a message stamped longer ago than this is a replayed recording: shown apart as <id>~replay and "
                  "marked REPLAY (0: every message is live)")
@@ -272,7 +291,8 @@ int main(int argc, char** argv) {
   loom::panel::HallLimits limits;
   limits.replay_after_s = o.replay_after_s;
   Hall hall(limits);
-  Router router(hall, o.channel_prefix);
+  loom::panel::Recorder recorder(o.lcmlog_minutes * 60.0, static_cast<std::size_t>(o.lcmlog_mib * 1024 * 1024));
+  Router router(hall, recorder, o.channel_prefix);
   // udpm (the normal case): the lean batched receiver. Anything else: LCM's own provider.
   std::unique_ptr<loom::panel::UdpmReceiver> udpm;
   std::unique_ptr<lcm::LCM> lcm;
@@ -439,6 +459,22 @@ int main(int argc, char** argv) {
     }
     res.set_content(loom::panel::json_text({{"loom", loom}, {"may_start", may_start}, {"client", req.remote_addr}, {"reply", text}}),
                     "application/json");
+  });
+  // The flight recorder's last minutes of one loom, as an lcmlog to replay (loom-replay) or open in lcm-spy.
+  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32})/last\.lcmlog)", [&](const httplib::Request& req, httplib::Response& res) {
+    const std::string loom = req.matches[1];
+    res.set_header("Cache-Control", "no-store");
+    const auto log = recorder.lcmlog(loom, std::chrono::duration_cast<std::chrono::microseconds>(
+                                               std::chrono::system_clock::now().time_since_epoch()).count());
+    if (!log) {
+      res.status = 404;
+      res.set_content(recorder.enabled() ? "nothing of loom " + loom + " heard in the last minutes\n"
+                                         : std::string("the recorder is off (--lcmlog-minutes 0)\n"),
+                      "text/plain; charset=utf-8");
+      return;
+    }
+    res.set_header("Content-Disposition", "attachment; filename=\"" + loom + "-last.lcmlog\"");
+    res.set_content(*log, "application/octet-stream");
   });
   // The row report: every row summary the panel kept for this loom (the newest 500) as CSV to download.
   svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32}(?:~replay)?)/rows\.csv)", [&](const httplib::Request& req, httplib::Response& res) {

@@ -6,12 +6,14 @@
 # page's "Fault history" table with wall-clock times (skipped without chromium/node). A read-only panel
 # (no --control-dir) answers 404 saying why. The same page plots the scope strip of the first axis and,
 # picked from its list, of the carriage (units, no scientific notation). Writes <out>/loom_panel_history.png.
-# Usage: panel_history.sh <loomctl> <loom-panel> <drive_fault scene> <out dir>
+# The row report (rows.csv) and the last minutes as an lcmlog (read back by loom-monitor) are downloaded.
+# Usage: panel_history.sh <loomctl> <loom-panel> <drive_fault scene> <out dir> <loom-monitor>
 set -euo pipefail
 LOOMCTL=$1
 PANEL=$2
 SCENE=$3
 OUT=$4
+MONITOR=$5
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/loom_panel_history.XXXXXX")
 PIDS=()
 fail() { echo "FAIL: $*" >&2; for f in "$WORK"/*.log; do echo "--- $f" >&2; tail -15 "$f" >&2; done; exit 1; }
@@ -82,6 +84,13 @@ grep -qi "^content-disposition: attachment; filename=\"$ID-rows.csv\"" "$WORK/ro
 head -1 "$WORK/rows.csv" | grep -q '^utc,loop_time_s,row,row_s,' || fail "rows.csv header: $(head -1 "$WORK/rows.csv")"
 sed -n 2p "$WORK/rows.csv" | grep -Eq '^[0-9]{4}-[0-9]{2}-[0-9]{2}T[0-9:]{8}Z,[0-9.]+,[0-9]+,' || fail "rows.csv line: $(sed -n 2p "$WORK/rows.csv")"
 grep -Eq '[0-9][eE][-+][0-9]' "$WORK/rows.csv" && fail "scientific notation in rows.csv"
+# The last minutes as an lcmlog: read back by loom-monitor through LCM's file provider (its own reader).
+curl -s -m 5 -D "$WORK/lcmlog.headers" -o "$WORK/last.lcmlog" "$BASE/api/loom/$ID/last.lcmlog"
+grep -qi "^content-disposition: attachment; filename=\"$ID-last.lcmlog\"" "$WORK/lcmlog.headers" || fail "last.lcmlog not offered as a file"
+"$MONITOR" --lcm-url "file://$WORK/last.lcmlog?mode=r" --loom-id "$ID" --channel status \
+  --timeout-s 10 >"$WORK/monitor.out" 2>"$WORK/monitor.log" || true
+grep -q "^loom=$ID .*state=" "$WORK/monitor.out" || fail "the downloaded lcmlog holds no STATUS of $ID: $(head -3 "$WORK/monitor.out")"
+lcmlog_status=$(grep -c "^loom=$ID " "$WORK/monitor.out")
 if (. "$(dirname "$0")/browser_lib.sh" >/dev/null); then
   . "$(dirname "$0")/browser_lib.sh"
   for _ in $(seq 1 100); do curl -s -m 2 "$BASE/api/loom/$ID" | grep -q '"status":{' && break; sleep 0.1; done
@@ -97,4 +106,5 @@ start_panel panel_ro.log
 [[ $(curl -s -m 5 -o "$WORK/ro" -w '%{http_code}' "$BASE/api/loom/$ID/history") == 404 ]] || fail "a read-only panel read the history"
 [[ $(curl -s -m 5 -o /dev/null -w '%{http_code}' "$BASE/api/loom/$ID/faults.log") == 404 ]] || fail "a read-only panel gave faults.log"
 grep -q "control socket" "$WORK/ro" || fail "the read-only refusal does not say why: $(cat "$WORK/ro")"
-echo "panel_history: ok (the fault and the start command from before the restart, shown by a fresh panel)"
+echo "panel_history: ok (the fault and the start command from before the restart, shown by a fresh panel;" \
+  "rows.csv; last.lcmlog with $lcmlog_status STATUS messages)"
