@@ -108,6 +108,19 @@ TEST(OperatorDesk, RefusalsSayWhy) {
   EXPECT_EQ(desk.decide(local("start"), fault, kNow).reply,
             "refused: start: drive_fault is latched: acknowledge it first (ctl ack)\n");
   EXPECT_EQ(desk.decide(local("ack"), view(State::kPick), kNow).reply, "refused: ack: no fault is latched (state pick)\n");
+  // The counters woven are not yet on disk (full disk): an ack would re-arm from the file's older counts,
+  // so the loop refuses it; the reply must say so, not `ok ack` (issue 22, item 6).
+  LoomView unsaved = view(State::kFault);
+  unsaved.fault = sequencer::Fault::kCountersNotSaved;
+  unsaved.counters_unsaved = true;
+  const Decision ack_unsaved = desk.decide(local("ack"), unsaved, kNow);
+  EXPECT_EQ(ack_unsaved.reply,
+            "refused: ack: the counters woven are not on disk yet (the last save failed): free space in the state "
+            "directory; the save is retried every second, then acknowledge\n");
+  EXPECT_FALSE(ack_unsaved.post.has_value());
+  EXPECT_TRUE(ack_unsaved.audit);
+  unsaved.counters_unsaved = false;  // the retried save went through
+  EXPECT_EQ(desk.decide(local("ack"), unsaved, kNow).reply, "ok ack\n");
   LoomView idle = view(State::kIdle);
   idle.estop_ok = false;
   EXPECT_EQ(desk.decide(local("start"), idle, kNow).reply, "refused: start: the e-stop chain is open: close it first\n");
@@ -135,6 +148,25 @@ TEST(OperatorDesk, WhoGaveTheCommandIsTheKernelsWordAndThePanelsClient) {
   EXPECT_EQ(desk.decide(local("pause"), view(State::kPick), kNow).who, "local user anna (uid 1000, pid 4242)");
   EXPECT_EQ(desk.decide(local("pause via=panel client=10.0.0.7"), view(State::kPick), kNow).who,
             "panel client 10.0.0.7 (not paired) via local user anna (uid 1000, pid 4242)");
+  // The COMMAND event's station.
+  EXPECT_EQ(desk.decide(local("pause"), view(State::kPick), kNow).station, "local");
+  EXPECT_EQ(desk.decide(local("pause via=panel client=10.0.0.7"), view(State::kPick), kNow).station, "panel");
+}
+
+// The I/O module's buttons go to the loop directly; their audit carries what the same command from the
+// socket would have answered in the state of the press.
+TEST(OperatorDesk, AButtonPressIsAnsweredAsTheSameCommandWouldBe) {
+  Pairings pairings;
+  OperatorDesk desk(pairings, "");
+  EXPECT_EQ(desk.answer_in_state("start", view(State::kIdle)), "ok start");
+  EXPECT_EQ(desk.answer_in_state("start", view(State::kPick)), "refused: start: already weaving (state pick)");
+  EXPECT_EQ(desk.answer_in_state("pause", view(State::kPick)), "ok pause");
+  EXPECT_EQ(desk.answer_in_state("ack", view(State::kPick)), "refused: ack: no fault is latched (state pick)");
+  LoomView open = view(State::kFault);
+  open.estop_ok = false;
+  EXPECT_EQ(desk.answer_in_state("ack", open),
+            "refused: ack: the e-stop chain is still open: close it (release the e-stop), then acknowledge");
+  EXPECT_EQ(desk.answer_in_state("ack", view(State::kFault)), "ok ack");
 }
 
 TEST(OperatorDesk, PairingIsDoneAtTheLoomCodesExpireAndTokensAreRevocable) {

@@ -167,7 +167,10 @@ wait_for "$work/d.sock" fault counters_not_saved 60
 woven=$(field "$work/d.sock" rows)
 on_disk=$(grep -o '"rows":[0-9]*' "$work/disk/state/counters.json" | cut -d: -f2)
 ((on_disk < woven)) || fail "the file kept up ($on_disk rows) with the woven $woven: the disk did not fill"
-ctl "$work/d.sock" ack >/dev/null || true
+rc=0
+reply=$(ctl "$work/d.sock" ack 2>&1) || rc=$?
+((rc != 0)) || fail "ctl ack exited 0 while the counters could not be saved: $reply"
+[[ $reply == "refused: ack: the counters woven are not on disk yet"* ]] || fail "ctl ack answered '$reply' while the save fails"
 sleep 1
 [[ $(field "$work/d.sock" state) == fault ]] || fail "ack re-armed while the counters could not be saved: $(ctl "$work/d.sock" status)"
 [[ $(field "$work/d.sock" rows) == "$woven" ]] || fail "rows changed from $woven under a refused ack"
@@ -181,5 +184,5 @@ ctl "$work/d.sock" ack >/dev/null
 wait_for "$work/d.sock" state idle 10
 [[ $(field "$work/d.sock" rows) == "$woven" ]] || fail "re-armed at rows $(field "$work/d.sock" rows), woven $woven"
 kill -TERM "$d"; wait "$d" || fail "serve exited $? on SIGTERM"
-echo "full disk while weaving: ack refused at $woven woven / $on_disk on disk, accepted after the retried save, re-armed at $woven: ok"
+echo "full disk while weaving: ack refused ('$reply') at $woven woven / $on_disk on disk, accepted after the retried save, re-armed at $woven: ok"
 echo "serve_service_test: ok"

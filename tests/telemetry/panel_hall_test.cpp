@@ -5,8 +5,13 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <unistd.h>
 #include <limits>
 
+#include "fault_history.hpp"
+#include "recorder.hpp"
 #include "hall.hpp"
 #include "udpm_receiver.hpp"
 #include "synthetic_loom.hpp"
@@ -157,6 +162,22 @@ TEST(PanelHall, TextThatIsNotUtf8IsReplacedNeverThrown) {
   EXPECT_TRUE(nlohmann::json::accept(all));
 }
 
+// Item 7: a fault the panel heard carries its wall-clock stamp (the page shows it beside loop time).
+TEST(PanelHall, FaultsCarryTheirWallClockStamp) {
+  Hall hall;
+  loomlcm::fault_t f{};
+  f.loom_id = "L1";
+  f.kind = "first";
+  f.name = "drive_fault";
+  f.utime = 1'790'000'000'123'456;
+  f.time_s = 12.5;
+  hall.on_fault(f);
+  const auto j = hall.loom_json("L1").value();
+  ASSERT_EQ(j["faults"].size(), 1u);
+  EXPECT_EQ(j["faults"][0]["utime"].get<std::int64_t>(), 1'790'000'000'123'456);
+  EXPECT_EQ(j["faults"][0]["time_s"].get<double>(), 12.5);
+}
+
 TEST(PanelHall, RowsCarryTheKnottingTime) {
   Hall hall;
   loomlcm::row_t r{};
@@ -270,4 +291,224 @@ TEST(PanelUdpm, ReceivesWhatLcmPublishes) {
     });
   }
   EXPECT_EQ(got, 1);
+}
+
+// Issue 22: a recording replayed onto the live group never mixes with the live loom of the same id.
+// A message stamped longer ago than replay_after_s is a replay: it is kept apart under "<id>~replay"
+// (which no live loom id can be) and marked; the live loom's picture is untouched by it.
+TEST(PanelHall, AReplayedRecordingIsKeptApartFromTheLiveLoomAndMarked) {
+  HallLimits lim;
+  lim.replay_after_s = 10.0;
+  const std::int64_t now_us = 1'800'000'000'000'000;
+  Hall h(lim, [now_us] { return now_us; });
+  loomlcm::status_t live = status("A", 5000, 7);
+  live.utime = now_us - 200'000;  // 0.2 s old: live
+  h.on_status(live);
+  loomlcm::status_t old = status("A", 100, 2);  // an earlier run: a lower tick would reset the live loom
+  old.utime = now_us - 3'600'000'000;           // recorded an hour ago
+  old.state = "paused";
+  h.on_status(old);
+  loomlcm::beat_t b = beat("A", 2, 0, 90.0);
+  b.utime = now_us - 3'599'000'000;
+  h.on_beat(b);
+  const auto a = h.loom_json("A").value();
+  EXPECT_EQ(a["status"]["row"], 7);
+  EXPECT_EQ(a["status"]["state"], "beat_sweep");
+  EXPECT_EQ(a["beats_seen"], 0);
+  EXPECT_FALSE(a["replay"].get<bool>());
+  EXPECT_TRUE(a["recorded_s_ago"].is_null());
+  EXPECT_EQ(a["loom"], "A");
+  const auto r = h.loom_json("A~replay").value();
+  EXPECT_TRUE(r["replay"].get<bool>());
+  EXPECT_EQ(r["loom"], "A");
+  EXPECT_EQ(r["status"]["row"], 2);
+  EXPECT_EQ(r["status"]["state"], "paused");
+  EXPECT_EQ(r["beats_seen"], 1);
+  EXPECT_NEAR(r["recorded_s_ago"].get<double>(), 3599.0, 1e-9);  // the latest replayed message's age
+  const auto hall = h.hall_json();
+  ASSERT_EQ(hall["looms"].size(), 2u);
+  EXPECT_EQ(hall["looms"][0]["id"], "A");
+  EXPECT_EQ(hall["looms"][1]["id"], "A~replay");
+  EXPECT_TRUE(hall["looms"][1]["replay"].get<bool>());
+  // Off (0): every message is taken as live, whatever its stamp (a log read through file://).
+  Hall off;
+  off.on_status(old);
+  EXPECT_FALSE(off.loom_json("A~replay").has_value());
+  EXPECT_FALSE(off.loom_json("A").value()["replay"].get<bool>());
+}
+
+// Item 7: the persisted fault history (serve's `faults` reply) as the panel's JSON, newest lines kept.
+// The lines are written out here as FaultHistory's documented format, not produced by it.
+TEST(PanelFaultHistory, LinesAreSplitAndTheNewestKept) {
+  const std::string reply =
+      "2026-11-23T20:15:03Z fault loom1 drive_fault 0x1002 axis=carriage device=0x7310 rows=3 picks=3 beats=45: "
+      "a servo drive reported a fault\n"
+      "2026-11-23T20:16:10Z ack loom1 drive_fault 0x1002 device=0x0000 rows=3 picks=3 beats=45: acknowledged by local "
+      "user anna (uid 1000, pid 42); re-arming from the measured positions\n"
+      "2026-11-23T20:17:00Z command loom1 start 0x0000 device=0x0000 rows=0 picks=0 beats=0: by local user anna: ok start\n"
+      "garbage \xff\xfe line\n";
+  const auto j = fault_history_json(reply, 3);
+  EXPECT_EQ(j["total"], 4);
+  EXPECT_EQ(j["shown"], 3);
+  ASSERT_EQ(j["lines"].size(), 3u);
+  EXPECT_EQ(j["lines"][0]["time"], "2026-11-23T20:16:10Z");
+  EXPECT_EQ(j["lines"][0]["kind"], "ack");
+  EXPECT_EQ(j["lines"][0]["name"], "drive_fault");
+  EXPECT_EQ(j["lines"][1]["kind"], "command");
+  EXPECT_EQ(j["lines"][1]["name"], "start");
+  EXPECT_EQ(j["lines"][1]["detail"], "0x0000 device=0x0000 rows=0 picks=0 beats=0: by local user anna: ok start");
+  EXPECT_FALSE(j["lines"][2].contains("kind"));  // not a history line: kept whole, not trusted
+  EXPECT_EQ(json_text(j["lines"][2]["line"]), "\"garbage \xEF\xBF\xBD\xEF\xBF\xBD line\"");  // U+FFFD, never thrown
+  const auto none = fault_history_json("no faults recorded in /var/lib/loomctl/faults.log\n", 50);
+  EXPECT_EQ(none["total"], 0);
+  EXPECT_EQ(none["note"], "no faults recorded in /var/lib/loomctl/faults.log");
+}
+
+namespace {
+loomlcm::axes_t axes_at(const std::string& id, double t, const std::vector<std::string>& names) {
+  loomlcm::axes_t m{};
+  m.loom_id = id;
+  m.time_s = t;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    loomlcm::axis_t a{};
+    a.name = names[i];
+    // Written out so the test knows each value: position = t + i, velocity = 1, following error = 1e-4 * (i + 1).
+    a.position = t + static_cast<double>(i);
+    a.velocity = 1.0;
+    a.following_error = 1e-4 * static_cast<double>(i + 1);
+    m.axes.push_back(a);
+  }
+  m.num_axes = static_cast<decltype(m.num_axes)>(m.axes.size());
+  return m;
+}
+}  // namespace
+
+// Item 7: a scope strip of any axis over the last N seconds of loop time, bounded in samples and time.
+TEST(PanelScope, EachAxisKeepsTheLastWindowOfSamples) {
+  HallLimits lim;
+  lim.scope_window_s = 2.0;
+  lim.scope_samples = 15;
+  Hall h(lim);
+  const std::vector<std::string> names{"beat_crank", "carriage", "helix"};
+  for (int k = 0; k <= 40; ++k) h.on_axes(axes_at("A", 0.1 * k, names));  // 0.0 .. 4.0 s at 10 Hz
+  const auto c = h.scope_json("A", "carriage").value();
+  EXPECT_EQ(c["axes"], nlohmann::json(names));
+  // The window is 2 s (21 samples at 10 Hz), the count 15: the count binds — t = 2.6 .. 4.0 s.
+  ASSERT_EQ(c["t"].size(), 15u);
+  EXPECT_NEAR(c["t"][0].get<double>(), 2.6, 1e-12);
+  EXPECT_NEAR(c["t"][14].get<double>(), 4.0, 1e-12);
+  EXPECT_NEAR(c["position"][14].get<double>(), 5.0, 1e-6);          // t + 1 (float storage)
+  EXPECT_NEAR(c["following_error"][0].get<double>(), 2e-4, 1e-10);  // axis 1
+  EXPECT_NEAR(c["velocity"][7].get<double>(), 1.0, 0.0);
+  // A looser count: the 2 s window binds — 4.0 - 2.0 .. 4.0 s.
+  HallLimits wide = lim;
+  wide.scope_samples = 1000;
+  Hall w(wide);
+  for (int k = 0; k <= 40; ++k) w.on_axes(axes_at("A", 0.1 * k, names));
+  const auto hw = w.scope_json("A", "helix").value();
+  EXPECT_EQ(hw["t"].size(), 21u);
+  EXPECT_NEAR(hw["t"][0].get<double>(), 2.0, 1e-12);
+  // The loop restarted (time went back): the strip starts afresh.
+  w.on_axes(axes_at("A", 0.5, names));
+  EXPECT_EQ(w.scope_json("A", "helix").value()["t"].size(), 1u);
+  // An unknown axis: empty traces; an unknown loom: nothing.
+  EXPECT_EQ(w.scope_json("A", "nosuch").value()["t"].size(), 0u);
+  EXPECT_FALSE(w.scope_json("B", "helix").has_value());
+  // NaN from the wire is sent as null, never as invalid JSON.
+  auto bad = axes_at("A", 0.6, names);
+  bad.axes[2].position = std::numeric_limits<double>::quiet_NaN();
+  w.on_axes(bad);
+  EXPECT_TRUE(w.scope_json("A", "helix").value()["position"][1].is_null());
+}
+
+// Item 7: the row report as a download — every row kept (more than the page's table), CSV, wall-clock
+// time and loop time, fixed notation. The expected lines are written out here.
+TEST(PanelHall, TheRowReportIsCsvOfEveryRowKept) {
+  HallLimits lim;
+  lim.rows_kept = 2;
+  lim.rows_report = 3;
+  Hall h(lim);
+  for (int r = 1; r <= 4; ++r) {
+    loomlcm::row_t m{};
+    m.loom_id = "A";
+    m.row = r;
+    m.utime = 1'790'000'000'000'000 + r * 1'000'000;  // 2026-09-21T14:13:2{1..4}Z (date -u -d @1790000001)
+    m.time_s = 10.0 * r;
+    m.row_s = 9.5;
+    m.shed_s = 0.5;
+    m.pick_s = 1.25;
+    m.beat_s = 7.75;
+    m.beats = 15;
+    m.carriage_steps = 14;
+    m.force_measured = r != 3;
+    m.force_min_n = 0.00001;  // printed fixed, never 1e-05
+    m.force_mean_n = 89.5;
+    m.force_max_n = 91;
+    m.beats_in_band = 15;
+    m.band_min_n = 80;
+    m.band_max_n = 100;
+    h.on_row(m);
+  }
+  EXPECT_EQ(h.loom_json("A").value()["rows"].size(), 2u);  // the page's table
+  const std::string csv = h.rows_csv("A").value();
+  const std::string want =
+      "utc,loop_time_s,row,row_s,shed_s,pick_s,beat_s,beats,carriage_steps,force_min_n,force_mean_n,force_max_n,"
+      "beats_in_band,band_min_n,band_max_n,knotting_s,knot_s,weaver_s,knots_tied,knots_retried,knots_by_hand\n"
+      "2026-09-21T14:13:22Z,20.000000,2,9.500000,0.500000,1.250000,7.750000,15,14,0.000010,89.500000,91.000000,15,"
+      "80.000000,100.000000,0.000000,0.000000,0.000000,0,0,0\n"
+      "2026-09-21T14:13:23Z,30.000000,3,9.500000,0.500000,1.250000,7.750000,15,14,,,,15,"
+      "80.000000,100.000000,0.000000,0.000000,0.000000,0,0,0\n"
+      "2026-09-21T14:13:24Z,40.000000,4,9.500000,0.500000,1.250000,7.750000,15,14,0.000010,89.500000,91.000000,15,"
+      "80.000000,100.000000,0.000000,0.000000,0.000000,0,0,0\n";
+  EXPECT_EQ(csv, want);
+  EXPECT_FALSE(h.rows_csv("B").has_value());
+}
+
+// Item 7: an lcmlog of the last minutes. What the recorder writes is read back by LCM's own log reader;
+// the window and the byte budget bound it.
+TEST(PanelRecorder, TheLastMinutesAreAnLcmLogLcmReads) {
+  Recorder rec(60.0, 1 << 20);
+  const std::int64_t t0 = 1'790'000'000'000'000;
+  for (int k = 0; k < 130; ++k) {  // one message a second for 130 s, payload "m<k>"
+    const std::string payload = "m" + std::to_string(k);
+    rec.add("A", k % 2 ? "LOOM.A.STATUS" : "LOOM.A.AXES", payload.data(), payload.size(), t0 + k * 1'000'000LL);
+  }
+  rec.add("B", "LOOM.B.STATUS", "b", 1, t0);
+  const auto bytes = rec.lcmlog("A", t0 + 129 * 1'000'000LL);
+  ASSERT_TRUE(bytes.has_value());
+  const std::string path = (std::filesystem::temp_directory_path() / ("panel_rec_" + std::to_string(::getpid()))).string();
+  {
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    std::fwrite(bytes->data(), 1, bytes->size(), f);
+    std::fclose(f);
+  }
+  lcm::LogFile log(path, "r");
+  ASSERT_TRUE(log.good());
+  std::vector<std::string> got;
+  std::int64_t first_us = 0, last_us = 0;
+  while (const lcm::LogEvent* ev = log.readNextEvent()) {
+    got.push_back(ev->channel + "=" + std::string(static_cast<const char*>(ev->data), static_cast<std::size_t>(ev->datalen)));
+    if (got.size() == 1) first_us = ev->timestamp;
+    last_us = ev->timestamp;
+  }
+  std::remove(path.c_str());
+  // The last 60 s before t = 129 s: messages 69..129 (61 of them).
+  ASSERT_EQ(got.size(), 61u);
+  EXPECT_EQ(got.front(), "LOOM.A.STATUS=m69");
+  EXPECT_EQ(got.back(), "LOOM.A.STATUS=m129");
+  EXPECT_EQ(got[1], "LOOM.A.AXES=m70");
+  EXPECT_EQ(first_us, t0 + 69'000'000);
+  EXPECT_EQ(last_us, t0 + 129'000'000);
+  EXPECT_FALSE(rec.lcmlog("C", t0).has_value());
+  // The byte budget for all looms: the loom holding the most gives up its oldest messages.
+  Recorder small(600.0, 10 * (64 + 16));
+  for (int k = 0; k < 20; ++k) small.add("A", "LOOM.A.AXES", "0123456789abcdef", 0, t0 + k);  // 11 + 0 + 64 each
+  EXPECT_LE(small.bytes(), 10u * (64 + 16));
+  small.add("B", "LOOM.B.AXES", "x", 1, t0 + 30);
+  EXPECT_TRUE(small.lcmlog("B", t0 + 30).has_value());  // B kept: A, the largest, gave way
+  EXPECT_LE(small.bytes(), 10u * (64 + 16));
+  Recorder off(0.0, 1 << 20);
+  off.add("A", "LOOM.A.AXES", "x", 1, t0);
+  EXPECT_FALSE(off.lcmlog("A", t0).has_value());
 }

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <ctime>
 
 namespace loom::panel {
 
@@ -126,12 +128,34 @@ json weaver_json(const loomlcm::weaver_request_t& m) {
 }
 
 json fault_json(const loomlcm::fault_t& m) {
-  return {{"time_s", num(m.time_s)}, {"kind", m.kind},   {"name", m.name},   {"code", hex(m.code)},
+  return {{"time_s", num(m.time_s)}, {"utime", m.utime}, {"kind", m.kind},   {"name", m.name},   {"code", hex(m.code)},
           {"text", m.text},          {"axis", m.axis},   {"device_code", hex(m.device_code)},
           {"state", m.state},        {"row", m.row},     {"picks", m.pick},  {"beats", m.beat}};
 }
 
 }  // namespace
+
+Hall::Hall(HallLimits limits, std::function<std::int64_t()> wall_now_us)
+    : limits_(limits), wall_now_us_(std::move(wall_now_us)) {
+  if (!wall_now_us_) {
+    wall_now_us_ = [] {
+      return std::chrono::duration_cast<std::chrono::microseconds>(
+                 std::chrono::system_clock::now().time_since_epoch()).count();
+    };
+  }
+}
+
+Hall::Loom* Hall::loom(const std::string& id, std::int64_t utime) {
+  if (limits_.replay_after_s <= 0.0) return loom(id);
+  const double age_s = static_cast<double>(wall_now_us_() - utime) * 1e-6;
+  if (!(age_s > limits_.replay_after_s)) return loom(id);
+  Loom* l = loom(id + kReplaySuffix);
+  if (l != nullptr) {
+    l->replay = true;
+    l->recorded_s_ago = age_s;
+  }
+  return l;
+}
 
 Hall::Loom* Hall::loom(const std::string& id) {
   auto it = looms_.find(id);
@@ -153,10 +177,13 @@ void Hall::changed() {
 
 void Hall::on_status(const loomlcm::status_t& m) {
   std::lock_guard lock(mu_);
-  if (Loom* l = loom(m.loom_id)) {
+  if (Loom* l = loom(m.loom_id, m.utime)) {
     if (l->status && m.tick < l->status->tick) {  // the loop restarted: what was kept belongs to the previous run
+      const Loom keep = *l;
       *l = Loom{};
-      l->heard = Clock::now();
+      l->heard = keep.heard;
+      l->replay = keep.replay;
+      l->recorded_s_ago = keep.recorded_s_ago;
     }
     l->status = m;
     changed();
@@ -165,15 +192,42 @@ void Hall::on_status(const loomlcm::status_t& m) {
 
 void Hall::on_axes(const loomlcm::axes_t& m) {
   std::lock_guard lock(mu_);
-  if (Loom* l = loom(m.loom_id)) {
+  if (Loom* l = loom(m.loom_id, m.utime)) {
     l->axes = m;
+    add_scope_sample(*l, m);
     changed();
+  }
+}
+
+void Hall::add_scope_sample(Loom& l, const loomlcm::axes_t& m) const {
+  if (!std::isfinite(m.time_s)) return;
+  const std::size_t n = std::min<std::size_t>(m.axes.size(), 32);
+  bool same = l.scope_names.size() == n;
+  for (std::size_t i = 0; same && i < n; ++i) same = l.scope_names[i] == m.axes[i].name;
+  // Another set of axes, or loop time going back (the loop restarted): the strip starts afresh.
+  if (!same || (!l.scope.empty() && m.time_s < l.scope.back().time_s)) {
+    l.scope.clear();
+    l.scope_names.clear();
+    for (std::size_t i = 0; i < n; ++i) l.scope_names.push_back(m.axes[i].name);
+  }
+  ScopeSample s;
+  s.time_s = m.time_s;
+  s.axes.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& a = m.axes[i];
+    s.axes.push_back({static_cast<float>(a.position), static_cast<float>(a.velocity),
+                      static_cast<float>(a.following_error)});
+  }
+  l.scope.push_back(std::move(s));
+  while (l.scope.size() > limits_.scope_samples ||
+         (l.scope.size() > 1 && l.scope.back().time_s - l.scope.front().time_s > limits_.scope_window_s)) {
+    l.scope.pop_front();
   }
 }
 
 void Hall::on_rt(const loomlcm::rt_stats_t& m) {
   std::lock_guard lock(mu_);
-  if (Loom* l = loom(m.loom_id)) {
+  if (Loom* l = loom(m.loom_id, m.utime)) {
     l->rt = m;
     changed();
   }
@@ -181,7 +235,7 @@ void Hall::on_rt(const loomlcm::rt_stats_t& m) {
 
 void Hall::on_beat(const loomlcm::beat_t& m) {
   std::lock_guard lock(mu_);
-  Loom* l = loom(m.loom_id);
+  Loom* l = loom(m.loom_id, m.utime);
   if (l == nullptr) return;
   if (m.row != l->current.row) {
     // A new row: the one before becomes "previous" (only if it is the row just before).
@@ -200,7 +254,7 @@ void Hall::on_beat(const loomlcm::beat_t& m) {
 
 void Hall::on_fault(const loomlcm::fault_t& m) {
   std::lock_guard lock(mu_);
-  if (Loom* l = loom(m.loom_id)) {
+  if (Loom* l = loom(m.loom_id, m.utime)) {
     l->faults.push_back(m);
     while (l->faults.size() > limits_.faults_kept) l->faults.pop_front();
     ++l->faults_seen;
@@ -210,16 +264,16 @@ void Hall::on_fault(const loomlcm::fault_t& m) {
 
 void Hall::on_row(const loomlcm::row_t& m) {
   std::lock_guard lock(mu_);
-  if (Loom* l = loom(m.loom_id)) {
+  if (Loom* l = loom(m.loom_id, m.utime)) {
     l->rows.push_back(m);
-    while (l->rows.size() > limits_.rows_kept) l->rows.pop_front();
+    while (l->rows.size() > std::max(limits_.rows_kept, limits_.rows_report)) l->rows.pop_front();
     changed();
   }
 }
 
 void Hall::on_design(const loomlcm::design_t& m) {
   std::lock_guard lock(mu_);
-  if (Loom* l = loom(m.loom_id)) {
+  if (Loom* l = loom(m.loom_id, m.utime)) {
     // Only a new row is a change worth pushing to every page; the periodic repeat just refreshes it.
     const bool moved = !l->design || l->design->rows_done != m.rows_done || l->design->name != m.name;
     l->design = m;
@@ -229,7 +283,7 @@ void Hall::on_design(const loomlcm::design_t& m) {
 
 void Hall::on_knots(const loomlcm::knots_t& m) {
   std::lock_guard lock(mu_);
-  if (Loom* l = loom(m.loom_id)) {
+  if (Loom* l = loom(m.loom_id, m.utime)) {
     l->knots = m;
     changed();
   }
@@ -237,7 +291,7 @@ void Hall::on_knots(const loomlcm::knots_t& m) {
 
 void Hall::on_weaver(const loomlcm::weaver_request_t& m) {
   std::lock_guard lock(mu_);
-  if (Loom* l = loom(m.loom_id)) {
+  if (Loom* l = loom(m.loom_id, m.utime)) {
     l->weaver.push_back(m);
     while (l->weaver.size() > limits_.weaver_requests_kept) l->weaver.pop_front();
     changed();
@@ -282,6 +336,9 @@ json Hall::knots_json(const loomlcm::knots_t& m) const {
 
 json Hall::summary(const std::string& id, const Loom& l, Clock::time_point now) {
   json j = {{"id", id},
+            {"loom", l.replay ? id.substr(0, id.size() - std::char_traits<char>::length(kReplaySuffix)) : id},
+            {"replay", l.replay},
+            {"recorded_s_ago", l.replay ? num(l.recorded_s_ago) : json(nullptr)},
             {"heard_s_ago", std::chrono::duration<double>(now - l.heard).count()},
             {"beats_seen", l.beats_seen},
             {"beats_in_band", l.beats_in_band},
@@ -323,7 +380,8 @@ std::optional<json> Hall::loom_json(const std::string& id) const {
   j["current_row"] = beats(l.current);
   j["previous_row"] = beats(l.previous);
   json rows = json::array();
-  for (const auto& r : l.rows) rows.push_back(row_json(r));
+  const std::size_t first = l.rows.size() > limits_.rows_kept ? l.rows.size() - limits_.rows_kept : 0;
+  for (std::size_t i = first; i < l.rows.size(); ++i) rows.push_back(row_json(l.rows[i]));
   j["rows"] = rows;
   json faults = json::array();
   for (const auto& f : l.faults) faults.push_back(fault_json(f));
@@ -335,6 +393,67 @@ std::optional<json> Hall::loom_json(const std::string& id) const {
   j["weaver_requests"] = weaver;
   j["controls"] = false;  // the HTTP side says whether it may act on this loom (main.cpp)
   return j;
+}
+
+namespace {
+// A number for the CSV: fixed notation with 6 decimals (a spreadsheet reads it; no 1e-05), empty when not finite.
+std::string csv_num(double v) {
+  if (!std::isfinite(v)) return "";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.6f", v);
+  return buf;
+}
+std::string utc_of(std::int64_t utime) {
+  if (utime <= 0) return "";
+  const std::time_t t = static_cast<std::time_t>(utime / 1'000'000);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+}  // namespace
+
+std::optional<std::string> Hall::rows_csv(const std::string& id) const {
+  std::lock_guard lock(mu_);
+  const auto it = looms_.find(id);
+  if (it == looms_.end()) return std::nullopt;
+  std::string out =
+      "utc,loop_time_s,row,row_s,shed_s,pick_s,beat_s,beats,carriage_steps,force_min_n,force_mean_n,force_max_n,"
+      "beats_in_band,band_min_n,band_max_n,knotting_s,knot_s,weaver_s,knots_tied,knots_retried,knots_by_hand\n";
+  for (const loomlcm::row_t& r : it->second.rows) {
+    const bool f = r.force_measured;
+    out += utc_of(r.utime) + "," + csv_num(r.time_s) + "," + std::to_string(r.row) + "," + csv_num(r.row_s) + "," +
+           csv_num(r.shed_s) + "," + csv_num(r.pick_s) + "," + csv_num(r.beat_s) + "," + std::to_string(r.beats) + "," +
+           std::to_string(r.carriage_steps) + "," + (f ? csv_num(r.force_min_n) : "") + "," +
+           (f ? csv_num(r.force_mean_n) : "") + "," + (f ? csv_num(r.force_max_n) : "") + "," +
+           std::to_string(r.beats_in_band) + "," + csv_num(r.band_min_n) + "," + csv_num(r.band_max_n) + "," +
+           csv_num(r.knotting_s) + "," + csv_num(r.knot_s) + "," + csv_num(r.weaver_s) + "," +
+           std::to_string(r.knots_tied) + "," + std::to_string(r.knots_retried) + "," + std::to_string(r.knots_by_hand) +
+           "\n";
+  }
+  return out;
+}
+
+std::optional<json> Hall::scope_json(const std::string& id, const std::string& axis) const {
+  std::lock_guard lock(mu_);
+  const auto it = looms_.find(id);
+  if (it == looms_.end()) return std::nullopt;
+  const Loom& l = it->second;
+  const auto at = std::find(l.scope_names.begin(), l.scope_names.end(), axis);
+  json t = json::array(), pos = json::array(), vel = json::array(), fe = json::array();
+  if (at != l.scope_names.end()) {
+    const auto i = static_cast<std::size_t>(at - l.scope_names.begin());
+    for (const ScopeSample& s : l.scope) {
+      t.push_back(num(s.time_s));
+      pos.push_back(num(static_cast<double>(s.axes[i][0])));
+      vel.push_back(num(static_cast<double>(s.axes[i][1])));
+      fe.push_back(num(static_cast<double>(s.axes[i][2])));
+    }
+  }
+  return json{{"loom", id},           {"axis", axis},     {"axes", l.scope_names},
+              {"window_s", num(limits_.scope_window_s)}, {"t", t}, {"position", pos},
+              {"velocity", vel},      {"following_error", fe}};
 }
 
 std::uint64_t Hall::version() const {

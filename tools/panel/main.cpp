@@ -8,12 +8,19 @@
 //   POST /api/loom/<id>/ctl/<pause|resume|stop|ack|next>   operator buttons, only with --control-dir
 //   POST /api/loom/<id>/pair  (body: the code from `loomctl ctl pair NAME`)  pair this client
 //   GET  /api/loom/<id>/authority   whether this client is paired (may give starting commands)
+//   GET  /api/loom/<id>/history     the loom's persisted fault history (faults.log), with --control-dir
+//   GET  /api/loom/<id>/faults.log  all of it, as a file to download
+//   GET  /api/loom/<id>/rows.csv    the row report: every row the panel kept (newest 500), as CSV
+//   GET  /api/loom/<id>/last.lcmlog every message of that loom heard in the last 5 minutes (--lcmlog-minutes)
+//   GET  /api/loom/<id>/scope?axis=NAME   the last 30 s of one axis' position, velocity, following error
 // Read-only by default: nothing it receives over HTTP reaches the loom. With --control-dir DIR the
 // page offers pause / stop at row end to every client, and resume / acknowledge / "row knotted" only to
 // a client paired with that loom (request_gate.hpp), each sent to that loom's local control socket
 // DIR/<id>.sock (loomctl serve's) tagged with the client's address and token, so the loom decides and
 // audits who pressed; never published on LCM. Host and Origin are checked, bodies, connections and
 // event streams bounded (README.md). Binds to 127.0.0.1 unless --bind says otherwise (a hall network).
+// A recording replayed onto the group (stamped older than --replay-after-s) is shown apart as
+// <id>~replay, marked, without buttons; it never mixes into the live loom of that id.
 // Exit 2 on bad arguments, 1 when it cannot listen or open LCM.
 #include <httplib.h>
 #include <sys/stat.h>
@@ -32,7 +39,9 @@
 #include <string>
 #include <thread>
 
+#include "fault_history.hpp"
 #include "hall.hpp"
+#include "recorder.hpp"
 #include "request_gate.hpp"
 #include "udpm_receiver.hpp"
 #include "loom/firmware/serve/control_socket.hpp"
@@ -45,6 +54,9 @@ extern const char* const kPanelHtml;
 namespace {
 
 using loom::panel::Hall;
+
+// Lines of the persisted fault history a page shows (the newest; serve keeps 256-512 KiB of them).
+constexpr std::size_t kHistoryShown = 50;
 
 std::atomic<bool> g_stop{false};
 httplib::Server* g_server = nullptr;
@@ -61,6 +73,9 @@ struct PanelOptions {
   int http_threads = 64;              // each open page holds one for its event stream
   int max_streams = 16;               // event streams at once (each holds a thread); more get 503
   int max_streams_per_client = 4;     // per client address
+  double replay_after_s = 10.0;       // older stamps are a replayed recording: shown apart, marked (hall.hpp)
+  double lcmlog_minutes = 5.0;        // the flight recorder's window (0: off)
+  double lcmlog_mib = 64.0;           // its memory for all looms together
   std::vector<std::string> hosts;     // --host: names the hall uses for this panel (Host header check)
   // Operator buttons act through the board's local control sockets, <control_dir>/<loom id>.sock,
   // never over LCM. Empty = read-only. The page shows buttons only when the JSON says "controls": true
@@ -132,6 +147,8 @@ std::string control_socket_of(const PanelOptions& o, const std::string& loom) {
 }
 
 bool controls_for(const PanelOptions& o, const std::string& loom) {
+  // A replayed recording has no loom behind it to command.
+  if (loom.find('~') != std::string::npos) return false;
   struct stat st {};
   return !o.control_dir.empty() && ::stat(control_socket_of(o, loom).c_str(), &st) == 0 && S_ISSOCK(st.st_mode);
 }
@@ -141,7 +158,8 @@ bool controls_for(const PanelOptions& o, const std::string& loom) {
 // 100 ms and the rest are skipped before decoding.
 class Router {
  public:
-  Router(Hall& hall, std::string prefix) : hall_(hall), prefix_(std::move(prefix) + ".") {}
+  Router(Hall& hall, loom::panel::Recorder& recorder, std::string prefix)
+      : hall_(hall), recorder_(recorder), prefix_(std::move(prefix) + ".") {}
   // Live traffic only: a log replayed at full speed would otherwise keep just its first AXES.
   void throttle_axes(bool on) { throttle_axes_ = on; }
 
@@ -152,6 +170,12 @@ class Router {
     if (dot == std::string_view::npos) return;
     const std::string_view id = rest.substr(0, dot), kind = rest.substr(dot + 1);
     if (!loom::telemetry::loom_id_error(id).empty()) return;
+    // Every message as received (before throttling) into the flight recorder: the lcmlog download.
+    if (recorder_.enabled()) {
+      recorder_.add(id, channel, data, size,
+                    std::chrono::duration_cast<std::chrono::microseconds>(
+                        std::chrono::system_clock::now().time_since_epoch()).count());
+    }
     const int len = static_cast<int>(size);
     if (kind == "STATUS") {
       decode<loomlcm::status_t>(data, len, [&](const auto& m) { hall_.on_status(m); });
@@ -197,6 +221,7 @@ class Router {
     use(m);
   }
   Hall& hall_;
+  loom::panel::Recorder& recorder_;
   std::string prefix_;
   std::map<std::string, std::chrono::steady_clock::time_point, std::less<>> last_axes_;
   std::uint64_t decode_errors_ = 0;
@@ -238,6 +263,18 @@ int main(int argc, char** argv) {
   app.add_option("--min-push-interval-s", o.min_push_interval_s, "shortest gap between two live updates of a page")
       ->check(CLI::Range(0.01, 60.0))
       ->capture_default_str();
+  app.add_option("--lcmlog-minutes", o.lcmlog_minutes,
+                 "keep every message of the last this many minutes per loom, downloadable as an lcmlog (0: off)")
+      ->check(CLI::Range(0.0, 60.0))
+      ->capture_default_str();
+  app.add_option("--lcmlog-mib", o.lcmlog_mib, "memory for those messages, all looms together (MiB)")
+      ->check(CLI::Range(1.0, 4096.0))
+      ->capture_default_str();
+  app.add_option("--replay-after-s", o.replay_after_s,
+                 "a message stamped longer ago than this is a replayed recording: shown apart as <id>~replay and "
+                 "marked REPLAY (0: every message is live)")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -251,8 +288,11 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  Hall hall;
-  Router router(hall, o.channel_prefix);
+  loom::panel::HallLimits limits;
+  limits.replay_after_s = o.replay_after_s;
+  Hall hall(limits);
+  loom::panel::Recorder recorder(o.lcmlog_minutes * 60.0, static_cast<std::size_t>(o.lcmlog_mib * 1024 * 1024));
+  Router router(hall, recorder, o.channel_prefix);
   // udpm (the normal case): the lean batched receiver. Anything else: LCM's own provider.
   std::unique_ptr<loom::panel::UdpmReceiver> udpm;
   std::unique_ptr<lcm::LCM> lcm;
@@ -315,16 +355,33 @@ int main(int argc, char** argv) {
     res.set_content(loom::panel::kPanelHtml, "text/html; charset=utf-8");
   };
   svr.Get("/", page);
-  svr.Get(R"(/loom/([A-Za-z0-9_-]{1,32}))", page);
+  // A loom's page and JSON also for a replayed recording (<id>~replay); commands never (POST routes below).
+  svr.Get(R"(/loom/([A-Za-z0-9_-]{1,32}(?:~replay)?))", page);
   svr.Get("/api/hall", [&](const httplib::Request&, httplib::Response& res) {
     res.set_content(loom::panel::json_text(hall.hall_json()), "application/json");
   });
-  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32}))", [&](const httplib::Request& req, httplib::Response& res) {
+  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32}(?:~replay)?))", [&](const httplib::Request& req, httplib::Response& res) {
     const auto j = loom_json(hall, o, req.matches[1]);
     if (!j) {
       res.status = 404;
       res.set_content(loom::panel::json_text({{"error", "loom not heard"}, {"id", std::string(req.matches[1])}}),
                       "application/json");
+      return;
+    }
+    res.set_content(loom::panel::json_text(*j), "application/json");
+  });
+  // The scope strip of one axis (?axis=NAME; the first axis when none): the last seconds of its position,
+  // velocity and following error. The page polls it once a second for the axis the technician picked.
+  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32}(?:~replay)?)/scope)", [&](const httplib::Request& req, httplib::Response& res) {
+    const std::string loom = req.matches[1];
+    res.set_header("Cache-Control", "no-store");
+    std::string axis = req.has_param("axis") ? req.get_param_value("axis") : std::string();
+    if (axis.size() > 64) axis.clear();
+    auto j = hall.scope_json(loom, axis);
+    if (j && axis.empty() && !(*j)["axes"].empty()) j = hall.scope_json(loom, (*j)["axes"][0].get<std::string>());
+    if (!j) {
+      res.status = 404;
+      res.set_content(loom::panel::json_text({{"error", "loom not heard"}, {"id", loom}}), "application/json");
       return;
     }
     res.set_content(loom::panel::json_text(*j), "application/json");
@@ -403,10 +460,92 @@ int main(int argc, char** argv) {
     res.set_content(loom::panel::json_text({{"loom", loom}, {"may_start", may_start}, {"client", req.remote_addr}, {"reply", text}}),
                     "application/json");
   });
+  // The flight recorder's last minutes of one loom, as an lcmlog to replay (loom-replay) or open in lcm-spy.
+  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32})/last\.lcmlog)", [&](const httplib::Request& req, httplib::Response& res) {
+    const std::string loom = req.matches[1];
+    res.set_header("Cache-Control", "no-store");
+    const auto log = recorder.lcmlog(loom, std::chrono::duration_cast<std::chrono::microseconds>(
+                                               std::chrono::system_clock::now().time_since_epoch()).count());
+    if (!log) {
+      res.status = 404;
+      res.set_content(recorder.enabled() ? "nothing of loom " + loom + " heard in the last minutes\n"
+                                         : std::string("the recorder is off (--lcmlog-minutes 0)\n"),
+                      "text/plain; charset=utf-8");
+      return;
+    }
+    res.set_header("Content-Disposition", "attachment; filename=\"" + loom + "-last.lcmlog\"");
+    res.set_content(*log, "application/octet-stream");
+  });
+  // The row report: every row summary the panel kept for this loom (the newest 500) as CSV to download.
+  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32}(?:~replay)?)/rows\.csv)", [&](const httplib::Request& req, httplib::Response& res) {
+    const std::string loom = req.matches[1];
+    res.set_header("Cache-Control", "no-store");
+    const auto csv = hall.rows_csv(loom);
+    if (!csv) {
+      res.status = 404;
+      res.set_content("loom " + loom + " not heard\n", "text/plain; charset=utf-8");
+      return;
+    }
+    res.set_header("Content-Disposition", "attachment; filename=\"" + loom + "-rows.csv\"");
+    res.set_content(*csv, "text/csv; charset=utf-8");
+  });
+  // The loom's persisted fault history (faults.log, through serve's `faults` request): it survives a
+  // restart of the panel, serve or the board, unlike what the panel heard on LCM. A GET: reading only.
+  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32})/history)", [&](const httplib::Request& req, httplib::Response& res) {
+    const std::string loom = req.matches[1];
+    res.set_header("Cache-Control", "no-store");
+    const auto error = [&](int status, const std::string& why) {
+      res.status = status;
+      res.set_content(loom::panel::json_text({{"loom", loom}, {"error", why}}), "application/json");
+    };
+    if (o.control_dir.empty()) {
+      return error(404, "read-only panel: the loom's fault history is read through its control socket (--control-dir)");
+    }
+    std::string text;
+    try {
+      text = loom::firmware::serve::control_request(control_socket_of(o, loom), on_behalf("faults", req, ""), 3000);
+    } catch (const std::exception& e) {
+      return error(503, e.what());
+    }
+    if (text.rfind("error:", 0) == 0 || text.rfind("refused:", 0) == 0) return error(502, trimmed(text));
+    auto j = loom::panel::fault_history_json(text, kHistoryShown);
+    j["loom"] = loom;
+    res.set_content(loom::panel::json_text(j), "application/json");
+  });
+  // The whole faults.log as a file for the technician's report (the page offers the link): the same
+  // text as `loomctl ctl faults`, through serve's socket.
+  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32})/faults\.log)", [&](const httplib::Request& req, httplib::Response& res) {
+    const std::string loom = req.matches[1];
+    res.set_header("Cache-Control", "no-store");
+    if (o.control_dir.empty()) {
+      res.status = 404;
+      res.set_content("read-only panel: the loom's faults.log is read through its control socket (--control-dir)\n",
+                      "text/plain; charset=utf-8");
+      return;
+    }
+    std::string text;
+    try {
+      text = loom::firmware::serve::control_request(control_socket_of(o, loom), on_behalf("faults", req, ""), 3000);
+    } catch (const std::exception& e) {
+      res.status = 503;
+      res.set_content(std::string(e.what()) + "\n", "text/plain; charset=utf-8");
+      return;
+    }
+    if (text.rfind("error:", 0) == 0 || text.rfind("refused:", 0) == 0) {
+      res.status = 502;
+      res.set_content(text, "text/plain; charset=utf-8");
+      return;
+    }
+    res.set_header("Content-Disposition", "attachment; filename=\"" + loom + "-faults.log\"");
+    res.set_content(text, "text/plain; charset=utf-8");
+  });
   StreamSlots slots(o.max_streams, o.max_streams_per_client);
   svr.Get("/events", [&](const httplib::Request& req, httplib::Response& res) {
     const std::string loom = req.has_param("loom") ? req.get_param_value("loom") : std::string();
-    if (!loom.empty() && !loom::telemetry::loom_id_error(loom).empty()) {
+    const std::string live_id = loom.size() > 7 && loom.compare(loom.size() - 7, 7, loom::panel::kReplaySuffix) == 0
+                                    ? loom.substr(0, loom.size() - 7)
+                                    : loom;
+    if (!loom.empty() && !loom::telemetry::loom_id_error(live_id).empty()) {
       res.status = 400;
       res.set_content("bad loom id\n", "text/plain");
       return;

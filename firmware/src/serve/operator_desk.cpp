@@ -55,6 +55,13 @@ std::string utc(std::int64_t s) {
 
 }  // namespace
 
+std::string OperatorDesk::answer_in_state(const std::string& word, const LoomView& v) const {
+  ParsedRequest r;
+  r.word = word;
+  const std::string why = refuse_for_state(r, v);
+  return why.empty() ? "ok " + word : "refused: " + word + ": " + why;
+}
+
 // "" when the command would change something now, else why not.
 std::string OperatorDesk::refuse_for_state(const ParsedRequest& r, const LoomView& v) const {
   const std::string& w = r.word;
@@ -84,6 +91,10 @@ std::string OperatorDesk::refuse_for_state(const ParsedRequest& r, const LoomVie
   if (w == "ack") {
     if (v.state != State::kFault) return "no fault is latched (state " + state + ")";
     if (!v.estop_ok) return "the e-stop chain is still open: close it (release the e-stop), then acknowledge";
+    if (v.counters_unsaved) {
+      return "the counters woven are not on disk yet (the last save failed): free space in the state directory; "
+             "the save is retried every second, then acknowledge";
+    }
     if (v.recovery == hal::LinkRecovery::kBusOff) {
       return "the CAN controller is still bus-off; it must restart first (ip link set " +
              (iface_.empty() ? std::string("can0") : iface_) +
@@ -103,6 +114,7 @@ Decision OperatorDesk::decide(const ControlRequest& req, const LoomView& v, std:
   std::string error;
   const auto parsed = parse_request(req.line, error);
   d.who = describe(req.peer);
+  d.station = "local";
   if (!parsed) {
     d.reply = "error: " + error + "\n";
     return d;
@@ -111,6 +123,7 @@ Decision OperatorDesk::decide(const ControlRequest& req, const LoomView& v, std:
   // Who: the kernel's word on the local user; a panel adds its client's address and pairing.
   std::optional<Pairing> paired;
   if (r.via_panel()) {
+    d.station = "panel";
     if (!r.field("token").empty()) paired = pairings_.find(r.field("token"), now_s);
     d.who = "panel client " + r.field("client") +
             (paired ? " paired as " + paired->name : std::string(r.field("token").empty() ? " (not paired)"

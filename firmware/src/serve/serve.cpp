@@ -31,6 +31,7 @@
 #include "loom/firmware/serve/journal.hpp"
 #include "loom/firmware/serve/sd_notify.hpp"
 #include "loom/firmware/serve/state_lock.hpp"
+#include "loom/telemetry/command_events.hpp"
 #include "loom/telemetry/identity.hpp"
 #include "loom/firmware/serve/operator_desk.hpp"
 #include "loom/firmware/serve/pairings.hpp"
@@ -93,7 +94,9 @@ std::string status_text(const OperatorLink& l, const std::string& loom_id, const
 // The audit of one command: a journal line naming who gave it and the verdict; accepted ones also go
 // to the fault history (`ctl faults`). Refused ones stay in the journal only, so a flood of refusals
 // cannot rotate the faults out of the history.
-void audit(FaultHistory& history, const std::string& loom_id, const std::string& line, const Decision& d) {
+// The COMMAND event (when telemetry is on) carries the same: word, station, who, verdict, state.
+void audit(FaultHistory& history, const std::string& loom_id, const std::string& line, const Decision& d,
+           telemetry::CommandEvents* events, sequencer::State state) {
   std::string verdict = d.reply;
   if (!verdict.empty() && verdict.back() == '\n') verdict.pop_back();
   // Tokens and pairing codes never reach a log.
@@ -104,6 +107,9 @@ void audit(FaultHistory& history, const std::string& loom_id, const std::string&
   std::string word = line.substr(0, line.find(' '));
   log(d.accepted() ? Severity::kNotice : Severity::kWarning, "operator: %s by %s: %s", word.c_str(), d.who.c_str(),
       verdict.c_str());
+  if (events != nullptr) {
+    events->publish({word, d.station, d.who, d.accepted(), verdict, sequencer::state_name(state)});
+  }
   if (!d.accepted()) return;
   FaultRecord r;
   r.loom_id = loom_id;
@@ -208,12 +214,41 @@ int serve_main(const ServeArgs& a) {
   std::mutex ack_mu;
   std::string ack_by;
   std::chrono::steady_clock::time_point ack_at{};
+  // Whether the counters on disk lag what was woven (the last save failed; the loop refuses an ack until a
+  // retried save succeeds): the desk refuses `ctl ack` with the reason instead of answering `ok`.
+  std::atomic<bool> counters_unsaved{false};
+  // The knotting heads' open request of the weaver, in words (the reporter sets it when the loop reports
+  // it): the `next` that answers it says which, in its reply and its audit (journal, faults.log, COMMAND).
+  std::mutex weaver_mu;
+  std::string weaver_request;
+  bool weaver_answered_unheard = false;  // a `next` answered a request whose words had not come yet
   Pairings pairings;
   OperatorDesk desk(pairings, a.iface);
+  // The audit as LCM events (COMMAND), for the service's whole life: sessions' publishers come and go.
+  std::unique_ptr<telemetry::CommandEvents> command_events;
+  if (!a.no_telemetry) {
+    try {
+      command_events = std::make_unique<telemetry::CommandEvents>(
+          cfg.telemetry.lcm_url, std::string(telemetry::kDefaultChannelPrefix), cfg.loom_id);
+    } catch (const std::exception& e) {
+      log(Severity::kErr, "loomctl serve: %s: telemetry: %s", cfg.source.c_str(), e.what());
+      return kExitBadInput;
+    }
+  }
   std::unique_ptr<ControlServer> server;
   try {
     server = std::make_unique<ControlServer>(socket_path, a.group, [&](const ControlRequest& req) -> std::string {
-      const Decision d = desk.decide(req, view_of(link, cfg.sequencer.knotting), static_cast<std::int64_t>(std::time(nullptr)));
+      LoomView view = view_of(link, cfg.sequencer.knotting);
+      view.counters_unsaved = counters_unsaved.load(std::memory_order_acquire);
+      Decision d = desk.decide(req, view, static_cast<std::int64_t>(std::time(nullptr)));
+      if (d.post == Command::kNext && view.state == sequencer::State::kKnotting) {
+        std::lock_guard<std::mutex> lock(weaver_mu);
+        // Taken once: a `next` before the reporter has heard the request it answers says plain `ok next`,
+        // and that request's words, when they come, are dropped: never named by a later `next`.
+        if (!weaver_request.empty()) d.reply = "ok next: answered " + weaver_request + "\n";
+        weaver_answered_unheard = weaver_request.empty();
+        weaver_request.clear();
+      }
       if (d.read == Decision::Read::kStatus) return status_text(link, cfg.loom_id, cfg.recipe.design.get(), design_progress);
       if (d.read == Decision::Read::kFaults) {
         std::string out;
@@ -228,7 +263,7 @@ int serve_main(const ServeArgs& a) {
         }
         link.post(*d.post);
       }
-      if (d.audit) audit(history, cfg.loom_id, req.line, d);
+      if (d.audit) audit(history, cfg.loom_id, req.line, d, command_events.get(), view.state);
       return d.reply;
     });
   } catch (const std::exception& e) {
@@ -341,11 +376,15 @@ int serve_main(const ServeArgs& a) {
       row_saves.saved(c.rows);
       row_saves.saved_knots(c.rows, c.knot.cycles_started);
       failed_save.reset();
+      counters_unsaved.store(false, std::memory_order_release);
     };
-    if (arm_unsaved) {  // armed from memory: the disk still lags until a retry succeeds
-      failed_save = arm_unsaved;
+    // Every failed save goes through here: the loop (row_saves) and the desk (counters_unsaved) both learn it.
+    const auto save_failed = [&](const sequencer::Counters& c) {
+      failed_save = c;
       row_saves.failed();
-    }
+      counters_unsaved.store(true, std::memory_order_release);
+    };
+    if (arm_unsaved) save_failed(*arm_unsaved);  // armed from memory: the disk still lags until a retry succeeds
     const auto on_event = [&](const RunEvent& e) {
       machine->collect_retired_recipes();
       switch (e.kind) {
@@ -398,16 +437,34 @@ int serve_main(const ServeArgs& a) {
         }
         case RunEvent::Kind::kButton:
           // Audit only: a press changes no counters, so nothing is saved for it.
-          log(Severity::kNotice, "operator: %s by the I/O module's %s button (state %s)",
-              e.button == Command::kStart ? "start" : e.button == Command::kPause ? "pause" : "ack",
-              e.button == Command::kStart ? "start" : e.button == Command::kPause ? "pause" : "reset/acknowledge",
-              sequencer::state_name(e.state));
+        {
+          const char* word = e.button == Command::kStart ? "start" : e.button == Command::kPause ? "pause" : "ack";
+          const std::string who = std::string("the I/O module's ") +
+                                  (e.button == Command::kStart   ? "start"
+                                   : e.button == Command::kPause ? "pause"
+                                                                 : "reset/acknowledge") +
+                                  " button";
+          log(Severity::kNotice, "operator: %s by %s (state %s)", word, who.c_str(), sequencer::state_name(e.state));
+          if (command_events) {
+            // The loop takes the press itself; the event says what the same command would have answered.
+            LoomView v = view_of(link, cfg.sequencer.knotting);
+            v.state = e.state;
+            v.counters_unsaved = counters_unsaved.load(std::memory_order_acquire);
+            const std::string verdict = desk.answer_in_state(word, v);
+            command_events->publish({word, "button", who, verdict.rfind("ok", 0) == 0, verdict,
+                                     sequencer::state_name(e.state)});
+          }
           return;
+        }
         case RunEvent::Kind::kWeaverRequest:
           // The loom waits for the weaver (lamp amber, buzzer): logged for the shift's record; the panel and
           // `ctl status` show it. Nothing changed in the counters.
           if (const sequencer::KnotProgram* p = machine->knot_program()) {
-            log(Severity::kNotice, "weaver asked: %s", sequencer::describe(e.request, *p).c_str());
+            const std::string asked = sequencer::describe(e.request, *p);
+            log(Severity::kNotice, "weaver asked: %s", asked.c_str());
+            std::lock_guard<std::mutex> lock(weaver_mu);
+            if (weaver_answered_unheard) weaver_answered_unheard = false;  // already answered
+            else weaver_request = asked;
           }
           return;
         case RunEvent::Kind::kPickDone:
@@ -421,8 +478,7 @@ int serve_main(const ServeArgs& a) {
         // The sequencer stops at the row boundary with counters_not_saved (a fault like any other); an
         // acknowledgement is refused until a retry (below) has saved these counts.
         log(Severity::kErr, "counters not saved: %s", ex.what());
-        failed_save = e.counters;
-        row_saves.failed();
+        save_failed(e.counters);
       }
     };
     // The reporter thread's poll: the watchdog is fed only while the loop's tick moves, and a failed

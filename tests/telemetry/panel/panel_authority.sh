@@ -13,12 +13,15 @@
 #      `ctl unpair` revokes the token;
 #   4. bounded: a 1 MiB body is refused (413); event streams beyond 4 per client get 503 while the
 #      buttons still answer, and so they do behind 40 idle connections; a design whose palette name is
-#      cp1252 (not UTF-8) keeps the panel up.
-# Usage: panel_authority.sh <loomctl> <loom-panel> <design csv>
+#      cp1252 (not UTF-8) keeps the panel up;
+#   5. every command serve decided went out as a COMMAND event (recorded by lcm-logger, decoded by
+#      telemetry_command_log) naming its station and who gave it, with the verdict; no code or token in it.
+# Usage: panel_authority.sh <loomctl> <loom-panel> <design csv> <telemetry_command_log>
 set -euo pipefail
 LOOMCTL=$1
 PANEL=$2
 DESIGN=$3
+COMMAND_LOG=$4
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/loom_panel_authority.XXXXXX")
 PIDS=()
 NS=lpa$$
@@ -78,6 +81,12 @@ done
 HPORT=$(sed -n 's|.*serving http://[0-9.]*:\([0-9]*\)/.*|\1|p' "$WORK/panel.log")
 [[ -n $HPORT ]] || fail "loom-panel did not start"
 BASE="http://$SERVER:$HPORT"
+
+# lcm-logger records the group from before serve starts (serve listens 2.5 s for a twin before arming).
+command -v lcm-logger >/dev/null || fail "lcm-logger not found (Debian package liblcm-bin)"
+lcm-logger -q -f --flush-interval=20 --lcm-url="$URL" "$WORK/audit.lcmlog" 2>"$WORK/logger.log" &
+LOGGER_PID=$!
+PIDS+=($!)
 
 SOCK="$WORK/run/$ID.sock"
 "$LOOMCTL" serve --config "$WORK/loom.toml" --state-dir "$WORK/state" --socket "$SOCK" --group "" \
@@ -191,4 +200,26 @@ t1=$(date +%s%N)
 echo "a button behind 4 event streams and 40 idle connections answered in $(((t1 - t0) / 1000000)) ms"
 remote curl -s -m 5 "$BASE/api/loom/$ID" | grep -q 'rouge garanc' || fail "the cp1252 palette name is not shown"
 kill -0 "$PANEL_PID" 2>/dev/null || fail "loom-panel died"
+
+# 5. the COMMAND events
+[[ -s $WORK/audit.lcmlog ]] || fail "lcm-logger recorded nothing on $URL"
+sleep 0.3
+kill -INT "$LOGGER_PID"
+wait "$LOGGER_PID" 2>/dev/null || true
+"$COMMAND_LOG" "$WORK/audit.lcmlog" "$ID" >"$WORK/commands.txt" || fail "COMMAND events did not decode"
+has_event() { grep -qE "$1" "$WORK/commands.txt" || fail "no COMMAND event like '$1'; got: $(cat "$WORK/commands.txt")"; }
+has_event "^COMMAND start station=local accepted=1 state=idle who=local user .* reply=ok start$"
+has_event "^COMMAND pause station=panel accepted=1 state=[a-z_]+ who=panel client $CLIENT \\(not paired\\) via local user .* reply=ok pause$"
+has_event "^COMMAND resume station=panel accepted=1 state=paused who=panel client $CLIENT paired as tablet-1 via .* reply=ok resume$"
+has_event "^COMMAND ack station=panel accepted=0 state=[a-z_]+ who=panel client $CLIENT paired as tablet-1 .* reply=refused: ack: no fault is latched"
+has_event "^COMMAND pair station=local accepted=1 .* reply=ok pair tablet-1 valid="
+has_event "^COMMAND unpair station=local accepted=1 "
+grep -q "$code" "$WORK/commands.txt" && fail "a pairing code reached a COMMAND event"
+grep -qE "token=|code=" "$WORK/commands.txt" && fail "a token or code field reached a COMMAND event"
+# The unpaired resume was refused by the panel and never reached serve; the revoked token's one did
+# (the panel cannot know the revocation) and serve refused it.
+[[ $(grep -c "^COMMAND resume station=panel accepted=1 " "$WORK/commands.txt") == 1 ]] || fail "resumes accepted: $(grep '^COMMAND resume' "$WORK/commands.txt")"
+grep -q "^COMMAND resume .*(not paired)" "$WORK/commands.txt" && fail "a resume the panel refused reached serve"
+has_event "^COMMAND resume station=panel accepted=0 state=paused who=panel client $CLIENT \\(token unknown or expired\\) .* reply=refused: resume: "
+echo "COMMAND events: $(wc -l <"$WORK/commands.txt") decided commands, each naming its station and who"
 echo "panel_authority: ok ($([[ $netns == 1 ]] && echo "client in network namespace $NS" || echo "client on loopback"))"

@@ -28,6 +28,10 @@ struct LoomView {
   bool estop_ok = true;
   bool knotting = false;  // the recipe has a knotting mode (`next` exists)
   sequencer::WeaverAsk weaver_ask = sequencer::WeaverAsk::kNone;  // the knotting heads wait for the weaver
+  // The last counters save failed: the file lags what was woven, and the loop refuses an ack until a
+  // retried save succeeds (an ack would re-arm from the older counts and weave those rows again). Not in
+  // the OperatorLink: serve sets it from its own save bookkeeping.
+  bool counters_unsaved = false;
 };
 LoomView view_of(const OperatorLink& link, bool knotting);
 
@@ -37,6 +41,7 @@ struct Decision {
   std::optional<Command> post;       // the command to hand to the loop
   Read read = Read::kNone;
   std::string who;                   // "local user anna (uid 1000, pid 42)", "panel client 10.0.0.5 paired as tab1 ..."
+  std::string station;               // "local" (the socket) or "panel" (a loom-panel client): the COMMAND event's station
   bool audit = false;                // a command that changes or would change the loom: log and record it
   bool accepted() const { return reply.rfind("ok", 0) == 0; }
 };
@@ -46,6 +51,10 @@ class OperatorDesk {
   // `iface`: the CAN interface named in the bus-off advice.
   OperatorDesk(Pairings& pairings, std::string iface) : pairings_(pairings), iface_(std::move(iface)) {}
   Decision decide(const ControlRequest& req, const LoomView& v, std::int64_t now_s);
+  // The reply a start/pause/ack (or any state-dependent word) gets in `v` from a station allowed to give
+  // it: "ok WORD" or "refused: WORD: why". For the I/O module's buttons, whose presses the loop takes
+  // directly: their audit says what the same command from the socket would have answered.
+  std::string answer_in_state(const std::string& word, const LoomView& v) const;
 
  private:
   std::string refuse_for_state(const ParsedRequest& r, const LoomView& v) const;
