@@ -1029,7 +1029,11 @@ void Sequencer::knotting(hal::Tick now, const hal::HalInputs& in) noexcept {
   knot_requested_ = false;  // answered the request, or came when none was open
   switch (st) {
     case RowKnotter::Status::kRunning:
+      return;
     case RowKnotter::Status::kAwaitingWeaver:
+      // Parked for the weaver, the heads at rest: a stop ends here, as it does while the weaver knots a row
+      // in weaver mode (the next run resumes the row at its first knot not known to be tied).
+      if (stop_requested_) enter(State::kDone, now);
       return;
     case RowKnotter::Status::kFault:
       latch(knotter_.fault(), now, knotter_.fault_axis());
@@ -1038,6 +1042,11 @@ void Sequencer::knotting(hal::Tick now, const hal::HalInputs& in) noexcept {
       const RowKnots& k = knotter_.row();
       row_.set_knots(k.ticks, k.weaver_ticks, k.tied, k.retried, k.by_hand);
       row_knotted_ = true;
+      // A pause asked for while the heads tied holds here, before the row's shed (resume sheds it).
+      if (pause_requested_) {
+        enter(State::kPaused, now);
+        return;
+      }
       next_row(now);
       return;
     }

@@ -262,9 +262,21 @@ grep -qF "operator: next by local user" "$work/serve10.log" && grep -qF "ok next
   fail "the journal does not say which request next answered"
 ctl faults | grep -qF " command loom1 next " || fail "next not in the history"
 ctl faults | grep -qF "ok next: answered $asked" || fail "the history does not say which request next answered"
-# SIGTERM is not honoured while the heads wait for the weaver (the runner stops at row end, which never
-# comes; see the report of issue 22): end this serve with SIGKILL until that is fixed.
 kill -9 "$pid"; wait "$pid" 2>/dev/null || true; pid=
 echo "knotting heads: next answered '$asked': ok"
+
+# 10b. SIGTERM while the heads wait for the weaver ends serve there (the row resumes at the next start)
+rm -rf "$work/state"
+start_serve serve10b.log --config "$src/firmware/config/knotting_loom.toml" \
+  --scene "$src/sim_hal/scenes/knotting_faults.toml"
+ctl start >/dev/null
+for _ in $(seq 1 1200); do grep -q "weaver asked: " "$work/serve10b.log" && break; sleep 0.05; done
+grep -q "weaver asked: " "$work/serve10b.log" || fail "the heads never asked the weaver"
+sleep 0.2
+t0=$(date +%s%N)
+stop_serve
+t1=$(date +%s%N)
+(( (t1 - t0) / 1000000 < 5000 )) || fail "SIGTERM while the heads wait for the weaver took $(( (t1 - t0) / 1000000 )) ms"
+echo "knotting heads: SIGTERM while the weaver is asked: ok"
 
 echo "serve_test: ok"

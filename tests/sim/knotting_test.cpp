@@ -167,6 +167,57 @@ TEST(Knotting, AJammedSelectorIsANamedFault) {
   EXPECT_EQ(w.fault_axis, cfg.sequencer.heads.selector_axis[1]);
 }
 
+// Stepping the machine tick by tick (no simulated weaver: the loom's requests stay open).
+struct Stepped {
+  firmware::Machine m;
+  hal::Tick t = 0;
+  Stepped(const firmware::LoomConfig& cfg, const firmware::Scene& sc, std::uint32_t rows)
+      : m(cfg, sc, options(rows), {}) {
+    m.sequencer().request_start();
+  }
+  static firmware::MachineOptions options(std::uint32_t rows) {
+    firmware::MachineOptions o;
+    o.telemetry = false;
+    o.rows = rows;
+    return o;
+  }
+  // Runs until `until` holds (true) or `limit` ticks pass (false).
+  template <class Pred>
+  bool run(Pred until, hal::Tick limit) {
+    for (const hal::Tick end = t + limit; t < end; ++t) {
+      if (until()) return true;
+      m.loop().cycle(t);
+    }
+    return until();
+  }
+};
+
+// A stop (ctl stop, SIGTERM to serve) while the heads wait for the weaver ends the run there, as it does
+// while the weaver knots a row in weaver mode; it does not wait for a row end that needs the weaver.
+TEST(Knotting, AStopWhileTheHeadsWaitForTheWeaverEndsTheRun) {
+  Stepped s(knotting_loom(), scene("miss_probability = 1.0\n"), 2);  // every knot slips: the weaver is asked
+  ASSERT_TRUE(s.run([&] { return s.m.sequencer().weaver_request().ask == sequencer::WeaverAsk::kTieByHand; }, 100000));
+  EXPECT_EQ(s.m.sequencer().state(), sequencer::State::kKnotting);
+  s.m.sequencer().request_stop_at_row_end();
+  ASSERT_TRUE(s.run([&] { return s.m.sequencer().state() == sequencer::State::kDone; }, 10));
+  EXPECT_EQ(s.m.sequencer().counters().rows, 0u);  // the row is not woven: the next run resumes its knots
+}
+
+// A pause asked for while the heads tie holds once the row's knots are tied, before its shed: the heald
+// frames have not moved, and resume sheds the row.
+TEST(Knotting, APauseWhileTheHeadsTieHoldsBeforeTheRowsShed) {
+  Stepped s(knotting_loom(), scene(""), 2);
+  ASSERT_TRUE(s.run([&] { return s.m.sequencer().state() == sequencer::State::kKnotting; }, 100000));
+  s.m.sequencer().request_pause();
+  const auto pistons = s.m.sim().pistons();
+  ASSERT_TRUE(s.run([&] { return s.m.sequencer().state() != sequencer::State::kKnotting; }, 100000));
+  EXPECT_EQ(s.m.sequencer().state(), sequencer::State::kPaused);
+  EXPECT_EQ(s.m.sequencer().counters().knot.cycles_done, static_cast<std::uint32_t>(s.m.knot_program()->stripe()));
+  EXPECT_EQ(s.m.sim().pistons(), pistons);  // no shed yet
+  s.m.sequencer().request_resume();
+  ASSERT_TRUE(s.run([&] { return s.m.sequencer().counters().picks > 0; }, 100000));
+}
+
 TEST(Knotting, AScenelessHeadsLoomAndAHeadlessKnotterAreRefused) {
   firmware::MachineOptions opt;
   opt.telemetry = false;

@@ -1,6 +1,8 @@
 // The COMMAND channel (issue 22: every command carries who gave it into a COMMAND/AUDIT event): a
 // CommandEvents writing through LCM's file:// provider, read back with lcm::LogFile and decoded by the
 // generated type. The expected channel and fields are written out here, not taken from the code.
+#include "loom/telemetry/command_events.hpp"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -9,7 +11,6 @@
 #include <string>
 #include <vector>
 
-#include "loom/telemetry/command_events.hpp"
 #include "loomlcm/command_t.hpp"
 
 namespace {
@@ -46,10 +47,13 @@ TEST(CommandEvents, EachAuditIsOneEventOnTheLoomsCommandChannel) {
     CommandEvents ev("file://" + path + "?mode=w", "LOOM", "hall3-7");
     EXPECT_EQ(ev.channel(), "LOOM.hall3-7.COMMAND");
     CommandAudit started{"start", "local", "local user anna (uid 1000, pid 42)", true, "ok start", "idle"};
-    CommandAudit refused{"resume", "panel", "panel client 10.0.0.5 (not paired) via local user www (uid 33, pid 7)",
-                         false,
-                         "refused: resume: a command that starts motion or resets a fault needs a paired panel client",
-                         "paused"};
+    CommandAudit refused{
+        "resume",
+        "panel",
+        "panel client 10.0.0.5 (not paired) via local user www (uid 33, pid 7)",
+        false,
+        "refused: resume: a command that starts motion or resets a fault needs a paired panel client",
+        "paused"};
     CommandAudit button{"pause", "button", "the I/O module's pause button", true, "ok pause", "pick"};
     EXPECT_TRUE(ev.publish(started));
     EXPECT_TRUE(ev.publish(refused));
@@ -86,7 +90,8 @@ TEST(CommandEvents, EachAuditIsOneEventOnTheLoomsCommandChannel) {
 }
 
 TEST(CommandEvents, AnUnopenableUrlIsRefusedAtConfigureTime) {
-  EXPECT_THROW(CommandEvents("file:///no_such_dir_for_loom/x.lcmlog?mode=w", "LOOM", "loom1"), std::invalid_argument);
+  EXPECT_THROW(CommandEvents("file:///no_such_dir_for_loom/x.lcmlog?mode=w", "LOOM", "loom1"),
+               std::invalid_argument);
 }
 
 }  // namespace

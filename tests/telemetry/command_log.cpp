@@ -27,8 +27,8 @@ int main(int argc, char** argv) {
       ++bad;
       continue;
     }
-    std::printf("COMMAND %s station=%s accepted=%d state=%s who=%s reply=%s\n", m.word.c_str(), m.station.c_str(),
-                m.accepted ? 1 : 0, m.state.c_str(), m.who.c_str(), m.reply.c_str());
+    std::printf("COMMAND %s station=%s accepted=%d state=%s who=%s reply=%s\n", m.word.c_str(),
+                m.station.c_str(), m.accepted ? 1 : 0, m.state.c_str(), m.who.c_str(), m.reply.c_str());
   }
   if (bad > 0) std::fprintf(stderr, "telemetry_command_log: %d COMMAND events did not decode\n", bad);
   return bad > 0 ? 1 : 0;

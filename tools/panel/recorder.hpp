@@ -18,10 +18,12 @@ namespace loom::panel {
 
 class Recorder {
  public:
-  Recorder(double window_s, std::size_t max_bytes) : window_us_(static_cast<std::int64_t>(window_s * 1e6)), max_bytes_(max_bytes) {}
+  Recorder(double window_s, std::size_t max_bytes)
+      : window_us_(static_cast<std::int64_t>(window_s * 1e6)), max_bytes_(max_bytes) {}
   bool enabled() const { return window_us_ > 0 && max_bytes_ > 0; }
   // LCM thread: one message of loom `id` on `channel`, received at `recv_us` (wall clock, µs).
-  void add(std::string_view id, std::string_view channel, const void* data, std::size_t size, std::int64_t recv_us);
+  void add(std::string_view id, std::string_view channel, const void* data, std::size_t size,
+           std::int64_t recv_us);
   // HTTP threads: the loom's messages kept, oldest first, as an LCM log file (the format lcm-logger writes:
   // big-endian sync word 0xEDA1DA01, event number, timestamp µs, channel length, data length, channel,
   // data), of the last window before `now_us` (a loom gone quiet keeps older ones until the byte budget

@@ -23,18 +23,23 @@ loomlcm::command_t to_command(const CommandAudit& a, const std::string& loom_id,
   return m;
 }
 
-CommandEvents::CommandEvents(const std::string& lcm_url, const std::string& prefix, const std::string& loom_id)
+CommandEvents::CommandEvents(const std::string& lcm_url, const std::string& prefix,
+                             const std::string& loom_id)
     : channel_(channel_names(prefix, loom_id).command), loom_id_(loom_id) {
   lcm_ = lcm_create(lcm_url.empty() ? nullptr : lcm_url.c_str());
-  if (lcm_ == nullptr) throw std::invalid_argument("telemetry lcm_url '" + lcm_url + "' could not be opened by LCM");
+  if (lcm_ == nullptr)
+    throw std::invalid_argument("telemetry lcm_url '" + lcm_url + "' could not be opened by LCM");
 }
 
-CommandEvents::~CommandEvents() { lcm_destroy(lcm_); }
+CommandEvents::~CommandEvents() {
+  lcm_destroy(lcm_);
+}
 
 bool CommandEvents::publish(const CommandAudit& a) noexcept {
   try {
     const std::int64_t utime = std::chrono::duration_cast<std::chrono::microseconds>(
-                                   std::chrono::system_clock::now().time_since_epoch()).count();
+                                   std::chrono::system_clock::now().time_since_epoch())
+                                   .count();
     const loomlcm::command_t m = to_command(a, loom_id_, utime);
     std::vector<std::uint8_t> buf(static_cast<std::size_t>(m.getEncodedSize()));
     const int n = m.encode(buf.data(), 0, static_cast<int>(buf.size()));

@@ -21,8 +21,8 @@ struct CommandAudit {
   std::string station;  // "local", "panel", "button"
   std::string who;
   bool accepted = false;
-  std::string reply;    // without its trailing newline; the caller has removed secrets
-  std::string state;    // the loom's state when decided
+  std::string reply;  // without its trailing newline; the caller has removed secrets
+  std::string state;  // the loom's state when decided
 };
 
 // Not RT-safe: allocates. The message for `a` (pure, for tests and the publisher).
