@@ -309,9 +309,13 @@ void Cia402Axis::on_profile_frame(hal::Tick now, const CanFrame& f) {
       mode_display_ = p.mode_display;
       if (homing_method_ != 0 && mode_display_ == od::kModeHoming && homing_commanded_) {
         // CiA 402 homing mode: bit 12 homing attained (with bit 10, target reached), bit 13 homing error.
-        if ((statusword_ & statusword::kHomingError) != 0) homing_error_ = true;
-        if (!referenced_ && (statusword_ & statusword::kHomingAttained) != 0 &&
-            (statusword_ & statusword::kTargetReached) != 0) {
+        // An error wins (bits 12 and 13 together are reserved, not a success) and stays latched until
+        // acknowledged: the axis is not referenced, and no later "attained" of that run makes it so.
+        if ((statusword_ & statusword::kHomingError) != 0) {
+          homing_error_ = true;
+          referenced_ = false;
+        } else if (!referenced_ && !homing_error_ && (statusword_ & statusword::kHomingAttained) != 0 &&
+                   (statusword_ & statusword::kTargetReached) != 0) {
           referenced_ = true;
           position_.reset(p.position_actual);  // the count jumped to the home offset: a new origin
           last_position_si_ = counts_to_si(position_.value(), counts_per_unit_);

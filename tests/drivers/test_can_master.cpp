@@ -424,6 +424,29 @@ TEST(CanHoming, ASwitchNeverFoundIsAHomingErrorUntilAcknowledged) {
   EXPECT_FALSE(h.rig.feedback[2].homing_error);
 }
 
+// A homing statusword with "homing error" (bit 13) is never a success, even beside "attained" (bit 12,
+// with target reached): the two together are reserved in CiA 402. Found by the CAN fuzzer.
+TEST(CanHoming, AHomingErrorBesideAttainedIsNotReferenced) {
+  HomingRig h(19, /*switch_missing=*/true);  // a long search: the run stays under way
+  ASSERT_TRUE(h.rig.configure());
+  h.rig.tick(test::DriveRig::hold(AxisRequest::kDisable));
+  for (int i = 0; i < 20; ++i) h.tick_homing();
+  ASSERT_FALSE(h.rig.feedback[2].referenced);
+  ASSERT_FALSE(h.rig.feedback[2].homing_error);
+  drivers::Tpdo1Mode bad;
+  bad.statusword = 0x0027 | drivers::statusword::kTargetReached | drivers::statusword::kHomingAttained |
+                   drivers::statusword::kHomingError;  // operation enabled, reached, attained AND error
+  bad.position_actual = 0;
+  bad.mode_display = drivers::od::kModeHoming;
+  ASSERT_EQ(h.rig.drives.send(drivers::pack_tpdo1_mode(3, bad)), drivers::SendResult::kOk);
+  // The drive's own TPDOs go on: the error stays latched, the axis unreferenced.
+  for (int i = 0; i < 50; ++i) {
+    h.tick_homing();
+    ASSERT_TRUE(h.rig.feedback[2].homing_error) << "tick " << i;
+    ASSERT_FALSE(h.rig.feedback[2].referenced) << "tick " << i;
+  }
+}
+
 TEST(CanHoming, TheHomeSwitchMethodStopsOnTheSwitch) {
   HomingRig h(19);
   ASSERT_TRUE(h.rig.configure());
