@@ -112,11 +112,50 @@ TEST(SequencerSim, DriveFaultStopsEveryAxisAndKeepsCounters) {
   EXPECT_EQ(r.seq->first_fault(), Fault::kDriveFault);  // first fault stays latched
 }
 
-TEST(SequencerSim, EStopMidRowIsLatched) {
+// The e-stop chain opens mid-row: latched in the tick the input says so, with the reaction the fault table
+// documents — every axis asked to quick-stop, the valves holding their state (a frame never closes onto a
+// stopped shuttle), the red lamp on, no cutter — and nothing commanded moves afterwards.
+TEST(SequencerSim, EStopMidRowIsLatchedAndStopsEverything) {
   Rig r;
   r.scene.faults.push_back({.at_s = 3.0, .kind = sim_hal::InjectedFault::kEStop});
   r.build(2);
-  r.run(200000, [] {});
+  hal::HalOutputs before{}, at_fault{};
+  bool seen = false;
+  hal::Tick latched_at = -1;
+  r.run(200000, [&] {
+    if (!seen && r.seq->first_fault() != Fault::kNone) {
+      seen = true;
+      at_fault = r.out;
+      latched_at = r.now;
+      EXPECT_FALSE(r.in.io.estop_ok) << "latched before the chain opened";
+    }
+    if (!seen) before = r.out;
+  });
+  ASSERT_TRUE(seen);
+  EXPECT_EQ(r.seq->first_fault(), Fault::kEStop);
+  EXPECT_EQ(r.seq->state(), State::kFault);
+  EXPECT_GT(latched_at, 0);
+  for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k) {
+    EXPECT_EQ(at_fault.axes[k].request, hal::AxisRequest::kQuickStop) << "axis " << k;
+  }
+  EXPECT_EQ(at_fault.io.piston_a_extend, before.io.piston_a_extend);
+  EXPECT_EQ(at_fault.io.piston_b_extend, before.io.piston_b_extend);
+  EXPECT_TRUE(at_fault.io.lamp_red);
+  EXPECT_FALSE(at_fault.io.lamp_green);
+  EXPECT_EQ(at_fault.io.cutter, decltype(at_fault.io.cutter){});
+  // The loop goes on with the chain still open: the targets stay where the fault left them, the valves too.
+  hal::PortHal hal(*r.world, *r.world);
+  for (int i = 0; i < 1000; ++i, ++r.now) {
+    hal.read(r.now, r.in);
+    r.seq->step(r.now, r.in, r.out);
+    hal.write(r.now, r.out);
+    for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k) {
+      ASSERT_EQ(r.out.axes[k].target_position, at_fault.axes[k].target_position) << "axis " << k << ", tick " << i;
+      ASSERT_EQ(r.out.axes[k].request, hal::AxisRequest::kQuickStop) << "axis " << k << ", tick " << i;
+    }
+    ASSERT_EQ(r.out.io.piston_a_extend, at_fault.io.piston_a_extend);
+    ASSERT_EQ(r.out.io.piston_b_extend, at_fault.io.piston_b_extend);
+  }
   EXPECT_EQ(r.seq->first_fault(), Fault::kEStop);
 }
 
