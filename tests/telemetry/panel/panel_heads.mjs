@@ -1,0 +1,62 @@
+// The knotting heads' view in a real browser: the row tied knot by knot and the magazines' levels.
+// Reads the page's DOM only (what the weaver sees): the cycle in progress and the tied knots advance
+// together (cycle j of the stripe shows j knots tied per head, the knot in progress outlined), every head
+// of the loom has a row in the heads table with one magazine level per slot, and the levels go down as
+// knots are tied — by as many knots as the page says were tied.
+// Usage: node --experimental-websocket panel_heads.mjs <chromium> <panel base url> <loom id> <png> <timeout s>
+import { writeFileSync } from "node:fs";
+import { launch, sleep } from "./cdp.mjs";
+
+const [chromiumBin, base, loomId, pngPath, timeoutArg] = process.argv.slice(2);
+const timeoutMs = Number(timeoutArg || 60) * 1000;
+let browser = null;
+const fail = msg => { console.error("FAIL: " + msg); browser?.close(); process.exit(1); };
+setTimeout(() => fail(`gave up after ${timeoutMs / 1000} s`), timeoutMs).unref();
+browser = await launch(chromiumBin, fail);
+const { send, open, evaluate } = browser;
+
+const page = await open(`${base}/loom/${loomId}`);
+const read = () => evaluate(page, `(() => {
+  const s = document.getElementById("heads");
+  if (!s) return null;
+  const rows = [...document.querySelectorAll("#heads-table tr[data-head]")];
+  return { knotting: s.dataset.knotting === "true", cycle: Number(s.dataset.cycle),
+           knots: document.querySelectorAll("#head-row .k").length,
+           tied: document.querySelectorAll("#head-row .k.tied").length,
+           now: document.querySelectorAll("#head-row .k.now").length,
+           heads: rows.length,
+           stock: rows.map(r => [...r.querySelectorAll(".mag")].map(m => Number(m.dataset.stock))),
+           rowKnots: document.getElementById("row-knots")?.textContent };
+})()`);
+const waitFor = async (what, ok, seconds) => {
+  const until = Date.now() + seconds * 1000;
+  let v = null;
+  while (Date.now() < until) {
+    v = await read();
+    if (v && ok(v)) return v;
+    await sleep(150);
+  }
+  fail(`${what}: not seen within ${seconds} s (last DOM read ${JSON.stringify(v)})`);
+};
+const sum = a => a.flat().reduce((x, y) => x + y, 0);
+
+// 1. The heads tie: a cycle in progress, one knot outlined per head, the cycles done shown tied.
+const a = await waitFor("the heads tying, a few knots in", v => v.knotting && v.cycle >= 2 && v.heads > 0, 60);
+if (a.now !== a.heads) fail(`${a.now} knots outlined as in progress, the loom has ${a.heads} heads`);
+if (a.tied !== a.heads * a.cycle) fail(`${a.tied} knots shown tied at cycle ${a.cycle + 1}, want ${a.heads * a.cycle}`);
+if (a.stock.some(h => h.length === 0 || h.some(n => !(n >= 0)))) fail(`magazine levels missing: ${JSON.stringify(a.stock)}`);
+const shot = await send("Page.captureScreenshot", { format: "png", captureBeyondViewport: true }, page);
+writeFileSync(pngPath, Buffer.from(shot.data, "base64"));
+// 2. Later in the same row: more knots tied, the yarn gone from the magazines knot for knot.
+const b = await waitFor("more knots tied in the same row", v => v.knotting && v.cycle >= a.cycle + 3, 60);
+if (b.tied !== b.heads * b.cycle) fail(`${b.tied} knots shown tied at cycle ${b.cycle + 1}, want ${b.heads * b.cycle}`);
+const used = sum(a.stock) - sum(b.stock);
+const tiedMore = b.tied - a.tied;
+// Each cycle takes one knot of yarn per head at TAKE; the one in progress may or may not have taken it yet.
+if (used < tiedMore || used > tiedMore + b.heads) {
+  fail(`the magazines lost ${used} knots of yarn while ${tiedMore} more knots were tied (${JSON.stringify(a.stock)} -> ${JSON.stringify(b.stock)})`);
+}
+console.log(`PASS: ${b.heads} heads, cycle ${a.cycle + 1} -> ${b.cycle + 1} of the row: ${a.tied} -> ${b.tied} knots shown tied, ` +
+  `magazines ${sum(a.stock)} -> ${sum(b.stock)} knots of yarn ("${b.rowKnots}"); screenshot ${pngPath}`);
+browser.close();
+process.exit(0);

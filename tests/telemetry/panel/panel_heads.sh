@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# The panel's knotting-heads view in a real browser: `loomctl serve` weaves the simulated loom with its six
+# heads (firmware/config/knotting_loom.toml, scene sim_hal/scenes/knotting.toml, 4x real time); loom-panel
+# listens to its telemetry; headless Chromium watches the row being tied knot by knot (the cycle and the
+# tied knots advance, the knot in progress outlined) and every head's magazine levels going down, as the
+# loom's own counters say. Writes <out>/loom_panel_heads.png. Exit 77 (skip) without chromium or node.
+# Usage: panel_heads.sh <loomctl> <loom-panel> <source dir> <out dir>
+set -euo pipefail
+LOOMCTL=$1
+PANEL=$2
+SRC=$3
+OUT=$4
+here=$(dirname "$0")
+fail() { echo "FAIL: $*" >&2; for f in "$WORK"/*.log; do echo "--- $f" >&2; tail -20 "$f" >&2; done; exit 1; }
+. "$(dirname "$0")/browser_lib.sh"
+mkdir -p "$OUT"
+WORK=$(mktemp -d "${TMPDIR:-/tmp}/loom_panel_heads.XXXXXX")
+PIDS=()
+cleanup() {
+  for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null || true; done
+  for p in "${PIDS[@]}"; do wait "$p" 2>/dev/null || true; done
+  rm -rf "$WORK" || true
+}
+trap cleanup EXIT
+
+PORT=$((20000 + ($$ * 13) % 20000))
+URL="udpm://239.255.76.67:${PORT}?ttl=0"
+ID="heads$$"
+mkdir -p "$WORK/run"
+"$PANEL" --port 0 --lcm-url "$URL" --control-dir "$WORK/run" 2>"$WORK/panel.log" &
+PIDS+=($!)
+for _ in $(seq 1 100); do
+  grep -q "serving http" "$WORK/panel.log" 2>/dev/null && break
+  sleep 0.05
+done
+BASE=$(sed -n 's|.*serving \(http://[0-9.]*:[0-9]*\)/.*|\1|p' "$WORK/panel.log")
+[ -n "$BASE" ] || fail "loom-panel did not start"
+
+SOCK="$WORK/run/$ID.sock"
+"$LOOMCTL" serve --config "$SRC/firmware/config/knotting_loom.toml" --scene "$SRC/sim_hal/scenes/knotting.toml" \
+  --state-dir "$WORK/state" --socket "$SOCK" --group "" --loom-id "$ID" --lcm-url "$URL" --pace 4 \
+  >"$WORK/serve.log" 2>&1 &
+PIDS+=($!)
+for _ in $(seq 1 200); do
+  [ -S "$SOCK" ] && "$LOOMCTL" ctl --socket "$SOCK" status >/dev/null 2>&1 && break
+  sleep 0.05
+done
+"$LOOMCTL" ctl --socket "$SOCK" start >/dev/null || fail "serve did not take start"
+
+node --experimental-websocket "$here/panel_heads.mjs" "$CHROMIUM" "$BASE" "$ID" "$OUT/loom_panel_heads.png" 90 \
+  2>&1 | grep -v ExperimentalWarning | grep -v "node --trace-warnings" || fail "browser check failed"
+[ -s "$OUT/loom_panel_heads.png" ] || fail "no screenshot written"
