@@ -26,7 +26,9 @@ const read = () => evaluate(page, `(() => {
            now: document.querySelectorAll("#head-row .k.now").length,
            heads: rows.length,
            stock: rows.map(r => [...r.querySelectorAll(".mag")].map(m => Number(m.dataset.stock))),
-           rowKnots: document.getElementById("row-knots")?.textContent };
+           rowKnots: document.getElementById("row-knots")?.textContent,
+           // The beat-force chart's x labels (no beat yet while the heads tie the first row).
+           xLabels: [...document.querySelectorAll('#force-chart text[y="242"]')].map(t => t.textContent) };
 })()`);
 const waitFor = async (what, ok, seconds) => {
   const until = Date.now() + seconds * 1000;
@@ -45,6 +47,7 @@ const a = await waitFor("the heads tying, a few knots in", v => v.knotting && v.
 if (a.now !== a.heads) fail(`${a.now} knots outlined as in progress, the loom has ${a.heads} heads`);
 if (a.tied !== a.heads * a.cycle) fail(`${a.tied} knots shown tied at cycle ${a.cycle + 1}, want ${a.heads * a.cycle}`);
 if (a.stock.some(h => h.length === 0 || h.some(n => !(n >= 0)))) fail(`magazine levels missing: ${JSON.stringify(a.stock)}`);
+if (a.xLabels.length !== 5 || new Set(a.xLabels).size !== 5) fail(`beat chart x labels ${JSON.stringify(a.xLabels)}: want five distinct`);
 const shot = await send("Page.captureScreenshot", { format: "png", captureBeyondViewport: true }, page);
 writeFileSync(pngPath, Buffer.from(shot.data, "base64"));
 // 2. Later in the same row: more knots tied, the yarn gone from the magazines knot for knot.
