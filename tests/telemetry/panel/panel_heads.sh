@@ -27,7 +27,14 @@ PORT=$((20000 + ($$ * 13) % 20000))
 URL="udpm://239.255.76.67:${PORT}?ttl=0"
 ID="heads$$"
 mkdir -p "$WORK/run"
-start_panel "$URL"
+"$PANEL" --port 0 --lcm-url "$URL" --control-dir "$WORK/run" 2>"$WORK/panel.log" &
+PIDS+=($!)
+for _ in $(seq 1 100); do
+  grep -q "serving http" "$WORK/panel.log" 2>/dev/null && break
+  sleep 0.05
+done
+BASE=$(sed -n 's|.*serving \(http://[0-9.]*:[0-9]*\)/.*|\1|p' "$WORK/panel.log")
+[ -n "$BASE" ] || fail "loom-panel did not start"
 
 SOCK="$WORK/run/$ID.sock"
 "$LOOMCTL" serve --config "$SRC/firmware/config/knotting_loom.toml" --scene "$SRC/sim_hal/scenes/knotting.toml" \

@@ -35,7 +35,14 @@ rows_json=$(grep -v '^[[:space:]]*#' "$DESIGN" | grep -v '^palette,' | grep -v '
   sed 's/[[:space:]]//g; s/,/","/g; s/^/["/; s/$/"]/' | paste -sd, | sed 's/^/[/; s/$/]/')
 height=$(grep -v '^[[:space:]]*#' "$DESIGN" | grep -v '^palette,' | grep -vc '^[[:space:]]*$')
 
-start_panel "$URL"
+"$PANEL" --port 0 --lcm-url "$URL" --control-dir "$WORK/run" 2>"$WORK/panel.log" &
+PIDS+=($!)
+for _ in $(seq 1 100); do
+  grep -q "serving http" "$WORK/panel.log" 2>/dev/null && break
+  sleep 0.05
+done
+BASE=$(sed -n 's|.*serving \(http://[0-9.]*:[0-9]*\)/.*|\1|p' "$WORK/panel.log")
+[ -n "$BASE" ] || fail "loom-panel did not start"
 
 SOCK="$WORK/run/$ID.sock"
 "$LOOMCTL" serve --config "$WORK/loom.toml" --state-dir "$WORK/state" --socket "$SOCK" --group "" \
