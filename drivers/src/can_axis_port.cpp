@@ -161,10 +161,12 @@ Status validate(const CanAxisPortConfig& c) {
   if (!(c.bus_load_budget > 0.0 && c.bus_load_budget <= 1.0)) {
     return Status::error(fmt("bus_load_budget = %g must be in (0, 1]", c.bus_load_budget));
   }
-  for (const FrameGroup& g : c.other_frames_per_cycle) {
-    if (g.data_bytes > 8) {
-      return Status::error("other_frames_per_cycle: data_bytes = " + std::to_string(g.data_bytes) +
-                           " exceeds 8 (classic CAN)");
+  for (const std::vector<FrameGroup>& bus : c.other_frames_per_cycle) {
+    for (const FrameGroup& g : bus) {
+      if (g.data_bytes > 8) {
+        return Status::error("other_frames_per_cycle: data_bytes = " + std::to_string(g.data_bytes) +
+                             " exceeds 8 (classic CAN)");
+      }
     }
   }
   return Status::ok();
@@ -173,6 +175,9 @@ Status validate(const CanAxisPortConfig& c) {
 std::size_t bus_count(const CanAxisPortConfig& c) {
   std::size_t n = 1;
   for (const CanAxisConfig& a : c.axes) n = std::max<std::size_t>(n, a.bus + 1U);
+  for (std::size_t b = 0; b < c.other_frames_per_cycle.size(); ++b) {
+    if (!c.other_frames_per_cycle[b].empty()) n = std::max(n, b + 1);
+  }
   return n;
 }
 
@@ -189,7 +194,10 @@ BusLoad planned_bus_load(const CanAxisPortConfig& c, std::size_t bus) {
   }
   n += homed;
   if (c.tpdo2) frames.push_back({kTpdo2Bytes, n});
-  if (bus == 0) frames.insert(frames.end(), c.other_frames_per_cycle.begin(), c.other_frames_per_cycle.end());
+  if (bus < kMaxBuses) {
+    const std::vector<FrameGroup>& other = c.other_frames_per_cycle[bus];
+    frames.insert(frames.end(), other.begin(), other.end());
+  }
   // The master heartbeat (1 byte) counted as if it were sent every cycle: the worst cycle holds it.
   if (c.master_node_id != 0) frames.push_back({1, 1});
   return compute_bus_load(frames, c.bitrate_bps, c.cycle_period_s);
@@ -223,11 +231,13 @@ void CanAxisPort::relink() {
   for (std::size_t i = 0; i < d_.n_axes; ++i) {
     if (d_.axes[i].bus() < kMaxBuses) d_.masters[d_.axes[i].bus()].add(d_.axes[i]);
   }
-  for (std::size_t k = 0; k < d_.n_attached; ++k) d_.masters[0].add(*d_.attached[k]);
+  for (std::size_t k = 0; k < d_.n_attached; ++k) {
+    if (d_.attached[k].bus < kMaxBuses) d_.masters[d_.attached[k].bus].add(*d_.attached[k].node);
+  }
 }
 
-void CanAxisPort::attach(CanNode& node) {
-  if (d_.n_attached < d_.attached.size()) d_.attached[d_.n_attached++] = &node;
+void CanAxisPort::attach(CanNode& node, std::size_t bus) {
+  if (d_.n_attached < d_.attached.size()) d_.attached[d_.n_attached++] = {&node, bus};
   relink();
 }
 
@@ -256,10 +266,17 @@ Status CanAxisPort::configure(std::span<CanBus* const> buses, ConfigureClock& cl
       return d_.n_buses == 1 ? s : Status::error("bus " + std::to_string(b) + ": " + s.message());
     }
   }
+  for (std::size_t k = 0; k < d_.n_attached; ++k) {
+    if (d_.attached[k].bus >= d_.n_buses) {
+      return Status::error(d_.attached[k].node->label() + " is attached to bus " + std::to_string(d_.attached[k].bus) +
+                           " but the port has " + std::to_string(d_.n_buses) +
+                           " bus(es): its frames are not in other_frames_per_cycle");
+    }
+  }
   relink();
   std::size_t expected = d_.n_axes + d_.n_attached;
   for (std::size_t b = 0; b < d_.n_buses; ++b) expected -= d_.masters[b].node_count();
-  if (expected != 0) return Status::error("an attached node shares its node id with an axis on bus 0");
+  if (expected != 0) return Status::error("an attached node shares its node id with another node on its bus");
   d_.consumer_ticks = ceil_ticks(d_.config.heartbeat_consumer_s, d_.config.cycle_period_s);
   d_.state_timeout_ticks = ceil_ticks(d_.config.state_timeout_s, d_.config.cycle_period_s);
 

@@ -98,9 +98,10 @@ std::vector<NamedBit> outputs_of(const IoWiring& w) {
   return v;
 }
 
+// Every required signal wired, every bit in range and used once per module.
 Status check_bits(const std::vector<NamedBit>& bits, int max_bits) {
   static_assert(kIoMaxInputBits >= kIoMaxOutputBits);
-  std::array<const std::string*, kIoMaxInputBits> used{};
+  std::array<std::array<const std::string*, kIoMaxInputBits>, kMaxIoModules> used{};
   for (const NamedBit& b : bits) {
     const int n = b.bit->bit;
     if (n == -1) {
@@ -111,11 +112,16 @@ Status check_bits(const std::vector<NamedBit>& bits, int max_bits) {
       return Status::error(b.name + ".bit = " + std::to_string(n) + " is outside 0.." +
                            std::to_string(max_bits - 1) + " (-1 = not wired)");
     }
-    if (used[static_cast<std::size_t>(n)] != nullptr) {
-      return Status::error(b.name + ".bit = " + std::to_string(n) + " is already used by " +
-                           *used[static_cast<std::size_t>(n)]);
+    if (b.bit->module >= kMaxIoModules) {
+      return Status::error(b.name + ".module = " + std::to_string(b.bit->module) + " is outside 0.." +
+                           std::to_string(kMaxIoModules - 1));
     }
-    used[static_cast<std::size_t>(n)] = &b.name;
+    const std::string*& user = used[b.bit->module][static_cast<std::size_t>(n)];
+    if (user != nullptr) {
+      return Status::error(b.name + ".bit = " + std::to_string(n) + " is already used by " + *user +
+                           (b.bit->module == 0 ? "" : " (both on I/O module " + std::to_string(b.bit->module) + ")"));
+    }
+    user = &b.name;
   }
   return Status::ok();
 }
@@ -173,6 +179,10 @@ Status validate(const IoWiring& w) {
   }
   if (Status s = check_bits(inputs_of(w), kIoMaxInputBits); !s) return s;
   if (Status s = check_bits(outputs_of(w), kIoMaxOutputBits); !s) return s;
+  if (w.load_cell_module >= kMaxIoModules) {
+    return Status::error("io.load_cell.module = " + std::to_string(w.load_cell_module) + " is outside 0.." +
+                         std::to_string(kMaxIoModules - 1));
+  }
   if (w.load_cell_channel < 0 || w.load_cell_channel > 254) {
     return Status::error("io.load_cell.channel = " + std::to_string(w.load_cell_channel) +
                          " is outside 0..254 (0 = no load cell, else the sub-index of 0x6401)");
@@ -189,9 +199,33 @@ Status validate(const IoWiring& w) {
   return Status::ok();
 }
 
+IoWiring module_wiring(const IoWiring& wiring, std::uint8_t module) {
+  IoWiring w = wiring;
+  const auto keep = [module](IoBit& b) {
+    if (b.module != module) b = IoBit{};
+  };
+  for (IoBit* b : {&w.piston_a_extended, &w.piston_a_retracted, &w.piston_b_extended, &w.piston_b_retracted,
+                   &w.shuttle_at_left, &w.shuttle_at_right, &w.estop_ok, &w.button_start, &w.button_pause,
+                   &w.button_ack, &w.row_knotted, &w.piston_a_extend, &w.piston_b_extend, &w.lamp_green,
+                   &w.lamp_amber, &w.lamp_red, &w.buzzer}) {
+    keep(*b);
+  }
+  for (IoBit& b : w.second) keep(b);
+  for (std::size_t h = 0; h < hal::kMaxKnottingHeads; ++h) {
+    keep(w.gripper_close[h]);
+    keep(w.cutter[h]);
+    keep(w.yarn_present[h]);
+  }
+  if (w.load_cell_module != module) w.load_cell_channel = 0;
+  return w;
+}
+
 Status validate(const CanIoConfig& c) {
   if (c.node_id < kMinNodeId || c.node_id > kMaxNodeId) {
     return Status::error("io.node = " + std::to_string(c.node_id) + " is outside 1..127");
+  }
+  if (c.module >= kMaxIoModules) {
+    return Status::error("io: module " + std::to_string(c.module) + " is outside 0.." + std::to_string(kMaxIoModules - 1));
   }
   if (Status s = validate(c.wiring); !s) return s;
   if (!(c.cycle_period_s > 0.0)) return Status::error("io: cycle period " + seconds(c.cycle_period_s) + " must be > 0");
@@ -245,7 +279,8 @@ hal::DigitalOutputs io_safe_outputs() {
   return o;
 }
 
-CanIoPort::CanIoPort(CanIoConfig config) : config_(std::move(config)) {}
+CanIoPort::CanIoPort(CanIoConfig config)
+    : config_(std::move(config)), wiring_(module_wiring(config_.wiring, config_.module)) {}
 
 std::string CanIoPort::who() const {
   return label() + ": ";
@@ -348,7 +383,7 @@ Status CanIoPort::map_pdo(SdoClient& sdo, bool rx, int pdo, const std::vector<st
 }
 
 Status CanIoPort::configure_mapping(SdoClient& sdo) {
-  const IoWiring& w = config_.wiring;
+  const IoWiring& w = wiring_;
   const std::uint8_t in_subs = io_input_subs(w);
   const std::uint8_t out_bytes = io_output_subs(w);
 
@@ -424,7 +459,7 @@ Status CanIoPort::locate(const std::array<PdoLayout, 4>& layouts, std::uint32_t 
 // The module refused to map `entry` into the inputs' TPDO: most likely it has fewer inputs than the
 // wiring uses, so say which signal makes the master read that far (the highest one, in the last sub).
 Status CanIoPort::explain_refused_input(const Status& s, std::uint32_t entry, std::uint8_t subs) const {
-  const std::vector<NamedBit> bits = inputs_of(config_.wiring);
+  const std::vector<NamedBit> bits = inputs_of(wiring_);
   const NamedBit* highest = signal_in_sub(bits, subs);
   if (highest == nullptr) return s;
   char range[24];
@@ -439,7 +474,7 @@ Status CanIoPort::explain_refused_input(const Status& s, std::uint32_t entry, st
 // switches) are compared as seen at the same instant, never one frame against another. A sub no signal
 // lives in is read when it comes in that TPDO and otherwise not needed.
 Status CanIoPort::locate_inputs(std::uint8_t subs) {
-  const std::vector<NamedBit> bits = inputs_of(config_.wiring);
+  const std::vector<NamedBit> bits = inputs_of(wiring_);
   input_slot_ = {};
   input_pdo_ = -1;
   std::uint32_t first = 0;  // the needed sub that fixed input_pdo_, for the message
@@ -470,7 +505,8 @@ Status CanIoPort::locate_inputs(std::uint8_t subs) {
 }
 
 std::string CanIoPort::label() const {
-  return "node " + std::to_string(config_.node_id) + " (I/O node)";
+  return "node " + std::to_string(config_.node_id) +
+         (config_.name.empty() ? " (I/O node)" : " (I/O module " + config_.name + ")");
 }
 
 NodeTiming CanIoPort::timing() const {
@@ -516,7 +552,7 @@ Status CanIoPort::configure_profile(SdoClient& sdo) {
 
   // The module's own reaction to a failure: valves off (see io_safe_outputs()).
   {
-    const IoWiring& w = config_.wiring;
+    const IoWiring& w = wiring_;
     const hal::DigitalOutputs safe = io_safe_outputs();
     std::array<std::uint8_t, kMaxOutputSubs> mode{}, value{};
     const auto put = [&](const IoBit& b, bool on) {
@@ -630,28 +666,38 @@ bool CanIoPort::input(const IoBit& b) const {
   return level != b.active_low;
 }
 
-void CanIoPort::read_io(hal::Tick /*now*/, const hal::AxisFeedbacks& /*axes*/, hal::DigitalInputs& io) {
-  const IoWiring& w = config_.wiring;
-  const auto first = first_switches(w);
-  std::array<bool, hal::kSafetySensorCount> sensors{};
-  for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) sensors[i] = input(*first[i]);
-  hal::set_safety_sensors(io, sensors);
-  // Before the first TPDO there is no news, not an opened chain: `refreshed` stays kNeverTick, which the
-  // sequencer counts as old from arming (stale → fault), and every input reads false (active-low ones
-  // too, see input()), so nothing can be confirmed (no shed, no pick) on inputs never seen.
-  io.estop_ok = inputs_refreshed_ == hal::kNeverTick || input(w.estop_ok);
-  io.button_start = input(w.button_start);
-  io.button_pause = input(w.button_pause);
-  io.button_ack = input(w.button_ack);
-  io.row_knotted = input(w.row_knotted);
+void CanIoPort::read_wired(hal::DigitalInputs& io) const {
+  const IoWiring& w = wiring_;
+  const auto take = [this](const IoBit& b, bool& to) {
+    if (b.bit >= 0) to = input(b);
+  };
+  take(w.piston_a_extended, io.piston_a_extended);
+  take(w.piston_a_retracted, io.piston_a_retracted);
+  take(w.piston_b_extended, io.piston_b_extended);
+  take(w.piston_b_retracted, io.piston_b_retracted);
+  take(w.shuttle_at_left, io.shuttle_at_left);
+  take(w.shuttle_at_right, io.shuttle_at_right);
+  // Before the first TPDO there is no news, not an opened chain: the sample's `refreshed` stays kNeverTick,
+  // which the sequencer counts as old from arming (stale → fault), and every input reads false (active-low
+  // ones too, see input()), so nothing can be confirmed (no shed, no pick) on inputs never seen.
+  if (w.estop_ok.bit >= 0) io.estop_ok = inputs_refreshed_ == hal::kNeverTick || input(w.estop_ok);
+  take(w.button_start, io.button_start);
+  take(w.button_pause, io.button_pause);
+  take(w.button_ack, io.button_ack);
+  take(w.row_knotted, io.row_knotted);
   // Each second channel from its own terminal, never derived from the first: false where not wired.
-  for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) io.second_channel[i] = input(w.second[i]);
-  for (std::size_t h = 0; h < static_cast<std::size_t>(w.heads); ++h) io.yarn_present[h] = input(w.yarn_present[h]);
+  for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) take(w.second[i], io.second_channel[i]);
+  for (std::size_t h = 0; h < static_cast<std::size_t>(w.heads); ++h) take(w.yarn_present[h], io.yarn_present[h]);
+}
+
+void CanIoPort::read_io(hal::Tick /*now*/, const hal::AxisFeedbacks& /*axes*/, hal::DigitalInputs& io) {
+  io = hal::DigitalInputs{};  // what this module does not carry reads false
+  read_wired(io);
   io.refreshed = inputs_refreshed_;
 }
 
 void CanIoPort::read_analog(hal::Tick /*now*/, hal::AnalogInputs& analog) {
-  const IoWiring& w = config_.wiring;
+  const IoWiring& w = wiring_;
   analog.beat_force_valid = w.load_cell_channel != 0 && analog_refreshed_ != hal::kNeverTick;
   analog.beat_force_n = analog.beat_force_valid
                             ? w.load_cell_n_per_count * static_cast<double>(analog_counts_) + w.load_cell_offset_n
@@ -663,7 +709,7 @@ void CanIoPort::write_io(hal::Tick /*now*/, const hal::DigitalOutputs& requested
   if (!configured_) return;
   // A node we cannot supervise gets its safe outputs (it may still hear us).
   const hal::DigitalOutputs& o = supervisor_.link_fault() != 0 ? io_safe_outputs() : requested;
-  const IoWiring& w = config_.wiring;
+  const IoWiring& w = wiring_;
   std::array<std::uint8_t, kMaxOutputSubs> bytes{};
   const auto put = [&](const IoBit& b, bool on) {
     if (b.bit < 0) return;

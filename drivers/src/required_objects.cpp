@@ -1,7 +1,10 @@
 // Required objects per node kind, named with the master's own od:: constants.
 #include "loom/drivers/required_objects.hpp"
 
+#include <algorithm>
 #include <cstdio>
+#include <initializer_list>
+#include <utility>
 
 #include "loom/drivers/can_io_port.hpp"
 #include "loom/drivers/pdo.hpp"
@@ -61,22 +64,59 @@ std::vector<RequiredObject> io_module_objects() {
   };
 }
 
-std::vector<RequiredObject> io_module_objects(const IoWiring& wiring) {
+namespace {
+
+// "a, b, c" of the parts that are present.
+std::string joined(std::initializer_list<std::pair<bool, const char*>> parts) {
+  std::string out;
+  for (const auto& [present, text] : parts) {
+    if (present) out += (out.empty() ? "" : ", ") + std::string(text);
+  }
+  return out;
+}
+
+bool wired(const IoBit& b) { return b.bit >= 0; }
+
+}  // namespace
+
+std::vector<RequiredObject> io_module_objects(const IoWiring& w) {
   // The group counts come from the same function configure() maps with, so a module checked against
   // this list is one the master accepts (a module with fewer groups cannot map what the wiring asks for).
-  std::vector<RequiredObject> v = io_module_objects();
-  for (RequiredObject& o : v) {
-    if (o.index == od401::kDigitalInputs8) o.subs = io_input_subs(wiring);
-    if (o.index == od401::kDigitalOutputs8) o.subs = io_output_subs(wiring);
-    if (wiring.heads <= 0) continue;
-    // The knotting heads' signals on the same module.
+  const auto heads = static_cast<std::size_t>(std::clamp(w.heads, 0, static_cast<int>(hal::kMaxKnottingHeads)));
+  const auto any = [&](const auto& signals) {
+    return std::any_of(signals.begin(), signals.begin() + static_cast<std::ptrdiff_t>(heads), wired);
+  };
+  const auto firsts = first_switches(w);
+  const bool sensors = std::any_of(firsts.begin(), firsts.end(), [](const IoBit* b) { return wired(*b); });
+  const bool seconds = std::any_of(w.second.begin(), w.second.end(), wired);
+  const bool buttons = wired(w.button_start) || wired(w.button_pause) || wired(w.button_ack) || wired(w.row_knotted);
+  const bool valves = wired(w.piston_a_extend) || wired(w.piston_b_extend);
+  const bool lamps = wired(w.lamp_green) || wired(w.lamp_amber) || wired(w.lamp_red);
+  const bool grippers = any(w.gripper_close) || any(w.cutter);
+  std::vector<RequiredObject> v;
+  for (RequiredObject& o : io_module_objects()) {
+    const bool load_cell_object = o.index == od401::kAnalogInput16 || o.index == od::kTpdoComm + 1;
+    if (load_cell_object && w.load_cell_channel == 0) continue;  // not on this module
     if (o.index == od401::kDigitalInputs8) {
-      o.why = "sensors and their second channels, e-stop chain, buttons, the heads' yarn-present switches";
+      o.subs = io_input_subs(w);
+      o.why = joined({{sensors, seconds ? "sensors and their second channels" : "sensors"},
+                      {!sensors && seconds, "the sensors' second channels"},
+                      {wired(w.estop_ok), "e-stop chain"},
+                      {buttons, "buttons"},
+                      {any(w.yarn_present), "the heads' yarn-present switches"}});
+      if (o.why.empty()) o.why = "none wired: read for the module's supervision";
     } else if (o.index == od401::kDigitalOutputs8) {
-      o.why = "valves, stack light, buzzer, the heads' grippers and cutters";
+      o.subs = io_output_subs(w);
+      o.why = joined({{valves, "valves"}, {lamps, "stack light"}, {wired(w.buzzer), "buzzer"},
+                      {grippers, "the heads' grippers and cutters"}});
+      if (o.why.empty()) o.why = "none wired";
     } else if (o.index == od401::kOutputErrorValue) {
-      o.why = "both valves de-energised, grippers open, cutters retracted on failure";
+      o.why = joined({{valves, "both valves de-energised"}, {grippers, "grippers open, cutters retracted"}});
+      o.why = o.why.empty() ? "the safe outputs on failure" : o.why + " on failure";
+    } else if (o.index == od401::kConsumerHeartbeat && !valves) {
+      o.why = "its outputs go safe when the controller dies";
     }
+    v.push_back(std::move(o));
   }
   return v;
 }
@@ -91,7 +131,7 @@ std::string describe(const RequiredObject& o) {
     std::snprintf(object, sizeof object, "0x%04X", o.index);
   }
   char buf[200];
-  std::snprintf(buf, sizeof buf, "%s %s%s: %s", object, o.name, o.optional ? " (optional)" : "", o.why);
+  std::snprintf(buf, sizeof buf, "%s %s%s: %s", object, o.name, o.optional ? " (optional)" : "", o.why.c_str());
   return buf;
 }
 

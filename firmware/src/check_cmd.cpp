@@ -27,6 +27,22 @@ void print_keys() {
   for (const KeyInfo& k : config_keys()) std::printf("%-36s %-8s %s\n", k.path, k.klass, k.range.c_str());
 }
 
+std::string io_module_signals(const IoModuleSpec& m) {
+  std::string out;
+  for (const std::string& s : m.signals) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
+// "io" for the [io] table's module, "io_modules.<name>" for a further one.
+std::string module_key(const LoomConfig& c, std::uint8_t module) {
+  return module == 0 ? std::string("io") : "io_modules." + c.io.modules[module - 1u].name;
+}
+
+// An input's bit, with its module when the loom has several.
+std::string input_at(const LoomConfig& c, const drivers::IoBit& b) {
+  return std::to_string(b.bit) + (c.io.modules.empty() ? "" : " (" + module_key(c, b.module) + ")");
+}
+
 // Which safety sensors have a second switch, where both are wired, and what a sensor without one
 // cannot catch.
 void print_safety_sensors(const LoomConfig& c) {
@@ -37,7 +53,7 @@ void print_safety_sensors(const LoomConfig& c) {
   for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) {
     const std::string name = hal::safety_sensor_name(static_cast<hal::SafetySensor>(i));
     if (c.sequencer.second_channel[i]) {
-      dual += "    " + name + ": inputs " + std::to_string(first[i]->bit) + " and " + std::to_string(w.second[i].bit) + "\n";
+      dual += "    " + name + ": inputs " + input_at(c, *first[i]) + " and " + input_at(c, w.second[i]) + "\n";
     } else {
       single += (single.empty() ? "" : ", ") + name;
     }
@@ -234,7 +250,14 @@ void print_plan(const LoomConfig& c) {
   print_knotting(c, knot_cycle);
 
   std::printf("\nCAN (for --hal socketcan)\n");
-  std::printf("  I/O module node %u (%s); controller heartbeat %s\n", c.io.node,
+  std::string io_nodes = "I/O module node " + std::to_string(c.io.node);
+  if (!c.io.modules.empty()) {
+    io_nodes = "I/O modules: io node " + std::to_string(c.io.node) + " on bus 0";
+    for (const IoModuleSpec& m : c.io.modules) {
+      io_nodes += ", " + m.name + " node " + std::to_string(m.node) + " on bus " + std::to_string(m.bus);
+    }
+  }
+  std::printf("  %s (%s); controller heartbeat %s\n", io_nodes.c_str(),
               c.io.kind == IoKind::kCan ? "on the bus" : "SIMULATED: needs --io simulated on hardware",
               c.can.master_node != 0 ? ("node " + std::to_string(c.can.master_node) + ", every " +
                                         std::to_string(c.can.master_heartbeat_ms) + " ms, consumers " +
@@ -249,7 +272,14 @@ void print_plan(const LoomConfig& c) {
     for (const AxisSpec& a : c.axes) {
       if (a.bus == b) on_bus += (on_bus.empty() ? "" : ", ") + a.name + " " + std::to_string(a.node);
     }
-    if (b == 0 && c.io.kind == IoKind::kCan) on_bus += ", I/O " + std::to_string(c.io.node);
+    if (c.io.kind == IoKind::kCan) {
+      const std::vector<std::size_t> io_buses = can_io_buses(c);
+      for (std::size_t k = 0; k < io_buses.size(); ++k) {
+        if (io_buses[k] != b) continue;
+        on_bus += (on_bus.empty() ? "" : ", ") + std::string(k == 0 ? "I/O " : "I/O " + c.io.modules[k - 1].name + " ") +
+                  std::to_string(k == 0 ? c.io.node : c.io.modules[k - 1].node);
+      }
+    }
     std::printf("  bus %zu (nodes %s) load: %s (budget %.0f %%)\n", b, on_bus.c_str(),
                 drivers::describe_bus_load(can_bus_load(c, b)).c_str(), c.can.bus_load_budget * 100.0);
   }
@@ -267,8 +297,18 @@ void print_plan(const LoomConfig& c) {
     std::printf("  objects the homing drives (nodes %s) must support as well:\n", homing.c_str());
     for (const auto& o : drivers::homing_drive_objects()) std::printf("    %s\n", drivers::describe(o).c_str());
   }
-  std::printf("  objects the I/O module (node %u) must support:\n", c.io.node);
-  for (const auto& o : drivers::io_module_objects(can_io_config(c).wiring)) std::printf("    %s\n", drivers::describe(o).c_str());
+  for (const drivers::CanIoConfig& m : can_io_configs(c)) {
+    if (c.io.modules.empty()) {
+      std::printf("  objects the I/O module (node %u) must support:\n", m.node_id);
+    } else {
+      std::printf("  objects the I/O module %s (node %u; %s) must support:\n", module_key(c, m.module).c_str(), m.node_id,
+                  m.module == 0 ? "every signal no other module lists"
+                                : ("signals " + io_module_signals(c.io.modules[m.module - 1u])).c_str());
+    }
+    for (const auto& o : drivers::io_module_objects(drivers::module_wiring(m.wiring, m.module))) {
+      std::printf("    %s\n", drivers::describe(o).c_str());
+    }
+  }
 }
 
 void print_scene(const Scene& s) {

@@ -19,6 +19,7 @@
 #include "loom/motion/fourbar.hpp"
 #include "loom/motion/mass_properties.hpp"
 #include "loom/motion/profile_crank.hpp"
+#include "io_modules_config.hpp"
 #include "toml_reader.hpp"
 
 namespace loom::firmware {
@@ -467,7 +468,8 @@ const std::set<std::string>& known_sections() {
   static const std::set<std::string> s = [] {
     std::set<std::string> out;
     for (const Key& k : keys()) out.insert(k.path.substr(0, k.path.find('.')));
-    out.insert("axes");  // [axes.<name>] tables, read by read_axes()
+    out.insert("axes");        // [axes.<name>] tables, read by read_axes()
+    out.insert("io_modules");  // [io_modules.<name>] tables, read by read_io_modules()
     return out;
   }();
   return s;
@@ -822,9 +824,20 @@ void check_can(const LoomConfig& c, const Fail& fail) {
     fail(key, value, "the CAN master refuses it: " + msg);
   }
   if (c.io.kind == IoKind::kCan) {
-    for (const AxisSpec& a : c.axes) {
-      if (a.bus == 0 && a.node == c.io.node) {
-        fail("io.node", std::to_string(c.io.node), "node id already used by axes." + a.name + ".node");
+    // Node ids are unique per bus: each module against the axes and the modules before it on its bus.
+    const std::vector<std::size_t> buses = can_io_buses(c);
+    const auto node_key = [&](std::size_t k) { return k == 0 ? std::string("io.node") : "io_modules." + c.io.modules[k - 1].name + ".node"; };
+    const auto node_of = [&](std::size_t k) { return k == 0 ? c.io.node : c.io.modules[k - 1].node; };
+    for (std::size_t k = 0; k < buses.size(); ++k) {
+      for (const AxisSpec& a : c.axes) {
+        if (a.bus == buses[k] && a.node == node_of(k)) {
+          fail(node_key(k), std::to_string(node_of(k)), "node id already used by axes." + a.name + ".node");
+        }
+      }
+      for (std::size_t j = 0; j < k; ++j) {
+        if (buses[j] == buses[k] && node_of(j) == node_of(k)) {
+          fail(node_key(k), std::to_string(node_of(k)), "node id already used by " + node_key(j) + " on bus " + std::to_string(buses[k]));
+        }
       }
     }
     if (c.knotting.mode == sequencer::KnottingMode::kHeads) {
@@ -841,11 +854,17 @@ void check_can(const LoomConfig& c, const Fail& fail) {
         }
       }
     }
-    if (const drivers::Status s = drivers::validate(can_io_config(c)); !s) {
+    if (const drivers::Status s = drivers::validate(can_io_configs(c).front()); !s) {
       // The driver names the signal first ("io.inputs.estop_ok.bit = 3 ...", "io.outputs.cutter.head2.bit
       // = 9 ..."): point at that signal's key (not at another signal the message names after it).
       std::string key = "io.node", value = std::to_string(c.io.node);
-      const std::string& msg = s.message();
+      std::string msg = s.message();
+      for (std::size_t k = 0; k < c.io.modules.size(); ++k) {  // the driver numbers modules; the file names them
+        const std::string numbered = "I/O module " + std::to_string(k + 1) + ")";
+        if (const std::size_t at = msg.find(numbered); at != std::string::npos) {
+          msg.replace(at, numbered.size(), "io_modules." + c.io.modules[k].name + ")");
+        }
+      }
       const std::size_t group_end = msg.find('.', 3);
       const std::string subject =
           group_end == std::string::npos ? std::string() : msg.substr(group_end + 1, msg.find(".bit") - group_end - 1);
@@ -1111,6 +1130,7 @@ LoomConfig parse_complete(const std::string& text, const std::string& source, co
   }
   refuse_moved_keys(r);
   read_axes(r, c, base != nullptr);
+  read_io_modules(r, c);
   r.reject_unknown(known_sections());
   check_relations(r, c);
   const Fail fail = [&](const std::string& key, const std::string& value, const std::string& why) {
@@ -1175,11 +1195,25 @@ drivers::CanAxisPortConfig can_axis_config(const LoomConfig& c) {
   cc.master_node_id = c.can.master_node;
   cc.master_heartbeat_s = c.can.master_heartbeat_ms * 1e-3;
   cc.master_consumer_s = c.can.master_consumer_ms * 1e-3;
-  if (c.io.kind == IoKind::kCan) cc.other_frames_per_cycle = drivers::io_frames_per_cycle(can_io_config(c).wiring);
+  if (c.io.kind == IoKind::kCan) {
+    const std::vector<drivers::CanIoConfig> modules = can_io_configs(c);
+    const std::vector<std::size_t> buses = can_io_buses(c);
+    for (std::size_t k = 0; k < modules.size(); ++k) {
+      const auto frames = drivers::io_frames_per_cycle(drivers::module_wiring(modules[k].wiring, modules[k].module));
+      std::vector<drivers::FrameGroup>& on_bus = cc.other_frames_per_cycle[std::min(buses[k], drivers::kMaxBuses - 1)];
+      on_bus.insert(on_bus.end(), frames.begin(), frames.end());
+    }
+  }
   return cc;
 }
 
-drivers::CanIoConfig can_io_config(const LoomConfig& c) {
+std::vector<std::size_t> can_io_buses(const LoomConfig& c) {
+  std::vector<std::size_t> buses{0};  // the [io] module is on bus 0
+  for (const IoModuleSpec& m : c.io.modules) buses.push_back(m.bus);
+  return buses;
+}
+
+std::vector<drivers::CanIoConfig> can_io_configs(const LoomConfig& c) {
   drivers::CanIoConfig ic;
   ic.node_id = c.io.node;
   ic.wiring = c.io.wiring;
@@ -1190,7 +1224,7 @@ drivers::CanIoConfig can_io_config(const LoomConfig& c) {
     w.heads = std::clamp(c.knotting.heads, 0, static_cast<int>(hal::kMaxKnottingHeads));
     const auto fill = [&](const IoSettings::HeadSignals& from, std::array<drivers::IoBit, hal::kMaxKnottingHeads>& to) {
       for (std::size_t h = 0; h < to.size(); ++h) {
-        to[h] = drivers::IoBit{h < from.bits.size() ? from.bits[h] : -1, from.active_low};
+        to[h] = drivers::IoBit{h < from.bits.size() ? from.bits[h] : -1, from.active_low, from.module};
       }
     };
     fill(c.io.gripper_close, w.gripper_close);
@@ -1205,7 +1239,18 @@ drivers::CanIoConfig can_io_config(const LoomConfig& c) {
   ic.operational_timeout_s = c.io.operational_timeout_ms * 1e-3;
   ic.master_node_id = c.can.master_node;
   ic.master_consumer_s = c.can.master_consumer_ms * 1e-3;
-  return ic;
+  std::vector<drivers::CanIoConfig> out{ic};
+  for (std::size_t k = 0; k < c.io.modules.size(); ++k) {
+    const IoModuleSpec& m = c.io.modules[k];
+    drivers::CanIoConfig mc = ic;  // the same wiring, bus timing and master; its own node and windows
+    mc.module = static_cast<std::uint8_t>(k + 1);
+    mc.name = m.name;
+    mc.node_id = m.node;
+    mc.boot_timeout_s = m.boot_timeout_ms * 1e-3;
+    mc.operational_timeout_s = m.operational_timeout_ms * 1e-3;
+    out.push_back(std::move(mc));
+  }
+  return out;
 }
 
 drivers::BusLoad can_bus_load(const LoomConfig& c, std::size_t bus) {
@@ -1254,6 +1299,9 @@ std::string restart_only_changes(const LoomConfig& running, const LoomConfig& ne
   if (const std::string a = axes_text(running), b = axes_text(next); a != b) {
     out += (out.empty() ? "" : ", ") + std::string("axes ") + a + " -> " + b;
   }
+  if (const std::string a = io_modules_text(running), b = io_modules_text(next); a != b) {
+    out += (out.empty() ? "" : ", ") + std::string("io_modules ") + a + " -> " + b;
+  }
   return out;
 }
 
@@ -1263,6 +1311,9 @@ std::vector<KeyInfo> config_keys() {
     out.push_back({k.path.c_str(), klass_name(k.klass), k.range});
     if (k.path == "can.master_consumer_ms") {
       for (const AxisKeyInfo& a : axis_keys()) out.push_back({a.path, "machine", a.range});
+    }
+    if (k.path == "io.yarn_present_active_low") {
+      for (const IoModuleKeyInfo& m : io_module_keys()) out.push_back({m.path, "machine", m.range});
     }
   }
   return out;

@@ -98,8 +98,8 @@ void Machine::simulated_weaver_sink(void* machine, const sequencer::WeaverReques
   static_cast<Machine*>(machine)->sim().ask_weaver(t);
 }
 
-// The CAN HAL: the CiA 402 drives on their buses and the CiA 401 I/O node on bus 0 (or, only when asked
-// for on the command line, the drives beside the simulated I/O node). Every refusal that needs no bus comes
+// The CAN HAL: the CiA 402 drives and the CiA 401 I/O modules on their buses (or, only when asked for on
+// the command line, the drives beside the simulated I/O node). Every refusal that needs no bus comes
 // before the bus is opened.
 void Machine::build_can_hal(const MachineOptions& opt) {
   const IoKind io_kind = opt.io.value_or(cfg_.io.kind);
@@ -109,12 +109,13 @@ void Machine::build_can_hal(const MachineOptions& opt) {
                       "sensors and valves are imaginary; give --io simulated to do this on purpose");
   }
   // Derived from the machine description (and validated when it was read).
-  const drivers::CanIoConfig ic = can_io_config(cfg_);
-  drivers::CanAxisPortConfig cc = can_axis_config(cfg_);
-  if (io_kind != IoKind::kCan) cc.other_frames_per_cycle.clear();
-  if (io_kind == IoKind::kCan && cfg_.io.kind != IoKind::kCan) {  // --io can over a simulated config
-    if (drivers::Status s = drivers::validate(ic); !s) throw ConfigError(cfg_.source + ": " + s.message());
-    cc.other_frames_per_cycle = drivers::io_frames_per_cycle(ic.wiring);
+  const std::vector<drivers::CanIoConfig> io_configs = can_io_configs(cfg_);
+  const std::vector<std::size_t> io_buses = can_io_buses(cfg_);
+  LoomConfig with_can_io = cfg_;
+  with_can_io.io.kind = io_kind;  // --io can over a simulated config puts the modules' frames on their buses
+  const drivers::CanAxisPortConfig cc = can_axis_config(with_can_io);
+  if (io_kind == IoKind::kCan && cfg_.io.kind != IoKind::kCan) {
+    if (drivers::Status s = drivers::validate(io_configs.front()); !s) throw ConfigError(cfg_.source + ": " + s.message());
   }
 
   // One interface per bus, in bus order: "can0,can1" puts the axes with bus = 1 on can1.
@@ -136,8 +137,8 @@ void Machine::build_can_hal(const MachineOptions& opt) {
   }
   if (ifaces.size() != buses) {
     throw ConfigError("--iface \"" + opt.iface + "\" names " + std::to_string(ifaces.size()) + " interface(s), but " +
-                      cfg_.source + " puts its axes on " + std::to_string(buses) +
-                      " CAN bus(es) (axes.<name>.bus 0.." + std::to_string(buses - 1) +
+                      cfg_.source + " puts its axes and I/O modules on " + std::to_string(buses) +
+                      " CAN bus(es) (axes.<name>.bus, io_modules.<name>.bus 0.." + std::to_string(buses - 1) +
                       "): give one interface per bus, comma-separated, bus 0 first");
   }
   buses_.clear();
@@ -158,8 +159,12 @@ void Machine::build_can_hal(const MachineOptions& opt) {
   }
   can_port_ = std::make_unique<drivers::CanAxisPort>(cc);
   if (io_kind == IoKind::kCan) {
-    io_port_ = std::make_unique<drivers::CanIoPort>(ic);
-    can_port_->attach(*io_port_);
+    io_port_ = std::make_unique<drivers::CanIoModules>();
+    for (std::size_t k = 0; k < io_configs.size(); ++k) {
+      io_modules_.push_back(std::make_unique<drivers::CanIoPort>(io_configs[k]));
+      can_port_->attach(*io_modules_.back(), io_buses[k]);
+      io_port_->add(*io_modules_.back());
+    }
   }
   drivers::MonotonicConfigureClock clock;
   if (const drivers::Status st = can_port_->configure(bus_ptrs, clock); !st) throw std::runtime_error(st.message());
@@ -167,8 +172,8 @@ void Machine::build_can_hal(const MachineOptions& opt) {
     notes_.push_back("CAN bus load (" + ifaces[b] + "): " + drivers::describe_bus_load(can_port_->bus_load(b)));
   }
   notes_.insert(notes_.end(), can_port_->notes().begin(), can_port_->notes().end());
-  if (io_port_) {  // brought up by bus 0's master in the same NMT sequence as the drives
-    notes_.insert(notes_.end(), io_port_->notes().begin(), io_port_->notes().end());
+  if (io_port_) {  // each module brought up by its bus' master in the same NMT sequence as the drives
+    for (const auto& m : io_modules_) notes_.insert(notes_.end(), m->notes().begin(), m->notes().end());
     hal_ = std::make_unique<hal::PortHal>(*can_port_, *io_port_);
   } else {
     // Asked for explicitly: the simulated I/O node follows the real helix shaft for its shuttle sensors.

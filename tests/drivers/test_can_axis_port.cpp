@@ -489,7 +489,7 @@ TEST(CanAxisPortConfigure, OverloadedBusIsRefusedBeforeAnyFrame) {
 
 TEST(CanAxisPortConfigure, OtherNodesCountTowardTheBudget) {
   CanAxisPortConfig cfg;
-  cfg.other_frames_per_cycle = {{8, 8}};  // an I/O node that chatters: 8 × 135 bits more
+  cfg.other_frames_per_cycle[0] = {{8, 8}};  // an I/O node that chatters: 8 × 135 bits more
   DriveRig rig(three_drives(), cfg);
   const drivers::Status s = rig.configure();
   ASSERT_FALSE(s.is_ok());

@@ -49,7 +49,7 @@ struct IoRig {
     rig.port.attach(port);
   }
   static drivers::CanAxisPortConfig with_io_frames(drivers::CanAxisPortConfig c, const CanIoConfig& io) {
-    c.other_frames_per_cycle = drivers::io_frames_per_cycle(io.wiring);
+    c.other_frames_per_cycle[0] = drivers::io_frames_per_cycle(io.wiring);
     return c;
   }
   // The axis port's master brings the I/O node up in the same NMT sequence as the drives.

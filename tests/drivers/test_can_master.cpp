@@ -272,7 +272,7 @@ TEST(CanMasterTwoBuses, NodeIdsAreUniquePerBusAndBusesAreBounded) {
 
 TEST(CanMasterTwoBuses, LoadIsCountedPerBus) {
   drivers::CanAxisPortConfig c = four_axes_two_buses();
-  c.other_frames_per_cycle = drivers::io_frames_per_cycle(drivers::IoWiring{});
+  c.other_frames_per_cycle[0] = drivers::io_frames_per_cycle(drivers::IoWiring{});
   // Bus 0: SYNC + 3 × (RPDO1 + TPDO1) + the I/O node's 3 PDOs + master heartbeat = 11 frames.
   EXPECT_EQ(drivers::planned_bus_load(c, 0).frames, 11u);
   // Bus 1: SYNC + RPDO1 + TPDO1 + master heartbeat = 4 frames (the I/O node lives on bus 0).

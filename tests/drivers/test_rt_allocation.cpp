@@ -100,7 +100,7 @@ TEST(CanIoPortRt, FiveThousandTicksWithoutAllocation) {
   rack.attach_io(io, {0, 2, drivers::kDefaultCountsPerRad, drivers::kDefaultCountsPerRad});
   RelayBus relay(master);
   drivers::CanAxisPortConfig axis_cfg;
-  axis_cfg.other_frames_per_cycle = drivers::io_frames_per_cycle(drivers::IoWiring{});
+  axis_cfg.other_frames_per_cycle[0] = drivers::io_frames_per_cycle(drivers::IoWiring{});
   drivers::CanAxisPort port{axis_cfg};
   drivers::CanIoPort io_port{drivers::CanIoConfig{}};
   port.attach(io_port);

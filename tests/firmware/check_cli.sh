@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # loomctl check prints the objects each kind of node must support, from the machine description: the
 # homing objects for the drives referenced by a homing run (and only then), and the I/O module's input and
-# output groups widened by the knotting heads' signals when the heads are fitted.
+# output groups widened by the knotting heads' signals when the heads are fitted, and each module's own when the
+# loom has several.
 # usage: check_cli.sh LOOMCTL SOURCE_DIR
 set -euo pipefail
 loomctl=$1
@@ -26,3 +27,15 @@ expect "$out/default.txt" "0x6200:01 write digital outputs, 8-bit: valves, stack
 expect "$out/heads.txt" "0x6200:01..04 write digital outputs, 8-bit: valves, stack light, buzzer, the heads' grippers and cutters"
 expect "$out/heads.txt" "0x6000:01..04 read digital inputs, 8-bit: sensors and their second channels, e-stop chain, buttons, the heads' yarn-present switches"
 echo "check_cli: PASS"
+
+# A second I/O module (the operator panel's, on bus 1): its node, bus and signals, its own bus load, and the
+# objects it must support for what it carries (not the valves' or sensors' reasons).
+"$loomctl" check --config "$src/tests/hil/hil_four_axis_loom.toml" >"$out/panel.txt"
+expect "$out/panel.txt" "I/O modules: io node 4 on bus 0, panel node 6 on bus 1"
+expect "$out/panel.txt" "bus 1 (nodes take_up 5, I/O panel 6) load:"
+expect "$out/panel.txt" "objects the I/O module io_modules.panel (node 6; signals lamp_green, lamp_amber, lamp_red, buzzer, button_start, button_pause, button_ack) must support:"
+expect "$out/panel.txt" "0x6000:01..02 read digital inputs, 8-bit: buttons"
+expect "$out/panel.txt" "0x6200:01 write digital outputs, 8-bit: stack light, buzzer"
+expect "$out/panel.txt" "0x6000:01..03 read digital inputs, 8-bit: sensors and their second channels, e-stop chain"
+! grep -q "0x6401.*panel\|panel.*0x6401" "$out/panel.txt" || fail "the panel module was given the load cell's object"
+[[ $(grep -c "0x6401 read analog input" "$out/panel.txt") == 1 ]] || fail "the load cell's object is listed for a module without it"

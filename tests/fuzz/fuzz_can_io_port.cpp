@@ -9,7 +9,11 @@
 //      second channel on bit 30 and one on bit 31: TPDO1 = 0x6000:01..04, no load cell (TPDO2
 //      disabled), outputs on 0x6200:01..02;
 //   2  the default wiring with two knotting heads: grippers on outputs 8, 9, cutters on 20, 21, yarn-present
-//      on inputs 24 (active low) and 25: TPDO1 = 0x6000:01..04, RPDO1 = 0x6200:01..03.
+//      on inputs 24 (active low) and 25: TPDO1 = 0x6000:01..04, RPDO1 = 0x6200:01..03;
+//   3  the second of a loom's two modules (an operator panel: the stack light, the buzzer and the buttons
+//      on it, everything else on the first): TPDO1 = 0x6000:01..02, no load cell, RPDO1 = 0x6200:01. The
+//      model reads it through a wiring written out by hand (only those signals), so every other signal
+//      must read false — the e-stop chain too, which is the first module's — and never be written.
 // The first input byte picks the template; each input starts from a copy of it, now on a bus the input
 // alone feeds (the simulated node is gone), and plays operations read from the rest with
 // FuzzedDataProvider:
@@ -126,6 +130,33 @@ drivers::CanIoConfig wiring_32_bits() {
   return c;
 }
 
+// The loom's whole wiring with the panel's signals on module 1, served as module 1.
+drivers::CanIoConfig panel_module() {
+  drivers::CanIoConfig c;
+  drivers::IoWiring& w = c.wiring;
+  for (drivers::IoBit* b : {&w.lamp_green, &w.lamp_amber, &w.lamp_red, &w.buzzer, &w.button_start, &w.button_pause,
+                            &w.button_ack}) {
+    b->module = 1;
+  }
+  w.button_ack.active_low = true;
+  c.module = 1;
+  c.name = "panel";
+  return c;
+}
+// By hand: what module 1 of panel_module() carries, nothing else.
+drivers::IoWiring panel_model() {
+  drivers::IoWiring w;
+  for (drivers::IoBit* b : {&w.piston_a_extended, &w.piston_a_retracted, &w.piston_b_extended, &w.piston_b_retracted,
+                            &w.shuttle_at_left, &w.shuttle_at_right, &w.estop_ok, &w.row_knotted, &w.piston_a_extend,
+                            &w.piston_b_extend}) {
+    *b = {};
+  }
+  for (drivers::IoBit& b : w.second) b = {};
+  w.button_ack = {10, true};
+  w.load_cell_channel = 0;
+  return w;
+}
+
 drivers::CanIoConfig two_heads() {
   drivers::CanIoConfig c;
   drivers::IoWiring& w = c.wiring;
@@ -144,6 +175,7 @@ struct Template {
   FuzzBus bus;
   drivers::CanIoPort port;
   Layout layout;
+  drivers::IoWiring model_wiring;  // what the model reads the port through (written out by hand)
   std::int64_t now_us = 0;
 
   // Virtual time for configure(): every idle() lets 100 µs pass on the network and the module.
@@ -168,12 +200,13 @@ struct Template {
     }
   }
 
-  Template(const drivers::CanIoConfig& config, Layout l)
+  Template(const drivers::CanIoConfig& config, Layout l, const drivers::IoWiring* by_hand = nullptr)
       : master(net.add_endpoint()),
         module_side(net.add_endpoint()),
         module(module_side, sim_can::SimIoConfig{}),
         port(config),
-        layout(l) {
+        layout(l),
+        model_wiring(by_hand != nullptr ? *by_hand : config.wiring) {
     module.power_on(now_us);
     bus.relay = &master;
     Clock clock(*this);
@@ -323,7 +356,9 @@ struct Checker {
     expect_input("piston_b_retracted", io.piston_b_retracted, m.input(w.piston_b_retracted), m);
     expect_input("shuttle_at_left", io.shuttle_at_left, m.input(w.shuttle_at_left), m);
     expect_input("shuttle_at_right", io.shuttle_at_right, m.input(w.shuttle_at_right), m);
-    expect_input("estop_ok", io.estop_ok, m.inputs_refreshed == hal::kNeverTick || m.input(w.estop_ok), m);
+    // The chain's module reads it closed before its first TPDO (no news is not an opened chain); a module
+    // without it reads false (CanIoModules takes it from the one that has it).
+    expect_input("estop_ok", io.estop_ok, w.estop_ok.bit >= 0 && (m.inputs_refreshed == hal::kNeverTick || m.input(w.estop_ok)), m);
     expect_input("button_start", io.button_start, m.input(w.button_start), m);
     expect_input("button_pause", io.button_pause, m.input(w.button_pause), m);
     expect_input("button_ack", io.button_ack, m.input(w.button_ack), m);
@@ -414,15 +449,17 @@ drivers::CanFrame node_frame(FuzzedDataProvider& in, std::uint32_t id, std::uint
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   // Process lifetime; never freed (libFuzzer exits).
-  static Template* const templates[3] = {new Template(drivers::CanIoConfig{}, Layout{3, true, 1}),
+  static const drivers::IoWiring panel = panel_model();
+  static Template* const templates[4] = {new Template(drivers::CanIoConfig{}, Layout{3, true, 1}),
                                          new Template(wiring_32_bits(), Layout{4, false, 2}),
-                                         new Template(two_heads(), Layout{4, true, 3})};
+                                         new Template(two_heads(), Layout{4, true, 3}),
+                                         new Template(panel_module(), Layout{2, false, 1}, &panel)};
   if (size == 0) return 0;
-  Template& t = *templates[data[0] % 3];
+  Template& t = *templates[data[0] % 4];
   FuzzBus& bus = t.bus;
   bus.reset();
   drivers::CanIoPort port = t.port;  // configured, bound to `bus`
-  const drivers::IoWiring& wiring = port.config().wiring;
+  const drivers::IoWiring& wiring = t.model_wiring;
 
   Model m;
   m.wiring = &wiring;

@@ -76,7 +76,7 @@ TEST(Iface, OneInterfacePerBusCommaSeparated) {
     return "accepted";
   };
   std::string e = error_of("nosuchcan7");
-  EXPECT_NE(e.find("--iface \"nosuchcan7\" names 1 interface(s), but four.toml puts its axes on 2 CAN bus(es)"),
+  EXPECT_NE(e.find("--iface \"nosuchcan7\" names 1 interface(s), but four.toml puts its axes and I/O modules on 2 CAN bus(es)"),
             std::string::npos)
       << e;
   e = error_of("nosuchcan7,nosuchcan7");

@@ -6,9 +6,12 @@
 //                  [--homing-nodes 1,2 [--power-up-seed N]]
 //   loom-sim-drive --iface vcan0 --loom LOOM.toml [--bus N] [--io-control FILE] ...
 // --loom: the nodes of bus N (default 0) as the machine description has them — drives in axis-slot order
-// with their scaling and referencing, the I/O node (bus 0, io.kind = "can") with the loom's width and helix
-// lead — and, for a loom with knotting heads, the heads behind the I/O node (grippers, cutters, yarn-present
-// switches, each head's magazine; the carriage and every head's servos must then be on this bus).
+// with their scaling and referencing, the I/O modules on that bus (io.kind = "can": the [io] one on bus 0,
+// each [io_modules.<name>] on its bus) with the loom's width and helix lead — and, for a loom with knotting
+// heads, the heads behind the module their grippers are wired to (grippers, cutters, yarn-present switches,
+// each head's magazine; the carriage and every head's servos must then be on this bus). Every module
+// simulates the whole plant on the terminals of the default wiring; the master reads and writes the ones
+// the machine description puts on it.
 // --homing-nodes: those drives have incremental encoders: they offer CiA 402 homing (mode 6; methods 19/21
 // on a home switch at physical 0, 33/34 on an index pulse every 4096 counts, 37 where they stand) and
 // power up at a random count (the seed is printed; give it back to reproduce a run).
@@ -178,6 +181,8 @@ int main(int argc, char** argv) {
   // --loom: the bus's nodes and the plant's facts from the machine description.
   std::vector<std::size_t> slot_of_node;  // loom axis slot of each simulated drive (--loom only)
   std::unique_ptr<loom::firmware::SimHeads> heads;
+  std::vector<int> io_nodes;  // the I/O modules simulated here (--io-node, or --loom's on this bus)
+  int heads_io_node = 0;      // the one the knotting heads are behind (0: none here)
   if (!loom_file.empty()) {
     try {
       const loom::firmware::LoomConfig cfg = loom::firmware::load_loom_config(loom_file);
@@ -190,10 +195,20 @@ int main(int argc, char** argv) {
         slot_of_node.push_back(slot);
         if (a.homing) homing_nodes.push_back(a.node);
       }
-      io_node = loom_bus == 0 && cfg.io.kind == loom::firmware::IoKind::kCan ? cfg.io.node : 0;
+      if (cfg.io.kind == loom::firmware::IoKind::kCan) {
+        const std::vector<loom::drivers::CanIoConfig> modules = loom::firmware::can_io_configs(cfg);
+        const std::vector<std::size_t> buses = loom::firmware::can_io_buses(cfg);
+        for (std::size_t k = 0; k < modules.size(); ++k) {
+          if (buses[k] != static_cast<std::size_t>(loom_bus)) continue;
+          io_nodes.push_back(modules[k].node_id);
+          if (cfg.knotting.mode == loom::sequencer::KnottingMode::kHeads && cfg.io.gripper_close.module == k) {
+            heads_io_node = modules[k].node_id;
+          }
+        }
+      }
       width_m = cfg.machine_spec.width_m;
       helix_lead_m = cfg.machine_spec.helix_lead_m;
-      if (io_node != 0 && cfg.knotting.mode == loom::sequencer::KnottingMode::kHeads) {
+      if (heads_io_node != 0) {
         heads = std::make_unique<loom::firmware::SimHeads>(loom::firmware::sim_heads(cfg));
         const loom::sim_hal::SimKnotting& k = heads->knotting;
         std::vector<std::size_t> needed{static_cast<std::size_t>(loom::hal::index(loom::hal::CoreAxis::kCarriage))};
@@ -214,7 +229,11 @@ int main(int argc, char** argv) {
       std::cerr << "loom-sim-drive: " << e.what() << "\n";
       return 2;
     }
-    if (nodes.empty()) return usage_error("--loom " + loom_file + ": no axis is on bus " + std::to_string(loom_bus));
+    if (nodes.empty() && io_nodes.empty()) {
+      return usage_error("--loom " + loom_file + ": no axis and no I/O module is on bus " + std::to_string(loom_bus));
+    }
+  } else if (io_node != 0) {
+    io_nodes.push_back(io_node);
   }
 
   std::set<int> seen;
@@ -222,7 +241,7 @@ int main(int argc, char** argv) {
     if (n < 1 || n > 127) return usage_error("--nodes: node id " + std::to_string(n) + " is outside 1..127");
     if (!seen.insert(n).second) return usage_error("--nodes: node id " + std::to_string(n) + " given twice");
   }
-  if (nodes.empty()) return usage_error("--nodes: at least one node id is needed");
+  if (nodes.empty() && io_nodes.empty()) return usage_error("--nodes: at least one node id is needed");
   if (io_node != 0 && (io_node < 1 || io_node > 127)) {
     return usage_error("--io-node: node id " + std::to_string(io_node) + " is outside 1..127");
   }
@@ -293,23 +312,31 @@ int main(int argc, char** argv) {
   std::signal(SIGTERM, on_signal);
 
   loom::sim_can::SimDriveRack rack(bus, configs);
-  std::unique_ptr<loom::sim_can::SimIoNode> io;
-  if (io_node != 0) {
+  std::vector<std::unique_ptr<loom::sim_can::SimIoNode>> ios;
+  for (int n : io_nodes) {
     loom::sim_can::SimIoConfig ic;
-    ic.node_id = static_cast<std::uint8_t>(io_node);
+    ic.node_id = static_cast<std::uint8_t>(n);
     ic.width_m = width_m;
     ic.helix_lead_m = helix_lead_m;
     ic.plant_cycle_s = plant_cycle_ms * 1e-3;
-    if (heads) ic.knotting = heads->knotting;
-    io = std::make_unique<loom::sim_can::SimIoNode>(bus, ic);
-    const double crank_cpr = counts_per_unit.empty() ? default_counts_per_unit(0) : counts_per_unit[0];
-    const double helix_cpr =
-        counts_per_unit.size() > 2 ? counts_per_unit[2] : default_counts_per_unit(2);
-    loom::sim_can::SimDriveRack::IoPlantSource source{0, 2, crank_cpr, helix_cpr, {}};
+    if (heads && n == heads_io_node) ic.knotting = heads->knotting;
+    ios.push_back(std::make_unique<loom::sim_can::SimIoNode>(bus, ic));
+    // The crank (1st) and helix (3rd) drives by rack position; with --loom, where the loom's slots 0 and 2
+    // are on this bus (a position past the rack: that shaft is on another bus, its sensors read rest).
+    std::size_t crank = 0, helix = 2;
+    if (!loom_file.empty()) {
+      const auto at = [&](std::size_t slot) {
+        return static_cast<std::size_t>(std::find(slot_of_node.begin(), slot_of_node.end(), slot) - slot_of_node.begin());
+      };
+      crank = at(0);
+      helix = at(2);
+    }
+    const auto cpr = [&](std::size_t i) { return i < counts_per_unit.size() ? counts_per_unit[i] : default_counts_per_unit(i); };
+    loom::sim_can::SimDriveRack::IoPlantSource source{crank, helix, cpr(crank), cpr(helix), {}};
     for (std::size_t i = 0; i < slot_of_node.size(); ++i) {  // every drive's position, by the loom's slot
       source.axes.push_back({i, slot_of_node[i], counts_per_unit[i]});
     }
-    rack.attach_io(*io, source);
+    rack.attach_io(*ios.back(), source);
   }
   // The control file (HIL fault tests): re-read when its modification time changes.
   timespec control_mtime{};
@@ -333,7 +360,7 @@ int main(int argc, char** argv) {
   rack.power_on(monotonic_us());
   std::cerr << "loom-sim-drive: " << nodes.size() << " " << personality << " drive(s) on " << iface << ", nodes";
   for (int n : nodes) std::cerr << ' ' << n;
-  if (io_node != 0) std::cerr << ", I/O node " << io_node;
+  for (int n : io_nodes) std::cerr << ", I/O node " << n;
   std::cerr << std::endl;
   std::int64_t next_control_check = 0;
 
@@ -369,7 +396,9 @@ int main(int argc, char** argv) {
       }
     }
   }
-  if (io && io->knotter() != nullptr) print_carpet(*io->knotter());
+  for (const auto& io : ios) {
+    if (io->knotter() != nullptr) print_carpet(*io->knotter());
+  }
   std::cerr << "loom-sim-drive: stopped\n";
   return 0;
 }

@@ -54,6 +54,9 @@ struct CanAxisConfig {
   double homing_accel = 0.0;  // SI/s² (0x609A)
 };
 
+// Buses a port can drive (can0..can3): CanAxisConfig::bus is 0..kMaxBuses-1.
+inline constexpr std::size_t kMaxBuses = 4;
+
 struct CanAxisPortConfig {
   // One per axis of the machine, in slot order (hal::AxisLayout); at most hal::kMaxAxes.
   std::vector<CanAxisConfig> axes{
@@ -84,26 +87,26 @@ struct CanAxisPortConfig {
   std::uint8_t tpdo2_every_n_sync = 1;  // 1..240
   std::uint32_t bitrate_bps = 1'000'000;
   double bus_load_budget = 0.70;                   // worst-case utilisation allowed, per bus
-  std::vector<FrameGroup> other_frames_per_cycle;  // other nodes on bus 0 (e.g. the I/O node)
+  // The other nodes' frames per bus (the I/O modules), by bus index: a bus that carries only an I/O
+  // module is still one of the port's buses, with its own master, SYNC and budget.
+  std::array<std::vector<FrameGroup>, kMaxBuses> other_frames_per_cycle{};
 };
-
-// Buses a port can drive (can0..can3): CanAxisConfig::bus is 0..kMaxBuses-1.
-inline constexpr std::size_t kMaxBuses = 4;
 
 // Configure-time only. Error naming the field and its value.
 Status validate(const CanAxisPortConfig& config);
-// Configure-time only. The buses the configuration uses: 1 + the highest CanAxisConfig::bus.
+// Configure-time only. The buses the configuration uses: 1 + the highest bus an axis or another node's
+// frames are on.
 std::size_t bus_count(const CanAxisPortConfig& config);
 // Configure-time only. The worst cycle this configuration puts on bus `bus`: SYNC, each of its drives'
-// RPDO1 and TPDO1 (and TPDO2), the other nodes' frames (bus 0 only: the I/O node) and the master
+// RPDO1 and TPDO1 (and TPDO2), the other nodes' frames on that bus (the I/O modules) and the master
 // heartbeat. The same figure the port checks against its budget when it configures, and `loomctl check`
 // prints per bus.
 BusLoad planned_bus_load(const CanAxisPortConfig& config, std::size_t bus = 0);
 
 // The hal::AxisPort of the CAN servo axes: one CanMaster per bus (bus owner: drain, dispatch, SYNC,
 // master heartbeat, bus-off, NMT bring-up of its nodes in one sequence), one Cia402Axis per axis (the
-// CiA 402 profile), and the other nodes of bus 0 (the I/O node) attached to bus 0's master. A fault of
-// any node on any bus stops every axis in the same tick.
+// CiA 402 profile), and the other nodes (the I/O modules) attached to their bus' master. A fault of any
+// node on any bus stops every axis in the same tick.
 class CanAxisPort final : public hal::AxisPort {
  public:
   // Bounds of the RT path (per bus).
@@ -115,10 +118,11 @@ class CanAxisPort final : public hal::AxisPort {
   CanAxisPort(const CanAxisPort& other);
   CanAxisPort& operator=(const CanAxisPort& other);
 
-  // Configure-time only. Another node on bus 0 (the I/O node): brought up in the same NMT sequence as
-  // the drives, its frames handed to it, its faults stop every axis and are reported as link faults. At
-  // most 4.
-  void attach(CanNode& node);
+  // Configure-time only. Another node on bus `bus` (an I/O module): brought up in the same NMT sequence as
+  // that bus' drives, its frames handed to it, its faults stop every axis and are reported as link faults.
+  // At most kMaxAttached; its frames must be in config.other_frames_per_cycle[bus].
+  static constexpr std::size_t kMaxAttached = 8;
+  void attach(CanNode& node, std::size_t bus = 0);
 
   // Configure-time only; blocks with timeouts. Validates the configuration and every bus' load, then
   // brings each bus up in one NMT sequence (can_master.hpp): reset-node → every boot-up → per drive by
@@ -167,7 +171,11 @@ class CanAxisPort final : public hal::AxisPort {
     std::size_t n_axes = 0;
     std::array<CanMaster, kMaxBuses> masters{};
     std::size_t n_buses = 0;
-    std::array<CanNode*, 4> attached{};  // on bus 0; not owned
+    struct Attached {
+      CanNode* node = nullptr;  // not owned
+      std::size_t bus = 0;
+    };
+    std::array<Attached, kMaxAttached> attached{};
     std::size_t n_attached = 0;
     std::vector<std::string> notes;
   };

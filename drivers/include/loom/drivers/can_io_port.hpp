@@ -3,10 +3,12 @@
 // buttons through 0x6000 in a TPDO, the beater's load cell through 0x6401 in a TPDO. Which bit is which
 // signal, its polarity and the load-cell scaling are wiring (config), so any module can be used.
 //
-// The module is a CanNode of bus 0's CanMaster (can_master.hpp): the master brings it up in the same NMT
-// sequence as the drives, drains the bus once per tick and hands this node's frames here, and supervises
-// it (heartbeat, boot-up, EMCY), so a fault of this node stops every axis in the same tick. This class
-// only does the CiA 401 profile. configure_profile() may block (SDO); the rest is RT-safe.
+// A loom may spread its signals over several modules (IoBit::module; CanIoModules joins them into one
+// hal::IoPort). Each module is a CanNode of its bus' CanMaster (can_master.hpp): the master brings it up
+// in the same NMT sequence as that bus' drives, drains the bus once per tick and hands this node's frames
+// here, and supervises it (heartbeat, boot-up, EMCY), so a fault of this node stops every axis in the
+// same tick. This class only does the CiA 401 profile. configure_profile() may block (SDO); the rest is
+// RT-safe.
 #pragma once
 
 #include <array>
@@ -34,11 +36,15 @@ inline constexpr std::uint16_t kConsumerHeartbeat = 0x1016;
 inline constexpr std::uint16_t kDeviceProfile401 = 0x0191;  // low word of 0x1000
 }  // namespace od401
 
-// One signal on a digital input or output: bit number across the 8-bit objects (bit b lives in
-// sub-index b/8 + 1, bit b%8), and polarity. bit = −1: not wired.
+// The I/O modules one loom can have (module 0 = the [io] table's, the others [io_modules.<name>]).
+inline constexpr std::size_t kMaxIoModules = 4;
+
+// One signal on a digital input or output: which module, bit number across that module's 8-bit objects
+// (bit b lives in sub-index b/8 + 1, bit b%8), and polarity. bit = −1: not wired.
 struct IoBit {
   int bit = -1;
-  bool active_low = false;  // the signal is true when the electrical bit is 0
+  bool active_low = false;   // the signal is true when the electrical bit is 0
+  std::uint8_t module = 0;   // 0..kMaxIoModules-1
 };
 
 // Inputs read from 0x6000:01..08 (64 bits) and outputs written to 0x6200:01..08 (64 bits), each in one
@@ -82,6 +88,7 @@ struct IoWiring {
   int load_cell_channel = 1;
   double load_cell_n_per_count = 0.01;
   double load_cell_offset_n = 0.0;
+  std::uint8_t load_cell_module = 0;
 };
 
 // The first switch of each safety sensor, in hal::SafetySensor order (the second ones are `second`).
@@ -91,12 +98,20 @@ inline std::array<const IoBit*, hal::kSafetySensorCount> first_switches(const Io
 }
 
 // Configure-time only. Error naming the field ("io.inputs.estop_ok.bit = 3 is already used by
-// io.inputs.piston_b_retracted") and its value.
+// io.inputs.piston_b_retracted") and its value. The loom's whole wiring: every required signal wired on
+// some module, no bit of one module used twice.
 Status validate(const IoWiring& wiring);
+
+// Configure-time only. The signals of the loom's wiring that are on module `module`, every other one
+// unwired (−1) and the load cell off unless it is there: what that module's node maps, reads and
+// writes. With one module it is the wiring itself.
+IoWiring module_wiring(const IoWiring& wiring, std::uint8_t module);
 
 struct CanIoConfig {
   std::uint8_t node_id = 4;
-  IoWiring wiring;
+  IoWiring wiring;          // the loom's whole wiring; this node serves module_wiring(wiring, module)
+  std::uint8_t module = 0;  // which of the loom's modules this node is
+  std::string name;         // the module's name in the machine description ("" = the loom's one I/O node)
   double cycle_period_s = 0.002;
   double heartbeat_producer_s = 0.100;  // written to the module's 0x1017
   double heartbeat_consumer_s = 0.250;  // silence longer than this = node lost
@@ -114,11 +129,13 @@ Status validate(const CanIoConfig& config);
 
 // Configure-time only. The 8-bit subs of 0x6000 (inputs) and of 0x6200 (outputs) the wiring uses: 1 up
 // to the one holding its highest wired bit (0x6000:01..03 for the default wiring's second channels).
+// Of one module's wiring (module_wiring()) when the loom has several.
 std::uint8_t io_input_subs(const IoWiring& wiring);
 std::uint8_t io_output_subs(const IoWiring& wiring);
 
 // The frames this node adds to every cycle with `wiring` (one RPDO, one or two TPDOs): the inputs' TPDO
 // carries one byte per 8-bit sub up to the highest wired input (3 with the default second channels).
+// `wiring` is the node's own (module_wiring()).
 std::vector<FrameGroup> io_frames_per_cycle(const IoWiring& wiring);
 
 // The output values the module is told to adopt by itself on failure (0x6206/0x6207): both valve coils
@@ -143,6 +160,11 @@ class CanIoPort final : public hal::IoPort, public CanNode {
 
   // hal::IoPort (RT-safe).
   void read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::DigitalInputs& io) override;
+  // RT-safe. Only the signals wired to this module into `io` (the others untouched: another module's),
+  // and when its inputs were last refreshed (kNeverTick before the first TPDO).
+  void read_wired(hal::DigitalInputs& io) const;
+  hal::Tick inputs_refreshed() const { return inputs_refreshed_; }
+  bool has_load_cell() const { return wiring_.load_cell_channel != 0; }
   void read_analog(hal::Tick now, hal::AnalogInputs& analog) override;
   void write_io(hal::Tick now, const hal::DigitalOutputs& io) override;
 
@@ -192,6 +214,7 @@ class CanIoPort final : public hal::IoPort, public CanNode {
   bool input(const IoBit& b) const;
 
   CanIoConfig config_;
+  IoWiring wiring_;  // this module's signals: module_wiring(config_.wiring, config_.module)
   CanBus* bus_ = nullptr;
   bool configured_ = false;
   std::vector<std::string> notes_;

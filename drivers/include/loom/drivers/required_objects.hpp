@@ -13,7 +13,7 @@ struct RequiredObject {
   std::uint16_t index;
   const char* name;
   bool optional;        // used when present, reported when absent
-  const char* why;
+  std::string why;
   // An array object whose size depends on the wiring: the master uses sub-indices 1..subs (0 = the
   // object as a whole, nothing to count).
   std::uint8_t subs = 0;
@@ -28,8 +28,10 @@ std::vector<RequiredObject> drive_objects();
 std::vector<RequiredObject> homing_drive_objects();
 // Configure-time only. The CiA 401 generic I/O module, objects only (no wiring: sub-indices not counted).
 std::vector<RequiredObject> io_module_objects();
-// Configure-time only. The same for `wiring`: how many 8-bit input and output groups (0x6000:01..n,
-// 0x6200:01..n) the module must have, e.g. 0x6000:01..03 when second channels sit on bits 16..21.
+// Configure-time only. The same for `wiring` (one module's: drivers::module_wiring()): how many 8-bit input
+// and output groups (0x6000:01..n, 0x6200:01..n) the module must have, e.g. 0x6000:01..03 when second
+// channels sit on bits 16..21, and what each object carries on this module; the load cell's objects only
+// when it is wired here.
 std::vector<RequiredObject> io_module_objects(const IoWiring& wiring);
 // "0x6041 statusword (TPDO1)" etc., one line per object; "0x6000:01..03 …" for a counted array.
 std::string describe(const RequiredObject& o);

@@ -97,8 +97,21 @@ inline std::vector<AxisSpec> default_axes() {
 // Where the valves, sensors, e-stop chain, buttons and load cell come from on the CAN HAL.
 enum class IoKind { kCan, kSimulated };
 
+// A further CiA 401 module, a table [io_modules.<name>]: its node on its bus, and the signals moved onto
+// it from the [io] table's module (their bits and polarities stay io.<signal>_bit / _active_low).
+struct IoModuleSpec {
+  std::string name;
+  std::uint8_t node = 0;
+  std::uint8_t bus = 0;
+  std::uint32_t boot_timeout_ms = 2000;
+  std::uint32_t operational_timeout_ms = 500;
+  std::vector<std::string> signals;  // io signal names as the file lists them ("lamp_green", "cutter", ...)
+};
+
 struct IoSettings {
   IoKind kind = IoKind::kCan;  // simulated I/O beside real drives needs --io simulated as well
+  // The [io] table's module (module 0, always on bus 0). Every signal is on it unless a further module
+  // in `modules` lists it (module k + 1 is modules[k]; the signal's IoBit::module says which).
   std::uint8_t node = 4;
   std::uint32_t boot_timeout_ms = 2000;
   std::uint32_t operational_timeout_ms = 500;
@@ -108,10 +121,12 @@ struct IoSettings {
   struct HeadSignals {
     std::vector<int> bits;
     bool active_low = false;
+    std::uint8_t module = 0;  // every head's signal of this kind is on one module
   };
   HeadSignals gripper_close{{8, 9, 10, 11, 12, 13}};
   HeadSignals cutter{{20, 21, 22, 23, 24, 25}};
   HeadSignals yarn_present{{24, 25, 26, 27, 28, 29}};
+  std::vector<IoModuleSpec> modules;  // [io_modules.<name>], by name; at most drivers::kMaxIoModules - 1
 };
 
 // Axis readings at the mechanical references, found when commissioning.
@@ -214,10 +229,13 @@ hal::AxisLayout axis_layout(const LoomConfig& c);
 sequencer::KnotProgram knot_program(const LoomConfig& c, std::uint64_t design_rows_done, std::uint32_t counter_rows);
 // Configure-time only. The CAN master's config for the machine's servo axes, from the same facts.
 drivers::CanAxisPortConfig can_axis_config(const LoomConfig& c);
-// Configure-time only. The CAN I/O module's config, from the same facts.
-drivers::CanIoConfig can_io_config(const LoomConfig& c);
-// Configure-time only. The worst-case load of CAN bus `bus` (its drives; on bus 0 also the I/O module;
-// the master heartbeat) — the figure that bus' CAN master checks when it configures. The machine uses
+// Configure-time only. The CAN I/O modules' configs, from the same facts: the [io] table's module first,
+// then [io_modules.<name>] in file order of names; each with the loom's whole wiring and its module index.
+std::vector<drivers::CanIoConfig> can_io_configs(const LoomConfig& c);
+// Configure-time only. The bus of each I/O module, in can_io_configs() order.
+std::vector<std::size_t> can_io_buses(const LoomConfig& c);
+// Configure-time only. The worst-case load of CAN bus `bus` (its drives and I/O modules; the master
+// heartbeat) — the figure that bus' CAN master checks when it configures. The machine uses
 // drivers::bus_count(can_axis_config(c)) buses.
 drivers::BusLoad can_bus_load(const LoomConfig& c, std::size_t bus = 0);
 

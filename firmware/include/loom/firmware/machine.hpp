@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "loom/drivers/can_axis_port.hpp"
+#include "loom/drivers/can_io_modules.hpp"
 #include "loom/drivers/can_io_port.hpp"
 #include "loom/drivers/socket_can_bus.hpp"
 #include "loom/firmware/config.hpp"
@@ -65,7 +66,6 @@ class Machine {
   void collect_retired_recipes() { slot_->collect(); }
   telemetry::Telemetry* telemetry() { return telemetry_.get(); }
   const drivers::CanAxisPort* can() const { return can_port_.get(); }
-  const drivers::CanIoPort* can_io() const { return io_port_.get(); }
   // Non-empty when the caller must print it on every start (kSimulatedIoBanner).
   const std::string& banner() const { return banner_; }
   // What bring-up found optional and absent or accepted as read back (0x1016, fixed mappings), and the
@@ -94,7 +94,8 @@ class Machine {
   std::unique_ptr<sim_hal::SimWorld> sim_;
   std::vector<std::unique_ptr<drivers::SocketCanBus>> buses_;  // bus i = the i-th --iface name
   std::unique_ptr<drivers::CanAxisPort> can_port_;
-  std::unique_ptr<drivers::CanIoPort> io_port_;
+  std::vector<std::unique_ptr<drivers::CanIoPort>> io_modules_;  // module k = can_io_configs()[k]
+  std::unique_ptr<drivers::CanIoModules> io_port_;                // the modules as the loop's one I/O port
   std::string banner_;
   std::vector<std::string> notes_;
   std::unique_ptr<hal::PortHal> hal_;

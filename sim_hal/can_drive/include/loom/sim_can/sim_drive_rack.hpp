@@ -17,7 +17,9 @@ class SimDriveRack {
   SimDriveRack(drivers::CanBus& bus, const std::vector<SimDriveConfig>& nodes);
 
   // Configure-time only. An I/O node on the same endpoint, whose plant follows the drives at rack
-  // positions `crank` and `helix` (counts → rad with their counts per rad).
+  // positions `crank` and `helix` (counts → rad with their counts per rad; a position past the rack's
+  // drives: that shaft is not on this bus). A loom with several I/O modules on one bus attaches each
+  // (the same source: one machine behind them).
   struct IoPlantSource {
     std::size_t crank = 0;
     std::size_t helix = 2;
@@ -49,7 +51,7 @@ class SimDriveRack {
  private:
   drivers::CanBus& bus_;
   std::vector<std::unique_ptr<SimDriveNode>> nodes_;
-  SimIoNode* io_ = nullptr;
+  std::vector<SimIoNode*> io_;
   IoPlantSource io_source_{};
   IoPlant io_controls_{};
 };
