@@ -30,6 +30,7 @@ hil_weave_until_armed stale_ack 2 "$counters"
 mark=$(hil_mark)
 hil_io_control ack
 hil_sim_took_controls press ack
+hil_loom_alive stale_ack "before the ack press reached the bus (a late master heartbeat in a loaded VM: EMCY 0x8130)"
 # input 10 = byte 1, bit 2: the low hex digit of byte 1 is one of 4-7, C-F
 hil_expect "$mark" "$io_tpdo#[0-9A-F]{3}[4-7C-F][0-9A-F]*" 5 "ack button pressed on the module's TPDO1" >/dev/null
 sleep "$press_s"
