@@ -27,6 +27,9 @@ const read = () => evaluate(page, `(() => {
            heads: rows.length,
            stock: rows.map(r => [...r.querySelectorAll(".mag")].map(m => Number(m.dataset.stock))),
            rowKnots: document.getElementById("row-knots")?.textContent,
+           // The axes table: name and unit of every axis (the knotters and selectors the machine adds too).
+           units: Object.fromEntries([...document.querySelectorAll("#axes tr")].slice(1)
+             .map(r => [r.children[0].textContent, r.children[5].textContent])),
            // The beat-force chart's x labels (no beat yet while the heads tie the first row).
            xLabels: [...document.querySelectorAll('#force-chart text[y="242"]')].map(t => t.textContent) };
 })()`);
@@ -47,6 +50,14 @@ const a = await waitFor("the heads tying, a few knots in", v => v.knotting && v.
 if (a.now !== a.heads) fail(`${a.now} knots outlined as in progress, the loom has ${a.heads} heads`);
 if (a.tied !== a.heads * a.cycle) fail(`${a.tied} knots shown tied at cycle ${a.cycle + 1}, want ${a.heads * a.cycle}`);
 if (a.stock.some(h => h.length === 0 || h.some(n => !(n >= 0)))) fail(`magazine levels missing: ${JSON.stringify(a.stock)}`);
+// Every axis names its unit, the ones the machine adds too (issue 22: they said "SI"): the knotting and
+// selector servos are rotary (rad), the carriage linear (m).
+const added = Object.keys(a.units).filter(n => /^(knotter|selector)_/.test(n));
+if (added.length !== 2 * a.heads) fail(`${added.length} knotter/selector axes in the axes table, want ${2 * a.heads}: ${JSON.stringify(a.units)}`);
+for (const [n, u] of Object.entries(a.units)) {
+  const want = n === "carriage" ? "m" : "rad";
+  if (u !== want) fail(`axis ${n} shows unit "${u}", want "${want}": ${JSON.stringify(a.units)}`);
+}
 if (a.xLabels.length !== 5 || new Set(a.xLabels).size !== 5) fail(`beat chart x labels ${JSON.stringify(a.xLabels)}: want five distinct`);
 const shot = await send("Page.captureScreenshot", { format: "png", captureBeyondViewport: true }, page);
 writeFileSync(pngPath, Buffer.from(shot.data, "base64"));
@@ -59,7 +70,7 @@ const tiedMore = b.tied - a.tied;
 if (used < tiedMore || used > tiedMore + b.heads) {
   fail(`the magazines lost ${used} knots of yarn while ${tiedMore} more knots were tied (${JSON.stringify(a.stock)} -> ${JSON.stringify(b.stock)})`);
 }
-console.log(`PASS: ${b.heads} heads, cycle ${a.cycle + 1} -> ${b.cycle + 1} of the row: ${a.tied} -> ${b.tied} knots shown tied, ` +
+console.log(`PASS: units of ${Object.keys(a.units).length} axes (${added.length} added) shown; ${b.heads} heads, cycle ${a.cycle + 1} -> ${b.cycle + 1} of the row: ${a.tied} -> ${b.tied} knots shown tied, ` +
   `magazines ${sum(a.stock)} -> ${sum(b.stock)} knots of yarn ("${b.rowKnots}"); screenshot ${pngPath}`);
 browser.close();
 process.exit(0);
