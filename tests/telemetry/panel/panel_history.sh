@@ -34,26 +34,16 @@ wait_for() {
   for _ in $(seq 1 $(($3 * 20))); do [[ $(field "$1" 2>/dev/null) == "$2" ]] && return 0; sleep 0.05; done
   fail "waited $3 s for $1=$2: $(ctl status 2>&1)"
 }
-start_serve() {  # start_serve LOG [args]
+. "$(dirname "$0")/browser_lib.sh"  # panel_up, panel_serve_up; have_browser for the browser part
+start_serve() {  # start_serve LOG [args]; sets SERVE
   local log=$1; shift
-  "$LOOMCTL" serve --state-dir "$WORK/state" --socket "$SOCK" --group "" --loom-id "$ID" --lcm-url "$URL" \
-    --pace 4 "$@" >"$WORK/$log" 2>&1 &
-  SERVE=$!
-  PIDS+=($!)
-  for _ in $(seq 1 200); do
-    [[ -S $SOCK ]] && ctl status >/dev/null 2>&1 && return 0
-    kill -0 "$SERVE" 2>/dev/null || fail "serve exited early"
-    sleep 0.05
-  done
-  fail "serve's socket did not come up"
+  panel_serve_up "$SOCK" "$log" --state-dir "$WORK/state" --loom-id "$ID" --lcm-url "$URL" --pace 4 "$@"
+  SERVE=$SERVE_PID
 }
 start_panel() {  # start_panel LOG [args]; sets BASE
   local log=$1; shift
-  "$PANEL" --port 0 --lcm-url "$URL" "$@" 2>"$WORK/$log" &
-  PIDS+=($!)
-  for _ in $(seq 1 100); do grep -q "serving http" "$WORK/$log" 2>/dev/null && break; sleep 0.05; done
-  BASE=$(sed -n 's|.*serving \(http://[0-9.]*:[0-9]*\)/.*|\1|p' "$WORK/$log")
-  [[ -n $BASE ]] || fail "loom-panel did not start"
+  panel_up "$log" --lcm-url "$URL" "$@"
+  BASE=$PANEL_BASE
 }
 
 start_serve serve1.log --scene "$SCENE"
@@ -97,11 +87,10 @@ grep -qi "^content-disposition: attachment; filename=\"$ID-last.lcmlog\"" "$WORK
   --timeout-s 10 >"$WORK/monitor.out" 2>"$WORK/monitor.log" || true
 grep -q "^loom=$ID .*state=" "$WORK/monitor.out" || fail "the downloaded lcmlog holds no STATUS of $ID: $(head -3 "$WORK/monitor.out")"
 lcmlog_status=$(grep -c "^loom=$ID " "$WORK/monitor.out")
-if (. "$(dirname "$0")/browser_lib.sh" >/dev/null); then
-  . "$(dirname "$0")/browser_lib.sh"
+if have_browser >/dev/null; then
   for _ in $(seq 1 100); do curl -s -m 2 "$BASE/api/loom/$ID" | grep -q '"status":{' && break; sleep 0.1; done
   node --experimental-websocket "$(dirname "$0")/panel_history.mjs" "$CHROMIUM" "$BASE" "$ID" \
-    "$OUT/loom_panel_history.png" 40 2>&1 | grep -v ExperimentalWarning | grep -v "node --trace-warnings" ||
+    "$OUT/loom_panel_history.png" 70 2>&1 | grep -v ExperimentalWarning | grep -v "node --trace-warnings" ||
     fail "browser check failed"
   [[ ${PIPESTATUS[0]} == 0 ]] || fail "browser check failed"
 else
