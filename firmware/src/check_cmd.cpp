@@ -76,8 +76,7 @@ void print_axes(const LoomConfig& c) {
   std::printf("\naxes (%zu of at most %zu)\n", c.axes.size(), hal::kMaxAxes);
   for (std::size_t i = 0; i < c.axes.size(); ++i) {
     const AxisSpec& a = c.axes[i];
-    const bool linear = !hal::is_rotary(a.role);
-    const char* unit = linear ? "m" : "rad";
+    const char* unit = hal::axis_unit(a.role);
     char speed[64] = "", ferror[96] = "not supervised by the controller";
     if (a.max_speed > 0.0) std::snprintf(speed, sizeof speed, ", top speed %g %s/s", a.max_speed, unit);
     if (a.ferror_min > 0.0) std::snprintf(ferror, sizeof ferror, "> max(%g %s, %g s x |v|)", a.ferror_min, unit, a.ferror_k_s);
@@ -88,7 +87,7 @@ void print_axes(const LoomConfig& c) {
   std::printf("  referencing (at every arming, in this order; an unreferenced axis never moves in production):\n");
   int step = 0;
   for (const AxisSpec& a : c.axes) {
-    const char* unit = hal::is_rotary(a.role) ? "rad" : "m";
+    const char* unit = hal::axis_unit(a.role);
     if (!a.homing) continue;
     const char* how = a.homing_method == 19   ? "home switch, active on its positive side"
                       : a.homing_method == 21 ? "home switch, active on its negative side"

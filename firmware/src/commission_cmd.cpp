@@ -63,7 +63,7 @@ std::string positions_line(const hal::HalInputs& in, const hal::AxisLayout& axes
     const hal::AxisFeedback& fb = in.axes[i];
     char buf[160];
     std::snprintf(buf, sizeof buf, " %s=%.9f %s (%s)", axes.name(i), fb.position,
-                  hal::is_rotary(axes.role(i)) ? "rad" : "m", hal::drive_state_name(fb.state));
+                  hal::axis_unit(axes.role(i)), hal::drive_state_name(fb.state));
     s += buf;
   }
   return s;

@@ -38,6 +38,7 @@ bool parse_axis_role(const char* text, AxisRole& role) {
 }
 
 bool is_rotary(AxisRole r) { return r != AxisRole::kCarriage; }
+const char* axis_unit(AxisRole r) { return is_rotary(r) ? "rad" : "m"; }
 
 AxisLayout AxisLayout::core() {
   AxisLayout l;

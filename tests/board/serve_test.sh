@@ -18,7 +18,11 @@
 #      `ctl status` answers at once, SIGTERM stops the service; `--socket` on a regular file is refused
 #      and the file kept;
 #  10. knotting heads: the weaver's `ctl next` that answers the heads' request (a knot to tie by hand)
-#      says which request it answered, in its reply, the journal and `ctl faults`.
+#      says which request it answered, in its reply, the journal and `ctl faults`;
+#  11. a restart is no reset (issue 22): a fault latched when serve stops (SIGTERM, or SIGKILL as a power
+#      cut) is latched again when it restarts — `ctl status` shows it, starting commands are refused —
+#      until `ctl ack`, which clears it for good (the next restart is idle); a bad latched-fault record is
+#      refused naming file:line, field and value, and left as it was.
 # Usage: serve_test.sh LOOMCTL SOURCE_DIR
 set -euo pipefail
 loomctl=$1
@@ -278,5 +282,49 @@ stop_serve
 t1=$(date +%s%N)
 (( (t1 - t0) / 1000000 < 5000 )) || fail "SIGTERM while the heads wait for the weaver took $(( (t1 - t0) / 1000000 )) ms"
 echo "knotting heads: SIGTERM while the weaver is asked: ok"
+
+# 11. a fault latched when serve stops stays latched across restarts until it is acknowledged
+rm -rf "$work/state"
+PACE=2 start_serve serve11.log --scene "$src/sim_hal/scenes/drive_fault.toml"
+ctl start >/dev/null
+wait_for state fault 60
+[[ -f $work/state/latched-fault ]] || fail "the latched fault is not kept in the state dir"
+stop_serve
+start_serve serve11b.log
+wait_for state fault 10
+[[ $(field fault) == drive_fault ]] || fail "the fault from before the restart is not latched: $(ctl status)"
+grep -q '^<3>FAULT drive_fault (0x1002).* latched before the restart, at 20[0-9-]*T[0-9:]*Z' "$work/serve11b.log" ||
+  fail "the journal does not say the fault was latched again"
+for c in start resume next; do
+  reply=$(ctl $c 2>&1) && fail "$c accepted with the fault from before the restart latched: $reply"
+  [[ $reply == *"drive_fault is latched"* ]] || fail "$c refused without naming the latched fault: $reply"
+done
+sleep 0.3
+[[ $(field state) == fault ]] || fail "did not stay latched after the restart: $(ctl status)"
+# a power cut while it is latched: still latched after it
+kill -9 "$pid"; wait "$pid" 2>/dev/null || true; pid=
+rm -f "$sock"
+start_serve serve11c.log
+wait_for state fault 10
+[[ $(field fault) == drive_fault ]] || fail "the fault is lost after a power cut: $(ctl status)"
+ctl ack | grep -q '^ok ack' || fail "ack refused after the restart"
+wait_for state idle 30
+[[ ! -e $work/state/latched-fault ]] || fail "the acknowledged fault is still on disk: $(cat "$work/state/latched-fault")"
+stop_serve
+start_serve serve11d.log
+sleep 0.3
+[[ $(field state) == idle && $(field fault) == none ]] || fail "an acknowledged fault came back after a restart: $(ctl status)"
+stop_serve
+# a bad record: refused with file:line, field and value (exit 2), the file left as it was
+printf 'kind = fault\nfault = drive_fualt\nlatched_at = 2026-11-26T20:50:03Z\n' >"$work/state/latched-fault"
+before=$(cat "$work/state/latched-fault")
+rc=0
+JOURNAL_STREAM=8:1 "$loomctl" serve --state-dir "$work/state" --socket "$sock" --group "" --no-telemetry \
+  >"$work/serve11e.log" 2>&1 || rc=$?
+[[ $rc == 2 ]] || fail "serve with a bad latched-fault record exited $rc, want 2"
+grep -qF "$work/state/latched-fault:2: fault = \"drive_fualt\": not a fault of the fault table" "$work/serve11e.log" ||
+  fail "the refusal does not name file:line, field and value: $(cat "$work/serve11e.log")"
+[[ $(cat "$work/state/latched-fault") == "$before" ]] || fail "the refused record was changed"
+echo "restart is no reset: ok"
 
 echo "serve_test: ok"

@@ -38,57 +38,13 @@ run_until_armed() {
   hil_start_candump
   fresh_machine
   counters=$HIL_WORK/$1.counters.json
-  out=$HIL_WORK/$1.loomctl.out
-  hil_weave_cmd 2 "$counters"
-  "${HIL_CMD[@]}" >"$out" 2>&1 &
-  loom_pid=$!
-  HIL_PIDS+=("$loom_pid")
-  # Armed = drive 1 commanded to Operation Enabled (RPDO1 controlword 0x000F), from candump.
-  local deadline=$((SECONDS + 30))
-  until [[ -n $(hil_frames_after 0 '201#0F00[0-9A-F]{8}' | head -n1) ]]; do
-    kill -0 "$loom_pid" 2>/dev/null || { sed 's/^/  loomctl| /' "$out"; hil_fail "$1: loomctl exited during bring-up"; }
-    ((SECONDS < deadline)) || hil_fail "$1: drives not enabled within 30 s"
-    sleep 0.05
-  done
-  sleep "${LOOM_HIL_FAULT_AFTER_S:-2}"
-  kill -0 "$loom_pid" 2>/dev/null || { sed 's/^/  loomctl| /' "$out"; hil_fail "$1: loomctl ended before the fault"; }
+  hil_weave_until_armed "$1" 2 "$counters"
+  loom_pid=$HIL_LOOM_PID
 }
 
 # expect_fault NAME REGEX — loomctl stops by itself with exit 3 and a FAULT line matching REGEX; the
 # counters file is kept.
-expect_fault() {
-  local deadline=$((SECONDS + 20)) status=0
-  while kill -0 "$loom_pid" 2>/dev/null && ((SECONDS < deadline)); do sleep 0.05; done
-  if kill -0 "$loom_pid" 2>/dev/null; then
-    kill -TERM "$loom_pid" 2>/dev/null || true
-    sleep 1
-    sed 's/^/  loomctl| /' "$out"
-    hil_stop_candump
-    hil_fail "$1: loomctl still running 20 s after the fault (stopped with SIGTERM; its output above, bus: $HIL_LOG)"
-  fi
-  wait "$loom_pid" || status=$?
-  sed 's/^/  loomctl| /' "$out"
-  cp "$out" "$HIL_LOGDIR/$HIL_NAME.loomctl.out"
-  hil_stop_candump
-  ((status == 3)) || hil_fail "$1: loomctl exited with $status, expected 3 (fault)"
-  local line
-  line=$(grep '^FAULT' "$out" | head -n1 || true)
-  grep -qE "$2" <<<"$line" || hil_fail "$1: first fault line does not match /$2/: $line"
-  [[ -f $counters ]] || hil_fail "$1: no counters file kept"
-  cp "$counters" "$HIL_LOGDIR/$HIL_NAME.counters.json"
-  hil_note "$1: exit 3, $line"
-}
-
-# sim_took_controls NAME WORDS — loom-sim-drive has applied the control file's WORDS (it echoes what it
-# applied and names every word it ignored): a misspelt word fails here, not as a fault that never came.
-sim_took_controls() {
-  local deadline=$((SECONDS + 5)) sim_out=$HIL_WORK/sim.out
-  until grep -qF "I/O controls now: $2" "$sim_out"; do
-    ((SECONDS < deadline)) || hil_fail "$1: loom-sim-drive did not apply '$2' within 5 s: $(tail -n 3 "$sim_out")"
-    sleep 0.02
-  done
-  ! grep -F -- '--io-control:' "$sim_out" || hil_fail "$1: loom-sim-drive ignored io-control words (above)"
-}
+expect_fault() { hil_expect_fault "$1" "$2" "$counters"; }
 
 # --- e-stop input -------------------------------------------------------------------------------------
 run_until_armed estop
@@ -120,7 +76,7 @@ expect_fault emcy 'drive_fault.*0x2310|0x2310.*drive_fault'
 case_start=$SECONDS
 run_until_armed stuck
 hil_io_control stuck=shuttle_at_left_2:on
-sim_took_controls stuck 'stuck=shuttle_at_left_2:on'
+hil_sim_took_controls stuck 'stuck=shuttle_at_left_2:on'
 expect_fault stuck '^FAULT sensor_discrepancy \(code 0x1020, sensor shuttle_at_left,'
 hil_io_control ""
 hil_note "stuck: case took $((SECONDS - case_start)) s (fresh machine, bring-up, 2 s weaving, fault)"

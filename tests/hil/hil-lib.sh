@@ -215,6 +215,70 @@ hil_start_sim_drives() {
 # hil_io_control WORDS... — what the simulated I/O node's e-stop chain and buttons see from now on.
 hil_io_control() { printf '%s\n' "$*" >"$HIL_IO_CONTROL.tmp" && mv "$HIL_IO_CONTROL.tmp" "$HIL_IO_CONTROL"; }
 
+# hil_sim_took_controls WHAT WORDS — loom-sim-drive has applied the control file's WORDS (it echoes what
+# it applied and names every word it ignored): a misspelt word fails here, not as a fault that never came.
+hil_sim_took_controls() {
+  local deadline=$((SECONDS + 5)) sim_out=$HIL_WORK/sim.out
+  until grep -qF "I/O controls now: $2" "$sim_out"; do
+    ((SECONDS < deadline)) || hil_fail "$1: loom-sim-drive did not apply '$2' within 5 s: $(tail -n 3 "$sim_out")"
+    sleep 0.02
+  done
+  ! grep -F -- '--io-control:' "$sim_out" || hil_fail "$1: loom-sim-drive ignored io-control words (above)"
+}
+
+# hil_weave_until_armed WHAT ROWS COUNTERS_FILE — start loomctl (hil_weave_cmd) in the background and
+# return once drive 1 has been commanded to Operation Enabled (RPDO1 controlword 0x000F, from candump)
+# and it has woven LOOM_HIL_FAULT_AFTER_S (2) more seconds. Sets HIL_LOOM_PID and HIL_LOOM_OUT.
+hil_weave_until_armed() {
+  local what=$1
+  HIL_LOOM_OUT=$HIL_WORK/$what.loomctl.out
+  hil_weave_cmd "$2" "$3"
+  "${HIL_CMD[@]}" >"$HIL_LOOM_OUT" 2>&1 &
+  HIL_LOOM_PID=$!
+  HIL_PIDS+=("$HIL_LOOM_PID")
+  local deadline=$((SECONDS + 30))
+  until [[ -n $(hil_frames_after 0 '201#0F00[0-9A-F]{8}' | head -n1) ]]; do
+    kill -0 "$HIL_LOOM_PID" 2>/dev/null ||
+      { sed 's/^/  loomctl| /' "$HIL_LOOM_OUT"; hil_fail "$what: loomctl exited during bring-up"; }
+    ((SECONDS < deadline)) || hil_fail "$what: drives not enabled within 30 s"
+    sleep 0.05
+  done
+  sleep "${LOOM_HIL_FAULT_AFTER_S:-2}"
+  hil_loom_alive "$what" "before the fault"
+}
+
+# hil_loom_alive WHAT WHEN — loomctl (hil_weave_until_armed) is still weaving, else fail showing its output.
+hil_loom_alive() {
+  kill -0 "$HIL_LOOM_PID" 2>/dev/null ||
+    { sed 's/^/  loomctl| /' "$HIL_LOOM_OUT"; hil_fail "$1: loomctl ended $2"; }
+}
+
+# hil_expect_fault WHAT REGEX COUNTERS_FILE — loomctl (hil_weave_until_armed) stops by itself within 20 s
+# with exit 3 and a first FAULT line matching REGEX (in HIL_FAULT_LINE); the counters file is kept. Stops
+# candump (HIL_LOG then names the kept log).
+hil_expect_fault() {
+  local what=$1 deadline=$((SECONDS + 20)) status=0
+  while kill -0 "$HIL_LOOM_PID" 2>/dev/null && ((SECONDS < deadline)); do sleep 0.05; done
+  if kill -0 "$HIL_LOOM_PID" 2>/dev/null; then
+    kill -TERM "$HIL_LOOM_PID" 2>/dev/null || true
+    sleep 1
+    sed 's/^/  loomctl| /' "$HIL_LOOM_OUT"
+    hil_stop_candump
+    hil_fail "$what: loomctl still running 20 s after the fault (stopped with SIGTERM; its output above, bus: $HIL_LOG)"
+  fi
+  wait "$HIL_LOOM_PID" || status=$?
+  hil_forget_pid "$HIL_LOOM_PID"
+  sed 's/^/  loomctl| /' "$HIL_LOOM_OUT"
+  cp "$HIL_LOOM_OUT" "$HIL_LOGDIR/$HIL_NAME.loomctl.out"
+  hil_stop_candump
+  ((status == 3)) || hil_fail "$what: loomctl exited with $status, expected 3 (fault)"
+  HIL_FAULT_LINE=$(grep '^FAULT' "$HIL_LOOM_OUT" | head -n1 || true)
+  grep -qE "$2" <<<"$HIL_FAULT_LINE" || hil_fail "$what: first fault line does not match /$2/: $HIL_FAULT_LINE"
+  [[ -f $3 ]] || hil_fail "$what: no counters file kept"
+  cp "$3" "$HIL_LOGDIR/$HIL_NAME.counters.json"
+  hil_note "$what: exit 3, $HIL_FAULT_LINE"
+}
+
 
 # hil_run_weave TIMEOUT_S — run HIL_CMD (hil_weave_cmd) with a time limit, show its output and keep it
 # as HIL_LOGDIR/NAME.loomctl.out; its exit status in HIL_STATUS (124/137 = timed out).

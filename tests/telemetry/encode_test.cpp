@@ -119,6 +119,23 @@ TEST(Encode, AxesCarryEveryAxisWithNames) {
   }
 }
 
+// Issue 22: the panel and the monitor showed "SI" for the axes a machine adds. Each axis carries its unit,
+// decided from its role in one place (hal::axis_unit): the carriage is linear (m), every other axis —
+// the core shafts, knotters, selectors, auxiliaries — rotary (rad).
+TEST(Encode, EveryAxisCarriesItsUnitFromItsDescription) {
+  loom::hal::AxisLayout layout = loom::hal::AxisLayout::core();
+  ASSERT_TRUE(layout.add("knotter_1", loom::hal::AxisRole::kKnotter));
+  ASSERT_TRUE(layout.add("selector_1", loom::hal::AxisRole::kSelector));
+  ASSERT_TRUE(layout.add("take_up", loom::hal::AxisRole::kAuxiliary));
+  Snapshot s = sample();
+  s.axis_count = static_cast<std::uint8_t>(layout.count);
+  const auto m = round_trip(to_axes(s, "L7", 42, layout));
+  ASSERT_EQ(m.axes.size(), 6u);
+  const char* want[] = {"rad", "m", "rad", "rad", "rad", "rad"};
+  for (std::size_t i = 0; i < 6; ++i) EXPECT_EQ(m.axes[i].unit, want[i]) << m.axes[i].name;
+  EXPECT_EQ(m.axes[3].name, "knotter_1");
+}
+
 TEST(Encode, RtTakesDropsAndBacklogFromTheRing) {
   const auto m = round_trip(to_rt_stats(sample(), "L7", 42, 11, 5));
   EXPECT_EQ(m.period_ns, 2'000'000);

@@ -62,7 +62,9 @@ TEST(MonitorLines, AxesLineListsEachAxis) {
   m.axes[0].name = "beat_crank";
   m.axes[0].position = 12.5;
   m.axes[0].drive_state = "operation_enabled";
+  m.axes[0].unit = "rad";
   m.axes[1].name = "carriage";
+  m.axes[1].unit = "m";
   m.axes[1].position = 0.75;
   m.axes[1].following_error = 0.001;
   m.axes[1].drive_state = "fault";
@@ -70,8 +72,8 @@ TEST(MonitorLines, AxesLineListsEachAxis) {
   m.axes[1].fault_code = 0x8611;
   EXPECT_EQ(axes_line(m),
             "axes loom=L tick=10 t=0.020s crank_phase=1.5000rad beater=0.2500rad force=88.0N"
-            " | beat_crank pos=12.5 vel=0 tgt=0 ferr=0 lim=0 eff=0 drive=operation_enabled"
-            " | carriage pos=0.75 vel=0 tgt=0 ferr=0.001 lim=0.002 eff=0 drive=fault code=0x8611");
+            " | beat_crank pos=12.5 vel=0 tgt=0 ferr=0 lim=0 eff=0 drive=operation_enabled unit=rad"
+            " | carriage pos=0.75 vel=0 tgt=0 ferr=0.001 lim=0.002 eff=0 drive=fault unit=m code=0x8611");
 }
 
 TEST(MonitorLines, RtLineInMicroseconds) {

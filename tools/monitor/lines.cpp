@@ -90,6 +90,7 @@ std::string axes_line(const loomlcm::axes_t& m) {
             fmt(" pos=%.6g vel=%.6g tgt=%.6g ferr=%.3g lim=%.3g eff=%.3g", a.position, a.velocity, a.target,
                 a.following_error, a.following_error_limit, a.effort) +
             " drive=" + printable_field(a.drive_state);
+    if (!a.unit.empty()) line += " unit=" + printable_field(a.unit);
     if (a.fault_code != 0) line += " code=" + hex(a.fault_code);
   }
   return line;

@@ -28,7 +28,8 @@ namespace loom::monitor {
 //   fault=<name|none> fault_code=0x<hhhh> [axis=<name> device_code=0x<hhhh> text="<operator text>"]
 std::string status_line(const loomlcm::status_t& m);
 // axes loom=<id> tick=<n> t=<s>s crank_phase=<rad> beater=<rad> force=<N>N then per axis
-// " | <name> pos=.. vel=.. tgt=.. ferr=.. lim=.. eff=.. drive=<state>" (+ " code=0x<hhhh>" when non-zero)
+// " | <name> pos=.. vel=.. tgt=.. ferr=.. lim=.. eff=.. drive=<state> unit=<rad|m>" (+ " code=0x<hhhh>" when
+// non-zero; no unit= from a publisher that sends none)
 std::string axes_line(const loomlcm::axes_t& m);
 // rt loom=<id> tick=<n> t=<s>s overruns=<n> tick_cost_us=<us> max_tick_cost_us=<us> wake_p50_us=..
 //   wake_p99_us=.. wake_max_us=.. dropped=<n> dropped_events=<n> backlog=<n> can_tx_dropped=<n> can_rx_errors=<n>

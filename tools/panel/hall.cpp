@@ -51,6 +51,7 @@ json axes_json(const loomlcm::axes_t& m) {
   json axes = json::array();
   for (const auto& a : m.axes) {
     axes.push_back({{"name", a.name},
+                    {"unit", a.unit},
                     {"position", num(a.position)},
                     {"velocity", num(a.velocity)},
                     {"target", num(a.target)},

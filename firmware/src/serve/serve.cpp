@@ -29,6 +29,7 @@
 #include "loom/firmware/serve/control_socket.hpp"
 #include "loom/firmware/serve/fault_history.hpp"
 #include "loom/firmware/serve/journal.hpp"
+#include "loom/firmware/serve/latched_fault.hpp"
 #include "loom/firmware/serve/sd_notify.hpp"
 #include "loom/firmware/serve/state_lock.hpp"
 #include "loom/telemetry/command_events.hpp"
@@ -171,6 +172,16 @@ int serve_main(const ServeArgs& a) {
   }
   CounterStore store(state + "/counters.json");
   FaultHistory history(state + "/faults.log");
+  // The fault latched when the service last stopped (power cut, restart, watchdog): latched again when
+  // the first session arms, until an acknowledgement clears it (a restart is no reset).
+  const LatchedFaultStore latched(state + "/latched-fault");
+  std::optional<LatchedFault> relatch;
+  try {
+    relatch = latched.load();
+  } catch (const ConfigError& e) {
+    log(Severity::kErr, "loomctl serve: %s", e.what());
+    return kExitBadInput;
+  }
   // The row each design has reached, beside the counters (only when the recipe names a design).
   std::unique_ptr<DesignBook> book;
   if (cfg.recipe.design) book = std::make_unique<DesignBook>(state + "/designs.json");
@@ -356,6 +367,18 @@ int serve_main(const ServeArgs& a) {
       seq.request_start();
       start_at_once = false;
     }
+    // Latched at the session's first tick, before anything can start; its kFault event is not a new fault.
+    bool relatch_pending = false;
+    if (relatch) {
+      seq.request_safe_stop(relatch->fault);
+      relatch_pending = true;
+      const FaultRecord& r = relatch->record;
+      log(Severity::kErr, "FAULT %s (0x%04X)%s%s latched before the restart, at %s (rows %u, picks %u): %s — latched "
+          "again; a restart is no reset: acknowledge it with ctl ack or the ack button", r.name.c_str(), r.code,
+          r.axis.empty() ? "" : " axis ", r.axis.c_str(), LatchedFaultStore::utc(relatch->latched_at_s).c_str(),
+          r.rows, r.picks, r.text.c_str());
+      relatch.reset();
+    }
     log(Severity::kNotice, "armed, %s: rows %u, picks %u (%u in the row in progress), beats %u",
         seq.state() == sequencer::State::kIdle ? "waiting for the operator (ctl start or the start button)"
                                                : "weaving",
@@ -425,6 +448,16 @@ int serve_main(const ServeArgs& a) {
           }
           if (!overrun && e.stopped_by != e.fault) r.text += std::string(" (motion stopped on ") +
                                                             sequencer::fault_name(e.stopped_by) + ")";
+          if (relatch_pending && f == e.fault) {  // the fault from before the restart: logged and on disk already
+            relatch_pending = false;
+            break;
+          }
+          relatch_pending = false;
+          try {
+            latched.save({f, r, static_cast<std::int64_t>(std::time(nullptr))});
+          } catch (const std::exception& ex) {
+            log(Severity::kErr, "latched fault not kept on disk (a restart would not latch it again): %s", ex.what());
+          }
           log(Severity::kErr, "FAULT %s (0x%04X)%s%s: %s; rows %u, picks %u — acknowledge with ctl ack or the ack "
               "button", r.name.c_str(), r.code, r.axis.empty() ? "" : " axis ", r.axis.c_str(), r.text.c_str(),
               r.rows, r.picks);
@@ -547,6 +580,11 @@ int serve_main(const ServeArgs& a) {
           log(Severity::kErr, "%s", ex.what());
         }
         log(Severity::kNotice, "fault %s %s", r.name.c_str(), r.text.c_str());
+        try {
+          latched.clear();
+        } catch (const std::exception& ex) {
+          log(Severity::kErr, "acknowledged fault still on disk (a restart would latch it again): %s", ex.what());
+        }
         // The counters in memory are the truth (a fault keeps them; counters_not_saved means the disk
         // lags them): write them before re-arming, which reads them back.
         try {

@@ -110,6 +110,7 @@ loomlcm::axes_t to_axes(const Snapshot& s, const std::string& loom_id, std::int6
     const AxisSample& a = s.axes[i];
     loomlcm::axis_t& o = m.axes[i];
     o.name = i < axes.count ? axes.name(i) : "axis" + std::to_string(i);
+    o.unit = i < axes.count ? hal::axis_unit(axes.role(i)) : "";
     o.position = a.position;
     o.velocity = a.velocity;
     o.target = a.target;

@@ -1,9 +1,53 @@
-# Sourced by the panel's browser tests. Sets CHROMIUM, or exits 77 (skip) when headless Chromium or a
-# node with a built-in WebSocket (the DevTools client in cdp.mjs) is missing.
-CHROMIUM=$(command -v chromium || command -v chromium-browser || true)
-[ -n "$CHROMIUM" ] || { echo "SKIP: chromium not installed (tools/deps.sh installs it)"; exit 77; }
-command -v node >/dev/null || { echo "SKIP: node not installed"; exit 77; }
-# node >= 20.10 with --experimental-websocket, or 22.
-node --experimental-websocket -e 'if (typeof WebSocket !== "function") process.exit(1)' 2>/dev/null ||
-  node -e 'if (typeof WebSocket !== "function") process.exit(1)' 2>/dev/null ||
-  { echo "SKIP: this node ($(node --version)) has no built-in WebSocket"; exit 77; }
+# Sourced by the panel's tests (it defines functions and runs nothing):
+#   have_browser — sets CHROMIUM; false, saying why, when headless Chromium or a node with a built-in
+#                  WebSocket (the DevTools client in cdp.mjs) is missing. Browser tests: `have_browser || exit 77`.
+#   panel_up, panel_serve_up — start loom-panel / `loomctl serve` and wait until they answer.
+# The two start helpers need from the caller: WORK (a scratch folder, their output goes there), PIDS (an
+# array the caller's cleanup kills), fail (prints and exits), and PANEL / LOOMCTL (the programs). Their
+# names are their own (panel_history.sh and serve_test.sh have a start_panel / start_serve of their own).
+# The waits are long enough for a loaded machine (`ctest -j2` beside a build): they end as soon as the
+# program answers, and fail at once, with its output, when it exits instead.
+
+have_browser() {
+  CHROMIUM=$(command -v chromium || command -v chromium-browser || true)
+  [[ -n $CHROMIUM ]] || { echo "SKIP: chromium not installed (tools/deps.sh installs it)"; return 1; }
+  command -v node >/dev/null || { echo "SKIP: node not installed"; return 1; }
+  # node >= 20.10 with --experimental-websocket, or 22.
+  node --experimental-websocket -e 'if (typeof WebSocket !== "function") process.exit(1)' 2>/dev/null ||
+    node -e 'if (typeof WebSocket !== "function") process.exit(1)' 2>/dev/null ||
+    { echo "SKIP: this node ($(node --version)) has no built-in WebSocket"; return 1; }
+}
+
+# panel_up LOG [loom-panel args...] — starts `$PANEL --port 0 ARGS` (stderr in WORK/LOG) and returns once
+# it serves HTTP, at most PANEL_UP_S (30) s. Sets PANEL_BASE (http://ADDR:PORT), PANEL_HTTP_PORT, PANEL_PID.
+panel_up() {
+  local log=$1 deadline=$((SECONDS + ${PANEL_UP_S:-30}))
+  shift
+  "$PANEL" --port 0 "$@" 2>"$WORK/$log" &
+  PANEL_PID=$!
+  PIDS+=("$PANEL_PID")
+  until grep -q "serving http" "$WORK/$log" 2>/dev/null; do
+    kill -0 "$PANEL_PID" 2>/dev/null || fail "loom-panel exited at start: $(tail -5 "$WORK/$log")"
+    ((SECONDS < deadline)) || fail "loom-panel did not serve within ${PANEL_UP_S:-30} s"
+    sleep 0.05
+  done
+  PANEL_BASE=$(sed -n 's|.*serving \(http://[0-9.]*:[0-9]*\)/.*|\1|p' "$WORK/$log")
+  [[ -n $PANEL_BASE ]] || fail "loom-panel did not say where it serves: $(tail -5 "$WORK/$log")"
+  PANEL_HTTP_PORT=${PANEL_BASE##*:}
+}
+
+# panel_serve_up SOCKET LOG [serve args...] — starts `$LOOMCTL serve --socket SOCKET --group "" ARGS`
+# (output in WORK/LOG) and returns once `ctl status` answers on SOCKET, at most SERVE_UP_S (60) s.
+# Sets SERVE_PID.
+panel_serve_up() {
+  local sock=$1 log=$2 deadline=$((SECONDS + ${SERVE_UP_S:-60}))
+  shift 2
+  "$LOOMCTL" serve --socket "$sock" --group "" "$@" >"$WORK/$log" 2>&1 &
+  SERVE_PID=$!
+  PIDS+=("$SERVE_PID")
+  until [[ -S $sock ]] && "$LOOMCTL" ctl --socket "$sock" status >/dev/null 2>&1; do
+    kill -0 "$SERVE_PID" 2>/dev/null || fail "serve exited at start: $(tail -5 "$WORK/$log")"
+    ((SECONDS < deadline)) || fail "serve's control socket did not answer within ${SERVE_UP_S:-60} s"
+    sleep 0.05
+  done
+}

@@ -2,7 +2,7 @@
 // headless Chromium with a throw-away profile, opens pages and evaluates expressions in them. Shared
 // by the panel's browser tests.
 import { spawn } from "node:child_process";
-import { mkdtempSync, rmSync } from "node:fs";
+import { mkdtempSync, rmSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 
@@ -59,4 +59,37 @@ export async function launch(chromiumBin, fail) {
     return r.result.value;
   };
   return { send, open, evaluate, close: () => { try { ws.close(); } catch {} close(); } };
+}
+
+// The preamble every check shares. Its arguments are `<chromium> <panel base url> <loom id> <png> <timeout s>
+// [more...]`; it sets an overall deadline (`timeout s`, else `defaultTimeoutS`) and launches Chromium.
+// Returns { base, loomId, pngPath, rest (the further arguments), started (ms), fail, send, open, evaluate,
+// close, waitFor, screenshot }:
+//   fail(msg)  prints "FAIL: msg", closes the browser and exits 1;
+//   waitFor(read, what, ok, seconds, everyMs = 200) polls `await read()` until ok(value) holds (a null
+//              value never does) and returns that value, else fails naming `what` and the last value read;
+//   screenshot(page, path = pngPath) writes the page as PNG.
+export async function startCheck(defaultTimeoutS = 60) {
+  const [chromiumBin, base, loomId, pngPath, timeoutArg, ...rest] = process.argv.slice(2);
+  const started = Date.now();
+  const timeoutMs = Number(timeoutArg || defaultTimeoutS) * 1000;
+  let browser = null;
+  const fail = msg => { console.error("FAIL: " + msg); browser?.close(); process.exit(1); };
+  setTimeout(() => fail(`gave up after ${timeoutMs / 1000} s`), timeoutMs).unref();
+  browser = await launch(chromiumBin, fail);
+  const waitFor = async (read, what, ok, seconds, everyMs = 200) => {
+    const until = Date.now() + seconds * 1000;
+    let v = null;
+    while (Date.now() < until) {
+      v = await read();
+      if (v !== null && v !== undefined && ok(v)) return v;
+      await sleep(everyMs);
+    }
+    fail(`${what}: not seen within ${seconds} s (last DOM read ${JSON.stringify(v)})`);
+  };
+  const screenshot = async (page, path = pngPath) => {
+    const shot = await browser.send("Page.captureScreenshot", { format: "png", captureBeyondViewport: true }, page);
+    writeFileSync(path, Buffer.from(shot.data, "base64"));
+  };
+  return { ...browser, base, loomId, pngPath, rest, started, timeoutMs, fail, waitFor, screenshot };
 }

@@ -39,6 +39,7 @@ cleanup() {
   rm -rf "$WORK" || true
 }
 trap cleanup EXIT
+. "$(dirname "$0")/browser_lib.sh"  # panel_up, panel_serve_up (no browser needed here)
 
 # The second host.
 SUB=$((($$ % 250) + 1))
@@ -71,15 +72,8 @@ sed 's/^palette,R,#9b1b30,madder red$/palette,R,#9b1b30,rouge garanc\xe9/' "$DES
 grep -q $'garanc\xe9' "$WORK/border.csv" || fail "could not write the cp1252 palette name"
 printf 'extends = "default"\n[recipe]\ndesign = "border.csv"\n' >"$WORK/loom.toml"
 
-"$PANEL" --port 0 --bind 0.0.0.0 --lcm-url "$URL" --control-dir "$WORK/run" 2>"$WORK/panel.log" &
-PIDS+=($!)
-PANEL_PID=$!
-for _ in $(seq 1 100); do
-  grep -q "serving http" "$WORK/panel.log" 2>/dev/null && break
-  sleep 0.05
-done
-HPORT=$(sed -n 's|.*serving http://[0-9.]*:\([0-9]*\)/.*|\1|p' "$WORK/panel.log")
-[[ -n $HPORT ]] || fail "loom-panel did not start"
+panel_up panel.log --bind 0.0.0.0 --lcm-url "$URL" --control-dir "$WORK/run"
+HPORT=$PANEL_HTTP_PORT
 BASE="http://$SERVER:$HPORT"
 
 # lcm-logger records the group from before serve starts (serve listens 2.5 s for a twin before arming).
@@ -89,14 +83,9 @@ LOGGER_PID=$!
 PIDS+=($!)
 
 SOCK="$WORK/run/$ID.sock"
-"$LOOMCTL" serve --config "$WORK/loom.toml" --state-dir "$WORK/state" --socket "$SOCK" --group "" \
-  --loom-id "$ID" --lcm-url "$URL" --pace 10 >"$WORK/serve.log" 2>&1 &
-PIDS+=($!)
+panel_serve_up "$SOCK" serve.log --config "$WORK/loom.toml" --state-dir "$WORK/state" --loom-id "$ID" \
+  --lcm-url "$URL" --pace 10
 ctl() { "$LOOMCTL" ctl --socket "$SOCK" "$@"; }
-for _ in $(seq 1 200); do
-  [[ -S $SOCK ]] && ctl status >/dev/null 2>&1 && break
-  sleep 0.05
-done
 field() { ctl status | tr ' ' '\n' | sed -n "s/^$1=//p"; }
 wait_for() {
   for _ in $(seq 1 $(($3 * 20))); do

@@ -3,18 +3,11 @@
 // the loom's row count advancing and every beat force of the current row drawn in the target band;
 // the hall page listing the loom. Writes a screenshot of the loom page.
 // Usage: node --experimental-websocket panel_browser.mjs <chromium> <panel base url> <loom id> <png> <timeout s>
-import { writeFileSync } from "node:fs";
-import { launch, sleep } from "./cdp.mjs";
+import { sleep, startCheck } from "./cdp.mjs";
 
-const [chromiumBin, base, loomId, pngPath, timeoutArg] = process.argv.slice(2);
+const browser = await startCheck(60);
+const { base, loomId, pngPath, started, timeoutMs, fail, open, evaluate, screenshot } = browser;
 const minBeats = Number(process.env.PANEL_MIN_BEATS || 3);  // more for a fuller screenshot
-const timeoutMs = Number(timeoutArg || 60) * 1000;
-const started = Date.now();
-let browser = null;
-const fail = msg => { console.error("FAIL: " + msg); browser?.close(); process.exit(1); };
-setTimeout(() => fail(`gave up after ${timeoutMs / 1000} s`), timeoutMs).unref();
-browser = await launch(chromiumBin, fail);
-const { send, open, evaluate } = browser;
 
 // ---- the loom page ----
 const loomPage = await open(`${base}/loom/${loomId}`);
@@ -47,8 +40,7 @@ for (const f of last.forces) {
     fail(`beat force ${f.n} N (class '${f.cls}') is not drawn in the 80-100 N band`);
   }
 }
-const shot = await send("Page.captureScreenshot", { format: "png", captureBeyondViewport: true }, loomPage);
-writeFileSync(pngPath, Buffer.from(shot.data, "base64"));
+await screenshot(loomPage);
 
 // ---- the hall page lists the loom ----
 const hallPage = await open(`${base}/`);
@@ -59,8 +51,7 @@ for (let i = 0; i < 40; i++) {
   await sleep(250);
 }
 if (!hall || !hall.includes(loomId)) fail(`the hall page does not list ${loomId}: ${JSON.stringify(hall)}`);
-const hallShot = await send("Page.captureScreenshot", { format: "png" }, hallPage);
-writeFileSync(pngPath.replace(/\.png$/, "_hall.png"), Buffer.from(hallShot.data, "base64"));
+await screenshot(hallPage, pngPath.replace(/\.png$/, "_hall.png"));
 
 console.log(`PASS: panel showed row ${first.row} -> ${last.row}, ${last.forces.length} beat forces in band ` +
   `(${last.forces.map(f => f.n).join(" ")}), hall lists ${hall.join(",")}; screenshot ${pngPath}`);

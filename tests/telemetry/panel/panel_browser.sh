@@ -10,6 +10,7 @@ PANEL=$2
 OUT=$3
 fail() { echo "FAIL: $*" >&2; exit 1; }
 . "$(dirname "$0")/browser_lib.sh"
+have_browser || exit 77
 mkdir -p "$OUT"
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/loom_panel_browser.XXXXXX")
 PIDS=()
@@ -23,19 +24,12 @@ PORT=$((20000 + ($$ * 7) % 20000))
 URL="udpm://239.255.76.67:${PORT}?ttl=0"
 ID="panel$$"
 
-"$PANEL" --port 0 --lcm-url "$URL" 2>"$WORK/panel.err" &
-PIDS+=($!)
-for _ in $(seq 1 100); do
-  grep -q "serving http" "$WORK/panel.err" 2>/dev/null && break
-  sleep 0.05
-done
-BASE=$(sed -n 's|.*serving \(http://[0-9.]*:[0-9]*\)/.*|\1|p' "$WORK/panel.err")
-[ -n "$BASE" ] || fail "loom-panel did not start: $(cat "$WORK/panel.err")"
+panel_up panel.err --lcm-url "$URL"
 
 # 3 rows at 4x real time: about 6 s of wall time per 3 rows... a row every ~1.9 s.
 "$LOOMCTL" weave --rows 6 --realtime --pace 4 --lcm-url "$URL" --loom-id "$ID" --quiet >"$WORK/weave.out" 2>&1 &
 PIDS+=($!)
 
-node --experimental-websocket "$(dirname "$0")/panel_browser.mjs" "$CHROMIUM" "$BASE" "$ID" \
+node --experimental-websocket "$(dirname "$0")/panel_browser.mjs" "$CHROMIUM" "$PANEL_BASE" "$ID" \
   "$OUT/loom_panel.png" 60 2>&1 | grep -v ExperimentalWarning | grep -v "node --trace-warnings" || fail "browser check failed"
 [ -s "$OUT/loom_panel.png" ] || fail "no screenshot written"

@@ -4,54 +4,53 @@
 // of the loom has a row in the heads table with one magazine level per slot, and the levels go down as
 // knots are tied — by as many knots as the page says were tied.
 // Usage: node --experimental-websocket panel_heads.mjs <chromium> <panel base url> <loom id> <png> <timeout s>
-import { writeFileSync } from "node:fs";
-import { launch, sleep } from "./cdp.mjs";
+import { startCheck } from "./cdp.mjs";
 
-const [chromiumBin, base, loomId, pngPath, timeoutArg] = process.argv.slice(2);
-const timeoutMs = Number(timeoutArg || 60) * 1000;
-let browser = null;
-const fail = msg => { console.error("FAIL: " + msg); browser?.close(); process.exit(1); };
-setTimeout(() => fail(`gave up after ${timeoutMs / 1000} s`), timeoutMs).unref();
-browser = await launch(chromiumBin, fail);
-const { send, open, evaluate } = browser;
+const browser = await startCheck(60);
+const { base, loomId, pngPath, fail, open, evaluate, screenshot } = browser;
 
 const page = await open(`${base}/loom/${loomId}`);
 const read = () => evaluate(page, `(() => {
   const s = document.getElementById("heads");
   if (!s) return null;
   const rows = [...document.querySelectorAll("#heads-table tr[data-head]")];
-  return { knotting: s.dataset.knotting === "true", cycle: Number(s.dataset.cycle),
+  return { knotting: s.dataset.knotting === "true", cycle: Number(s.dataset.cycle), row: Number(s.dataset.row),
            knots: document.querySelectorAll("#head-row .k").length,
            tied: document.querySelectorAll("#head-row .k.tied").length,
            now: document.querySelectorAll("#head-row .k.now").length,
            heads: rows.length,
            stock: rows.map(r => [...r.querySelectorAll(".mag")].map(m => Number(m.dataset.stock))),
            rowKnots: document.getElementById("row-knots")?.textContent,
+           // The axes table: name and unit of every axis (the knotters and selectors the machine adds too).
+           units: Object.fromEntries([...document.querySelectorAll("#axes tr")].slice(1)
+             .map(r => [r.children[0].textContent, r.children[5].textContent])),
            // The beat-force chart's x labels (no beat yet while the heads tie the first row).
            xLabels: [...document.querySelectorAll('#force-chart text[y="242"]')].map(t => t.textContent) };
 })()`);
-const waitFor = async (what, ok, seconds) => {
-  const until = Date.now() + seconds * 1000;
-  let v = null;
-  while (Date.now() < until) {
-    v = await read();
-    if (v && ok(v)) return v;
-    await sleep(150);
-  }
-  fail(`${what}: not seen within ${seconds} s (last DOM read ${JSON.stringify(v)})`);
-};
+const waitFor = (what, ok, seconds) => browser.waitFor(read, what, ok, seconds, 150);
 const sum = a => a.flat().reduce((x, y) => x + y, 0);
 
-// 1. The heads tie: a cycle in progress, one knot outlined per head, the cycles done shown tied.
-const a = await waitFor("the heads tying, a few knots in", v => v.knotting && v.cycle >= 2 && v.heads > 0, 60);
+// 1. The heads tie: a cycle in progress, one knot outlined per head, the cycles done shown tied. Early
+// enough in the row that three more cycles follow in it (a page first read late in a row — a slow start
+// under load — waits for the next row, instead of comparing knots across two rows).
+const cyclesLeft = v => v.knots / v.heads - v.cycle;
+const a = await waitFor("the heads tying, a few knots in, three more cycles to go in the row",
+  v => v.knotting && v.cycle >= 2 && v.heads > 0 && cyclesLeft(v) > 3, 60);
 if (a.now !== a.heads) fail(`${a.now} knots outlined as in progress, the loom has ${a.heads} heads`);
 if (a.tied !== a.heads * a.cycle) fail(`${a.tied} knots shown tied at cycle ${a.cycle + 1}, want ${a.heads * a.cycle}`);
 if (a.stock.some(h => h.length === 0 || h.some(n => !(n >= 0)))) fail(`magazine levels missing: ${JSON.stringify(a.stock)}`);
+// Every axis names its unit, the ones the machine adds too (issue 22: they said "SI"): the knotting and
+// selector servos are rotary (rad), the carriage linear (m).
+const added = Object.keys(a.units).filter(n => /^(knotter|selector)_/.test(n));
+if (added.length !== 2 * a.heads) fail(`${added.length} knotter/selector axes in the axes table, want ${2 * a.heads}: ${JSON.stringify(a.units)}`);
+for (const [n, u] of Object.entries(a.units)) {
+  const want = n === "carriage" ? "m" : "rad";
+  if (u !== want) fail(`axis ${n} shows unit "${u}", want "${want}": ${JSON.stringify(a.units)}`);
+}
 if (a.xLabels.length !== 5 || new Set(a.xLabels).size !== 5) fail(`beat chart x labels ${JSON.stringify(a.xLabels)}: want five distinct`);
-const shot = await send("Page.captureScreenshot", { format: "png", captureBeyondViewport: true }, page);
-writeFileSync(pngPath, Buffer.from(shot.data, "base64"));
+await screenshot(page);
 // 2. Later in the same row: more knots tied, the yarn gone from the magazines knot for knot.
-const b = await waitFor("more knots tied in the same row", v => v.knotting && v.cycle >= a.cycle + 3, 60);
+const b = await waitFor("more knots tied in the same row", v => v.knotting && v.row === a.row && v.cycle >= a.cycle + 3, 60);
 if (b.tied !== b.heads * b.cycle) fail(`${b.tied} knots shown tied at cycle ${b.cycle + 1}, want ${b.heads * b.cycle}`);
 const used = sum(a.stock) - sum(b.stock);
 const tiedMore = b.tied - a.tied;
@@ -59,7 +58,7 @@ const tiedMore = b.tied - a.tied;
 if (used < tiedMore || used > tiedMore + b.heads) {
   fail(`the magazines lost ${used} knots of yarn while ${tiedMore} more knots were tied (${JSON.stringify(a.stock)} -> ${JSON.stringify(b.stock)})`);
 }
-console.log(`PASS: ${b.heads} heads, cycle ${a.cycle + 1} -> ${b.cycle + 1} of the row: ${a.tied} -> ${b.tied} knots shown tied, ` +
+console.log(`PASS: units of ${Object.keys(a.units).length} axes (${added.length} added) shown; ${b.heads} heads, cycle ${a.cycle + 1} -> ${b.cycle + 1} of the row: ${a.tied} -> ${b.tied} knots shown tied, ` +
   `magazines ${sum(a.stock)} -> ${sum(b.stock)} knots of yarn ("${b.rowKnots}"); screenshot ${pngPath}`);
 browser.close();
 process.exit(0);

@@ -1,27 +1,17 @@
 // The loom's page in a real browser shows the persisted fault history (faults.log through the panel),
 // with wall-clock times, for a fault the panel itself never heard.
 // Usage: node --experimental-websocket panel_history.mjs <chromium> <panel base url> <loom id> <png> <timeout s>
-import { writeFileSync } from "node:fs";
-import { launch, sleep } from "./cdp.mjs";
+import { startCheck } from "./cdp.mjs";
 
-const [chromiumBin, base, loomId, pngPath, timeoutArg] = process.argv.slice(2);
-const timeoutMs = Number(timeoutArg || 30) * 1000;
-let browser = null;
-const fail = msg => { console.error("FAIL: " + msg); browser?.close(); process.exit(1); };
-setTimeout(() => fail(`gave up after ${timeoutMs / 1000} s`), timeoutMs).unref();
-browser = await launch(chromiumBin, fail);
-const { send, open, evaluate } = browser;
+const browser = await startCheck(30);
+const { base, loomId, pngPath, fail, open, evaluate, screenshot } = browser;
 const page = await open(`${base}/loom/${loomId}`);
-let v = null;
-for (;;) {
-  v = await evaluate(page, `(() => {
-    const rows = [...document.querySelectorAll("#history tr[data-kind]")];
-    return { download: document.getElementById("faults-log")?.getAttribute("href") || null, kinds: rows.map(r => r.dataset.kind), names: rows.map(r => r.children[2].textContent),
-             when: rows.map(r => r.children[0].textContent), live: document.querySelectorAll("#faults tr").length };
-  })()`);
-  if (v.kinds.includes("fault")) break;
-  await sleep(200);
-}
+const historyRead = () => evaluate(page, `(() => {
+  const rows = [...document.querySelectorAll("#history tr[data-kind]")];
+  return { download: document.getElementById("faults-log")?.getAttribute("href") || null, kinds: rows.map(r => r.dataset.kind), names: rows.map(r => r.children[2].textContent),
+           when: rows.map(r => r.children[0].textContent), live: document.querySelectorAll("#faults tr").length };
+})()`);
+const v = await browser.waitFor(historyRead, "the fault in the page's history table", h => h.kinds.includes("fault"), 20);
 const i = v.kinds.indexOf("fault");
 if (v.names[i] !== "drive_fault") fail(`history row ${JSON.stringify(v)}`);
 if (!/\(\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ\)/.test(v.when[i])) fail(`no wall-clock time: ${v.when[i]}`);
@@ -36,10 +26,7 @@ const scopeRead = () => evaluate(page, `(() => {
            strips: [p, v, e].filter(x => x).length, text: (sc ? sc.textContent : "") + " " +
            (document.getElementById("axes")?.textContent || ""), units: [...document.querySelectorAll("#axes tr td:nth-child(6)")].map(td => td.textContent) };
 })()`);
-const waitScope = async (what, ok) => {
-  for (let i = 0; i < 100; ++i) { const s = await scopeRead(); if (ok(s)) return s; await sleep(200); }
-  fail(`${what}: ${JSON.stringify(await scopeRead())}`);
-};
+const waitScope = (what, ok) => browser.waitFor(scopeRead, what, ok, 20);
 const first = await waitScope("the first axis plotted", s => s.points >= 10 && s.strips === 3);
 await evaluate(page, `(() => { const s = document.getElementById("scope-axis"); s.value = "carriage";
   s.dispatchEvent(new Event("change", { bubbles: true })); })()`);
@@ -49,8 +36,7 @@ if (!carriage.text.includes("velocity m/s") || !carriage.units.includes("m") || 
   fail(`units missing: ${JSON.stringify(carriage)}`);
 }
 console.log(`scope: ${first.axis} then carriage plotted (${carriage.points} samples each of position, velocity, following error)`);
-const shot = await send("Page.captureScreenshot", { format: "png", captureBeyondViewport: true }, page);
-writeFileSync(pngPath, Buffer.from(shot.data, "base64"));
+await screenshot(page);
 console.log(`history shown in the browser: ${v.kinds.length} lines (${v.kinds.join(" ")})`);
 browser.close();
 process.exit(0);

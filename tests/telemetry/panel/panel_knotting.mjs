@@ -5,18 +5,13 @@
 // Usage: node --experimental-websocket panel_knotting.mjs <chromium> <panel base url> <loom id> <png>
 //        <timeout s> <design rows JSON: [[codes of design row 1], [codes of design row 2]]> <height>
 //        <pairing code from `loomctl ctl pair`: "Row knotted" is offered only to a paired device>
-import { writeFileSync } from "node:fs";
-import { launch, sleep } from "./cdp.mjs";
+import { sleep, startCheck } from "./cdp.mjs";
 
-const [chromiumBin, base, loomId, pngPath, timeoutArg, rowsJson, heightArg, pairCode] = process.argv.slice(2);
+const browser = await startCheck(60);
+const { base, loomId, pngPath, rest, fail, open, evaluate, screenshot } = browser;
+const [rowsJson, heightArg, pairCode] = rest;
 const expected = JSON.parse(rowsJson);
 const height = Number(heightArg);
-const timeoutMs = Number(timeoutArg || 60) * 1000;
-let browser = null;
-const fail = msg => { console.error("FAIL: " + msg); browser?.close(); process.exit(1); };
-setTimeout(() => fail(`gave up after ${timeoutMs / 1000} s`), timeoutMs).unref();
-browser = await launch(chromiumBin, fail);
-const { send, open, evaluate } = browser;
 
 const page = await open(`${base}/loom/${loomId}`);
 const read = () => evaluate(page, `(() => {
@@ -27,16 +22,7 @@ const read = () => evaluate(page, `(() => {
            knots: [...document.querySelectorAll("#next-row .knot")].map(k => k.dataset.code),
            button: !!document.querySelector('button[data-cmd="next"]:not([disabled])') };
 })()`);
-const waitFor = async (what, ok, seconds) => {
-  const until = Date.now() + seconds * 1000;
-  let v = null;
-  while (Date.now() < until) {
-    v = await read();
-    if (ok(v)) return v;
-    await sleep(200);
-  }
-  fail(`${what}: not seen within ${seconds} s (last DOM read ${JSON.stringify(v)})`);
-};
+const waitFor = (what, ok, seconds) => browser.waitFor(read, what, ok, seconds);
 const same = (a, b) => JSON.stringify(a) === JSON.stringify(b);
 
 // 0. Unpaired, the page offers no "Row knotted" (a starting command); the weaver pairs the device.
@@ -54,8 +40,7 @@ if (!same(first.knots, expected[0])) fail(`design row 1 shown as ${JSON.stringif
 await sleep(1500);
 const still = await read();
 if (still.state !== "await_knotting" || still.rowsDone !== 0) fail(`did not wait for the weaver: ${JSON.stringify(still)}`);
-const shot = await send("Page.captureScreenshot", { format: "png", captureBeyondViewport: true }, page);
-writeFileSync(pngPath, Buffer.from(shot.data, "base64"));
+await screenshot(page);
 // 3. The weaver presses the panel's button (a DOM click: the page's own fetch to the control socket).
 await evaluate(page, `document.querySelector('button[data-cmd="next"]').click()`);
 // 4. Row 1 is woven, and the loom parks again with design row 2 shown.

@@ -13,6 +13,7 @@ OUT=$4
 here=$(dirname "$0")
 fail() { echo "FAIL: $*" >&2; for f in "$WORK"/*.log; do echo "--- $f" >&2; tail -20 "$f" >&2; done; exit 1; }
 . "$(dirname "$0")/browser_lib.sh"
+have_browser || exit 77
 mkdir -p "$OUT"
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/loom_panel_knotting.XXXXXX")
 PIDS=()
@@ -35,29 +36,16 @@ rows_json=$(grep -v '^[[:space:]]*#' "$DESIGN" | grep -v '^palette,' | grep -v '
   sed 's/[[:space:]]//g; s/,/","/g; s/^/["/; s/$/"]/' | paste -sd, | sed 's/^/[/; s/$/]/')
 height=$(grep -v '^[[:space:]]*#' "$DESIGN" | grep -v '^palette,' | grep -vc '^[[:space:]]*$')
 
-"$PANEL" --port 0 --lcm-url "$URL" --control-dir "$WORK/run" 2>"$WORK/panel.log" &
-PIDS+=($!)
-for _ in $(seq 1 100); do
-  grep -q "serving http" "$WORK/panel.log" 2>/dev/null && break
-  sleep 0.05
-done
-BASE=$(sed -n 's|.*serving \(http://[0-9.]*:[0-9]*\)/.*|\1|p' "$WORK/panel.log")
-[ -n "$BASE" ] || fail "loom-panel did not start"
-
+panel_up panel.log --lcm-url "$URL" --control-dir "$WORK/run"
 SOCK="$WORK/run/$ID.sock"
-"$LOOMCTL" serve --config "$WORK/loom.toml" --state-dir "$WORK/state" --socket "$SOCK" --group "" \
-  --loom-id "$ID" --lcm-url "$URL" --pace 4 >"$WORK/serve.log" 2>&1 &
-PIDS+=($!)
-for _ in $(seq 1 200); do
-  [ -S "$SOCK" ] && "$LOOMCTL" ctl --socket "$SOCK" status >/dev/null 2>&1 && break
-  sleep 0.05
-done
+panel_serve_up "$SOCK" serve.log --config "$WORK/loom.toml" --state-dir "$WORK/state" --loom-id "$ID" \
+  --lcm-url "$URL" --pace 4
 "$LOOMCTL" ctl --socket "$SOCK" start >/dev/null || fail "serve did not take start"
 # "Row knotted" starts motion: the panel offers it only to a device paired at the loom.
 CODE=$("$LOOMCTL" ctl --socket "$SOCK" pair knot-test | sed -n 's/.*code=\([0-9]*\).*/\1/p')
 [ -n "$CODE" ] || fail "ctl pair printed no code"
 
-node --experimental-websocket "$here/panel_knotting.mjs" "$CHROMIUM" "$BASE" "$ID" "$OUT/loom_panel_knotting.png" 80 \
+node --experimental-websocket "$here/panel_knotting.mjs" "$CHROMIUM" "$PANEL_BASE" "$ID" "$OUT/loom_panel_knotting.png" 80 \
   "$rows_json" "$height" "$CODE" 2>&1 | grep -v ExperimentalWarning | grep -v "node --trace-warnings" ||
   fail "browser check failed"
 grep -q "$ID next by 127.0.0.1 (token) -> ok next" "$WORK/panel.log" || fail "the panel did not log the button it sent"

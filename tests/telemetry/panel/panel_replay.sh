@@ -11,6 +11,7 @@ PANEL=$1
 FEED=$2
 fail() { echo "FAIL: $*" >&2; for f in "$WORK"/*.err; do echo "--- $f" >&2; tail -15 "$f" >&2; done; exit 1; }
 command -v lcm-logplayer >/dev/null || { echo "SKIP: lcm-logplayer not found (liblcm-bin)"; exit 77; }
+. "$(dirname "$0")/browser_lib.sh"  # panel_up (no browser needed here)
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/loom_panel_replay.XXXXXX")
 PIDS=()
 cleanup() {
@@ -26,15 +27,8 @@ REC="$WORK/old.lcmlog"
 "$FEED" --lcm-url "file://$REC?mode=w" --loom-id "$ID" --rows 3 --tick-us 2000 --max-rate 0 >/dev/null
 sleep 3  # the recording is now older than --replay-after-s 2
 
-"$PANEL" --port 0 --lcm-url "$URL" --replay-after-s 2 --control-dir "$WORK" 2>"$WORK/panel.err" &
-PIDS+=($!)
-PANEL_PID=$!
-for _ in $(seq 1 100); do
-  grep -q "serving http" "$WORK/panel.err" 2>/dev/null && break
-  sleep 0.05
-done
-BASE=$(sed -n 's|.*serving \(http://[0-9.]*:[0-9]*\)/.*|\1|p' "$WORK/panel.err")
-[[ -n $BASE ]] || fail "loom-panel did not start"
+panel_up panel.err --lcm-url "$URL" --replay-after-s 2 --control-dir "$WORK"
+BASE=$PANEL_BASE
 
 get() { curl -s -m 5 "$BASE$1"; }
 json() {  # json PATH EXPR: a field of a JSON reply, by python

@@ -38,6 +38,10 @@ inline constexpr std::size_t kAxisRoleCount = 6;
 const char* axis_role_name(AxisRole r);                     // "beat_crank", ..., "auxiliary"
 bool parse_axis_role(const char* text, AxisRole& role);     // false for an unknown name
 bool is_rotary(AxisRole r);                                 // rad (true) or m (the carriage)
+// The SI unit of an axis' position: "rad" for a rotary axis, "m" for a linear one (is_rotary). The one
+// place it is decided: the config's checks, commissioning and telemetry (AXES, for the panel and monitor)
+// all take it from here.
+const char* axis_unit(AxisRole r);
 
 // The machine's axes: names and roles, in slot order. Plain fixed-size data, built at configure time
 // and shared by the sequencer, the simulator, the drivers and telemetry.
