@@ -1,6 +1,6 @@
 // `loom-profile dump`: a recipe's profiles written as plain CSV — the scalar facts of the profile set,
 // the rocker and crank-law tables as the loop reads them, one row's beat sweep and one pick in time —
-// so a committed copy (tests/profiles/golden/) catches any unintended change in motion.
+// so a committed copy (tests/motion/profiles/golden/) catches any unintended change in motion.
 #pragma once
 
 #include <string>

@@ -1,5 +1,6 @@
 // The words of loom-sim-drive's --io-control file (HIL fault tests), parsed into the I/O node's
-// controls. Kept out of main.cpp so the parsing is unit-tested (tests/drivers/test_sim_io_node.cpp).
+// controls. Kept out of main.cpp so the parsing is unit-tested
+// (tests/sim_hal/can_drive/test_sim_io_node.cpp).
 //
 // Whitespace-separated words; a word present is active, a word absent inactive (the whole file is the
 // state, so removing a word undoes it):

@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # Golden-file test: dumps every case of golden/cases.txt with loom-profile and compares the result
-# with the committed copy, number by number (tests/profiles/golden_diff). A failure names the file,
-# line and column that moved; if the change is intended, run tests/profiles/regen-golden.sh.
+# with the committed copy, number by number (tests/motion/profiles/golden_diff). A failure names the file,
+# line and column that moved; if the change is intended, run tests/motion/profiles/regen-golden.sh.
 # Usage: golden_test.sh LOOM_PROFILE GOLDEN_DIFF SOURCE_DIR
 set -euo pipefail
 tool=$1 diff=$2 src=$3
-here=$src/tests/profiles
+here=$src/tests/motion/profiles
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 status=0
@@ -17,7 +17,7 @@ while IFS='|' read -r name args; do
   if "$diff" "$here/golden/$name" "$work/$name"; then
     echo "golden $name: identical within tolerance"
   else
-    echo "golden $name: DIFFERS (intended? regenerate with tests/profiles/regen-golden.sh)"
+    echo "golden $name: DIFFERS (intended? regenerate with tests/motion/profiles/regen-golden.sh)"
     status=1
   fi
 done <"$here/golden/cases.txt"
