@@ -6,6 +6,7 @@
 
 #include "fake_can_network.hpp"
 #include "loom/drivers/can_axis_port.hpp"
+#include "loom/drivers/can_io_modules.hpp"
 #include "loom/drivers/can_io_port.hpp"
 #include "loom/hal/hal.hpp"
 #include "loom/sim_can/sim_drive_rack.hpp"
@@ -87,7 +88,7 @@ TEST(CanAxisPortRt, TwentyThousandTicksWithoutAllocation) {
 
 // The I/O node's per-tick path (on_frame through the axis port's drain, read_io with both channels of
 // every safety sensor, write_io) allocates nothing either, with the default wiring's three input bytes
-// and a switch sticking and freeing on the way.
+// and a switch sticking and freeing on the way — through CanIoModules, as the machine runs it.
 TEST(CanIoPortRt, FiveThousandTicksWithoutAllocation) {
   FakeCanNetwork net;
   auto& master = net.add_endpoint();
@@ -110,7 +111,9 @@ TEST(CanIoPortRt, FiveThousandTicksWithoutAllocation) {
   ASSERT_TRUE(port.configure(relay, clock).is_ok());
   relay.set_passthrough(false);
 
-  hal::PortHal hal(port, io_port);
+  drivers::CanIoModules modules;
+  modules.add(io_port);
+  hal::PortHal hal(port, modules);
   hal::HalInputs in{};
   hal::HalOutputs out{};
   long worst = 0;
