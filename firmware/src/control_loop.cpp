@@ -11,13 +11,6 @@
 
 namespace loom::firmware {
 namespace {
-template <std::size_t N>
-void copy_name(std::array<char, N>& dst, const char* src) noexcept {
-  std::size_t i = 0;
-  for (; i + 1 < N && src[i] != '\0'; ++i) dst[i] = src[i];
-  for (; i < N; ++i) dst[i] = '\0';
-}
-
 
 static_assert(telemetry::kMaxKnotSlots == static_cast<std::size_t>(sequencer::kMaxMagazineSlots), "the snapshot holds every magazine slot");
 
@@ -202,7 +195,7 @@ void ControlLoop::push_fault(telemetry::Event::FaultKind kind, sequencer::Fault 
   e.axis = static_cast<std::int8_t>(axis);
   e.device_code = device_code;
   e.sensor = static_cast<std::int8_t>(sensor);
-  copy_name(e.state, sequencer::state_name(seq_.events().began_in()));
+  e.state = static_cast<std::uint8_t>(seq_.events().began_in());
   push_event(e);
 }
 
@@ -236,28 +229,21 @@ void ControlLoop::fill_snapshot(hal::Tick now) noexcept {
   telemetry::Snapshot& s = snap_;
   s.tick = now;
   s.period_ns = period_ns_;
-  // Names and the fault's code are looked up only when the state or the fault changed.
-  if (!names_shown_ || seq_.state() != shown_state_) {
-    shown_state_ = seq_.state();
-    copy_name(s.state, sequencer::state_name(shown_state_));
-  }
+  // Enums, named by the publisher; the fault's code is looked up only when the fault changed.
+  s.state = static_cast<std::uint8_t>(seq_.state());
   const sequencer::Fault f = seq_.first_fault();
   const bool faulted = f != sequencer::Fault::kNone;
-  if (!names_shown_ || f != shown_first_fault_) {
+  s.first_fault = static_cast<std::uint8_t>(f);
+  if (!code_shown_ || f != shown_first_fault_) {
     shown_first_fault_ = f;
-    copy_name(s.first_fault, faulted ? sequencer::fault_name(f) : "");
     s.first_fault_code = sequencer::fault_code(f);
+    code_shown_ = true;
   }
   s.fault_axis = static_cast<std::int8_t>(faulted ? seq_.fault_axis() : -1);
   s.fault_sensor = static_cast<std::int8_t>(faulted ? seq_.fault_sensor() : -1);
   s.fault_device_code = faulted ? seq_.fault_detail() : 0;
   s.fault_tick = faulted ? seq_.fault_tick() : hal::kNeverTick;
-  const sequencer::Fault stopped_by = faulted ? seq_.stopped_by() : sequencer::Fault::kNone;
-  if (!names_shown_ || stopped_by != shown_stopped_by_) {
-    shown_stopped_by_ = stopped_by;
-    copy_name(s.stopped_by, faulted ? sequencer::fault_name(stopped_by) : "");
-  }
-  names_shown_ = true;
+  s.stopped_by = static_cast<std::uint8_t>(faulted ? seq_.stopped_by() : sequencer::Fault::kNone);
   s.row = seq_.counters().rows;
   s.pick = seq_.counters().picks;
   s.beat = seq_.counters().beats;

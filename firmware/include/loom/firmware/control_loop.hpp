@@ -89,12 +89,9 @@ class ControlLoop {
   hal::HalInputs in_{};
   hal::HalOutputs out_{};
   telemetry::Snapshot snap_{};
-  // What snap_'s names (and fault code) show, so fill_snapshot looks them up only when they change: the
-  // snapshot keeps them from tick to tick.
-  bool names_shown_ = false;
-  sequencer::State shown_state_ = sequencer::State::kIdle;
+  // The fault snap_'s fault code is for, so fill_snapshot looks the code up only when the fault changes.
+  bool code_shown_ = false;
   sequencer::Fault shown_first_fault_ = sequencer::Fault::kNone;
-  sequencer::Fault shown_stopped_by_ = sequencer::Fault::kNone;
   // The crank target and recipe snap_'s crank phase and beater angle were computed for.
   bool crank_shown_ = false;
   double shown_crank_target_ = 0.0;
