@@ -19,7 +19,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <stdexcept>
 
 #include "loom/motion/angles.hpp"
@@ -1020,7 +1019,7 @@ void Sequencer::next_row(hal::Tick now) noexcept {
     knotter_requests_seen_ = knotter_.requests();
     knot_requested_ = false;
     knotter_.begin(counters_.rows, counters_.knot, row_starts_left() ? 0.0 : profiles_->carriage_travel_m(), now, cmd_);
-    note_knotter(counters_.knot, knotter_requests_seen_);
+    if (knotter_.requests() != knotter_requests_seen_) events_.add(EventKind::kWeaverRequest);
     enter(State::kKnotting, now);
     return;
   }
@@ -1060,10 +1059,11 @@ void Sequencer::knotting(hal::Tick now, const hal::HalInputs& in) noexcept {
   }
   const bool await_disk = cfg_.await_row_saved;
   const std::uint32_t on_disk = knots_on_disk_rows_ == counters_.rows ? knots_on_disk_started_ : 0;
-  const KnotCounters before = counters_.knot;
   const std::uint32_t requests_before = knotter_.requests();
   const RowKnotter::Status st = knotter_.step(now, in, cmd_, counters_.knot, knot_requested_, await_disk, on_disk);
-  note_knotter(before, requests_before);
+  // The heads report what their step did: their counters moved, a request made of the weaver.
+  if (knotter_.counters_moved()) events_.add(EventKind::kKnotProgress);
+  if (knotter_.requests() != requests_before) events_.add(EventKind::kWeaverRequest);
   knot_requested_ = false;  // answered the request, or came when none was open
   switch (st) {
     case RowKnotter::Status::kRunning:
@@ -1157,15 +1157,6 @@ void Sequencer::track_beat_force(const hal::HalInputs& in) noexcept {
   if (k < 0 || k >= profiles_->beats_per_row()) return;
   if (!beater_in_warp(interlock_ctx_, crank)) return;
   row_.force(k, in.analog.beat_force_n);
-}
-
-// The heads report through the counters they keep and the requests they count: a step of theirs that moved
-// either is news.
-void Sequencer::note_knotter(const KnotCounters& before, std::uint32_t requests_before) noexcept {
-  // (Five counters, no padding: one comparison of their bytes, every knotting tick.)
-  static_assert(sizeof(KnotCounters) == 5 * sizeof(std::uint32_t), "KnotCounters is its five counters");
-  if (std::memcmp(&before, &counters_.knot, sizeof(KnotCounters)) != 0) events_.add(EventKind::kKnotProgress);
-  if (knotter_.requests() != requests_before) events_.add(EventKind::kWeaverRequest);
 }
 
 void Sequencer::publish_beat(int k) noexcept {

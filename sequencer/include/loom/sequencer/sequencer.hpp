@@ -257,7 +257,6 @@ class Sequencer {
   Fault shed_fault(ShedVerdict v) const noexcept;
   void publish_beat(int k) noexcept;
   void add_fault_event(EventKind kind) noexcept;  // kFaultLatched / kDiagnosisRefined with the first fault's details
-  void note_knotter(const KnotCounters& before, std::uint32_t requests_before) noexcept;  // its counters or requests moved
   bool expect_shuttle_left() const noexcept { return counters_.picks % 2 == 0; }  // it starts at the left
   bool row_starts_left() const noexcept { return counters_.rows % 2 == 0; }      // sweeps alternate
   PistonEnds ends_a() const noexcept { return {io_.piston_a_extended, io_.piston_a_retracted}; }
