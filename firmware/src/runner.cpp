@@ -222,6 +222,9 @@ class LoopBody {
         cmds |= static_cast<std::uint32_t>(c);
         RunEvent e = base_event(RunEvent::Kind::kButton, tick);
         e.button = c;
+        // The state the press was seen in: the sequencer may have acted on it in that tick already (a start
+        // press has left idle), and the audit's verdict is the one the press got.
+        e.state = seq_.events().began_in();
         emit(e);
       }
     }
