@@ -11,21 +11,6 @@
 
 namespace loom::firmware {
 namespace {
-template <std::size_t N>
-void copy_name(std::array<char, N>& dst, const char* src) noexcept {
-  std::size_t i = 0;
-  for (; i + 1 < N && src[i] != '\0'; ++i) dst[i] = src[i];
-  for (; i < N; ++i) dst[i] = '\0';
-}
-
-// The snapshot keeps its names from tick to tick and they are string literals (state_name,
-// fault_name): copy one only when it changed, not three 24–32 byte loops every tick.
-template <std::size_t N>
-void set_name(std::array<char, N>& dst, const char* src, const char*& shown) noexcept {
-  if (src == shown) return;
-  copy_name(dst, src);
-  shown = src;
-}
 
 static_assert(telemetry::kMaxKnotSlots == static_cast<std::size_t>(sequencer::kMaxMagazineSlots), "the snapshot holds every magazine slot");
 
@@ -59,7 +44,8 @@ void ControlLoop::cycle(hal::Tick now) noexcept {
   hal_.write(now, out_);
   if (telemetry_ != nullptr) {
     // Events first: the publisher sends a tick's events before that tick's samples.
-    push_events(now);
+    // The usual tick has no event and no device reporting a fault: one branch-free pass over the flags.
+    if (!seq_.events().empty() || devices_reporting_ || any_device_fault()) push_events(now);
     fill_snapshot(now);
     if (lossless_) {
       telemetry_->push_waiting(snap_);
@@ -96,142 +82,168 @@ void ControlLoop::fill_event_context(telemetry::Event& e, hal::Tick now) const n
   e.band_max_n = ctx_.beat_force_max_n;
 }
 
+// The sequencer's events of this tick, forwarded in its order (BEAT, ROW, WEAVER, FAULT), then what the
+// drives and the link report themselves (the HAL's own fault flags, not sequencer state).
+// True when a drive or the link reports a fault now. With it false and no report left from the last tick
+// (devices_reporting_), push_device_faults would find nothing to push or forget.
+bool ControlLoop::any_device_fault() const noexcept {
+  bool any = in_.link.link_fault;
+  for (std::size_t i = 0; i < n_axes_; ++i) {
+    const hal::AxisFeedback& a = in_.axes[i];
+    any |= a.fault | (a.state == hal::DriveState::kFault) | (a.state == hal::DriveState::kFaultReactionActive);
+  }
+  return any;
+}
+
 void ControlLoop::push_events(hal::Tick now) noexcept {
-  if (!primed_) {
-    // Counters resumed from disk are not events of this run.
-    beat_events_seen_ = seq_.beat_events();
-    rows_seen_ = seq_.counters().rows;
-    weaver_requests_seen_ = seq_.weaver_requests();
-    primed_ = true;
-  }
-  // BEAT: the sequencer completes at most one beat per tick, so polling every tick sees each once.
-  if (seq_.beat_events() != beat_events_seen_) {
-    beat_events_seen_ = seq_.beat_events();
-    const sequencer::BeatEvent& b = seq_.last_beat();
-    telemetry::Event e;
-    e.kind = telemetry::Event::Kind::kBeat;
-    fill_event_context(e, now);
-    e.row = b.row;
-    e.beat_index = b.index;
-    e.x_m = b.x_m;
-    e.peak_force_n = b.peak_force_n;
-    e.force_measured = b.force_measured;
-    e.in_band = b.in_band;
-    push_event(e);
-  }
-  // ROW: a completed row with its time split and force summary.
-  if (seq_.counters().rows != rows_seen_) {
-    rows_seen_ = seq_.counters().rows;
-    const sequencer::RowStats& r = seq_.last_row();
-    telemetry::Event e;
-    e.kind = telemetry::Event::Kind::kRow;
-    fill_event_context(e, now);
-    e.row = r.row;
-    e.row_ticks = r.total_ticks;
-    e.shed_ticks = r.shed_ticks;
-    e.pick_ticks = r.pick_ticks;
-    e.beat_ticks = r.beat_ticks;
-    e.knotting_ticks = r.knotting_ticks;
-    e.beats = static_cast<std::uint16_t>(r.beats);
-    e.carriage_steps = static_cast<std::uint16_t>(r.carriage_steps);
-    e.force_measured = r.force_measured;
-    e.force_min_n = r.force_min_n;
-    e.force_mean_n = r.force_mean_n;
-    e.force_max_n = r.force_max_n;
-    e.knot_ticks = r.knot_ticks;
-    e.weaver_ticks = r.weaver_ticks;
-    e.knots_tied = static_cast<std::uint16_t>(r.knots_tied);
-    e.knots_retried = static_cast<std::uint16_t>(r.knots_retried);
-    e.knots_by_hand = static_cast<std::uint16_t>(r.knots_by_hand);
-    std::uint16_t in_band = 0;
-    const int n = r.beats < sequencer::kMaxBeatsPerRow ? r.beats : sequencer::kMaxBeatsPerRow;
-    for (int k = 0; r.force_measured && k < n; ++k) {  // bounded: kMaxBeatsPerRow
-      const double f = r.beat[static_cast<std::size_t>(k)].peak_force_n;
-      if (f >= ctx_.beat_force_min_n && f <= ctx_.beat_force_max_n) ++in_band;
-    }
-    e.beats_in_band = in_band;
-    push_event(e);
-  }
-  // WEAVER: each request the knotting heads make of the weaver (at most one per tick), once; the
-  // publisher words it. A loom without heads never counts one.
-  if (seq_.weaver_requests() != weaver_requests_seen_) {
-    weaver_requests_seen_ = seq_.weaver_requests();
-    const sequencer::WeaverRequest& q = seq_.knotter().request();
-    telemetry::Event e;
-    e.kind = telemetry::Event::Kind::kWeaver;
-    fill_event_context(e, now);
-    e.row = q.row;
-    e.ask = static_cast<std::uint8_t>(q.ask);
-    e.request = weaver_requests_seen_;
-    e.design_row = q.design_row;
-    e.knot = static_cast<std::int16_t>(q.knot);
-    e.head = static_cast<std::int16_t>(q.head);
-    e.slot = static_cast<std::int16_t>(q.slot);
-    push_event(e);
-  }
-  // FAULT: the latched first fault, a later diagnosis of its root cause, and every device report.
-  const sequencer::Fault f = seq_.first_fault();
-  const auto fault_event = [&](telemetry::Event::FaultKind kind, sequencer::Fault which, int axis,
-                               std::uint16_t device_code, int sensor = -1) {
-    telemetry::Event e;
-    e.kind = telemetry::Event::Kind::kFault;
-    fill_event_context(e, now);
-    e.fault_kind = kind;
-    e.fault = static_cast<std::uint8_t>(which);
-    e.axis = static_cast<std::int8_t>(axis);
-    e.device_code = device_code;
-    e.sensor = static_cast<std::int8_t>(sensor);
-    copy_name(e.state, sequencer::state_name(prev_state_));
-    push_event(e);
-  };
+  const sequencer::TickEvents& events = seq_.events();
   int first_axis_reported = -2;  // axis of a first/diagnosis event this tick (-1: none), -2: no such event
   bool link_reported = false;
-  if (f != prev_fault_ || seq_.fault_axis() != prev_fault_axis_ || seq_.fault_detail() != prev_fault_detail_) {
-    if (f != sequencer::Fault::kNone) {
-      fault_event(prev_fault_ == sequencer::Fault::kNone ? telemetry::Event::FaultKind::kFirst
-                                                          : telemetry::Event::FaultKind::kDiagnosis,
-                  f, seq_.fault_axis(), seq_.fault_detail(), seq_.fault_sensor());
-      first_axis_reported = seq_.fault_axis();
-      link_reported = f == sequencer::Fault::kLinkFault ||
-                      (f == sequencer::Fault::kHeartbeatLost && seq_.fault_axis() < 0);
+  {
+    // A fault latched and refined in the same tick is one FAULT (first) with what is known at its end.
+    const bool latched = events.has(sequencer::EventKind::kFaultLatched);
+    for (const sequencer::TickEvent& ev : events) {  // bounded: TickEvents::kCapacity
+      switch (ev.kind) {
+        case sequencer::EventKind::kBeat: push_beat(ev.beat, now); break;
+        case sequencer::EventKind::kRow: push_row(now); break;
+        case sequencer::EventKind::kWeaverRequest: push_weaver_request(now); break;
+        case sequencer::EventKind::kFaultLatched:
+        case sequencer::EventKind::kDiagnosisRefined:
+          if (latched && ev.kind == sequencer::EventKind::kDiagnosisRefined) break;
+          push_fault(latched ? telemetry::Event::FaultKind::kFirst : telemetry::Event::FaultKind::kDiagnosis,
+                     seq_.first_fault(), seq_.fault_axis(), seq_.fault_detail(), seq_.fault_sensor(), now);
+          first_axis_reported = seq_.fault_axis();
+          link_reported = seq_.first_fault() == sequencer::Fault::kLinkFault ||
+                          (seq_.first_fault() == sequencer::Fault::kHeartbeatLost && seq_.fault_axis() < 0);
+          break;
+        default: break;  // picks, pauses, knot progress and buttons travel in the snapshot and the reporter
+      }
     }
-    prev_fault_ = f;
-    prev_fault_axis_ = seq_.fault_axis();
-    prev_fault_detail_ = seq_.fault_detail();
   }
+  push_device_faults(first_axis_reported, link_reported, now);
+}
+
+void ControlLoop::push_beat(const sequencer::BeatEvent& b, hal::Tick now) noexcept {
+  telemetry::Event e;
+  e.kind = telemetry::Event::Kind::kBeat;
+  fill_event_context(e, now);
+  e.row = b.row;
+  e.beat_index = b.index;
+  e.x_m = b.x_m;
+  e.peak_force_n = b.peak_force_n;
+  e.force_measured = b.force_measured;
+  e.in_band = b.in_band;
+  push_event(e);
+}
+
+// ROW: the completed row with its time split and force summary.
+void ControlLoop::push_row(hal::Tick now) noexcept {
+  const sequencer::RowStats& r = seq_.last_row();
+  telemetry::Event e;
+  e.kind = telemetry::Event::Kind::kRow;
+  fill_event_context(e, now);
+  e.row = r.row;
+  e.row_ticks = r.total_ticks;
+  e.shed_ticks = r.shed_ticks;
+  e.pick_ticks = r.pick_ticks;
+  e.beat_ticks = r.beat_ticks;
+  e.knotting_ticks = r.knotting_ticks;
+  e.beats = static_cast<std::uint16_t>(r.beats);
+  e.carriage_steps = static_cast<std::uint16_t>(r.carriage_steps);
+  e.force_measured = r.force_measured;
+  e.force_min_n = r.force_min_n;
+  e.force_mean_n = r.force_mean_n;
+  e.force_max_n = r.force_max_n;
+  e.knot_ticks = r.knot_ticks;
+  e.weaver_ticks = r.weaver_ticks;
+  e.knots_tied = static_cast<std::uint16_t>(r.knots_tied);
+  e.knots_retried = static_cast<std::uint16_t>(r.knots_retried);
+  e.knots_by_hand = static_cast<std::uint16_t>(r.knots_by_hand);
+  std::uint16_t in_band = 0;
+  const int n = r.beats < sequencer::kMaxBeatsPerRow ? r.beats : sequencer::kMaxBeatsPerRow;
+  for (int k = 0; r.force_measured && k < n; ++k) {  // bounded: kMaxBeatsPerRow
+    const double f = r.beat[static_cast<std::size_t>(k)].peak_force_n;
+    if (f >= ctx_.beat_force_min_n && f <= ctx_.beat_force_max_n) ++in_band;
+  }
+  e.beats_in_band = in_band;
+  push_event(e);
+}
+
+// WEAVER: a request the knotting heads made of the weaver; the publisher words it.
+void ControlLoop::push_weaver_request(hal::Tick now) noexcept {
+  const sequencer::WeaverRequest& q = seq_.knotter().request();
+  telemetry::Event e;
+  e.kind = telemetry::Event::Kind::kWeaver;
+  fill_event_context(e, now);
+  e.row = q.row;
+  e.ask = static_cast<std::uint8_t>(q.ask);
+  e.request = seq_.weaver_requests();
+  e.design_row = q.design_row;
+  e.knot = static_cast<std::int16_t>(q.knot);
+  e.head = static_cast<std::int16_t>(q.head);
+  e.slot = static_cast<std::int16_t>(q.slot);
+  push_event(e);
+}
+
+void ControlLoop::push_fault(telemetry::Event::FaultKind kind, sequencer::Fault which, int axis,
+                             std::uint16_t device_code, int sensor, hal::Tick now) noexcept {
+  telemetry::Event e;
+  e.kind = telemetry::Event::Kind::kFault;
+  fill_event_context(e, now);
+  e.fault_kind = kind;
+  e.fault = static_cast<std::uint8_t>(which);
+  e.axis = static_cast<std::int8_t>(axis);
+  e.device_code = device_code;
+  e.sensor = static_cast<std::int8_t>(sensor);
+  e.state = static_cast<std::uint8_t>(seq_.events().began_in());
+  push_event(e);
+}
+
+// Every drive's and the link's own fault report, once per report (a new fault or a new code), except the
+// one the sequencer's first fault or diagnosis already names this tick. These edges are the HAL's inputs,
+// not sequencer state: only their last values are kept.
+void ControlLoop::push_device_faults(int first_axis_reported, bool link_reported, hal::Tick now) noexcept {
+  bool any = false;
   for (std::size_t i = 0; i < n_axes_; ++i) {
     const hal::AxisFeedback& a = in_.axes[i];
     const bool faulted = axis_faulted(a);
     if (!faulted && !prev_axis_fault_[i]) continue;  // the usual tick: nothing to report or forget (code is 0)
     const bool report = faulted && (!prev_axis_fault_[i] || a.fault_code != prev_axis_fault_code_[i]);
     if (report && static_cast<int>(i) != first_axis_reported) {
-      fault_event(telemetry::Event::FaultKind::kDevice, sequencer::Fault::kDriveFault, static_cast<int>(i),
-                  a.fault_code);
+      push_fault(telemetry::Event::FaultKind::kDevice, sequencer::Fault::kDriveFault, static_cast<int>(i),
+                 a.fault_code, -1, now);
     }
     prev_axis_fault_[i] = faulted;
     prev_axis_fault_code_[i] = faulted ? a.fault_code : 0;
+    any |= faulted;
   }
   if (in_.link.link_fault && !prev_link_fault_ && !link_reported) {
-    fault_event(telemetry::Event::FaultKind::kDevice, sequencer::Fault::kLinkFault, -1, in_.link.link_fault_code);
+    push_fault(telemetry::Event::FaultKind::kDevice, sequencer::Fault::kLinkFault, -1, in_.link.link_fault_code,
+               -1, now);
   }
   prev_link_fault_ = in_.link.link_fault;
-  prev_state_ = seq_.state();
+  devices_reporting_ = any || prev_link_fault_;
 }
 
 void ControlLoop::fill_snapshot(hal::Tick now) noexcept {
   telemetry::Snapshot& s = snap_;
   s.tick = now;
   s.period_ns = period_ns_;
-  set_name(s.state, sequencer::state_name(seq_.state()), shown_state_);
+  // Enums, named by the publisher; the fault's code is looked up only when the fault changed.
+  s.state = static_cast<std::uint8_t>(seq_.state());
   const sequencer::Fault f = seq_.first_fault();
   const bool faulted = f != sequencer::Fault::kNone;
-  set_name(s.first_fault, faulted ? sequencer::fault_name(f) : "", shown_first_fault_);
-  s.first_fault_code = sequencer::fault_code(f);
+  s.first_fault = static_cast<std::uint8_t>(f);
+  if (!code_shown_ || f != shown_first_fault_) {
+    shown_first_fault_ = f;
+    s.first_fault_code = sequencer::fault_code(f);
+    code_shown_ = true;
+  }
   s.fault_axis = static_cast<std::int8_t>(faulted ? seq_.fault_axis() : -1);
   s.fault_sensor = static_cast<std::int8_t>(faulted ? seq_.fault_sensor() : -1);
   s.fault_device_code = faulted ? seq_.fault_detail() : 0;
   s.fault_tick = faulted ? seq_.fault_tick() : hal::kNeverTick;
-  set_name(s.stopped_by, faulted ? sequencer::fault_name(seq_.stopped_by()) : "", shown_stopped_by_);
+  s.stopped_by = static_cast<std::uint8_t>(faulted ? seq_.stopped_by() : sequencer::Fault::kNone);
   s.row = seq_.counters().rows;
   s.pick = seq_.counters().picks;
   s.beat = seq_.counters().beats;

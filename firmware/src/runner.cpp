@@ -105,10 +105,6 @@ class LoopBody {
     RunResult& res = rt_.result;
     const std::int64_t period_ns =
         std::max<std::int64_t>(1, std::llround(opt_.period_s * 1e9 / (opt_.realtime ? opt_.pace : 1.0)));
-    rows_seen_ = seq_.counters().rows;
-    picks_seen_ = seq_.counters().picks;
-    knots_seen_ = seq_.counters().knot;
-    requests_seen_ = seq_.weaver_requests();
     const hal::Tick refresh_every = std::max<hal::Tick>(1, static_cast<hal::Tick>(1.0 / opt_.period_s));
     const std::int64_t begin = rt_.clock.now_ns();
     std::int64_t deadline = begin + period_ns;
@@ -139,7 +135,7 @@ class LoopBody {
       stats_.max_tick_cost_ns = std::max(stats_.max_tick_cost_ns, cost);
       rt_.cost.add(cost);
 
-      report_changes(tick);
+      report_events(tick);
       publish_status(tick);
       if (tick % refresh_every == 0) {
         // Bounded (two scans of a fixed histogram), once a second, in the tick's slack.
@@ -216,21 +212,21 @@ class LoopBody {
       cmds = opt_.link->pending.exchange(0, std::memory_order_acquire);
     }
     if (opt_.operator_buttons) {
-      const hal::DigitalInputs& io = rt_.loop.inputs().io;
-      // Each press is audited (the reporter logs who gave the command: the I/O module's button).
-      const auto press = [&](bool now, bool before, Command c) {
-        if (!now || before) return;
+      // The presses the sequencer saw in the last tick (debounced, one per press), as commands, each audited:
+      // the reporter logs who gave the command, the I/O module's button.
+      for (const sequencer::TickEvent& ev : seq_.events()) {  // bounded: TickEvents::kCapacity
+        if (ev.kind != sequencer::EventKind::kButton || ev.button == sequencer::Button::kRowKnotted) continue;
+        const Command c = ev.button == sequencer::Button::kStart   ? Command::kStart
+                          : ev.button == sequencer::Button::kPause ? Command::kPause
+                                                                   : Command::kAck;
         cmds |= static_cast<std::uint32_t>(c);
         RunEvent e = base_event(RunEvent::Kind::kButton, tick);
         e.button = c;
+        // The state the press was seen in: the sequencer may have acted on it in that tick already (a start
+        // press has left idle), and the audit's verdict is the one the press got.
+        e.state = seq_.events().began_in();
         emit(e);
-      };
-      press(io.button_start, prev_start_, Command::kStart);
-      press(io.button_pause, prev_pause_, Command::kPause);
-      press(io.button_ack, prev_ack_, Command::kAck);
-      prev_start_ = io.button_start;
-      prev_pause_ = io.button_pause;
-      prev_ack_ = io.button_ack;
+      }
     }
     if (opt_.stop_flag != nullptr && !stop_sent_ && opt_.stop_flag->load(std::memory_order_relaxed)) {
       seq_.request_stop_at_row_end();
@@ -335,24 +331,22 @@ class LoopBody {
     }
   }
 
-  void report_changes(hal::Tick tick) noexcept {
-    const sequencer::Counters& c = seq_.counters();
-    if (c.rows != rows_seen_ || c.picks != picks_seen_) {
-      const bool row_done = c.rows != rows_seen_;
-      rows_seen_ = c.rows;
-      picks_seen_ = c.picks;
-      RunEvent e = base_event(row_done ? RunEvent::Kind::kRowDone : RunEvent::Kind::kPickDone, tick);
-      if (row_done) e.row = seq_.last_row();
+  // The sequencer's events of this tick as run events, in the reporter's order: the row or pick (saved with
+  // the counters), the knots, the weaver's request, a pause or resume, the fault. Each carries the counters
+  // and the fault as they are at the end of the tick.
+  void report_events(hal::Tick tick) noexcept {
+    const sequencer::TickEvents& ev = seq_.events();
+    if (ev.empty()) return;  // the usual tick
+    using sequencer::EventKind;
+    if (ev.has(EventKind::kRow)) {
+      RunEvent e = base_event(RunEvent::Kind::kRowDone, tick);
+      e.row = seq_.last_row();
       emit(e);
+    } else if (ev.has(EventKind::kPick)) {
+      emit(base_event(RunEvent::Kind::kPickDone, tick));
     }
-    const sequencer::KnotCounters& k = c.knot;
-    if (k.tied != knots_seen_.tied || k.retried != knots_seen_.retried || k.by_hand != knots_seen_.by_hand ||
-        k.cycles_started != knots_seen_.cycles_started || k.cycles_done != knots_seen_.cycles_done) {
-      knots_seen_ = k;
-      emit(base_event(RunEvent::Kind::kKnotProgress, tick));
-    }
-    if (seq_.weaver_requests() != requests_seen_) {
-      requests_seen_ = seq_.weaver_requests();
+    if (ev.has(EventKind::kKnotProgress)) emit(base_event(RunEvent::Kind::kKnotProgress, tick));
+    if (ev.has(EventKind::kWeaverRequest)) {
       const sequencer::WeaverRequest& r = seq_.weaver_request();
       if (r.ask != sequencer::WeaverAsk::kNone) {
         RunEvent e = base_event(RunEvent::Kind::kWeaverRequest, tick);
@@ -361,15 +355,10 @@ class LoopBody {
         if (opt_.weaver_sink != nullptr) opt_.weaver_sink(opt_.weaver_sink_ctx, r);
       }
     }
-    const sequencer::State s = seq_.state();
-    const bool paused = s == sequencer::State::kPaused;
-    if (paused != was_paused_) {
-      was_paused_ = paused;
-      emit(base_event(paused ? RunEvent::Kind::kPaused : RunEvent::Kind::kResumed, tick));
-    }
-    const bool fault = s == sequencer::State::kFault;
-    if (fault && !was_fault_) emit(base_event(RunEvent::Kind::kFault, tick));
-    was_fault_ = fault;
+    // A pause and its resume in one tick (never seen) cancel out, as the state shows.
+    const bool paused = ev.has(EventKind::kPaused), resumed = ev.has(EventKind::kResumed);
+    if (paused != resumed) emit(base_event(paused ? RunEvent::Kind::kPaused : RunEvent::Kind::kResumed, tick));
+    if (ev.has(EventKind::kFaultLatched)) emit(base_event(RunEvent::Kind::kFault, tick));
   }
 
   void publish_status(hal::Tick tick) noexcept {
@@ -395,12 +384,7 @@ class LoopBody {
   const RunOptions& opt_;
   LoopStats& stats_;
   telemetry::Telemetry* telemetry_;  // non-null: virtual time, lossless telemetry (wait before the tick)
-  std::uint32_t rows_seen_ = 0, picks_seen_ = 0;
-  sequencer::KnotCounters knots_seen_{};
-  std::uint32_t requests_seen_ = 0;
-  bool was_paused_ = false, was_fault_ = false;
   bool stop_sent_ = false, stop_now_sent_ = false, exit_pending_ = false;
-  bool prev_start_ = false, prev_pause_ = false, prev_ack_ = false;
   std::int64_t knotting_wait_ = 0;  // ticks the loom has waited for the simulated weaver
 };
 
@@ -497,6 +481,9 @@ RunResult run_loop(ControlLoop& loop, sequencer::Sequencer& seq, const RunOption
   // Configure-time: the histograms (and in real time the ~2 MB event ring) live on the heap,
   // value-initialised, which touches every page before the loop starts.
   auto rt = std::make_unique<Runtime>(loop, seq, opt, clock, on_event);
+  // With the buttons and a session held after a fault, an ack ends the session (the owner re-arms): the
+  // sequencer reports that press and leaves it to us.
+  if (opt.operator_buttons && opt.hold_when_finished) seq.leave_ack_button_to_owner();
 
   if (!opt.realtime) {
     LoopBody(*rt).run();

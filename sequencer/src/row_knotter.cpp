@@ -242,7 +242,10 @@ RowKnotter::Status RowKnotter::check(hal::Tick now, const hal::HalInputs& in, co
   }
   // Write-ahead: "cycle j started" is on disk before the cycle starts, so a power cut inside it is known
   // after the restart and its knots are never tied a second time.
-  counters.cycles_started = std::max(counters.cycles_started, static_cast<std::uint32_t>(j_ + 1));
+  if (counters.cycles_started < static_cast<std::uint32_t>(j_ + 1)) {
+    counters.cycles_started = static_cast<std::uint32_t>(j_ + 1);
+    counters_moved_ = true;
+  }
   if (await_disk && on_disk_started < counters.cycles_started) return Status::kRunning;
   start_cycle(now);
   return Status::kRunning;
@@ -286,10 +289,12 @@ void RowKnotter::finish_cycle(hal::Tick now, const hal::HalOutputs& cmd, KnotCou
     if (seen_[hh]) {
       ++counters.tied;
       ++row_.tied;
+      counters_moved_ = true;
       active_[hh] = false;
     } else if (attempt_ == 0) {
       ++counters.retried;
       ++row_.retried;
+      counters_moved_ = true;
       retry = true;  // stays active: ties again
     } else {
       missed_[hh] = true;
@@ -312,8 +317,10 @@ void RowKnotter::finish_cycle(hal::Tick now, const hal::HalOutputs& cmd, KnotCou
 }
 
 void RowKnotter::cycle_done(hal::Tick now, const hal::HalOutputs& cmd, KnotCounters& counters) noexcept {
+  const KnotCounters was = counters;
   counters.cycles_done = static_cast<std::uint32_t>(j_ + 1);
   counters.cycles_started = std::max(counters.cycles_started, counters.cycles_done);
+  counters_moved_ |= counters.cycles_done != was.cycles_done || counters.cycles_started != was.cycles_started;
   enter_cycle(j_ + 1, now, cmd);
 }
 
@@ -332,6 +339,7 @@ RowKnotter::Status RowKnotter::weaver(hal::Tick now, const hal::HalOutputs& cmd,
     }
     ++counters.by_hand;  // tied (or checked and finished) by the weaver
     ++row_.by_hand;
+    counters_moved_ = true;
     missed_[static_cast<std::size_t>(request_.head)] = false;
   }
   for (; ask_head_ < heads_; ++ask_head_) {  // one request at a time, head by head
@@ -347,6 +355,7 @@ RowKnotter::Status RowKnotter::weaver(hal::Tick now, const hal::HalOutputs& cmd,
 RowKnotter::Status RowKnotter::step(hal::Tick now, const hal::HalInputs& in, hal::HalOutputs& cmd,
                                     KnotCounters& counters, bool weaver_done, bool await_disk,
                                     std::uint32_t on_disk_started) noexcept {
+  counters_moved_ = false;
   if (!fitted()) return Status::kDone;
   // Every tick: the moves in flight write their targets; grippers and cutters are open unless a running
   // cycle closes them. A carriage move waits at its origin while any gripper is measured in the warp (the

@@ -13,6 +13,7 @@
 //   7. track_beat_force()  the load cell's peak per beat
 //   8. interlocks          judge the proposed outputs against the measured inputs; a trip latches
 //   9. signal()            the stack light
+// What is news (a beat, a pick, a row, a fault, a pause …) is appended to events_ where it happens.
 // A fault found in step 2 wins over any plan: the state functions then only hold.
 #include "loom/sequencer/sequencer.hpp"
 
@@ -220,6 +221,7 @@ void Sequencer::latch(Fault f, hal::Tick now, int axis, std::uint16_t detail, in
     fault_sensor_ = sensor;
     fault_detail_ = detail;
     fault_tick_ = now;
+    add_fault_event(EventKind::kFaultLatched);
   }
   // An acknowledgement counts only as a deliberate act after the fault: one given before (a press while
   // weaving, a command racing the fault) is discarded here, whatever its source.
@@ -230,8 +232,19 @@ void Sequencer::latch(Fault f, hal::Tick now, int axis, std::uint16_t detail, in
 }
 
 void Sequencer::enter(State s, hal::Tick now) noexcept {
+  if ((s == State::kPaused) != (state_ == State::kPaused)) {
+    events_.add(s == State::kPaused ? EventKind::kPaused : EventKind::kResumed);
+  }
   state_ = s;
   state_since_ = now;
+}
+
+void Sequencer::add_fault_event(EventKind kind) noexcept {
+  TickEvent& e = events_.add(kind);
+  e.fault = first_fault_;
+  e.axis = static_cast<std::int8_t>(fault_axis_);
+  e.sensor = static_cast<std::int8_t>(fault_sensor_);
+  e.detail = fault_detail_;
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -239,6 +252,7 @@ void Sequencer::enter(State s, hal::Tick now) noexcept {
 // ---------------------------------------------------------------------------------------------------
 
 void Sequencer::step(hal::Tick now, const hal::HalInputs& raw, hal::HalOutputs& out) noexcept {
+  events_.clear(state_);
   sense(raw);
   // The sequencer and its interlocks see debounced sensors: a copy of the inputs with them, of the
   // configured axes only (the arrays are sized for the capacity).
@@ -466,6 +480,7 @@ void Sequencer::refine_diagnosis(hal::Tick now, const hal::HalInputs& in) noexce
       first_fault_ = a.fault_kind == hal::FaultKind::kNodeLost ? Fault::kHeartbeatLost : Fault::kDriveFault;
       fault_axis_ = static_cast<int>(i);
       fault_detail_ = a.fault_code;
+      add_fault_event(EventKind::kDiagnosisRefined);
       return;
     }
   }
@@ -473,19 +488,31 @@ void Sequencer::refine_diagnosis(hal::Tick now, const hal::HalInputs& in) noexce
     first_fault_ = in.link.link_fault_kind == hal::FaultKind::kNodeLost ? Fault::kHeartbeatLost : Fault::kLinkFault;
     fault_axis_ = -1;
     fault_detail_ = in.link.link_fault_code;
+    add_fault_event(EventKind::kDiagnosisRefined);
   }
 }
 
 void Sequencer::operator_requests(hal::Tick now) noexcept {
+  // Each press is also an event (the reporter audits it and turns it into the session's commands).
   if (start_edge_.update(io_.button_start)) {
+    events_.add(EventKind::kButton).button = Button::kStart;
     if (state_ == State::kIdle) start_requested_ = true;
     if (state_ == State::kPaused || pause_requested_) pause_requested_ = false;  // start also resumes
   }
-  if (pause_edge_.update(io_.button_pause) && state_ != State::kIdle) pause_requested_ = true;
+  if (pause_edge_.update(io_.button_pause)) {
+    events_.add(EventKind::kButton).button = Button::kPause;
+    if (state_ != State::kIdle) pause_requested_ = true;
+  }
   // The ack button counts only when pressed after the fault latched (not in the tick that latched it: its
   // debounced edge means it was pressed before).
-  if (ack_edge_.update(io_.button_ack) && state_ == State::kFault && now != fault_tick_) ack_requested_ = true;
-  if (knotted_edge_.update(io_.row_knotted)) knot_requested_ = true;
+  if (ack_edge_.update(io_.button_ack)) {
+    events_.add(EventKind::kButton).button = Button::kAck;
+    if (!ack_button_to_owner_ && state_ == State::kFault && now != fault_tick_) ack_requested_ = true;
+  }
+  if (knotted_edge_.update(io_.row_knotted)) {
+    events_.add(EventKind::kButton).button = Button::kRowKnotted;
+    knot_requested_ = true;
+  }
 }
 
 void Sequencer::run_state(hal::Tick now, const hal::HalInputs& in) noexcept {
@@ -749,6 +776,7 @@ void Sequencer::pick(hal::Tick now, const hal::HalInputs& in) noexcept {
   if (arrived && !helix_move_.active) {
     ++counters_.picks;
     ++counters_.picks_in_row;
+    events_.add(EventKind::kPick);
     row_.add_pick(now - phase_start_);
     if (counters_.picks_in_row < cfg_.picks_per_row) {
       if (pause_requested_) {
@@ -824,6 +852,7 @@ bool Sequencer::reconcile_at_arming(hal::Tick now, const hal::HalInputs& in) noe
   if (counters_.picks_in_row < cfg_.picks_per_row && shed_of_pick_n && before_sweep) {
     ++counters_.picks;
     ++counters_.picks_in_row;
+    events_.add(EventKind::kPick);  // the pick whose count never reached the file: counted now
     return true;
   }
   latch(Fault::kShuttleSideMismatch, now);
@@ -941,8 +970,12 @@ void Sequencer::end_row(hal::Tick now) noexcept {
   while (beats_published_ < row_beats_) publish_beat(beats_published_);
   ++counters_.rows;
   counters_.picks_in_row = 0;
-  counters_.knot.cycles_started = counters_.knot.cycles_done = 0;
   last_row_ = row_.finish(now, now - sweep_start_, row_beats_, profiles_->cam().steps());
+  events_.add(EventKind::kRow);
+  if (counters_.knot.cycles_started != 0 || counters_.knot.cycles_done != 0) {
+    counters_.knot.cycles_started = counters_.knot.cycles_done = 0;  // the next row's knotting starts afresh
+    events_.add(EventKind::kKnotProgress);
+  }
   if (cfg_.await_row_saved) {
     enter(State::kRowEnd, now);
     return;
@@ -986,6 +1019,7 @@ void Sequencer::next_row(hal::Tick now) noexcept {
     knotter_requests_seen_ = knotter_.requests();
     knot_requested_ = false;
     knotter_.begin(counters_.rows, counters_.knot, row_starts_left() ? 0.0 : profiles_->carriage_travel_m(), now, cmd_);
+    if (knotter_.requests() != knotter_requests_seen_) events_.add(EventKind::kWeaverRequest);
     enter(State::kKnotting, now);
     return;
   }
@@ -1025,7 +1059,11 @@ void Sequencer::knotting(hal::Tick now, const hal::HalInputs& in) noexcept {
   }
   const bool await_disk = cfg_.await_row_saved;
   const std::uint32_t on_disk = knots_on_disk_rows_ == counters_.rows ? knots_on_disk_started_ : 0;
+  const std::uint32_t requests_before = knotter_.requests();
   const RowKnotter::Status st = knotter_.step(now, in, cmd_, counters_.knot, knot_requested_, await_disk, on_disk);
+  // The heads report what their step did: their counters moved, a request made of the weaver.
+  if (knotter_.counters_moved()) events_.add(EventKind::kKnotProgress);
+  if (knotter_.requests() != requests_before) events_.add(EventKind::kWeaverRequest);
   knot_requested_ = false;  // answered the request, or came when none was open
   switch (st) {
     case RowKnotter::Status::kRunning:
@@ -1122,7 +1160,7 @@ void Sequencer::track_beat_force(const hal::HalInputs& in) noexcept {
 }
 
 void Sequencer::publish_beat(int k) noexcept {
-  BeatEvent e;
+  BeatEvent& e = events_.add(EventKind::kBeat).beat;
   e.row = counters_.rows + 1;
   e.index = static_cast<std::uint16_t>(k);
   const RowStats& r = row_.stats();
@@ -1133,8 +1171,6 @@ void Sequencer::publish_beat(int k) noexcept {
   }
   e.force_measured = r.force_measured;
   e.in_band = e.force_measured && e.peak_force_n >= cfg_.beat_force_min_n && e.peak_force_n <= cfg_.beat_force_max_n;
-  last_beat_ = e;
-  ++beat_events_;
   beats_published_ = k + 1;
 }
 

@@ -269,6 +269,26 @@ void SimWorld::apply_injected_faults(hal::Tick now) noexcept {
   if (now >= latency_until_) latency_ticks_ = 0;
 }
 
+namespace {
+// One axis' feedback as its drive reports it; `jump` is an encoder glitch's offset (0.0 outside one: adding
+// it also turns a -0.0 sum into +0.0, the same on every path).
+inline hal::AxisFeedback feedback_of(const SimAxis& s, double jump, hal::Tick now) noexcept {
+  hal::AxisFeedback fb;
+  fb.state = s.state;
+  fb.position = s.position + s.offset + jump;
+  fb.velocity = s.velocity;
+  fb.effort = 0.0;
+  fb.fault = s.state == hal::DriveState::kFault;
+  fb.fault_code = s.fault_code;
+  fb.fault_kind = fb.fault ? hal::FaultKind::kDrive : s.fault_code != 0 ? hal::FaultKind::kEmcy : hal::FaultKind::kNone;
+  fb.following_error = false;
+  fb.referenced = s.referenced;
+  fb.homing_error = false;
+  fb.refreshed = now;
+  return fb;
+}
+}  // namespace
+
 void SimWorld::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) {
   // (the call only when a fault strikes now or has struck: before, it would do nothing)
   if (next_fault_ != 0 || (!fault_tick_.empty() && fault_tick_[0] <= now)) apply_injected_faults(now);
@@ -278,46 +298,17 @@ void SimWorld::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatu
   const bool direct = history_ticks_ == 1 && next_fault_ == 0;
   if (direct) {
     // No fault has struck, so no encoder glitch either (glitch_left_ is all 0): the loop below, on `axes`,
-    // without the glitch's test and count ("+ 0.0" kept: it turns a -0.0 sum into +0.0 as there).
-    for (std::size_t i = 0; i < n_axes_; ++i) {
-      const SimAxis& s = axes_[i];
-      hal::AxisFeedback fb;
-      fb.state = s.state;
-      fb.position = s.position + s.offset + 0.0;
-      fb.velocity = s.velocity;
-      fb.effort = 0.0;
-      fb.fault = s.state == hal::DriveState::kFault;
-      fb.fault_code = s.fault_code;
-      fb.fault_kind = fb.fault ? hal::FaultKind::kDrive : s.fault_code != 0 ? hal::FaultKind::kEmcy : hal::FaultKind::kNone;
-      fb.following_error = false;
-      fb.referenced = s.referenced;
-      fb.homing_error = false;
-      fb.refreshed = now;
-      axes[i] = fb;
-    }
+    // without the glitch's test and count.
+    for (std::size_t i = 0; i < n_axes_; ++i) axes[i] = feedback_of(axes_[i], 0.0, now);
     link = hal::LinkStatus{};
     return;
   }
-  hal::AxisFeedback* truth =
-      direct ? axes.data() : &history_[static_cast<std::size_t>(now) % history_ticks_ * n_axes_];
+  hal::AxisFeedback* truth = &history_[static_cast<std::size_t>(now) % history_ticks_ * n_axes_];
   for (std::size_t i = 0; i < n_axes_; ++i) {
-    const SimAxis& s = axes_[i];
-    hal::AxisFeedback& fb = truth[i];
-    fb.state = s.state;
-    fb.position = s.position + s.offset + (glitch_left_[i] > 0 ? glitch_jump_[i] : 0.0);
-    fb.velocity = s.velocity;
-    fb.effort = 0.0;
-    fb.fault = s.state == hal::DriveState::kFault;
-    fb.fault_code = s.fault_code;
-    fb.fault_kind = fb.fault ? hal::FaultKind::kDrive : s.fault_code != 0 ? hal::FaultKind::kEmcy : hal::FaultKind::kNone;
-    fb.following_error = false;
-    fb.referenced = s.referenced;
-    fb.homing_error = false;
-    fb.refreshed = now;
+    truth[i] = feedback_of(axes_[i], glitch_left_[i] > 0 ? glitch_jump_[i] : 0.0, now);
     if (glitch_left_[i] > 0) --glitch_left_[i];
   }
   link = hal::LinkStatus{};
-  if (direct) return;
   if (bus_off_) {  // no frame gets through any more, and the simulated controller never restarts
     link.link_fault = true;
     link.link_fault_kind = hal::FaultKind::kBusOff;

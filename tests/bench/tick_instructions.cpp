@@ -81,7 +81,11 @@ void digest_tick(Digest& d, const firmware::ControlLoop& loop, std::size_t n_axe
   d.add(out.io.lamp_red), d.add(out.io.buzzer);
   if (!telemetry) return;
   const telemetry::Snapshot& s = loop.snapshot();
-  d.add(s.tick), d.add_name(s.state.data()), d.add_name(s.first_fault.data()), d.add_name(s.stopped_by.data());
+  // The names, as the snapshot carried them before it carried the enums (digests compare across that).
+  const bool faulted = s.first_fault != 0;
+  d.add(s.tick), d.add_name(sequencer::state_name(static_cast<sequencer::State>(s.state)));
+  d.add_name(faulted ? sequencer::fault_name(static_cast<sequencer::Fault>(s.first_fault)) : "");
+  d.add_name(faulted ? sequencer::fault_name(static_cast<sequencer::Fault>(s.stopped_by)) : "");
   d.add(s.row), d.add(s.pick), d.add(s.beat), d.add(s.row_in_progress), d.add(s.crank_phase_rad);
   d.add(s.beater_angle_rad), d.add(s.beat_force_n), d.add(s.axis_count), d.add(s.inputs), d.add(s.inputs_2);
   d.add(s.outputs), d.add(s.fault_axis), d.add(s.fault_tick);

@@ -47,6 +47,8 @@ class SlowHal final : public hal::Hal {
     const auto i = static_cast<std::size_t>(now);
     clock_.advance(i < cost_ns.size() ? cost_ns[i] : default_cost_ns);
     inner_.read(now, in);
+    in.io.button_start = start_pressed;  // the I/O module's buttons, held as scripted
+    in.io.button_ack = ack_pressed;
     if (recovery) {  // a CAN link's recovery state, as the CAN ports report it
       in.link.recovery = *recovery;
       in.link.silent_node = silent_node;
@@ -57,6 +59,7 @@ class SlowHal final : public hal::Hal {
   std::int64_t default_cost_ns = 10'000;
   std::optional<hal::LinkRecovery> recovery;
   std::uint8_t silent_node = 0;
+  bool start_pressed = false, ack_pressed = false;
 
  private:
   hal::Hal& inner_;
@@ -326,4 +329,49 @@ TEST(RunnerCommands, ARunStoppedByASymptomWaitsOutTheDiagnosisWindowBeforeEnding
   r2.seq->request_safe_stop(sequencer::Fault::kLoopOverrun);
   const RunResult res2 = firmware::run_loop(*r2.loop, *r2.seq, o, [](const firmware::RunEvent&) {});
   EXPECT_LE(res2.ticks, r2.seq->fault_tick() + 10);
+}
+
+// The buttons are decoded once, by the sequencer (debounced, one event per press); the runner turns its
+// presses into commands and audits each in the state the press was seen in — not the state after the
+// sequencer acted on it (a start press has left idle by then: its verdict is "ok", not "already weaving").
+TEST(RunnerButtons, APressIsAuditedOnceInTheStateItWasSeenIn) {
+  Rig r;
+  r.slow->default_cost_ns = 0;
+  firmware::OperatorLink link;
+  std::vector<firmware::RunEvent> presses;
+  RunOptions o;
+  o.period_s = r.cfg.sequencer.period_s;
+  o.clock = &r.clock;
+  o.link = &link;
+  o.operator_buttons = true;
+  o.hold_when_finished = true;
+  o.max_ticks = 40;
+  const auto run = [&] {
+    return firmware::run_loop(*r.loop, *r.seq, o, [&](const firmware::RunEvent& e) {
+      if (e.kind == firmware::RunEvent::Kind::kButton) presses.push_back(e);
+    });
+  };
+  run();  // idle, nothing pressed
+  ASSERT_TRUE(presses.empty());
+  r.slow->start_pressed = true;  // held down for the whole run: one press
+  run();
+  ASSERT_EQ(presses.size(), 1u);
+  EXPECT_EQ(presses[0].button, firmware::Command::kStart);
+  EXPECT_EQ(presses[0].state, sequencer::State::kIdle);
+  EXPECT_NE(r.seq->state(), sequencer::State::kIdle);
+  r.slow->start_pressed = false;
+  // An ack press on a latched fault ends the session for re-arming; the sequencer leaves it to the runner
+  // (it stays latched: the service re-arms from the measured positions).
+  r.seq->request_safe_stop(sequencer::Fault::kLoopOverrun);
+  run();
+  ASSERT_EQ(r.seq->state(), sequencer::State::kFault);
+  presses.clear();
+  r.slow->ack_pressed = true;
+  const RunResult res = run();
+  EXPECT_EQ(res.end, RunResult::End::kAckRequested);
+  ASSERT_EQ(presses.size(), 1u);
+  EXPECT_EQ(presses[0].button, firmware::Command::kAck);
+  EXPECT_EQ(presses[0].state, sequencer::State::kFault);
+  EXPECT_EQ(r.seq->state(), sequencer::State::kFault);
+  EXPECT_EQ(r.seq->first_fault(), sequencer::Fault::kLoopOverrun);
 }

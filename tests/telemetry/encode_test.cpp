@@ -12,13 +12,14 @@
 namespace {
 
 using namespace loom::telemetry;
+namespace sequencer = loom::sequencer;
 
 Snapshot sample() {
   Snapshot s;
   s.tick = 123'456;
   s.period_ns = 2'000'000;
-  test_support::set_name(s.state, "beat");
-  test_support::set_name(s.first_fault, "heartbeat_lost");
+  s.state = test_support::byte_of(sequencer::State::kBeatSweep);
+  s.first_fault = test_support::byte_of(sequencer::Fault::kHeartbeatLost);
   s.first_fault_code = 0x8130;
   s.row = 7;
   s.row_in_progress = 8;
@@ -26,7 +27,7 @@ Snapshot sample() {
   s.fault_axis = 1;
   s.fault_device_code = 0x8611;
   s.fault_tick = 100'000;
-  test_support::set_name(s.stopped_by, "stale_feedback");
+  s.stopped_by = test_support::byte_of(sequencer::Fault::kStaleFeedback);
   s.pick = 8;
   s.beat = 29;
   s.crank_phase_rad = 1.25;
@@ -74,7 +75,7 @@ TEST(Encode, StatusCarriesStateCountersAndFault) {
   EXPECT_EQ(m.tick, 123'456);
   EXPECT_DOUBLE_EQ(m.time_s, 123'456 * 0.002);
   EXPECT_EQ(m.period_ns, 2'000'000);
-  EXPECT_EQ(m.state, "beat");
+  EXPECT_EQ(m.state, "beat_sweep");
   EXPECT_EQ(m.row, 8);  // the row in progress
   EXPECT_EQ(m.rows_done, 7);
   EXPECT_EQ(m.rows_target, 20);
@@ -154,7 +155,7 @@ TEST(Encode, RtTakesDropsAndBacklogFromTheRing) {
 
 TEST(Encode, NoFaultMeansNoFaultDetails) {
   Snapshot s = sample();
-  s.first_fault.fill('\0');
+  s.first_fault = s.stopped_by = 0;
   s.first_fault_code = 0;
   const auto m = to_status(s, "L7", 0);
   EXPECT_EQ(m.fault_axis, "");
@@ -212,7 +213,7 @@ TEST(Encode, FaultEventNamesAxisCodeAndText) {
   e.fault = 2;  // the fault table's third entry: drive_fault
   e.axis = 1;
   e.device_code = 0x8611;
-  test_support::set_name(e.state, "beat_sweep");
+  e.state = test_support::byte_of(sequencer::State::kBeatSweep);
   const auto m = round_trip(to_fault(e, "L7", 9));
   EXPECT_EQ(m.kind, "first");
   EXPECT_EQ(m.name, "drive_fault");
@@ -239,7 +240,7 @@ TEST(Encode, ASensorDiscrepancyNamesItsSensorInTheText) {
   EXPECT_EQ(m.text,
             "the two channels of a safety sensor disagree (a stuck switch or a wiring fault): shuttle_at_right");
   Snapshot s = sample();
-  test_support::set_name(s.first_fault, "sensor_discrepancy");
+  s.first_fault = test_support::byte_of(sequencer::Fault::kSensorDiscrepancy);
   s.fault_sensor = static_cast<std::int8_t>(loom::hal::SafetySensor::kPistonBExtended);
   EXPECT_EQ(round_trip(to_status(s, "L7", 9)).fault_text,
             "the two channels of a safety sensor disagree (a stuck switch or a wiring fault): piston_b_extended");
@@ -272,13 +273,15 @@ TEST(Encode, RowEventSplitsTimeInSeconds) {
   EXPECT_DOUBLE_EQ(m.force_max_n, 91.0);
 }
 
-TEST(Encode, UnterminatedNamesStopAtTheArrayEnd) {
+// The ring carries enums; a byte outside them (a corrupted slot) is named "?", never read past a table.
+TEST(Encode, AStateOrFaultOutsideTheEnumsIsNamedQuestionMark) {
   Snapshot s = sample();
-  std::memset(s.state.data(), 'S', s.state.size());
-  std::memset(s.first_fault.data(), 'F', s.first_fault.size());
+  s.state = 0xEE;
+  s.first_fault = s.stopped_by = 0xEE;
   const auto m = to_status(s, "L7", 0);
-  EXPECT_EQ(m.state, std::string(s.state.size(), 'S'));
-  EXPECT_EQ(m.first_fault, std::string(s.first_fault.size(), 'F'));
+  EXPECT_EQ(m.state, "?");
+  EXPECT_EQ(m.first_fault, "?");
+  EXPECT_EQ(m.stopped_by, "?");
 }
 
 // copy_in_use (snapshot.hpp): what the loop puts into a ring slot. Every field arrives; of the axes only
@@ -287,9 +290,9 @@ TEST(Snapshot, CopyInUseCopiesEveryFieldAndOnlyTheMachinesAxes) {
   Snapshot from;
   from.tick = 123456;
   from.period_ns = 2'000'000;
-  std::strcpy(from.state.data(), "beat_sweep");
-  std::strcpy(from.first_fault.data(), "drive_fault");
-  std::strcpy(from.stopped_by.data(), "estop");
+  from.state = test_support::byte_of(sequencer::State::kBeatSweep);
+  from.first_fault = test_support::byte_of(sequencer::Fault::kDriveFault);
+  from.stopped_by = test_support::byte_of(sequencer::Fault::kEStop);
   from.first_fault_code = 7;
   from.row = 11, from.pick = 22, from.beat = 33, from.row_in_progress = 12, from.rows_target = 40;
   from.crank_phase_rad = 1.25, from.beater_angle_rad = -0.5, from.beat_force_n = 91.0, from.beat_force_valid = true;
@@ -307,9 +310,9 @@ TEST(Snapshot, CopyInUseCopiesEveryFieldAndOnlyTheMachinesAxes) {
   copy_in_use(to, from);
   EXPECT_EQ(to.tick, 123456);
   EXPECT_EQ(to.period_ns, 2'000'000);
-  EXPECT_STREQ(to.state.data(), "beat_sweep");
-  EXPECT_STREQ(to.first_fault.data(), "drive_fault");
-  EXPECT_STREQ(to.stopped_by.data(), "estop");
+  EXPECT_EQ(to.state, from.state);
+  EXPECT_EQ(to.first_fault, from.first_fault);
+  EXPECT_EQ(to.stopped_by, from.stopped_by);
   EXPECT_EQ(to.first_fault_code, 7);
   EXPECT_EQ(to.row, 11u);
   EXPECT_EQ(to.pick, 22u);

@@ -10,6 +10,7 @@
 #include "lines.hpp"
 #include "loom/sequencer/knot_program.hpp"
 #include "loom/sequencer/row_knotter.hpp"
+#include "loom/sequencer/sequencer.hpp"
 #include "loom/telemetry/encode.hpp"
 #include "loom/telemetry/schedule.hpp"
 
@@ -51,7 +52,7 @@ Snapshot knotting_sample() {
   Snapshot s;
   s.tick = 1000;
   s.period_ns = 2'000'000;
-  std::snprintf(s.state.data(), s.state.size(), "knotting");
+  s.state = static_cast<std::uint8_t>(seq::State::kKnotting);
   s.row = 0;  // no row done: production row 1, design row 0
   KnotSample& k = s.knots;
   k.heads = 2;

@@ -37,10 +37,10 @@ got=$(wc -l <"$WORK/status.lines")
 [ "$got" -eq "$N_STATUS" ] || fail "replayed $got STATUS lines, published $N_STATUS"
 check_rows "$WORK/status.lines" "$ROWS"
 
-# The sequencer states appear in row-cycle order: shed → pick → beat → row_done, repeating.
+# The sequencer states appear in row-cycle order: shed → pick → beat_sweep → row_end, repeating.
 states=$(sed -n 's/.* state=\([^ ]*\) .*/\1/p' "$WORK/status.lines" | uniq | tr '\n' ' ')
 want=""
-for _ in $(seq 1 "$ROWS"); do want+="shed pick beat row_done "; done
+for _ in $(seq 1 "$ROWS"); do want+="shed pick beat_sweep row_end "; done
 want+="shed "
 [ "$states" = "$want" ] || fail "state order '$states', expected '$want'"
 

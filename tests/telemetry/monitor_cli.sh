@@ -52,5 +52,5 @@ expect 1 "of $((N + 1)) lines" --lcm-url "file://$LOG?mode=r" --channel status -
   fail "event view of the log failed: $(cat "$WORK/err")"
 grep -q "^L1 t=0.000s state - -> shed, row 1$" "$WORK/view" || fail "event view: first line $(head -1 "$WORK/view")"
 n_changes=$(grep -c " state " "$WORK/view")
-[ "$n_changes" -eq 9 ] || fail "event view: $n_changes state changes, expected 9 (shed pick beat row_done x2, shed)"
+[ "$n_changes" -eq 9 ] || fail "event view: $n_changes state changes, expected 9 (shed pick beat_sweep row_end x2, shed)"
 echo "PASS: loom-monitor CLI errors exit 2, empty runs exit 1, $N STATUS lines read from a log"

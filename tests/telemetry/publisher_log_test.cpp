@@ -18,6 +18,7 @@
 namespace {
 
 using namespace loom::telemetry;
+namespace sequencer = loom::sequencer;
 namespace fs = std::filesystem;
 
 class PublisherLog : public ::testing::Test {
@@ -46,7 +47,7 @@ Snapshot steady(std::int64_t tick) {
   Snapshot s;
   s.tick = tick;
   s.period_ns = 1'000'000;
-  test_support::set_name(s.state, "beat");
+  s.state = test_support::byte_of(sequencer::State::kBeatSweep);
   return s;
 }
 
@@ -102,7 +103,12 @@ TEST_F(PublisherLog, WeavingRunShowsEveryStatusChangeInOrder) {
   std::vector<Key> want;
   for (std::int64_t t = 0; t < ticks; ++t) {
     const Snapshot s = test_support::script_snapshot(w, t);
-    const Key k{s.state.data(), s.row, s.pick, s.beat, s.first_fault.data(), s.first_fault_code};
+    const Key k{sequencer::state_name(static_cast<sequencer::State>(s.state)),
+                s.row,
+                s.pick,
+                s.beat,
+                s.first_fault != 0 ? sequencer::fault_name(static_cast<sequencer::Fault>(s.first_fault)) : "",
+                s.first_fault_code};
     if (want.empty() || want.back() != k) want.push_back(k);
   }
   std::vector<Key> got;

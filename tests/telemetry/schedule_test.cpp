@@ -13,13 +13,14 @@
 namespace {
 
 using namespace loom::telemetry;
+namespace sequencer = loom::sequencer;
 using test_support::script_snapshot;
 using test_support::WeaveScript;
 
 Snapshot steady(std::int64_t tick) {
   Snapshot s;
   s.tick = tick;
-  test_support::set_name(s.state, "beat");
+  s.state = test_support::byte_of(sequencer::State::kBeatSweep);
   return s;
 }
 
@@ -91,13 +92,13 @@ TEST(Schedule, ChangeRestartsTheHeartbeat) {
   EXPECT_EQ(sent, (std::vector<std::int64_t>{0, 10, 15, 25, 35}));
 }
 
-TEST(Schedule, BytesAfterTheTerminatorAreNotAChange) {
+TEST(Schedule, ANewFaultIsAChangeAtOnce) {
   ChannelSchedule sched({.status_every_n_ticks = 1000, .axes_every_n_ticks = 1000, .rt_every_n_ticks = 1000});
-  Snapshot a = steady(0);
-  ASSERT_TRUE(sched.decide(a).status);
-  Snapshot b = steady(1);
-  b.state[10] = 'x';  // garbage after "beat\0"
-  EXPECT_FALSE(sched.decide(b).status);
+  ASSERT_TRUE(sched.decide(steady(0)).status);
+  EXPECT_FALSE(sched.decide(steady(1)).status);
+  Snapshot b = steady(2);
+  b.first_fault = test_support::byte_of(sequencer::Fault::kEStop);
+  EXPECT_TRUE(sched.decide(b).status);
 }
 
 TEST(Schedule, TickGoingBackwardsRestartsEveryChannel) {

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "loom/hal/types.hpp"
+#include "loom/sequencer/sequencer.hpp"
 #include "loom/telemetry/snapshot.hpp"
 #include "loomlcm/design_t.hpp"
 
@@ -33,22 +34,17 @@ struct WeaveScript {
   std::int64_t ticks_for_rows(std::int64_t rows) const { return rows * row_ticks(); }
 };
 
-inline void set_name(std::array<char, 24>& dst, std::string_view name) {
-  dst.fill('\0');
-  std::memcpy(dst.data(), name.data(), std::min(name.size(), dst.size() - 1));
-}
-inline void set_name(std::array<char, 32>& dst, std::string_view name) {
-  dst.fill('\0');
-  std::memcpy(dst.data(), name.data(), std::min(name.size(), dst.size() - 1));
-}
+// The snapshot carries the sequencer's enums as bytes.
+inline std::uint8_t byte_of(sequencer::State s) { return static_cast<std::uint8_t>(s); }
+inline std::uint8_t byte_of(sequencer::Fault f) { return static_cast<std::uint8_t>(f); }
 
-// State name at `tick` (before a fault).
-inline std::string_view script_state(const WeaveScript& w, std::int64_t tick) {
+// State at `tick` (before a fault): shed → pick → beat_sweep → row_end, repeating.
+inline sequencer::State script_state(const WeaveScript& w, std::int64_t tick) {
   const std::int64_t in_row = tick % w.row_ticks();
-  if (in_row < w.shed_ticks) return "shed";
-  if (in_row < w.shed_ticks + w.pick_ticks) return "pick";
-  if (in_row < w.row_ticks() - w.row_done_ticks) return "beat";
-  return "row_done";
+  if (in_row < w.shed_ticks) return sequencer::State::kShed;
+  if (in_row < w.shed_ticks + w.pick_ticks) return sequencer::State::kPick;
+  if (in_row < w.row_ticks() - w.row_done_ticks) return sequencer::State::kBeatSweep;
+  return sequencer::State::kRowEnd;
 }
 
 inline Snapshot script_snapshot(const WeaveScript& w, std::int64_t tick) {
@@ -64,9 +60,9 @@ inline Snapshot script_snapshot(const WeaveScript& w, std::int64_t tick) {
   Snapshot s;
   s.tick = tick;
   s.period_ns = w.period_ns;
-  set_name(s.state, faulted ? std::string_view("fault") : script_state(w, t));
+  s.state = byte_of(faulted ? sequencer::State::kFault : script_state(w, t));
   if (faulted) {
-    set_name(s.first_fault, "estop");
+    s.first_fault = s.stopped_by = byte_of(sequencer::Fault::kEStop);
     s.first_fault_code = 0x1001;
   }
   s.row = static_cast<std::uint32_t>(row);

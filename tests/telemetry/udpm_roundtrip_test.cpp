@@ -21,6 +21,7 @@
 namespace {
 
 using namespace loom::telemetry;
+namespace sequencer = loom::sequencer;
 using Key = std::tuple<std::string, std::int64_t, std::int64_t, std::int64_t>;  // state, row, pick, beat
 
 // Handlers are static with a context pointer: LCM 1.3.1's member-function subscribe crashes under
@@ -75,7 +76,7 @@ TEST(UdpmRoundTrip, SubscriberSeesRowsAndStatesAdvanceInOrder) {
   std::vector<Key> want;
   for (std::int64_t t = 0; t < ticks; ++t) {
     const Snapshot s = test_support::script_snapshot(w, t);
-    const Key k{s.state.data(), s.row, s.pick, s.beat};
+    const Key k{sequencer::state_name(static_cast<sequencer::State>(s.state)), s.row, s.pick, s.beat};
     if (want.empty() || want.back() != k) want.push_back(k);
   }
 

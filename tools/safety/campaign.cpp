@@ -242,7 +242,6 @@ RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& sp
       return knotter->gripper_in_warp(h, servo);  // off the linkage's range: the simulator's own reading
     }
   };
-  std::uint32_t requests_seen = m.sequencer().weaver_requests();
   hal::Tick fault_at = -1;
   hal::Tick t = 0;
   const hal::Tick max_ticks = kn.heads > 0 ? 200000 : 60000;
@@ -257,8 +256,7 @@ RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& sp
     const double x = sim.shuttle_x();
     const bool shuttle_in_shed = x > window && x < cfg.machine.width_m - window;
     m.loop().cycle(t);
-    if (m.sequencer().weaver_requests() != requests_seen) {  // the simulated weaver answers, as in a weave
-      requests_seen = m.sequencer().weaver_requests();
+    if (m.sequencer().events().has(sequencer::EventKind::kWeaverRequest)) {  // the simulated weaver answers, as in a weave
       if (m.sequencer().weaver_request().ask != sequencer::WeaverAsk::kNone) {
         firmware::Machine::simulated_weaver_sink(&m, m.sequencer().weaver_request());
       }

@@ -8,17 +8,11 @@
 #include "loom/sequencer/faults.hpp"
 #include "loom/sequencer/knot_program.hpp"
 #include "loom/sequencer/row_knotter.hpp"
+#include "loom/sequencer/sequencer.hpp"
 
 namespace loom::telemetry {
 
 namespace {
-
-// Snapshot strings are NUL-terminated when they fit, but a name that fills the array exactly has no
-// terminator: never read past the array.
-template <std::size_t N>
-std::string from_cstr(const std::array<char, N>& a) {
-  return std::string(a.begin(), std::find(a.begin(), a.end(), '\0'));
-}
 
 std::int64_t to_i64(std::uint64_t v) noexcept {
   return static_cast<std::int64_t>(
@@ -33,15 +27,6 @@ std::string axis_or_empty(const hal::AxisLayout& axes, int axis) {
   return axis >= 0 && static_cast<std::size_t>(axis) < axes.count ? axes.name(static_cast<std::size_t>(axis)) : std::string();
 }
 
-// The operator text of a fault named in a snapshot (the snapshot carries the name, not the enum).
-std::string fault_text_of(const std::string& name) {
-#define LOOM_FAULT_TEXT(id, code, fname, text) \
-  if (name == fname) return text;
-  LOOM_FAULT_TABLE(LOOM_FAULT_TEXT)
-#undef LOOM_FAULT_TEXT
-  return {};
-}
-
 }  // namespace
 
 double loop_time_s(const Snapshot& s) noexcept {
@@ -53,6 +38,10 @@ namespace {
 // "?" for a value outside it.
 sequencer::Fault fault_of(std::uint8_t v) noexcept {
   return static_cast<sequencer::Fault>(v);
+}
+// A state from the ring (the sequencer's enum as a byte): its name, "?" outside the enum.
+std::string state_of(std::uint8_t v) {
+  return sequencer::state_name(static_cast<sequencer::State>(v));
 }
 // The operator text, naming the safety sensor a fault is about ("...: shuttle_at_right").
 std::string with_sensor(std::string text, std::int8_t sensor) {
@@ -71,21 +60,21 @@ loomlcm::status_t to_status(const Snapshot& s, const std::string& loom_id, std::
   m.tick = s.tick;
   m.time_s = loop_time_s(s);
   m.period_ns = s.period_ns;
-  m.state = from_cstr(s.state);
+  m.state = state_of(s.state);
   m.row = s.row_in_progress;
   m.rows_done = s.row;
   m.rows_target = s.rows_target;
   m.pick = s.pick;
   m.beat = s.beat;
   m.beats_per_row = s.beats_per_row;
-  m.first_fault = from_cstr(s.first_fault);
+  const bool faulted = s.first_fault != 0;
+  m.first_fault = faulted ? sequencer::fault_name(fault_of(s.first_fault)) : "";
   m.first_fault_code = s.first_fault_code;
-  const bool faulted = !m.first_fault.empty();
   m.fault_axis = faulted ? axis_or_empty(axes, s.fault_axis) : std::string();
   m.fault_device_code = faulted ? s.fault_device_code : 0;
-  m.fault_text = faulted ? with_sensor(fault_text_of(m.first_fault), s.fault_sensor) : std::string();
+  m.fault_text = faulted ? with_sensor(sequencer::fault_text(fault_of(s.first_fault)), s.fault_sensor) : std::string();
   m.fault_time_s = faulted && s.fault_tick >= 0 ? seconds(s.fault_tick, s.period_ns) : 0.0;
-  m.stopped_by = from_cstr(s.stopped_by);
+  m.stopped_by = faulted ? sequencer::fault_name(fault_of(s.stopped_by)) : "";
   m.outputs = s.outputs;
   m.inputs = s.inputs;
   m.inputs_2 = s.inputs_2;
@@ -193,7 +182,7 @@ loomlcm::fault_t to_fault(const Event& e, const std::string& loom_id, std::int64
   m.text = with_sensor(sequencer::fault_text(f), e.sensor);
   m.axis = axis_or_empty(axes, e.axis);
   m.device_code = e.device_code;
-  m.state = from_cstr(e.state);
+  m.state = state_of(e.state);
   m.row = static_cast<std::int32_t>(e.row);
   m.rows_done = e.rows_done;
   m.pick = e.pick;
@@ -244,7 +233,7 @@ loomlcm::knots_t to_knots(const Snapshot& s, const sequencer::KnotProgram& p, co
   m.loom_id = loom_id;
   m.tick = s.tick;
   m.time_s = loop_time_s(s);
-  m.state = from_cstr(s.state);
+  m.state = state_of(s.state);
   m.knotting = k.knotting;
   m.row = static_cast<std::int32_t>(s.row + 1);  // the row knotted is the one after the completed rows
   m.design_row = p.design_row(s.row);

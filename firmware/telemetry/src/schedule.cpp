@@ -21,15 +21,9 @@ std::string decimation_error(const Decimation& d) {
 }
 
 ChannelSchedule::StatusKey ChannelSchedule::key_of(const Snapshot& s) noexcept {
-  // Copy only up to the terminator: bytes after a NUL left over from a longer earlier name must not
-  // count as a change.
   StatusKey k;
-  const auto copy_cstr = [](const auto& src, auto& dst) {
-    const auto end = std::find(src.begin(), src.end(), '\0');
-    std::copy(src.begin(), end, dst.begin());
-  };
-  copy_cstr(s.state, k.state);
-  copy_cstr(s.first_fault, k.first_fault);
+  k.state = s.state;
+  k.first_fault = s.first_fault;
   k.first_fault_code = s.first_fault_code;
   k.row = s.row;
   k.pick = s.pick;

@@ -1,6 +1,7 @@
 // One control cycle, no loop inside, steps in a fixed order (LinuxCNC's motion controller pattern):
 //   read inputs → sequencer (checks faults, advances the row cycle, samples profiles, interlocks)
-//   → write outputs → push the tick's events (BEAT, ROW, FAULT; never decimated) → push a POD snapshot.
+//   → write outputs → forward the sequencer's events of the tick (BEAT, ROW, WEAVER, FAULT; never
+//   decimated) and the devices' own fault reports → push a POD snapshot.
 // Everything the cycle touches is allocated before the first tick.
 #pragma once
 
@@ -68,6 +69,13 @@ class ControlLoop {
   void fill_snapshot(hal::Tick now) noexcept;
   void fill_knots() noexcept;
   void push_events(hal::Tick now) noexcept;
+  void push_beat(const sequencer::BeatEvent& b, hal::Tick now) noexcept;
+  void push_row(hal::Tick now) noexcept;
+  void push_weaver_request(hal::Tick now) noexcept;
+  void push_fault(telemetry::Event::FaultKind kind, sequencer::Fault which, int axis, std::uint16_t device_code,
+                  int sensor, hal::Tick now) noexcept;
+  void push_device_faults(int first_axis_reported, bool link_reported, hal::Tick now) noexcept;
+  bool any_device_fault() const noexcept;
   void push_event(const telemetry::Event& e) noexcept;
   void fill_event_context(telemetry::Event& e, hal::Tick now) const noexcept;
   std::uint32_t row_in_progress() const noexcept;
@@ -81,26 +89,18 @@ class ControlLoop {
   hal::HalInputs in_{};
   hal::HalOutputs out_{};
   telemetry::Snapshot snap_{};
-  // The names snap_ holds (string literals; nullptr: none yet), so fill_snapshot copies only changes.
-  const char* shown_state_ = nullptr;
-  const char* shown_first_fault_ = nullptr;
-  const char* shown_stopped_by_ = nullptr;
+  // The fault snap_'s fault code is for, so fill_snapshot looks the code up only when the fault changes.
+  bool code_shown_ = false;
+  sequencer::Fault shown_first_fault_ = sequencer::Fault::kNone;
   // The crank target and recipe snap_'s crank phase and beater angle were computed for.
   bool crank_shown_ = false;
   double shown_crank_target_ = 0.0;
   std::uint32_t shown_recipe_ = 0;
   LoopStats stats_{};
   TelemetryContext ctx_{};
-  // What the previous tick showed, so each event is pushed exactly once.
-  std::uint32_t beat_events_seen_ = 0;
-  std::uint32_t rows_seen_ = 0;
-  std::uint32_t weaver_requests_seen_ = 0;
   bool knots_shown_ = false;  // snap_.knots was filled at least once
-  bool primed_ = false;
-  sequencer::State prev_state_ = sequencer::State::kIdle;
-  sequencer::Fault prev_fault_ = sequencer::Fault::kNone;
-  int prev_fault_axis_ = -1;
-  std::uint16_t prev_fault_detail_ = 0;
+  // The drives' and the link's last fault flags (HAL inputs), so each device report is pushed once.
+  bool devices_reporting_ = false;  // some prev_axis_fault_ or prev_link_fault_ is set
   std::array<std::uint16_t, hal::kMaxAxes> prev_axis_fault_code_{};
   std::array<bool, hal::kMaxAxes> prev_axis_fault_{};
   bool prev_link_fault_ = false;

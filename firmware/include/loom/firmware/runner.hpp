@@ -96,7 +96,7 @@ struct RunEvent {
   hal::Tick tick = 0;
   sequencer::RowStats row{};
   sequencer::Counters counters{};
-  sequencer::State state = sequencer::State::kIdle;
+  sequencer::State state = sequencer::State::kIdle;  // at the end of the tick; kButton: the tick the press was seen in began in
   sequencer::Fault fault = sequencer::Fault::kNone;  // kFault: the first fault
   sequencer::Fault stopped_by = sequencer::Fault::kNone;
   int fault_axis = -1;

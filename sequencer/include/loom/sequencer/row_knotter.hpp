@@ -111,6 +111,9 @@ class RowKnotter {
   int fault_axis() const noexcept { return fault_axis_; }
   const WeaverRequest& request() const noexcept { return request_; }
   std::uint32_t requests() const noexcept { return requests_; }  // counts requests made (never reset)
+  // RT-safe. The last step() changed `counters` (a cycle started or done, a knot tied, retried or tied by
+  // hand): the sequencer's kKnotProgress.
+  bool counters_moved() const noexcept { return counters_moved_; }
   const RowKnots& row() const noexcept { return row_; }
   int cycle() const noexcept { return j_; }  // the knot cycle in progress (0-based)
   // RT-safe. Yarn left in slot `slot` of head `head`'s magazine, in knots, as the loom counts it (-1 when
@@ -180,6 +183,7 @@ class RowKnotter {
   int fault_axis_ = -1;
   WeaverRequest request_{};
   std::uint32_t requests_ = 0;
+  bool counters_moved_ = false;  // by the last step()
   RowKnots row_{};
 };
 

@@ -18,6 +18,7 @@
 #include "loom/sequencer/row_knotter.hpp"
 #include "loom/sequencer/row_stats.hpp"
 #include "loom/sequencer/shed_monitor.hpp"
+#include "loom/sequencer/tick_events.hpp"
 
 namespace loom::sequencer {
 
@@ -45,17 +46,6 @@ struct Counters {
   std::uint32_t beats = 0;         // beats delivered (beater passed the fell)
   std::uint32_t picks_in_row = 0;  // picks of the row in progress (restart resumes here)
   KnotCounters knot{};             // knotting heads: knots tied/retried/by hand, the row's cycles
-};
-
-// One beat as the technician sees it: published once per beat, when the beater has left the warp
-// after passing the fell (its peak force is then final).
-struct BeatEvent {
-  std::uint32_t row = 0;       // 1-based row being woven
-  std::uint16_t index = 0;     // 0-based beat within the row
-  float x_m = 0.0f;            // carriage position (beater's left edge from the left selvedge)
-  float peak_force_n = 0.0f;   // 0 when no load cell
-  bool force_measured = false;
-  bool in_band = false;        // force_measured and within [beat_force_min_n, beat_force_max_n]
 };
 
 struct SequencerConfig {
@@ -146,6 +136,10 @@ class Sequencer {
   void request_acknowledge() noexcept {
     if (state_ == State::kFault) ack_requested_ = true;
   }
+  // Configure-time only. The ack button is then only reported (events(): kButton), never acted on here: the
+  // owner decides (the service's runner ends the session so the service re-arms, or refuses while the link
+  // cannot be re-armed). Otherwise (weave, tests) a press acknowledges as request_acknowledge() does.
+  void leave_ack_button_to_owner() noexcept { ack_button_to_owner_ = true; }
   // RT-safe. The weaver has knotted the row (knotting mode): weave it. Ignored unless waiting for it.
   void request_row_knotted() noexcept { knot_requested_ = true; }
   // RT-safe. A fault found outside the sequencer (the runner's overrun policy): latched at the next step
@@ -178,8 +172,12 @@ class Sequencer {
   int knot_cycle() const noexcept { return knotter_.cycle(); }
 
   // RT-safe. One tick: check faults → advance the row cycle → sample profiles → check interlocks →
-  // write every field of `out`.
+  // write every field of `out`, and list what happened in events().
   void step(hal::Tick now, const hal::HalInputs& in, hal::HalOutputs& out) noexcept;
+  // RT-safe. What the last step() did that is news (beats, picks, rows, faults, pauses, knots, requests,
+  // button presses), in order; valid until the next step(). Readers forward it instead of comparing
+  // polled state with the last tick's.
+  const TickEvents& events() const noexcept { return events_; }
 
   State state() const noexcept { return state_; }
   // The machine's axes (slot order); the HAL's arrays are used up to axes().count.
@@ -195,10 +193,6 @@ class Sequencer {
   int fault_sensor() const noexcept { return fault_sensor_; }
   hal::Tick fault_tick() const noexcept { return fault_tick_; }
   const RowStats& last_row() const noexcept { return last_row_; }
-  // RT-safe. Counts completed beats since construction (never reset); when it changes, last_beat() is
-  // the newest. A reader that polls every tick sees every beat (at most one completes per tick).
-  std::uint32_t beat_events() const noexcept { return beat_events_; }
-  const BeatEvent& last_beat() const noexcept { return last_beat_; }
   const motion::ProfileSet& profiles() const noexcept { return *profiles_; }
   std::uint32_t recipe_changes() const noexcept { return recipe_changes_; }
   // Beater crank phase from park of the current command (rad) and the table's rocker angle there.
@@ -262,6 +256,7 @@ class Sequencer {
   void configure_knot_guard();
   Fault shed_fault(ShedVerdict v) const noexcept;
   void publish_beat(int k) noexcept;
+  void add_fault_event(EventKind kind) noexcept;  // kFaultLatched / kDiagnosisRefined with the first fault's details
   bool expect_shuttle_left() const noexcept { return counters_.picks % 2 == 0; }  // it starts at the left
   bool row_starts_left() const noexcept { return counters_.rows % 2 == 0; }      // sweeps alternate
   PistonEnds ends_a() const noexcept { return {io_.piston_a_extended, io_.piston_a_retracted}; }
@@ -338,6 +333,7 @@ class Sequencer {
   DualChannelSensors dual_;
   Debouncer<4> buttons_;  // start, pause, ack, row knotted
   RisingEdge start_edge_, pause_edge_, ack_edge_, knotted_edge_;
+  bool ack_button_to_owner_ = false;  // leave_ack_button_to_owner()
   bool knot_requested_ = false;  // "row knotted" since the loom last started waiting for it
   bool row_knotted_ = false;     // the row about to start has been knotted
   hal::Tick knotting_ticks_ = 0;
@@ -370,8 +366,7 @@ class Sequencer {
   hal::Tick phase_start_ = 0, sweep_start_ = 0;
   int row_beats_ = 0;
   int beats_published_ = 0;        // beats of this row already published as BeatEvents
-  std::uint32_t beat_events_ = 0;
-  BeatEvent last_beat_{};
+  TickEvents events_;              // this tick's (step() clears it)
   RowStats last_row_{};  // the last completed row
 };
 

@@ -42,8 +42,8 @@ class ChannelSchedule {
  private:
   // The part of a snapshot whose every change must reach STATUS subscribers.
   struct StatusKey {
-    std::array<char, sizeof(Snapshot::state)> state{};
-    std::array<char, sizeof(Snapshot::first_fault)> first_fault{};
+    std::uint8_t state = 0;
+    std::uint8_t first_fault = 0;
     std::uint16_t first_fault_code = 0;
     std::uint32_t row = 0;
     std::uint32_t pick = 0;

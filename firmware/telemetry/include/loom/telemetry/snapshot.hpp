@@ -46,11 +46,14 @@ struct KnotSample {
   std::array<std::array<std::int32_t, kMaxKnotSlots>, hal::kMaxKnottingHeads> stock{};  // knots left, -1 unknown
 };
 
+// The sequencer's state and faults travel as its enums (telemetry does not include the sequencer in its
+// public headers: bytes); the publisher names them (encode.cpp), the text edge.
 struct Snapshot {
   hal::Tick tick = 0;
   std::int64_t period_ns = 0;
-  std::array<char, 24> state{};        // sequencer state name, NUL-terminated
-  std::array<char, 32> first_fault{};  // latched first-fault name, "" when none
+  std::uint8_t state = 0;              // sequencer::State
+  std::uint8_t first_fault = 0;        // sequencer::Fault of the latched first fault, 0 (kNone) when none
+  std::uint8_t stopped_by = 0;         // sequencer::Fault that stopped motion, 0 when none
   std::uint16_t first_fault_code = 0;
   std::uint32_t row = 0;               // production counters (completed rows, picks, beats)
   std::uint32_t pick = 0;
@@ -62,7 +65,6 @@ struct Snapshot {
   std::int8_t fault_sensor = -1;       // hal::SafetySensor the first fault names, -1 when none
   std::uint16_t fault_device_code = 0; // device (EMCY) code of the first fault
   hal::Tick fault_tick = hal::kNeverTick;
-  std::array<char, 32> stopped_by{};   // the fault that stopped motion, "" when none
   double crank_phase_rad = 0.0;        // beat-up crank phase within the turn [0, 2π)
   double beater_angle_rad = 0.0;       // rocker angle from the profile
   double beat_force_n = 0.0;           // load-cell force at this tick (0 when not measured)
@@ -132,7 +134,7 @@ struct Event {
   std::int8_t axis = -1;           // -1 when not axis-specific
   std::int8_t sensor = -1;         // hal::SafetySensor the fault names, -1 when none
   std::uint16_t device_code = 0;
-  std::array<char, 24> state{};    // sequencer state just before the fault
+  std::uint8_t state = 0;          // sequencer::State just before the fault
   // kRow
   hal::Tick row_ticks = 0, shed_ticks = 0, pick_ticks = 0, beat_ticks = 0;
   hal::Tick knotting_ticks = 0;  // knotting mode: the weaver's time before the row
