@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -82,7 +83,49 @@ struct CanAxisPortConfig {
   std::array<std::vector<FrameGroup>, kMaxBuses> other_frames_per_cycle{};
 };
 
-// Configure-time only. Error naming the field and its value.
+// Which setting a refusal of the configuration is about. The loom config maps it (with the axis) to the
+// TOML key that sets it, so its file:line:col message never has to read the refusal's text.
+enum class CanAxisField {
+  kAxisCount,
+  // Per axis (CanAxisConfigFault::axis says which).
+  kNodeId,          // outside 1..127
+  kNodeIdTaken,     // another axis on the same bus has it
+  kNodeIdIsMaster,  // the master's own node id
+  kBus,
+  kCountsPerUnit,
+  kRatedEffort,
+  kFerrorMin,
+  kFerrorK,
+  kBringUpTimeouts,  // boot_timeout_s / operational_timeout_s
+  kHomingMethod,
+  kHomingSpeed,  // homing_speed / homing_accel
+  kHomeOffset,
+  // The port's.
+  kCyclePeriod,
+  kHeartbeatProducer,
+  kHeartbeatConsumer,
+  kSdoTimeout,
+  kBootTimeout,
+  kStateTimeout,
+  kTpdo2EveryN,
+  kBitrate,
+  kOperationalTimeout,
+  kMasterNode,
+  kMasterHeartbeat,  // master_heartbeat_s / master_consumer_s
+  kBusLoadBudget,
+  kOtherFrames,
+};
+
+// A refusal: the field, the axis it is on (per-axis fields), and the message naming field, value and reason.
+struct CanAxisConfigFault {
+  CanAxisField field = CanAxisField::kAxisCount;
+  std::size_t axis = 0;  // index into CanAxisPortConfig::axes
+  std::string message;   // "axes.carriage.counts_per_unit = 0 must be a positive number"
+};
+
+// Configure-time only. The first refusal of the configuration, or none.
+std::optional<CanAxisConfigFault> find_fault(const CanAxisPortConfig& config);
+// Configure-time only. Error naming the field and its value (find_fault()'s message).
 Status validate(const CanAxisPortConfig& config);
 // Configure-time only. The buses the configuration uses: 1 + the highest bus an axis or another node's
 // frames are on.

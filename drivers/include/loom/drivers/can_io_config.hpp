@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -88,9 +89,47 @@ inline std::array<const IoBit*, hal::kSafetySensorCount> first_switches(const Io
           &w.piston_b_retracted, &w.shuttle_at_left,    &w.shuttle_at_right};
 }
 
+// Which setting a refusal of the I/O configuration is about. The loom config maps it (with the signal)
+// to the TOML key that sets it, so its file:line:col message never has to read the refusal's text.
+enum class IoField {
+  kNode,
+  kModule,
+  kHeads,
+  kSignalBit,     // a signal's bit: required and unwired, out of range, or used twice on one module
+  kSignalModule,  // a signal's module
+  kLoadCellModule,
+  kLoadCellChannel,
+  kLoadCellGain,
+  kLoadCellOffset,
+  kCyclePeriod,
+  kHeartbeatProducer,
+  kHeartbeatConsumer,
+  kSdoTimeout,
+  kBootTimeout,
+  kOperationalTimeout,
+  kMasterNode,
+  kMasterConsumer,
+};
+
+// A refusal: the field, the signal it is about (kSignalBit, kSignalModule) and the message naming field,
+// value and reason.
+struct IoConfigFault {
+  IoField field = IoField::kNode;
+  std::string signal{};   // "estop_ok", "shuttle_at_right_2", "cutter"
+  int head = 0;           // a knotting head's signal: the head, 1-based; 0 otherwise
+  std::string message{};  // "io.outputs.buzzer.bit = 4 is already used by io.outputs.lamp_green"
+  // A bit used twice on module k > 0: the message goes on "(both on I/O module k)" (describe()); the loom
+  // config names the module by its [io_modules.<name>] instead.
+  std::uint8_t shared_module = 0;
+};
+// The refusal in one line, as validate() reports it.
+std::string describe(const IoConfigFault& fault);
+
+// Configure-time only. The first refusal of the loom's whole wiring (every required signal wired on some
+// module, no bit of one module used twice), or none.
+std::optional<IoConfigFault> find_fault(const IoWiring& wiring);
 // Configure-time only. Error naming the field ("io.inputs.estop_ok.bit = 3 is already used by
-// io.inputs.piston_b_retracted") and its value. The loom's whole wiring: every required signal wired on
-// some module, no bit of one module used twice.
+// io.inputs.piston_b_retracted") and its value: describe(find_fault()).
 Status validate(const IoWiring& wiring);
 
 // Configure-time only. The signals of the loom's wiring that are on module `module`, every other one
@@ -115,7 +154,9 @@ struct CanIoConfig {
   double master_consumer_s = 0.500;
 };
 
-// Configure-time only.
+// Configure-time only. The first refusal of the module's config (its node, timing and the whole wiring).
+std::optional<IoConfigFault> find_fault(const CanIoConfig& config);
+// Configure-time only. describe(find_fault()).
 Status validate(const CanIoConfig& config);
 
 // Configure-time only. The 8-bit subs of 0x6000 (inputs) and of 0x6200 (outputs) the wiring uses: 1 up

@@ -14,6 +14,8 @@ struct NamedBit {
   std::string name;  // "io.inputs.estop_ok", "io.outputs.gripper_close.head2"
   const IoBit* bit;
   bool required;
+  std::string signal;  // the signal alone ("estop_ok", "gripper_close"): its config key is io.<signal>_bit(s)
+  int head = 0;        // a knotting head's signal: the head as the operator counts it (1-based); else 0
 };
 
 // The knotting heads the wiring uses (IoWiring::heads clamped to 0..hal::kMaxKnottingHeads).
