@@ -10,6 +10,7 @@
 #include "loom/drivers/can_error_frame.hpp"
 #include "loom/drivers/cob_id.hpp"
 #include "loom/drivers/emcy.hpp"
+#include "loom/drivers/io_signals.hpp"
 #include "loom/drivers/nmt.hpp"
 #include "loom/drivers/pdo.hpp"
 #include "loom/drivers/sdo.hpp"
@@ -17,17 +18,17 @@
 
 namespace loom::drivers {
 
+using io_signals::inputs_of;
+using io_signals::key_and_value;
+using io_signals::NamedBit;
+using io_signals::signal_in_sub;
+using io_signals::used_heads;
+
 namespace {
 
 std::string hex(std::uint32_t v, int digits) {
   char buf[16];
   std::snprintf(buf, sizeof(buf), "0x%0*X", digits, v);
-  return buf;
-}
-
-std::string seconds(double s) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g s", s);
   return buf;
 }
 
@@ -42,236 +43,12 @@ std::string object_name(std::uint32_t map_entry) {
   return buf;
 }
 
-struct NamedBit {
-  std::string name;  // "io.inputs.estop_ok", "io.outputs.gripper_close.head2"
-  const IoBit* bit;
-  bool required;
-};
-
-// Names of the second channels in hal::SafetySensor order.
-constexpr std::array<const char*, hal::kSafetySensorCount> kSecondChannelNames{
-    "io.inputs.piston_a_extended_2", "io.inputs.piston_a_retracted_2", "io.inputs.piston_b_extended_2",
-    "io.inputs.piston_b_retracted_2", "io.inputs.shuttle_at_left_2",    "io.inputs.shuttle_at_right_2"};
-
-// Head h's (0-based) signal of one kind, named with the head's number as the operator counts it (1-based).
-NamedBit head_signal(const char* group_and_kind, int h, const IoBit& bit) {
-  return {std::string(group_and_kind) + ".head" + std::to_string(h + 1), &bit, true};
-}
-int used_heads(const IoWiring& w) {
-  return std::clamp(w.heads, 0, static_cast<int>(hal::kMaxKnottingHeads));
-}
-
-// The wiring's signals by name, inputs then outputs, for validation and messages. The second channels
-// are inputs like any other, so a bit shared between a first and a second channel is refused.
-std::vector<NamedBit> inputs_of(const IoWiring& w) {
-  std::vector<NamedBit> v{{"io.inputs.piston_a_extended", &w.piston_a_extended, true},
-                          {"io.inputs.piston_a_retracted", &w.piston_a_retracted, true},
-                          {"io.inputs.piston_b_extended", &w.piston_b_extended, true},
-                          {"io.inputs.piston_b_retracted", &w.piston_b_retracted, true},
-                          {"io.inputs.shuttle_at_left", &w.shuttle_at_left, true},
-                          {"io.inputs.shuttle_at_right", &w.shuttle_at_right, true},
-                          {"io.inputs.estop_ok", &w.estop_ok, true},
-                          {"io.inputs.button_start", &w.button_start, false},
-                          {"io.inputs.button_pause", &w.button_pause, false},
-                          {"io.inputs.button_ack", &w.button_ack, false},
-                          {"io.inputs.row_knotted", &w.row_knotted, false}};
-  // Optional: a machine may have single-channel sensing (then the sequencer's plausibility checks alone).
-  for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) {
-    v.push_back({kSecondChannelNames[i], &w.second[i], false});
-  }
-  for (int h = 0; h < used_heads(w); ++h) {
-    v.push_back(head_signal("io.inputs.yarn_present", h, w.yarn_present[static_cast<std::size_t>(h)]));
-  }
-  return v;
-}
-std::vector<NamedBit> outputs_of(const IoWiring& w) {
-  std::vector<NamedBit> v{{"io.outputs.piston_a_extend", &w.piston_a_extend, true},
-                          {"io.outputs.piston_b_extend", &w.piston_b_extend, true},
-                          {"io.outputs.lamp_green", &w.lamp_green, false},
-                          {"io.outputs.lamp_amber", &w.lamp_amber, false},
-                          {"io.outputs.lamp_red", &w.lamp_red, false},
-                          {"io.outputs.buzzer", &w.buzzer, false}};
-  for (int h = 0; h < used_heads(w); ++h) {
-    v.push_back(head_signal("io.outputs.gripper_close", h, w.gripper_close[static_cast<std::size_t>(h)]));
-    v.push_back(head_signal("io.outputs.cutter", h, w.cutter[static_cast<std::size_t>(h)]));
-  }
-  return v;
-}
-
-// Every required signal wired, every bit in range and used once per module.
-Status check_bits(const std::vector<NamedBit>& bits, int max_bits) {
-  static_assert(kIoMaxInputBits >= kIoMaxOutputBits);
-  std::array<std::array<const std::string*, kIoMaxInputBits>, kMaxIoModules> used{};
-  for (const NamedBit& b : bits) {
-    const int n = b.bit->bit;
-    if (n == -1) {
-      if (b.required) return Status::error(b.name + ".bit = -1: this signal must be wired");
-      continue;
-    }
-    if (n < 0 || n >= max_bits) {
-      return Status::error(b.name + ".bit = " + std::to_string(n) + " is outside 0.." +
-                           std::to_string(max_bits - 1) + " (-1 = not wired)");
-    }
-    if (b.bit->module >= kMaxIoModules) {
-      return Status::error(b.name + ".module = " + std::to_string(b.bit->module) + " is outside 0.." +
-                           std::to_string(kMaxIoModules - 1));
-    }
-    const std::string*& user = used[b.bit->module][static_cast<std::size_t>(n)];
-    if (user != nullptr) {
-      return Status::error(b.name + ".bit = " + std::to_string(n) + " is already used by " + *user +
-                           (b.bit->module == 0 ? "" : " (both on I/O module " + std::to_string(b.bit->module) + ")"));
-    }
-    user = &b.name;
-  }
-  return Status::ok();
-}
-
-int highest_bit(const std::vector<NamedBit>& bits) {
-  int hi = -1;
-  for (const NamedBit& b : bits) hi = std::max(hi, b.bit->bit);
-  return hi;
-}
-
-// The 8-bit subs a set of signals needs: up to the one holding the highest wired bit (at least one, so
-// the PDO exists even when nothing optional is wired).
-std::uint8_t subs_for(const std::vector<NamedBit>& bits) {
-  return static_cast<std::uint8_t>(std::max(highest_bit(bits), 0) / 8 + 1);
-}
-
-// The wired signal with the highest bit in 8-bit sub `sub` (1-based), the one named when the module
-// cannot deliver that sub; nullptr when no signal lives there (then the master can do without it).
-const NamedBit* signal_in_sub(const std::vector<NamedBit>& bits, int sub) {
-  const NamedBit* found = nullptr;
-  for (const NamedBit& b : bits) {
-    const int n = b.bit->bit;
-    if (n >= 0 && n / 8 + 1 == sub && (found == nullptr || n > found->bit->bit)) found = &b;
-  }
-  return found;
-}
-
-// The config key an operator edits for a signal ("io.inputs.shuttle_at_right_2" →
-// "io.shuttle_at_right_2_bit", "io.inputs.yarn_present.head2" → "io.yarn_present_bits (head 2)") and its
-// value: a bring-up refusal points at the TOML line that asks for the input the module cannot deliver.
-std::string key_and_value(const NamedBit& b) {
-  const std::string& name = b.name;
-  const std::string group = name.rfind("io.inputs.", 0) == 0 ? "io.inputs." : "io.outputs.";
-  const std::string signal = name.substr(group.size());
-  const std::size_t head = signal.find(".head");
-  const std::string value = " = " + std::to_string(b.bit->bit);
-  if (head == std::string::npos) return "io." + signal + "_bit" + value;
-  return "io." + signal.substr(0, head) + "_bits (head " + signal.substr(head + 5) + ")" + value;
-}
-
 bool interop_readback_code(std::uint32_t abort) {
   // A module with a fixed mapping says read-only (0x06010002) or unsupported access (0x06010000).
   return abort == sdo_abort::kReadOnly || abort == sdo_abort::kUnsupportedAccess;
 }
 
 }  // namespace
-
-// ---------------------------------------------------------------------------------------------------
-// Configuration
-// ---------------------------------------------------------------------------------------------------
-Status validate(const IoWiring& w) {
-  if (w.heads < 0 || w.heads > static_cast<int>(hal::kMaxKnottingHeads)) {
-    return Status::error("io: " + std::to_string(w.heads) + " knotting heads wired; at most " +
-                         std::to_string(hal::kMaxKnottingHeads));
-  }
-  if (Status s = check_bits(inputs_of(w), kIoMaxInputBits); !s) return s;
-  if (Status s = check_bits(outputs_of(w), kIoMaxOutputBits); !s) return s;
-  if (w.load_cell_module >= kMaxIoModules) {
-    return Status::error("io.load_cell.module = " + std::to_string(w.load_cell_module) + " is outside 0.." +
-                         std::to_string(kMaxIoModules - 1));
-  }
-  if (w.load_cell_channel < 0 || w.load_cell_channel > 254) {
-    return Status::error("io.load_cell.channel = " + std::to_string(w.load_cell_channel) +
-                         " is outside 0..254 (0 = no load cell, else the sub-index of 0x6401)");
-  }
-  if (!std::isfinite(w.load_cell_n_per_count) || w.load_cell_n_per_count == 0.0) {
-    char buf[128];
-    std::snprintf(buf, sizeof(buf), "io.load_cell.n_per_count = %g must be a non-zero number",
-                  w.load_cell_n_per_count);
-    return Status::error(buf);
-  }
-  if (!std::isfinite(w.load_cell_offset_n)) {
-    return Status::error("io.load_cell.offset_n is not a finite number");
-  }
-  return Status::ok();
-}
-
-IoWiring module_wiring(const IoWiring& wiring, std::uint8_t module) {
-  IoWiring w = wiring;
-  const auto keep = [module](IoBit& b) {
-    if (b.module != module) b = IoBit{};
-  };
-  for (IoBit* b : {&w.piston_a_extended, &w.piston_a_retracted, &w.piston_b_extended, &w.piston_b_retracted,
-                   &w.shuttle_at_left, &w.shuttle_at_right, &w.estop_ok, &w.button_start, &w.button_pause,
-                   &w.button_ack, &w.row_knotted, &w.piston_a_extend, &w.piston_b_extend, &w.lamp_green,
-                   &w.lamp_amber, &w.lamp_red, &w.buzzer}) {
-    keep(*b);
-  }
-  for (IoBit& b : w.second) keep(b);
-  for (std::size_t h = 0; h < hal::kMaxKnottingHeads; ++h) {
-    keep(w.gripper_close[h]);
-    keep(w.cutter[h]);
-    keep(w.yarn_present[h]);
-  }
-  if (w.load_cell_module != module) w.load_cell_channel = 0;
-  return w;
-}
-
-Status validate(const CanIoConfig& c) {
-  if (c.node_id < kMinNodeId || c.node_id > kMaxNodeId) {
-    return Status::error("io.node = " + std::to_string(c.node_id) + " is outside 1..127");
-  }
-  if (c.module >= kMaxIoModules) {
-    return Status::error("io: module " + std::to_string(c.module) + " is outside 0.." + std::to_string(kMaxIoModules - 1));
-  }
-  if (Status s = validate(c.wiring); !s) return s;
-  if (!(c.cycle_period_s > 0.0)) return Status::error("io: cycle period " + seconds(c.cycle_period_s) + " must be > 0");
-  const double producer_ms = c.heartbeat_producer_s * 1e3;
-  if (!(producer_ms >= 1.0 && producer_ms <= 65535.0) || std::abs(producer_ms - std::round(producer_ms)) > 1e-6) {
-    return Status::error("io: heartbeat producer time " + seconds(c.heartbeat_producer_s) +
-                         " must be a whole number of ms in 0.001..65.535 s");
-  }
-  if (!(c.heartbeat_consumer_s > c.heartbeat_producer_s)) {
-    return Status::error("io: heartbeat consumer time " + seconds(c.heartbeat_consumer_s) +
-                         " must exceed the producer time " + seconds(c.heartbeat_producer_s));
-  }
-  if (!(c.sdo_timeout_s > 0.0)) return Status::error("io: SDO timeout " + seconds(c.sdo_timeout_s) + " must be > 0");
-  if (!(c.boot_timeout_s > 0.0)) {
-    return Status::error("io.boot_timeout_s = " + seconds(c.boot_timeout_s) + " must be > 0");
-  }
-  if (!(c.operational_timeout_s > 0.0)) {
-    return Status::error("io.operational_timeout_s = " + seconds(c.operational_timeout_s) + " must be > 0");
-  }
-  if (c.master_node_id > kMaxNodeId) {
-    return Status::error("can.master_node = " + std::to_string(c.master_node_id) + " is outside 0..127");
-  }
-  if (c.master_node_id != 0) {
-    const double ms = c.master_consumer_s * 1e3;
-    if (!(ms >= 1.0 && ms <= 65535.0)) {
-      return Status::error("io: master heartbeat consumer time " + seconds(c.master_consumer_s) +
-                           " must be in 0.001..65.535 s");
-    }
-  }
-  return Status::ok();
-}
-
-std::uint8_t io_input_subs(const IoWiring& w) {
-  return subs_for(inputs_of(w));
-}
-std::uint8_t io_output_subs(const IoWiring& w) {
-  return subs_for(outputs_of(w));
-}
-
-std::vector<FrameGroup> io_frames_per_cycle(const IoWiring& w) {
-  std::vector<FrameGroup> g;
-  g.push_back({io_output_subs(w), 1});  // RPDO: digital outputs
-  g.push_back({io_input_subs(w), 1});   // TPDO: digital inputs, one 8-bit sub per byte
-  if (w.load_cell_channel != 0) g.push_back({2, 1});  // TPDO: load cell
-  return g;
-}
 
 hal::DigitalOutputs io_safe_outputs() {
   hal::DigitalOutputs o;  // grippers open, cutters retracted: every head's outputs false

@@ -6,7 +6,7 @@
 #include <initializer_list>
 #include <utility>
 
-#include "loom/drivers/can_io_port.hpp"
+#include "loom/drivers/can_io_config.hpp"
 #include "loom/drivers/pdo.hpp"
 
 namespace loom::drivers {

@@ -9,6 +9,7 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <utility>
 #include <sstream>
 
 #include "loom/drivers/bus_load.hpp"
@@ -802,26 +803,70 @@ void check_relations(const TomlReader& r, const LoomConfig& c) {
   }
 }
 
+// The key (and its value) a refusal of the CAN master's configuration is pinned to: the key that sets the
+// field. Fields no single key sets, or whose own key's range already refuses every bad value, keep the
+// keys their refusals have always named (the tests pin the messages): can.heartbeat_timeout_ms, or
+// can.bus_load_budget for the bus, bit-rate and axis-count limits.
+std::pair<std::string, std::string> can_master_key(const LoomConfig& c, const drivers::CanAxisConfigFault& f) {
+  using F = drivers::CanAxisField;
+  const AxisSpec* axis = f.axis < c.axes.size() ? &c.axes[f.axis] : nullptr;
+  const std::string on_axis = axis != nullptr ? "axes." + axis->name + "." : "";
+  switch (f.field) {
+    case F::kHeartbeatProducer: return {"can.heartbeat_ms", std::to_string(c.can.heartbeat_ms)};
+    case F::kMasterHeartbeat: return {"can.master_heartbeat_ms", std::to_string(c.can.master_heartbeat_ms)};
+    case F::kSdoTimeout: return {"can.sdo_timeout_ms", std::to_string(c.can.sdo_timeout_ms)};
+    case F::kCountsPerUnit:
+      if (axis != nullptr) return {on_axis + "counts_per_rev", fmt_num(axis->counts_per_rev)};
+      break;
+    case F::kFerrorMin:
+    case F::kFerrorK:
+      if (axis != nullptr) return {on_axis + "ferror_min", fmt_num(axis->ferror_min)};
+      break;
+    case F::kHomingMethod:
+    case F::kHomingSpeed:
+    case F::kHomeOffset:
+      if (axis != nullptr) return {on_axis + "homing_method", std::to_string(axis->homing_method)};
+      break;
+    case F::kAxisCount:
+    case F::kBus:
+    case F::kNodeIdTaken:
+    case F::kBitrate:
+    case F::kBusLoadBudget: return {"can.bus_load_budget", fmt_num(c.can.bus_load_budget)};
+    case F::kNodeId:
+    case F::kNodeIdIsMaster:
+    case F::kRatedEffort:
+    case F::kBringUpTimeouts:
+    case F::kCyclePeriod:
+    case F::kHeartbeatConsumer:
+    case F::kBootTimeout:
+    case F::kStateTimeout:
+    case F::kTpdo2EveryN:
+    case F::kOperationalTimeout:
+    case F::kMasterNode:
+    case F::kOtherFrames: break;
+  }
+  return {"can.heartbeat_timeout_ms", std::to_string(c.can.heartbeat_timeout_ms)};
+}
+
+// The key (and its value) a refusal of the I/O module's configuration is pinned to: a signal's bit is set
+// by io.<signal>_bit (a knotting head's by io.<signal>_bits), as the key table has it; the rest by io.node.
+std::pair<std::string, std::string> io_module_key(const LoomConfig& c, const drivers::IoConfigFault& f) {
+  if (f.field == drivers::IoField::kSignalBit) {
+    const std::string path = "io." + f.signal + (f.head == 0 ? "_bit" : "_bits");
+    for (const Key& k : keys()) {
+      if (k.path == path) return {k.path, k.value(c)};
+    }
+  }
+  return {"io.node", std::to_string(c.io.node)};
+}
+
 // The CAN master's own validation (drives and I/O module), with its complaint pinned to the key that
 // sets the field; the worst-case bus load counts every node's frames.
 void check_can(const LoomConfig& c, const Fail& fail) {
   const drivers::CanAxisPortConfig cc = can_axis_config(c);
-  if (const drivers::Status s = drivers::validate(cc); !s) {
-    const std::string& msg = s.message();
-    std::string key = "can.heartbeat_timeout_ms", value = std::to_string(c.can.heartbeat_timeout_ms);
-    if (msg.find("heartbeat_producer") == 0) key = "can.heartbeat_ms", value = std::to_string(c.can.heartbeat_ms);
-    if (msg.find("master_heartbeat") == 0) key = "can.master_heartbeat_ms", value = std::to_string(c.can.master_heartbeat_ms);
-    if (msg.find("master_consumer") == 0) key = "can.master_consumer_ms", value = std::to_string(c.can.master_consumer_ms);
-    if (msg.find("sdo") == 0) key = "can.sdo_timeout_ms", value = std::to_string(c.can.sdo_timeout_ms);
-    for (const AxisSpec& a : c.axes) {
-      if (msg.rfind("axes." + a.name + ".counts_per_unit", 0) == 0) key = "axes." + a.name + ".counts_per_rev", value = fmt_num(a.counts_per_rev);
-      if (msg.rfind("axes." + a.name + ".ferror", 0) == 0) key = "axes." + a.name + ".ferror_min", value = fmt_num(a.ferror_min);
-      if (msg.rfind("axes." + a.name + ".hom", 0) == 0) key = "axes." + a.name + ".homing_method", value = std::to_string(a.homing_method);
-    }
-    if (msg.find("bus") != std::string::npos || msg.find("bit") != std::string::npos) {
-      key = "can.bus_load_budget", value = fmt_num(c.can.bus_load_budget);
-    }
-    fail(key, value, "the CAN master refuses it: " + msg);
+  if (const std::optional<drivers::CanAxisConfigFault> f = drivers::find_fault(cc)) {
+    const auto [key, value] = can_master_key(c, *f);
+    fail(key, value, "the CAN master refuses it: " + f->message);
   }
   if (c.io.kind == IoKind::kCan) {
     // Node ids are unique per bus: each module against the axes and the modules before it on its bus.
@@ -854,29 +899,14 @@ void check_can(const LoomConfig& c, const Fail& fail) {
         }
       }
     }
-    if (const drivers::Status s = drivers::validate(can_io_configs(c).front()); !s) {
-      // The driver names the signal first ("io.inputs.estop_ok.bit = 3 ...", "io.outputs.cutter.head2.bit
-      // = 9 ..."): point at that signal's key (not at another signal the message names after it).
-      std::string key = "io.node", value = std::to_string(c.io.node);
-      std::string msg = s.message();
-      for (std::size_t k = 0; k < c.io.modules.size(); ++k) {  // the driver numbers modules; the file names them
-        const std::string numbered = "I/O module " + std::to_string(k + 1) + ")";
-        if (const std::size_t at = msg.find(numbered); at != std::string::npos) {
-          msg.replace(at, numbered.size(), "io_modules." + c.io.modules[k].name + ")");
-        }
-      }
-      const std::size_t group_end = msg.find('.', 3);
-      const std::string subject =
-          group_end == std::string::npos ? std::string() : msg.substr(group_end + 1, msg.find(".bit") - group_end - 1);
-      for (const Key& k : keys()) {
-        if (k.path.rfind("io.", 0) != 0 || k.path.size() < 4) continue;
-        const std::string name = k.path.substr(3, k.path.rfind('_') - 3);
-        const bool bit_key = k.path.size() > 4 && k.path.substr(k.path.size() - 4) == "_bit";
-        const bool head_key = k.path.size() > 5 && k.path.substr(k.path.size() - 5) == "_bits";
-        if ((bit_key && subject == name) || (head_key && subject.rfind(name + ".head", 0) == 0)) {
-          key = k.path, value = k.value(c);
-          break;
-        }
+    if (const std::optional<drivers::IoConfigFault> f = drivers::find_fault(can_io_configs(c).front())) {
+      const auto [key, value] = io_module_key(c, *f);
+      std::string msg = f->message;
+      if (f->shared_module != 0) {  // the driver numbers modules; the file names them
+        const std::size_t k = f->shared_module;
+        msg += " (both on " +
+               (k <= c.io.modules.size() ? "io_modules." + c.io.modules[k - 1].name : "I/O module " + std::to_string(k)) +
+               ")";
       }
       fail(key, value, "the I/O module refuses it: " + msg);
     }

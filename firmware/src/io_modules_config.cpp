@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <sstream>
 
-#include "loom/drivers/can_axis_port.hpp"
+#include "loom/drivers/can_axis_config.hpp"
 
 namespace loom::firmware {
 
