@@ -827,13 +827,22 @@ std::pair<std::string, std::string> can_master_key(const LoomConfig& c, const dr
     case F::kHomeOffset:
       if (axis != nullptr) return {on_axis + "homing_method", std::to_string(axis->homing_method)};
       break;
-    case F::kAxisCount:
-    case F::kBus:
+    case F::kNodeId:
     case F::kNodeIdTaken:
+      if (axis != nullptr) return {on_axis + "node", std::to_string(axis->node)};
+      break;
+    case F::kNodeIdIsMaster:  // the drive's node id or the master's, whichever the file says
+      if (axis != nullptr) {
+        return {on_axis + "node|can.master_node", std::to_string(axis->node) + "|" + std::to_string(c.can.master_node)};
+      }
+      return {"can.master_node", std::to_string(c.can.master_node)};
+    case F::kBus:
+      if (axis != nullptr) return {on_axis + "bus", std::to_string(axis->bus)};
+      break;
+    case F::kMasterNode: return {"can.master_node", std::to_string(c.can.master_node)};
+    case F::kAxisCount:
     case F::kBitrate:
     case F::kBusLoadBudget: return {"can.bus_load_budget", fmt_num(c.can.bus_load_budget)};
-    case F::kNodeId:
-    case F::kNodeIdIsMaster:
     case F::kRatedEffort:
     case F::kBringUpTimeouts:
     case F::kCyclePeriod:
@@ -842,7 +851,6 @@ std::pair<std::string, std::string> can_master_key(const LoomConfig& c, const dr
     case F::kStateTimeout:
     case F::kTpdo2EveryN:
     case F::kOperationalTimeout:
-    case F::kMasterNode:
     case F::kOtherFrames: break;
   }
   return {"can.heartbeat_timeout_ms", std::to_string(c.can.heartbeat_timeout_ms)};
@@ -1163,7 +1171,17 @@ LoomConfig parse_complete(const std::string& text, const std::string& source, co
   read_io_modules(r, c);
   r.reject_unknown(known_sections());
   check_relations(r, c);
+  // `key` may name two facts that clash ("axes.helix.node|can.master_node", values likewise): the one the
+  // file says is the line to point at (the first when it says both).
   const Fail fail = [&](const std::string& key, const std::string& value, const std::string& why) {
+    const std::size_t bar = key.find('|'), vbar = value.find('|');
+    if (bar != std::string::npos) {
+      const std::string k1 = key.substr(0, bar), v1 = value.substr(0, vbar);
+      const std::string k2 = key.substr(bar + 1), v2 = vbar == std::string::npos ? value : value.substr(vbar + 1);
+      if (present(k1)) r.fail(k1, v1, why);
+      if (present(k2)) r.fail(k2, v2, why);
+      throw ConfigError(source + ": " + k1 + " = " + v1 + " (from the embedded default): " + why);
+    }
     if (present(key)) r.fail(key, value, why);
     throw ConfigError(source + ": " + key + " = " + value + " (from the embedded default): " + why);
   };

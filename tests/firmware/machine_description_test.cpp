@@ -346,3 +346,13 @@ TEST(MachineKnotting, HeadsNeedAMagazineThatHoldsEveryColourOfTheDesign) {
             std::string::npos);
   std::filesystem::remove_all(dir);
 }
+
+// A drive on the controller's own node id: the refusal points at whichever of the two the file says.
+TEST(MachineDescription, ADriveOnTheMastersNodeIdIsRefusedAtTheLineThatSaysIt) {
+  EXPECT_EQ(config_error(ext("[can]\nmaster_node = 3\n")),
+            "loom.toml:3:15: can.master_node = 3: the CAN master refuses it: axes.helix.node_id = 3 is the master's own "
+            "node id");
+  EXPECT_EQ(config_error(ext("[axes.helix]\nnode = 127\n")),
+            "loom.toml:3:8: axes.helix.node = 127: the CAN master refuses it: axes.helix.node_id = 127 is the master's "
+            "own node id");
+}
