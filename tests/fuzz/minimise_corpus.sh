@@ -19,7 +19,7 @@ for f in "$corpus"/*; do
   if [[ $(basename "$f") =~ ^[0-9a-f]{40}$ ]]; then cp "$f" "$work/digests/"; else cp "$f" "$work/keep/"; fi
 done
 before=$(find "$corpus" -type f | wc -l)
-"$fuzzer" -merge=1 -use_counters=0 -use_value_profile=0 "$work/keep" "$work/digests" >"$work/merge.log" 2>&1 ||
+"$fuzzer" -merge=1 -use_counters=0 -use_value_profile=0 -artifact_prefix="$work/" "$work/keep" "$work/digests" >"$work/merge.log" 2>&1 ||
   { cat "$work/merge.log" >&2; exit 1; }
 find "$corpus" -type f -delete
 cp "$work/keep"/* "$corpus/"
