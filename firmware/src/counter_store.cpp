@@ -144,31 +144,18 @@ sequencer::Counters CounterStore::parse(const std::string& text, const std::stri
 }
 
 std::optional<sequencer::Counters> CounterStore::load() const {
-  const int fd = ::open(path_.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
-  if (fd < 0) {
-    if (errno == ENOENT) return std::nullopt;  // the only case that starts from zero
-    throw ConfigError(path_ + ": counters file exists but cannot be read: " + std::strerror(errno) +
-                      " (refusing to restart the production counts)");
+  const StateFileRead r = read_state_file(path_, 4096);
+  switch (r.outcome) {
+    case StateFileRead::Outcome::kAbsent: return std::nullopt;  // the only case that starts from zero
+    case StateFileRead::Outcome::kCannotOpen:
+      throw ConfigError(path_ + ": counters file exists but cannot be read: " + r.error +
+                        " (refusing to restart the production counts)");
+    case StateFileRead::Outcome::kNotRegular:
+      throw ConfigError(path_ + ": not a counters file (not a regular file of at most 4 KiB)");
+    case StateFileRead::Outcome::kCannotRead: throw ConfigError(path_ + ": counters file cannot be read: " + r.error);
+    case StateFileRead::Outcome::kRead: break;
   }
-  struct stat st {};
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || st.st_size > 4096) {
-    ::close(fd);
-    throw ConfigError(path_ + ": not a counters file (not a regular file of at most 4 KiB)");
-  }
-  std::string text(static_cast<std::size_t>(st.st_size), '\0');
-  std::size_t got = 0;
-  while (got < text.size()) {
-    const ssize_t n = ::read(fd, text.data() + got, text.size() - got);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const int err = errno;
-      ::close(fd);
-      throw ConfigError(path_ + ": counters file cannot be read: " + (n < 0 ? std::strerror(err) : "it shrank"));
-    }
-    got += static_cast<std::size_t>(n);
-  }
-  ::close(fd);
-  return parse(text, path_);
+  return parse(r.text, path_);
 }
 
 void CounterStore::save(const sequencer::Counters& c) const {

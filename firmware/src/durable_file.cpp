@@ -1,6 +1,7 @@
 #include "loom/firmware/durable_file.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -42,6 +43,40 @@ void write_file_durably(const std::string& path, const std::string& body) {
   const int rc = ::fsync(dfd);
   ::close(dfd);
   if (rc != 0 && errno != EINVAL) sys_fail("cannot sync directory of", path);
+}
+
+StateFileRead read_state_file(const std::string& path, std::size_t max_bytes) {
+  using O = StateFileRead::Outcome;
+  StateFileRead r;
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);  // a FIFO must not block the reader
+  if (fd < 0) {
+    r.outcome = errno == ENOENT ? O::kAbsent : O::kCannotOpen;
+    r.error = std::strerror(errno);
+    return r;
+  }
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || static_cast<std::size_t>(st.st_size) > max_bytes) {
+    ::close(fd);
+    r.outcome = O::kNotRegular;
+    return r;
+  }
+  r.text.assign(static_cast<std::size_t>(st.st_size), '\0');
+  std::size_t got = 0;
+  while (got < r.text.size()) {
+    const ssize_t n = ::read(fd, r.text.data() + got, r.text.size() - got);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      r.error = n < 0 ? std::strerror(errno) : "it shrank";
+      ::close(fd);
+      r.outcome = O::kCannotRead;
+      r.text.clear();
+      return r;
+    }
+    got += static_cast<std::size_t>(n);
+  }
+  ::close(fd);
+  r.outcome = O::kRead;
+  return r;
 }
 
 }  // namespace loom::firmware

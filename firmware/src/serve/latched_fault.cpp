@@ -176,33 +176,22 @@ LatchedFault LatchedFaultStore::parse(const std::string& text, const std::string
 }
 
 std::optional<LatchedFault> LatchedFaultStore::load() const {
-  const int fd = ::open(path_.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
-  if (fd < 0) {
-    if (errno == ENOENT) return std::nullopt;
-    throw ConfigError(path_ + ": latched-fault record exists but cannot be read: " + std::strerror(errno) +
-                      " (refusing to arm: a fault may still be latched)");
+  const StateFileRead r = read_state_file(path_, kMaxBytes);
+  switch (r.outcome) {
+    case StateFileRead::Outcome::kAbsent:
+      return std::nullopt;
+    case StateFileRead::Outcome::kCannotOpen:
+      throw ConfigError(path_ + ": latched-fault record exists but cannot be read: " + r.error +
+                        " (refusing to arm: a fault may still be latched)");
+    case StateFileRead::Outcome::kNotRegular:
+      throw ConfigError(path_ + ":1: file = \"" + path_ +
+                        "\": not a latched-fault record (not a regular file of at most 4 KiB)");
+    case StateFileRead::Outcome::kCannotRead:
+      throw ConfigError(path_ + ": latched-fault record cannot be read: " + r.error);
+    case StateFileRead::Outcome::kRead:
+      break;
   }
-  struct stat st {};
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || static_cast<std::size_t>(st.st_size) > kMaxBytes) {
-    ::close(fd);
-    throw ConfigError(path_ + ":1: file = \"" + path_ +
-                      "\": not a latched-fault record (not a regular file of at most 4 KiB)");
-  }
-  std::string text(static_cast<std::size_t>(st.st_size), '\0');
-  std::size_t got = 0;
-  while (got < text.size()) {
-    const ssize_t n = ::read(fd, text.data() + got, text.size() - got);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const int err = errno;
-      ::close(fd);
-      throw ConfigError(
-          path_ + ": latched-fault record cannot be read: " + (n < 0 ? std::strerror(err) : "it shrank"));
-    }
-    got += static_cast<std::size_t>(n);
-  }
-  ::close(fd);
-  return parse(text, path_);
+  return parse(r.text, path_);
 }
 
 void LatchedFaultStore::save(const LatchedFault& f) const {
