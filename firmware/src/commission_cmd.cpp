@@ -1,10 +1,9 @@
-// See commission_cmd.hpp. The loop here is not the weaving loop: nothing moves, so it ticks on the
-// calling thread at normal priority (SYNC and the master heartbeat keep the drives and the I/O node
-// supervised) and reads the loop's inputs between ticks, on the same thread.
+// See commission_cmd.hpp. A session that never starts: nothing moves, so the Session ticks the loop on
+// the calling thread at normal priority (SYNC and the master heartbeat keep the drives and the I/O node
+// supervised) and the loop's inputs are read between ticks, on the same thread.
 #include "commission_cmd.hpp"
 
 #include <poll.h>
-#include <time.h>
 #include <unistd.h>
 
 #include <array>
@@ -17,14 +16,12 @@
 
 #include "loom/firmware/config.hpp"
 #include "loom/firmware/durable_file.hpp"
-#include "loom/firmware/machine.hpp"
+#include "loom/firmware/session.hpp"
 #include "loom/firmware/toml_edit.hpp"
 #include "toml_reader.hpp"
 
 namespace loom::firmware {
 namespace {
-
-constexpr int kExitOk = 0, kExitBadInput = 2, kExitNotArmed = 4;
 
 // What each capture name measures, and the config key it writes.
 struct Capture {
@@ -35,7 +32,8 @@ struct Capture {
   const char* pose;
 };
 constexpr Capture kCaptures[] = {
-    {"park", hal::CoreAxis::kBeatCrank, "beatup", "crank_park_position_rad", "the crank at its park pose, beater clear of the warp"},
+    {"park", hal::CoreAxis::kBeatCrank, "beatup", "crank_park_position_rad",
+     "the crank at its park pose, beater clear of the warp"},
     {"home", hal::CoreAxis::kCarriage, "carriage", "home_position_m", "the carriage at the left selvedge"},
     {"left", hal::CoreAxis::kHelix, "helix", "left_position_rad", "the helix carrier at the left selvedge"},
 };
@@ -45,8 +43,10 @@ constexpr Capture kCaptures[] = {
 // and out of the right one's. (The crank's park and the carriage's home have no sensor on this loom.)
 std::string pose_contradiction(const Capture& c, const hal::DigitalInputs& io) {
   if (c.axis != hal::CoreAxis::kHelix) return "";
-  if (io.shuttle_at_right) return "shuttle_at_right=1: the shuttle (and its carrier) is at the right selvedge";
-  if (!io.shuttle_at_left) return "shuttle_at_left=0: no shuttle seen at the left selvedge (is it on its carrier?)";
+  if (io.shuttle_at_right)
+    return "shuttle_at_right=1: the shuttle (and its carrier) is at the right selvedge";
+  if (!io.shuttle_at_left)
+    return "shuttle_at_left=0: no shuttle seen at the left selvedge (is it on its carrier?)";
   return "";
 }
 
@@ -70,17 +70,16 @@ std::string positions_line(const hal::HalInputs& in, const hal::AxisLayout& axes
 }
 
 // The I/O module's inputs as wired: name and value, the safety sensors' second switches where fitted.
-std::vector<std::pair<std::string, bool>> named_inputs(const hal::DigitalInputs& io,
-                                                        const std::array<bool, hal::kSafetySensorCount>& second) {
-  std::vector<std::pair<std::string, bool>> v{{"piston_a_extended", io.piston_a_extended},
-                                              {"piston_a_retracted", io.piston_a_retracted},
-                                              {"piston_b_extended", io.piston_b_extended},
-                                              {"piston_b_retracted", io.piston_b_retracted},
-                                              {"shuttle_at_left", io.shuttle_at_left},
-                                              {"shuttle_at_right", io.shuttle_at_right}};
+std::vector<std::pair<std::string, bool>> named_inputs(
+    const hal::DigitalInputs& io, const std::array<bool, hal::kSafetySensorCount>& second) {
+  std::vector<std::pair<std::string, bool>> v{
+      {"piston_a_extended", io.piston_a_extended}, {"piston_a_retracted", io.piston_a_retracted},
+      {"piston_b_extended", io.piston_b_extended}, {"piston_b_retracted", io.piston_b_retracted},
+      {"shuttle_at_left", io.shuttle_at_left},     {"shuttle_at_right", io.shuttle_at_right}};
   for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) {
-    if (second[i]) v.emplace_back(std::string(hal::safety_sensor_name(static_cast<hal::SafetySensor>(i))) + "_2",
-                                  io.second_channel[i]);
+    if (second[i])
+      v.emplace_back(std::string(hal::safety_sensor_name(static_cast<hal::SafetySensor>(i))) + "_2",
+                     io.second_channel[i]);
   }
   v.insert(v.end(), {{"estop_ok", io.estop_ok},
                      {"button_start", io.button_start},
@@ -93,7 +92,8 @@ std::vector<std::pair<std::string, bool>> named_inputs(const hal::DigitalInputs&
 std::string inputs_line(const hal::HalInputs& in, const std::array<bool, hal::kSafetySensorCount>& second) {
   std::string s = "inputs:";
   for (const auto& [name, on] : named_inputs(in.io, second)) s += " " + name + "=" + (on ? "1" : "0");
-  return s + " load_cell=" + (in.analog.beat_force_valid ? std::to_string(in.analog.beat_force_n) + "N" : "-");
+  return s +
+         " load_cell=" + (in.analog.beat_force_valid ? std::to_string(in.analog.beat_force_n) + "N" : "-");
 }
 
 // Every input whose value changed since the last call, one line each: wiring is checked by working
@@ -114,12 +114,10 @@ class Commissioning {
   Commissioning(const CommissionArgs& a, LoomConfig cfg, std::string text)
       : a_(a), cfg_(std::move(cfg)), text_(std::move(text)) {}
 
-  int run(Machine& m) {
-    loop_ = &m.loop();
-    seq_ = &m.sequencer();
-    realtime_ = a_.hal == "socketcan" || (a_.capture.empty() && !a_.io_once);
-    period_ns_ = static_cast<std::int64_t>(std::llround(cfg_.sequencer.period_s * 1e9));
-    clock_gettime(CLOCK_MONOTONIC, &next_);
+  int run(Session& session) {
+    session_ = &session;
+    loop_ = &session.machine().loop();
+    seq_ = &session.machine().sequencer();
     tick(static_cast<hal::Tick>(std::ceil(a_.settle_s / cfg_.sequencer.period_s)));
     if (!all_disabled()) {
       std::fprintf(stderr, "loomctl commission: a drive is not disabled (%s); refusing to go on\n",
@@ -127,7 +125,8 @@ class Commissioning {
       return kExitNotArmed;
     }
     if (a_.io_once || !a_.capture.empty()) {
-      std::printf("%s\n%s\n", positions_line(loop_->inputs(), cfg_.sequencer.axes).c_str(), inputs_line(loop_->inputs(), cfg_.sequencer.second_channel).c_str());
+      std::printf("%s\n%s\n", positions_line(loop_->inputs(), cfg_.sequencer.axes).c_str(),
+                  inputs_line(loop_->inputs(), cfg_.sequencer.second_channel).c_str());
       for (const std::string& c : a_.capture) {
         if (!take(*capture_named(c))) return kExitBadInput;  // nothing written
       }
@@ -137,20 +136,8 @@ class Commissioning {
   }
 
  private:
-  // Runs `n` ticks at the loop period (real time on a bus, as fast as possible in a simulation run
-  // non-interactively); drives are never asked to enable: the sequencer is idle and stays so.
-  void tick(hal::Tick n) {
-    for (hal::Tick i = 0; i < n; ++i) {
-      loop_->cycle(now_++);
-      if (!realtime_) continue;
-      next_.tv_nsec += period_ns_;
-      while (next_.tv_nsec >= 1'000'000'000) {
-        next_.tv_nsec -= 1'000'000'000;
-        ++next_.tv_sec;
-      }
-      clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next_, nullptr);
-    }
-  }
+  // Drives are never asked to enable: the sequencer is idle and stays so.
+  void tick(hal::Tick n) { session_->tick(n); }
 
   bool all_disabled() const {
     for (const hal::AxisFeedback& fb : loop_->inputs().axes) {
@@ -182,7 +169,8 @@ class Commissioning {
     std::string next;
     try {
       next = set_toml_values(text_, captured_, changes);
-      parse_loom_config(next, a_.config);  // the file must still be a valid loom before it replaces the old one
+      parse_loom_config(next,
+                        a_.config);  // the file must still be a valid loom before it replaces the old one
       write_file_durably(a_.config, next);
     } catch (const std::exception& e) {  // an invalid result (ConfigError) or a failed write
       std::fprintf(stderr, "loomctl commission: %s: not written: %s\n", a_.config.c_str(), e.what());
@@ -195,9 +183,11 @@ class Commissioning {
   }
 
   int interactive() {
-    std::printf("%s\n%s\n", positions_line(loop_->inputs(), cfg_.sequencer.axes).c_str(), inputs_line(loop_->inputs(), cfg_.sequencer.second_channel).c_str());
-    std::printf("drives disabled: move each axis by hand. Type park (crank at its park pose), home (carriage at the "
-                "left selvedge), left (helix carrier at the left selvedge), write, positions, io, or quit.\n");
+    std::printf("%s\n%s\n", positions_line(loop_->inputs(), cfg_.sequencer.axes).c_str(),
+                inputs_line(loop_->inputs(), cfg_.sequencer.second_channel).c_str());
+    std::printf(
+        "drives disabled: move each axis by hand. Type park (crank at its park pose), home (carriage at the "
+        "left selvedge), left (helix carrier at the left selvedge), write, positions, io, or quit.\n");
     hal::DigitalInputs last = loop_->inputs().io;
     const hal::Tick per_second = static_cast<hal::Tick>(std::llround(1.0 / cfg_.sequencer.period_s));
     std::string pending;
@@ -216,7 +206,8 @@ class Commissioning {
         std::string cmd = pending.substr(0, nl);
         pending.erase(0, nl + 1);
         while (!cmd.empty() && (cmd.back() == ' ' || cmd.back() == '\r')) cmd.pop_back();
-        if (cmd == "quit") return captured_.empty() ? kExitOk : (std::printf("not written (quit)\n"), kExitOk);
+        if (cmd == "quit")
+          return captured_.empty() ? kExitOk : (std::printf("not written (quit)\n"), kExitOk);
         if (cmd == "write") {
           if (const int rc = write(); rc != kExitOk) return rc;
         } else if (cmd == "positions") {
@@ -235,12 +226,9 @@ class Commissioning {
   const CommissionArgs& a_;
   LoomConfig cfg_;
   std::string text_;
+  Session* session_ = nullptr;
   ControlLoop* loop_ = nullptr;
   sequencer::Sequencer* seq_ = nullptr;
-  bool realtime_ = false;
-  std::int64_t period_ns_ = 0;
-  timespec next_{};
-  hal::Tick now_ = 0;
   std::vector<TomlAssignment> captured_;
 };
 
@@ -257,38 +245,21 @@ int run_commission(const CommissionArgs& a) {
     std::fprintf(stderr, "loomctl commission: --write needs --capture (interactively, type write)\n");
     return kExitBadInput;
   }
-  if (a.hal == "socketcan" && a.iface.empty()) {
-    std::fprintf(stderr, "loomctl commission: --hal socketcan needs --iface NAME\n");
-    return kExitBadInput;
-  }
-  LoomConfig cfg;
-  std::string text;
-  try {
-    text = read_config_file(a.config);
-    cfg = parse_loom_config(text, a.config);
-  } catch (const ConfigError& e) {
-    std::fprintf(stderr, "loomctl commission: %s\n", e.what());
-    return kExitBadInput;
-  }
-  MachineOptions mo;
-  mo.hal = a.hal == "socketcan" ? HalKind::kSocketCan : HalKind::kSim;
-  mo.iface = a.iface;
-  mo.telemetry = false;
-  mo.rows = 0;
-  mo.sim_state_path = a.sim_state;
-  if (!a.io.empty()) mo.io = a.io == "simulated" ? IoKind::kSimulated : IoKind::kCan;
-  std::unique_ptr<Machine> machine;
-  try {
-    machine = std::make_unique<Machine>(cfg, default_scene(), mo, sequencer::Counters{});
-  } catch (const ConfigError& e) {
-    std::fprintf(stderr, "loomctl commission: %s\n", e.what());
-    return kExitBadInput;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "loomctl commission: cannot bring the bus up: %s\n", e.what());
-    return kExitNotArmed;
-  }
-  if (!machine->banner().empty()) std::fprintf(stderr, "loomctl commission: WARNING: %s\n", machine->banner().c_str());
-  return Commissioning(a, cfg, text).run(*machine);
+  const Say say = console_say("loomctl commission");
+  return exit_code_of(say, [&] {
+    SessionOptions so = SessionOptions::from_command_line(a.hal, a.iface, a.io);
+    // Interactive: the positions and inputs move at the machine's pace. Scripted: as fast as it can.
+    so.realtime = a.capture.empty() && !a.io_once;
+    const std::string text = read_config_file(a.config);
+    const LoomConfig cfg = parse_loom_config(text, a.config);
+    Session session(so, say);
+    MachineOptions mo;
+    mo.telemetry = false;
+    mo.rows = 0;
+    mo.sim_state_path = a.sim_state;
+    session.build(cfg, default_scene(), mo, sequencer::Counters{});
+    return Commissioning(a, cfg, text).run(session);
+  });
 }
 
 }  // namespace loom::firmware

@@ -12,12 +12,12 @@
 namespace loom::firmware {
 
 struct CommissionArgs {
-  std::string config;              // required: the file the calibration is written into
+  std::string config;  // required: the file the calibration is written into
   std::string hal = "sim", iface, io, sim_state;
   std::vector<std::string> capture;  // park, home, left: capture these at once (non-interactive)
-  bool write = false;              // with --capture: write them into the config
-  bool io_once = false;            // print positions and every input once, then exit
-  double settle_s = 0.5;           // non-interactive: run this long before reading (first PDOs, debounce)
+  bool write = false;                // with --capture: write them into the config
+  bool io_once = false;              // print positions and every input once, then exit
+  double settle_s = 0.5;             // non-interactive: run this long before reading (first PDOs, debounce)
 };
 
 // Exit code: 0 done, 2 bad input, 4 cannot bring the bus up.

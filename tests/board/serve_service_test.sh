@@ -162,8 +162,14 @@ d=$last
 wait_socket "$work/d.sock"
 ctl "$work/d.sock" start >/dev/null
 wait_for "$work/d.sock" rows 1 30
-fill
+# Kept full until a save fails: a fill that lands while a save's temporary file exists leaves the old
+# counters' page free once that save renames over them, and the saves could go on in it for ever (seen
+# on a loaded host). Each round fills a new file: dd truncating the last one would free its pages first.
+keep_full() { local i=0; while :; do dd if=/dev/zero of="$work/disk/fill.$i" bs=4k status=none 2>/dev/null || true; i=$((i + 1)); sleep 0.1; done; }
+keep_full &
+filler=$!
 wait_for "$work/d.sock" fault counters_not_saved 60
+kill "$filler" 2>/dev/null || true; wait "$filler" 2>/dev/null || true
 woven=$(field "$work/d.sock" rows)
 on_disk=$(grep -o '"rows":[0-9]*' "$work/disk/state/counters.json" | cut -d: -f2)
 ((on_disk < woven)) || fail "the file kept up ($on_disk rows) with the woven $woven: the disk did not fill"
@@ -174,7 +180,7 @@ reply=$(ctl "$work/d.sock" ack 2>&1) || rc=$?
 sleep 1
 [[ $(field "$work/d.sock" state) == fault ]] || fail "ack re-armed while the counters could not be saved: $(ctl "$work/d.sock" status)"
 [[ $(field "$work/d.sock" rows) == "$woven" ]] || fail "rows changed from $woven under a refused ack"
-rm -f "$work/disk/fill"
+rm -f "$work/disk/fill"*
 for _ in $(seq 1 60); do
   [[ $(grep -o '"rows":[0-9]*' "$work/disk/state/counters.json" | cut -d: -f2) == "$woven" ]] && break
   sleep 0.1

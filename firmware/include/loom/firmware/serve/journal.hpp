@@ -7,9 +7,11 @@
 #include <cstdarg>
 #include <string>
 
+#include "loom/firmware/severity.hpp"
+
 namespace loom::firmware::serve {
 
-enum class Severity : int { kErr = 3, kWarning = 4, kNotice = 5, kInfo = 6, kDebug = 7 };
+using loom::firmware::Severity;
 
 // Whether lines carry the "<N>" prefix: true when JOURNAL_STREAM is set (or LOOM_LOG_PREFIX=1),
 // false when LOOM_LOG_PREFIX=0. Decided once, at the first line.

@@ -1,0 +1,401 @@
+// See weave_cmd.hpp. The session's steps are the Session's; what is weave's own is its policy: the
+// signals, the recipe reload, the simulated weaver, and what it prints and writes about each row.
+#include "weave_cmd.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <vector>
+
+#include "loom/firmware/carpet_png.hpp"
+#include "loom/firmware/session.hpp"
+#include "loom/motion/angles.hpp"
+#include "loom/report/run_report.hpp"
+
+namespace loom::firmware {
+namespace {
+
+std::atomic<bool> g_stop{false};
+std::atomic<bool> g_stop_now{false};
+std::atomic<bool> g_reload{false};
+std::atomic<bool> g_pause{false};
+// The first SIGINT/SIGTERM stops at the end of the row; a second one stops at once (safe stop: quick
+// stop of every axis, valves hold, counters kept, fault stop_requested).
+extern "C" void on_signal(int) {
+  if (g_stop.exchange(true)) g_stop_now.store(true);
+}
+extern "C" void on_hangup(int) {
+  g_reload.store(true);
+}
+extern "C" void on_pause(int) {
+  g_pause.store(true);
+}
+extern "C" void on_resume(int) {
+  g_pause.store(false);
+}
+
+// What weave resolved from its arguments before anything is built.
+struct WeaveInputs {
+  Scene scene;
+  LoomConfig cfg;
+  std::string config_path;  // "" = the embedded default (nothing to reload)
+};
+
+WeaveInputs resolve_inputs(const WeaveArgs& a) {
+  WeaveInputs in;
+  in.scene = a.scene.empty() ? default_scene() : load_scene(a.scene);
+  in.config_path = a.config;
+  if (in.config_path.empty() && !in.scene.config_path.empty()) {
+    in.config_path = (std::filesystem::path(a.scene).parent_path() / in.scene.config_path).string();
+  }
+  in.cfg = in.config_path.empty() ? default_loom_config() : load_loom_config(in.config_path);
+  if (a.period_ms > 0.0) {
+    in.cfg.run.period_s = a.period_ms * 1e-3;
+    rederive_and_check(in.cfg, "--period-ms = " + std::to_string(a.period_ms));
+  }
+  if (!a.lcm_url.empty()) in.cfg.telemetry.lcm_url = a.lcm_url;
+  if (!a.loom_id.empty()) in.cfg.loom_id = a.loom_id;
+  return in;
+}
+
+void print_header(const Machine& m, const Scene& scene, const WeaveArgs& a) {
+  const auto& p = m.profiles();
+  const auto& w = p.beatup().warp();
+  std::printf("loomctl: loom '%s' (%s), width %.3f m, period %.3g ms, HAL %s%s%s\n",
+              m.config().loom_id.c_str(), m.config().source.c_str(), p.spec().width_m,
+              m.config().sequencer.period_s * 1e3, a.hal.c_str(), a.hal == "sim" ? ", scene " : ", iface ",
+              a.hal == "sim" ? scene.spec.name.c_str() : a.iface.c_str());
+  if (a.hal == "sim") {
+    std::string effects;
+    for (const auto& e : scene.spec.effects) effects += (effects.empty() ? "" : ", ") + e;
+    std::printf("  effects: %s\n", effects.c_str());
+  }
+  std::printf(
+      "  beat-up: swing %.2f deg, stroke %.1f mm, warp window %.1f..%.1f deg from park, %d beats/row "
+      "at %.1f rad/s, pitch %.1f mm\n",
+      motion::deg(p.beatup().dead_centres().swing), p.beatup().stroke_arc_m() * 1e3, motion::deg(w.enter),
+      motion::deg(w.exit), p.beats_per_row(), p.spec().crank.velocity, p.pitch_m() * 1e3);
+  std::printf("  pick: %.2f helix turns in %.3f s (accel limit %.0f rad/s^2, carrier and drive)\n",
+              p.spec().width_m / p.spec().helix_lead_m, p.pick().duration(), p.helix_accel_limit());
+  for (const std::string& n : m.notes()) std::printf("  CAN: %s\n", n.c_str());
+}
+
+// The reporter's side of a weave: what each run event prints, writes and saves. Called between ticks in
+// virtual time, on the reporter thread in real time; never from the loop.
+class WeaveReporter {
+ public:
+  WeaveReporter(const WeaveArgs& a, const WeaveInputs& in, Machine& m, ProductionRecord& record,
+                std::unique_ptr<report::ReportWriter> writer, const sequencer::Counters& resume)
+      : a_(a),
+        in_(in),
+        m_(m),
+        record_(record),
+        writer_(std::move(writer)),
+        period_(in.cfg.sequencer.period_s),
+        target_rows_(resume.rows + a.rows),
+        picks_at_row_start_(resume.picks),
+        progress_bar_(isatty(STDOUT_FILENO) && a.rows >= 20 && !a.quiet) {}
+
+  void operator()(const RunEvent& e) {
+    m_.collect_retired_recipes();
+    if (g_reload.exchange(false)) reload_recipe();
+    if (e.kind == RunEvent::Kind::kWeaverRequest && m_.knot_program() != nullptr) {
+      ++weaver_requests_;
+      std::printf("weaver asked: %s\n", sequencer::describe(e.request, *m_.knot_program()).c_str());
+      std::fflush(stdout);
+    }
+    if (e.kind == RunEvent::Kind::kPaused || e.kind == RunEvent::Kind::kResumed) {
+      std::printf("%s after row %u, pick %u\n", e.kind == RunEvent::Kind::kPaused ? "paused" : "resumed",
+                  e.counters.rows, e.counters.picks);
+      std::fflush(stdout);
+    }
+    if (e.kind == RunEvent::Kind::kRowDone) row_done(e);
+    // Saved after the reload above, so a row that waits for this save starts with the new recipe.
+    if (record_.kept()) save(e.counters);
+  }
+
+  std::unique_ptr<report::ReportWriter>& writer() { return writer_; }
+  const std::string& counters_error() const { return counters_error_; }
+
+  // The rows woven in this run against the hand's time for the same row (the thesis, ch. 6: ~5 min
+  // knotting + 2 shedding and picking + 3 beating). A flat weave has no knots: its rows compare with the
+  // 5 min of shed, pick and beat. A knotted row compares whole: the machine's time plus whatever the
+  // weaver's hands took (knotting every row, or helping the heads).
+  void print_speed(const sequencer::Counters& c) const {
+    if (rows_ == 0) return;
+    const double per_row = machine_s_ / rows_;
+    if (in_.cfg.knotting.mode == sequencer::KnottingMode::kNone) {
+      std::printf(
+          "woven %u rows (total %u): %.2f s per row vs ~300 s by hand (shed, pick, beat: %.0fx faster); "
+          "picks %u, beats %u\n",
+          rows_, c.rows, per_row, 300.0 / per_row, c.picks, c.beats);
+      return;
+    }
+    const double whole = per_row + weaver_outside_s_ / rows_;
+    std::printf(
+        "woven %u knotted rows (total %u): %.2f s per whole row (knotting %.2f s by the heads, %.2f s by "
+        "the weaver's hands) vs ~600 s for the weaver's whole row (%.1fx faster); picks %u, beats %u, knots "
+        "%u tied by the heads, %u retried, %u by hand, %u requests to the weaver\n",
+        rows_, c.rows, whole, knot_s_ / rows_, weaver_s_ / rows_, 600.0 / whole, c.picks, c.beats,
+        c.knot.tied, c.knot.retried, c.knot.by_hand, weaver_requests_);
+  }
+
+ private:
+  double secs(hal::Tick t) const { return static_cast<double>(t) * period_; }
+
+  // SIGHUP: re-read the recipe (the loom config file) and hand it to the loop for the next row.
+  void reload_recipe() {
+    try {
+      if (in_.config_path.empty())
+        throw ConfigError("no --config file to reload (running the embedded default)");
+      LoomConfig next = load_loom_config(in_.config_path);
+      // Command-line overrides of run settings hold for the reloaded file too.
+      next.run.period_s = in_.cfg.run.period_s;
+      next.telemetry.lcm_url = in_.cfg.telemetry.lcm_url;
+      next.loom_id = in_.cfg.loom_id;
+      derive_module_configs(next);
+      m_.publish_recipe(next);
+      std::printf("recipe: %s reloaded; the loom adopts it at the next row\n", in_.config_path.c_str());
+    } catch (const ConfigError& ex) {
+      std::fprintf(stderr, "loomctl: recipe not reloaded, weaving on with the current one: %s\n", ex.what());
+    }
+  }
+
+  void row_done(const RunEvent& e) {
+    const sequencer::RowStats& r = e.row;
+    ++rows_;
+    machine_s_ += secs(r.total_ticks);
+    knot_s_ += secs(r.knot_ticks);
+    weaver_s_ += secs(r.knotting_ticks + r.weaver_ticks);
+    weaver_outside_s_ += secs(r.knotting_ticks);  // the weaver's own knotting is not in the row's time
+    if (writer_) {
+      try {
+        writer_->add_row(r, e.counters.picks - picks_at_row_start_, secs(e.tick));
+      } catch (const std::exception& ex) {
+        std::fprintf(stderr, "loomctl: WARNING: report row not written: %s\n", ex.what());
+      }
+    }
+    picks_at_row_start_ = e.counters.picks;
+    if (progress_bar_) {
+      const int width = 40;
+      const int done = static_cast<int>(width * rows_ / a_.rows);
+      std::printf("\r[%.*s%*s] %u/%u rows", done, "########################################", width - done,
+                  "", rows_, a_.rows);
+      if (rows_ == a_.rows) std::printf("\n");
+    } else {
+      print_row(r);
+    }
+    std::fflush(stdout);
+  }
+
+  void print_row(const sequencer::RowStats& r) const {
+    std::printf("row %u/%u: %.2f s (shed %.2f s, pick %.2f s, beat %.2f s), %d beats, %d carriage steps",
+                r.row, target_rows_, secs(r.total_ticks), secs(r.shed_ticks), secs(r.pick_ticks),
+                secs(r.beat_ticks), r.beats, r.carriage_steps);
+    if (r.knotting_ticks > 0) std::printf(", knotted in %.2f s before it", secs(r.knotting_ticks));
+    if (r.knots_tied + r.knots_by_hand > 0) {
+      std::printf(", %d knots tied in %.2f s (%d retried, %d by hand", r.knots_tied, secs(r.knot_ticks),
+                  r.knots_retried, r.knots_by_hand);
+      if (r.weaver_ticks > 0) std::printf(", %.2f s waiting for the weaver", secs(r.weaver_ticks));
+      std::printf(")");
+    }
+    if (r.force_measured) {
+      std::printf(", peak beat force min/mean/max %.1f/%.1f/%.1f N", r.force_min_n, r.force_mean_n,
+                  r.force_max_n);
+    }
+    std::printf("\n");
+  }
+
+  void save(const sequencer::Counters& c) {
+    try {
+      record_.save(c);
+    } catch (const std::exception& ex) {
+      // The sequencer stops at the row boundary (a safe point) with counters_not_saved, keeping its counters.
+      if (counters_error_.empty()) {
+        std::fprintf(stderr, "loomctl: counters not saved: %s; stopping at the end of the row\n", ex.what());
+      }
+      counters_error_ = ex.what();
+    }
+  }
+
+  const WeaveArgs& a_;
+  const WeaveInputs& in_;
+  Machine& m_;
+  ProductionRecord& record_;
+  std::unique_ptr<report::ReportWriter> writer_;  // streams each row to disk (constant memory)
+  const double period_;
+  const std::uint32_t target_rows_;
+  std::uint32_t picks_at_row_start_;
+  const bool progress_bar_;  // a terminal only; logs get the per-row lines
+  std::uint32_t rows_ = 0;   // rows woven in this run
+  double machine_s_ = 0.0;
+  double knot_s_ = 0.0, weaver_s_ = 0.0;  // the heads' knotting, and the weaver's hands, in those rows
+  double weaver_outside_s_ = 0.0;
+  std::uint32_t weaver_requests_ = 0;
+  std::string counters_error_;  // why the last save failed
+};
+
+std::unique_ptr<report::ReportWriter> open_report(const WeaveArgs& a, const WeaveInputs& in, bool hardware) {
+  if (a.report.empty()) return nullptr;
+  report::RunHeader rh;
+  rh.loom_id = in.cfg.loom_id;
+  rh.scene = hardware ? "socketcan:" + a.iface : in.scene.spec.name;
+  rh.effects = hardware ? std::vector<std::string>{} : in.scene.spec.effects;
+  rh.period_s = in.cfg.sequencer.period_s;
+  rh.beat_force_min_n = in.cfg.sequencer.beat_force_min_n;
+  rh.beat_force_max_n = in.cfg.sequencer.beat_force_max_n;
+  try {
+    return std::make_unique<report::ReportWriter>(a.report, rh);
+  } catch (const std::exception& e) {
+    throw SessionError(kExitBadInput, "--report " + a.report + ": " + e.what());
+  }
+}
+
+// The carpet the simulated heads knotted, beside the report, compared with the design knot for knot.
+void write_carpet(const WeaveArgs& a, const LoomConfig& cfg, Machine& m) {
+  const sim_hal::SimKnotter* k = m.sim().knotter();
+  if (k == nullptr || a.report.empty()) return;
+  const std::string png = a.report + "/carpet.png";
+  try {
+    const CarpetCheck cc = write_carpet_png(*k, *m.knot_program(), *cfg.recipe.design, k->first_row(), png);
+    std::printf("carpet: %s: %d rows from production row %u (design row %d), %d knots (%d by hand); %s\n",
+                png.c_str(), cc.rows, k->first_row(), m.knot_program()->design_row(k->first_row()) + 1,
+                cc.knots, cc.by_hand,
+                cc.equal() ? "equals the design knot for knot"
+                           : ("DIFFERS from the design: " + std::to_string(cc.missing) + " missing, " +
+                              std::to_string(cc.wrong) + " wrong colour, " + std::to_string(cc.doubled) +
+                              " tied twice")
+                                 .c_str());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "loomctl: %s\n", e.what());
+  }
+}
+
+void print_fault(const FaultReport& f, double period, const sequencer::Counters& c) {
+  const std::string note = f.stopped_note();
+  std::printf(
+      "FAULT %s (code 0x%04X%s%s%s%s, device code 0x%04X) at t=%.3f s%s%s: %s; rows completed %u, picks %u, "
+      "beats %u\n",
+      f.name(), f.code(), f.axis.empty() ? "" : ", axis ", f.axis.c_str(), f.sensor >= 0 ? ", sensor " : "",
+      f.sensor_name(), f.device_code, static_cast<double>(f.tick) * period, note.empty() ? "" : " ",
+      note.c_str(), sequencer::fault_text(f.fault), c.rows, c.picks, c.beats);
+}
+
+int weave(const WeaveArgs& a, const Say& say) {
+  // ---- build and arm: everything that can fail on input fails here, before anything moves ----
+  SessionOptions so = SessionOptions::from_command_line(a.hal, a.iface, a.io, a.pace);
+  so.realtime = a.realtime;
+  so.allow_degraded = a.allow_degraded;
+  const WeaveInputs in = resolve_inputs(a);
+  if (a.knotting_s > 0.0 && (so.hardware() || !in.cfg.sequencer.knotting)) {
+    char value[32];
+    std::snprintf(value, sizeof value, "%g", a.knotting_s);
+    throw ConfigError(std::string("--knotting-s = ") + value + ": " +
+                      (so.hardware() ? "the simulated weaver exists in simulation only (on a loom the weaver "
+                                       "presses the pedal)"
+                                     : "the loom has no weaver's knotting (set knotting.mode = \"weaver\")"));
+  }
+  ProductionRecord record(a.counters, in.cfg);
+  const sequencer::Counters resume = record.load();
+  // `--rows N` weaves N more rows after the ones already counted; the sum must stay a count.
+  if (static_cast<std::uint64_t>(resume.rows) + a.rows > UINT32_MAX) {
+    throw ConfigError("--rows = " + std::to_string(a.rows) + ": after row " + std::to_string(resume.rows) +
+                      " this would pass the row counter's range (4294967295); counters are never wrapped");
+  }
+  record.prove_writable(resume);  // a loom that must count and cannot refuses to arm
+  const std::uint64_t design_rows = record.activate_design(resume.rows);
+  record.begin_session(resume);
+  prepare_realtime(so, say);
+
+  Session session(so, say);
+  MachineOptions mo;
+  mo.telemetry = !a.no_telemetry;
+  mo.rows = resume.rows + a.rows;  // the sequencer counts absolute rows; weave `rows` more
+  mo.sim_state_path = a.sim_state;
+  mo.await_row_saved = record.kept();  // no row starts before the one before it is on disk
+  mo.design_rows_done = design_rows;
+  Machine& machine = session.build(in.cfg, in.scene, mo, resume);
+  if (!a.quiet) print_header(machine, in.scene, a);
+  if (resume.rows > 0) {
+    std::printf("  resuming after row %u (picks %u, beats %u)\n", resume.rows, resume.picks, resume.beats);
+  }
+  if (const auto& d = in.cfg.recipe.design; d && !a.quiet) {
+    std::printf("  %s%s\n", design_position(*d, design_rows).c_str(),
+                record.kept() ? "" : " (no --counters: the row reached is not remembered)");
+  }
+
+  // ---- run ----
+  WeaveReporter reporter(a, in, machine, record, open_report(a, in, so.hardware()), resume);
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  std::signal(SIGHUP, on_hangup);
+  std::signal(SIGUSR1, on_pause);  // pause at the next safe point (before a shed change)
+  std::signal(SIGUSR2, on_resume);
+  sequencer::Sequencer& seq = machine.sequencer();
+  seq.request_start();
+  RunOptions ro = session.run_options(&record);
+  ro.grace_ticks = static_cast<hal::Tick>(0.2 / ro.period_s);
+  ro.stop_flag = &g_stop;
+  ro.stop_now_flag = &g_stop_now;
+  ro.pause_flag = &g_pause;
+  ro.simulated_knotting_s = a.knotting_s;
+  if (machine.knot_program() != nullptr && !so.hardware()) {
+    ro.weaver_sink = Machine::simulated_weaver_sink;
+    ro.weaver_sink_ctx = &machine;
+  }
+  const RunResult res = session.run(ro, [&reporter](const RunEvent& e) { reporter(e); });
+
+  // ---- report ----
+  const sequencer::Counters& c = seq.counters();
+  const std::optional<FaultReport> fault = session.fault();
+  const double period = ro.period_s;
+  report::RunEnd summary;
+  summary.counters = c;
+  summary.machine_s = static_cast<double>(res.ticks) * period;
+  summary.wall_s = res.wall_s;
+  if (fault) {
+    summary.fault = report::FaultSummary{fault->name(),
+                                         fault->code(),
+                                         fault->axis,
+                                         fault->device_code,
+                                         static_cast<double>(fault->tick) * period,
+                                         sequencer::fault_name(fault->stopped_by),
+                                         sequencer::fault_text(fault->fault)};
+  }
+  if (!so.hardware()) write_carpet(a, in.cfg, machine);
+  if (auto& writer = reporter.writer()) {
+    try {
+      writer->finish(summary);
+      std::printf("report: %s/summary.json, beat_force.svg, row_timeline.svg\n", a.report.c_str());
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "loomctl: report not written: %s\n", e.what());
+    }
+  }
+  if (fault) {
+    print_fault(*fault, period, c);
+    if (fault->fault == sequencer::Fault::kCountersNotSaved && !reporter.counters_error().empty()) {
+      std::printf("  the save failed: %s\n", reporter.counters_error().c_str());
+    }
+    return kExitFault;
+  }
+  if (!reporter.counters_error().empty()) {
+    std::printf("FAULT counters_not_saved: %s; rows completed %u, picks %u, beats %u (not on disk)\n",
+                reporter.counters_error().c_str(), c.rows, c.picks, c.beats);
+    return kExitFault;
+  }
+  reporter.print_speed(c);
+  return kExitOk;
+}
+
+}  // namespace
+
+int run_weave(const WeaveArgs& a) {
+  const Say say = console_say("loomctl");
+  return exit_code_of(say, [&] { return weave(a, say); });
+}
+
+}  // namespace loom::firmware
