@@ -19,6 +19,7 @@
 #include <thread>
 
 #include "loom/firmware/latency_histogram.hpp"
+#include "loom/sequencer/operator_requests.hpp"
 #include "loom/telemetry/spsc_ring.hpp"
 #include "loom/telemetry/telemetry.hpp"
 
@@ -205,29 +206,13 @@ class LoopBody {
     res.telemetry_wait_max_ns = std::max(res.telemetry_wait_max_ns, waited);
   }
 
-  // Applies operator commands (and button edges). True when the session ends here.
+  // Applies operator commands, the I/O module's presses among them. True when the session ends here.
   bool take_commands(hal::Tick tick) noexcept {
     std::uint32_t cmds = 0;
     if (opt_.link != nullptr && opt_.link->pending.load(std::memory_order_relaxed) != 0) {
       cmds = opt_.link->pending.exchange(0, std::memory_order_acquire);
     }
-    if (opt_.operator_buttons) {
-      // The presses the sequencer saw in the last tick (debounced, one per press), as commands, each audited:
-      // the reporter logs who gave the command, the I/O module's button.
-      for (const sequencer::TickEvent& ev : seq_.events()) {  // bounded: TickEvents::kCapacity
-        if (ev.kind != sequencer::EventKind::kButton || ev.button == sequencer::Button::kRowKnotted) continue;
-        const Command c = ev.button == sequencer::Button::kStart   ? Command::kStart
-                          : ev.button == sequencer::Button::kPause ? Command::kPause
-                                                                   : Command::kAck;
-        cmds |= static_cast<std::uint32_t>(c);
-        RunEvent e = base_event(RunEvent::Kind::kButton, tick);
-        e.button = c;
-        // The state the press was seen in: the sequencer may have acted on it in that tick already (a start
-        // press has left idle), and the audit's verdict is the one the press got.
-        e.state = seq_.events().began_in();
-        emit(e);
-      }
-    }
+    cmds |= take_presses(tick);
     if (opt_.stop_flag != nullptr && !stop_sent_ && opt_.stop_flag->load(std::memory_order_relaxed)) {
       seq_.request_stop_at_row_end();
       stop_sent_ = true;
@@ -237,7 +222,11 @@ class LoopBody {
       stop_now_sent_ = true;
     }
     if (opt_.pause_flag != nullptr) {
-      opt_.pause_flag->load(std::memory_order_relaxed) ? seq_.request_pause() : seq_.request_resume();
+      // On a change only: held level every tick, the flag would cancel a pause press at the next tick (and
+      // re-pause a loom a start press resumed). The last operator act wins, whatever its station.
+      const bool pause = opt_.pause_flag->load(std::memory_order_relaxed);
+      if (pause != pause_flag_was_) pause ? seq_.request_pause() : seq_.request_resume();
+      pause_flag_was_ = pause;
     }
     if (opt_.simulated_knotting_s > 0.0) {
       knotting_wait_ = seq_.state() == sequencer::State::kAwaitKnotting ? knotting_wait_ + 1 : 0;
@@ -253,16 +242,16 @@ class LoopBody {
     const auto has = [&](Command c) { return (cmds & static_cast<std::uint32_t>(c)) != 0; };
     const sequencer::State s = seq_.state();
     RunResult& res = rt_.result;
-    if (has(Command::kNext)) seq_.request_row_knotted();
-    if (has(Command::kPause)) seq_.request_pause();
+    // Start, pause and next mean what operator_requests.hpp says, as a press of the same button does.
+    if (has(Command::kNext)) sequencer::make_request(seq_, sequencer::OperatorRequest::kRowKnotted);
+    if (has(Command::kPause)) sequencer::make_request(seq_, sequencer::OperatorRequest::kPause);
     if (has(Command::kResume)) seq_.request_resume();
     if (has(Command::kStart)) {
-      if (s == sequencer::State::kIdle) seq_.request_start();
-      if (s == sequencer::State::kPaused) seq_.request_resume();
       if (s == sequencer::State::kDone && opt_.hold_when_finished) {
         res.end = RunResult::End::kStartRequested;
         return true;
       }
+      sequencer::make_request(seq_, sequencer::OperatorRequest::kStart);
     }
     if (has(Command::kStop) && s != sequencer::State::kIdle && s != sequencer::State::kDone &&
         s != sequencer::State::kFault) {
@@ -270,7 +259,12 @@ class LoopBody {
       seq_.request_stop_at_row_end();
       seq_.request_resume();  // paused between picks: finish the row, then stop
     }
+    if (has(Command::kAck) && s == sequencer::State::kFault && !opt_.hold_when_finished) {
+      // weave: back to idle (refused while the e-stop chain is open); the run ends after its grace anyway.
+      sequencer::make_request(seq_, sequencer::OperatorRequest::kAcknowledge);
+    }
     if (has(Command::kAck) && s == sequencer::State::kFault && opt_.hold_when_finished) {
+      // The service re-arms instead of acknowledging in place.
       // Re-arming reconfigures the link: pointless (and the operator would think it done) while the
       // controller is still off the bus or a lost node is still silent. The status says which.
       // Likewise while the e-stop chain is still open: the fault stays latched (re-arming would show no
@@ -295,6 +289,45 @@ class LoopBody {
       if (!quiet_state()) seq_.request_stop_at_row_end();
     }
     return false;
+  }
+
+  // The presses the sequencer saw in the last tick (debounced, one event per press) as the commands of the
+  // same words: from here on a press goes the way a command from the socket goes. Each start, pause and ack
+  // press is audited once (operator_buttons), in the state the tick that saw it began in: that is the state
+  // the press was judged in (an ack press counts only if the fault was latched before it).
+  std::uint32_t take_presses(hal::Tick tick) noexcept {
+    std::uint32_t cmds = 0;
+    const sequencer::TickEvents& events = seq_.events();
+    for (const sequencer::TickEvent& ev : events) {  // bounded: TickEvents::kCapacity
+      if (ev.kind != sequencer::EventKind::kButton) continue;
+      const sequencer::OperatorRequest r = sequencer::request_of(ev.button, events.began_in());
+      cmds |= static_cast<std::uint32_t>(command_of(r));
+      // The pedal is not audited: the service's record names only the three buttons.
+      if (!opt_.operator_buttons || ev.button == sequencer::Button::kRowKnotted) continue;
+      RunEvent e = base_event(RunEvent::Kind::kButton, tick);
+      e.button = ev.button == sequencer::Button::kStart   ? Command::kStart
+                 : ev.button == sequencer::Button::kPause ? Command::kPause
+                                                          : Command::kAck;
+      e.state = events.began_in();
+      emit(e);
+    }
+    return cmds;
+  }
+
+  static Command command_of(sequencer::OperatorRequest r) noexcept {
+    switch (r) {
+      case sequencer::OperatorRequest::kStart:
+        return Command::kStart;
+      case sequencer::OperatorRequest::kPause:
+        return Command::kPause;
+      case sequencer::OperatorRequest::kAcknowledge:
+        return Command::kAck;
+      case sequencer::OperatorRequest::kRowKnotted:
+        return Command::kNext;
+      case sequencer::OperatorRequest::kNone:
+        break;
+    }
+    return Command{};
   }
 
   // Nothing is moving towards a goal: leaving the loop here loses no row in progress.
@@ -385,6 +418,7 @@ class LoopBody {
   LoopStats& stats_;
   telemetry::Telemetry* telemetry_;  // non-null: virtual time, lossless telemetry (wait before the tick)
   bool stop_sent_ = false, stop_now_sent_ = false, exit_pending_ = false;
+  bool pause_flag_was_ = false;     // pause_flag as last seen
   std::int64_t knotting_wait_ = 0;  // ticks the loom has waited for the simulated weaver
 };
 
@@ -481,9 +515,6 @@ RunResult run_loop(ControlLoop& loop, sequencer::Sequencer& seq, const RunOption
   // Configure-time: the histograms (and in real time the ~2 MB event ring) live on the heap,
   // value-initialised, which touches every page before the loop starts.
   auto rt = std::make_unique<Runtime>(loop, seq, opt, clock, on_event);
-  // With the buttons and a session held after a fault, an ack ends the session (the owner re-arms): the
-  // sequencer reports that press and leaves it to us.
-  if (opt.operator_buttons && opt.hold_when_finished) seq.leave_ack_button_to_owner();
 
   if (!opt.realtime) {
     LoopBody(*rt).run();

@@ -4,7 +4,7 @@
 //   2. check_faults()      e-stop, stop-now, drives (fault, EMCY), link, non-finite or jumping feedback,
 //                          the load cell, impossible sensor pictures, staleness → latch the first fault
 //   3. refine_diagnosis()  in a fault: a root cause seen within the diagnosis window replaces a symptom
-//   4. operator_requests() buttons → start, pause/resume, acknowledge (requests, acted on when safe)
+//   4. report_presses()    buttons and pedal → kButton events only (the owner makes them requests)
 //   5. run_state()         the current state's own function; the states, in cycle order:
 //        idle → enabling → positioning → shed_test → shed → pick → (shed → pick …) → beat_sweep
 //        → row_end (only when the row's counters must be on disk first) → await_knotting (the weaver
@@ -268,7 +268,7 @@ void Sequencer::step(hal::Tick now, const hal::HalInputs& raw, hal::HalOutputs& 
     external_fault_ = Fault::kNone;
   }
   if (state_ == State::kFault) refine_diagnosis(now, in);
-  operator_requests(now);
+  report_presses();
   if (state_ == State::kIdle && start_requested_ && !in.io.estop_ok) {
     start_requested_ = false;
     latch(Fault::kEStop, now);
@@ -492,27 +492,13 @@ void Sequencer::refine_diagnosis(hal::Tick now, const hal::HalInputs& in) noexce
   }
 }
 
-void Sequencer::operator_requests(hal::Tick now) noexcept {
-  // Each press is also an event (the reporter audits it and turns it into the session's commands).
-  if (start_edge_.update(io_.button_start)) {
-    events_.add(EventKind::kButton).button = Button::kStart;
-    if (state_ == State::kIdle) start_requested_ = true;
-    if (state_ == State::kPaused || pause_requested_) pause_requested_ = false;  // start also resumes
-  }
-  if (pause_edge_.update(io_.button_pause)) {
-    events_.add(EventKind::kButton).button = Button::kPause;
-    if (state_ != State::kIdle) pause_requested_ = true;
-  }
-  // The ack button counts only when pressed after the fault latched (not in the tick that latched it: its
-  // debounced edge means it was pressed before).
-  if (ack_edge_.update(io_.button_ack)) {
-    events_.add(EventKind::kButton).button = Button::kAck;
-    if (!ack_button_to_owner_ && state_ == State::kFault && now != fault_tick_) ack_requested_ = true;
-  }
-  if (knotted_edge_.update(io_.row_knotted)) {
-    events_.add(EventKind::kButton).button = Button::kRowKnotted;
-    knot_requested_ = true;
-  }
+void Sequencer::report_presses() noexcept {
+  // Reported, never acted on here: the owner turns each press into the request_*() call every other operator
+  // path uses (operator_requests.hpp), so a command means one thing whatever station gave it.
+  if (start_edge_.update(io_.button_start)) events_.add(EventKind::kButton).button = Button::kStart;
+  if (pause_edge_.update(io_.button_pause)) events_.add(EventKind::kButton).button = Button::kPause;
+  if (ack_edge_.update(io_.button_ack)) events_.add(EventKind::kButton).button = Button::kAck;
+  if (knotted_edge_.update(io_.row_knotted)) events_.add(EventKind::kButton).button = Button::kRowKnotted;
 }
 
 void Sequencer::run_state(hal::Tick now, const hal::HalInputs& in) noexcept {

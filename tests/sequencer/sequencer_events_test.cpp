@@ -1,7 +1,8 @@
 // The sequencer says what happened: step() lists this tick's events (Sequencer::events()), and nothing
 // else has to compare polled state with the last tick's. Two rigs:
 //  - ScriptedLoom: inputs written by the test, tick by tick (drives that follow their targets at once and
-//    enable when asked, sensors set by hand): buttons, faults, diagnosis, acknowledgement;
+//    enable when asked, sensors set by hand): buttons (reported, made requests only by an owner), faults,
+//    diagnosis, acknowledgement;
 //  - the simulated loom (SimWorld): whole rows, where the list must agree with the counters it summarises
 //    (one kPick per counted pick, one kRow per row, every beat once and in order) and with the pauses.
 #include <gtest/gtest.h>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "loom/hal/hal.hpp"
+#include "loom/sequencer/operator_requests.hpp"
 #include "loom/sequencer/sequencer.hpp"
 #include "loom/sim_hal/sim_world.hpp"
 
@@ -80,7 +82,10 @@ TEST(SequencerEvents, AnOrdinaryTickSaysNothing) {
   EXPECT_EQ(l.seq->events().began_in(), State::kIdle);
 }
 
-TEST(SequencerEvents, AButtonPressIsOneEventOnceDebouncedAndActsInTheSameTick) {
+// The sequencer decodes and debounces the buttons and reports each press; it acts on none of them itself:
+// a command means one thing whatever station gave it, and its owner makes the request
+// (operator_requests.hpp).
+TEST(SequencerEvents, APressIsOneEventOnceDebouncedAndTheSequencerDoesNotActOnIt) {
   ScriptedLoom l;
   for (int k = 0; k < 10; ++k) l.tick();
   l.in.io.button_start = true;
@@ -94,11 +99,40 @@ TEST(SequencerEvents, AButtonPressIsOneEventOnceDebouncedAndActsInTheSameTick) {
     ASSERT_EQ(kinds(ev), std::vector<EventKind>{EventKind::kButton});
     EXPECT_EQ(ev[0].button, Button::kStart);
     EXPECT_EQ(ev.began_in(), State::kIdle);
-    EXPECT_EQ(l.seq->state(), State::kEnabling);  // the press started the loom in the tick it was seen
   }
   EXPECT_EQ(events, 1);  // held down: still one press
   EXPECT_EQ(pressed_at,
             10 + l.cfg.debounce_ticks - 1);  // pressed from tick 10: the debounce_ticks-th tick reading it
+  // Start, pause, ack and the pedal pressed again and again with nobody to take them: reported, never acted
+  // on.
+  for (int press = 0; press < 3; ++press) {
+    l.in.io.button_start = l.in.io.button_pause = l.in.io.button_ack = l.in.io.row_knotted = false;
+    for (int k = 0; k < 10; ++k) l.tick();
+    l.in.io.button_start = l.in.io.button_pause = l.in.io.button_ack = l.in.io.row_knotted = true;
+    int presses = 0;
+    for (int k = 0; k < 10; ++k) {
+      for (const TickEvent& e : l.tick()) presses += e.kind == EventKind::kButton;
+    }
+    EXPECT_EQ(presses, 4);
+  }
+  for (int k = 0; k < 200; ++k) l.tick();
+  EXPECT_EQ(l.seq->state(), State::kIdle);
+  for (std::size_t i = 0; i < l.seq->axes().count; ++i)
+    EXPECT_EQ(l.out.axes[i].request, hal::AxisRequest::kDisable);
+}
+
+// Through its owner a press acts in the step after the one that saw it, as a command between two steps does.
+TEST(SequencerEvents, ThroughItsOwnerAStartPressStartsTheLoomInTheNextStep) {
+  ScriptedLoom l;
+  for (int k = 0; k < 10; ++k) l.tick();
+  l.in.io.button_start = true;
+  ASSERT_TRUE(l.run_until([&] { return l.seq->events().has(EventKind::kButton); }, 20));
+  EXPECT_EQ(l.seq->state(), State::kIdle);  // seen, not acted on
+  EXPECT_EQ(sequencer::request_of(Button::kStart, l.seq->events().began_in()),
+            sequencer::OperatorRequest::kStart);
+  sequencer::apply_presses(*l.seq);
+  l.tick();
+  EXPECT_EQ(l.seq->state(), State::kEnabling);
 }
 
 TEST(SequencerEvents, AStartWithTheEStopOpenLatchesTheFaultInTheStateItBeganIn) {
@@ -145,11 +179,10 @@ TEST(SequencerEvents, AStaleAxisIsLatchedThenRefinedToTheDriveThatFaulted) {
   for (int k = 0; k < 200; ++k) EXPECT_TRUE(l.tick().empty());
 }
 
-TEST(SequencerEvents, AnAckButtonLeftToTheOwnerIsReportedNotActedOn) {
-  for (const bool to_owner : {false, true}) {
-    SCOPED_TRACE(to_owner ? "left to the owner" : "acted on");
+TEST(SequencerEvents, AnAckPressIsReportedAndAcknowledgesOnlyThroughItsOwner) {
+  for (const bool owner : {false, true}) {
+    SCOPED_TRACE(owner ? "the owner makes the request" : "nobody takes the press");
     ScriptedLoom l;
-    if (to_owner) l.seq->leave_ack_button_to_owner();
     l.seq->request_start();
     ASSERT_TRUE(l.run_until([&] { return l.seq->state() == State::kEnabling; }));
     l.seq->request_stop_now();
@@ -162,8 +195,42 @@ TEST(SequencerEvents, AnAckButtonLeftToTheOwnerIsReportedNotActedOn) {
     const sequencer::TickEvents& ack = l.seq->events();
     ASSERT_EQ(kinds(ack), std::vector<EventKind>{EventKind::kButton});
     EXPECT_EQ(ack[0].button, Button::kAck);
-    EXPECT_EQ(l.seq->state(), to_owner ? State::kFault : State::kIdle);
+    EXPECT_EQ(ack.began_in(), State::kFault);
+    EXPECT_EQ(l.seq->state(), State::kFault);  // seen, not acted on
+    if (owner) sequencer::apply_presses(*l.seq);
+    l.tick();
+    EXPECT_EQ(l.seq->state(), owner ? State::kIdle : State::kFault);
+    if (owner) {
+      for (std::size_t i = 0; i < l.seq->axes().count; ++i) {
+        EXPECT_EQ(l.out.axes[i].request, hal::AxisRequest::kFaultReset);
+      }
+    }
+    for (int k = 0; k < 100; ++k) l.tick();
+    EXPECT_EQ(l.seq->state(), owner ? State::kIdle : State::kFault);
   }
+}
+
+// An ack press whose debounced edge is seen in the tick the fault latched was pressed before the fault: the
+// tick began in another state, so the press asks nothing, though the fault is latched when its owner looks.
+TEST(SequencerEvents, AnAckPressSeenInTheTickTheFaultLatchedAcknowledgesNothing) {
+  ScriptedLoom l;
+  l.seq->request_start();
+  ASSERT_TRUE(l.run_until([&] { return l.seq->state() == State::kEnabling; }));
+  l.in.io.button_ack = true;
+  for (int k = 0; k < l.cfg.debounce_ticks - 1; ++k) ASSERT_TRUE(l.tick().empty());
+  const State arming = l.seq->state();
+  ASSERT_NE(arming, State::kFault);
+  l.seq->request_stop_now();  // latched in the tick that sees the press
+  const sequencer::TickEvents& ev = l.tick();
+  ASSERT_EQ(kinds(ev), (std::vector<EventKind>{EventKind::kFaultLatched, EventKind::kButton}));
+  EXPECT_EQ(ev[1].button, Button::kAck);
+  EXPECT_EQ(ev.began_in(), arming);
+  EXPECT_EQ(l.seq->state(), State::kFault);
+  EXPECT_EQ(sequencer::request_of(Button::kAck, ev.began_in()), sequencer::OperatorRequest::kNone);
+  sequencer::apply_presses(*l.seq);
+  for (int k = 0; k < 100; ++k) l.tick();
+  EXPECT_EQ(l.seq->state(), State::kFault);
+  EXPECT_EQ(l.seq->first_fault(), Fault::kStopRequested);
 }
 
 // The simulated loom weaves whole rows: the list must say exactly what the counters count.

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "loom/hal/hal.hpp"
+#include "loom/sequencer/operator_requests.hpp"
 #include "loom/sequencer/sequencer.hpp"
 #include "loom/sim_hal/sim_world.hpp"
 
@@ -39,6 +40,7 @@ struct Rig {
       hal.read(now, in);
       tamper(now, in);
       seq->step(now, in, out);
+      sequencer::apply_presses(*seq);  // the owner: the I/O module's presses become requests
       hal.write(now, out);
       if (until()) {
         ++now;

@@ -8,6 +8,7 @@
 #include "loom/motion/angles.hpp"
 #include "loom/motion/profile_set.hpp"
 #include "loom/motion/profile_slot.hpp"
+#include "loom/sequencer/operator_requests.hpp"
 #include "loom/sequencer/sequencer.hpp"
 #include "loom/sim_hal/sim_world.hpp"
 
@@ -393,6 +394,7 @@ TEST(SequencerSim, KnottingModeWaitsBeforeEveryRowForTheWeaver) {
     r.in.io.row_knotted = waiting_since >= 0 && r.now - waiting_since >= 300 && pedal_ticks < 20;
     if (r.in.io.row_knotted) ++pedal_ticks;
     r.seq->step(r.now, r.in, r.out);
+    sequencer::apply_presses(*r.seq);  // the owner: the pedal's press becomes request_row_knotted()
     hal.write(r.now, r.out);
     if (r.seq->state() == State::kAwaitKnotting) {
       if (waiting_since < 0) {
@@ -415,6 +417,32 @@ TEST(SequencerSim, KnottingModeWaitsBeforeEveryRowForTheWeaver) {
   EXPECT_FALSE(moved_while_waiting);
   // Recorded with the row: the pedal's debounce (3 ticks) after 300 ticks, give or take a tick.
   EXPECT_NEAR(static_cast<double>(r.seq->last_row().knotting_ticks), 300.0 + r.cfg.debounce_ticks, 2.0);
+}
+
+// The pedal is reported like any button and acted on by nobody but the owner: without one the wait goes on.
+TEST(SequencerSim, ThePedalAloneDoesNotEndTheKnottingWait) {
+  Rig r;
+  r.cfg.knotting = true;
+  r.build(2);
+  hal::PortHal hal(*r.world, *r.world);
+  int presses = 0;
+  hal::Tick waiting_since = -1;
+  for (; r.now < 20000 && !r.seq->finished(); ++r.now) {
+    hal.read(r.now, r.in);
+    // Pressed for 20 ticks, 300 and 600 ticks into the wait: two presses.
+    const hal::Tick into = waiting_since < 0 ? -1 : r.now - waiting_since;
+    r.in.io.row_knotted = (into >= 300 && into < 320) || (into >= 600 && into < 620);
+    r.seq->step(r.now, r.in, r.out);
+    hal.write(r.now, r.out);
+    for (const sequencer::TickEvent& e : r.seq->events()) {
+      presses += e.kind == sequencer::EventKind::kButton && e.button == sequencer::Button::kRowKnotted;
+    }
+    if (r.seq->state() == State::kAwaitKnotting && waiting_since < 0) waiting_since = r.now;
+  }
+  ASSERT_GE(waiting_since, 0) << sequencer::fault_name(r.seq->first_fault());
+  EXPECT_EQ(presses, 2);
+  EXPECT_EQ(r.seq->state(), State::kAwaitKnotting);
+  EXPECT_EQ(r.seq->counters().rows, 0u);
 }
 
 TEST(SequencerSim, KnottingWaitEndsOnRequestAndAStopThereIsDone) {

@@ -11,6 +11,7 @@
 #include "loom/firmware/machine.hpp"
 #include "loom/motion/errors.hpp"
 #include "loom/motion/knot_cycle.hpp"
+#include "loom/sequencer/operator_requests.hpp"
 
 namespace loom::safety {
 namespace {
@@ -256,6 +257,9 @@ RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& sp
     const double x = sim.shuttle_x();
     const bool shuttle_in_shed = x > window && x < cfg.machine.width_m - window;
     m.loop().cycle(t);
+    // The campaign owns the loop, as the runner does in a weave: the pedal the simulated weaver presses
+    // becomes request_row_knotted() here (the sequencer only reports presses).
+    sequencer::apply_presses(m.sequencer());
     if (m.sequencer().events().has(sequencer::EventKind::kWeaverRequest)) {  // the simulated weaver answers, as in a weave
       if (m.sequencer().weaver_request().ask != sequencer::WeaverAsk::kNone) {
         firmware::Machine::simulated_weaver_sink(&m, m.sequencer().weaver_request());

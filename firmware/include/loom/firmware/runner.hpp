@@ -55,13 +55,13 @@ RtSetup setup_realtime(int fifo_priority, std::size_t heap_prefault_bytes = 8u <
 // Operator commands into the loop and live status out of it (the control socket's side of the loop).
 // ---------------------------------------------------------------------------------------------------
 enum class Command : std::uint32_t {
-  kStart = 1u << 0,   // idle → weave; done → a new session (the runner returns kStartRequested)
-  kPause = 1u << 1,   // hold at the next safe point
+  kStart = 1u << 0,  // idle → weave; done → a new session (the runner returns kStartRequested)
+  kPause = 1u << 1,  // hold at the next safe point
   kResume = 1u << 2,
-  kStop = 1u << 3,    // stop at the end of the row in progress
-  kAck = 1u << 4,     // acknowledge a latched fault (the runner returns kAckRequested; the owner re-arms)
-  kExit = 1u << 5,    // leave the loop (service shutdown): stop at row end first when weaving
-  kNext = 1u << 6,    // knotting mode: the weaver has knotted the row, weave it
+  kStop = 1u << 3,  // stop at the end of the row in progress
+  kAck = 1u << 4,   // acknowledge a latched fault (held session: kAckRequested, the owner re-arms)
+  kExit = 1u << 5,  // leave the loop (service shutdown): stop at row end first when weaving
+  kNext = 1u << 6,  // knotting mode: the weaver has knotted the row, weave it
 };
 
 // Shared between the loop thread and any number of non-RT threads. Commands are bits in one atomic word
@@ -102,7 +102,7 @@ struct RunEvent {
   int fault_axis = -1;
   std::uint16_t fault_detail = 0;
   int fault_sensor = -1;  // hal::SafetySensor the fault names (sensor_discrepancy), or -1
-  Command button = Command::kStart;  // kButton: the I/O module's button pressed (operator_buttons)
+  Command button = Command::kStart;    // kButton: the I/O module's button pressed (audited: operator_buttons)
   sequencer::WeaverRequest request{};  // kWeaverRequest
 };
 // Run events waiting for the reporter (real time only: in virtual time the handler runs in place and no
@@ -160,7 +160,10 @@ struct RunOptions {
   // Operator commands and live status (serve). With `hold_when_finished` the loop keeps cycling after
   // the sequencer is done or faulted (drives held / quick-stopped) until a command ends the session.
   OperatorLink* link = nullptr;
-  bool operator_buttons = false;   // the I/O node's start/pause/ack buttons act like the commands
+  // The I/O module's presses (the sequencer's kButton events) act in every run, through the commands of the
+  // same words (sequencer/operator_requests.hpp); with this set each start, pause and ack press is also
+  // audited as a RunEvent::kButton (serve).
+  bool operator_buttons = false;
   bool hold_when_finished = false;
   // Real time only: called on the reporter thread every few milliseconds (the service's watchdog and
   // retries live here, off the loop thread). Never called from the loop.

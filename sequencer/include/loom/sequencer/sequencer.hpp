@@ -100,7 +100,7 @@ struct SequencerConfig {
   bool await_row_saved = false;
   double row_save_timeout_s = 5.0;
   // Knotting mode (handmade carpets: knot a row, pass the weft, beat): before every new row the loom
-  // parks and waits for "row knotted" — the pedal/button input row_knotted, or request_row_knotted().
+  // parks and waits for "row knotted": request_row_knotted(), which the owner also makes of a pedal press.
   bool knotting = false;
   // Knotting heads (knotting.mode = "heads"): the design as magazine slots, the knot cycle and the heads'
   // axes. Before every new row the heads tie it (RowKnotter) while the beater is parked and the shed still.
@@ -130,16 +130,12 @@ class Sequencer {
   // kept, latched as the named fault stop_requested.
   void request_stop_now() noexcept { stop_now_requested_ = true; }
   // RT-safe. Acknowledge a latched fault: the drives get their fault-reset edge, the machine goes idle
-  // and re-arms from measured positions on the next start. (The operator's ack button does the same.)
+  // and re-arms from measured positions on the next start. (The owner makes an ack press this request.)
   // Only after the fault: a request while no fault is latched is discarded, never kept for the next one;
   // refused (the fault stays latched) while the e-stop chain is open.
   void request_acknowledge() noexcept {
     if (state_ == State::kFault) ack_requested_ = true;
   }
-  // Configure-time only. The ack button is then only reported (events(): kButton), never acted on here: the
-  // owner decides (the service's runner ends the session so the service re-arms, or refuses while the link
-  // cannot be re-armed). Otherwise (weave, tests) a press acknowledges as request_acknowledge() does.
-  void leave_ack_button_to_owner() noexcept { ack_button_to_owner_ = true; }
   // RT-safe. The weaver has knotted the row (knotting mode): weave it. Ignored unless waiting for it.
   void request_row_knotted() noexcept { knot_requested_ = true; }
   // RT-safe. A fault found outside the sequencer (the runner's overrun policy): latched at the next step
@@ -214,7 +210,7 @@ class Sequencer {
   bool all_quiet(hal::Tick now, const hal::HalInputs& in) const noexcept;  // check_faults' usual tick
   bool check_faults_in_order(hal::Tick now, const hal::HalInputs& in) noexcept;
   void refine_diagnosis(hal::Tick now, const hal::HalInputs& in) noexcept;
-  void operator_requests(hal::Tick now) noexcept;
+  void report_presses() noexcept;
   void run_state(hal::Tick now, const hal::HalInputs& in) noexcept;
   void play_moves(hal::Tick now) noexcept;
   void track_beat_force(const hal::HalInputs& in) noexcept;
@@ -333,7 +329,6 @@ class Sequencer {
   DualChannelSensors dual_;
   Debouncer<4> buttons_;  // start, pause, ack, row knotted
   RisingEdge start_edge_, pause_edge_, ack_edge_, knotted_edge_;
-  bool ack_button_to_owner_ = false;  // leave_ack_button_to_owner()
   bool knot_requested_ = false;  // "row knotted" since the loom last started waiting for it
   bool row_knotted_ = false;     // the row about to start has been knotted
   hal::Tick knotting_ticks_ = 0;

@@ -26,7 +26,7 @@ struct BeatEvent {
   bool in_band = false;  // force_measured and within [beat_force_min_n, beat_force_max_n]
 };
 
-// The operator's buttons on the I/O module (debounced, one event per press).
+// The I/O module's buttons (debounced, one event per press; only reported: see operator_requests.hpp).
 enum class Button : std::uint8_t { kStart, kPause, kAck, kRowKnotted };
 
 enum class EventKind : std::uint8_t {

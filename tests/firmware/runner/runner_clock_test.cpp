@@ -4,9 +4,9 @@
 // and the HAL were scripted to produce. The loop is the real one: sim HAL, real sequencer.
 #include <gtest/gtest.h>
 
-#include <optional>
-
+#include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "loom/firmware/config.hpp"
@@ -47,7 +47,9 @@ class SlowHal final : public hal::Hal {
     const auto i = static_cast<std::size_t>(now);
     clock_.advance(i < cost_ns.size() ? cost_ns[i] : default_cost_ns);
     inner_.read(now, in);
+    if (script) script(now);
     in.io.button_start = start_pressed;  // the I/O module's buttons, held as scripted
+    in.io.button_pause = pause_pressed;
     in.io.button_ack = ack_pressed;
     if (recovery) {  // a CAN link's recovery state, as the CAN ports report it
       in.link.recovery = *recovery;
@@ -59,7 +61,8 @@ class SlowHal final : public hal::Hal {
   std::int64_t default_cost_ns = 10'000;
   std::optional<hal::LinkRecovery> recovery;
   std::uint8_t silent_node = 0;
-  bool start_pressed = false, ack_pressed = false;
+  bool start_pressed = false, pause_pressed = false, ack_pressed = false;
+  std::function<void(hal::Tick)> script;  // called with each tick before its buttons are read
 
  private:
   hal::Hal& inner_;
@@ -146,7 +149,8 @@ TEST(RunnerClock, OverrunsThatAreNotConsecutiveDoNotStop) {
   Rig r;
   r.slow->cost_ns.assign(200, 10'000);
   // Four in a row, one good tick, four in a row: never five consecutive.
-  for (int i : {50, 51, 52, 53, 55, 56, 57, 58}) r.slow->cost_ns[static_cast<std::size_t>(i)] = kPeriodNs + 500'000;
+  for (int i : {50, 51, 52, 53, 55, 56, 57, 58})
+    r.slow->cost_ns[static_cast<std::size_t>(i)] = kPeriodNs + 500'000;
   const RunResult res = r.run(200, 5);
   EXPECT_EQ(res.overruns, 8u);
   EXPECT_EQ(res.max_consecutive_overruns, 4u);
@@ -182,10 +186,14 @@ TEST(RunnerClock, SummaryReportsTickCostAndTelemetryWaitApart) {
   r.telemetry_wait_max_ns = 6'356'992;
   r.telemetry_wait_yields = 18'056;
   const std::string text = firmware::describe_run(r, RunOptions{});
-  EXPECT_NE(text.find("tick cost (the tick's own work) median 4.1 \u00b5s, p99.9 12.3 \u00b5s, max 40.2 \u00b5s"),
-            std::string::npos) << text;
+  EXPECT_NE(
+      text.find("tick cost (the tick's own work) median 4.1 \u00b5s, p99.9 12.3 \u00b5s, max 40.2 \u00b5s"),
+      std::string::npos)
+      << text;
   EXPECT_NE(text.find("telemetry wait"), std::string::npos) << text;
-  EXPECT_NE(text.find("1203 ticks, total 512300.0 \u00b5s, max 6357.0 \u00b5s, 18056 yields"), std::string::npos) << text;
+  EXPECT_NE(text.find("1203 ticks, total 512300.0 \u00b5s, max 6357.0 \u00b5s, 18056 yields"),
+            std::string::npos)
+      << text;
   // No wait: nothing about it.
   r.telemetry_wait_ticks = 0;
   EXPECT_EQ(firmware::describe_run(r, RunOptions{}).find("telemetry wait"), std::string::npos);
@@ -285,7 +293,8 @@ TEST(RunnerCommands, AckIsRefusedWhileALostNodeIsSilentOrTheBusIsOff) {
     const RunResult res = run_virtual(r, 100, link);
     EXPECT_EQ(res.end, RunResult::End::kMaxTicks) << hal::link_recovery_name(rec);
     EXPECT_EQ(res.acks_refused, 1u);
-    EXPECT_NE(firmware::describe_run(res, RunOptions{}).find("acknowledgements refused while the link could not be re-armed 1"),
+    EXPECT_NE(firmware::describe_run(res, RunOptions{})
+                  .find("acknowledgements refused while the link could not be re-armed 1"),
               std::string::npos);
     EXPECT_EQ(link.link_recovery.load(), static_cast<std::uint8_t>(rec));
     EXPECT_EQ(link.silent_node.load(), 3);
@@ -331,9 +340,10 @@ TEST(RunnerCommands, ARunStoppedByASymptomWaitsOutTheDiagnosisWindowBeforeEnding
   EXPECT_LE(res2.ticks, r2.seq->fault_tick() + 10);
 }
 
-// The buttons are decoded once, by the sequencer (debounced, one event per press); the runner turns its
-// presses into commands and audits each in the state the press was seen in — not the state after the
-// sequencer acted on it (a start press has left idle by then: its verdict is "ok", not "already weaving").
+// The buttons are decoded once, by the sequencer (debounced, one event per press, acted on by nobody there);
+// the runner turns its presses into commands and audits each in the state the press was seen in — the state
+// it was judged in, not the state at the end of that tick (a fault latched in it does not make a stale ack
+// press count, and its verdict says so).
 TEST(RunnerButtons, APressIsAuditedOnceInTheStateItWasSeenIn) {
   Rig r;
   r.slow->default_cost_ns = 0;
@@ -360,8 +370,8 @@ TEST(RunnerButtons, APressIsAuditedOnceInTheStateItWasSeenIn) {
   EXPECT_EQ(presses[0].state, sequencer::State::kIdle);
   EXPECT_NE(r.seq->state(), sequencer::State::kIdle);
   r.slow->start_pressed = false;
-  // An ack press on a latched fault ends the session for re-arming; the sequencer leaves it to the runner
-  // (it stays latched: the service re-arms from the measured positions).
+  // An ack press on a latched fault ends the session for re-arming: the fault stays latched in this
+  // sequencer (the service re-arms from the measured positions).
   r.seq->request_safe_stop(sequencer::Fault::kLoopOverrun);
   run();
   ASSERT_EQ(r.seq->state(), sequencer::State::kFault);
@@ -374,4 +384,111 @@ TEST(RunnerButtons, APressIsAuditedOnceInTheStateItWasSeenIn) {
   EXPECT_EQ(presses[0].state, sequencer::State::kFault);
   EXPECT_EQ(r.seq->state(), sequencer::State::kFault);
   EXPECT_EQ(r.seq->first_fault(), sequencer::Fault::kLoopOverrun);
+}
+
+// A pause press reaches the sequencer the way a pause command does, in a weave as in the service: weave's
+// SIGUSR1/SIGUSR2 flag acts on a change only, so it no longer cancels the press at the next tick.
+TEST(RunnerButtons, InAWeaveAPressStartsPausesResumesAndAcknowledgesThroughTheRunner) {
+  Rig r;
+  r.slow->default_cost_ns = 0;
+  const std::atomic<bool> pause_flag{false};  // as loomctl weave passes it (SIGUSR1 pauses, SIGUSR2 resumes)
+  const hal::Tick d = r.cfg.sequencer.debounce_ticks;
+  hal::Tick started = -1, paused = -1, resumed = -1, faulted = -1, acked = -1;
+  const auto hold = [&](bool& button, hal::Tick now, hal::Tick from) {
+    button = now >= from && now < from + 20;
+  };
+  r.slow->script = [&](hal::Tick now) {
+    const sequencer::State s = r.seq->state();
+    hold(r.slow->start_pressed, now, 10);
+    if (started < 0 && s != sequencer::State::kIdle) started = now;
+    hold(r.slow->pause_pressed, now, 1500);  // weaving row 1: holds at the next safe point
+    if (paused < 0 && s == sequencer::State::kPaused) paused = now;
+    if (paused >= 0) hold(r.slow->start_pressed, now, paused + 100);  // start also resumes
+    if (paused >= 0 && resumed < 0 && s != sequencer::State::kPaused) resumed = now;
+    if (resumed >= 0 && faulted < 0) {
+      r.seq->request_safe_stop(sequencer::Fault::kLoopOverrun);
+      faulted = now;
+    }
+    if (faulted >= 0) hold(r.slow->ack_pressed, now, faulted + 10);
+    if (faulted >= 0 && acked < 0 && s == sequencer::State::kIdle) acked = now;
+  };
+  RunOptions o;
+  o.period_s = r.cfg.sequencer.period_s;
+  o.clock = &r.clock;
+  o.pause_flag = &pause_flag;
+  o.max_ticks = 60'000;
+  const RunResult res = firmware::run_loop(*r.loop, *r.seq, o, [](const firmware::RunEvent&) {});
+  // Each press acts in the step after the one that saw it (debounce_ticks after it went down).
+  EXPECT_EQ(started, 10 + d + 1);
+  ASSERT_GT(paused, 1500 + d) << "the pause press was lost";
+  EXPECT_EQ(resumed, paused + 100 + d + 1);
+  ASSERT_GT(faulted, 0);
+  EXPECT_EQ(acked, faulted + 10 + d + 1);
+  EXPECT_EQ(r.seq->state(), sequencer::State::kIdle);
+  EXPECT_EQ(res.end, RunResult::End::kFinished);  // weave's run ends after the fault's grace ticks
+}
+
+// The service's runner: each press audited once, in the state it was seen in, and acting through the same
+// commands as the socket's — a pause press pauses, an ack press on a latched fault ends the session for
+// re-arming. An ack press seen in the tick the fault latched was pressed before it: no re-arming.
+TEST(RunnerButtons, InTheServiceAnAckPressSeenInTheTickTheFaultLatchedDoesNotReArm) {
+  Rig r;
+  r.slow->default_cost_ns = 0;
+  firmware::OperatorLink link;
+  std::vector<firmware::RunEvent> presses;
+  const hal::Tick d = r.cfg.sequencer.debounce_ticks;
+  hal::Tick paused = -1;
+  r.slow->script = [&](hal::Tick now) {
+    r.slow->start_pressed = now >= 10 && now < 30;
+    r.slow->pause_pressed = now >= 1500 && now < 1520;
+    if (paused < 0 && r.seq->state() == sequencer::State::kPaused) paused = now;
+    // Pressed at `paused + 100`; the fault latches in the tick whose debounce sees the press.
+    r.slow->ack_pressed = paused >= 0 && now >= paused + 100 && now < paused + 120;
+    if (paused >= 0 && now == paused + 100 + d - 1) r.seq->request_safe_stop(sequencer::Fault::kLoopOverrun);
+  };
+  RunOptions o;
+  o.period_s = r.cfg.sequencer.period_s;
+  o.clock = &r.clock;
+  o.link = &link;
+  o.operator_buttons = true;
+  o.hold_when_finished = true;
+  o.max_ticks = 20'000;
+  const auto on_event = [&](const firmware::RunEvent& e) {
+    if (e.kind == firmware::RunEvent::Kind::kButton) presses.push_back(e);
+  };
+  RunResult res = firmware::run_loop(*r.loop, *r.seq, o, on_event);
+  ASSERT_GT(paused, 0) << "the pause press was lost";
+  EXPECT_EQ(res.end, RunResult::End::kMaxTicks) << "the ack pressed before the fault re-armed";
+  ASSERT_EQ(r.seq->state(), sequencer::State::kFault);
+  EXPECT_EQ(r.seq->first_fault(), sequencer::Fault::kLoopOverrun);
+  ASSERT_EQ(presses.size(), 3u);
+  EXPECT_EQ(presses[0].button, firmware::Command::kStart);
+  EXPECT_EQ(presses[0].state, sequencer::State::kIdle);
+  EXPECT_EQ(presses[1].button, firmware::Command::kPause);
+  EXPECT_EQ(presses[2].button, firmware::Command::kAck);
+  EXPECT_EQ(presses[2].state, sequencer::State::kPaused);  // audited in the state it was judged in
+  // Pressed again, after the fault: the session ends for re-arming.
+  presses.clear();
+  r.slow->script = [&](hal::Tick now) { r.slow->ack_pressed = now >= 10 && now < 30; };
+  o.max_ticks = 200;
+  res = firmware::run_loop(*r.loop, *r.seq, o, on_event);
+  EXPECT_EQ(res.end, RunResult::End::kAckRequested);
+  EXPECT_EQ(res.ticks, 10 + d);  // the tick after the one that saw the press
+  ASSERT_EQ(presses.size(), 1u);
+  EXPECT_EQ(presses[0].state, sequencer::State::kFault);
+}
+
+// The control loop on its own (as loomctl commission drives it while the technician works every button by
+// hand) acts on no press: only an owner makes requests of them, and commissioning makes none.
+TEST(ControlLoopButtons, TheLoopAloneActsOnNoPress) {
+  Rig r;
+  for (hal::Tick t = 0; t < 400; ++t) {
+    r.slow->start_pressed = (t / 50) % 2 == 1;  // pressed and released four times
+    r.slow->ack_pressed = r.slow->start_pressed;
+    r.loop->cycle(t);
+    ASSERT_EQ(r.seq->state(), sequencer::State::kIdle) << "tick " << t;
+    for (std::size_t i = 0; i < r.seq->axes().count; ++i) {
+      ASSERT_EQ(r.loop->outputs().axes[i].request, hal::AxisRequest::kDisable) << "tick " << t;
+    }
+  }
 }
