@@ -35,7 +35,8 @@ std::int64_t MonotonicClock::now_ns() noexcept {
 }
 
 void MonotonicClock::sleep_until(std::int64_t deadline_ns) noexcept {
-  const timespec ts{static_cast<time_t>(deadline_ns / 1'000'000'000), static_cast<long>(deadline_ns % 1'000'000'000)};
+  const timespec ts{static_cast<time_t>(deadline_ns / 1'000'000'000),
+                    static_cast<long>(deadline_ns % 1'000'000'000)};
   while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
   }
 }
@@ -55,7 +56,8 @@ int make_attrs(pthread_attr_t& attr, int policy, int priority, std::size_t stack
   sched_param sp{};
   sp.sched_priority = policy == SCHED_FIFO ? priority : 0;
   if ((rc = pthread_attr_setschedparam(&attr, &sp)) != 0) return rc;
-  if ((rc = pthread_attr_setstacksize(&attr, std::max<std::size_t>(stack_bytes, PTHREAD_STACK_MIN))) != 0) return rc;
+  if ((rc = pthread_attr_setstacksize(&attr, std::max<std::size_t>(stack_bytes, PTHREAD_STACK_MIN))) != 0)
+    return rc;
   if (cpu >= 0) {
     cpu_set_t set;
     CPU_ZERO(&set);
@@ -79,7 +81,11 @@ struct RealTimeParts {
 
 struct Runtime {
   Runtime(ControlLoop& l, sequencer::Sequencer& s, const RunOptions& o, LoopClock& c, const EventHandler& h)
-      : loop(l), seq(s), opt(o), clock(c), on_event(h),
+      : loop(l),
+        seq(s),
+        opt(o),
+        clock(c),
+        on_event(h),
         rt_parts(o.realtime ? std::make_unique<RealTimeParts>() : nullptr) {}
   ControlLoop& loop;
   sequencer::Sequencer& seq;
@@ -99,7 +105,11 @@ constexpr std::size_t kMaxEventsPerTick = 5 + hal::kMaxAxes;
 class LoopBody {
  public:
   explicit LoopBody(Runtime& rt)
-      : rt_(rt), seq_(rt.seq), opt_(rt.opt), stats_(rt.loop.stats()), telemetry_(rt.loop.lossless_telemetry()) {}
+      : rt_(rt),
+        seq_(rt.seq),
+        opt_(rt.opt),
+        stats_(rt.loop.stats()),
+        telemetry_(rt.loop.lossless_telemetry()) {}
 
   // The loop. RT-safe after its first statement: no allocation, no locks, no syscalls but the clock's.
   void run() noexcept {
@@ -217,7 +227,8 @@ class LoopBody {
       seq_.request_stop_at_row_end();
       stop_sent_ = true;
     }
-    if (opt_.stop_now_flag != nullptr && !stop_now_sent_ && opt_.stop_now_flag->load(std::memory_order_relaxed)) {
+    if (opt_.stop_now_flag != nullptr && !stop_now_sent_ &&
+        opt_.stop_now_flag->load(std::memory_order_relaxed)) {
       seq_.request_stop_now();
       stop_now_sent_ = true;
     }
@@ -230,13 +241,15 @@ class LoopBody {
     }
     if (opt_.simulated_knotting_s > 0.0) {
       knotting_wait_ = seq_.state() == sequencer::State::kAwaitKnotting ? knotting_wait_ + 1 : 0;
-      if (static_cast<double>(knotting_wait_) * opt_.period_s >= opt_.simulated_knotting_s) seq_.request_row_knotted();
+      if (static_cast<double>(knotting_wait_) * opt_.period_s >= opt_.simulated_knotting_s)
+        seq_.request_row_knotted();
     }
     if (opt_.row_saves != nullptr) {
       const std::uint32_t on_disk = opt_.row_saves->rows_on_disk.load(std::memory_order_acquire);
       seq_.note_rows_saved(on_disk, opt_.row_saves->last_save_failed.load(std::memory_order_acquire));
       const std::uint64_t knots = opt_.row_saves->knots_on_disk.load(std::memory_order_acquire);
-      seq_.note_knots_saved(static_cast<std::uint32_t>(knots >> 32), static_cast<std::uint32_t>(knots & 0xFFFFFFFFu));
+      seq_.note_knots_saved(static_cast<std::uint32_t>(knots >> 32),
+                            static_cast<std::uint32_t>(knots & 0xFFFFFFFFu));
     }
     if (cmds == 0) return false;
     const auto has = [&](Command c) { return (cmds & static_cast<std::uint32_t>(c)) != 0; };
@@ -292,9 +305,9 @@ class LoopBody {
   }
 
   // The presses the sequencer saw in the last tick (debounced, one event per press) as the commands of the
-  // same words: from here on a press goes the way a command from the socket goes. Each start, pause and ack
-  // press is audited once (operator_buttons), in the state the tick that saw it began in: that is the state
-  // the press was judged in (an ack press counts only if the fault was latched before it).
+  // same words: from here on a press goes the way a command from the socket goes. Each press is audited once
+  // (audit_buttons), in the state the tick that saw it began in: that is the state the press was judged in
+  // (an ack press counts only if the fault was latched before it).
   std::uint32_t take_presses(hal::Tick tick) noexcept {
     std::uint32_t cmds = 0;
     const sequencer::TickEvents& events = seq_.events();
@@ -302,16 +315,28 @@ class LoopBody {
       if (ev.kind != sequencer::EventKind::kButton) continue;
       const sequencer::OperatorRequest r = sequencer::request_of(ev.button, events.began_in());
       cmds |= static_cast<std::uint32_t>(command_of(r));
-      // The pedal is not audited: the service's record names only the three buttons.
-      if (!opt_.operator_buttons || ev.button == sequencer::Button::kRowKnotted) continue;
+      if (!opt_.audit_buttons) continue;
       RunEvent e = base_event(RunEvent::Kind::kButton, tick);
-      e.button = ev.button == sequencer::Button::kStart   ? Command::kStart
-                 : ev.button == sequencer::Button::kPause ? Command::kPause
-                                                          : Command::kAck;
+      e.button = command_of_button(ev.button);
       e.state = events.began_in();
       emit(e);
     }
     return cmds;
+  }
+
+  // The command a button stands for in the audit: the pedal is the weaver's `next`.
+  static Command command_of_button(sequencer::Button b) noexcept {
+    switch (b) {
+      case sequencer::Button::kStart:
+        return Command::kStart;
+      case sequencer::Button::kPause:
+        return Command::kPause;
+      case sequencer::Button::kAck:
+        return Command::kAck;
+      case sequencer::Button::kRowKnotted:
+        break;
+    }
+    return Command::kNext;
   }
 
   static Command command_of(sequencer::OperatorRequest r) noexcept {
@@ -390,7 +415,8 @@ class LoopBody {
     }
     // A pause and its resume in one tick (never seen) cancel out, as the state shows.
     const bool paused = ev.has(EventKind::kPaused), resumed = ev.has(EventKind::kResumed);
-    if (paused != resumed) emit(base_event(paused ? RunEvent::Kind::kPaused : RunEvent::Kind::kResumed, tick));
+    if (paused != resumed)
+      emit(base_event(paused ? RunEvent::Kind::kPaused : RunEvent::Kind::kResumed, tick));
     if (ev.has(EventKind::kFaultLatched)) emit(base_event(RunEvent::Kind::kFault, tick));
   }
 
@@ -495,7 +521,9 @@ RtSetup setup_realtime(int fifo_priority, std::size_t heap_prefault_bytes) {
   pthread_attr_t attr;
   int rc = make_attrs(attr, SCHED_FIFO, fifo_priority, PTHREAD_STACK_MIN + (64u << 10), -1);
   pthread_t th{};
-  if (rc == 0) rc = pthread_create(&th, &attr, [](void*) -> void* { return nullptr; }, nullptr);
+  if (rc == 0)
+    rc = pthread_create(
+        &th, &attr, [](void*) -> void* { return nullptr; }, nullptr);
   pthread_attr_destroy(&attr);
   if (rc == 0) {
     pthread_join(th, nullptr);
@@ -509,7 +537,8 @@ RtSetup setup_realtime(int fifo_priority, std::size_t heap_prefault_bytes) {
 // ---------------------------------------------------------------------------------------------------
 // The runner
 // ---------------------------------------------------------------------------------------------------
-RunResult run_loop(ControlLoop& loop, sequencer::Sequencer& seq, const RunOptions& opt, const EventHandler& on_event) {
+RunResult run_loop(ControlLoop& loop, sequencer::Sequencer& seq, const RunOptions& opt,
+                   const EventHandler& on_event) {
   MonotonicClock monotonic;
   LoopClock& clock = opt.clock != nullptr ? *opt.clock : monotonic;
   // Configure-time: the histograms (and in real time the ~2 MB event ring) live on the heap,
@@ -521,7 +550,8 @@ RunResult run_loop(ControlLoop& loop, sequencer::Sequencer& seq, const RunOption
   } else {
     const bool want_fifo = opt.fifo_priority > 0;
     pthread_attr_t attr;
-    int rc = make_attrs(attr, want_fifo ? SCHED_FIFO : SCHED_OTHER, opt.fifo_priority, opt.stack_bytes, opt.cpu);
+    int rc =
+        make_attrs(attr, want_fifo ? SCHED_FIFO : SCHED_OTHER, opt.fifo_priority, opt.stack_bytes, opt.cpu);
     pthread_t th{};
     if (rc == 0) rc = pthread_create(&th, &attr, loop_thread_main, rt.get());
     pthread_attr_destroy(&attr);
@@ -577,26 +607,29 @@ std::string describe_run(const RunResult& r, const RunOptions& opt) {
   char ratio[32];
   std::snprintf(ratio, sizeof ratio, ratio_fmt, r.achieved_ratio);
   const auto us = [](std::int64_t ns) { return static_cast<double>(ns) * 1e-3; };
-  int n = std::snprintf(buf, sizeof buf,
-                        "loop: %lld ticks (%.2f s machine time) in %.3f s wall (%sx real time); tick cost (the tick's "
-                        "own work) median %.1f \u00b5s, p99.9 %.1f \u00b5s, max %.1f \u00b5s; overruns %u",
-                        static_cast<long long>(r.ticks), machine_s, r.wall_s, ratio, us(r.median_tick_cost_ns),
-                        us(r.p999_tick_cost_ns), us(r.max_tick_cost_ns), r.overruns);
+  int n = std::snprintf(
+      buf, sizeof buf,
+      "loop: %lld ticks (%.2f s machine time) in %.3f s wall (%sx real time); tick cost (the tick's "
+      "own work) median %.1f \u00b5s, p99.9 %.1f \u00b5s, max %.1f \u00b5s; overruns %u",
+      static_cast<long long>(r.ticks), machine_s, r.wall_s, ratio, us(r.median_tick_cost_ns),
+      us(r.p999_tick_cost_ns), us(r.max_tick_cost_ns), r.overruns);
   std::string s(buf, static_cast<std::size_t>(std::max(n, 0)));
   if (r.telemetry_wait_ticks > 0) {
-    n = std::snprintf(buf, sizeof buf,
-                      "; telemetry wait (virtual time: the loop waited between ticks for the LCM publisher to free "
-                      "ring space, not part of the tick) %llu ticks, total %.1f \u00b5s, max %.1f \u00b5s, %llu yields",
-                      static_cast<unsigned long long>(r.telemetry_wait_ticks), us(r.telemetry_wait_total_ns),
-                      us(r.telemetry_wait_max_ns), static_cast<unsigned long long>(r.telemetry_wait_yields));
+    n = std::snprintf(
+        buf, sizeof buf,
+        "; telemetry wait (virtual time: the loop waited between ticks for the LCM publisher to free "
+        "ring space, not part of the tick) %llu ticks, total %.1f \u00b5s, max %.1f \u00b5s, %llu yields",
+        static_cast<unsigned long long>(r.telemetry_wait_ticks), us(r.telemetry_wait_total_ns),
+        us(r.telemetry_wait_max_ns), static_cast<unsigned long long>(r.telemetry_wait_yields));
     s.append(buf, static_cast<std::size_t>(std::max(n, 0)));
   }
   if (opt.realtime) {
-    n = std::snprintf(buf, sizeof buf, "; wake-up latency p50 %lld ns, p99 %lld ns, max %lld ns; loop thread %s",
-                      static_cast<long long>(r.wake_latency_p50_ns), static_cast<long long>(r.wake_latency_p99_ns),
-                      static_cast<long long>(r.wake_latency_max_ns),
-                      r.loop_policy == SCHED_FIFO ? ("SCHED_FIFO " + std::to_string(r.loop_priority)).c_str()
-                                                  : "SCHED_OTHER");
+    n = std::snprintf(
+        buf, sizeof buf, "; wake-up latency p50 %lld ns, p99 %lld ns, max %lld ns; loop thread %s",
+        static_cast<long long>(r.wake_latency_p50_ns), static_cast<long long>(r.wake_latency_p99_ns),
+        static_cast<long long>(r.wake_latency_max_ns),
+        r.loop_policy == SCHED_FIFO ? ("SCHED_FIFO " + std::to_string(r.loop_priority)).c_str()
+                                    : "SCHED_OTHER");
     s.append(buf, static_cast<std::size_t>(std::max(n, 0)));
   }
   if (r.events_dropped > 0) s += "; run events dropped " + std::to_string(r.events_dropped);
@@ -604,14 +637,16 @@ std::string describe_run(const RunResult& r, const RunOptions& opt) {
     s += "; acknowledgements refused while the link could not be re-armed " + std::to_string(r.acks_refused);
   }
   if (r.acks_refused_unsaved > 0) {
-    s += "; acknowledgements refused while the counters could not be saved " + std::to_string(r.acks_refused_unsaved);
+    s += "; acknowledgements refused while the counters could not be saved " +
+         std::to_string(r.acks_refused_unsaved);
   }
   if (r.fifo_refused) s += "\nloomctl: WARNING: SCHED_FIFO was refused; the loop ran at SCHED_OTHER";
   if (r.fell_behind) {
-    n = std::snprintf(buf, sizeof buf,
-                      "\nloomctl: WARNING: could not keep up: asked for %gx real time, achieved %.2fx (%u overruns; "
-                      "a tick period of %.0f ns is shorter than the loop can hold)",
-                      opt.pace, r.achieved_ratio, r.overruns, opt.period_s * 1e9 / opt.pace);
+    n = std::snprintf(
+        buf, sizeof buf,
+        "\nloomctl: WARNING: could not keep up: asked for %gx real time, achieved %.2fx (%u overruns; "
+        "a tick period of %.0f ns is shorter than the loop can hold)",
+        opt.pace, r.achieved_ratio, r.overruns, opt.period_s * 1e9 / opt.pace);
     s.append(buf, static_cast<std::size_t>(std::max(n, 0)));
   }
   if (r.overrun_stop) {

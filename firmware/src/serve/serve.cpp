@@ -370,7 +370,7 @@ class Service {
     Machine& machine = session.machine();
     RunOptions ro = session.run_options(&record_);
     ro.link = &link_;
-    ro.operator_buttons = true;
+    ro.audit_buttons = true;
     ro.hold_when_finished = true;
     // The reporter thread's poll: the watchdog is fed only while the loop's tick moves, and a failed save
     // is retried, so freeing the disk lets the acknowledgement through.
@@ -498,24 +498,29 @@ class Service {
     }
   }
 
-  // The I/O module's button, audited like any command: who, and the verdict in the state of the press.
+  // The I/O module's buttons and the weaver's pedal, audited like any command: who, and the verdict in the
+  // state the press was seen in — what the same command would have answered then.
   void audit_button(const RunEvent& e) {
-    const char* word = e.button == Command::kStart ? "start" : e.button == Command::kPause ? "pause" : "ack";
-    const std::string who = std::string("the I/O module's ") +
-                            (e.button == Command::kStart   ? "start"
-                             : e.button == Command::kPause ? "pause"
-                                                           : "reset/acknowledge") +
-                            " button";
-    log(Severity::kNotice, "operator: %s by %s (state %s)", word, who.c_str(),
-        sequencer::state_name(e.state));
-    if (!command_events_) return;
-    // The loop takes the press itself; the event says what the same command would have answered.
+    struct Press {
+      const char* word;
+      const char* who;
+    };
+    const Press p = e.button == Command::kStart   ? Press{"start", "the I/O module's start button"}
+                    : e.button == Command::kPause ? Press{"pause", "the I/O module's pause button"}
+                    : e.button == Command::kAck   ? Press{"ack", "the I/O module's reset/acknowledge button"}
+                                                  : Press{"next", "the weaver's row-knotted pedal"};
     LoomView v = view_of(link_, cfg_.sequencer.knotting);
     v.state = e.state;
     v.counters_unsaved = counters_unsaved_.load(std::memory_order_acquire);
-    const std::string verdict = desk_.answer_in_state(word, v);
-    command_events_->publish(
-        {word, "button", who, verdict.rfind("ok", 0) == 0, verdict, sequencer::state_name(e.state)});
+    // One start button and no resume button: a start press while paused resumes, and is judged as resume.
+    const bool resumes = e.button == Command::kStart && e.state == sequencer::State::kPaused;
+    const std::string verdict = desk_.answer_in_state(resumes ? "resume" : p.word, v);
+    log(Severity::kNotice, "operator: %s by %s (state %s): %s", p.word, p.who, sequencer::state_name(e.state),
+        verdict.c_str());
+    if (command_events_) {
+      command_events_->publish(
+          {p.word, "button", p.who, verdict.rfind("ok", 0) == 0, verdict, sequencer::state_name(e.state)});
+    }
   }
 
   // The loom waits for the weaver (lamp amber, buzzer): logged for the shift's record; the panel and

@@ -51,7 +51,8 @@ class SlowHal final : public hal::Hal {
     in.io.button_start = start_pressed;  // the I/O module's buttons, held as scripted
     in.io.button_pause = pause_pressed;
     in.io.button_ack = ack_pressed;
-    if (recovery) {  // a CAN link's recovery state, as the CAN ports report it
+    in.io.row_knotted = knotted_pressed;  // the weaver's pedal
+    if (recovery) {                       // a CAN link's recovery state, as the CAN ports report it
       in.link.recovery = *recovery;
       in.link.silent_node = silent_node;
     }
@@ -61,7 +62,7 @@ class SlowHal final : public hal::Hal {
   std::int64_t default_cost_ns = 10'000;
   std::optional<hal::LinkRecovery> recovery;
   std::uint8_t silent_node = 0;
-  bool start_pressed = false, pause_pressed = false, ack_pressed = false;
+  bool start_pressed = false, pause_pressed = false, ack_pressed = false, knotted_pressed = false;
   std::function<void(hal::Tick)> script;  // called with each tick before its buttons are read
 
  private:
@@ -353,7 +354,7 @@ TEST(RunnerButtons, APressIsAuditedOnceInTheStateItWasSeenIn) {
   o.period_s = r.cfg.sequencer.period_s;
   o.clock = &r.clock;
   o.link = &link;
-  o.operator_buttons = true;
+  o.audit_buttons = true;
   o.hold_when_finished = true;
   o.max_ticks = 40;
   const auto run = [&] {
@@ -384,6 +385,30 @@ TEST(RunnerButtons, APressIsAuditedOnceInTheStateItWasSeenIn) {
   EXPECT_EQ(presses[0].state, sequencer::State::kFault);
   EXPECT_EQ(r.seq->state(), sequencer::State::kFault);
   EXPECT_EQ(r.seq->first_fault(), sequencer::Fault::kLoopOverrun);
+}
+
+// The weaver's pedal is a command like the buttons (`next`): audited once per press, in the state it was
+// seen in, when the run audits presses; a run that does not (weave) emits nothing for it.
+TEST(RunnerButtons, ThePedalIsAuditedAsNext) {
+  for (const bool audit : {true, false}) {
+    Rig r;
+    r.slow->default_cost_ns = 0;
+    std::vector<firmware::RunEvent> presses;
+    RunOptions o;
+    o.period_s = r.cfg.sequencer.period_s;
+    o.clock = &r.clock;
+    o.audit_buttons = audit;
+    o.max_ticks = 40;
+    // Released first (a pedal held since power-on is no press), then held to the end: one press.
+    r.slow->script = [&r](hal::Tick now) { r.slow->knotted_pressed = now >= 10; };
+    firmware::run_loop(*r.loop, *r.seq, o, [&](const firmware::RunEvent& e) {
+      if (e.kind == firmware::RunEvent::Kind::kButton) presses.push_back(e);
+    });
+    ASSERT_EQ(presses.size(), audit ? 1u : 0u);
+    if (!audit) continue;
+    EXPECT_EQ(presses[0].button, firmware::Command::kNext);
+    EXPECT_EQ(presses[0].state, sequencer::State::kIdle);
+  }
 }
 
 // A pause press reaches the sequencer the way a pause command does, in a weave as in the service: weave's
@@ -450,7 +475,7 @@ TEST(RunnerButtons, InTheServiceAnAckPressSeenInTheTickTheFaultLatchedDoesNotReA
   o.period_s = r.cfg.sequencer.period_s;
   o.clock = &r.clock;
   o.link = &link;
-  o.operator_buttons = true;
+  o.audit_buttons = true;
   o.hold_when_finished = true;
   o.max_ticks = 20'000;
   const auto on_event = [&](const firmware::RunEvent& e) {

@@ -40,9 +40,9 @@ class MonotonicClock final : public LoopClock {
 // Process-wide real-time preparation (configure-time only).
 // ---------------------------------------------------------------------------------------------------
 struct RtSetup {
-  bool memory_locked = false;   // mlockall(MCL_CURRENT | MCL_FUTURE) and a pre-faulted heap
-  bool fifo = false;            // a thread may be created at SCHED_FIFO `fifo_priority` (probed, not taken)
-  std::string problems;         // "" when both succeeded
+  bool memory_locked = false;  // mlockall(MCL_CURRENT | MCL_FUTURE) and a pre-faulted heap
+  bool fifo = false;           // a thread may be created at SCHED_FIFO `fifo_priority` (probed, not taken)
+  std::string problems;        // "" when both succeeded
   bool ok() const { return memory_locked && fifo; }
 };
 // Locks memory, pre-faults `heap_prefault_bytes` of heap (and keeps glibc from returning it or serving
@@ -69,7 +69,9 @@ enum class Command : std::uint32_t {
 // set of relaxed atomics the loop stores every tick, each field individually consistent.
 struct OperatorLink {
   std::atomic<std::uint32_t> pending{0};
-  void post(Command c) noexcept { pending.fetch_or(static_cast<std::uint32_t>(c), std::memory_order_release); }
+  void post(Command c) noexcept {
+    pending.fetch_or(static_cast<std::uint32_t>(c), std::memory_order_release);
+  }
 
   std::atomic<std::uint8_t> state{0};        // sequencer::State
   std::atomic<std::uint8_t> first_fault{0};  // sequencer::Fault
@@ -79,7 +81,8 @@ struct OperatorLink {
   std::atomic<std::uint8_t> link_recovery{0};  // hal::LinkRecovery: whether an acknowledgement can re-arm
   std::atomic<std::uint8_t> silent_node{0};    // the lost node still silent (kNodeSilent)
   std::atomic<bool> estop_ok{true};            // the e-stop chain is closed (an acknowledgement can re-arm)
-  std::atomic<std::uint8_t> weaver_ask{0};     // sequencer::WeaverAsk: the knotting heads' open request (next answers it)
+  std::atomic<std::uint8_t> weaver_ask{
+      0};  // sequencer::WeaverAsk: the knotting heads' open request (next answers it)
   std::atomic<std::int64_t> tick{0};
 };
 
@@ -90,19 +93,30 @@ struct RunEvent {
   // kKnotProgress: the knotting heads' counters moved (a knot cycle started or done, knots tied): saved like
   // a pick. kWeaverRequest: the loom asks the weaver (`request`).
   enum class Kind : std::uint8_t {
-    kRowDone, kPickDone, kPaused, kResumed, kFault, kOverrunStop, kFinished, kButton, kKnotProgress, kWeaverRequest
+    kRowDone,
+    kPickDone,
+    kPaused,
+    kResumed,
+    kFault,
+    kOverrunStop,
+    kFinished,
+    kButton,
+    kKnotProgress,
+    kWeaverRequest
   };
   Kind kind = Kind::kRowDone;
   hal::Tick tick = 0;
   sequencer::RowStats row{};
   sequencer::Counters counters{};
-  sequencer::State state = sequencer::State::kIdle;  // at the end of the tick; kButton: the tick the press was seen in began in
+  sequencer::State state =
+      sequencer::State::kIdle;  // at the end of the tick; kButton: the tick the press was seen in began in
   sequencer::Fault fault = sequencer::Fault::kNone;  // kFault: the first fault
   sequencer::Fault stopped_by = sequencer::Fault::kNone;
   int fault_axis = -1;
   std::uint16_t fault_detail = 0;
   int fault_sensor = -1;  // hal::SafetySensor the fault names (sensor_discrepancy), or -1
-  Command button = Command::kStart;    // kButton: the I/O module's button pressed (audited: operator_buttons)
+  Command button =
+      Command::kStart;  // kButton: the I/O module's button pressed (audit_buttons); kNext: the pedal
   sequencer::WeaverRequest request{};  // kWeaverRequest
 };
 // Run events waiting for the reporter (real time only: in virtual time the handler runs in place and no
@@ -133,13 +147,14 @@ struct RowSaves {
 
 struct RunOptions {
   double period_s = 0.002;
-  bool realtime = false;         // pace at the tick rate (always true with hardware)
-  double pace = 1.0;             // with realtime: run this many times faster than real time (sim only)
-  hal::Tick max_ticks = 0;       // 0 = no limit
-  hal::Tick grace_ticks = 100;   // ticks run after the sequencer finishes (quick stop reaches the drives;
-                                 // longer while a symptom's root cause may still be diagnosed)
-  const std::atomic<bool>* stop_flag = nullptr;   // set asynchronously → stop at row end
-  const std::atomic<bool>* stop_now_flag = nullptr;  // set asynchronously → safe stop at once (stop_requested)
+  bool realtime = false;        // pace at the tick rate (always true with hardware)
+  double pace = 1.0;            // with realtime: run this many times faster than real time (sim only)
+  hal::Tick max_ticks = 0;      // 0 = no limit
+  hal::Tick grace_ticks = 100;  // ticks run after the sequencer finishes (quick stop reaches the drives;
+                                // longer while a symptom's root cause may still be diagnosed)
+  const std::atomic<bool>* stop_flag = nullptr;  // set asynchronously → stop at row end
+  const std::atomic<bool>* stop_now_flag =
+      nullptr;                                    // set asynchronously → safe stop at once (stop_requested)
   const std::atomic<bool>* pause_flag = nullptr;  // true → pause at the next safe point, false → resume
   RowSaves* row_saves = nullptr;                  // the counters-file handshake, when one is kept
   // Simulation: a weaver who says "row knotted" this long after the loom starts waiting (knotting mode).
@@ -150,9 +165,9 @@ struct RunOptions {
   void* weaver_sink_ctx = nullptr;
 
   // Real-time thread (realtime only).
-  int fifo_priority = 80;        // SCHED_FIFO priority of the loop thread; 0 = SCHED_OTHER
-  bool require_fifo = false;     // true: refuse to run (RunResult::error) when SCHED_FIFO is not granted
-  int cpu = -1;                  // pin the loop thread to this CPU (an isolated one); -1 = any
+  int fifo_priority = 80;     // SCHED_FIFO priority of the loop thread; 0 = SCHED_OTHER
+  bool require_fifo = false;  // true: refuse to run (RunResult::error) when SCHED_FIFO is not granted
+  int cpu = -1;               // pin the loop thread to this CPU (an isolated one); -1 = any
   std::size_t stack_bytes = 512u << 10;  // loop thread stack, pre-faulted before the first tick
   // Overrun policy: this many consecutive overruns latch loop_overrun (safe stop). 0 = count only.
   std::uint32_t overrun_stop_after = 0;
@@ -161,26 +176,33 @@ struct RunOptions {
   // the sequencer is done or faulted (drives held / quick-stopped) until a command ends the session.
   OperatorLink* link = nullptr;
   // The I/O module's presses (the sequencer's kButton events) act in every run, through the commands of the
-  // same words (sequencer/operator_requests.hpp); with this set each start, pause and ack press is also
-  // audited as a RunEvent::kButton (serve).
-  bool operator_buttons = false;
+  // same words (sequencer/operator_requests.hpp); with this set each press — start, pause, ack and the
+  // weaver's row-knotted pedal — is also audited as a RunEvent::kButton (serve).
+  bool audit_buttons = false;
   bool hold_when_finished = false;
   // Real time only: called on the reporter thread every few milliseconds (the service's watchdog and
   // retries live here, off the loop thread). Never called from the loop.
   std::function<void()> reporter_poll;
 
-  LoopClock* clock = nullptr;      // nullptr = MonotonicClock
+  LoopClock* clock = nullptr;  // nullptr = MonotonicClock
 };
 
 struct RunResult {
-  enum class End : std::uint8_t { kFinished, kMaxTicks, kExitRequested, kStartRequested, kAckRequested, kError };
+  enum class End : std::uint8_t {
+    kFinished,
+    kMaxTicks,
+    kExitRequested,
+    kStartRequested,
+    kAckRequested,
+    kError
+  };
   End end = End::kFinished;
   std::string error;  // kError: why the loop could not start (e.g. SCHED_FIFO refused)
   hal::Tick ticks = 0;
   double wall_s = 0.0;
   std::uint32_t overruns = 0;
   std::uint32_t max_consecutive_overruns = 0;
-  bool overrun_stop = false;       // the overrun policy latched loop_overrun
+  bool overrun_stop = false;  // the overrun policy latched loop_overrun
   // The tick's own work (read inputs, sequencer, write outputs, queue telemetry), never a wait.
   std::int64_t max_tick_cost_ns = 0;
   std::int64_t median_tick_cost_ns = 0;  // from a fixed-size histogram, no allocation while running
@@ -188,22 +210,22 @@ struct RunResult {
   // Virtual time with lossless telemetry only: before a tick whose snapshot or events would not fit,
   // the loop waits (yielding) for the LCM publisher to free ring space. That wait is the publisher's
   // pace, not the tick's cost, so it is measured and reported apart. Real time never waits (drops).
-  std::uint64_t telemetry_wait_ticks = 0;    // ticks that had to wait
+  std::uint64_t telemetry_wait_ticks = 0;  // ticks that had to wait
   std::int64_t telemetry_wait_total_ns = 0;
   std::int64_t telemetry_wait_max_ns = 0;
-  std::uint64_t telemetry_wait_yields = 0;   // sched_yield calls while waiting
+  std::uint64_t telemetry_wait_yields = 0;  // sched_yield calls while waiting
   // Real time only: how late the loop woke after each deadline.
   std::int64_t wake_latency_p50_ns = 0, wake_latency_p99_ns = 0, wake_latency_max_ns = 0;
   std::uint64_t events_dropped = 0;
-  std::uint32_t acks_refused = 0;  // acknowledgements while the link could not be re-armed yet
+  std::uint32_t acks_refused = 0;          // acknowledgements while the link could not be re-armed yet
   std::uint32_t acks_refused_unsaved = 0;  // acknowledgements while the counters still could not be saved
   // What the loop thread actually ran at (realtime only; read back with pthread_getschedparam inside it).
-  int loop_policy = -1;            // SCHED_FIFO, SCHED_OTHER, ...; -1 = ran on the caller (virtual time)
+  int loop_policy = -1;  // SCHED_FIFO, SCHED_OTHER, ...; -1 = ran on the caller (virtual time)
   int loop_priority = 0;
-  bool fifo_refused = false;       // SCHED_FIFO was requested and refused; the loop ran at SCHED_OTHER
+  bool fifo_refused = false;  // SCHED_FIFO was requested and refused; the loop ran at SCHED_OTHER
   // Achieved speed against the request: machine seconds per wall second (pace in real time).
   double achieved_ratio = 0.0;
-  bool fell_behind = false;        // realtime and the achieved ratio is below 97 % of the requested pace
+  bool fell_behind = false;  // realtime and the achieved ratio is below 97 % of the requested pace
 };
 
 // Non-RT callback for row completions, faults and the end of the run. In virtual time it is called
@@ -212,7 +234,8 @@ using EventHandler = std::function<void(const RunEvent&)>;
 
 // Runs the loop until the sequencer finishes (plus grace), max_ticks, or — with a link — a command ends
 // the session. In real time the caller's thread becomes the reporter while a new thread runs the loop.
-RunResult run_loop(ControlLoop& loop, sequencer::Sequencer& seq, const RunOptions& opt, const EventHandler& on_event);
+RunResult run_loop(ControlLoop& loop, sequencer::Sequencer& seq, const RunOptions& opt,
+                   const EventHandler& on_event);
 
 // One line for the end of a run: ticks, wall time, achieved ratio, tick cost p50/p99.9/max in µs, the
 // telemetry wait apart (virtual time), wake-up latency p50/p99/max, overruns, dropped events; and a
