@@ -324,19 +324,10 @@ class LoopBody {
     return cmds;
   }
 
-  // The command a button stands for in the audit: the pedal is the weaver's `next`.
+  // The command a button stands for in the audit: its request as if the press counted (an ack press is
+  // audited as ack even when it acknowledges nothing: its verdict says so); the pedal is the weaver's `next`.
   static Command command_of_button(sequencer::Button b) noexcept {
-    switch (b) {
-      case sequencer::Button::kStart:
-        return Command::kStart;
-      case sequencer::Button::kPause:
-        return Command::kPause;
-      case sequencer::Button::kAck:
-        return Command::kAck;
-      case sequencer::Button::kRowKnotted:
-        break;
-    }
-    return Command::kNext;
+    return command_of(sequencer::request_of(b, sequencer::State::kFault));
   }
 
   static Command command_of(sequencer::OperatorRequest r) noexcept {
