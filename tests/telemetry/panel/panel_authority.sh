@@ -70,7 +70,9 @@ mkdir -p "$WORK/run"
 # A palette name in cp1252 (0xE9 = é): loomctl accepts the file; the panel must stay up.
 sed 's/^palette,R,#9b1b30,madder red$/palette,R,#9b1b30,rouge garanc\xe9/' "$DESIGN" >"$WORK/border.csv"
 grep -q $'garanc\xe9' "$WORK/border.csv" || fail "could not write the cp1252 palette name"
-printf 'extends = "default"\n[recipe]\ndesign = "border.csv"\n' >"$WORK/loom.toml"
+# The row-save budget is machine time: at --pace 10 the default 5 s is half a second of wall time, less than
+# two durable writes (counters, design book) can take on a loaded CI host; 60 s is 6 s of wall time.
+printf 'extends = "default"\n[recipe]\ndesign = "border.csv"\n[timing]\nrow_save_timeout_s = 60.0\n' >"$WORK/loom.toml"
 
 panel_up panel.log --bind 0.0.0.0 --lcm-url "$URL" --control-dir "$WORK/run"
 HPORT=$PANEL_HTTP_PORT
