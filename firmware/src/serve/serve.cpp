@@ -453,6 +453,19 @@ class Service {
         e.counters.beats, knotting);
   }
 
+  // A fault history record of `kind` naming `f`, with the counters it happened at.
+  FaultRecord record_of(const char* kind, sequencer::Fault f, const sequencer::Counters& c) const {
+    FaultRecord r;
+    r.loom_id = cfg_.loom_id;
+    r.kind = kind;
+    r.name = sequencer::fault_name(f);
+    r.code = sequencer::fault_code(f);
+    r.rows = c.rows;
+    r.picks = c.picks;
+    r.beats = c.beats;
+    return r;
+  }
+
   // A fault latched (or the overrun policy stopped the loop): kept on disk so a restart latches it again,
   // logged, and added to the history.
   void record_fault(const RunEvent& e) {
@@ -463,16 +476,9 @@ class Service {
     } else {
       f = FaultReport::of(e, cfg_.sequencer.axes);
     }
-    FaultRecord r;
-    r.loom_id = cfg_.loom_id;
-    r.kind = overrun ? "overrun_stop" : "fault";
-    r.name = f.name();
-    r.code = f.code();
+    FaultRecord r = record_of(overrun ? "overrun_stop" : "fault", f.fault, e.counters);
     r.axis = f.axis;
     r.device_code = f.device_code;
-    r.rows = e.counters.rows;
-    r.picks = e.counters.picks;
-    r.beats = e.counters.beats;
     r.text = f.text();
     if (relatch_pending_ &&
         f.fault == e.fault) {  // the fault from before the restart: logged and on disk already
@@ -569,15 +575,7 @@ class Service {
   }
 
   void acknowledged(const sequencer::Sequencer& seq) {
-    FaultRecord r;
-    r.loom_id = cfg_.loom_id;
-    r.kind = "ack";
-    const sequencer::Fault f = seq.first_fault();
-    r.name = sequencer::fault_name(f);
-    r.code = sequencer::fault_code(f);
-    r.rows = seq.counters().rows;
-    r.picks = seq.counters().picks;
-    r.beats = seq.counters().beats;
+    FaultRecord r = record_of("ack", seq.first_fault(), seq.counters());
     {
       std::lock_guard<std::mutex> lock(ack_mu_);
       // The loop reports the acknowledgement itself; none from the desk in the last second: the button.
