@@ -89,6 +89,8 @@ std::string CounterStore::format(const sequencer::Counters& c) {
     os << ",\"knots\":" << k.tied << ",\"knots_retried\":" << k.retried << ",\"knots_by_hand\":" << k.by_hand
        << ",\"knot_cycles_started\":" << k.cycles_started << ",\"knot_cycles_done\":" << k.cycles_done;
   }
+  // Only while a cycle's knots are partly counted (a file from before it existed has none: zero).
+  if (k.cycle_heads_done != 0) os << ",\"knot_cycle_heads_done\":" << k.cycle_heads_done;
   os << "}\n";
   return os.str();
 }
@@ -102,7 +104,8 @@ sequencer::Counters CounterStore::parse(const std::string& text, const std::stri
       const std::string k = cur.key();
       static const std::set<std::string> known{"rows",          "picks",         "beats",
                                                "picks_in_row",  "knots",         "knots_retried",
-                                               "knots_by_hand", "knot_cycles_started", "knot_cycles_done"};
+                                               "knots_by_hand", "knot_cycles_started", "knot_cycles_done",
+                                               "knot_cycle_heads_done"};
       if (!known.count(k)) cur.fail("unknown field \"" + k + "\"");
       if (fields.count(k)) cur.fail("field \"" + k + "\" given twice");
       cur.expect(':');
@@ -121,11 +124,22 @@ sequencer::Counters CounterStore::parse(const std::string& text, const std::stri
     if (!fields.count(k)) cur.fail(std::string("lacks \"") + k + "\"");
   }
   sequencer::Counters c{fields["rows"], fields["picks"], fields["beats"], fields["picks_in_row"], {}};
+  std::string contradict_early;  // found among the knot counts, said with the other contradictions
   // The knot counts come together or not at all (a file from before the heads has none).
   const char* knot_fields[] = {"knots", "knots_retried", "knots_by_hand", "knot_cycles_started", "knot_cycles_done"};
   const auto knot_given = std::count_if(std::begin(knot_fields), std::end(knot_fields), [&](const char* k) { return fields.count(k) > 0; });
   if (knot_given != 0 && knot_given != 5) cur.fail("the knot counts come together: some of knots, knots_retried, knots_by_hand, knot_cycles_started, knot_cycles_done are missing");
-  c.knot = {fields["knots"], fields["knots_retried"], fields["knots_by_hand"], fields["knot_cycles_started"], fields["knot_cycles_done"]};
+  c.knot = {fields["knots"], fields["knots_retried"], fields["knots_by_hand"], fields["knot_cycles_started"], fields["knot_cycles_done"],
+            fields["knot_cycle_heads_done"]};
+  if (c.knot.cycle_heads_done >> hal::kMaxKnottingHeads != 0) {
+    cur.fail("knot_cycle_heads_done = " + std::to_string(c.knot.cycle_heads_done) + " names a head beyond the " +
+             std::to_string(hal::kMaxKnottingHeads) + " a loom may have");
+  }
+  if (c.knot.cycle_heads_done != 0 && c.knot.cycles_started <= c.knot.cycles_done) {
+    contradict_early = "knot_cycle_heads_done = " + std::to_string(c.knot.cycle_heads_done) +
+                       " names heads of a cycle that was not started (knot_cycles_started = knot_cycles_done = " +
+                       std::to_string(c.knot.cycles_done) + ")";
+  }
   // Every completed row had at least one pick and one beat; the picks of the row in progress are
   // picks too. Counts that say otherwise were not written by loomctl.
   const auto contradict = [&](const std::string& why) { throw ConfigError(source + ": counters contradict each other: " + why); };
@@ -133,6 +147,7 @@ sequencer::Counters CounterStore::parse(const std::string& text, const std::stri
     contradict("picks = " + std::to_string(c.picks) + " is less than rows + picks_in_row = " +
                std::to_string(static_cast<std::uint64_t>(c.rows) + c.picks_in_row));
   }
+  if (!contradict_early.empty()) contradict(contradict_early);
   if (c.knot.cycles_done > c.knot.cycles_started) {
     contradict("knot_cycles_done = " + std::to_string(c.knot.cycles_done) + " exceeds knot_cycles_started = " +
                std::to_string(c.knot.cycles_started));

@@ -12,7 +12,8 @@ namespace loom::firmware {
 namespace {
 
 [[noreturn]] void sys_fail(const std::string& what, const std::string& path) {
-  throw std::runtime_error(what + " " + path + ": " + std::strerror(errno));
+  const int err = errno;
+  throw DurableWriteError(what + " " + path + ": " + std::strerror(err), err);
 }
 
 }  // namespace
@@ -43,6 +44,55 @@ void write_file_durably(const std::string& path, const std::string& body) {
   const int rc = ::fsync(dfd);
   ::close(dfd);
   if (rc != 0 && errno != EINVAL) sys_fail("cannot sync directory of", path);
+}
+
+void DiskReserve::ensure() const {
+  struct stat st {};
+  if (::stat(path_.c_str(), &st) == 0 && S_ISREG(st.st_mode) &&
+      static_cast<std::size_t>(st.st_blocks) * 512 >= bytes_) {
+    return;  // there whole, its blocks allocated
+  }
+  // Allocated, not a sparse hole (a hole frees nothing when deleted), then made durable like any state file.
+  const std::string tmp = path_ + ".tmp";
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+  if (fd < 0) sys_fail("cannot create the disk reserve", tmp);
+  const int rc = ::posix_fallocate(fd, 0, static_cast<off_t>(bytes_));
+  if (rc != 0 || ::fsync(fd) != 0) {
+    const int err = rc != 0 ? rc : errno;
+    ::close(fd);
+    ::unlink(tmp.c_str());
+    errno = err;
+    sys_fail("cannot keep " + std::to_string(bytes_ / 1024) + " KiB in reserve for the fault record at",
+             path_);
+  }
+  ::close(fd);
+  if (::rename(tmp.c_str(), path_.c_str()) != 0) {
+    const int err = errno;
+    ::unlink(tmp.c_str());
+    errno = err;
+    sys_fail("cannot rename onto", path_);
+  }
+}
+
+bool DiskReserve::release() const noexcept {
+  if (::unlink(path_.c_str()) != 0) return false;
+  const std::string dir = path_.find('/') == std::string::npos ? "." : path_.substr(0, path_.rfind('/'));
+  const int dfd = ::open(dir.empty() ? "/" : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    ::fsync(dfd);
+    ::close(dfd);
+  }
+  return true;
+}
+
+void write_file_durably(const std::string& path, const std::string& body, const DiskReserve& reserve) {
+  try {
+    write_file_durably(path, body);
+  } catch (const DurableWriteError& e) {
+    if (e.error != ENOSPC && e.error != EDQUOT) throw;
+    if (!reserve.release()) throw;
+    write_file_durably(path, body);
+  }
 }
 
 StateFileRead read_state_file(const std::string& path, std::size_t max_bytes) {

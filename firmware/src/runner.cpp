@@ -117,6 +117,7 @@ class LoopBody {
     const std::int64_t period_ns =
         std::max<std::int64_t>(1, std::llround(opt_.period_s * 1e9 / (opt_.realtime ? opt_.pace : 1.0)));
     const hal::Tick refresh_every = std::max<hal::Tick>(1, static_cast<hal::Tick>(1.0 / opt_.period_s));
+    const hal::Tick poll_every = std::max<hal::Tick>(1, static_cast<hal::Tick>(0.1 / opt_.period_s));
     const std::int64_t begin = rt_.clock.now_ns();
     std::int64_t deadline = begin + period_ns;
     std::uint32_t consecutive = 0;
@@ -148,6 +149,9 @@ class LoopBody {
 
       report_events(tick);
       publish_status(tick);
+      // Virtual time: the loop runs on the caller's thread, so the reporter's poll (retries of a failed save)
+      // is called here between ticks, every 100 ms of machine time; real time calls it from the reporter.
+      if (!opt_.realtime && opt_.reporter_poll && tick % poll_every == 0) opt_.reporter_poll();
       if (tick % refresh_every == 0) {
         // Bounded (two scans of a fixed histogram), once a second, in the tick's slack.
         if (rt_.rt_parts) {
@@ -216,15 +220,77 @@ class LoopBody {
     res.telemetry_wait_max_ns = std::max(res.telemetry_wait_max_ns, waited);
   }
 
-  // Applies operator commands, the I/O module's presses among them. True when the session ends here.
+  // Takes the tick's operator commands — the control socket's, the I/O module's presses, weave's signals —
+  // and applies what operator_policy.hpp decides of them. True when the session ends here.
   bool take_commands(hal::Tick tick) noexcept {
     std::uint32_t cmds = 0;
     if (opt_.link != nullptr && opt_.link->pending.load(std::memory_order_relaxed) != 0) {
       cmds = opt_.link->pending.exchange(0, std::memory_order_acquire);
     }
     cmds |= take_presses(tick);
+    cmds |= take_signals();
+    if (opt_.simulated_knotting_s > 0.0) {
+      knotting_wait_ = seq_.state() == sequencer::State::kAwaitKnotting ? knotting_wait_ + 1 : 0;
+      if (static_cast<double>(knotting_wait_) * opt_.period_s >= opt_.simulated_knotting_s)
+        seq_.request_row_knotted();
+    }
+    bool last_save_failed = false;
+    if (opt_.row_saves != nullptr) {
+      const std::uint32_t on_disk = opt_.row_saves->rows_on_disk.load(std::memory_order_acquire);
+      last_save_failed = opt_.row_saves->last_save_failed.load(std::memory_order_acquire);
+      seq_.note_rows_saved(on_disk, last_save_failed);
+      const std::uint64_t knots = opt_.row_saves->knots_on_disk.load(std::memory_order_acquire);
+      seq_.note_knots_saved(static_cast<std::uint32_t>(knots >> 32),
+                            static_cast<std::uint32_t>(knots & 0xFFFFFFFFu));
+    }
+    if (cmds == 0) return false;
+    PolicyInputs in;
+    in.commands = cmds;
+    in.state = seq_.state();
+    in.held_session = opt_.hold_when_finished;
+    in.estop_ok = rt_.loop.inputs().io.estop_ok;
+    in.link_recovery = rt_.loop.inputs().link.recovery;
+    in.last_save_failed = last_save_failed;
+    const Decision d = decide(in);
+    apply(d, seq_);
+    RunResult& res = rt_.result;
+    res.commands_overridden += d.overridden != 0 ? 1u : 0u;
+    switch (d.refusal) {
+      case Decision::Refusal::kAckLinkDown:
+      case Decision::Refusal::kAckEStopOpen:
+        ++res.acks_refused;
+        break;
+      case Decision::Refusal::kAckCountersUnsaved:
+        ++res.acks_refused_unsaved;
+        break;
+      case Decision::Refusal::kNone:
+        break;
+    }
+    exit_pending_ = exit_pending_ || d.exit_when_quiet;
+    switch (d.end) {
+      case Decision::End::kNone:
+        return false;
+      case Decision::End::kStopped:
+        res.end = RunResult::End::kExitRequested;
+        return true;
+      case Decision::End::kStartRequested:
+        res.end = RunResult::End::kStartRequested;
+        return true;
+      case Decision::End::kAckRequested:
+        res.end = RunResult::End::kAckRequested;
+        return true;
+    }
+    return false;
+  }
+
+  // weave's signals as the commands of the same words, each once, when it changes: SIGINT/SIGTERM is a stop
+  // (the second a stop now, applied at once: a safe stop never moves anything), SIGUSR1/SIGUSR2 pause and
+  // resume. Held level every tick, the pause flag would cancel a pause press at the next tick (and re-pause a
+  // loom a start press resumed): the last operator act wins, whatever its station.
+  std::uint32_t take_signals() noexcept {
+    std::uint32_t cmds = 0;
     if (opt_.stop_flag != nullptr && !stop_sent_ && opt_.stop_flag->load(std::memory_order_relaxed)) {
-      seq_.request_stop_at_row_end();
+      cmds |= static_cast<std::uint32_t>(Command::kStop);
       stop_sent_ = true;
     }
     if (opt_.stop_now_flag != nullptr && !stop_now_sent_ &&
@@ -233,75 +299,12 @@ class LoopBody {
       stop_now_sent_ = true;
     }
     if (opt_.pause_flag != nullptr) {
-      // On a change only: held level every tick, the flag would cancel a pause press at the next tick (and
-      // re-pause a loom a start press resumed). The last operator act wins, whatever its station.
       const bool pause = opt_.pause_flag->load(std::memory_order_relaxed);
-      if (pause != pause_flag_was_) pause ? seq_.request_pause() : seq_.request_resume();
+      if (pause != pause_flag_was_)
+        cmds |= static_cast<std::uint32_t>(pause ? Command::kPause : Command::kResume);
       pause_flag_was_ = pause;
     }
-    if (opt_.simulated_knotting_s > 0.0) {
-      knotting_wait_ = seq_.state() == sequencer::State::kAwaitKnotting ? knotting_wait_ + 1 : 0;
-      if (static_cast<double>(knotting_wait_) * opt_.period_s >= opt_.simulated_knotting_s)
-        seq_.request_row_knotted();
-    }
-    if (opt_.row_saves != nullptr) {
-      const std::uint32_t on_disk = opt_.row_saves->rows_on_disk.load(std::memory_order_acquire);
-      seq_.note_rows_saved(on_disk, opt_.row_saves->last_save_failed.load(std::memory_order_acquire));
-      const std::uint64_t knots = opt_.row_saves->knots_on_disk.load(std::memory_order_acquire);
-      seq_.note_knots_saved(static_cast<std::uint32_t>(knots >> 32),
-                            static_cast<std::uint32_t>(knots & 0xFFFFFFFFu));
-    }
-    if (cmds == 0) return false;
-    const auto has = [&](Command c) { return (cmds & static_cast<std::uint32_t>(c)) != 0; };
-    const sequencer::State s = seq_.state();
-    RunResult& res = rt_.result;
-    // Start, pause and next mean what operator_requests.hpp says, as a press of the same button does.
-    if (has(Command::kNext)) sequencer::make_request(seq_, sequencer::OperatorRequest::kRowKnotted);
-    if (has(Command::kPause)) sequencer::make_request(seq_, sequencer::OperatorRequest::kPause);
-    if (has(Command::kResume)) seq_.request_resume();
-    if (has(Command::kStart)) {
-      if (s == sequencer::State::kDone && opt_.hold_when_finished) {
-        res.end = RunResult::End::kStartRequested;
-        return true;
-      }
-      sequencer::make_request(seq_, sequencer::OperatorRequest::kStart);
-    }
-    if (has(Command::kStop) && s != sequencer::State::kIdle && s != sequencer::State::kDone &&
-        s != sequencer::State::kFault) {
-      // Only a loom that is weaving stops at row end: a stop while idle must not cut the next start short.
-      seq_.request_stop_at_row_end();
-      seq_.request_resume();  // paused between picks: finish the row, then stop
-    }
-    if (has(Command::kAck) && s == sequencer::State::kFault && !opt_.hold_when_finished) {
-      // weave: back to idle (refused while the e-stop chain is open); the run ends after its grace anyway.
-      sequencer::make_request(seq_, sequencer::OperatorRequest::kAcknowledge);
-    }
-    if (has(Command::kAck) && s == sequencer::State::kFault && opt_.hold_when_finished) {
-      // The service re-arms instead of acknowledging in place.
-      // Re-arming reconfigures the link: pointless (and the operator would think it done) while the
-      // controller is still off the bus or a lost node is still silent. The status says which.
-      // Likewise while the e-stop chain is still open: the fault stays latched (re-arming would show no
-      // fault until the next start re-latched it).
-      const hal::LinkRecovery rec = rt_.loop.inputs().link.recovery;
-      if (rec == hal::LinkRecovery::kBusOff || rec == hal::LinkRecovery::kNodeSilent ||
-          !rt_.loop.inputs().io.estop_ok) {
-        ++res.acks_refused;
-        return false;
-      }
-      // Re-arming reads the counters back from disk: while the last save failed the file lags what was
-      // woven, and re-arming from it would weave those rows again. The fault stays until a save succeeds.
-      if (opt_.row_saves != nullptr && opt_.row_saves->last_save_failed.load(std::memory_order_acquire)) {
-        ++res.acks_refused_unsaved;
-        return false;
-      }
-      res.end = RunResult::End::kAckRequested;
-      return true;
-    }
-    if (has(Command::kExit)) {
-      exit_pending_ = true;
-      if (!quiet_state()) seq_.request_stop_at_row_end();
-    }
-    return false;
+    return cmds;
   }
 
   // The presses the sequencer saw in the last tick (debounced, one event per press) as the commands of the
@@ -347,11 +350,7 @@ class LoopBody {
   }
 
   // Nothing is moving towards a goal: leaving the loop here loses no row in progress.
-  bool quiet_state() const noexcept {
-    const sequencer::State s = seq_.state();
-    return s == sequencer::State::kIdle || s == sequencer::State::kPaused || s == sequencer::State::kDone ||
-           s == sequencer::State::kFault;
-  }
+  bool quiet_state() const noexcept { return quiet(seq_.state()); }
 
   RunEvent base_event(RunEvent::Kind kind, hal::Tick tick) const noexcept {
     RunEvent e;

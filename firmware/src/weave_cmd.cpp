@@ -4,11 +4,14 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "loom/firmware/carpet_png.hpp"
@@ -23,8 +26,8 @@ std::atomic<bool> g_stop{false};
 std::atomic<bool> g_stop_now{false};
 std::atomic<bool> g_reload{false};
 std::atomic<bool> g_pause{false};
-// The first SIGINT/SIGTERM stops at the end of the row; a second one stops at once (safe stop: quick
-// stop of every axis, valves hold, counters kept, fault stop_requested).
+// The first SIGINT/SIGTERM stops at the next hold point (a row's end, between picks or knot cycles); a second
+// one stops at once (safe stop: quick stop of every axis, valves hold, counters kept, fault stop_requested).
 extern "C" void on_signal(int) {
   if (g_stop.exchange(true)) g_stop_now.store(true);
 }
@@ -130,18 +133,21 @@ class WeaveReporter {
     const double per_row = machine_s_ / rows_;
     if (in_.cfg.knotting.mode == sequencer::KnottingMode::kNone) {
       std::printf(
-          "woven %u rows (total %u): %.2f s per row vs ~300 s by hand (shed, pick, beat: %.0fx faster); "
+          "woven %u rows (total %u): %.2f s per row vs ~%.0f s by hand (shed, pick, beat: %.0fx faster); "
           "picks %u, beats %u\n",
-          rows_, c.rows, per_row, 300.0 / per_row, c.picks, c.beats);
+          rows_, c.rows, per_row, report::kManualRowSeconds, report::kManualRowSeconds / per_row, c.picks,
+          c.beats);
       return;
     }
+    // The same whole-row figure as summary.json's faster_than_manual (report/run_report.cpp).
     const double whole = per_row + weaver_outside_s_ / rows_;
     std::printf(
         "woven %u knotted rows (total %u): %.2f s per whole row (knotting %.2f s by the heads, %.2f s by "
-        "the weaver's hands) vs ~600 s for the weaver's whole row (%.1fx faster); picks %u, beats %u, knots "
+        "the weaver's hands) vs ~%.0f s for the weaver's whole row (%.1fx faster); picks %u, beats %u, knots "
         "%u tied by the heads, %u retried, %u by hand, %u requests to the weaver\n",
-        rows_, c.rows, whole, knot_s_ / rows_, weaver_s_ / rows_, 600.0 / whole, c.picks, c.beats,
-        c.knot.tied, c.knot.retried, c.knot.by_hand, weaver_requests_);
+        rows_, c.rows, whole, knot_s_ / rows_, weaver_s_ / rows_, report::kManualKnottedRowSeconds,
+        report::kManualKnottedRowSeconds / whole, c.picks, c.beats, c.knot.tied, c.knot.retried,
+        c.knot.by_hand, weaver_requests_);
   }
 
  private:
@@ -210,18 +216,47 @@ class WeaveReporter {
     std::printf("\n");
   }
 
+  // A failed save is tried again (retry_save), as the service does: a disk that frees up lets the loom
+  // weave on; one that does not ends in counters_not_saved at the row's end, or once a knot cycle's
+  // write-ahead has waited timing.row_save_timeout_s — never a loom standing mid-row for ever.
   void save(const sequencer::Counters& c) {
     try {
       record_.save(c);
+      unsaved_.reset();
+      counters_error_.clear();  // on disk again: nothing lags
     } catch (const std::exception& ex) {
-      // The sequencer stops at the row boundary (a safe point) with counters_not_saved, keeping its counters.
       if (counters_error_.empty()) {
-        std::fprintf(stderr, "loomctl: counters not saved: %s; stopping at the end of the row\n", ex.what());
+        std::fprintf(stderr,
+                     "loomctl: counters not saved: %s; retrying (the loom stops with counters_not_saved at "
+                     "the row's end, or when a knot cycle has waited %.3g s for it)\n",
+                     ex.what(), in_.cfg.sequencer.row_save_timeout_s);
       }
       counters_error_ = ex.what();
+      unsaved_ = c;
     }
   }
 
+ public:
+  // The runner's poll (between ticks, every 100 ms of machine time in virtual time): a failed save again,
+  // paced in real time at one try per half second of machine time — several within the save's deadline
+  // (timing.row_save_timeout_s), whatever --pace says.
+  void retry_save() {
+    if (!unsaved_) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_retry_ < retry_every_) return;
+    last_retry_ = now;
+    try {
+      record_.save(*unsaved_);
+      unsaved_.reset();
+      counters_error_.clear();
+      std::fprintf(stderr, "loomctl: counters saved again (rows %u)\n",
+                   record_.row_saves()->rows_on_disk.load());
+    } catch (const std::exception&) {
+      // Still failing: the first failure was said; the sequencer's deadline decides.
+    }
+  }
+
+ private:
   const WeaveArgs& a_;
   const WeaveInputs& in_;
   Machine& m_;
@@ -236,7 +271,18 @@ class WeaveReporter {
   double knot_s_ = 0.0, weaver_s_ = 0.0;  // the heads' knotting, and the weaver's hands, in those rows
   double weaver_outside_s_ = 0.0;
   std::uint32_t weaver_requests_ = 0;
-  std::string counters_error_;  // why the last save failed
+  std::string counters_error_;                  // why the last save failed
+  std::optional<sequencer::Counters> unsaved_;  // the counters a failed save could not write yet
+  std::chrono::steady_clock::time_point last_retry_{};
+  std::chrono::steady_clock::duration retry_every_{};  // wall time between tries (0 in virtual time)
+
+ public:
+  void pace_retries(bool realtime, double pace) {
+    const double machine_s = std::min(0.5, in_.cfg.sequencer.row_save_timeout_s / 5.0);
+    retry_every_ = realtime ? std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                  std::chrono::duration<double>(machine_s / std::max(pace, 1e-3)))
+                            : std::chrono::steady_clock::duration::zero();
+  }
 };
 
 std::unique_ptr<report::ReportWriter> open_report(const WeaveArgs& a, const WeaveInputs& in, bool hardware) {
@@ -248,6 +294,8 @@ std::unique_ptr<report::ReportWriter> open_report(const WeaveArgs& a, const Weav
   rh.period_s = in.cfg.sequencer.period_s;
   rh.beat_force_min_n = in.cfg.sequencer.beat_force_min_n;
   rh.beat_force_max_n = in.cfg.sequencer.beat_force_max_n;
+  rh.manual_row_s = in.cfg.knotting.mode == sequencer::KnottingMode::kNone ? report::kManualRowSeconds
+                                                                           : report::kManualKnottedRowSeconds;
   try {
     return std::make_unique<report::ReportWriter>(a.report, rh);
   } catch (const std::exception& e) {
@@ -343,6 +391,8 @@ int weave(const WeaveArgs& a, const Say& say) {
   ro.stop_now_flag = &g_stop_now;
   ro.pause_flag = &g_pause;
   ro.simulated_knotting_s = a.knotting_s;
+  reporter.pace_retries(ro.realtime, ro.pace);
+  ro.reporter_poll = [&reporter] { reporter.retry_save(); };
   if (machine.knot_program() != nullptr && !so.hardware()) {
     ro.weaver_sink = Machine::simulated_weaver_sink;
     ro.weaver_sink_ctx = &machine;

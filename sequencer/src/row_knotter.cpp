@@ -114,9 +114,11 @@ void RowKnotter::begin(std::uint32_t row0, const KnotCounters& progress, double 
     slot_[hh] = -1;  // where a selector stands is read back from its command when it is next sent
   }
   next_carriage_ = next_selectors_ = false;
+  disk_wait_since_ = hal::kNeverTick;
   // A cycle started and not finished: the power failed while its knots were being tied. Whether they are
   // is not known; tying again could tie one twice, so the weaver checks them (kCheck asks).
   interrupted_ = progress.cycles_started > progress.cycles_done && progress.cycles_done < static_cast<std::uint32_t>(stripe_);
+  heads_done_at_cut_ = interrupted_ ? progress.cycle_heads_done : 0;
   enter_cycle(static_cast<int>(progress.cycles_done), now, cmd);
 }
 
@@ -203,7 +205,7 @@ void RowKnotter::start_cycle(hal::Tick now) noexcept {
 }
 
 RowKnotter::Status RowKnotter::check(hal::Tick now, const hal::HalInputs& in, const hal::HalOutputs& cmd,
-                                     KnotCounters& counters, bool await_disk, std::uint32_t on_disk_started) noexcept {
+                                     KnotCounters& counters, const StepInputs& s) noexcept {
   // Every servo where it was sent (a drive trails its command by a few ticks: settle_s).
   const bool settled = seconds(now - phase_since_) >= k_.settle_s;
   for (int h = 0; h < heads_; ++h) {
@@ -219,7 +221,11 @@ RowKnotter::Status RowKnotter::check(hal::Tick now, const hal::HalInputs& in, co
   }
   if (interrupted_) {  // the power failed inside this cycle: the weaver checks its knots first
     interrupted_ = false;
-    missed_ = active_;
+    // (but not those the counters already hold: each knot is counted once, by the head or by the weaver)
+    for (int h = 0; h < heads_; ++h) {
+      const auto hh = static_cast<std::size_t>(h);
+      missed_[hh] = active_[hh] && (heads_done_at_cut_ & (1u << h)) == 0;
+    }
     hand_ask_ = WeaverAsk::kCheckKnot;
     ask_head_ = 0;
     phase_ = Phase::kWeaver;
@@ -240,13 +246,26 @@ RowKnotter::Status RowKnotter::check(hal::Tick now, const hal::HalInputs& in, co
       return Status::kFault;
     }
   }
+  // A stop or a pause holds here, between two cycles: before "cycle j started" is written ahead, so the
+  // next run (or the resume) begins cycle j afresh and no knot is asked of the weaver for nothing.
+  if (s.hold && counters.cycles_started < static_cast<std::uint32_t>(j_ + 1)) return Status::kHeld;
   // Write-ahead: "cycle j started" is on disk before the cycle starts, so a power cut inside it is known
   // after the restart and its knots are never tied a second time.
   if (counters.cycles_started < static_cast<std::uint32_t>(j_ + 1)) {
     counters.cycles_started = static_cast<std::uint32_t>(j_ + 1);
     counters_moved_ = true;
   }
-  if (await_disk && on_disk_started < counters.cycles_started) return Status::kRunning;
+  if (s.await_disk && s.on_disk_started < counters.cycles_started) {
+    // The save has a deadline like every other wait on the disk: a full or failing disk is the fault
+    // counters_not_saved (quick stop, red lamp), never a loom standing mid-row for ever.
+    if (disk_wait_since_ == hal::kNeverTick) disk_wait_since_ = now;
+    if (s.disk_timeout_ticks > 0 && now - disk_wait_since_ > s.disk_timeout_ticks) {
+      fail(Fault::kCountersNotSaved, -1);
+      return Status::kFault;
+    }
+    return Status::kRunning;
+  }
+  disk_wait_since_ = hal::kNeverTick;
   start_cycle(now);
   return Status::kRunning;
 }
@@ -288,6 +307,7 @@ void RowKnotter::finish_cycle(hal::Tick now, const hal::HalOutputs& cmd, KnotCou
     knotter_origin_[hh] += k_.cycle->end_offset_rad();  // the servo is at rest again, a cycle on
     if (seen_[hh]) {
       ++counters.tied;
+      counters.cycle_heads_done |= 1u << h;
       ++row_.tied;
       counters_moved_ = true;
       active_[hh] = false;
@@ -320,7 +340,9 @@ void RowKnotter::cycle_done(hal::Tick now, const hal::HalOutputs& cmd, KnotCount
   const KnotCounters was = counters;
   counters.cycles_done = static_cast<std::uint32_t>(j_ + 1);
   counters.cycles_started = std::max(counters.cycles_started, counters.cycles_done);
-  counters_moved_ |= counters.cycles_done != was.cycles_done || counters.cycles_started != was.cycles_started;
+  counters.cycle_heads_done = 0;
+  counters_moved_ |= counters.cycles_done != was.cycles_done || counters.cycles_started != was.cycles_started ||
+                     was.cycle_heads_done != 0;
   enter_cycle(j_ + 1, now, cmd);
 }
 
@@ -338,6 +360,7 @@ RowKnotter::Status RowKnotter::weaver(hal::Tick now, const hal::HalOutputs& cmd,
       return Status::kRunning;
     }
     ++counters.by_hand;  // tied (or checked and finished) by the weaver
+    counters.cycle_heads_done |= 1u << request_.head;
     ++row_.by_hand;
     counters_moved_ = true;
     missed_[static_cast<std::size_t>(request_.head)] = false;
@@ -353,8 +376,7 @@ RowKnotter::Status RowKnotter::weaver(hal::Tick now, const hal::HalOutputs& cmd,
 }
 
 RowKnotter::Status RowKnotter::step(hal::Tick now, const hal::HalInputs& in, hal::HalOutputs& cmd,
-                                    KnotCounters& counters, bool weaver_done, bool await_disk,
-                                    std::uint32_t on_disk_started) noexcept {
+                                    KnotCounters& counters, const StepInputs& s) noexcept {
   counters_moved_ = false;
   if (!fitted()) return Status::kDone;
   // Every tick: the moves in flight write their targets; grippers and cutters are open unless a running
@@ -386,7 +408,7 @@ RowKnotter::Status RowKnotter::step(hal::Tick now, const hal::HalInputs& in, hal
       phase_since_ = now;
       [[fallthrough]];
     case Phase::kCheck: {
-      const Status st = check(now, in, cmd, counters, await_disk, on_disk_started);
+      const Status st = check(now, in, cmd, counters, s);
       if (st != Status::kRunning || phase_ != Phase::kCycle) return st;
       [[fallthrough]];
     }
@@ -394,7 +416,7 @@ RowKnotter::Status RowKnotter::step(hal::Tick now, const hal::HalInputs& in, hal
       run_cycle(now, in, cmd, counters);
       break;
     case Phase::kWeaver:
-      return weaver(now, cmd, counters, weaver_done);
+      return weaver(now, cmd, counters, s.weaver_done);
     case Phase::kReturn:
       if (carriage_moving) return Status::kRunning;
       phase_ = Phase::kDone;

@@ -175,6 +175,7 @@ Sequencer::Sequencer(const motion::ProfileSet& profiles, const SequencerConfig& 
   diagnosis_ticks_ = ticks(cfg_.diagnosis_window_s);
   arrival_grace_ticks_ = ticks(cfg_.arrival_grace_s);
   enable_timeout_ticks_ = ticks(cfg_.enable_timeout_s);
+  row_save_timeout_ticks_ = ticks(cfg_.row_save_timeout_s);
   interlock_ctx_.warp = &profiles_->beatup().warp();
   interlock_ctx_.crank_park_position = cfg_.crank_park_position_rad;
   if (cfg_.heads.program != nullptr && cfg_.heads.cycle != nullptr) configure_knot_guard();
@@ -232,11 +233,41 @@ void Sequencer::latch(Fault f, hal::Tick now, int axis, std::uint16_t detail, in
 }
 
 void Sequencer::enter(State s, hal::Tick now) noexcept {
-  if ((s == State::kPaused) != (state_ == State::kPaused)) {
-    events_.add(s == State::kPaused ? EventKind::kPaused : EventKind::kResumed);
+  // Resumed only when the loom goes on from a pause: a stop (done) or a fault ends the pause, not resumes it.
+  if (s == State::kPaused && state_ != State::kPaused) events_.add(EventKind::kPaused);
+  if (state_ == State::kPaused && s != State::kPaused && s != State::kDone && s != State::kFault) {
+    events_.add(EventKind::kResumed);
   }
   state_ = s;
   state_since_ = now;
+}
+
+void Sequencer::request_stop() noexcept {
+  switch (state_) {
+    case State::kIdle:
+      start_requested_ = false;  // nothing moves yet: a start not taken is cancelled, no stop is kept for later
+      return;
+    case State::kDone:
+    case State::kFault:
+      return;
+    default:
+      stop_requested_ = true;
+      return;
+  }
+}
+
+bool Sequencer::hold_here(hal::Tick now) noexcept {
+  // The points where the loom may stand (beater parked or between beats of no row, shuttle at a selvedge,
+  // no knot cycle under way): a stop ends the run here, a pause holds here.
+  if (stop_requested_) {
+    enter(State::kDone, now);
+    return true;
+  }
+  if (pause_requested_) {
+    enter(State::kPaused, now);
+    return true;
+  }
+  return false;
 }
 
 void Sequencer::add_fault_event(EventKind kind) noexcept {
@@ -539,6 +570,10 @@ void Sequencer::idle(hal::Tick now, const hal::HalInputs& in) noexcept {
 }
 
 void Sequencer::enabling(hal::Tick now, const hal::HalInputs& in) noexcept {
+  if (stop_requested_) {  // nothing has moved yet: the drives hold where they are
+    enter(State::kDone, now);
+    return;
+  }
   request_all(cmd_, n_axes_, AxisRequest::kEnable);
   // Until every drive is enabled the targets follow the measured positions: enabling never jumps.
   bool all = true;
@@ -556,6 +591,12 @@ void Sequencer::enabling(hal::Tick now, const hal::HalInputs& in) noexcept {
 void Sequencer::begin_homing(hal::Tick now, const hal::HalInputs& in) noexcept {
   // Slot order is the machine's order: the beat crank first (its home point is clear of the warp), the
   // carriage once the beater is clear, then the added axes. The helix is never homed (absolute only).
+  // A stop lets a homing run in progress finish (a drive's homing cut short leaves its axis unreferenced)
+  // and starts no other.
+  if (stop_requested_) {
+    enter(State::kDone, now);
+    return;
+  }
   for (std::size_t i = 0; i < n_axes_; ++i) {
     if (in.axes[i].referenced) continue;
     if (cfg_.homing_timeout_s[i] <= 0.0) {  // unreferenced, and no homing run configured for it
@@ -611,6 +652,12 @@ void Sequencer::positioning(hal::Tick now, const hal::HalInputs& in) noexcept {
   // Re-arm from measured positions: the knotting servos to rest (nothing may cross a gripper left in the
   // warp), then the crank to the nearest park, then the carriage to the row's start side.
   if (!knotters_at_rest(now, in)) return;
+  // A stop lets the re-arm move in progress finish and starts no other (the knotting servos' way back to
+  // rest always finishes first: nothing may stand with a gripper in the warp).
+  if (stop_requested_ && !crank_move_.active && !carriage_move_.active) {
+    enter(State::kDone, now);
+    return;
+  }
   if (!crank_parking_planned_) {
     crank_parking_planned_ = true;
     const double phase = motion::wrap_pi(in.axes[index(CoreAxis::kBeatCrank)].position - cfg_.crank_park_position_rad);
@@ -687,6 +734,10 @@ void Sequencer::shed_test(hal::Tick now) noexcept {
     return;
   }
   if (v != ShedVerdict::kOpen) return;
+  if (stop_requested_) {  // between two strokes: the test runs again in full at the next start
+    enter(State::kDone, now);
+    return;
+  }
   if (++shed_test_step_ < kShedTestStrokes) {
     const bool a_up = shed_test_step_ % 2 == 0;
     start_stroke(a_up, !a_up);
@@ -765,11 +816,7 @@ void Sequencer::pick(hal::Tick now, const hal::HalInputs& in) noexcept {
     events_.add(EventKind::kPick);
     row_.add_pick(now - phase_start_);
     if (counters_.picks_in_row < cfg_.picks_per_row) {
-      if (pause_requested_) {
-        enter(State::kPaused, now);
-      } else {
-        begin_shed(now);
-      }
+      if (!hold_here(now)) begin_shed(now);
     } else {
       begin_sweep(now);
     }
@@ -787,8 +834,22 @@ void Sequencer::beat_sweep(hal::Tick now) noexcept {
 }
 
 void Sequencer::paused(hal::Tick now) noexcept {
-  // Paused between the picks of a row resumes that row; paused at a row's end starts the next.
-  if (!pause_requested_) row_.started() ? begin_shed(now) : next_row(now);
+  // A stop leaves a paused loom standing: it ends the run where it holds (the next run resumes the row, its
+  // picks or its knots, from the counters), never by finishing the row first.
+  if (stop_requested_) {
+    paused_in_knotting_ = false;
+    enter(State::kDone, now);
+    return;
+  }
+  if (pause_requested_) return;
+  // Resumed: paused between two knot cycles goes on knotting; between the picks of a row resumes that row;
+  // at a row's end starts the next.
+  if (paused_in_knotting_) {
+    paused_in_knotting_ = false;
+    enter(State::kKnotting, now);
+    return;
+  }
+  row_.started() ? begin_shed(now) : next_row(now);
 }
 
 void Sequencer::fault(hal::Tick now) noexcept {
@@ -983,11 +1044,9 @@ void Sequencer::row_end(hal::Tick now) noexcept {
 
 void Sequencer::after_row(hal::Tick now) noexcept {
   const bool enough = cfg_.rows_to_weave != 0 && counters_.rows >= cfg_.rows_to_weave;
-  if (enough || stop_requested_) {
+  if (enough) {
     enter(State::kDone, now);
-  } else if (pause_requested_) {
-    enter(State::kPaused, now);
-  } else {
+  } else if (!hold_here(now)) {
     next_row(now);
   }
 }
@@ -1043,16 +1102,25 @@ void Sequencer::knotting(hal::Tick now, const hal::HalInputs& in) noexcept {
     knotter_requests_seen_ = knotter_.requests();
     knot_requested_ = false;
   }
-  const bool await_disk = cfg_.await_row_saved;
-  const std::uint32_t on_disk = knots_on_disk_rows_ == counters_.rows ? knots_on_disk_started_ : 0;
+  RowKnotter::StepInputs ks;
+  ks.weaver_done = knot_requested_;
+  ks.hold = stop_requested_ || pause_requested_;
+  ks.await_disk = cfg_.await_row_saved;
+  ks.on_disk_started = knots_on_disk_rows_ == counters_.rows ? knots_on_disk_started_ : 0;
+  ks.disk_timeout_ticks = row_save_timeout_ticks_;
   const std::uint32_t requests_before = knotter_.requests();
-  const RowKnotter::Status st = knotter_.step(now, in, cmd_, counters_.knot, knot_requested_, await_disk, on_disk);
+  const RowKnotter::Status st = knotter_.step(now, in, cmd_, counters_.knot, ks);
   // The heads report what their step did: their counters moved, a request made of the weaver.
   if (knotter_.counters_moved()) events_.add(EventKind::kKnotProgress);
   if (knotter_.requests() != requests_before) events_.add(EventKind::kWeaverRequest);
   knot_requested_ = false;  // answered the request, or came when none was open
   switch (st) {
     case RowKnotter::Status::kRunning:
+      return;
+    case RowKnotter::Status::kHeld:
+      // Between two knot cycles, the heads at rest: a stop ends the run here, a pause holds here (resume
+      // goes on knotting); the next run after a stop begins this cycle afresh.
+      if (hold_here(now) && state_ == State::kPaused) paused_in_knotting_ = true;
       return;
     case RowKnotter::Status::kAwaitingWeaver:
       // Parked for the weaver, the heads at rest: a stop ends here, as it does while the weaver knots a row
@@ -1066,12 +1134,8 @@ void Sequencer::knotting(hal::Tick now, const hal::HalInputs& in) noexcept {
       const RowKnots& k = knotter_.row();
       row_.set_knots(k.ticks, k.weaver_ticks, k.tied, k.retried, k.by_hand);
       row_knotted_ = true;
-      // A pause asked for while the heads tied holds here, before the row's shed (resume sheds it).
-      if (pause_requested_) {
-        enter(State::kPaused, now);
-        return;
-      }
-      next_row(now);
+      // A stop or pause asked for as the last cycle ended holds here, before the row's shed (resume sheds it).
+      if (!hold_here(now)) next_row(now);
       return;
     }
   }

@@ -456,7 +456,7 @@ TEST(SequencerSim, KnottingWaitEndsOnRequestAndAStopThereIsDone) {
       r.seq->request_row_knotted();
       ++knots;
     } else {
-      r.seq->request_stop_at_row_end();  // waiting before row 2: a stop ends the session here
+      r.seq->request_stop();  // waiting before row 2: a stop ends the session here
     }
   });
   EXPECT_EQ(r.seq->state(), State::kDone);

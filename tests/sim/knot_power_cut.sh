@@ -56,4 +56,10 @@ echo "$line"
 echo "counters: $(tr -d '\n ' <"$counters")"
 [[ $line == *"equals the design knot for knot"* ]] || { echo "FAIL: the carpet is not the design"; tail -30 "$work/log"; exit 1; }
 [[ $(field rows) == "$rows_wanted" ]] || { echo "FAIL: rows $(field rows), wanted $rows_wanted"; exit 1; }
+# The counters' tallies are the carpet's: every knot counted once, by a head or by the weaver (a head's knot in
+# a cycle the cut interrupted is the weaver's to check only when the counters did not hold it already).
+knots_in_carpet=$(grep -oE '[0-9]+ knots \(' <<<"$line" | grep -oE '^[0-9]+')
+[[ -n $knots_in_carpet ]] || { echo "FAIL: no knot count in '$line'"; exit 1; }
+counted=$(($(field knots) + $(field knots_by_hand)))
+((counted == knots_in_carpet)) || { echo "FAIL: the counters count $counted knots (heads $(field knots), by hand $(field knots_by_hand)) in a carpet of $knots_in_carpet"; exit 1; }
 echo "PASS: $killed power cuts ($mid_knot while a row was being knotted) in $runs runs; every knot tied once"

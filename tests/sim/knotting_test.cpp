@@ -16,6 +16,7 @@
 #include "loom/firmware/config.hpp"
 #include "loom/firmware/machine.hpp"
 #include "loom/firmware/runner.hpp"
+#include "loom/hal/motion_outputs.hpp"
 
 using namespace loom;
 
@@ -198,24 +199,35 @@ TEST(Knotting, AStopWhileTheHeadsWaitForTheWeaverEndsTheRun) {
   Stepped s(knotting_loom(), scene("miss_probability = 1.0\n"), 2);  // every knot slips: the weaver is asked
   ASSERT_TRUE(s.run([&] { return s.m.sequencer().weaver_request().ask == sequencer::WeaverAsk::kTieByHand; }, 100000));
   EXPECT_EQ(s.m.sequencer().state(), sequencer::State::kKnotting);
-  s.m.sequencer().request_stop_at_row_end();
+  s.m.sequencer().request_stop();
   ASSERT_TRUE(s.run([&] { return s.m.sequencer().state() == sequencer::State::kDone; }, 10));
   EXPECT_EQ(s.m.sequencer().counters().rows, 0u);  // the row is not woven: the next run resumes its knots
 }
 
-// A pause asked for while the heads tie holds once the row's knots are tied, before its shed: the heald
-// frames have not moved, and resume sheds the row.
-TEST(Knotting, APauseWhileTheHeadsTieHoldsBeforeTheRowsShed) {
+// A pause asked for while the heads tie holds after the knot cycle in progress, before the next one starts
+// (nothing taken, nothing written ahead): the heads stand at rest, no heald frame has moved, and resume goes
+// on knotting the same row from the next knot — the row is then tied in full, every knot once.
+TEST(Knotting, APauseWhileTheHeadsTieHoldsAfterTheKnotCycleInProgress) {
   Stepped s(knotting_loom(), scene(""), 2);
-  ASSERT_TRUE(s.run([&] { return s.m.sequencer().state() == sequencer::State::kKnotting; }, 100000));
+  ASSERT_TRUE(s.run([&] { return s.m.sequencer().state() == sequencer::State::kKnotting && s.m.sequencer().knot_cycle() == 2; }, 100000));
   s.m.sequencer().request_pause();
   const auto pistons = s.m.sim().pistons();
   ASSERT_TRUE(s.run([&] { return s.m.sequencer().state() != sequencer::State::kKnotting; }, 100000));
   EXPECT_EQ(s.m.sequencer().state(), sequencer::State::kPaused);
-  EXPECT_EQ(s.m.sequencer().counters().knot.cycles_done, static_cast<std::uint32_t>(s.m.knot_program()->stripe()));
-  EXPECT_EQ(s.m.sim().pistons(), pistons);  // no shed yet
+  const sequencer::KnotCounters held = s.m.sequencer().counters().knot;
+  // Asked as cycle 2's carriage step and selectors travelled: cycles 0 and 1 tied, cycle 2 not begun (not
+  // written ahead: the next run would begin it afresh).
+  EXPECT_EQ(held.cycles_done, 2u);
+  EXPECT_EQ(held.cycles_started, 2u);
+  EXPECT_EQ(s.m.sim().pistons(), pistons);  // no shed
+  // Standing: nothing moves while paused.
+  const hal::HalOutputs before = s.m.loop().outputs();
+  ASSERT_FALSE(s.run([&] { return s.m.sequencer().state() != sequencer::State::kPaused; }, 2000));
+  EXPECT_FALSE(hal::motion_started(before, s.m.loop().outputs(), s.m.sequencer().axes().count, s.m.knot_program()->heads()));
   s.m.sequencer().request_resume();
   ASSERT_TRUE(s.run([&] { return s.m.sequencer().counters().picks > 0; }, 100000));
+  EXPECT_EQ(s.m.sequencer().counters().knot.tied + s.m.sequencer().counters().knot.by_hand,
+            static_cast<std::uint32_t>(s.m.knot_program()->knots_per_row()));
 }
 
 TEST(Knotting, AScenelessHeadsLoomAndAHeadlessKnotterAreRefused) {

@@ -9,6 +9,8 @@
 #include <thread>
 
 #include "loom/firmware/machine.hpp"
+#include "loom/firmware/operator_policy.hpp"
+#include "loom/hal/motion_outputs.hpp"
 #include "loom/motion/errors.hpp"
 #include "loom/motion/knot_cycle.hpp"
 #include "loom/sequencer/operator_requests.hpp"
@@ -199,11 +201,72 @@ sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run,
   return s;
 }
 
+const char* stopping_act_name(StoppingAct::Kind k) {
+  switch (k) {
+    case StoppingAct::Kind::kStop: return "stop";
+    case StoppingAct::Kind::kPause: return "pause";
+    case StoppingAct::Kind::kExit: return "exit";
+    case StoppingAct::Kind::kStopNow: return "stop now";
+  }
+  return "?";
+}
+
+std::vector<StoppingAct> random_stopping_acts(std::uint64_t seed, std::uint64_t run, int heads, std::string& description) {
+  // An independent stream from the scene's (a different mix), so adding acts changed no scene.
+  std::mt19937_64 rng(mix(mix(seed ^ 0x5709u) ^ mix(run)));
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<StoppingAct> acts;
+  const double n = u(rng);
+  const int count = n < 0.5 ? 0 : n < 0.85 ? 1 : 2;
+  const double horizon = heads > 0 ? 60000.0 : 9000.0;  // ticks: about two rows
+  std::ostringstream d;
+  for (int i = 0; i < count; ++i) {
+    StoppingAct a;
+    a.at = static_cast<hal::Tick>(u(rng) * horizon);
+    a.kind = static_cast<StoppingAct::Kind>(static_cast<int>(u(rng) * 4));
+    a.held_session = u(rng) < 0.5;
+    acts.push_back(a);
+  }
+  std::sort(acts.begin(), acts.end(), [](const StoppingAct& a, const StoppingAct& b) { return a.at < b.at; });
+  for (std::size_t i = 0; i < acts.size(); ++i) {
+    const StoppingAct& a = acts[i];
+    d << (i == 0 ? " | " : ", ") << stopping_act_name(a.kind) << (a.held_session ? " (serve)" : " (weave)")
+      << " at tick " << a.at;
+  }
+  description += d.str();
+  return acts;
+}
+
 namespace {
 void note_power_cut(void* flag) { *static_cast<bool*>(flag) = true; }
+
+// Gives `a` as its owner does: the runner's operator policy, or (stop now) the sequencer's safe stop.
+void give(firmware::Machine& m, const StoppingAct& a) {
+  if (a.kind == StoppingAct::Kind::kStopNow) {
+    m.sequencer().request_stop_now();
+    return;
+  }
+  firmware::PolicyInputs in;
+  in.commands = static_cast<std::uint32_t>(a.kind == StoppingAct::Kind::kStop    ? firmware::Command::kStop
+                                           : a.kind == StoppingAct::Kind::kPause ? firmware::Command::kPause
+                                                                                  : firmware::Command::kExit);
+  in.state = m.sequencer().state();
+  in.held_session = a.held_session;
+  in.estop_ok = m.loop().inputs().io.estop_ok;
+  firmware::apply(firmware::decide(in), m.sequencer());
+}
+
+// Where the loom stands after a stopping command: nothing it commands may start moving from here.
+bool standing(const sequencer::Sequencer& seq) {
+  const sequencer::State s = seq.state();
+  return s == sequencer::State::kPaused || s == sequencer::State::kDone || s == sequencer::State::kFault ||
+         s == sequencer::State::kIdle || s == sequencer::State::kAwaitKnotting ||
+         (s == sequencer::State::kKnotting && seq.weaver_request().ask != sequencer::WeaverAsk::kNone);
+}
 }  // namespace
 
-RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& spec, std::uint32_t rows) {
+RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& spec, std::uint32_t rows,
+                   const std::vector<StoppingAct>& acts) {
   firmware::Scene scene;
   scene.spec = spec;
   firmware::MachineOptions opt;
@@ -246,8 +309,23 @@ RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& sp
   hal::Tick fault_at = -1;
   hal::Tick t = 0;
   const hal::Tick max_ticks = kn.heads > 0 ? 200000 : 60000;
+  std::size_t next_act = 0;
+  hal::Tick standing_ticks = 0;
+  bool stopped = false;        // a stopping command was given and no starting command since
+  bool stood_before = false;   // ... and the loom stood at the end of the last tick
+  hal::HalOutputs out_before = m.loop().outputs();
+  const std::size_t n_axes = m.sequencer().axes().count;
   for (; t < max_ticks; ++t) {
+    // A run ends once the loom is done or faulted — or, after a stopping command, once it has stood a while.
     if (m.sequencer().finished() && (fault_at < 0 || t > fault_at + 300)) break;
+    if (stopped && stood_before && next_act >= acts.size() && m.sequencer().state() != sequencer::State::kKnotting &&
+        m.sequencer().state() != sequencer::State::kAwaitKnotting && standing_ticks > 2000) {
+      break;
+    }
+    while (next_act < acts.size() && acts[next_act].at <= t) {
+      give(m, acts[next_act++]);
+      stopped = true;
+    }
     const bool warp_before = sim.beater_in_warp();
     bool gripper_before = false;
     for (int h = 0; h < kn.heads; ++h) gripper_before |= in_warp(h, head_at[static_cast<std::size_t>(2 * h)]);
@@ -260,6 +338,16 @@ RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& sp
     // The campaign owns the loop, as the runner does in a weave: the pedal the simulated weaver presses
     // becomes request_row_knotted() here (the sequencer only reports presses).
     sequencer::apply_presses(m.sequencer());
+    if (m.sequencer().events().has(sequencer::EventKind::kButton)) stopped = false;  // a starting press (the pedal)
+    if (stopped && stood_before) {
+      if (const hal::MotionChange mc = hal::motion_started(out_before, m.loop().outputs(), n_axes, kn.heads)) {
+        why << hal::motion_change_name(mc.what) << " (index " << mc.index << ") after a stopping command, the loom "
+            << "standing, at tick " << t;
+      }
+    }
+    stood_before = stopped && standing(m.sequencer());
+    standing_ticks = stood_before ? standing_ticks + 1 : 0;
+    out_before = m.loop().outputs();
     if (m.sequencer().events().has(sequencer::EventKind::kWeaverRequest)) {  // the simulated weaver answers, as in a weave
       if (m.sequencer().weaver_request().ask != sequencer::WeaverAsk::kNone) {
         firmware::Machine::simulated_weaver_sink(&m, m.sequencer().weaver_request());
@@ -284,7 +372,9 @@ RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& sp
       if (moved(head2[sel], head_at[sel]) && (holding[static_cast<std::size_t>(h)] || knotter->gripper_closed(h))) selector_with_yarn = h;
     }
     const bool frames_moved = moved(p2[0], pistons[0]) || moved(p2[1], pistons[1]);
-    if (gripper_before && gripper_now && (moved(c2, carriage) || moved(k2, crank) || frames_moved)) {
+    if (!why.str().empty()) {
+      // already found (a stopping command's standing loom set moving)
+    } else if (gripper_before && gripper_now && (moved(c2, carriage) || moved(k2, crank) || frames_moved)) {
       why << (moved(c2, carriage) ? "carriage" : moved(k2, crank) ? "beater crank" : "heald frame")
           << " moved while a knotting gripper was in the warp at tick " << t;
     } else if (knotter_moved && warp_before && sim.beater_in_warp()) {
@@ -357,7 +447,9 @@ CampaignResult run_campaign(const CampaignOptions& opt) {
       const sim_hal::SceneSpec scene =
           random_scene(opt.seed, run, local.sequencer.second_channel, with_heads ? local.knotting.heads : 0,
                        with_heads ? static_cast<int>(local.knotting.slot_colours.size()) : 0, description);
-      const RunOutcome o = run_one(local, scene, opt.rows);
+      const std::vector<StoppingAct> acts =
+          random_stopping_acts(opt.seed, run, with_heads ? local.knotting.heads : 0, description);
+      const RunOutcome o = run_one(local, scene, opt.rows, acts);
       const std::lock_guard<std::mutex> lock(mu);
       ++result.runs;
       result.faulted += o.faulted;

@@ -12,7 +12,11 @@
 //   - the carriage, the beater's crank and the heald frames never move while a gripper is in the warp;
 //   - no knotting servo leaves its rest while the beater is in the warp;
 //   - no selector turns while its gripper holds yarn;
-//   - no knot is tied twice, and every row the counters call woven has every knot tied (none skipped).
+//   - no knot is tied twice, and every row the counters call woven has every knot tied (none skipped);
+// and, with stopping commands drawn at random ticks (stop, pause, exit, stop now — as the service and weave
+// apply them, through the operator policy):
+//   - once the loom stands after one (paused, done, faulted, idle, waiting for the weaver), nothing it
+//     commands starts moving until a starting command (the weaver's pedal) comes (hal/motion_outputs.hpp).
 // "Moves" means more than 1 µm (or µrad) in a tick: a servo's settling tail is not motion that can
 // catch a warp thread. Each run is deterministic for (campaign seed, run index), whatever the threads.
 #pragma once
@@ -47,8 +51,23 @@ sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run,
                                 const std::array<bool, hal::kSafetySensorCount>& second_channel, int heads, int slots,
                                 std::string& description);
 
-// Weave `rows` rows of `scene` on `cfg` and check the true state every tick.
-RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& scene, std::uint32_t rows);
+// A stopping command an operator gives at a tick: stop (weave's SIGTERM or the service's ctl/panel stop),
+// pause, exit (the service's SIGTERM), or stop now (a second SIGTERM).
+struct StoppingAct {
+  enum class Kind : std::uint8_t { kStop, kPause, kExit, kStopNow };
+  hal::Tick at = 0;
+  Kind kind = Kind::kStop;
+  bool held_session = false;  // as the service gives it (else as weave does)
+};
+const char* stopping_act_name(StoppingAct::Kind k);
+
+// The stopping commands of run `run` (none, one or two, at random ticks within the run's usual length),
+// appended to `description`.
+std::vector<StoppingAct> random_stopping_acts(std::uint64_t seed, std::uint64_t run, int heads, std::string& description);
+
+// Weave `rows` rows of `scene` on `cfg`, giving `acts` at their ticks, and check the true state every tick.
+RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& scene, std::uint32_t rows,
+                   const std::vector<StoppingAct>& acts = {});
 
 struct Violation {
   std::uint64_t run = 0;

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "loom/firmware/control_loop.hpp"
+#include "loom/firmware/operator_policy.hpp"
 #include "loom/sequencer/sequencer.hpp"
 
 namespace loom::firmware {
@@ -54,15 +55,7 @@ RtSetup setup_realtime(int fifo_priority, std::size_t heap_prefault_bytes = 8u <
 // ---------------------------------------------------------------------------------------------------
 // Operator commands into the loop and live status out of it (the control socket's side of the loop).
 // ---------------------------------------------------------------------------------------------------
-enum class Command : std::uint32_t {
-  kStart = 1u << 0,  // idle → weave; done → a new session (the runner returns kStartRequested)
-  kPause = 1u << 1,  // hold at the next safe point
-  kResume = 1u << 2,
-  kStop = 1u << 3,  // stop at the end of the row in progress
-  kAck = 1u << 4,   // acknowledge a latched fault (held session: kAckRequested, the owner re-arms)
-  kExit = 1u << 5,  // leave the loop (service shutdown): stop at row end first when weaving
-  kNext = 1u << 6,  // knotting mode: the weaver has knotted the row, weave it
-};
+// Command: operator_policy.hpp (what each command does, in one place).
 
 // Shared between the loop thread and any number of non-RT threads. Commands are bits in one atomic word
 // (set with fetch_or, taken with exchange: lock-free, no lost commands, nothing allocated); status is a
@@ -152,7 +145,7 @@ struct RunOptions {
   hal::Tick max_ticks = 0;      // 0 = no limit
   hal::Tick grace_ticks = 100;  // ticks run after the sequencer finishes (quick stop reaches the drives;
                                 // longer while a symptom's root cause may still be diagnosed)
-  const std::atomic<bool>* stop_flag = nullptr;  // set asynchronously → stop at row end
+  const std::atomic<bool>* stop_flag = nullptr;  // set asynchronously → a stop (Command::kStop)
   const std::atomic<bool>* stop_now_flag =
       nullptr;                                    // set asynchronously → safe stop at once (stop_requested)
   const std::atomic<bool>* pause_flag = nullptr;  // true → pause at the next safe point, false → resume
@@ -180,8 +173,8 @@ struct RunOptions {
   // weaver's row-knotted pedal — is also audited as a RunEvent::kButton (serve).
   bool audit_buttons = false;
   bool hold_when_finished = false;
-  // Real time only: called on the reporter thread every few milliseconds (the service's watchdog and
-  // retries live here, off the loop thread). Never called from the loop.
+  // Called on the reporter thread every few milliseconds in real time, between ticks every 100 ms of
+  // machine time in virtual time (the service's watchdog, failed saves tried again). Never from the RT loop.
   std::function<void()> reporter_poll;
 
   LoopClock* clock = nullptr;  // nullptr = MonotonicClock
@@ -219,6 +212,7 @@ struct RunResult {
   std::uint64_t events_dropped = 0;
   std::uint32_t acks_refused = 0;          // acknowledgements while the link could not be re-armed yet
   std::uint32_t acks_refused_unsaved = 0;  // acknowledgements while the counters still could not be saved
+  std::uint32_t commands_overridden = 0;   // ticks whose starting commands a stopping one overrode
   // What the loop thread actually ran at (realtime only; read back with pthread_getschedparam inside it).
   int loop_policy = -1;  // SCHED_FIFO, SCHED_OTHER, ...; -1 = ran on the caller (virtual time)
   int loop_priority = 0;

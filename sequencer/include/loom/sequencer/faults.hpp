@@ -38,7 +38,7 @@ namespace loom::sequencer {
   X(kShuttleSlipped, 0x101C, "shuttle_slipped", "the shuttle did not leave or arrive with its carrier (slipped off the magnet)") \
   X(kShedSensorLate, 0x101D, "shed_sensor_late", "a heald frame took far longer than its learned stroke (stuck on its way)") \
   X(kLoopOverrun, 0x101E, "loop_overrun", "the control loop missed its deadline too many ticks in a row") \
-  X(kCountersNotSaved, 0x101F, "counters_not_saved", "the production counters of a finished row could not be saved") \
+  X(kCountersNotSaved, 0x101F, "counters_not_saved", "the production counters could not be saved in time (a finished row, or a knot cycle's start written ahead)") \
   X(kSensorDiscrepancy, 0x1020, "sensor_discrepancy", "the two channels of a safety sensor disagree (a stuck switch or a wiring fault)") \
   X(kHomingFailed, 0x1021, "homing_failed", "an axis' homing run failed or did not find its reference in time") \
   X(kAxisUnreferenced, 0x1022, "axis_unreferenced", "an axis lost its reference (drive power cycle) or cannot be homed") \

@@ -83,11 +83,17 @@ struct KnotCounters {
   std::uint32_t tied = 0, retried = 0, by_hand = 0;   // production totals: knots tied by the heads, knot
                                                       // cycles run again after a miss, knots tied by the weaver
   std::uint32_t cycles_started = 0, cycles_done = 0;  // of the row in progress (written ahead: see check)
+  // The heads (bit h) whose knot of the cycle in progress (cycle `cycles_done`) is counted already — tied by
+  // the head, or by the weaver — while another head of it still waits: a restart then asks the weaver to
+  // check only the others, and no knot is counted twice. Zero between cycles.
+  std::uint32_t cycle_heads_done = 0;
 };
 
 class RowKnotter {
  public:
-  enum class Status : std::uint8_t { kRunning, kAwaitingWeaver, kDone, kFault };
+  // kHeld: asked to hold, the heads stand between two knot cycles (the next cycle's carriage step and
+  // selectors arrived, nothing taken, nothing written ahead); the next step without `hold` goes on from there.
+  enum class Status : std::uint8_t { kRunning, kAwaitingWeaver, kDone, kFault, kHeld };
 
   // Configure-time. `carriage_home_m`: the carriage reading at the left selvedge; `carriage` its limits.
   // `guard`: where a knotting servo holds its gripper in the warp (the interlocks' own test): no carriage move
@@ -102,10 +108,17 @@ class RowKnotter {
   // finished (the power failed in it) is asked of the weaver first.
   void begin(std::uint32_t row0, const KnotCounters& progress, double return_to_m, hal::Tick now,
              const hal::HalOutputs& cmd) noexcept;
-  // RT-safe. One tick. `weaver_done`: the weaver answered the request (only read while one is open);
-  // `on_disk_started`: the row's cycles-started count the counters file holds (when `await_disk`).
+  // What the sequencer tells the heads each tick.
+  struct StepInputs {
+    bool weaver_done = false;  // the weaver answered the request (only read while one is open)
+    bool hold = false;         // a stop or a pause: stand at the next point between two knot cycles
+    bool await_disk = false;   // no cycle starts before its start is on disk ...
+    std::uint32_t on_disk_started = 0;  // ... as the counters file holds the row's cycles-started count
+    hal::Tick disk_timeout_ticks = 0;   // ... within this many ticks, else counters_not_saved (0: no limit)
+  };
+  // RT-safe. One tick.
   Status step(hal::Tick now, const hal::HalInputs& in, hal::HalOutputs& cmd, KnotCounters& counters,
-              bool weaver_done, bool await_disk, std::uint32_t on_disk_started) noexcept;
+              const StepInputs& s) noexcept;
 
   Fault fault() const noexcept { return fault_; }
   int fault_axis() const noexcept { return fault_axis_; }
@@ -145,7 +158,7 @@ class RowKnotter {
   void cycle_done(hal::Tick now, const hal::HalOutputs& cmd, KnotCounters& counters) noexcept;
   void ask(WeaverAsk a, int head, int knot, int slot, hal::Tick now) noexcept;
   Status check(hal::Tick now, const hal::HalInputs& in, const hal::HalOutputs& cmd, KnotCounters& counters,
-               bool await_disk, std::uint32_t on_disk_started) noexcept;
+               const StepInputs& s) noexcept;
   void run_cycle(hal::Tick now, const hal::HalInputs& in, hal::HalOutputs& cmd, KnotCounters& counters) noexcept;
   Status weaver(hal::Tick now, const hal::HalOutputs& cmd, KnotCounters& counters, bool weaver_done) noexcept;
   bool play(Move& m, hal::Tick now, double& target) const noexcept;  // true when it moved the target this tick
@@ -162,9 +175,11 @@ class RowKnotter {
   int heads_ = 0, stripe_ = 0;
   Phase phase_ = Phase::kDone;
   hal::Tick phase_since_ = 0, row_since_ = 0, weaver_since_ = 0;
+  hal::Tick disk_wait_since_ = hal::kNeverTick;  // the write-ahead of the cycle in check is waiting for the disk
   int j_ = 0;                 // knot cycle in progress
   int attempt_ = 0;           // 0 first try, 1 the retry
   bool interrupted_ = false;  // cycle j_ was started before a power cut: ask the weaver first
+  std::uint32_t heads_done_at_cut_ = 0;  // ... except of these heads, whose knots the counters hold
   int ask_head_ = 0;          // next head to consider for a request in kWeaver
   WeaverAsk hand_ask_ = WeaverAsk::kTieByHand;  // what kWeaver asks for the heads in missed_
   Move carriage_move_{};

@@ -35,7 +35,7 @@ enum class State : std::uint8_t {
   kAwaitKnotting,  // knotting mode: parked before a new row until the weaver says the row is knotted
   kKnotting,     // knotting heads: tying the row knot by knot before its shed change (or asking the weaver)
   kPaused,       // holding at a safe point (before a shed change), drives enabled, until resumed
-  kDone,         // all requested rows woven (or stop at row end): holding, enabled
+  kDone,         // all requested rows woven, or stopped at a hold point: holding, enabled
   kFault,        // latched fault: quick stop, valves hold, counters kept
 };
 const char* state_name(State s);
@@ -122,10 +122,22 @@ class Sequencer {
   // (then the machine re-arms, so a changed width re-homes the carriage). `slot` must outlive this.
   Sequencer(motion::ProfileSlot& slot, const SequencerConfig& cfg, Counters resume = {});
 
-  void request_start() noexcept { start_requested_ = true; }       // RT-safe
-  void request_stop_at_row_end() noexcept { stop_requested_ = true; }  // RT-safe
-  void request_pause() noexcept { pause_requested_ = true; }        // RT-safe: holds before the next shed
-  void request_resume() noexcept { pause_requested_ = false; }      // RT-safe
+  void request_start() noexcept { start_requested_ = true; }  // RT-safe
+  // RT-safe. Stop: the loom comes to rest at the next point where it may stand — where a pause would hold
+  // (a row's end, between the picks of a row, between two knot cycles of the heads), or at once where it
+  // already stands (paused, waiting for the weaver) — and stays there in kDone. It never sets the loom
+  // moving: a paused loom stays where it is, and an idle one forgets a start it has not yet taken. What is in
+  // progress when it comes (a beat sweep, a pick, a knot cycle, a homing run, a re-arm move) is finished,
+  // never cut short: the stop only keeps the next motion from starting. Nothing to do when done or faulted.
+  void request_stop() noexcept;
+  // RT-safe. Hold at the next point where a stop would stand (see request_stop), drives enabled, until
+  // resumed. Never sets the loom moving; a pause while idle is nothing to hold.
+  void request_pause() noexcept { pause_requested_ = true; }
+  void request_resume() noexcept { pause_requested_ = false; }  // RT-safe
+  // RT-safe. A pause asked for and not yet reached (the loom is still moving towards its hold point).
+  bool pause_pending() const noexcept { return pause_requested_ && state_ != State::kPaused; }
+  // RT-safe. A stop asked for and not yet reached.
+  bool stop_pending() const noexcept { return stop_requested_ && state_ != State::kDone; }
   // RT-safe. Stop at once (the second SIGINT/SIGTERM): quick stop of every axis, valves hold, counters
   // kept, latched as the named fault stop_requested.
   void request_stop_now() noexcept { stop_now_requested_ = true; }
@@ -229,6 +241,7 @@ class Sequencer {
   void knotting(hal::Tick now, const hal::HalInputs& in) noexcept;
   bool knotters_at_rest(hal::Tick now, const hal::HalInputs& in) noexcept;  // positioning: back to TAKE first
   void paused(hal::Tick now) noexcept;
+  bool hold_here(hal::Tick now) noexcept;  // at a hold point: a stop (→ done) or a pause (→ paused) takes it
   void fault(hal::Tick now) noexcept;
   // ---- transitions and helpers ----
   hal::Tick ticks(double seconds) const noexcept;
@@ -330,6 +343,7 @@ class Sequencer {
   Debouncer<4> buttons_;  // start, pause, ack, row knotted
   RisingEdge start_edge_, pause_edge_, ack_edge_, knotted_edge_;
   bool knot_requested_ = false;  // "row knotted" since the loom last started waiting for it
+  bool paused_in_knotting_ = false;  // the pause holds between two knot cycles: resuming goes on knotting
   bool row_knotted_ = false;     // the row about to start has been knotted
   hal::Tick knotting_ticks_ = 0;
   RowKnotter knotter_;                     // the knotting heads (fitted() when the machine has them)
@@ -354,6 +368,7 @@ class Sequencer {
   std::array<double, hal::kMaxAxes> max_step_{};  // the most an axis can move in one tick (m or rad)
   // The configured times the tick compares against, in ticks (ticks() of cfg_'s seconds, once).
   hal::Tick stale_ticks_ = 0, diagnosis_ticks_ = 0, arrival_grace_ticks_ = 0, enable_timeout_ticks_ = 0;
+  hal::Tick row_save_timeout_ticks_ = 0;
   bool load_cell_seen_ = false;
 
   // Row bookkeeping.
