@@ -342,6 +342,24 @@ TEST_F(LoomSynthCli, CrankRockerNear180KeepsItsDigits) {
   const long double a = std::sin(hp) * std::sin(s / 2.0L) / std::cos(s / 2.0L + hp);
   EXPECT_NEAR(std::stod(rows[1][4]), static_cast<double>(a), 1e-13 * static_cast<double>(a)) << r.out;
 }
+
+// Hard case A2 through the CLI: the slider-crank's π − φ is taken in degrees too, so at φ = 180° − 1e-12° the
+// coupler b = 1/(2√(k² + λ²s²)) (k = sin(ε/2), s = cos(ε/2), λ² = 2k/(s²(w + k)), w = √(4 + k²)) keeps its
+// digits; computed here in long double from the exact ε. Before: 1 % off (π − rad(φ) lost ulp(π) of ε).
+TEST_F(LoomSynthCli, SliderCrankNear180KeepsItsDigits) {
+  for (const char* phi : {"179.999999", "179.999999999", "179.999999999999"}) {
+    const CliRun r = run(std::string("slider-crank --phi ") + phi + " --full-precision");
+    ASSERT_EQ(r.exit_code, 0) << phi << ": " << r.err;
+    const auto rows = csv(r.out);
+    ASSERT_EQ(rows.size(), 2u) << r.out;
+    const long double d2r = 3.141592653589793238462643383279502884L / 180.0L;
+    const long double eps = (180.0L - static_cast<long double>(std::stod(phi))) * d2r;
+    const long double k = std::sin(eps / 2.0L), s = std::cos(eps / 2.0L), w = std::sqrt(4.0L + k * k);
+    const long double lambda2 = 2.0L * k / (s * s * (w + k));
+    const long double b = 0.5L / std::sqrt(k * k + lambda2 * s * s);
+    EXPECT_NEAR(std::stod(rows[1][2]) / static_cast<double>(b), 1.0, 1e-9) << phi << ": " << r.out;
+  }
+}
 }  // namespace
 
 namespace {

@@ -153,3 +153,44 @@ TEST(RunReport, UnwritableDirectoryIsNamed) {
     EXPECT_NE(std::string(e.what()).find("/proc/loom_no_such_dir/x"), std::string::npos);
   }
 }
+
+// A knotted run: each row carries its knots and knotting times, the totals compare whole rows with the
+// weaver's whole row (the heads' knotting inside the row, the weaver's own before it — the same figure weave
+// prints), and the timeline draws the knotting, most of a knotted row.
+TEST(RunReport, KnottedRowsCarryTheirKnotsAndCompareWholeRows) {
+  const auto dir = fresh_dir("knotted");
+  report::RunHeader h = header();
+  h.manual_row_s = report::kManualKnottedRowSeconds;
+  report::ReportWriter w(dir.string(), h);
+  sequencer::RowStats a = row(1);
+  a.knot_ticks = 25000, a.weaver_ticks = 5000, a.total_ticks = 3700 + 30000;  // heads: inside the row
+  a.knots_tied = 358, a.knots_retried = 4, a.knots_by_hand = 2;
+  sequencer::RowStats b = row(2);
+  b.knotting_ticks = 60000;  // weaver mode: the weaver knotted 120 s before the row
+  w.add_row(a, 1, 67.4);
+  w.add_row(b, 1, 194.8);
+  report::RunEnd end;
+  end.counters = {2, 2, 6, 0};
+  end.machine_s = 194.8;
+  end.wall_s = 1.0;
+  w.finish(end);
+  const nlohmann::json j = nlohmann::json::parse(read(dir / "summary.json"));
+  const auto& r0 = j.at("rows")[0];
+  EXPECT_EQ(r0.at("knots").at("tied"), 358);
+  EXPECT_EQ(r0.at("knots").at("retried"), 4);
+  EXPECT_EQ(r0.at("knots").at("by_hand"), 2);
+  EXPECT_DOUBLE_EQ(r0.at("knotting_s").get<double>(), 50.0);
+  EXPECT_DOUBLE_EQ(r0.at("weaver_s").get<double>(), 10.0);
+  EXPECT_DOUBLE_EQ(r0.at("whole_row_s").get<double>(), 67.4);
+  EXPECT_DOUBLE_EQ(j.at("rows")[1].at("whole_row_s").get<double>(), 7.4 + 120.0);
+  const auto& t = j.at("totals");
+  const double whole = (67.4 + 127.4) / 2.0;
+  EXPECT_NEAR(t.at("whole_row_time_mean_s").get<double>(), whole, 1e-9);
+  EXPECT_EQ(t.at("manual_row_time_s"), 600.0);
+  EXPECT_NEAR(t.at("faster_than_manual").get<double>(), 600.0 / whole, 1e-9);
+  EXPECT_EQ(t.at("knots_this_run").at("tied"), 358);
+  EXPECT_EQ(t.at("knots_this_run").at("by_hand"), 2);
+  EXPECT_NEAR(t.at("knots_this_run").at("weaver_time_s").get<double>(), 10.0 + 120.0, 1e-9);
+  const std::string svg = read(dir / "row_timeline.svg");
+  EXPECT_NE(svg.find("knotting"), std::string::npos) << "the timeline has no knotting lane";
+}

@@ -24,7 +24,7 @@ double thesis_scaled(double unit_length, double stroke) {
 
 void design_slider_crank(const DesignArgs& args, std::ostream& out, std::ostream& err) {
   require_positive_length("--stroke", args.stroke);
-  const double phi = rad(args.phi_deg);
+  const motion::CrankRotation phi = motion::CrankRotation::degrees(args.phi_deg);  // π − φ exact near 180°
   blame("--phi " + input_value(args.phi_deg), [&] { return motion::soylemez_lambda_bounds(phi); });
   const double stroke = args.thesis_rounding ? 1.0 : args.stroke;
   motion::SliderCrankDesign d =

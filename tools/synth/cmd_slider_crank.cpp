@@ -75,7 +75,7 @@ void run_slider_crank(const SliderCrankArgs& args, std::ostream& out, std::ostre
   std::ostringstream table;
   std::size_t printed = 0;
   for (double phi_deg : phis) {
-    const double phi = motion::rad(phi_deg);
+    const motion::CrankRotation phi = motion::CrankRotation::degrees(phi_deg);  // π − φ exact near 180°
     motion::SliderCrankDesign d;
     try {
       motion::soylemez_lambda_bounds(phi);

@@ -65,6 +65,9 @@ class PlotBuilder {
     if (t.complete) {
       t.time_s = row.at("time_s").get<double>();
       t.end_s = row.value("end_s", -1.0);
+      t.knotting_s = row.value("knotting_s", 0.0) + row.value("weaver_s", 0.0);  // heads: inside the row
+      t.weaver_knotting_s = row.value("weaver_knotting_s", 0.0);                 // weaver mode: before it
+      knotted_ = knotted_ || t.knotting_s > 0.0 || t.weaver_knotting_s > 0.0;
       t.shed_s = row.at("shed_s").get<double>();
       t.pick_s = row.at("pick_s").get<double>();
       t.beat_s = row.at("beat_s").get<double>();
@@ -112,7 +115,8 @@ class PlotBuilder {
 
     // ---- every row's timeline ----
     Timeline tl;
-    tl.lanes = {"shed", "pick", "beat sweep"};
+    tl.lanes = knotted_ ? std::vector<std::string>{"knotting", "shed", "pick", "beat sweep"}
+                        : std::vector<std::string>{"shed", "pick", "beat sweep"};
     tl.height_px = 280;
     const std::uint64_t complete = rows_ - (incomplete_ ? 1 : 0);
     tl.title = rows_ > timeline_.size()
@@ -124,8 +128,17 @@ class PlotBuilder {
       const std::string label = "row " + std::to_string(r.row);
       if (r.complete) {
         const double end = r.end_s >= 0.0 ? r.end_s : prev_end + r.time_s;
-        const double t0 = end - r.time_s;
-        // Shed and pick alternate per pick; drawn as one block each, in row order.
+        const double row_start = end - r.time_s;
+        // The knotting comes first: the heads' inside the row (with the waits for the weaver's hand), the
+        // weaver's own before it (weaver mode). Then shed and pick, which alternate per pick and are drawn
+        // as one block each, and the beat sweep, in row order.
+        if (r.weaver_knotting_s > 0.0) {
+          tl.bars.push_back({"knotting", row_start - r.weaver_knotting_s, row_start, "#8c564b", false, ""});
+        }
+        if (r.knotting_s > 0.0) {
+          tl.bars.push_back({"knotting", row_start, row_start + r.knotting_s, "#8c564b", false, ""});
+        }
+        const double t0 = row_start + r.knotting_s;
         tl.bars.push_back({"shed", t0, t0 + r.shed_s, "#2ca02c", false, ""});
         tl.bars.push_back({"pick", t0 + r.shed_s, t0 + r.shed_s + r.pick_s, "#1f77b4", false, ""});
         tl.bars.push_back({"beat sweep", t0 + r.shed_s + r.pick_s, t0 + r.shed_s + r.pick_s + r.beat_s, "#d62728", false, label});
@@ -147,12 +160,14 @@ class PlotBuilder {
     long long row = 0;
     bool complete = true;
     double time_s = 0.0, end_s = -1.0, shed_s = 0.0, pick_s = 0.0, beat_s = 0.0;
+    double knotting_s = 0.0, weaver_knotting_s = 0.0;
     std::vector<std::pair<double, std::string>> faults;  // (t_s, name)
   };
   std::deque<Series> force_;
   std::deque<TimelineRow> timeline_;
   std::uint64_t rows_ = 0, force_rows_ = 0;
   bool incomplete_ = false;
+  bool knotted_ = false;  // some row was knotted (its knotting is drawn: most of a knotted row's time)
   long long incomplete_row_ = 0;
 };
 
@@ -171,9 +186,17 @@ json row_json(const sequencer::RowStats& r, std::uint32_t picks, double period_s
     jb["peak_force_n"] = r.force_measured ? json(b.peak_force_n) : json(nullptr);
     beats.push_back(jb);
   }
+  const auto secs = [&](hal::Tick t) { return static_cast<double>(t) * period_s; };
   return {{"row", r.row},
           {"complete", true},
-          {"time_s", static_cast<double>(r.total_ticks) * period_s},
+          {"time_s", secs(r.total_ticks)},
+          // The whole row as the weaver's row compares with it: the weaver's own knotting before it (weaver
+          // mode) is outside time_s; the heads' knotting and the waits for the weaver's hand are inside.
+          {"whole_row_s", secs(r.total_ticks + r.knotting_ticks)},
+          {"knotting_s", secs(r.knot_ticks)},
+          {"weaver_s", secs(r.weaver_ticks)},
+          {"weaver_knotting_s", secs(r.knotting_ticks)},
+          {"knots", {{"tied", r.knots_tied}, {"retried", r.knots_retried}, {"by_hand", r.knots_by_hand}}},
           {"shed_s", static_cast<double>(r.shed_ticks) * period_s},
           {"pick_s", static_cast<double>(r.pick_ticks) * period_s},
           {"beat_s", static_cast<double>(r.beat_ticks) * period_s},
@@ -201,6 +224,12 @@ void ReportWriter::add_row(const sequencer::RowStats& r, std::uint32_t picks, do
   if (!*rows_out_) throw std::runtime_error("cannot write " + (fs::path(dir_) / "rows.jsonl").string());
   ++rows_;
   row_time_s_ += static_cast<double>(r.total_ticks) * header_.period_s;
+  whole_row_s_ += static_cast<double>(r.total_ticks + r.knotting_ticks) * header_.period_s;
+  knots_tied_ += static_cast<std::uint64_t>(r.knots_tied);
+  knots_retried_ += static_cast<std::uint64_t>(r.knots_retried);
+  knots_by_hand_ += static_cast<std::uint64_t>(r.knots_by_hand);
+  knotting_s_ += static_cast<double>(r.knot_ticks) * header_.period_s;
+  weaver_s_ += static_cast<double>(r.weaver_ticks + r.knotting_ticks) * header_.period_s;
   last_end_s_ = end_s;
   for (int k = 0; r.force_measured && k < r.beats && k < sequencer::kMaxBeatsPerRow; ++k) {
     const double f = r.beat[static_cast<std::size_t>(k)].peak_force_n;
@@ -243,10 +272,17 @@ void ReportWriter::finish(const RunEnd& end) {
                  {"wall_time_s", end.wall_s},
                  {"speedup_vs_real_time", end.wall_s > 0 ? end.machine_s / end.wall_s : 0.0}};
   if (rows_ > 0) {
-    const double mean = row_time_s_ / static_cast<double>(rows_);
-    totals["row_time_mean_s"] = mean;
-    totals["manual_row_time_s"] = kManualRowSeconds;
-    totals["faster_than_manual"] = kManualRowSeconds / mean;
+    const double n = static_cast<double>(rows_);
+    totals["row_time_mean_s"] = row_time_s_ / n;
+    // Whole rows against the hand's whole row: the same figure weave prints.
+    totals["whole_row_time_mean_s"] = whole_row_s_ / n;
+    totals["manual_row_time_s"] = header_.manual_row_s;
+    totals["faster_than_manual"] = header_.manual_row_s / (whole_row_s_ / n);
+    totals["knots_this_run"] = {{"tied", knots_tied_},
+                                {"retried", knots_retried_},
+                                {"by_hand", knots_by_hand_},
+                                {"knotting_time_s", knotting_s_},
+                                {"weaver_time_s", weaver_s_}};
   }
   if (force_count_ > 0) {
     totals["beat_force_n"] = {{"min", force_min_},
@@ -267,6 +303,7 @@ void ReportWriter::finish(const RunEnd& end) {
                {"period_s", header_.period_s},
                {"beat_force_min_n", header_.beat_force_min_n},
                {"beat_force_max_n", header_.beat_force_max_n},
+               {"manual_row_s", header_.manual_row_s},
                {"result", end.fault ? "fault" : "completed"},
                {"first_fault", end.fault ? fault_json(*end.fault) : json(nullptr)},
                {"totals", totals}};

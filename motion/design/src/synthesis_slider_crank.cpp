@@ -22,32 +22,35 @@ struct HalfAngles {
   double sin_phi;
 };
 
-double checked_phi(double phi_rad) {
-  if (!std::isfinite(phi_rad)) {
+// The rotation checked against [90°, 180°) — the upper end on the exact supplement π − φ, so that a φ given
+// in degrees a hair below 180° is designed, not refused as 180°.
+CrankRotation checked_phi(CrankRotation phi) {
+  if (!std::isfinite(phi.phi_rad) || !std::isfinite(phi.supplement_rad)) {
     throw MotionError(ErrorCode::kInvalidInput, "slider-crank synthesis: phi must be finite");
   }
-  if (std::fabs(phi_rad - 0.5 * kPi) <= kSynthesisSnap_rad) return 0.5 * kPi;
-  if (phi_rad < 0.5 * kPi || phi_rad >= kPi - kSynthesisSnap_rad) {
+  if (std::fabs(phi.phi_rad - 0.5 * kPi) <= kSynthesisSnap_rad) return CrankRotation{0.5 * kPi, 0.5 * kPi};
+  if (phi.phi_rad < 0.5 * kPi || phi.supplement_rad <= kSynthesisSnap_rad) {
     std::ostringstream msg;
-    msg << "slider-crank synthesis: phi = " << deg(phi_rad) << " deg is outside [90, 180) deg";
-    if (phi_rad >= kPi - kSynthesisSnap_rad && phi_rad <= kPi + kSynthesisSnap_rad) {
+    msg << "slider-crank synthesis: phi = " << deg(phi.phi_rad) << " deg is outside [90, 180) deg";
+    if (std::fabs(phi.supplement_rad) <= kSynthesisSnap_rad) {
       msg << " (phi = 180 deg needs an infinitely long coupler)";
-    } else if (phi_rad > kPi) {
+    } else if (phi.supplement_rad < 0.0) {
       msg << " (give the short-side rotation 360 - phi)";
     }
     throw MotionError(ErrorCode::kInvalidInput, msg.str());
   }
-  return phi_rad;
+  return phi;
 }
 
-HalfAngles half_angles(double phi_rad) {
-  const double eps = kPi - phi_rad;
-  const double g = phi_rad - 0.5 * kPi;
+// From the supplement ε = π − φ (exact when φ came in degrees) and g = φ − π/2 (exact: Sterbenz).
+HalfAngles half_angles(CrankRotation phi) {
+  const double eps = phi.supplement_rad;
+  const double g = phi.phi_rad - 0.5 * kPi;
   HalfAngles h{};
   h.k = std::sin(0.5 * eps);
   h.s = std::cos(0.5 * eps);
   h.sin_g = std::sin(g);
-  h.sin_phi = std::cos(g);
+  h.sin_phi = std::sin(eps);
   return h;
 }
 
@@ -87,7 +90,7 @@ SliderCrankDesign assemble(double stroke, double phi_rad, const HalfAngles& h, d
 
 }  // namespace
 
-LambdaBounds soylemez_lambda_bounds(double phi_rad) {
+LambdaBounds soylemez_lambda_bounds(CrankRotation phi_rad) {
   const HalfAngles h = half_angles(checked_phi(phi_rad));
   LambdaBounds lb;
   lb.lower = (h.k * h.k) / (h.s * h.s);
@@ -95,16 +98,16 @@ LambdaBounds soylemez_lambda_bounds(double phi_rad) {
   return lb;
 }
 
-double soylemez_lambda_opt(double phi_rad) {
+double soylemez_lambda_opt(CrankRotation phi_rad) {
   const HalfAngles h = half_angles(checked_phi(phi_rad));
   const double w = std::sqrt(4.0 + h.k * h.k);
   // λ² = (√(5 + 4t²) − 1)/(2t²) with t = s/k, multiplied through by k² and rationalised.
   return std::sqrt(2.0 * h.k / (h.s * h.s * (w + h.k)));
 }
 
-SliderCrankDesign soylemez_slider_crank(double stroke, double phi_rad) {
+SliderCrankDesign soylemez_slider_crank(double stroke, CrankRotation phi_rad) {
   check_stroke(stroke);
-  const double phi = checked_phi(phi_rad);
+  const CrankRotation phi = checked_phi(phi_rad);
   const HalfAngles h = half_angles(phi);
   const double k = h.k;
   const double s = h.s;
@@ -117,13 +120,13 @@ SliderCrankDesign soylemez_slider_crank(double stroke, double phi_rad) {
   const double k2_minus_lambda_s2 = k4_minus / (k * k + lambda * s * s);
   // At φ = π/2 the optimum is λ = 1 = both bounds: a = b, c = 0, μ_min = 0.
   const bool at_bound = !(one_minus_lambda2 > 0.0);
-  return assemble(stroke, phi, h, at_bound ? 1.0 : lambda, at_bound ? 1.0 : lambda2,
+  return assemble(stroke, phi.phi_rad, h, at_bound ? 1.0 : lambda, at_bound ? 1.0 : lambda2,
                   at_bound ? 0.0 : one_minus_lambda2, k2_minus_lambda_s2, at_bound);
 }
 
-SliderCrankDesign soylemez_slider_crank(double stroke, double phi_rad, double lambda) {
+SliderCrankDesign soylemez_slider_crank(double stroke, CrankRotation phi_rad, double lambda) {
   check_stroke(stroke);
-  const double phi = checked_phi(phi_rad);
+  const CrankRotation phi = checked_phi(phi_rad);
   const HalfAngles h = half_angles(phi);
   if (!std::isfinite(lambda)) {
     throw MotionError(ErrorCode::kInvalidInput, "slider-crank synthesis: lambda must be finite");
@@ -142,12 +145,21 @@ SliderCrankDesign soylemez_slider_crank(double stroke, double phi_rad, double la
     std::ostringstream msg;
     msg.precision(10);
     msg << "slider-crank synthesis: lambda = " << lambda << " is outside its bounds [" << lower
-        << ", 1] for phi = " << deg(phi) << " deg (1/tan^2(phi/2) <= lambda <= 1)";
+        << ", 1] for phi = " << deg(phi.phi_rad) << " deg (1/tan^2(phi/2) <= lambda <= 1)";
     throw MotionError(ErrorCode::kOutOfBounds, msg.str());
   }
   const double one_minus_lambda2 = (1.0 - lam) * (1.0 + lam);
   const double k2_minus_lambda_s2 = h.k * h.k - lam * h.s * h.s;
-  return assemble(stroke, phi, h, lam, lam * lam, one_minus_lambda2, k2_minus_lambda_s2, at_bound);
+  return assemble(stroke, phi.phi_rad, h, lam, lam * lam, one_minus_lambda2, k2_minus_lambda_s2, at_bound);
+}
+
+LambdaBounds soylemez_lambda_bounds(double phi_rad) { return soylemez_lambda_bounds(CrankRotation::radians(phi_rad)); }
+double soylemez_lambda_opt(double phi_rad) { return soylemez_lambda_opt(CrankRotation::radians(phi_rad)); }
+SliderCrankDesign soylemez_slider_crank(double stroke, double phi_rad) {
+  return soylemez_slider_crank(stroke, CrankRotation::radians(phi_rad));
+}
+SliderCrankDesign soylemez_slider_crank(double stroke, double phi_rad, double lambda) {
+  return soylemez_slider_crank(stroke, CrankRotation::radians(phi_rad), lambda);
 }
 
 }  // namespace loom::motion

@@ -139,6 +139,23 @@ TEST(Soylemez, PhiToward180StaysAccurate) {
   }
 }
 
+// Hard case A2: φ given in degrees keeps π − φ exact, so the design a hair below 180° is right to full
+// relative precision — checked by the forward kinematics of the designed mechanism (its dead centres are ε
+// apart, ε computed in long double) — where the radian path loses ulp(π)/ε of ε (1 % at 180° − 1e-12°).
+TEST(Soylemez, PhiIn180DegreesMinusATinyBitKeepsItsDigits) {
+  for (const double phi_deg : {179.999999, 180.0 - 1e-9, 180.0 - 1e-12}) {
+    const long double eps =
+        (180.0L - static_cast<long double>(phi_deg)) * 3.141592653589793238462643383279502884L / 180.0L;
+    const SliderCrankDesign d = soylemez_slider_crank(1.0, loom::motion::CrankRotation::degrees(phi_deg));
+    ASSERT_TRUE(std::isfinite(d.mechanism.coupler) && std::isfinite(d.mu_min_rad)) << phi_deg;
+    const auto dc = loom::motion::slider_dead_centres(d.mechanism);
+    EXPECT_NEAR(dc.stroke, 1.0, 1e-9) << phi_deg;
+    EXPECT_NEAR(static_cast<double>(dc.phi_half_difference_rad / eps), 1.0, 1e-9) << phi_deg;
+    EXPECT_NEAR(static_cast<double>(d.mechanism.coupler * std::sqrt(2.0L * eps)), 1.0, 1e-9 + 2.0 * static_cast<double>(eps))
+        << phi_deg;
+  }
+}
+
 TEST(Soylemez, Phi180IsAnErrorWithTheRightLimits) {
   EXPECT_EQ(code_of_call([] { soylemez_slider_crank(1.0, kPi); }), ErrorCode::kInvalidInput);
   EXPECT_EQ(code_of_call([] { soylemez_slider_crank(1.0, rad(180.0)); }), ErrorCode::kInvalidInput);

@@ -39,6 +39,16 @@ struct SliderCrankDesign {
   unsigned flags = 0;
 };
 
+// The crank rotation φ together with its supplement π − φ, each to full relative precision. Near
+// φ = 180° the designs depend on π − φ, which `π − φ_rad` gets only to ulp(π)/|π − φ| (9.5e-9 relative at
+// 179.999999°, 1 % at 180° − 1e-12°); from degrees the supplement is exact (Sterbenz) before conversion.
+struct CrankRotation {
+  double phi_rad = 0.0;         // φ
+  double supplement_rad = 0.0;  // π − φ
+  static CrankRotation degrees(double phi_deg);  // supplement from 180 − φ_deg, converted after
+  static CrankRotation radians(double phi_rad);  // supplement from π − φ_rad (as accurate as φ_rad is)
+};
+
 struct LambdaBounds {
   double lower = 0.0;  // 1 / tan²(φ/2): the folded dead centre puts the coupler across the line
   double upper = 1.0;  // a = b: the folded dead centre puts the slider on the crank pivot
@@ -47,18 +57,24 @@ struct LambdaBounds {
 // configure-time only. Feasible λ for crank rotation φ; both ends are change points (μ_min = 0).
 // Throws kInvalidInput unless π/2 ≤ φ < π.
 LambdaBounds soylemez_lambda_bounds(double phi_rad);
+LambdaBounds soylemez_lambda_bounds(CrankRotation phi);
 
 // configure-time only. λ maximising μ_min (the root Q₁ of the thesis' cubic, eq. 4.24), written in
 // half-angle form so it stays accurate as φ → π. Throws kInvalidInput unless π/2 ≤ φ < π.
 double soylemez_lambda_opt(double phi_rad);
+double soylemez_lambda_opt(CrankRotation phi);
 
 // configure-time only. Optimum design (λ = λ_opt) for a stroke > 0 and π/2 ≤ φ < π. b grows like
-// stroke / √(2(π − φ)) as φ → π and stays finite and accurate; φ = π exactly is kInvalidInput.
+// stroke / √(2(π − φ)) as φ → π and stays finite and accurate; φ = π exactly is kInvalidInput. The design
+// depends on π − φ: give φ as a CrankRotation (from degrees) to keep it to full relative precision near
+// 180° (the radian overloads lose ulp(π)/(π − φ) of it).
 SliderCrankDesign soylemez_slider_crank(double stroke, double phi_rad);
+SliderCrankDesign soylemez_slider_crank(double stroke, CrankRotation phi);
 
 // configure-time only. Design for a given λ in soylemez_lambda_bounds(φ): kOutOfBounds outside
 // (message names the bounds), flagged kDesignChangePoint at either bound.
 SliderCrankDesign soylemez_slider_crank(double stroke, double phi_rad, double lambda);
+SliderCrankDesign soylemez_slider_crank(double stroke, CrankRotation phi, double lambda);
 
 // ---------------------------------------------------------------------------------------------
 // Khare–Dave crank-rocker. Frame: crank pivot A0 at the origin, rocker pivot B0 at (ground, 0);
@@ -99,15 +115,6 @@ struct CrankRockerDesign {
   unsigned flags = 0;
 };
 
-// The crank rotation φ together with its supplement π − φ, each to full relative precision. Near
-// φ = 180° the designs depend on π − φ, which `π − φ_rad` gets only to ulp(π)/|π − φ| (9.5e-9 relative at
-// 179.999999°, 1 % at 180° − 1e-12°); from degrees the supplement is exact (Sterbenz) before conversion.
-struct CrankRotation {
-  double phi_rad = 0.0;         // φ
-  double supplement_rad = 0.0;  // π − φ
-  static CrankRotation degrees(double phi_deg);  // supplement from 180 − φ_deg, converted after
-  static CrankRotation radians(double phi_rad);  // supplement from π − φ_rad (as accurate as φ_rad is)
-};
 
 // configure-time only. Feasible β for (ψ, φ); for φ = π + ψ lower = upper. Throws kInvalidInput
 // unless 0 < ψ < π and π/2 + ψ/2 < φ < 3π/2 + ψ/2 (no crank-rocker exists outside).
