@@ -1,7 +1,7 @@
 // loom-panel — a live page per loom and a hall page, for a phone, a tablet or a hall PC. A separate,
 // non-real-time process: it subscribes to the looms' LCM telemetry (every loom id it hears), keeps a
 // bounded picture of each (hall.hpp) and serves it over HTTP with live updates as server-sent events.
-//   loom-panel [--port 8080] [--bind 127.0.0.1] [--lcm-url URL]
+//   loom-panel [--port 8080] [--bind 127.0.0.1] [--lcm-url URL] [--tls-cert FILE --tls-key FILE]
 //   GET /                 the hall: every loom heard          GET /loom/<id>      one loom
 //   GET /api/hall         the hall as JSON                    GET /api/loom/<id>  one loom as JSON
 //   GET /events[?loom=ID] server-sent events: the same JSON, pushed on change (at most 4 per second)
@@ -16,8 +16,9 @@
 // Read-only by default: nothing it receives over HTTP reaches the loom. With --control-dir DIR the
 // page offers pause / stop at row end to every client, and resume / acknowledge / "row knotted" only to
 // a client paired with that loom (request_gate.hpp), each sent to that loom's local control socket
-// DIR/<id>.sock (loomctl serve's) tagged with the client's address and token, so the loom decides and
-// audits who pressed; never published on LCM. Host and Origin are checked, bodies, connections and
+// DIR/<id>.sock (loomctl serve's) tagged with the client's address, the page's device secret and its
+// token, so the loom decides and audits who pressed; never published on LCM. With --tls-cert it serves
+// HTTPS only and the pairing cookie is Secure (README.md: the hall's threat model). Host and Origin are checked, bodies, connections and
 // event streams bounded (README.md). Binds to 127.0.0.1 unless --bind says otherwise (a hall network).
 // A recording replayed onto the group (stamped older than --replay-after-s) is shown apart as
 // <id>~replay, marked, without buttons; it never mixes into the live loom of that id.

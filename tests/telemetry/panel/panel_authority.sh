@@ -110,11 +110,12 @@ wait_for() {
   done
   fail "waited $3 s for $1=$2: $(ctl status)"
 }
-# post PATH BODY [curl args...] → the HTTP status (the reply in $WORK/body)
+# post PATH BODY [curl args...] → the HTTP status (the reply in $WORK/body); the tablet's device secret
+# unless POST_DEVICE says another
 post() {
   local path=$1 body=$2; shift 2
   remote curl -s -m 5 -o "$WORK/body" -w '%{http_code}' -X POST -H 'X-Loom-Panel: 1' -H 'Content-Type: text/plain' \
-    -H "X-Loom-Device: $DEV" --data-binary "$body" "$@" "$BASE$path" || true
+    -H "X-Loom-Device: ${POST_DEVICE:-$DEV}" --data-binary "$body" "$@" "$BASE$path" || true
 }
 cmd() { post "/api/loom/$ID/ctl/$1" "" "${@:2}"; }
 
@@ -183,7 +184,7 @@ TOKEN=$(awk -v k="loom_token_$ID" '$6 == k { print $7 }' "$WORK/jar")
   -H "X-Loom-Device: $DEV" -H "Cookie: loom_token_$ID=$TOKEN" --data-binary '' "$BASE/api/loom/$ID/ctl/resume") == 403 ]] ||
   fail "a captured token replayed from $OTHER was not refused: $(cat "$WORK/body")"
 grep -q 'redeemed on another device' "$WORK/body" || fail "the replay's refusal does not say why: $(cat "$WORK/body")"
-[[ $(cmd resume -b "$WORK/jar" -H 'X-Loom-Device: ffffffffffffffffffffffffffffffff') == 403 ]] ||
+[[ $(POST_DEVICE=ffffffffffffffffffffffffffffffff cmd resume -b "$WORK/jar") == 403 ]] ||
   fail "the token with another device's secret was not refused: $(cat "$WORK/body")"
 [[ $(field state) == paused ]] || fail "a replayed token set the loom going: $(ctl status)"
 remote curl -s -m 5 -b "$WORK/jar" -H "X-Loom-Device: $DEV" "$BASE/api/loom/$ID/authority" | grep -q '"may_start":true' ||
