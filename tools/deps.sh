@@ -28,6 +28,7 @@ packages=(
   iproute2 can-utils            # vcan set-up, candump/cansend for HIL checks
   clang libclang-rt-14-dev llvm # fuzz build: clang++ -fsanitize=fuzzer (libFuzzer), llvm-symbolizer
   libcpp-httplib-dev            # loom-panel's HTTP server
+  libssl-dev openssl            # loom-panel over TLS (cpp-httplib's SSLServer); test certificates
   default-jdk-headless liblcm-java libjchart2d-java  # loomlcm.jar and loom-spy (lcm-spy)
   chromium xvfb xauth imagemagick nodejs  # browser and Xvfb tests of loom-panel and loom-spy
   rt-tests                      # cyclictest: the latency floor the loop is compared with

@@ -118,7 +118,8 @@ if(TARGET loom-panel)
 endif()
 string(APPEND CPACK_DEBIAN_PACKAGE_DEPENDS ", adduser")
 # loom-spy's Java side (a viewer: boards without a display do without it).
-set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "can-utils, iproute2, default-jre-headless | java11-runtime-headless, liblcm-java, libjchart2d-java")
+# openssl: the panel's self-signed certificate made at install (postinst; without it, plain HTTP only).
+set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "openssl, can-utils, iproute2, default-jre-headless | java11-runtime-headless, liblcm-java, libjchart2d-java")
 set(CPACK_DEBIAN_PACKAGE_SUGGESTS "rt-tests, liblcm-bin, xvfb")
 foreach(f postinst prerm postrm conffiles)
   configure_file(${pkg}/${f} ${CMAKE_BINARY_DIR}/packaging/${f} COPYONLY)

@@ -6,7 +6,10 @@
 # and a unique loom id in /etc/loomctl/loom-id (printed); the unit's ExecStartPre refuses to start
 # while /etc/default/loomctl does not say what the board drives (exit 2, naming LOOMCTL_HAL); with
 # LOOMCTL_HAL=sim the unit's own ExecStart line, run as the loomctl user the way systemd runs it, arms,
-# waits, weaves a row on `ctl start` from a member of group loom, and stops on SIGTERM; the default loom
+# waits, weaves a row on `ctl start` from a member of group loom (an `operator` account joined to it with
+# `adduser operator loom`, running `loomctl ctl status` exactly as the READMEs write it, no --socket: ctl
+# finds the board's id), a user outside the group is told to `adduser USER loom`, and the service stops
+# on SIGTERM; the default loom
 # id is refused on hardware; remove runs prerm/postrm and purge leaves the production counters.
 # Skips (exit 77) when not root, or without debootstrap or network for a first cache.
 # Usage: package_install_test.sh BUILD_DIR SOURCE_DIR
@@ -92,12 +95,23 @@ sed -i 's/^LOOMCTL_ARGS=""$/LOOMCTL_ARGS="--pace 25 --no-telemetry"/' "$root/etc
 run_unit_line "$exec_start" >"$work/serve.log" 2>&1 &
 pid=$!
 sock=/run/loomctl/$loom_id.sock
-ctl() { chroot "$root" setpriv --reuid=nobody --regid=loom --clear-groups /usr/bin/loomctl ctl --socket "$sock" "$@"; }
+# The operator, made a member of group loom the way the package's README says, runs `loomctl ctl status`
+# exactly as the READMEs write it: no --socket, no --loom-id (ctl reads the board's id from
+# /etc/loomctl/loom-id).
+in_root adduser --disabled-password --gecos "" operator >"$work/adduser.log" 2>&1 || fail "adduser operator"
+in_root adduser operator loom >>"$work/adduser.log" 2>&1 || fail "adduser operator loom: $(cat "$work/adduser.log")"
+as_operator() { chroot "$root" setpriv --reuid=operator --regid=operator --init-groups "$@"; }
+ctl() { as_operator /usr/bin/loomctl ctl "$@"; }
 field() { ctl status | tr ' ' '\n' | sed -n "s/^$1=//p"; }
 for _ in $(seq 1 200); do [[ -S $root$sock ]] && break; sleep 0.05; done
 [[ -S $root$sock ]] || fail "no control socket $sock"
 sleep 0.3
-[[ $(field loom) == "$loom_id" ]] || fail "serving as '$(field loom)', not the derived id $loom_id"
+[[ $(field loom) == "$loom_id" ]] || fail "serving as '$(field loom)', not the derived id $loom_id: $(ctl status 2>&1)"
+# Outside group loom: the refusal says which group, and how to join it.
+rc=0
+chroot "$root" setpriv --reuid=nobody --regid=nogroup --clear-groups /usr/bin/loomctl ctl status >"$work/nobody.log" 2>&1 || rc=$?
+[[ $rc == 1 ]] && grep -q "Members of group loom may command the loom: sudo adduser nobody loom" "$work/nobody.log" ||
+  fail "a user outside group loom is not told how to join it (exit $rc): $(cat "$work/nobody.log")"
 [[ $(field state) == idle ]] || fail "not waiting: $(ctl status)"
 ctl start >/dev/null
 for _ in $(seq 1 600); do [[ $(field rows) == 1 ]] && break; sleep 0.05; done

@@ -5,7 +5,8 @@
 #   2. systemd's protocol spoken to a stand-in receiver ($NOTIFY_SOCKET): READY=1 once armed, WATCHDOG=1
 #      while the loop ticks; the loop thread alone is stalled (ptrace-stopped, the rest of the process
 #      runs): the pings stop; the stalled serve is killed and restarted as systemd would, and comes back
-#      armed and waiting (state idle) at the same counts — never into motion;
+#      armed and waiting (state idle) at the same counts — never into motion; the control socket's thread
+#      alone stalled: the pings stop too (operators would get no answer), and the journal says so;
 #   3. one publisher per loom id: a serve with another state directory but the same loom id hears the
 #      first one's IDENTITY on the LCM group and refuses to arm, exit 4, naming its host and pid; a serve
 #      with another id arms beside it;
@@ -120,8 +121,36 @@ sleep 1
 [[ $(field "$work/w.sock" state) == idle ]] || fail "restarted serve moved without a start: $(ctl "$work/w.sock" status)"
 [[ $(field "$work/w.sock" rows) == "$rows_at_stall" ]] || fail "restart lost or repeated rows: $(ctl "$work/w.sock" status), file had $rows_at_stall"
 (($(grep -c "READY=1" "$work/notify.txt") == 2)) || fail "the restarted serve did not say READY=1"
-kill -TERM "$last"; wait "$last" || true
-echo "watchdog: $pings_before pings while running, none in 2.5 s with the loop stopped, restart waits at row $rows_at_stall: ok"
+# The control socket's thread stalled alone (a handler stuck on a hung disk; issue 30: pings went on
+# while operators got no answer for 12 s): the pings stop too, and the journal says why.
+ctl "$work/w.sock" start >/dev/null
+wait_for "$work/w.sock" rows $((rows_at_stall + 1)) 30
+cth=$(grep -l '^loom-ctl$' /proc/"$last"/task/*/comm | head -1 | cut -d/ -f5)
+[[ -n $cth ]] || fail "no loom-ctl thread in serve $last"
+rm -f "$work/stalled"
+python3 - "$cth" "$work/stalled" <<'PY' &
+import ctypes, sys, time
+libc = ctypes.CDLL(None, use_errno=True)
+tid = int(sys.argv[1])
+if libc.ptrace(0x4206, tid, 0, 0) != 0 or libc.ptrace(0x4207, tid, 0, 0) != 0:
+    sys.exit(f"ptrace: errno {ctypes.get_errno()}")
+open(sys.argv[2], "w").close()
+time.sleep(60)
+PY
+stall=$!
+pids+=("$stall")
+for _ in $(seq 1 200); do [[ -e $work/stalled ]] && break; sleep 0.05; done
+[[ -e $work/stalled ]] || fail "could not stop the control socket's thread"
+sleep 1
+c0=$(grep -c "WATCHDOG=1" "$work/notify.txt" || true)
+sleep 2.5
+c1=$(grep -c "WATCHDOG=1" "$work/notify.txt" || true)
+[[ $c1 == "$c0" ]] || fail "the watchdog was fed while the control socket's thread was stopped ($c0 → $c1 pings)"
+grep -q "the control socket's thread has not come round" "$work/w2.log" || fail "the journal does not say the control thread hung"
+kill -9 "$last" "$stall" 2>/dev/null || true
+wait "$last" 2>/dev/null || true
+echo "watchdog: $pings_before pings while running, none in 2.5 s with the loop stopped, restart waits at row $rows_at_stall;" \
+  "none in 2.5 s with the control socket's thread stopped: ok"
 
 # ---- 3. one publisher per loom id (an LCM group of this test's own: host-only, a port per run) ----
 url="udpm://239.255.76.93:$((7000 + $$ % 2000))?ttl=0"

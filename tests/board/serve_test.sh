@@ -17,8 +17,9 @@
 #   9. a client that trickles its request and one that never reads a ~300 KB `faults` reply hold nobody:
 #      `ctl status` answers at once, SIGTERM stops the service; `--socket` on a regular file is refused
 #      and the file kept;
-#  10. knotting heads: the weaver's `ctl next` that answers the heads' request (a knot to tie by hand)
-#      says which request it answered, in its reply, the journal and `ctl faults`;
+#  10. knotting heads: `ctl status` lists the heads' open request in words; a pause given while they wait
+#      is shown pending and withdrawn by `ctl resume`; the weaver's `ctl next` that answers the request
+#      (a knot to tie by hand) says which request it answered, in its reply, the journal and `ctl faults`;
 #  11. a restart is no reset (issue 22): a fault latched when serve stops (SIGTERM, or SIGKILL as a power
 #      cut) is latched again when it restarts — `ctl status` shows it, starting commands are refused —
 #      until `ctl ack`, which clears it for good (the next restart is idle); a bad latched-fault record is
@@ -84,6 +85,9 @@ rows=$(field rows)
 grep -q '^<6>row 1 done' "$work/serve1.log" || fail "no <6> row line"
 ctl faults | grep -q ' fault loom1 ' && fail "a fault recorded on a clean run: $(ctl faults)"
 ctl faults | grep -q ' command loom1 start .*by local user' || fail "the start command is not in the history: $(ctl faults)"
+# A command's history line carries the counters it was given at (issue 30: they all said rows=0 picks=0).
+ctl faults | grep -qE ' command loom1 stop .* rows=[1-9][0-9]* picks=[1-9][0-9]* beats=[1-9][0-9]*: by ' ||
+  fail "the stop command's history line lacks the counters: $(ctl faults | grep ' command loom1 stop')"
 ctl next 2>/dev/null && fail "next accepted without a knotting mode"
 ctl faults | grep -q ' command loom1 next' && fail "a refused command went into the history"
 
@@ -138,6 +142,7 @@ sleep 0.3
 [[ $(field state) == await_knotting ]] || fail "did not keep waiting for the weaver: $(ctl status)"
 [[ $(field rows) == 0 ]] || fail "wove before the row was knotted: $(ctl status)"
 [[ $(field design) == border.csv && $(field design_row) == 1/6 ]] || fail "design row 1/6 not shown: $(ctl status)"
+ctl status | grep -q '^open: weaver knot_row: knot row 1 by hand' || fail "status does not list the open request: $(ctl status)"
 ctl next | grep -q '^ok next' || fail "next not acknowledged"
 wait_for rows 1 30
 wait_for state await_knotting 30
@@ -260,6 +265,16 @@ for _ in $(seq 1 1200); do grep -q "weaver asked: " "$work/serve10.log" && break
 asked=$(sed -n 's/^.*weaver asked: //p' "$work/serve10.log" | head -1)
 [[ -n $asked ]] || fail "the heads never asked the weaver"
 sleep 0.2  # the reporter has logged it; the loop waits for the weaver
+# ctl status lists the heads' open request in words (issue 30: it showed none).
+ctl status | grep -F ": $asked, then answer" | grep -qE '^open: weaver (tie_by_hand|check_knot|reload): ' ||
+  fail "status does not list the heads' request '$asked': $(ctl status)"
+# A pause given while the heads wait holds only after the row is knotted: status says it is pending, and
+# resume withdraws it (issue 30: it was invisible, and resume refused it as "not paused").
+ctl pause | grep -q '^ok pause' || fail "pause refused while the heads wait"
+[[ $(field state) == knotting ]] || fail "not knotting while the heads wait: $(ctl status)"
+ctl status | grep -q '^open: pause: given' || fail "status does not show the pending pause: $(ctl status)"
+ctl resume | grep -q '^ok resume' || fail "resume refused the pending pause"
+ctl status | grep -q '^open: pause' && fail "a withdrawn pause still shown: $(ctl status)"
 reply=$(ctl next) || fail "next refused while the heads wait: $reply"
 [[ $reply == "ok next: answered $asked" ]] || fail "next says '$reply', the heads asked '$asked'"
 grep -qF "operator: next by local user" "$work/serve10.log" && grep -qF "ok next: answered $asked" "$work/serve10.log" ||

@@ -3,7 +3,8 @@
 // state chosen by the first input bytes. Checked on every input: the reply is one or more lines of
 // printable ASCII ending in '\n' (nothing a client sends can forge a log or reply line); a command is
 // handed to the loop only with an `ok` reply; a starting command through a panel is handed on only with
-// the live pairing's token ("token=@" in the input stands for it; anything else is a forgery); nothing
+// the live pairing's token ("token=@" in the input stands for it; anything else is a forgery; it counts
+// only with client=10.0.0.9 device=0123456789abcdef0123456789abcdef, the device that redeemed it); nothing
 // escapes as an exception.
 #include <cstddef>
 #include <cstdint>
@@ -32,7 +33,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (token.empty()) {
     std::string error;
     const std::string code = pairings.new_code("fuzz", 1, 1'000'000'000);
-    token = pairings.redeem(code, "10.0.0.9", 1'000'000'000, error)->token;
+    token =
+        pairings.redeem(code, "10.0.0.9", "0123456789abcdef0123456789abcdef", 1'000'000'000, error)->token;
   }
   LoomView v;
   v.state = static_cast<sequencer::State>(data[0] % kStates);

@@ -1,7 +1,7 @@
 // loom-panel — a live page per loom and a hall page, for a phone, a tablet or a hall PC. A separate,
 // non-real-time process: it subscribes to the looms' LCM telemetry (every loom id it hears), keeps a
 // bounded picture of each (hall.hpp) and serves it over HTTP with live updates as server-sent events.
-//   loom-panel [--port 8080] [--bind 127.0.0.1] [--lcm-url URL]
+//   loom-panel [--port 8080] [--bind 127.0.0.1] [--lcm-url URL] [--tls-cert FILE --tls-key FILE]
 //   GET /                 the hall: every loom heard          GET /loom/<id>      one loom
 //   GET /api/hall         the hall as JSON                    GET /api/loom/<id>  one loom as JSON
 //   GET /events[?loom=ID] server-sent events: the same JSON, pushed on change (at most 4 per second)
@@ -16,8 +16,9 @@
 // Read-only by default: nothing it receives over HTTP reaches the loom. With --control-dir DIR the
 // page offers pause / stop at row end to every client, and resume / acknowledge / "row knotted" only to
 // a client paired with that loom (request_gate.hpp), each sent to that loom's local control socket
-// DIR/<id>.sock (loomctl serve's) tagged with the client's address and token, so the loom decides and
-// audits who pressed; never published on LCM. Host and Origin are checked, bodies, connections and
+// DIR/<id>.sock (loomctl serve's) tagged with the client's address, the page's device secret and its
+// token, so the loom decides and audits who pressed; never published on LCM. With --tls-cert it serves
+// HTTPS only and the pairing cookie is Secure (README.md: the hall's threat model). Host and Origin are checked, bodies, connections and
 // event streams bounded (README.md). Binds to 127.0.0.1 unless --bind says otherwise (a hall network).
 // A recording replayed onto the group (stamped older than --replay-after-s) is shown apart as
 // <id>~replay, marked, without buttons; it never mixes into the live loom of that id.
@@ -81,6 +82,10 @@ struct PanelOptions {
   // never over LCM. Empty = read-only. The page shows buttons only when the JSON says "controls": true
   // (the option is set and that loom's socket exists).
   std::string control_dir;
+  // TLS: the certificate (PEM, chain first) and its key; both or neither. With them the panel serves
+  // HTTPS only and its pairing cookies are Secure.
+  std::string tls_cert, tls_key;
+  bool tls() const { return !tls_cert.empty(); }
 };
 
 // The client's pairing token for `loom`, from its cookie loom_token_<id> ("" when none or malformed).
@@ -99,11 +104,21 @@ std::string token_of(const httplib::Request& req, const std::string& loom) {
   return "";
 }
 
-// A request line for the loom's control socket on behalf of this HTTP client.
+// The page's per-device secret (X-Loom-Device, kept in the browser's storage), "" when none or malformed.
+std::string device_of(const httplib::Request& req) {
+  const std::string d = req.get_header_value("X-Loom-Device");
+  return loom::panel::device_shape(d) ? d : std::string();
+}
+
+// A request line for the loom's control socket on behalf of this HTTP client: its address, the page's
+// device secret and its token (the loom counts a token only from the address and secret it was
+// redeemed with).
 std::string on_behalf(const std::string& word, const httplib::Request& req, const std::string& token) {
   std::string client;
   for (char c : req.remote_addr) client += (c > ' ' && c < 0x7F) ? c : '?';
-  return word + " via=panel client=" + (client.empty() ? "unknown" : client) + (token.empty() ? "" : " token=" + token);
+  const std::string device = device_of(req);
+  return word + " via=panel client=" + (client.empty() ? "unknown" : client) +
+         (device.empty() ? "" : " device=" + device) + (token.empty() ? "" : " token=" + token);
 }
 
 std::string trimmed(std::string s) {
@@ -270,6 +285,13 @@ int main(int argc, char** argv) {
   app.add_option("--lcmlog-mib", o.lcmlog_mib, "memory for those messages, all looms together (MiB)")
       ->check(CLI::Range(1.0, 4096.0))
       ->capture_default_str();
+  auto* cert = app.add_option("--tls-cert", o.tls_cert,
+                               "serve HTTPS with this certificate (PEM; a board's is /etc/loomctl/panel.crt, made at "
+                               "install when the builder gave none); pairing cookies become Secure")
+                   ->check(CLI::ExistingFile);
+  auto* key = app.add_option("--tls-key", o.tls_key, "the private key of --tls-cert (PEM)")->check(CLI::ExistingFile);
+  cert->needs(key);
+  key->needs(cert);
   app.add_option("--replay-after-s", o.replay_after_s,
                  "a message stamped longer ago than this is a replayed recording: shown apart as <id>~replay and "
                  "marked REPLAY (0: every message is live)")
@@ -315,7 +337,19 @@ int main(int argc, char** argv) {
     lcm->subscribeFunction(re + "\\..*", &Router::on_lcm, &router)->setQueueCapacity(10000);
   }
 
-  httplib::Server svr;
+  std::unique_ptr<httplib::Server> server;
+  if (o.tls()) {
+    auto ssl = std::make_unique<httplib::SSLServer>(o.tls_cert.c_str(), o.tls_key.c_str());
+    if (!ssl->is_valid()) {
+      std::fprintf(stderr, "loom-panel: --tls-cert %s / --tls-key %s: not a usable certificate and key (PEM)\n",
+                   o.tls_cert.c_str(), o.tls_key.c_str());
+      return 2;
+    }
+    server = std::move(ssl);
+  } else {
+    server = std::make_unique<httplib::Server>();
+  }
+  httplib::Server& svr = *server;
   svr.new_task_queue = [&] { return new httplib::ThreadPool(static_cast<std::size_t>(o.http_threads)); };
   // Bounded: bodies (a pairing code is a few bytes), idle and slow connections, keep-alive reuse.
   svr.set_payload_max_length(4096);
@@ -438,8 +472,12 @@ int main(int argc, char** argv) {
     if (text.rfind("ok redeem ", 0) != 0) return reply(403, text);
     const std::string token = reply_field(text, "token");
     if (!loom::panel::token_shape(token)) return reply(502, "the loom's reply carried no token");
-    res.set_header("Set-Cookie", "loom_token_" + loom + "=" + token + "; Path=/; HttpOnly; SameSite=Strict; Max-Age=" +
-                                     std::to_string(24 * 7 * 3600));
+    // The cookie lasts as long as the pairing (the loom's valid_s), not a fixed week.
+    const std::string valid = reply_field(text, "valid_s");
+    if (valid.empty() || valid.size() > 9 || valid.find_first_not_of("0123456789") != std::string::npos) {
+      return reply(502, "the loom's reply carried no validity");
+    }
+    res.set_header("Set-Cookie", loom::panel::token_cookie(loom, token, std::stoll(valid), o.tls()));
     const std::string name = text.substr(10, text.find(' ', 10) - 10);
     reply(200, "paired as " + name + " until " + reply_field(text, "expires"));
   });
@@ -601,7 +639,7 @@ int main(int argc, char** argv) {
   sigaction(SIGTERM, &sa, nullptr);
 
   std::thread http([&] { svr.listen_after_bind(); });
-  std::fprintf(stderr, "loom-panel: serving http://%s:%d/ (%s), LCM %s\n", o.bind.c_str(), port,
+  std::fprintf(stderr, "loom-panel: serving %s://%s:%d/ (%s), LCM %s\n", o.tls() ? "https" : "http", o.bind.c_str(), port,
                o.control_dir.empty() ? "read-only" : ("operator buttons via " + o.control_dir).c_str(),
                o.lcm_url.empty() ? "default URL" : o.lcm_url.c_str());
   const auto on_packet = [&](const loom::panel::LcmPacket& p) { router.route(p.channel, p.data, p.size); };

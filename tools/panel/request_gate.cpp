@@ -77,4 +77,15 @@ bool token_shape(const std::string& s) {
          });
 }
 
+bool device_shape(const std::string& s) {
+  return s.size() >= 32 && s.size() <= 64 && std::all_of(s.begin(), s.end(), [](char c) {
+           return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f');
+         });
+}
+
+std::string token_cookie(const std::string& loom, const std::string& token, long long valid_s, bool tls) {
+  return "loom_token_" + loom + "=" + token + "; Path=/; HttpOnly; SameSite=Strict; Max-Age=" +
+         std::to_string(valid_s < 0 ? 0 : valid_s) + (tls ? "; Secure" : "");
+}
+
 }  // namespace loom::panel

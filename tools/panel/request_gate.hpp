@@ -32,5 +32,12 @@ PanelCommand panel_command(const std::string& c);
 
 // Whether `s` is a 32-hex-digit token (what a pairing cookie must hold before it is forwarded).
 bool token_shape(const std::string& s);
+// Whether `s` is a device secret as the page makes it (X-Loom-Device: 32 to 64 lower-case hex digits):
+// the page keeps it in its storage and sends it with each command; the loom binds a token to it.
+bool device_shape(const std::string& s);
+
+// The pairing cookie for `loom`: HttpOnly, SameSite=Strict, for as long as the pairing lasts (`valid_s`,
+// the loom's word), and Secure when the panel serves over TLS.
+std::string token_cookie(const std::string& loom, const std::string& token, long long valid_s, bool tls);
 
 }  // namespace loom::panel

@@ -1,16 +1,124 @@
 // CLI registration of the board subcommands, `loomctl ctl`, --version and the man-style help footer.
 #include "loom/firmware/serve/commands.hpp"
 
+#include <grp.h>
+#include <pwd.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <vector>
 
 #include "loom/firmware/serve/control_socket.hpp"
+#include "loom/telemetry/channels.hpp"
 
 namespace loom::firmware::serve {
 
 const char* version() { return LOOM_VERSION; }
 
+namespace {
+
+std::string trim(std::string s) {
+  const auto b = s.find_first_not_of(" \t\r");
+  if (b == std::string::npos) return "";
+  return s.substr(b, s.find_last_not_of(" \t\r") - b + 1);
+}
+
+// The value of LOOMCTL_LOOM_ID= in the id file (shell syntax: comments, optional quotes), "" when the file
+// is absent. Throws on a file that is there but unreadable or malformed.
+std::string loom_id_from(const std::string& file) {
+  std::ifstream in(file);
+  if (!in) {
+    if (errno == ENOENT) return "";
+    throw std::runtime_error("cannot read " + file + ": " + std::strerror(errno));
+  }
+  std::string line, id;
+  int n = 0, at = 0;
+  while (std::getline(in, line)) {
+    ++n;
+    line = trim(line);
+    if (line.empty() || line[0] == '#') continue;
+    const std::string key = "LOOMCTL_LOOM_ID=";
+    if (line.rfind(key, 0) != 0) continue;
+    id = line.substr(key.size());
+    if (id.size() >= 2 && (id.front() == '"' || id.front() == '\'') && id.back() == id.front()) {
+      id = id.substr(1, id.size() - 2);
+    }
+    at = n;
+  }
+  if (at == 0) throw std::runtime_error(file + ": no LOOMCTL_LOOM_ID= line (give --loom-id or --socket)");
+  if (auto e = telemetry::loom_id_error(id); !e.empty()) {
+    throw std::runtime_error(file + ":" + std::to_string(at) + ": LOOMCTL_LOOM_ID '" + id + "': " + e);
+  }
+  return id;
+}
+
+}  // namespace
+
+std::string ctl_socket(const CtlArgs& a, std::string& how) {
+  if (!a.socket.empty()) {
+    how = "--socket";
+    return a.socket;
+  }
+  if (!a.loom_id.empty()) {
+    how = "--loom-id " + a.loom_id;
+    return a.run_dir + "/" + a.loom_id + ".sock";
+  }
+  if (const std::string id = loom_id_from(a.loom_id_file); !id.empty()) {
+    how = "loom id " + id + " from " + a.loom_id_file;
+    return a.run_dir + "/" + id + ".sock";
+  }
+  // No id file (a board set up by hand, a development machine): the only loom served here.
+  std::vector<std::string> socks;
+  std::error_code ec;
+  for (std::filesystem::directory_iterator it(a.run_dir, ec), end; !ec && it != end; it.increment(ec)) {
+    if (it->path().extension() == ".sock") socks.push_back(it->path().filename().string());
+  }
+  if (ec && ec != std::errc::no_such_file_or_directory) {
+    throw std::runtime_error("cannot list " + a.run_dir + ": " + ec.message() + ctl_permission_advice(a.run_dir));
+  }
+  std::sort(socks.begin(), socks.end());
+  if (socks.size() == 1) {
+    how = "the only socket in " + a.run_dir;
+    return a.run_dir + "/" + socks[0];
+  }
+  if (socks.empty()) {
+    throw std::runtime_error("which loom? no " + a.loom_id_file + " and no control socket in " + a.run_dir +
+                             " (is loomctl serve running? give --loom-id ID or --socket PATH)");
+  }
+  std::string list;
+  for (const std::string& s : socks) list += (list.empty() ? "" : ", ") + s;
+  throw std::runtime_error("which loom? " + a.run_dir + " has " + std::to_string(socks.size()) + " (" + list +
+                           "): give --loom-id ID");
+}
+
+std::string ctl_permission_advice(const std::string& path) {
+  // Only when the kernel refuses us (a socket missing or a dead serve are said otherwise).
+  if (::access(path.c_str(), R_OK | W_OK) == 0 || errno != EACCES) return "";
+  std::string user = "USER";
+  if (const passwd* pw = ::getpwuid(::geteuid()); pw != nullptr) user = pw->pw_name;
+  if (::getgrnam("loom") == nullptr) {
+    return ". Members of group loom may command the loom, but this system has no group loom (is the loomctl "
+           "package installed? its postinst makes it)";
+  }
+  return ". Members of group loom may command the loom: sudo adduser " + user +
+         " loom, then log in again (a new group counts from the next login). adduser needs an existing "
+         "account: for a new operator, sudo adduser NAME first";
+}
+
 int ctl_main(const CtlArgs& a) {
-  const std::string path = a.socket.empty() ? "/run/loomctl/" + a.loom_id + ".sock" : a.socket;
+  std::string how, path;
+  try {
+    path = ctl_socket(a, how);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "loomctl ctl: %s\n", e.what());
+    return 1;
+  }
   std::string request = a.command;
   if (!a.name.empty()) request += " " + a.name;
   if (a.hours > 0) request += " hours=" + std::to_string(a.hours);
@@ -18,7 +126,7 @@ int ctl_main(const CtlArgs& a) {
   try {
     reply = control_request(path, request, a.timeout_ms);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "loomctl ctl: %s\n", e.what());
+    std::fprintf(stderr, "loomctl ctl: %s (%s)%s\n", e.what(), how.c_str(), ctl_permission_advice(path).c_str());
     return 1;
   }
   // Only `ok ...` (and the reading commands' text) means done: a refusal says why and exits 1.
@@ -37,7 +145,8 @@ EXIT STATUS
 FILES
   /etc/loomctl/loom.toml        the loom's configuration (serve's default --config; a conffile)
   /var/lib/loomctl/             serve's state: counters.json, sim-state.bin, faults.log(.1)
-  /run/loomctl/<loom-id>.sock   serve's control socket (group loom, mode 0660)
+  /etc/loomctl/loom-id          this board's loom id (LOOMCTL_LOOM_ID=, made at install; ctl's default)
+  /run/loomctl/<loom-id>.sock   serve's control socket (group loom, mode 0660: sudo adduser USER loom)
   /usr/share/loomctl/lcmtypes/  the LCM message types of the telemetry channels
 
 SIGNALS
@@ -87,7 +196,9 @@ BoardCommands::BoardCommands(CLI::App& app) {
   ctl_->add_option("name", c.name, "pair/unpair: the client's name (letters, digits, _ - .)");
   ctl_->add_option("--hours", c.hours, "pair: how long the pairing lasts (default 12)")->check(CLI::Range(1, 168));
   ctl_->add_option("--socket", c.socket, "control socket (default /run/loomctl/<loom-id>.sock)");
-  ctl_->add_option("--loom-id", c.loom_id, "loom id (default loom1)");
+  ctl_->add_option("--loom-id", c.loom_id,
+                   "loom id (default: the board's, LOOMCTL_LOOM_ID in /etc/loomctl/loom-id; without that file "
+                   "the only socket in /run/loomctl)");
   ctl_->add_option("--timeout-ms", c.timeout_ms, "how long to wait for the reply")->check(CLI::Range(1, 600000));
 }
 

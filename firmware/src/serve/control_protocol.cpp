@@ -17,7 +17,7 @@ std::optional<CommandClass> class_of(std::string_view w) {
 }
 
 bool known_field(std::string_view k) {
-  return k == "via" || k == "client" || k == "token" || k == "code" || k == "hours";
+  return k == "via" || k == "client" || k == "token" || k == "code" || k == "hours" || k == "device";
 }
 
 std::string word_list() {
@@ -86,7 +86,7 @@ std::optional<ParsedRequest> parse_request(std::string_view line, std::string& e
     }
     const std::string key(tok.substr(0, eq));
     if (!known_field(key)) {
-      error = "unknown field '" + shown(key) + "' (via, client, token, code, hours)";
+      error = "unknown field '" + shown(key) + "' (via, client, token, device, code, hours)";
       return std::nullopt;
     }
     if (r.fields.size() >= kMaxFields || r.fields.count(key) != 0) {

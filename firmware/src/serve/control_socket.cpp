@@ -118,6 +118,7 @@ ControlServer::ControlServer(std::string path, std::string group_name, RequestHa
       group_note_ = "group '" + group_name + "' does not exist; " + path_ + " stays with the service's own group";
     }
   }
+  alive_ns_.store(std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count());
   thread_ = std::thread([this] { serve(); });
 }
 
@@ -156,6 +157,8 @@ void ControlServer::serve() {
     return true;
   };
   while (!stop_.load()) {
+    alive_ns_.store(std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count(),
+                    std::memory_order_relaxed);
     fds.clear();
     fds.push_back({clients.size() < limits_.max_clients ? fd_ : -1, POLLIN, 0});
     Clock::time_point next = Clock::now() + std::chrono::milliseconds(100);  // notice stop_ at least this often

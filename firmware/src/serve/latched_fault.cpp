@@ -44,6 +44,30 @@ std::string trim(const std::string& s) {
   return s.substr(b, s.find_last_not_of(" \t") - b + 1);
 }
 
+// `s` with \r, \n, \t as such and every other byte outside printable ASCII as \xNN.
+std::string escaped(const std::string& s) {
+  std::string out;
+  for (const char ch : s) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c == '\r')
+      out += "\\r";
+    else if (c == '\n')
+      out += "\\n";
+    else if (c == '\t')
+      out += "\\t";
+    else if (c == '\\')
+      out += "\\\\";
+    else if (c < 0x20 || c >= 0x7F) {
+      char b[8];
+      std::snprintf(b, sizeof b, "\\x%02X", c);
+      out += b;
+    } else {
+      out += ch;
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string LatchedFaultStore::utc(std::int64_t unix_s) {
@@ -81,10 +105,14 @@ LatchedFault LatchedFaultStore::parse(const std::string& text, const std::string
   int line = 0;
   const auto refuse = [&](int at, const std::string& field, const std::string& value,
                           const std::string& why) {
-    throw ConfigError(source + ":" + std::to_string(at) + ": " + field + " = \"" + value.substr(0, 80) +
-                      (value.size() > 80 ? "..." : "") + "\": " + why +
-                      " (a latched-fault record; refusing to arm from it — fix or remove the file, then "
-                      "acknowledge at the loom)");
+    // A CR (a file saved with Windows line ends) and any other control byte shown, never printed raw.
+    const bool cr = value.find('\r') != std::string::npos;
+    throw ConfigError(
+        source + ":" + std::to_string(at) + ": " + field + " = \"" + escaped(value.substr(0, 80)) +
+        (value.size() > 80 ? "..." : "") + "\": " + why +
+        (cr ? " (the line ends in \\r: the file has Windows line ends (CRLF); serve writes LF only)" : "") +
+        " (a latched-fault record; refusing to arm from it — fix or remove the file, then "
+        "acknowledge at the loom)");
   };
   while (std::getline(in, raw)) {
     ++line;

@@ -76,7 +76,11 @@ std::string OperatorDesk::refuse_for_state(const ParsedRequest& r, const LoomVie
     return "";
   }
   if (w == "pause") return weaving(v.state) ? "" : "not weaving (state " + state + ")";
-  if (w == "resume") return v.state == State::kPaused ? "" : "not paused (state " + state + ")";
+  if (w == "resume") {
+    // A pause not reached yet (the loom holds at the next safe point): resume withdraws it.
+    if (v.pause_pending && weaving(v.state)) return "";
+    return v.state == State::kPaused ? "" : "not paused (state " + state + ")";
+  }
   if (w == "stop") {
     return weaving(v.state) || v.state == State::kPaused ? "" : "not weaving (state " + state + "): nothing to stop";
   }
@@ -121,14 +125,18 @@ Decision OperatorDesk::decide(const ControlRequest& req, const LoomView& v, std:
   }
   const ParsedRequest& r = *parsed;
   // Who: the kernel's word on the local user; a panel adds its client's address and pairing.
+  // A token counts only from the device that redeemed it: its address and the page's device secret.
   std::optional<Pairing> paired;
+  bool elsewhere = false;
+  std::string unpaired_why = "not paired";
   if (r.via_panel()) {
     d.station = "panel";
-    if (!r.field("token").empty()) paired = pairings_.find(r.field("token"), now_s);
+    if (!r.field("token").empty()) {
+      paired = pairings_.find(r.field("token"), r.field("client"), r.field("device"), now_s, &elsewhere);
+      unpaired_why = elsewhere ? "token of another device" : "token unknown or expired";
+    }
     d.who = "panel client " + r.field("client") +
-            (paired ? " paired as " + paired->name : std::string(r.field("token").empty() ? " (not paired)"
-                                                                                          : " (token unknown or expired)")) +
-            " via " + describe(req.peer);
+            (paired ? " paired as " + paired->name : " (" + unpaired_why + ")") + " via " + describe(req.peer);
   }
   const auto refuse = [&](const std::string& why) {
     d.reply = "refused: " + r.word + ": " + why + "\n";
@@ -154,10 +162,12 @@ Decision OperatorDesk::decide(const ControlRequest& req, const LoomView& v, std:
       d.audit = true;
       if (r.word == "redeem") {
         if (!r.via_panel()) return refuse("only a panel redeems a pairing code for its client");
-        auto p = pairings_.redeem(r.field("code"), r.field("client"), now_s, error);
+        auto p = pairings_.redeem(r.field("code"), r.field("client"), r.field("device"), now_s, error);
         if (!p) return refuse(error);
         d.who = "panel client " + r.field("client") + " paired as " + p->name + " via " + describe(req.peer);
-        d.reply = "ok redeem " + p->name + " token=" + p->token + " expires=" + utc(p->expires_s) + "\n";
+        // valid_s: what the panel gives its cookie as Max-Age (the cookie ends with the pairing).
+        d.reply = "ok redeem " + p->name + " token=" + p->token + " expires=" + utc(p->expires_s) +
+                  " valid_s=" + std::to_string(p->expires_s - now_s) + "\n";
         return d;
       }
       if (r.via_panel()) return refuse("pairing is done at the loom (its local socket), never through a panel");
@@ -189,7 +199,9 @@ Decision OperatorDesk::decide(const ControlRequest& req, const LoomView& v, std:
   d.audit = true;
   if (r.cls == CommandClass::kStarting && r.via_panel() && !paired) {
     return refuse("a command that starts motion or resets a fault needs a paired panel client (this one is " +
-                  std::string(r.field("token").empty() ? "not paired" : "not paired: token unknown or expired") +
+                  std::string(r.field("token").empty() ? "not paired"
+                              : elsewhere ? "not paired: its token was redeemed on another device"
+                                          : "not paired: token unknown or expired") +
                   "; pair it with `loomctl ctl pair NAME` at the loom)");
   }
   if (auto why = refuse_for_state(r, v); !why.empty()) return refuse(why);

@@ -41,7 +41,7 @@ bool SystemdNotifier::notify(const std::string& state) const {
          static_cast<ssize_t>(state.size());
 }
 
-void LoopWatchdog::poll(std::int64_t loop_tick, std::int64_t now_ns) {
+void LoopWatchdog::poll(std::int64_t loop_tick, std::int64_t now_ns, std::int64_t control_idle_ns) {
   if (n_.watchdog_ns() == 0) return;
   if (loop_tick != last_tick_) {
     last_tick_ = loop_tick;
@@ -50,7 +50,7 @@ void LoopWatchdog::poll(std::int64_t loop_tick, std::int64_t now_ns) {
   // Alive = the tick moved recently (a quarter of the interval: a loop of any sane period ticks many
   // times in that). A stalled loop gets no ping, and systemd kills and restarts the service.
   const bool alive = last_move_ns_ != 0 && now_ns - last_move_ns_ <= n_.watchdog_ns() / 4;
-  if (!alive || now_ns - last_ping_ns_ < n_.watchdog_ns() / 2) return;
+  if (!alive || control_hung(control_idle_ns) || now_ns - last_ping_ns_ < n_.watchdog_ns() / 2) return;
   last_ping_ns_ = now_ns;
   n_.notify("WATCHDOG=1");
 }

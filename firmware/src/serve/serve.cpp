@@ -92,8 +92,9 @@ std::string status_text(const OperatorLink& l, const std::string& loom_id, const
 // to the fault history (`ctl faults`). Refused ones stay in the journal only, so a flood of refusals
 // cannot rotate the faults out of the history.
 // The COMMAND event (when telemetry is on) carries the same: word, station, who, verdict, state.
+// The counters in the history's record are the loom's when the command was decided.
 void audit(FaultHistory& history, const std::string& loom_id, const std::string& line, const Decision& d,
-           telemetry::CommandEvents* events, sequencer::State state) {
+           telemetry::CommandEvents* events, sequencer::State state, const OperatorLink& link) {
   std::string verdict = d.reply;
   if (!verdict.empty() && verdict.back() == '\n') verdict.pop_back();
   // Tokens and pairing codes never reach a log.
@@ -112,6 +113,9 @@ void audit(FaultHistory& history, const std::string& loom_id, const std::string&
   r.loom_id = loom_id;
   r.kind = "command";
   r.name = word;
+  r.rows = link.rows.load(std::memory_order_relaxed);
+  r.picks = link.picks.load(std::memory_order_relaxed);
+  r.beats = link.beats.load(std::memory_order_relaxed);
   r.text = "by " + d.who + ": " + verdict;
   try {
     history.append(r);
@@ -262,6 +266,7 @@ class Service {
   std::string answer(const ControlRequest& req) {
     LoomView view = view_of(link_, cfg_.sequencer.knotting);
     view.counters_unsaved = counters_unsaved_.load(std::memory_order_acquire);
+    view.pause_pending = pause_pending_.load(std::memory_order_acquire);
     Decision d = desk_.decide(req, view, static_cast<std::int64_t>(std::time(nullptr)));
     if (d.post == Command::kNext && view.state == sequencer::State::kKnotting) {
       std::lock_guard<std::mutex> lock(weaver_mu_);
@@ -272,7 +277,8 @@ class Service {
       weaver_request_.clear();
     }
     if (d.read == Decision::Read::kStatus) {
-      return status_text(link_, cfg_.loom_id, cfg_.recipe.design.get(), design_progress_);
+      return status_text(link_, cfg_.loom_id, cfg_.recipe.design.get(), design_progress_) +
+             open_requests(view);
     }
     if (d.read == Decision::Read::kFaults) {
       std::string out;
@@ -285,10 +291,38 @@ class Service {
         ack_by_ = d.who;
         ack_at_ = std::chrono::steady_clock::now();
       }
+      if (*d.post == Command::kPause) pause_pending_.store(true, std::memory_order_release);
+      if (*d.post == Command::kResume || *d.post == Command::kStop)
+        pause_pending_.store(false, std::memory_order_release);
       link_.post(*d.post);
     }
-    if (d.audit) audit(history_, cfg_.loom_id, req.line, d, command_events_.get(), view.state);
+    if (d.audit) audit(history_, cfg_.loom_id, req.line, d, command_events_.get(), view.state, link_);
     return d.reply;
+  }
+
+  // What the loom waits for, as lines after the status line: the weaver's open request (the row to knot,
+  // or the heads' request in words) and a pause given but not reached yet.
+  std::string open_requests(const LoomView& v) {
+    std::string out;
+    if (v.state == sequencer::State::kAwaitKnotting) {
+      out += "open: weaver knot_row: knot row " +
+             std::to_string(link_.rows.load(std::memory_order_relaxed) + 1) +
+             " by hand, then answer (ctl next, the pedal or the panel)\n";
+    } else if (v.state == sequencer::State::kKnotting && v.weaver_ask != sequencer::WeaverAsk::kNone) {
+      std::string words;
+      {
+        std::lock_guard<std::mutex> lock(weaver_mu_);
+        words = weaver_request_;
+      }
+      out += std::string("open: weaver ") + sequencer::weaver_ask_name(v.weaver_ask) + ": " +
+             (words.empty() ? std::string("the knotting heads wait for the weaver") : words) +
+             ", then answer (ctl next, the pedal or the panel)\n";
+    }
+    if (v.pause_pending && weaving(v.state)) {
+      out += "open: pause: given, the loom holds at the next safe point (state " +
+             std::string(sequencer::state_name(v.state)) + "); ctl resume withdraws it\n";
+    }
+    return out;
   }
 
   // ---- build and arm one session from what is on disk ----
@@ -319,6 +353,7 @@ class Service {
     }
     // Latched at the session's first tick, before anything can start; its kFault event is not a new fault.
     relatch_pending_ = false;
+    pause_pending_.store(false, std::memory_order_release);  // a new session holds no pause
     if (relatch_) {
       seq.request_safe_stop(relatch_->fault);
       relatch_pending_ = true;
@@ -393,7 +428,20 @@ class Service {
 
   void poll() {
     const std::int64_t now = MonotonicClock{}.now_ns();
-    watchdog_.poll(link_.tick.load(std::memory_order_acquire), now);
+    const std::int64_t control_idle = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                          std::chrono::steady_clock::now().time_since_epoch())
+                                          .count() -
+                                      server_->alive_ns();
+    watchdog_.poll(link_.tick.load(std::memory_order_acquire), now, control_idle);
+    if (watchdog_.control_hung(control_idle) != control_hung_) {
+      control_hung_ = !control_hung_;
+      if (control_hung_) {
+        log(Severity::kErr,
+            "the control socket's thread has not come round for %.1f s (operators get no answer): "
+            "the watchdog is no longer fed, systemd restarts the service",
+            static_cast<double>(control_idle) * 1e-9);
+      }
+    }
     if (!failed_save_ || now - last_retry_ns_ < kSaveRetryNs) return;
     last_retry_ns_ = now;
     try {
@@ -413,11 +461,13 @@ class Service {
         break;
       case RunEvent::Kind::kPaused:
       case RunEvent::Kind::kResumed:
+        pause_pending_.store(false, std::memory_order_release);
         log(Severity::kNotice, "%s after row %u, pick %u",
             e.kind == RunEvent::Kind::kPaused ? "paused" : "resumed", e.counters.rows, e.counters.picks);
         break;
       case RunEvent::Kind::kFault:
       case RunEvent::Kind::kOverrunStop:
+        pause_pending_.store(false, std::memory_order_release);
         record_fault(e);
         break;
       case RunEvent::Kind::kButton:
@@ -523,6 +573,8 @@ class Service {
     const std::string verdict = desk_.answer_in_state(resumes ? "resume" : p.word, v);
     log(Severity::kNotice, "operator: %s by %s (state %s): %s", p.word, p.who, sequencer::state_name(e.state),
         verdict.c_str());
+    if (e.button == Command::kPause && verdict.rfind("ok", 0) == 0)
+      pause_pending_.store(true, std::memory_order_release);
     if (command_events_) {
       command_events_->publish(
           {p.word, "button", p.who, verdict.rfind("ok", 0) == 0, verdict, sequencer::state_name(e.state)});
@@ -634,6 +686,7 @@ class Service {
   // Whether the counters on disk lag what was woven (the last save failed; the loop refuses an ack until a
   // retried save succeeds): the desk refuses `ctl ack` with the reason instead of answering `ok`.
   std::atomic<bool> counters_unsaved_{false};
+  std::atomic<bool> pause_pending_{false};          // LoomView::pause_pending (control thread and reporter)
   std::optional<sequencer::Counters> failed_save_;  // the latest counters a save failed for (reporter thread)
   std::int64_t last_retry_ns_ = 0;
   std::optional<sequencer::Counters> unsaved_;  // woven but not on disk when a session ended
@@ -647,6 +700,7 @@ class Service {
   std::unique_ptr<telemetry::CommandEvents> command_events_;
   std::unique_ptr<ControlServer> server_;  // last: its thread calls answer(), which uses all of the above
   bool start_at_once_ = false, ready_sent_ = false;
+  bool control_hung_ = false;  // the control socket's thread was last seen hung (reporter thread)
 };
 
 }  // namespace

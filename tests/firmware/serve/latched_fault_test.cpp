@@ -127,6 +127,22 @@ TEST(LatchedFault, ABadRecordIsRefusedNamingFileLineFieldAndValue) {
   }
 }
 
+// A record saved with Windows line ends (an editor on a laptop): refused, and the \r it carries is shown
+// as \r, not printed raw (issue 30: the message showed `kind = "fault"` with an invisible CR in it).
+TEST(LatchedFault, ACrlfRecordIsRefusedShowingTheCarriageReturn) {
+  const std::string why =
+      refusal("kind = fault\r\nfault = drive_fault\r\nlatched_at = 2026-11-18T11:06:40Z\r\n");
+  EXPECT_EQ(why.find('\r'), std::string::npos) << why;
+  EXPECT_NE(why.find("/state/latched-fault:1: kind = \"fault\\r\": must be fault or overrun_stop"),
+            std::string::npos)
+      << why;
+  EXPECT_NE(why.find("Windows line ends (CRLF)"), std::string::npos) << why;
+  // Other control bytes as \xNN.
+  const std::string bell =
+      refusal("kind = fa\x07ult\nfault = drive_fault\nlatched_at = 2026-11-18T11:06:40Z\n");
+  EXPECT_NE(bell.find("kind = \"fa\\x07ult\""), std::string::npos) << bell;
+}
+
 TEST(LatchedFault, AFileThatIsNotARecordIsRefusedAndLeftAlone) {
   const std::string dir = temp_dir();
   const LatchedFaultStore store(dir + "/latched-fault");

@@ -19,19 +19,20 @@ have_browser() {
 }
 
 # panel_up LOG [loom-panel args...] — starts `$PANEL --port 0 ARGS` (stderr in WORK/LOG) and returns once
-# it serves HTTP, at most PANEL_UP_S (30) s. Sets PANEL_BASE (http://ADDR:PORT), PANEL_HTTP_PORT, PANEL_PID.
+# it serves HTTP (or HTTPS with --tls-cert), at most PANEL_UP_S (30) s. Sets PANEL_BASE (http[s]://ADDR:PORT),
+# PANEL_HTTP_PORT, PANEL_PID.
 panel_up() {
   local log=$1 deadline=$((SECONDS + ${PANEL_UP_S:-30}))
   shift
   "$PANEL" --port 0 "$@" 2>"$WORK/$log" &
   PANEL_PID=$!
   PIDS+=("$PANEL_PID")
-  until grep -q "serving http" "$WORK/$log" 2>/dev/null; do
+  until grep -qE "serving https?://" "$WORK/$log" 2>/dev/null; do
     kill -0 "$PANEL_PID" 2>/dev/null || fail "loom-panel exited at start: $(tail -5 "$WORK/$log")"
     ((SECONDS < deadline)) || fail "loom-panel did not serve within ${PANEL_UP_S:-30} s"
     sleep 0.05
   done
-  PANEL_BASE=$(sed -n 's|.*serving \(http://[0-9.]*:[0-9]*\)/.*|\1|p' "$WORK/$log")
+  PANEL_BASE=$(sed -n 's|.*serving \(https\{0,1\}://[0-9.]*:[0-9]*\)/.*|\1|p' "$WORK/$log")
   [[ -n $PANEL_BASE ]] || fail "loom-panel did not say where it serves: $(tail -5 "$WORK/$log")"
   PANEL_HTTP_PORT=${PANEL_BASE##*:}
 }

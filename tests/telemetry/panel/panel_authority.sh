@@ -11,6 +11,10 @@
 #   3. paired with the code from `loomctl ctl pair`: resume is carried out, and serve's journal, the
 #      panel's log and `ctl faults` name the client's address and pairing; a wrong code is refused;
 #      `ctl unpair` revokes the token;
+#   3b. (issue 30) a device sending wrong codes at full speed from another address does not keep the
+#      tablet from pairing; the token cookie replayed from another address, or without the page's device
+#      secret (X-Loom-Device), is refused; the cookie's Max-Age is the pairing's --hours; over TLS
+#      (--tls-cert, a self-signed certificate made here) the panel serves HTTPS and the cookie is Secure;
 #   4. bounded: a 1 MiB body is refused (413); event streams beyond 4 per client get 503 while the
 #      buttons still answer, and so they do behind 40 idle connections; a design whose palette name is
 #      cp1252 (not UTF-8) keeps the panel up;
@@ -62,6 +66,16 @@ if [[ $netns != 1 ]]; then
   remote() { "$@"; }
   echo "client: curl on 127.0.0.1 (no network namespace here; the panel trusts no address either way)"
 fi
+# Another device of the hall: the host itself (its address on the veth), or 127.0.0.2 on loopback.
+if [[ $netns == 1 ]]; then
+  OTHER=$SERVER
+  other() { "$@"; }
+else
+  OTHER=127.0.0.2
+  other() { "$@" --interface 127.0.0.2; }
+fi
+# The tablet's page secret (the page keeps one in its storage and sends it as X-Loom-Device).
+DEV=0123456789abcdef0123456789abcdef
 
 PORT=$((20000 + ($$ * 13) % 20000))
 URL="udpm://239.255.76.67:${PORT}?ttl=0"
@@ -96,11 +110,12 @@ wait_for() {
   done
   fail "waited $3 s for $1=$2: $(ctl status)"
 }
-# post PATH BODY [curl args...] → the HTTP status (the reply in $WORK/body)
+# post PATH BODY [curl args...] → the HTTP status (the reply in $WORK/body); the tablet's device secret
+# unless POST_DEVICE says another
 post() {
   local path=$1 body=$2; shift 2
   remote curl -s -m 5 -o "$WORK/body" -w '%{http_code}' -X POST -H 'X-Loom-Panel: 1' -H 'Content-Type: text/plain' \
-    --data-binary "$body" "$@" "$BASE$path" || true
+    -H "X-Loom-Device: ${POST_DEVICE:-$DEV}" --data-binary "$body" "$@" "$BASE$path" || true
 }
 cmd() { post "/api/loom/$ID/ctl/$1" "" "${@:2}"; }
 
@@ -139,11 +154,41 @@ code=$(ctl pair tablet-1 | sed -n 's/.*code=\([0-9]*\).*/\1/p')
 [[ -n $code ]] || fail "ctl pair printed no code"
 wrong=$(printf '%06d' $(((10#$code + 1) % 1000000)))
 [[ $(post "/api/loom/$ID/pair" "$wrong") == 403 ]] || fail "a wrong code paired"
+# Another device sends wrong codes as fast as it can (bounded: 5 s) while the tablet enters the right one.
+other_post() {
+  other curl -s -m 5 -o /dev/null -w '%{http_code}\n' -X POST -H 'X-Loom-Panel: 1' -H 'Content-Type: text/plain' \
+    -H 'X-Loom-Device: ffffffffffffffffffffffffffffffff' --data-binary "$1" "$BASE/api/loom/$ID/pair" || true
+}
+(
+  end=$((SECONDS + 5))
+  while ((SECONDS < end)); do other_post "$wrong"; done >"$WORK/guesses"
+) &
+GUESSER=$!
+PIDS+=($GUESSER)
+sleep 2
 [[ $(post "/api/loom/$ID/pair" "$code" -c "$WORK/jar") == 200 ]] ||
-  fail "pairing with the right code: $(cat "$WORK/body")"
+  fail "pairing with the right code while another device guesses: $(cat "$WORK/body")"
+wait "$GUESSER" || true
+guesses=$(wc -l <"$WORK/guesses")
+[[ $guesses -ge 20 ]] || fail "the guessing device sent only $guesses codes"
+grep -v '^403$' "$WORK/guesses" | grep -q . && fail "a guess was not refused: $(sort "$WORK/guesses" | uniq -c)"
+judged=$(grep -c "refused: redeem: wrong pairing code" "$WORK/serve.log" || true)
+echo "a device guessing at full speed: $guesses codes in 5 s, $judged judged (1 is the tablet's own); the tablet paired"
 grep -q "loom_token_$ID" "$WORK/jar" || fail "no token cookie set"
 grep -q '#HttpOnly_' "$WORK/jar" || fail "the token cookie is not HttpOnly"
-remote curl -s -m 5 -b "$WORK/jar" "$BASE/api/loom/$ID/authority" | grep -q '"may_start":true' || fail "a paired client may not start"
+# The token captured off the hall network: replayed from another address, or from this one without the
+# page's device secret, it starts nothing.
+TOKEN=$(awk -v k="loom_token_$ID" '$6 == k { print $7 }' "$WORK/jar")
+[[ ${#TOKEN} == 32 ]] || fail "no token in the jar"
+[[ $(other curl -s -m 5 -o "$WORK/body" -w '%{http_code}' -X POST -H 'X-Loom-Panel: 1' -H 'Content-Type: text/plain' \
+  -H "X-Loom-Device: $DEV" -H "Cookie: loom_token_$ID=$TOKEN" --data-binary '' "$BASE/api/loom/$ID/ctl/resume") == 403 ]] ||
+  fail "a captured token replayed from $OTHER was not refused: $(cat "$WORK/body")"
+grep -q 'redeemed on another device' "$WORK/body" || fail "the replay's refusal does not say why: $(cat "$WORK/body")"
+[[ $(POST_DEVICE=ffffffffffffffffffffffffffffffff cmd resume -b "$WORK/jar") == 403 ]] ||
+  fail "the token with another device's secret was not refused: $(cat "$WORK/body")"
+[[ $(field state) == paused ]] || fail "a replayed token set the loom going: $(ctl status)"
+remote curl -s -m 5 -b "$WORK/jar" -H "X-Loom-Device: $DEV" "$BASE/api/loom/$ID/authority" | grep -q '"may_start":true' ||
+  fail "a paired client may not start"
 [[ $(cmd resume -b "$WORK/jar") == 200 ]] || fail "paired resume: $(cat "$WORK/body")"
 wait_for state pick 30
 grep -q "operator: resume by panel client $CLIENT paired as tablet-1 via local user" "$WORK/serve.log" ||
@@ -160,6 +205,35 @@ wait_for state paused 30
 ctl unpair tablet-1 | grep -q '^ok unpair' || fail "unpair"
 [[ $(cmd resume -b "$WORK/jar") == 403 ]] || fail "a revoked token still resumes: $(cat "$WORK/body")"
 [[ $(field state) == paused ]] || fail "a revoked token set the loom going"
+# The cookie lasts as long as the pairing: --hours 3 is Max-Age 10800 (less the seconds the redeem took).
+code=$(ctl pair tablet-2 --hours 3 | sed -n 's/.*code=\([0-9]*\).*/\1/p')
+[[ $(post "/api/loom/$ID/pair" "$code" -D "$WORK/headers") == 200 ]] || fail "pairing tablet-2: $(cat "$WORK/body")"
+max_age=$(sed -n 's/^Set-Cookie: .*Max-Age=\([0-9]*\).*/\1/pi' "$WORK/headers" | tr -d '\r')
+((max_age > 10800 - 5 && max_age <= 10800)) || fail "cookie Max-Age '$max_age' for a 3-hour pairing: $(grep -i set-cookie "$WORK/headers")"
+grep -qi '^Set-Cookie: .*; Secure' "$WORK/headers" && fail "a Secure cookie over plain HTTP"
+ctl unpair tablet-2 >/dev/null
+# TLS: a second panel with a certificate (self-signed here, as the package makes one at install).
+if command -v openssl >/dev/null; then
+  openssl req -x509 -newkey rsa:2048 -nodes -days 2 -subj "/CN=$SERVER" -keyout "$WORK/panel.key" \
+    -out "$WORK/panel.crt" 2>"$WORK/openssl.log" || fail "openssl could not make a certificate"
+  HTTP_BASE=$BASE HTTP_PANEL_PID=$PANEL_PID
+  panel_up panel-tls.log --bind 0.0.0.0 --lcm-url "$URL" --control-dir "$WORK/run" --tls-cert "$WORK/panel.crt" \
+    --tls-key "$WORK/panel.key"
+  [[ $PANEL_BASE == https://* ]] || fail "the TLS panel says it serves $PANEL_BASE"
+  BASE="https://$SERVER:$PANEL_HTTP_PORT"
+  code=$(ctl pair tablet-3 --hours 1 | sed -n 's/.*code=\([0-9]*\).*/\1/p')
+  [[ $(post "/api/loom/$ID/pair" "$code" -k -D "$WORK/headers" -H "Origin: https://$SERVER:$PANEL_HTTP_PORT") == 200 ]] ||
+    fail "pairing over TLS: $(cat "$WORK/body")"
+  grep -qi '^Set-Cookie: loom_token_.*; Secure' "$WORK/headers" || fail "the TLS panel's cookie is not Secure: $(grep -i set-cookie "$WORK/headers")"
+  grep -qi '^Set-Cookie: .*Max-Age=3[0-9][0-9][0-9]' "$WORK/headers" || fail "the TLS cookie's Max-Age is not the hour"
+  [[ $(remote curl -s -m 5 -o /dev/null -w '%{http_code}' "http://$SERVER:$PANEL_HTTP_PORT/api/hall" || true) != 200 ]] ||
+    fail "the TLS panel answered plain HTTP"
+  ctl unpair tablet-3 >/dev/null
+  BASE=$HTTP_BASE PANEL_PID=$HTTP_PANEL_PID
+  echo "TLS: the panel served HTTPS with a self-signed certificate; its pairing cookie is Secure"
+else
+  fail "openssl not found (Debian package openssl; tools/deps.sh installs it)"
+fi
 
 # 4. bounds
 head -c 1048576 /dev/zero >"$WORK/big"

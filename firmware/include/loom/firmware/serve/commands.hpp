@@ -37,10 +37,23 @@ struct CtlArgs {
   std::string name;  // pair/unpair NAME
   int hours = 0;     // pair: 0 → the service's default
   std::string socket;
-  std::string loom_id = "loom1";
+  std::string loom_id;  // "" → the board's (ctl_socket)
   int timeout_ms = 5000;
+  // Where an installed board keeps its loom id and its services' sockets (tests give their own).
+  std::string loom_id_file = "/etc/loomctl/loom-id";
+  std::string run_dir = "/run/loomctl";
 };
 int ctl_main(const CtlArgs& a);
+
+// The control socket `ctl` talks to: --socket; else <run_dir>/<id>.sock for --loom-id; else for the
+// board's id (LOOMCTL_LOOM_ID= in the loom-id file postinst writes); else the only socket in run_dir.
+// `how` says which (for messages). Throws std::runtime_error naming file:line, or what to give, when it
+// cannot tell (a malformed id file, several looms' sockets, none at all).
+std::string ctl_socket(const CtlArgs& a, std::string& how);
+
+// What to add to a failed connection's error: for EACCES, which group may command the loom and how to
+// join it; "" otherwise.
+std::string ctl_permission_advice(const std::string& path);
 
 // Adds `serve`, `ctl`, `--version` and the help footer to `app`. After app.parse(), run() executes the
 // chosen board subcommand and returns its exit code, or nullopt when another subcommand was chosen.

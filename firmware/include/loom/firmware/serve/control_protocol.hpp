@@ -23,7 +23,7 @@ enum class CommandClass { kStopping, kStarting, kReading, kPairing };
 struct ParsedRequest {
   std::string word;                          // "start", "pair", ...
   std::string arg;                           // the positional argument (pair/unpair NAME), else ""
-  std::map<std::string, std::string> fields; // key=value pairs (via, client, token, code, hours)
+  std::map<std::string, std::string> fields; // key=value pairs (via, client, token, device, code, hours)
   CommandClass cls = CommandClass::kReading;
   bool via_panel() const { return fields.count("via") != 0 && fields.at("via") == "panel"; }
   std::string field(const std::string& k) const {

@@ -63,6 +63,10 @@ class ControlServer {
   const std::string& group_note() const { return group_note_; }
   // Clients dropped at a deadline or over a limit, and requests dropped unexecuted (client gone).
   std::uint64_t clients_dropped() const { return dropped_.load(std::memory_order_relaxed); }
+  // When the server's thread last went round its loop (std::chrono::steady_clock, ns): at least every
+  // 100 ms while it is well. A handler that hangs (a stuck disk under the audit) stops it: the service's
+  // watchdog stops pinging (sd_notify.hpp).
+  std::int64_t alive_ns() const { return alive_ns_.load(std::memory_order_relaxed); }
 
  private:
   void serve();
@@ -73,6 +77,7 @@ class ControlServer {
   int fd_ = -1;
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> dropped_{0};
+  std::atomic<std::int64_t> alive_ns_{0};
   std::thread thread_;
 };
 

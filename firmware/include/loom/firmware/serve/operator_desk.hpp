@@ -32,6 +32,10 @@ struct LoomView {
   // retried save succeeds (an ack would re-arm from the older counts and weave those rows again). Not in
   // the OperatorLink: serve sets it from its own save bookkeeping.
   bool counters_unsaved = false;
+  // A pause was given and the loom has not reached the safe point it holds at yet (serve's own record:
+  // set by an accepted pause, cleared when the loom pauses, resumes, faults or a session ends). A resume
+  // then withdraws it.
+  bool pause_pending = false;
 };
 LoomView view_of(const OperatorLink& link, bool knotting);
 

@@ -28,13 +28,21 @@ class SystemdNotifier {
   std::int64_t watchdog_ns_ = 0;
 };
 
-// Feeds the watchdog only while the control loop is alive: the loop's tick counter must have moved
-// recently. Called from the non-RT reporter as often as it likes; pings at half the interval.
+// Feeds the watchdog only while the control loop is alive — the loop's tick counter must have moved
+// recently — and the control socket's thread answers: it must have gone round its loop within half the
+// interval (a handler stuck on a hung disk leaves every operator unanswered; systemd restarts the
+// service, which comes back armed and waiting). Called from the non-RT reporter as often as it likes;
+// pings at half the interval.
 class LoopWatchdog {
  public:
   explicit LoopWatchdog(const SystemdNotifier& n) : n_(n) {}
-  // `loop_tick`: the tick the loop last published; `now_ns`: a monotonic clock.
-  void poll(std::int64_t loop_tick, std::int64_t now_ns);
+  // `loop_tick`: the tick the loop last published; `now_ns`: a monotonic clock; `control_idle_ns`: how
+  // long ago the control socket's thread last went round its loop.
+  void poll(std::int64_t loop_tick, std::int64_t now_ns, std::int64_t control_idle_ns = 0);
+  // Whether `control_idle_ns` counts as hung (no ping for it).
+  bool control_hung(std::int64_t control_idle_ns) const {
+    return n_.watchdog_ns() > 0 && control_idle_ns > n_.watchdog_ns() / 2;
+  }
   // Between sessions (re-arming) no loop runs: the serve thread itself is the proof of life.
   void ping_outside_loop() const;
 

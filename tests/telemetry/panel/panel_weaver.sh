@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# The weaver answers the knotting heads from the panel (issue 30): `loomctl serve` weaves the six-head
+# loom with a broken yarn (sim_hal/scenes/knotting_faults.toml: the heads ask the weaver to tie a knot by
+# hand); loom-panel offers buttons through serve's control socket; headless Chromium pairs the page with
+# a code from `loomctl ctl pair`, sees the heads' request and a button that answers it (before: only
+# Pause and Stop while the heads waited), presses it, and serve's journal says the panel client's `next`
+# answered that request. Writes <out>/loom_panel_weaver.png. Exit 77 (skip) without chromium or node.
+# Usage: panel_weaver.sh <loomctl> <loom-panel> <source dir> <out dir>
+set -euo pipefail
+LOOMCTL=$1
+PANEL=$2
+SRC=$3
+OUT=$4
+here=$(dirname "$0")
+fail() { echo "FAIL: $*" >&2; for f in "$WORK"/*.log; do echo "--- $f" >&2; tail -20 "$f" >&2; done; exit 1; }
+. "$(dirname "$0")/browser_lib.sh"
+have_browser || exit 77
+mkdir -p "$OUT"
+WORK=$(mktemp -d "${TMPDIR:-/tmp}/loom_panel_weaver.XXXXXX")
+PIDS=()
+cleanup() {
+  for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null || true; done
+  for p in "${PIDS[@]}"; do wait "$p" 2>/dev/null || true; done
+  rm -rf "$WORK" || true
+}
+trap cleanup EXIT
+
+PORT=$((20000 + ($$ * 17) % 20000))
+URL="udpm://239.255.76.67:${PORT}?ttl=0"
+ID="weaver$$"
+mkdir -p "$WORK/run"
+panel_up panel.log --lcm-url "$URL" --control-dir "$WORK/run"
+SOCK="$WORK/run/$ID.sock"
+panel_serve_up "$SOCK" serve.log --config "$SRC/firmware/config/knotting_loom.toml" \
+  --scene "$SRC/sim_hal/scenes/knotting_faults.toml" --state-dir "$WORK/state" --loom-id "$ID" --lcm-url "$URL" --pace 4
+CODE=$("$LOOMCTL" ctl --socket "$SOCK" pair weaver-tablet | sed -n 's/.*code=\([0-9]*\).*/\1/p')
+[ -n "$CODE" ] || fail "ctl pair printed no code"
+"$LOOMCTL" ctl --socket "$SOCK" start >/dev/null || fail "serve did not take start"
+node --experimental-websocket "$here/panel_weaver.mjs" "$CHROMIUM" "$PANEL_BASE" "$ID" "$OUT/loom_panel_weaver.png" 100 \
+  "$CODE" 2>&1 | grep -v ExperimentalWarning | grep -v "node --trace-warnings" || fail "browser check failed"
+asked=$(sed -n 's/^.*weaver asked: //p' "$WORK/serve.log" | head -1)
+[[ -n $asked ]] || fail "serve never logged the heads' request"
+grep -q "operator: next by panel client 127.0.0.1 paired as weaver-tablet .*: ok next: answered " "$WORK/serve.log" ||
+  fail "serve's journal does not say the panel's next answered the heads' request"
+[ -s "$OUT/loom_panel_weaver.png" ] || fail "no screenshot written"
+echo "panel_weaver: ok (the heads asked: $asked)"
