@@ -98,10 +98,10 @@ Yarns loom_yarns(const LoomConfig& c, bool from_magazines) {
     }
   } else {
     if (!c.recipe.design) {
-      throw Refusal(
-          c.source +
-          ": recipe.design = \"\": no design whose palette names the loom's yarns; set one, or give "
-          "--palette-from-magazines");
+      throw Refusal(c.source + ": recipe.design = \"\": no design whose palette names the loom's yarns; " +
+                    (c.knotting.slot_colours.empty()
+                         ? std::string("set recipe.design to a design whose palette lines are the yarns")
+                         : std::string("set one, or give --palette-from-magazines")));
     }
     out.from = "the palette of recipe.design = \"" + c.recipe.design_file + "\"";
     for (const design::Colour& colour : c.recipe.design->palette())

@@ -43,6 +43,11 @@ expect "$out/two.err" "--tile and --scale together: give one of --tile, --scale 
 expect "$out/ground.err" "--ground Q: not one of the yarns (R, I, B)"
 [[ $(fit over "$out/rug.png" --loom "$loom" --tile --out "$out/rug.csv") == 2 ]] || fail "the picture was overwritten"
 expect "$out/over.err" "--out/--preview would overwrite the picture $out/rug.png"
+# A loom that names no yarns (the default: a flat weave, no design, no magazines).
+[[ $(fit noyarns "$out/rug.png" --loom "$src/firmware/config/default_loom.toml" --scale --out "$out/rug_map.csv") == 2 ]] || fail "no yarns accepted"
+expect "$out/noyarns.err" "default_loom.toml: recipe.design = \"\": no design whose palette names the loom's yarns"
+[[ $(fit nomag "$out/rug.png" --loom "$src/firmware/config/default_loom.toml" --scale --palette-from-magazines --out "$out/rug_map.csv") == 2 ]] || fail "no magazines accepted"
+expect "$out/nomag.err" "default_loom.toml: knotting.slot_colours = []: the loom has no magazine yarns for --palette-from-magazines"
 nothing_written "refusals"
 
 # The default limit: every colour of the drawing is mapped or listed, each once, in one run.
