@@ -9,6 +9,7 @@
 
 #include "check_cmd.hpp"
 #include "commission_cmd.hpp"
+#include "design_cmd.hpp"
 #include "loom/firmware/serve/commands.hpp"
 #include "loom/firmware/session.hpp"
 #include "weave_cmd.hpp"
@@ -97,6 +98,7 @@ int main(int argc, char** argv) {
   com_cmd->add_option("--settle-s", com.settle_s, "non-interactive: run this long before reading")
       ->check(kFinite & CLI::Range(0.05, 30.0));
   const firmware::serve::BoardCommands board(app);  // serve, ctl, --version
+  const firmware::DesignCommand design(app);        // design fit
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -110,5 +112,6 @@ int main(int argc, char** argv) {
   if (check_cmd->parsed()) return firmware::run_check(check);
   if (com_cmd->parsed()) return firmware::run_commission(com);
   if (const auto rc = board.run()) return *rc;
+  if (const auto rc = design.run()) return *rc;
   return firmware::run_weave(a);
 }

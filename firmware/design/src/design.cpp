@@ -57,7 +57,8 @@ std::vector<Cell> split_cells(const std::string& line) {
 
 class CsvReader {
  public:
-  CsvReader(const std::string& text, const std::string& source) : text_(text), source_(source) {}
+  CsvReader(const std::string& text, const std::string& source, std::vector<std::size_t>* grid_lines = nullptr)
+      : text_(text), source_(source), grid_lines_(grid_lines) {}
 
   Design read() {
     std::size_t pos = 0;
@@ -152,6 +153,7 @@ class CsvReader {
       row.push_back(it->second);
     }
     rows_.push_back(std::move(row));
+    if (grid_lines_ != nullptr) grid_lines_->push_back(line_no_);
   }
 
   void check_code(const Cell& c) const {
@@ -180,6 +182,7 @@ class CsvReader {
 
   const std::string& text_;
   const std::string& source_;
+  std::vector<std::size_t>* grid_lines_;  // where each grid line is, when the caller asks
   std::size_t line_no_ = 0;
   int width_ = 0;
   std::vector<Colour> palette_;
@@ -209,6 +212,26 @@ std::span<const std::uint16_t> Design::row(int r) const {
 
 Design parse_design_csv(const std::string& text, const std::string& source) {
   return CsvReader(text, source).read();
+}
+
+Design parse_design_csv(const std::string& text, const std::string& source, std::vector<std::size_t>& grid_lines) {
+  grid_lines.clear();
+  return CsvReader(text, source, &grid_lines).read();
+}
+
+std::string design_csv_cell_at(const std::string& text, const std::string& source, std::size_t line, int knot) {
+  std::size_t pos = text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
+  for (std::size_t n = 1; n < line && pos != std::string::npos; ++n) {
+    pos = text.find('\n', pos);
+    if (pos != std::string::npos) ++pos;
+  }
+  std::size_t col = 1;
+  if (pos != std::string::npos) {
+    const std::size_t nl = text.find('\n', pos);
+    const auto cells = split_cells(text.substr(pos, nl == std::string::npos ? std::string::npos : nl - pos));
+    if (knot >= 0 && static_cast<std::size_t>(knot) < cells.size()) col = cells[static_cast<std::size_t>(knot)].col;
+  }
+  return source + ":" + std::to_string(line) + ":" + std::to_string(col);
 }
 
 Design parse_design(const std::string& bytes, const std::string& source) {

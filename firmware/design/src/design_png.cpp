@@ -1,43 +1,23 @@
-// PNG designs through libpng's simplified API: decoded from memory to 8-bit RGB (alpha composited
-// onto white, palette and grey images expanded), one pixel per knot, each distinct colour a code.
-#include <png.h>
-
+// PNG designs: one pixel per knot (decode_png_rgb, picture.cpp), each distinct colour a code "#rrggbb".
 #include <cstdio>
 #include <map>
 
 #include "loom/design/design.hpp"
+#include "loom/design/picture.hpp"
 
 namespace loom::design {
 
 Design parse_design_png(const std::string& bytes, const std::string& source) {
-  png_image img{};
-  img.version = PNG_IMAGE_VERSION;
-  const auto fail = [&](const std::string& why) -> DesignError {
-    const std::string lib = img.message[0] != '\0' ? std::string(" (libpng: ") + img.message + ")" : "";
-    png_image_free(&img);
-    return DesignError(source + ": " + why + lib);
-  };
-  if (png_image_begin_read_from_memory(&img, bytes.data(), bytes.size()) == 0) throw fail("not a readable PNG");
-  const auto w = static_cast<long>(img.width), h = static_cast<long>(img.height);
-  if (w < 1 || w > kMaxWidth || h < 1 || h > kMaxHeight) {
-    throw fail(std::to_string(w) + " x " + std::to_string(h) + " pixels: a design is 1.." + std::to_string(kMaxWidth) +
-               " knots wide and 1.." + std::to_string(kMaxHeight) + " rows (one pixel per knot)");
-  }
-  img.format = PNG_FORMAT_RGB;
-  std::vector<png_byte> rgb(PNG_IMAGE_SIZE(img));
-  const png_color white{255, 255, 255};
-  if (png_image_finish_read(&img, &white, rgb.data(), 0, nullptr) == 0) throw fail("cannot decode");
-  png_image_free(&img);
-
+  int w = 0, h = 0;
+  const std::vector<std::uint32_t> rgb = decode_png_rgb(bytes, source, w, h);
   std::vector<Colour> palette;
   std::map<std::uint32_t, std::uint16_t> index;
-  std::vector<std::uint16_t> knots(static_cast<std::size_t>(w * h));
-  for (long y = 0; y < h; ++y) {
+  std::vector<std::uint16_t> knots(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+  for (int y = 0; y < h; ++y) {
     // Pixel row 0 is the top of the picture; design row 0 (woven first) is its bottom.
-    const long r = h - 1 - y;
-    for (long x = 0; x < w; ++x) {
-      const png_byte* p = &rgb[static_cast<std::size_t>((y * w + x) * 3)];
-      const std::uint32_t c = static_cast<std::uint32_t>(p[0]) << 16 | static_cast<std::uint32_t>(p[1]) << 8 | p[2];
+    const int r = h - 1 - y;
+    for (int x = 0; x < w; ++x) {
+      const std::uint32_t c = rgb[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)];
       auto it = index.find(c);
       if (it == index.end()) {
         if (static_cast<int>(palette.size()) >= kMaxColours) {
@@ -49,10 +29,10 @@ Design parse_design_png(const std::string& bytes, const std::string& source) {
         it = index.emplace(c, static_cast<std::uint16_t>(palette.size())).first;
         palette.push_back(Colour{code, c, ""});
       }
-      knots[static_cast<std::size_t>(r * w + x)] = it->second;
+      knots[static_cast<std::size_t>(r) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] = it->second;
     }
   }
-  return Design(source, static_cast<int>(w), std::move(palette), std::move(knots));
+  return Design(source, w, std::move(palette), std::move(knots));
 }
 
 }  // namespace loom::design

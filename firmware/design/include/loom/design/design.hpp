@@ -61,6 +61,10 @@ class Design {
 //   codes (before the grid); every other non-empty line is one row of the picture, one cell per knot,
 //   each a palette code or a literal #RRGGBB. Every row has the same number of knots.
 Design parse_design_csv(const std::string& text, const std::string& source);
+// The same, noting the file line of each grid line, top line first (for messages that point at a knot).
+Design parse_design_csv(const std::string& text, const std::string& source, std::vector<std::size_t>& grid_lines);
+// "source:line:col" of knot `knot` (0-based, left to right) on the grid line at file line `line` (1-based).
+std::string design_csv_cell_at(const std::string& text, const std::string& source, std::size_t line, int knot);
 //   PNG: one pixel per knot (alpha ignored); each distinct colour becomes a code "#rrggbb".
 Design parse_design_png(const std::string& bytes, const std::string& source);
 // By the file's extension (.csv or .png, any case); anything else is a DesignError.
