@@ -9,8 +9,10 @@
 
 #include "check_cmd.hpp"
 #include "commission_cmd.hpp"
+#include "job_cmd.hpp"
 #include "loom/firmware/serve/commands.hpp"
 #include "loom/firmware/session.hpp"
+#include "report_cmd.hpp"
 #include "weave_cmd.hpp"
 
 using namespace loom;
@@ -97,6 +99,8 @@ int main(int argc, char** argv) {
   com_cmd->add_option("--settle-s", com.settle_s, "non-interactive: run this long before reading")
       ->check(kFinite & CLI::Range(0.05, 30.0));
   const firmware::serve::BoardCommands board(app);  // serve, ctl, --version
+  const firmware::JobCommands jobs(app);
+  const firmware::ReportCommands reports(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -110,5 +114,7 @@ int main(int argc, char** argv) {
   if (check_cmd->parsed()) return firmware::run_check(check);
   if (com_cmd->parsed()) return firmware::run_commission(com);
   if (const auto rc = board.run()) return *rc;
+  if (const auto rc = jobs.run()) return *rc;
+  if (const auto rc = reports.run()) return *rc;
   return firmware::run_weave(a);
 }
