@@ -2,8 +2,14 @@
 // bound and stepped, every failure a RecordError naming the file and SQLite's message.
 #include "loom/record/production_record.hpp"
 
+#include <fcntl.h>
 #include <sqlite3.h>
+#include <sys/file.h>
 #include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 
 namespace loom::record {
 namespace {
@@ -184,6 +190,21 @@ const char* opcua_machinery_state(MachineState s) {
 }
 
 ProductionRecord::ProductionRecord(const std::string& path) : path_(path) {
+  // One writer: a second one (another process, or a second object here) is refused at once. SQLite's own
+  // locks would only serialise the two, row by row, into one muddled record. The lock is a flock on a file
+  // beside the database, released by the kernel when the writer dies.
+  writer_lock_ = ::open((path + ".writer").c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
+  if (writer_lock_ < 0) {
+    throw RecordError(path +
+                      ".writer: cannot open the production record's writer lock: " + std::strerror(errno));
+  }
+  if (::flock(writer_lock_, LOCK_EX | LOCK_NB) != 0) {
+    const int err = errno;
+    ::close(writer_lock_);
+    const std::string why = err == EWOULDBLOCK ? "lock " + path + ".writer held" : std::strerror(err);
+    throw RecordError(path + ": the production record has a writer already (" + why +
+                      "): one loomctl writes it");
+  }
   // A file that exists but is not an SQLite database must not be turned into one.
   db_ = open_db(path, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
   try {
@@ -204,6 +225,7 @@ ProductionRecord::ProductionRecord(const std::string& path) : path_(path) {
   } catch (...) {
     sqlite3_close(db_);
     db_ = nullptr;
+    ::close(writer_lock_);
     throw;
   }
 }
@@ -211,6 +233,7 @@ ProductionRecord::ProductionRecord(const std::string& path) : path_(path) {
 ProductionRecord::~ProductionRecord() {
   sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);  // an uncommitted transaction after a throw
   sqlite3_close(db_);
+  ::close(writer_lock_);  // releases the flock
 }
 
 void ProductionRecord::exec(const char* sql) {

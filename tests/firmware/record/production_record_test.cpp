@@ -268,6 +268,17 @@ TEST(ProductionRecord, AnotherSchemaVersionOrNotADatabaseIsRefusedAndLeftAlone) 
             std::string::npos);
 }
 
+TEST(ProductionRecord, HasOneWriter) {
+  TempDir t;
+  {
+    ProductionRecord first(t.db());
+    EXPECT_NE(error_of([&] { ProductionRecord second(t.db()); }).find("has a writer already"),
+              std::string::npos);
+    EXPECT_TRUE(read_job_report(t.db(), 1) == std::nullopt);  // readers are welcome
+  }
+  EXPECT_NO_THROW(ProductionRecord again(t.db()));  // released with the first
+}
+
 TEST(ProductionRecord, WritesInWalMode) {
   TempDir t;
   { ProductionRecord rec(t.db()); }

@@ -76,7 +76,7 @@ class ProductionRecord {
   static constexpr int kSchemaVersion = 1;
 
   // Opens `path` for writing, creating the schema in a new file. RecordError naming the path when it is not
-  // a loomctl record of kSchemaVersion, or SQLite refuses (another writer holds it: SQLITE_BUSY).
+  // a loomctl record of kSchemaVersion, another writer has it open (flock on PATH.writer), or SQLite refuses.
   explicit ProductionRecord(const std::string& path);
   ~ProductionRecord();
   ProductionRecord(const ProductionRecord&) = delete;
@@ -109,6 +109,7 @@ class ProductionRecord {
   void exec(const char* sql);
 
   std::string path_;
+  int writer_lock_ = -1;  // flock on PATH.writer: one writer
   sqlite3* db_ = nullptr;
   std::uint32_t job_ = 0;
   MachineState state_ = MachineState::kIdle;
