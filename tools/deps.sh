@@ -25,6 +25,8 @@ packages=(
   nlohmann-json3-dev            # run reports (summary.json)
   libnlopt-cxx-dev              # optimiser (balancing)
   libpng-dev                    # carpet designs drawn as PNGs (one pixel per knot)
+  libsqlite3-dev                # the production record (firmware/record)
+  libssl-dev                    # SHA-256 of a job's design file (OpenSSL EVP, firmware/job)
   iproute2 can-utils            # vcan set-up, candump/cansend for HIL checks
   clang libclang-rt-14-dev llvm # fuzz build: clang++ -fsanitize=fuzzer (libFuzzer), llvm-symbolizer
   libcpp-httplib-dev            # loom-panel's HTTP server
@@ -42,7 +44,7 @@ if [[ $arm64 == 1 ]]; then
   packages+=(
     g++-aarch64-linux-gnu qemu-user-static dpkg-dev
     libtomlplusplus-dev:arm64 libgtest-dev:arm64 libgmock-dev:arm64 libbenchmark-dev:arm64
-    libnlopt-cxx-dev:arm64 libpng-dev:arm64
+    libnlopt-cxx-dev:arm64 libpng-dev:arm64 libsqlite3-dev:arm64 libssl-dev:arm64
   )
 fi
 

@@ -109,10 +109,11 @@ set(CPACK_DEBIAN_PACKAGE_PRIORITY optional)
 set(CPACK_STRIP_FILES ON)
 # Runtime dependencies by Debian name (tests/board/package_test.sh checks that every library the
 # binaries load comes from one of these): the C++ runtime, LCM, toml++, NLopt (loom-dynamics' balancing),
-# Google Benchmark (loom-profile's lookup timings), libpng (designs), cpp-httplib (loom-panel), and
-# adduser for the postinst. Names are the same on amd64 and arm64.
+# Google Benchmark (loom-profile's lookup timings), libpng (designs), SQLite (the production record),
+# OpenSSL's libcrypto (a job's design hash), cpp-httplib (loom-panel), and adduser for the postinst.
+# Names are the same on amd64 and arm64.
 set(CPACK_DEBIAN_PACKAGE_DEPENDS
-    "libc6 (>= 2.36), libstdc++6 (>= 12), libgcc-s1, liblcm1 (>= 1.3.1), libtomlplusplus3 (>= 3.3.0), libnlopt0 (>= 2.7.1), libbenchmark1debian (>= 1.7.1), libpng16-16 (>= 1.6.39)")
+    "libc6 (>= 2.36), libstdc++6 (>= 12), libgcc-s1, liblcm1 (>= 1.3.1), libtomlplusplus3 (>= 3.3.0), libnlopt0 (>= 2.7.1), libbenchmark1debian (>= 1.7.1), libpng16-16 (>= 1.6.39), libsqlite3-0 (>= 3.40.1), libssl3 (>= 3.0.0)")
 if(TARGET loom-panel)
   string(APPEND CPACK_DEBIAN_PACKAGE_DEPENDS ", libcpp-httplib0.11 (>= 0.11.4)")
 endif()

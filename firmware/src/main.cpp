@@ -10,8 +10,10 @@
 #include "check_cmd.hpp"
 #include "commission_cmd.hpp"
 #include "design_cmd.hpp"
+#include "job_cmd.hpp"
 #include "loom/firmware/serve/commands.hpp"
 #include "loom/firmware/session.hpp"
+#include "report_cmd.hpp"
 #include "weave_cmd.hpp"
 
 using namespace loom;
@@ -99,6 +101,8 @@ int main(int argc, char** argv) {
       ->check(kFinite & CLI::Range(0.05, 30.0));
   const firmware::serve::BoardCommands board(app);  // serve, ctl, --version
   const firmware::DesignCommand design(app);        // design fit
+  const firmware::JobCommands jobs(app);
+  const firmware::ReportCommands reports(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -113,5 +117,7 @@ int main(int argc, char** argv) {
   if (com_cmd->parsed()) return firmware::run_commission(com);
   if (const auto rc = board.run()) return *rc;
   if (const auto rc = design.run()) return *rc;
+  if (const auto rc = jobs.run()) return *rc;
+  if (const auto rc = reports.run()) return *rc;
   return firmware::run_weave(a);
 }
