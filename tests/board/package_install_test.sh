@@ -6,8 +6,8 @@
 # and a unique loom id in /etc/loomctl/loom-id (printed); the unit's ExecStartPre refuses to start
 # while /etc/default/loomctl does not say what the board drives (exit 2, naming LOOMCTL_HAL); with
 # LOOMCTL_HAL=sim the unit's own ExecStart line, run as the loomctl user the way systemd runs it, arms,
-# waits, weaves a row on `ctl start` from a member of group loom (an `operator` account joined to it with
-# `adduser operator loom`, running `loomctl ctl status` exactly as the READMEs write it, no --socket: ctl
+# waits, weaves a row on `ctl start` from a member of group loom (a `weaver` account (Debian has a system group `operator`) joined to it with
+# `adduser weaver loom`, running `loomctl ctl status` exactly as the READMEs write it, no --socket: ctl
 # finds the board's id), a user outside the group is told to `adduser USER loom`, and the service stops
 # on SIGTERM; the default loom
 # id is refused on hardware; remove runs prerm/postrm and purge leaves the production counters.
@@ -98,9 +98,9 @@ sock=/run/loomctl/$loom_id.sock
 # The operator, made a member of group loom the way the package's README says, runs `loomctl ctl status`
 # exactly as the READMEs write it: no --socket, no --loom-id (ctl reads the board's id from
 # /etc/loomctl/loom-id).
-in_root adduser --disabled-password --gecos "" operator >"$work/adduser.log" 2>&1 || fail "adduser operator"
-in_root adduser operator loom >>"$work/adduser.log" 2>&1 || fail "adduser operator loom: $(cat "$work/adduser.log")"
-as_operator() { chroot "$root" setpriv --reuid=operator --regid=operator --init-groups "$@"; }
+in_root adduser --disabled-password --gecos "" weaver >"$work/adduser.log" 2>&1 || fail "adduser weaver"
+in_root adduser weaver loom >>"$work/adduser.log" 2>&1 || fail "adduser weaver loom: $(cat "$work/adduser.log")"
+as_operator() { chroot "$root" setpriv --reuid=weaver --regid=weaver --init-groups "$@"; }
 ctl() { as_operator /usr/bin/loomctl ctl "$@"; }
 field() { ctl status | tr ' ' '\n' | sed -n "s/^$1=//p"; }
 for _ in $(seq 1 200); do [[ -S $root$sock ]] && break; sleep 0.05; done

@@ -14,7 +14,8 @@
 #      the reason (no SIGBUS); and when the disk fills while weaving, the row stops with
 #      counters_not_saved, `ctl ack` is refused while the save still fails (the fault stays), and once
 #      the disk has room the retried save lets the ack through, re-arming at the woven count — never the
-#      file's older one.
+#      file's older one; a fault latched on the full disk is kept (the service's reserve of disk room),
+#      a restart on the still full disk refuses to arm, and with room again the fault is latched again.
 # Usage: serve_service_test.sh LOOMCTL
 set -euo pipefail
 loomctl=$1
@@ -172,10 +173,13 @@ echo "one publisher per loom id: $(grep -o "refusing to arm: loom id.*by host [^
 
 # ---- 4. full disk ----
 mkdir "$work/disk"
-mount -t tmpfs -o size=256k tmpfs "$work/disk"
+mount -t tmpfs -o size=384k tmpfs "$work/disk"  # the sim-state file (~200 kB), the reserve (64 kB), the counters
 fill() { dd if=/dev/zero of="$work/disk/fill" bs=4k status=none 2>/dev/null || true; }
 # 3a: a fresh sim-state file on a full disk is refused, not mapped sparse (which died of SIGBUS).
 mkdir "$work/disk/full"
+# (the service's reserve of disk room already there, as a loom that armed before keeps it: the sim-state file
+# is what does not fit)
+dd if=/dev/zero of="$work/disk/full/reserve" bs=64k count=1 status=none
 fill
 rc=0
 "$loomctl" serve --state-dir "$work/disk/full" --socket "$work/f.sock" --group "" --no-telemetry >"$work/f.log" 2>&1 || rc=$?
@@ -189,6 +193,9 @@ echo "full disk, fresh sim-state: refused ($(grep -o 'cannot allocate.*' "$work/
 serve d.log "$work/disk/state" "$work/d.sock"
 d=$last
 wait_socket "$work/d.sock"
+# Its reserve of disk room used up (as by a fault record on a full disk before): nothing frees room for the
+# counters' retries, which fail until the disk has room again. (3c shows the reserve at work.)
+rm -f "$work/disk/state/reserve"
 ctl "$work/d.sock" start >/dev/null
 wait_for "$work/d.sock" rows 1 30
 # Kept full until a save fails: a fill that lands while a save's temporary file exists leaves the old
@@ -220,4 +227,39 @@ wait_for "$work/d.sock" state idle 10
 [[ $(field "$work/d.sock" rows) == "$woven" ]] || fail "re-armed at rows $(field "$work/d.sock" rows), woven $woven"
 kill -TERM "$d"; wait "$d" || fail "serve exited $? on SIGTERM"
 echo "full disk while weaving: ack refused ('$reply') at $woven woven / $on_disk on disk, accepted after the retried save, re-armed at $woven: ok"
+
+# 3c: a fault latched on a full disk survives a restart: the latched-fault record is written into the room the
+# service keeps in reserve (it was lost before: the restart armed idle, fault=none, and started on ctl start).
+serve e.log "$work/disk/state" "$work/e.sock"
+e=$last
+wait_socket "$work/e.sock"
+[[ -e $work/disk/state/reserve ]] || fail "serve armed without keeping its reserve"
+ctl "$work/e.sock" start >/dev/null
+wait_for "$work/e.sock" rows $((woven + 1)) 30
+keep_full &
+filler=$!
+wait_for "$work/e.sock" fault counters_not_saved 60
+kill "$filler" 2>/dev/null || true; wait "$filler" 2>/dev/null || true
+[[ -e $work/disk/state/latched-fault ]] || fail "the fault latched on the full disk was not kept: $(ls "$work/disk/state")"
+grep -q "^fault = counters_not_saved" "$work/disk/state/latched-fault" || fail "latched-fault: $(cat "$work/disk/state/latched-fault")"
+[[ ! -e $work/disk/state/reserve ]] || fail "the reserve was not the room the record used"
+kill -TERM "$e"; wait "$e" || true
+# Restarted on the still full disk: refuses to arm (no room to keep a next fault), saying why.
+rc=0
+"$loomctl" serve --state-dir "$work/disk/state" --socket "$work/e.sock" --group "" --no-telemetry --pace 25 >"$work/e2.log" 2>&1 || rc=$?
+((rc == 4)) || fail "serve on the still full disk exited $rc, not 4 (refusing to arm)"
+grep -q "refusing to arm: cannot keep .* in reserve" "$work/e2.log" || fail "no reason: $(cat "$work/e2.log")"
+# Room again: the restart latches the fault again; start is refused until ack.
+rm -f "$work/disk/fill"*
+serve e3.log "$work/disk/state" "$work/e.sock"
+e=$last
+wait_socket "$work/e.sock"
+wait_for "$work/e.sock" fault counters_not_saved 10
+rc=0
+reply=$(ctl "$work/e.sock" start 2>&1) || rc=$?
+((rc != 0)) || fail "ctl start after the restart answered '$reply' with the fault latched"
+ctl "$work/e.sock" ack >/dev/null
+wait_for "$work/e.sock" state idle 10
+kill -TERM "$e"; wait "$e" || true
+echo "fault latched on a full disk: kept in the reserve, refused to arm while still full, latched again after the restart ('$reply'), cleared by ack: ok"
 echo "serve_service_test: ok"

@@ -2,7 +2,8 @@
 # loomctl serve end to end on the simulated loom (paced 10x real time, no telemetry), with a temporary
 # state directory and control socket:
 #   1. serve arms and waits: nothing moves until `ctl start`;
-#   2. `ctl start` weaves; a row completes; `ctl stop` stops at the end of the row (state done);
+#   2. `ctl start` weaves; a row completes; `ctl stop` stops at the next hold point (state done); paused,
+#      `ctl stop` leaves the loom standing (done, no pick, beat or row more);
 #   3. SIGTERM ends the service (exit 0); restarted on the same state it comes up armed at the same
 #      row, idle (resumable, not moving); killed with SIGKILL mid-row and restarted, likewise;
 #   4. a fault scene: the fault is logged with severity <3>, kept in the fault history (`ctl faults`),
@@ -90,6 +91,19 @@ ctl faults | grep -qE ' command loom1 stop .* rows=[1-9][0-9]* picks=[1-9][0-9]*
   fail "the stop command's history line lacks the counters: $(ctl faults | grep ' command loom1 stop')"
 ctl next 2>/dev/null && fail "next accepted without a knotting mode"
 ctl faults | grep -q ' command loom1 next' && fail "a refused command went into the history"
+# 2b. stop means stop (issue 30): paused mid-run, a stop leaves the loom standing — state done, not one pick,
+# beat or row more (it resumed the loom and wove the row to its end).
+ctl start >/dev/null
+wait_for rows $((rows + 1)) 30
+ctl pause >/dev/null
+wait_for state paused 30
+held=$(ctl status | grep -o 'rows=[0-9]* picks=[0-9]* beats=[0-9]*')
+ctl stop | grep -q '^ok stop' || fail "stop of the paused loom not acknowledged"
+wait_for state done 10
+sleep 2  # 20 s of machine time at 10x: a row would have been woven
+[[ $(ctl status | grep -o 'rows=[0-9]* picks=[0-9]* beats=[0-9]*') == "$held" ]] ||
+  fail "the stopped paused loom moved on: $held -> $(ctl status)"
+rows=$(field rows)
 
 # 3. restart on the same state: armed at the same row, idle
 stop_serve

@@ -223,7 +223,7 @@ std::optional<LatchedFault> LatchedFaultStore::load() const {
 }
 
 void LatchedFaultStore::save(const LatchedFault& f) const {
-  write_file_durably(path_, format(f));
+  write_file_durably(path_, format(f), reserve_);
 }
 
 void LatchedFaultStore::clear() const {

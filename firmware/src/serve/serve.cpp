@@ -188,7 +188,7 @@ class Service {
         state_lock_(lock_state_dir(state_, cfg_.loom_id, socket_path_)),
         record_(state_ + "/counters.json", cfg_),
         history_(state_ + "/faults.log"),
-        latched_(state_ + "/latched-fault"),
+        latched_(state_ + "/latched-fault", state_ + "/reserve"),
         watchdog_(systemd_),
         desk_(pairings_, a.iface) {
     // The fault latched when the service last stopped (power cut, restart, watchdog): latched again when
@@ -327,6 +327,15 @@ class Service {
 
   // ---- build and arm one session from what is on disk ----
   void arm(Session& session) {
+    // Room for the latched-fault record on a full disk: a loom whose fault could not be kept would forget
+    // it at the next restart. A disk too full to keep it refuses to arm, as unwritable counters do.
+    try {
+      latched_.keep_reserve();
+    } catch (const std::exception& e) {
+      throw SessionError(kExitNotArmed, std::string("refusing to arm: ") + e.what() +
+                                            " (free space in the state directory; a fault latched on a full "
+                                            "disk must still be kept)");
+    }
     sequencer::Counters resume = record_.load();
     // Counters woven but not on disk when the last session ended: armed from these, never from the file's
     // older counts (which would weave those rows again).

@@ -60,7 +60,7 @@ const std::string kGood =
 
 TEST(LatchedFault, WhatIsSavedIsLoadedBackAndAnAcknowledgementRemovesIt) {
   const std::string dir = temp_dir();
-  const LatchedFaultStore store(dir + "/latched-fault");
+  const LatchedFaultStore store(dir + "/latched-fault", dir + "/reserve");
   EXPECT_FALSE(store.load().has_value()) << "no file: no fault latched";
   store.save(drive_fault());
   const auto back = store.load();
@@ -145,7 +145,7 @@ TEST(LatchedFault, ACrlfRecordIsRefusedShowingTheCarriageReturn) {
 
 TEST(LatchedFault, AFileThatIsNotARecordIsRefusedAndLeftAlone) {
   const std::string dir = temp_dir();
-  const LatchedFaultStore store(dir + "/latched-fault");
+  const LatchedFaultStore store(dir + "/latched-fault", dir + "/reserve");
   std::filesystem::create_directories(dir + "/latched-fault");
   EXPECT_THROW(store.load(), ConfigError);
   std::filesystem::remove_all(dir + "/latched-fault");

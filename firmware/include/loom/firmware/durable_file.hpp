@@ -40,7 +40,7 @@ StateFileRead read_state_file(const std::string& path, std::size_t max_bytes);
 // that cannot be written does) and releases it only to write such a record. Non-RT.
 class DiskReserve {
  public:
-  explicit DiskReserve(std::string path, std::size_t bytes = 256u << 10)
+  explicit DiskReserve(std::string path, std::size_t bytes = 64u << 10)
       : path_(std::move(path)), bytes_(bytes) {}
   // Makes the reserve (written, fsync'd, not sparse) unless it is there whole. Throws std::runtime_error
   // naming the path when the disk cannot hold it (nothing left behind).

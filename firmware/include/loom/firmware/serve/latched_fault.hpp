@@ -22,6 +22,7 @@
 #include <optional>
 #include <string>
 
+#include "loom/firmware/durable_file.hpp"
 #include "loom/firmware/serve/fault_history.hpp"
 #include "loom/sequencer/faults.hpp"
 
@@ -35,14 +36,21 @@ struct LatchedFault {
 
 class LatchedFaultStore {
  public:
-  explicit LatchedFaultStore(std::string path) : path_(std::move(path)) {}
+  // `reserve`: room kept beside it (durable_file.hpp) that a save on a full disk frees first — a fault
+  // latched because the counters could not be saved is still kept, and latched again after a restart.
+  LatchedFaultStore(std::string path, std::string reserve_path)
+      : path_(std::move(path)), reserve_(std::move(reserve_path)) {}
   // Missing file → nullopt (no fault was latched). Anything else that is not a valid record → ConfigError.
   std::optional<LatchedFault> load() const;
-  // Throws std::runtime_error naming the path on failure (the previous file stays).
+  // Throws std::runtime_error naming the path on failure (the previous file stays); on a full disk the
+  // reserve is released first and the save tried again.
   void save(const LatchedFault& f) const;
+  // Arming: the reserve is there (made when missing). Throws std::runtime_error when the disk cannot hold it.
+  void keep_reserve() const { reserve_.ensure(); }
   // Removes the record (acknowledged). A missing file is not an error. Throws std::runtime_error.
   void clear() const;
   const std::string& path() const { return path_; }
+  const std::string& reserve_path() const { return reserve_.path(); }
 
   static std::string format(const LatchedFault& f);
   static LatchedFault parse(const std::string& text, const std::string& source);
@@ -51,6 +59,7 @@ class LatchedFaultStore {
 
  private:
   std::string path_;
+  DiskReserve reserve_;
 };
 
 }  // namespace loom::firmware::serve
