@@ -11,7 +11,7 @@
 #include <string>
 
 #include "config_error.hpp"
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/sequencer/sequencer.hpp"
 
 using namespace loom::firmware;

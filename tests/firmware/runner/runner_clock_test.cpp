@@ -9,7 +9,7 @@
 #include <optional>
 #include <vector>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/control_loop.hpp"
 #include "loom/firmware/runner.hpp"
 #include "loom/sim_hal/sim_world.hpp"
