@@ -107,6 +107,86 @@ std::pair<std::string, std::string> io_module_key(const LoomConfig& c, const dri
   return {"io.node", std::to_string(c.io.node)};
 }
 
+// The key a refusal of the knotting spec is pinned to: the one that sets the refused field.
+const char* knotting_key(sequencer::KnottingField f) {
+  using F = sequencer::KnottingField;
+  switch (f) {
+    case F::kKnotsPerDm:
+      return "knotting.knots_per_dm";
+    case F::kRowsPerDm:
+      return "knotting.rows_per_dm";
+    case F::kHeads:
+      return "knotting.heads";
+    case F::kHeadSpacing:
+      return "knotting.head_spacing_m";
+    case F::kSlotColours:
+      return "knotting.slot_colours";
+    case F::kKnotsPerSlot:
+      return "knotting.knots_per_slot";
+  }
+  return "knotting.mode";
+}
+
+// The key (and its value as the file writes it) a refusal of the sequencer's configuration is pinned
+// to: the key that sets the field. The machine's constants, which no key sets, are pinned to the key
+// they relate to.
+std::pair<std::string, std::string> sequencer_key(const LoomConfig& c, const sequencer::SequencerFault& f) {
+  using F = sequencer::SequencerField;
+  const auto ms = [](double s) { return fmt_num(s * 1e3); };
+  const auto key = [&](const char* path) {
+    return std::pair<std::string, std::string>{path, value_of(c, path)};
+  };
+  switch (f.field) {
+    case F::kPeriod:
+    case F::kArrivalGrace:  // a machine constant, counted in periods
+      return {"timing.period_ms", ms(c.run.period_s)};
+    case F::kBeatsPerPosition:
+      return key("recipe.beats_per_position");
+    case F::kPicksPerRow:
+      return key("recipe.picks_per_row");
+    case F::kAxes:
+      return {"axes", ""};
+    case F::kAxisMaxSpeed:
+      if (f.axis < c.axes.size())
+        return {"axes." + c.axes[f.axis].name + ".max_speed", fmt_num(c.axes[f.axis].max_speed)};
+      return {"axes", ""};
+    case F::kDebounceTicks:
+      return key("timing.debounce_ticks");
+    case F::kSensorDiscrepancy:
+      return {"timing.sensor_discrepancy_ms", ms(c.run.sensor_discrepancy_s)};
+    case F::kCrankParkPosition:
+      return key("beatup.crank_park_position_rad");
+    case F::kCarriageHome:
+      return key("carriage.home_position_m");
+    case F::kHelixLeftPosition:
+      return key("helix.left_position_rad");
+    case F::kEnableTimeout:
+      return key("timing.enable_timeout_s");
+    case F::kPickTimeoutMargin:
+      return key("timing.pick_timeout_margin_s");
+    case F::kStaleTimeout:
+      return {"timing.stale_timeout_ms", ms(c.run.stale_timeout_s)};
+    case F::kDiagnosisWindow:
+      return key("can.heartbeat_timeout_ms");  // the window follows from it on CAN
+    case F::kRowSaveTimeout:
+      return key("timing.row_save_timeout_s");
+    case F::kSelvedgeSensorWindow:
+    case F::kShuttleFollowTolerance:
+      return key("loom.width_m");  // constants of the shuttle's path
+    case F::kKnottingHeads:
+      return key("knotting.heads");
+    case F::kKnottingMode:
+      return key("knotting.mode");
+    case F::kSlotColours:
+      return key("knotting.slot_colours");
+    case F::kSelectorLimits:
+      return key("knotting.selector_accel_rad_s2");
+    case F::kKnotterSettings:
+      return key("knotting.take_position_rad");
+  }
+  return {"timing.period_ms", ms(c.run.period_s)};
+}
+
 // The loop period must resolve the beat. A beat presses the comb into the fell for only a short arc of
 // crank (the simulated load cell: the last 5 mm of the tip's travel, about 33 deg of crank); its force
 // rises through the contact and peaks as the beater leaves the cloth. The load cell is read once per
@@ -170,14 +250,12 @@ void check_relations(const TomlReader& r, const LoomConfig& c) {
     r.fail("timing.stale_timeout_ms", fmt_num(c.run.stale_timeout_s * 1e3),
            "must be at least two periods (timing.period_ms = " + fmt_num(c.run.period_s * 1e3) + ")");
   }
-  if (const std::string why = sequencer::validate(c.knotting, m.width_m); !why.empty()) {
-    const std::string named = why.substr(0, why.find_first_of(" :["));
+  // At the key that sets the refused field, or at knotting.mode when the file takes that key from the
+  // embedded default (the mode is what makes the default matter).
+  if (const std::optional<sequencer::KnottingFault> f = sequencer::find_fault(c.knotting, m.width_m)) {
+    const std::string named = knotting_key(f->field);
     const std::string key = present(named) ? named : "knotting.mode";
-    std::string value;
-    for (const Key& k : keys()) {
-      if (k.path == key) value = k.value(c);
-    }
-    r.fail(key, value, why);
+    r.fail(key, value_of(c, key), f->message);
   }
   check_design_fits_heads(r, c);
   if (c.knotting.mode == sequencer::KnottingMode::kHeads) {
@@ -293,6 +371,12 @@ void check_motion(const LoomConfig& c, const Fail& fail) {
          "gives " + std::to_string(set->beats_per_row()) + " beats per row on a " +
              fmt_num(c.machine_spec.width_m) + " m loom; the sequencer holds at most " +
              std::to_string(sequencer::kMaxBeatsPerRow));
+  }
+  // The sequencer's own validation (its capacities, calibration offsets, time-outs in ticks), at the key
+  // that sets the refused field.
+  if (const std::optional<sequencer::SequencerFault> f = sequencer::find_fault(c.sequencer, *set)) {
+    const auto [key, value] = sequencer_key(c, *f);
+    fail(key, value, f->message);
   }
   // A homed crank comes to rest at its home point before anything else moves: the beater must be clear
   // of the warp there, or the carriage could never home or move after it.

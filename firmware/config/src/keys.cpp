@@ -591,6 +591,11 @@ const Key* find_key(const std::string& path) {
   return nullptr;
 }
 
+std::string value_of(const LoomConfig& c, const std::string& path) {
+  const Key* k = find_key(path);
+  return k != nullptr ? k->value(c) : std::string();
+}
+
 void refuse_moved_keys(TomlReader& r) {
   static const struct {
     const char* old_key;

@@ -28,6 +28,8 @@ struct Key {
 const std::vector<Key>& keys();
 // The key at `path`, or null.
 const Key* find_key(const std::string& path);
+// The canonical value of the key at `path` in `c` ("" if there is no such key).
+std::string value_of(const LoomConfig& c, const std::string& path);
 // The top-level tables a loom file may have.
 const std::set<std::string>& known_sections();
 
