@@ -165,6 +165,9 @@ TEST(MachineDescription, EveryModuleConfigIsDerivedFromOneFact) {
   EXPECT_EQ(c.sequencer.period_s, 0.001);
   EXPECT_EQ(c.machine.period_s, 0.001);
   EXPECT_EQ(can_axis_config(c).cycle_period_s, 0.001);
+  // The loop's clocks take the period in nanoseconds and the CAN diagnosis window from the same derivation.
+  EXPECT_EQ(c.timing.period_ns, 1'000'000);
+  EXPECT_DOUBLE_EQ(c.timing.can_diagnosis_window_s, c.can.heartbeat_timeout_ms * 1e-3 + 10 * 0.001);
 }
 
 TEST(MachineDescription, AReloadMayChangeOnlyTheRecipe) {

@@ -88,9 +88,14 @@ void derive(LoomConfig& c, const Fail& fail) {
   p.max_table_error_rad = rc.max_table_error_rad;
   p.crank.velocity = master_crank_speed(c, fail);
 
+  LoopTiming& t = c.timing;
+  t.period_s = c.run.period_s;
+  t.period_ns = static_cast<std::int64_t>(std::llround(t.period_s * 1e9));
+  t.can_diagnosis_window_s = c.can.heartbeat_timeout_ms * 1e-3 + 10.0 * t.period_s;
+
   sequencer::SequencerConfig& s = c.sequencer;
   s = sequencer::SequencerConfig{};
-  s.period_s = c.run.period_s;
+  s.period_s = t.period_s;
   s.axes = axis_layout(c);
   for (std::size_t i = hal::kCoreAxisCount; i < c.axes.size(); ++i) s.axis_max_speed[i] = c.axes[i].max_speed;
   for (std::size_t i = 0; i < c.axes.size(); ++i)
@@ -145,7 +150,7 @@ void derive(LoomConfig& c, const Fail& fail) {
 
   sim_hal::SimMachine& sm = c.machine;
   sm = sim_hal::SimMachine{};
-  sm.period_s = c.run.period_s;
+  sm.period_s = t.period_s;
   sm.axis_count = c.axes.size();
   for (std::size_t i = 0; i < c.axes.size(); ++i) {
     const AxisSpec& a = c.axes[i];

@@ -189,6 +189,16 @@ struct TelemetrySettings {
   std::uint32_t status_every = 50, axes_every = 10, rt_every = 500;
 };
 
+// The loop's timing, derived once from timing.period_ms (and the CAN heartbeat) for everything that
+// runs at it: the control loop's and the session's clocks take the period in nanoseconds from here.
+struct LoopTiming {
+  double period_s = 0.002;
+  std::int64_t period_ns = 2'000'000;  // period_s rounded to the nanosecond
+  // On CAN, how long the sequencer waits after stale PDOs for the heartbeat loss that names the root
+  // cause: the heartbeat time-out and ten periods.
+  double can_diagnosis_window_s = 0.27;
+};
+
 struct LoomConfig {
   std::string source = "<embedded default>";  // where it came from, for messages
   // What the file says, each fact once.
@@ -209,6 +219,7 @@ struct LoomConfig {
 
   // Derived by derive_module_configs() from the facts above; never edited by hand.
   double beat_force_target_n = 0.0;  // > 0 when the crank speed was derived from a beat-force target
+  LoopTiming timing;
   motion::ProfileSpec profile;
   sequencer::SequencerConfig sequencer;
   sim_hal::SimMachine machine;
