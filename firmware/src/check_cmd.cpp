@@ -13,8 +13,8 @@
 
 #include "loom/drivers/bus_load.hpp"
 #include "loom/drivers/required_objects.hpp"
-#include "loom/firmware/config.hpp"
-#include "loom/firmware/scene_config.hpp"
+#include "loom/config/config.hpp"
+#include "loom/config/scene_config.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/profile_set.hpp"
 #include "loom/sim_hal/effects.hpp"

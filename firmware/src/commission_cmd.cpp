@@ -14,11 +14,11 @@
 #include <utility>
 #include <vector>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
+#include "loom/config/toml_edit.hpp"
+#include "loom/config/toml_reader.hpp"
 #include "loom/firmware/durable_file.hpp"
 #include "loom/firmware/session.hpp"
-#include "loom/firmware/toml_edit.hpp"
-#include "toml_reader.hpp"
 
 namespace loom::firmware {
 namespace {

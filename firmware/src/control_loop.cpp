@@ -30,12 +30,12 @@ bool axis_faulted(const hal::AxisFeedback& a) noexcept {
 }  // namespace
 
 ControlLoop::ControlLoop(hal::Hal& hal, sequencer::Sequencer& seq, telemetry::Telemetry* telemetry,
-                         double period_s, bool lossless_telemetry)
+                         std::int64_t period_ns, bool lossless_telemetry)
     : hal_(hal),
       seq_(seq),
       n_axes_(seq.axes().count),
       telemetry_(telemetry),
-      period_ns_(static_cast<std::int64_t>(std::llround(period_s * 1e9))),
+      period_ns_(period_ns),
       lossless_(lossless_telemetry) {}
 
 void ControlLoop::cycle(hal::Tick now) noexcept {

@@ -20,7 +20,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/durable_file.hpp"
 
 namespace loom::firmware {

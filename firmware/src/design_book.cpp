@@ -4,9 +4,9 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/durable_file.hpp"
-#include "toml_reader.hpp"
+#include "loom/config/toml_reader.hpp"
 
 namespace loom::firmware {
 

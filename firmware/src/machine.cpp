@@ -23,7 +23,7 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
   scfg.await_row_saved = opt.await_row_saved;
   if (opt.hal == HalKind::kSocketCan) {
     // A dead drive first shows as stale PDOs (fast stop), then as a lost heartbeat (the root cause).
-    scfg.diagnosis_window_s = cfg_.can.heartbeat_timeout_ms * 1e-3 + 10.0 * cfg_.sequencer.period_s;
+    scfg.diagnosis_window_s = cfg_.timing.can_diagnosis_window_s;
   }
   sequencer_ = std::make_unique<sequencer::Sequencer>(*slot_, scfg, resume);
   if (knot_program_) {
@@ -67,7 +67,7 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
     }
     telemetry_->start();
   }
-  loop_ = std::make_unique<ControlLoop>(*hal_, *sequencer_, telemetry_.get(), cfg_.sequencer.period_s,
+  loop_ = std::make_unique<ControlLoop>(*hal_, *sequencer_, telemetry_.get(), cfg_.timing.period_ns,
                                         opt.lossless_telemetry && opt.hal == HalKind::kSim);
   TelemetryContext tc;
   tc.beat_force_min_n = cfg_.sequencer.beat_force_min_n;

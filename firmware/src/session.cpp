@@ -248,7 +248,7 @@ RunResult Session::run(const RunOptions& ro, const EventHandler& on_event) {
 }
 
 void Session::tick(hal::Tick n) {
-  const auto period_ns = static_cast<std::int64_t>(std::llround(machine_->config().sequencer.period_s * 1e9));
+  const std::int64_t period_ns = machine_->config().timing.period_ns;
   if (next_tick_ == 0) next_deadline_ns_ = clock_.now_ns();
   for (hal::Tick i = 0; i < n; ++i) {
     machine_->loop().cycle(next_tick_++);

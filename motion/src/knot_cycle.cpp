@@ -42,7 +42,10 @@ using Eigen::Vector2d;
 
 Vector2d unit(double a) { return {std::cos(a), std::sin(a)}; }
 
-[[noreturn]] void fail(ErrorCode code, const std::string& what) { detail::fail(kWho, code, what); }
+// As detail::fail (the message "knot cycle: <what>"), with the spec fact it is about.
+[[noreturn]] void fail(ErrorCode code, const std::string& what, KnotCycleField field = KnotCycleField::kLinkage) {
+  throw KnotCycleError(code, field, std::string(kWho) + ": " + what);
+}
 
 std::string num(double v) {
   std::ostringstream os;
@@ -52,8 +55,8 @@ std::string num(double v) {
 }
 
 void require_finite(const char* field, double v) { detail::require_finite(kWho, field, v, ""); }
-void require_positive(const char* field, double v) {
-  if (!std::isfinite(v) || !(v > 0.0)) fail(ErrorCode::kInvalidInput, std::string(field) + " = " + num(v) + ": must be finite and > 0");
+void require_positive(const char* field, double v, KnotCycleField about = KnotCycleField::kLinkage) {
+  if (!std::isfinite(v) || !(v > 0.0)) fail(ErrorCode::kInvalidInput, std::string(field) + " = " + num(v) + ": must be finite and > 0", about);
 }
 void require_non_negative(const char* field, double v) {
   if (!std::isfinite(v) || !(v >= 0.0)) fail(ErrorCode::kInvalidInput, std::string(field) + " = " + num(v) + ": must be finite and >= 0");
@@ -88,15 +91,20 @@ void check_spec(const KnotCycleSpec& s) {
   if (s.branch != Branch::kPositive && s.branch != Branch::kNegative) {
     fail(ErrorCode::kInvalidInput, "branch = " + std::to_string(static_cast<int>(s.branch)) + ": must be positive or negative");
   }
-  require_finite("warp_entry_x_m", s.warp_entry_x_m);
+  if (!std::isfinite(s.warp_entry_x_m)) {  // detail::require_finite's words, with the field
+    std::ostringstream os;
+    os << "warp_entry_x_m = " << s.warp_entry_x_m << ": must be finite";
+    fail(ErrorCode::kInvalidInput, os.str(), KnotCycleField::kWarpEntry);
+  }
   if (!std::isfinite(s.min_transmission_rad) || s.min_transmission_rad < 0.0 || s.min_transmission_rad >= kPi / 2) {
-    fail(ErrorCode::kInvalidInput, "min_transmission_rad = " + num(s.min_transmission_rad) + ": must be in [0, pi/2)");
+    fail(ErrorCode::kInvalidInput, "min_transmission_rad = " + num(s.min_transmission_rad) + ": must be in [0, pi/2)",
+         KnotCycleField::kMinTransmission);
   }
   require_non_negative("gravity_m_s2", s.gravity_m_s2);
   require_positive("max_speed_rad_s", s.max_speed_rad_s);
   require_positive("max_accel_rad_s2", s.max_accel_rad_s2);
   require_positive("jerk_rad_s3", s.jerk_rad_s3);
-  require_positive("max_torque_nm", s.max_torque_nm);
+  require_positive("max_torque_nm", s.max_torque_nm, KnotCycleField::kMaxTorque);
   require_non_negative("rotor_inertia_kg_m2", s.rotor_inertia_kg_m2);
   require_non_negative("grip_s", s.grip_s);
   require_non_negative("cut_s", s.cut_s);
@@ -382,6 +390,9 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
            num(deg(spec.min_transmission_rad)) + " deg)";
   };
   if (!stroke.ok) {
+    // Stopped by the transmission angle (not a dead centre or toggle): the minimum is the fact to change.
+    const KnotCycleField stopped_by =
+        stroke.unreachable || stroke.toggle ? KnotCycleField::kLinkage : KnotCycleField::kMinTransmission;
     // The other way round: would the points be reachable there (order defect) or not at all?
     const SweepResult other = sweep(crank_abs[0], -dir * ahead(-dir, 1), spec.min_transmission_rad);
     std::ostringstream os;
@@ -389,11 +400,11 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
       os << "order defect: turning from TAKE (" << deg(crank_abs[0]) << " deg) towards WRAP the crank meets "
          << what_stops(stroke) << " at " << deg(stroke.stopped_at)
          << " deg; the other way it reaches PULL (" << deg(crank_abs[2]) << " deg) before WRAP (" << deg(crank_abs[1]) << " deg)";
-      fail(ErrorCode::kOutOfBounds, os.str());
+      fail(ErrorCode::kOutOfBounds, os.str(), stopped_by);
     }
     os << "the stroke TAKE→WRAP→PULL (" << deg(crank_abs[0]) << " → " << deg(crank_abs[1]) << " → " << deg(crank_abs[2])
        << " deg) meets " << what_stops(stroke) << " at crank angle " << deg(stroke.stopped_at) << " deg";
-    fail(ErrorCode::kSingular, os.str());
+    fail(ErrorCode::kSingular, os.str(), stopped_by);
   }
   rep.stroke_rad = dir * to_pull;
   rep.min_transmission_rad = stroke.min_transmission;
@@ -419,7 +430,8 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
     const double hold = std::fabs(kc.dynamics_at(crank_abs[i]).gravity_nm);
     if (!(hold < spec.max_torque_nm)) {
       fail(ErrorCode::kOutOfBounds, "max_torque_nm = " + num(spec.max_torque_nm) + ": holding the links against gravity at " +
-                                        point_name(i) + " takes " + num(hold) + " N m");
+                                        point_name(i) + " takes " + num(hold) + " N m",
+           KnotCycleField::kMaxTorque);
     }
   }
 
@@ -447,7 +459,8 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
         if (!(room * in > 0.0)) {
           fail(ErrorCode::kOutOfBounds, "max_torque_nm = " + num(spec.max_torque_nm) + ": gravity alone needs " +
                                             num(d.gravity_nm) + " N m at servo angle " + num(deg(start_rel + m.position)) +
-                                            " deg from TAKE");
+                                            " deg from TAKE",
+               KnotCycleField::kMaxTorque);
         }
         s2 = std::max(s2, in / room);
       }
@@ -532,7 +545,8 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
   if (!(spec.points[1].x_m >= spec.warp_entry_x_m) || !(spec.points[0].x_m < entry)) {
     fail(ErrorCode::kInvalidInput, "warp_entry_x_m = " + num(spec.warp_entry_x_m) + ": must lie between TAKE x (" +
                                        num(spec.points[0].x_m) + " m, outside the warp by " + num(kWarpMargin_m) +
-                                       " m) and WRAP x (" + num(spec.points[1].x_m) + " m, inside)");
+                                       " m) and WRAP x (" + num(spec.points[1].x_m) + " m, inside)",
+         KnotCycleField::kWarpEntry);
   }
   {
     const int n = 4096;

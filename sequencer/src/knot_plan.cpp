@@ -80,48 +80,62 @@ int knots_per_stripe(const KnottingSpec& s) {
   return static_cast<int>(std::floor(s.head_spacing_m / knot_pitch_m(s) + 1e-9));
 }
 
-std::string validate(const KnottingSpec& s, double width_m) {
+std::optional<KnottingFault> find_fault(const KnottingSpec& s, double width_m) {
+  using F = KnottingField;
   const auto fin = [](double v) { return std::isfinite(v); };
   if (!fin(s.knots_per_dm) || s.knots_per_dm < 5.0 || s.knots_per_dm > 200.0) {
-    return "knotting.knots_per_dm must be in [5, 200]";
+    return KnottingFault{F::kKnotsPerDm, "knotting.knots_per_dm must be in [5, 200]"};
   }
-  if (!fin(s.rows_per_dm) || s.rows_per_dm < 5.0 || s.rows_per_dm > 200.0) return "knotting.rows_per_dm must be in [5, 200]";
-  if (s.mode != KnottingMode::kHeads) return "";
+  if (!fin(s.rows_per_dm) || s.rows_per_dm < 5.0 || s.rows_per_dm > 200.0) {
+    return KnottingFault{F::kRowsPerDm, "knotting.rows_per_dm must be in [5, 200]"};
+  }
+  if (s.mode != KnottingMode::kHeads) return std::nullopt;
   if (s.heads < 1 || s.heads > kMaxKnottingHeads) {
-    return "knotting.heads must be 1.." + std::to_string(kMaxKnottingHeads);
+    return KnottingFault{F::kHeads, "knotting.heads must be 1.." + std::to_string(kMaxKnottingHeads)};
   }
-  if (!fin(s.head_spacing_m) || knots_per_stripe(s) < 1) return "knotting.head_spacing_m must hold at least one knot pitch";
+  if (!fin(s.head_spacing_m) || knots_per_stripe(s) < 1) {
+    return KnottingFault{F::kHeadSpacing, "knotting.head_spacing_m must hold at least one knot pitch"};
+  }
   // Every head sits over a knot when head 1 does: the spacing is a whole number of knot pitches.
   if (const double p = knot_pitch_m(s), whole = knots_per_stripe(s) * p; std::abs(s.head_spacing_m - whole) > 0.01 * p) {
-    return "knotting.head_spacing_m = " + std::to_string(s.head_spacing_m) + " is not a whole number of knot pitches (" +
-           std::to_string(p) + " m at knotting.knots_per_dm): the heads would miss their knots; " +
-           std::to_string(whole) + " m puts each over its knot";
+    return KnottingFault{F::kHeadSpacing, "knotting.head_spacing_m = " + std::to_string(s.head_spacing_m) +
+                                              " is not a whole number of knot pitches (" + std::to_string(p) +
+                                              " m at knotting.knots_per_dm): the heads would miss their knots; " +
+                                              std::to_string(whole) + " m puts each over its knot"};
   }
   // The heads' stripes together must reach the right selvedge: head h ties [h·n, (h+1)·n).
   const int n = knots_per_stripe(s), k = knots_per_row(s, width_m);
   if (s.heads * n < k) {
-    return "knotting.head_spacing_m: " + std::to_string(s.heads) + " heads x " + std::to_string(n) +
-           " knots per stripe cover " + std::to_string(s.heads * n) + " of the row's " + std::to_string(k) +
-           " knots (loom.width_m / knotting.heads is the spacing that covers the width)";
+    return KnottingFault{F::kHeadSpacing, "knotting.head_spacing_m: " + std::to_string(s.heads) + " heads x " +
+           std::to_string(n) + " knots per stripe cover " + std::to_string(s.heads * n) + " of the row's " + std::to_string(k) +
+           " knots (loom.width_m / knotting.heads is the spacing that covers the width)"};
   }
   if ((s.heads - 1) * n >= k) {
-    return "knotting.heads: the last head's stripe starts beyond the row's " + std::to_string(k) +
-           " knots (fewer heads, or a narrower spacing)";
+    return KnottingFault{F::kHeads, "knotting.heads: the last head's stripe starts beyond the row's " +
+                                        std::to_string(k) + " knots (fewer heads, or a narrower spacing)"};
   }
   if (s.slot_colours.empty() || s.slot_colours.size() > static_cast<std::size_t>(kMaxMagazineSlots)) {
-    return "knotting.slot_colours must name 1.." + std::to_string(kMaxMagazineSlots) + " colours (one per magazine slot)";
+    return KnottingFault{F::kSlotColours, "knotting.slot_colours must name 1.." + std::to_string(kMaxMagazineSlots) +
+                                              " colours (one per magazine slot)"};
   }
   for (std::size_t i = 0; i < s.slot_colours.size(); ++i) {
-    if (s.slot_colours[i].empty()) return "knotting.slot_colours[" + std::to_string(i) + "] is empty";
+    if (s.slot_colours[i].empty()) {
+      return KnottingFault{F::kSlotColours, "knotting.slot_colours[" + std::to_string(i) + "] is empty"};
+    }
     for (std::size_t j = 0; j < i; ++j) {
       if (s.slot_colours[i] == s.slot_colours[j]) {
-        return "knotting.slot_colours: \"" + s.slot_colours[i] + "\" is in slots " + std::to_string(j) + " and " +
-               std::to_string(i);
+        return KnottingFault{F::kSlotColours, "knotting.slot_colours: \"" + s.slot_colours[i] + "\" is in slots " +
+                                                  std::to_string(j) + " and " + std::to_string(i)};
       }
     }
   }
-  if (s.knots_per_slot < 1) return "knotting.knots_per_slot must be at least 1";
-  return "";
+  if (s.knots_per_slot < 1) return KnottingFault{F::kKnotsPerSlot, "knotting.knots_per_slot must be at least 1"};
+  return std::nullopt;
+}
+
+std::string validate(const KnottingSpec& s, double width_m) {
+  const std::optional<KnottingFault> f = find_fault(s, width_m);
+  return f ? f->message : std::string();
 }
 
 int slot_of(const KnottingSpec& s, const std::string& code) {

@@ -19,7 +19,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
+#include <utility>
 
 #include "loom/motion/angles.hpp"
 
@@ -67,69 +69,83 @@ const char* state_name(State s) {
   return "?";
 }
 
-std::string validate(const SequencerConfig& c, const motion::ProfileSet& p) {
+std::optional<SequencerFault> find_fault(const SequencerConfig& c, const motion::ProfileSet& p) {
+  using F = SequencerField;
+  const auto fault = [](F field, std::string message, std::size_t axis = 0) {
+    return SequencerFault{field, axis, std::move(message)};
+  };
   const auto fin = [](double v) { return std::isfinite(v); };
-  if (!(c.period_s > 0.0) || !fin(c.period_s)) return "timing.period_ms must be positive and finite";
+  if (!(c.period_s > 0.0) || !fin(c.period_s)) return fault(F::kPeriod, "timing.period_ms must be positive and finite");
   if (p.beats_per_row() > kMaxBeatsPerRow) {
-    return "recipe.beats_per_position = " + std::to_string(p.spec().beats_per_position) + " gives " +
-           std::to_string(p.beats_per_row()) + " beats per row; the sequencer holds at most " +
-           std::to_string(kMaxBeatsPerRow) + " (narrow the loom or beat each position fewer times)";
+    return fault(F::kBeatsPerPosition,
+                 "recipe.beats_per_position = " + std::to_string(p.spec().beats_per_position) + " gives " +
+                     std::to_string(p.beats_per_row()) + " beats per row; the sequencer holds at most " +
+                     std::to_string(kMaxBeatsPerRow) + " (narrow the loom or beat each position fewer times)");
   }
-  if (c.picks_per_row < 1) return "recipe.picks_per_row must be at least 1";
+  if (c.picks_per_row < 1) return fault(F::kPicksPerRow, "recipe.picks_per_row must be at least 1");
   if (c.axes.count < hal::kCoreAxisCount || c.axes.count > hal::kMaxAxes) {
-    return "axes: the loom has " + std::to_string(c.axes.count) + " axes; it needs the three core axes and holds at most " +
-           std::to_string(hal::kMaxAxes);
+    return fault(F::kAxes, "axes: the loom has " + std::to_string(c.axes.count) +
+                               " axes; it needs the three core axes and holds at most " + std::to_string(hal::kMaxAxes));
   }
   for (std::size_t i = 0; i < hal::kCoreAxisCount; ++i) {
     if (c.axes.role(i) != static_cast<hal::AxisRole>(i)) {
-      return std::string("axes: slot ") + std::to_string(i) + " must hold the " +
-             hal::axis_role_name(static_cast<hal::AxisRole>(i)) + " axis";
+      return fault(F::kAxes, std::string("axes: slot ") + std::to_string(i) + " must hold the " +
+                                 hal::axis_role_name(static_cast<hal::AxisRole>(i)) + " axis");
     }
   }
   for (std::size_t i = hal::kCoreAxisCount; i < c.axes.count; ++i) {
     if (!std::isfinite(c.axis_max_speed[i]) || !(c.axis_max_speed[i] > 0.0)) {
-      return std::string("axes.") + c.axes.name(i) + ".max_speed must be positive and finite";
+      return fault(F::kAxisMaxSpeed, std::string("axes.") + c.axes.name(i) + ".max_speed must be positive and finite", i);
     }
   }
-  if (c.debounce_ticks < 1) return "timing.debounce_ticks must be at least 1";
+  if (c.debounce_ticks < 1) return fault(F::kDebounceTicks, "timing.debounce_ticks must be at least 1");
   if (!fin(c.sensor_discrepancy_s) || c.sensor_discrepancy_s < c.period_s || c.sensor_discrepancy_s > 1.0) {
-    return "timing.sensor_discrepancy_ms must be between one period and 1000 ms";
+    return fault(F::kSensorDiscrepancy, "timing.sensor_discrepancy_ms must be between one period and 1000 ms");
   }
   const struct {
+    F field;
     const char* key;
     double v;
-  } offsets[] = {{"beatup.crank_park_position_rad", c.crank_park_position_rad},
-                 {"carriage.home_position_m", c.carriage_home_m},
-                 {"helix.left_position_rad", c.helix_left_position_rad}};
+  } offsets[] = {{F::kCrankParkPosition, "beatup.crank_park_position_rad", c.crank_park_position_rad},
+                 {F::kCarriageHome, "carriage.home_position_m", c.carriage_home_m},
+                 {F::kHelixLeftPosition, "helix.left_position_rad", c.helix_left_position_rad}};
   for (const auto& o : offsets) {
-    if (!fin(o.v) || std::abs(o.v) > 1e6) return std::string(o.key) + " must be finite and within ±1e6";
+    if (!fin(o.v) || std::abs(o.v) > 1e6) return fault(o.field, std::string(o.key) + " must be finite and within ±1e6");
   }
   // Every time-out becomes a tick count: it must be finite and fit the integer time base with room.
   const struct {
+    F field;
     const char* key;
     double s;
-  } times[] = {{"timing.enable_timeout_s", c.enable_timeout_s},
-               {"timing.pick_timeout_margin_s", c.pick_timeout_margin_s},
-               {"timing.stale_timeout_ms", c.stale_timeout_s},
-               {"diagnosis window", c.diagnosis_window_s},
-               {"arrival grace", c.arrival_grace_s},
-               {"timing.row_save_timeout_s", c.row_save_timeout_s}};
+  } times[] = {{F::kEnableTimeout, "timing.enable_timeout_s", c.enable_timeout_s},
+               {F::kPickTimeoutMargin, "timing.pick_timeout_margin_s", c.pick_timeout_margin_s},
+               {F::kStaleTimeout, "timing.stale_timeout_ms", c.stale_timeout_s},
+               {F::kDiagnosisWindow, "diagnosis window", c.diagnosis_window_s},
+               {F::kArrivalGrace, "arrival grace", c.arrival_grace_s},
+               {F::kRowSaveTimeout, "timing.row_save_timeout_s", c.row_save_timeout_s}};
   for (const auto& t : times) {
     if (!fin(t.s) || t.s < 0.0 || t.s / c.period_s > 1e12) {
-      return std::string(t.key) + " must be a finite time below 1e12 periods";
+      return fault(t.field, std::string(t.key) + " must be a finite time below 1e12 periods");
     }
   }
   if (!(c.selvedge_sensor_window_m > 0.0) || !fin(c.selvedge_sensor_window_m)) {
-    return "machine selvedge sensor window must be positive and finite";
+    return fault(F::kSelvedgeSensorWindow, "machine selvedge sensor window must be positive and finite");
   }
   if (!(c.shuttle_follow_tolerance_m > 0.0) || !(c.shuttle_follow_tolerance_m < c.selvedge_sensor_window_m)) {
-    return "shuttle follow tolerance must be positive and below the selvedge sensor window";
+    return fault(F::kShuttleFollowTolerance,
+                 "shuttle follow tolerance must be positive and below the selvedge sensor window");
   }
-  if ((c.heads.program == nullptr) != (c.heads.cycle == nullptr)) return "knotting heads: a knot program needs its knot cycle";
+  if ((c.heads.program == nullptr) != (c.heads.cycle == nullptr)) {
+    return fault(F::kKnottingHeads, "knotting heads: a knot program needs its knot cycle");
+  }
   if (c.heads.program != nullptr) {
-    if (c.knotting) return "knotting.mode: the weaver's knotting and the knotting heads exclude each other";
+    if (c.knotting) {
+      return fault(F::kKnottingMode, "knotting.mode: the weaver's knotting and the knotting heads exclude each other");
+    }
     const int heads = c.heads.program->heads();
-    if (c.heads.program->slots() < 1 || c.heads.program->slots() > kMaxMagazineSlots) return "knotting.slot_colours: 1..16 slots";
+    if (c.heads.program->slots() < 1 || c.heads.program->slots() > kMaxMagazineSlots) {
+      return fault(F::kSlotColours, "knotting.slot_colours: 1..16 slots");
+    }
     for (int h = 0; h < heads; ++h) {
       const auto hh = static_cast<std::size_t>(h);
       const int kn = c.heads.knotter_axis[hh], sel = c.heads.selector_axis[hh];
@@ -138,19 +154,27 @@ std::string validate(const SequencerConfig& c, const motion::ProfileSet& p) {
                c.axes.role(static_cast<std::size_t>(a)) == role;
       };
       if (!slot_ok(kn, hal::AxisRole::kKnotter) || !slot_ok(sel, hal::AxisRole::kSelector)) {
-        return "knotting heads: head " + std::to_string(h + 1) + " needs a knotter and a selector axis";
+        return fault(F::kKnottingHeads,
+                     "knotting heads: head " + std::to_string(h + 1) + " needs a knotter and a selector axis");
       }
     }
     const auto fin_pos = [&](double v) { return std::isfinite(v) && v > 0.0; };
-    if (!fin_pos(c.heads.selector.velocity) || !fin_pos(c.heads.selector.acceleration) || !fin_pos(c.heads.selector.jerk)) {
-      return "knotting.selector limits must be positive and finite";
+    if (!fin_pos(c.heads.selector.velocity) || !fin_pos(c.heads.selector.acceleration) ||
+        !fin_pos(c.heads.selector.jerk)) {
+      return fault(F::kSelectorLimits, "knotting.selector limits must be positive and finite");
     }
     if (!fin_pos(c.heads.servo_tolerance_rad) || !std::isfinite(c.heads.settle_s) || c.heads.settle_s < 0.0 ||
         !std::isfinite(c.heads.take_position_rad) || !std::isfinite(c.heads.selector_zero_rad)) {
-      return "knotting: servo tolerance, settle time and commissioning offsets must be finite";
+      return fault(F::kKnotterSettings,
+                   "knotting: servo tolerance, settle time and commissioning offsets must be finite");
     }
   }
-  return "";
+  return std::nullopt;
+}
+
+std::string validate(const SequencerConfig& c, const motion::ProfileSet& p) {
+  const std::optional<SequencerFault> f = find_fault(c, p);
+  return f ? f->message : std::string();
 }
 
 Sequencer::Sequencer(motion::ProfileSlot& slot, const SequencerConfig& cfg, Counters resume)

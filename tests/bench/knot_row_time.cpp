@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/machine.hpp"
 #include "loom/firmware/runner.hpp"
 #include "loom/sequencer/knot_plan.hpp"

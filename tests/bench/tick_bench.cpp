@@ -17,7 +17,7 @@
 #include <cstdlib>
 #include <vector>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/machine.hpp"
 #include "loom/firmware/runner.hpp"
 #include "loom/motion/angles.hpp"

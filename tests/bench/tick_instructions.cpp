@@ -23,9 +23,9 @@
 #include <string>
 #include <thread>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/machine.hpp"
-#include "loom/firmware/scene_config.hpp"
+#include "loom/config/scene_config.hpp"
 #include "loom/hal/types.hpp"
 #include "loom/sequencer/sequencer.hpp"
 

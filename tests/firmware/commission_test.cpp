@@ -3,8 +3,8 @@
 // it, and refuses lines it cannot rewrite safely. Expected texts are written out by hand.
 #include <gtest/gtest.h>
 
-#include "loom/firmware/config.hpp"
-#include "loom/firmware/toml_edit.hpp"
+#include "loom/config/config.hpp"
+#include "loom/config/toml_edit.hpp"
 
 namespace {
 

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "config_error.hpp"
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/motion/profile_set.hpp"
 
 #include <cmath>

@@ -14,7 +14,7 @@
 #include <string>
 #include <thread>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/counter_store.hpp"
 
 using namespace loom::firmware;

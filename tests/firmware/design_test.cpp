@@ -10,7 +10,7 @@
 #include <fstream>
 
 #include "loom/design/design.hpp"
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/design_book.hpp"
 #include "loom/telemetry/encode.hpp"
 

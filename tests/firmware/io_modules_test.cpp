@@ -6,8 +6,8 @@
 #include <string>
 
 #include "config_error.hpp"
+#include "loom/config/config.hpp"
 #include "loom/drivers/bus_load.hpp"
-#include "loom/firmware/config.hpp"
 
 using namespace loom::firmware;
 namespace drivers = loom::drivers;

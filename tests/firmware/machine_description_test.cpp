@@ -11,7 +11,7 @@
 #include <string>
 
 #include "config_error.hpp"
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/sequencer/sequencer.hpp"
 
 using namespace loom::firmware;
@@ -165,6 +165,9 @@ TEST(MachineDescription, EveryModuleConfigIsDerivedFromOneFact) {
   EXPECT_EQ(c.sequencer.period_s, 0.001);
   EXPECT_EQ(c.machine.period_s, 0.001);
   EXPECT_EQ(can_axis_config(c).cycle_period_s, 0.001);
+  // The loop's clocks take the period in nanoseconds and the CAN diagnosis window from the same derivation.
+  EXPECT_EQ(c.timing.period_ns, 1'000'000);
+  EXPECT_DOUBLE_EQ(c.timing.can_diagnosis_window_s, c.can.heartbeat_timeout_ms * 1e-3 + 10 * 0.001);
 }
 
 TEST(MachineDescription, AReloadMayChangeOnlyTheRecipe) {
@@ -355,4 +358,22 @@ TEST(MachineDescription, ADriveOnTheMastersNodeIdIsRefusedAtTheLineThatSaysIt) {
   EXPECT_EQ(config_error(ext("[axes.helix]\nnode = 127\n")),
             "loom.toml:3:8: axes.helix.node = 127: the CAN master refuses it: axes.helix.node_id = 127 is the master's "
             "own node id");
+}
+
+// The modules' refusals reach the file by their typed field (no key read back from a message): at the
+// key that sets it, at knotting.mode when the file takes that key from the embedded default, and the
+// sequencer's own at parse time, before anything is armed.
+TEST(MachineDescription, ModuleRefusalsArePinnedToTheKeyOfTheirField) {
+  EXPECT_EQ(config_error(ext("[knotting]\nmode = \"heads\"\n")),
+            "loom.toml:3:8: knotting.mode = heads: knotting.slot_colours must name 1..16 colours (one per magazine "
+            "slot)");
+  EXPECT_EQ(config_error(ext("[knotting]\nmode = \"heads\"\nslot_colours = []\n")),
+            "loom.toml:4:16: knotting.slot_colours = : knotting.slot_colours must name 1..16 colours (one per "
+            "magazine slot)");
+  EXPECT_EQ(config_error(ext("[knotting]\nmode = \"heads\"\nheads = 2\nhead_spacing_m = 0.5\nslot_colours = [\"R\"]\n")),
+            "loom.toml:5:18: knotting.head_spacing_m = 0.5: knotting.head_spacing_m: 2 heads x 150 knots per stripe "
+            "cover 300 of the row's 360 knots (loom.width_m / knotting.heads is the spacing that covers the width)");
+  EXPECT_EQ(config_error(ext("[timing]\nsensor_discrepancy_ms = 1\n")),
+            "loom.toml:3:25: timing.sensor_discrepancy_ms = 1: timing.sensor_discrepancy_ms must be between one "
+            "period and 1000 ms");
 }

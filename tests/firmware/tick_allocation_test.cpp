@@ -5,8 +5,8 @@
 
 #include <string>
 
-#include "loom/firmware/config.hpp"
-#include "loom/firmware/scene_config.hpp"
+#include "loom/config/config.hpp"
+#include "loom/config/scene_config.hpp"
 #include "loom/firmware/machine.hpp"
 #include "alloc_counter.hpp"
 

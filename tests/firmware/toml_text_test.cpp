@@ -7,7 +7,7 @@
 #include <string>
 
 #include "config_error.hpp"
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 
 using namespace loom::firmware;
 

@@ -6,7 +6,7 @@
 
 #include <string>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/machine.hpp"
 
 namespace loom::firmware {

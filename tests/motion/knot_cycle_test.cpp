@@ -469,3 +469,45 @@ TEST(KnotCycle, CrankRockerTurnsOn) {
 }
 
 }  // namespace
+
+// Each refusal says which fact of the spec to change (KnotCycleError::field), so loom-synth blames its
+// option without reading the message; the field agrees with the fact the message names.
+TEST(KnotCycleRefuses, SaysWhichFactToChange) {
+  using loom::motion::KnotCycleError;
+  using loom::motion::KnotCycleField;
+  const auto refusal = [](const KnotCycleSpec& s) -> std::pair<KnotCycleField, std::string> {
+    try {
+      KnotCycle::build(s);
+    } catch (const KnotCycleError& e) {
+      return {e.field(), e.what()};
+    }
+    ADD_FAILURE() << "no KnotCycleError";
+    return {KnotCycleField::kLinkage, ""};
+  };
+  const auto expect = [&](const KnotCycleSpec& s, KnotCycleField field, const char* names) {
+    const auto [f, why] = refusal(s);
+    EXPECT_EQ(f, field) << why;
+    EXPECT_NE(why.find(names), std::string::npos) << why;
+  };
+  KnotCycleSpec s = seed001_knot_cycle_spec();
+  s.max_torque_nm = 1e-5;  // cannot hold the links against gravity
+  expect(s, KnotCycleField::kMaxTorque, "max_torque_nm");
+  s.max_torque_nm = -1.0;
+  expect(s, KnotCycleField::kMaxTorque, "max_torque_nm");
+  s = seed001_knot_cycle_spec();
+  s.warp_entry_x_m = 0.026;  // beyond WRAP
+  expect(s, KnotCycleField::kWarpEntry, "warp_entry_x_m");
+  s.warp_entry_x_m = std::numeric_limits<double>::quiet_NaN();
+  expect(s, KnotCycleField::kWarpEntry, "warp_entry_x_m");
+  s = seed001_knot_cycle_spec();
+  s.min_transmission_rad = rad(40);  // the stroke has 38.2° at TAKE
+  expect(s, KnotCycleField::kMinTransmission, "min_transmission_rad");
+  s.min_transmission_rad = rad(95);
+  expect(s, KnotCycleField::kMinTransmission, "min_transmission_rad");
+  s = seed001_knot_cycle_spec();
+  s.points[1].gripper_rad += rad(1);  // the linkage misses WRAP's gripper angle
+  expect(s, KnotCycleField::kLinkage, "knot cycle");
+  s = seed001_knot_cycle_spec();
+  s.crank.length_m = 0.0;
+  expect(s, KnotCycleField::kLinkage, "crank.length_m");
+}

@@ -7,7 +7,7 @@
 #include <fstream>
 #include <string>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/machine.hpp"
 #include "loom/firmware/runner.hpp"
 #include "loom/report/run_report.hpp"

@@ -167,3 +167,35 @@ TEST(KnotProgram, ADesignTheMagazinesCannotHoldIsRefusedNamingTheRowAndColour) {
         << e.what();
   }
 }
+
+// Each refusal carries the spec's field (the config maps it to its key), the one its message names first.
+TEST(KnotPlan, RefusalsCarryTheirField) {
+  using loom::sequencer::KnottingField;
+  const auto field_of = [](const KnottingSpec& s) {
+    const std::optional<loom::sequencer::KnottingFault> f = find_fault(s, 1.2);
+    EXPECT_TRUE(f.has_value());
+    EXPECT_EQ(f ? f->message : "", validate(s, 1.2));
+    return f ? f->field : KnottingField::kKnotsPerSlot;
+  };
+  KnottingSpec s = heads_spec();
+  EXPECT_FALSE(find_fault(s, 1.2).has_value());
+  s.knots_per_dm = 4.0;
+  EXPECT_EQ(field_of(s), KnottingField::kKnotsPerDm);
+  s = heads_spec();
+  s.rows_per_dm = 300.0;
+  EXPECT_EQ(field_of(s), KnottingField::kRowsPerDm);
+  s = heads_spec();
+  s.heads = 0;
+  EXPECT_EQ(field_of(s), KnottingField::kHeads);
+  s = heads_spec();
+  s.head_spacing_m = 0.5;  // 2 x 150 knots cover 300 of 360
+  EXPECT_EQ(field_of(s), KnottingField::kHeadSpacing);
+  s.head_spacing_m = 0.6015;  // not a whole number of pitches
+  EXPECT_EQ(field_of(s), KnottingField::kHeadSpacing);
+  s = heads_spec();
+  s.slot_colours = {"R", ""};
+  EXPECT_EQ(field_of(s), KnottingField::kSlotColours);
+  s = heads_spec();
+  s.knots_per_slot = 0;
+  EXPECT_EQ(field_of(s), KnottingField::kKnotsPerSlot);
+}

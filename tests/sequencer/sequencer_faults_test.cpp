@@ -370,3 +370,31 @@ TEST(SequencerFaults, ASecondChannelThatNeverSwitchesIsFoundAtTheFirstStroke) {
   EXPECT_EQ(r.seq->fault_sensor(), static_cast<int>(hal::SafetySensor::kPistonAExtended));
   EXPECT_EQ(r.seq->counters().picks, 0u);
 }
+
+// validate()'s refusals carry their field (the config maps it to its key, never reading the message).
+TEST(SequencerFaults, ConfigurationRefusalsCarryTheirField) {
+  const motion::ProfileSet p{motion::ProfileSpec{}};
+  EXPECT_FALSE(sequencer::find_fault(sequencer::SequencerConfig{}, p).has_value());
+  const auto expect = [&](const sequencer::SequencerConfig& c, sequencer::SequencerField field, const char* names) {
+    const std::optional<sequencer::SequencerFault> f = sequencer::find_fault(c, p);
+    ASSERT_TRUE(f.has_value());
+    EXPECT_EQ(f->field, field) << f->message;
+    EXPECT_EQ(f->message, sequencer::validate(c, p));
+    EXPECT_NE(f->message.find(names), std::string::npos) << f->message;
+  };
+  sequencer::SequencerConfig c;
+  c.period_s = 0.0;
+  expect(c, sequencer::SequencerField::kPeriod, "timing.period_ms");
+  c = {};
+  c.sensor_discrepancy_s = c.period_s / 2;
+  expect(c, sequencer::SequencerField::kSensorDiscrepancy, "timing.sensor_discrepancy_ms");
+  c = {};
+  c.helix_left_position_rad = 2e6;
+  expect(c, sequencer::SequencerField::kHelixLeftPosition, "helix.left_position_rad");
+  c = {};
+  c.row_save_timeout_s = std::numeric_limits<double>::infinity();
+  expect(c, sequencer::SequencerField::kRowSaveTimeout, "timing.row_save_timeout_s");
+  c = {};
+  c.debounce_ticks = 0;
+  expect(c, sequencer::SequencerField::kDebounceTicks, "timing.debounce_ticks");
+}

@@ -8,9 +8,9 @@
 #include <gtest/gtest.h>
 
 #include "campaign.hpp"
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/machine.hpp"
-#include "loom/firmware/scene_config.hpp"
+#include "loom/config/scene_config.hpp"
 
 using namespace loom;
 

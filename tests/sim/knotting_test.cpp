@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "loom/firmware/carpet_png.hpp"
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/machine.hpp"
 #include "loom/firmware/runner.hpp"
 #include "loom/hal/motion_outputs.hpp"

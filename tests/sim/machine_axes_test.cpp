@@ -5,7 +5,7 @@
 #include <cmath>
 #include <string>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/machine.hpp"
 
 using namespace loom;

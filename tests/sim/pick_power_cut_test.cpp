@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/machine.hpp"
 
 using namespace loom;

@@ -8,7 +8,7 @@
 #include <string>
 #include <unistd.h>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/machine.hpp"
 
 using namespace loom;

@@ -4,8 +4,8 @@
 
 #include <string>
 
-#include "loom/firmware/config.hpp"
-#include "loom/firmware/scene_config.hpp"
+#include "loom/config/config.hpp"
+#include "loom/config/scene_config.hpp"
 
 using namespace loom;
 

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <string>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/machine.hpp"
 
 using namespace loom;

@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 
 namespace loom::test {
 

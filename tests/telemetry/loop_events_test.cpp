@@ -9,7 +9,7 @@
 #include <set>
 
 #include "log_reader.hpp"
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/machine.hpp"
 
 using namespace loom;

@@ -6,7 +6,7 @@
 #include <cstring>
 #include <string>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/sequencer/fault_recovery.hpp"
 #include "loom/sequencer/faults.hpp"
 

@@ -1,7 +1,7 @@
 // See linkage_options.hpp. Order of precedence: explicit option > config file > the thesis' loom.
 #include "linkage_options.hpp"
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/cli/numbers.hpp"
 #include "loom/cli/run.hpp"
 

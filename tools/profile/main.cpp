@@ -15,7 +15,7 @@
 #include "chart.hpp"
 #include "dump.hpp"
 #include "loom/cli/numbers.hpp"
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/errors.hpp"
 #include "summary.hpp"

@@ -28,7 +28,7 @@
 #include <string>
 #include <vector>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 
 namespace loom::safety {
 

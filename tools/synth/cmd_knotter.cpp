@@ -124,11 +124,12 @@ void run_knotter(const KnotterArgs& args, std::ostream& out, std::ostream& err) 
     std::size_t driven;
     std::optional<motion::KnotCycle> cycle;
     std::string refusal;
+    motion::KnotCycleField refused_for = motion::KnotCycleField::kLinkage;  // the spec fact the refusal is about
   };
   std::vector<Candidate> cands;
   for (std::size_t k = 0; k < 2; ++k) {
     if ((args.drive == "first" && k != 0) || (args.drive == "second" && k != 1)) continue;
-    Candidate c{k, std::nullopt, ""};
+    Candidate c{k, std::nullopt, "", motion::KnotCycleField::kLinkage};
     const ThreePointSolution& d = r.solutions[k];
     const ThreePointSolution& o = r.solutions[1 - k];
     if (std::fabs(d.a2 - o.a2) <= 1e-9 * std::max(std::fabs(d.a2), std::fabs(o.a2))) {
@@ -136,6 +137,9 @@ void run_knotter(const KnotterArgs& args, std::ostream& out, std::ostream& err) 
     } else {
       try {
         c.cycle = motion::KnotCycle::build(linkage_from(pts, theta0, d, o, base));
+      } catch (const motion::KnotCycleError& e) {
+        c.refusal = e.what();
+        c.refused_for = e.field();
       } catch (const motion::MotionError& e) {
         c.refusal = e.what();
       }
@@ -150,10 +154,20 @@ void run_knotter(const KnotterArgs& args, std::ostream& out, std::ostream& err) 
   if (best == nullptr) {
     std::string why;
     for (const Candidate& c : cands) why += std::string(why.empty() ? "" : "; ") + "driving the " + chain_name(c.driven) + " chain's side link: " + c.refusal;
-    if (why.find("warp_entry_x_m") != std::string::npos) throw ArgError("--warp-entry-mm " + input_value(args.warp_entry_mm) + ": " + why);
-    if (why.find("max_torque_nm") != std::string::npos) throw ArgError("--max-torque-nm " + input_value(args.max_torque_nm) + ": " + why);
+    // The option to blame is the refused fact's (KnotCycleError::field), never read from the message.
+    const auto refused_for = [&](motion::KnotCycleField f) {
+      return std::any_of(cands.begin(), cands.end(), [f](const Candidate& c) { return c.refused_for == f; });
+    };
+    if (refused_for(motion::KnotCycleField::kWarpEntry)) {
+      throw ArgError("--warp-entry-mm " + input_value(args.warp_entry_mm) + ": " + why);
+    }
+    if (refused_for(motion::KnotCycleField::kMaxTorque)) {
+      throw ArgError("--max-torque-nm " + input_value(args.max_torque_nm) + ": " + why);
+    }
     std::string blamed = point_args + " --theta0-deg " + input_value(args.theta0_deg);
-    if (why.find("min_transmission_rad") != std::string::npos) blamed += " --min-transmission-deg " + input_value(args.min_transmission_deg);
+    if (refused_for(motion::KnotCycleField::kMinTransmission)) {
+      blamed += " --min-transmission-deg " + input_value(args.min_transmission_deg);
+    }
     throw ArgError(blamed + ": no usable knotting linkage: " + why);
   }
   for (const Candidate& c : cands) {

@@ -23,7 +23,7 @@
 #include <optional>
 #include <utility>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/serve/commands.hpp"
 #include "loom/firmware/serve/control_socket.hpp"
 #include "loom/firmware/serve/fault_history.hpp"

@@ -42,7 +42,7 @@
 #include <vector>
 
 #include "loom/drivers/can_axis_port.hpp"
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/sim_heads.hpp"
 #include "loom/drivers/nmt.hpp"
 #include "loom/drivers/socket_can_bus.hpp"

@@ -20,7 +20,7 @@
 #include <sstream>
 #include <thread>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/machine.hpp"
 #include "loom/firmware/runner.hpp"
 

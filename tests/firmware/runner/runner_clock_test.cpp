@@ -9,7 +9,7 @@
 #include <optional>
 #include <vector>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/control_loop.hpp"
 #include "loom/firmware/runner.hpp"
 #include "loom/sim_hal/sim_world.hpp"
@@ -78,7 +78,7 @@ struct Rig {
     sim = std::make_unique<sim_hal::SimWorld>(cfg.machine, firmware::default_scene().spec);
     port = std::make_unique<hal::PortHal>(*sim, *sim);
     slow = std::make_unique<SlowHal>(*port, clock);
-    loop = std::make_unique<firmware::ControlLoop>(*slow, *seq, nullptr, cfg.sequencer.period_s, false);
+    loop = std::make_unique<firmware::ControlLoop>(*slow, *seq, nullptr, cfg.timing.period_ns, false);
   }
   RunResult run(hal::Tick ticks, std::uint32_t overrun_stop_after = 0) {
     RunOptions o;

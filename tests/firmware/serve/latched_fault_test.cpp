@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 
 using namespace loom::firmware::serve;
 using loom::firmware::ConfigError;

@@ -48,7 +48,8 @@ class ControlLoop {
  public:
   // Configure-time only. `telemetry` may be null (no publishing). With `lossless_telemetry` the cycle
   // waits for ring space instead of dropping: only for virtual time, where nothing is real-time.
-  ControlLoop(hal::Hal& hal, sequencer::Sequencer& seq, telemetry::Telemetry* telemetry, double period_s,
+  // `period_ns` is the loop's period as the config derives it (LoomConfig::timing).
+  ControlLoop(hal::Hal& hal, sequencer::Sequencer& seq, telemetry::Telemetry* telemetry, std::int64_t period_ns,
               bool lossless_telemetry);
 
   // Configure-time only.

@@ -12,7 +12,7 @@
 #include "loom/drivers/can_io_modules.hpp"
 #include "loom/drivers/can_io_port.hpp"
 #include "loom/drivers/socket_can_bus.hpp"
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/control_loop.hpp"
 #include "loom/motion/profile_set.hpp"
 #include "loom/motion/profile_slot.hpp"

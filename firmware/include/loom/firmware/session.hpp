@@ -20,7 +20,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/counter_store.hpp"
 #include "loom/firmware/design_book.hpp"
 #include "loom/firmware/machine.hpp"

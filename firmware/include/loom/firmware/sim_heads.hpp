@@ -5,7 +5,7 @@
 
 #include <memory>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/motion/knot_cycle.hpp"
 #include "loom/sequencer/knot_program.hpp"
 #include "loom/sequencer/sequencer.hpp"

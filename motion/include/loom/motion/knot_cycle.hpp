@@ -18,8 +18,10 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
+#include "loom/motion/errors.hpp"
 #include "loom/motion/fourbar.hpp"
 #include "loom/motion/jerk_move.hpp"
 #include "loom/motion/phase_table.hpp"
@@ -124,10 +126,26 @@ struct KnotCycleReport {
   std::vector<PathSample> path;  // the gripper over the cycle, for plots (256 samples)
 };
 
+// The spec fact a refusal of KnotCycle::build is about, for a caller that maps it to its own input
+// (loom-synth's options) without reading the message: the warp entry, the minimum transmission angle, the
+// servo's torque, or (everything else) the linkage itself.
+enum class KnotCycleField : std::uint8_t { kLinkage, kWarpEntry, kMinTransmission, kMaxTorque };
+
+// What KnotCycle::build throws: a MotionError (code and message as documented there) with its field.
+class KnotCycleError : public MotionError {
+ public:
+  KnotCycleError(ErrorCode code, KnotCycleField field, const std::string& what)
+      : MotionError(code, what), field_(field) {}
+  KnotCycleField field() const noexcept { return field_; }
+
+ private:
+  KnotCycleField field_;
+};
+
 class KnotCycle {
  public:
   // Configure-time only. Checks the spec and the linkage against the points and plans the cycle.
-  // Throws MotionError:
+  // Throws KnotCycleError (a MotionError; its field() says which fact to change):
   //   kInvalidInput    a field non-finite, negative or zero where it must be positive (names it);
   //                    the warp entry not between TAKE and WRAP along x
   //   kNotAssemblable  the linkage misses a precision point, or the gripper angle there

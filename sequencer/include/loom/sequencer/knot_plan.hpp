@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -57,8 +58,24 @@ struct KnottingSpec {
   double selector_jerk_rad_s3 = 20000.0;
 };
 
-// Configure-time. "" when the spec is usable on a loom `width_m` wide, else why not (naming the
-// [knotting] key to change).
+// The KnottingSpec fact a refusal is about: a caller maps it to its own input (the loom file's
+// [knotting] key), never by reading the message.
+enum class KnottingField : std::uint8_t {
+  kKnotsPerDm,
+  kRowsPerDm,
+  kHeads,
+  kHeadSpacing,
+  kSlotColours,
+  kKnotsPerSlot,
+};
+struct KnottingFault {
+  KnottingField field;
+  std::string message;  // why, naming the [knotting] key to change
+};
+
+// Configure-time. Nothing when the spec is usable on a loom `width_m` wide, else the first refusal.
+std::optional<KnottingFault> find_fault(const KnottingSpec& spec, double width_m);
+// Configure-time. "" when the spec is usable on a loom `width_m` wide, else find_fault()'s message.
 std::string validate(const KnottingSpec& spec, double width_m);
 
 // Knots across the loom: floor(width · knots per m), the pitch between them, and the knots in one

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "loom/hal/types.hpp"
@@ -107,9 +108,44 @@ struct SequencerConfig {
   KnottingConfig heads{};
 };
 
-// Configure-time only. "" when the sequencer can run `profiles` with `cfg`, else why not, naming the
-// config key: every fixed capacity (kMaxBeatsPerRow), finite calibration offsets and time-outs whose
-// tick counts fit the integer time base.
+// The SequencerConfig fact a refusal is about: a caller maps it to its own input (the loom file's key),
+// never by reading the message. Some have no key of their own (the machine's constants).
+enum class SequencerField : std::uint8_t {
+  kPeriod,
+  kBeatsPerPosition,
+  kPicksPerRow,
+  kAxes,
+  kAxisMaxSpeed,  // SequencerFault::axis says which
+  kDebounceTicks,
+  kSensorDiscrepancy,
+  kCrankParkPosition,
+  kCarriageHome,
+  kHelixLeftPosition,
+  kEnableTimeout,
+  kPickTimeoutMargin,
+  kStaleTimeout,
+  kDiagnosisWindow,
+  kArrivalGrace,
+  kRowSaveTimeout,
+  kSelvedgeSensorWindow,
+  kShuttleFollowTolerance,
+  kKnottingHeads,
+  kKnottingMode,
+  kSlotColours,
+  kSelectorLimits,
+  kKnotterSettings,
+};
+struct SequencerFault {
+  SequencerField field;
+  std::size_t axis = 0;  // the axis' slot, for kAxisMaxSpeed
+  std::string message;   // why, naming the config key
+};
+
+// Configure-time only. Nothing when the sequencer can run `profiles` with `cfg`, else the first refusal:
+// every fixed capacity (kMaxBeatsPerRow), finite calibration offsets and time-outs whose tick counts fit
+// the integer time base.
+std::optional<SequencerFault> find_fault(const SequencerConfig& cfg, const motion::ProfileSet& profiles);
+// Configure-time only. "" when the sequencer can run `profiles` with `cfg`, else find_fault()'s message.
 std::string validate(const SequencerConfig& cfg, const motion::ProfileSet& profiles);
 
 class Sequencer {

@@ -18,15 +18,15 @@
 #include <string>
 #include <vector>
 
+#include "loom/config/scene_config.hpp"  // the scene file (kept here so callers of config.hpp see it)
 #include "loom/design/design.hpp"
-#include "loom/motion/knot_cycle.hpp"
-#include "loom/sequencer/knot_program.hpp"
 #include "loom/drivers/can_axis_config.hpp"
 #include "loom/drivers/can_io_config.hpp"
+#include "loom/motion/knot_cycle.hpp"
 #include "loom/motion/profile_set.hpp"
 #include "loom/sequencer/knot_plan.hpp"
+#include "loom/sequencer/knot_program.hpp"
 #include "loom/sequencer/sequencer.hpp"
-#include "loom/firmware/scene_config.hpp"  // the scene file (kept here so callers of config.hpp see it)
 #include "loom/sim_hal/scene.hpp"
 
 namespace loom::firmware {
@@ -56,10 +56,10 @@ struct CanSettings {
 struct AxisSpec {
   std::string name;
   hal::AxisRole role = hal::AxisRole::kAuxiliary;
-  std::uint8_t node = 0;             // CANopen node id of its drive
-  std::uint8_t bus = 0;              // which CAN bus its drive is on: 0 = the first --iface, 1 = the second, ...
-  double counts_per_rev = 1048576.0; // encoder counts per motor revolution
-  double lead_m = 0.0;               // linear axes: travel per motor revolution (m); rotary axes: 0
+  std::uint8_t node = 0;  // CANopen node id of its drive
+  std::uint8_t bus = 0;   // which CAN bus its drive is on: 0 = the first --iface, 1 = the second, ...
+  double counts_per_rev = 1048576.0;  // encoder counts per motor revolution
+  double lead_m = 0.0;                // linear axes: travel per motor revolution (m); rotary axes: 0
   // Added axes' top speed (rad/s or m/s; bounds the plausible feedback step). The core axes' limits are
   // facts of their mechanisms ([beatup] via the recipe, [carriage], [helix]) and are not repeated here.
   double max_speed = 0.0;
@@ -74,10 +74,10 @@ struct AxisSpec {
   // captures the references once) or "homing" (an incremental encoder: a CiA 402 homing run after every
   // power-up of the drive, before the axis may move in production).
   bool homing = false;
-  int homing_method = 0;          // 19 / 21 home switch (positive / negative side), 33 / 34 index pulse, 37 here
-  double home_offset = 0.0;       // the reading at the home point (0x607C), SI
-  double homing_speed = 0.0;      // SI/s (0x6099)
-  double homing_accel = 0.0;      // SI/s^2 (0x609A)
+  int homing_method = 0;      // 19 / 21 home switch (positive / negative side), 33 / 34 index pulse, 37 here
+  double home_offset = 0.0;   // the reading at the home point (0x607C), SI
+  double homing_speed = 0.0;  // SI/s (0x6099)
+  double homing_accel = 0.0;  // SI/s^2 (0x609A)
   double homing_timeout_s = 0.0;  // a run not referenced by then is the fault homing_failed
 
   // Drive counts per SI unit (per rad, or per m on a linear axis).
@@ -164,8 +164,8 @@ struct Recipe {
   std::shared_ptr<const design::Design> design;
   int beats_per_position = 1;
   double overlap_m = 0.02;
-  double cam_margin_rad = 20.0 * 3.141592653589793 / 180.0;  // cam_margin_deg = 20
-  double beat_force_min_n = 80.0, beat_force_max_n = 100.0;  // the band every beat must hit
+  double cam_margin_rad = 20.0 * 3.141592653589793 / 180.0;   // cam_margin_deg = 20
+  double beat_force_min_n = 80.0, beat_force_max_n = 100.0;   // the band every beat must hit
   std::size_t table_size = motion::ProfileSpec{}.table_size;  // one default, motion's
   motion::Interp table_interp = motion::Interp::kCubic;
   motion::Precision table_precision = motion::Precision::kDouble;
@@ -180,13 +180,23 @@ struct RunSettings {
   double stale_timeout_s = 0.05;
   double row_save_timeout_s = 5.0;  // a finished row's counters not confirmed on disk by then: a fault
   int debounce_ticks = 3;
-  double sensor_discrepancy_s = 0.02;  // the two channels of a safety sensor may disagree this long
+  double sensor_discrepancy_s = 0.02;     // the two channels of a safety sensor may disagree this long
   std::uint32_t overrun_stop_after = 10;  // on hardware: this many overruns in a row → safe stop (0 = never)
 };
 
 struct TelemetrySettings {
   std::string lcm_url;
   std::uint32_t status_every = 50, axes_every = 10, rt_every = 500;
+};
+
+// The loop's timing, derived once from timing.period_ms (and the CAN heartbeat) for everything that
+// runs at it: the control loop's and the session's clocks take the period in nanoseconds from here.
+struct LoopTiming {
+  double period_s = 0.002;
+  std::int64_t period_ns = 2'000'000;  // period_s rounded to the nanosecond
+  // On CAN, how long the sequencer waits after stale PDOs for the heartbeat loss that names the root
+  // cause: the heartbeat time-out and ten periods.
+  double can_diagnosis_window_s = 0.27;
 };
 
 struct LoomConfig {
@@ -209,6 +219,7 @@ struct LoomConfig {
 
   // Derived by derive_module_configs() from the facts above; never edited by hand.
   double beat_force_target_n = 0.0;  // > 0 when the crank speed was derived from a beat-force target
+  LoopTiming timing;
   motion::ProfileSpec profile;
   sequencer::SequencerConfig sequencer;
   sim_hal::SimMachine machine;
@@ -226,7 +237,8 @@ hal::AxisLayout axis_layout(const LoomConfig& c);
 // Configure-time only. The recipe's design as the knotting heads tie it (`c.recipe.design` must be set):
 // `design_rows_done` of its rows woven by production row `counter_rows`. Throws std::invalid_argument naming
 // the design row, colour and knot when the loom's magazines or width cannot tie it.
-sequencer::KnotProgram knot_program(const LoomConfig& c, std::uint64_t design_rows_done, std::uint32_t counter_rows);
+sequencer::KnotProgram knot_program(const LoomConfig& c, std::uint64_t design_rows_done,
+                                    std::uint32_t counter_rows);
 // Configure-time only. The CAN master's config for the machine's servo axes, from the same facts.
 drivers::CanAxisPortConfig can_axis_config(const LoomConfig& c);
 // Configure-time only. The CAN I/O modules' configs, from the same facts: the [io] table's module first,

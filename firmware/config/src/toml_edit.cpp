@@ -1,10 +1,10 @@
 // See toml_edit.hpp. Line-based on purpose: a loom config is flat tables of `key = value  # comment`,
 // and a line-level edit is the only kind that keeps everything else byte for byte.
-#include "loom/firmware/toml_edit.hpp"
+#include "loom/config/toml_edit.hpp"
 
 #include <sstream>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 
 namespace loom::firmware {
 namespace {
@@ -46,8 +46,10 @@ std::size_t value_end(const std::string& line, std::size_t from) {
   for (std::size_t i = from; i < line.size(); ++i) {
     const char c = line[i];
     if (quote != 0) {
-      if (c == '\\' && quote == '"') ++i;
-      else if (c == quote) quote = 0;
+      if (c == '\\' && quote == '"')
+        ++i;
+      else if (c == quote)
+        quote = 0;
     } else if (c == '"' || c == '\'') {
       quote = c;
     } else if (c == '#') {
@@ -108,7 +110,8 @@ std::string set_toml_values(const std::string& text, const std::vector<TomlAssig
       lines.push_back("");
       lines.push_back("[" + a.section + "]");
       lines.push_back(a.key + " = " + a.value);
-      changes.push_back(std::to_string(lines.size()) + ": " + name + " = " + a.value + " (added with its section)");
+      changes.push_back(std::to_string(lines.size()) + ": " + name + " = " + a.value +
+                        " (added with its section)");
     }
   }
   std::string out;

@@ -1,5 +1,5 @@
 // TomlReader: parse errors and value errors share one format so a technician can jump to the line.
-#include "toml_reader.hpp"
+#include "loom/config/toml_reader.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -38,7 +38,8 @@ std::string show_value(const toml::node& n) {
   return os.str();
 }
 
-void collect_keys(const toml::table& t, const std::string& prefix, std::vector<std::pair<std::string, const toml::node*>>& out) {
+void collect_keys(const toml::table& t, const std::string& prefix,
+                  std::vector<std::pair<std::string, const toml::node*>>& out) {
   for (const auto& [k, v] : t) {
     const std::string path = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
     if (const auto* sub = v.as_table()) {
@@ -78,13 +79,14 @@ void check_depth(const std::string& text, const std::string& source) {
       in_key = false;
     } else if (ch == '.' && in_key) {
       if (++dots >= kMaxKeyDepth) {
-        throw ConfigError(source + ":" + std::to_string(line) + ":" + std::to_string(col) + ": key nested deeper than " +
-                          std::to_string(kMaxKeyDepth) + " levels");
+        throw ConfigError(source + ":" + std::to_string(line) + ":" + std::to_string(col) +
+                          ": key nested deeper than " + std::to_string(kMaxKeyDepth) + " levels");
       }
     } else if ((ch == '[' || ch == '{') && !in_key) {
       if (++nesting > kMaxNesting) {
         throw ConfigError(source + ":" + std::to_string(line) + ":" + std::to_string(col) +
-                          ": arrays/inline tables nested deeper than " + std::to_string(kMaxNesting) + " levels");
+                          ": arrays/inline tables nested deeper than " + std::to_string(kMaxNesting) +
+                          " levels");
       }
     } else if ((ch == ']' || ch == '}') && !in_key && nesting > 0) {
       --nesting;
@@ -159,8 +161,8 @@ class TokenContext {
  public:
   void new_line() { *this = TokenContext{}; }
   bool quote_opens_string() const {
-    return !in_bare_ && (before_ == 0 || before_ == '=' || before_ == '[' || before_ == ',' || before_ == '{' ||
-                         before_ == '.');
+    return !in_bare_ && (before_ == 0 || before_ == '=' || before_ == '[' || before_ == ',' ||
+                         before_ == '{' || before_ == '.');
   }
   void string_closed() {
     in_bare_ = false;
@@ -180,8 +182,12 @@ class TokenContext {
     }
     if (blank) return;
     switch (ch) {
-      case '=': key_next_ = false; break;
-      case ',': key_next_ = braces_ > 0; break;
+      case '=':
+        key_next_ = false;
+        break;
+      case ',':
+        key_next_ = braces_ > 0;
+        break;
       case '{':
         ++braces_;
         key_next_ = true;
@@ -191,7 +197,8 @@ class TokenContext {
         break;
       case '[':
       case ']':
-      case '.': break;
+      case '.':
+        break;
       default:
         in_bare_ = true;
         bare_is_key_ = key_next_;
@@ -201,19 +208,19 @@ class TokenContext {
   }
 
  private:
-  bool in_bare_ = false;     // inside a bare token
-  bool bare_is_key_ = false; // ... a key (ended by any non-key character) or a value (ended by a terminator)
-  bool key_next_ = true;     // the next token is a key: at the line's start, after { and after , inside { }
+  bool in_bare_ = false;      // inside a bare token
+  bool bare_is_key_ = false;  // ... a key (ended by any non-key character) or a value (ended by a terminator)
+  bool key_next_ = true;      // the next token is a key: at the line's start, after { and after , inside { }
   int braces_ = 0;
-  char before_ = 0;          // the last character outside strings on this line, 0 at its start
+  char before_ = 0;  // the last character outside strings on this line, 0 at its start
 };
 
 void check_text(const std::string& text, const std::string& source) {
   enum class In { kToml, kComment, kBasic, kLiteral, kMultiBasic, kMultiLiteral };
   In in = In::kToml;
-  bool escaped = false;         // the previous character was a backslash in a basic string
-  bool line_ending = false;     // after a multi-line string's `\` + space/tab: only space/tab until the break
-  bool skipping = false;        // after a line-ending backslash: toml++ skips whitespace and line breaks
+  bool escaped = false;      // the previous character was a backslash in a basic string
+  bool line_ending = false;  // after a multi-line string's `\` + space/tab: only space/tab until the break
+  bool skipping = false;     // after a line-ending backslash: toml++ skips whitespace and line breaks
   TokenContext tokens;
   std::size_t line = 1, col = 0;
   const auto fail = [&](const std::string& why) {
@@ -251,7 +258,8 @@ void check_text(const std::string& text, const std::string& source) {
           in = In::kComment;
         } else if ((ch == '"' || ch == '\'') && tokens.quote_opens_string()) {
           const bool multi = run(i, ch) >= 3;
-          in = ch == '"' ? (multi ? In::kMultiBasic : In::kBasic) : (multi ? In::kMultiLiteral : In::kLiteral);
+          in =
+              ch == '"' ? (multi ? In::kMultiBasic : In::kBasic) : (multi ? In::kMultiLiteral : In::kLiteral);
           if (multi) i += 2, col += 2;
         } else {
           tokens.take(ch);
@@ -277,7 +285,8 @@ void check_text(const std::string& text, const std::string& source) {
         if (escaped) {
           escaped = false;
           if (!ascii) {
-            fail("non-ASCII character " + hex_code_point(cp) + " after a backslash in a string (not a TOML escape)");
+            fail("non-ASCII character " + hex_code_point(cp) +
+                 " after a backslash in a string (not a TOML escape)");
           }
           if (in == In::kMultiBasic && (ch == ' ' || ch == '\t')) line_ending = true;
           if (in == In::kMultiBasic && ch == '\r') skipping = true;
@@ -355,8 +364,8 @@ std::string read_config_file(const std::string& path, long max_bytes, const char
   }
   if (st.st_size > kMaxBytes) {
     ::close(fd);
-    throw ConfigError(path + ": " + std::to_string(st.st_size) + " bytes: larger than any " + what + " (limit " +
-                      std::to_string(max_bytes >> 20) + " MiB)");
+    throw ConfigError(path + ": " + std::to_string(st.st_size) + " bytes: larger than any " + what +
+                      " (limit " + std::to_string(max_bytes >> 20) + " MiB)");
   }
   std::string text(static_cast<std::size_t>(st.st_size), '\0');
   std::size_t got = 0;
@@ -366,7 +375,8 @@ std::string read_config_file(const std::string& path, long max_bytes, const char
     if (n <= 0) {
       const int err = errno;
       ::close(fd);
-      throw ConfigError(path + ": cannot read" + (n < 0 ? std::string(": ") + std::strerror(err) : ": file shrank"));
+      throw ConfigError(path + ": cannot read" +
+                        (n < 0 ? std::string(": ") + std::strerror(err) : ": file shrank"));
     }
     got += static_cast<std::size_t>(n);
   }
@@ -374,14 +384,18 @@ std::string read_config_file(const std::string& path, long max_bytes, const char
   return text;
 }
 
-std::string positive(double v) { return v > 0.0 && std::isfinite(v) ? "" : "must be positive and finite"; }
+std::string positive(double v) {
+  return v > 0.0 && std::isfinite(v) ? "" : "must be positive and finite";
+}
 std::string in_range(double v, double lo, double hi) {
   if (v >= lo && v <= hi) return "";
   std::ostringstream os;
   os << "must be in [" << lo << ", " << hi << "]";
   return os.str();
 }
-std::string non_negative(double v) { return v >= 0.0 && std::isfinite(v) ? "" : "must be >= 0 and finite"; }
+std::string non_negative(double v) {
+  return v >= 0.0 && std::isfinite(v) ? "" : "must be >= 0 and finite";
+}
 
 std::string TomlReader::show(const toml::node& n) const {
   // The value as the user wrote it (1e-320 stays 1e-320), when it sits on one line.
@@ -408,7 +422,8 @@ std::string TomlReader::show(const toml::node& n) const {
 TomlReader::TomlReader(const std::string& text, std::string source) : source_(std::move(source)) {
   std::istringstream in(text);
   for (std::string line; std::getline(in, line);) lines_.push_back(line);
-  if (text.find('\0') != std::string::npos) throw ConfigError(source_ + ":1:1: not a text file (contains NUL bytes)");
+  if (text.find('\0') != std::string::npos)
+    throw ConfigError(source_ + ":1:1: not a text file (contains NUL bytes)");
   check_text(text, source_);
   check_depth(text, source_);
   try {
@@ -437,12 +452,14 @@ void TomlReader::fail_missing(const std::string& path, const std::string& why) c
   const std::string section = path.substr(0, path.find('.'));
   const toml::node* sec = find(section);
   if (sec && sec->source().begin.line > 0) {
-    throw ConfigError(where(source_, sec->source()) + ": [" + section + "] " + path.substr(path.find('.') + 1) + ": " + why);
+    throw ConfigError(where(source_, sec->source()) + ": [" + section + "] " +
+                      path.substr(path.find('.') + 1) + ": " + why);
   }
   throw ConfigError(source_ + ":1:1: " + path + ": " + why);
 }
 
-void TomlReader::number(const std::string& path, double& out, const std::function<std::string(double)>& check) {
+void TomlReader::number(const std::string& path, double& out,
+                        const std::function<std::string(double)>& check) {
   used_.insert(path);
   const toml::node* n = find(path);
   if (!n) return;
@@ -507,14 +524,16 @@ void TomlReader::string_list(const std::string& path, std::vector<std::string>& 
   }
 }
 
-void TomlReader::integer_list(const std::string& path, std::vector<int>& out, int lo, int hi, std::size_t max_size) {
+void TomlReader::integer_list(const std::string& path, std::vector<int>& out, int lo, int hi,
+                              std::size_t max_size) {
   used_.insert(path);
   const toml::node* n = find(path);
   if (!n) return;
   const toml::array* arr = n->as_array();
   if (!arr) fail_at(*n, path, show(*n), "expected an array of integers");
   if (arr->size() > max_size) {
-    fail_at(*n, path, show(*n), "at most " + std::to_string(max_size) + " entries (" + std::to_string(arr->size()) + " given)");
+    fail_at(*n, path, show(*n),
+            "at most " + std::to_string(max_size) + " entries (" + std::to_string(arr->size()) + " given)");
   }
   out.clear();
   for (const auto& e : *arr) {
@@ -539,8 +558,9 @@ void TomlReader::reject_unknown(const std::set<std::string>& sections) const {
     }
     std::string list;
     for (const auto& s : sections) list += (list.empty() ? "" : ", ") + s;
-    fail_at(v, "[" + name + "]", "{...}",
-            "unknown section" + (best.empty() ? " (sections: " + list + ")" : " (did you mean [" + best + "]?)"));
+    fail_at(
+        v, "[" + name + "]", "{...}",
+        "unknown section" + (best.empty() ? " (sections: " + list + ")" : " (did you mean [" + best + "]?)"));
   }
   reject_unknown();
 }

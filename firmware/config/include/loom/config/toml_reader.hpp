@@ -2,14 +2,15 @@
 // "file:line:col: field = value: why", and rejects keys nobody asked for (typos must not pass).
 #pragma once
 
+#include <toml++/toml.h>
+
 #include <functional>
 #include <set>
 #include <sstream>
 #include <string>
 #include <vector>
-#include <toml++/toml.h>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 
 namespace loom::firmware {
 

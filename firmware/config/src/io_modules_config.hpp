@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "loom/firmware/config.hpp"
-#include "toml_reader.hpp"
+#include "loom/config/config.hpp"
+#include "loom/config/toml_reader.hpp"
 
 namespace loom::firmware {
 

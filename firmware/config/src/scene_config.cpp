@@ -2,6 +2,8 @@
 // field is an error at the fault, a field the kind does not use is an error at that field (it would
 // silently do nothing), and times must be finite — `at_s = nan` would otherwise never strike and hide
 // every later fault.
+#include "loom/config/scene_config.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -9,16 +11,17 @@
 #include <set>
 #include <sstream>
 
-#include "loom/firmware/config.hpp"
-#include "loom/firmware/scene_config.hpp"
-#include "toml_reader.hpp"
+#include "loom/config/config.hpp"
+#include "loom/config/toml_reader.hpp"
 
 namespace loom::firmware {
 namespace {
 
 constexpr double kMaxSceneTimeS = 1e7;  // about four months of machine time
 
-std::string read_text(const std::string& path) { return read_config_file(path); }
+std::string read_text(const std::string& path) {
+  return read_config_file(path);
+}
 
 std::string shown(const toml::node& n) {
   std::ostringstream os;
@@ -68,13 +71,14 @@ const std::map<InjectedFault, KindFields>& kind_fields() {
 std::string kinds_list() {
   std::string list;
   for (int i = 0; i < sim_hal::kInjectedFaultCount; ++i) {
-    list += (list.empty() ? "" : ", ") + std::string(sim_hal::injected_fault_name(static_cast<InjectedFault>(i)));
+    list +=
+        (list.empty() ? "" : ", ") + std::string(sim_hal::injected_fault_name(static_cast<InjectedFault>(i)));
   }
   return list;
 }
 
-void read_fault(const TomlReader& r, const toml::table& t, std::size_t n,
-                bool load_cell_fitted, sim_hal::FaultInjection& f) {
+void read_fault(const TomlReader& r, const toml::table& t, std::size_t n, bool load_cell_fitted,
+                sim_hal::FaultInjection& f) {
   const std::string prefix = "fault[" + std::to_string(n) + "].";
   const toml::node* kind_node = t.get("kind");
   if (kind_node == nullptr) {
@@ -94,7 +98,8 @@ void read_fault(const TomlReader& r, const toml::table& t, std::size_t n,
   const std::string when = power_cut ? "at_tick" : "at_s";
   if (t.get(when) == nullptr) {
     r.fail_at(t, prefix + when, "(missing)",
-              power_cut ? "a power cut strikes at a tick: give at_tick" : "every fault needs at_s (seconds from start)");
+              power_cut ? "a power cut strikes at a tick: give at_tick"
+                        : "every fault needs at_s (seconds from start)");
   }
   for (const std::string& k : fields.required) {
     if (t.get(k) == nullptr) r.fail_at(t, prefix + k, "(missing)", "a " + *kind + " fault needs " + k);
@@ -120,7 +125,8 @@ void read_fault(const TomlReader& r, const toml::table& t, std::size_t n,
     const auto integer = [&](std::int64_t lo, std::int64_t hi) {
       const auto x = v.value_exact<std::int64_t>();
       if (!x || *x < lo || *x > hi) {
-        r.fail_at(v, field, shown(v), "must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+        r.fail_at(v, field, shown(v),
+                  "must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
       }
       return *x;
     };
@@ -161,7 +167,8 @@ void read_fault(const TomlReader& r, const toml::table& t, std::size_t n,
       // others' once the scene meets its loom (check_scene_fits).
       const std::string x = text();
       const int core = hal::core_axis_layout().find(x.c_str());
-      if (x.empty() || x.size() > hal::AxisLayout::kNameMax) r.fail_at(v, field, shown(v), "must name an axis of the loom");
+      if (x.empty() || x.size() > hal::AxisLayout::kNameMax)
+        r.fail_at(v, field, shown(v), "must name an axis of the loom");
       f.axis_name = x;
       f.axis = core >= 0 ? static_cast<std::size_t>(core) : hal::kMaxAxes;
     } else if (k == "code") {
@@ -176,7 +183,8 @@ void read_fault(const TomlReader& r, const toml::table& t, std::size_t n,
       f.jump = number(-1e3, 1e3);
       if (f.jump == 0.0) r.fail_at(v, field, shown(v), "an encoder glitch must jump (non-zero)");
     } else if (k == "head") {
-      f.head = static_cast<int>(integer(1, static_cast<std::int64_t>(hal::kMaxKnottingHeads))) - 1;  // 1-based in the file
+      f.head = static_cast<int>(integer(1, static_cast<std::int64_t>(hal::kMaxKnottingHeads))) -
+               1;  // 1-based in the file
     } else if (k == "slot") {
       f.slot = static_cast<int>(integer(0, 15));
     } else if (k == "ticks") {
@@ -199,8 +207,8 @@ void read_fault(const TomlReader& r, const toml::table& t, std::size_t n,
 }
 
 bool same_fault(const sim_hal::FaultInjection& a, const sim_hal::FaultInjection& b) {
-  return a.kind == b.kind && a.at_s == b.at_s && a.at_tick == b.at_tick && a.axis_name == b.axis_name && a.piston == b.piston &&
-         a.sensor == b.sensor && a.head == b.head && a.slot == b.slot;
+  return a.kind == b.kind && a.at_s == b.at_s && a.at_tick == b.at_tick && a.axis_name == b.axis_name &&
+         a.piston == b.piston && a.sensor == b.sensor && a.head == b.head && a.slot == b.slot;
 }
 
 }  // namespace
@@ -215,7 +223,8 @@ Scene parse_scene(const std::string& text, const std::string& source) {
   s.spec.seed = static_cast<std::uint64_t>(seed);
   r.string("config", s.config_path);
   r.string_list("effects", s.spec.effects);
-  if (s.spec.effects.empty()) r.fail("effects", "[]", "name at least one effect (\"ideal\": nothing simulated)");
+  if (s.spec.effects.empty())
+    r.fail("effects", "[]", "name at least one effect (\"ideal\": nothing simulated)");
   for (std::size_t i = 0; i < s.spec.effects.size(); ++i) {
     const std::string& e = s.spec.effects[i];
     const auto& known = sim_hal::known_effects();
@@ -234,9 +243,10 @@ Scene parse_scene(const std::string& text, const std::string& source) {
   const auto named = [&](const char* effect) {
     return std::find(s.spec.effects.begin(), s.spec.effects.end(), effect) != s.spec.effects.end();
   };
-  for (const char* effect : {sim_hal::kEffectServoLag, sim_hal::kEffectPneumatics, sim_hal::kEffectShuttleSlip,
-                             sim_hal::kEffectSensorNoise, sim_hal::kEffectBeatContact, sim_hal::kEffectInertia,
-                             sim_hal::kEffectJointFriction, sim_hal::kEffectKnotter}) {
+  for (const char* effect :
+       {sim_hal::kEffectServoLag, sim_hal::kEffectPneumatics, sim_hal::kEffectShuttleSlip,
+        sim_hal::kEffectSensorNoise, sim_hal::kEffectBeatContact, sim_hal::kEffectInertia,
+        sim_hal::kEffectJointFriction, sim_hal::kEffectKnotter}) {
     if (r.root().contains(effect) && !named(effect)) {
       r.fail(effect, "{...}", "parameters given for an effect the scene does not name");
     }
@@ -254,14 +264,18 @@ Scene parse_scene(const std::string& text, const std::string& source) {
   }
   if (named(sim_hal::kEffectShuttleSlip)) {
     sim_hal::ShuttleSlip p;
-    r.number("shuttle_slip.carrier_force_n", p.carrier_force_n, [](double v) { return in_range(v, 1e-3, 1e4); });
-    r.number("shuttle_slip.shuttle_mass_kg", p.shuttle_mass_kg, [](double v) { return in_range(v, 1e-3, 100.0); });
-    r.number("shuttle_slip.race_friction_m_s2", p.race_friction_m_s2, [](double v) { return in_range(v, 1e-3, 1e3); });
+    r.number("shuttle_slip.carrier_force_n", p.carrier_force_n,
+             [](double v) { return in_range(v, 1e-3, 1e4); });
+    r.number("shuttle_slip.shuttle_mass_kg", p.shuttle_mass_kg,
+             [](double v) { return in_range(v, 1e-3, 100.0); });
+    r.number("shuttle_slip.race_friction_m_s2", p.race_friction_m_s2,
+             [](double v) { return in_range(v, 1e-3, 1e3); });
     s.spec.shuttle_slip = p;
   }
   if (named(sim_hal::kEffectSensorNoise)) {
     sim_hal::SensorNoise p;
-    r.number("sensor_noise.flip_probability", p.flip_probability, [](double v) { return in_range(v, 0.0, 0.2); });
+    r.number("sensor_noise.flip_probability", p.flip_probability,
+             [](double v) { return in_range(v, 0.0, 0.2); });
     s.spec.sensor_noise = p;
   }
   if (named(sim_hal::kEffectJointFriction) && !named(sim_hal::kEffectInertia)) {
@@ -269,8 +283,10 @@ Scene parse_scene(const std::string& text, const std::string& source) {
   }
   if (named(sim_hal::kEffectInertia)) {
     sim_hal::Inertia p;
-    r.number("inertia.motor_torque_limit_nm", p.motor_torque_limit_nm, [](double v) { return in_range(v, 1e-3, 1e5); });
-    r.number("inertia.drive_inertia_kg_m2", p.drive_inertia_kg_m2, [](double v) { return in_range(v, 0.0, 100.0); });
+    r.number("inertia.motor_torque_limit_nm", p.motor_torque_limit_nm,
+             [](double v) { return in_range(v, 1e-3, 1e5); });
+    r.number("inertia.drive_inertia_kg_m2", p.drive_inertia_kg_m2,
+             [](double v) { return in_range(v, 0.0, 100.0); });
     r.number("inertia.bandwidth_hz", p.bandwidth_hz, [](double v) { return in_range(v, 1.0, 500.0); });
     std::int64_t sub = p.substeps;
     r.integer("inertia.substeps", sub, 1, 1000);
@@ -295,20 +311,24 @@ Scene parse_scene(const std::string& text, const std::string& source) {
   }
   if (named(sim_hal::kEffectBeatContact)) {
     sim_hal::BeatContact p;
-    r.number("beat_contact.beater_mass_kg", p.beater_mass_kg, [](double v) { return in_range(v, 1e-3, 1e3); });
-    r.number("beat_contact.contact_depth_m", p.contact_depth_m, [](double v) { return in_range(v, 1e-6, 1.0); });
+    r.number("beat_contact.beater_mass_kg", p.beater_mass_kg,
+             [](double v) { return in_range(v, 1e-3, 1e3); });
+    r.number("beat_contact.contact_depth_m", p.contact_depth_m,
+             [](double v) { return in_range(v, 1e-6, 1.0); });
     s.spec.beat_contact = p;
   }
   r.consume("fault");
   if (const toml::node* faults = r.root().get("fault")) {
     const toml::array* arr = faults->as_array();
-    if (!arr || !arr->is_array_of_tables()) r.fail_at(*faults, "fault", shown(*faults), "expected [[fault]] tables");
+    if (!arr || !arr->is_array_of_tables())
+      r.fail_at(*faults, "fault", shown(*faults), "expected [[fault]] tables");
     std::size_t n = 0;
     for (const toml::node& fn : *arr) {
       sim_hal::FaultInjection f;
       read_fault(r, *fn.as_table(), n, named(sim_hal::kEffectBeatContact), f);
       for (const auto& g : s.spec.faults) {
-        if (same_fault(f, g)) r.fail_at(fn, "fault[" + std::to_string(n) + "]", "{...}", "the same fault is injected twice");
+        if (same_fault(f, g))
+          r.fail_at(fn, "fault[" + std::to_string(n) + "]", "{...}", "the same fault is injected twice");
       }
       if (f.kind == InjectedFault::kPowerCut) {
         for (const auto& g : s.spec.faults) {
@@ -330,13 +350,15 @@ Scene parse_scene(const std::string& text, const std::string& source) {
 Scene check_scene_fits(Scene scene, const LoomConfig& cfg, bool simulated_io) {
   const bool heads = cfg.knotting.mode == sequencer::KnottingMode::kHeads;
   if (scene.spec.knotter && !heads) {
-    throw ConfigError(scene.source + ": effects: \"knotter\" simulates knotting heads; the loom (" + cfg.source +
-                      ") has none (knotting.mode = \"" + sequencer::knotting_mode_name(cfg.knotting.mode) + "\")");
+    throw ConfigError(scene.source + ": effects: \"knotter\" simulates knotting heads; the loom (" +
+                      cfg.source + ") has none (knotting.mode = \"" +
+                      sequencer::knotting_mode_name(cfg.knotting.mode) + "\")");
   }
   if (heads && simulated_io && !scene.spec.knotter) {
-    throw ConfigError(scene.source + ": effects: the loom (" + cfg.source +
-                      ") ties its knots with heads (knotting.mode = \"heads\"): the scene must name the effect \"knotter\" "
-                      "(the heads' yarn, knots and the weaver are simulated only when named)");
+    throw ConfigError(
+        scene.source + ": effects: the loom (" + cfg.source +
+        ") ties its knots with heads (knotting.mode = \"heads\"): the scene must name the effect \"knotter\" "
+        "(the heads' yarn, knots and the weaver are simulated only when named)");
   }
   for (std::size_t n = 0; n < scene.spec.faults.size(); ++n) {
     sim_hal::FaultInjection& f = scene.spec.faults[n];
@@ -347,25 +369,28 @@ Scene check_scene_fits(Scene scene, const LoomConfig& cfg, bool simulated_io) {
       const int slot = cfg.sequencer.axes.find(f.axis_name.c_str());
       if (slot < 0) {
         std::string names;
-        for (std::size_t i = 0; i < cfg.sequencer.axes.count; ++i) names += std::string(i ? ", " : "") + cfg.sequencer.axes.name(i);
-        throw ConfigError(at + ": fault[" + std::to_string(n) + "].axis = \"" + f.axis_name + "\": the loom (" +
-                          cfg.source + ") has no such axis (its axes: " + names + ")");
+        for (std::size_t i = 0; i < cfg.sequencer.axes.count; ++i)
+          names += std::string(i ? ", " : "") + cfg.sequencer.axes.name(i);
+        throw ConfigError(at + ": fault[" + std::to_string(n) + "].axis = \"" + f.axis_name +
+                          "\": the loom (" + cfg.source + ") has no such axis (its axes: " + names + ")");
       }
       f.axis = static_cast<std::size_t>(slot);
     }
     if (f.kind == InjectedFault::kSelectorJam || f.kind == InjectedFault::kYarnOut) {
       if (!scene.spec.knotter) {
-        throw ConfigError(at + ": fault[" + std::to_string(n) + "].kind = \"" + sim_hal::injected_fault_name(f.kind) +
+        throw ConfigError(at + ": fault[" + std::to_string(n) + "].kind = \"" +
+                          sim_hal::injected_fault_name(f.kind) +
                           "\": a knotting head's fault needs the effect \"knotter\"");
       }
       if (f.head >= cfg.knotting.heads) {
-        throw ConfigError(at + ": fault[" + std::to_string(n) + "].head = " + std::to_string(f.head + 1) + ": the loom (" +
-                          cfg.source + ") has " + std::to_string(cfg.knotting.heads) + " knotting heads");
+        throw ConfigError(at + ": fault[" + std::to_string(n) + "].head = " + std::to_string(f.head + 1) +
+                          ": the loom (" + cfg.source + ") has " + std::to_string(cfg.knotting.heads) +
+                          " knotting heads");
       }
       if (f.kind == InjectedFault::kYarnOut && f.slot >= static_cast<int>(cfg.knotting.slot_colours.size())) {
-        throw ConfigError(at + ": fault[" + std::to_string(n) + "].slot = " + std::to_string(f.slot) + ": the heads' magazines have " +
-                          std::to_string(cfg.knotting.slot_colours.size()) + " slots (0.." +
-                          std::to_string(cfg.knotting.slot_colours.size() - 1) + ")");
+        throw ConfigError(at + ": fault[" + std::to_string(n) + "].slot = " + std::to_string(f.slot) +
+                          ": the heads' magazines have " + std::to_string(cfg.knotting.slot_colours.size()) +
+                          " slots (0.." + std::to_string(cfg.knotting.slot_colours.size() - 1) + ")");
       }
     }
     if (f.kind != InjectedFault::kStuckSensor && f.kind != InjectedFault::kIntermittentSensor) continue;
@@ -378,8 +403,12 @@ Scene check_scene_fits(Scene scene, const LoomConfig& cfg, bool simulated_io) {
   return scene;
 }
 
-Scene load_scene(const std::string& path) { return parse_scene(read_text(path), path); }
-Scene default_scene() { return parse_scene(kDefaultSceneToml, "<embedded default.toml scene>"); }
+Scene load_scene(const std::string& path) {
+  return parse_scene(read_text(path), path);
+}
+Scene default_scene() {
+  return parse_scene(kDefaultSceneToml, "<embedded default.toml scene>");
+}
 
 std::string scene_to_toml(const sim_hal::SceneSpec& s, const std::string& config) {
   std::ostringstream os;
@@ -399,26 +428,29 @@ std::string scene_to_toml(const sim_hal::SceneSpec& s, const std::string& config
   os << "]\n";
   if (s.servo_lag) os << "\n[servo_lag]\ntau_s = " << s.servo_lag->tau_s << "\n";
   if (s.pneumatics) {
-    os << "\n[pneumatics]\nfill_tau_s = " << s.pneumatics->fill_tau_s << "\nbreakaway = " << s.pneumatics->breakaway << "\n";
+    os << "\n[pneumatics]\nfill_tau_s = " << s.pneumatics->fill_tau_s
+       << "\nbreakaway = " << s.pneumatics->breakaway << "\n";
   }
   if (s.shuttle_slip) {
     os << "\n[shuttle_slip]\ncarrier_force_n = " << s.shuttle_slip->carrier_force_n
        << "\nshuttle_mass_kg = " << s.shuttle_slip->shuttle_mass_kg
        << "\nrace_friction_m_s2 = " << s.shuttle_slip->race_friction_m_s2 << "\n";
   }
-  if (s.sensor_noise) os << "\n[sensor_noise]\nflip_probability = " << s.sensor_noise->flip_probability << "\n";
+  if (s.sensor_noise)
+    os << "\n[sensor_noise]\nflip_probability = " << s.sensor_noise->flip_probability << "\n";
   if (s.beat_contact) {
     os << "\n[beat_contact]\nbeater_mass_kg = " << s.beat_contact->beater_mass_kg
        << "\ncontact_depth_m = " << s.beat_contact->contact_depth_m << "\n";
   }
   if (s.inertia) {
     os << "\n[inertia]\nmotor_torque_limit_nm = " << s.inertia->motor_torque_limit_nm
-       << "\ndrive_inertia_kg_m2 = " << s.inertia->drive_inertia_kg_m2 << "\nbandwidth_hz = " << s.inertia->bandwidth_hz
-       << "\nsubsteps = " << s.inertia->substeps << "\nbeater_mass_kg = " << s.inertia->beater_mass_kg << "\n";
+       << "\ndrive_inertia_kg_m2 = " << s.inertia->drive_inertia_kg_m2
+       << "\nbandwidth_hz = " << s.inertia->bandwidth_hz << "\nsubsteps = " << s.inertia->substeps
+       << "\nbeater_mass_kg = " << s.inertia->beater_mass_kg << "\n";
   }
   if (s.knotter) {
-    os << "\n[knotter]\nmiss_probability = " << s.knotter->miss_probability << "\nweaver_s = " << s.knotter->weaver_s
-       << "\ncarpet_rows = " << s.knotter->carpet_rows << "\n";
+    os << "\n[knotter]\nmiss_probability = " << s.knotter->miss_probability
+       << "\nweaver_s = " << s.knotter->weaver_s << "\ncarpet_rows = " << s.knotter->carpet_rows << "\n";
   }
   if (s.joint_friction) {
     os << "\n[joint_friction]\nviscous_nm_s = " << s.joint_friction->viscous_nm_s

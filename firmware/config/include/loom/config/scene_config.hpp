@@ -15,7 +15,7 @@ namespace loom::firmware {
 struct Scene {
   std::string source = "<embedded default scene>";
   sim_hal::SceneSpec spec;
-  std::string config_path;  // loom config named by the scene ("" = embedded default)
+  std::string config_path;               // loom config named by the scene ("" = embedded default)
   std::vector<std::string> fault_where;  // "file:line:col" of each [[fault]] (spec.faults order)
 };
 

@@ -1,0 +1,144 @@
+// Reading a loom file: the key table in file order, the axes and I/O modules, the cross-field checks,
+// the one derivation and each module's own validation; a recipe's restart-only changes; the key list.
+#include <string>
+
+#include "axes.hpp"
+#include "checks.hpp"
+#include "derive.hpp"
+#include "io_modules_config.hpp"
+#include "keys.hpp"
+#include "loom/config/config.hpp"
+#include "loom/config/toml_reader.hpp"
+
+namespace loom::firmware {
+
+using namespace detail;
+
+namespace {
+
+LoomConfig parse_complete(const std::string& text, const std::string& source, const LoomConfig* base) {
+  TomlReader r(text, source);
+  r.consume("extends");
+  LoomConfig c = base ? *base : LoomConfig{};
+  c.source = source;
+  const auto present = [&](const std::string& path) { return r.root().at_path(path).node() != nullptr; };
+  for (const Key& k : keys()) {
+    if (present(k.path)) {
+      k.read(r, c);
+    } else {
+      r.consume(k.path);
+      if (!base && k.required) {
+        r.fail_missing(k.path,
+                       "missing: a config file must be complete, or begin with extends = \"default\" to take "
+                       "what it does not say from the embedded default loom");
+      }
+    }
+  }
+  // The crank speed is given, or follows from a beat-force target: exactly one of the two.
+  const bool speed = present("recipe.crank_speed_rad_s"), force = present("recipe.beat_force_target_n");
+  if (speed && force) {
+    r.fail("recipe.crank_speed_rad_s", fmt_num(c.recipe.crank_speed_rad_s),
+           "give either beat_force_target_n or crank_speed_rad_s, not both");
+  }
+  if (speed) c.recipe.beat_force_target_n = 0.0;
+  if (force) c.recipe.crank_speed_rad_s = 0.0;
+  if (!speed && !force && !base) {
+    r.fail_missing("recipe.beat_force_target_n",
+                   "missing: give beat_force_target_n (N) or crank_speed_rad_s (rad/s)");
+  }
+  refuse_moved_keys(r);
+  read_axes(r, c, base != nullptr);
+  read_io_modules(r, c);
+  r.reject_unknown(known_sections());
+  check_relations(r, c);
+  // `key` may name two facts that clash ("axes.helix.node|can.master_node", values likewise): the one the
+  // file says is the line to point at (the first when it says both).
+  const Fail fail = [&](const std::string& key, const std::string& value, const std::string& why) {
+    const std::size_t bar = key.find('|'), vbar = value.find('|');
+    if (bar != std::string::npos) {
+      const std::string k1 = key.substr(0, bar), v1 = value.substr(0, vbar);
+      const std::string k2 = key.substr(bar + 1),
+                        v2 = vbar == std::string::npos ? value : value.substr(vbar + 1);
+      if (present(k1)) r.fail(k1, v1, why);
+      if (present(k2)) r.fail(k2, v2, why);
+      throw ConfigError(source + ": " + k1 + " = " + v1 + " (from the embedded default): " + why);
+    }
+    if (present(key)) r.fail(key, value, why);
+    throw ConfigError(source + ": " + key + " = " + value + " (from the embedded default): " + why);
+  };
+  derive(c, fail);
+  check_can(c, fail);
+  check_motion(c, fail);
+  check_beat_resolution(c, fail);
+  return c;
+}
+
+}  // namespace
+
+void rederive_and_check(LoomConfig& c, const std::string& origin) {
+  const Fail fail = [&](const std::string& key, const std::string& value, const std::string& why) {
+    throw ConfigError(origin + ": with it, " + key + " = " + value + ": " + why);
+  };
+  if (c.run.stale_timeout_s < 2.0 * c.run.period_s) {
+    fail("timing.stale_timeout_ms", fmt_num(c.run.stale_timeout_s * 1e3), "must be at least two periods");
+  }
+  derive(c, fail);
+  check_can(c, fail);
+  check_motion(c, fail);
+  check_beat_resolution(c, fail);
+}
+
+LoomConfig parse_loom_config(const std::string& text, const std::string& source) {
+  // `extends` is read before anything else: it decides whether missing keys are errors.
+  const TomlReader probe(text, source);
+  if (const toml::node* ext = probe.root().get("extends")) {
+    const auto name = ext->value<std::string>();
+    if (!name || *name != "default") {
+      probe.fail("extends", name ? '"' + *name + '"' : "?",
+                 "only \"default\" (the embedded default loom) can be extended");
+    }
+    static const LoomConfig base = parse_complete(kDefaultLoomToml, "<embedded default_loom.toml>", nullptr);
+    return parse_complete(text, source, &base);
+  }
+  return parse_complete(text, source, nullptr);
+}
+
+LoomConfig load_loom_config(const std::string& path) {
+  return parse_loom_config(read_config_file(path), path);
+}
+
+LoomConfig default_loom_config() {
+  return parse_loom_config(kDefaultLoomToml, "<embedded default_loom.toml>");
+}
+
+std::string restart_only_changes(const LoomConfig& running, const LoomConfig& next) {
+  std::string out;
+  for (const Key& k : keys()) {
+    if (k.klass == Klass::kRecipe) continue;
+    const std::string a = k.value(running), b = k.value(next);
+    if (a != b) out += (out.empty() ? "" : ", ") + k.path + " " + a + " -> " + b;
+  }
+  if (const std::string a = axes_text(running), b = axes_text(next); a != b) {
+    out += (out.empty() ? "" : ", ") + std::string("axes ") + a + " -> " + b;
+  }
+  if (const std::string a = io_modules_text(running), b = io_modules_text(next); a != b) {
+    out += (out.empty() ? "" : ", ") + std::string("io_modules ") + a + " -> " + b;
+  }
+  return out;
+}
+
+std::vector<KeyInfo> config_keys() {
+  std::vector<KeyInfo> out;
+  for (const Key& k : keys()) {
+    out.push_back({k.path.c_str(), klass_name(k.klass), k.range});
+    if (k.path == "can.master_consumer_ms") {
+      for (const AxisKeyInfo& a : axis_keys()) out.push_back({a.path, "machine", a.range});
+    }
+    if (k.path == "io.yarn_present_active_low") {
+      for (const IoModuleKeyInfo& m : io_module_keys()) out.push_back({m.path, "machine", m.range});
+    }
+  }
+  return out;
+}
+
+}  // namespace loom::firmware
