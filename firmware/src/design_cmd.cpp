@@ -12,7 +12,7 @@
 
 #include "loom/design/design.hpp"
 #include "loom/design/picture.hpp"
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/durable_file.hpp"
 #include "loom/firmware/session.hpp"
 

@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <string>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/serve/commands.hpp"
 #include "loom/firmware/serve/state_lock.hpp"
 #include "loom/firmware/session.hpp"

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/firmware/machine.hpp"
 #include "loom/firmware/operator_policy.hpp"
 #include "loom/hal/motion_outputs.hpp"

@@ -11,7 +11,7 @@
 #include <sstream>
 
 #include "cli_run.hpp"
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 #include "loom/job/design_hash.hpp"
 
 namespace fs = std::filesystem;

@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "loom/firmware/config.hpp"
+#include "loom/config/config.hpp"
 
 namespace loom::job {
 
