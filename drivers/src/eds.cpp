@@ -660,14 +660,15 @@ class Reader {
     const Section* s = section("DUMMYUSAGE");
     if (s == nullptr) return;
     for (const Key& k : s->keys) {
-      const auto index =
-          k.name.rfind("DUMMY", 0) == 0 ? parse_unsigned("0x" + k.name.substr(5), 0xFFFF) : std::nullopt;
-      const auto v = parse_unsigned(k.value, 1);
-      if (!index || *index < 1 || *index > 0x1F || !v) {
+      // 0 = not a DummyNNNN key (data types 0x0001..0x001F only).
+      const std::uint64_t index =
+          k.name.rfind("DUMMY", 0) == 0 ? parse_unsigned("0x" + k.name.substr(5), 0xFFFF).value_or(0) : 0;
+      const std::uint64_t v = parse_unsigned(k.value, 1).value_or(2);
+      if (index < 1 || index > 0x1F || v > 1) {
         warn(k.line, k.written + " = \"" + shown(k.value) + "\" is not DummyNNNN=0|1: ignored");
         continue;
       }
-      d_.dummy_usage[static_cast<std::uint16_t>(*index)] = *v == 1;
+      d_.dummy_usage[static_cast<std::uint16_t>(index)] = v == 1;
     }
   }
 
@@ -1064,9 +1065,11 @@ std::vector<PdoDescription> pdos(const Description& d) {
   for (const bool receive : {true, false}) {
     const std::uint16_t comm_base = receive ? 0x1400 : 0x1800;
     const std::uint16_t map_base = receive ? 0x1600 : 0x1A00;
-    for (int n = 0; n < 512; ++n) {
-      const Object* comm = d.object(static_cast<std::uint16_t>(comm_base + n));
-      if (comm == nullptr) continue;
+    // The communication objects present, in order (a walk of the map's range, not 512 lookups).
+    for (auto it = d.objects.lower_bound(comm_base); it != d.objects.end() && it->first < comm_base + 0x200;
+         ++it) {
+      const int n = it->first - comm_base;
+      const Object* comm = &it->second;
       PdoDescription p;
       p.receive = receive;
       p.number = n + 1;

@@ -312,7 +312,10 @@ class Checker {
     device_type();
     for (const ObjectNeed& n : needs_.objects) object(n);
     pdo_counts();
-    for (const PdoNeed& p : needs_.pdos) pdo(p);
+    for (std::size_t k = 0; k < needs_.pdos.size(); ++k) {
+      need_ = k;
+      pdo(needs_.pdos[k]);
+    }
     modes();
     sync();
     scaling();
@@ -527,7 +530,10 @@ class Checker {
       why_not =
           std::string(dir) + std::to_string(d.number) + " mapping is fixed to " + entries_text(d.mapping);
     }
-    if (used != nullptr) used_.emplace_back(used->receive, used->number);
+    if (used != nullptr) {
+      used_.emplace_back(used->receive, used->number);
+      out_.pdo_plan.push_back(PdoAssignment{need_, used->receive, used->number, used->kind});
+    }
     if (used == nullptr) {
       std::string remedy = "choose a node whose mapping can carry it";
       if (!n.receive && n.number == 2)
@@ -639,7 +645,8 @@ class Checker {
   const Description& eds_;
   const NodeNeeds& needs_;
   NodeCheck& out_;
-  std::vector<std::pair<bool, int>> used_;  // PDOs already given to a need (receive, number)
+  std::vector<std::pair<bool, int>> used_;
+  std::size_t need_ = 0;  // the PdoNeed being checked  // PDOs already given to a need (receive, number)
 };
 
 }  // namespace

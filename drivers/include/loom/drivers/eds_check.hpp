@@ -89,10 +89,19 @@ struct Finding {
   std::string remedy;   // what the builder can do ("" for info)
 };
 
+// Which of the node's PDOs serves which PdoNeed (NodeNeeds::pdos[need]).
+struct PdoAssignment {
+  std::size_t need = 0;
+  bool receive = false;
+  int number = 1;
+  MappingKind kind = MappingKind::kDynamic;
+};
+
 struct NodeCheck {
   NodeProfile profile;
   std::vector<Finding> findings;
-  bool ok() const;  // no error
+  std::vector<PdoAssignment> pdo_plan;  // the needs a PDO of the node can serve
+  bool ok() const;                      // no error
 };
 
 // Configure-time only. The EDS's own read errors come first (an EDS with errors is not compared).
