@@ -69,7 +69,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (const eds::SdoWrite& w : eds::parameter_writes(d, n.node_id)) expected[key(w)] = w;
     for (const eds::SdoWrite& w : writes) expected[key(w)] = w;
     std::vector<eds::SdoWrite> merged;
-    for (const auto& [k, w] : expected) merged.push_back(w);
+    for (const auto& [at, w] : expected) merged.push_back(w);
     if (eds::parameter_writes(back, n.node_id) != merged)
       fail("the DCF's ParameterValues differ from the writes");
   }
