@@ -128,6 +128,35 @@ TEST(EdsDcf, CompactArraysAreWrittenOutAsSubIndexSections) {
   EXPECT_EQ(dcf.dummy_usage, eds.dummy_usage);
 }
 
+TEST(EdsDcf, ADcfsParameterValuesAreWritesOfWritableNumbersWithTheNodeIdResolved) {
+  const std::string text =
+      "[1000]\nParameterName=t\nDataType=7\nAccessType=ro\nDefaultValue=0x191\n"
+      "[1001]\nParameterName=e\nDataType=5\nAccessType=ro\n"
+      "[1018]\nParameterName=id\nObjectType=9\nSubNumber=2\n"
+      "[1018sub0]\nParameterName=n\nDataType=5\nAccessType=ro\nDefaultValue=1\n"
+      "[1018sub1]\nParameterName=v\nDataType=7\nAccessType=ro\nDefaultValue=1\nParameterValue=2\n"  // ro: not
+                                                                                                    // written
+      "[1800]\nParameterName=tpdo1\nObjectType=9\nSubNumber=2\n"
+      "[1800sub0]\nParameterName=n\nDataType=5\nAccessType=const\nDefaultValue=1\n"
+      "[1800sub1]\nParameterName=cob\nDataType=7\nAccessType=rw\nParameterValue=$NODEID+0x180\n"
+      "[2000]\nParameterName=gain\nDataType=8\nAccessType=rw\nParameterValue=1.5\n"    // REAL32
+      "[2001]\nParameterName=label\nDataType=9\nAccessType=rw\nParameterValue=left\n"  // a string: not
+                                                                                       // expedited
+      "[2002]\nParameterName=offset\nDataType=3\nAccessType=rww\nParameterValue=-2\n";
+  const Description dcf = read_eds(text, "t.dcf");
+  ASSERT_FALSE(dcf.has_errors());
+  // 0x185 for node 5; 1.5f = 0x3FC00000 (IEEE 754: sign 0, exponent 127, mantissa 0.5); -2 as INTEGER16
+  // 0xFFFE.
+  const std::vector<SdoWrite> expected{
+      {0x1800, 1, 4, 0x185}, {0x2000, 0, 4, 0x3FC00000}, {0x2002, 0, 2, 0xFFFE}};
+  EXPECT_EQ(parameter_writes(dcf, 5), expected);
+  // Written out and read back (the node-relative value stays relative).
+  const Description back = read_eds(write_dcf(dcf, 5, 250, {}), "back.dcf");
+  EXPECT_FALSE(back.has_errors());
+  EXPECT_EQ(parameter_writes(back, 5), expected);
+  EXPECT_EQ(parameter_writes(back, 9)[0].value, 0x189u);
+}
+
 TEST(EdsDcf, AMismatchedIdentityNamesTheNodeAndBothIdentities) {
   const Description d = read_eds_file(path_of("acme_ax400_dynamic.eds"));
   EXPECT_TRUE(check_identity(d, "node 2 (axes.carriage)", Identity{0x4A2, 0x401234, 0x20001}).is_ok());
