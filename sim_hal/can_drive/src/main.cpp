@@ -4,6 +4,7 @@
 //   loom-sim-drive --iface vcan0 --nodes 1,2,3 [--io-node 4] [--personality standard|fixed]
 //                  [--counts-per-unit A,B,C] [--initial-position a,b,c] [--io-control FILE]
 //                  [--homing-nodes 1,2 [--power-up-seed N]]
+//   loom-sim-drive --iface vcan0 --nodes 1,2,3 --eds VENDOR.eds   (every drive as the EDS describes it)
 //   loom-sim-drive --iface vcan0 --loom LOOM.toml [--bus N] [--io-control FILE] ...
 // --loom: the nodes of bus N (default 0) as the machine description has them — drives in axis-slot order
 // with their scaling and referencing, the I/O modules on that bus (io.kind = "can": the [io] one on bus 0,
@@ -47,6 +48,7 @@
 #include "loom/drivers/nmt.hpp"
 #include "loom/drivers/socket_can_bus.hpp"
 #include "loom/sim_can/io_control.hpp"
+#include "loom/sim_can/eds_dictionary.hpp"
 #include "loom/sim_can/sim_drive_rack.hpp"
 
 namespace {
@@ -129,6 +131,7 @@ int main(int argc, char** argv) {
   std::uint64_t power_up_seed = 0;
   std::string loom_file;
   int loom_bus = 0;
+  std::string eds_file;
   app.add_option("--iface", iface, "CAN interface, e.g. vcan0")->required();
   auto* loom_opt = app.add_option("--loom", loom_file,
                                   "the machine description: simulate bus --bus's drives and (bus 0) its I/O node with "
@@ -148,6 +151,10 @@ int main(int argc, char** argv) {
   app.add_option("--personality", personality,
                  "standard | fixed (read-only PDO mappings, no TPDO3/4, no 0x1016, slow boot and start)")
       ->check(CLI::IsMember({"standard", "fixed"}));
+  app.add_option("--eds", eds_file,
+                 "build every drive's object dictionary from this CiA 306 EDS: its objects, access, fixed or "
+                 "dynamic PDO mapping, PDO count, supported modes (0x6502) and identity (0x1018)")
+      ->excludes("--personality");
   app.add_option("--boot-delay-ms", boot_delay_ms, "boot-up delay (default 0; fixed personality 300)");
   app.add_option("--operational-delay-ms", operational_delay_ms,
                  "NMT start → operational delay (default 0; fixed personality 400)");
@@ -271,6 +278,14 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "loom-sim-drive: power-up seed %llu (--power-up-seed to repeat)\n",
                  static_cast<unsigned long long>(power_up_seed));
   }
+  loom::drivers::eds::Description description;
+  if (!eds_file.empty()) {
+    description = loom::drivers::eds::read_eds_file(eds_file);
+    for (const loom::drivers::eds::Diagnostic& d : description.diagnostics) {
+      std::cerr << "loom-sim-drive: " << loom::drivers::eds::format(description.file, d) << "\n";
+    }
+    if (description.has_errors()) return 2;
+  }
   std::vector<loom::sim_can::SimDriveConfig> configs;
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     const double cpu = counts_per_unit.empty() ? default_counts_per_unit(i) : counts_per_unit[i];
@@ -296,6 +311,11 @@ int main(int argc, char** argv) {
     if (fixed) {
       c.fixed_mapping = true;
       c.missing_objects = {0x1802, 0x1803, 0x1A02, 0x1A03, 0x1016};
+    }
+    if (!eds_file.empty()) {
+      loom::sim_can::SimDriveConfig described = loom::sim_can::drive_from_eds(description, c.node_id);
+      c.dictionary = std::move(described.dictionary);
+      c.supports_csp = described.supports_csp;
     }
     configs.push_back(c);
   }

@@ -115,7 +115,9 @@ static_assert(slave::sorted(kTable), "the dictionary is binary-searched: list ob
 SimDriveNode::SimDriveNode(drivers::CanBus& bus, SimDriveConfig config)
     : bus_(bus),
       config_(std::move(config)),
-      od_(kTable, slave::OdOptions{config_.missing_objects, config_.fixed_mapping}),
+      od_(config_.dictionary.empty() ? std::span<const slave::Entry>(kTable)
+                                     : std::span<const slave::Entry>(config_.dictionary),
+          slave::OdOptions{config_.missing_objects, config_.fixed_mapping}),
       rng_(config_.power_up_seed) {
   position_ = config_.initial_position;
   previous_position_ = position_;
@@ -144,8 +146,10 @@ void SimDriveNode::reset_communication() {
 
 void SimDriveNode::reset_application() {
   od_.reset_application();
-  od_.set(kSupportedModes, 0,
-          kModesPpPv | (config_.supports_csp ? kModeCspBit : 0U) | (config_.supports_homing ? kModeHomingBit : 0U));
+  if (config_.dictionary.empty()) {  // a described drive's 0x6502 is its description's
+    od_.set(kSupportedModes, 0,
+            kModesPpPv | (config_.supports_csp ? kModeCspBit : 0U) | (config_.supports_homing ? kModeHomingBit : 0U));
+  }
   homing_running_ = homing_attained_ = homing_error_ = false;
   state_ = drive_settle(DriveState::kNotReadyToSwitchOn);
   controlword_ = 0;
