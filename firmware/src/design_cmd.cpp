@@ -10,9 +10,9 @@
 #include <stdexcept>
 #include <vector>
 
+#include "loom/config/config.hpp"
 #include "loom/design/design.hpp"
 #include "loom/design/picture.hpp"
-#include "loom/config/config.hpp"
 #include "loom/firmware/durable_file.hpp"
 #include "loom/firmware/session.hpp"
 
