@@ -314,6 +314,13 @@ TEST(MachineKnotting, HeadsNeedAMagazineThatHoldsEveryColourOfTheDesign) {
       << load_error(dir + "/bad.toml");
   std::ofstream(dir + "/good.toml") << ext(heads + "slot_colours = [\"R\", \"W\", \"B\"]\n" + head_axes + "[recipe]\ndesign = \"rug.csv\"\n");
   EXPECT_EQ(load_error(dir + "/good.toml"), "");
+  // Heads without a design to tie: refused where the file says heads, by check as by weave (issue 30: check
+  // passed it and weave refused it without a line).
+  std::ofstream(dir + "/no_design.toml") << ext(heads + "slot_colours = [\"R\", \"W\", \"B\"]\n" + head_axes);
+  EXPECT_NE(load_error(dir + "/no_design.toml")
+                .find("no_design.toml:3:8: knotting.mode = heads: the heads tie a design's knots: set recipe.design"),
+            std::string::npos)
+      << load_error(dir + "/no_design.toml");
   // The heads' signals on the I/O module: one bit per head, refused at the list's own line otherwise.
   const auto with_io = [&](const std::string& from, const std::string& to) {
     std::string axes = head_axes;
