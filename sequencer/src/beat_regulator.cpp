@@ -146,17 +146,14 @@ BeatRegulatorLimits SweepClock::configure(const motion::ProfileSet& p, double pe
 
 void SweepClock::start(hal::Tick t0) noexcept {
   seg_tick_ = t0;
-  seg_time_ = 0.0;
+  seg_time_ = c_ = 0.0;
   s0_ = s1_ = 1.0;
   T_ = 0.0;
-  warped_ = false;
-  pending_ = false;
+  warped_ = pending_ = active_ = false;
 }
 
-double SweepClock::time_at(hal::Tick now) const noexcept {
-  const double u = static_cast<double>(now - seg_tick_) * dt_;
-  if (u >= T_) return seg_time_ + s0_ * T_ + (s1_ - s0_) * T_ * 0.5 + s1_ * (u - T_);
-  // During a change: s = s0 + Δs·S(u/T), S(x) = 2x² (x ≤ ½) or 1 − 2(1 − x)², whose integral is I(x).
+double SweepClock::time_in_change(double u) const noexcept {
+  // s = s0 + Δs·S(u/T), S(x) = 2x² (x ≤ ½) or 1 − 2(1 − x)², whose integral from 0 is I(x).
   const double x = u / T_;
   const double y = 1.0 - x;
   const double integral = x <= 0.5 ? (2.0 / 3.0) * x * x * x : x - 0.5 + (2.0 / 3.0) * y * y * y;
@@ -181,11 +178,13 @@ void SweepClock::request(int beat, double scale) noexcept {
   pending_scale_ = b >= beats_ ? 1.0 : std::clamp(scale, min_scale_, max_scale_);
   pending_from_ = window_from(b);
   pending_to_ = window_to(b);
-  pending_ = true;
+  pending_ = pending_scale_ != s1_;  // the speed it is at already: nothing to do
+  active_ = pending_ || warped_;
 }
 
 void SweepClock::begin_change(hal::Tick now, double master) noexcept {
   pending_ = false;
+  active_ = warped_;
   // The scale now: a change before this one has ended before its beat entered the warp, so this is s1_
   // (computed in full all the same: a change never starts from a speed the crank is not at).
   const double u = static_cast<double>(now - seg_tick_) * dt_;
@@ -206,7 +205,9 @@ void SweepClock::begin_change(hal::Tick now, double master) noexcept {
   s0_ = s_now;
   s1_ = s_now + ds;
   T_ = t;
-  warped_ = true;
+  // After the change τ = seg_time + s0·T + Δs·T/2 + s1·(u − T) = c + s1·u.
+  c_ = seg_time_ + (s0_ - s1_) * T_ * 0.5;
+  warped_ = active_ = true;
 }
 
 }  // namespace loom::sequencer

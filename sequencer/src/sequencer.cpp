@@ -1209,7 +1209,8 @@ void Sequencer::play_moves(hal::Tick now) noexcept {
   };
   // The crank's move is sampled once: as a move of its own and, in the sweep, as the master phase — at
   // the sweep clock's time, warped by the beat regulator's speeds (the tick time while there are none).
-  const double sweep_t = sweeping_ ? sweep_clock_.time_at(now) : seconds_since(now, crank_move_.t0);
+  const bool warped = sweeping_ && sweep_clock_.active();  // else the clock is the tick time: not asked
+  const double sweep_t = warped ? sweep_clock_.time_at(now) : seconds_since(now, crank_move_.t0);
   const bool crank_played = crank_move_.active;
   const double crank_offset = crank_played || sweeping_ ? crank_move_.move.position_at(sweep_t) : 0.0;
   if (crank_played) {
@@ -1221,7 +1222,7 @@ void Sequencer::play_moves(hal::Tick now) noexcept {
   if (!sweeping_) return;
   // The sweep move is the master phase; the crank follows the speed law (constant: the same). A speed
   // change the regulator asked for starts once the master is inside its window (carriage at rest).
-  sweep_clock_.advance(now, crank_offset);
+  if (warped) sweep_clock_.advance(now, crank_offset);
   const motion::Phase master = motion::Phase::from_rad(crank_offset);
   const double phi = profiles_->crank_phase_at(master);
   cmd_.axes[index(CoreAxis::kBeatCrank)].target_position = crank_sweep_origin_ + phi;
@@ -1230,7 +1231,8 @@ void Sequencer::play_moves(hal::Tick now) noexcept {
   // A beat is delivered when the commanded crank passes the fell of turn k.
   const double fell = profiles_->beatup().warp().fell;
   while (row_beats_ < profiles_->beats_per_row() && phi >= motion::kTwoPi * row_beats_ + fell) {
-    row_.beat_at(row_beats_, cmd_.axes[index(CoreAxis::kCarriage)].target_position - cfg_.carriage_home_m);
+    row_.beat_at(row_beats_, cmd_.axes[index(CoreAxis::kCarriage)].target_position - cfg_.carriage_home_m,
+                 sweep_clock_.scale());
     ++row_beats_;
     ++counters_.beats;
   }
@@ -1264,7 +1266,7 @@ void Sequencer::publish_beat(int k) noexcept {
   }
   e.force_measured = r.force_measured;
   e.in_band = e.force_measured && e.peak_force_n >= cfg_.beat_force_min_n && e.peak_force_n <= cfg_.beat_force_max_n;
-  e.speed_scale = static_cast<float>(sweep_clock_.scale());
+  e.speed_scale = k < kMaxBeatsPerRow ? r.beat[static_cast<std::size_t>(k)].speed_scale : 1.0f;
   beats_published_ = k + 1;
   if (sweeping_ && regulator_.enabled()) regulate_after(k, e);
 }
@@ -1281,7 +1283,7 @@ int Sequencer::beat_position(int k) const noexcept {
 void Sequencer::regulate_after(int k, const BeatEvent& e) noexcept {
   const int next = k + 1;
   const bool last = next >= profiles_->beats_per_row();
-  const double s = regulator_.after_beat(beat_position(k), sweep_clock_.scale(), e.force_measured && e.peak_force_n > 0.0f,
+  const double s = regulator_.after_beat(beat_position(k), e.speed_scale, e.force_measured && e.peak_force_n > 0.0f,
                                          e.peak_force_n, last ? -1 : beat_position(next));
   sweep_clock_.request(next, s);
 }

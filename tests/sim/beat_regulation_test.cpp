@@ -52,13 +52,12 @@ std::uint64_t test_seed() {
   return seed;
 }
 
-Weave weave(bool closed_loop, bool warp_tension = true) {
+Weave weave(bool closed_loop, double noise = sim_hal::WarpTension{}.noise) {
   firmware::Scene scene = firmware::load_scene(std::string(LOOM_SOURCE_DIR) + "/sim_hal/scenes/default.toml");
   scene.spec.seed = test_seed();
-  if (warp_tension) {
-    scene.spec.effects.push_back(sim_hal::kEffectWarpTension);
-    scene.spec.warp_tension = sim_hal::WarpTension{};  // the effect's defaults
-  }
+  scene.spec.effects.push_back(sim_hal::kEffectWarpTension);
+  scene.spec.warp_tension = sim_hal::WarpTension{};  // the effect's defaults
+  scene.spec.warp_tension->noise = noise;
   firmware::LoomConfig cfg = firmware::default_loom_config();
   cfg.sequencer.beat_regulator.enabled = closed_loop;
   firmware::MachineOptions opt;
@@ -114,24 +113,31 @@ TEST(BeatRegulation, WarpTensionTakesTheOpenLoopOutOfTheBandAndTheRegulatorHolds
       "  closed loop: %5.1f %% of beats in the band (%d), peaks %.1f..%.1f N, %.0f s; crank speed "
       "x%.3f..x%.3f\n",
       closed.share(), closed.in_band(), closed_lo, closed_hi, closed.seconds, s_lo, s_hi);
-  // The regulator's accuracy against the beats it has seen: the worst |F - 90 N| over each span of beats.
+  // The regulator's accuracy against the beats it has seen: the worst |F - 90 N| over each span of beats,
+  // with the effect's noise and without it (what the regulator's prediction alone leaves).
+  const Weave quiet = weave(true, 0.0);
+  ASSERT_EQ(quiet.state, sequencer::State::kDone) << sequencer::fault_name(quiet.fault);
   const double target = 90.0;
-  std::printf(
-      "  closed loop, worst |F - 90 N|: beat 1 %.1f N; beats 2-15 (row 1, nothing remembered) %.1f N; "
-      "row 2 %.1f N; rows 3-10 %.1f N; rows 11-200 %.1f N\n",
-      worst_error(closed.beats, 0, 1, target), worst_error(closed.beats, 1, 15, target),
-      worst_error(closed.beats, 15, 30, target), worst_error(closed.beats, 30, 150, target),
-      worst_error(closed.beats, 150, closed.beats.size(), target));
-  for (const double within : {10.0, 5.0, 3.0, 2.0}) {
-    std::size_t settled = 0;  // beats after which every later beat is within `within` of the target
-    for (std::size_t i = closed.beats.size(); i-- > 0;) {
-      if (std::abs(closed.beats[i].force_n - target) > within) {
-        settled = i + 1;
-        break;
+  for (const Weave* r : {&closed, &quiet}) {
+    std::printf(
+        "  closed loop, %s: worst |F - 90 N| beat 1 %.1f N | beats 2-15 (row 1) %.1f N | row 2 %.1f N | "
+        "rows 3-10 %.1f N | rows 11-200 %.1f N",
+        r == &closed ? "1 % noise" : "no noise ", worst_error(r->beats, 0, 1, target),
+        worst_error(r->beats, 1, 15, target), worst_error(r->beats, 15, 30, target),
+        worst_error(r->beats, 30, 150, target), worst_error(r->beats, 150, r->beats.size(), target));
+    for (const double within : {5.0, 2.0, 1.0}) {
+      std::size_t settled = 0;  // beats after which every later beat is within `within` of the target
+      for (std::size_t i = r->beats.size(); i-- > 0;) {
+        if (std::abs(r->beats[i].force_n - target) > within) {
+          settled = i + 1;
+          break;
+        }
       }
+      std::printf(" | within %.0f N from beat %zu", within, settled + 1);
     }
-    std::printf("  closed loop: every beat within +/-%.0f N of 90 N from beat %zu on\n", within, settled + 1);
+    std::printf("\n");
   }
+  EXPECT_LT(worst_error(quiet.beats, 30, quiet.beats.size(), target), 1.0);  // remembered: within a newton
   EXPECT_LT(open.share(), 90.0);  // the effect's defaults take the open loop out of the band
   EXPECT_LT(open_lo, 80.0);       // below it in the slack middle
   EXPECT_GT(open_hi, 100.0);      // above it at the selvedges once the tension has drifted up

@@ -109,13 +109,20 @@ class SweepClock {
 
   // RT-safe. A sweep begins at tick `t0` at scale 1.
   void start(hal::Tick t0) noexcept;
+  // RT-safe. Whether this sweep's clock differs from the tick time: a change asked for or made. While not,
+  // the caller samples the sweep at the tick time itself and need not call time_at() or advance().
+  bool active() const noexcept { return active_; }
   // RT-safe. The time at which to sample the sweep move at tick `now` (the tick time while the scale is 1).
-  double time_at(hal::Tick now) const noexcept;
+  // After a change, τ = c + s1·u, one multiply-add (c folds the change's own integral in).
+  double time_at(hal::Tick now) const noexcept {
+    const double u = static_cast<double>(now - seg_tick_) * dt_;
+    return u < T_ ? time_in_change(u) : c_ + s1_ * u;
+  }
   // RT-safe. Beat `beat` (0-based; beats_per_row() means the braking, at scale 1) is to be beaten at
   // `scale`: the change happens in that beat's window, once the master has reached it.
   void request(int beat, double scale) noexcept;
-  // RT-safe, every tick of the sweep, with the master phase just sampled at `now`: starts a requested
-  // change when the master is inside its window.
+  // RT-safe, every tick of the sweep while active(), with the master phase just sampled at `now`: starts a
+  // requested change when the master is inside its window.
   void advance(hal::Tick now, double master) noexcept {
     if (pending_ && master >= pending_from_) begin_change(now, master);
   }
@@ -125,6 +132,7 @@ class SweepClock {
 
  private:
   void begin_change(hal::Tick now, double master) noexcept;
+  double time_in_change(double u) const noexcept;
   double window_from(int beat) const noexcept;  // master phase where beat's window opens
   double window_to(int beat) const noexcept;    // and where it closes
 
@@ -137,11 +145,13 @@ class SweepClock {
   double step_end_ = 0.0;  // of the end of the carriage step before a turn's entry (may be < 0)
   int beats_ = 0, per_position_ = 1;
   double min_scale_ = 1.0, max_scale_ = 1.0;
-  // The segment in force: from tick seg_tick_ (sweep time seg_time_), the scale goes s0_ → s1_ over T_ s.
+  // The segment in force: from tick seg_tick_ (sweep time seg_time_), the scale goes s0_ → s1_ over T_ s;
+  // after it, τ = c_ + s1_·u (u: seconds since seg_tick_).
   hal::Tick seg_tick_ = 0;
-  double seg_time_ = 0.0, s0_ = 1.0, s1_ = 1.0, T_ = 0.0;
+  double seg_time_ = 0.0, s0_ = 1.0, s1_ = 1.0, T_ = 0.0, c_ = 0.0;
   bool warped_ = false;  // some change has happened in this sweep
   bool pending_ = false;
+  bool active_ = false;  // pending_ || warped_
   double pending_scale_ = 1.0, pending_from_ = 0.0, pending_to_ = 0.0;
 };
 
