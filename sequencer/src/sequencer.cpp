@@ -267,6 +267,7 @@ void Sequencer::latch(Fault f, hal::Tick now, int axis, std::uint16_t detail, in
   ack_requested_ = false;
   crank_move_.active = carriage_move_.active = helix_move_.active = false;
   sweeping_ = false;
+  sweep_clock_.stop();
   enter(State::kFault, now);
 }
 
@@ -1054,6 +1055,7 @@ void Sequencer::begin_sweep(hal::Tick now) noexcept {
 
 void Sequencer::end_row(hal::Tick now) noexcept {
   sweeping_ = false;
+  sweep_clock_.stop();
   while (beats_published_ < row_beats_) publish_beat(beats_published_);
   ++counters_.rows;
   counters_.picks_in_row = 0;
@@ -1209,8 +1211,8 @@ void Sequencer::play_moves(hal::Tick now) noexcept {
   };
   // The crank's move is sampled once: as a move of its own and, in the sweep, as the master phase — at
   // the sweep clock's time, warped by the beat regulator's speeds (the tick time while there are none).
-  const bool warped = sweeping_ && sweep_clock_.active();  // else the clock is the tick time: not asked
-  const double sweep_t = warped ? sweep_clock_.time_at(now) : seconds_since(now, crank_move_.t0);
+  // (active() only in a sweep: the clock is stopped with it.)
+  const double sweep_t = sweep_clock_.active() ? sweep_clock_.time_at(now) : seconds_since(now, crank_move_.t0);
   const bool crank_played = crank_move_.active;
   const double crank_offset = crank_played || sweeping_ ? crank_move_.move.position_at(sweep_t) : 0.0;
   if (crank_played) {
@@ -1221,8 +1223,9 @@ void Sequencer::play_moves(hal::Tick now) noexcept {
   play(helix_move_, CoreAxis::kHelix);
   if (!sweeping_) return;
   // The sweep move is the master phase; the crank follows the speed law (constant: the same). A speed
-  // change the regulator asked for starts once the master is inside its window (carriage at rest).
-  if (warped) sweep_clock_.advance(now, crank_offset);
+  // change the regulator asked for starts once the master is inside its window (carriage at rest); this
+  // tick's targets are sampled already, it acts from the next.
+  if (sweep_clock_.active()) sweep_clock_.advance(now, crank_offset);
   const motion::Phase master = motion::Phase::from_rad(crank_offset);
   const double phi = profiles_->crank_phase_at(master);
   cmd_.axes[index(CoreAxis::kBeatCrank)].target_position = crank_sweep_origin_ + phi;
@@ -1231,8 +1234,7 @@ void Sequencer::play_moves(hal::Tick now) noexcept {
   // A beat is delivered when the commanded crank passes the fell of turn k.
   const double fell = profiles_->beatup().warp().fell;
   while (row_beats_ < profiles_->beats_per_row() && phi >= motion::kTwoPi * row_beats_ + fell) {
-    row_.beat_at(row_beats_, cmd_.axes[index(CoreAxis::kCarriage)].target_position - cfg_.carriage_home_m,
-                 sweep_clock_.scale());
+    row_.beat_at(row_beats_, cmd_.axes[index(CoreAxis::kCarriage)].target_position - cfg_.carriage_home_m);
     ++row_beats_;
     ++counters_.beats;
   }
@@ -1266,9 +1268,11 @@ void Sequencer::publish_beat(int k) noexcept {
   }
   e.force_measured = r.force_measured;
   e.in_band = e.force_measured && e.peak_force_n >= cfg_.beat_force_min_n && e.peak_force_n <= cfg_.beat_force_max_n;
-  e.speed_scale = k < kMaxBeatsPerRow ? r.beat[static_cast<std::size_t>(k)].speed_scale : 1.0f;
+  // The speed it was beaten at: the clock's, which the next beat's change (asked for below) has not moved yet.
+  e.speed_scale = static_cast<float>(sweep_clock_.scale());
+  row_.speed(k, e.speed_scale);
   beats_published_ = k + 1;
-  if (sweeping_ && regulator_.enabled()) regulate_after(k, e);
+  if (e.force_measured && sweeping_ && regulator_.enabled()) regulate_after(k, e);  // a load cell: closed loop
 }
 
 int Sequencer::beat_position(int k) const noexcept {

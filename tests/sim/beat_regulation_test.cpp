@@ -125,6 +125,10 @@ TEST(BeatRegulation, WarpTensionTakesTheOpenLoopOutOfTheBandAndTheRegulatorHolds
         r == &closed ? "1 % noise" : "no noise ", worst_error(r->beats, 0, 1, target),
         worst_error(r->beats, 1, 15, target), worst_error(r->beats, 15, 30, target),
         worst_error(r->beats, 30, 150, target), worst_error(r->beats, 150, r->beats.size(), target));
+    double sum2 = 0.0;  // rows 11-200: the root mean square error, to set beside the effect's own noise
+    for (std::size_t i = 150; i < r->beats.size(); ++i)
+      sum2 += (r->beats[i].force_n - target) * (r->beats[i].force_n - target);
+    std::printf(" (rms %.2f N)", std::sqrt(sum2 / static_cast<double>(r->beats.size() - 150)));
     for (const double within : {5.0, 2.0, 1.0}) {
       std::size_t settled = 0;  // beats after which every later beat is within `within` of the target
       for (std::size_t i = r->beats.size(); i-- > 0;) {

@@ -109,6 +109,8 @@ class SweepClock {
 
   // RT-safe. A sweep begins at tick `t0` at scale 1.
   void start(hal::Tick t0) noexcept;
+  // RT-safe. The sweep has ended (or was cut by a fault): active() is false until the next start().
+  void stop() noexcept { pending_ = active_ = false; }
   // RT-safe. Whether this sweep's clock differs from the tick time: a change asked for or made. While not,
   // the caller samples the sweep at the tick time itself and need not call time_at() or advance().
   bool active() const noexcept { return active_; }

@@ -58,10 +58,11 @@ class RowRecorder {
     stats_.knots_by_hand = by_hand;
   }
   void add_pick(hal::Tick ticks) noexcept { stats_.pick_ticks += ticks; }
-  void beat_at(int k, double x_m, double speed_scale = 1.0) noexcept {
-    if (k < 0 || k >= kMaxBeatsPerRow) return;
-    stats_.beat[static_cast<std::size_t>(k)].x_m = static_cast<float>(x_m);
-    stats_.beat[static_cast<std::size_t>(k)].speed_scale = static_cast<float>(speed_scale);
+  void beat_at(int k, double x_m) noexcept {
+    if (k >= 0 && k < kMaxBeatsPerRow) stats_.beat[static_cast<std::size_t>(k)].x_m = static_cast<float>(x_m);
+  }
+  void speed(int k, float scale) noexcept {
+    if (k >= 0 && k < kMaxBeatsPerRow) stats_.beat[static_cast<std::size_t>(k)].speed_scale = scale;
   }
   void force(int k, double f_n) noexcept {
     if (k < 0 || k >= kMaxBeatsPerRow) return;
