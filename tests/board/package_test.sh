@@ -120,8 +120,14 @@ fi
 sock=$work/loom.sock
 ctl() { "$root/usr/bin/loomctl" ctl --socket "$sock" "$@"; }
 field() { ctl status | tr ' ' '\n' | sed -n "s/^$1=//p"; }
-wait_for() {
-  for _ in $(seq 1 $(($3 * 20))); do [[ $(field "$1") == "$2" ]] && return 0; sleep 0.05; done
+wait_for() {  # bounded in seconds; rows counted as "at least" (a row may pass between two polls)
+  local end=$((SECONDS + $3)) v
+  while ((SECONDS < end)); do
+    v=$(field "$1")
+    [[ $v == "$2" ]] && return 0
+    [[ $1 == rows && -n $v ]] && ((v >= $2)) && return 0
+    sleep 0.05
+  done
   fail "waited $3 s for $1=$2: $(ctl status)"
 }
 "$root/usr/bin/loomctl" serve --config "$root/etc/loomctl/loom.toml" --state-dir "$work/state" --socket "$sock" \

@@ -35,9 +35,21 @@ trap cleanup EXIT
 fail() { echo "FAIL: $*" >&2; for f in "$work"/*.log; do echo "--- $f" >&2; tail -20 "$f" >&2; done; exit 1; }
 ctl() { "$loomctl" ctl --socket "$1" "${@:2}"; }
 field() { ctl "$1" status | tr ' ' '\n' | sed -n "s/^$2=//p"; }
+# Waits are bounded in seconds, not in polls: under a sanitizer on a loaded machine one `ctl status` can
+# take longer than a row (0.3 s at --pace 25), so a row count is waited for as "at least" (wait_rows).
 wait_for() {  # wait_for SOCKET FIELD VALUE SECONDS
-  for _ in $(seq 1 $(($4 * 20))); do [[ $(field "$1" "$2" 2>/dev/null) == "$3" ]] && return 0; sleep 0.05; done
+  local end=$((SECONDS + $4))
+  while ((SECONDS < end)); do [[ $(field "$1" "$2" 2>/dev/null) == "$3" ]] && return 0; sleep 0.05; done
   fail "waited $4 s for $2=$3: $(ctl "$1" status 2>&1)"
+}
+wait_rows() {  # wait_rows SOCKET N SECONDS: at least N rows woven
+  local end=$((SECONDS + $3)) n
+  while ((SECONDS < end)); do
+    n=$(field "$1" rows 2>/dev/null)
+    [[ -n $n ]] && ((n >= $2)) && return 0
+    sleep 0.05
+  done
+  fail "waited $3 s for rows >= $2: $(ctl "$1" status 2>&1)"
 }
 serve() {  # serve LOG STATE SOCKET [extra]: starts serve in the background, sets $last (telemetry off
   local log=$1 state=$2 sock=$3; shift 3  # unless the extra arguments give --lcm-url)
@@ -82,7 +94,7 @@ NOTIFY_SOCKET=$notify WATCHDOG_USEC=1000000 serve w.log "$work/wstate" "$work/w.
 w=$last
 wait_socket "$work/w.sock"
 ctl "$work/w.sock" start >/dev/null
-wait_for "$work/w.sock" rows 1 30
+wait_rows "$work/w.sock" 1 30
 sleep 1.5
 grep -q "READY=1" "$work/notify.txt" || fail "no READY=1: $(cat "$work/notify.txt")"
 pings_before=$(grep -c "WATCHDOG=1" "$work/notify.txt" || true)
@@ -125,7 +137,7 @@ sleep 1
 # The control socket's thread stalled alone (a handler stuck on a hung disk; issue 30: pings went on
 # while operators got no answer for 12 s): the pings stop too, and the journal says why.
 ctl "$work/w.sock" start >/dev/null
-wait_for "$work/w.sock" rows $((rows_at_stall + 1)) 30
+wait_rows "$work/w.sock" $((rows_at_stall + 1)) 30
 cth=$(grep -l '^loom-ctl$' /proc/"$last"/task/*/comm | head -1 | cut -d/ -f5)
 [[ -n $cth ]] || fail "no loom-ctl thread in serve $last"
 rm -f "$work/stalled"
@@ -197,7 +209,7 @@ wait_socket "$work/d.sock"
 # counters' retries, which fail until the disk has room again. (3c shows the reserve at work.)
 rm -f "$work/disk/state/reserve"
 ctl "$work/d.sock" start >/dev/null
-wait_for "$work/d.sock" rows 1 30
+wait_rows "$work/d.sock" 1 30
 # Kept full until a save fails: a fill that lands while a save's temporary file exists leaves the old
 # counters' page free once that save renames over them, and the saves could go on in it for ever (seen
 # on a loaded host). Each round fills a new file: dd truncating the last one would free its pages first.
@@ -235,7 +247,7 @@ e=$last
 wait_socket "$work/e.sock"
 [[ -e $work/disk/state/reserve ]] || fail "serve armed without keeping its reserve"
 ctl "$work/e.sock" start >/dev/null
-wait_for "$work/e.sock" rows $((woven + 1)) 30
+wait_rows "$work/e.sock" $((woven + 1)) 30
 keep_full &
 filler=$!
 wait_for "$work/e.sock" fault counters_not_saved 60
