@@ -42,7 +42,11 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   weave_cmd->add_option("--scene", a.scene, "simulation scene file (TOML); default: embedded default scene")
       ->check(CLI::ExistingFile);
-  weave_cmd->add_option("--rows", a.rows, "rows to weave")->check(CLI::Range(1u, 1000000u));
+  CLI::Option* weave_rows =
+      weave_cmd
+          ->add_option("--rows", a.rows,
+                       "rows to weave (with a carpet job: at most its rows left, the default)")
+          ->check(CLI::Range(1u, 1000000u));
   weave_cmd->add_option("--hal", a.hal, "sim | socketcan")->check(CLI::IsMember({"sim", "socketcan"}));
   weave_cmd->add_option("--iface", a.iface,
                         "SocketCAN interface(s) (with --hal socketcan), e.g. can0, or can0,can1 for a loom "
@@ -72,6 +76,13 @@ int main(int argc, char** argv) {
   weave_cmd->add_option("--report", a.report, "write DIR/summary.json and plots (beat force, row timeline)");
   weave_cmd->add_option("--sim-state", a.sim_state,
                         "sim HAL: keep the simulated machine's physical state in FILE (survives a kill)");
+  weave_cmd
+      ->add_option(
+          "--state-dir", a.state_dir,
+          "serve's state directory: its counters, simulated machine and carpet job queue (weaves the "
+          "current job, or starts the next queued one)")
+      ->excludes("--counters")
+      ->excludes("--sim-state");
   firmware::CheckArgs check;
   CLI::App* check_cmd =
       app.add_subcommand("check", "validate a loom config (and scene) and print its plan; moves nothing");
@@ -119,5 +130,6 @@ int main(int argc, char** argv) {
   if (const auto rc = design.run()) return *rc;
   if (const auto rc = jobs.run()) return *rc;
   if (const auto rc = reports.run()) return *rc;
+  a.rows_given = weave_rows->count() > 0;
   return firmware::run_weave(a);
 }

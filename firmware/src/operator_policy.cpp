@@ -34,6 +34,10 @@ Decision decide(const PolicyInputs& in) noexcept {
       d.end = Decision::End::kStartRequested;
       return d;
     }
+    if (in.nothing_to_weave && s == State::kIdle) {
+      d.refusal = Decision::Refusal::kStartNothingToWeave;
+      return d;
+    }
     d.start = true;  // also resumes, and cancels a pause not yet reached (operator_requests.hpp)
   }
   if (has(Command::kAck) && s == State::kFault) {

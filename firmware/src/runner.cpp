@@ -251,6 +251,7 @@ class LoopBody {
     in.estop_ok = rt_.loop.inputs().io.estop_ok;
     in.link_recovery = rt_.loop.inputs().link.recovery;
     in.last_save_failed = last_save_failed;
+    in.nothing_to_weave = opt_.nothing_to_weave;
     const Decision d = decide(in);
     apply(d, seq_);
     RunResult& res = rt_.result;
@@ -263,6 +264,7 @@ class LoopBody {
       case Decision::Refusal::kAckCountersUnsaved:
         ++res.acks_refused_unsaved;
         break;
+      case Decision::Refusal::kStartNothingToWeave:
       case Decision::Refusal::kNone:
         break;
     }
@@ -389,6 +391,13 @@ class LoopBody {
     if (ev.has(EventKind::kRow)) {
       RunEvent e = base_event(RunEvent::Kind::kRowDone, tick);
       e.row = seq_.last_row();
+      const sequencer::RowKnotter& k = seq_.knotter();
+      e.stock_known = k.stock(0, 0) >= 0;
+      for (int h = 0; e.stock_known && h < sequencer::kMaxKnottingHeads; ++h) {
+        for (int sl = 0; sl < sequencer::kMaxMagazineSlots; ++sl) {
+          e.stock[static_cast<std::size_t>(h)][static_cast<std::size_t>(sl)] = k.stock(h, sl);
+        }
+      }
       emit(e);
     } else if (ev.has(EventKind::kPick)) {
       emit(base_event(RunEvent::Kind::kPickDone, tick));

@@ -1,12 +1,14 @@
 // See session.hpp.
 #include "loom/firmware/session.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <utility>
 
 #include "loom/design/design.hpp"
+#include "loom/job/yarn_stock.hpp"
 
 namespace loom::firmware {
 
@@ -108,6 +110,15 @@ void ProductionRecord::prove_writable(const sequencer::Counters& c) const {
 }
 
 std::uint64_t ProductionRecord::activate_design(std::uint32_t counter_rows) {
+  if (CarpetJob* j = jobs()) {
+    try {
+      return j->arm(counter_rows);
+    } catch (const ConfigError&) {
+      throw;
+    } catch (const std::exception& ex) {
+      throw ConfigError(std::string("job queue cannot be written, refusing to arm: ") + ex.what());
+    }
+  }
   if (!book_) return 0;
   try {
     return book_->activate(design_name_, counter_rows);
@@ -127,7 +138,11 @@ void ProductionRecord::save(const sequencer::Counters& c) {
   if (!store_) return;
   try {
     store_->save(c);
-    if (book_) book_->record(c.rows);
+    if (CarpetJob* j = jobs()) {
+      if (j->row_saved(c.rows)) carpet_done_ = true;
+    } else if (book_) {
+      book_->record(c.rows);
+    }
   } catch (...) {
     // The loop must stop at the row boundary: weaving on without a durable count would lose work at the
     // next power cut.
@@ -136,6 +151,49 @@ void ProductionRecord::save(const sequencer::Counters& c) {
   }
   row_saves_->saved(c.rows);
   row_saves_->saved_knots(c.rows, c.knot.cycles_started);
+}
+
+void ProductionRecord::keep_magazines(const LoomConfig& cfg) {
+  if (!store_ || cfg.knotting.mode != sequencer::KnottingMode::kHeads) return;
+  const auto dir = std::filesystem::path(path_).parent_path();
+  magazines_path_ = job::YarnStock::path_in(dir.empty() ? std::string(".") : dir.string());
+  heads_ = cfg.knotting.heads;
+  slots_ = static_cast<int>(cfg.knotting.slot_colours.size());
+  knots_per_slot_ = cfg.knotting.knots_per_slot;
+}
+
+std::optional<sequencer::MagazineLevels> ProductionRecord::load_magazines(const Say& say) const {
+  if (magazines_path_.empty()) return std::nullopt;
+  const std::optional<job::YarnStock> s = job::YarnStock::load(magazines_path_);
+  if (!s) {
+    say(Severity::kNotice, "magazines: no levels kept yet (" + magazines_path_ +
+                               "): every slot is taken as full — load full magazines before the start");
+    return std::nullopt;
+  }
+  if (const std::string why = s->mismatch(heads_, slots_, knots_per_slot_); !why.empty()) {
+    say(Severity::kWarning, "magazines: the kept levels (" + magazines_path_ + ") are not this loom's (" +
+                                why +
+                                "): every slot is taken as full — load full magazines before the start");
+    return std::nullopt;
+  }
+  sequencer::MagazineLevels levels{};
+  for (int h = 0; h < heads_; ++h) {
+    for (int sl = 0; sl < slots_; ++sl) {
+      levels[static_cast<std::size_t>(h)][static_cast<std::size_t>(sl)] = s->knots(h, sl);
+    }
+  }
+  return levels;
+}
+
+void ProductionRecord::save_magazines(const RunEvent& e) const {
+  if (magazines_path_.empty() || !e.stock_known) return;
+  job::YarnStock s(heads_, slots_, knots_per_slot_);
+  for (int h = 0; h < heads_; ++h) {
+    for (int sl = 0; sl < slots_; ++sl) {
+      s.set(h, sl, std::max(0, e.stock[static_cast<std::size_t>(h)][static_cast<std::size_t>(sl)]));
+    }
+  }
+  s.save(magazines_path_);
 }
 
 std::string design_position(const design::Design& d, std::uint64_t rows_done) {

@@ -14,7 +14,10 @@
 #include <optional>
 #include <vector>
 
+#include "loom/firmware/carpet_job.hpp"
 #include "loom/firmware/carpet_png.hpp"
+#include "loom/firmware/job_recorder.hpp"
+#include "loom/firmware/serve/state_lock.hpp"
 #include "loom/firmware/session.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/report/run_report.hpp"
@@ -45,7 +48,8 @@ extern "C" void on_resume(int) {
 struct WeaveInputs {
   Scene scene;
   LoomConfig cfg;
-  std::string config_path;  // "" = the embedded default (nothing to reload)
+  std::string config_path;       // "" = the embedded default (nothing to reload)
+  bool design_from_job = false;  // cfg's recipe design is the carpet job's, not the config file's
 };
 
 WeaveInputs resolve_inputs(const WeaveArgs& a) {
@@ -92,16 +96,18 @@ void print_header(const Machine& m, const Scene& scene, const WeaveArgs& a) {
 class WeaveReporter {
  public:
   WeaveReporter(const WeaveArgs& a, const WeaveInputs& in, Machine& m, ProductionRecord& record,
-                std::unique_ptr<report::ReportWriter> writer, const sequencer::Counters& resume)
+                std::unique_ptr<report::ReportWriter> writer, const sequencer::Counters& resume,
+                std::uint32_t rows)
       : a_(a),
         in_(in),
         m_(m),
         record_(record),
         writer_(std::move(writer)),
         period_(in.cfg.sequencer.period_s),
-        target_rows_(resume.rows + a.rows),
+        target_rows_(resume.rows + rows),
+        first_row_(resume.rows),
         picks_at_row_start_(resume.picks),
-        progress_bar_(isatty(STDOUT_FILENO) && a.rows >= 20 && !a.quiet) {}
+        progress_bar_(isatty(STDOUT_FILENO) && rows >= 20 && !a.quiet) {}
 
   void operator()(const RunEvent& e) {
     m_.collect_retired_recipes();
@@ -117,11 +123,16 @@ class WeaveReporter {
       std::fflush(stdout);
     }
     if (e.kind == RunEvent::Kind::kRowDone) row_done(e);
+    if (recorder_ != nullptr) record_event(e);
+    // The magazines before the counters: a cut between the two leaves the levels low (a reload asked
+    // early), never high (a slot running dry in a row).
+    if (e.kind == RunEvent::Kind::kRowDone) save_magazines(e);
     // Saved after the reload above, so a row that waits for this save starts with the new recipe.
     if (record_.kept()) save(e.counters);
   }
 
   std::unique_ptr<report::ReportWriter>& writer() { return writer_; }
+  void keep_record(JobRecorder* r) { recorder_ = r; }
   const std::string& counters_error() const { return counters_error_; }
 
   // The rows woven in this run against the hand's time for the same row (the thesis, ch. 6: ~5 min
@@ -148,10 +159,41 @@ class WeaveReporter {
         rows_, c.rows, whole, knot_s_ / rows_, weaver_s_ / rows_, report::kManualKnottedRowSeconds,
         report::kManualKnottedRowSeconds / whole, c.picks, c.beats, c.knot.tied, c.knot.retried,
         c.knot.by_hand, weaver_requests_);
+    print_yarn(c);
   }
 
  private:
   double secs(hal::Tick t) const { return static_cast<double>(t) * period_; }
+
+  // The production record is the job's account, not the loop's: a write it refuses is said once and the
+  // weave goes on (the counters, saved separately, stay the authority).
+  void record_event(const RunEvent& e) {
+    try {
+      recorder_->on_event(e, m_.knot_program(), in_.cfg.recipe.design.get());
+    } catch (const std::exception& ex) {
+      std::fprintf(stderr, "loomctl: WARNING: the production record stops here: %s\n", ex.what());
+      recorder_ = nullptr;
+    }
+  }
+
+  // The yarn the rows of this run put into the carpet, per colour (the design's knots of those rows; a
+  // retried knot takes its yarn again, on top).
+  void print_yarn(const sequencer::Counters& c) const {
+    const sequencer::KnotProgram* p = m_.knot_program();
+    const design::Design* d = in_.cfg.recipe.design.get();
+    if (p == nullptr || d == nullptr || c.rows <= first_row_) return;
+    std::vector<std::uint64_t> knots(d->palette().size(), 0);
+    for (std::uint32_t r = first_row_; r < c.rows; ++r) {
+      for (const std::uint16_t k : d->row(p->design_row(r))) ++knots[k];
+    }
+    std::string line;
+    for (std::size_t i = 0; i < knots.size(); ++i) {
+      if (knots[i] == 0) continue;
+      line += (line.empty() ? "" : ", ") + d->palette()[i].code + " " + std::to_string(knots[i]);
+    }
+    std::printf("yarn into the carpet (knots per colour): %s; %llu retried knots took yarn again\n",
+                line.c_str(), static_cast<unsigned long long>(retried_));
+  }
 
   // SIGHUP: re-read the recipe (the loom config file) and hand it to the loop for the next row.
   void reload_recipe() {
@@ -163,6 +205,10 @@ class WeaveReporter {
       next.run.period_s = in_.cfg.run.period_s;
       next.telemetry.lcm_url = in_.cfg.telemetry.lcm_url;
       next.loom_id = in_.cfg.loom_id;
+      if (in_.design_from_job) {  // the carpet job's design stays: a recipe reload never changes the carpet
+        next.recipe.design = in_.cfg.recipe.design;
+        next.recipe.design_file = in_.cfg.recipe.design_file;
+      }
       derive_module_configs(next);
       m_.publish_recipe(next);
       std::printf("recipe: %s reloaded; the loom adopts it at the next row\n", in_.config_path.c_str());
@@ -176,6 +222,7 @@ class WeaveReporter {
     ++rows_;
     machine_s_ += secs(r.total_ticks);
     knot_s_ += secs(r.knot_ticks);
+    retried_ += static_cast<std::uint64_t>(r.knots_retried);
     weaver_s_ += secs(r.knotting_ticks + r.weaver_ticks);
     weaver_outside_s_ += secs(r.knotting_ticks);  // the weaver's own knotting is not in the row's time
     if (writer_) {
@@ -219,6 +266,17 @@ class WeaveReporter {
   // A failed save is tried again (retry_save), as the service does: a disk that frees up lets the loom
   // weave on; one that does not ends in counters_not_saved at the row's end, or once a knot cycle's
   // write-ahead has waited timing.row_save_timeout_s — never a loom standing mid-row for ever.
+  void save_magazines(const RunEvent& e) {
+    try {
+      record_.save_magazines(e);
+    } catch (const std::exception& ex) {
+      std::fprintf(stderr,
+                   "loomctl: WARNING: the magazines' levels were not saved (a restart would take them as "
+                   "of the last saved row): %s\n",
+                   ex.what());
+    }
+  }
+
   void save(const sequencer::Counters& c) {
     try {
       record_.save(c);
@@ -264,11 +322,14 @@ class WeaveReporter {
   std::unique_ptr<report::ReportWriter> writer_;  // streams each row to disk (constant memory)
   const double period_;
   const std::uint32_t target_rows_;
+  const std::uint32_t first_row_;  // the counters' rows when this run began
   std::uint32_t picks_at_row_start_;
   const bool progress_bar_;  // a terminal only; logs get the per-row lines
   std::uint32_t rows_ = 0;   // rows woven in this run
   double machine_s_ = 0.0;
   double knot_s_ = 0.0, weaver_s_ = 0.0;  // the heads' knotting, and the weaver's hands, in those rows
+  std::uint64_t retried_ = 0;             // knots the heads retried in those rows
+  JobRecorder* recorder_ = nullptr;       // the carpet job's production record (weave --state-dir)
   double weaver_outside_s_ = 0.0;
   std::uint32_t weaver_requests_ = 0;
   std::string counters_error_;                  // why the last save failed
@@ -333,12 +394,41 @@ void print_fault(const FaultReport& f, double period, const sequencer::Counters&
       note.c_str(), sequencer::fault_text(f.fault), c.rows, c.picks, c.beats);
 }
 
+// Where a weave keeps its production state: the files given one by one (--counters, --sim-state), or
+// serve's state directory (locked as serve locks it, so the two never weave one loom's state at once).
+struct WeaveState {
+  std::string counters, sim_state;
+  std::unique_ptr<serve::StateDirLock> lock;
+};
+
+WeaveState open_state_dir(const WeaveArgs& a, const WeaveInputs& in) {
+  WeaveState st;
+  if (a.state_dir.empty()) {
+    st.counters = a.counters;
+    st.sim_state = a.sim_state;
+    return st;
+  }
+  std::error_code ec;
+  if (!std::filesystem::is_directory(a.state_dir, ec)) {
+    throw ConfigError("--state-dir " + a.state_dir + ": not a directory");
+  }
+  try {
+    st.lock = std::make_unique<serve::StateDirLock>(a.state_dir, in.cfg.loom_id, "(loomctl weave)");
+  } catch (const std::exception& e) {
+    throw SessionError(kExitNotArmed, std::string("refusing to arm: ") + e.what());
+  }
+  st.counters = a.state_dir + "/counters.json";
+  if (a.hal == "sim") st.sim_state = a.state_dir + "/sim-state.bin";
+  return st;
+}
+
 int weave(const WeaveArgs& a, const Say& say) {
   // ---- build and arm: everything that can fail on input fails here, before anything moves ----
   SessionOptions so = SessionOptions::from_command_line(a.hal, a.iface, a.io, a.pace);
   so.realtime = a.realtime;
   so.allow_degraded = a.allow_degraded;
-  const WeaveInputs in = resolve_inputs(a);
+  WeaveInputs in = resolve_inputs(a);
+  const WeaveState st = open_state_dir(a, in);
   if (a.knotting_s > 0.0 && (so.hardware() || !in.cfg.sequencer.knotting)) {
     char value[32];
     std::snprintf(value, sizeof value, "%g", a.knotting_s);
@@ -347,11 +437,32 @@ int weave(const WeaveArgs& a, const Say& say) {
                                        "presses the pedal)"
                                      : "the loom has no weaver's knotting (set knotting.mode = \"weaver\")"));
   }
-  ProductionRecord record(a.counters, in.cfg);
+  ProductionRecord record(st.counters, in.cfg);
   const sequencer::Counters resume = record.load();
+  CarpetJob* job = nullptr;
+  if (!a.state_dir.empty()) {
+    record.keep_magazines(in.cfg);
+    record.weave_jobs(std::make_unique<CarpetJob>(a.state_dir));
+    job = record.jobs();
+    if (job != nullptr) {
+      in.cfg = job->config_for(in.cfg);  // the job's design, checked against its hash and the loom
+      in.design_from_job = true;
+    } else if (auto done = CarpetJob(a.state_dir).carpet_done_id(); done != 0) {
+      throw ConfigError("--state-dir " + a.state_dir + ": no carpet job to weave: job " +
+                        std::to_string(done) +
+                        " is carpet_done (cut it off, tie the fringe warp) and none is queued: add the next "
+                        "one with loomctl job add DESIGN --state-dir " +
+                        a.state_dir);
+    }
+  }
+  std::uint32_t rows = a.rows;
+  if (job != nullptr) {
+    const std::uint64_t left = job->rows_left();
+    rows = static_cast<std::uint32_t>(std::min<std::uint64_t>(a.rows_given ? a.rows : left, left));
+  }
   // `--rows N` weaves N more rows after the ones already counted; the sum must stay a count.
-  if (static_cast<std::uint64_t>(resume.rows) + a.rows > UINT32_MAX) {
-    throw ConfigError("--rows = " + std::to_string(a.rows) + ": after row " + std::to_string(resume.rows) +
+  if (static_cast<std::uint64_t>(resume.rows) + rows > UINT32_MAX) {
+    throw ConfigError("--rows = " + std::to_string(rows) + ": after row " + std::to_string(resume.rows) +
                       " this would pass the row counter's range (4294967295); counters are never wrapped");
   }
   record.prove_writable(resume);  // a loom that must count and cannot refuses to arm
@@ -362,14 +473,21 @@ int weave(const WeaveArgs& a, const Say& say) {
   Session session(so, say);
   MachineOptions mo;
   mo.telemetry = !a.no_telemetry;
-  mo.rows = resume.rows + a.rows;  // the sequencer counts absolute rows; weave `rows` more
-  mo.sim_state_path = a.sim_state;
+  mo.rows = resume.rows + rows;  // the sequencer counts absolute rows; weave `rows` more
+  mo.sim_state_path = st.sim_state;
   mo.await_row_saved = record.kept();  // no row starts before the one before it is on disk
   mo.design_rows_done = design_rows;
   Machine& machine = session.build(in.cfg, in.scene, mo, resume);
+  if (const auto levels = record.load_magazines(say)) machine.sequencer().restore_magazines(*levels);
   if (!a.quiet) print_header(machine, in.scene, a);
   if (resume.rows > 0) {
     std::printf("  resuming after row %u (picks %u, beats %u)\n", resume.rows, resume.picks, resume.beats);
+  }
+  // weave runs at the machine: the next queued job starts here, as a start button would start it — once
+  // everything that can refuse the input has passed.
+  if (job != nullptr) {
+    const bool started = job->start(resume.rows);
+    std::printf("  %s%s\n", job->describe().c_str(), started ? " (started now)" : "");
   }
   if (const auto& d = in.cfg.recipe.design; d && !a.quiet) {
     std::printf("  %s%s\n", design_position(*d, design_rows).c_str(),
@@ -377,7 +495,7 @@ int weave(const WeaveArgs& a, const Say& say) {
   }
 
   // ---- run ----
-  WeaveReporter reporter(a, in, machine, record, open_report(a, in, so.hardware()), resume);
+  WeaveReporter reporter(a, in, machine, record, open_report(a, in, so.hardware()), resume, rows);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   std::signal(SIGHUP, on_hangup);
@@ -397,7 +515,26 @@ int weave(const WeaveArgs& a, const Say& say) {
     ro.weaver_sink = Machine::simulated_weaver_sink;
     ro.weaver_sink_ctx = &machine;
   }
+  // The job's production record (production.sqlite in the state directory).
+  std::unique_ptr<JobRecorder> job_record;
+  if (job != nullptr) {
+    try {
+      job_record =
+          std::make_unique<JobRecorder>(a.state_dir, job->job(), resume.rows, ro.period_s, !ro.realtime);
+      reporter.keep_record(job_record.get());
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "loomctl: WARNING: no production record for this run: %s\n", e.what());
+    }
+  }
   const RunResult res = session.run(ro, [&reporter](const RunEvent& e) { reporter(e); });
+  const bool carpet_done = record.take_carpet_done();
+  if (job_record) {
+    try {
+      job_record->finish(res.ticks, carpet_done);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "loomctl: WARNING: the production record's last commit failed: %s\n", e.what());
+    }
+  }
 
   // ---- report ----
   const sequencer::Counters& c = seq.counters();
@@ -438,6 +575,12 @@ int weave(const WeaveArgs& a, const Say& say) {
     return kExitFault;
   }
   reporter.print_speed(c);
+  if (carpet_done) {
+    std::printf(
+        "carpet done: the job's last row is woven (rows %u): cut the carpet off and tie the fringe warp; "
+        "the next queued job starts at the machine (loomctl job list --state-dir %s)\n",
+        c.rows, a.state_dir.c_str());
+  }
   return kExitOk;
 }
 

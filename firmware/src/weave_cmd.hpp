@@ -12,8 +12,12 @@ namespace loom::firmware {
 
 struct WeaveArgs {
   std::string config, scene, hal = "sim", iface, counters, lcm_url, loom_id, report, sim_state, io;
+  // serve's state directory: counters, the simulated machine, the carpet job queue (the current job is
+  // woven, or the next queued one is started: weave runs at the machine)
+  std::string state_dir;
   std::uint32_t rows = 3;
-  double period_ms = 0.0;  // 0: the config's
+  bool rows_given = false;  // --rows on the command line (a job's rows left are the default with a job)
+  double period_ms = 0.0;   // 0: the config's
   double pace = 1.0;
   double knotting_s = 0.0;  // sim: a simulated weaver says "row knotted" this long after each wait begins
   bool realtime = false, allow_degraded = false, no_telemetry = false, quiet = false;

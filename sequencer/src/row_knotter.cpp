@@ -78,6 +78,18 @@ void RowKnotter::configure(const KnottingConfig& k, const KnotGuard* guard, doub
   phase_ = Phase::kDone;
 }
 
+void RowKnotter::restore_stock(const MagazineLevels& levels) noexcept {
+  if (!fitted()) return;
+  const std::int32_t full = k_.program->knots_per_slot();
+  for (int h = 0; h < heads_; ++h) {
+    for (int s = 0; s < kMaxMagazineSlots; ++s) {
+      const std::int32_t v = levels[static_cast<std::size_t>(h)][static_cast<std::size_t>(s)];
+      stock_[static_cast<std::size_t>(h)][static_cast<std::size_t>(s)] = v < 0 ? 0 : (v > full ? full : v);
+    }
+  }
+  stock_known_ = true;
+}
+
 double RowKnotter::rest_behind(double position) const noexcept {
   if (!fitted()) return position;
   const double turn = k_.cycle->end_offset_rad();

@@ -71,7 +71,7 @@ wait_socket "$work/a.sock"
 rc=0
 "$loomctl" serve --state-dir "$work/state" --socket "$work/b.sock" --group "" --no-telemetry >"$work/b.log" 2>&1 || rc=$?
 [[ $rc == 4 ]] || fail "a second serve on the same state directory exited $rc, not 4"
-grep -q "in use by another serve (pid=$a .*socket=$work/a.sock" "$work/b.log" || fail "the refusal does not name the first serve: $(cat "$work/b.log")"
+grep -q "in use by another loomctl serve or weave (pid=$a .*socket=$work/a.sock" "$work/b.log" || fail "the refusal does not name the first serve: $(cat "$work/b.log")"
 [[ ! -e $work/b.sock ]] || fail "the refused serve opened a control socket"
 [[ $(field "$work/a.sock" state) == idle ]] || fail "the first serve was disturbed"
 kill -TERM "$a"; wait "$a" || fail "serve exited $? on SIGTERM"

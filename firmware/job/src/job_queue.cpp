@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include "loom/design/design.hpp"
 #include "loom/firmware/durable_file.hpp"
@@ -532,7 +533,11 @@ void JobQueue::mark_carpet_done() {
 }
 
 void JobQueue::check_design(const Job& job) {
-  const DesignRead file = read_design(job.design_path);
+  (void)read_checked_design(job);
+}
+
+std::string JobQueue::read_checked_design(const Job& job) {
+  DesignRead file = read_design(job.design_path);
   if (!file.error.empty()) {
     throw JobError("the design file of job " + std::to_string(job.id) +
                    " cannot be read: " + job.design_path + ": " + file.error);
@@ -543,6 +548,7 @@ void JobQueue::check_design(const Job& job) {
                    ", was " + job.sha256 + " (" + job.design_path +
                    "; add it as a new job to weave the new design)");
   }
+  return std::move(file.bytes);
 }
 
 void JobQueue::check_yarn(const Job& job, const firmware::LoomConfig& loom) {

@@ -12,6 +12,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -24,6 +25,7 @@
 #include <utility>
 
 #include "loom/config/config.hpp"
+#include "loom/firmware/job_recorder.hpp"
 #include "loom/firmware/serve/commands.hpp"
 #include "loom/firmware/serve/control_socket.hpp"
 #include "loom/firmware/serve/fault_history.hpp"
@@ -197,6 +199,8 @@ class Service {
     // Real time: memory locked and SCHED_FIFO probed for the loop thread only (this thread, the control
     // thread and the telemetry publisher stay SCHED_OTHER).
     prepare_realtime(so_, say_in_journal);
+    record_.weave_jobs(std::make_unique<CarpetJob>(state_));  // JobError: a bad jobs.txt refuses to start
+    record_.keep_magazines(cfg_);
     // `ctl status` answers from the link, which the loop fills from its first tick on; until then (config,
     // the LCM identity check, arming) it shows the counters on disk, never zeros that look like a reset.
     try {
@@ -268,6 +272,14 @@ class Service {
     view.counters_unsaved = counters_unsaved_.load(std::memory_order_acquire);
     view.pause_pending = pause_pending_.load(std::memory_order_acquire);
     Decision d = desk_.decide(req, view, static_cast<std::int64_t>(std::time(nullptr)));
+    if (d.post == Command::kStart &&
+        (view.state == sequencer::State::kIdle || view.state == sequencer::State::kDone)) {
+      std::lock_guard<std::mutex> lock(job_mu_);
+      if (!start_refusal_.empty()) {  // the loom stands: nothing to weave, or the job's design changed
+        d.reply = "refused: start: " + start_refusal_ + "\n";
+        d.post.reset();
+      }
+    }
     if (d.post == Command::kNext && view.state == sequencer::State::kKnotting) {
       std::lock_guard<std::mutex> lock(weaver_mu_);
       // Taken once: a `next` before the reporter has heard the request it answers says plain `ok next`,
@@ -277,7 +289,7 @@ class Service {
       weaver_request_.clear();
     }
     if (d.read == Decision::Read::kStatus) {
-      return status_text(link_, cfg_.loom_id, cfg_.recipe.design.get(), design_progress_) +
+      return job_status(status_text(link_, cfg_.loom_id, armed_design().get(), design_progress_), view) +
              open_requests(view);
     }
     if (d.read == Decision::Read::kFaults) {
@@ -291,6 +303,7 @@ class Service {
         ack_by_ = d.who;
         ack_at_ = std::chrono::steady_clock::now();
       }
+      if (*d.post == Command::kStart) started_at_machine(d);
       if (*d.post == Command::kPause) pause_pending_.store(true, std::memory_order_release);
       if (*d.post == Command::kResume || *d.post == Command::kStop)
         pause_pending_.store(false, std::memory_order_release);
@@ -342,8 +355,9 @@ class Service {
     const std::optional<sequencer::Counters> arm_unsaved = unsaved_;
     if (unsaved_) resume = *std::exchange(unsaved_, std::nullopt);
     show_counters(resume);
-    const std::uint64_t design_rows = record_.activate_design(resume.rows);
-    if (const design::Design* d = cfg_.recipe.design.get()) {
+    const ArmedJob armed = arm_job(resume);
+    const std::uint64_t design_rows = armed.design_rows;
+    if (const design::Design* d = armed.cfg.recipe.design.get()) {
       design_progress_.rows_at_arm.store(design_rows);
       design_progress_.counter_rows_at_arm.store(resume.rows);
       log(Severity::kNotice, "%s", design_position(*d, design_rows).c_str());
@@ -353,12 +367,27 @@ class Service {
     mo.design_rows_done = design_rows;
     mo.telemetry = !a_.no_telemetry;
     mo.rows = a_.rows == 0 ? 0 : resume.rows + a_.rows;
+    if (armed.rows_left > 0) {
+      mo.rows = resume.rows + static_cast<std::uint32_t>(std::min<std::uint64_t>(
+                                  armed.rows_left, a_.rows == 0 ? armed.rows_left : a_.rows));
+    }
     mo.await_row_saved = true;  // the state dir always keeps the counters
     if (!so_.hardware()) mo.sim_state_path = state_ + "/sim-state.bin";
-    sequencer::Sequencer& seq = session.build(cfg_, scene_, mo, resume).sequencer();
+    sequencer::Sequencer& seq = session.build(armed.cfg, scene_, mo, resume).sequencer();
+    if (const auto levels = record_.load_magazines(say_in_journal)) seq.restore_magazines(*levels);
+    {
+      std::lock_guard<std::mutex> lock(job_mu_);
+      armed_design_ = armed.cfg.recipe.design;
+      start_refusal_ = armed.refusal;
+    }
     if (start_at_once_) {
-      seq.request_start();
       start_at_once_ = false;
+      if (armed.refusal.empty()) {
+        started_at_machine(std::nullopt);
+        seq.request_start();
+      } else {
+        log(Severity::kWarning, "start not taken: %s", armed.refusal.c_str());
+      }
     }
     // Latched at the session's first tick, before anything can start; its kFault event is not a new fault.
     relatch_pending_ = false;
@@ -386,6 +415,118 @@ class Service {
     failed_save_.reset();
     last_retry_ns_ = 0;
     if (arm_unsaved) save_failed(*arm_unsaved);  // armed from memory: the disk lags until a retry succeeds
+  }
+
+  // ---- the carpet job ----
+  struct ArmedJob {
+    LoomConfig cfg;                 // the loom with the job's design (or the recipe's, without a job)
+    std::uint64_t design_rows = 0;  // rows of the design (or the job's carpet) woven
+    std::uint64_t rows_left = 0;    // of the job's carpet (0: no job, no limit from it)
+    std::string refusal;            // why a start is refused ("" when the loom may weave)
+  };
+
+  // The job queue read again (only this service changes it while it runs), the rows a power cut kept
+  // from it credited, and the loom described with the job's design. A queue with nothing to weave, or a
+  // job whose design file changed, arms the loom standing: every start refused with the reason.
+  ArmedJob arm_job(const sequencer::Counters& resume) {
+    ArmedJob a{cfg_, 0, 0, ""};
+    job_record_refused_ = false;  // each session tries the record again
+    CarpetJob& q = *record_.job_queue();
+    q.reload();
+    a.design_rows = record_.activate_design(resume.rows);
+    if (CarpetJob* job = record_.jobs()) {
+      try {
+        a.cfg = job->config_for(cfg_);
+        a.rows_left = job->rows_left();
+        log(Severity::kNotice, "%s", job->describe().c_str());
+      } catch (const job::JobError& e) {
+        a.refusal =
+            std::string(e.what()) + " (the loom stands; loomctl job start-over or remove with serve stopped)";
+        a.design_rows = 0;
+      }
+    } else if (const std::uint32_t done = q.carpet_done_id(); done != 0) {
+      a.refusal =
+          "no carpet job to weave: job " + std::to_string(done) +
+          " is carpet_done and none is queued (add the next with loomctl job add while serve is stopped)";
+    }
+    if (!a.refusal.empty()) log(Severity::kWarning, "%s", a.refusal.c_str());
+    return a;
+  }
+
+  // An accepted start at the machine (the control socket, a paired panel, a re-arm's start): a queued job
+  // becomes current, audited in the journal. A press of the start button is heard after the loop acted:
+  // its first row's save starts the job then (CarpetJob::row_saved).
+  void started_at_machine(const std::optional<Decision>& by) {
+    {
+      std::lock_guard<std::mutex> lock(job_mu_);
+      carpet_done_job_ = 0;
+    }
+    CarpetJob* job = record_.jobs();
+    if (job == nullptr) return;
+    try {
+      if (job->start(link_.rows.load(std::memory_order_relaxed))) {
+        log(Severity::kNotice, "%s: started at the machine%s%s", job->describe().c_str(), by ? " by " : "",
+            by ? by->who.c_str() : "");
+      }
+    } catch (const std::exception& e) {
+      log(Severity::kErr,
+          "the job queue was not written at the start (%s): the first row's save starts the job", e.what());
+    }
+  }
+
+  // The carpet's last row is on disk: the loom holds (done) for the cut-off; status says carpet_done until
+  // the next start.
+  void carpet_done(const sequencer::Counters& c) {
+    std::uint32_t id = 0;
+    if (const CarpetJob* q = record_.job_queue()) id = q->carpet_done_id();
+    const bool next_queued = record_.jobs() != nullptr;
+    {
+      std::lock_guard<std::mutex> lock(job_mu_);
+      carpet_done_job_ = id;
+      if (!next_queued) {
+        start_refusal_ =
+            "no carpet job to weave: job " + std::to_string(id) +
+            " is carpet_done and none is queued (add the next with loomctl job add while serve is "
+            "stopped)";
+      }
+    }
+    carpet_finished_ = true;  // the record ends the job with the row's event
+    log(Severity::kNotice,
+        "carpet done: job %u, its last row woven (rows %u): cut the carpet off and tie the fringe warp; the "
+        "next "
+        "queued job starts at the machine (ctl start)",
+        id, c.rows);
+  }
+
+  std::shared_ptr<const design::Design> armed_design() {
+    std::lock_guard<std::mutex> lock(job_mu_);
+    return armed_design_ ? armed_design_ : cfg_.recipe.design;
+  }
+
+  // The status line with the job: " job=N job_row=R/L", and state=carpet_done while the loom waits for
+  // the cut-off (or stands with nothing to weave).
+  std::string job_status(std::string line, const LoomView& v) {
+    std::uint32_t done_id = 0;
+    bool nothing = false;
+    {
+      std::lock_guard<std::mutex> lock(job_mu_);
+      done_id = carpet_done_job_;
+      nothing = !start_refusal_.empty();
+    }
+    if (const CarpetJob* q = record_.job_queue()) {
+      if (done_id == 0 && nothing) done_id = q->carpet_done_id();
+      if (!line.empty() && line.back() == '\n') line.pop_back();
+      if (done_id != 0 && (v.state == sequencer::State::kDone || v.state == sequencer::State::kIdle)) {
+        const std::string from = std::string("state=") + sequencer::state_name(v.state) + " ";
+        if (const auto at = line.find(from); at != std::string::npos)
+          line.replace(at, from.size(), "state=carpet_done ");
+        line += " carpet_done_job=" + std::to_string(done_id);
+      } else {
+        line += q->status_fields();
+      }
+      line += "\n";
+    }
+    return line;
   }
 
   // One loom id, one publisher: another loom (or a recording replayed onto the live group) with this id
@@ -416,14 +557,59 @@ class Service {
     ro.link = &link_;
     ro.audit_buttons = true;
     ro.hold_when_finished = true;
+    {
+      std::lock_guard<std::mutex> lock(job_mu_);
+      ro.nothing_to_weave = !start_refusal_.empty();
+    }
     // The reporter thread's poll: the watchdog is fed only while the loop's tick moves, and a failed save
     // is retried, so freeing the disk lets the acknowledgement through.
     ro.reporter_poll = [this] { poll(); };
-    return session.run(ro, [this, &machine](const RunEvent& e) { on_event(e, machine); });
+    const RunResult res = session.run(ro, [this, &machine](const RunEvent& e) { on_event(e, machine); });
+    if (job_record_) {
+      try {
+        job_record_->finish(res.ticks, false);
+      } catch (const std::exception& ex) {
+        log(Severity::kWarning, "the production record's last commit failed: %s", ex.what());
+      }
+      job_record_.reset();
+    }
+    return res;
+  }
+
+  // The carpet job's production record (production.sqlite), kept from the job's start at the machine: a
+  // record that cannot be written is said once and the loom weaves on (the counters are the authority).
+  void record_job_event(const RunEvent& e, const Machine& machine) {
+    if (!job_record_) {
+      CarpetJob* job = record_.jobs();
+      if (job == nullptr || !job->started() || job_record_refused_) return;
+      try {
+        const job::Job j = job->job();
+        job_record_ =
+            std::make_unique<JobRecorder>(state_, j, j.progress.at_counter_rows, cfg_.sequencer.period_s,
+                                          !so_.hardware() && so_.pace != 1.0);
+      } catch (const std::exception& ex) {
+        job_record_refused_ = true;
+        log(Severity::kWarning, "no production record for this job: %s", ex.what());
+        return;
+      }
+    }
+    try {
+      job_record_->on_event(e, machine.knot_program(), machine.config().recipe.design.get());
+      if (carpet_finished_) {
+        job_record_->finish(e.tick, true);
+        job_record_.reset();
+        carpet_finished_ = false;
+      }
+    } catch (const std::exception& ex) {
+      log(Severity::kWarning, "the production record stops here: %s", ex.what());
+      job_record_.reset();
+      job_record_refused_ = true;
+    }
   }
 
   void save_counters(const sequencer::Counters& c) {
     record_.save(c);
+    if (record_.take_carpet_done()) carpet_done(c);
     failed_save_.reset();
     counters_unsaved_.store(false, std::memory_order_release);
   }
@@ -467,6 +653,12 @@ class Service {
     switch (e.kind) {
       case RunEvent::Kind::kRowDone:
         log_row(e);
+        // The magazines before the counters: a cut between the two leaves the levels low, never high.
+        try {
+          record_.save_magazines(e);
+        } catch (const std::exception& ex) {
+          log(Severity::kWarning, "the magazines' levels were not saved: %s", ex.what());
+        }
         break;
       case RunEvent::Kind::kPaused:
       case RunEvent::Kind::kResumed:
@@ -484,6 +676,7 @@ class Service {
         return;  // a press changes no counters: nothing to save
       case RunEvent::Kind::kWeaverRequest:
         heard_weaver_request(e, machine);
+        record_job_event(e, machine);
         return;  // nothing changed in the counters
       case RunEvent::Kind::kPickDone:
       case RunEvent::Kind::kKnotProgress:
@@ -498,6 +691,7 @@ class Service {
       log(Severity::kErr, "counters not saved: %s", ex.what());
       save_failed(e.counters);
     }
+    record_job_event(e, machine);
   }
 
   void log_row(const RunEvent& e) const {
@@ -685,6 +879,15 @@ class Service {
       relatch_;                   // the fault from before a restart, until the first session latches it
   bool relatch_pending_ = false;  // the session's first fault event is that one (not a new fault)
   DesignProgress design_progress_;
+  // The carpet job (arming and the reporter write, the control thread reads).
+  std::mutex job_mu_;
+  std::shared_ptr<const design::Design> armed_design_;  // the design the armed loom ties
+  std::string start_refusal_;          // why a start is refused now ("" when the loom may weave)
+  std::uint32_t carpet_done_job_ = 0;  // the job whose carpet was finished in this service, until a start
+  // The production record of the job being woven (reporter thread only).
+  std::unique_ptr<JobRecorder> job_record_;
+  bool job_record_refused_ = false;
+  bool carpet_finished_ = false;
   const SystemdNotifier systemd_;
   LoopWatchdog watchdog_;
   OperatorLink link_;

@@ -23,9 +23,9 @@ StateDirLock::StateDirLock(const std::string& state_dir, const std::string& loom
     ::close(fd_);
     fd_ = -1;
     if (err == EWOULDBLOCK) {
-      throw std::runtime_error("state directory " + state_dir + " is in use by another serve (" +
+      throw std::runtime_error("state directory " + state_dir + " is in use by another loomctl serve or weave (" +
                                (who.empty() ? "holder unknown" : who) + ", lock " + path_ +
-                               "): two serves on one state directory would share its counters and machine "
+                               "): two on one state directory would share its counters and machine "
                                "state; give each loom its own --state-dir and loom id");
     }
     throw std::runtime_error("cannot lock " + path_ + ": " + std::strerror(err));

@@ -176,3 +176,25 @@ TEST(OperatorPolicy, AServiceAcknowledgementIsRefusedWhileItCannotReArm) {
 }
 
 }  // namespace
+
+// A carpet finished with nothing queued: a start (button or command) never sets the idle loom moving;
+// from done it still ends the held session, so the service re-arms and reads the queue again.
+TEST(OperatorPolicy, NothingToWeaveRefusesAStartFromIdleOnly) {
+  const auto start = [](State s, bool nothing, bool held) {
+    PolicyInputs in;
+    in.commands = bit(Command::kStart);
+    in.state = s;
+    in.held_session = held;
+    in.nothing_to_weave = nothing;
+    return firmware::decide(in);
+  };
+  const Decision idle = start(State::kIdle, true, true);
+  EXPECT_FALSE(starts_anything(idle));
+  EXPECT_EQ(idle.refusal, Decision::Refusal::kStartNothingToWeave);
+  EXPECT_EQ(idle.end, Decision::End::kNone);
+  EXPECT_TRUE(start(State::kIdle, false, true).start);
+  EXPECT_EQ(start(State::kDone, true, true).end, Decision::End::kStartRequested);
+  // Paused in a row of a job: a start resumes it (the job is being woven; nothing_to_weave is not set then,
+  // and if it were, a resume is not a new carpet).
+  EXPECT_TRUE(start(State::kPaused, true, true).start);
+}

@@ -46,6 +46,10 @@ struct PolicyInputs {
   bool estop_ok = true;
   hal::LinkRecovery link_recovery = hal::LinkRecovery::kHealthy;
   bool last_save_failed = false;  // the counters file lags what was woven
+  // The service's carpet job queue has nothing to weave (the last job is carpet_done, none queued): a
+  // start from idle is refused (the loom waits for the cut-off and the next job); from done it still ends
+  // the session, so the owner re-arms and looks at the queue again.
+  bool nothing_to_weave = false;
 };
 
 struct Decision {
@@ -66,9 +70,10 @@ struct Decision {
   End end = End::kNone;
   enum class Refusal : std::uint8_t {
     kNone,
-    kAckLinkDown,         // the controller is off the bus or a lost node is still silent
-    kAckEStopOpen,        // the e-stop chain is still open
-    kAckCountersUnsaved,  // the last save failed: re-arming from the file would weave rows again
+    kAckLinkDown,          // the controller is off the bus or a lost node is still silent
+    kAckEStopOpen,         // the e-stop chain is still open
+    kAckCountersUnsaved,   // the last save failed: re-arming from the file would weave rows again
+    kStartNothingToWeave,  // the job queue has no job to weave
   };
   Refusal refusal = Refusal::kNone;
   std::uint32_t overridden = 0;  // starting commands dropped because a stopping one came in the same tick

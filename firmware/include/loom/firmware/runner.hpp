@@ -111,6 +111,10 @@ struct RunEvent {
   Command button =
       Command::kStart;  // kButton: the I/O module's button pressed (audit_buttons); kNext: the pedal
   sequencer::WeaverRequest request{};  // kWeaverRequest
+  // kRowDone on a loom with knotting heads: the magazines' levels as the loom counts them at the row's end
+  // (kept in the state directory, so a restart starts from them).
+  bool stock_known = false;
+  sequencer::MagazineLevels stock{};
 };
 // Run events waiting for the reporter (real time only: in virtual time the handler runs in place and no
 // ring is allocated). An event is at most one per row, pick, pause, resume or fault,
@@ -173,6 +177,8 @@ struct RunOptions {
   // weaver's row-knotted pedal — is also audited as a RunEvent::kButton (serve).
   bool audit_buttons = false;
   bool hold_when_finished = false;
+  // The carpet job queue has nothing to weave: a start from idle is refused (PolicyInputs).
+  bool nothing_to_weave = false;
   // Called on the reporter thread every few milliseconds in real time, between ticks every 100 ms of
   // machine time in virtual time (the service's watchdog, failed saves tried again). Never from the RT loop.
   std::function<void()> reporter_poll;

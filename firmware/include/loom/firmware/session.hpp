@@ -19,8 +19,10 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "loom/config/config.hpp"
+#include "loom/firmware/carpet_job.hpp"
 #include "loom/firmware/counter_store.hpp"
 #include "loom/firmware/design_book.hpp"
 #include "loom/firmware/machine.hpp"
@@ -109,8 +111,25 @@ class ProductionRecord {
   // Arming a loom that must count: the counters written once before anything moves. ConfigError when
   // the file cannot be written ("refusing to arm").
   void prove_writable(const sequencer::Counters& c) const;
+  // The carpet job queue of a state directory: while it has a job to weave, the job's progress replaces
+  // the design book's (the design is the job's) and every row saved is credited to the job.
+  void weave_jobs(std::unique_ptr<CarpetJob> jobs) { jobs_ = std::move(jobs); }
+  CarpetJob* jobs() const { return jobs_ && jobs_->in_use() ? jobs_.get() : nullptr; }
+  CarpetJob* job_queue() const { return jobs_.get(); }  // also when it has nothing to weave
+  // The carpet's last row was saved (the job is carpet_done): true once, then false.
+  bool take_carpet_done() { return std::exchange(carpet_done_, false); }
+  // The magazines' levels (magazines.txt beside the counters, loom::job::YarnStock), for a loom with
+  // knotting heads that keeps its counters: read at arming, written at every row's end, so a restart starts
+  // from the levels before it instead of full magazines.
+  void keep_magazines(const LoomConfig& cfg);
+  // The levels to arm with; nullopt (start full) when there is no file yet or it is for other magazines,
+  // said through `say`. ConfigError on a file that is not a magazines file.
+  std::optional<sequencer::MagazineLevels> load_magazines(const Say& say) const;
+  // A row's end (kRowDone with stock_known): the levels written durably. Throws as the counters' save does.
+  void save_magazines(const RunEvent& e) const;
   // Arming: the recipe's design made the active one at `counter_rows`; returns the rows of it woven
-  // before (0 without a design or without a record). ConfigError when the book cannot be read or written.
+  // before (0 without a design or without a record). With a job: the job's rows woven. ConfigError when
+  // the book cannot be read or written.
   std::uint64_t activate_design(std::uint32_t counter_rows);
   // A new session's handshake: the loop is told that `c` is on disk (a fresh RowSaves).
   void begin_session(const sequencer::Counters& c);
@@ -127,6 +146,11 @@ class ProductionRecord {
   std::unique_ptr<CounterStore> store_;
   std::unique_ptr<DesignBook> book_;
   std::unique_ptr<RowSaves> row_saves_;
+  std::unique_ptr<CarpetJob> jobs_;
+  bool carpet_done_ = false;
+  std::string magazines_path_;  // "" when not kept
+  int heads_ = 0, slots_ = 0;
+  std::int32_t knots_per_slot_ = 0;
 };
 
 // Where the design stands, in words: "design NAME (W x H knots): row R to knot next[, repeat N]".

@@ -31,6 +31,9 @@
 
 namespace loom::sequencer {
 
+// Knots of yarn left in each slot of each head's magazine ([head][slot]).
+using MagazineLevels = std::array<std::array<std::int32_t, kMaxMagazineSlots>, hal::kMaxKnottingHeads>;
+
 // What the loom asks of the weaver while it waits (lamp amber, buzzer): answered by the weaver's pedal or
 // `ctl next` once done.
 enum class WeaverAsk : std::uint8_t {
@@ -131,6 +134,9 @@ class RowKnotter {
   int cycle() const noexcept { return j_; }  // the knot cycle in progress (0-based)
   // RT-safe. Yarn left in slot `slot` of head `head`'s magazine, in knots, as the loom counts it (-1 when
   // unknown: before the first row or out of range).
+  // Not RT (arming, before the first row): the magazines' levels kept from before a restart (knots per
+  // slot, [head][slot]; a negative level is read as empty) instead of full magazines at the first row.
+  void restore_stock(const MagazineLevels& levels) noexcept;
   std::int32_t stock(int head, int slot) const noexcept {
     if (!stock_known_ || head < 0 || head >= heads_ || slot < 0 || slot >= kMaxMagazineSlots) return -1;
     return stock_[static_cast<std::size_t>(head)][static_cast<std::size_t>(slot)];

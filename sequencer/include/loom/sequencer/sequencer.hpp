@@ -212,6 +212,8 @@ class Sequencer {
   const KnotGuard& knot_guard() const noexcept { return interlock_ctx_.knot; }
   // The knotting heads' progress in the row (cycle, requests, magazines).
   const RowKnotter& knotter() const noexcept { return knotter_; }
+  // Not RT (arming): the magazines' levels from before a restart (RowKnotter::restore_stock).
+  void restore_magazines(const MagazineLevels& levels) noexcept { knotter_.restore_stock(levels); }
   // RT-safe. The knot cycle the heads are on (0-based) while knotting.
   int knot_cycle() const noexcept { return knotter_.cycle(); }
 

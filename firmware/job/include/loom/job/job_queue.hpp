@@ -118,6 +118,8 @@ class JobQueue {
   // The design file still has the bytes the job was added with. JobError "the design file changed under
   // job N: hash X, was Y (PATH)" or that it cannot be read: never silently mixed.
   static void check_design(const Job& job);
+  // The same check, returning the bytes it hashed (read once: what is woven is what was checked).
+  static std::string read_checked_design(const Job& job);
   // Every colour of the job is in a slot of `loom`'s magazines (the start's check: the magazines may have
   // been changed since the job was added). JobError naming every colour in no slot.
   static void check_yarn(const Job& job, const firmware::LoomConfig& loom);
