@@ -16,6 +16,7 @@
 
 #include "loom/firmware/carpet_png.hpp"
 #include "loom/firmware/session.hpp"
+#include "loom/firmware/sim_weaver.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/report/run_report.hpp"
 
@@ -399,13 +400,9 @@ int weave(const WeaveArgs& a, const Say& say) {
   ro.stop_flag = &g_stop;
   ro.stop_now_flag = &g_stop_now;
   ro.pause_flag = &g_pause;
-  ro.simulated_knotting_s = a.knotting_s;
+  if (ro.sim_weaver != nullptr) ro.sim_weaver->knot_rows_after(a.knotting_s);
   reporter.pace_retries(ro.realtime, ro.pace);
   ro.reporter_poll = [&reporter] { reporter.retry_save(); };
-  if (machine.knot_program() != nullptr && !so.hardware()) {
-    ro.weaver_sink = Machine::simulated_weaver_sink;
-    ro.weaver_sink_ctx = &machine;
-  }
   const RunResult res = session.run(ro, [&reporter](const RunEvent& e) { reporter(e); });
 
   // ---- report ----
