@@ -3,15 +3,18 @@
 
 #include <png.h>
 
+#include <algorithm>
 #include <stdexcept>
 #include <vector>
 
 namespace loom::firmware {
 
 CarpetCheck write_carpet_png(const sim_hal::SimKnotter& carpet, const sequencer::KnotProgram& program,
-                             const design::Design& design, std::uint32_t first_row, const std::string& path) {
+                             const design::Design& design, std::uint32_t first_row, const std::string& path,
+                             int rows_woven) {
   CarpetCheck c;
-  c.rows = carpet.rows();
+  c.rows = std::max(carpet.rows(), rows_woven);
+  c.unrecorded = static_cast<int>(carpet.knots_beyond());
   const int w = carpet.knots_per_row();
   // The colour of each magazine slot, from the design's palette (slots hold palette codes).
   std::vector<std::uint32_t> slot_rgb(static_cast<std::size_t>(program.slots()), 0);
@@ -25,7 +28,7 @@ CarpetCheck write_carpet_png(const sim_hal::SimKnotter& carpet, const sequencer:
   for (int r = 0; r < c.rows; ++r) {
     const int y = h - 1 - r;  // the first row woven at the bottom, as the design file draws it
     for (int k = 0; k < w; ++k) {
-      const sim_hal::KnotCell& cell = carpet.cell(r, k);
+      const sim_hal::KnotCell cell = carpet.cell(r, k);
       png_byte* px = &rgba[(static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(k)) * 4];
       const int want = program.slot(first_row + static_cast<std::uint32_t>(r), k);
       if (cell.ties == 0) {

@@ -8,6 +8,7 @@
 #include "loom/drivers/can_link_info.hpp"
 #include "loom/drivers/configure_clock.hpp"
 #include "loom/firmware/sim_heads.hpp"
+#include "loom/firmware/sim_weaver.hpp"
 #include "loom/motion/errors.hpp"
 
 namespace loom::firmware {
@@ -46,6 +47,7 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
     build_can_hal(opt);
   } else {
     hal_ = std::make_unique<hal::PortHal>(*sim_, *sim_);
+    sim_weaver_ = std::make_unique<SimWeaver>(*sim_, cfg_.sequencer.period_s);
   }
 
   if (opt.telemetry) {
@@ -88,14 +90,7 @@ void Machine::build_knotting(const MachineOptions& opt, std::uint32_t counter_ro
 }
 
 void Machine::simulated_weaver_sink(void* machine, const sequencer::WeaverRequest& r) noexcept {
-  sim_hal::WeaverTask t;
-  t.kind = r.ask == sequencer::WeaverAsk::kReload      ? sim_hal::WeaverTask::Kind::kReload
-           : r.ask == sequencer::WeaverAsk::kCheckKnot ? sim_hal::WeaverTask::Kind::kCheckKnot
-                                                       : sim_hal::WeaverTask::Kind::kTieByHand;
-  t.head = r.head;
-  t.knot = r.knot;
-  t.slot = r.slot;
-  static_cast<Machine*>(machine)->sim().ask_weaver(t);
+  static_cast<Machine*>(machine)->sim().ask_weaver(SimWeaver::task_for(r));
 }
 
 // The CAN HAL: the CiA 402 drives and the CiA 401 I/O modules on their buses (or, only when asked for on

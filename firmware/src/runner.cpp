@@ -19,6 +19,7 @@
 #include <thread>
 
 #include "loom/firmware/latency_histogram.hpp"
+#include "loom/firmware/sim_weaver.hpp"
 #include "loom/sequencer/operator_requests.hpp"
 #include "loom/telemetry/spsc_ring.hpp"
 #include "loom/telemetry/telemetry.hpp"
@@ -229,11 +230,7 @@ class LoopBody {
     }
     cmds |= take_presses(tick);
     cmds |= take_signals();
-    if (opt_.simulated_knotting_s > 0.0) {
-      knotting_wait_ = seq_.state() == sequencer::State::kAwaitKnotting ? knotting_wait_ + 1 : 0;
-      if (static_cast<double>(knotting_wait_) * opt_.period_s >= opt_.simulated_knotting_s)
-        seq_.request_row_knotted();
-    }
+    if (opt_.sim_weaver != nullptr) opt_.sim_weaver->on_tick(seq_);
     bool last_save_failed = false;
     if (opt_.row_saves != nullptr) {
       const std::uint32_t on_disk = opt_.row_saves->rows_on_disk.load(std::memory_order_acquire);
@@ -409,7 +406,7 @@ class LoopBody {
         RunEvent e = base_event(RunEvent::Kind::kWeaverRequest, tick);
         e.request = r;
         emit(e);
-        if (opt_.weaver_sink != nullptr) opt_.weaver_sink(opt_.weaver_sink_ctx, r);
+        if (opt_.sim_weaver != nullptr) opt_.sim_weaver->answer(r);
       }
     }
     // A pause and its resume in one tick (never seen) cancel out, as the state shows.
@@ -443,8 +440,7 @@ class LoopBody {
   LoopStats& stats_;
   telemetry::Telemetry* telemetry_;  // non-null: virtual time, lossless telemetry (wait before the tick)
   bool stop_sent_ = false, stop_now_sent_ = false, exit_pending_ = false;
-  bool pause_flag_was_ = false;     // pause_flag as last seen
-  std::int64_t knotting_wait_ = 0;  // ticks the loom has waited for the simulated weaver
+  bool pause_flag_was_ = false;  // pause_flag as last seen
 };
 
 // Touches `bytes` of this thread's stack so the loop never takes a first-touch page fault on it.

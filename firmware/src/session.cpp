@@ -282,6 +282,7 @@ RunOptions Session::run_options(ProductionRecord* record) const {
   ro.cpu = opt_.cpu;
   ro.overrun_stop_after = opt_.overrun_stop.value_or(opt_.hardware() ? cfg.run.overrun_stop_after : 0);
   ro.row_saves = record != nullptr ? record->row_saves() : nullptr;
+  ro.sim_weaver = machine_->sim_weaver();  // simulation: the weaver answers the loom's requests
   return ro;
 }
 

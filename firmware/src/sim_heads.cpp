@@ -31,6 +31,10 @@ sim_hal::SimKnotting sim_knotting(const sequencer::SequencerConfig& s) {
   k.in_warp_from_rad = g.in_warp_from_rad;
   k.in_warp_to_rad = g.in_warp_to_rad;
   k.full_turn = g.full_turn;
+  // The carpet's length, so the simulator's record of it is sized here, before the tick: the run's last row
+  // (the sequencer stops after it) or, with no end, a pass of the design.
+  k.last_row = s.rows_to_weave;
+  k.design_rows = p.design_rows();
   return k;
 }
 

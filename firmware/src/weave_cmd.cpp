@@ -19,6 +19,7 @@
 #include "loom/firmware/job_recorder.hpp"
 #include "loom/firmware/serve/state_lock.hpp"
 #include "loom/firmware/session.hpp"
+#include "loom/firmware/sim_weaver.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/report/run_report.hpp"
 
@@ -370,15 +371,24 @@ void write_carpet(const WeaveArgs& a, const LoomConfig& cfg, Machine& m) {
   if (k == nullptr || a.report.empty()) return;
   const std::string png = a.report + "/carpet.png";
   try {
-    const CarpetCheck cc = write_carpet_png(*k, *m.knot_program(), *cfg.recipe.design, k->first_row(), png);
-    std::printf("carpet: %s: %d rows from production row %u (design row %d), %d knots (%d by hand); %s\n",
-                png.c_str(), cc.rows, k->first_row(), m.knot_program()->design_row(k->first_row()) + 1,
-                cc.knots, cc.by_hand,
-                cc.equal() ? "equals the design knot for knot"
-                           : ("DIFFERS from the design: " + std::to_string(cc.missing) + " missing, " +
-                              std::to_string(cc.wrong) + " wrong colour, " + std::to_string(cc.doubled) +
-                              " tied twice")
-                                 .c_str());
+    // Every row the counters say was woven since the carpet began is compared, knotted or not.
+    const std::uint32_t woven = m.sequencer().counters().rows;
+    const int rows_woven = woven > k->first_row() ? static_cast<int>(woven - k->first_row()) : 0;
+    const CarpetCheck cc =
+        write_carpet_png(*k, *m.knot_program(), *cfg.recipe.design, k->first_row(), png, rows_woven);
+    std::printf(
+        "carpet: %s: %d rows from production row %u (design row %d), %d knots (%d by hand); %s\n",
+        png.c_str(), cc.rows, k->first_row(), m.knot_program()->design_row(k->first_row()) + 1, cc.knots,
+        cc.by_hand,
+        cc.equal()
+            ? "equals the design knot for knot"
+            : ("DIFFERS from the design: " + std::to_string(cc.missing) + " missing, " +
+               std::to_string(cc.wrong) + " wrong colour, " + std::to_string(cc.doubled) + " tied twice" +
+               (cc.unrecorded == 0
+                    ? std::string()
+                    : ", " + std::to_string(cc.unrecorded) + " tied beyond the simulator's record of " +
+                          std::to_string(k->capacity_rows()) + " rows (scene knotter.carpet_rows)"))
+                  .c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "loomctl: %s\n", e.what());
   }
@@ -508,13 +518,9 @@ int weave(const WeaveArgs& a, const Say& say) {
   ro.stop_flag = &g_stop;
   ro.stop_now_flag = &g_stop_now;
   ro.pause_flag = &g_pause;
-  ro.simulated_knotting_s = a.knotting_s;
+  if (ro.sim_weaver != nullptr) ro.sim_weaver->knot_rows_after(a.knotting_s);
   reporter.pace_retries(ro.realtime, ro.pace);
   ro.reporter_poll = [&reporter] { reporter.retry_save(); };
-  if (machine.knot_program() != nullptr && !so.hardware()) {
-    ro.weaver_sink = Machine::simulated_weaver_sink;
-    ro.weaver_sink_ctx = &machine;
-  }
   // The job's production record (production.sqlite in the state directory).
   std::unique_ptr<JobRecorder> job_record;
   if (job != nullptr) {

@@ -13,37 +13,112 @@ constexpr int kPedalTicks = 10;          // the weaver's pedal press (longer tha
 }  // namespace
 
 namespace {
-void fresh(PersistedCarpet& c, const SimKnotting& m, std::uint32_t first_row) {
+// A knot's cell in one byte: bits 0-4 its slot + 1 (0: no knot), bits 5-6 its ties (up to 3), bit 7 by hand.
+constexpr std::uint8_t kSlotMask = 0x1f, kTiesShift = 5, kTiesMask = 0x3, kByHand = 0x80;
+
+KnotCell unpack(std::uint8_t b) noexcept {
+  KnotCell c;
+  c.slot = static_cast<std::int8_t>(static_cast<int>(b & kSlotMask) - 1);
+  c.ties = static_cast<std::uint8_t>((b >> kTiesShift) & kTiesMask);
+  c.by_hand = (b & kByHand) != 0;
+  return c;
+}
+
+void fresh(PersistedCarpet& c, const SimKnotting& m, std::uint32_t first_row, std::size_t room) {
   c.magic = PersistedCarpet::kMagic;
   c.first_row = first_row;
   c.knots_per_row = m.knots_per_row;
   c.row = 0;
   c.row_has_knots = 0;
+  c.knots_beyond = 0;
   for (auto& head : c.stock) head.fill(m.knots_per_slot);
-  c.cells.fill(KnotCell{});
+  std::fill_n(knot_cells(c), room, std::uint8_t{0});
 }
 }  // namespace
 
+// The knotter's own carpet (no sim-state file): a buffer of header and cells, grown at configure time.
+class SimKnotter::OwnCarpet final : public CarpetKeeper {
+ public:
+  PersistedCarpet& reserve(std::size_t cells) override {
+    if (cells > room_ || words_.empty()) {
+      std::vector<std::uint64_t> grown((sizeof(PersistedCarpet) + cells + 7) / 8, 0);
+      if (!words_.empty()) std::copy(words_.begin(), words_.end(), grown.begin());
+      words_ = std::move(grown);
+      room_ = cells;
+    }
+    return *reinterpret_cast<PersistedCarpet*>(words_.data());
+  }
+  std::size_t room() const noexcept override { return room_; }
+
+ private:
+  std::vector<std::uint64_t> words_;  // 8-byte aligned, as the header needs
+  std::size_t room_ = 0;
+};
+
 SimKnotter::SimKnotter(const SimKnotting& m, const Knotter& k, double period_s)
-    : m_(m), k_(k), period_s_(period_s), own_(std::make_unique<PersistedCarpet>()), st_(own_.get()) {
-  capacity_rows_ = std::min(std::max(1, k.carpet_rows),
-                            static_cast<int>(PersistedCarpet::kCells / static_cast<std::size_t>(std::max(1, m.knots_per_row))));
-  fresh(*st_, m_, 0);
+    : m_(m), k_(k), period_s_(period_s), own_(std::make_unique<OwnCarpet>()),
+      beyond_(static_cast<std::size_t>(std::max(0, m.knots_per_row)), 0) {
+  keep_in(*own_, 0, false);
   holding_.fill(-1);
 }
 
-void SimKnotter::persist_in(PersistedCarpet& persisted, std::uint32_t counter_rows) {
-  const bool ours = persisted.magic == PersistedCarpet::kMagic && persisted.knots_per_row == m_.knots_per_row &&
-                    persisted.row >= 0 && persisted.row <= capacity_rows_;
-  if (!ours) fresh(persisted, m_, counter_rows);
-  st_ = &persisted;
+SimKnotter::~SimKnotter() = default;
+
+// Rows the record needs for a carpet begun at production row `first_row` with `rows_knotted` rows in it.
+int SimKnotter::rows_needed(std::uint32_t first_row, int rows_knotted) const noexcept {
+  if (k_.carpet_rows > 0) return k_.carpet_rows;
+  long long rows = 0;
+  if (m_.last_row > first_row) {
+    rows = static_cast<long long>(m_.last_row - first_row);
+  } else {
+    rows = static_cast<long long>(rows_knotted) + std::max(m_.design_rows, Knotter::kUnboundedRows);
+  }
+  return static_cast<int>(std::clamp<long long>(std::max<long long>(rows, rows_knotted), 1, 1'000'000));
+}
+
+void SimKnotter::keep_in(CarpetKeeper& keeper, std::uint32_t counter_rows, bool adopt) {
+  const std::size_t width = static_cast<std::size_t>(std::max(1, m_.knots_per_row));
+  const std::size_t had = keeper.room();
+  const PersistedCarpet* old = had > 0 ? &keeper.reserve(had) : nullptr;
+  const bool ours = adopt && old != nullptr && old->magic == PersistedCarpet::kMagic &&
+                    old->knots_per_row == m_.knots_per_row && old->row >= 0 && old->row_has_knots >= 0 &&
+                    (static_cast<std::size_t>(old->row) <= had / width || old->knots_beyond > 0);
+  const std::uint32_t first = ours ? old->first_row : counter_rows;
+  const int knotted = ours ? old->row + (old->row_has_knots ? 1 : 0) : 0;
+  const std::size_t rows = static_cast<std::size_t>(rows_needed(first, knotted));
+  // Room for every row, never less than the keeper has (a carpet kept is never cut short).
+  PersistedCarpet& c = keeper.reserve(std::max(had, rows * width));
+  const std::size_t room = keeper.room();
+  if (!ours) fresh(c, m_, counter_rows, room);
+  st_ = &c;
+  cells_ = knot_cells(c);
+  capacity_rows_ = static_cast<int>(std::min<std::size_t>(room / width, rows));
+  std::fill(beyond_.begin(), beyond_.end(), std::uint8_t{0});
+}
+
+void SimKnotter::persist_in(CarpetKeeper& keeper, std::uint32_t counter_rows) {
+  keep_in(keeper, counter_rows, true);
   own_.reset();
 }
 
-const KnotCell& SimKnotter::cell(int row, int knot) const noexcept {
-  static const KnotCell kNone{};
-  if (row < 0 || row >= capacity_rows_ || knot < 0 || knot >= m_.knots_per_row) return kNone;
-  return st_->cells[static_cast<std::size_t>(row) * static_cast<std::size_t>(m_.knots_per_row) + static_cast<std::size_t>(knot)];
+void SimKnotter::start_at_row(std::uint32_t counter_rows) {
+  if (own_) keep_in(*own_, counter_rows, false);
+}
+
+KnotCell SimKnotter::cell(int row, int knot) const noexcept {
+  if (row < 0 || row >= capacity_rows_ || knot < 0 || knot >= m_.knots_per_row) return KnotCell{};
+  return unpack(cells_[static_cast<std::size_t>(row) * static_cast<std::size_t>(m_.knots_per_row) +
+                       static_cast<std::size_t>(knot)]);
+}
+
+std::uint8_t& SimKnotter::current(int knot) noexcept {
+  if (st_->row >= capacity_rows_) return beyond_[static_cast<std::size_t>(knot)];
+  return cells_[static_cast<std::size_t>(st_->row) * static_cast<std::size_t>(m_.knots_per_row) +
+                static_cast<std::size_t>(knot)];
+}
+
+std::uint8_t SimKnotter::current_cell(int knot) const noexcept {
+  return const_cast<SimKnotter*>(this)->current(knot);
 }
 
 int SimKnotter::knot_under(int head, double carriage) const noexcept {
@@ -62,15 +137,12 @@ bool SimKnotter::in_warp(double knotter) const noexcept {
   return rel > m_.in_warp_from_rad && rel < m_.in_warp_to_rad;
 }
 
-void SimKnotter::tie(int row, int knot, int slot, bool by_hand) noexcept {
-  if (row >= capacity_rows_) {
-    ++overflow_;
-    return;
-  }
-  KnotCell& c = st_->cells[static_cast<std::size_t>(row) * static_cast<std::size_t>(m_.knots_per_row) + static_cast<std::size_t>(knot)];
-  if (c.ties < 255) ++c.ties;
-  c.slot = static_cast<std::int8_t>(slot);
-  c.by_hand = by_hand;
+void SimKnotter::tie(int knot, int slot, bool by_hand) noexcept {
+  if (st_->row >= capacity_rows_) ++st_->knots_beyond;  // tied, but past the record: the check says so
+  std::uint8_t& b = current(knot);
+  const int ties = std::min<int>(kTiesMask, ((b >> kTiesShift) & kTiesMask) + 1);
+  b = static_cast<std::uint8_t>((slot + 1) & kSlotMask) | static_cast<std::uint8_t>(ties << kTiesShift) |
+      (by_hand ? kByHand : std::uint8_t{0});
   st_->row_has_knots = 1;
 }
 
@@ -99,7 +171,7 @@ void SimKnotter::on_outputs(const hal::DigitalOutputs& out, const std::array<dou
     // the knot is tied at the knot under the head, unless it slips off.
     if (out.cutter[hh] && !cutter_[hh] && holding_[hh] >= 0) {
       const int k = knot_under(h, carriage);
-      if (in_warp(knotter) && k >= 0 && rng.uniform() >= k_.miss_probability) tie(st_->row, k, holding_[hh], false);
+      if (in_warp(knotter) && k >= 0 && rng.uniform() >= k_.miss_probability) tie(k, holding_[hh], false);
       holding_[hh] = -1;  // cut: the rest of the yarn stays in the magazine's feed
     }
     if (!out.gripper_close[hh]) holding_[hh] = -1;  // opened: whatever it held drops
@@ -118,10 +190,10 @@ void SimKnotter::on_outputs(const hal::DigitalOutputs& out, const std::array<dou
         break;
       case WeaverTask::Kind::kCheckKnot:
         // A knot that is there is left alone (it was tied before the power failed); a missing one is tied.
-        if (task_.knot >= 0 && task_.knot < m_.knots_per_row && cell(st_->row, task_.knot).ties > 0) break;
+        if (task_.knot >= 0 && task_.knot < m_.knots_per_row && ((current_cell(task_.knot) >> kTiesShift) & kTiesMask) > 0) break;
         [[fallthrough]];
       case WeaverTask::Kind::kTieByHand:
-        if (task_.knot >= 0 && task_.knot < m_.knots_per_row) tie(st_->row, task_.knot, task_.slot, true);
+        if (task_.knot >= 0 && task_.knot < m_.knots_per_row) tie(task_.knot, task_.slot, true);
         // At the head the weaver sees an empty slot (why it missed) and fills it.
         if (task_.head >= 0 && task_.head < m_.heads && task_.slot >= 0 && task_.slot < m_.slots &&
             st_->stock[static_cast<std::size_t>(task_.head)][static_cast<std::size_t>(task_.slot)] <= 0) {
@@ -138,7 +210,7 @@ void SimKnotter::inputs(const std::array<double, hal::kMaxAxes>& position, hal::
   const double carriage = position[hal::index(hal::CoreAxis::kCarriage)];
   for (int h = 0; h < m_.heads; ++h) {
     const int k = knot_under(h, carriage);
-    io.yarn_present[static_cast<std::size_t>(h)] = k >= 0 && cell(st_->row, k).ties > 0;
+    io.yarn_present[static_cast<std::size_t>(h)] = k >= 0 && ((current_cell(k) >> kTiesShift) & kTiesMask) > 0;
   }
   io.row_knotted = pedal_left_ > 0;
 }
@@ -146,6 +218,7 @@ void SimKnotter::inputs(const std::array<double, hal::kMaxAxes>& position, hal::
 void SimKnotter::on_weft() noexcept {
   if (st_->row_has_knots == 0) return;
   st_->row_has_knots = 0;
+  if (st_->row >= capacity_rows_) std::fill(beyond_.begin(), beyond_.end(), std::uint8_t{0});
   ++st_->row;
 }
 

@@ -13,14 +13,45 @@
 
 namespace loom::sim_hal {
 namespace {
-// The machine, then (page-aligned) the knotting heads' carpet.
+// The machine, then (page-aligned) the knotting heads' carpet: its header, then its cells (as many as the
+// carpet has room for: the file's size says how many).
 constexpr std::size_t kCarpetOffset = (sizeof(PersistedMachine) + 4095) / 4096 * 4096;
-constexpr std::size_t kFileSize = kCarpetOffset + sizeof(PersistedCarpet);
+constexpr std::size_t kMinFileSize = kCarpetOffset + sizeof(PersistedCarpet);
+constexpr std::size_t kMaxFileSize = std::size_t{1} << 32;  // 4 GiB: far beyond any carpet (a 1e6-row one is 360 MB)
 }  // namespace
 
-SimStateFile::SimStateFile(const std::string& path) {
-  // Never truncate or reinterpret a file that is not ours: an existing file must be exactly one
-  // PersistedMachine carrying the magic (or empty, as a fresh file is).
+void SimStateFile::map(std::size_t bytes) {
+  void* p = ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_SHARED, fd_, 0);
+  if (p == MAP_FAILED) throw std::runtime_error("cannot map sim state file " + path_ + ": " + std::strerror(errno));
+  map_ = static_cast<PersistedMachine*>(p);
+  carpet_ = reinterpret_cast<PersistedCarpet*>(static_cast<char*>(p) + kCarpetOffset);
+  size_ = bytes;
+  room_ = bytes - kMinFileSize;
+}
+
+PersistedCarpet& SimStateFile::reserve(std::size_t cells) {
+  if (cells <= room_) return *carpet_;
+  const std::size_t bytes = kMinFileSize + cells;
+  if (bytes > kMaxFileSize) {
+    throw std::runtime_error("sim state file " + path_ + ": a carpet of " + std::to_string(cells) +
+                             " knots is beyond the simulator's record");
+  }
+  // Blocks allocated before the file is mapped longer (as at creation): a full disk is a refusal here, not a
+  // SIGBUS in the tick. On failure the file and its mapping stay as they were.
+  if (const int rc = ::posix_fallocate(fd_, 0, static_cast<off_t>(bytes)); rc != 0) {
+    throw std::runtime_error("cannot allocate sim state file " + path_ + " for a carpet of " + std::to_string(cells) +
+                             " knots (" + std::to_string(bytes) + " bytes): " + std::strerror(rc));
+  }
+  ::munmap(map_, size_);
+  map_ = nullptr;
+  carpet_ = nullptr;
+  map(bytes);
+  return *carpet_;
+}
+
+SimStateFile::SimStateFile(const std::string& path) : path_(path) {
+  // Never truncate or reinterpret a file that is not ours: an existing file must start with one
+  // PersistedMachine carrying the magic, followed by a carpet (or be empty, as a fresh file is).
   fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
   if (fd_ < 0) throw std::runtime_error("cannot open sim state file " + path + ": " + std::strerror(errno));
   const auto refuse = [&](const std::string& why) {
@@ -30,30 +61,32 @@ SimStateFile::SimStateFile(const std::string& path) {
   };
   struct stat st {};
   if (::fstat(fd_, &st) != 0 || !S_ISREG(st.st_mode)) refuse("not a regular file");
-  if (st.st_size != 0 && st.st_size != static_cast<off_t>(kFileSize)) {
+  if (st.st_size != 0 &&
+      (st.st_size < static_cast<off_t>(kMinFileSize) || st.st_size > static_cast<off_t>(kMaxFileSize))) {
     refuse("not a loomctl sim-state file (" + std::to_string(st.st_size) + " bytes, expected " +
-           std::to_string(kFileSize) + "); not touched");
+           std::to_string(kMinFileSize) + " to " + std::to_string(kMaxFileSize) + "); not touched");
   }
+  const std::size_t bytes = st.st_size == 0 ? kMinFileSize : static_cast<std::size_t>(st.st_size);
   // The file's blocks are allocated now (posix_fallocate; a no-op where they exist), never left a sparse
   // hole (ftruncate): a store into a mapped hole on a full disk is a SIGBUS in the loop; here it is a
   // refusal before anything is armed.
   {
-    const int rc = ::posix_fallocate(fd_, 0, kFileSize);
+    const int rc = ::posix_fallocate(fd_, 0, static_cast<off_t>(bytes));
     if (rc != 0) {
       ::close(fd_);
       fd_ = -1;
       if (st.st_size == 0) ::unlink(path.c_str());  // ours and empty: leave no file a later run would adopt
-      throw std::runtime_error("cannot allocate sim state file " + path + " (" +
-                               std::to_string(kFileSize) + " bytes): " + std::strerror(rc));
+      throw std::runtime_error("cannot allocate sim state file " + path + " (" + std::to_string(bytes) +
+                               " bytes): " + std::strerror(rc));
     }
   }
-  void* p = ::mmap(nullptr, kFileSize, PROT_READ | PROT_WRITE, MAP_SHARED, fd_, 0);
-  if (p == MAP_FAILED) {
+  try {
+    map(bytes);
+  } catch (const std::runtime_error&) {
     ::close(fd_);
-    throw std::runtime_error("cannot map sim state file " + path + ": " + std::strerror(errno));
+    fd_ = -1;
+    throw;
   }
-  map_ = static_cast<PersistedMachine*>(p);
-  carpet_ = reinterpret_cast<PersistedCarpet*>(static_cast<char*>(p) + kCarpetOffset);
   if (st.st_size != 0) {
     const PersistedMachine& m = *map_;
     std::string why;
@@ -71,7 +104,7 @@ SimStateFile::SimStateFile(const std::string& path) {
       why = "shuttle position " + std::to_string(m.shuttle_x) + " m is not plausible";
     }
     if (!why.empty()) {
-      ::munmap(map_, kFileSize);
+      ::munmap(map_, size_);
       map_ = nullptr;
       carpet_ = nullptr;
       refuse(why);
@@ -80,7 +113,7 @@ SimStateFile::SimStateFile(const std::string& path) {
 }
 
 SimStateFile::~SimStateFile() {
-  if (map_ != nullptr) ::munmap(map_, kFileSize);
+  if (map_ != nullptr) ::munmap(map_, size_);
   if (fd_ >= 0) ::close(fd_);
 }
 

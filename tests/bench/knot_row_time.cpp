@@ -89,8 +89,7 @@ RowTime one_row(const std::string& dir, const Class& c, int heads, double period
     firmware::RunOptions ro;
     ro.period_s = lc.sequencer.period_s;
     ro.max_ticks = 5'000'000;
-    ro.weaver_sink = firmware::Machine::simulated_weaver_sink;
-    ro.weaver_sink_ctx = &m;
+    ro.sim_weaver = m.sim_weaver();
     firmware::run_loop(m.loop(), m.sequencer(), ro, [&](const firmware::RunEvent& e) {
       if (e.kind != firmware::RunEvent::Kind::kRowDone) return;
       t.ok = true;

@@ -90,8 +90,7 @@ Woven weave(const firmware::LoomConfig& cfg, const firmware::Scene& sc, std::uin
   firmware::RunOptions ro;
   ro.period_s = cfg.sequencer.period_s;
   ro.max_ticks = 400000;
-  ro.weaver_sink = firmware::Machine::simulated_weaver_sink;
-  ro.weaver_sink_ctx = &m;
+  ro.sim_weaver = m.sim_weaver();
   Woven w;
   firmware::run_loop(m.loop(), m.sequencer(), ro, [&](const firmware::RunEvent& e) {
     if (e.kind == firmware::RunEvent::Kind::kWeaverRequest) w.requests.push_back(e.request);

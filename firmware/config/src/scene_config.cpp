@@ -305,7 +305,8 @@ Scene parse_scene(const std::string& text, const std::string& source) {
     r.number("knotter.miss_probability", p.miss_probability, [](double v) { return in_range(v, 0.0, 1.0); });
     r.number("knotter.weaver_s", p.weaver_s, [](double v) { return in_range(v, 1e-3, 3600.0); });
     std::int64_t rows = p.carpet_rows;
-    r.integer("knotter.carpet_rows", rows, 1, 20000);
+    // 0: the record is as long as the run's carpet; N: an override (a deliberately short record).
+    r.integer("knotter.carpet_rows", rows, 0, 1'000'000);
     p.carpet_rows = static_cast<int>(rows);
     s.spec.knotter = p;
   }

@@ -23,6 +23,7 @@
 namespace loom::firmware {
 
 enum class HalKind { kSim, kSocketCan };
+class SimWeaver;
 
 struct MachineOptions {
   HalKind hal = HalKind::kSim;
@@ -75,8 +76,10 @@ class Machine {
   sim_hal::SimWorld& sim() { return *sim_; }  // configure-time: e.g. a power-cut handler for in-process runs
   const LoomConfig& config() const { return cfg_; }
   // RT-safe. The loom asks the weaver: with the simulated machine's knotter the simulated weaver answers
-  // (`machine` is this Machine; the shape fits RunOptions::weaver_sink).
+  // (`machine` is this Machine: for in-process tests that step the sequencer themselves).
   static void simulated_weaver_sink(void* machine, const sequencer::WeaverRequest& r) noexcept;
+  // The simulated weaver (null on hardware): what Session gives the runner, in weave and serve alike.
+  SimWeaver* sim_weaver() const { return sim_weaver_.get(); }
   // The design as the knotting heads tie it (null without heads).
   const sequencer::KnotProgram* knot_program() const { return knot_program_.get(); }
   const motion::KnotCycle* knot_cycle() const { return knot_cycle_.get(); }  // null without heads
@@ -92,6 +95,7 @@ class Machine {
   std::unique_ptr<sequencer::Sequencer> sequencer_;
   std::unique_ptr<sim_hal::SimStateFile> sim_state_;
   std::unique_ptr<sim_hal::SimWorld> sim_;
+  std::unique_ptr<SimWeaver> sim_weaver_;                      // the simulated HAL only
   std::vector<std::unique_ptr<drivers::SocketCanBus>> buses_;  // bus i = the i-th --iface name
   std::unique_ptr<drivers::CanAxisPort> can_port_;
   std::vector<std::unique_ptr<drivers::CanIoPort>> io_modules_;  // module k = can_io_configs()[k]

@@ -142,6 +142,8 @@ struct RowSaves {
   }
 };
 
+class SimWeaver;
+
 struct RunOptions {
   double period_s = 0.002;
   bool realtime = false;        // pace at the tick rate (always true with hardware)
@@ -154,12 +156,9 @@ struct RunOptions {
       nullptr;                                    // set asynchronously → safe stop at once (stop_requested)
   const std::atomic<bool>* pause_flag = nullptr;  // true → pause at the next safe point, false → resume
   RowSaves* row_saves = nullptr;                  // the counters-file handshake, when one is kept
-  // Simulation: a weaver who says "row knotted" this long after the loom starts waiting (knotting mode).
-  double simulated_knotting_s = 0.0;
-  // Knotting heads: called (on the loop's thread, RT-safe) with every request the loom makes of the weaver;
-  // the simulated machine's weaver answers them. Null: the weaver is a person at the panel.
-  void (*weaver_sink)(void* ctx, const sequencer::WeaverRequest& r) = nullptr;
-  void* weaver_sink_ctx = nullptr;
+  // Simulation: the simulated weaver (sim_weaver.hpp), called each tick and with every request the loom
+  // makes of the weaver (on the loop's thread, RT-safe). Null: the weaver is a person at the panel.
+  SimWeaver* sim_weaver = nullptr;
 
   // Real-time thread (realtime only).
   int fifo_priority = 80;     // SCHED_FIFO priority of the loop thread; 0 = SCHED_OTHER

@@ -23,7 +23,9 @@ struct PersistedMachine {
   static constexpr std::uint64_t kMagic = 0x4c4f4f4d53494d32ull;  // "LOOMSIM2"
 };
 
-class SimStateFile {
+// The file: the machine (one page), then the knotting heads' carpet (its header and one byte per knot), as
+// long as the carpet needs: a file without heads ends after the carpet's header; reserve() grows it.
+class SimStateFile final : public CarpetKeeper {
  public:
   // Configure-time only. Opens (creating) and maps `path`; throws std::runtime_error naming the path
   // when it cannot, and std::invalid_argument (nothing written) when the file exists but is not a
@@ -40,10 +42,18 @@ class SimStateFile {
   void store(const PersistedMachine& s) noexcept;
   // The knotting heads' persisted carpet and magazines, in the same file after the machine (the knotter
   // effect keeps them there directly: the carpet survives the power cut as the real one would).
-  PersistedCarpet* carpet() noexcept { return carpet_; }
+  CarpetKeeper* carpet() noexcept { return this; }
+  // Configure-time (CarpetKeeper). Grows the file (blocks allocated, never a sparse hole) and maps it again;
+  // throws std::runtime_error naming the path and size when the disk has no room (the file is left as it was).
+  PersistedCarpet& reserve(std::size_t cells) override;
+  std::size_t room() const noexcept override { return room_; }
 
  private:
+  void map(std::size_t bytes);
+  std::string path_;
   int fd_ = -1;
+  std::size_t size_ = 0;  // bytes mapped (the file's size)
+  std::size_t room_ = 0;  // knots of carpet after its header
   PersistedMachine* map_ = nullptr;
   PersistedCarpet* carpet_ = nullptr;
 };
