@@ -16,7 +16,7 @@ hil_require_vcan
 hil_find_binaries
 eds_dir=$(cd "$HIL_SRC/../drivers/eds" && pwd)
 hil_start_candump
-HIL_SIM_EXTRA=(--eds "$eds_dir/acme_ax400_dynamic.eds")
+HIL_SIM_EDS=$eds_dir/acme_ax400_dynamic.eds
 hil_start_sim_drives
 
 # The HIL loom with every axis' EDS named (relative to the loom file, as a builder writes it).

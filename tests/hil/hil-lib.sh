@@ -202,8 +202,11 @@ hil_start_sim_drives() {
   # must not starve them, so they run at a higher real-time priority where that is allowed.
   local rt=()
   chrt -f 90 true 2>/dev/null && rt=(chrt -f 90)
+  # HIL_SIM_EDS: the drives built from that EDS instead of a built-in personality.
+  local kind=(--personality "$HIL_PERSONALITY")
+  [[ -z ${HIL_SIM_EDS:-} ]] || kind=(--eds "$HIL_SIM_EDS")
   hil_spawn sim "${rt[@]}" "$HIL_SIM" --iface "$HIL_IFACE" --nodes "$HIL_NODES" --io-node "$HIL_IO_NODE" \
-    --io-control "$HIL_IO_CONTROL" --width-m 0.6 --personality "$HIL_PERSONALITY" \
+    --io-control "$HIL_IO_CONTROL" --width-m 0.6 "${kind[@]}" \
     --plant-cycle-ms "$HIL_PERIOD_MS" "${HIL_SIM_EXTRA[@]}"
   HIL_SIM_PID=$HIL_LAST_PID
   for n in ${HIL_NODES//,/ } $HIL_IO_NODE; do
