@@ -212,7 +212,7 @@ hil_start_sim_drives() {
   for n in ${HIL_NODES//,/ } $HIL_IO_NODE; do
     hil_expect "$mark" "$(printf '%03X' $((0x700 + n)))#00" 10 "boot-up of simulated node $n" >/dev/null
   done
-  hil_note "loom-sim-drive up ($HIL_PERSONALITY drives): nodes $HIL_NODES and I/O node $HIL_IO_NODE booted (pid $HIL_SIM_PID)"
+  hil_note "loom-sim-drive up (${HIL_SIM_EDS:+drives from }${HIL_SIM_EDS:-$HIL_PERSONALITY drives}): nodes $HIL_NODES and I/O node $HIL_IO_NODE booted (pid $HIL_SIM_PID)"
 }
 
 # hil_io_control WORDS... — what the simulated I/O node's e-stop chain and buttons see from now on.
