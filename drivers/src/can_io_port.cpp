@@ -100,18 +100,31 @@ Status CanIoPort::map_pdo(SdoClient& sdo, bool rx, int pdo, const std::vector<st
   const std::uint32_t cob = rx ? cob::rpdo(pdo + 1, id) : cob::tpdo(pdo + 1, id);
   const auto fail = [&](const Status& s) { return Status::error(who() + s.message()); };
 
-  bool fixed = false;
-  if (Status s = sdo.write(id, comm, 1, cob | od::kPdoInvalidBit, 4); !s) {
-    if (!interop_readback_code(sdo.last_abort())) return fail(s);
-    fixed = true;  // cannot even invalidate it: use it as it is
+  // A module configured from its EDS (only what differs is written): a PDO already carrying `wanted` is
+  // not re-mapped (no invalidate, no clear).
+  bool mapped = false;
+  if (sdo.skips_unchanged()) {
+    Result<std::uint32_t> n = sdo.read(id, map, 0);
+    mapped = n && n.value() == wanted.size();
+    for (std::size_t k = 0; mapped && k < wanted.size(); ++k) {
+      Result<std::uint32_t> e = sdo.read(id, map, static_cast<std::uint8_t>(k + 1));
+      mapped = e && e.value() == wanted[k];
+    }
   }
-  if (!fixed) {
+  bool fixed = false;
+  if (!mapped) {
+    if (Status s = sdo.write(id, comm, 1, cob | od::kPdoInvalidBit, 4); !s) {
+      if (!interop_readback_code(sdo.last_abort())) return fail(s);
+      fixed = true;  // cannot even invalidate it: use it as it is
+    }
+  }
+  if (!fixed && !mapped) {
     if (Status s = sdo.write(id, map, 0, 0, 1); !s) {
       if (!interop_readback_code(sdo.last_abort())) return fail(s);
       fixed = true;
     }
   }
-  if (!fixed) {
+  if (!fixed && !mapped) {
     for (std::size_t k = 0; k < wanted.size(); ++k) {
       if (Status s = sdo.write(id, map, static_cast<std::uint8_t>(k + 1), wanted[k], 4); !s) {
         if (refused != nullptr) *refused = wanted[k];  // the caller can say what needed it

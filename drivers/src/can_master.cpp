@@ -8,8 +8,10 @@
 
 #include "loom/drivers/can_error_frame.hpp"
 #include "loom/drivers/cob_id.hpp"
+#include "loom/drivers/eds_boot.hpp"
 #include "loom/drivers/emcy.hpp"
 #include "loom/drivers/nmt.hpp"
+#include "loom/drivers/node_description.hpp"
 #include "loom/drivers/sdo_client.hpp"
 
 namespace loom::drivers {
@@ -143,7 +145,19 @@ Status CanMaster::bring_up(CanBus& bus, ConfigureClock& clock) {
 
   SdoClient sdo(bus, clock, static_cast<std::int64_t>(config_.sdo_timeout_s * 1e6), note);
   for (std::size_t i = 0; i < n_nodes_; ++i) {
-    if (Status s = nodes_[i]->configure_profile(sdo); !s) return s;
+    // A node with an EDS: the right node (0x1018), then the description's configuration, only what differs.
+    const NodeDescription* d = nodes_[i]->description();
+    if (d != nullptr) {
+      Result<eds::Identity> id = read_identity(sdo, nodes_[i]->node_id());
+      if (!id) return Status::error(nodes_[i]->label() + ": 0x1018 identity: " + id.error());
+      if (Status s = eds::check_identity(d->eds, nodes_[i]->label(), id.value()); !s) return s;
+      Result<ApplyReport> applied = apply_configuration(sdo, nodes_[i]->node_id(), d->writes, d->store);
+      if (!applied) return Status::error(nodes_[i]->label() + ": " + applied.error());
+    }
+    sdo.set_skip_unchanged(d != nullptr);
+    const Status profile = nodes_[i]->configure_profile(sdo);
+    sdo.set_skip_unchanged(false);
+    if (Status s = profile; !s) return s;
     if (bus_off) return Status::error(nodes_[i]->label() + ": CAN bus-off during configuration");
   }
 

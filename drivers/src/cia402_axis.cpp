@@ -29,6 +29,7 @@ void Cia402Axis::setup(const CanAxisConfig& a, const CanAxisPortConfig& port) {
   label_ = "node " + std::to_string(a.node_id) + " (" + a.name + ")";
   node_ = a.node_id;
   bus_ = a.bus;
+  description_ = a.description;
   timing_ = NodeTiming{a.boot_timeout_s > 0.0 ? a.boot_timeout_s : port.boot_timeout_s,
                        a.operational_timeout_s > 0.0 ? a.operational_timeout_s : port.operational_timeout_s,
                        port.heartbeat_consumer_s};
@@ -181,55 +182,66 @@ Status Cia402Axis::configure_pdos(SdoClient& sdo) {
       {static_cast<std::uint16_t>(od::kTpdoComm + 3), 0, cob::tpdo(4, node), nullptr, 0, 0, true},
   };
   for (const PdoPlan& p : plans) {
-    if (Status s = sdo.write(node, p.comm, 1, p.cob_id | od::kPdoInvalidBit, 4); !s) {
-      if (sdo.last_abort() == sdo_abort::kNoObject && p.optional) {
-        // Nothing to disable; a wanted optional PDO the drive lacks is reported.
-        if (p.entries != nullptr) {
-          notes_.push_back(who + describe_object(p.comm, 1) +
-                           " absent: no velocity/torque PDO, velocity is derived from positions");
-        }
-        continue;
-      }
-      if (!fixed_code()) return fail(s);
-      if (p.entries == nullptr) continue;  // cannot disable a fixed PDO: the master ignores its frames
-    }
-    if (p.entries == nullptr) continue;
-    bool fixed = false;
-    if (Status s = sdo.write(node, p.map, 0, 0, 1); !s) {
-      if (!fixed_code()) return fail(s);
-      fixed = true;
-    }
-    if (!fixed) {
-      for (std::uint8_t k = 0; k < p.n_entries; ++k) {
-        if (Status s = sdo.write(node, p.map, static_cast<std::uint8_t>(k + 1), encode_map_entry(p.entries[k]), 4);
-            !s) {
-          return fail(s);
-        }
-      }
-      if (Status s = sdo.write(node, p.map, 0, p.n_entries, 1); !s) return fail(s);
-    } else {
+    // A node configured from its EDS (only what differs is written): a PDO that already carries exactly
+    // the layout is not re-mapped (no invalidate, no clear).
+    bool mapped = false;
+    if (sdo.skips_unchanged() && p.entries != nullptr) {
       std::array<std::uint32_t, 8> e{};
       Result<std::uint32_t> n = read_map(p.map, e);
-      if (!n) return fail(n.status());
-      bool same = n.value() == p.n_entries;
-      for (std::uint8_t k = 0; same && k < p.n_entries; ++k) same = e[k] == encode_map_entry(p.entries[k]);
-      if (!same) {
-        std::string missing;
-        for (std::uint8_t k = 0; k < p.n_entries; ++k) {
-          char buf[48];
-          std::snprintf(buf, sizeof(buf), "%s0x%04X (%s, %u bits) at entry %u", missing.empty() ? "" : ", ",
-                        p.entries[k].index, object_name(p.entries[k].index), p.entries[k].bits, k + 1U);
-          if (k >= n.value() || e[k] != encode_map_entry(p.entries[k])) missing += buf;
-        }
-        if (p.optional) {
-          notes_.push_back(who + describe_object(p.map, 0) + " is fixed and lacks " + missing +
-                           ": velocity is derived from positions");
+      mapped = n && n.value() == p.n_entries;
+      for (std::uint8_t k = 0; mapped && k < p.n_entries; ++k) mapped = e[k] == encode_map_entry(p.entries[k]);
+    }
+    if (!mapped) {
+      if (Status s = sdo.write(node, p.comm, 1, p.cob_id | od::kPdoInvalidBit, 4); !s) {
+        if (sdo.last_abort() == sdo_abort::kNoObject && p.optional) {
+          // Nothing to disable; a wanted optional PDO the drive lacks is reported.
+          if (p.entries != nullptr) {
+            notes_.push_back(who + describe_object(p.comm, 1) +
+                             " absent: no velocity/torque PDO, velocity is derived from positions");
+          }
           continue;
         }
-        return Status::error(who + describe_object(p.map, 0) + " is read-only and does not carry what the "
-                                   "master needs: missing " + missing);
+        if (!fixed_code()) return fail(s);
+        if (p.entries == nullptr) continue;  // cannot disable a fixed PDO: the master ignores its frames
       }
-      notes_.push_back(who + describe_object(p.map, 0) + " is fixed (read-only); read back and accepted");
+      if (p.entries == nullptr) continue;
+      bool fixed = false;
+      if (Status s = sdo.write(node, p.map, 0, 0, 1); !s) {
+        if (!fixed_code()) return fail(s);
+        fixed = true;
+      }
+      if (!fixed) {
+        for (std::uint8_t k = 0; k < p.n_entries; ++k) {
+          if (Status s = sdo.write(node, p.map, static_cast<std::uint8_t>(k + 1), encode_map_entry(p.entries[k]), 4);
+              !s) {
+            return fail(s);
+          }
+        }
+        if (Status s = sdo.write(node, p.map, 0, p.n_entries, 1); !s) return fail(s);
+      } else {
+        std::array<std::uint32_t, 8> e{};
+        Result<std::uint32_t> n = read_map(p.map, e);
+        if (!n) return fail(n.status());
+        bool same = n.value() == p.n_entries;
+        for (std::uint8_t k = 0; same && k < p.n_entries; ++k) same = e[k] == encode_map_entry(p.entries[k]);
+        if (!same) {
+          std::string missing;
+          for (std::uint8_t k = 0; k < p.n_entries; ++k) {
+            char buf[48];
+            std::snprintf(buf, sizeof(buf), "%s0x%04X (%s, %u bits) at entry %u", missing.empty() ? "" : ", ",
+                          p.entries[k].index, object_name(p.entries[k].index), p.entries[k].bits, k + 1U);
+            if (k >= n.value() || e[k] != encode_map_entry(p.entries[k])) missing += buf;
+          }
+          if (p.optional) {
+            notes_.push_back(who + describe_object(p.map, 0) + " is fixed and lacks " + missing +
+                             ": velocity is derived from positions");
+            continue;
+          }
+          return Status::error(who + describe_object(p.map, 0) + " is read-only and does not carry what the "
+                                     "master needs: missing " + missing);
+        }
+        notes_.push_back(who + describe_object(p.map, 0) + " is fixed (read-only); read back and accepted");
+      }
     }
     if (Status s = sdo.write(node, p.comm, 2, p.transmission_type, 1); !s) {
       if (!fixed_code()) return fail(s);

@@ -73,6 +73,21 @@ Result<SdoReply> SdoClient::exchange(std::uint8_t node, const CanFrame& request,
 
 Status SdoClient::write(std::uint8_t node, std::uint16_t index, std::uint8_t sub, std::uint32_t value,
                         std::uint8_t size) {
+  if (skip_unchanged_ && size >= 1 && size <= 4) {
+    const std::uint32_t mask = size == 4 ? 0xFFFFFFFFu : (1u << (8 * size)) - 1u;
+    Result<std::uint32_t> now = read(node, index, sub);
+    if (now && (now.value() & mask) == (value & mask)) {
+      ++skipped_writes_;
+      return Status::ok();
+    }
+    // An object the node does not have refuses the write the same way: not sent, the same abort code.
+    if (!now && (last_abort_ == sdo_abort::kNoObject || last_abort_ == sdo_abort::kNoSubIndex)) {
+      char v[16];
+      std::snprintf(v, sizeof(v), "0x%0*X", 2 * size, value);
+      return Status::error("SDO write " + describe_object(index, sub) + " = " + v +
+                           " not sent: " + now.error());
+    }
+  }
   char v[16];
   std::snprintf(v, sizeof(v), "0x%0*X", 2 * size, value);
   const std::string what = "SDO write " + describe_object(index, sub) + " = " + v;

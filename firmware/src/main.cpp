@@ -9,6 +9,7 @@
 
 #include "check_cmd.hpp"
 #include "commission_cmd.hpp"
+#include "dcf_cmd.hpp"
 #include "design_cmd.hpp"
 #include "job_cmd.hpp"
 #include "loom/firmware/serve/commands.hpp"
@@ -91,6 +92,12 @@ int main(int argc, char** argv) {
   check_cmd->add_flag("--keys", check.keys,
                       "list every config key with its class (machine/recipe/run) and range");
   firmware::CommissionArgs com;
+  firmware::DcfArgs dcf;
+  CLI::App* dcf_cmd = app.add_subcommand("dcf",
+                                         "write a DCF (CiA 306) per node that names its EDS, with the values "
+                                         "the loom configures; moves nothing");
+  dcf_cmd->add_option("--config", dcf.config, "loom config file (TOML); default: embedded default loom");
+  dcf_cmd->add_option("--out", dcf.out, "folder for the DCF files (created if missing)")->required();
   CLI::App* com_cmd = app.add_subcommand(
       "commission",
       "drives disabled: show live axis positions and I/O inputs, capture the calibration into the config");
@@ -126,6 +133,7 @@ int main(int argc, char** argv) {
   }
   if (check_cmd->parsed()) return firmware::run_check(check);
   if (com_cmd->parsed()) return firmware::run_commission(com);
+  if (dcf_cmd->parsed()) return firmware::run_dcf(dcf);
   if (const auto rc = board.run()) return *rc;
   if (const auto rc = design.run()) return *rc;
   if (const auto rc = jobs.run()) return *rc;

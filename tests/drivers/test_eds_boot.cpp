@@ -4,8 +4,13 @@
 // writes nothing; judged from the frames on the fake bus and from reading the values back.
 #include <gtest/gtest.h>
 
+#include <memory>
+#include <set>
+
 #include "drive_rig.hpp"
 #include "loom/drivers/eds_boot.hpp"
+#include "loom/drivers/node_description.hpp"
+#include "loom/sim_can/eds_dictionary.hpp"
 
 namespace loom::drivers {
 namespace {
@@ -98,6 +103,92 @@ TEST(EdsBoot, StoringOnANodeWithout1010AndReadingAnIdentityItLacksAreErrorsNamin
   const std::size_t from = b.rig.net.log().size();
   EXPECT_FALSE(apply_configuration(b.sdo, 1, {{0x2000, 0, 8, 1}}, false).is_ok());
   EXPECT_EQ(b.rig.net.log().size(), from);
+}
+
+// The master's bring-up of a port whose axes name their EDS (CanAxisConfig::description), against
+// simulated drives built from EDS files (sim_can::drive_from_eds).
+struct DescribedRig {
+  static std::shared_ptr<const NodeDescription> describe(const std::string& file, const CanAxisConfig& axis,
+                                                         const CanAxisPortConfig& port) {
+    auto d = std::make_shared<NodeDescription>();
+    d->eds = eds::read_eds_file(path_of(file));
+    const eds::NodeNeeds needs = eds::drive_needs(axis, port);
+    d->writes = eds::loom_writes(d->eds, needs, eds::check_node(d->eds, needs));
+    return d;
+  }
+  // Nodes 1..3 are simulated from `sim`, the port's axes described by `described`.
+  static test::DriveRig make(const std::array<const char*, 3>& sim,
+                             const std::array<const char*, 3>& described) {
+    std::vector<sim_can::SimDriveConfig> nodes;
+    CanAxisPortConfig port;
+    for (std::size_t i = 0; i < 3; ++i) {
+      const auto node = static_cast<std::uint8_t>(i + 1);
+      nodes.push_back(sim_can::drive_from_eds(eds::read_eds_file(path_of(sim[i])), node));
+      port.axes[i].description = describe(described[i], port.axes[i], port);
+    }
+    return test::DriveRig(std::move(nodes), port);
+  }
+};
+
+// Downloads (index << 8 | sub) to `node` since log index `from`.
+std::multiset<std::uint32_t> downloads(const test::DriveRig& rig, std::uint8_t node, std::size_t from) {
+  std::multiset<std::uint32_t> out;
+  for (std::size_t i = from; i < rig.net.log().size(); ++i) {
+    const auto& l = rig.net.log()[i];
+    if (l.from == 0 && l.frame.id == 0x600U + node && (l.frame.data[0] & 0xE0) == 0x20) {
+      out.insert((std::uint32_t{l.frame.data[1]} | std::uint32_t{l.frame.data[2]} << 8) << 8 |
+                 l.frame.data[3]);
+    }
+  }
+  return out;
+}
+
+TEST(EdsBringUp, ANodeWhoseIdentityDiffersFromItsEdsStopsBringUpNamingTheNodeAndBothIdentities) {
+  // Node 3 is a Brick BX2 on the bus, but the machine description says an Acme AX400.
+  test::DriveRig rig =
+      DescribedRig::make({"acme_ax400_dynamic.eds", "acme_ax400_dynamic.eds", "brick_bx2_fixed.eds"},
+                         {"acme_ax400_dynamic.eds", "acme_ax400_dynamic.eds", "acme_ax400_dynamic.eds"});
+  const Status s = rig.configure();
+  ASSERT_FALSE(s.is_ok());
+  // The identities as the two files write them ([DeviceInfo] of brick_bx2_fixed.eds and
+  // acme_ax400_dynamic.eds).
+  EXPECT_NE(s.message().find("node 3 (helix)"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("vendor 0x00000B1C product 0x00000202"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("vendor 0x000004A2 product 0x00401234"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("acme_ax400_dynamic.eds"), std::string::npos) << s.message();
+  // Nothing was written to the wrong node, and no node was started.
+  EXPECT_TRUE(downloads(rig, 3, 0).empty());
+  for (const auto& l : rig.net.log()) EXPECT_FALSE(l.frame.id == 0x000 && l.frame.data[0] == 0x01);
+}
+
+// Judged against the EDS files themselves: the downloads a described node gets at bring-up are exactly
+// the loom's values that differ from the file's DefaultValues (the simulated node starts from them after
+// NMT reset) plus the unused TPDOs' invalidation where the file has them valid — each object once.
+TEST(EdsBringUp, OnlyTheValuesThatDifferFromTheNodesDictionaryAreWritten) {
+  const std::array<const char*, 3> files{"acme_ax400_dynamic.eds", "acme_ax400_dynamic.eds",
+                                         "brick_bx2_fixed.eds"};
+  test::DriveRig rig = DescribedRig::make(files, files);
+  ASSERT_TRUE(rig.configure().is_ok());
+  for (std::uint8_t node = 1; node <= 3; ++node) {
+    SCOPED_TRACE(int{node});
+    const eds::Description d = eds::read_eds_file(path_of(files[node - 1u]));
+    const NodeDescription& nd = *rig.port.config().axes[node - 1u].description;
+    std::multiset<std::uint32_t> expected;
+    for (const eds::SdoWrite& w : nd.writes) {
+      const eds::Entry* e = d.entry(w.index, w.sub);
+      ASSERT_NE(e, nullptr);
+      const auto def = e->value().bits(node, e->type);
+      const std::uint64_t mask = w.size >= 8 ? ~0ULL : (1ULL << (8 * w.size)) - 1;
+      if (!def || (*def & mask) != (w.value & mask)) expected.insert(std::uint32_t{w.index} << 8 | w.sub);
+    }
+    for (std::uint16_t comm = 0x1801; comm <= 0x1803; ++comm) {  // TPDO2..4: unused, invalidated
+      const eds::Entry* e = d.entry(comm, 1);
+      if (e == nullptr || !eds::writable(e->access)) continue;
+      const auto def = e->value().bits(node, e->type);
+      if (def && (*def & 0x80000000u) == 0) expected.insert(std::uint32_t{comm} << 8 | 1);
+    }
+    EXPECT_EQ(downloads(rig, node, 0), expected);
+  }
 }
 
 }  // namespace

@@ -202,14 +202,17 @@ hil_start_sim_drives() {
   # must not starve them, so they run at a higher real-time priority where that is allowed.
   local rt=()
   chrt -f 90 true 2>/dev/null && rt=(chrt -f 90)
+  # HIL_SIM_EDS: the drives built from that EDS instead of a built-in personality.
+  local kind=(--personality "$HIL_PERSONALITY")
+  [[ -z ${HIL_SIM_EDS:-} ]] || kind=(--eds "$HIL_SIM_EDS")
   hil_spawn sim "${rt[@]}" "$HIL_SIM" --iface "$HIL_IFACE" --nodes "$HIL_NODES" --io-node "$HIL_IO_NODE" \
-    --io-control "$HIL_IO_CONTROL" --width-m 0.6 --personality "$HIL_PERSONALITY" \
+    --io-control "$HIL_IO_CONTROL" --width-m 0.6 "${kind[@]}" \
     --plant-cycle-ms "$HIL_PERIOD_MS" "${HIL_SIM_EXTRA[@]}"
   HIL_SIM_PID=$HIL_LAST_PID
   for n in ${HIL_NODES//,/ } $HIL_IO_NODE; do
     hil_expect "$mark" "$(printf '%03X' $((0x700 + n)))#00" 10 "boot-up of simulated node $n" >/dev/null
   done
-  hil_note "loom-sim-drive up ($HIL_PERSONALITY drives): nodes $HIL_NODES and I/O node $HIL_IO_NODE booted (pid $HIL_SIM_PID)"
+  hil_note "loom-sim-drive up (${HIL_SIM_EDS:+drives from }${HIL_SIM_EDS:-$HIL_PERSONALITY drives}): nodes $HIL_NODES and I/O node $HIL_IO_NODE booted (pid $HIL_SIM_PID)"
 }
 
 # hil_io_control WORDS... — what the simulated I/O node's e-stop chain and buttons see from now on.

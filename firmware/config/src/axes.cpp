@@ -7,6 +7,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "eds_keys.hpp"
 #include "keys.hpp"
 
 namespace loom::firmware {
@@ -84,6 +85,8 @@ const std::vector<AxisKeyInfo>& axis_keys() {
       {"axes.<name>.homing_speed", "[1e-4, 100] rad/s or m/s"},
       {"axes.<name>.homing_accel", "[1e-3, 1e5] rad/s^2 or m/s^2"},
       {"axes.<name>.homing_timeout_s", "[0.1, 600]"},
+      {"axes.<name>.eds",
+       "path of the drive's EDS (CiA 306), relative to this file; checked, and used at bring-up"},
   };
   return k;
 }
@@ -100,6 +103,7 @@ std::string axes_text(const LoomConfig& c) {
          << fmt_num(a.homing_speed) << "/s " << fmt_num(a.homing_accel) << "/s2 "
          << fmt_num(a.homing_timeout_s) << "s";
     }
+    if (!a.eds.empty()) os << " eds " << a.eds;
     os << "]";
   }
   return os.str();
@@ -193,6 +197,7 @@ void read_axes(TomlReader& r, LoomConfig& c, bool extending) {
     a.boot_ms = static_cast<std::uint32_t>(boot);
     a.operational_ms = static_cast<std::uint32_t>(op);
     read_referencing(r, node, p, a, is_new);
+    read_eds_key(r, p + "eds", a.eds);
   }
   // Slot order: the core roles first (slots 0..2), then the others by name (toml++ keeps keys sorted).
   std::stable_sort(c.axes.begin(), c.axes.end(), [](const AxisSpec& x, const AxisSpec& y) {

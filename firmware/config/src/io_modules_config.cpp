@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <sstream>
 
+#include "eds_keys.hpp"
 #include "loom/drivers/can_axis_config.hpp"
 
 namespace loom::firmware {
@@ -99,6 +100,7 @@ const std::vector<IoModuleKeyInfo>& io_module_keys() {
       {"io_modules.<name>.operational_timeout_ms", "[10, 60000] (integer); default 500"},
       {"io_modules.<name>.signals",
        "io signal names (piston_a_extended … buzzer, load_cell, gripper_close, cutter, yarn_present)"},
+      {"io_modules.<name>.eds", "path of the module's EDS (CiA 306), relative to this file"},
   };
   return k;
 }
@@ -152,6 +154,7 @@ void read_io_modules(TomlReader& r, LoomConfig& c) {
       v = m.operational_timeout_ms;
       r.integer(p + "operational_timeout_ms", v, 10, 60000);
       m.operational_timeout_ms = static_cast<std::uint32_t>(v);
+      detail::read_eds_key(r, p + "eds", m.eds);
       r.string_list(p + "signals", m.signals);
       const std::string shown = "[" + quoted_list(m.signals) + "]";
       if (m.signals.empty()) r.fail(p + "signals", shown, "a module carries at least one signal");
@@ -192,7 +195,9 @@ std::string io_modules_text(const LoomConfig& c) {
   std::ostringstream os;
   for (const IoModuleSpec& m : c.io.modules) {
     os << "[" << m.name << " node " << int{m.node} << " bus " << int{m.bus} << " boot " << m.boot_timeout_ms
-       << " op " << m.operational_timeout_ms << " signals " << quoted_list(m.signals) << "]";
+       << " op " << m.operational_timeout_ms << " signals " << quoted_list(m.signals);
+    if (!m.eds.empty()) os << " eds " << m.eds;
+    os << "]";
   }
   return os.str();
 }

@@ -7,6 +7,7 @@
 #include <memory>
 #include <sstream>
 
+#include "eds_keys.hpp"
 #include "loom/motion/angles.hpp"
 
 namespace loom::firmware::detail {
@@ -331,6 +332,13 @@ const std::vector<Key>& keys() {
         io_kind_name, parse_io_kind));
     v.push_back(integer<std::uint8_t>("io.node", M::kMachine, 1, 127,
                                       [](LoomConfig& c) -> std::uint8_t& { return c.io.node; }));
+    {
+      Key eds{"io.eds", M::kMachine, "path of the I/O module's EDS (CiA 306), relative to this file",
+              false,    nullptr,     nullptr};
+      eds.read = [](TomlReader& r, LoomConfig& c) { read_eds_key(r, "io.eds", c.io.eds); };
+      eds.value = [](const LoomConfig& c) { return c.io.eds; };
+      v.push_back(eds);
+    }
     v.push_back(integer<std::uint32_t>("io.boot_timeout_ms", M::kMachine, 10, 60000,
                                        [](LoomConfig& c) -> std::uint32_t& { return c.io.boot_timeout_ms; }));
     v.push_back(

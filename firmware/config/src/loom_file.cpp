@@ -5,6 +5,7 @@
 #include "axes.hpp"
 #include "checks.hpp"
 #include "derive.hpp"
+#include "eds_keys.hpp"
 #include "io_modules_config.hpp"
 #include "keys.hpp"
 #include "loom/config/config.hpp"
@@ -51,6 +52,7 @@ LoomConfig parse_complete(const std::string& text, const std::string& source, co
   read_io_modules(r, c);
   r.reject_unknown(known_sections());
   check_relations(r, c);
+  check_eds_keys(r, c);
   // `key` may name two facts that clash ("axes.helix.node|can.master_node", values likewise): the one the
   // file says is the line to point at (the first when it says both).
   const Fail fail = [&](const std::string& key, const std::string& value, const std::string& why) {

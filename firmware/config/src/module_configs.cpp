@@ -5,8 +5,28 @@
 
 #include "loom/config/config.hpp"
 #include "loom/drivers/bus_load.hpp"
+#include "loom/drivers/eds_check.hpp"
+#include "loom/drivers/node_description.hpp"
 
 namespace loom::firmware {
+
+namespace {
+
+// The node's EDS for the CAN master: its identity and the writes the loom makes (none when the EDS lacks
+// what the loom needs: the profile's own bring-up then refuses the node as without an EDS). Null for a
+// file that cannot be read (the config was refused for it when read).
+std::shared_ptr<const drivers::NodeDescription> node_description(const std::string& path,
+                                                                 const drivers::eds::NodeNeeds& needs) {
+  if (path.empty()) return nullptr;
+  auto d = std::make_shared<drivers::NodeDescription>();
+  d->eds = drivers::eds::read_eds_file(path);
+  if (d->eds.has_errors()) return nullptr;
+  const drivers::eds::NodeCheck check = drivers::eds::check_node(d->eds, needs);
+  if (check.ok()) d->writes = drivers::eds::loom_writes(d->eds, needs, check);
+  return d;
+}
+
+}  // namespace
 
 drivers::CanAxisPortConfig can_axis_config(const LoomConfig& c) {
   drivers::CanAxisPortConfig cc;
@@ -38,6 +58,9 @@ drivers::CanAxisPortConfig can_axis_config(const LoomConfig& c) {
   cc.master_node_id = c.can.master_node;
   cc.master_heartbeat_s = c.can.master_heartbeat_ms * 1e-3;
   cc.master_consumer_s = c.can.master_consumer_ms * 1e-3;
+  for (std::size_t i = 0; i < c.axes.size(); ++i) {
+    cc.axes[i].description = node_description(c.axes[i].eds, drivers::eds::drive_needs(cc.axes[i], cc));
+  }
   if (c.io.kind == IoKind::kCan) {
     const std::vector<drivers::CanIoConfig> modules = can_io_configs(c);
     const std::vector<std::size_t> buses = can_io_buses(c);
@@ -86,6 +109,7 @@ std::vector<drivers::CanIoConfig> can_io_configs(const LoomConfig& c) {
   ic.master_node_id = c.can.master_node;
   ic.master_consumer_s = c.can.master_consumer_ms * 1e-3;
   std::vector<drivers::CanIoConfig> out{ic};
+  out[0].description = node_description(c.io.eds, drivers::eds::io_module_needs(out[0]));
   for (std::size_t k = 0; k < c.io.modules.size(); ++k) {
     const IoModuleSpec& m = c.io.modules[k];
     drivers::CanIoConfig mc = ic;  // the same wiring, bus timing and master; its own node and windows
@@ -94,6 +118,7 @@ std::vector<drivers::CanIoConfig> can_io_configs(const LoomConfig& c) {
     mc.node_id = m.node;
     mc.boot_timeout_s = m.boot_timeout_ms * 1e-3;
     mc.operational_timeout_s = m.operational_timeout_ms * 1e-3;
+    mc.description = node_description(m.eds, drivers::eds::io_module_needs(mc));
     out.push_back(std::move(mc));
   }
   return out;

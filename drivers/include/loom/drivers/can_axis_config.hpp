@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <numbers>
 #include <optional>
 #include <string>
@@ -15,6 +16,8 @@
 #include "loom/drivers/status.hpp"
 
 namespace loom::drivers {
+
+struct NodeDescription;  // node_description.hpp
 
 // 20-bit single-turn encoders; the carriage's ball screw advances 10 mm per motor revolution.
 inline constexpr double kCountsPerRev = 1048576.0;  // 2^20
@@ -43,6 +46,9 @@ struct CanAxisConfig {
   double home_offset = 0.0;   // SI: the reading at the home point (0x607C)
   double homing_speed = 0.0;  // SI/s: 0x6099:01; 0x6099:02 (search for zero) a quarter of it
   double homing_accel = 0.0;  // SI/s² (0x609A)
+  // The drive's EDS (node_description.hpp), when the machine description names one: its identity is
+  // checked and its configuration written (only what differs) at bring-up. Null: none.
+  std::shared_ptr<const NodeDescription> description{};
 };
 
 // Buses a port can drive (can0..can3): CanAxisConfig::bus is 0..kMaxBuses-1.

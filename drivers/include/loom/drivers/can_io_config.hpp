@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -15,6 +16,8 @@
 #include "loom/hal/types.hpp"
 
 namespace loom::drivers {
+
+struct NodeDescription;  // node_description.hpp
 
 // CiA 401 objects.
 namespace od401 {
@@ -152,6 +155,8 @@ struct CanIoConfig {
   // their safe state (0x6206/0x6207) when the host dies. 0 = do not configure a consumer.
   std::uint8_t master_node_id = 0x7F;
   double master_consumer_s = 0.500;
+  // The module's EDS (node_description.hpp), as CanAxisConfig::description. Null: none.
+  std::shared_ptr<const NodeDescription> description{};
 };
 
 // Configure-time only. The first refusal of the module's config (its node, timing and the whole wiring).

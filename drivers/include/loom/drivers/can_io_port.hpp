@@ -61,6 +61,7 @@ class CanIoPort final : public hal::IoPort, public CanNode {
   // mapping is fixed, and accepted only when it carries every object the wiring needs).
   std::uint8_t node_id() const override { return config_.node_id; }
   std::string label() const override;
+  const NodeDescription* description() const override { return config_.description.get(); }
   NodeTiming timing() const override;
   void bring_up_started() override;
   Status configure_profile(SdoClient& sdo) override;

@@ -23,6 +23,7 @@
 namespace loom::drivers {
 
 class SdoClient;
+struct NodeDescription;
 
 // A node's bring-up windows and heartbeat consumer time (seconds; 0 window = the master's default).
 struct NodeTiming {
@@ -52,6 +53,10 @@ class CanNode {
   // True when the profile reports the node's EMCY itself (a drive's in its axis feedback); otherwise the
   // master reports it as a link fault that stops every axis.
   virtual bool reports_own_emcy() const { return false; }
+  // Configure-time. The node's EDS when the machine description names one (null: none): bring_up()
+  // checks its 0x1018 identity against it and makes its writes (only those that differ) before
+  // configure_profile(), which then writes only what still differs as well.
+  virtual const NodeDescription* description() const { return nullptr; }
 
   // RT-safe. A frame from the bus: heartbeat and EMCY to the supervisor, the rest to the profile. Frames
   // of other nodes and error frames are ignored; nothing is taken before the node was brought up.

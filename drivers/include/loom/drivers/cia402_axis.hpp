@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,7 @@ class Cia402Axis final : public CanNode {
   void on_profile_frame(hal::Tick now, const CanFrame& frame) override;
   void acknowledge() override;
   bool reports_own_emcy() const override { return true; }
+  const NodeDescription* description() const override { return description_.get(); }
 
   // RT-safe. This tick's feedback, given the state of the axis' bus.
   void fill_feedback(hal::AxisFeedback& fb, bool bus_off, bool bus_configured) const;
@@ -81,6 +83,7 @@ class Cia402Axis final : public CanNode {
   double homing_speed_ = 0.0;
   double homing_accel_ = 0.0;
   std::vector<std::string> notes_;
+  std::shared_ptr<const NodeDescription> description_;
 
   // RT state.
   bool up_ = false;

@@ -32,6 +32,14 @@ class SdoClient {
   // callers can apply CiA 301 interoperability rules to specific codes (read-only mapping, no object).
   std::uint32_t last_abort() const { return last_abort_; }
 
+  // Configure-time only. While on, write() first reads the value and sends no download when it is
+  // already `value` (a node configured from its EDS: only what differs is written); an object the node
+  // lacks (the read aborted 0x06020000 / 0x06090011) fails with that abort code, unsent; a value that
+  // cannot be read otherwise is written as before. skipped_writes() counts the downloads saved.
+  void set_skip_unchanged(bool on) { skip_unchanged_ = on; }
+  bool skips_unchanged() const { return skip_unchanged_; }
+  int skipped_writes() const { return skipped_writes_; }
+
  private:
   Result<SdoReply> exchange(std::uint8_t node, const CanFrame& request, const std::string& what);
 
@@ -40,6 +48,8 @@ class SdoClient {
   std::int64_t timeout_us_;
   FrameHandler other_frames_;
   std::uint32_t last_abort_ = 0;
+  bool skip_unchanged_ = false;
+  int skipped_writes_ = 0;
 };
 
 // "0x60C2:01 (interpolation time period)". Configure-time only.

@@ -79,6 +79,9 @@ struct AxisSpec {
   double homing_speed = 0.0;  // SI/s (0x6099)
   double homing_accel = 0.0;  // SI/s^2 (0x609A)
   double homing_timeout_s = 0.0;  // a run not referenced by then is the fault homing_failed
+  // The drive's electronic data sheet (CiA 306 EDS or DCF), axes.<name>.eds: its path (a relative one in
+  // the file is relative to the file); "" = none (the loom assumes a drive with every object it needs).
+  std::string eds{};
 
   // Drive counts per SI unit (per rad, or per m on a linear axis).
   double counts_per_unit() const;
@@ -106,6 +109,7 @@ struct IoModuleSpec {
   std::uint32_t boot_timeout_ms = 2000;
   std::uint32_t operational_timeout_ms = 500;
   std::vector<std::string> signals;  // io signal names as the file lists them ("lamp_green", "cutter", ...)
+  std::string eds{};                 // io_modules.<name>.eds: the module's EDS path ("" = none)
 };
 
 struct IoSettings {
@@ -113,6 +117,7 @@ struct IoSettings {
   // The [io] table's module (module 0, always on bus 0). Every signal is on it unless a further module
   // in `modules` lists it (module k + 1 is modules[k]; the signal's IoBit::module says which).
   std::uint8_t node = 4;
+  std::string eds{};  // io.eds: the [io] module's EDS path ("" = none)
   std::uint32_t boot_timeout_ms = 2000;
   std::uint32_t operational_timeout_ms = 500;
   drivers::IoWiring wiring;  // bit per signal, polarity, load-cell channel and scaling
