@@ -110,24 +110,25 @@ BeatRegulatorLimits SweepClock::configure(const motion::ProfileSet& p, double pe
   jerk_ = p.spec().crank.jerk;
   ramp_ = sweep.ramp_distance();
   const motion::WarpWindow& w = p.beatup().warp();
-  enter_ = master_of(p.crank_law(), w.enter);
-  exit_ = master_of(p.crank_law(), w.exit);
-  // The cam steps in [exit + margin, enter + 2π − margin] of crank phase after a turn: it has come to rest
-  // at enter − margin of the next.
-  const motion::CarriageCam& cam = p.cam();
-  step_end_ = master_of(p.crank_law(), cam.window_start() + cam.window_length() - motion::kTwoPi);
+  const motion::CrankLaw& law = p.crank_law();
+  enter_ = master_of(law, w.enter);
+  // Half-way from the warp's edges to the fell: the tip is still a quarter of the warp depth or more from
+  // the fell (the approach is about quadratic near the dead centre), far outside any contact.
+  approach_ = master_of(law, 0.5 * (w.enter + w.fell));
+  depart_ = master_of(law, 0.5 * (w.fell + w.exit));
+  // Half-way from the warp exit to the start of the carriage's step (the cam margin after the exit): the
+  // carriage is still at rest there, and its step and the dwell after it are played at the recipe's speed.
+  exit_ = master_of(law, 0.5 * (w.exit + p.cam().window_start()));
   beats_ = p.beats_per_row();
-  per_position_ = std::max(1, cam.beats_per_position());
 
-  // Bounds: the carriage steps at s·v, so s·v must not exceed the fastest crank its limits allow; and the
-  // braking window must be able to bring any s back to 1 (one tick is lost to seeing the window open).
-  double hi = std::min(cfg.max_speed_scale, p.carriage_peaks().max_crank_speed_rad_s / v_);
+  // Bounds: every return to 1 must fit its window (it ends before the carriage's step, the last one before
+  // the braking too); one tick is lost to seeing the window open.
+  double hi = std::max(1.0, cfg.max_speed_scale);
   double lo = std::min(1.0, cfg.min_speed_scale);
-  hi = std::max(1.0, hi);
-  const double braking = window_to(beats_) - window_from(beats_);
+  const double back = return_to(beats_ - 1) - return_from(beats_ - 1);
   const auto back_fits = [&](double s) {
     const double top = std::max(s, 1.0);
-    return std::abs(s - 1.0) <= step_capacity(braking - v_ * top * dt_, v_, top, accel_, jerk_);
+    return std::abs(s - 1.0) <= step_capacity(back - v_ * top * dt_, v_, top, accel_, jerk_);
   };
   for (int i = 0; i < 60 && !back_fits(hi); ++i) hi = 1.0 + 0.5 * (hi - 1.0);
   for (int i = 0; i < 60 && !back_fits(lo); ++i) lo = 1.0 - 0.5 * (1.0 - lo);
@@ -137,9 +138,8 @@ BeatRegulatorLimits SweepClock::configure(const motion::ProfileSet& p, double pe
   l.target_n = target_n;
   l.min_scale = lo;
   l.max_scale = hi;
-  // The narrowest window a beat after a carriage step has (its dwell), at the fastest beat.
-  const double dwell = enter_ - step_end_;
-  l.max_step = beats_ / per_position_ > 1 ? step_capacity(dwell - v_ * hi * dt_, v_, hi, accel_, jerk_) : 0.0;
+  // The largest change one beat's approach allows, at the fastest beat.
+  l.max_step = step_capacity(approach_ - enter_ - v_ * hi * dt_, v_, hi, accel_, jerk_);
   start(0);
   return l;
 }
@@ -147,9 +147,9 @@ BeatRegulatorLimits SweepClock::configure(const motion::ProfileSet& p, double pe
 void SweepClock::start(hal::Tick t0) noexcept {
   seg_tick_ = t0;
   seg_time_ = c_ = 0.0;
-  s0_ = s1_ = 1.0;
+  s0_ = s1_ = beat_scale_ = 1.0;
   T_ = 0.0;
-  warped_ = pending_ = active_ = false;
+  warped_ = pending_ = returning_ = active_ = false;
 }
 
 double SweepClock::time_in_change(double u) const noexcept {
@@ -161,45 +161,70 @@ double SweepClock::time_in_change(double u) const noexcept {
 }
 
 double SweepClock::window_from(int beat) const noexcept {
+  // Beat 0's approach may still be in the run-up, which is played as planned.
   const double turn = motion::kTwoPi * beat;
-  if (beat == 0) return ramp_;                               // after the run-up; the carriage is still
-  if (beat >= beats_) return turn - motion::kTwoPi + exit_;  // braking: once the last beat has left the warp
-  if (beat % per_position_ == 0) return turn + step_end_;    // once the carriage has stepped
-  return turn - motion::kTwoPi + exit_;                      // the same position: once the beater is out
+  return beat == 0 ? std::max(ramp_, enter_) : turn + enter_;
 }
 
 double SweepClock::window_to(int beat) const noexcept {
-  if (beat >= beats_) return motion::kTwoPi * beats_ - ramp_;  // before the braking
-  return motion::kTwoPi * beat + enter_;                       // before the beater enters the warp
+  return motion::kTwoPi * beat + approach_;
+}
+
+double SweepClock::return_from(int beat) const noexcept {
+  return motion::kTwoPi * beat + depart_;
+}
+
+double SweepClock::return_to(int beat) const noexcept {
+  // Before the carriage's step, or the braking: each carriage step and its settling are as open loop.
+  return std::min(motion::kTwoPi * beat + exit_, motion::kTwoPi * beats_ - ramp_);
 }
 
 void SweepClock::request(int beat, double scale) noexcept {
-  const int b = std::clamp(beat, 0, beats_);
-  pending_scale_ = b >= beats_ ? 1.0 : std::clamp(scale, min_scale_, max_scale_);
-  pending_from_ = window_from(b);
-  pending_to_ = window_to(b);
-  pending_ = pending_scale_ != s1_;  // the speed it is at already: nothing to do
-  active_ = pending_ || warped_;
+  if (beat < 0 || beat >= beats_) return;  // after the last beat: its return to 1 is already planned
+  pending_scale_ = std::clamp(scale, min_scale_, max_scale_);
+  pending_beat_ = beat;
+  pending_from_ = window_from(beat);
+  pending_to_ = window_to(beat);
+  pending_ = pending_scale_ != 1.0;  // the recipe's speed: the return after the last beat is there already
+  if (!pending_) beat_scale_ = 1.0;
+  active_ = pending_ || returning_ || warped_;
 }
 
-void SweepClock::begin_change(hal::Tick now, double master) noexcept {
-  pending_ = false;
-  active_ = warped_;
-  // The scale now: a change before this one has ended before its beat entered the warp, so this is s1_
-  // (computed in full all the same: a change never starts from a speed the crank is not at).
+void SweepClock::advance_slow(hal::Tick now, double master) noexcept {
+  if (returning_ && master >= return_from_) {
+    returning_ = false;
+    begin_change(now, master, 1.0, return_to_);
+  }
+  if (pending_ && master >= pending_from_) {
+    pending_ = false;
+    const bool changed = begin_change(now, master, pending_scale_, pending_to_);
+    beat_scale_ = s1_;  // what this beat meets the fell at (its change is over before the contact)
+    if (changed) {
+      // Whatever speed the beat is beaten at, it is back at the recipe's before the carriage may move.
+      returning_ = true;
+      return_from_ = return_from(pending_beat_);
+      return_to_ = return_to(pending_beat_);
+    }
+  }
+  active_ = pending_ || returning_ || warped_;
+}
+
+bool SweepClock::begin_change(hal::Tick now, double master, double target, double until) noexcept {
+  // The scale now: a change before this one has ended before its window closed, so this is s1_ (computed
+  // in full all the same: a change never starts from a speed the crank is not at).
   const double u = static_cast<double>(now - seg_tick_) * dt_;
   double s_now = s1_;
   if (u < T_) {
     const double x = u / T_;
     s_now = s0_ + (s1_ - s0_) * (x <= 0.5 ? 2.0 * x * x : 1.0 - 2.0 * (1.0 - x) * (1.0 - x));
   }
-  const double avail = pending_to_ - master;
-  if (!(avail > 0.0) || pending_scale_ == s_now) return;  // the window has passed (or nothing to change)
+  const double avail = until - master;
+  if (!(avail > 0.0) || target == s_now) return false;  // the window has passed (or nothing to change)
   // Cover at most the window's remaining phase: ∫s dt over the change is T·(s0 + s1)/2 ≤ T·max(s0, s1).
-  const double t = avail / (v_ * std::max(s_now, pending_scale_));
+  const double t = avail / (v_ * std::max(s_now, target));
   const double room = std::min(accel_ * t / (2.0 * v_), jerk_ * t * t / (4.0 * v_));
-  const double ds = std::clamp(pending_scale_ - s_now, -room, room);
-  if (ds == 0.0) return;
+  const double ds = std::clamp(target - s_now, -room, room);
+  if (ds == 0.0) return false;
   seg_time_ = time_at(now);
   seg_tick_ = now;
   s0_ = s_now;
@@ -207,7 +232,8 @@ void SweepClock::begin_change(hal::Tick now, double master) noexcept {
   T_ = t;
   // After the change τ = seg_time + s0·T + Δs·T/2 + s1·(u − T) = c + s1·u.
   c_ = seg_time_ + (s0_ - s1_) * T_ * 0.5;
-  warped_ = active_ = true;
+  warped_ = true;
+  return true;
 }
 
 }  // namespace loom::sequencer

@@ -1268,8 +1268,8 @@ void Sequencer::publish_beat(int k) noexcept {
   }
   e.force_measured = r.force_measured;
   e.in_band = e.force_measured && e.peak_force_n >= cfg_.beat_force_min_n && e.peak_force_n <= cfg_.beat_force_max_n;
-  // The speed it was beaten at: the clock's, which the next beat's change (asked for below) has not moved yet.
-  e.speed_scale = static_cast<float>(sweep_clock_.scale());
+  // The speed it was beaten at (the clock is back at the recipe's by now; the next beat's is asked below).
+  e.speed_scale = static_cast<float>(sweep_clock_.beat_scale());
   row_.speed(k, e.speed_scale);
   beats_published_ = k + 1;
   if (e.force_measured && sweeping_ && regulator_.enabled()) regulate_after(k, e);  // a load cell: closed loop

@@ -2,7 +2,7 @@
 //   - the clock at scale 1 is the tick time, bit for bit (a loom without a load cell runs as before);
 //   - a sweep played at changing speeds keeps the carriage still while the speed changes, keeps the
 //     master's acceleration and jerk within the recipe's crank limits, beats every beat at a constant
-//     speed, and brakes at scale 1;
+//     speed, steps the carriage only at scale 1, and brakes at scale 1;
 //   - the regulator, against a synthetic warp (F = g·s², g from a profile across the width times a drift
 //     per row), settles on the band's middle and stays within its bounds.
 #include "loom/sequencer/beat_regulator.hpp"
@@ -37,6 +37,7 @@ TEST(SweepClock, AtScaleOneItIsTheTickTimeBitForBit) {
 namespace {
 struct Played {
   std::vector<double> master, cam, scale;  // per tick
+  std::vector<double> at_fell, reported;   // per beat: the speed as the crank passes the fell, beat_scale()
 };
 
 // Plays one sweep of `p` on the clock, asking each beat for scales[k % size] once the beat before it has
@@ -45,7 +46,7 @@ Played play(const motion::ProfileSet& p, SweepClock& c, const std::vector<double
   Played out;
   c.start(0);
   c.request(0, scales[0]);
-  const double exit = p.beatup().warp().exit;
+  const double exit = p.beatup().warp().exit, fell = p.beatup().warp().fell;
   int published = 0;
   double prev_time = 0.0;
   for (hal::Tick t = 0; t < 100000; ++t) {
@@ -57,7 +58,11 @@ Played play(const motion::ProfileSet& p, SweepClock& c, const std::vector<double
     out.cam.push_back(p.cam().position_at(crank));
     out.scale.push_back(t == 0 ? 1.0 : (tau - prev_time) / dt);
     prev_time = tau;
+    if (out.at_fell.size() < static_cast<std::size_t>(p.beats_per_row()) &&
+        crank >= motion::kTwoPi * static_cast<double>(out.at_fell.size()) + fell)
+      out.at_fell.push_back(out.scale.back());
     while (published < p.beats_per_row() && crank >= motion::kTwoPi * published + exit) {
+      out.reported.push_back(c.beat_scale());  // as the sequencer publishes the beat
       ++published;
       c.request(published, scales[static_cast<std::size_t>(published) % scales.size()]);
     }
@@ -67,7 +72,7 @@ Played play(const motion::ProfileSet& p, SweepClock& c, const std::vector<double
 }
 }  // namespace
 
-TEST(SweepClock, SpeedChangesOnlyWhileTheCarriageRestsWithinTheCrankLimits) {
+TEST(SweepClock, SpeedChangesOnlyWhileTheCarriageRestsWithinTheCrankLimitsAndItStepsAtScaleOne) {
   for (const motion::CrankLawKind law : {motion::CrankLawKind::kConstant, motion::CrankLawKind::kElliptic}) {
     motion::ProfileSpec spec;
     spec.crank_law.kind = law;
@@ -100,20 +105,46 @@ TEST(SweepClock, SpeedChangesOnlyWhileTheCarriageRestsWithinTheCrankLimits) {
       EXPECT_LE(std::abs(accel), spec.crank.acceleration + spec.crank.jerk * dt + 1e-6) << "tick " << i;
     }
     EXPECT_GT(changing_ticks, 10);
-    // Every beat at a constant speed: across each warp window the master's speed does not change (between
-    // two ticks both inside it: r.scale[i] is the mean over the tick before i).
+    // Every contact at a constant speed: from half-way between the warp entry and the fell to half-way
+    // between the fell and the exit the master's speed does not change (between two ticks both inside:
+    // r.scale[i] is the mean over the tick before i).
     const motion::WarpWindow& w = p.beatup().warp();
-    const auto in_warp = [&](double master) {
-      const double in_turn = std::fmod(p.crank_phase_at(motion::Phase::from_rad(master)), motion::kTwoPi);
-      return in_turn > w.enter && in_turn < w.exit;
+    const auto in_turn = [&](double master) {
+      return std::fmod(p.crank_phase_at(motion::Phase::from_rad(master)), motion::kTwoPi);
     };
+    const auto near_fell = [&](double master) {
+      const double phase = in_turn(master);
+      return phase > 0.5 * (w.enter + w.fell) && phase < 0.5 * (w.fell + w.exit);
+    };
+    int contact_ticks = 0, stepping_ticks = 0;
     for (std::size_t i = 2; i < n; ++i) {
-      const double crank = p.crank_phase_at(motion::Phase::from_rad(r.master[i]));
-      if (r.master[i] > p.crank_sweep().ramp_distance() && in_warp(r.master[i - 2]) && in_warp(r.master[i]) &&
-          r.master[i] < motion::kTwoPi * p.beats_per_row() - p.crank_sweep().ramp_distance()) {
-        ASSERT_NEAR(r.scale[i], r.scale[i - 1], 1e-9) << "tick " << i << " (" << crank << " rad)";
+      if (near_fell(r.master[i - 2]) && near_fell(r.master[i])) {
+        ++contact_ticks;
+        ASSERT_NEAR(r.scale[i], r.scale[i - 1], 1e-9)
+            << "tick " << i << " (" << in_turn(r.master[i]) << " rad)";
+      }
+      // The carriage moves only at the recipe's speed: its steps and their settling are as open loop.
+      if (r.cam[i] != r.cam[i - 1]) {
+        ++stepping_ticks;
+        ASSERT_NEAR(r.scale[i], 1.0, 1e-9) << "tick " << i;
       }
     }
+    EXPECT_GT(contact_ticks, 100);
+    EXPECT_GT(stepping_ticks, 100);
+    // Some beats were beaten at another speed than the recipe's.
+    int fast = 0, slow = 0;
+    for (std::size_t i = 1; i < n; ++i) {
+      if (near_fell(r.master[i - 1]) && near_fell(r.master[i])) {
+        fast += r.scale[i] > 1.01;
+        slow += r.scale[i] < 0.99;
+      }
+    }
+    EXPECT_GT(fast, 10);
+    EXPECT_GT(slow, 10);
+    // Each beat's speed as reported when it is published is the one it met the fell at.
+    ASSERT_EQ(r.reported.size(), static_cast<std::size_t>(p.beats_per_row()));
+    ASSERT_EQ(r.at_fell.size(), r.reported.size());
+    for (std::size_t k = 0; k < r.reported.size(); ++k) EXPECT_NEAR(r.reported[k], r.at_fell[k], 1e-9) << k;
     // The braking is played at scale 1: the sweep's own braking, shifted in time.
     const double brake_from = motion::kTwoPi * p.beats_per_row() - p.crank_sweep().ramp_distance();
     for (std::size_t i = 1; i < n; ++i) {
