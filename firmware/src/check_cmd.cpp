@@ -18,6 +18,7 @@
 #include "loom/config/scene_config.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/profile_set.hpp"
+#include "loom/sequencer/beat_regulator.hpp"
 #include "loom/sim_hal/effects.hpp"
 
 namespace loom::firmware {
@@ -202,6 +203,22 @@ void print_plan(const LoomConfig& c) {
   } else {
     std::printf("  crank speed %.3f rad/s (%.1f r/min): fixed by recipe.crank_speed_rad_s\n", c.profile.crank.velocity,
                 c.profile.crank.velocity * 60.0 / motion::kTwoPi);
+  }
+  {
+    // The beat regulator (sequencer/beat_regulator.hpp): its bounds on this recipe, and when it acts.
+    sequencer::SweepClock clock;
+    const sequencer::BeatRegulatorLimits l = clock.configure(
+        p, c.run.period_s, c.sequencer.beat_regulator, 0.5 * (rc.beat_force_min_n + rc.beat_force_max_n));
+    const double v = c.profile.crank.velocity;
+    if (!c.sequencer.beat_regulator.enabled) {
+      std::printf("  beat force: open loop (the beat regulator is off)\n");
+    } else {
+      std::printf("  beat force: closed loop when the beats are measured (a load cell: io.load_cell_channel = %d%s; in\n"
+                  "    simulation a scene naming beat_contact), else open loop: each beat's peak sets the next beat's crank\n"
+                  "    speed within %.2f..%.2f rad/s (x%.2f..x%.2f, up to %.1f %% per beat), aiming at %.0f N\n",
+                  c.io.wiring.load_cell_channel, c.io.wiring.load_cell_channel == 0 ? ", none" : "", v * l.min_scale,
+                  v * l.max_scale, l.min_scale, l.max_scale, 100.0 * l.max_step, l.target_n);
+    }
   }
   std::printf("  crank law %s; tables: %zu knots, %s, %s; measured error rocker %.2g rad, crank law %.2g rad (limit %.2g)\n",
               motion::crank_law_name(rc.crank_law.kind), c.profile.table_size, motion::interp_name(c.profile.table_interp),

@@ -70,6 +70,30 @@ WeaveInputs resolve_inputs(const WeaveArgs& a) {
   return in;
 }
 
+// Closed or open loop, and why. The beat regulator acts on measured beats, and beats are measured when the
+// machine has a load cell: simulated, when the scene names beat_contact; on the bus, io.load_cell_channel.
+void print_beat_regulation(const Machine& m, const Scene& scene, bool simulated_io) {
+  const sequencer::SequencerConfig& sc = m.config().sequencer;
+  const double v = m.profiles().spec().crank.velocity;
+  const bool load_cell =
+      simulated_io ? scene.spec.beat_contact.has_value() : m.config().io.wiring.load_cell_channel != 0;
+  if (!sc.beat_regulator.enabled || !load_cell) {
+    std::printf("  beat force: open loop, %s: every beat at %.2f rad/s\n",
+                !sc.beat_regulator.enabled ? "the beat regulator is off"
+                : simulated_io             ? "no load cell (the scene does not name beat_contact)"
+                                           : "no load cell (io.load_cell_channel = 0)",
+                v);
+    return;
+  }
+  sequencer::SweepClock clock;  // the bounds the sequencer derives for this recipe
+  const sequencer::BeatRegulatorLimits l = clock.configure(m.profiles(), sc.period_s, sc.beat_regulator,
+                                                           0.5 * (sc.beat_force_min_n + sc.beat_force_max_n));
+  std::printf(
+      "  beat force: closed loop on the load cell, aiming at %.0f N: each beat's peak sets the next beat's "
+      "crank speed within %.2f..%.2f rad/s (x%.2f..x%.2f, up to %.1f %% per beat)\n",
+      l.target_n, v * l.min_scale, v * l.max_scale, l.min_scale, l.max_scale, 100.0 * l.max_step);
+}
+
 void print_header(const Machine& m, const Scene& scene, const WeaveArgs& a) {
   const auto& p = m.profiles();
   const auto& w = p.beatup().warp();
@@ -87,6 +111,7 @@ void print_header(const Machine& m, const Scene& scene, const WeaveArgs& a) {
       "at %.1f rad/s, pitch %.1f mm\n",
       motion::deg(p.beatup().dead_centres().swing), p.beatup().stroke_arc_m() * 1e3, motion::deg(w.enter),
       motion::deg(w.exit), p.beats_per_row(), p.spec().crank.velocity, p.pitch_m() * 1e3);
+  print_beat_regulation(m, scene, a.hal == "sim" || !m.banner().empty());
   std::printf("  pick: %.2f helix turns in %.3f s (accel limit %.0f rad/s^2, carrier and drive)\n",
               p.spec().width_m / p.spec().helix_lead_m, p.pick().duration(), p.helix_accel_limit());
   for (const std::string& n : m.notes()) std::printf("  CAN: %s\n", n.c_str());

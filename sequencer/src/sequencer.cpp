@@ -83,6 +83,13 @@ std::optional<SequencerFault> find_fault(const SequencerConfig& c, const motion:
                      std::to_string(kMaxBeatsPerRow) + " (narrow the loom or beat each position fewer times)");
   }
   if (c.picks_per_row < 1) return fault(F::kPicksPerRow, "recipe.picks_per_row must be at least 1");
+  const BeatRegulatorConfig& br = c.beat_regulator;
+  if (!(br.min_speed_scale > 0.0 && br.min_speed_scale <= 1.0) || !(br.max_speed_scale >= 1.0 && br.max_speed_scale <= 2.0)) {
+    return fault(F::kBeatRegulator, "beat regulator: speed scale bounds must satisfy 0 < min <= 1 <= max <= 2");
+  }
+  if (!(br.memory_weight > 0.0 && br.memory_weight <= 1.0) || !(br.drift_weight > 0.0 && br.drift_weight <= 1.0)) {
+    return fault(F::kBeatRegulator, "beat regulator: memory and drift weights must be in (0, 1]");
+  }
   if (c.axes.count < hal::kCoreAxisCount || c.axes.count > hal::kMaxAxes) {
     return fault(F::kAxes, "axes: the loom has " + std::to_string(c.axes.count) +
                                " axes; it needs the three core axes and holds at most " + std::to_string(hal::kMaxAxes));
@@ -214,7 +221,14 @@ void Sequencer::configure_knot_guard() {
 void Sequencer::adopt_limits() noexcept {
   const motion::ProfileSpec& s = profiles_->spec();
   const double dt = cfg_.period_s;
-  max_step_[index(CoreAxis::kBeatCrank)] = kStepPlausibility * s.crank.velocity * dt + 1e-3;
+  // The beat regulator's bounds for this recipe (a new recipe's positions start unremembered), aiming at
+  // the band's middle, where either edge is farthest.
+  const BeatRegulatorLimits limits = sweep_clock_.configure(*profiles_, dt, cfg_.beat_regulator,
+                                                            0.5 * (cfg_.beat_force_min_n + cfg_.beat_force_max_n));
+  regulator_.configure(cfg_.beat_regulator, limits, profiles_->beats_per_row() / std::max(1, s.beats_per_position));
+  // The crank's fastest is the regulator's fastest beat.
+  const double crank_top = s.crank.velocity * (cfg_.beat_regulator.enabled ? limits.max_scale : 1.0);
+  max_step_[index(CoreAxis::kBeatCrank)] = kStepPlausibility * crank_top * dt + 1e-3;
   max_step_[index(CoreAxis::kCarriage)] =
       kStepPlausibility * std::max(s.carriage_max_speed_m_s, cfg_.carriage.velocity) * dt + 1e-4;
   max_step_[index(CoreAxis::kHelix)] = kStepPlausibility * profiles_->helix_limits().velocity * dt + 1e-3;
@@ -253,6 +267,7 @@ void Sequencer::latch(Fault f, hal::Tick now, int axis, std::uint16_t detail, in
   ack_requested_ = false;
   crank_move_.active = carriage_move_.active = helix_move_.active = false;
   sweeping_ = false;
+  sweep_clock_.stop();
   enter(State::kFault, now);
 }
 
@@ -1029,6 +1044,8 @@ void Sequencer::begin_sweep(hal::Tick now) noexcept {
   carriage_sweep_origin_ = cmd_.axes[index(CoreAxis::kCarriage)].target_position;
   crank_sweep_origin_ = cmd_.axes[index(CoreAxis::kBeatCrank)].target_position;
   crank_move_ = {true, now, crank_sweep_origin_, profiles_->crank_sweep()};
+  sweep_clock_.start(now);
+  if (regulator_.enabled()) sweep_clock_.request(0, regulator_.first_beat(beat_position(0)));
   sweeping_ = true;
   row_beats_ = 0;
   beats_published_ = 0;
@@ -1038,6 +1055,7 @@ void Sequencer::begin_sweep(hal::Tick now) noexcept {
 
 void Sequencer::end_row(hal::Tick now) noexcept {
   sweeping_ = false;
+  sweep_clock_.stop();
   while (beats_published_ < row_beats_) publish_beat(beats_published_);
   ++counters_.rows;
   counters_.picks_in_row = 0;
@@ -1191,8 +1209,10 @@ void Sequencer::play_moves(hal::Tick now) noexcept {
     cmd_.axes[index(axis)].target_position = m.origin + m.move.position_at(t);
     if (t >= m.move.duration()) m.active = false;
   };
-  // The crank's move is sampled once: as a move of its own and, in the sweep, as the master phase.
-  const double sweep_t = seconds_since(now, crank_move_.t0);  // before the move may end
+  // The crank's move is sampled once: as a move of its own and, in the sweep, as the master phase — at
+  // the sweep clock's time, warped by the beat regulator's speeds (the tick time while there are none).
+  // (active() only in a sweep: the clock is stopped with it.)
+  const double sweep_t = sweep_clock_.active() ? sweep_clock_.time_at(now) : seconds_since(now, crank_move_.t0);
   const bool crank_played = crank_move_.active;
   const double crank_offset = crank_played || sweeping_ ? crank_move_.move.position_at(sweep_t) : 0.0;
   if (crank_played) {
@@ -1202,7 +1222,10 @@ void Sequencer::play_moves(hal::Tick now) noexcept {
   play(carriage_move_, CoreAxis::kCarriage);
   play(helix_move_, CoreAxis::kHelix);
   if (!sweeping_) return;
-  // The sweep move is the master phase; the crank follows the speed law (constant: the same).
+  // The sweep move is the master phase; the crank follows the speed law (constant: the same). A speed
+  // change the regulator asked for starts once the master is inside its window (carriage at rest); this
+  // tick's targets are sampled already, it acts from the next.
+  if (sweep_clock_.active()) sweep_clock_.advance(now, crank_offset);
   const motion::Phase master = motion::Phase::from_rad(crank_offset);
   const double phi = profiles_->crank_phase_at(master);
   cmd_.axes[index(CoreAxis::kBeatCrank)].target_position = crank_sweep_origin_ + phi;
@@ -1245,7 +1268,28 @@ void Sequencer::publish_beat(int k) noexcept {
   }
   e.force_measured = r.force_measured;
   e.in_band = e.force_measured && e.peak_force_n >= cfg_.beat_force_min_n && e.peak_force_n <= cfg_.beat_force_max_n;
+  // The speed it was beaten at (the clock is back at the recipe's by now; the next beat's is asked below).
+  e.speed_scale = static_cast<float>(sweep_clock_.beat_scale());
+  row_.speed(k, e.speed_scale);
   beats_published_ = k + 1;
+  if (e.force_measured && sweeping_ && regulator_.enabled()) regulate_after(k, e);  // a load cell: closed loop
+}
+
+int Sequencer::beat_position(int k) const noexcept {
+  const int per = std::max(1, profiles_->spec().beats_per_position);
+  const int i = k / per, positions = profiles_->beats_per_row() / per;
+  return carriage_sweep_dir_ > 0.0 ? i : positions - 1 - i;
+}
+
+// Beat k is final (the beater has left the warp): the regulator learns from it and chooses the next
+// beat's speed, which the sweep clock plays in that beat's window; after the last beat, back to the
+// recipe's speed before the braking. Per beat, never per tick.
+void Sequencer::regulate_after(int k, const BeatEvent& e) noexcept {
+  const int next = k + 1;
+  const bool last = next >= profiles_->beats_per_row();
+  const double s = regulator_.after_beat(beat_position(k), e.speed_scale, e.force_measured && e.peak_force_n > 0.0f,
+                                         e.peak_force_n, last ? -1 : beat_position(next));
+  sweep_clock_.request(next, s);
 }
 
 void Sequencer::signal() noexcept {

@@ -8,9 +8,9 @@
 namespace loom::sim_hal {
 
 const std::vector<std::string>& known_effects() {
-  static const std::vector<std::string> names{kEffectIdeal,       kEffectServoLag,      kEffectPneumatics,
-                                              kEffectShuttleSlip, kEffectSensorNoise,   kEffectBeatContact,
-                                              kEffectInertia,     kEffectJointFriction, kEffectKnotter};
+  static const std::vector<std::string> names{
+      kEffectIdeal,       kEffectServoLag, kEffectPneumatics,    kEffectShuttleSlip, kEffectSensorNoise,
+      kEffectBeatContact, kEffectInertia,  kEffectJointFriction, kEffectKnotter,     kEffectWarpTension};
   return names;
 }
 

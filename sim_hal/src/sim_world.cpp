@@ -82,6 +82,12 @@ SimWorld::SimWorld(const SimMachine& machine, const SceneSpec& scene)
       }
       if (!scene_.knotter) scene_.knotter = Knotter{};
       knotter_ = std::make_unique<SimKnotter>(m_.knotting, *scene_.knotter, m_.period_s);
+    } else if (e == kEffectWarpTension) {
+      if (std::find(scene_.effects.begin(), scene_.effects.end(), kEffectBeatContact) == scene_.effects.end()) {
+        throw std::invalid_argument("effect 'warp_tension' scales the beat's force on the load cell: name 'beat_contact' too");
+      }
+      if (!scene_.warp_tension) scene_.warp_tension = WarpTension{};
+      warp_tension_ = std::make_unique<WarpTensionModel>(*scene_.warp_tension, m_, scene_.seed);
     } else if (e == kEffectJointFriction) {
       if (std::find(scene_.effects.begin(), scene_.effects.end(), kEffectInertia) == scene_.effects.end()) {
         throw std::invalid_argument("effect 'joint_friction' acts on the crank's dynamics: name 'inertia' too");
@@ -110,7 +116,7 @@ std::size_t SimWorld::effect_count() const {
   std::size_t n = 0;
   for (std::size_t i = 0; i < n_axes_; ++i) n += axes_[i].effects.size();
   n += scene_.pneumatics.has_value() + scene_.shuttle_slip.has_value() + scene_.sensor_noise.has_value() +
-       scene_.beat_contact.has_value() + scene_.joint_friction.has_value();
+       scene_.beat_contact.has_value() + scene_.joint_friction.has_value() + (warp_tension_ != nullptr);
   return n;
 }
 
@@ -416,7 +422,7 @@ void SimWorld::bracket_contact() {
   contact_to_ = std::min(w.exit, last_far(w.exit, w.fell) + kContactMarginRad);
 }
 
-void SimWorld::step_beat_contact(double crank_position, double omega) noexcept {
+void SimWorld::step_beat_contact(double crank_position, double omega, const hal::AxisFeedbacks& fb) noexcept {
   const double alpha = (omega - crank_v_prev_) / m_.period_s;
   crank_v_prev_ = omega;
   beat_force_n_ = 0.0;
@@ -429,6 +435,11 @@ void SimWorld::step_beat_contact(double crank_position, double omega) noexcept {
   // Tangential tip acceleration from the kinematic coefficients: L·(θ4'' ω² + θ4' α).
   const double a_t = m_.beatup.beater_arm_m * (s.d2 * omega * omega + s.d1 * alpha);
   beat_force_n_ = scene_.beat_contact->beater_mass_kg * std::abs(a_t);
+  if (warp_tension_) {  // in contact only: a scene without the effect pays nothing here
+    const auto turn = static_cast<std::int64_t>(std::floor((crank_position - m_.crank_park_position_rad) / motion::kTwoPi));
+    const std::size_t c = hal::index(hal::CoreAxis::kCarriage);
+    beat_force_n_ *= warp_tension_->factor(turn, drives_simulated_ ? axes_[c].position + axes_[c].offset : fb[c].position);
+  }
 }
 
 void SimWorld::read_analog(hal::Tick now, hal::AnalogInputs& analog) {
@@ -488,7 +499,7 @@ void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::Digit
     knotter_->inputs(at, io);
   }
   // The load cell rides the beater, which the crank drives: real (CAN) or simulated.
-  if (scene_.beat_contact) step_beat_contact(pos(hal::CoreAxis::kBeatCrank), vel(hal::CoreAxis::kBeatCrank));
+  if (scene_.beat_contact) step_beat_contact(pos(hal::CoreAxis::kBeatCrank), vel(hal::CoreAxis::kBeatCrank), axes);
   constexpr std::size_t n = hal::kSafetySensorCount;
   const std::array<bool, n> truth{piston_[0] >= 1.0,
                                   piston_[0] <= 0.0,

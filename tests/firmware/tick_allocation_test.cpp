@@ -65,6 +65,15 @@ TEST(TickAllocations, ServoLagSceneAllocatesNothingPerTick) {
   EXPECT_EQ(allocations_while_weaving(scene, 2, &ticks), 0u);
 }
 
+// The beat regulator at work (issue 31): warp_tension makes every beat's force differ, so the regulator
+// learns from each measured beat and the sweep's clock changes the crank's speed between beats.
+TEST(TickAllocations, RegulatedBeatsAllocateNothingPerTick) {
+  const std::string scenes = std::string(LOOM_SOURCE_DIR) + "/sim_hal/scenes/";
+  hal::Tick ticks = 0;
+  EXPECT_EQ(allocations_while_weaving(firmware::load_scene(scenes + "warp_tension.toml"), 3, &ticks), 0u);
+  EXPECT_GE(ticks, 10000);
+}
+
 // The ticks with the most to say: the sequencer's event list (faults latched and refined, the knotting
 // heads' progress and requests of the weaver) forwarded to telemetry, and the drives' own fault reports.
 TEST(TickAllocations, EventfulScenesAllocateNothingPerTick) {

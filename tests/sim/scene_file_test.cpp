@@ -122,3 +122,36 @@ TEST(SceneFile, AFaultInASecondSwitchTheLoomDoesNotHaveIsRefusedAtTheFault) {
     EXPECT_NE(std::string(e.what()).find("io.shuttle_at_right_2_bit = -1"), std::string::npos) << e.what();
   }
 }
+
+// warp_tension: its numbers are range-checked at their line, it needs beat_contact, `points` and
+// `centre_ratio` exclude each other, and both forms round-trip through the writer.
+TEST(SceneFile, WarpTensionIsCheckedAtItsLineAndRoundTrips) {
+  const std::string effects = "effects = [\"ideal\", \"beat_contact\", \"warp_tension\"]\n[warp_tension]\n";
+  EXPECT_EQ(error_of(effects + "noise = 0.5\n"), "s.toml:3:9: warp_tension.noise = 0.5: must be in [0, 0.2]");
+  EXPECT_EQ(error_of(effects + "drift_per_row = nan\n"),
+            "s.toml:3:17: warp_tension.drift_per_row = nan: must be finite");
+  EXPECT_EQ(error_of(effects + "points = [1.0]\n"),
+            "s.toml:3:10: warp_tension.points = [...]: expected 2..64 relative tensions, equally spaced from the left "
+            "selvedge to the right");
+  EXPECT_EQ(error_of(effects + "points = [1.0, -2.0]\n"),
+            "s.toml:3:16: warp_tension.points = -2: each relative tension must be a number in [0.05, 5]");
+  EXPECT_NE(error_of(effects + "points = [1.0, 0.9]\ncentre_ratio = 0.9\n").find("not both"), std::string::npos);
+  EXPECT_NE(error_of(effects + "tilt = 1\n").find("warp_tension.tilt"), std::string::npos);  // unknown key
+  EXPECT_NE(error_of("effects = [\"ideal\", \"warp_tension\"]\n").find("name \"beat_contact\" too"), std::string::npos);
+  EXPECT_NE(error_of("effects = [\"ideal\", \"beat_contact\"]\n[warp_tension]\nnoise = 0.1\n")
+                .find("parameters given for an effect the scene does not name"),
+            std::string::npos);
+  for (const bool with_points : {false, true}) {
+    sim_hal::SceneSpec s;
+    s.effects = {"ideal", "beat_contact", "warp_tension"};
+    s.beat_contact = sim_hal::BeatContact{};
+    s.warp_tension = sim_hal::WarpTension{.centre_ratio = 0.8125, .points = {}, .drift_per_row = -0.0015, .noise = 0.03};
+    if (with_points) s.warp_tension->points = {1.1, 0.875, 1.0};
+    const std::string text = firmware::scene_to_toml(s);
+    const firmware::Scene back = firmware::parse_scene(text, "written.toml");
+    EXPECT_EQ(firmware::scene_to_toml(back.spec), text);
+    ASSERT_TRUE(back.spec.warp_tension.has_value());
+    EXPECT_EQ(back.spec.warp_tension->points, s.warp_tension->points);
+    EXPECT_EQ(back.spec.warp_tension->drift_per_row, -0.0015);
+  }
+}

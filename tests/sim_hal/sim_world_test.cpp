@@ -4,7 +4,12 @@
 
 #include <cmath>
 #include <filesystem>
+#include <cstdio>
+#include <cstdlib>
+#include <random>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "loom/motion/angles.hpp"
 #include "loom/sim_hal/sim_world.hpp"
@@ -42,6 +47,10 @@ TEST(SimWorld, UnnamedEffectsAreNotBuilt) {
   EXPECT_EQ(SimWorld(m, scene({"inertia", "joint_friction"})).effect_count(), 2u);
   EXPECT_THROW(SimWorld(m, scene({"joint_friction"})), std::invalid_argument);
   EXPECT_THROW(SimWorld(m, scene({"warp_drive"})), std::invalid_argument);
+  EXPECT_EQ(SimWorld(m, scene({"ideal", "beat_contact"})).effect_count(), 1u);
+  EXPECT_EQ(SimWorld(m, scene({"ideal", "beat_contact", "warp_tension"})).effect_count(), 2u);
+  EXPECT_EQ(SimWorld(m, scene({"ideal", "beat_contact"})).warp_tension(), nullptr);
+  EXPECT_THROW(SimWorld(m, scene({"ideal", "warp_tension"})), std::invalid_argument);  // it scales beat_contact's force
 }
 
 TEST(SimWorld, ServoLagIsTheExactFirstOrderStepResponse) {
@@ -180,4 +189,95 @@ TEST(SimWorld, BeatContactBracketHoldsEveryPhaseInContact) {
       EXPECT_TRUE(from == w.enter && to == w.exit);
     }
   }
+}
+
+namespace {
+// The peak load-cell force of each crank turn, the crank turning at `omega` from park and the carriage
+// stepping `pitch` once per turn while the beater is clear (at park).
+std::vector<double> beat_peaks(const SceneSpec& s, double omega, double pitch, int turns) {
+  const SimMachine m;
+  SimWorld w(m, s);
+  hal::AxisCommands cmd{};
+  for (auto& c : cmd) c.request = hal::AxisRequest::kEnable;
+  hal::AxisFeedbacks fb{};
+  hal::LinkStatus link{};
+  hal::DigitalInputs io{};
+  hal::AnalogInputs analog{};
+  const int per_turn = static_cast<int>(std::lround(motion::kTwoPi / (omega * m.period_s)));
+  std::vector<double> peaks(static_cast<std::size_t>(turns), 0.0);
+  for (hal::Tick t = 0; t < static_cast<hal::Tick>(per_turn) * turns; ++t) {
+    const auto turn = static_cast<std::size_t>(t / per_turn);
+    cmd[hal::index(hal::CoreAxis::kBeatCrank)].target_position = omega * m.period_s * static_cast<double>(t);
+    cmd[hal::index(hal::CoreAxis::kCarriage)].target_position = pitch * static_cast<double>(turn);
+    w.write_axes(t, cmd);
+    w.read_axes(t, fb, link);
+    w.read_io(t, fb, io);
+    w.read_analog(t, analog);
+    peaks[turn] = std::max(peaks[turn], analog.beat_force_n);
+  }
+  return peaks;
+}
+}  // namespace
+
+// warp_tension scales each beat's contact force by the profile across the width where the comb beats (its
+// middle: carriage + half the beater) and the drift over the carriage travel swept so far (a row per
+// width − beater width), checked against the closed forms written out here.
+TEST(SimWorld, WarpTensionScalesTheBeatByProfileAndDrift) {
+  const SimMachine m;  // 1.2 m wide, 0.10 m comb: 1.1 m of travel per row
+  const double pitch = 1.1 / 14.0, omega = 16.0;
+  SceneSpec plain = scene({"ideal", "beat_contact"});
+  SceneSpec taut = scene({"ideal", "beat_contact", "warp_tension"});
+  taut.warp_tension = WarpTension{.centre_ratio = 0.8, .points = {}, .drift_per_row = 0.05, .noise = 0.0};
+  const int turns = 29;  // two rows' worth of carriage travel (14 steps each), then one more beat
+  const std::vector<double> f0 = beat_peaks(plain, omega, pitch, turns);
+  const std::vector<double> f1 = beat_peaks(taut, omega, pitch, turns);
+  for (int j = 0; j < turns; ++j) {
+    ASSERT_GT(f0[static_cast<std::size_t>(j)], 50.0) << "turn " << j;  // every turn beats
+    const double x = pitch * j;                                          // one-way: the carriage keeps going
+    const double u = std::min(1.0, (x + 0.05) / 1.2);
+    const double profile = 0.8 + 0.2 * ((2.0 * u - 1.0) * (2.0 * u - 1.0));  // 1 at the selvedges, 0.8 mid
+    const double rows = x / 1.1;
+    EXPECT_NEAR(f1[static_cast<std::size_t>(j)] / f0[static_cast<std::size_t>(j)], profile * (1.0 + 0.05 * rows), 1e-9)
+        << "turn " << j;
+  }
+}
+
+TEST(SimWorld, WarpTensionPointsAreLinearBetweenEquallySpacedPoints) {
+  SimMachine m;
+  WarpTension p{.centre_ratio = 1.0, .points = {1.1, 0.9, 1.0}, .drift_per_row = 0.0, .noise = 0.0};
+  const WarpTensionModel model(p, m, 1);
+  EXPECT_DOUBLE_EQ(model.profile(0.0), 1.1);
+  EXPECT_DOUBLE_EQ(model.profile(0.25), 1.0);
+  EXPECT_DOUBLE_EQ(model.profile(0.5), 0.9);
+  EXPECT_DOUBLE_EQ(model.profile(0.75), 0.95);
+  EXPECT_DOUBLE_EQ(model.profile(1.0), 1.0);
+  EXPECT_DOUBLE_EQ(model.profile(2.0), 1.0);  // beyond a selvedge: the selvedge's
+  p.points = {1.0};
+  EXPECT_THROW(WarpTensionModel(p, m, 1), std::invalid_argument);
+  m.beater_width_m = m.width_m;
+  EXPECT_THROW(WarpTensionModel(WarpTension{}, m, 1), std::invalid_argument);
+}
+
+// Each beat draws its own variation once (a contact of several ticks keeps it): over many beats its mean
+// is 1 and its standard deviation `noise`; the same seed replays it. Seed: LOOM_TEST_SEED (printed).
+TEST(SimWorld, WarpTensionNoiseHasItsDeviationAndReplays) {
+  const char* env = std::getenv("LOOM_TEST_SEED");
+  const std::uint64_t seed = env ? std::stoull(env) : std::random_device{}();
+  std::printf("seed %llu (LOOM_TEST_SEED)\n", static_cast<unsigned long long>(seed));
+  const WarpTension p{.centre_ratio = 1.0, .points = {}, .drift_per_row = 0.0, .noise = 0.02};
+  const SimMachine m;
+  WarpTensionModel a(p, m, seed), b(p, m, seed);
+  constexpr int kBeats = 20000;
+  double sum = 0.0, sum2 = 0.0;
+  for (int k = 0; k < kBeats; ++k) {
+    const double f = a.factor(k, 0.0);
+    ASSERT_EQ(a.factor(k, 0.0), f);  // the same contact: the same draw
+    ASSERT_EQ(b.factor(k, 0.0), f);  // the same seed: the same beats
+    sum += f;
+    sum2 += f * f;
+  }
+  const double mean = sum / kBeats, sd = std::sqrt(sum2 / kBeats - mean * mean);
+  // Five standard errors: the mean's is 0.02 / sqrt(20000) = 1.4e-4, the deviation's about 0.5 % of it.
+  EXPECT_NEAR(mean, 1.0, 5 * 0.02 / std::sqrt(kBeats));
+  EXPECT_NEAR(sd, 0.02, 5 * 0.02 / std::sqrt(2.0 * kBeats));
 }

@@ -147,6 +147,16 @@ sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run,
     s.effects.push_back(sim_hal::kEffectBeatContact);
     s.beat_contact = sim_hal::BeatContact{};
     d << "beat_contact ";
+    // Half the time an uneven, drifting warp behind it, so the beat regulator has work to do (it acts on
+    // every measured beat). Drawn from a stream of its own: the other draws, and so every scene drawn
+    // before this effect existed, stay as they were for the same seed and run.
+    std::mt19937_64 wrng(mix(seed ^ mix(run) ^ 0x7E45105Eull));
+    if (u(wrng) < 0.5) {
+      s.effects.push_back(sim_hal::kEffectWarpTension);
+      s.warp_tension = sim_hal::WarpTension{.centre_ratio = 0.75 + 0.4 * u(wrng), .points = {},
+                                            .drift_per_row = -0.01 + 0.03 * u(wrng), .noise = 0.03 * u(wrng)};
+      d << "warp_tension(" << s.warp_tension->centre_ratio << ", " << s.warp_tension->drift_per_row << "/row) ";
+    }
   }
   if (u(rng) < 0.02) {
     s.effects.push_back(sim_hal::kEffectInertia);

@@ -183,6 +183,8 @@ std::pair<std::string, std::string> sequencer_key(const LoomConfig& c, const seq
       return key("knotting.selector_accel_rad_s2");
     case F::kKnotterSettings:
       return key("knotting.take_position_rad");
+    case F::kBeatRegulator:  // the regulator's constants: about the band it holds
+      return key("recipe.beat_force_min_n");
   }
   return {"timing.period_ms", ms(c.run.period_s)};
 }

@@ -161,6 +161,8 @@ void derive(LoomConfig& c, const Fail& fail) {
                          .index_pitch = hal::is_rotary(a.role) ? 2.0 * M_PI : a.lead_m};
   }
   sm.width_m = m.width_m;
+  sm.beater_width_m = m.beater_width_m;  // where across the width the comb beats (warp_tension)
+  sm.carriage_home_m = m.calibration.carriage_home_m;
   sm.helix_lead_m = m.helix_lead_m;
   sm.piston_travel_s = m.shed.piston_travel_s;
   sm.beatup = m.beatup;

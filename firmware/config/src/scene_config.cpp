@@ -246,7 +246,7 @@ Scene parse_scene(const std::string& text, const std::string& source) {
   for (const char* effect :
        {sim_hal::kEffectServoLag, sim_hal::kEffectPneumatics, sim_hal::kEffectShuttleSlip,
         sim_hal::kEffectSensorNoise, sim_hal::kEffectBeatContact, sim_hal::kEffectInertia,
-        sim_hal::kEffectJointFriction, sim_hal::kEffectKnotter}) {
+        sim_hal::kEffectJointFriction, sim_hal::kEffectKnotter, sim_hal::kEffectWarpTension}) {
     if (r.root().contains(effect) && !named(effect)) {
       r.fail(effect, "{...}", "parameters given for an effect the scene does not name");
     }
@@ -317,6 +317,38 @@ Scene parse_scene(const std::string& text, const std::string& source) {
     r.number("beat_contact.contact_depth_m", p.contact_depth_m,
              [](double v) { return in_range(v, 1e-6, 1.0); });
     s.spec.beat_contact = p;
+  }
+  if (named(sim_hal::kEffectWarpTension)) {
+    if (!named(sim_hal::kEffectBeatContact)) {
+      r.fail("effects", "\"warp_tension\"",
+             "scales the beat's force on the load cell: name \"beat_contact\" too");
+    }
+    sim_hal::WarpTension p;
+    r.number("warp_tension.centre_ratio", p.centre_ratio, [](double v) { return in_range(v, 0.05, 5.0); });
+    r.number("warp_tension.drift_per_row", p.drift_per_row,
+             [](double v) { return in_range(v, -0.01, 0.01); });
+    r.number("warp_tension.noise", p.noise, [](double v) { return in_range(v, 0.0, 0.2); });
+    r.consume("warp_tension.points");
+    const toml::table* wt = r.root().get_as<toml::table>(sim_hal::kEffectWarpTension);
+    if (const toml::node* pts = wt ? wt->get("points") : nullptr) {
+      const toml::array* arr = pts->as_array();
+      if (arr == nullptr || arr->size() < 2 || arr->size() > 64) {
+        r.fail_at(*pts, "warp_tension.points", shown(*pts),
+                  "expected 2..64 relative tensions, equally spaced from the left selvedge to the right");
+      }
+      if (wt->get("centre_ratio") != nullptr) {
+        r.fail_at(*pts, "warp_tension.points", shown(*pts), "give either points or centre_ratio, not both");
+      }
+      for (const toml::node& e : *arr) {
+        const auto v = e.value<double>();
+        if (!v || !std::isfinite(*v) || *v < 0.05 || *v > 5.0) {
+          r.fail_at(e, "warp_tension.points", shown(e),
+                    "each relative tension must be a number in [0.05, 5]");
+        }
+        p.points.push_back(*v);
+      }
+    }
+    s.spec.warp_tension = p;
   }
   r.consume("fault");
   if (const toml::node* faults = r.root().get("fault")) {
@@ -442,6 +474,19 @@ std::string scene_to_toml(const sim_hal::SceneSpec& s, const std::string& config
   if (s.beat_contact) {
     os << "\n[beat_contact]\nbeater_mass_kg = " << s.beat_contact->beater_mass_kg
        << "\ncontact_depth_m = " << s.beat_contact->contact_depth_m << "\n";
+  }
+  if (s.warp_tension) {
+    os << "\n[warp_tension]\n";
+    if (s.warp_tension->points.empty()) {
+      os << "centre_ratio = " << s.warp_tension->centre_ratio << "\n";
+    } else {
+      os << "points = [";
+      for (std::size_t i = 0; i < s.warp_tension->points.size(); ++i)
+        os << (i ? ", " : "") << s.warp_tension->points[i];
+      os << "]\n";
+    }
+    os << "drift_per_row = " << s.warp_tension->drift_per_row << "\nnoise = " << s.warp_tension->noise
+       << "\n";
   }
   if (s.inertia) {
     os << "\n[inertia]\nmotor_torque_limit_nm = " << s.inertia->motor_torque_limit_nm

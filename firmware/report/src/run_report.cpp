@@ -184,6 +184,7 @@ json row_json(const sequencer::RowStats& r, std::uint32_t picks, double period_s
     const auto& b = r.beat[static_cast<std::size_t>(k)];
     json jb = {{"x_m", b.x_m}};
     jb["peak_force_n"] = r.force_measured ? json(b.peak_force_n) : json(nullptr);
+    jb["speed_scale"] = b.speed_scale;  // the beat's crank speed over the recipe's (the beat regulator's)
     beats.push_back(jb);
   }
   const auto secs = [&](hal::Tick t) { return static_cast<double>(t) * period_s; };

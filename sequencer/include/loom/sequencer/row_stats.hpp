@@ -17,6 +17,7 @@ inline constexpr int kMaxBeatsPerRow = 256;
 struct BeatRecord {
   float x_m = 0.0f;           // carriage position (beater's left edge from the left selvedge)
   float peak_force_n = 0.0f;  // peak load-cell force during this beat (0 when no load cell)
+  float speed_scale = 1.0f;   // its crank speed over the recipe's (the beat regulator's choice; 1 open loop)
 };
 
 struct RowStats {
@@ -59,6 +60,9 @@ class RowRecorder {
   void add_pick(hal::Tick ticks) noexcept { stats_.pick_ticks += ticks; }
   void beat_at(int k, double x_m) noexcept {
     if (k >= 0 && k < kMaxBeatsPerRow) stats_.beat[static_cast<std::size_t>(k)].x_m = static_cast<float>(x_m);
+  }
+  void speed(int k, float scale) noexcept {
+    if (k >= 0 && k < kMaxBeatsPerRow) stats_.beat[static_cast<std::size_t>(k)].speed_scale = scale;
   }
   void force(int k, double f_n) noexcept {
     if (k < 0 || k >= kMaxBeatsPerRow) return;

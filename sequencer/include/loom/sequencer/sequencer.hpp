@@ -12,6 +12,7 @@
 #include "loom/motion/jerk_move.hpp"
 #include "loom/motion/profile_set.hpp"
 #include "loom/motion/profile_slot.hpp"
+#include "loom/sequencer/beat_regulator.hpp"
 #include "loom/sequencer/debounce.hpp"
 #include "loom/sequencer/dual_channel.hpp"
 #include "loom/sequencer/faults.hpp"
@@ -92,6 +93,10 @@ struct SequencerConfig {
   double shuttle_follow_tolerance_m = 0.002;
   double beat_force_min_n = 80.0;         // the band every beat must hit (thesis: 80–100 N)
   double beat_force_max_n = 100.0;
+  // The per-beat regulator (beat_regulator.hpp): from each measured beat it sets the next beat's crank
+  // speed, aiming at the band's middle. It acts only on measured beats: a loom without a load cell runs
+  // open loop, every beat at the recipe's speed.
+  BeatRegulatorConfig beat_regulator{};
   double load_cell_max_n = 5000.0;        // a load-cell reading beyond this is a failed cell, not a beat
   motion::JerkLimits carriage{.velocity = 0.5, .acceleration = 5.0, .jerk = 100.0};  // re-arm moves
   // Row-boundary handshake: with await_row_saved, no row starts before the reporter has confirmed that
@@ -134,6 +139,7 @@ enum class SequencerField : std::uint8_t {
   kSlotColours,
   kSelectorLimits,
   kKnotterSettings,
+  kBeatRegulator,  // SequencerConfig::beat_regulator (no key: the machine's constants)
 };
 struct SequencerFault {
   SequencerField field;
@@ -239,6 +245,10 @@ class Sequencer {
   int fault_sensor() const noexcept { return fault_sensor_; }
   hal::Tick fault_tick() const noexcept { return fault_tick_; }
   const RowStats& last_row() const noexcept { return last_row_; }
+  // The beat regulator: its bounds and target (limits()), what it has learned; and the crank's speed
+  // scale in the sweep now (1 outside a sweep and open loop).
+  const BeatRegulator& beat_regulator() const noexcept { return regulator_; }
+  double beat_speed_scale() const noexcept { return sweeping_ ? sweep_clock_.scale() : 1.0; }
   const motion::ProfileSet& profiles() const noexcept { return *profiles_; }
   std::uint32_t recipe_changes() const noexcept { return recipe_changes_; }
   // Beater crank phase from park of the current command (rad) and the table's rocker angle there.
@@ -303,6 +313,8 @@ class Sequencer {
   void configure_knot_guard();
   Fault shed_fault(ShedVerdict v) const noexcept;
   void publish_beat(int k) noexcept;
+  int beat_position(int k) const noexcept;  // carriage position (0 = left selvedge) of beat k of this sweep
+  void regulate_after(int k, const BeatEvent& e) noexcept;  // the regulator's turn, once per beat
   void add_fault_event(EventKind kind) noexcept;  // kFaultLatched / kDiagnosisRefined with the first fault's details
   bool expect_shuttle_left() const noexcept { return counters_.picks % 2 == 0; }  // it starts at the left
   bool row_starts_left() const noexcept { return counters_.rows % 2 == 0; }      // sweeps alternate
@@ -353,6 +365,10 @@ class Sequencer {
   double carriage_sweep_origin_ = 0.0;
   double carriage_sweep_dir_ = 1.0;
   double crank_sweep_origin_ = 0.0;
+  // The beat regulator and the sweep's warped clock (beat_regulator.hpp): the sweep move is sampled at
+  // sweep_clock_.time_at(now), which is the tick time while every beat is at the recipe's speed.
+  BeatRegulator regulator_;
+  SweepClock sweep_clock_;
 
   // The pick in progress: where the carrier goes and when it entered the arrival sensor's reach.
   bool pick_to_right_ = true;

@@ -23,7 +23,8 @@ struct BeatEvent {
   float x_m = 0.0f;           // carriage position (beater's left edge from the left selvedge)
   float peak_force_n = 0.0f;  // 0 when no load cell
   bool force_measured = false;
-  bool in_band = false;  // force_measured and within [beat_force_min_n, beat_force_max_n]
+  bool in_band = false;      // force_measured and within [beat_force_min_n, beat_force_max_n]
+  float speed_scale = 1.0f;  // the beat's crank speed over the recipe's (the beat regulator's; 1 open loop)
 };
 
 // The I/O module's buttons (debounced, one event per press; only reported: see operator_requests.hpp).

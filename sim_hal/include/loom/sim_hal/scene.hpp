@@ -23,6 +23,7 @@ inline constexpr const char* kEffectBeatContact = "beat_contact";   // beater lo
 inline constexpr const char* kEffectInertia = "inertia";             // rigid-body beat-up behind a torque-limited servo
 inline constexpr const char* kEffectJointFriction = "joint_friction"; // crank bearing friction (needs inertia)
 inline constexpr const char* kEffectKnotter = "knotter";             // the knotting heads, their yarn and the weaver
+inline constexpr const char* kEffectWarpTension = "warp_tension";   // uneven, drifting warp tension (needs beat_contact)
 const std::vector<std::string>& known_effects();
 
 struct ServoLag {
@@ -56,6 +57,20 @@ struct SensorNoise {
 struct BeatContact {
   double beater_mass_kg = 2.5;
   double contact_depth_m = 0.005;
+};
+
+// The warp's tension where the comb beats, relative to the uniform warp the loom was set up for; it scales
+// the beat contact's force on the load cell (warp_tension.hpp). Across the width: the parabola through 1 at
+// both selvedges and `centre_ratio` in the middle, or, when `points` is given, the relative tensions at
+// equally spaced points from the left selvedge to the right, linear between. Over the rows: × (1 +
+// drift_per_row × rows woven) — a warp beam held by a constant brake pulls harder as it empties. Per beat:
+// × (1 + noise × a standard normal draw), seeded by the scene. The defaults take the open-loop beat out of
+// the 80–100 N band: a slack middle (0.84: 75 N) and, after 200 rows, taut selvedges (1.24: 111 N).
+struct WarpTension {
+  double centre_ratio = 0.84;
+  std::vector<double> points;  // empty: the parabola
+  double drift_per_row = 0.0012;
+  double noise = 0.01;
 };
 
 // The beat-up crank stops being a kinematic follower: the linkage's rigid-body dynamics (thesis cast-iron
@@ -159,6 +174,8 @@ struct SimMachine {
   std::size_t axis_count = hal::kCoreAxisCount;  // the machine's axes (hal::AxisLayout::count)
   std::array<SimReferencing, hal::kMaxAxes> referencing{};  // per axis; default absolute
   double width_m = 1.2;
+  double beater_width_m = 0.10;  // the comb (warp_tension: where across the width it beats)
+  double carriage_home_m = 0.0;  // carriage axis reading at the left selvedge
   double helix_lead_m = 0.10;
   double piston_travel_s = 0.25;          // heald frame stroke time with the nominal air supply
   double selvedge_sensor_window_m = 0.005;
@@ -182,6 +199,7 @@ struct SceneSpec {
   std::optional<Inertia> inertia;
   std::optional<JointFriction> joint_friction;
   std::optional<Knotter> knotter;
+  std::optional<WarpTension> warp_tension;
   std::vector<FaultInjection> faults;
 };
 

@@ -16,6 +16,7 @@
 #include "loom/sim_hal/random.hpp"
 #include "loom/sim_hal/scene.hpp"
 #include "loom/sim_hal/sim_state_file.hpp"
+#include "loom/sim_hal/warp_tension.hpp"
 
 namespace loom::sim_hal {
 
@@ -83,6 +84,8 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   std::uint32_t injected_overruns() const { return injected_overruns_; }
   // The knotting heads (scene effect "knotter"; null without it): the carpet as knotted, for reports and tests.
   const SimKnotter* knotter() const { return knotter_.get(); }
+  // The warp's tension (scene effect "warp_tension"; null without it): rows counted, the last beat's factor.
+  const WarpTensionModel* warp_tension() const { return warp_tension_.get(); }
   // RT-safe. The loom asks the weaver (the panel's request): the simulated weaver does it after a while and
   // presses the pedal. Ignored without the knotter effect.
   void ask_weaver(const WeaverTask& t) noexcept {
@@ -99,7 +102,8 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   void step_axis(std::size_t slot, const hal::AxisCommand& cmd) noexcept;
   void step_homing(std::size_t slot) noexcept;
   void step_shuttle(double helix_position) noexcept;
-  void step_beat_contact(double crank_position, double crank_velocity) noexcept;
+  // `fb`: the HAL's feedback, for the carriage when the drives are real (warp_tension only).
+  void step_beat_contact(double crank_position, double crank_velocity, const hal::AxisFeedbacks& fb) noexcept;
   void bracket_contact();  // configure time: contact_from_, contact_to_
   void readings(std::array<double, hal::kMaxAxes>& out) const noexcept;  // every axis as its drive reads it
 
@@ -139,6 +143,7 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   std::uint32_t injected_overruns_ = 0;
   bool powered_off_ = false;
   std::unique_ptr<SimKnotter> knotter_;         // scene effect "knotter"
+  std::unique_ptr<WarpTensionModel> warp_tension_;  // scene effect "warp_tension"
   std::array<bool, hal::kMaxAxes> jammed_{};    // a jammed axis no longer follows its target
   int shuttle_side_ = 0;                        // the selvedge it last arrived at: -1 left, +1 right, 0 none yet
   static constexpr int kMidPick = 2;            // restarted with the shuttle in the shed: any arrival is a weft
