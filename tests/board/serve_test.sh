@@ -303,9 +303,12 @@ set -e
 grep -q 'is not a socket' "$work/serve9b.log" || fail "no reason given for refusing --socket on a file"
 
 # 10. the heads ask the weaver to tie a knot by hand (a slot runs dry); `next` names the request it answers
+# (the simulated weaver of this copy of the scene takes an hour, so the request stays open for ctl next:
+# serve's simulated weaver would otherwise do the work after the scene's 15 s)
+sed 's/^weaver_s = .*/weaver_s = 3600.0/' "$src/sim_hal/scenes/knotting_faults.toml" >"$work/knotting_slow_weaver.toml"
+grep -q '^weaver_s = 3600.0' "$work/knotting_slow_weaver.toml" || fail "the scene copy has no slow weaver"
 rm -rf "$work/state"
-start_serve serve10.log --config "$src/firmware/config/knotting_loom.toml" \
-  --scene "$src/sim_hal/scenes/knotting_faults.toml"
+start_serve serve10.log --config "$src/firmware/config/knotting_loom.toml" --scene "$work/knotting_slow_weaver.toml"
 ctl start >/dev/null
 for _ in $(seq 1 1200); do grep -q "weaver asked: " "$work/serve10.log" && break; sleep 0.05; done
 asked=$(sed -n 's/^.*weaver asked: //p' "$work/serve10.log" | head -1)
@@ -332,8 +335,7 @@ echo "knotting heads: next answered '$asked': ok"
 
 # 10b. SIGTERM while the heads wait for the weaver ends serve there (the row resumes at the next start)
 rm -rf "$work/state"
-start_serve serve10b.log --config "$src/firmware/config/knotting_loom.toml" \
-  --scene "$src/sim_hal/scenes/knotting_faults.toml"
+start_serve serve10b.log --config "$src/firmware/config/knotting_loom.toml" --scene "$work/knotting_slow_weaver.toml"
 ctl start >/dev/null
 for _ in $(seq 1 1200); do grep -q "weaver asked: " "$work/serve10b.log" && break; sleep 0.05; done
 grep -q "weaver asked: " "$work/serve10b.log" || fail "the heads never asked the weaver"
