@@ -29,10 +29,14 @@ std::uint32_t ceil_ticks(double seconds, double period_s) {
 // How bad a recovery state is, for reporting the worst over several buses.
 int rank(hal::LinkRecovery r) {
   switch (r) {
-    case hal::LinkRecovery::kHealthy: return 0;
-    case hal::LinkRecovery::kReady: return 1;
-    case hal::LinkRecovery::kNodeSilent: return 2;
-    case hal::LinkRecovery::kBusOff: return 3;
+    case hal::LinkRecovery::kHealthy:
+      return 0;
+    case hal::LinkRecovery::kReady:
+      return 1;
+    case hal::LinkRecovery::kNodeSilent:
+      return 2;
+    case hal::LinkRecovery::kBusOff:
+      return 3;
   }
   return 0;
 }
@@ -46,15 +50,17 @@ CanAxisPort::CanAxisPort(CanAxisPortConfig config) {
   d_.config = std::move(config);
   d_.n_axes = std::min(d_.config.axes.size(), hal::kMaxAxes);
   d_.n_buses = std::min(drivers::bus_count(d_.config), kMaxBuses);
-  const CanMasterConfig mc{d_.config.cycle_period_s, d_.config.sdo_timeout_s, d_.config.boot_timeout_s,
-                           d_.config.operational_timeout_s, d_.config.master_node_id,
-                           d_.config.master_heartbeat_s};
+  const CanMasterConfig mc{d_.config.cycle_period_s, d_.config.sdo_timeout_s,
+                           d_.config.boot_timeout_s, d_.config.operational_timeout_s,
+                           d_.config.master_node_id, d_.config.master_heartbeat_s};
   for (CanMaster& m : d_.masters) m = CanMaster(mc);
   for (std::size_t i = 0; i < d_.n_axes; ++i) d_.axes[i].setup(d_.config.axes[i], d_.config);
   relink();
 }
 
-CanAxisPort::CanAxisPort(const CanAxisPort& other) : hal::AxisPort(other), d_(other.d_) { relink(); }
+CanAxisPort::CanAxisPort(const CanAxisPort& other) : hal::AxisPort(other), d_(other.d_) {
+  relink();
+}
 
 CanAxisPort& CanAxisPort::operator=(const CanAxisPort& other) {
   d_ = other.d_;
@@ -92,9 +98,9 @@ Status CanAxisPort::configure(std::span<CanBus* const> buses, ConfigureClock& cl
   d_.notes.clear();
   if (Status s = validate(d_.config); !s) return Status::error("CAN axis configuration: " + s.message());
   if (buses.size() != d_.n_buses) {
-    return Status::error("the axes use " + std::to_string(d_.n_buses) + " CAN bus(es) (highest axes.<name>.bus = " +
-                         std::to_string(d_.n_buses - 1) + ") but " + std::to_string(buses.size()) +
-                         " interface(s) were given");
+    return Status::error("the axes use " + std::to_string(d_.n_buses) +
+                         " CAN bus(es) (highest axes.<name>.bus = " + std::to_string(d_.n_buses - 1) +
+                         ") but " + std::to_string(buses.size()) + " interface(s) were given");
   }
   for (std::size_t b = 0; b < d_.n_buses; ++b) {
     d_.bus_loads[b] = planned_bus_load(d_.config, b);
@@ -104,8 +110,9 @@ Status CanAxisPort::configure(std::span<CanBus* const> buses, ConfigureClock& cl
   }
   for (std::size_t k = 0; k < d_.n_attached; ++k) {
     if (d_.attached[k].bus >= d_.n_buses) {
-      return Status::error(d_.attached[k].node->label() + " is attached to bus " + std::to_string(d_.attached[k].bus) +
-                           " but the port has " + std::to_string(d_.n_buses) +
+      return Status::error(d_.attached[k].node->label() + " is attached to bus " +
+                           std::to_string(d_.attached[k].bus) + " but the port has " +
+                           std::to_string(d_.n_buses) +
                            " bus(es): its frames are not in other_frames_per_cycle");
     }
   }
@@ -171,7 +178,8 @@ bool CanAxisPort::any_fault() const {
 void CanAxisPort::write_axes(hal::Tick now, const hal::AxisCommands& commands) {
   if (!d_.configured) return;
   bool reset = false;
-  for (std::size_t i = 0; i < d_.n_axes; ++i) reset = reset || commands[i].request == AxisRequest::kFaultReset;
+  for (std::size_t i = 0; i < d_.n_axes; ++i)
+    reset = reset || commands[i].request == AxisRequest::kFaultReset;
   if (reset) {
     for (std::size_t b = 0; b < d_.n_buses; ++b) d_.masters[b].acknowledge();
   }

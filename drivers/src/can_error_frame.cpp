@@ -36,7 +36,11 @@ CanFrame error_frame(std::uint32_t error_class) {
 
 }  // namespace
 
-CanFrame make_bus_off_error_frame() { return error_frame(CAN_ERR_BUSOFF); }
-CanFrame make_restarted_error_frame() { return error_frame(CAN_ERR_RESTARTED); }
+CanFrame make_bus_off_error_frame() {
+  return error_frame(CAN_ERR_BUSOFF);
+}
+CanFrame make_restarted_error_frame() {
+  return error_frame(CAN_ERR_RESTARTED);
+}
 
 }  // namespace loom::drivers

@@ -133,7 +133,8 @@ Status CanIoPort::map_pdo(SdoClient& sdo, bool rx, int pdo, const std::vector<st
     }
     if (Status s = sdo.write(id, map, 0, static_cast<std::uint32_t>(wanted.size()), 1); !s) return fail(s);
   }
-  if (fixed) notes_.push_back(who() + hex(map, 4) + " mapping is fixed (write refused): read back and used as found");
+  if (fixed)
+    notes_.push_back(who() + hex(map, 4) + " mapping is fixed (write refused): read back and used as found");
 
   // Synchronous transmission so silence is visible every cycle (TPDO) / outputs apply on SYNC (RPDO: any).
   if (!rx) {
@@ -183,7 +184,8 @@ Status CanIoPort::configure_mapping(SdoClient& sdo) {
   std::vector<std::uint32_t> outputs;
   for (std::uint8_t k = 1; k <= out_bytes; ++k) outputs.push_back(entry(od401::kDigitalOutputs8, k, 8));
   const bool analog = w.load_cell_channel != 0;
-  const std::uint32_t load_cell = entry(od401::kAnalogInput16, static_cast<std::uint8_t>(w.load_cell_channel), 16);
+  const std::uint32_t load_cell =
+      entry(od401::kAnalogInput16, static_cast<std::uint8_t>(w.load_cell_channel), 16);
 
   tpdo_ = {};
   rpdo_ = {};
@@ -232,8 +234,8 @@ Status CanIoPort::configure_mapping(SdoClient& sdo) {
 
 // Where `wanted` sits in `layouts`; refused, naming the object and what needs it, when the module's
 // mapping lacks it or maps it with another length.
-Status CanIoPort::locate(const std::array<PdoLayout, 4>& layouts, std::uint32_t wanted, const std::string& what,
-                         Slot& slot) const {
+Status CanIoPort::locate(const std::array<PdoLayout, 4>& layouts, std::uint32_t wanted,
+                         const std::string& what, Slot& slot) const {
   slot = find(layouts, wanted);
   if (slot.pdo < 0) {
     return Status::error(who() + "no PDO carries " + object_name(wanted) + " (" + what +
@@ -366,19 +368,22 @@ Status CanIoPort::configure_profile(SdoClient& sdo) {
     const std::uint8_t bytes = io_output_subs(w);
     bool absent = false;
     for (std::uint8_t k = 0; k < bytes && !absent; ++k) {
-      if (Status s = sdo.write(id, od401::kOutputErrorMode, static_cast<std::uint8_t>(k + 1), mode[k], 1); !s) {
+      if (Status s = sdo.write(id, od401::kOutputErrorMode, static_cast<std::uint8_t>(k + 1), mode[k], 1);
+          !s) {
         if (sdo.last_abort() != sdo_abort::kNoObject) return fail(s);
         absent = true;
         break;
       }
-      if (Status s = sdo.write(id, od401::kOutputErrorValue, static_cast<std::uint8_t>(k + 1), value[k], 1); !s) {
+      if (Status s = sdo.write(id, od401::kOutputErrorValue, static_cast<std::uint8_t>(k + 1), value[k], 1);
+          !s) {
         if (sdo.last_abort() != sdo_abort::kNoObject) return fail(s);
         absent = true;
       }
     }
     if (absent) {
-      notes_.push_back(who() + "0x6206/0x6207 (output error mode/value) absent: the outputs keep their last "
-                               "state if the master dies; wire the valves' supply through the e-stop chain");
+      notes_.push_back(who() +
+                       "0x6206/0x6207 (output error mode/value) absent: the outputs keep their last "
+                       "state if the master dies; wire the valves' supply through the e-stop chain");
     }
   }
 
@@ -386,9 +391,11 @@ Status CanIoPort::configure_profile(SdoClient& sdo) {
     const std::uint32_t v = (static_cast<std::uint32_t>(config_.master_node_id) << 16) |
                             static_cast<std::uint32_t>(std::lround(config_.master_consumer_s * 1e3));
     if (Status s = sdo.write(id, od401::kConsumerHeartbeat, 1, v, 4); !s) {
-      if (sdo.last_abort() != sdo_abort::kNoObject && sdo.last_abort() != sdo_abort::kNoSubIndex) return fail(s);
-      notes_.push_back(who() + "0x1016 (consumer heartbeat time) absent: the module cannot notice that the "
-                               "master died; only its own failure mode protects the outputs");
+      if (sdo.last_abort() != sdo_abort::kNoObject && sdo.last_abort() != sdo_abort::kNoSubIndex)
+        return fail(s);
+      notes_.push_back(who() +
+                       "0x1016 (consumer heartbeat time) absent: the module cannot notice that the "
+                       "master died; only its own failure mode protects the outputs");
     }
   }
 
@@ -403,15 +410,24 @@ void CanIoPort::on_profile_frame(hal::Tick now, const CanFrame& f) {
   const auto read_le = [&](const Slot& s, std::uint32_t& v) {
     if (s.offset + s.bytes > f.dlc) return false;
     v = 0;
-    for (std::size_t b = 0; b < s.bytes; ++b) v |= static_cast<std::uint32_t>(f.data[s.offset + b]) << (8 * b);
+    for (std::size_t b = 0; b < s.bytes; ++b)
+      v |= static_cast<std::uint32_t>(f.data[s.offset + b]) << (8 * b);
     return true;
   };
   int tpdo = -1;
   switch (d.function) {
-    case CobFunction::kTpdo1: tpdo = 0; break;
-    case CobFunction::kTpdo2: tpdo = 1; break;
-    case CobFunction::kTpdo3: tpdo = 2; break;
-    case CobFunction::kTpdo4: tpdo = 3; break;
+    case CobFunction::kTpdo1:
+      tpdo = 0;
+      break;
+    case CobFunction::kTpdo2:
+      tpdo = 1;
+      break;
+    case CobFunction::kTpdo3:
+      tpdo = 2;
+      break;
+    case CobFunction::kTpdo4:
+      tpdo = 3;
+      break;
     default:
       return;
   }
@@ -477,7 +493,8 @@ void CanIoPort::read_wired(hal::DigitalInputs& io) const {
   take(w.row_knotted, io.row_knotted);
   // Each second channel from its own terminal, never derived from the first: false where not wired.
   for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) take(w.second[i], io.second_channel[i]);
-  for (std::size_t h = 0; h < static_cast<std::size_t>(w.heads); ++h) take(w.yarn_present[h], io.yarn_present[h]);
+  for (std::size_t h = 0; h < static_cast<std::size_t>(w.heads); ++h)
+    take(w.yarn_present[h], io.yarn_present[h]);
 }
 
 void CanIoPort::read_io(hal::Tick /*now*/, const hal::AxisFeedbacks& /*axes*/, hal::DigitalInputs& io) {
@@ -489,9 +506,10 @@ void CanIoPort::read_io(hal::Tick /*now*/, const hal::AxisFeedbacks& /*axes*/, h
 void CanIoPort::read_analog(hal::Tick /*now*/, hal::AnalogInputs& analog) {
   const IoWiring& w = wiring_;
   analog.beat_force_valid = w.load_cell_channel != 0 && analog_refreshed_ != hal::kNeverTick;
-  analog.beat_force_n = analog.beat_force_valid
-                            ? w.load_cell_n_per_count * static_cast<double>(analog_counts_) + w.load_cell_offset_n
-                            : 0.0;
+  analog.beat_force_n =
+      analog.beat_force_valid
+          ? w.load_cell_n_per_count * static_cast<double>(analog_counts_) + w.load_cell_offset_n
+          : 0.0;
   analog.refreshed = analog_refreshed_;
 }
 
@@ -503,7 +521,8 @@ void CanIoPort::write_io(hal::Tick /*now*/, const hal::DigitalOutputs& requested
   std::array<std::uint8_t, kMaxOutputSubs> bytes{};
   const auto put = [&](const IoBit& b, bool on) {
     if (b.bit < 0) return;
-    if (on != b.active_low) bytes[static_cast<std::size_t>(b.bit / 8)] |= static_cast<std::uint8_t>(1U << (b.bit % 8));
+    if (on != b.active_low)
+      bytes[static_cast<std::size_t>(b.bit / 8)] |= static_cast<std::uint8_t>(1U << (b.bit % 8));
   };
   put(w.piston_a_extend, o.piston_a_extend);
   put(w.piston_b_extend, o.piston_b_extend);
@@ -519,7 +538,8 @@ void CanIoPort::write_io(hal::Tick /*now*/, const hal::DigitalOutputs& requested
   f.id = cob::rpdo(output_pdo_ + 1, config_.node_id);
   f.dlc = output_pdo_bytes_;
   for (std::size_t k = 0; k < output_slot_.size(); ++k) {
-    if (output_slot_[k].pdo == output_pdo_ && output_slot_[k].bytes == 1) f.data[output_slot_[k].offset] = bytes[k];
+    if (output_slot_[k].pdo == output_pdo_ && output_slot_[k].bytes == 1)
+      f.data[output_slot_[k].offset] = bytes[k];
   }
   if (bus_->send(f) != SendResult::kOk) ++tx_dropped_;
 }

@@ -81,22 +81,24 @@ Result<CanLinkInfo> read_can_link_info(const std::string& iface) {
   CanLinkInfo out;
   out.up = (info.ifi_flags & IFF_UP) != 0;
   const std::size_t head = NLMSG_LENGTH(sizeof(ifinfomsg));
-  for_each_attr(buf.data() + head, h.nlmsg_len - head, [&](unsigned type, const unsigned char* d, std::size_t len) {
-    if (type != IFLA_LINKINFO) return;
-    for_each_attr(d, len, [&](unsigned t2, const unsigned char* d2, std::size_t len2) {
-      if (t2 == IFLA_INFO_KIND) {
-        out.kind.assign(reinterpret_cast<const char*>(d2), strnlen(reinterpret_cast<const char*>(d2), len2));
-      } else if (t2 == IFLA_INFO_DATA) {
-        for_each_attr(d2, len2, [&](unsigned t3, const unsigned char* d3, std::size_t len3) {
-          if (t3 == IFLA_CAN_BITTIMING && len3 >= sizeof(can_bittiming)) {
-            can_bittiming bt{};
-            std::memcpy(&bt, d3, sizeof(bt));
-            out.bitrate_bps = bt.bitrate;
-          }
-        });
-      }
-    });
-  });
+  for_each_attr(buf.data() + head, h.nlmsg_len - head,
+                [&](unsigned type, const unsigned char* d, std::size_t len) {
+                  if (type != IFLA_LINKINFO) return;
+                  for_each_attr(d, len, [&](unsigned t2, const unsigned char* d2, std::size_t len2) {
+                    if (t2 == IFLA_INFO_KIND) {
+                      out.kind.assign(reinterpret_cast<const char*>(d2),
+                                      strnlen(reinterpret_cast<const char*>(d2), len2));
+                    } else if (t2 == IFLA_INFO_DATA) {
+                      for_each_attr(d2, len2, [&](unsigned t3, const unsigned char* d3, std::size_t len3) {
+                        if (t3 == IFLA_CAN_BITTIMING && len3 >= sizeof(can_bittiming)) {
+                          can_bittiming bt{};
+                          std::memcpy(&bt, d3, sizeof(bt));
+                          out.bitrate_bps = bt.bitrate;
+                        }
+                      });
+                    }
+                  });
+                });
   return out;
 }
 
@@ -104,18 +106,20 @@ Status check_can_bitrate(const std::string& iface, const CanLinkInfo& info, std:
                          std::string& note) {
   note.clear();
   if (info.kind == "vcan" || info.kind == "vxcan") {
-    note = iface + " is a virtual CAN link (" + info.kind + "): it has no bitrate; can.bitrate = " +
-           std::to_string(bitrate_bps) + " is used for the bus-load arithmetic only";
+    note = iface + " is a virtual CAN link (" + info.kind +
+           "): it has no bitrate; can.bitrate = " + std::to_string(bitrate_bps) +
+           " is used for the bus-load arithmetic only";
     return Status::ok();
   }
   if (info.kind != "can") {
     return Status::error(iface + " is not a CAN interface (link kind '" + info.kind + "')");
   }
   if (info.bitrate_bps != bitrate_bps) {
-    return Status::error(iface + " runs at " + std::to_string(info.bitrate_bps) + " bit/s but can.bitrate = " +
-                         std::to_string(bitrate_bps) + "; bring it up with: ip link set " + iface +
-                         " down && ip link set " + iface + " type can bitrate " + std::to_string(bitrate_bps) +
-                         " && ip link set " + iface + " up");
+    return Status::error(iface + " runs at " + std::to_string(info.bitrate_bps) +
+                         " bit/s but can.bitrate = " + std::to_string(bitrate_bps) +
+                         "; bring it up with: ip link set " + iface + " down && ip link set " + iface +
+                         " type can bitrate " + std::to_string(bitrate_bps) + " && ip link set " + iface +
+                         " up");
   }
   return Status::ok();
 }

@@ -54,7 +54,8 @@ bool CanMaster::add(CanNode& node) {
 }
 
 std::uint32_t CanMaster::consumer_ticks(const CanNode& node) const {
-  return static_cast<std::uint32_t>(std::ceil(node.timing().heartbeat_consumer_s / config_.cycle_period_s - 1e-9));
+  return static_cast<std::uint32_t>(
+      std::ceil(node.timing().heartbeat_consumer_s / config_.cycle_period_s - 1e-9));
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -115,9 +116,9 @@ Status CanMaster::bring_up(CanBus& bus, ConfigureClock& clock) {
       for (std::size_t i = 0; i < n_nodes_; ++i) {
         all = all && done[i];
         const NodeTiming t = nodes_[i]->timing();
-        const double window = boot ? (t.boot_timeout_s > 0.0 ? t.boot_timeout_s : config_.boot_timeout_s)
-                                   : (t.operational_timeout_s > 0.0 ? t.operational_timeout_s
-                                                                    : config_.operational_timeout_s);
+        const double window =
+            boot ? (t.boot_timeout_s > 0.0 ? t.boot_timeout_s : config_.boot_timeout_s)
+                 : (t.operational_timeout_s > 0.0 ? t.operational_timeout_s : config_.operational_timeout_s);
         if (!done[i] && clock.now_us() - start >= static_cast<std::int64_t>(window * 1e6)) {
           char buf[48];
           std::snprintf(buf, sizeof(buf), " within %.3g s", window);
@@ -132,7 +133,8 @@ Status CanMaster::bring_up(CanBus& bus, ConfigureClock& clock) {
   drain();  // stale frames from before the reset mean nothing
   booted.fill(false);
   for (std::size_t i = 0; i < n_nodes_; ++i) {
-    if (Status s = send(make_nmt(NmtCommand::kResetNode, nodes_[i]->node_id()), nodes_[i]->label() + ": NMT reset-node");
+    if (Status s = send(make_nmt(NmtCommand::kResetNode, nodes_[i]->node_id()),
+                        nodes_[i]->label() + ": NMT reset-node");
         !s) {
       return s;
     }
@@ -163,7 +165,9 @@ Status CanMaster::bring_up(CanBus& bus, ConfigureClock& clock) {
 
   operational.fill(false);
   for (std::size_t i = 0; i < n_nodes_; ++i) {
-    if (Status s = send(make_nmt(NmtCommand::kStart, nodes_[i]->node_id()), nodes_[i]->label() + ": NMT start"); !s) {
+    if (Status s =
+            send(make_nmt(NmtCommand::kStart, nodes_[i]->node_id()), nodes_[i]->label() + ": NMT start");
+        !s) {
       return s;
     }
   }
@@ -173,10 +177,11 @@ Status CanMaster::bring_up(CanBus& bus, ConfigureClock& clock) {
     return s;
   }
 
-  master_hb_ticks_ = config_.master_node_id == 0
-                         ? 0
-                         : std::max<std::uint32_t>(1, static_cast<std::uint32_t>(std::floor(
-                                                          config_.master_heartbeat_s / config_.cycle_period_s + 1e-9)));
+  master_hb_ticks_ =
+      config_.master_node_id == 0
+          ? 0
+          : std::max<std::uint32_t>(1, static_cast<std::uint32_t>(std::floor(
+                                           config_.master_heartbeat_s / config_.cycle_period_s + 1e-9)));
   bus_ = &bus;
   for (std::size_t i = 0; i < n_nodes_; ++i) {
     nodes_[i]->supervisor_.arm(consumer_ticks(*nodes_[i]));
@@ -213,7 +218,8 @@ void CanMaster::poll(hal::Tick now) {
       nodes_[static_cast<std::size_t>(k)]->on_frame(now, f);
     } else if (d.function == CobFunction::kEmcy && d.node != 0) {
       // An EMCY from a node nobody owns stops every axis too (recovery is the operator's acknowledgement).
-      if (const auto e = parse_emcy(f); e && e->code != 0 && foreign_emcy_code_ == 0) foreign_emcy_code_ = e->code;
+      if (const auto e = parse_emcy(f); e && e->code != 0 && foreign_emcy_code_ == 0)
+        foreign_emcy_code_ = e->code;
     }
     // Anything else: other nodes' traffic, SYNC/NMT echoes of other masters.
   }

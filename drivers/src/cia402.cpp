@@ -1,6 +1,6 @@
 // CiA 402 master state machine (statusword masks and controlword commands from CiA 402-2 §8.1; the
-// facts are summarised in CiA 402, summarised in README "Running against a CAN interface"). Each state maps to exactly one command per
-// request, so the drive is led one confirmed transition at a time.
+// facts are summarised in CiA 402, summarised in README "Running against a CAN interface"). Each state maps
+// to exactly one command per request, so the drive is led one confirmed transition at a time.
 #include "loom/drivers/cia402.hpp"
 
 #include <cmath>

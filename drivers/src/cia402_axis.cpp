@@ -24,8 +24,9 @@ constexpr std::uint16_t kConsumerHeartbeat = 0x1016;
 }  // namespace
 
 void Cia402Axis::setup(const CanAxisConfig& a, const CanAxisPortConfig& port) {
-  sdo_cfg_ = SdoSettings{port.cycle_period_s, port.heartbeat_producer_s, port.master_node_id,
-                         port.master_consumer_s, port.tpdo2, port.tpdo2_every_n_sync};
+  sdo_cfg_ =
+      SdoSettings{port.cycle_period_s, port.heartbeat_producer_s, port.master_node_id, port.master_consumer_s,
+                  port.tpdo2,          port.tpdo2_every_n_sync};
   label_ = "node " + std::to_string(a.node_id) + " (" + a.name + ")";
   node_ = a.node_id;
   bus_ = a.bus;
@@ -66,7 +67,9 @@ void Cia402Axis::bring_up_started() {
   mode_display_ = od::kModeCsp;
 }
 
-void Cia402Axis::brought_up(CanBus& /*bus*/) { up_ = true; }
+void Cia402Axis::brought_up(CanBus& /*bus*/) {
+  up_ = true;
+}
 
 // ---------------------------------------------------------------------------------------------------
 // Bring-up (configure-time only): the profile's part, between boot-up and NMT start
@@ -114,9 +117,11 @@ Status Cia402Axis::configure_profile(SdoClient& sdo) {
     const std::uint32_t v = (static_cast<std::uint32_t>(sdo_cfg_.master_node_id) << 16) |
                             static_cast<std::uint32_t>(std::lround(sdo_cfg_.master_consumer_s * 1e3));
     if (Status s = sdo.write(node, kConsumerHeartbeat, 1, v, 4); !s) {
-      if (sdo.last_abort() != sdo_abort::kNoObject && sdo.last_abort() != sdo_abort::kNoSubIndex) return fail(s);
-      notes_.push_back(who + "0x1016 (consumer heartbeat time) absent: the drive will not stop by itself if the "
-                             "master dies");
+      if (sdo.last_abort() != sdo_abort::kNoObject && sdo.last_abort() != sdo_abort::kNoSubIndex)
+        return fail(s);
+      notes_.push_back(who +
+                       "0x1016 (consumer heartbeat time) absent: the drive will not stop by itself if the "
+                       "master dies");
     } else {
       has_consumer_ = true;
     }
@@ -137,7 +142,6 @@ Status Cia402Axis::configure_profile(SdoClient& sdo) {
   return Status::ok();
 }
 
-
 Status Cia402Axis::configure_pdos(SdoClient& sdo) {
   const bool homed = homing_method_ != 0;
   const std::uint8_t node = node_;
@@ -150,7 +154,8 @@ Status Cia402Axis::configure_pdos(SdoClient& sdo) {
   const auto read_map = [&](std::uint16_t map, std::array<std::uint32_t, 8>& e) -> Result<std::uint32_t> {
     Result<std::uint32_t> n = sdo.read(node, map, 0);
     if (!n) return n;
-    if (n.value() > 8) return Status::error(describe_object(map, 0) + " = " + std::to_string(n.value()) + " (> 8)");
+    if (n.value() > 8)
+      return Status::error(describe_object(map, 0) + " = " + std::to_string(n.value()) + " (> 8)");
     for (std::uint32_t k = 0; k < n.value(); ++k) {
       Result<std::uint32_t> v = sdo.read(node, map, static_cast<std::uint8_t>(k + 1));
       if (!v) return v.status();
@@ -171,10 +176,12 @@ Status Cia402Axis::configure_pdos(SdoClient& sdo) {
     bool optional;  // used when the drive has it, noted when absent (TPDO2: velocity and torque)
   };
   const PdoPlan plans[] = {
-      {od::kRpdoComm, od::kRpdoMap, cob::rpdo(1, node), homed ? kRpdo1HomingMapping.data() : kRpdo1Mapping.data(),
-       static_cast<std::uint8_t>(homed ? 3 : 2), 1, false},
-      {od::kTpdoComm, od::kTpdoMap, cob::tpdo(1, node), homed ? kTpdo1HomingMapping.data() : kTpdo1Mapping.data(),
-       static_cast<std::uint8_t>(homed ? 3 : 2), 1, false},
+      {od::kRpdoComm, od::kRpdoMap, cob::rpdo(1, node),
+       homed ? kRpdo1HomingMapping.data() : kRpdo1Mapping.data(), static_cast<std::uint8_t>(homed ? 3 : 2), 1,
+       false},
+      {od::kTpdoComm, od::kTpdoMap, cob::tpdo(1, node),
+       homed ? kTpdo1HomingMapping.data() : kTpdo1Mapping.data(), static_cast<std::uint8_t>(homed ? 3 : 2), 1,
+       false},
       {static_cast<std::uint16_t>(od::kTpdoComm + 1), static_cast<std::uint16_t>(od::kTpdoMap + 1),
        cob::tpdo(2, node), sdo_cfg_.tpdo2 ? kTpdo2Mapping.data() : nullptr,
        static_cast<std::uint8_t>(sdo_cfg_.tpdo2 ? 2 : 0), sdo_cfg_.tpdo2_every_n_sync, true},
@@ -189,7 +196,8 @@ Status Cia402Axis::configure_pdos(SdoClient& sdo) {
       std::array<std::uint32_t, 8> e{};
       Result<std::uint32_t> n = read_map(p.map, e);
       mapped = n && n.value() == p.n_entries;
-      for (std::uint8_t k = 0; mapped && k < p.n_entries; ++k) mapped = e[k] == encode_map_entry(p.entries[k]);
+      for (std::uint8_t k = 0; mapped && k < p.n_entries; ++k)
+        mapped = e[k] == encode_map_entry(p.entries[k]);
     }
     if (!mapped) {
       if (Status s = sdo.write(node, p.comm, 1, p.cob_id | od::kPdoInvalidBit, 4); !s) {
@@ -212,7 +220,8 @@ Status Cia402Axis::configure_pdos(SdoClient& sdo) {
       }
       if (!fixed) {
         for (std::uint8_t k = 0; k < p.n_entries; ++k) {
-          if (Status s = sdo.write(node, p.map, static_cast<std::uint8_t>(k + 1), encode_map_entry(p.entries[k]), 4);
+          if (Status s =
+                  sdo.write(node, p.map, static_cast<std::uint8_t>(k + 1), encode_map_entry(p.entries[k]), 4);
               !s) {
             return fail(s);
           }
@@ -237,8 +246,10 @@ Status Cia402Axis::configure_pdos(SdoClient& sdo) {
                              ": velocity is derived from positions");
             continue;
           }
-          return Status::error(who + describe_object(p.map, 0) + " is read-only and does not carry what the "
-                                     "master needs: missing " + missing);
+          return Status::error(who + describe_object(p.map, 0) +
+                               " is read-only and does not carry what the "
+                               "master needs: missing " +
+                               missing);
         }
         notes_.push_back(who + describe_object(p.map, 0) + " is fixed (read-only); read back and accepted");
       }
@@ -265,28 +276,34 @@ Status Cia402Axis::configure_pdos(SdoClient& sdo) {
   return Status::ok();
 }
 
-
 // The homing run's parameters, in drive units, so the RT path only switches the mode and starts it.
 Status Cia402Axis::configure_homing(SdoClient& sdo, std::uint32_t supported_modes) {
   const std::string who = label_ + ": ";
   const auto fail = [&](const Status& s) { return Status::error(who + s.message()); };
   if ((supported_modes & od::kSupportsHomingBit) == 0) {
     char buf[160];
-    std::snprintf(buf, sizeof(buf),
-                  "referencing = \"homing\" but the drive does not offer homing mode (0x6502 = 0x%08X, bit 5 clear)",
-                  supported_modes);
+    std::snprintf(
+        buf, sizeof(buf),
+        "referencing = \"homing\" but the drive does not offer homing mode (0x6502 = 0x%08X, bit 5 clear)",
+        supported_modes);
     return Status::error(who + buf);
   }
-  const auto counts = [&](double si) { return static_cast<std::uint32_t>(std::llround(si * counts_per_unit_)); };
-  if (Status s = sdo.write(node_, od::kHomingMethod, 0, static_cast<std::uint8_t>(homing_method_), 1); !s) return fail(s);
-  if (Status s = sdo.write(node_, od::kHomeOffset, 0, static_cast<std::uint32_t>(home_offset_counts_), 4); !s) {
+  const auto counts = [&](double si) {
+    return static_cast<std::uint32_t>(std::llround(si * counts_per_unit_));
+  };
+  if (Status s = sdo.write(node_, od::kHomingMethod, 0, static_cast<std::uint8_t>(homing_method_), 1); !s)
+    return fail(s);
+  if (Status s = sdo.write(node_, od::kHomeOffset, 0, static_cast<std::uint32_t>(home_offset_counts_), 4);
+      !s) {
     return fail(s);
   }
   if (homing_method_ != 37) {  // 37 sets the current position: no travel, no speeds
     const std::uint32_t fast = std::max<std::uint32_t>(1, counts(homing_speed_));
     if (Status s = sdo.write(node_, od::kHomingSpeeds, 1, fast, 4); !s) return fail(s);
-    if (Status s = sdo.write(node_, od::kHomingSpeeds, 2, std::max<std::uint32_t>(1, fast / 4), 4); !s) return fail(s);
-    if (Status s = sdo.write(node_, od::kHomingAcceleration, 0, std::max<std::uint32_t>(1, counts(homing_accel_)), 4);
+    if (Status s = sdo.write(node_, od::kHomingSpeeds, 2, std::max<std::uint32_t>(1, fast / 4), 4); !s)
+      return fail(s);
+    if (Status s = sdo.write(node_, od::kHomingAcceleration, 0,
+                             std::max<std::uint32_t>(1, counts(homing_accel_)), 4);
         !s) {
       return fail(s);
     }
@@ -331,7 +348,7 @@ void Cia402Axis::on_profile_frame(hal::Tick now, const CanFrame& f) {
           referenced_ = true;
           position_.reset(p.position_actual);  // the count jumped to the home offset: a new origin
           last_position_si_ = counts_to_si(position_.value(), counts_per_unit_);
-          refreshed_ = hal::kNeverTick;      // no velocity across the jump
+          refreshed_ = hal::kNeverTick;  // no velocity across the jump
         }
       }
       const double pos = counts_to_si(position_.update(p.position_actual), counts_per_unit_);
@@ -341,7 +358,8 @@ void Cia402Axis::on_profile_frame(hal::Tick now, const CanFrame& f) {
       last_position_si_ = pos;
       refreshed_ = now;
       // Following error against the target commanded before this feedback (LinuxCNC's velocity-scaled rule).
-      if (ferror_min_ > 0.0 && cmd_valid_ && state_ == DriveState::kOperationEnabled && mode_display_ == od::kModeCsp) {
+      if (ferror_min_ > 0.0 && cmd_valid_ && state_ == DriveState::kOperationEnabled &&
+          mode_display_ == od::kModeCsp) {
         const double err = std::abs(last_cmd_si_ - pos);
         if (err > ferror_high_water_) ferror_high_water_ = err;
         if (err > std::max(ferror_min_, ferror_k_s_ * std::abs(cmd_velocity_))) ferror_fault_ = true;
@@ -379,7 +397,8 @@ void Cia402Axis::fill_feedback(hal::AxisFeedback& fb, bool bus_off, bool bus_con
   fb.refreshed = refreshed_;
   fb.referenced = referenced_;
   fb.homing_error = homing_error_;
-  fb.following_error = state_ == DriveState::kOperationEnabled && mode_display_ == od::kModeCsp && (statusword_ & statusword::kCspFollowingError) != 0;
+  fb.following_error = state_ == DriveState::kOperationEnabled && mode_display_ == od::kModeCsp &&
+                       (statusword_ & statusword::kCspFollowingError) != 0;
   const bool in_fault_state = state_ == DriveState::kFault || state_ == DriveState::kFaultReactionActive;
   const bool drive_fault = in_fault_state || emcy != 0 || ferror_fault_;
   fb.fault = link_down || link_fault != 0 || drive_fault || tracker_.timed_out;
@@ -420,17 +439,18 @@ CanFrame Cia402Axis::command(const hal::AxisCommand& cmd, bool stop_all, bool bu
   // nothing to run and is simply enabled.
   const bool homing = cmd.request == AxisRequest::kHome && homing_method_ != 0 && !referenced_;
   const AxisRequest wanted_request = cmd.request == AxisRequest::kHome ? AxisRequest::kEnable : cmd.request;
-  const AxisRequest request =
-      lost || (stop_all && wanted_request != AxisRequest::kFaultReset && wanted_request != AxisRequest::kDisable)
-          ? AxisRequest::kQuickStop
-          : wanted_request;
+  const AxisRequest request = lost || (stop_all && wanted_request != AxisRequest::kFaultReset &&
+                                       wanted_request != AxisRequest::kDisable)
+                                  ? AxisRequest::kQuickStop
+                                  : wanted_request;
   const Cia402Step step = cia402_step(state_, request, tracker_, state_timeout_ticks);
   tracker_ = step.next;
   std::uint16_t controlword = step.controlword;
   const std::int8_t mode = homing && request == AxisRequest::kEnable ? od::kModeHoming : od::kModeCsp;
-  if (mode == od::kModeHoming && state_ == DriveState::kOperationEnabled && mode_display_ == od::kModeHoming &&
-      controlword == controlword::kEnableOperation && !homing_error_) {
-    controlword |= controlword::kHomingStart;  // the drive starts on its rising edge and runs while it is held
+  if (mode == od::kModeHoming && state_ == DriveState::kOperationEnabled &&
+      mode_display_ == od::kModeHoming && controlword == controlword::kEnableOperation && !homing_error_) {
+    controlword |=
+        controlword::kHomingStart;  // the drive starts on its rising edge and runs while it is held
     homing_commanded_ = true;
   }
   if (mode != od::kModeHoming) homing_commanded_ = false;

@@ -104,12 +104,16 @@ const char* fault_code_text(std::uint16_t code) {
 
 hal::FaultKind link_fault_kind(std::uint16_t code) {
   switch (code) {
-    case fault_code::kNone: return hal::FaultKind::kNone;
+    case fault_code::kNone:
+      return hal::FaultKind::kNone;
     case fault_code::kHeartbeatLost:
     case fault_code::kNodeRebooted:
-    case fault_code::kNodeNotOperational: return hal::FaultKind::kNodeLost;
-    case fault_code::kCommunication: return hal::FaultKind::kCommunication;
-    default: return hal::FaultKind::kEmcy;
+    case fault_code::kNodeNotOperational:
+      return hal::FaultKind::kNodeLost;
+    case fault_code::kCommunication:
+      return hal::FaultKind::kCommunication;
+    default:
+      return hal::FaultKind::kEmcy;
   }
 }
 

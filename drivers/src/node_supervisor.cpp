@@ -51,8 +51,8 @@ void NodeSupervisor::acknowledge(bool still_in_fault) {
 }
 
 bool NodeSupervisor::heard_again(hal::Tick now) const {
-  return booted_ ||
-         (last_heartbeat_ != hal::kNeverTick && now - last_heartbeat_ <= static_cast<hal::Tick>(consumer_ticks_));
+  return booted_ || (last_heartbeat_ != hal::kNeverTick &&
+                     now - last_heartbeat_ <= static_cast<hal::Tick>(consumer_ticks_));
 }
 
 }  // namespace loom::drivers

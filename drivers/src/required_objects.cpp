@@ -16,12 +16,16 @@ std::vector<RequiredObject> drive_objects() {
       {od::kDeviceType, "device type", false, "identifies a CiA 402 drive"},
       {od::kErrorRegister, "error register", false, "EMCY context"},
       {od::kHeartbeatProducer, "producer heartbeat time", false, "the drive is supervised by its heartbeat"},
-      {od401::kConsumerHeartbeat, "consumer heartbeat time", true, "the drive stops by itself when the controller dies"},
+      {od401::kConsumerHeartbeat, "consumer heartbeat time", true,
+       "the drive stops by itself when the controller dies"},
       {od::kRpdoComm, "RPDO1 communication", false, "controlword + target position every SYNC"},
-      {od::kRpdoMap, "RPDO1 mapping (writable, or fixed to 0x6040 + 0x607A)", false, "read back when read-only"},
+      {od::kRpdoMap, "RPDO1 mapping (writable, or fixed to 0x6040 + 0x607A)", false,
+       "read back when read-only"},
       {od::kTpdoComm, "TPDO1 communication", false, "statusword + position actual every SYNC"},
-      {od::kTpdoMap, "TPDO1 mapping (writable, or fixed to 0x6041 + 0x6064)", false, "read back when read-only"},
-      {static_cast<std::uint16_t>(od::kTpdoComm + 1), "TPDO2 communication", true, "velocity + torque actual"},
+      {od::kTpdoMap, "TPDO1 mapping (writable, or fixed to 0x6041 + 0x6064)", false,
+       "read back when read-only"},
+      {static_cast<std::uint16_t>(od::kTpdoComm + 1), "TPDO2 communication", true,
+       "velocity + torque actual"},
       {od::kErrorCode, "error code", false, "fault text for the technician"},
       {od::kControlword, "controlword", false, "CiA 402 power state machine"},
       {od::kStatusword, "statusword", false, "CiA 402 state, following error bit"},
@@ -38,7 +42,8 @@ std::vector<RequiredObject> drive_objects() {
 
 std::vector<RequiredObject> homing_drive_objects() {
   return {
-      {od::kModesOfOperation, "modes of operation", false, "set to 6 (homing) for the referencing run, then 8"},
+      {od::kModesOfOperation, "modes of operation", false,
+       "set to 6 (homing) for the referencing run, then 8"},
       {od::kHomeOffset, "home offset", false, "the axis' reading at the home point"},
       {od::kHomingMethod, "homing method", false, "the configured method (switch, index pulse or here)"},
       {od::kHomingSpeeds, "homing speeds", false, ":01 search for the switch, :02 search for zero"},
@@ -54,7 +59,8 @@ std::vector<RequiredObject> io_module_objects() {
       {od401::kConsumerHeartbeat, "consumer heartbeat time", true, "valves drop when the controller dies"},
       {od::kRpdoComm, "RPDO1 communication/mapping", false, "digital outputs every SYNC"},
       {od::kTpdoComm, "TPDO1 communication/mapping", false, "digital inputs every SYNC"},
-      {static_cast<std::uint16_t>(od::kTpdoComm + 1), "TPDO2 communication/mapping", true, "load cell (when wired)"},
+      {static_cast<std::uint16_t>(od::kTpdoComm + 1), "TPDO2 communication/mapping", true,
+       "load cell (when wired)"},
       {od401::kDigitalInputs8, "read digital inputs, 8-bit", false,
        "sensors and their second channels, e-stop chain, buttons"},
       {od401::kDigitalOutputs8, "write digital outputs, 8-bit", false, "valves, stack light, buzzer"},
@@ -75,21 +81,25 @@ std::string joined(std::initializer_list<std::pair<bool, const char*>> parts) {
   return out;
 }
 
-bool wired(const IoBit& b) { return b.bit >= 0; }
+bool wired(const IoBit& b) {
+  return b.bit >= 0;
+}
 
 }  // namespace
 
 std::vector<RequiredObject> io_module_objects(const IoWiring& w) {
   // The group counts come from the same function configure() maps with, so a module checked against
   // this list is one the master accepts (a module with fewer groups cannot map what the wiring asks for).
-  const auto heads = static_cast<std::size_t>(std::clamp(w.heads, 0, static_cast<int>(hal::kMaxKnottingHeads)));
+  const auto heads =
+      static_cast<std::size_t>(std::clamp(w.heads, 0, static_cast<int>(hal::kMaxKnottingHeads)));
   const auto any = [&](const auto& signals) {
     return std::any_of(signals.begin(), signals.begin() + static_cast<std::ptrdiff_t>(heads), wired);
   };
   const auto firsts = first_switches(w);
   const bool sensors = std::any_of(firsts.begin(), firsts.end(), [](const IoBit* b) { return wired(*b); });
   const bool seconds = std::any_of(w.second.begin(), w.second.end(), wired);
-  const bool buttons = wired(w.button_start) || wired(w.button_pause) || wired(w.button_ack) || wired(w.row_knotted);
+  const bool buttons =
+      wired(w.button_start) || wired(w.button_pause) || wired(w.button_ack) || wired(w.row_knotted);
   const bool valves = wired(w.piston_a_extend) || wired(w.piston_b_extend);
   const bool lamps = wired(w.lamp_green) || wired(w.lamp_amber) || wired(w.lamp_red);
   const bool grippers = any(w.gripper_close) || any(w.cutter);
@@ -107,7 +117,9 @@ std::vector<RequiredObject> io_module_objects(const IoWiring& w) {
       if (o.why.empty()) o.why = "none wired: read for the module's supervision";
     } else if (o.index == od401::kDigitalOutputs8) {
       o.subs = io_output_subs(w);
-      o.why = joined({{valves, "valves"}, {lamps, "stack light"}, {wired(w.buzzer), "buzzer"},
+      o.why = joined({{valves, "valves"},
+                      {lamps, "stack light"},
+                      {wired(w.buzzer), "buzzer"},
                       {grippers, "the heads' grippers and cutters"}});
       if (o.why.empty()) o.why = "none wired";
     } else if (o.index == od401::kOutputErrorValue) {
@@ -131,7 +143,8 @@ std::string describe(const RequiredObject& o) {
     std::snprintf(object, sizeof object, "0x%04X", o.index);
   }
   char buf[200];
-  std::snprintf(buf, sizeof buf, "%s %s%s: %s", object, o.name, o.optional ? " (optional)" : "", o.why.c_str());
+  std::snprintf(buf, sizeof buf, "%s %s%s: %s", object, o.name, o.optional ? " (optional)" : "",
+                o.why.c_str());
   return buf;
 }
 

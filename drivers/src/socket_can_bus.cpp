@@ -41,10 +41,10 @@ Result<std::unique_ptr<SocketCanBus>> SocketCanBus::open(const std::string& ifac
   if (fd < 0) {
     const int err = errno;
     if (err == EAFNOSUPPORT) {
-      return Status::error(
-          open_error(iface, "this kernel has no CAN support (socket(PF_CAN) failed: " + errno_text(err) +
-                                "); load the can and can-raw modules (modprobe can can-raw), or run the HIL "
-                                "tests in a qemu VM that has CAN: tools/vcan/hil-run, see tools/vcan/README.md"));
+      return Status::error(open_error(
+          iface, "this kernel has no CAN support (socket(PF_CAN) failed: " + errno_text(err) +
+                     "); load the can and can-raw modules (modprobe can can-raw), or run the HIL "
+                     "tests in a qemu VM that has CAN: tools/vcan/hil-run, see tools/vcan/README.md"));
     }
     if (err == EPROTONOSUPPORT) {
       return Status::error(open_error(

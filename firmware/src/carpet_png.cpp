@@ -29,7 +29,9 @@ CarpetCheck write_carpet_png(const sim_hal::SimKnotter& carpet, const sequencer:
     const int y = h - 1 - r;  // the first row woven at the bottom, as the design file draws it
     for (int k = 0; k < w; ++k) {
       const sim_hal::KnotCell cell = carpet.cell(r, k);
-      png_byte* px = &rgba[(static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(k)) * 4];
+      png_byte* px =
+          &rgba[(static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(k)) *
+                4];
       const int want = program.slot(first_row + static_cast<std::uint32_t>(r), k);
       if (cell.ties == 0) {
         ++c.missing;
@@ -39,7 +41,8 @@ CarpetCheck write_carpet_png(const sim_hal::SimKnotter& carpet, const sequencer:
       if (cell.by_hand) ++c.by_hand;
       if (cell.ties > 1) ++c.doubled;
       if (cell.slot != want) ++c.wrong;
-      const std::uint32_t rgb = cell.slot >= 0 && cell.slot < program.slots() ? slot_rgb[static_cast<std::size_t>(cell.slot)] : 0;
+      const std::uint32_t rgb =
+          cell.slot >= 0 && cell.slot < program.slots() ? slot_rgb[static_cast<std::size_t>(cell.slot)] : 0;
       px[0] = static_cast<png_byte>(rgb >> 16);
       px[1] = static_cast<png_byte>(rgb >> 8);
       px[2] = static_cast<png_byte>(rgb);

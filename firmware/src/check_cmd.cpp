@@ -2,8 +2,6 @@
 // from the machine description, computed by the same code the loop and the CAN master use.
 #include "check_cmd.hpp"
 
-#include "loom/motion/knot_cycle.hpp"
-
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -11,12 +9,13 @@
 #include <optional>
 #include <string>
 
-#include "loom/drivers/bus_load.hpp"
-#include "loom/drivers/required_objects.hpp"
 #include "loom/config/config.hpp"
 #include "loom/config/eds_nodes.hpp"
 #include "loom/config/scene_config.hpp"
+#include "loom/drivers/bus_load.hpp"
+#include "loom/drivers/required_objects.hpp"
 #include "loom/motion/angles.hpp"
+#include "loom/motion/knot_cycle.hpp"
 #include "loom/motion/profile_set.hpp"
 #include "loom/sequencer/beat_regulator.hpp"
 #include "loom/sim_hal/effects.hpp"
@@ -55,21 +54,24 @@ void print_safety_sensors(const LoomConfig& c) {
   for (std::size_t i = 0; i < hal::kSafetySensorCount; ++i) {
     const std::string name = hal::safety_sensor_name(static_cast<hal::SafetySensor>(i));
     if (c.sequencer.second_channel[i]) {
-      dual += "    " + name + ": inputs " + input_at(c, *first[i]) + " and " + input_at(c, w.second[i]) + "\n";
+      dual +=
+          "    " + name + ": inputs " + input_at(c, *first[i]) + " and " + input_at(c, w.second[i]) + "\n";
     } else {
       single += (single.empty() ? "" : ", ") + name;
     }
   }
   if (!dual.empty()) {
-    std::printf("  two switches each, acted on only while both agree; apart longer than %.0f ms (after the %d-tick "
-                "debounce) is the fault sensor_discrepancy:\n%s",
-                c.sequencer.sensor_discrepancy_s * 1e3, c.sequencer.debounce_ticks, dual.c_str());
+    std::printf(
+        "  two switches each, acted on only while both agree; apart longer than %.0f ms (after the %d-tick "
+        "debounce) is the fault sensor_discrepancy:\n%s",
+        c.sequencer.sensor_discrepancy_s * 1e3, c.sequencer.debounce_ticks, dual.c_str());
   }
   if (!single.empty()) {
-    std::printf("  WARNING single switch (io.<sensor>_2_bit = -1): %s. A stuck switch there that meets a second "
-                "fault (a shuttle slipped off its carrier, a piston seized mid-stroke) reads as the healthy machine "
-                "would: a frame can close on the shuttle or a pick run through a half-open shed.\n",
-                single.c_str());
+    std::printf(
+        "  WARNING single switch (io.<sensor>_2_bit = -1): %s. A stuck switch there that meets a second "
+        "fault (a shuttle slipped off its carrier, a piston seized mid-stroke) reads as the healthy machine "
+        "would: a frame can close on the shuttle or a pick run through a half-open shed.\n",
+        single.c_str());
   }
 }
 
@@ -81,12 +83,15 @@ void print_axes(const LoomConfig& c) {
     const char* unit = hal::axis_unit(a.role);
     char speed[64] = "", ferror[96] = "not supervised by the controller";
     if (a.max_speed > 0.0) std::snprintf(speed, sizeof speed, ", top speed %g %s/s", a.max_speed, unit);
-    if (a.ferror_min > 0.0) std::snprintf(ferror, sizeof ferror, "> max(%g %s, %g s x |v|)", a.ferror_min, unit, a.ferror_k_s);
-    std::printf("  %zu %-12s %-10s bus %u node %3u  %.0f counts/%s%s; following error %s\n", i, a.name.c_str(),
-                hal::axis_role_name(a.role), a.bus, a.node, a.counts_per_unit(), unit, speed, ferror);
+    if (a.ferror_min > 0.0)
+      std::snprintf(ferror, sizeof ferror, "> max(%g %s, %g s x |v|)", a.ferror_min, unit, a.ferror_k_s);
+    std::printf("  %zu %-12s %-10s bus %u node %3u  %.0f counts/%s%s; following error %s\n", i,
+                a.name.c_str(), hal::axis_role_name(a.role), a.bus, a.node, a.counts_per_unit(), unit, speed,
+                ferror);
   }
   // Referencing: what the loom does with each axis after its drive powers up, in the order it arms.
-  std::printf("  referencing (at every arming, in this order; an unreferenced axis never moves in production):\n");
+  std::printf(
+      "  referencing (at every arming, in this order; an unreferenced axis never moves in production):\n");
   int step = 0;
   for (const AxisSpec& a : c.axes) {
     const char* unit = hal::axis_unit(a.role);
@@ -96,11 +101,12 @@ void print_axes(const LoomConfig& c) {
                       : a.homing_method == 33 ? "index pulse, negative direction"
                       : a.homing_method == 34 ? "index pulse, positive direction"
                                               : "where it stands";
-    std::printf("    %d. %s: CiA 402 homing method %d (%s) at %g %s/s, reads %g %s at the home point; fault "
-                "homing_failed after %g s%s\n",
-                ++step, a.name.c_str(), a.homing_method, how, a.homing_speed, unit, a.home_offset, unit,
-                a.homing_timeout_s,
-                a.role == hal::AxisRole::kCarriage ? " (only once the beater is clear of the warp)" : "");
+    std::printf(
+        "    %d. %s: CiA 402 homing method %d (%s) at %g %s/s, reads %g %s at the home point; fault "
+        "homing_failed after %g s%s\n",
+        ++step, a.name.c_str(), a.homing_method, how, a.homing_speed, unit, a.home_offset, unit,
+        a.homing_timeout_s,
+        a.role == hal::AxisRole::kCarriage ? " (only once the beater is clear of the warp)" : "");
   }
   std::string absolute;
   for (const AxisSpec& a : c.axes) {
@@ -123,7 +129,8 @@ void print_knotting(const LoomConfig& c, const std::optional<motion::KnotCycle>&
     return;
   }
   std::printf(", %s knot, %g knots/dm x %g rows/dm = %g knots/dm^2 (%s)\n", sequencer::knot_type_name(k.knot),
-              k.knots_per_dm, k.rows_per_dm, density, sequencer::carpet_class_name(sequencer::carpet_class(density)));
+              k.knots_per_dm, k.rows_per_dm, density,
+              sequencer::carpet_class_name(sequencer::carpet_class(density)));
   const int per_row = sequencer::knots_per_row(k, c.machine_spec.width_m);
   std::printf("  %d knots per row over %.3f m (pitch %.2f mm)\n", per_row, c.machine_spec.width_m,
               sequencer::knot_pitch_m(k) * 1e3);
@@ -132,34 +139,44 @@ void print_knotting(const LoomConfig& c, const std::optional<motion::KnotCycle>&
     return;
   }
   const int stripe = sequencer::knots_per_stripe(k);
-  std::printf("  %d heads %.3f m apart, each tying a stripe of up to %d knots: %d knot cycles and %d carriage steps "
-              "of one pitch per row\n",
-              k.heads, k.head_spacing_m, stripe, std::min(stripe, per_row), std::max(0, std::min(stripe, per_row) - 1));
+  std::printf(
+      "  %d heads %.3f m apart, each tying a stripe of up to %d knots: %d knot cycles and %d carriage steps "
+      "of one pitch per row\n",
+      k.heads, k.head_spacing_m, stripe, std::min(stripe, per_row),
+      std::max(0, std::min(stripe, per_row) - 1));
   // The knot cycle: built (and checked) from the linkage and the servo's limits.
   const motion::KnotCycle& cycle = *knot_cycle;  // built (and checked) once, in print_plan
   const motion::KnotCycleReport& rep = cycle.report();
-  std::printf("  knot cycle %.3f s through seed 001's linkage (%s, servo %s): TAKE %.1f deg, WRAP %.1f deg, PULL %.1f deg "
-              "(crank); least transmission angle %.1f deg\n",
-              cycle.duration_s(), motion::grashof_class_name(rep.grashof), rep.full_turn ? "turns on round" : "swings back",
-              motion::deg(rep.crank_angles_rad[0]), motion::deg(rep.crank_angles_rad[1]), motion::deg(rep.crank_angles_rad[2]),
-              motion::deg(rep.min_transmission_rad));
+  std::printf(
+      "  knot cycle %.3f s through seed 001's linkage (%s, servo %s): TAKE %.1f deg, WRAP %.1f deg, PULL "
+      "%.1f deg "
+      "(crank); least transmission angle %.1f deg\n",
+      cycle.duration_s(), motion::grashof_class_name(rep.grashof),
+      rep.full_turn ? "turns on round" : "swings back", motion::deg(rep.crank_angles_rad[0]),
+      motion::deg(rep.crank_angles_rad[1]), motion::deg(rep.crank_angles_rad[2]),
+      motion::deg(rep.min_transmission_rad));
   std::printf("   ");
   for (const auto& seg : rep.segments) {
     std::printf(" %s %.3f s (%s)", seg.name, seg.end_s - seg.begin_s, motion::knot_limit_name(seg.bound));
   }
-  std::printf("\n    servo %.3g rad/s (the knotter axes' max_speed), %.3g rad/s^2, %.3g N m: peak torque %.3g N m at %.3f s; "
-              "gripper in the warp %.3f..%.3f s, cutter %.3f..%.3f s, yarn-present sampled %.3f..%.3f s\n",
-              c.knot_cycle.max_speed_rad_s, c.knot_cycle.max_accel_rad_s2, c.knot_cycle.max_torque_nm,
-              std::abs(rep.peak_torque_nm), rep.peak_torque_t_s, cycle.in_warp().begin_s, cycle.in_warp().end_s,
-              cycle.cutter().begin_s, cycle.cutter().end_s, cycle.yarn_sample().begin_s, cycle.yarn_sample().end_s);
+  std::printf(
+      "\n    servo %.3g rad/s (the knotter axes' max_speed), %.3g rad/s^2, %.3g N m: peak torque %.3g N m at "
+      "%.3f s; "
+      "gripper in the warp %.3f..%.3f s, cutter %.3f..%.3f s, yarn-present sampled %.3f..%.3f s\n",
+      c.knot_cycle.max_speed_rad_s, c.knot_cycle.max_accel_rad_s2, c.knot_cycle.max_torque_nm,
+      std::abs(rep.peak_torque_nm), rep.peak_torque_t_s, cycle.in_warp().begin_s, cycle.in_warp().end_s,
+      cycle.cutter().begin_s, cycle.cutter().end_s, cycle.yarn_sample().begin_s, cycle.yarn_sample().end_s);
   const int cycles = std::min(stripe, per_row);
-  std::printf("  knotting about %.1f s per row (%d cycles; the carriage steps and the selectors index while the grippers "
-              "return)\n",
-              cycles * cycle.duration_s(), cycles);
+  std::printf(
+      "  knotting about %.1f s per row (%d cycles; the carriage steps and the selectors index while the "
+      "grippers "
+      "return)\n",
+      cycles * cycle.duration_s(), cycles);
   std::string slots;
-  for (std::size_t i = 0; i < k.slot_colours.size(); ++i) slots += (i ? ", " : "") + std::to_string(i) + "=" + k.slot_colours[i];
-  std::printf("  magazine (every head alike): %zu slots [%s], %d knots of yarn per full slot\n", k.slot_colours.size(),
-              slots.c_str(), k.knots_per_slot);
+  for (std::size_t i = 0; i < k.slot_colours.size(); ++i)
+    slots += (i ? ", " : "") + std::to_string(i) + "=" + k.slot_colours[i];
+  std::printf("  magazine (every head alike): %zu slots [%s], %d knots of yarn per full slot\n",
+              k.slot_colours.size(), slots.c_str(), k.knots_per_slot);
   if (!c.recipe.design) return;
   const design::Design& d = *c.recipe.design;
   std::vector<std::string> codes;
@@ -171,13 +188,15 @@ void print_knotting(const LoomConfig& c, const std::optional<motion::KnotCycle>&
   for (int r = 0; r < d.height(); ++r) {  // checked when the config was read: every colour has a slot
     const sequencer::RowKnotPlan p = sequencer::plan_row(k, c.machine_spec.width_m, d.row(r), codes, at);
     int row_moves = 0;
-    for (int h = 0; h < k.heads; ++h) row_moves = std::max(row_moves, p.selector_moves[static_cast<std::size_t>(h)]);
+    for (int h = 0; h < k.heads; ++h)
+      row_moves = std::max(row_moves, p.selector_moves[static_cast<std::size_t>(h)]);
     moves += row_moves;
     worst = std::max(worst, row_moves);
   }
-  std::printf("  design '%s': %d rows of %d knots; selector moves per row (the busiest head): mean %.1f, most %d\n",
-              d.name().c_str(), d.height(), d.width(), d.height() > 0 ? static_cast<double>(moves) / d.height() : 0.0,
-              worst);
+  std::printf(
+      "  design '%s': %d rows of %d knots; selector moves per row (the busiest head): mean %.1f, most %d\n",
+      d.name().c_str(), d.height(), d.width(), d.height() > 0 ? static_cast<double>(moves) / d.height() : 0.0,
+      worst);
 }
 
 void print_plan(const LoomConfig& c) {
@@ -191,18 +210,24 @@ void print_plan(const LoomConfig& c) {
   std::printf("  linkage: crank %.4g, coupler %.4g, rocker %.4g, ground %.4g m; beater arm %.4g m, %.3g kg\n",
               c.profile.beatup.bar.crank, c.profile.beatup.bar.coupler, c.profile.beatup.bar.rocker,
               c.profile.beatup.bar.ground, c.profile.beatup.beater_arm_m, c.machine_spec.beater_mass_kg);
-  std::printf("  swing %.2f deg, stroke %.1f mm; warp window %.1f..%.1f deg from park (fell at %.1f deg), clear %.1f deg\n",
-              motion::deg(p.beatup().dead_centres().swing), p.beatup().stroke_arc_m() * 1e3, motion::deg(w.enter),
-              motion::deg(w.exit), motion::deg(w.fell), motion::deg(w.clear()));
+  std::printf(
+      "  swing %.2f deg, stroke %.1f mm; warp window %.1f..%.1f deg from park (fell at %.1f deg), clear %.1f "
+      "deg\n",
+      motion::deg(p.beatup().dead_centres().swing), p.beatup().stroke_arc_m() * 1e3, motion::deg(w.enter),
+      motion::deg(w.exit), motion::deg(w.fell), motion::deg(w.clear()));
   if (c.beat_force_target_n > 0.0) {
-    std::printf("  crank speed %.3f rad/s (%.1f r/min): the linkage's inverse dynamics put a %.1f N peak on the fell\n"
-                "    at that speed (recipe.beat_force_target_n; every beat must land in %.0f..%.0f N)%s\n",
-                c.profile.crank.velocity, c.profile.crank.velocity * 60.0 / motion::kTwoPi, c.beat_force_target_n,
-                rc.beat_force_min_n, rc.beat_force_max_n,
-                rc.crank_law.kind == motion::CrankLawKind::kConstant ? "" : "; master speed, the elliptic law speeds the crank up at the fell");
+    std::printf(
+        "  crank speed %.3f rad/s (%.1f r/min): the linkage's inverse dynamics put a %.1f N peak on the "
+        "fell\n"
+        "    at that speed (recipe.beat_force_target_n; every beat must land in %.0f..%.0f N)%s\n",
+        c.profile.crank.velocity, c.profile.crank.velocity * 60.0 / motion::kTwoPi, c.beat_force_target_n,
+        rc.beat_force_min_n, rc.beat_force_max_n,
+        rc.crank_law.kind == motion::CrankLawKind::kConstant
+            ? ""
+            : "; master speed, the elliptic law speeds the crank up at the fell");
   } else {
-    std::printf("  crank speed %.3f rad/s (%.1f r/min): fixed by recipe.crank_speed_rad_s\n", c.profile.crank.velocity,
-                c.profile.crank.velocity * 60.0 / motion::kTwoPi);
+    std::printf("  crank speed %.3f rad/s (%.1f r/min): fixed by recipe.crank_speed_rad_s\n",
+                c.profile.crank.velocity, c.profile.crank.velocity * 60.0 / motion::kTwoPi);
   }
   {
     // The beat regulator (sequencer/beat_regulator.hpp): its bounds on this recipe, and when it acts.
@@ -213,50 +238,67 @@ void print_plan(const LoomConfig& c) {
     if (!c.sequencer.beat_regulator.enabled) {
       std::printf("  beat force: open loop (the beat regulator is off)\n");
     } else {
-      std::printf("  beat force: closed loop when the beats are measured (a load cell: io.load_cell_channel = %d%s; in\n"
-                  "    simulation a scene naming beat_contact), else open loop: each beat's peak sets the next beat's crank\n"
-                  "    speed within %.2f..%.2f rad/s (x%.2f..x%.2f, up to %.1f %% per beat), aiming at %.0f N\n",
-                  c.io.wiring.load_cell_channel, c.io.wiring.load_cell_channel == 0 ? ", none" : "", v * l.min_scale,
-                  v * l.max_scale, l.min_scale, l.max_scale, 100.0 * l.max_step, l.target_n);
+      std::printf(
+          "  beat force: closed loop when the beats are measured (a load cell: io.load_cell_channel = %d%s; "
+          "in\n"
+          "    simulation a scene naming beat_contact), else open loop: each beat's peak sets the next "
+          "beat's crank\n"
+          "    speed within %.2f..%.2f rad/s (x%.2f..x%.2f, up to %.1f %% per beat), aiming at %.0f N\n",
+          c.io.wiring.load_cell_channel, c.io.wiring.load_cell_channel == 0 ? ", none" : "", v * l.min_scale,
+          v * l.max_scale, l.min_scale, l.max_scale, 100.0 * l.max_step, l.target_n);
     }
   }
-  std::printf("  crank law %s; tables: %zu knots, %s, %s; measured error rocker %.2g rad, crank law %.2g rad (limit %.2g)\n",
-              motion::crank_law_name(rc.crank_law.kind), c.profile.table_size, motion::interp_name(c.profile.table_interp),
-              motion::precision_name(c.profile.table_precision), p.rocker_table_error(), p.crank_table_error(),
-              c.profile.max_table_error_rad);
+  std::printf(
+      "  crank law %s; tables: %zu knots, %s, %s; measured error rocker %.2g rad, crank law %.2g rad (limit "
+      "%.2g)\n",
+      motion::crank_law_name(rc.crank_law.kind), c.profile.table_size,
+      motion::interp_name(c.profile.table_interp), motion::precision_name(c.profile.table_precision),
+      p.rocker_table_error(), p.crank_table_error(), c.profile.max_table_error_rad);
 
   std::printf("\nbeat sweep\n");
-  std::printf("  %d beats per row (%d per position), pitch %.1f mm, beater %.0f mm with %.0f mm overlap\n", p.beats_per_row(),
-              c.profile.beats_per_position, p.pitch_m() * 1e3, c.profile.beater_width_m * 1e3, c.profile.overlap_m * 1e3);
+  std::printf("  %d beats per row (%d per position), pitch %.1f mm, beater %.0f mm with %.0f mm overlap\n",
+              p.beats_per_row(), c.profile.beats_per_position, p.pitch_m() * 1e3,
+              c.profile.beater_width_m * 1e3, c.profile.overlap_m * 1e3);
   const auto& pk = p.carriage_peaks();
-  std::printf("  %d carriage steps over %.3f m, each in %.1f ms of the clear window: peak %.3f m/s, %.2f m/s^2, %.0f m/s^3\n"
-              "    (limits %.3g m/s, %.3g m/s^2, %.3g m/s^3; fastest crank that fits: %.2f rad/s)\n",
-              p.cam().steps(), p.carriage_travel_m(), pk.step_time_s * 1e3, pk.speed_m_s, pk.accel_m_s2, pk.jerk_m_s3,
-              c.profile.carriage_max_speed_m_s, c.profile.carriage_max_accel_m_s2, c.profile.carriage_max_jerk_m_s3,
-              pk.max_crank_speed_rad_s);
+  std::printf(
+      "  %d carriage steps over %.3f m, each in %.1f ms of the clear window: peak %.3f m/s, %.2f m/s^2, %.0f "
+      "m/s^3\n"
+      "    (limits %.3g m/s, %.3g m/s^2, %.3g m/s^3; fastest crank that fits: %.2f rad/s)\n",
+      p.cam().steps(), p.carriage_travel_m(), pk.step_time_s * 1e3, pk.speed_m_s, pk.accel_m_s2, pk.jerk_m_s3,
+      c.profile.carriage_max_speed_m_s, c.profile.carriage_max_accel_m_s2, c.profile.carriage_max_jerk_m_s3,
+      pk.max_crank_speed_rad_s);
 
   std::printf("\npick\n");
-  std::printf("  %.2f helix turns (width %.3f m / lead %.3f m) in %.3f s; acceleration limit %.0f rad/s^2 (carrier %.3g N on a %.3g kg shuttle: %.1f m/s^2)\n",
-              c.profile.width_m / c.profile.helix_lead_m, c.profile.width_m, c.profile.helix_lead_m, p.pick().duration(),
-              p.helix_accel_limit(), c.profile.carrier_force_n, c.profile.shuttle_mass_kg, p.shuttle_accel_limit_m_s2());
+  std::printf(
+      "  %.2f helix turns (width %.3f m / lead %.3f m) in %.3f s; acceleration limit %.0f rad/s^2 (carrier "
+      "%.3g N on a %.3g kg shuttle: %.1f m/s^2)\n",
+      c.profile.width_m / c.profile.helix_lead_m, c.profile.width_m, c.profile.helix_lead_m,
+      p.pick().duration(), p.helix_accel_limit(), c.profile.carrier_force_n, c.profile.shuttle_mass_kg,
+      p.shuttle_accel_limit_m_s2());
 
   std::printf("\nrow\n");
   const double shed_nominal = c.profile.shed.piston_travel_s + c.profile.shed.settle_s;
-  const double row = c.sequencer.picks_per_row * (shed_nominal + p.pick().duration()) + p.crank_sweep().duration();
-  std::printf("  %u pick(s) per row: shed %.2f s (sensors must confirm within %.2f s) + pick %.2f s each; beat sweep %.2f s\n",
-              c.sequencer.picks_per_row, shed_nominal, c.profile.shed.timeout_s, p.pick().duration(),
-              p.crank_sweep().duration());
+  const double row =
+      c.sequencer.picks_per_row * (shed_nominal + p.pick().duration()) + p.crank_sweep().duration();
+  std::printf(
+      "  %u pick(s) per row: shed %.2f s (sensors must confirm within %.2f s) + pick %.2f s each; beat sweep "
+      "%.2f s\n",
+      c.sequencer.picks_per_row, shed_nominal, c.profile.shed.timeout_s, p.pick().duration(),
+      p.crank_sweep().duration());
   // The knot cycle from the linkage and the servo's limits (checked when the config was read).
   std::optional<motion::KnotCycle> knot_cycle;
   if (c.knotting.mode == sequencer::KnottingMode::kHeads) knot_cycle = motion::KnotCycle::build(c.knot_cycle);
   if (knot_cycle) {
     // A knotted row compares whole with the weaver's whole row (~5 min knotting + 2 shed and pick + 3 beat).
     const motion::KnotCycle& cycle = *knot_cycle;
-    const int cycles = std::min(sequencer::knots_per_stripe(c.knotting), sequencer::knots_per_row(c.knotting, c.machine_spec.width_m));
+    const int cycles = std::min(sequencer::knots_per_stripe(c.knotting),
+                                sequencer::knots_per_row(c.knotting, c.machine_spec.width_m));
     const double knot = cycles * cycle.duration_s();
-    std::printf("  about %.2f s per whole row: knotting %.2f s by %d heads + shed, pick and beat %.2f s (%.0fx faster than "
-                "~600 s for the weaver's whole row)\n",
-                knot + row, knot, c.knotting.heads, row, 600.0 / (knot + row));
+    std::printf(
+        "  about %.2f s per whole row: knotting %.2f s by %d heads + shed, pick and beat %.2f s (%.0fx "
+        "faster than "
+        "~600 s for the weaver's whole row)\n",
+        knot + row, knot, c.knotting.heads, row, 600.0 / (knot + row));
   } else {
     std::printf("  about %.2f s per row (%.0fx faster than ~300 s by hand)\n", row, 300.0 / row);
   }
@@ -278,10 +320,11 @@ void print_plan(const LoomConfig& c) {
               c.io.kind == IoKind::kCan ? "on the bus" : "SIMULATED: needs --io simulated on hardware",
               c.can.master_node != 0 ? ("node " + std::to_string(c.can.master_node) + ", every " +
                                         std::to_string(c.can.master_heartbeat_ms) + " ms, consumers " +
-                                        std::to_string(c.can.master_consumer_ms) + " ms").c_str()
+                                        std::to_string(c.can.master_consumer_ms) + " ms")
+                                           .c_str()
                                      : "off");
-  std::printf("  heartbeats %u ms, lost after %u ms; bit rate %u bit/s\n", c.can.heartbeat_ms, c.can.heartbeat_timeout_ms,
-              c.can.bitrate);
+  std::printf("  heartbeats %u ms, lost after %u ms; bit rate %u bit/s\n", c.can.heartbeat_ms,
+              c.can.heartbeat_timeout_ms, c.can.bitrate);
   // Per bus: the figure that bus' CAN master checks when it configures (bus i = the i-th --iface name).
   const std::size_t buses = drivers::bus_count(can_axis_config(c));
   for (std::size_t b = 0; b < buses; ++b) {
@@ -293,7 +336,8 @@ void print_plan(const LoomConfig& c) {
       const std::vector<std::size_t> io_buses = can_io_buses(c);
       for (std::size_t k = 0; k < io_buses.size(); ++k) {
         if (io_buses[k] != b) continue;
-        on_bus += (on_bus.empty() ? "" : ", ") + std::string(k == 0 ? "I/O " : "I/O " + c.io.modules[k - 1].name + " ") +
+        on_bus += (on_bus.empty() ? "" : ", ") +
+                  std::string(k == 0 ? "I/O " : "I/O " + c.io.modules[k - 1].name + " ") +
                   std::to_string(k == 0 ? c.io.node : c.io.modules[k - 1].node);
       }
     }
@@ -302,23 +346,28 @@ void print_plan(const LoomConfig& c) {
   }
   std::string nodes;
   for (const AxisSpec& a : c.axes) {
-    nodes += (nodes.empty() ? "" : ", ") + std::to_string(a.node) + (buses > 1 ? "@bus" + std::to_string(a.bus) : "");
+    nodes += (nodes.empty() ? "" : ", ") + std::to_string(a.node) +
+             (buses > 1 ? "@bus" + std::to_string(a.bus) : "");
   }
   std::printf("  objects every drive (nodes %s) must support:\n", nodes.c_str());
   for (const auto& o : drivers::drive_objects()) std::printf("    %s\n", drivers::describe(o).c_str());
   std::string homing;
   for (const AxisSpec& a : c.axes) {
-    if (a.homing) homing += (homing.empty() ? "" : ", ") + std::to_string(a.node) + (buses > 1 ? "@bus" + std::to_string(a.bus) : "");
+    if (a.homing)
+      homing += (homing.empty() ? "" : ", ") + std::to_string(a.node) +
+                (buses > 1 ? "@bus" + std::to_string(a.bus) : "");
   }
   if (!homing.empty()) {
     std::printf("  objects the homing drives (nodes %s) must support as well:\n", homing.c_str());
-    for (const auto& o : drivers::homing_drive_objects()) std::printf("    %s\n", drivers::describe(o).c_str());
+    for (const auto& o : drivers::homing_drive_objects())
+      std::printf("    %s\n", drivers::describe(o).c_str());
   }
   for (const drivers::CanIoConfig& m : can_io_configs(c)) {
     if (c.io.modules.empty()) {
       std::printf("  objects the I/O module (node %u) must support:\n", m.node_id);
     } else {
-      std::printf("  objects the I/O module %s (node %u; %s) must support:\n", module_key(c, m.module).c_str(), m.node_id,
+      std::printf("  objects the I/O module %s (node %u; %s) must support:\n",
+                  module_key(c, m.module).c_str(), m.node_id,
                   m.module == 0 ? "every signal no other module lists"
                                 : ("signals " + io_module_signals(c.io.modules[m.module - 1u])).c_str());
     }
@@ -348,12 +397,15 @@ int print_eds(const LoomConfig& c) {
                 n.needs.node.c_str(), n.eds.file.c_str(), hex(p.vendor).c_str(), hex(p.product).c_str(),
                 hex(p.revision).c_str(), p.rpdos, p.tpdos, p.fixed_mapping ? "fixed" : "dynamic",
                 p.supported_modes ? (", modes " + eds::describe_modes(*p.supported_modes)).c_str() : "",
-                p.consumer_heartbeat ? ", watches the controller (0x1016)" : ", cannot watch the controller (no 0x1016)");
-    for (const eds::Finding& f : n.check.findings) std::printf("    %s\n", eds::format(n.eds, n.needs, f).c_str());
+                p.consumer_heartbeat ? ", watches the controller (0x1016)"
+                                     : ", cannot watch the controller (no 0x1016)");
+    for (const eds::Finding& f : n.check.findings)
+      std::printf("    %s\n", eds::format(n.eds, n.needs, f).c_str());
     if (n.check.ok()) {
-      std::printf("    the loom configures %zu values at bring-up (only those that differ are written; loomctl dcf "
-                  "writes them as a DCF)\n",
-                  n.writes.size());
+      std::printf(
+          "    the loom configures %zu values at bring-up (only those that differ are written; loomctl dcf "
+          "writes them as a DCF)\n",
+          n.writes.size());
     } else {
       ++refused;
     }
@@ -392,8 +444,9 @@ int run_check(const CheckArgs& a) {
     const int refused = print_eds(c);
     if (!a.scene.empty()) print_scene(scene);
     if (refused > 0) {
-      std::fprintf(stderr, "loomctl: check: %d node(s) lack what the loom needs (the error lines above, each with "
-                           "its EDS file:line) — nothing was moved\n",
+      std::fprintf(stderr,
+                   "loomctl: check: %d node(s) lack what the loom needs (the error lines above, each with "
+                   "its EDS file:line) — nothing was moved\n",
                    refused);
       return 2;
     }

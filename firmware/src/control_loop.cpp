@@ -12,7 +12,8 @@
 namespace loom::firmware {
 namespace {
 
-static_assert(telemetry::kMaxKnotSlots == static_cast<std::size_t>(sequencer::kMaxMagazineSlots), "the snapshot holds every magazine slot");
+static_assert(telemetry::kMaxKnotSlots == static_cast<std::size_t>(sequencer::kMaxMagazineSlots),
+              "the snapshot holds every magazine slot");
 
 // Bits 0..n-1 from n (<= 8) consecutive bools (little-endian words): with byte i at bit 8i, the multiply
 // puts it at bit 56 + i (the 2^(7(8-i)) term) and every other term at a distinct lower bit or past bit 63,
@@ -90,7 +91,8 @@ bool ControlLoop::any_device_fault() const noexcept {
   bool any = in_.link.link_fault;
   for (std::size_t i = 0; i < n_axes_; ++i) {
     const hal::AxisFeedback& a = in_.axes[i];
-    any |= a.fault | (a.state == hal::DriveState::kFault) | (a.state == hal::DriveState::kFaultReactionActive);
+    any |=
+        a.fault | (a.state == hal::DriveState::kFault) | (a.state == hal::DriveState::kFaultReactionActive);
   }
   return any;
 }
@@ -104,9 +106,15 @@ void ControlLoop::push_events(hal::Tick now) noexcept {
     const bool latched = events.has(sequencer::EventKind::kFaultLatched);
     for (const sequencer::TickEvent& ev : events) {  // bounded: TickEvents::kCapacity
       switch (ev.kind) {
-        case sequencer::EventKind::kBeat: push_beat(ev.beat, now); break;
-        case sequencer::EventKind::kRow: push_row(now); break;
-        case sequencer::EventKind::kWeaverRequest: push_weaver_request(now); break;
+        case sequencer::EventKind::kBeat:
+          push_beat(ev.beat, now);
+          break;
+        case sequencer::EventKind::kRow:
+          push_row(now);
+          break;
+        case sequencer::EventKind::kWeaverRequest:
+          push_weaver_request(now);
+          break;
         case sequencer::EventKind::kFaultLatched:
         case sequencer::EventKind::kDiagnosisRefined:
           if (latched && ev.kind == sequencer::EventKind::kDiagnosisRefined) break;
@@ -116,7 +124,8 @@ void ControlLoop::push_events(hal::Tick now) noexcept {
           link_reported = seq_.first_fault() == sequencer::Fault::kLinkFault ||
                           (seq_.first_fault() == sequencer::Fault::kHeartbeatLost && seq_.fault_axis() < 0);
           break;
-        default: break;  // picks, pauses, knot progress and buttons travel in the snapshot and the reporter
+        default:
+          break;  // picks, pauses, knot progress and buttons travel in the snapshot and the reporter
       }
     }
   }
@@ -207,7 +216,8 @@ void ControlLoop::push_device_faults(int first_axis_reported, bool link_reported
   for (std::size_t i = 0; i < n_axes_; ++i) {
     const hal::AxisFeedback& a = in_.axes[i];
     const bool faulted = axis_faulted(a);
-    if (!faulted && !prev_axis_fault_[i]) continue;  // the usual tick: nothing to report or forget (code is 0)
+    if (!faulted && !prev_axis_fault_[i])
+      continue;  // the usual tick: nothing to report or forget (code is 0)
     const bool report = faulted && (!prev_axis_fault_[i] || a.fault_code != prev_axis_fault_code_[i]);
     if (report && static_cast<int>(i) != first_axis_reported) {
       push_fault(telemetry::Event::FaultKind::kDevice, sequencer::Fault::kDriveFault, static_cast<int>(i),
@@ -218,8 +228,8 @@ void ControlLoop::push_device_faults(int first_axis_reported, bool link_reported
     any |= faulted;
   }
   if (in_.link.link_fault && !prev_link_fault_ && !link_reported) {
-    push_fault(telemetry::Event::FaultKind::kDevice, sequencer::Fault::kLinkFault, -1, in_.link.link_fault_code,
-               -1, now);
+    push_fault(telemetry::Event::FaultKind::kDevice, sequencer::Fault::kLinkFault, -1,
+               in_.link.link_fault_code, -1, now);
   }
   prev_link_fault_ = in_.link.link_fault;
   devices_reporting_ = any || prev_link_fault_;
@@ -276,31 +286,33 @@ void ControlLoop::fill_snapshot(hal::Tick now) noexcept {
     a.drive_state = static_cast<std::uint8_t>(in_.axes[i].state);
     a.request = static_cast<std::uint8_t>(out_.axes[i].request);
   }
-  s.outputs = static_cast<std::uint8_t>((out_.io.piston_a_extend ? 1 : 0) | (out_.io.piston_b_extend ? 2 : 0));
+  s.outputs =
+      static_cast<std::uint8_t>((out_.io.piston_a_extend ? 1 : 0) | (out_.io.piston_b_extend ? 2 : 0));
   const auto& io = in_.io;
   static_assert(hal::kSafetySensorCount == 6, "inputs_2 packs six second channels");
   if constexpr (std::endian::native == std::endian::little) {
     // The seven flags (A ext … estop_ok, declared in bit order) and the six second channels are runs of
     // bools, bytes of 0 or 1: one multiply gathers byte i of a word into bit i of its top byte.
     using hal::DigitalInputs;
-    static_assert(offsetof(DigitalInputs, piston_a_retracted) == offsetof(DigitalInputs, piston_a_extended) + 1 &&
-                  offsetof(DigitalInputs, piston_b_extended) == offsetof(DigitalInputs, piston_a_extended) + 2 &&
-                  offsetof(DigitalInputs, piston_b_retracted) == offsetof(DigitalInputs, piston_a_extended) + 3 &&
-                  offsetof(DigitalInputs, shuttle_at_left) == offsetof(DigitalInputs, piston_a_extended) + 4 &&
-                  offsetof(DigitalInputs, shuttle_at_right) == offsetof(DigitalInputs, piston_a_extended) + 5 &&
-                  offsetof(DigitalInputs, estop_ok) == offsetof(DigitalInputs, piston_a_extended) + 6,
-                  "the seven input flags are consecutive bytes in bit order");
+    static_assert(
+        offsetof(DigitalInputs, piston_a_retracted) == offsetof(DigitalInputs, piston_a_extended) + 1 &&
+            offsetof(DigitalInputs, piston_b_extended) == offsetof(DigitalInputs, piston_a_extended) + 2 &&
+            offsetof(DigitalInputs, piston_b_retracted) == offsetof(DigitalInputs, piston_a_extended) + 3 &&
+            offsetof(DigitalInputs, shuttle_at_left) == offsetof(DigitalInputs, piston_a_extended) + 4 &&
+            offsetof(DigitalInputs, shuttle_at_right) == offsetof(DigitalInputs, piston_a_extended) + 5 &&
+            offsetof(DigitalInputs, estop_ok) == offsetof(DigitalInputs, piston_a_extended) + 6,
+        "the seven input flags are consecutive bytes in bit order");
     const auto* bytes = reinterpret_cast<const unsigned char*>(&io);
     s.inputs = pack_flags(bytes + offsetof(DigitalInputs, piston_a_extended), 7);
     s.inputs_2 = pack_flags(bytes + offsetof(DigitalInputs, second_channel), hal::kSafetySensorCount);
   } else {
-    s.inputs = static_cast<std::uint8_t>(
-        (io.piston_a_extended ? 1 : 0) | (io.piston_a_retracted ? 2 : 0) | (io.piston_b_extended ? 4 : 0) |
-        (io.piston_b_retracted ? 8 : 0) | (io.shuttle_at_left ? 16 : 0) | (io.shuttle_at_right ? 32 : 0) |
-        (io.estop_ok ? 64 : 0));
+    s.inputs = static_cast<std::uint8_t>((io.piston_a_extended ? 1 : 0) | (io.piston_a_retracted ? 2 : 0) |
+                                         (io.piston_b_extended ? 4 : 0) | (io.piston_b_retracted ? 8 : 0) |
+                                         (io.shuttle_at_left ? 16 : 0) | (io.shuttle_at_right ? 32 : 0) |
+                                         (io.estop_ok ? 64 : 0));
     const auto& c2 = io.second_channel;
-    s.inputs_2 = static_cast<std::uint8_t>((c2[0] ? 1 : 0) | (c2[1] ? 2 : 0) | (c2[2] ? 4 : 0) | (c2[3] ? 8 : 0) |
-                                           (c2[4] ? 16 : 0) | (c2[5] ? 32 : 0));
+    s.inputs_2 = static_cast<std::uint8_t>((c2[0] ? 1 : 0) | (c2[1] ? 2 : 0) | (c2[2] ? 4 : 0) |
+                                           (c2[3] ? 8 : 0) | (c2[4] ? 16 : 0) | (c2[5] ? 32 : 0));
   }
   s.overruns = stats_.overruns;
   s.tick_cost_ns = stats_.last_tick_cost_ns;
@@ -322,7 +334,9 @@ void ControlLoop::fill_knots() noexcept {
   if (knots_shown_ && !knotting && !k.knotting) return;
   const sequencer::KnotProgram& p = *ctx_.knot_program;
   const sequencer::RowKnotter& r = seq_.knotter();
-  const int heads = p.heads() < static_cast<int>(hal::kMaxKnottingHeads) ? p.heads() : static_cast<int>(hal::kMaxKnottingHeads);
+  const int heads = p.heads() < static_cast<int>(hal::kMaxKnottingHeads)
+                        ? p.heads()
+                        : static_cast<int>(hal::kMaxKnottingHeads);
   const int slots = p.slots() < sequencer::kMaxMagazineSlots ? p.slots() : sequencer::kMaxMagazineSlots;
   k.heads = static_cast<std::uint8_t>(heads > 0 ? heads : 0);
   k.slots = static_cast<std::uint8_t>(slots > 0 ? slots : 0);

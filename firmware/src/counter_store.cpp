@@ -9,11 +9,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
-#include <algorithm>
 #include <iterator>
 #include <map>
 #include <set>
@@ -33,8 +33,8 @@ struct Cursor {
   std::size_t i = 0;
 
   [[noreturn]] void fail(const std::string& why) const {
-    throw ConfigError(source + ": offset " + std::to_string(i) + ": " + why + " (counters file: " +
-                      text.substr(0, 80) + (text.size() > 80 ? "..." : "") + ")");
+    throw ConfigError(source + ": offset " + std::to_string(i) + ": " + why +
+                      " (counters file: " + text.substr(0, 80) + (text.size() > 80 ? "..." : "") + ")");
   }
   void skip_ws() {
     while (i < text.size() && (text[i] == ' ' || text[i] == '\t' || text[i] == '\n' || text[i] == '\r')) ++i;
@@ -52,7 +52,8 @@ struct Cursor {
     expect('"');
     const std::size_t start = i;
     while (i < text.size() && text[i] != '"') {
-      if (!(std::islower(static_cast<unsigned char>(text[i])) || text[i] == '_')) fail("unexpected character in a key");
+      if (!(std::islower(static_cast<unsigned char>(text[i])) || text[i] == '_'))
+        fail("unexpected character in a key");
       ++i;
     }
     if (i >= text.size()) fail("unterminated key");
@@ -64,12 +65,13 @@ struct Cursor {
     while (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i]))) ++i;
     const std::string digits = text.substr(start, i - start);
     // Anything glued to the digits (".5", "e3", "-") makes the value something other than a count.
-    const bool trailing = i < text.size() && (std::isalnum(static_cast<unsigned char>(text[i])) || text[i] == '.' ||
-                                               text[i] == '+' || text[i] == '-');
+    const bool trailing = i < text.size() && (std::isalnum(static_cast<unsigned char>(text[i])) ||
+                                              text[i] == '.' || text[i] == '+' || text[i] == '-');
     if (digits.empty() || trailing || (digits.size() > 1 && digits[0] == '0')) {
       std::size_t end = i;
       while (end < text.size() && text[end] != ',' && text[end] != '}') ++end;
-      fail("\"" + field + "\" = " + text.substr(start, end - start) + ": must be a whole number in 0..4294967295");
+      fail("\"" + field + "\" = " + text.substr(start, end - start) +
+           ": must be a whole number in 0..4294967295");
     }
     if (digits.size() > 10 || std::stoull(digits) > UINT32_MAX) {
       fail("\"" + field + "\" = " + digits + ": beyond 4294967295 (a counter is never wrapped)");
@@ -102,9 +104,15 @@ sequencer::Counters CounterStore::parse(const std::string& text, const std::stri
   if (!cur.peek('}')) {
     for (;;) {
       const std::string k = cur.key();
-      static const std::set<std::string> known{"rows",          "picks",         "beats",
-                                               "picks_in_row",  "knots",         "knots_retried",
-                                               "knots_by_hand", "knot_cycles_started", "knot_cycles_done",
+      static const std::set<std::string> known{"rows",
+                                               "picks",
+                                               "beats",
+                                               "picks_in_row",
+                                               "knots",
+                                               "knots_retried",
+                                               "knots_by_hand",
+                                               "knot_cycles_started",
+                                               "knot_cycles_done",
                                                "knot_cycle_heads_done"};
       if (!known.count(k)) cur.fail("unknown field \"" + k + "\"");
       if (fields.count(k)) cur.fail("field \"" + k + "\" given twice");
@@ -126,31 +134,43 @@ sequencer::Counters CounterStore::parse(const std::string& text, const std::stri
   sequencer::Counters c{fields["rows"], fields["picks"], fields["beats"], fields["picks_in_row"], {}};
   std::string contradict_early;  // found among the knot counts, said with the other contradictions
   // The knot counts come together or not at all (a file from before the heads has none).
-  const char* knot_fields[] = {"knots", "knots_retried", "knots_by_hand", "knot_cycles_started", "knot_cycles_done"};
-  const auto knot_given = std::count_if(std::begin(knot_fields), std::end(knot_fields), [&](const char* k) { return fields.count(k) > 0; });
-  if (knot_given != 0 && knot_given != 5) cur.fail("the knot counts come together: some of knots, knots_retried, knots_by_hand, knot_cycles_started, knot_cycles_done are missing");
-  c.knot = {fields["knots"], fields["knots_retried"], fields["knots_by_hand"], fields["knot_cycles_started"], fields["knot_cycles_done"],
+  const char* knot_fields[] = {"knots", "knots_retried", "knots_by_hand", "knot_cycles_started",
+                               "knot_cycles_done"};
+  const auto knot_given = std::count_if(std::begin(knot_fields), std::end(knot_fields),
+                                        [&](const char* k) { return fields.count(k) > 0; });
+  if (knot_given != 0 && knot_given != 5)
+    cur.fail(
+        "the knot counts come together: some of knots, knots_retried, knots_by_hand, knot_cycles_started, "
+        "knot_cycles_done are missing");
+  c.knot = {fields["knots"],
+            fields["knots_retried"],
+            fields["knots_by_hand"],
+            fields["knot_cycles_started"],
+            fields["knot_cycles_done"],
             fields["knot_cycle_heads_done"]};
   if (c.knot.cycle_heads_done >> hal::kMaxKnottingHeads != 0) {
-    cur.fail("knot_cycle_heads_done = " + std::to_string(c.knot.cycle_heads_done) + " names a head beyond the " +
-             std::to_string(hal::kMaxKnottingHeads) + " a loom may have");
+    cur.fail("knot_cycle_heads_done = " + std::to_string(c.knot.cycle_heads_done) +
+             " names a head beyond the " + std::to_string(hal::kMaxKnottingHeads) + " a loom may have");
   }
   if (c.knot.cycle_heads_done != 0 && c.knot.cycles_started <= c.knot.cycles_done) {
-    contradict_early = "knot_cycle_heads_done = " + std::to_string(c.knot.cycle_heads_done) +
-                       " names heads of a cycle that was not started (knot_cycles_started = knot_cycles_done = " +
-                       std::to_string(c.knot.cycles_done) + ")";
+    contradict_early =
+        "knot_cycle_heads_done = " + std::to_string(c.knot.cycle_heads_done) +
+        " names heads of a cycle that was not started (knot_cycles_started = knot_cycles_done = " +
+        std::to_string(c.knot.cycles_done) + ")";
   }
   // Every completed row had at least one pick and one beat; the picks of the row in progress are
   // picks too. Counts that say otherwise were not written by loomctl.
-  const auto contradict = [&](const std::string& why) { throw ConfigError(source + ": counters contradict each other: " + why); };
+  const auto contradict = [&](const std::string& why) {
+    throw ConfigError(source + ": counters contradict each other: " + why);
+  };
   if (static_cast<std::uint64_t>(c.rows) + c.picks_in_row > c.picks) {
     contradict("picks = " + std::to_string(c.picks) + " is less than rows + picks_in_row = " +
                std::to_string(static_cast<std::uint64_t>(c.rows) + c.picks_in_row));
   }
   if (!contradict_early.empty()) contradict(contradict_early);
   if (c.knot.cycles_done > c.knot.cycles_started) {
-    contradict("knot_cycles_done = " + std::to_string(c.knot.cycles_done) + " exceeds knot_cycles_started = " +
-               std::to_string(c.knot.cycles_started));
+    contradict("knot_cycles_done = " + std::to_string(c.knot.cycles_done) +
+               " exceeds knot_cycles_started = " + std::to_string(c.knot.cycles_started));
   }
   if (c.beats < c.rows) {
     contradict("beats = " + std::to_string(c.beats) + " is less than rows = " + std::to_string(c.rows));
@@ -161,14 +181,17 @@ sequencer::Counters CounterStore::parse(const std::string& text, const std::stri
 std::optional<sequencer::Counters> CounterStore::load() const {
   const StateFileRead r = read_state_file(path_, 4096);
   switch (r.outcome) {
-    case StateFileRead::Outcome::kAbsent: return std::nullopt;  // the only case that starts from zero
+    case StateFileRead::Outcome::kAbsent:
+      return std::nullopt;  // the only case that starts from zero
     case StateFileRead::Outcome::kCannotOpen:
       throw ConfigError(path_ + ": counters file exists but cannot be read: " + r.error +
                         " (refusing to restart the production counts)");
     case StateFileRead::Outcome::kNotRegular:
       throw ConfigError(path_ + ": not a counters file (not a regular file of at most 4 KiB)");
-    case StateFileRead::Outcome::kCannotRead: throw ConfigError(path_ + ": counters file cannot be read: " + r.error);
-    case StateFileRead::Outcome::kRead: break;
+    case StateFileRead::Outcome::kCannotRead:
+      throw ConfigError(path_ + ": counters file cannot be read: " + r.error);
+    case StateFileRead::Outcome::kRead:
+      break;
   }
   return parse(r.text, path_);
 }

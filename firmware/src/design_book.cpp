@@ -5,8 +5,8 @@
 #include <nlohmann/json.hpp>
 
 #include "loom/config/config.hpp"
-#include "loom/firmware/durable_file.hpp"
 #include "loom/config/toml_reader.hpp"
+#include "loom/firmware/durable_file.hpp"
 
 namespace loom::firmware {
 
@@ -34,16 +34,19 @@ void DesignBook::load() {
   } catch (const nlohmann::json::parse_error& e) {
     throw bad(std::string("not a design book: ") + e.what());
   }
-  if (!j.is_object() || j.size() != 3 || !j.contains("active") || !j.contains("at_rows") || !j.contains("designs")) {
+  if (!j.is_object() || j.size() != 3 || !j.contains("active") || !j.contains("at_rows") ||
+      !j.contains("designs")) {
     throw bad("want exactly {\"active\", \"at_rows\", \"designs\"}");
   }
   if (!j["active"].is_string()) throw bad("\"active\" = " + j["active"].dump() + ": not a design name");
   if (!j["at_rows"].is_number_unsigned() || j["at_rows"].get<std::uint64_t>() > UINT32_MAX) {
     throw bad("\"at_rows\" = " + j["at_rows"].dump() + ": not a row count in 0..4294967295");
   }
-  if (!j["designs"].is_object()) throw bad("\"designs\" = " + j["designs"].dump().substr(0, 60) + ": not an object");
+  if (!j["designs"].is_object())
+    throw bad("\"designs\" = " + j["designs"].dump().substr(0, 60) + ": not an object");
   for (const auto& [name, rows] : j["designs"].items()) {
-    if (name.empty() || name.size() > 255) throw bad("design name '" + name.substr(0, 60) + "': want 1..255 characters");
+    if (name.empty() || name.size() > 255)
+      throw bad("design name '" + name.substr(0, 60) + "': want 1..255 characters");
     // Every row a design has is a row the production counters counted, and those are 32-bit: a larger
     // count was not written by loomctl (and would wrap when credited).
     if (!rows.is_number_unsigned() || rows.get<std::uint64_t>() > UINT32_MAX) {
@@ -58,8 +61,9 @@ void DesignBook::load() {
 
 void DesignBook::credit(std::uint32_t counter_rows) {
   if (counter_rows < at_rows_) {
-    throw ConfigError(path_ + ": written at production row " + std::to_string(at_rows_) + " but the counters say " +
-                      std::to_string(counter_rows) + " (production counts never go back; refusing to guess)");
+    throw ConfigError(path_ + ": written at production row " + std::to_string(at_rows_) +
+                      " but the counters say " + std::to_string(counter_rows) +
+                      " (production counts never go back; refusing to guess)");
   }
   if (!active_.empty()) {
     std::uint64_t& rows = designs_[active_];

@@ -13,7 +13,8 @@
 
 namespace loom::firmware {
 
-Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions& opt, sequencer::Counters resume)
+Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions& opt,
+                 sequencer::Counters resume)
     : cfg_(cfg) {
   const bool simulated_io = opt.hal == HalKind::kSim || opt.io.value_or(cfg_.io.kind) == IoKind::kSimulated;
   const Scene fitted = check_scene_fits(scene, cfg_, simulated_io);
@@ -81,7 +82,8 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
 
 // The knotting heads: the knot cycle from the linkage and the design as magazine slots, both built once
 // here (the design's progress says which row comes next) and read by the tick.
-void Machine::build_knotting(const MachineOptions& opt, std::uint32_t counter_rows, sequencer::SequencerConfig& scfg) {
+void Machine::build_knotting(const MachineOptions& opt, std::uint32_t counter_rows,
+                             sequencer::SequencerConfig& scfg) {
   KnottingHeads heads = build_heads(cfg_, opt.design_rows_done, counter_rows);
   knot_cycle_ = std::move(heads.cycle);
   knot_program_ = std::move(heads.program);
@@ -99,9 +101,10 @@ void Machine::simulated_weaver_sink(void* machine, const sequencer::WeaverReques
 void Machine::build_can_hal(const MachineOptions& opt) {
   const IoKind io_kind = opt.io.value_or(cfg_.io.kind);
   if (io_kind == IoKind::kSimulated && opt.io != IoKind::kSimulated) {
-    throw ConfigError(cfg_.source +
-                      ": io.kind = \"simulated\" with the CAN HAL: the servos would move while the e-stop chain, "
-                      "sensors and valves are imaginary; give --io simulated to do this on purpose");
+    throw ConfigError(
+        cfg_.source +
+        ": io.kind = \"simulated\" with the CAN HAL: the servos would move while the e-stop chain, "
+        "sensors and valves are imaginary; give --io simulated to do this on purpose");
   }
   // Derived from the machine description (and validated when it was read).
   const std::vector<drivers::CanIoConfig> io_configs = can_io_configs(cfg_);
@@ -110,7 +113,8 @@ void Machine::build_can_hal(const MachineOptions& opt) {
   with_can_io.io.kind = io_kind;  // --io can over a simulated config puts the modules' frames on their buses
   const drivers::CanAxisPortConfig cc = can_axis_config(with_can_io);
   if (io_kind == IoKind::kCan && cfg_.io.kind != IoKind::kCan) {
-    if (drivers::Status s = drivers::validate(io_configs.front()); !s) throw ConfigError(cfg_.source + ": " + s.message());
+    if (drivers::Status s = drivers::validate(io_configs.front()); !s)
+      throw ConfigError(cfg_.source + ": " + s.message());
   }
 
   // One interface per bus, in bus order: "can0,can1" puts the axes with bus = 1 on can1.
@@ -123,17 +127,20 @@ void Machine::build_can_hal(const MachineOptions& opt) {
   }
   const std::size_t buses = drivers::bus_count(cc);
   for (std::size_t i = 0; i < ifaces.size(); ++i) {
-    if (ifaces[i].empty()) throw ConfigError("--iface \"" + opt.iface + "\": interface " + std::to_string(i) + " has no name");
+    if (ifaces[i].empty())
+      throw ConfigError("--iface \"" + opt.iface + "\": interface " + std::to_string(i) + " has no name");
     for (std::size_t j = 0; j < i; ++j) {
       if (ifaces[j] == ifaces[i]) {
-        throw ConfigError("--iface \"" + opt.iface + "\": " + ifaces[i] + " is named twice (one bus per interface)");
+        throw ConfigError("--iface \"" + opt.iface + "\": " + ifaces[i] +
+                          " is named twice (one bus per interface)");
       }
     }
   }
   if (ifaces.size() != buses) {
-    throw ConfigError("--iface \"" + opt.iface + "\" names " + std::to_string(ifaces.size()) + " interface(s), but " +
-                      cfg_.source + " puts its axes and I/O modules on " + std::to_string(buses) +
-                      " CAN bus(es) (axes.<name>.bus, io_modules.<name>.bus 0.." + std::to_string(buses - 1) +
+    throw ConfigError("--iface \"" + opt.iface + "\" names " + std::to_string(ifaces.size()) +
+                      " interface(s), but " + cfg_.source + " puts its axes and I/O modules on " +
+                      std::to_string(buses) + " CAN bus(es) (axes.<name>.bus, io_modules.<name>.bus 0.." +
+                      std::to_string(buses - 1) +
                       "): give one interface per bus, comma-separated, bus 0 first");
   }
   buses_.clear();
@@ -162,9 +169,11 @@ void Machine::build_can_hal(const MachineOptions& opt) {
     }
   }
   drivers::MonotonicConfigureClock clock;
-  if (const drivers::Status st = can_port_->configure(bus_ptrs, clock); !st) throw std::runtime_error(st.message());
+  if (const drivers::Status st = can_port_->configure(bus_ptrs, clock); !st)
+    throw std::runtime_error(st.message());
   for (std::size_t b = 0; b < buses; ++b) {
-    notes_.push_back("CAN bus load (" + ifaces[b] + "): " + drivers::describe_bus_load(can_port_->bus_load(b)));
+    notes_.push_back("CAN bus load (" + ifaces[b] +
+                     "): " + drivers::describe_bus_load(can_port_->bus_load(b)));
   }
   notes_.insert(notes_.end(), can_port_->notes().begin(), can_port_->notes().end());
   if (io_port_) {  // each module brought up by its bus' master in the same NMT sequence as the drives
@@ -182,7 +191,8 @@ void Machine::publish_recipe(const LoomConfig& next) {
   // A reload may change the recipe only: the machine and the run settings are what the HAL, the
   // simulator and the loop were built from.
   if (const std::string changed = restart_only_changes(cfg_, next); !changed.empty()) {
-    throw ConfigError(next.source + ": only [recipe] and [profiles] may change while weaving; restart to change " +
+    throw ConfigError(next.source +
+                      ": only [recipe] and [profiles] may change while weaving; restart to change " +
                       changed);
   }
   // Recipe keys the sequencer holds (not the profiles) are fixed for the run: say so rather than
@@ -198,7 +208,8 @@ void Machine::publish_recipe(const LoomConfig& next) {
               next.sequencer.beat_force_max_n != cfg_.sequencer.beat_force_max_n,
           "recipe.beat_force_min_n/max_n");
   if (!fixed.empty()) {
-    throw ConfigError(next.source + ": " + fixed + " change only with a restart (the sequencer or the design progress holds them)");
+    throw ConfigError(next.source + ": " + fixed +
+                      " change only with a restart (the sequencer or the design progress holds them)");
   }
   try {
     slot_->publish(std::make_unique<const motion::ProfileSet>(next.profile));

@@ -7,21 +7,30 @@ namespace loom::hal {
 
 const char* axis_name(CoreAxis a) {
   switch (a) {
-    case CoreAxis::kBeatCrank: return "beat_crank";
-    case CoreAxis::kCarriage: return "carriage";
-    case CoreAxis::kHelix: return "helix";
+    case CoreAxis::kBeatCrank:
+      return "beat_crank";
+    case CoreAxis::kCarriage:
+      return "carriage";
+    case CoreAxis::kHelix:
+      return "helix";
   }
   return "?";
 }
 
 const char* axis_role_name(AxisRole r) {
   switch (r) {
-    case AxisRole::kBeatCrank: return "beat_crank";
-    case AxisRole::kCarriage: return "carriage";
-    case AxisRole::kHelix: return "helix";
-    case AxisRole::kKnotter: return "knotter";
-    case AxisRole::kSelector: return "selector";
-    case AxisRole::kAuxiliary: return "auxiliary";
+    case AxisRole::kBeatCrank:
+      return "beat_crank";
+    case AxisRole::kCarriage:
+      return "carriage";
+    case AxisRole::kHelix:
+      return "helix";
+    case AxisRole::kKnotter:
+      return "knotter";
+    case AxisRole::kSelector:
+      return "selector";
+    case AxisRole::kAuxiliary:
+      return "auxiliary";
   }
   return "?";
 }
@@ -37,8 +46,12 @@ bool parse_axis_role(const char* text, AxisRole& role) {
   return false;
 }
 
-bool is_rotary(AxisRole r) { return r != AxisRole::kCarriage; }
-const char* axis_unit(AxisRole r) { return is_rotary(r) ? "rad" : "m"; }
+bool is_rotary(AxisRole r) {
+  return r != AxisRole::kCarriage;
+}
+const char* axis_unit(AxisRole r) {
+  return is_rotary(r) ? "rad" : "m";
+}
 
 AxisLayout AxisLayout::core() {
   AxisLayout l;
@@ -71,49 +84,74 @@ int AxisLayout::find(const char* name) const {
 
 const char* drive_state_name(DriveState s) {
   switch (s) {
-    case DriveState::kUnknown: return "unknown";
-    case DriveState::kNotReadyToSwitchOn: return "not_ready_to_switch_on";
-    case DriveState::kSwitchOnDisabled: return "switch_on_disabled";
-    case DriveState::kReadyToSwitchOn: return "ready_to_switch_on";
-    case DriveState::kSwitchedOn: return "switched_on";
-    case DriveState::kOperationEnabled: return "operation_enabled";
-    case DriveState::kQuickStopActive: return "quick_stop_active";
-    case DriveState::kFaultReactionActive: return "fault_reaction_active";
-    case DriveState::kFault: return "fault";
+    case DriveState::kUnknown:
+      return "unknown";
+    case DriveState::kNotReadyToSwitchOn:
+      return "not_ready_to_switch_on";
+    case DriveState::kSwitchOnDisabled:
+      return "switch_on_disabled";
+    case DriveState::kReadyToSwitchOn:
+      return "ready_to_switch_on";
+    case DriveState::kSwitchedOn:
+      return "switched_on";
+    case DriveState::kOperationEnabled:
+      return "operation_enabled";
+    case DriveState::kQuickStopActive:
+      return "quick_stop_active";
+    case DriveState::kFaultReactionActive:
+      return "fault_reaction_active";
+    case DriveState::kFault:
+      return "fault";
   }
   return "?";
 }
 
 const char* safety_sensor_name(SafetySensor s) {
   switch (s) {
-    case SafetySensor::kPistonAExtended: return "piston_a_extended";
-    case SafetySensor::kPistonARetracted: return "piston_a_retracted";
-    case SafetySensor::kPistonBExtended: return "piston_b_extended";
-    case SafetySensor::kPistonBRetracted: return "piston_b_retracted";
-    case SafetySensor::kShuttleAtLeft: return "shuttle_at_left";
-    case SafetySensor::kShuttleAtRight: return "shuttle_at_right";
+    case SafetySensor::kPistonAExtended:
+      return "piston_a_extended";
+    case SafetySensor::kPistonARetracted:
+      return "piston_a_retracted";
+    case SafetySensor::kPistonBExtended:
+      return "piston_b_extended";
+    case SafetySensor::kPistonBRetracted:
+      return "piston_b_retracted";
+    case SafetySensor::kShuttleAtLeft:
+      return "shuttle_at_left";
+    case SafetySensor::kShuttleAtRight:
+      return "shuttle_at_right";
   }
   return "?";
 }
 
 const char* fault_kind_name(FaultKind k) {
   switch (k) {
-    case FaultKind::kNone: return "none";
-    case FaultKind::kDrive: return "drive";
-    case FaultKind::kEmcy: return "emcy";
-    case FaultKind::kNodeLost: return "node_lost";
-    case FaultKind::kBusOff: return "bus_off";
-    case FaultKind::kCommunication: return "communication";
+    case FaultKind::kNone:
+      return "none";
+    case FaultKind::kDrive:
+      return "drive";
+    case FaultKind::kEmcy:
+      return "emcy";
+    case FaultKind::kNodeLost:
+      return "node_lost";
+    case FaultKind::kBusOff:
+      return "bus_off";
+    case FaultKind::kCommunication:
+      return "communication";
   }
   return "?";
 }
 
 const char* link_recovery_name(LinkRecovery r) {
   switch (r) {
-    case LinkRecovery::kHealthy: return "healthy";
-    case LinkRecovery::kBusOff: return "bus_off";
-    case LinkRecovery::kNodeSilent: return "node_silent";
-    case LinkRecovery::kReady: return "ready";
+    case LinkRecovery::kHealthy:
+      return "healthy";
+    case LinkRecovery::kBusOff:
+      return "bus_off";
+    case LinkRecovery::kNodeSilent:
+      return "node_silent";
+    case LinkRecovery::kReady:
+      return "ready";
   }
   return "?";
 }

@@ -9,6 +9,8 @@
 namespace loom::motion::detail {
 
 // RT-safe. 2^floor(log2(largest)) for a finite largest > 0.
-inline double length_scale(double largest) { return std::ldexp(1.0, std::ilogb(largest)); }
+inline double length_scale(double largest) {
+  return std::ldexp(1.0, std::ilogb(largest));
+}
 
 }  // namespace loom::motion::detail

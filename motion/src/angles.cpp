@@ -21,7 +21,8 @@ double fmod_two_pi(double a) {
     n += a >= 0.0 ? 1.0 : -1.0;
     r = std::fma(-n, kTwoPi, a);
   }
-  return r == 0.0 ? std::copysign(0.0, a) : r;  // fmod's zero has the sign of a; fma's exact cancellation is +0
+  return r == 0.0 ? std::copysign(0.0, a)
+                  : r;  // fmod's zero has the sign of a; fma's exact cancellation is +0
 }
 }  // namespace
 

@@ -34,7 +34,7 @@ BeatUp::BeatUp(const BeatUpGeometry& g) : g_(g), dc_(motion::dead_centres(g.bar,
   // The crank turns CCW. Before the fell it comes from the other dead centre; after, it goes toward it.
   const double other_theta2 = ext ? dc_.crank_folded : dc_.crank_extended;
   const double before = wrap_two_pi(fell_theta2_ - other_theta2);  // crank travel other → fell
-  const double after = kTwoPi - before;                             // crank travel fell → other
+  const double after = kTwoPi - before;                            // crank travel fell → other
   const auto depth_at = [&](double theta2) { return from_fell(solve(g_.bar, theta2, g_.branch).theta4); };
   // Bisection: find offset x in (0, span) with depth(fell ± x) = warp depth; depth grows with x.
   const auto boundary = [&](double dir, double span) {

@@ -83,7 +83,8 @@ CamSample CarriageCam::at(double phase) const noexcept {
   const double u = (rel - k * kTwoPi) / length_;
   const CamSample s = smooth_step(u);
   const double c = 1.0 / length_;
-  return {pitch_ * (started - 1.0 + s.position), pitch_ * s.d1 * c, pitch_ * s.d2 * c * c, pitch_ * s.d3 * c * c * c};
+  return {pitch_ * (started - 1.0 + s.position), pitch_ * s.d1 * c, pitch_ * s.d2 * c * c,
+          pitch_ * s.d3 * c * c * c};
 }
 
 double CarriageCam::position_at(double phase) const noexcept {

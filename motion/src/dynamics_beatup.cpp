@@ -36,7 +36,8 @@ void require_body(const char* what, const PlanarInertia& b) {
 }
 
 // Coefficients of r × F on (Fx, Fy).
-inline void put_moment_arm(Eigen::Matrix<double, 9, 9>& a, int row, int col, const Eigen::Vector2d& r, double scale) {
+inline void put_moment_arm(Eigen::Matrix<double, 9, 9>& a, int row, int col, const Eigen::Vector2d& r,
+                           double scale) {
   a(row, col) = -r.y() * scale;
   a(row, col + 1) = r.x() * scale;
 }
@@ -109,8 +110,8 @@ std::array<BodyMotion, 3> four_bar_motion(const FourBar& m, const FourBarPose& p
   return b;
 }
 
-FourBarForces four_bar_forces(const FourBar& m, const FourBarInertias& in, const FourBarPose& pose,
-                              double w2, double a2, const Eigen::Vector2d& g, const RockerLoad& load) {
+FourBarForces four_bar_forces(const FourBar& m, const FourBarInertias& in, const FourBarPose& pose, double w2,
+                              double a2, const Eigen::Vector2d& g, const RockerLoad& load) {
   require_finite("crank speed (rad/s)", w2);
   require_finite("crank acceleration (rad/s^2)", a2);
   if (!g.allFinite()) invalid("gravity vector must be finite");
@@ -142,19 +143,25 @@ FourBarForces four_bar_forces(const FourBar& m, const FourBarInertias& in, const
   Eigen::Matrix<double, 9, 9> A = Eigen::Matrix<double, 9, 9>::Zero();
   Eigen::Matrix<double, 9, 1> rhs;
   // Crank: F_a0 − F_a = m a − m g; (A0−G)×F_a0 − (A−G)×F_a + T = I α.
-  A(0, 0) = 1; A(0, 2) = -1;
-  A(1, 1) = 1; A(1, 3) = -1;
+  A(0, 0) = 1;
+  A(0, 2) = -1;
+  A(1, 1) = 1;
+  A(1, 3) = -1;
   put_moment_arm(A, 2, 0, a0 - gc[0], s);
   put_moment_arm(A, 2, 2, -(pa - gc[0]), s);
   A(2, 8) = 1.0;
   // Coupler: F_a − F_b = m a − m g; (A−G)×F_a − (B−G)×F_b = I α.
-  A(3, 2) = 1; A(3, 4) = -1;
-  A(4, 3) = 1; A(4, 5) = -1;
+  A(3, 2) = 1;
+  A(3, 4) = -1;
+  A(4, 3) = 1;
+  A(4, 5) = -1;
   put_moment_arm(A, 5, 2, pa - gc[1], s);
   put_moment_arm(A, 5, 4, -(pb - gc[1]), s);
   // Rocker: F_b + F_b0 = m a − m g − F_load; (B−G)×F_b + (B0−G)×F_b0 = I α − (P−G)×F_load.
-  A(6, 4) = 1; A(6, 6) = 1;
-  A(7, 5) = 1; A(7, 7) = 1;
+  A(6, 4) = 1;
+  A(6, 6) = 1;
+  A(7, 5) = 1;
+  A(7, 7) = 1;
   put_moment_arm(A, 8, 4, pb - gc[2], s);
   put_moment_arm(A, 8, 6, b0 - gc[2], s);
   for (int i = 0; i < 3; ++i) {
@@ -297,7 +304,8 @@ ReducedTerms BeatUpDynamics::reduced(double theta2) const {
     const Eigen::Vector2d j = mo[i].velocity(b.centre_m);
     const Eigen::Vector2d jp = mo[i].acceleration(b.centre_m);
     t.inertia_kg_m2 += b.mass_kg * j.squaredNorm() + b.inertia_kg_m2 * mo[i].omega_rad_s * mo[i].omega_rad_s;
-    t.dinertia_kg_m2_rad += 2.0 * (b.mass_kg * j.dot(jp) + b.inertia_kg_m2 * mo[i].omega_rad_s * mo[i].alpha_rad_s2);
+    t.dinertia_kg_m2_rad +=
+        2.0 * (b.mass_kg * j.dot(jp) + b.inertia_kg_m2 * mo[i].omega_rad_s * mo[i].alpha_rad_s2);
     t.gravity_torque_nm -= b.mass_kg * opt_.gravity_m_s2.dot(j);
   }
   return t;

@@ -1,9 +1,9 @@
 // Kinetic/potential energy and shaking load of moving links, straight from their motion. Kept apart
 // from the force solvers on purpose: the tests compare the two.
+#include "loom/motion/dynamics_body.hpp"
+
 #include <algorithm>
 #include <cmath>
-
-#include "loom/motion/dynamics_body.hpp"
 
 namespace loom::motion {
 

@@ -84,7 +84,9 @@ GearPhase EllipticGearPair::phase(double phi1_rad) const {
   return g;
 }
 
-double EllipticGearPair::max_speed_ratio() const { return (1.0 + e_) / (1.0 - e_); }
+double EllipticGearPair::max_speed_ratio() const {
+  return (1.0 + e_) / (1.0 - e_);
+}
 
 bool EllipticGearPair::concave_pitch_curve() const {
   // Curvature of r = p/(1 + e cos kφ) changes sign exactly when e exceeds 1/(k² - 1).

@@ -1,11 +1,12 @@
 // Tabulated reduced model of the beat-up. M and V are stored with their exact slopes, and the lookup
 // returns the interpolant's own derivative, so the equation integrated is the Lagrangian of the
 // tabulated M and V — a conservative system in its own right.
+#include "loom/motion/forward_dynamics.hpp"
+
 #include <cmath>
 #include <sstream>
 
 #include "loom/motion/errors.hpp"
-#include "loom/motion/forward_dynamics.hpp"
 
 namespace loom::motion {
 
@@ -30,15 +31,17 @@ std::size_t validated(std::size_t samples, const BeatContact& contact, double vi
 
 }  // namespace
 
-BeatUpForwardModel::BeatUpForwardModel(const BeatUpDynamics& d, std::size_t samples, const BeatContact& contact,
-                                       double viscous, double drive_inertia)
+BeatUpForwardModel::BeatUpForwardModel(const BeatUpDynamics& d, std::size_t samples,
+                                       const BeatContact& contact, double viscous, double drive_inertia)
     : inertia_(validated(samples, contact, viscous, drive_inertia),
                [&](double th) {
                  const ReducedTerms t = d.reduced(th);
                  return PhaseTable::Exact{t.inertia_kg_m2, t.dinertia_kg_m2_rad};
                }),
       potential_(samples,
-                 [&](double th) { return PhaseTable::Exact{d.potential_energy(th), d.reduced(th).gravity_torque_nm}; }),
+                 [&](double th) {
+                   return PhaseTable::Exact{d.potential_energy(th), d.reduced(th).gravity_torque_nm};
+                 }),
       rocker_(samples,
               [&](double th) {
                 const BeatUpGeometry& g = d.head().geometry();
@@ -63,7 +66,9 @@ ReducedTerms BeatUpForwardModel::terms(double theta) const noexcept {
   return t;
 }
 
-double BeatUpForwardModel::potential_j(double theta) const noexcept { return potential_.at(theta).value; }
+double BeatUpForwardModel::potential_j(double theta) const noexcept {
+  return potential_.at(theta).value;
+}
 
 double BeatUpForwardModel::external_torque_nm(const CrankState& s) const noexcept {
   double q = -viscous_ * s.omega_rad_s;
@@ -90,14 +95,15 @@ double BeatUpForwardModel::energy_j(const CrankState& s) const noexcept {
 
 double BeatUpExactForwardModel::acceleration(const CrankState& s, double torque_nm) const {
   const ReducedTerms t = d_->reduced(s.theta_rad);
-  const double q = d_->contact_generalized_force({s.theta_rad, s.omega_rad_s, 0.0}, contact_) - viscous_ * s.omega_rad_s;
+  const double q =
+      d_->contact_generalized_force({s.theta_rad, s.omega_rad_s, 0.0}, contact_) - viscous_ * s.omega_rad_s;
   return (torque_nm + q - 0.5 * t.dinertia_kg_m2_rad * s.omega_rad_s * s.omega_rad_s - t.gravity_torque_nm) /
          (t.inertia_kg_m2 + drive_inertia_);
 }
 
 double BeatUpExactForwardModel::energy_j(const CrankState& s) const {
-  return d_->kinetic_energy({s.theta_rad, s.omega_rad_s, 0.0}) + 0.5 * drive_inertia_ * s.omega_rad_s * s.omega_rad_s +
-         d_->potential_energy(s.theta_rad);
+  return d_->kinetic_energy({s.theta_rad, s.omega_rad_s, 0.0}) +
+         0.5 * drive_inertia_ * s.omega_rad_s * s.omega_rad_s + d_->potential_energy(s.theta_rad);
 }
 
 }  // namespace loom::motion

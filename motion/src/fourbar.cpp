@@ -6,17 +6,17 @@
 
 #include <algorithm>
 #include <array>
-#include <functional>
 #include <cmath>
+#include <functional>
 #include <sstream>
 #include <utility>
 
 #include "checks.hpp"
-#include "scale.hpp"
 #include "geometry.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/errors.hpp"
 #include "newton_solve.hpp"
+#include "scale.hpp"
 
 namespace loom::motion {
 namespace {
@@ -140,7 +140,8 @@ FourBarPosition solve_position(const FourBar& given, double theta2, Branch branc
   if (pin.margin < -tol) {
     std::ostringstream os;
     os << "four-bar cannot be assembled at crank angle " << deg(theta2) << " deg: coupler and rocker miss "
-       << "closing the loop by " << -pin.margin * (largest_link(given) / largest_link(m)) << " " << describe(given);
+       << "closing the loop by " << -pin.margin * (largest_link(given) / largest_link(m)) << " "
+       << describe(given);
     throw MotionError(ErrorCode::kNotAssemblable, os.str());
   }
   FourBarPosition p;

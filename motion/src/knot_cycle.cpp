@@ -40,10 +40,13 @@ constexpr int kAccuracySamples = 20011;  // prime: off the table's knots
 
 using Eigen::Vector2d;
 
-Vector2d unit(double a) { return {std::cos(a), std::sin(a)}; }
+Vector2d unit(double a) {
+  return {std::cos(a), std::sin(a)};
+}
 
 // As detail::fail (the message "knot cycle: <what>"), with the spec fact it is about.
-[[noreturn]] void fail(ErrorCode code, const std::string& what, KnotCycleField field = KnotCycleField::kLinkage) {
+[[noreturn]] void fail(ErrorCode code, const std::string& what,
+                       KnotCycleField field = KnotCycleField::kLinkage) {
   throw KnotCycleError(code, field, std::string(kWho) + ": " + what);
 }
 
@@ -54,12 +57,16 @@ std::string num(double v) {
   return os.str();
 }
 
-void require_finite(const char* field, double v) { detail::require_finite(kWho, field, v, ""); }
+void require_finite(const char* field, double v) {
+  detail::require_finite(kWho, field, v, "");
+}
 void require_positive(const char* field, double v, KnotCycleField about = KnotCycleField::kLinkage) {
-  if (!std::isfinite(v) || !(v > 0.0)) fail(ErrorCode::kInvalidInput, std::string(field) + " = " + num(v) + ": must be finite and > 0", about);
+  if (!std::isfinite(v) || !(v > 0.0))
+    fail(ErrorCode::kInvalidInput, std::string(field) + " = " + num(v) + ": must be finite and > 0", about);
 }
 void require_non_negative(const char* field, double v) {
-  if (!std::isfinite(v) || !(v >= 0.0)) fail(ErrorCode::kInvalidInput, std::string(field) + " = " + num(v) + ": must be finite and >= 0");
+  if (!std::isfinite(v) || !(v >= 0.0))
+    fail(ErrorCode::kInvalidInput, std::string(field) + " = " + num(v) + ": must be finite and >= 0");
 }
 
 void check_link(const char* name, const KnotLinkSpec& l) {
@@ -89,15 +96,18 @@ void check_spec(const KnotCycleSpec& s) {
   require_finite("gripper_along_m", s.gripper_along_m);
   require_finite("gripper_normal_m", s.gripper_normal_m);
   if (s.branch != Branch::kPositive && s.branch != Branch::kNegative) {
-    fail(ErrorCode::kInvalidInput, "branch = " + std::to_string(static_cast<int>(s.branch)) + ": must be positive or negative");
+    fail(ErrorCode::kInvalidInput,
+         "branch = " + std::to_string(static_cast<int>(s.branch)) + ": must be positive or negative");
   }
   if (!std::isfinite(s.warp_entry_x_m)) {  // detail::require_finite's words, with the field
     std::ostringstream os;
     os << "warp_entry_x_m = " << s.warp_entry_x_m << ": must be finite";
     fail(ErrorCode::kInvalidInput, os.str(), KnotCycleField::kWarpEntry);
   }
-  if (!std::isfinite(s.min_transmission_rad) || s.min_transmission_rad < 0.0 || s.min_transmission_rad >= kPi / 2) {
-    fail(ErrorCode::kInvalidInput, "min_transmission_rad = " + num(s.min_transmission_rad) + ": must be in [0, pi/2)",
+  if (!std::isfinite(s.min_transmission_rad) || s.min_transmission_rad < 0.0 ||
+      s.min_transmission_rad >= kPi / 2) {
+    fail(ErrorCode::kInvalidInput,
+         "min_transmission_rad = " + num(s.min_transmission_rad) + ": must be in [0, pi/2)",
          KnotCycleField::kMinTransmission);
   }
   require_non_negative("gravity_m_s2", s.gravity_m_s2);
@@ -110,12 +120,17 @@ void check_spec(const KnotCycleSpec& s) {
   require_non_negative("cut_s", s.cut_s);
   require_non_negative("release_s", s.release_s);
   if (s.table_size < 16 || static_cast<std::size_t>(s.table_size) > PhaseTable::kMaxSize) {
-    fail(ErrorCode::kInvalidInput, "table_size = " + std::to_string(s.table_size) + ": must be in [16, 2^24]");
+    fail(ErrorCode::kInvalidInput,
+         "table_size = " + std::to_string(s.table_size) + ": must be in [16, 2^24]");
   }
-  const double pivots = std::hypot(s.rocker_pivot_x_m - s.crank_pivot_x_m, s.rocker_pivot_y_m - s.crank_pivot_y_m);
-  if (!(pivots > 0.0)) fail(ErrorCode::kInvalidInput, "crank and rocker pivots coincide: the ground link has no length");
-  if (std::hypot(s.gripper_along_m, s.gripper_normal_m) > 1e3 * std::max({pivots, s.crank.length_m, s.coupler.length_m, s.rocker.length_m})) {
-    fail(ErrorCode::kInvalidInput, "gripper_along_m/gripper_normal_m: the gripper is over 1000 link lengths off the coupler");
+  const double pivots =
+      std::hypot(s.rocker_pivot_x_m - s.crank_pivot_x_m, s.rocker_pivot_y_m - s.crank_pivot_y_m);
+  if (!(pivots > 0.0))
+    fail(ErrorCode::kInvalidInput, "crank and rocker pivots coincide: the ground link has no length");
+  if (std::hypot(s.gripper_along_m, s.gripper_normal_m) >
+      1e3 * std::max({pivots, s.crank.length_m, s.coupler.length_m, s.rocker.length_m})) {
+    fail(ErrorCode::kInvalidInput,
+         "gripper_along_m/gripper_normal_m: the gripper is over 1000 link lengths off the coupler");
   }
 }
 
@@ -124,17 +139,24 @@ const char* point_name(std::size_t i) {
   return kPoint[i];
 }
 
-const char* branch_name(Branch b) { return b == Branch::kPositive ? "positive" : "negative"; }
+const char* branch_name(Branch b) {
+  return b == Branch::kPositive ? "positive" : "negative";
+}
 
 }  // namespace
 
 const char* knot_limit_name(KnotLimit l) {
   switch (l) {
-    case KnotLimit::kDwell: return "dwell";
-    case KnotLimit::kSpeed: return "speed";
-    case KnotLimit::kAcceleration: return "acceleration";
-    case KnotLimit::kJerk: return "jerk";
-    case KnotLimit::kTorque: return "torque";
+    case KnotLimit::kDwell:
+      return "dwell";
+    case KnotLimit::kSpeed:
+      return "speed";
+    case KnotLimit::kAcceleration:
+      return "acceleration";
+    case KnotLimit::kJerk:
+      return "jerk";
+    case KnotLimit::kTorque:
+      return "torque";
   }
   return "?";
 }
@@ -148,7 +170,8 @@ KnotLinkSpec delrin_link(double length_m) {
 KnotCycleSpec seed001_knot_cycle_spec() {
   KnotCycleSpec s;
   // Seed 001's precision points (mm → m) and θ0 = 275°.
-  s.points = {KnotPoint{0.0, 0.0, rad(10.0)}, KnotPoint{0.025, 0.015, rad(3.0)}, KnotPoint{0.030, 0.001, rad(-25.0)}};
+  s.points = {KnotPoint{0.0, 0.0, rad(10.0)}, KnotPoint{0.025, 0.015, rad(3.0)},
+              KnotPoint{0.030, 0.001, rad(-25.0)}};
   s.theta0_rad = rad(275.0);
   // The two real chains of the three-point synthesis: (a0, a1, a2) = (1.255712, 17.165528, 17.229329)
   // and (23.285522, 37.525177, 31.525943) mm. Ground pivots a0·u(θ0); the servo drives the 17.17 mm
@@ -197,7 +220,9 @@ KnotCycle::Dynamics KnotCycle::dynamics_at(double crank_abs_rad) const {
   const double t2 = crank_abs_rad - ground_angle_;
   const FourBarPose pose = solve(fourbar_, t2, spec_.branch);
   const double cg = std::cos(ground_angle_), sg = std::sin(ground_angle_);
-  auto to_knot = [&](const Vector2d& v) { return Vector2d(cg * v.x() - sg * v.y(), sg * v.x() + cg * v.y()); };
+  auto to_knot = [&](const Vector2d& v) {
+    return Vector2d(cg * v.x() - sg * v.y(), sg * v.x() + cg * v.y());
+  };
   Dynamics d;
   const KnotLinkSpec& cr = spec_.crank;
   const KnotLinkSpec& cp = spec_.coupler;
@@ -215,8 +240,8 @@ KnotCycle::Dynamics KnotCycle::dynamics_at(double crank_abs_rad) const {
   };
   add_body(FourBarLink::kCoupler, cp, pose.k3, pose.k3p);
   add_body(FourBarLink::kRocker, rk, pose.k4, pose.k4p);
-  const PointCoefficients grip =
-      point_coefficients(fourbar_, pose, FourBarLink::kCoupler, Vector2d(spec_.gripper_along_m, spec_.gripper_normal_m));
+  const PointCoefficients grip = point_coefficients(fourbar_, pose, FourBarLink::kCoupler,
+                                                    Vector2d(spec_.gripper_along_m, spec_.gripper_normal_m));
   const Vector2d p = to_knot(grip.position);
   d.gripper_x_m = spec_.crank_pivot_x_m + p.x();
   d.gripper_y_m = spec_.crank_pivot_y_m + p.y();
@@ -253,10 +278,10 @@ namespace {
 // Where a sweep from `from` over `distance` (signed) stops being usable, if it does.
 struct SweepResult {
   bool ok = true;
-  double stopped_at = 0.0;       // absolute crank angle of the first bad sample
-  bool unreachable = false;      // the loop does not close there (beyond the crank's range)
-  bool toggle = false;           // coupler and rocker in line there
-  double min_transmission = kPi; // min over the sweep of min(μ, π − μ)
+  double stopped_at = 0.0;        // absolute crank angle of the first bad sample
+  bool unreachable = false;       // the loop does not close there (beyond the crank's range)
+  bool toggle = false;            // coupler and rocker in line there
+  double min_transmission = kPi;  // min over the sweep of min(μ, π − μ)
   double min_at = 0.0;
 };
 
@@ -274,7 +299,8 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
   KnotCycleReport& rep = kc.report_;
   rep.grashof = classify(fb);
   if (rep.grashof == GrashofClass::kChangePoint) {
-    fail(ErrorCode::kSingular, "the linkage is a change-point four-bar (s + l = p + q): its branches meet at the flat pose");
+    fail(ErrorCode::kSingular,
+         "the linkage is a change-point four-bar (s + l = p + q): its branches meet at the flat pose");
   }
 
   // --- The precision points: the linkage must put the gripper there with the coupler line at the
@@ -294,7 +320,8 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
       const Vector2d u = unit(th3), n(-u.y(), u.x());
       const Vector2d a = Vector2d(pt.x_m, pt.y_m) - grip_local.x() * u - grip_local.y() * n;
       const Vector2d b = a + spec.coupler.length_m * u;
-      const double miss = std::max(std::fabs((a - a0).norm() - spec.crank.length_m), std::fabs((b - b0).norm() - spec.rocker.length_m));
+      const double miss = std::max(std::fabs((a - a0).norm() - spec.crank.length_m),
+                                   std::fabs((b - b0).norm() - spec.rocker.length_m));
       if (miss < best) {
         best = miss;
         best_flip = f;
@@ -304,14 +331,16 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
     }
     if (!(best <= kPointTolerance_m)) {
       std::ostringstream os;
-      os << "the linkage misses " << point_name(i) << " (" << pt.x_m << ", " << pt.y_m << ") m with the gripper link at "
-         << deg(pt.gripper_rad) << " deg by " << best << " m (more than " << kPointTolerance_m
+      os << "the linkage misses " << point_name(i) << " (" << pt.x_m << ", " << pt.y_m
+         << ") m with the gripper link at " << deg(pt.gripper_rad) << " deg by " << best << " m (more than "
+         << kPointTolerance_m
          << " m): crank/rocker pivots, link lengths or gripper offset do not belong to these points";
       fail(ErrorCode::kNotAssemblable, os.str());
     }
     if (flip >= 0 && best_flip != flip) {
       std::ostringstream os;
-      os << "at " << point_name(i) << " the coupler would have to be turned half a turn against the other points to hold the "
+      os << "at " << point_name(i)
+         << " the coupler would have to be turned half a turn against the other points to hold the "
          << "gripper link at " << deg(pt.gripper_rad) << " deg: no rigid coupler passes all three points";
       fail(ErrorCode::kNotAssemblable, os.str());
     }
@@ -326,9 +355,10 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
   for (std::size_t i = 0; i < 3; ++i) {
     if (branch_at[i] != spec.branch) {
       std::ostringstream os;
-      os << "branch defect: " << point_name(i) << " lies on the " << branch_name(branch_at[i]) << " assembly branch, the spec says "
-         << branch_name(spec.branch) << " (TAKE " << branch_name(branch_at[0]) << ", WRAP " << branch_name(branch_at[1])
-         << ", PULL " << branch_name(branch_at[2]) << "): the linkage would have to be taken apart between the points";
+      os << "branch defect: " << point_name(i) << " lies on the " << branch_name(branch_at[i])
+         << " assembly branch, the spec says " << branch_name(spec.branch) << " (TAKE "
+         << branch_name(branch_at[0]) << ", WRAP " << branch_name(branch_at[1]) << ", PULL "
+         << branch_name(branch_at[2]) << "): the linkage would have to be taken apart between the points";
       fail(ErrorCode::kWrongBranch, os.str());
     }
     const FourBarPosition pos = solve_position(fb, crank_abs[i] - kc.ground_angle_, spec.branch);
@@ -336,8 +366,8 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
     const double err = std::fabs(wrap_pi(th3_knot - (spec.points[i].gripper_rad + flip * kPi)));
     if (!(err <= kAngleTolerance_rad)) {
       std::ostringstream os;
-      os << "at " << point_name(i) << " the coupler stands at " << deg(th3_knot) << " deg, not along the gripper angle "
-         << deg(spec.points[i].gripper_rad) << " deg";
+      os << "at " << point_name(i) << " the coupler stands at " << deg(th3_knot)
+         << " deg, not along the gripper angle " << deg(spec.points[i].gripper_rad) << " deg";
       fail(ErrorCode::kNotAssemblable, os.str());
     }
   }
@@ -349,8 +379,9 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
   double dir = ahead(1.0, 1) < ahead(1.0, 2) ? 1.0 : -1.0;
   const double to_wrap = ahead(dir, 1), to_pull = ahead(dir, 2);
   if (!(to_wrap > 0.0) || !(to_pull > to_wrap)) {
-    fail(ErrorCode::kOutOfBounds, "order defect: two precision points share a crank angle (TAKE " + num(deg(crank_abs[0])) + ", WRAP " +
-                                      num(deg(crank_abs[1])) + ", PULL " + num(deg(crank_abs[2])) + " deg)");
+    fail(ErrorCode::kOutOfBounds, "order defect: two precision points share a crank angle (TAKE " +
+                                      num(deg(crank_abs[0])) + ", WRAP " + num(deg(crank_abs[1])) +
+                                      ", PULL " + num(deg(crank_abs[2])) + " deg)");
   }
 
   auto sweep = [&](double from, double distance, double min_transmission) {
@@ -386,8 +417,8 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
   auto what_stops = [&](const SweepResult& r) {
     if (r.unreachable) return std::string("the end of its range (a dead centre: the loop cannot close)");
     if (r.toggle) return std::string("a toggle (coupler and rocker in line)");
-    return "a transmission angle of " + num(deg(r.min_transmission)) + " deg (below min_transmission_rad = " +
-           num(deg(spec.min_transmission_rad)) + " deg)";
+    return "a transmission angle of " + num(deg(r.min_transmission)) +
+           " deg (below min_transmission_rad = " + num(deg(spec.min_transmission_rad)) + " deg)";
   };
   if (!stroke.ok) {
     // Stopped by the transmission angle (not a dead centre or toggle): the minimum is the fact to change.
@@ -398,12 +429,13 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
     std::ostringstream os;
     if (other.ok && other.min_transmission >= spec.min_transmission_rad) {
       os << "order defect: turning from TAKE (" << deg(crank_abs[0]) << " deg) towards WRAP the crank meets "
-         << what_stops(stroke) << " at " << deg(stroke.stopped_at)
-         << " deg; the other way it reaches PULL (" << deg(crank_abs[2]) << " deg) before WRAP (" << deg(crank_abs[1]) << " deg)";
+         << what_stops(stroke) << " at " << deg(stroke.stopped_at) << " deg; the other way it reaches PULL ("
+         << deg(crank_abs[2]) << " deg) before WRAP (" << deg(crank_abs[1]) << " deg)";
       fail(ErrorCode::kOutOfBounds, os.str(), stopped_by);
     }
-    os << "the stroke TAKE→WRAP→PULL (" << deg(crank_abs[0]) << " → " << deg(crank_abs[1]) << " → " << deg(crank_abs[2])
-       << " deg) meets " << what_stops(stroke) << " at crank angle " << deg(stroke.stopped_at) << " deg";
+    os << "the stroke TAKE→WRAP→PULL (" << deg(crank_abs[0]) << " → " << deg(crank_abs[1]) << " → "
+       << deg(crank_abs[2]) << " deg) meets " << what_stops(stroke) << " at crank angle "
+       << deg(stroke.stopped_at) << " deg";
     fail(ErrorCode::kSingular, os.str(), stopped_by);
   }
   rep.stroke_rad = dir * to_pull;
@@ -417,7 +449,8 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
     back = dir * (kTwoPi - to_pull);
     const SweepResult ret = sweep(crank_abs[2], back, std::asin(kNearToggleSine));
     if (!ret.ok) {
-      fail(ErrorCode::kSingular, "the full-turn return from PULL passes a toggle at crank angle " + num(deg(ret.stopped_at)) + " deg");
+      fail(ErrorCode::kSingular, "the full-turn return from PULL passes a toggle at crank angle " +
+                                     num(deg(ret.stopped_at)) + " deg");
     }
     rep.min_transmission_return_rad = ret.min_transmission;
   } else {
@@ -429,8 +462,9 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
   for (std::size_t i = 0; i < 3; ++i) {
     const double hold = std::fabs(kc.dynamics_at(crank_abs[i]).gravity_nm);
     if (!(hold < spec.max_torque_nm)) {
-      fail(ErrorCode::kOutOfBounds, "max_torque_nm = " + num(spec.max_torque_nm) + ": holding the links against gravity at " +
-                                        point_name(i) + " takes " + num(hold) + " N m",
+      fail(ErrorCode::kOutOfBounds,
+           "max_torque_nm = " + num(spec.max_torque_nm) + ": holding the links against gravity at " +
+               point_name(i) + " takes " + num(hold) + " N m",
            KnotCycleField::kMaxTorque);
     }
   }
@@ -457,9 +491,9 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
       if (std::fabs(total) > limit) {
         const double room = std::copysign(limit, in) - d.gravity_nm;
         if (!(room * in > 0.0)) {
-          fail(ErrorCode::kOutOfBounds, "max_torque_nm = " + num(spec.max_torque_nm) + ": gravity alone needs " +
-                                            num(d.gravity_nm) + " N m at servo angle " + num(deg(start_rel + m.position)) +
-                                            " deg from TAKE",
+          fail(ErrorCode::kOutOfBounds,
+               "max_torque_nm = " + num(spec.max_torque_nm) + ": gravity alone needs " + num(d.gravity_nm) +
+                   " N m at servo angle " + num(deg(start_rel + m.position)) + " deg from TAKE",
                KnotCycleField::kMaxTorque);
         }
         s2 = std::max(s2, in / room);
@@ -469,7 +503,8 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
     p.scale = std::sqrt(s2);
     for (int attempt = 0; attempt < 8; ++attempt) {
       const double s = p.scale;
-      p.move = JerkMove::plan(distance, JerkLimits{limits.velocity / s, limits.acceleration / (s * s), limits.jerk / (s * s * s)});
+      p.move = JerkMove::plan(distance, JerkLimits{limits.velocity / s, limits.acceleration / (s * s),
+                                                   limits.jerk / (s * s * s)});
       if (s == 1.0) break;
       double peak = 0.0;
       const double Ts = p.move.duration();
@@ -488,7 +523,8 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
     if (p.scale > 1.0) return KnotLimit::kTorque;
     if (std::fabs(p.move.peak_velocity()) >= spec.max_speed_rad_s * (1.0 - 1e-9)) return KnotLimit::kSpeed;
     double peak_acc = 0.0;
-    for (int k = 0; k <= 256; ++k) peak_acc = std::max(peak_acc, std::fabs(p.move.at(p.move.duration() * k / 256).acceleration));
+    for (int k = 0; k <= 256; ++k)
+      peak_acc = std::max(peak_acc, std::fabs(p.move.at(p.move.duration() * k / 256).acceleration));
     // The acceleration plateau is flat: a sample on it reads the limit to rounding.
     return peak_acc >= spec.max_accel_rad_s2 * (1.0 - 1e-9) ? KnotLimit::kAcceleration : KnotLimit::kJerk;
   };
@@ -505,11 +541,11 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
     const Planned* move;
   };
   const std::array<Seg, 6> segs{{{"grip", spec.grip_s, 0.0, nullptr},
-                                  {"take_to_wrap", m1.move.duration(), 0.0, &m1},
-                                  {"wrap_to_pull", m2.move.duration(), d1, &m2},
-                                  {"cut", spec.cut_s, rep.stroke_rad, nullptr},
-                                  {"release", spec.release_s, rep.stroke_rad, nullptr},
-                                  {"return", m3.move.duration(), rep.stroke_rad, &m3}}};
+                                 {"take_to_wrap", m1.move.duration(), 0.0, &m1},
+                                 {"wrap_to_pull", m2.move.duration(), d1, &m2},
+                                 {"cut", spec.cut_s, rep.stroke_rad, nullptr},
+                                 {"release", spec.release_s, rep.stroke_rad, nullptr},
+                                 {"return", m3.move.duration(), rep.stroke_rad, &m3}}};
   double t = 0.0;
   for (std::size_t i = 0; i < segs.size(); ++i) {
     Piece& pc = kc.pieces_[i];
@@ -541,11 +577,14 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
 
   // In the warp: from the geometry along the exact motion, x ≥ entry − margin, crossings by bisection.
   const double entry = spec.warp_entry_x_m - kWarpMargin_m;
-  auto grip_x = [&](double tt) { return kc.dynamics_at(kc.take_angle_ + kc.exact(tt).angle_rad).gripper_x_m; };
+  auto grip_x = [&](double tt) {
+    return kc.dynamics_at(kc.take_angle_ + kc.exact(tt).angle_rad).gripper_x_m;
+  };
   if (!(spec.points[1].x_m >= spec.warp_entry_x_m) || !(spec.points[0].x_m < entry)) {
-    fail(ErrorCode::kInvalidInput, "warp_entry_x_m = " + num(spec.warp_entry_x_m) + ": must lie between TAKE x (" +
-                                       num(spec.points[0].x_m) + " m, outside the warp by " + num(kWarpMargin_m) +
-                                       " m) and WRAP x (" + num(spec.points[1].x_m) + " m, inside)",
+    fail(ErrorCode::kInvalidInput,
+         "warp_entry_x_m = " + num(spec.warp_entry_x_m) + ": must lie between TAKE x (" +
+             num(spec.points[0].x_m) + " m, outside the warp by " + num(kWarpMargin_m) + " m) and WRAP x (" +
+             num(spec.points[1].x_m) + " m, inside)",
          KnotCycleField::kWarpEntry);
   }
   {
@@ -561,7 +600,10 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
       for (int it = 0; it < 60; ++it) {
         const double mid = 0.5 * (lo + hi);
         const bool in = grip_x(mid) >= entry;
-        if (in == rising) hi = mid; else lo = mid;
+        if (in == rising)
+          hi = mid;
+        else
+          lo = mid;
       }
       return rising ? lo : hi;  // the outer bound: the window errs on the safe side
     };
@@ -573,7 +615,8 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
 
   // --- The table and its accuracy.
   const double T = kc.duration_;
-  kc.table_ = PhaseTable(TableSpec{static_cast<std::size_t>(spec.table_size), Interp::kQuintic, Precision::kDouble, kc.end_offset_},
+  kc.table_ = PhaseTable(TableSpec{static_cast<std::size_t>(spec.table_size), Interp::kQuintic,
+                                   Precision::kDouble, kc.end_offset_},
                          [&](double phi) {
                            const Sample e = kc.exact(phi / kTwoPi * T);
                            const double sc = T / kTwoPi;
@@ -583,8 +626,10 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
     const double tt = T * (k + 0.5) / kAccuracySamples;
     const Sample a = kc.sample(tt), e = kc.exact(tt);
     rep.table_angle_error_rad = std::max(rep.table_angle_error_rad, std::fabs(a.angle_rad - e.angle_rad));
-    rep.table_velocity_error_rad_s = std::max(rep.table_velocity_error_rad_s, std::fabs(a.velocity_rad_s - e.velocity_rad_s));
-    rep.table_accel_error_rad_s2 = std::max(rep.table_accel_error_rad_s2, std::fabs(a.accel_rad_s2 - e.accel_rad_s2));
+    rep.table_velocity_error_rad_s =
+        std::max(rep.table_velocity_error_rad_s, std::fabs(a.velocity_rad_s - e.velocity_rad_s));
+    rep.table_accel_error_rad_s2 =
+        std::max(rep.table_accel_error_rad_s2, std::fabs(a.accel_rad_s2 - e.accel_rad_s2));
   }
 
   // --- Peak torque, inertia range and the gripper path along the exact motion.
@@ -593,7 +638,8 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
     const double tt = T * k / (4 * kTorqueSamples);
     const Sample e = kc.exact(tt);
     const Dynamics d = kc.dynamics_at(kc.take_angle_ + e.angle_rad);
-    const double tau = d.inertia_kg_m2 * e.accel_rad_s2 + 0.5 * d.dinertia * e.velocity_rad_s * e.velocity_rad_s + d.gravity_nm;
+    const double tau = d.inertia_kg_m2 * e.accel_rad_s2 +
+                       0.5 * d.dinertia * e.velocity_rad_s * e.velocity_rad_s + d.gravity_nm;
     if (std::fabs(tau) > std::fabs(rep.peak_torque_nm)) {
       rep.peak_torque_nm = tau;
       rep.peak_torque_t_s = tt;

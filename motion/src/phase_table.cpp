@@ -17,14 +17,19 @@ namespace loom::motion {
 
 const char* interp_name(Interp i) {
   switch (i) {
-    case Interp::kLinear: return "linear";
-    case Interp::kCubic: return "cubic";
-    case Interp::kQuintic: return "quintic";
+    case Interp::kLinear:
+      return "linear";
+    case Interp::kCubic:
+      return "cubic";
+    case Interp::kQuintic:
+      return "quintic";
   }
   return "?";
 }
 
-const char* precision_name(Precision p) { return p == Precision::kFloat ? "float32" : "double"; }
+const char* precision_name(Precision p) {
+  return p == Precision::kFloat ? "float32" : "double";
+}
 
 bool parse_interp(const char* text, Interp& out) {
   for (Interp i : {Interp::kLinear, Interp::kCubic, Interp::kQuintic}) {
@@ -72,7 +77,8 @@ PhaseTable::PhaseTable(const TableSpec& spec, const std::function<PhaseExact(dou
       throw MotionError(ErrorCode::kInvalidInput, os.str());
     }
     // Take the rise out: what remains is periodic, and small enough for float32 knots.
-    residual[i] = {e.value - spec.rise * static_cast<double>(i) / static_cast<double>(n_), e.d1 - slope_, e.d2};
+    residual[i] = {e.value - spec.rise * static_cast<double>(i) / static_cast<double>(n_), e.d1 - slope_,
+                   e.d2};
     lo = std::min(lo, residual[i].value);
     hi = std::max(hi, residual[i].value);
   }
@@ -86,9 +92,15 @@ PhaseTable::PhaseTable(const TableSpec& spec, const std::function<PhaseExact(dou
   const auto pick = [&]<class T>(std::vector<T>& store) {
     fill(residual, store);
     switch (spec.interp) {
-      case Interp::kLinear: lookup_ = &lookup<Interp::kLinear, T>; break;
-      case Interp::kCubic: lookup_ = &lookup<Interp::kCubic, T>; break;
-      case Interp::kQuintic: lookup_ = &lookup<Interp::kQuintic, T>; break;
+      case Interp::kLinear:
+        lookup_ = &lookup<Interp::kLinear, T>;
+        break;
+      case Interp::kCubic:
+        lookup_ = &lookup<Interp::kCubic, T>;
+        break;
+      case Interp::kQuintic:
+        lookup_ = &lookup<Interp::kQuintic, T>;
+        break;
     }
   };
   if (spec.precision == Precision::kFloat) {
@@ -106,7 +118,8 @@ PhaseTable::PhaseTable(std::size_t n, const std::function<Exact(double)>& f)
               os << "phase table needs at least 4 samples, got " << n;
               throw MotionError(ErrorCode::kInvalidInput, os.str());
             }
-            return TableSpec{.size = n, .interp = Interp::kCubic, .precision = Precision::kDouble, .rise = 0.0};
+            return TableSpec{
+                .size = n, .interp = Interp::kCubic, .precision = Precision::kDouble, .rise = 0.0};
           }(),
           [&f](double p) {
             const Exact e = f(p);
@@ -139,7 +152,8 @@ PhaseSample PhaseTable::lookup(const PhaseTable& tb, const Phase& p) noexcept {
   const std::size_t i = detail::locate(p.frac, tb.n_, t);
   const SegmentValue<T> s = interpolate<I, T>(knots + i * knot_fields(I), t);
   PhaseSample out;
-  out.value = tb.base_ + static_cast<double>(s.p) + tb.spec_.rise * (static_cast<double>(p.turns) + p.frac_turns());
+  out.value =
+      tb.base_ + static_cast<double>(s.p) + tb.spec_.rise * (static_cast<double>(p.turns) + p.frac_turns());
   out.d1 = static_cast<double>(s.dp) * tb.inv_h_ + tb.slope_;
   out.d2 = static_cast<double>(s.ddp) * (tb.inv_h_ * tb.inv_h_);
   return out;

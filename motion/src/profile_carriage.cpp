@@ -46,8 +46,8 @@ CarriagePeaks carriage_step_peaks(const CarriageCam& cam, const CrankLaw& law, d
   for (int j = 0; j <= kSamplesPerTurn; ++j) masters.push_back(m0 + kTwoPi * j / kSamplesPerTurn);
   if (law.spec().kind == CrankLawKind::kConstant) {
     // Where s', s'' and s''' of the smooth step peak: u = 1/2, (5 ± √5)/10, (5 ± √15)/10.
-    for (double u : {0.5, (5.0 - std::sqrt(5.0)) / 10.0, (5.0 + std::sqrt(5.0)) / 10.0, (5.0 - std::sqrt(15.0)) / 10.0,
-                     (5.0 + std::sqrt(15.0)) / 10.0}) {
+    for (double u : {0.5, (5.0 - std::sqrt(5.0)) / 10.0, (5.0 + std::sqrt(5.0)) / 10.0,
+                     (5.0 - std::sqrt(15.0)) / 10.0, (5.0 + std::sqrt(15.0)) / 10.0}) {
       masters.push_back(start + u * length);
     }
   }
@@ -68,13 +68,14 @@ CarriagePeaks carriage_step_peaks(const CarriageCam& cam, const CrankLaw& law, d
   const auto headroom = [](double limit, double need, double power) {
     return need > 0.0 ? std::pow(limit / need, 1.0 / power) : std::numeric_limits<double>::infinity();
   };
-  peaks.max_crank_speed_rad_s =
-      omega * std::min({headroom(limits.speed_m_s, peaks.speed_m_s, 1.0), headroom(limits.accel_m_s2, peaks.accel_m_s2, 2.0),
-                        headroom(limits.jerk_m_s3, peaks.jerk_m_s3, 3.0)});
+  peaks.max_crank_speed_rad_s = omega * std::min({headroom(limits.speed_m_s, peaks.speed_m_s, 1.0),
+                                                  headroom(limits.accel_m_s2, peaks.accel_m_s2, 2.0),
+                                                  headroom(limits.jerk_m_s3, peaks.jerk_m_s3, 3.0)});
   return peaks;
 }
 
-CarriagePeaks check_carriage_step(const CarriageCam& cam, const CrankLaw& law, double omega, const CarriageLimits& limits) {
+CarriagePeaks check_carriage_step(const CarriageCam& cam, const CrankLaw& law, double omega,
+                                  const CarriageLimits& limits) {
   for (const auto& [name, v] : {std::pair{"carriage.max_speed_m_s", limits.speed_m_s},
                                 std::pair{"carriage.max_accel_m_s2", limits.accel_m_s2},
                                 std::pair{"carriage.max_jerk_m_s3", limits.jerk_m_s3}}) {
@@ -89,15 +90,17 @@ CarriagePeaks check_carriage_step(const CarriageCam& cam, const CrankLaw& law, d
              j = p.jerk_m_s3 > limits.jerk_m_s3;
   if (!v && !a && !j) return p;
   std::ostringstream os;
-  os << "carriage step of " << cam.pitch() * 1e3 << " mm does not fit the beater's clear window at crank speed "
-     << omega << " rad/s (" << crank_law_name(law.spec().kind) << " law): the window leaves "
-     << deg(cam.window_length()) << " deg of crank (" << p.step_time_s * 1e3
-     << " ms) after the cam margins, and the step needs peak " << p.speed_m_s << " m/s, " << p.accel_m_s2
-     << " m/s^2, " << p.jerk_m_s3 << " m/s^3; the limits are carriage.max_speed_m_s = " << limits.speed_m_s
-     << (v ? " (exceeded)" : "") << ", carriage.max_accel_m_s2 = " << limits.accel_m_s2 << (a ? " (exceeded)" : "")
+  os << "carriage step of " << cam.pitch() * 1e3
+     << " mm does not fit the beater's clear window at crank speed " << omega << " rad/s ("
+     << crank_law_name(law.spec().kind) << " law): the window leaves " << deg(cam.window_length())
+     << " deg of crank (" << p.step_time_s * 1e3 << " ms) after the cam margins, and the step needs peak "
+     << p.speed_m_s << " m/s, " << p.accel_m_s2 << " m/s^2, " << p.jerk_m_s3
+     << " m/s^3; the limits are carriage.max_speed_m_s = " << limits.speed_m_s << (v ? " (exceeded)" : "")
+     << ", carriage.max_accel_m_s2 = " << limits.accel_m_s2 << (a ? " (exceeded)" : "")
      << ", carriage.max_jerk_m_s3 = " << limits.jerk_m_s3 << (j ? " (exceeded)" : "")
      << ". Lower recipe.crank_speed_rad_s to at most " << p.max_crank_speed_rad_s
-     << " rad/s, or shorten the pitch (beatup.beater_width_m, recipe.overlap_m), or lower recipe.cam_margin_deg";
+     << " rad/s, or shorten the pitch (beatup.beater_width_m, recipe.overlap_m), or lower "
+        "recipe.cam_margin_deg";
   throw MotionError(ErrorCode::kInvalidInput, os.str());
 }
 

@@ -12,7 +12,9 @@
 
 namespace loom::motion {
 
-const char* crank_law_name(CrankLawKind k) { return k == CrankLawKind::kElliptic ? "elliptic" : "constant"; }
+const char* crank_law_name(CrankLawKind k) {
+  return k == CrankLawKind::kElliptic ? "elliptic" : "constant";
+}
 
 bool parse_crank_law(const char* text, CrankLawKind& out) {
   for (CrankLawKind k : {CrankLawKind::kConstant, CrankLawKind::kElliptic}) {
@@ -51,7 +53,8 @@ CrankLaw::CrankLaw(const CrankLawSpec& spec, double fell_phase, const TableSpec&
       bad("ellipse_e", spec.ellipse_e, "must be in [0, 1) (0 is constant speed, 1 an open curve)");
     }
     if (spec.ellipse_lobes < 1) bad("ellipse_lobes", spec.ellipse_lobes, "must be >= 1");
-    if (!std::isfinite(spec.ellipse_phi02_rad)) bad("ellipse_phi02", spec.ellipse_phi02_rad, "must be finite");
+    if (!std::isfinite(spec.ellipse_phi02_rad))
+      bad("ellipse_phi02", spec.ellipse_phi02_rad, "must be finite");
     if (!std::isfinite(fell_phase)) bad("fell phase", fell_phase, "must be finite");
     const EllipticGearPair gear(1.0, spec.ellipse_e, spec.ellipse_lobes);
     // The driving-pinion angle c at park: the crank reaches the fell (Φc = fell) when φ2 = φ02, and

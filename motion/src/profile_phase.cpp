@@ -17,12 +17,14 @@ constexpr double kSaturateTurns = 4611686018427387904.0;  // 2^62
 
 Phase Phase::times(std::int64_t n) const noexcept {
   const bool negative = n < 0;
-  const std::uint64_t m = negative ? std::uint64_t{0} - static_cast<std::uint64_t>(n) : static_cast<std::uint64_t>(n);
+  const std::uint64_t m =
+      negative ? std::uint64_t{0} - static_cast<std::uint64_t>(n) : static_cast<std::uint64_t>(n);
   const Wide product = static_cast<Wide>(frac) * m;
   Phase r;
   r.frac = static_cast<std::uint64_t>(product);
   // Whole turns wrap like int64 (documented): do the arithmetic unsigned, where wrapping is defined.
-  r.turns = static_cast<std::int64_t>(static_cast<std::uint64_t>(turns) * m + static_cast<std::uint64_t>(product >> 64));
+  r.turns = static_cast<std::int64_t>(static_cast<std::uint64_t>(turns) * m +
+                                      static_cast<std::uint64_t>(product >> 64));
   return negative ? -r : r;
 }
 
@@ -33,8 +35,8 @@ Phase Phase::from_turns(double x) noexcept {
   // path (x86-64 without SSE4.1 has no rounding instruction).
   x = x < -kSaturateTurns ? -kSaturateTurns : x > kSaturateTurns ? kSaturateTurns : x;
   double whole = static_cast<double>(static_cast<std::int64_t>(x));  // |x| <= 2^62: truncation is exact
-  if (whole > x) whole -= 1.0;                                        // floor for negative x
-  double rest = x - whole;  // exact for |x| < 2^62; in [0, 1] after rounding
+  if (whole > x) whole -= 1.0;                                       // floor for negative x
+  double rest = x - whole;                     // exact for |x| < 2^62; in [0, 1] after rounding
   const double scaled = rest * kUnitsPerTurn;  // >= 0
   // Adding and taking away 2^52 rounds a value below 2^52 to a whole number in the current rounding mode,
   // as nearbyint does; from 2^52 up every double is whole.
@@ -46,13 +48,21 @@ Phase Phase::from_turns(double x) noexcept {
   return {static_cast<std::int64_t>(whole), static_cast<std::uint64_t>(units)};
 }
 
-Phase Phase::from_rad(double rad) noexcept { return from_turns(rad / kTwoPi); }
+Phase Phase::from_rad(double rad) noexcept {
+  return from_turns(rad / kTwoPi);
+}
 
-double Phase::to_turns() const noexcept { return static_cast<double>(turns) + frac_turns(); }
+double Phase::to_turns() const noexcept {
+  return static_cast<double>(turns) + frac_turns();
+}
 
-double Phase::to_rad() const noexcept { return kTwoPi * static_cast<double>(turns) + frac_rad(); }
+double Phase::to_rad() const noexcept {
+  return kTwoPi * static_cast<double>(turns) + frac_rad();
+}
 
-double Phase::frac_rad() const noexcept { return kTwoPi * frac_turns(); }
+double Phase::frac_rad() const noexcept {
+  return kTwoPi * frac_turns();
+}
 
 Phase phase_step(double speed_rad_s, double period_s) {
   if (!std::isfinite(speed_rad_s) || !(period_s > 0.0) || !std::isfinite(period_s)) {

@@ -12,7 +12,9 @@
 namespace loom::motion {
 namespace {
 
-[[noreturn]] void infeasible(const std::ostringstream& os) { throw MotionError(ErrorCode::kInvalidInput, os.str()); }
+[[noreturn]] void infeasible(const std::ostringstream& os) {
+  throw MotionError(ErrorCode::kInvalidInput, os.str());
+}
 
 int beats_for(const ProfileSpec& s) {
   const double pitch = s.beater_width_m - s.overlap_m;
@@ -61,11 +63,12 @@ ProfileSet::ProfileSet(const ProfileSpec& spec)
   crank_error_ = midpoint_error(crank_law_.table(), [this](double p) { return crank_law_.exact(p).offset; });
   if (!(rocker_error_ <= spec.max_table_error_rad) || !(crank_error_ <= spec.max_table_error_rad)) {
     std::ostringstream os;
-    os << spec.table_size << "-knot " << interp_name(spec.table_interp) << " " << precision_name(spec.table_precision)
-       << " tables miss the exact kinematics by up to " << std::max(rocker_error_, crank_error_)
-       << " rad (rocker " << rocker_error_ << ", crank law " << crank_error_
-       << "), more than profiles.max_table_error_rad = " << spec.max_table_error_rad
-       << "; raise profiles.table_size or use profiles.interp = \"quintic\" (float32 knots stop near 3e-8 rad)";
+    os << spec.table_size << "-knot " << interp_name(spec.table_interp) << " "
+       << precision_name(spec.table_precision) << " tables miss the exact kinematics by up to "
+       << std::max(rocker_error_, crank_error_) << " rad (rocker " << rocker_error_ << ", crank law "
+       << crank_error_ << "), more than profiles.max_table_error_rad = " << spec.max_table_error_rad
+       << "; raise profiles.table_size or use profiles.interp = \"quintic\" (float32 knots stop near 3e-8 "
+          "rad)";
     infeasible(os);
   }
   // Equal pitch from selvedge to selvedge: never more than the nominal pitch, so overlap is kept.
@@ -90,17 +93,18 @@ ProfileSet::ProfileSet(const ProfileSpec& spec)
   const double crank_braking = kTwoPi - ramp + crank_law_.exact(-ramp).offset;
   if (crank_at_speed > w.enter || crank_braking < w.exit || sweep_.peak_velocity() < spec.crank.velocity) {
     std::ostringstream os;
-    os << "beat-up crank cannot reach " << spec.crank.velocity << " rad/s before the first beat: run-up needs "
-       << deg(ramp) << " deg of master phase (crank at " << deg(crank_at_speed) << " deg), the beater enters the warp "
-       << deg(w.enter) << " deg after park and leaves it " << deg(kTwoPi - w.exit)
+    os << "beat-up crank cannot reach " << spec.crank.velocity
+       << " rad/s before the first beat: run-up needs " << deg(ramp) << " deg of master phase (crank at "
+       << deg(crank_at_speed) << " deg), the beater enters the warp " << deg(w.enter)
+       << " deg after park and leaves it " << deg(kTwoPi - w.exit)
        << " deg before park; raise recipe.crank_accel_rad_s2 / recipe.crank_jerk_rad_s3 or lower "
           "recipe.crank_speed_rad_s";
     infeasible(os);
   }
-  carriage_peaks_ = check_carriage_step(
-      cam_, crank_law_, spec.crank.velocity,
-      {.speed_m_s = spec.carriage_max_speed_m_s, .accel_m_s2 = spec.carriage_max_accel_m_s2,
-       .jerk_m_s3 = spec.carriage_max_jerk_m_s3});
+  carriage_peaks_ = check_carriage_step(cam_, crank_law_, spec.crank.velocity,
+                                        {.speed_m_s = spec.carriage_max_speed_m_s,
+                                         .accel_m_s2 = spec.carriage_max_accel_m_s2,
+                                         .jerk_m_s3 = spec.carriage_max_jerk_m_s3});
 
   // The carrier drags the shuttle magnetically: shuttle acceleration must stay below F/m.
   if (!(spec.helix_lead_m > 0) || !(spec.carrier_force_n > 0) || !(spec.shuttle_mass_kg > 0)) {

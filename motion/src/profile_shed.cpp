@@ -18,8 +18,12 @@ namespace {
   throw MotionError(ErrorCode::kInvalidInput, os.str());
 }
 
-bool at_end(PistonEnds p, bool extend) { return p.extended == extend && p.retracted == !extend; }
-bool on_start(PistonEnds p, bool extend) { return extend ? p.retracted : p.extended; }
+bool at_end(PistonEnds p, bool extend) {
+  return p.extended == extend && p.retracted == !extend;
+}
+bool on_start(PistonEnds p, bool extend) {
+  return extend ? p.retracted : p.extended;
+}
 
 }  // namespace
 
@@ -40,26 +44,33 @@ void validate(const ShedSpec& s) {
   }
   if (!(s.piston_travel_s + s.debounce_s < s.timeout_s)) {
     std::ostringstream os;
-    os << "shedding.timeout_s = " << s.timeout_s << " must exceed shedding.piston_travel_s = " << s.piston_travel_s
-       << " plus the debounce " << s.debounce_s << " s, or a healthy shed change times out";
+    os << "shedding.timeout_s = " << s.timeout_s
+       << " must exceed shedding.piston_travel_s = " << s.piston_travel_s << " plus the debounce "
+       << s.debounce_s << " s, or a healthy shed change times out";
     throw MotionError(ErrorCode::kInvalidInput, os.str());
   }
   if (!(s.release_timeout_s < s.timeout_s)) {
     std::ostringstream os;
-    os << "shedding.release_timeout_s = " << s.release_timeout_s << " must be shorter than shedding.timeout_s = "
-       << s.timeout_s;
+    os << "shedding.release_timeout_s = " << s.release_timeout_s
+       << " must be shorter than shedding.timeout_s = " << s.timeout_s;
     throw MotionError(ErrorCode::kInvalidInput, os.str());
   }
 }
 
 const char* shed_verdict_name(ShedVerdict v) {
   switch (v) {
-    case ShedVerdict::kMoving: return "moving";
-    case ShedVerdict::kSettling: return "settling";
-    case ShedVerdict::kOpen: return "open";
-    case ShedVerdict::kTooEarly: return "too_early";
-    case ShedVerdict::kNotReleased: return "not_released";
-    case ShedVerdict::kTimeout: return "timeout";
+    case ShedVerdict::kMoving:
+      return "moving";
+    case ShedVerdict::kSettling:
+      return "settling";
+    case ShedVerdict::kOpen:
+      return "open";
+    case ShedVerdict::kTooEarly:
+      return "too_early";
+    case ShedVerdict::kNotReleased:
+      return "not_released";
+    case ShedVerdict::kTimeout:
+      return "timeout";
   }
   return "?";
 }

@@ -7,9 +7,9 @@
 #include <sstream>
 
 #include "checks.hpp"
-#include "scale.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/errors.hpp"
+#include "scale.hpp"
 
 namespace loom::motion {
 
@@ -31,8 +31,9 @@ void check_full_turn(const SliderCrank& m, bool accept_change_point) {
   const bool turns = accept_change_point ? margin > -slack : margin > slack;
   if (!turns) {
     std::ostringstream msg;
-    msg << "slider-crank: coupler b = " << m.coupler << " must exceed crank a + |offset e| = "
-        << m.crank + std::fabs(m.offset) << " for a full-turning crank";
+    msg << "slider-crank: coupler b = " << m.coupler
+        << " must exceed crank a + |offset e| = " << m.crank + std::fabs(m.offset)
+        << " for a full-turning crank";
     if (std::fabs(margin) <= slack) msg << " (b = a + |e| within 1e-12 b: change point)";
     throw MotionError(ErrorCode::kNotCrank, msg.str());
   }
@@ -51,13 +52,13 @@ namespace {
 // crank pin, h the coupler's run along the line (h² + q² = b²), x = a cos θ + h, and the coupler
 // angle φ3 = atan2(q, h) with dφ3/dθ = q'/h (from h h' = −q q').
 struct SliderCoefficients {
-  double x, dx, ddx;           // slider position and its θ-derivatives
-  double phi3, k3, k3p;        // coupler angle and its θ-derivatives
+  double x, dx, ddx;     // slider position and its θ-derivatives
+  double phi3, k3, k3p;  // coupler angle and its θ-derivatives
   double q, h;
 };
 
-// Scale-free: the loop is solved in units of L, a power of two near the largest length (so squares and products cannot
-// overflow or underflow at any scale a double can hold) and the lengths are scaled back.
+// Scale-free: the loop is solved in units of L, a power of two near the largest length (so squares and
+// products cannot overflow or underflow at any scale a double can hold) and the lengths are scaled back.
 SliderCoefficients coefficients(const SliderCrank& m, double theta_rad) noexcept {
   const double L = detail::length_scale(std::fmax(std::fmax(m.crank, m.coupler), std::fabs(m.offset)));
   const double a = m.crank / L;
@@ -110,7 +111,8 @@ PointCoefficients slider_coupler_point(const SliderCrank& m, double theta_rad,
 }
 
 SliderDeadCentres slider_dead_centres(const SliderCrank& m) {
-  // In units of L, a power of two near the largest length (scale-free, see coefficients()); lengths scaled back below.
+  // In units of L, a power of two near the largest length (scale-free, see coefficients()); lengths scaled
+  // back below.
   check_lengths(m);
   const double L = detail::length_scale(std::fmax(std::fmax(m.crank, m.coupler), std::fabs(m.offset)));
   const double a = m.crank / L;

@@ -6,7 +6,8 @@ namespace loom::sequencer {
 std::uint16_t fault_code(Fault f) {
   switch (f) {
 #define LOOM_FAULT_CODE(id, code, name, text) \
-  case Fault::id: return code;
+  case Fault::id:                             \
+    return code;
     LOOM_FAULT_TABLE(LOOM_FAULT_CODE)
 #undef LOOM_FAULT_CODE
   }
@@ -16,7 +17,8 @@ std::uint16_t fault_code(Fault f) {
 const char* fault_name(Fault f) {
   switch (f) {
 #define LOOM_FAULT_NAME(id, code, name, text) \
-  case Fault::id: return name;
+  case Fault::id:                             \
+    return name;
     LOOM_FAULT_TABLE(LOOM_FAULT_NAME)
 #undef LOOM_FAULT_NAME
   }
@@ -26,7 +28,8 @@ const char* fault_name(Fault f) {
 const char* fault_text(Fault f) {
   switch (f) {
 #define LOOM_FAULT_TEXT(id, code, name, text) \
-  case Fault::id: return text;
+  case Fault::id:                             \
+    return text;
     LOOM_FAULT_TABLE(LOOM_FAULT_TEXT)
 #undef LOOM_FAULT_TEXT
   }

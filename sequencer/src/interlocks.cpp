@@ -9,8 +9,10 @@
 namespace loom::sequencer {
 
 bool shed_confirmed(const hal::DigitalInputs& io) {
-  const bool a_up = io.piston_a_extended && !io.piston_a_retracted && io.piston_b_retracted && !io.piston_b_extended;
-  const bool b_up = io.piston_b_extended && !io.piston_b_retracted && io.piston_a_retracted && !io.piston_a_extended;
+  const bool a_up =
+      io.piston_a_extended && !io.piston_a_retracted && io.piston_b_retracted && !io.piston_b_extended;
+  const bool b_up =
+      io.piston_b_extended && !io.piston_b_retracted && io.piston_a_retracted && !io.piston_a_extended;
   return a_up || b_up;
 }
 
@@ -24,7 +26,9 @@ bool gripper_in_warp(const KnotGuard& g, double knotter_position) {
   return rel > g.in_warp_from_rad && rel < g.in_warp_to_rad;
 }
 
-bool shuttle_at_selvedge(const hal::DigitalInputs& io) { return io.shuttle_at_left || io.shuttle_at_right; }
+bool shuttle_at_selvedge(const hal::DigitalInputs& io) {
+  return io.shuttle_at_left || io.shuttle_at_right;
+}
 
 bool beater_in_warp(const InterlockContext& ctx, double crank_position) {
   const double phase = motion::wrap_two_pi(crank_position - ctx.crank_park_position);
@@ -48,14 +52,15 @@ Fault check_knotting(const InterlockContext& ctx, const hal::HalInputs& measured
     const bool inside = gripper_in_warp(g, measured.axes[static_cast<std::size_t>(g.knotter[hh])].position);
     if (inside && (carriage_moves || crank_moves || valves_change)) return Fault::kGripperInWarp;
     if (moved(g.knotter[hh]) && !clear) return Fault::kKnotNotClear;
-    if (moved(g.selector[hh]) && (prev.io.gripper_close[hh] || next.io.gripper_close[hh])) return Fault::kSelectorWithYarn;
+    if (moved(g.selector[hh]) && (prev.io.gripper_close[hh] || next.io.gripper_close[hh]))
+      return Fault::kSelectorWithYarn;
   }
   return Fault::kNone;
 }
 }  // namespace
 
-Fault check_interlocks(const InterlockContext& ctx, const hal::HalInputs& measured, const hal::HalOutputs& prev,
-                       const hal::HalOutputs& next) {
+Fault check_interlocks(const InterlockContext& ctx, const hal::HalInputs& measured,
+                       const hal::HalOutputs& prev, const hal::HalOutputs& next) {
   const auto moved = [&](hal::CoreAxis a) {
     return next.axes[hal::index(a)].target_position != prev.axes[hal::index(a)].target_position;
   };
@@ -64,11 +69,12 @@ Fault check_interlocks(const InterlockContext& ctx, const hal::HalInputs& measur
     return Fault::kCarriageInWarp;
   }
   if (moved(hal::CoreAxis::kHelix) && !shed_confirmed(measured.io)) return Fault::kPickWithoutShed;
-  const bool valves_change =
-      next.io.piston_a_extend != prev.io.piston_a_extend || next.io.piston_b_extend != prev.io.piston_b_extend;
+  const bool valves_change = next.io.piston_a_extend != prev.io.piston_a_extend ||
+                             next.io.piston_b_extend != prev.io.piston_b_extend;
   if (valves_change && !shuttle_at_selvedge(measured.io)) return Fault::kShedWithShuttle;
-  if (ctx.knot.heads > 0) return check_knotting(ctx, measured, prev, next, moved(hal::CoreAxis::kCarriage),
-                                                moved(hal::CoreAxis::kBeatCrank), valves_change);
+  if (ctx.knot.heads > 0)
+    return check_knotting(ctx, measured, prev, next, moved(hal::CoreAxis::kCarriage),
+                          moved(hal::CoreAxis::kBeatCrank), valves_change);
   return Fault::kNone;
 }
 

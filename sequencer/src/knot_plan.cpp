@@ -24,28 +24,36 @@ bool parse_named(const char* text, std::initializer_list<E> values, const char* 
 
 const char* knotting_mode_name(KnottingMode m) {
   switch (m) {
-    case KnottingMode::kNone: return "none";
-    case KnottingMode::kWeaver: return "weaver";
-    case KnottingMode::kHeads: return "heads";
+    case KnottingMode::kNone:
+      return "none";
+    case KnottingMode::kWeaver:
+      return "weaver";
+    case KnottingMode::kHeads:
+      return "heads";
   }
   return "?";
 }
 
 bool parse_knotting_mode(const char* text, KnottingMode& m) {
-  return parse_named(text, {KnottingMode::kNone, KnottingMode::kWeaver, KnottingMode::kHeads}, knotting_mode_name, m);
+  return parse_named(text, {KnottingMode::kNone, KnottingMode::kWeaver, KnottingMode::kHeads},
+                     knotting_mode_name, m);
 }
 
 const char* knot_type_name(KnotType k) {
   switch (k) {
-    case KnotType::kTurkish: return "turkish";
-    case KnotType::kPersianLeft: return "persian_left";
-    case KnotType::kPersianRight: return "persian_right";
+    case KnotType::kTurkish:
+      return "turkish";
+    case KnotType::kPersianLeft:
+      return "persian_left";
+    case KnotType::kPersianRight:
+      return "persian_right";
   }
   return "?";
 }
 
 bool parse_knot_type(const char* text, KnotType& k) {
-  return parse_named(text, {KnotType::kTurkish, KnotType::kPersianLeft, KnotType::kPersianRight}, knot_type_name, k);
+  return parse_named(text, {KnotType::kTurkish, KnotType::kPersianLeft, KnotType::kPersianRight},
+                     knot_type_name, k);
 }
 
 CarpetClass carpet_class(double n) {
@@ -59,17 +67,25 @@ CarpetClass carpet_class(double n) {
 
 const char* carpet_class_name(CarpetClass c) {
   switch (c) {
-    case CarpetClass::kOutside: return "outside the thesis' classes (215..10000 knots/dm^2)";
-    case CarpetClass::kCoarse: return "coarse";
-    case CarpetClass::kMedium: return "medium";
-    case CarpetClass::kFine: return "fine";
-    case CarpetClass::kExtraFine: return "extra fine";
-    case CarpetClass::kExtraExtraFine: return "extra extra fine";
+    case CarpetClass::kOutside:
+      return "outside the thesis' classes (215..10000 knots/dm^2)";
+    case CarpetClass::kCoarse:
+      return "coarse";
+    case CarpetClass::kMedium:
+      return "medium";
+    case CarpetClass::kFine:
+      return "fine";
+    case CarpetClass::kExtraFine:
+      return "extra fine";
+    case CarpetClass::kExtraExtraFine:
+      return "extra extra fine";
   }
   return "?";
 }
 
-double knot_pitch_m(const KnottingSpec& s) { return 0.1 / s.knots_per_dm; }
+double knot_pitch_m(const KnottingSpec& s) {
+  return 0.1 / s.knots_per_dm;
+}
 
 // A hair of tolerance, so that 1.2 m at 30 knots/dm is 360 knots, not 359.999… → 359.
 int knots_per_row(const KnottingSpec& s, double width_m) {
@@ -97,25 +113,30 @@ std::optional<KnottingFault> find_fault(const KnottingSpec& s, double width_m) {
     return KnottingFault{F::kHeadSpacing, "knotting.head_spacing_m must hold at least one knot pitch"};
   }
   // Every head sits over a knot when head 1 does: the spacing is a whole number of knot pitches.
-  if (const double p = knot_pitch_m(s), whole = knots_per_stripe(s) * p; std::abs(s.head_spacing_m - whole) > 0.01 * p) {
-    return KnottingFault{F::kHeadSpacing, "knotting.head_spacing_m = " + std::to_string(s.head_spacing_m) +
-                                              " is not a whole number of knot pitches (" + std::to_string(p) +
-                                              " m at knotting.knots_per_dm): the heads would miss their knots; " +
-                                              std::to_string(whole) + " m puts each over its knot"};
+  if (const double p = knot_pitch_m(s), whole = knots_per_stripe(s) * p;
+      std::abs(s.head_spacing_m - whole) > 0.01 * p) {
+    return KnottingFault{F::kHeadSpacing,
+                         "knotting.head_spacing_m = " + std::to_string(s.head_spacing_m) +
+                             " is not a whole number of knot pitches (" + std::to_string(p) +
+                             " m at knotting.knots_per_dm): the heads would miss their knots; " +
+                             std::to_string(whole) + " m puts each over its knot"};
   }
   // The heads' stripes together must reach the right selvedge: head h ties [h·n, (h+1)·n).
   const int n = knots_per_stripe(s), k = knots_per_row(s, width_m);
   if (s.heads * n < k) {
-    return KnottingFault{F::kHeadSpacing, "knotting.head_spacing_m: " + std::to_string(s.heads) + " heads x " +
-           std::to_string(n) + " knots per stripe cover " + std::to_string(s.heads * n) + " of the row's " + std::to_string(k) +
-           " knots (loom.width_m / knotting.heads is the spacing that covers the width)"};
+    return KnottingFault{F::kHeadSpacing,
+                         "knotting.head_spacing_m: " + std::to_string(s.heads) + " heads x " +
+                             std::to_string(n) + " knots per stripe cover " + std::to_string(s.heads * n) +
+                             " of the row's " + std::to_string(k) +
+                             " knots (loom.width_m / knotting.heads is the spacing that covers the width)"};
   }
   if ((s.heads - 1) * n >= k) {
     return KnottingFault{F::kHeads, "knotting.heads: the last head's stripe starts beyond the row's " +
                                         std::to_string(k) + " knots (fewer heads, or a narrower spacing)"};
   }
   if (s.slot_colours.empty() || s.slot_colours.size() > static_cast<std::size_t>(kMaxMagazineSlots)) {
-    return KnottingFault{F::kSlotColours, "knotting.slot_colours must name 1.." + std::to_string(kMaxMagazineSlots) +
+    return KnottingFault{F::kSlotColours, "knotting.slot_colours must name 1.." +
+                                              std::to_string(kMaxMagazineSlots) +
                                               " colours (one per magazine slot)"};
   }
   for (std::size_t i = 0; i < s.slot_colours.size(); ++i) {
@@ -124,12 +145,14 @@ std::optional<KnottingFault> find_fault(const KnottingSpec& s, double width_m) {
     }
     for (std::size_t j = 0; j < i; ++j) {
       if (s.slot_colours[i] == s.slot_colours[j]) {
-        return KnottingFault{F::kSlotColours, "knotting.slot_colours: \"" + s.slot_colours[i] + "\" is in slots " +
-                                                  std::to_string(j) + " and " + std::to_string(i)};
+        return KnottingFault{F::kSlotColours, "knotting.slot_colours: \"" + s.slot_colours[i] +
+                                                  "\" is in slots " + std::to_string(j) + " and " +
+                                                  std::to_string(i)};
       }
     }
   }
-  if (s.knots_per_slot < 1) return KnottingFault{F::kKnotsPerSlot, "knotting.knots_per_slot must be at least 1"};
+  if (s.knots_per_slot < 1)
+    return KnottingFault{F::kKnotsPerSlot, "knotting.knots_per_slot must be at least 1"};
   return std::nullopt;
 }
 
@@ -150,8 +173,9 @@ RowKnotPlan plan_row(const KnottingSpec& s, double width_m, std::span<const std:
   RowKnotPlan p;
   p.knots = knots_per_row(s, width_m);
   if (static_cast<int>(row.size()) != p.knots) {
-    throw std::invalid_argument("the design row is " + std::to_string(row.size()) + " knots wide; the loom ties " +
-                                std::to_string(p.knots) + " per row (loom.width_m at knotting.knots_per_dm)");
+    throw std::invalid_argument("the design row is " + std::to_string(row.size()) +
+                                " knots wide; the loom ties " + std::to_string(p.knots) +
+                                " per row (loom.width_m at knotting.knots_per_dm)");
   }
   const int n = knots_per_stripe(s);
   for (int h = 0; h < s.heads; ++h) {
@@ -164,7 +188,8 @@ RowKnotPlan plan_row(const KnottingSpec& s, double width_m, std::span<const std:
       const int slot = slot_of(s, code);
       if (slot < 0) {
         throw std::invalid_argument("colour \"" + code + "\" (knot " + std::to_string(k + 1) + ", head " +
-                                    std::to_string(h + 1) + ") is in no magazine slot (knotting.slot_colours)");
+                                    std::to_string(h + 1) +
+                                    ") is in no magazine slot (knotting.slot_colours)");
       }
       if (slot != slot_before[hh]) ++p.selector_moves[hh];
       slot_before[hh] = slot;

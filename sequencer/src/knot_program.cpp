@@ -11,7 +11,8 @@ KnotProgram KnotProgram::build(const KnottingSpec& spec, double width_m, int des
                                std::uint32_t counter_rows_at_start) {
   if (const std::string why = validate(spec, width_m); !why.empty()) throw std::invalid_argument(why);
   if (design_width < 1 || design_height < 1 ||
-      knots_bottom_up.size() != static_cast<std::size_t>(design_width) * static_cast<std::size_t>(design_height)) {
+      knots_bottom_up.size() !=
+          static_cast<std::size_t>(design_width) * static_cast<std::size_t>(design_height)) {
     throw std::invalid_argument("the design holds no knots");
   }
   KnotProgram p;
@@ -36,7 +37,8 @@ KnotProgram KnotProgram::build(const KnottingSpec& spec, double width_m, int des
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument("design row " + std::to_string(r + 1) + ": " + e.what());
     }
-    for (const std::uint16_t colour : row) p.slot_.push_back(static_cast<std::uint8_t>(slot_of(spec, palette_codes[colour])));
+    for (const std::uint16_t colour : row)
+      p.slot_.push_back(static_cast<std::uint8_t>(slot_of(spec, palette_codes[colour])));
   }
   return p;
 }
@@ -45,15 +47,17 @@ int KnotProgram::design_row(std::uint32_t counter_row) const noexcept {
   if (design_rows_ == 0) return 0;
   // Rows before the start map back too (a carpet compared from its first row after restarts).
   const auto h = static_cast<std::int64_t>(design_rows_);
-  const std::int64_t d = static_cast<std::int64_t>(design_rows_done_ % static_cast<std::uint64_t>(h)) +
-                         (static_cast<std::int64_t>(counter_row) - static_cast<std::int64_t>(counter_rows_at_start_)) % h;
+  const std::int64_t d =
+      static_cast<std::int64_t>(design_rows_done_ % static_cast<std::uint64_t>(h)) +
+      (static_cast<std::int64_t>(counter_row) - static_cast<std::int64_t>(counter_rows_at_start_)) % h;
   return static_cast<int>(((d % h) + h) % h);
 }
 
 int KnotProgram::slot(std::uint32_t counter_row, int k) const noexcept {
   if (design_rows_ == 0 || k < 0 || k >= knots_) return -1;
-  const std::size_t at = static_cast<std::size_t>(design_row(counter_row)) * static_cast<std::size_t>(knots_) +
-                         static_cast<std::size_t>(k);
+  const std::size_t at =
+      static_cast<std::size_t>(design_row(counter_row)) * static_cast<std::size_t>(knots_) +
+      static_cast<std::size_t>(k);
   return slot_[at];
 }
 

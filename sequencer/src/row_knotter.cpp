@@ -10,10 +10,14 @@ namespace loom::sequencer {
 
 const char* weaver_ask_name(WeaverAsk a) {
   switch (a) {
-    case WeaverAsk::kNone: return "none";
-    case WeaverAsk::kTieByHand: return "tie_by_hand";
-    case WeaverAsk::kReload: return "reload";
-    case WeaverAsk::kCheckKnot: return "check_knot";
+    case WeaverAsk::kNone:
+      return "none";
+    case WeaverAsk::kTieByHand:
+      return "tie_by_hand";
+    case WeaverAsk::kReload:
+      return "reload";
+    case WeaverAsk::kCheckKnot:
+      return "check_knot";
   }
   return "?";
 }
@@ -21,16 +25,21 @@ const char* weaver_ask_name(WeaverAsk a) {
 std::string describe(const WeaverRequest& r, const KnotProgram& p) {
   const std::string colour = r.slot >= 0 && r.slot < p.slots() ? p.slot_colour(r.slot) : "?";
   const std::string head = "head " + std::to_string(r.head + 1);
-  const std::string where = "row " + std::to_string(r.row) + " (design row " + std::to_string(r.design_row + 1) + "): ";
+  const std::string where =
+      "row " + std::to_string(r.row) + " (design row " + std::to_string(r.design_row + 1) + "): ";
   const std::string knot = "knot " + std::to_string(r.knot + 1) + " (" + head + ")";
   switch (r.ask) {
-    case WeaverAsk::kNone: return "nothing";
+    case WeaverAsk::kNone:
+      return "nothing";
     case WeaverAsk::kTieByHand:
-      return where + "tie " + knot + " by hand in colour " + colour + " (the head missed it twice: look at slot " +
-             std::to_string(r.slot) + "'s yarn and the gripper)";
-    case WeaverAsk::kReload: return where + "reload colour " + colour + " into slot " + std::to_string(r.slot) + " of " + head;
+      return where + "tie " + knot + " by hand in colour " + colour +
+             " (the head missed it twice: look at slot " + std::to_string(r.slot) +
+             "'s yarn and the gripper)";
+    case WeaverAsk::kReload:
+      return where + "reload colour " + colour + " into slot " + std::to_string(r.slot) + " of " + head;
     case WeaverAsk::kCheckKnot:
-      return where + "check " + knot + " (the power failed while it was tied): finish or tie it by hand in colour " + colour;
+      return where + "check " + knot +
+             " (the power failed while it was tied): finish or tie it by hand in colour " + colour;
   }
   return "?";
 }
@@ -42,8 +51,10 @@ KnotGuard knot_guard(const KnottingConfig& heads) {
   KnotGuard g;
   g.heads = heads.program->heads();
   for (int h = 0; h < g.heads; ++h) {
-    g.knotter[static_cast<std::size_t>(h)] = static_cast<std::int8_t>(heads.knotter_axis[static_cast<std::size_t>(h)]);
-    g.selector[static_cast<std::size_t>(h)] = static_cast<std::int8_t>(heads.selector_axis[static_cast<std::size_t>(h)]);
+    g.knotter[static_cast<std::size_t>(h)] =
+        static_cast<std::int8_t>(heads.knotter_axis[static_cast<std::size_t>(h)]);
+    g.selector[static_cast<std::size_t>(h)] =
+        static_cast<std::int8_t>(heads.selector_axis[static_cast<std::size_t>(h)]);
   }
   g.take_position_rad = heads.take_position_rad;
   g.full_turn = c.end_offset_rad() != 0.0;
@@ -64,8 +75,8 @@ KnotGuard knot_guard(const KnottingConfig& heads) {
   return g;
 }
 
-void RowKnotter::configure(const KnottingConfig& k, const KnotGuard* guard, double period_s, double carriage_home_m,
-                           const motion::JerkLimits& carriage) {
+void RowKnotter::configure(const KnottingConfig& k, const KnotGuard* guard, double period_s,
+                           double carriage_home_m, const motion::JerkLimits& carriage) {
   k_ = k;
   guard_ = guard;
   period_s_ = period_s;
@@ -129,7 +140,8 @@ void RowKnotter::begin(std::uint32_t row0, const KnotCounters& progress, double 
   disk_wait_since_ = hal::kNeverTick;
   // A cycle started and not finished: the power failed while its knots were being tied. Whether they are
   // is not known; tying again could tie one twice, so the weaver checks them (kCheck asks).
-  interrupted_ = progress.cycles_started > progress.cycles_done && progress.cycles_done < static_cast<std::uint32_t>(stripe_);
+  interrupted_ = progress.cycles_started > progress.cycles_done &&
+                 progress.cycles_done < static_cast<std::uint32_t>(stripe_);
   heads_done_at_cut_ = interrupted_ ? progress.cycle_heads_done : 0;
   enter_cycle(static_cast<int>(progress.cycles_done), now, cmd);
 }
@@ -148,7 +160,8 @@ void RowKnotter::plan_selectors(int j, hal::Tick now, const hal::HalOutputs& cmd
     const int s = k_.program->slot(row0_, k);
     if (s == slot_[hh]) continue;
     const double at = cmd.axes[static_cast<std::size_t>(k_.selector_axis[hh])].target_position;
-    selector_move_[hh] = {true, true, now, at, motion::JerkMove::plan(selector_goal(s, at) - at, k_.selector)};
+    selector_move_[hh] = {true, true, now, at,
+                          motion::JerkMove::plan(selector_goal(s, at) - at, k_.selector)};
     slot_[hh] = s;
   }
 }
@@ -164,7 +177,8 @@ void RowKnotter::enter_cycle(int j, hal::Tick now, const hal::HalOutputs& cmd) n
   attempt_ = 0;
   if (j_ >= stripe_) {  // the row is knotted: the carriage goes back to the row's start selvedge
     const double from = cmd.axes[hal::index(hal::CoreAxis::kCarriage)].target_position;
-    carriage_move_ = {true, false, now, from, motion::JerkMove::plan(carriage_home_m_ + return_to_m_ - from, carriage_)};
+    carriage_move_ = {true, false, now, from,
+                      motion::JerkMove::plan(carriage_home_m_ + return_to_m_ - from, carriage_)};
     phase_ = Phase::kReturn;
     phase_since_ = now;
     return;
@@ -224,8 +238,10 @@ RowKnotter::Status RowKnotter::check(hal::Tick now, const hal::HalInputs& in, co
     const auto hh = static_cast<std::size_t>(h);
     const auto sel = static_cast<std::size_t>(k_.selector_axis[hh]);
     const auto kn = static_cast<std::size_t>(k_.knotter_axis[hh]);
-    const bool sel_off = std::abs(in.axes[sel].position - cmd.axes[sel].target_position) > k_.servo_tolerance_rad;
-    const bool kn_off = std::abs(in.axes[kn].position - cmd.axes[kn].target_position) > k_.servo_tolerance_rad;
+    const bool sel_off =
+        std::abs(in.axes[sel].position - cmd.axes[sel].target_position) > k_.servo_tolerance_rad;
+    const bool kn_off =
+        std::abs(in.axes[kn].position - cmd.axes[kn].target_position) > k_.servo_tolerance_rad;
     if (!sel_off && !kn_off) continue;
     if (!settled) return Status::kRunning;
     fail(sel_off ? Fault::kSelectorJam : Fault::kKnotServoLag, static_cast<int>(sel_off ? sel : kn));
@@ -282,7 +298,8 @@ RowKnotter::Status RowKnotter::check(hal::Tick now, const hal::HalInputs& in, co
   return Status::kRunning;
 }
 
-void RowKnotter::run_cycle(hal::Tick now, const hal::HalInputs& in, hal::HalOutputs& cmd, KnotCounters& counters) noexcept {
+void RowKnotter::run_cycle(hal::Tick now, const hal::HalInputs& in, hal::HalOutputs& cmd,
+                           KnotCounters& counters) noexcept {
   const motion::KnotCycle& c = *k_.cycle;
   const double t = seconds(now - cycle_t0_);
   const motion::KnotCycle::Sample s = c.sample(t);
@@ -290,7 +307,8 @@ void RowKnotter::run_cycle(hal::Tick now, const hal::HalInputs& in, hal::HalOutp
   for (int h = 0; h < heads_; ++h) {
     const auto hh = static_cast<std::size_t>(h);
     if (!active_[hh]) continue;
-    cmd.axes[static_cast<std::size_t>(k_.knotter_axis[hh])].target_position = knotter_origin_[hh] + s.angle_rad;
+    cmd.axes[static_cast<std::size_t>(k_.knotter_axis[hh])].target_position =
+        knotter_origin_[hh] + s.angle_rad;
     cmd.io.gripper_close[hh] = c.gripper_closed().contains(t);
     cmd.io.cutter[hh] = c.cutter().contains(t);
     if (c.yarn_sample().contains(t) && in.io.yarn_present[hh]) seen_[hh] = true;
@@ -353,8 +371,8 @@ void RowKnotter::cycle_done(hal::Tick now, const hal::HalOutputs& cmd, KnotCount
   counters.cycles_done = static_cast<std::uint32_t>(j_ + 1);
   counters.cycles_started = std::max(counters.cycles_started, counters.cycles_done);
   counters.cycle_heads_done = 0;
-  counters_moved_ |= counters.cycles_done != was.cycles_done || counters.cycles_started != was.cycles_started ||
-                     was.cycle_heads_done != 0;
+  counters_moved_ |= counters.cycles_done != was.cycles_done ||
+                     counters.cycles_started != was.cycles_started || was.cycle_heads_done != 0;
   enter_cycle(j_ + 1, now, cmd);
 }
 
@@ -366,7 +384,8 @@ RowKnotter::Status RowKnotter::weaver(hal::Tick now, const hal::HalOutputs& cmd,
     const WeaverAsk done = request_.ask;
     request_.ask = WeaverAsk::kNone;
     if (done == WeaverAsk::kReload) {  // the slot is full again: check the cycle again
-      stock_[static_cast<std::size_t>(request_.head)][static_cast<std::size_t>(request_.slot)] = k_.program->knots_per_slot();
+      stock_[static_cast<std::size_t>(request_.head)][static_cast<std::size_t>(request_.slot)] =
+          k_.program->knots_per_slot();
       phase_ = Phase::kCheck;
       phase_since_ = now;
       return Status::kRunning;
@@ -397,7 +416,8 @@ RowKnotter::Status RowKnotter::step(hal::Tick now, const hal::HalInputs& in, hal
   if (carriage_move_.active && !carriage_move_.started) {
     bool inside = false;
     for (int h = 0; h < heads_ && guard_ != nullptr; ++h) {
-      inside |= gripper_in_warp(*guard_, in.axes[static_cast<std::size_t>(k_.knotter_axis[static_cast<std::size_t>(h)])].position);
+      inside |= gripper_in_warp(
+          *guard_, in.axes[static_cast<std::size_t>(k_.knotter_axis[static_cast<std::size_t>(h)])].position);
     }
     if (inside) {
       carriage_move_.t0 = now;
@@ -405,11 +425,13 @@ RowKnotter::Status RowKnotter::step(hal::Tick now, const hal::HalInputs& in, hal
       carriage_move_.started = true;
     }
   }
-  const bool carriage_moving = play(carriage_move_, now, cmd.axes[hal::index(hal::CoreAxis::kCarriage)].target_position);
+  const bool carriage_moving =
+      play(carriage_move_, now, cmd.axes[hal::index(hal::CoreAxis::kCarriage)].target_position);
   bool selectors_moving = false;
   for (int h = 0; h < heads_; ++h) {
     const auto hh = static_cast<std::size_t>(h);
-    selectors_moving |= play(selector_move_[hh], now, cmd.axes[static_cast<std::size_t>(k_.selector_axis[hh])].target_position);
+    selectors_moving |= play(selector_move_[hh], now,
+                             cmd.axes[static_cast<std::size_t>(k_.selector_axis[hh])].target_position);
     cmd.io.gripper_close[hh] = false;
     cmd.io.cutter[hh] = false;
   }

@@ -27,21 +27,23 @@
 
 namespace loom::sequencer {
 namespace {
-using hal::CoreAxis;
 using hal::AxisRequest;
+using hal::CoreAxis;
 using hal::DriveState;
 using hal::index;
-constexpr double kArrivalMarginM = 0.002;         // carrier position uncertainty at the arrival sensor
-constexpr double kCarrierAtSelvedgeM = 1e-6;      // a pick starting farther off its selvedge (a cut pick) is re-planned
-constexpr double kStepPlausibility = 4.0;         // an axis may move at most this × its top speed per tick
-constexpr int kShedTestStrokes = 4;               // arming shed test: A up, B up, A up, B up
+constexpr double kArrivalMarginM = 0.002;  // carrier position uncertainty at the arrival sensor
+constexpr double kCarrierAtSelvedgeM =
+    1e-6;  // a pick starting farther off its selvedge (a cut pick) is re-planned
+constexpr double kStepPlausibility = 4.0;  // an axis may move at most this × its top speed per tick
+constexpr int kShedTestStrokes = 4;        // arming shed test: A up, B up, A up, B up
 
 void request_all(hal::HalOutputs& o, std::size_t n_axes, AxisRequest r) {
   for (std::size_t i = 0; i < n_axes; ++i) o.axes[i].request = r;
 }
-bool finite(double x) { return std::isfinite(x); }
+bool finite(double x) {
+  return std::isfinite(x);
+}
 }  // namespace
-
 
 namespace {
 bool drive_in_fault(const hal::AxisFeedback& a) {
@@ -51,20 +53,34 @@ bool drive_in_fault(const hal::AxisFeedback& a) {
 
 const char* state_name(State s) {
   switch (s) {
-    case State::kIdle: return "idle";
-    case State::kEnabling: return "enabling";
-    case State::kHoming: return "homing";
-    case State::kPositioning: return "positioning";
-    case State::kShedTest: return "shed_test";
-    case State::kShed: return "shed";
-    case State::kPick: return "pick";
-    case State::kBeatSweep: return "beat_sweep";
-    case State::kRowEnd: return "row_end";
-    case State::kAwaitKnotting: return "await_knotting";
-    case State::kKnotting: return "knotting";
-    case State::kPaused: return "paused";
-    case State::kDone: return "done";
-    case State::kFault: return "fault";
+    case State::kIdle:
+      return "idle";
+    case State::kEnabling:
+      return "enabling";
+    case State::kHoming:
+      return "homing";
+    case State::kPositioning:
+      return "positioning";
+    case State::kShedTest:
+      return "shed_test";
+    case State::kShed:
+      return "shed";
+    case State::kPick:
+      return "pick";
+    case State::kBeatSweep:
+      return "beat_sweep";
+    case State::kRowEnd:
+      return "row_end";
+    case State::kAwaitKnotting:
+      return "await_knotting";
+    case State::kKnotting:
+      return "knotting";
+    case State::kPaused:
+      return "paused";
+    case State::kDone:
+      return "done";
+    case State::kFault:
+      return "fault";
   }
   return "?";
 }
@@ -75,24 +91,30 @@ std::optional<SequencerFault> find_fault(const SequencerConfig& c, const motion:
     return SequencerFault{field, axis, std::move(message)};
   };
   const auto fin = [](double v) { return std::isfinite(v); };
-  if (!(c.period_s > 0.0) || !fin(c.period_s)) return fault(F::kPeriod, "timing.period_ms must be positive and finite");
+  if (!(c.period_s > 0.0) || !fin(c.period_s))
+    return fault(F::kPeriod, "timing.period_ms must be positive and finite");
   if (p.beats_per_row() > kMaxBeatsPerRow) {
     return fault(F::kBeatsPerPosition,
                  "recipe.beats_per_position = " + std::to_string(p.spec().beats_per_position) + " gives " +
                      std::to_string(p.beats_per_row()) + " beats per row; the sequencer holds at most " +
-                     std::to_string(kMaxBeatsPerRow) + " (narrow the loom or beat each position fewer times)");
+                     std::to_string(kMaxBeatsPerRow) +
+                     " (narrow the loom or beat each position fewer times)");
   }
   if (c.picks_per_row < 1) return fault(F::kPicksPerRow, "recipe.picks_per_row must be at least 1");
   const BeatRegulatorConfig& br = c.beat_regulator;
-  if (!(br.min_speed_scale > 0.0 && br.min_speed_scale <= 1.0) || !(br.max_speed_scale >= 1.0 && br.max_speed_scale <= 2.0)) {
-    return fault(F::kBeatRegulator, "beat regulator: speed scale bounds must satisfy 0 < min <= 1 <= max <= 2");
+  if (!(br.min_speed_scale > 0.0 && br.min_speed_scale <= 1.0) ||
+      !(br.max_speed_scale >= 1.0 && br.max_speed_scale <= 2.0)) {
+    return fault(F::kBeatRegulator,
+                 "beat regulator: speed scale bounds must satisfy 0 < min <= 1 <= max <= 2");
   }
-  if (!(br.memory_weight > 0.0 && br.memory_weight <= 1.0) || !(br.drift_weight > 0.0 && br.drift_weight <= 1.0)) {
+  if (!(br.memory_weight > 0.0 && br.memory_weight <= 1.0) ||
+      !(br.drift_weight > 0.0 && br.drift_weight <= 1.0)) {
     return fault(F::kBeatRegulator, "beat regulator: memory and drift weights must be in (0, 1]");
   }
   if (c.axes.count < hal::kCoreAxisCount || c.axes.count > hal::kMaxAxes) {
     return fault(F::kAxes, "axes: the loom has " + std::to_string(c.axes.count) +
-                               " axes; it needs the three core axes and holds at most " + std::to_string(hal::kMaxAxes));
+                               " axes; it needs the three core axes and holds at most " +
+                               std::to_string(hal::kMaxAxes));
   }
   for (std::size_t i = 0; i < hal::kCoreAxisCount; ++i) {
     if (c.axes.role(i) != static_cast<hal::AxisRole>(i)) {
@@ -102,12 +124,14 @@ std::optional<SequencerFault> find_fault(const SequencerConfig& c, const motion:
   }
   for (std::size_t i = hal::kCoreAxisCount; i < c.axes.count; ++i) {
     if (!std::isfinite(c.axis_max_speed[i]) || !(c.axis_max_speed[i] > 0.0)) {
-      return fault(F::kAxisMaxSpeed, std::string("axes.") + c.axes.name(i) + ".max_speed must be positive and finite", i);
+      return fault(F::kAxisMaxSpeed,
+                   std::string("axes.") + c.axes.name(i) + ".max_speed must be positive and finite", i);
     }
   }
   if (c.debounce_ticks < 1) return fault(F::kDebounceTicks, "timing.debounce_ticks must be at least 1");
   if (!fin(c.sensor_discrepancy_s) || c.sensor_discrepancy_s < c.period_s || c.sensor_discrepancy_s > 1.0) {
-    return fault(F::kSensorDiscrepancy, "timing.sensor_discrepancy_ms must be between one period and 1000 ms");
+    return fault(F::kSensorDiscrepancy,
+                 "timing.sensor_discrepancy_ms must be between one period and 1000 ms");
   }
   const struct {
     F field;
@@ -117,7 +141,8 @@ std::optional<SequencerFault> find_fault(const SequencerConfig& c, const motion:
                  {F::kCarriageHome, "carriage.home_position_m", c.carriage_home_m},
                  {F::kHelixLeftPosition, "helix.left_position_rad", c.helix_left_position_rad}};
   for (const auto& o : offsets) {
-    if (!fin(o.v) || std::abs(o.v) > 1e6) return fault(o.field, std::string(o.key) + " must be finite and within ±1e6");
+    if (!fin(o.v) || std::abs(o.v) > 1e6)
+      return fault(o.field, std::string(o.key) + " must be finite and within ±1e6");
   }
   // Every time-out becomes a tick count: it must be finite and fit the integer time base with room.
   const struct {
@@ -147,7 +172,8 @@ std::optional<SequencerFault> find_fault(const SequencerConfig& c, const motion:
   }
   if (c.heads.program != nullptr) {
     if (c.knotting) {
-      return fault(F::kKnottingMode, "knotting.mode: the weaver's knotting and the knotting heads exclude each other");
+      return fault(F::kKnottingMode,
+                   "knotting.mode: the weaver's knotting and the knotting heads exclude each other");
     }
     const int heads = c.heads.program->heads();
     if (c.heads.program->slots() < 1 || c.heads.program->slots() > kMaxMagazineSlots) {
@@ -161,8 +187,8 @@ std::optional<SequencerFault> find_fault(const SequencerConfig& c, const motion:
                c.axes.role(static_cast<std::size_t>(a)) == role;
       };
       if (!slot_ok(kn, hal::AxisRole::kKnotter) || !slot_ok(sel, hal::AxisRole::kSelector)) {
-        return fault(F::kKnottingHeads,
-                     "knotting heads: head " + std::to_string(h + 1) + " needs a knotter and a selector axis");
+        return fault(F::kKnottingHeads, "knotting heads: head " + std::to_string(h + 1) +
+                                            " needs a knotter and a selector axis");
       }
     }
     const auto fin_pos = [&](double v) { return std::isfinite(v) && v > 0.0; };
@@ -223,9 +249,10 @@ void Sequencer::adopt_limits() noexcept {
   const double dt = cfg_.period_s;
   // The beat regulator's bounds for this recipe (a new recipe's positions start unremembered), aiming at
   // the band's middle, where either edge is farthest.
-  const BeatRegulatorLimits limits = sweep_clock_.configure(*profiles_, dt, cfg_.beat_regulator,
-                                                            0.5 * (cfg_.beat_force_min_n + cfg_.beat_force_max_n));
-  regulator_.configure(cfg_.beat_regulator, limits, profiles_->beats_per_row() / std::max(1, s.beats_per_position));
+  const BeatRegulatorLimits limits = sweep_clock_.configure(
+      *profiles_, dt, cfg_.beat_regulator, 0.5 * (cfg_.beat_force_min_n + cfg_.beat_force_max_n));
+  regulator_.configure(cfg_.beat_regulator, limits,
+                       profiles_->beats_per_row() / std::max(1, s.beats_per_position));
   // The crank's fastest is the regulator's fastest beat.
   const double crank_top = s.crank.velocity * (cfg_.beat_regulator.enabled ? limits.max_scale : 1.0);
   max_step_[index(CoreAxis::kBeatCrank)] = kStepPlausibility * crank_top * dt + 1e-3;
@@ -246,7 +273,8 @@ double Sequencer::seconds_since(hal::Tick now, hal::Tick t0) const noexcept {
 }
 
 double Sequencer::commanded_crank_phase() const noexcept {
-  return motion::wrap_two_pi(cmd_.axes[index(CoreAxis::kBeatCrank)].target_position - cfg_.crank_park_position_rad);
+  return motion::wrap_two_pi(cmd_.axes[index(CoreAxis::kBeatCrank)].target_position -
+                             cfg_.crank_park_position_rad);
 }
 
 double Sequencer::commanded_rocker_angle() const noexcept {
@@ -284,7 +312,8 @@ void Sequencer::enter(State s, hal::Tick now) noexcept {
 void Sequencer::request_stop() noexcept {
   switch (state_) {
     case State::kIdle:
-      start_requested_ = false;  // nothing moves yet: a start not taken is cancelled, no stop is kept for later
+      start_requested_ =
+          false;  // nothing moves yet: a start not taken is cancelled, no stop is kept for later
       return;
     case State::kDone:
     case State::kFault:
@@ -414,7 +443,8 @@ bool Sequencer::all_quiet(hal::Tick now, const hal::HalInputs& in) const noexcep
   for (std::size_t i = 0; i < n_axes_; ++i) {
     const hal::AxisFeedback& a = in.axes[i];
     flag |= a.fault | (a.state == DriveState::kFault) | (a.state == DriveState::kFaultReactionActive) |
-            (enabled_outputs_ & !a.referenced) | (a.fault_kind != hal::FaultKind::kNone) | (now - a.refreshed > stale);
+            (enabled_outputs_ & !a.referenced) | (a.fault_kind != hal::FaultKind::kNone) |
+            (now - a.refreshed > stale);
     // x - x is 0 for a finite x and NaN for inf or NaN; the sum is 0 only when both are finite.
     const bool finite_rest = (a.velocity - a.velocity) + (a.effort - a.effort) == 0.0;
     const bool small_step = std::abs(a.position - last(i).position) <= max_step_[i];
@@ -426,8 +456,8 @@ bool Sequencer::all_quiet(hal::Tick now, const hal::HalInputs& in) const noexcep
               : load_cell_seen_;
   flag |= dual_.discrepant() >= 0;
   flag |= (sensed_ticks_ > cfg_.debounce_ticks) &
-          ((io_.piston_a_extended & io_.piston_a_retracted) | (io_.piston_b_extended & io_.piston_b_retracted) |
-           (io_.shuttle_at_left & io_.shuttle_at_right));
+          ((io_.piston_a_extended & io_.piston_a_retracted) |
+           (io_.piston_b_extended & io_.piston_b_retracted) | (io_.shuttle_at_left & io_.shuttle_at_right));
   return !flag;
 }
 
@@ -444,7 +474,8 @@ bool Sequencer::check_faults_in_order(hal::Tick now, const hal::HalInputs& in) n
     const hal::AxisFeedback& a = in.axes[i];
     const int axis = static_cast<int>(i);
     if (drive_in_fault(a)) {
-      latch(a.fault_kind == hal::FaultKind::kNodeLost ? Fault::kHeartbeatLost : Fault::kDriveFault, now, axis, a.fault_code);
+      latch(a.fault_kind == hal::FaultKind::kNodeLost ? Fault::kHeartbeatLost : Fault::kDriveFault, now, axis,
+            a.fault_code);
       return true;
     }
     // A drive that powered up again has no reference: it must not move until homed at the next arming.
@@ -454,13 +485,14 @@ bool Sequencer::check_faults_in_order(hal::Tick now, const hal::HalInputs& in) n
     }
     // Any device fault stops motion in the same tick, even if the drive stays enabled (an EMCY).
     if (a.fault_kind != hal::FaultKind::kNone) {
-      latch(a.fault_kind == hal::FaultKind::kNodeLost ? Fault::kHeartbeatLost : Fault::kDriveEmcy, now, axis, a.fault_code);
+      latch(a.fault_kind == hal::FaultKind::kNodeLost ? Fault::kHeartbeatLost : Fault::kDriveEmcy, now, axis,
+            a.fault_code);
       return true;
     }
   }
   if (in.link.link_fault) {
-    latch(in.link.link_fault_kind == hal::FaultKind::kNodeLost ? Fault::kHeartbeatLost : Fault::kLinkFault, now, -1,
-          in.link.link_fault_code);
+    latch(in.link.link_fault_kind == hal::FaultKind::kNodeLost ? Fault::kHeartbeatLost : Fault::kLinkFault,
+          now, -1, in.link.link_fault_code);
     return true;
   }
   // Data never seen counts as old as the time since arming: the first PDOs of a freshly started bus
@@ -499,7 +531,8 @@ bool Sequencer::check_faults_in_order(hal::Tick now, const hal::HalInputs& in) n
     const hal::Tick apart = a.refreshed != hal::kNeverTick && was.refreshed != hal::kNeverTick
                                 ? std::max<hal::Tick>(1, a.refreshed - was.refreshed)
                                 : 1;
-    // A homing run that references the axis re-bases its reading once: that step is the reference, not a jump.
+    // A homing run that references the axis re-bases its reading once: that step is the reference, not a
+    // jump.
     const bool rebased = a.referenced != was.referenced;
     if (positions_primed_ && !rebased &&
         std::abs(a.position - was.position) > max_step_[i] * static_cast<double>(apart)) {
@@ -525,7 +558,8 @@ bool Sequencer::check_faults_in_order(hal::Tick now, const hal::HalInputs& in) n
     return true;
   }
   if (sensed_ticks_ > cfg_.debounce_ticks) {
-    if ((io_.piston_a_extended && io_.piston_a_retracted) || (io_.piston_b_extended && io_.piston_b_retracted)) {
+    if ((io_.piston_a_extended && io_.piston_a_retracted) ||
+        (io_.piston_b_extended && io_.piston_b_retracted)) {
       latch(Fault::kShedSensorConflict, now);
       return true;
     }
@@ -555,7 +589,8 @@ void Sequencer::refine_diagnosis(hal::Tick now, const hal::HalInputs& in) noexce
     }
   }
   if (in.link.link_fault) {
-    first_fault_ = in.link.link_fault_kind == hal::FaultKind::kNodeLost ? Fault::kHeartbeatLost : Fault::kLinkFault;
+    first_fault_ =
+        in.link.link_fault_kind == hal::FaultKind::kNodeLost ? Fault::kHeartbeatLost : Fault::kLinkFault;
     fault_axis_ = -1;
     fault_detail_ = in.link.link_fault_code;
     add_fault_event(EventKind::kDiagnosisRefined);
@@ -573,20 +608,47 @@ void Sequencer::report_presses() noexcept {
 
 void Sequencer::run_state(hal::Tick now, const hal::HalInputs& in) noexcept {
   switch (state_) {
-    case State::kIdle: idle(now, in); break;
-    case State::kEnabling: enabling(now, in); break;
-    case State::kHoming: homing(now, in); break;
-    case State::kPositioning: positioning(now, in); break;
-    case State::kShedTest: shed_test(now); break;
-    case State::kShed: shed(now); break;
-    case State::kPick: pick(now, in); break;
-    case State::kBeatSweep: beat_sweep(now); break;
-    case State::kRowEnd: row_end(now); break;
-    case State::kAwaitKnotting: await_knotting(now); break;
-    case State::kKnotting: knotting(now, in); break;
-    case State::kPaused: paused(now); break;
-    case State::kDone: break;
-    case State::kFault: fault(now); break;
+    case State::kIdle:
+      idle(now, in);
+      break;
+    case State::kEnabling:
+      enabling(now, in);
+      break;
+    case State::kHoming:
+      homing(now, in);
+      break;
+    case State::kPositioning:
+      positioning(now, in);
+      break;
+    case State::kShedTest:
+      shed_test(now);
+      break;
+    case State::kShed:
+      shed(now);
+      break;
+    case State::kPick:
+      pick(now, in);
+      break;
+    case State::kBeatSweep:
+      beat_sweep(now);
+      break;
+    case State::kRowEnd:
+      row_end(now);
+      break;
+    case State::kAwaitKnotting:
+      await_knotting(now);
+      break;
+    case State::kKnotting:
+      knotting(now, in);
+      break;
+    case State::kPaused:
+      paused(now);
+      break;
+    case State::kDone:
+      break;
+    case State::kFault:
+      fault(now);
+      break;
   }
 }
 
@@ -699,7 +761,8 @@ void Sequencer::positioning(hal::Tick now, const hal::HalInputs& in) noexcept {
   }
   if (!crank_parking_planned_) {
     crank_parking_planned_ = true;
-    const double phase = motion::wrap_pi(in.axes[index(CoreAxis::kBeatCrank)].position - cfg_.crank_park_position_rad);
+    const double phase =
+        motion::wrap_pi(in.axes[index(CoreAxis::kBeatCrank)].position - cfg_.crank_park_position_rad);
     crank_move_ = {true, now, cmd_.axes[index(CoreAxis::kBeatCrank)].target_position,
                    motion::JerkMove::plan(-phase, profiles_->spec().crank)};
     return;
@@ -821,13 +884,15 @@ void Sequencer::pick(hal::Tick now, const hal::HalInputs& in) noexcept {
   carrier_step_m_ = std::abs(helix - prev_helix_rad_) * lead / motion::kTwoPi;
   prev_helix_rad_ = helix;
   const hal::Tick io_at = in.io.refreshed, helix_at = in.axes[index(CoreAxis::kHelix)].refreshed;
-  const hal::Tick skew_ticks =
-      io_at == hal::kNeverTick || helix_at == hal::kNeverTick ? 0 : (io_at > helix_at ? io_at - helix_at : helix_at - io_at);
+  const hal::Tick skew_ticks = io_at == hal::kNeverTick || helix_at == hal::kNeverTick
+                                   ? 0
+                                   : (io_at > helix_at ? io_at - helix_at : helix_at - io_at);
   const double skew_m = static_cast<double>(std::min<hal::Tick>(skew_ticks, cfg_.debounce_ticks + 1)) *
                         std::max(carrier_step_m_, carrier_prev_step_m_);
   if (!pick_resumed_) {
     if (carrier_left_ == hal::kNeverTick && from_start_m > reach + tol + skew_m) carrier_left_ = now;
-    if (carrier_left_ != hal::kNeverTick && still_at_start && now - carrier_left_ > cfg_.debounce_ticks + 1 + skew_ticks) {
+    if (carrier_left_ != hal::kNeverTick && still_at_start &&
+        now - carrier_left_ > cfg_.debounce_ticks + 1 + skew_ticks) {
       latch(Fault::kShuttleSlipped, now);
       return;
     }
@@ -837,7 +902,8 @@ void Sequencer::pick(hal::Tick now, const hal::HalInputs& in) noexcept {
     raw_arrival_at_m_ = to_goal_m;
     raw_arrival_lateness_m_ = carrier_step_m_ + skew_m;
   }
-  if (!raw_arrived && !arrived && to_goal_m > reach) raw_arrival_at_m_ = -1.0;  // a bounce before the carrier came
+  if (!raw_arrived && !arrived && to_goal_m > reach)
+    raw_arrival_at_m_ = -1.0;  // a bounce before the carrier came
   if (arrived && to_goal_m > reach + kArrivalMarginM + skew_m) {
     latch(Fault::kShuttleSensorEarly, now);
     return;
@@ -845,7 +911,8 @@ void Sequencer::pick(hal::Tick now, const hal::HalInputs& in) noexcept {
   // The arrival edge must come as the carrier crosses the switching point: well before it the shuttle
   // cannot be there (unless it ran ahead, off its carrier); well after it, it did not come with it.
   if (arrived && raw_arrival_at_m_ >= 0.0 &&
-      (raw_arrival_at_m_ < reach - tol - raw_arrival_lateness_m_ || raw_arrival_at_m_ > reach + 0.25 * tol + skew_m)) {
+      (raw_arrival_at_m_ < reach - tol - raw_arrival_lateness_m_ ||
+       raw_arrival_at_m_ > reach + 0.25 * tol + skew_m)) {
     latch(Fault::kShuttleSlipped, now);
     return;
   }
@@ -863,7 +930,8 @@ void Sequencer::pick(hal::Tick now, const hal::HalInputs& in) noexcept {
   }
   const bool missed = !arrived && carrier_at_selvedge_ != hal::kNeverTick &&
                       now - carrier_at_selvedge_ > cfg_.debounce_ticks + arrival_grace_ticks_;
-  if (missed || seconds_since(now, state_since_) > profiles_->pick().duration() + cfg_.pick_timeout_margin_s) {
+  if (missed ||
+      seconds_since(now, state_since_) > profiles_->pick().duration() + cfg_.pick_timeout_margin_s) {
     latch(Fault::kShuttleNotArrived, now);
   }
 }
@@ -918,9 +986,11 @@ void Sequencer::fault(hal::Tick now) noexcept {
 
 bool Sequencer::reconcile_at_arming(hal::Tick now, const hal::HalInputs& in) noexcept {
   const KnotCounters& k = counters_.knot;
-  const bool knots_impossible = k.cycles_done > k.cycles_started ||
-                                (knotter_.fitted() && k.cycles_started > static_cast<std::uint32_t>(cfg_.heads.program->stripe()));
-  if (counters_.picks_in_row > cfg_.picks_per_row || counters_.picks_in_row > counters_.picks || knots_impossible) {
+  const bool knots_impossible =
+      k.cycles_done > k.cycles_started ||
+      (knotter_.fitted() && k.cycles_started > static_cast<std::uint32_t>(cfg_.heads.program->stripe()));
+  if (counters_.picks_in_row > cfg_.picks_per_row || counters_.picks_in_row > counters_.picks ||
+      knots_impossible) {
     latch(Fault::kCountersInconsistent, now);
     return false;
   }
@@ -1015,13 +1085,15 @@ void Sequencer::begin_pick(hal::Tick now, bool resumed) noexcept {
     // the first or last ticks of a pick the shuttle is still (or already) at a selvedge while the carrier
     // stands a few millimetres off it, and a relative goal would carry that offset into the arrival check
     // (a false shuttle_slipped). Off the selvedge, the carrier goes straight to the goal (bounded move).
-    const double start_rad = cfg_.helix_left_position_rad + (pick_to_right_ ? 0.0 : profiles_->pick().distance());
+    const double start_rad =
+        cfg_.helix_left_position_rad + (pick_to_right_ ? 0.0 : profiles_->pick().distance());
     pick_goal_rad_ = cfg_.helix_left_position_rad + (pick_to_right_ ? profiles_->pick().distance() : 0.0);
     const double off_m = std::abs(from - start_rad) * profiles_->spec().helix_lead_m / motion::kTwoPi;
     if (off_m <= kCarrierAtSelvedgeM) {
       helix_move_ = {true, now, from, pick_to_right_ ? profiles_->pick() : profiles_->pick_back()};
     } else {
-      helix_move_ = {true, now, from, motion::JerkMove::plan(pick_goal_rad_ - from, profiles_->helix_limits())};
+      helix_move_ = {true, now, from,
+                     motion::JerkMove::plan(pick_goal_rad_ - from, profiles_->helix_limits())};
     }
   }
   carrier_at_selvedge_ = hal::kNeverTick;
@@ -1095,7 +1167,8 @@ void Sequencer::after_row(hal::Tick now) noexcept {
 
 void Sequencer::next_row(hal::Tick now) noexcept {
   const KnotCounters& kc = counters_.knot;
-  if (knotter_.fitted() && !row_knotted_ && kc.cycles_done >= static_cast<std::uint32_t>(cfg_.heads.program->stripe()) &&
+  if (knotter_.fitted() && !row_knotted_ &&
+      kc.cycles_done >= static_cast<std::uint32_t>(cfg_.heads.program->stripe()) &&
       kc.cycles_started == kc.cycles_done) {
     row_knotted_ = true;  // every knot of this row was tied before a restart: on to its shed
   }
@@ -1105,7 +1178,8 @@ void Sequencer::next_row(hal::Tick now) noexcept {
     row_.begin(counters_.rows + 1, now);
     knotter_requests_seen_ = knotter_.requests();
     knot_requested_ = false;
-    knotter_.begin(counters_.rows, counters_.knot, row_starts_left() ? 0.0 : profiles_->carriage_travel_m(), now, cmd_);
+    knotter_.begin(counters_.rows, counters_.knot, row_starts_left() ? 0.0 : profiles_->carriage_travel_m(),
+                   now, cmd_);
     if (knotter_.requests() != knotter_requests_seen_) events_.add(EventKind::kWeaverRequest);
     enter(State::kKnotting, now);
     return;
@@ -1176,7 +1250,8 @@ void Sequencer::knotting(hal::Tick now, const hal::HalInputs& in) noexcept {
       const RowKnots& k = knotter_.row();
       row_.set_knots(k.ticks, k.weaver_ticks, k.tied, k.retried, k.by_hand);
       row_knotted_ = true;
-      // A stop or pause asked for as the last cycle ended holds here, before the row's shed (resume sheds it).
+      // A stop or pause asked for as the last cycle ended holds here, before the row's shed (resume sheds
+      // it).
       if (!hold_here(now)) next_row(now);
       return;
     }
@@ -1185,15 +1260,22 @@ void Sequencer::knotting(hal::Tick now, const hal::HalInputs& in) noexcept {
 
 Fault Sequencer::shed_fault(ShedVerdict v) const noexcept {
   switch (v) {
-    case ShedVerdict::kTooEarly: return Fault::kShedSensorEarly;
-    case ShedVerdict::kTooLate: return Fault::kShedSensorLate;
-    case ShedVerdict::kNotReleased: return Fault::kShedNotReleased;
-    case ShedVerdict::kAirLost: return Fault::kAirLost;
-    case ShedVerdict::kConflict: return Fault::kShedSensorConflict;
-    case ShedVerdict::kTimeout: return Fault::kShedTimeout;
+    case ShedVerdict::kTooEarly:
+      return Fault::kShedSensorEarly;
+    case ShedVerdict::kTooLate:
+      return Fault::kShedSensorLate;
+    case ShedVerdict::kNotReleased:
+      return Fault::kShedNotReleased;
+    case ShedVerdict::kAirLost:
+      return Fault::kAirLost;
+    case ShedVerdict::kConflict:
+      return Fault::kShedSensorConflict;
+    case ShedVerdict::kTimeout:
+      return Fault::kShedTimeout;
     case ShedVerdict::kMoving:
     case ShedVerdict::kSettling:
-    case ShedVerdict::kOpen: break;
+    case ShedVerdict::kOpen:
+      break;
   }
   return Fault::kNone;
 }
@@ -1212,7 +1294,8 @@ void Sequencer::play_moves(hal::Tick now) noexcept {
   // The crank's move is sampled once: as a move of its own and, in the sweep, as the master phase — at
   // the sweep clock's time, warped by the beat regulator's speeds (the tick time while there are none).
   // (active() only in a sweep: the clock is stopped with it.)
-  const double sweep_t = sweep_clock_.active() ? sweep_clock_.time_at(now) : seconds_since(now, crank_move_.t0);
+  const double sweep_t =
+      sweep_clock_.active() ? sweep_clock_.time_at(now) : seconds_since(now, crank_move_.t0);
   const bool crank_played = crank_move_.active;
   const double crank_offset = crank_played || sweeping_ ? crank_move_.move.position_at(sweep_t) : 0.0;
   if (crank_played) {
@@ -1267,12 +1350,14 @@ void Sequencer::publish_beat(int k) noexcept {
     e.peak_force_n = b.peak_force_n;
   }
   e.force_measured = r.force_measured;
-  e.in_band = e.force_measured && e.peak_force_n >= cfg_.beat_force_min_n && e.peak_force_n <= cfg_.beat_force_max_n;
+  e.in_band =
+      e.force_measured && e.peak_force_n >= cfg_.beat_force_min_n && e.peak_force_n <= cfg_.beat_force_max_n;
   // The speed it was beaten at (the clock is back at the recipe's by now; the next beat's is asked below).
   e.speed_scale = static_cast<float>(sweep_clock_.beat_scale());
   row_.speed(k, e.speed_scale);
   beats_published_ = k + 1;
-  if (e.force_measured && sweeping_ && regulator_.enabled()) regulate_after(k, e);  // a load cell: closed loop
+  if (e.force_measured && sweeping_ && regulator_.enabled())
+    regulate_after(k, e);  // a load cell: closed loop
 }
 
 int Sequencer::beat_position(int k) const noexcept {
@@ -1287,8 +1372,9 @@ int Sequencer::beat_position(int k) const noexcept {
 void Sequencer::regulate_after(int k, const BeatEvent& e) noexcept {
   const int next = k + 1;
   const bool last = next >= profiles_->beats_per_row();
-  const double s = regulator_.after_beat(beat_position(k), e.speed_scale, e.force_measured && e.peak_force_n > 0.0f,
-                                         e.peak_force_n, last ? -1 : beat_position(next));
+  const double s =
+      regulator_.after_beat(beat_position(k), e.speed_scale, e.force_measured && e.peak_force_n > 0.0f,
+                            e.peak_force_n, last ? -1 : beat_position(next));
   sweep_clock_.request(next, s);
 }
 
@@ -1296,8 +1382,9 @@ void Sequencer::signal() noexcept {
   // Stack light: red = a fault waits for acknowledgement; green = weaving; amber = waiting for the
   // operator (idle, arming, paused, done).
   const bool asking = state_ == State::kKnotting && knotter_.request().ask != WeaverAsk::kNone;
-  const bool weaving = state_ == State::kHoming || state_ == State::kPositioning || state_ == State::kShedTest || state_ == State::kShed ||
-                       state_ == State::kPick || state_ == State::kBeatSweep || state_ == State::kRowEnd ||
+  const bool weaving = state_ == State::kHoming || state_ == State::kPositioning ||
+                       state_ == State::kShedTest || state_ == State::kShed || state_ == State::kPick ||
+                       state_ == State::kBeatSweep || state_ == State::kRowEnd ||
                        (state_ == State::kKnotting && !asking);
   cmd_.io.lamp_red = state_ == State::kFault;
   cmd_.io.lamp_green = weaving;

@@ -5,21 +5,34 @@
 
 namespace loom::sequencer {
 namespace {
-bool at_end(PistonEnds p, bool extend) { return p.extended == extend && p.retracted == !extend; }
-bool on_start(PistonEnds p, bool extend) { return extend ? p.retracted : p.extended; }
+bool at_end(PistonEnds p, bool extend) {
+  return p.extended == extend && p.retracted == !extend;
+}
+bool on_start(PistonEnds p, bool extend) {
+  return extend ? p.retracted : p.extended;
+}
 }  // namespace
 
 const char* shed_verdict_name(ShedVerdict v) noexcept {
   switch (v) {
-    case ShedVerdict::kMoving: return "moving";
-    case ShedVerdict::kSettling: return "settling";
-    case ShedVerdict::kOpen: return "open";
-    case ShedVerdict::kTooEarly: return "too_early";
-    case ShedVerdict::kTooLate: return "too_late";
-    case ShedVerdict::kNotReleased: return "not_released";
-    case ShedVerdict::kAirLost: return "air_lost";
-    case ShedVerdict::kTimeout: return "timeout";
-    case ShedVerdict::kConflict: return "conflict";
+    case ShedVerdict::kMoving:
+      return "moving";
+    case ShedVerdict::kSettling:
+      return "settling";
+    case ShedVerdict::kOpen:
+      return "open";
+    case ShedVerdict::kTooEarly:
+      return "too_early";
+    case ShedVerdict::kTooLate:
+      return "too_late";
+    case ShedVerdict::kNotReleased:
+      return "not_released";
+    case ShedVerdict::kAirLost:
+      return "air_lost";
+    case ShedVerdict::kTimeout:
+      return "timeout";
+    case ShedVerdict::kConflict:
+      return "conflict";
   }
   return "?";
 }
@@ -84,7 +97,8 @@ ShedVerdict ShedMonitor::update(const motion::ShedSpec& s, double t, PistonEnds 
   for (std::size_t i = 0; i < 2; ++i) {
     const Frame& f = frame_[i];
     const double learned = learned_[i][f.extend ? 1 : 0];
-    if (f.full_stroke && learned > 0.0 && f.arrived < 0.0 && t > kLearnedLatestFactor * learned + kLateMarginS) {
+    if (f.full_stroke && learned > 0.0 && f.arrived < 0.0 &&
+        t > kLearnedLatestFactor * learned + kLateMarginS) {
       return latched_ = ShedVerdict::kTooLate;
     }
   }

@@ -54,7 +54,8 @@ class CrankInertiaEffect final : public AxisEffect {
       const double frac = static_cast<double>(i + 1) / n;
       const double goal = prev_target_ + frac * (target - prev_target_) + offset_;
       const double m_eff = model_.terms(state_.theta_rad).inertia_kg_m2;
-      const double pd = m_eff * (wn * wn * (goal - state_.theta_rad) + 2.0 * wn * (v_target - state_.omega_rad_s));
+      const double pd =
+          m_eff * (wn * wn * (goal - state_.theta_rad) + 2.0 * wn * (v_target - state_.omega_rad_s));
       const double tau = std::clamp(pd, -p_.motor_torque_limit_nm, p_.motor_torque_limit_nm);
       const double friction = -coulomb_ * std::tanh(state_.omega_rad_s / 1e-3);
       state_ = motion::step_rk4(model_, state_, h, motion::StepTorque::hold(tau + friction));
@@ -76,10 +77,13 @@ class CrankInertiaEffect final : public AxisEffect {
 
 }  // namespace
 
-std::unique_ptr<AxisEffect> make_crank_inertia(const SimMachine& machine, const Inertia& p, const JointFriction* friction) {
+std::unique_ptr<AxisEffect> make_crank_inertia(const SimMachine& machine, const Inertia& p,
+                                               const JointFriction* friction) {
   return std::make_unique<CrankInertiaEffect>(machine, p, friction);
 }
 
-std::unique_ptr<AxisEffect> make_servo_lag(const ServoLag& p) { return std::make_unique<ServoLagEffect>(p); }
+std::unique_ptr<AxisEffect> make_servo_lag(const ServoLag& p) {
+  return std::make_unique<ServoLagEffect>(p);
+}
 
 }  // namespace loom::sim_hal

@@ -56,7 +56,10 @@ class SimKnotter::OwnCarpet final : public CarpetKeeper {
 };
 
 SimKnotter::SimKnotter(const SimKnotting& m, const Knotter& k, double period_s)
-    : m_(m), k_(k), period_s_(period_s), own_(std::make_unique<OwnCarpet>()),
+    : m_(m),
+      k_(k),
+      period_s_(period_s),
+      own_(std::make_unique<OwnCarpet>()),
       beyond_(static_cast<std::size_t>(std::max(0, m.knots_per_row)), 0) {
   keep_in(*own_, 0, false);
   holding_.fill(-1);
@@ -185,19 +188,23 @@ void SimKnotter::on_outputs(const hal::DigitalOutputs& out, const std::array<dou
     switch (task_.kind) {
       case WeaverTask::Kind::kReload:
         if (task_.head >= 0 && task_.head < m_.heads && task_.slot >= 0 && task_.slot < m_.slots) {
-          st_->stock[static_cast<std::size_t>(task_.head)][static_cast<std::size_t>(task_.slot)] = m_.knots_per_slot;
+          st_->stock[static_cast<std::size_t>(task_.head)][static_cast<std::size_t>(task_.slot)] =
+              m_.knots_per_slot;
         }
         break;
       case WeaverTask::Kind::kCheckKnot:
         // A knot that is there is left alone (it was tied before the power failed); a missing one is tied.
-        if (task_.knot >= 0 && task_.knot < m_.knots_per_row && ((current_cell(task_.knot) >> kTiesShift) & kTiesMask) > 0) break;
+        if (task_.knot >= 0 && task_.knot < m_.knots_per_row &&
+            ((current_cell(task_.knot) >> kTiesShift) & kTiesMask) > 0)
+          break;
         [[fallthrough]];
       case WeaverTask::Kind::kTieByHand:
         if (task_.knot >= 0 && task_.knot < m_.knots_per_row) tie(task_.knot, task_.slot, true);
         // At the head the weaver sees an empty slot (why it missed) and fills it.
         if (task_.head >= 0 && task_.head < m_.heads && task_.slot >= 0 && task_.slot < m_.slots &&
             st_->stock[static_cast<std::size_t>(task_.head)][static_cast<std::size_t>(task_.slot)] <= 0) {
-          st_->stock[static_cast<std::size_t>(task_.head)][static_cast<std::size_t>(task_.slot)] = m_.knots_per_slot;
+          st_->stock[static_cast<std::size_t>(task_.head)][static_cast<std::size_t>(task_.slot)] =
+              m_.knots_per_slot;
         }
         break;
     }
@@ -210,7 +217,8 @@ void SimKnotter::inputs(const std::array<double, hal::kMaxAxes>& position, hal::
   const double carriage = position[hal::index(hal::CoreAxis::kCarriage)];
   for (int h = 0; h < m_.heads; ++h) {
     const int k = knot_under(h, carriage);
-    io.yarn_present[static_cast<std::size_t>(h)] = k >= 0 && ((current_cell(k) >> kTiesShift) & kTiesMask) > 0;
+    io.yarn_present[static_cast<std::size_t>(h)] =
+        k >= 0 && ((current_cell(k) >> kTiesShift) & kTiesMask) > 0;
   }
   io.row_knotted = pedal_left_ > 0;
 }

@@ -17,12 +17,14 @@ namespace {
 // carpet has room for: the file's size says how many).
 constexpr std::size_t kCarpetOffset = (sizeof(PersistedMachine) + 4095) / 4096 * 4096;
 constexpr std::size_t kMinFileSize = kCarpetOffset + sizeof(PersistedCarpet);
-constexpr std::size_t kMaxFileSize = std::size_t{1} << 32;  // 4 GiB: far beyond any carpet (a 1e6-row one is 360 MB)
+constexpr std::size_t kMaxFileSize = std::size_t{1}
+                                     << 32;  // 4 GiB: far beyond any carpet (a 1e6-row one is 360 MB)
 }  // namespace
 
 void SimStateFile::map(std::size_t bytes) {
   void* p = ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_SHARED, fd_, 0);
-  if (p == MAP_FAILED) throw std::runtime_error("cannot map sim state file " + path_ + ": " + std::strerror(errno));
+  if (p == MAP_FAILED)
+    throw std::runtime_error("cannot map sim state file " + path_ + ": " + std::strerror(errno));
   map_ = static_cast<PersistedMachine*>(p);
   carpet_ = reinterpret_cast<PersistedCarpet*>(static_cast<char*>(p) + kCarpetOffset);
   size_ = bytes;
@@ -39,8 +41,9 @@ PersistedCarpet& SimStateFile::reserve(std::size_t cells) {
   // Blocks allocated before the file is mapped longer (as at creation): a full disk is a refusal here, not a
   // SIGBUS in the tick. On failure the file and its mapping stay as they were.
   if (const int rc = ::posix_fallocate(fd_, 0, static_cast<off_t>(bytes)); rc != 0) {
-    throw std::runtime_error("cannot allocate sim state file " + path_ + " for a carpet of " + std::to_string(cells) +
-                             " knots (" + std::to_string(bytes) + " bytes): " + std::strerror(rc));
+    throw std::runtime_error("cannot allocate sim state file " + path_ + " for a carpet of " +
+                             std::to_string(cells) + " knots (" + std::to_string(bytes) +
+                             " bytes): " + std::strerror(rc));
   }
   ::munmap(map_, size_);
   map_ = nullptr;
@@ -90,15 +93,19 @@ SimStateFile::SimStateFile(const std::string& path) : path_(path) {
   if (st.st_size != 0) {
     const PersistedMachine& m = *map_;
     std::string why;
-    if (m.magic != PersistedMachine::kMagic) why = "not a loomctl sim-state file (no LOOMSIM2 magic); not touched";
+    if (m.magic != PersistedMachine::kMagic)
+      why = "not a loomctl sim-state file (no LOOMSIM2 magic); not touched";
     for (double x : m.added_axis_position) {
-      if (why.empty() && !(std::isfinite(x) && std::abs(x) <= kMaxAbsPosition)) why = "axis position " + std::to_string(x) + " is not plausible";
+      if (why.empty() && !(std::isfinite(x) && std::abs(x) <= kMaxAbsPosition))
+        why = "axis position " + std::to_string(x) + " is not plausible";
     }
     for (double x : m.axis_position) {
-      if (why.empty() && !(std::isfinite(x) && std::abs(x) <= kMaxAbsPosition)) why = "axis position " + std::to_string(x) + " is not plausible";
+      if (why.empty() && !(std::isfinite(x) && std::abs(x) <= kMaxAbsPosition))
+        why = "axis position " + std::to_string(x) + " is not plausible";
     }
     for (double x : m.piston) {
-      if (why.empty() && !(x >= 0.0 && x <= 1.0)) why = "piston stroke fraction " + std::to_string(x) + " is outside [0, 1]";
+      if (why.empty() && !(x >= 0.0 && x <= 1.0))
+        why = "piston stroke fraction " + std::to_string(x) + " is outside [0, 1]";
     }
     if (why.empty() && !(std::isfinite(m.shuttle_x) && std::abs(m.shuttle_x) <= 100.0)) {
       why = "shuttle position " + std::to_string(m.shuttle_x) + " m is not plausible";
@@ -123,6 +130,8 @@ bool SimStateFile::load(PersistedMachine& out) const {
   return true;
 }
 
-void SimStateFile::store(const PersistedMachine& s) noexcept { *map_ = s; }
+void SimStateFile::store(const PersistedMachine& s) noexcept {
+  *map_ = s;
+}
 
 }  // namespace loom::sim_hal

@@ -32,8 +32,9 @@ SimWorld::SimWorld(const SimMachine& machine, const SceneSpec& scene)
   }
   n_axes_ = m_.axis_count;
   silent_since_.fill(-1);
-  const bool latency = std::any_of(scene_.faults.begin(), scene_.faults.end(),
-                                   [](const FaultInjection& f) { return f.kind == InjectedFault::kCanLatency; });
+  const bool latency = std::any_of(scene_.faults.begin(), scene_.faults.end(), [](const FaultInjection& f) {
+    return f.kind == InjectedFault::kCanLatency;
+  });
   history_ticks_ = latency ? kHistory : 1;
   // Power-up: a homed axis' incremental encoder starts at an arbitrary count (drawn from the scene's
   // seed, so a run replays), an absolute one reads the machine position.
@@ -49,7 +50,8 @@ SimWorld::SimWorld(const SimMachine& machine, const SceneSpec& scene)
     const bool names_axis = f.kind == InjectedFault::kDriveFault || f.kind == InjectedFault::kHeartbeatLoss ||
                             f.kind == InjectedFault::kEmcy || f.kind == InjectedFault::kEncoderGlitch;
     if (names_axis && f.axis >= n_axes_) {
-      throw std::invalid_argument("fault on axis '" + f.axis_name + "': the simulated machine has no such axis");
+      throw std::invalid_argument("fault on axis '" + f.axis_name +
+                                  "': the simulated machine has no such axis");
     }
   }
   history_.resize(history_ticks_ * n_axes_);
@@ -78,19 +80,23 @@ SimWorld::SimWorld(const SimMachine& machine, const SceneSpec& scene)
           make_crank_inertia(m_, *scene_.inertia, friction ? &*scene_.joint_friction : nullptr));
     } else if (e == kEffectKnotter) {
       if (m_.knotting.heads < 1) {
-        throw std::invalid_argument("effect 'knotter' simulates the knotting heads: the loom has none (knotting.mode = \"heads\")");
+        throw std::invalid_argument(
+            "effect 'knotter' simulates the knotting heads: the loom has none (knotting.mode = \"heads\")");
       }
       if (!scene_.knotter) scene_.knotter = Knotter{};
       knotter_ = std::make_unique<SimKnotter>(m_.knotting, *scene_.knotter, m_.period_s);
     } else if (e == kEffectWarpTension) {
-      if (std::find(scene_.effects.begin(), scene_.effects.end(), kEffectBeatContact) == scene_.effects.end()) {
-        throw std::invalid_argument("effect 'warp_tension' scales the beat's force on the load cell: name 'beat_contact' too");
+      if (std::find(scene_.effects.begin(), scene_.effects.end(), kEffectBeatContact) ==
+          scene_.effects.end()) {
+        throw std::invalid_argument(
+            "effect 'warp_tension' scales the beat's force on the load cell: name 'beat_contact' too");
       }
       if (!scene_.warp_tension) scene_.warp_tension = WarpTension{};
       warp_tension_ = std::make_unique<WarpTensionModel>(*scene_.warp_tension, m_, scene_.seed);
     } else if (e == kEffectJointFriction) {
       if (std::find(scene_.effects.begin(), scene_.effects.end(), kEffectInertia) == scene_.effects.end()) {
-        throw std::invalid_argument("effect 'joint_friction' acts on the crank's dynamics: name 'inertia' too");
+        throw std::invalid_argument(
+            "effect 'joint_friction' acts on the crank's dynamics: name 'inertia' too");
       }
     } else {
       throw std::invalid_argument("unknown simulation effect '" + e + "'");
@@ -133,7 +139,8 @@ void SimWorld::attach_state_file(SimStateFile& file) {
   if (file.load(pm)) {
     hal::AxisFeedbacks axes{};
     for (std::size_t i = 0; i < pm.axis_position.size(); ++i) axes[i].position = pm.axis_position[i];
-    for (std::size_t i = 0; i < pm.added_axis_position.size(); ++i) axes[hal::kCoreAxisCount + i].position = pm.added_axis_position[i];
+    for (std::size_t i = 0; i < pm.added_axis_position.size(); ++i)
+      axes[hal::kCoreAxisCount + i].position = pm.added_axis_position[i];
     set_initial_state(axes, pm.piston);
     shuttle_x_ = pm.shuttle_x;
     // A shuttle cut mid-pick is still carrying its weft: its arrival at either selvedge locks the knots.
@@ -167,12 +174,16 @@ void SimWorld::apply_injected_faults(hal::Tick now) noexcept {
     const FaultInjection& f = scene_.faults[next_fault_++];
     const std::size_t ax = f.axis;  // checked in the constructor
     switch (f.kind) {
-      case InjectedFault::kEStop: estop_ok_ = false; break;
+      case InjectedFault::kEStop:
+        estop_ok_ = false;
+        break;
       case InjectedFault::kDriveFault:
         axes_[ax].state = hal::DriveState::kFault;
         axes_[ax].fault_code = f.code;
         break;
-      case InjectedFault::kStuckPiston: piston_stuck_[static_cast<std::size_t>(f.piston)] = true; break;
+      case InjectedFault::kStuckPiston:
+        piston_stuck_[static_cast<std::size_t>(f.piston)] = true;
+        break;
       case InjectedFault::kStuckSensor:
         stuck_sensor_[static_cast<std::size_t>(f.sensor)] = f.stuck_value;
         sensor_until_[static_cast<std::size_t>(f.sensor)] = std::numeric_limits<hal::Tick>::max();
@@ -190,21 +201,32 @@ void SimWorld::apply_injected_faults(hal::Tick now) noexcept {
                                   static_cast<hal::Tick>(history_ticks_ - 1));
         latency_until_ = ticks(f.duration_s);
         break;
-      case InjectedFault::kBusOff: bus_off_ = true; break;
-      case InjectedFault::kHeartbeatLoss: silent_since_[ax] = now; break;
-      case InjectedFault::kEmcy: axes_[ax].fault_code = f.code; break;  // still Operation Enabled
+      case InjectedFault::kBusOff:
+        bus_off_ = true;
+        break;
+      case InjectedFault::kHeartbeatLoss:
+        silent_since_[ax] = now;
+        break;
+      case InjectedFault::kEmcy:
+        axes_[ax].fault_code = f.code;
+        break;  // still Operation Enabled
       case InjectedFault::kEncoderGlitch:
         glitch_left_[ax] = std::max(1, f.ticks);
         glitch_jump_[ax] = f.jump;
         break;
-      case InjectedFault::kLoadCellFailure: load_cell_failed_ = f.load_cell; break;
-      case InjectedFault::kAirLoss: air_lost_ = true; break;
+      case InjectedFault::kLoadCellFailure:
+        load_cell_failed_ = f.load_cell;
+        break;
+      case InjectedFault::kAirLoss:
+        air_lost_ = true;
+        break;
       case InjectedFault::kLoopStall:
         stall_until_ = now + std::max(1, f.ticks);
         injected_overruns_ += static_cast<std::uint32_t>(std::max(1, f.ticks));
         break;
       case InjectedFault::kSelectorJam:
-        if (knotter_ && f.head >= 0 && f.head < m_.knotting.heads) jammed_[m_.knotting.selector_axis[static_cast<std::size_t>(f.head)]] = true;
+        if (knotter_ && f.head >= 0 && f.head < m_.knotting.heads)
+          jammed_[m_.knotting.selector_axis[static_cast<std::size_t>(f.head)]] = true;
         break;
       case InjectedFault::kYarnOut:
         if (knotter_) knotter_->yarn_out(f.head, f.slot);
@@ -219,7 +241,8 @@ void SimWorld::apply_injected_faults(hal::Tick now) noexcept {
   // Until a fault strikes, nothing below has anything to recover (the per-tick cost of an unfaulted scene).
   if (next_fault_ == 0) return;
   for (std::size_t i = 0; i < sensor_until_.size(); ++i) {
-    if (stuck_sensor_[i] && now >= sensor_until_[i]) stuck_sensor_[i].reset();  // an intermittent fault recovers
+    if (stuck_sensor_[i] && now >= sensor_until_[i])
+      stuck_sensor_[i].reset();  // an intermittent fault recovers
   }
   if (now >= frame_loss_until_) frame_loss_p_ = 0.0;
   if (now >= latency_until_) latency_ticks_ = 0;
@@ -236,7 +259,9 @@ inline hal::AxisFeedback feedback_of(const SimAxis& s, double jump, hal::Tick no
   fb.effort = 0.0;
   fb.fault = s.state == hal::DriveState::kFault;
   fb.fault_code = s.fault_code;
-  fb.fault_kind = fb.fault ? hal::FaultKind::kDrive : s.fault_code != 0 ? hal::FaultKind::kEmcy : hal::FaultKind::kNone;
+  fb.fault_kind = fb.fault            ? hal::FaultKind::kDrive
+                  : s.fault_code != 0 ? hal::FaultKind::kEmcy
+                                      : hal::FaultKind::kNone;
   fb.following_error = false;
   fb.referenced = s.referenced;
   fb.homing_error = false;
@@ -274,7 +299,8 @@ void SimWorld::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatu
   }
   // Latency: what arrives now was sampled `latency_ticks_` ago and carries that sample's tick.
   const hal::Tick delay = std::min<hal::Tick>(latency_ticks_, now);
-  const hal::AxisFeedback* arrived = &history_[static_cast<std::size_t>(now - delay) % history_ticks_ * n_axes_];
+  const hal::AxisFeedback* arrived =
+      &history_[static_cast<std::size_t>(now - delay) % history_ticks_ * n_axes_];
   for (std::size_t i = 0; i < n_axes_; ++i) {
     if (silent_since_[i] >= 0) {
       // A silent node sends nothing; its heartbeat consumer reports it after the heartbeat time.
@@ -321,7 +347,9 @@ void SimWorld::step_axis(std::size_t slot, const hal::AxisCommand& cmd) noexcept
     }
   } else {
     switch (cmd.request) {
-      case AxisRequest::kDisable: ax.state = DriveState::kSwitchOnDisabled; break;
+      case AxisRequest::kDisable:
+        ax.state = DriveState::kSwitchOnDisabled;
+        break;
       case AxisRequest::kEnable:
       case AxisRequest::kHome:
         if (ax.state != DriveState::kQuickStopActive) ax.state = DriveState::kOperationEnabled;
@@ -329,7 +357,8 @@ void SimWorld::step_axis(std::size_t slot, const hal::AxisCommand& cmd) noexcept
       case AxisRequest::kQuickStop:
         if (ax.state == DriveState::kOperationEnabled) ax.state = DriveState::kQuickStopActive;
         break;
-      case AxisRequest::kFaultReset: break;
+      case AxisRequest::kFaultReset:
+        break;
     }
   }
   // A homing run moves the axis by itself (the drive's mode 6) until its reference point; anything but
@@ -353,10 +382,18 @@ void SimWorld::step_homing(std::size_t slot) noexcept {
     const double pitch = ref.index_pitch;
     switch (ref.method) {
       case 19:  // switch active on the positive side: its edge, approached from either side
-      case 21: ax.homing_goal = home; break;
-      case 33: ax.homing_goal = home + std::floor((ax.position - home) / pitch) * pitch; break;
-      case 34: ax.homing_goal = home + std::ceil((ax.position - home) / pitch) * pitch; break;
-      default: ax.homing_goal = ax.position; break;  // 37: here
+      case 21:
+        ax.homing_goal = home;
+        break;
+      case 33:
+        ax.homing_goal = home + std::floor((ax.position - home) / pitch) * pitch;
+        break;
+      case 34:
+        ax.homing_goal = home + std::ceil((ax.position - home) / pitch) * pitch;
+        break;
+      default:
+        ax.homing_goal = ax.position;
+        break;  // 37: here
     }
     ax.homing = true;
   }
@@ -380,7 +417,8 @@ void SimWorld::write_axes(hal::Tick, const hal::AxisCommands& axes) {
   for (std::size_t i = 0; i < n_axes_; ++i) {
     SimAxis& ax = axes_[i];
     const hal::AxisCommand& cmd = axes[i];
-    if (ax.state == hal::DriveState::kOperationEnabled && cmd.request == hal::AxisRequest::kEnable && !jammed_[i]) {
+    if (ax.state == hal::DriveState::kOperationEnabled && cmd.request == hal::AxisRequest::kEnable &&
+        !jammed_[i]) {
       // The usual tick, here rather than through step_axis (its power-state and homing decisions cost
       // more than this): enabled, asked to stay so, following its target. The same steps as there.
       const double before = ax.position;
@@ -436,9 +474,11 @@ void SimWorld::step_beat_contact(double crank_position, double omega, const hal:
   const double a_t = m_.beatup.beater_arm_m * (s.d2 * omega * omega + s.d1 * alpha);
   beat_force_n_ = scene_.beat_contact->beater_mass_kg * std::abs(a_t);
   if (warp_tension_) {  // in contact only: a scene without the effect pays nothing here
-    const auto turn = static_cast<std::int64_t>(std::floor((crank_position - m_.crank_park_position_rad) / motion::kTwoPi));
+    const auto turn =
+        static_cast<std::int64_t>(std::floor((crank_position - m_.crank_park_position_rad) / motion::kTwoPi));
     const std::size_t c = hal::index(hal::CoreAxis::kCarriage);
-    beat_force_n_ *= warp_tension_->factor(turn, drives_simulated_ ? axes_[c].position + axes_[c].offset : fb[c].position);
+    beat_force_n_ *=
+        warp_tension_->factor(turn, drives_simulated_ ? axes_[c].position + axes_[c].offset : fb[c].position);
   }
 }
 
@@ -486,12 +526,18 @@ void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::Digit
   // HAL's fresh helix feedback, so this I/O node also works beside real (CAN) drives.
   // When this world also simulates the drives, the shuttle and the beater follow the true axes, not
   // what the (possibly delayed or glitched) feedback says.
-  const auto pos = [&](hal::CoreAxis a) { return drives_simulated_ ? axes_[hal::index(a)].position : axes[hal::index(a)].position; };
-  const auto vel = [&](hal::CoreAxis a) { return drives_simulated_ ? axes_[hal::index(a)].velocity : axes[hal::index(a)].velocity; };
+  const auto pos = [&](hal::CoreAxis a) {
+    return drives_simulated_ ? axes_[hal::index(a)].position : axes[hal::index(a)].position;
+  };
+  const auto vel = [&](hal::CoreAxis a) {
+    return drives_simulated_ ? axes_[hal::index(a)].velocity : axes[hal::index(a)].velocity;
+  };
   step_shuttle(pos(hal::CoreAxis::kHelix));
   if (knotter_) {
     // A weft locks the knots tied so far into their row: the shuttle arrived at the other selvedge.
-    const int side = shuttle_x_ <= m_.selvedge_sensor_window_m ? -1 : shuttle_x_ >= m_.width_m - m_.selvedge_sensor_window_m ? 1 : 0;
+    const int side = shuttle_x_ <= m_.selvedge_sensor_window_m                ? -1
+                     : shuttle_x_ >= m_.width_m - m_.selvedge_sensor_window_m ? 1
+                                                                              : 0;
     if (side != 0 && shuttle_side_ != 0 && side != shuttle_side_) knotter_->on_weft();
     if (side != 0) shuttle_side_ = side;
     std::array<double, hal::kMaxAxes> at{};
@@ -499,7 +545,8 @@ void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::Digit
     knotter_->inputs(at, io);
   }
   // The load cell rides the beater, which the crank drives: real (CAN) or simulated.
-  if (scene_.beat_contact) step_beat_contact(pos(hal::CoreAxis::kBeatCrank), vel(hal::CoreAxis::kBeatCrank), axes);
+  if (scene_.beat_contact)
+    step_beat_contact(pos(hal::CoreAxis::kBeatCrank), vel(hal::CoreAxis::kBeatCrank), axes);
   constexpr std::size_t n = hal::kSafetySensorCount;
   const std::array<bool, n> truth{piston_[0] >= 1.0,
                                   piston_[0] <= 0.0,
@@ -568,7 +615,8 @@ void SimWorld::write_io(hal::Tick, const hal::DigitalOutputs& io) {
     PersistedMachine pm;
     pm.magic = PersistedMachine::kMagic;
     for (std::size_t i = 0; i < pm.axis_position.size(); ++i) pm.axis_position[i] = axes_[i].position;
-    for (std::size_t i = hal::kCoreAxisCount; i < n_axes_; ++i) pm.added_axis_position[i - hal::kCoreAxisCount] = axes_[i].position;
+    for (std::size_t i = hal::kCoreAxisCount; i < n_axes_; ++i)
+      pm.added_axis_position[i - hal::kCoreAxisCount] = axes_[i].position;
     pm.piston = piston_;
     pm.shuttle_x = shuttle_x_;
     state_file_->store(pm);

@@ -9,7 +9,6 @@
 // drives within the 70 % budget and the controller drives 4 buses, so the table runs at --period-ms
 // (default 4 ms, where every head count fits); `--period-ms 2` gives the 1..6-head rows at 2 ms.
 #include <CLI/CLI.hpp>
-
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -30,7 +29,8 @@ struct Class {
   const char* name;
   double knots_per_dm;  // across and along (a square knot grid)
 };
-constexpr Class kClasses[] = {{"coarse", 20.0}, {"medium", 30.0}, {"fine", 40.0}, {"extra fine", 45.0}, {"extra extra fine", 60.0}};
+constexpr Class kClasses[] = {
+    {"coarse", 20.0}, {"medium", 30.0}, {"fine", 40.0}, {"extra fine", 45.0}, {"extra extra fine", 60.0}};
 
 struct RowTime {
   bool ok = false;
@@ -63,13 +63,15 @@ RowTime one_row(const std::string& dir, const Class& c, int heads, double period
   std::string cfg = "extends = \"default\"\n[can]\nbus_load_budget = " + std::to_string(bus_budget) +
                     "\n[timing]\nperiod_ms = " + std::to_string(period_ms) +
                     "\n[knotting]\nmode = \"heads\"\nknots_per_dm = " + std::to_string(c.knots_per_dm) +
-                    "\nrows_per_dm = " + std::to_string(c.knots_per_dm) + "\nheads = " + std::to_string(heads) +
-                    "\nhead_spacing_m = " + exact(spacing) + "\nslot_colours = [\"R\", \"I\", \"B\"]\n";
+                    "\nrows_per_dm = " + std::to_string(c.knots_per_dm) +
+                    "\nheads = " + std::to_string(heads) + "\nhead_spacing_m = " + exact(spacing) +
+                    "\nslot_colours = [\"R\", \"I\", \"B\"]\n";
   for (int h = 1; h <= heads; ++h) {
     const int bus = 1 + (h - 1) * 3 / heads;  // buses 1..3, the heads spread evenly
     for (const char* role : {"knotter", "selector"}) {
-      cfg += std::string("[axes.") + role + "_" + (h < 10 ? "0" : "") + std::to_string(h) + "]\nrole = \"" + role +
-             "\"\nbus = " + std::to_string(bus) + "\nnode = " + std::to_string((role[0] == 'k' ? 20 : 50) + h) +
+      cfg += std::string("[axes.") + role + "_" + (h < 10 ? "0" : "") + std::to_string(h) + "]\nrole = \"" +
+             role + "\"\nbus = " + std::to_string(bus) +
+             "\nnode = " + std::to_string((role[0] == 'k' ? 20 : 50) + h) +
              "\ncounts_per_rev = 4096\nmax_speed = " + (role[0] == 'k' ? "60.0" : "20.0") +
              "\nferror_min = 0.2\nreferencing = \"absolute\"\n";
     }
@@ -79,8 +81,8 @@ RowTime one_row(const std::string& dir, const Class& c, int heads, double period
   RowTime t;
   try {
     const firmware::LoomConfig lc = firmware::load_loom_config(dir + "/loom.toml");
-    const firmware::Scene scene =
-        firmware::parse_scene("name = \"bench\"\nseed = 1\neffects = [\"ideal\", \"knotter\"]\n", "bench.toml");
+    const firmware::Scene scene = firmware::parse_scene(
+        "name = \"bench\"\nseed = 1\neffects = [\"ideal\", \"knotter\"]\n", "bench.toml");
     firmware::MachineOptions opt;
     opt.telemetry = false;
     opt.rows = 1;
@@ -112,12 +114,15 @@ int main(int argc, char** argv) {
   bool smoke = false;
   std::vector<int> heads{1, 2, 4, 8, 12};
   app.add_option("--period-ms", period_ms, "control period (ms)")->check(CLI::Range(1.0, 10.0));
-  app.add_option("--bus-budget", bus_budget, "CAN bus-load budget the configurations are checked against")->check(CLI::Range(0.05, 1.0));
+  app.add_option("--bus-budget", bus_budget, "CAN bus-load budget the configurations are checked against")
+      ->check(CLI::Range(0.05, 1.0));
   app.add_option("--heads", heads, "head counts (columns)")->check(CLI::Range(1, 12));
-  app.add_flag("--smoke", smoke, "one configuration only (the medium class, 6 heads): proves the harness runs");
+  app.add_flag("--smoke", smoke,
+               "one configuration only (the medium class, 6 heads): proves the harness runs");
   CLI11_PARSE(app, argc, argv);
   if (smoke) heads = {6};
-  const std::string dir = std::filesystem::temp_directory_path() / ("loom_knot_bench_" + std::to_string(::getpid()));
+  const std::string dir =
+      std::filesystem::temp_directory_path() / ("loom_knot_bench_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   std::printf("| class (knots/dm²) | knots/row |");
   for (int h : heads) std::printf(" %d head%s |", h, h == 1 ? "" : "s");
@@ -129,7 +134,8 @@ int main(int argc, char** argv) {
     if (smoke && std::string(c.name) != "medium") continue;
     sequencer::KnottingSpec k;
     k.knots_per_dm = c.knots_per_dm;
-    std::printf("| %s (%.0f) | %d |", c.name, c.knots_per_dm * c.knots_per_dm, sequencer::knots_per_row(k, 1.2));
+    std::printf("| %s (%.0f) | %d |", c.name, c.knots_per_dm * c.knots_per_dm,
+                sequencer::knots_per_row(k, 1.2));
     for (int h : heads) {
       const RowTime t = one_row(dir, c, h, period_ms, bus_budget);
       if (!t.ok) {
@@ -142,9 +148,10 @@ int main(int argc, char** argv) {
     std::printf("\n");
     std::fflush(stdout);
   }
-  std::printf("\nwhole row = knotting + shed + pick + beat, machine time at a %.3g ms period; (Nx) = ~600 s for the "
-              "weaver's whole row / the loom's\n",
-              period_ms);
+  std::printf(
+      "\nwhole row = knotting + shed + pick + beat, machine time at a %.3g ms period; (Nx) = ~600 s for the "
+      "weaver's whole row / the loom's\n",
+      period_ms);
   std::filesystem::remove_all(dir);
   return status;
 }

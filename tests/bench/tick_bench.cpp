@@ -50,7 +50,9 @@ firmware::Scene scene_with(const std::vector<std::string>& effects) {
   return s;  // parameter blocks default when an effect is named without one
 }
 
-void BM_Tick(benchmark::State& state, std::vector<std::string> effects) { run_ticks(state, scene_with(effects)); }
+void BM_Tick(benchmark::State& state, std::vector<std::string> effects) {
+  run_ticks(state, scene_with(effects));
+}
 
 void BM_RockerExactSolve(benchmark::State& state) {
   const motion::BeatUp b(motion::default_beatup_geometry());
@@ -86,8 +88,12 @@ void BM_RockerTable(benchmark::State& state) {
 // ---------------------------------------------------------------------------------------------------
 // The loop's own clock: the same clock_nanosleep to absolute deadlines the runner sleeps with.
 firmware::MonotonicClock g_clock;
-std::int64_t now_ns() { return g_clock.now_ns(); }
-void sleep_until_ns(std::int64_t deadline) { g_clock.sleep_until(deadline); }
+std::int64_t now_ns() {
+  return g_clock.now_ns();
+}
+void sleep_until_ns(std::int64_t deadline) {
+  g_clock.sleep_until(deadline);
+}
 
 void spin_until_ns(std::int64_t deadline) {
   while (now_ns() < deadline) {
@@ -106,7 +112,8 @@ void report_percentiles(benchmark::State& state, std::vector<std::int64_t>& ns) 
   if (ns.empty()) return;
   std::sort(ns.begin(), ns.end());
   const auto at = [&](double q) {
-    return static_cast<double>(ns[std::min(ns.size() - 1, static_cast<std::size_t>(q * static_cast<double>(ns.size())))]);
+    return static_cast<double>(
+        ns[std::min(ns.size() - 1, static_cast<std::size_t>(q * static_cast<double>(ns.size())))]);
   };
   state.counters["p50_ns"] = at(0.5);
   state.counters["p99.9_ns"] = at(0.999);
@@ -180,10 +187,16 @@ BENCHMARK_CAPTURE(BM_Tick, sensor_noise, std::vector<std::string>{"ideal", "sens
 BENCHMARK_CAPTURE(BM_Tick, beat_contact, std::vector<std::string>{"ideal", "beat_contact"});
 BENCHMARK_CAPTURE(BM_Tick, inertia, std::vector<std::string>{"inertia"});
 BENCHMARK_CAPTURE(BM_Tick, inertia_friction, std::vector<std::string>{"inertia", "joint_friction"});
-BENCHMARK_CAPTURE(BM_Tick, all, std::vector<std::string>{"servo_lag", "pneumatics", "shuttle_slip", "sensor_noise",
-                                                         "beat_contact", "inertia", "joint_friction"});
+BENCHMARK_CAPTURE(BM_Tick, all,
+                  std::vector<std::string>{"servo_lag", "pneumatics", "shuttle_slip", "sensor_noise",
+                                           "beat_contact", "inertia", "joint_friction"});
 BENCHMARK(BM_RockerExactSolve);
 BENCHMARK(BM_RockerTable)->RangeMultiplier(4)->Range(64, 65536);
 BENCHMARK(BM_TickAfterSleep)->Arg(0)->Arg(50)->UseManualTime()->Iterations(sleep_iterations());
-BENCHMARK(BM_CacheLinesAfterSleep)->Arg(0)->Arg(64)->Arg(256)->UseManualTime()->Iterations(sleep_iterations());
+BENCHMARK(BM_CacheLinesAfterSleep)
+    ->Arg(0)
+    ->Arg(64)
+    ->Arg(256)
+    ->UseManualTime()
+    ->Iterations(sleep_iterations());
 BENCHMARK_MAIN();

@@ -15,7 +15,6 @@
 // --digest adds a hash of what every tick read, commanded and published (the values, field by field):
 // an optimisation that keeps behaviour identical keeps the digest of every scene.
 #include <CLI/CLI.hpp>
-
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -24,8 +23,8 @@
 #include <thread>
 
 #include "loom/config/config.hpp"
-#include "loom/firmware/machine.hpp"
 #include "loom/config/scene_config.hpp"
+#include "loom/firmware/machine.hpp"
 #include "loom/hal/types.hpp"
 #include "loom/sequencer/sequencer.hpp"
 
@@ -75,9 +74,11 @@ void digest_tick(Digest& d, const firmware::ControlLoop& loop, std::size_t n_axe
   d.add(io.piston_a_extended), d.add(io.piston_a_retracted), d.add(io.piston_b_extended);
   d.add(io.piston_b_retracted), d.add(io.shuttle_at_left), d.add(io.shuttle_at_right), d.add(io.estop_ok);
   for (bool b : io.second_channel) d.add(b);
-  d.add(io.refreshed), d.add(in.analog.beat_force_n), d.add(in.analog.beat_force_valid), d.add(in.analog.refreshed);
+  d.add(io.refreshed), d.add(in.analog.beat_force_n), d.add(in.analog.beat_force_valid),
+      d.add(in.analog.refreshed);
   d.add(in.link.link_fault), d.add(in.link.link_fault_code), d.add(in.link.recovery);
-  d.add(out.io.piston_a_extend), d.add(out.io.piston_b_extend), d.add(out.io.lamp_green), d.add(out.io.lamp_amber);
+  d.add(out.io.piston_a_extend), d.add(out.io.piston_b_extend), d.add(out.io.lamp_green),
+      d.add(out.io.lamp_amber);
   d.add(out.io.lamp_red), d.add(out.io.buzzer);
   if (!telemetry) return;
   const telemetry::Snapshot& s = loop.snapshot();
@@ -90,31 +91,37 @@ void digest_tick(Digest& d, const firmware::ControlLoop& loop, std::size_t n_axe
   d.add(s.beater_angle_rad), d.add(s.beat_force_n), d.add(s.axis_count), d.add(s.inputs), d.add(s.inputs_2);
   d.add(s.outputs), d.add(s.fault_axis), d.add(s.fault_tick);
   for (std::size_t i = 0; i < n_axes; ++i) {
-    d.add(s.axes[i].position), d.add(s.axes[i].target), d.add(s.axes[i].following_error), d.add(s.axes[i].request);
+    d.add(s.axes[i].position), d.add(s.axes[i].target), d.add(s.axes[i].following_error),
+        d.add(s.axes[i].request);
   }
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Runs the control loop for a fixed number of ticks; run it under callgrind with "
-               "--collect-atstart=no --toggle-collect=measured_tick (tests/bench/tick_instructions.sh)"};
+  CLI::App app{
+      "Runs the control loop for a fixed number of ticks; run it under callgrind with "
+      "--collect-atstart=no --toggle-collect=measured_tick (tests/bench/tick_instructions.sh)"};
   std::string config_path, scene_path, lcm_url = "memq://";
   bool telemetry = false, digest = false;
   long long warmup = 4000, ticks = 4000;
   app.add_option("--config", config_path, "loom config file (default: the embedded default loom)");
   app.add_option("--scene", scene_path, "scene file (default: the embedded default scene)");
   app.add_flag("--telemetry", telemetry, "publish telemetry (lossless, as in virtual time)");
-  app.add_flag("--digest", digest, "print a hash of every tick's inputs, outputs and snapshot (not for callgrind)");
+  app.add_flag("--digest", digest,
+               "print a hash of every tick's inputs, outputs and snapshot (not for callgrind)");
   app.add_option("--lcm-url", lcm_url, "LCM URL for --telemetry")->capture_default_str();
-  app.add_option("--warmup", warmup, "ticks woven before measuring")->capture_default_str()->check(CLI::NonNegativeNumber);
+  app.add_option("--warmup", warmup, "ticks woven before measuring")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--ticks", ticks, "ticks measured")->capture_default_str()->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
   try {
     firmware::LoomConfig cfg =
         config_path.empty() ? firmware::default_loom_config() : firmware::load_loom_config(config_path);
     cfg.telemetry.lcm_url = lcm_url;
-    const firmware::Scene scene = scene_path.empty() ? firmware::default_scene() : firmware::load_scene(scene_path);
+    const firmware::Scene scene =
+        scene_path.empty() ? firmware::default_scene() : firmware::load_scene(scene_path);
     firmware::MachineOptions opt;
     opt.telemetry = telemetry;
     opt.lossless_telemetry = true;

@@ -1,5 +1,6 @@
-// Bus-load arithmetic against the published table (classic CAN, worst-case stuffing per Davis et al. 2007), and the worst-case
-// stuffing formula checked as a true upper bound by stuffing real frames bit by bit (CRC-15 included).
+// Bus-load arithmetic against the published table (classic CAN, worst-case stuffing per Davis et al. 2007),
+// and the worst-case stuffing formula checked as a true upper bound by stuffing real frames bit by bit
+// (CRC-15 included).
 #include <gtest/gtest.h>
 
 #include <random>

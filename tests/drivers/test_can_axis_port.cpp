@@ -4,10 +4,9 @@
 // configuration errors that name the node, the object and the step.
 #include <gtest/gtest.h>
 
-#include <span>
-
 #include <cmath>
 #include <numbers>
+#include <span>
 
 #include "drive_rig.hpp"
 #include "loom/drivers/cob_id.hpp"
@@ -97,7 +96,7 @@ TEST(CanAxisPort, OnlyTheMappedPdosFlowAtFourFramesOutPerTick) {
       ++other_pdo;  // the drives' factory TPDO2 must have been switched off
     }
   }
-  EXPECT_EQ(from_master, 20 * 4);  // SYNC + 3 RPDO
+  EXPECT_EQ(from_master, 20 * 4);   // SYNC + 3 RPDO
   EXPECT_EQ(master_heartbeats, 1);  // every 100 ms = 50 ticks
   EXPECT_EQ(tpdo1, 20 * 3);
   EXPECT_EQ(other_pdo, 0);
@@ -310,7 +309,8 @@ TEST(CanAxisPort, UnconfirmedTransitionTimesOutIntoAFault) {
   EXPECT_EQ(more, 2);
   EXPECT_TRUE(helix.fault);
   EXPECT_EQ(helix.fault_code, drivers::fault_code::kStateTimeout);
-  EXPECT_EQ(rig.port.last_controlword(hal::index(hal::CoreAxis::kHelix)), drivers::controlword::kDisableVoltage);
+  EXPECT_EQ(rig.port.last_controlword(hal::index(hal::CoreAxis::kHelix)),
+            drivers::controlword::kDisableVoltage);
   EXPECT_TRUE(rig.feedback[0].state == DriveState::kOperationEnabled);
 
   // The bus heals; a fault-reset request clears the latch and the axis enables.
@@ -337,9 +337,10 @@ TEST(CanAxisPort, BusOffLatchesALinkFaultAndCountsDroppedFrames) {
   EXPECT_EQ(rig.link.recovery, hal::LinkRecovery::kBusOff);  // an acknowledgement cannot help yet
   rig.net.restart();
   for (int i = 0; i < 5; ++i) rig.tick(DriveRig::hold(kEnable));
-  EXPECT_TRUE(rig.link.link_fault);  // latched until configure()
+  EXPECT_TRUE(rig.link.link_fault);                         // latched until configure()
   EXPECT_EQ(rig.link.recovery, hal::LinkRecovery::kReady);  // the controller is back: re-arming can work
-  EXPECT_EQ(rig.port.last_controlword(hal::index(hal::CoreAxis::kBeatCrank)), drivers::controlword::kQuickStop);
+  EXPECT_EQ(rig.port.last_controlword(hal::index(hal::CoreAxis::kBeatCrank)),
+            drivers::controlword::kQuickStop);
 }
 
 TEST(CanAxisPort, FullTransmitQueueDropsAndCountsWithoutFault) {
@@ -414,7 +415,7 @@ TEST(CanAxisPort, VelocityFromTpdo2OrFromFiniteDifferences) {
     // One count per cycle of quantisation in the per-cycle difference.
     const double tol = 1.0 / (cfg.axes[2].counts_per_unit * dt);
     EXPECT_NEAR(rig.feedback[2].velocity, v, tol) << "tpdo2=" << tpdo2;
-    EXPECT_EQ(rig.feedback[2].effort, 0.0);  // the ideal drive needs no torque
+    EXPECT_EQ(rig.feedback[2].effort, 0.0);                   // the ideal drive needs no torque
     EXPECT_EQ(rig.port.bus_load().frames, tpdo2 ? 11u : 8u);  // incl. the master heartbeat
   }
 }

@@ -42,7 +42,8 @@ int last_dlc(const test::FakeCanNetwork& net, std::uint32_t id) {
 
 // Servo drives + the I/O node on one endpoint, the master's two ports on the other.
 struct IoRig {
-  explicit IoRig(sim_can::SimIoConfig io_cfg = {}, std::vector<sim_can::SimDriveConfig> drives = three_drives(),
+  explicit IoRig(sim_can::SimIoConfig io_cfg = {},
+                 std::vector<sim_can::SimDriveConfig> drives = three_drives(),
                  drivers::CanAxisPortConfig axis_cfg = {}, CanIoConfig port_cfg = {})
       : rig(std::move(drives), with_io_frames(axis_cfg, port_cfg)), io(rig.drives, io_cfg), port(port_cfg) {
     rig.rack.attach_io(io, {0, 2, drivers::kDefaultCountsPerRad, drivers::kDefaultCountsPerRad});
@@ -129,7 +130,8 @@ TEST(IoWiring, DuplicateBitBetweenAFirstAndASecondChannelNamesBoth) {
   }
   IoWiring w;
   w.second[5].bit = 11;  // the knotting pedal's input
-  EXPECT_EQ(drivers::validate(w).message(), "io.inputs.shuttle_at_right_2.bit = 11 is already used by io.inputs.row_knotted");
+  EXPECT_EQ(drivers::validate(w).message(),
+            "io.inputs.shuttle_at_right_2.bit = 11 is already used by io.inputs.row_knotted");
   IoWiring twice;
   twice.second[1].bit = 20;  // two second channels on one input
   EXPECT_EQ(drivers::validate(twice).message(),
@@ -141,7 +143,8 @@ TEST(IoWiring, InputBitsReach63AndSecondChannelsAreOptional) {
   w.second[0].bit = 63;
   EXPECT_TRUE(drivers::validate(w));
   w.second[0].bit = 64;
-  EXPECT_EQ(drivers::validate(w).message(), "io.inputs.piston_a_extended_2.bit = 64 is outside 0..63 (-1 = not wired)");
+  EXPECT_EQ(drivers::validate(w).message(),
+            "io.inputs.piston_a_extended_2.bit = 64 is outside 0..63 (-1 = not wired)");
   EXPECT_TRUE(drivers::validate(single_channel()));
 }
 
@@ -160,10 +163,12 @@ TEST(IoWiring, EveryHeadUsedIsWiredAndNamedByItsNumber) {
   EXPECT_TRUE(drivers::validate(two_heads()));
   IoWiring unwired = two_heads();
   unwired.cutter[1].bit = -1;
-  EXPECT_EQ(drivers::validate(unwired).message(), "io.outputs.cutter.head2.bit = -1: this signal must be wired");
+  EXPECT_EQ(drivers::validate(unwired).message(),
+            "io.outputs.cutter.head2.bit = -1: this signal must be wired");
   IoWiring clash = two_heads();
   clash.gripper_close[1].bit = 5;  // the amber lamp's output
-  EXPECT_EQ(drivers::validate(clash).message(), "io.outputs.gripper_close.head2.bit = 5 is already used by io.outputs.lamp_amber");
+  EXPECT_EQ(drivers::validate(clash).message(),
+            "io.outputs.gripper_close.head2.bit = 5 is already used by io.outputs.lamp_amber");
   IoWiring input_clash = two_heads();
   input_clash.yarn_present[0].bit = 11;  // the weaver's pedal
   EXPECT_EQ(drivers::validate(input_clash).message(),
@@ -177,7 +182,6 @@ TEST(IoWiring, EveryHeadUsedIsWiredAndNamedByItsNumber) {
   too_many.heads = 13;
   EXPECT_EQ(drivers::validate(too_many).message(), "io: 13 knotting heads wired; at most 12");
 }
-
 
 TEST(IoWiring, FramesPerCycle) {
   IoWiring w;
@@ -210,19 +214,23 @@ TEST(IoWiring, HeadsWidenTheFramesAndTheObjectsAModuleMustHave) {
   const auto g = drivers::io_frames_per_cycle(w);
   EXPECT_EQ(g[0].data_bytes, 3u);  // outputs up to the cutters on 20, 21: 0x6200:01..03
   EXPECT_EQ(g[1].data_bytes, 4u);  // inputs up to yarn-present on 24, 25: 0x6000:01..04
-  EXPECT_EQ(required_line(drivers::io_module_objects(w), 0x6000),
-            "0x6000:01..04 read digital inputs, 8-bit: sensors and their second channels, e-stop chain, buttons, "
-            "the heads' yarn-present switches");
+  EXPECT_EQ(
+      required_line(drivers::io_module_objects(w), 0x6000),
+      "0x6000:01..04 read digital inputs, 8-bit: sensors and their second channels, e-stop chain, buttons, "
+      "the heads' yarn-present switches");
   EXPECT_EQ(required_line(drivers::io_module_objects(w), 0x6200),
-            "0x6200:01..03 write digital outputs, 8-bit: valves, stack light, buzzer, the heads' grippers and cutters");
+            "0x6200:01..03 write digital outputs, 8-bit: valves, stack light, buzzer, the heads' grippers "
+            "and cutters");
 }
 
 TEST(IoWiring, RequiredObjectsCountTheInputGroupsTheWiringUses) {
-  EXPECT_EQ(required_line(drivers::io_module_objects(IoWiring{}), 0x6000),
-            "0x6000:01..03 read digital inputs, 8-bit: sensors and their second channels, e-stop chain, buttons");
+  EXPECT_EQ(
+      required_line(drivers::io_module_objects(IoWiring{}), 0x6000),
+      "0x6000:01..03 read digital inputs, 8-bit: sensors and their second channels, e-stop chain, buttons");
   EXPECT_EQ(required_line(drivers::io_module_objects(IoWiring{}), 0x6200),
             "0x6200:01 write digital outputs, 8-bit: valves, stack light, buzzer");
-  EXPECT_TRUE(contains(required_line(drivers::io_module_objects(single_channel()), 0x6000), "0x6000:01..02 "));
+  EXPECT_TRUE(
+      contains(required_line(drivers::io_module_objects(single_channel()), 0x6000), "0x6000:01..02 "));
   IoWiring high;
   high.second[5].bit = 30;
   EXPECT_TRUE(contains(required_line(drivers::io_module_objects(high), 0x6000), "0x6000:01..04 "));
@@ -321,7 +329,7 @@ TEST(CanIoPort, KnottingHeadsSignalsTravelBothWaysAndFailSafe) {
   k.carriage_home_m = -0.005;  // the carriage drive at 0 stands over the middle of knot 0's pitch
   k.knotter_axis = {3, 5};
   k.selector_axis = {4, 6};
-  k.in_warp_from_rad = -1.0;   // the knotting servo at 0 is both at TAKE and in the warp: a plant test only
+  k.in_warp_from_rad = -1.0;  // the knotting servo at 0 is both at TAKE and in the warp: a plant test only
   k.in_warp_to_rad = 1.0;
   k.full_turn = false;
   CanIoConfig port_cfg;
@@ -329,8 +337,11 @@ TEST(CanIoPort, KnottingHeadsSignalsTravelBothWaysAndFailSafe) {
   IoRig r(io_cfg, three_drives(), {}, port_cfg);
   // The three drives stand for the carriage (slot 1), head 1's knotting servo (slot 3) and selector (slot 4);
   // head 2's servos read 0 as well (unmapped slots).
-  sim_can::SimDriveRack::IoPlantSource src{0, 2, drivers::kDefaultCountsPerRad, drivers::kDefaultCountsPerRad, {}};
-  src.axes = {{1, 1, drivers::kDefaultCountsPerM}, {0, 3, drivers::kDefaultCountsPerRad}, {2, 4, drivers::kDefaultCountsPerRad}};
+  sim_can::SimDriveRack::IoPlantSource src{
+      0, 2, drivers::kDefaultCountsPerRad, drivers::kDefaultCountsPerRad, {}};
+  src.axes = {{1, 1, drivers::kDefaultCountsPerM},
+              {0, 3, drivers::kDefaultCountsPerRad},
+              {2, 4, drivers::kDefaultCountsPerRad}};
   r.rig.rack.attach_io(r.io, src);
   const drivers::Status s = r.configure();
   ASSERT_TRUE(s) << s.message();
@@ -457,7 +468,7 @@ TEST(CanIoPort, RemoteRequestsOnItsTpdosAreNotSamples) {
   ASSERT_TRUE(r.in.io.estop_ok);
   ASSERT_TRUE(r.in.io.piston_a_retracted);
   ASSERT_TRUE(r.in.analog.beat_force_valid);
-  r.rig.rack.io_controls().silent = true;  // only the requests below on 0x184/0x284
+  r.rig.rack.io_controls().silent = true;                    // only the requests below on 0x184/0x284
   for (int i = 0; i < 2; ++i) r.tick(AxisRequest::kEnable);  // the TPDOs in flight arrive
   const hal::DigitalInputs io = r.in.io;
   const hal::AnalogInputs analog = r.in.analog;
@@ -489,8 +500,9 @@ TEST(CanIoPort, LoadCellScaledByTheWiringAndShuttleFollowsTheHelix) {
   ic.load_cell_n_per_count = 0.01;  // the module's: the master sees twice the force plus 1 N
   ic.beat_peak_n = 90.0;
   ic.fell_crank_rad = 0.0;  // crank at 0 rad = at the fell
-  IoRig r(ic, three_drives(0, 0, static_cast<std::int32_t>(11.97 * 2 * 3.14159265358979 *
-                                                            drivers::kDefaultCountsPerRad)),
+  IoRig r(ic,
+          three_drives(
+              0, 0, static_cast<std::int32_t>(11.97 * 2 * 3.14159265358979 * drivers::kDefaultCountsPerRad)),
           {}, pc);
   ASSERT_TRUE(r.configure());
   r.enable_all();
@@ -537,7 +549,8 @@ TEST(Interop, IoModuleWithFixedMappingLackingTheLoadCellIsRefused) {
   IoRig r(ic, three_drives(), {}, pc);
   const drivers::Status s = r.configure();
   ASSERT_FALSE(s);
-  EXPECT_TRUE(contains(s.message(), "node 4 (I/O node): no PDO carries 0x6401:02 (load cell)")) << s.message();
+  EXPECT_TRUE(contains(s.message(), "node 4 (I/O node): no PDO carries 0x6401:02 (load cell)"))
+      << s.message();
 }
 
 // A 16-input module with a fixed TPDO1 {0x6000:01, 0x6000:02}: the default wiring's second channels
@@ -554,7 +567,8 @@ TEST(Interop, IoModuleWithFixedMappingLackingTheSecondChannelsIsRefusedNamingThe
   const drivers::Status s = r.configure();
   ASSERT_FALSE(s);
   EXPECT_EQ(s.message(),
-            "node 4 (I/O node): no PDO carries 0x6000:03 (digital inputs, needed by io.shuttle_at_right_2_bit = 21); "
+            "node 4 (I/O node): no PDO carries 0x6000:03 (digital inputs, needed by "
+            "io.shuttle_at_right_2_bit = 21); "
             "the module's mapping (fixed or refused) lacks it");
 }
 
@@ -577,9 +591,10 @@ TEST(Interop, IoModuleWithSixteenInputsRefusingTheThirdGroupIsExplainedByTheSign
   ASSERT_FALSE(s);
   EXPECT_TRUE(contains(s.message(), "node 4 (I/O node): SDO write 0x1A00:03")) << s.message();
   EXPECT_TRUE(contains(s.message(), "0x06040041")) << s.message();
-  EXPECT_TRUE(contains(s.message(), "; 0x6000:03 is mapped because the wiring reads 0x6000:01..03 up to "
-                                    "io.shuttle_at_right_2_bit = 21 (a module with fewer digital inputs needs "
-                                    "that signal moved or unwired, -1)"))
+  EXPECT_TRUE(contains(s.message(),
+                       "; 0x6000:03 is mapped because the wiring reads 0x6000:01..03 up to "
+                       "io.shuttle_at_right_2_bit = 21 (a module with fewer digital inputs needs "
+                       "that signal moved or unwired, -1)"))
       << s.message();
   // The same module serves single-channel sensing.
   CanIoConfig pc;
@@ -598,9 +613,10 @@ TEST(Interop, IoModuleWithInputsSplitOverTwoTpdosIsRefused) {
   IoRig r(ic);
   const drivers::Status s = r.configure();
   ASSERT_FALSE(s);
-  EXPECT_EQ(s.message(),
-            "node 4 (I/O node): 0x6000:03 (digital inputs, needed by io.shuttle_at_right_2_bit = 21) is in TPDO2, "
-            "0x6000:01 in TPDO1; the master needs every digital input in one TPDO (one sample per cycle)");
+  EXPECT_EQ(
+      s.message(),
+      "node 4 (I/O node): 0x6000:03 (digital inputs, needed by io.shuttle_at_right_2_bit = 21) is in TPDO2, "
+      "0x6000:01 in TPDO1; the master needs every digital input in one TPDO (one sample per cycle)");
 }
 
 // Rule 2: "object does not exist" while disabling an unused PDO is not an error.
@@ -639,7 +655,7 @@ std::vector<sim_can::SimDriveConfig> fixed_drives(std::int64_t boot_us, std::int
 
 TEST(Interop, FixedPersonalityDriveIsAcceptedWithNotes) {
   drivers::CanAxisPortConfig ac;
-  ac.tpdo2 = true;  // its fixed TPDO2 carries velocity + torque: used
+  ac.tpdo2 = true;                  // its fixed TPDO2 carries velocity + torque: used
   ac.operational_timeout_s = 0.25;  // the per-node windows below are what let the slow drives in
   ac.axes[0].operational_timeout_s = 0.6;
   ac.axes[1].operational_timeout_s = 0.6;
@@ -650,7 +666,7 @@ TEST(Interop, FixedPersonalityDriveIsAcceptedWithNotes) {
   const auto& notes = r.rig.port.notes();
   EXPECT_TRUE(any_note(notes, "node 1 (beat_crank): 0x1016 (consumer heartbeat time) absent"));
   EXPECT_TRUE(any_note(notes, "0x1600:00 (RPDO1 mapping) is fixed (read-only); read back and accepted") ||
-              any_note(notes, "0x1600:00") );
+              any_note(notes, "0x1600:00"));
   EXPECT_TRUE(r.rig.port.has_tpdo2(hal::index(hal::CoreAxis::kCarriage)));
   EXPECT_FALSE(r.rig.port.has_consumer(hal::index(hal::CoreAxis::kCarriage)));
   r.enable_all();
@@ -663,7 +679,8 @@ TEST(Interop, SlowOperationalSwitchNeedsItsPerNodeWindow) {
   IoRig r({}, fixed_drives(0, 400'000), ac);
   const drivers::Status s = r.configure();
   ASSERT_FALSE(s);
-  EXPECT_TRUE(contains(s.message(), "node 1 (beat_crank): no operational heartbeat after NMT start within 0.25 s"))
+  EXPECT_TRUE(
+      contains(s.message(), "node 1 (beat_crank): no operational heartbeat after NMT start within 0.25 s"))
       << s.message();
 }
 
@@ -693,7 +710,8 @@ TEST(FaultReaction, EmcyFromAnEnabledDriveQuickStopsEveryAxisInTheSameTick) {
   EXPECT_TRUE(r.in.axes[1].fault);
   EXPECT_EQ(r.in.axes[1].fault_code, 0x2310);
   for (hal::CoreAxis a : {hal::CoreAxis::kBeatCrank, hal::CoreAxis::kCarriage, hal::CoreAxis::kHelix}) {
-    EXPECT_EQ(r.rig.port.last_controlword(hal::index(a)), drivers::controlword::kQuickStop) << hal::axis_name(a);
+    EXPECT_EQ(r.rig.port.last_controlword(hal::index(a)), drivers::controlword::kQuickStop)
+        << hal::axis_name(a);
   }
 }
 
@@ -736,12 +754,14 @@ TEST(FaultReaction, SilentIoNodeIsLostWithinItsConsumerTimeAndStopsEveryAxis) {
   // The last heartbeat came up to one producer period (100 ms) before the cut; consumer 250 ms.
   EXPECT_LE(static_cast<double>(r.rig.tick_index - cut) * 0.002, 0.250 + 0.004);
   EXPECT_LE(r.in.io.refreshed, cut + 1);  // stale inputs keep their old tick (one frame was in flight)
-  EXPECT_EQ(r.rig.port.last_controlword(hal::index(hal::CoreAxis::kCarriage)), drivers::controlword::kQuickStop);
+  EXPECT_EQ(r.rig.port.last_controlword(hal::index(hal::CoreAxis::kCarriage)),
+            drivers::controlword::kQuickStop);
   // Until it is heard again, acknowledging cannot re-arm: the link names the silent node.
   EXPECT_EQ(r.in.link.recovery, hal::LinkRecovery::kNodeSilent);
   EXPECT_EQ(r.in.link.silent_node, 4);
   r.rig.rack.io_controls().silent = false;  // the cable is back: its heartbeats resume
-  for (int i = 0; i < 100 && r.in.link.recovery != hal::LinkRecovery::kReady; ++i) r.tick(AxisRequest::kEnable);
+  for (int i = 0; i < 100 && r.in.link.recovery != hal::LinkRecovery::kReady; ++i)
+    r.tick(AxisRequest::kEnable);
   EXPECT_EQ(r.in.link.recovery, hal::LinkRecovery::kReady);
   EXPECT_TRUE(r.in.link.link_fault);  // still latched: only re-arming (configure) clears it
 }
@@ -814,7 +834,8 @@ TEST(FaultReaction, FollowingErrorScalesWithCommandedSpeedAndKeepsAHighWaterMark
   EXPECT_EQ(r.in.axes[2].fault_code, drivers::fault_code::kFollowingError);
   EXPECT_GE(n, 4);
   EXPECT_LE(n, 8);
-  EXPECT_EQ(r.rig.port.last_controlword(hal::index(hal::CoreAxis::kBeatCrank)), drivers::controlword::kQuickStop);
+  EXPECT_EQ(r.rig.port.last_controlword(hal::index(hal::CoreAxis::kBeatCrank)),
+            drivers::controlword::kQuickStop);
   EXPECT_GT(r.rig.port.ferror_high_water(hal::index(hal::CoreAxis::kHelix)), 0.99);
 }
 

@@ -33,7 +33,8 @@ CanFrame heartbeat(std::uint8_t node, std::uint8_t state) {
   CanFrame f;
   f.id = 0x700U + node;
   f.dlc = 1;
-  f.data[0] = state;  // CiA 301 7.2.8.3.2.2: 0x00 boot-up, 0x04 stopped, 0x05 operational, 0x7F pre-operational
+  f.data[0] =
+      state;  // CiA 301 7.2.8.3.2.2: 0x00 boot-up, 0x04 stopped, 0x05 operational, 0x7F pre-operational
   return f;
 }
 CanFrame emcy(std::uint8_t node, std::uint16_t code) {
@@ -48,7 +49,7 @@ CanFrame emcy(std::uint8_t node, std::uint16_t code) {
 
 TEST(NodeSupervisor, HeartbeatConsumerTripsOneTickAfterTheConsumerTime) {
   NodeSupervisor s;
-  s.arm(125);  // 250 ms at 2 ms
+  s.arm(125);         // 250 ms at 2 ms
   s.supervise(1000);  // starts counting here
   ASSERT_TRUE(s.on_heartbeat(1050, heartbeat(3, 0x05)));
   s.supervise(1175);
@@ -193,7 +194,8 @@ TEST(CanMasterTwoBuses, EachBusCarriesItsOwnCycleAndNodeIdsArePerBus) {
   // One SYNC per tick on each bus, and each drive's RPDO1 on its own bus only.
   EXPECT_EQ(r.buses[0]->frames_from_master(0x080, m0), 20u);
   EXPECT_EQ(r.buses[1]->frames_from_master(0x080, m1), 20u);
-  for (std::uint32_t node = 1; node <= 3; ++node) EXPECT_EQ(r.buses[0]->frames_from_master(0x200 + node, m0), 20u);
+  for (std::uint32_t node = 1; node <= 3; ++node)
+    EXPECT_EQ(r.buses[0]->frames_from_master(0x200 + node, m0), 20u);
   EXPECT_EQ(r.buses[1]->frames_from_master(0x201, m1), 20u);
   EXPECT_EQ(r.buses[1]->frames_from_master(0x202, m1), 0u);
   // Each target is 0.01 rad (6.5 counts) past the last feedback, which lags the drive by up to two ticks.
@@ -262,7 +264,8 @@ TEST(CanMasterTwoBuses, NodeIdsAreUniquePerBusAndBusesAreBounded) {
   c.axes[3].bus = 0;  // node 1 twice on bus 0
   drivers::Status s = drivers::validate(c);
   ASSERT_FALSE(s);
-  EXPECT_NE(s.message().find("axes.take_up.node_id = 1 is already used by another axis on bus 0"), std::string::npos)
+  EXPECT_NE(s.message().find("axes.take_up.node_id = 1 is already used by another axis on bus 0"),
+            std::string::npos)
       << s.message();
   c.axes[3].bus = 4;
   s = drivers::validate(c);
@@ -277,9 +280,12 @@ TEST(CanMasterTwoBuses, LoadIsCountedPerBus) {
   EXPECT_EQ(drivers::planned_bus_load(c, 0).frames, 11u);
   // Bus 1: SYNC + RPDO1 + TPDO1 + master heartbeat = 4 frames (the I/O node lives on bus 0).
   EXPECT_EQ(drivers::planned_bus_load(c, 1).frames, 4u);
-  EXPECT_LT(drivers::planned_bus_load(c, 1).utilisation_worst, drivers::planned_bus_load(c, 0).utilisation_worst);
-  ::testing::Test::RecordProperty("bus0_load", std::to_string(drivers::planned_bus_load(c, 0).utilisation_worst));
-  ::testing::Test::RecordProperty("bus1_load", std::to_string(drivers::planned_bus_load(c, 1).utilisation_worst));
+  EXPECT_LT(drivers::planned_bus_load(c, 1).utilisation_worst,
+            drivers::planned_bus_load(c, 0).utilisation_worst);
+  ::testing::Test::RecordProperty("bus0_load",
+                                  std::to_string(drivers::planned_bus_load(c, 0).utilisation_worst));
+  ::testing::Test::RecordProperty("bus1_load",
+                                  std::to_string(drivers::planned_bus_load(c, 1).utilisation_worst));
 }
 
 }  // namespace
@@ -352,7 +358,8 @@ TEST(CanHoming, AnIncrementalAxisIsUnreferencedAfterBringUpAndHomesToItsIndexPul
   // Independent truth: the simulated axis stands on an index pulse and its count is the home offset.
   EXPECT_EQ(h.helix().physical_position() % HomingRig::kIndexEvery, 0) << h.helix().physical_position();
   EXPECT_NEAR(h.rig.feedback[2].position, 0.5, 1.0 / drivers::kDefaultCountsPerRad);
-  EXPECT_EQ(h.helix().position(), static_cast<std::int32_t>(std::llround(0.5 * drivers::kDefaultCountsPerRad)));
+  EXPECT_EQ(h.helix().position(),
+            static_cast<std::int32_t>(std::llround(0.5 * drivers::kDefaultCountsPerRad)));
   // The mode travelled in the PDOs: 7-byte RPDO1s to node 3 with 0x6060 = 6, then back to 8.
   bool saw_homing = false;
   for (const auto& l : h.rig.net.log()) {
@@ -394,12 +401,13 @@ TEST(CanHoming, AnUnreferencedAxisIsNeverMovedAndABootUpUnreferencesIt) {
     });
   }
   EXPECT_EQ(h.rig.feedback[2].state, DriveState::kOperationEnabled);
-  EXPECT_EQ(h.helix().position(), count);  // held: its count means nothing yet
+  EXPECT_EQ(h.helix().position(), count);         // held: its count means nothing yet
   EXPECT_NE(h.rig.rack.node(0).position(), 100);  // a referenced axis did move
   // Method 37: the current position is the home point.
   for (int i = 0; i < 10 && !h.rig.feedback[2].referenced; ++i) h.tick_homing();
   ASSERT_TRUE(h.rig.feedback[2].referenced);
-  EXPECT_EQ(h.helix().position(), static_cast<std::int32_t>(std::llround(0.5 * drivers::kDefaultCountsPerRad)));
+  EXPECT_EQ(h.helix().position(),
+            static_cast<std::int32_t>(std::llround(0.5 * drivers::kDefaultCountsPerRad)));
   // A power cycle: a new random count; the master sees the boot-up, and after re-arming the axis is
   // unreferenced again.
   h.rig.rack.node(2).power_off();
@@ -461,7 +469,8 @@ TEST(CanHoming, ADriveWithoutHomingModeIsRefusedNamingTheObject) {
   HomingRig h(34, false, /*drive_homes=*/false);
   const drivers::Status s = h.rig.configure();
   ASSERT_FALSE(s);
-  EXPECT_NE(s.message().find("node 3 (helix): referencing = \"homing\" but the drive does not offer homing mode (0x6502"),
+  EXPECT_NE(s.message().find(
+                "node 3 (helix): referencing = \"homing\" but the drive does not offer homing mode (0x6502"),
             std::string::npos)
       << s.message();
 }

@@ -1,9 +1,10 @@
 // The CAN axis port's per-tick path allocates nothing: operator new is counted while read_axes and
 // write_axes run over 20,000 ticks against simulated drives, including a heartbeat loss, a drive fault
-// with EMCY and a fault reset; likewise the I/O node's read_io/write_io. (Its own executable: tests/support's counter replaces the global operator new.)
+// with EMCY and a fault reset; likewise the I/O node's read_io/write_io. (Its own executable: tests/support's
+// counter replaces the global operator new.)
 #include <gtest/gtest.h>
 
-
+#include "alloc_counter.hpp"
 #include "fake_can_network.hpp"
 #include "loom/drivers/can_axis_port.hpp"
 #include "loom/drivers/can_io_modules.hpp"
@@ -12,7 +13,6 @@
 #include "loom/sim_can/sim_drive_rack.hpp"
 #include "loom/sim_can/sim_io_node.hpp"
 #include "relay_bus.hpp"
-#include "alloc_counter.hpp"
 
 namespace loom::test {
 namespace {

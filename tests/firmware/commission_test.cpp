@@ -30,23 +30,28 @@ TEST(TomlEdit, ReplacesOnlyTheValueKeepingTheCommentAndEveryOtherLine) {
 
 TEST(TomlEdit, ALongerValuePushesTheCommentOnAndAHashInAStringIsNotAComment) {
   std::vector<std::string> changes;
-  EXPECT_EQ(set_toml_values("[a]\nk = 0 # c\ns = \"x#y\"\n", {{"a", "k", "123.456789"}, {"a", "s", "\"z\""}}, changes),
+  EXPECT_EQ(set_toml_values("[a]\nk = 0 # c\ns = \"x#y\"\n", {{"a", "k", "123.456789"}, {"a", "s", "\"z\""}},
+                            changes),
             "[a]\nk = 123.456789 # c\ns = \"z\"\n");
 }
 
 TEST(TomlEdit, MissingKeysAndSectionsAreAdded) {
   std::vector<std::string> changes;
-  EXPECT_EQ(set_toml_values("extends = \"default\"\n[carriage]\nmax_speed_m_s = 1.0\n",
-                            {{"carriage", "home_position_m", "0.5"}, {"helix", "left_position_rad", "2"}}, changes),
-            "extends = \"default\"\n[carriage]\nhome_position_m = 0.5\nmax_speed_m_s = 1.0\n\n[helix]\nleft_position_rad = 2\n");
+  EXPECT_EQ(
+      set_toml_values("extends = \"default\"\n[carriage]\nmax_speed_m_s = 1.0\n",
+                      {{"carriage", "home_position_m", "0.5"}, {"helix", "left_position_rad", "2"}}, changes),
+      "extends = \"default\"\n[carriage]\nhome_position_m = 0.5\nmax_speed_m_s = "
+      "1.0\n\n[helix]\nleft_position_rad = 2\n");
   EXPECT_EQ(changes[0], "3: carriage.home_position_m = 0.5 (added)");
   EXPECT_EQ(changes[1], "7: helix.left_position_rad = 2 (added with its section)");
 }
 
 TEST(TomlEdit, ValuesItCannotRewriteOnTheirLineAreRefused) {
   std::vector<std::string> changes;
-  EXPECT_THROW(set_toml_values("[a]\nk = [1,\n 2]\n", {{"a", "k", "3"}}, changes), loom::firmware::ConfigError);
-  EXPECT_THROW(set_toml_values("[a]\nk = \"\"\"x\n\"\"\"\n", {{"a", "k", "3"}}, changes), loom::firmware::ConfigError);
+  EXPECT_THROW(set_toml_values("[a]\nk = [1,\n 2]\n", {{"a", "k", "3"}}, changes),
+               loom::firmware::ConfigError);
+  EXPECT_THROW(set_toml_values("[a]\nk = \"\"\"x\n\"\"\"\n", {{"a", "k", "3"}}, changes),
+               loom::firmware::ConfigError);
 }
 
 TEST(TomlEdit, TheEmbeddedDefaultStaysAValidLoomWithOnlyTheCalibrationChanged) {

@@ -1,27 +1,28 @@
 // Config and CLI input errors: one line naming file, line, column, field and value; exit 2; nothing
 // started. Also the embedded defaults parse and the shipped scenes load.
+#include "loom/config/config.hpp"
+
 #include <gtest/gtest.h>
 
-#include "cli_run.hpp"
-
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
+#include "cli_run.hpp"
 #include "config_error.hpp"
-#include "loom/config/config.hpp"
 #include "loom/motion/profile_set.hpp"
-
-#include <cmath>
 
 using namespace loom::firmware;
 
 namespace {
 
-using loom::test::config_error;
 using loom::test::CliRun;
-CliRun run_loomctl(const std::string& args) { return loom::test::run_command(std::string(LOOMCTL_PATH) + " " + args); }
+using loom::test::config_error;
+CliRun run_loomctl(const std::string& args) {
+  return loom::test::run_command(std::string(LOOMCTL_PATH) + " " + args);
+}
 std::string write_temp(const std::string& name, const std::string& text) {
   const auto path = std::filesystem::temp_directory_path() / name;
   std::ofstream(path) << text;
@@ -41,22 +42,26 @@ TEST(Config, EmbeddedDefaultsParse) {
 }
 
 TEST(Config, ShippedScenesLoad) {
-  for (const char* name : {"default", "ideal", "servo_lag", "drive_fault", "estop", "stuck_piston", "shuttle_slip",
-                           "stuck_sensor", "sensor_noise", "dynamics"}) {
+  for (const char* name : {"default", "ideal", "servo_lag", "drive_fault", "estop", "stuck_piston",
+                           "shuttle_slip", "stuck_sensor", "sensor_noise", "dynamics"}) {
     const Scene s = load_scene(std::string(LOOM_SOURCE_DIR) + "/sim_hal/scenes/" + name + ".toml");
     EXPECT_EQ(s.spec.name, name);
   }
 }
 
 TEST(Config, OutOfRangeValueNamesFileLineColumnFieldAndValue) {
-  const std::string e = config_error("extends = \"default\"\n[loom]\nwidth_m = 1.2\n\n[beatup]\ncrank_m = -0.058\n");
+  const std::string e =
+      config_error("extends = \"default\"\n[loom]\nwidth_m = 1.2\n\n[beatup]\ncrank_m = -0.058\n");
   EXPECT_EQ(e, "loom.toml:6:11: beatup.crank_m = -0.058: must be in [0.005, 2]");
 }
 
 TEST(Config, WrongTypeAndUnknownKeyAndBadEnum) {
-  EXPECT_EQ(config_error("extends = \"default\"\n[helix]\nlead_m = \"ten\"\n"), "loom.toml:3:10: helix.lead_m = \"ten\": expected a number");
-  EXPECT_EQ(config_error("extends = \"default\"\n[helix]\nleed_m = 0.1\n"), "loom.toml:3:10: helix.leed_m = 0.1: unknown field");
-  EXPECT_NE(config_error("extends = \"default\"\n[beatup]\nbranch = \"up\"\n").find("beatup.branch = \"up\": must be one of"),
+  EXPECT_EQ(config_error("extends = \"default\"\n[helix]\nlead_m = \"ten\"\n"),
+            "loom.toml:3:10: helix.lead_m = \"ten\": expected a number");
+  EXPECT_EQ(config_error("extends = \"default\"\n[helix]\nleed_m = 0.1\n"),
+            "loom.toml:3:10: helix.leed_m = 0.1: unknown field");
+  EXPECT_NE(config_error("extends = \"default\"\n[beatup]\nbranch = \"up\"\n")
+                .find("beatup.branch = \"up\": must be one of"),
             std::string::npos);
 }
 
@@ -67,12 +72,14 @@ TEST(Config, SyntaxErrorHasLineAndColumn) {
 
 TEST(Config, InfeasibleMotionIsRefusedWithTheLimits) {
   // A crank so slow to accelerate that it cannot reach speed before the first beat.
-  const std::string e = config_error("extends = \"default\"\n[recipe]\ncrank_speed_rad_s = 15.5\ncrank_accel_rad_s2 = 5.0\n");
+  const std::string e =
+      config_error("extends = \"default\"\n[recipe]\ncrank_speed_rad_s = 15.5\ncrank_accel_rad_s2 = 5.0\n");
   EXPECT_NE(e.find("cannot reach 15.5 rad/s before the first beat"), std::string::npos) << e;
 }
 
 TEST(Config, HeartbeatTimeoutMustDetectLossWithinThreePeriods) {
-  EXPECT_NE(config_error("extends = \"default\"\n[can]\nheartbeat_ms = 100\nheartbeat_timeout_ms = 400\n").find("loom.toml:4:24: can.heartbeat_timeout_ms = 400: the CAN master refuses it"),
+  EXPECT_NE(config_error("extends = \"default\"\n[can]\nheartbeat_ms = 100\nheartbeat_timeout_ms = 400\n")
+                .find("loom.toml:4:24: can.heartbeat_timeout_ms = 400: the CAN master refuses it"),
             std::string::npos);
 }
 
@@ -87,7 +94,8 @@ TEST(Config, SceneRejectsUnknownEffectsAndOrphanParameters) {
             }())
                 .find("s.toml:1:"),
             std::string::npos);
-  EXPECT_THROW((void)parse_scene("effects = [\"ideal\"]\n[servo_lag]\ntau_s = 0.01\n", "s.toml"), ConfigError);
+  EXPECT_THROW((void)parse_scene("effects = [\"ideal\"]\n[servo_lag]\ntau_s = 0.01\n", "s.toml"),
+               ConfigError);
 }
 
 TEST(LoomctlCli, BadConfigValueIsOneLineAndExit2) {
@@ -108,7 +116,8 @@ TEST(LoomctlCli, BadArgumentsExit2) {
 TEST(LoomctlCli, WeavesThreeRowsAndPrintsRowSummaries) {
   const CliRun r = run_loomctl("weave --rows 3 --no-telemetry");
   EXPECT_EQ(r.exit_code, 0) << r.output;
-  for (const char* row : {"row 1/3:", "row 2/3:", "row 3/3:"}) EXPECT_NE(r.output.find(row), std::string::npos);
+  for (const char* row : {"row 1/3:", "row 2/3:", "row 3/3:"})
+    EXPECT_NE(r.output.find(row), std::string::npos);
   EXPECT_NE(r.output.find("15 beats, 14 carriage steps"), std::string::npos) << r.output;
 }
 
@@ -116,7 +125,7 @@ TEST(LoomctlCli, FaultSceneExits3AndKeepsCounters) {
   const std::string counters = (std::filesystem::temp_directory_path() / "loom_fault_counters.json").string();
   std::filesystem::remove(counters);
   const CliRun r = run_loomctl("weave --rows 5 --no-telemetry --counters " + counters + " --scene " +
-                            std::string(LOOM_SOURCE_DIR) + "/sim_hal/scenes/drive_fault.toml");
+                               std::string(LOOM_SOURCE_DIR) + "/sim_hal/scenes/drive_fault.toml");
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("FAULT drive_fault"), std::string::npos) << r.output;
   std::ifstream f(counters);
@@ -127,8 +136,8 @@ TEST(LoomctlCli, FaultSceneExits3AndKeepsCounters) {
 TEST(LoomctlCli, ResumesFromSavedCounters) {
   // A fresh simulated machine has its shuttle at the left, which only an even pick count agrees with
   // (odd counts against it are refused as shuttle_side_mismatch: see tests/sim/reproductions_test.cpp).
-  const std::string counters = write_temp("loom_resume_counters.json",
-                                         "{\"rows\":6,\"picks\":6,\"beats\":90,\"picks_in_row\":0}\n");
+  const std::string counters =
+      write_temp("loom_resume_counters.json", "{\"rows\":6,\"picks\":6,\"beats\":90,\"picks_in_row\":0}\n");
   const CliRun r = run_loomctl("weave --rows 1 --no-telemetry --counters " + counters);
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("row 7/7:"), std::string::npos) << r.output;
@@ -141,18 +150,23 @@ TEST(Config, BeatForceTargetSetsTheCrankSpeedAndExcludesAFixedSpeed) {
   const LoomConfig c = default_loom_config();
   EXPECT_DOUBLE_EQ(c.beat_force_target_n, 90.0);
   EXPECT_NEAR(c.profile.crank.velocity, 16.06, 0.01);  // the beat-up's inverse dynamics for 90 N
-  const LoomConfig slow = parse_loom_config("extends = \"default\"\n[recipe]\nbeat_force_target_n = 80.0\n", "loom.toml");
+  const LoomConfig slow =
+      parse_loom_config("extends = \"default\"\n[recipe]\nbeat_force_target_n = 80.0\n", "loom.toml");
   // The beater force is inertial: speed scales with the square root of the force.
   EXPECT_NEAR(slow.profile.crank.velocity / c.profile.crank.velocity, std::sqrt(80.0 / 90.0), 1e-9);
-  const LoomConfig fixed = parse_loom_config("extends = \"default\"\n[recipe]\ncrank_speed_rad_s = 15.5\n", "loom.toml");
+  const LoomConfig fixed =
+      parse_loom_config("extends = \"default\"\n[recipe]\ncrank_speed_rad_s = 15.5\n", "loom.toml");
   EXPECT_DOUBLE_EQ(fixed.profile.crank.velocity, 15.5);
   EXPECT_EQ(fixed.beat_force_target_n, 0.0);
-  EXPECT_NE(config_error("extends = \"default\"\n[recipe]\ncrank_speed_rad_s = 15.5\nbeat_force_target_n = 90.0\n").find("not both"),
-            std::string::npos);
+  EXPECT_NE(
+      config_error("extends = \"default\"\n[recipe]\ncrank_speed_rad_s = 15.5\nbeat_force_target_n = 90.0\n")
+          .find("not both"),
+      std::string::npos);
 }
 
 TEST(Config, BeatsPerPositionMultipliesTheBeatsOfARow) {
-  const LoomConfig c = parse_loom_config("extends = \"default\"\n[recipe]\nbeats_per_position = 3\n", "loom.toml");
+  const LoomConfig c =
+      parse_loom_config("extends = \"default\"\n[recipe]\nbeats_per_position = 3\n", "loom.toml");
   const loom::motion::ProfileSet p(c.profile);
   EXPECT_EQ(p.beats_per_row(), 45);
   EXPECT_EQ(p.cam().steps(), 14);
@@ -169,19 +183,26 @@ TEST(Config, LoopPeriodMustResolveTheBeat) {
   EXPECT_EQ(config_error(head + "period_ms = 10.8\n"), "");
   EXPECT_EQ(config_error(head + "period_ms = 10\n"), "");
   const std::string e = config_error(head + "period_ms = 10.9\n");
-  EXPECT_EQ(e.rfind("loom.toml:3:13: timing.period_ms = 10.9: the crank turns 10.0 deg per tick at the beat (16.06 rad/s); "
+  EXPECT_EQ(e.rfind("loom.toml:3:13: timing.period_ms = 10.9: the crank turns 10.0 deg per tick at the beat "
+                    "(16.06 rad/s); "
                     "at most 10 deg per tick, i.e. period_ms <= 10.86 for this recipe",
                     0),
             0u)
       << e;
   const std::string e20 = config_error(head + "period_ms = 20\n");
-  EXPECT_EQ(e20.rfind("loom.toml:3:13: timing.period_ms = 20: the crank turns 18.4 deg per tick at the beat", 0), 0u) << e20;
+  EXPECT_EQ(
+      e20.rfind("loom.toml:3:13: timing.period_ms = 20: the crank turns 18.4 deg per tick at the beat", 0),
+      0u)
+      << e20;
   EXPECT_NE(e20.find("the load cell, read once per tick, can miss its peak"), std::string::npos) << e20;
   // A slower crank allows a longer period: 12.5 rad/s turns 8.6 deg in 12 ms.
-  EXPECT_EQ(config_error("extends = \"default\"\n[recipe]\ncrank_speed_rad_s = 12.5\n[timing]\nperiod_ms = 12\n"), "");
-  EXPECT_NE(config_error("extends = \"default\"\n[recipe]\ncrank_speed_rad_s = 12.5\n[timing]\nperiod_ms = 15\n")
-                .find("timing.period_ms = 15: the crank turns 10.7 deg per tick at the beat (12.50 rad/s)"),
-            std::string::npos);
+  EXPECT_EQ(
+      config_error("extends = \"default\"\n[recipe]\ncrank_speed_rad_s = 12.5\n[timing]\nperiod_ms = 12\n"),
+      "");
+  EXPECT_NE(
+      config_error("extends = \"default\"\n[recipe]\ncrank_speed_rad_s = 12.5\n[timing]\nperiod_ms = 15\n")
+          .find("timing.period_ms = 15: the crank turns 10.7 deg per tick at the beat (12.50 rad/s)"),
+      std::string::npos);
 }
 
 TEST(Config, LoopPeriodFromTheCommandLineIsCheckedToo) {
@@ -193,7 +214,9 @@ TEST(Config, LoopPeriodFromTheCommandLineIsCheckedToo) {
     rederive_and_check(c, "--period-ms 20");
     ADD_FAILURE() << "20 ms accepted";
   } catch (const ConfigError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("--period-ms 20: with it, timing.period_ms = 20: the crank turns 18.4 deg", 0), 0u)
+    EXPECT_EQ(std::string(e.what()).rfind(
+                  "--period-ms 20: with it, timing.period_ms = 20: the crank turns 18.4 deg", 0),
+              0u)
         << e.what();
   }
 }
@@ -201,13 +224,16 @@ TEST(Config, LoopPeriodFromTheCommandLineIsCheckedToo) {
 TEST(LoomctlCli, CoarseLoopPeriodIsRefusedByCheckAndWeave) {
   const CliRun w = run_loomctl("weave --rows 1 --no-telemetry --period-ms 20");
   EXPECT_EQ(w.exit_code, 2) << w.output;
-  EXPECT_NE(w.output.find("timing.period_ms = 20: the crank turns 18.4 deg per tick at the beat"), std::string::npos)
+  EXPECT_NE(w.output.find("timing.period_ms = 20: the crank turns 18.4 deg per tick at the beat"),
+            std::string::npos)
       << w.output;
-  const std::string path = write_temp("loom_period20.toml", "extends = \"default\"\n[timing]\nperiod_ms = 20\n");
+  const std::string path =
+      write_temp("loom_period20.toml", "extends = \"default\"\n[timing]\nperiod_ms = 20\n");
   const CliRun c = run_loomctl("check --config " + path);
   EXPECT_EQ(c.exit_code, 2) << c.output;
-  EXPECT_NE(c.output.find(path + ":3:13: timing.period_ms = 20: the crank turns 18.4 deg per tick at the beat"),
-            std::string::npos)
+  EXPECT_NE(
+      c.output.find(path + ":3:13: timing.period_ms = 20: the crank turns 18.4 deg per tick at the beat"),
+      std::string::npos)
       << c.output;
   EXPECT_EQ(run_loomctl("weave --rows 1 --no-telemetry --period-ms 10").exit_code, 0);
 }
@@ -220,7 +246,8 @@ TEST(Config, StructDefaultsAgreeWithTheEmbeddedDefaultToml) {
   // Every machine, CAN, I/O, timing and telemetry key, compared as loomctl prints them.
   EXPECT_EQ(restart_only_changes(built, parsed), "");
   ASSERT_EQ(built.axes.size(), 3u);
-  EXPECT_DOUBLE_EQ(built.axes[1].counts_per_unit(), 104857600.0);  // 2^20 counts per 10 mm, as the drives assume
+  EXPECT_DOUBLE_EQ(built.axes[1].counts_per_unit(),
+                   104857600.0);  // 2^20 counts per 10 mm, as the drives assume
   EXPECT_DOUBLE_EQ(built.axes[1].counts_per_unit(), loom::drivers::kDefaultCountsPerM);
   EXPECT_DOUBLE_EQ(built.axes[0].counts_per_unit(), loom::drivers::kDefaultCountsPerRad);
   // The recipe's numeric keys (restart_only_changes leaves the recipe out).
@@ -254,12 +281,17 @@ TEST(Config, SecondSwitchesAreWiredInputsAndDeriveTheSequencersDualChannels) {
   for (bool wired : dual.sequencer.second_channel) EXPECT_TRUE(wired);
   for (bool fitted : dual.machine.second_channel) EXPECT_TRUE(fitted);
   EXPECT_DOUBLE_EQ(dual.sequencer.sensor_discrepancy_s, 0.02);
-  const LoomConfig single = parse_loom_config("extends = \"default\"\n[io]\nshuttle_at_left_2_bit = -1\n", "loom.toml");
-  EXPECT_FALSE(single.sequencer.second_channel[static_cast<std::size_t>(loom::hal::SafetySensor::kShuttleAtLeft)]);
-  EXPECT_FALSE(single.machine.second_channel[static_cast<std::size_t>(loom::hal::SafetySensor::kShuttleAtLeft)]);
-  EXPECT_TRUE(single.sequencer.second_channel[static_cast<std::size_t>(loom::hal::SafetySensor::kShuttleAtRight)]);
+  const LoomConfig single =
+      parse_loom_config("extends = \"default\"\n[io]\nshuttle_at_left_2_bit = -1\n", "loom.toml");
+  EXPECT_FALSE(
+      single.sequencer.second_channel[static_cast<std::size_t>(loom::hal::SafetySensor::kShuttleAtLeft)]);
+  EXPECT_FALSE(
+      single.machine.second_channel[static_cast<std::size_t>(loom::hal::SafetySensor::kShuttleAtLeft)]);
+  EXPECT_TRUE(
+      single.sequencer.second_channel[static_cast<std::size_t>(loom::hal::SafetySensor::kShuttleAtRight)]);
   const std::string e = config_error("extends = \"default\"\n[io]\nshuttle_at_right_2_bit = 5\n");
-  EXPECT_EQ(e.rfind("loom.toml:3:26: io.shuttle_at_right_2_bit = 5: the I/O module refuses it: ", 0), 0u) << e;
+  EXPECT_EQ(e.rfind("loom.toml:3:26: io.shuttle_at_right_2_bit = 5: the I/O module refuses it: ", 0), 0u)
+      << e;
   EXPECT_NE(e.find("already used by io.inputs.shuttle_at_right"), std::string::npos) << e;
   EXPECT_EQ(config_error("extends = \"default\"\n[io]\npiston_a_extended_2_bit = 64\n"),
             "loom.toml:3:27: io.piston_a_extended_2_bit = 64: must be in [-1, 63]");

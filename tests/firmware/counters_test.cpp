@@ -2,8 +2,6 @@
 // wrapped), the counts agree with each other, a counters file that cannot be written refuses to arm,
 // and a save that fails mid-run stops the loom at the end of the row with a named fault.
 #include <gtest/gtest.h>
-
-#include "cli_run.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -14,6 +12,7 @@
 #include <string>
 #include <thread>
 
+#include "cli_run.hpp"
 #include "loom/config/config.hpp"
 #include "loom/firmware/counter_store.hpp"
 
@@ -32,7 +31,9 @@ std::string parse_error(const std::string& text) {
 }
 
 using loom::test::CliRun;
-CliRun run_loomctl(const std::string& args) { return loom::test::run_command(std::string(LOOMCTL_PATH) + " " + args); }
+CliRun run_loomctl(const std::string& args) {
+  return loom::test::run_command(std::string(LOOMCTL_PATH) + " " + args);
+}
 
 fs::path temp_dir(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("loom_counters_" + std::to_string(::getpid()) + "_" + name);
@@ -55,8 +56,10 @@ TEST(Counters, RoundTripAndStrictShape) {
   EXPECT_EQ(back.picks, 9u);
   EXPECT_EQ(back.beats, 105u);
   EXPECT_EQ(back.picks_in_row, 2u);
-  EXPECT_EQ(CounterStore::parse(" { \"picks_in_row\" : 0 , \"beats\":4294967295,\"rows\":1,\"picks\":1}\n", "c").beats,
-            4294967295u);
+  EXPECT_EQ(
+      CounterStore::parse(" { \"picks_in_row\" : 0 , \"beats\":4294967295,\"rows\":1,\"picks\":1}\n", "c")
+          .beats,
+      4294967295u);
 }
 
 TEST(Counters, TheKnottingHeadsCountsComeTogetherAndAgree) {
@@ -76,12 +79,14 @@ TEST(Counters, TheKnottingHeadsCountsComeTogetherAndAgree) {
   EXPECT_EQ(back.knot.cycles_started, 17u);
   EXPECT_EQ(back.knot.cycles_done, 16u);
   // All five or none; a cycle done that never started is not loomctl's.
-  EXPECT_NE(parse_error("{\"rows\":4,\"picks\":8,\"beats\":60,\"picks_in_row\":0,\"knots\":5}").find("the knot counts come together"),
+  EXPECT_NE(parse_error("{\"rows\":4,\"picks\":8,\"beats\":60,\"picks_in_row\":0,\"knots\":5}")
+                .find("the knot counts come together"),
             std::string::npos);
-  EXPECT_NE(parse_error("{\"rows\":4,\"picks\":8,\"beats\":60,\"picks_in_row\":0,\"knots\":5,\"knots_retried\":0,"
-                        "\"knots_by_hand\":0,\"knot_cycles_started\":2,\"knot_cycles_done\":3}")
-                .find("knot_cycles_done = 3 exceeds knot_cycles_started = 2"),
-            std::string::npos);
+  EXPECT_NE(
+      parse_error("{\"rows\":4,\"picks\":8,\"beats\":60,\"picks_in_row\":0,\"knots\":5,\"knots_retried\":0,"
+                  "\"knots_by_hand\":0,\"knot_cycles_started\":2,\"knot_cycles_done\":3}")
+          .find("knot_cycles_done = 3 exceeds knot_cycles_started = 2"),
+      std::string::npos);
 }
 
 TEST(Counters, ValuesAreWholeCountsNeverRoundedOrWrapped) {
@@ -98,19 +103,26 @@ TEST(Counters, ValuesAreWholeCountsNeverRoundedOrWrapped) {
 }
 
 TEST(Counters, ShapeErrorsAreNamed) {
-  EXPECT_NE(parse_error("{\"rows\":1,\"picks\":1,\"beats\":1}").find("lacks \"picks_in_row\""), std::string::npos);
-  EXPECT_NE(parse_error("{\"rows\":1,\"rows\":1,\"picks\":1,\"beats\":1,\"picks_in_row\":0}").find("given twice"),
+  EXPECT_NE(parse_error("{\"rows\":1,\"picks\":1,\"beats\":1}").find("lacks \"picks_in_row\""),
             std::string::npos);
-  EXPECT_NE(parse_error("{\"rows\":1,\"picks\":1,\"beats\":1,\"picks_in_row\":0,\"spare\":1}").find("unknown field"),
+  EXPECT_NE(
+      parse_error("{\"rows\":1,\"rows\":1,\"picks\":1,\"beats\":1,\"picks_in_row\":0}").find("given twice"),
+      std::string::npos);
+  EXPECT_NE(parse_error("{\"rows\":1,\"picks\":1,\"beats\":1,\"picks_in_row\":0,\"spare\":1}")
+                .find("unknown field"),
             std::string::npos);
-  EXPECT_NE(parse_error("{\"rows\":1,\"picks\":1,\"beats\":1,\"picks_in_row\":0} x").find("trailing text"), std::string::npos);
+  EXPECT_NE(parse_error("{\"rows\":1,\"picks\":1,\"beats\":1,\"picks_in_row\":0} x").find("trailing text"),
+            std::string::npos);
   EXPECT_NE(parse_error("").find("expected '{'"), std::string::npos);
 }
 
 TEST(Counters, CountsThatContradictEachOtherAreRefused) {
-  EXPECT_NE(parse_error("{\"rows\":5,\"picks\":3,\"beats\":75,\"picks_in_row\":0}").find("contradict"), std::string::npos);
-  EXPECT_NE(parse_error("{\"rows\":5,\"picks\":5,\"beats\":75,\"picks_in_row\":1}").find("contradict"), std::string::npos);
-  EXPECT_NE(parse_error("{\"rows\":5,\"picks\":5,\"beats\":4,\"picks_in_row\":0}").find("contradict"), std::string::npos);
+  EXPECT_NE(parse_error("{\"rows\":5,\"picks\":3,\"beats\":75,\"picks_in_row\":0}").find("contradict"),
+            std::string::npos);
+  EXPECT_NE(parse_error("{\"rows\":5,\"picks\":5,\"beats\":75,\"picks_in_row\":1}").find("contradict"),
+            std::string::npos);
+  EXPECT_NE(parse_error("{\"rows\":5,\"picks\":5,\"beats\":4,\"picks_in_row\":0}").find("contradict"),
+            std::string::npos);
 }
 
 TEST(Counters, MissingStartsFromZeroButUnreadableIsAnError) {
@@ -145,7 +157,8 @@ TEST(CountersCli, UnreadableCountersExit2AndTheFileIsUntouched) {
 
 TEST(CountersCli, RowsNearTheCounterRangeAreRefusedNotWrapped) {
   const fs::path d = temp_dir("cli_wrap");
-  std::ofstream(d / "c.json") << "{\"rows\":4294967295,\"picks\":4294967295,\"beats\":4294967295,\"picks_in_row\":0}\n";
+  std::ofstream(d / "c.json")
+      << "{\"rows\":4294967295,\"picks\":4294967295,\"beats\":4294967295,\"picks_in_row\":0}\n";
   const CliRun r = run_loomctl("weave --rows 1 --no-telemetry --counters " + (d / "c.json").string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("never wrapped"), std::string::npos) << r.output;
@@ -172,8 +185,8 @@ TEST(CountersCli, ASaveThatFailsMidRunStopsAtTheRowEndWithANamedFault) {
   const fs::path d = temp_dir("cli_midrun");
   const std::string counters = (d / "c.json").string();
   // Paced so the first row takes ~1.9 s; the save at its end finds its temp path taken.
-  FILE* p = popen((std::string(LOOMCTL_PATH) + " weave --rows 3 --no-telemetry --realtime --pace 4 --counters " +
-                   counters + " 2>&1")
+  FILE* p = popen((std::string(LOOMCTL_PATH) +
+                   " weave --rows 3 --no-telemetry --realtime --pace 4 --counters " + counters + " 2>&1")
                       .c_str(),
                   "r");
   std::this_thread::sleep_for(std::chrono::milliseconds(600));

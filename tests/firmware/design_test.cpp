@@ -3,13 +3,14 @@
 // decodes to exactly those colours, bottom pixel row first; every bad file is refused with its
 // file:line:col, field and value; the design book credits rows to the right design across restarts
 // and power cuts, and refuses what it cannot explain.
+#include "loom/design/design.hpp"
+
 #include <gtest/gtest.h>
 #include <png.h>
 
 #include <filesystem>
 #include <fstream>
 
-#include "loom/design/design.hpp"
 #include "loom/config/config.hpp"
 #include "loom/firmware/design_book.hpp"
 #include "loom/telemetry/encode.hpp"
@@ -38,7 +39,8 @@ std::string error_of(const std::string& text) {
 
 TEST(DesignCsv, LastLineIsTheFirstRowWoven) {
   const Design d = parse_design_csv(
-      "\xEF\xBB\xBF# a comment\r\npalette,R,#9b1b30,madder red\r\npalette , B , #1D3F8A\n\nR,B,R\n B , B ,#c8a040\n",
+      "\xEF\xBB\xBF# a comment\r\npalette,R,#9b1b30,madder red\r\npalette , B , #1D3F8A\n\nR,B,R\n B , B "
+      ",#c8a040\n",
       "/some/where/rug.csv");
   EXPECT_EQ(d.name(), "rug.csv");
   EXPECT_EQ(d.width(), 3);
@@ -54,33 +56,41 @@ TEST(DesignCsv, LastLineIsTheFirstRowWoven) {
 
 TEST(DesignCsv, EveryRefusalNamesLineColumnAndValue) {
   EXPECT_EQ(error_of("palette,R,#ff0000\nR,R\nR,X\n"),
-            "rug.csv:3:3: colour code 'X' is not in the palette (the palette has R); define it with palette,X,#RRGGBB");
+            "rug.csv:3:3: colour code 'X' is not in the palette (the palette has R); define it with "
+            "palette,X,#RRGGBB");
   EXPECT_EQ(error_of("palette,R,#ff0000\nR,R\nR\n"),
             "rug.csv:3:1: row of 1 knots; the design's rows have 2 (every row the same width)");
   EXPECT_EQ(error_of("palette,R,#ff0000\nR,,R\n"), "rug.csv:2:3: empty cell: every knot needs a colour code");
-  EXPECT_EQ(error_of("palette,R,#ff0000\npalette,R,#00ff00\n"), "rug.csv:2:9: palette code 'R' defined twice");
+  EXPECT_EQ(error_of("palette,R,#ff0000\npalette,R,#00ff00\n"),
+            "rug.csv:2:9: palette code 'R' defined twice");
   EXPECT_EQ(error_of("palette,R,#ff0000\nR\npalette,B,#0000ff\n"),
             "rug.csv:3:1: palette line after the grid began (define every code before the first row)");
   EXPECT_EQ(error_of("palette,R,red\n"), "rug.csv:1:11: colour of 'R' = 'red': want #RRGGBB");
-  EXPECT_EQ(error_of("# only a comment\n"), "rug.csv:2:1: no rows of knots (a design needs at least one grid line)");
+  EXPECT_EQ(error_of("# only a comment\n"),
+            "rug.csv:2:1: no rows of knots (a design needs at least one grid line)");
   EXPECT_EQ(error_of(""), "rug.csv:1:1: no rows of knots (a design needs at least one grid line)");
-  EXPECT_NE(error_of("palette,R,#ff0000\nR,R\x01\n").find("rug.csv:2:4: control character 0x01"), std::string::npos);
-  EXPECT_NE(error_of("palette,R,#ff0000\nR,red yarn\n").find("rug.csv:2:3: colour code 'red yarn': want 1..16 letters"),
+  EXPECT_NE(error_of("palette,R,#ff0000\nR,R\x01\n").find("rug.csv:2:4: control character 0x01"),
             std::string::npos);
-  EXPECT_NE(error_of("palette,#abcdef,#ff0000\n").find("rug.csv:1:9: palette code '#abcdef' starts with '#'"), std::string::npos);
+  EXPECT_NE(error_of("palette,R,#ff0000\nR,red yarn\n")
+                .find("rug.csv:2:3: colour code 'red yarn': want 1..16 letters"),
+            std::string::npos);
+  EXPECT_NE(error_of("palette,#abcdef,#ff0000\n").find("rug.csv:1:9: palette code '#abcdef' starts with '#'"),
+            std::string::npos);
 }
 
 TEST(DesignCsv, BoundsAreChecked) {
   std::string wide;
   for (int i = 0; i <= loom::design::kMaxWidth; ++i) wide += i ? ",#000000" : "#000000";
-  EXPECT_NE(error_of(wide + "\n").find("4001 knots per row: more than 4000"), std::string::npos) << error_of(wide + "\n");
+  EXPECT_NE(error_of(wide + "\n").find("4001 knots per row: more than 4000"), std::string::npos)
+      << error_of(wide + "\n");
   std::string many;
   for (int i = 0; i <= loom::design::kMaxColours; ++i) {
     char cell[16];
     std::snprintf(cell, sizeof cell, "%s#%06x", i ? "," : "", i);
     many += cell;
   }
-  EXPECT_NE(error_of(many + "\n").find("more than 256 colours in one design"), std::string::npos) << error_of(many + "\n");
+  EXPECT_NE(error_of(many + "\n").find("more than 256 colours in one design"), std::string::npos)
+      << error_of(many + "\n");
 }
 
 // A PNG from libpng's encoder (independent of the decoder under test): 3 x 2 pixels, RGB.
@@ -100,7 +110,8 @@ std::string png_of(int w, int h, const std::vector<std::uint8_t>& rgb) {
 
 TEST(DesignPng, OnePixelPerKnotBottomRowFirst) {
   // Top pixel row: red, red, white; bottom: blue, white, red.
-  const std::string png = png_of(3, 2, {255, 0, 0, 255, 0, 0, 255, 255, 255, 0, 0, 255, 255, 255, 255, 255, 0, 0});
+  const std::string png =
+      png_of(3, 2, {255, 0, 0, 255, 0, 0, 255, 255, 255, 0, 0, 255, 255, 255, 255, 255, 0, 0});
   const Design d = parse_design(png, "dir/medallion.PNG");
   EXPECT_EQ(d.name(), "medallion.PNG");
   EXPECT_EQ(d.width(), 3);
@@ -111,12 +122,15 @@ TEST(DesignPng, OnePixelPerKnotBottomRowFirst) {
 
 TEST(DesignPng, PhotographsAndNonPngsAreRefused) {
   std::vector<std::uint8_t> photo;
-  for (int i = 0; i < 300; ++i) photo.insert(photo.end(), {static_cast<std::uint8_t>(i), static_cast<std::uint8_t>(i / 256), 7});
+  for (int i = 0; i < 300; ++i)
+    photo.insert(photo.end(), {static_cast<std::uint8_t>(i), static_cast<std::uint8_t>(i / 256), 7});
   try {
     parse_design(png_of(300, 1, photo), "photo.png");
     FAIL() << "accepted";
   } catch (const DesignError& e) {
-    EXPECT_NE(std::string(e.what()).find("photo.png: more than 256 distinct colours (pixel 256,0)"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("photo.png: more than 256 distinct colours (pixel 256,0)"),
+              std::string::npos)
+        << e.what();
   }
   EXPECT_THROW(parse_design("not a png", "x.png"), DesignError);
   EXPECT_THROW(parse_design("R\n", "x.txt"), DesignError);
@@ -135,7 +149,8 @@ TEST(DesignPosition, RepeatsAfterTheLastRow) {
 }
 
 TEST(DesignTelemetry, CarriesTheRowKnottedLastTheNextAndTwoAfter) {
-  const Design d = parse_design_csv("palette,A,#000001\npalette,B,#000002\npalette,C,#000003\nC,C\nB,B\nA,B\n", "d.csv");
+  const Design d =
+      parse_design_csv("palette,A,#000001\npalette,B,#000002\npalette,C,#000003\nC,C\nB,B\nA,B\n", "d.csv");
   auto m = loom::telemetry::to_design(d, 0, "loom1", 5);
   EXPECT_EQ(m.next_row, 1);
   EXPECT_EQ(m.repeat, 1);
@@ -202,20 +217,26 @@ TEST_F(DesignBookTest, WhatCannotBeExplainedIsRefused) {
     }
     return "accepted";
   };
-  EXPECT_NE(refusal("{\"active\":\"a.csv\",\"at_rows\":9,\"designs\":{\"a.csv\":4}}").find("written at production row 9 but the counters say 5"),
+  EXPECT_NE(refusal("{\"active\":\"a.csv\",\"at_rows\":9,\"designs\":{\"a.csv\":4}}")
+                .find("written at production row 9 but the counters say 5"),
             std::string::npos);
-  EXPECT_NE(refusal("{\"active\":\"a.csv\",\"at_rows\":1,\"designs\":{\"a.csv\":-4}}").find("\"designs\".\"a.csv\" = -4: not a row count"),
+  EXPECT_NE(refusal("{\"active\":\"a.csv\",\"at_rows\":1,\"designs\":{\"a.csv\":-4}}")
+                .find("\"designs\".\"a.csv\" = -4: not a row count"),
             std::string::npos);
   // Row counts are bounded like the production counters they come from: 2^64-1 used to be accepted and wrap.
   EXPECT_NE(refusal("{\"active\":\"a.csv\",\"at_rows\":1,\"designs\":{\"a.csv\":18446744073709551615}}")
                 .find("= 18446744073709551615: not a row count in 0..4294967295"),
             std::string::npos);
-  EXPECT_NE(refusal("{\"active\":\"a.csv\",\"at_rows\":1,\"designs\":{\"a.csv\":4294967295}}").find("would pass 4294967295"),
+  EXPECT_NE(refusal("{\"active\":\"a.csv\",\"at_rows\":1,\"designs\":{\"a.csv\":4294967295}}")
+                .find("would pass 4294967295"),
             std::string::npos);
-  EXPECT_NE(refusal("{\"active\":\"a.csv\",\"at_rows\":1.5,\"designs\":{}}").find("\"at_rows\" = 1.5"), std::string::npos);
-  EXPECT_NE(refusal("{\"active\":\"z.csv\",\"at_rows\":1,\"designs\":{}}").find("active design 'z.csv' has no entry"),
+  EXPECT_NE(refusal("{\"active\":\"a.csv\",\"at_rows\":1.5,\"designs\":{}}").find("\"at_rows\" = 1.5"),
             std::string::npos);
-  EXPECT_NE(refusal("{\"active\":\"\",\"at_rows\":1,\"designs\":{},\"x\":1}").find("want exactly"), std::string::npos);
+  EXPECT_NE(refusal("{\"active\":\"z.csv\",\"at_rows\":1,\"designs\":{}}")
+                .find("active design 'z.csv' has no entry"),
+            std::string::npos);
+  EXPECT_NE(refusal("{\"active\":\"\",\"at_rows\":1,\"designs\":{},\"x\":1}").find("want exactly"),
+            std::string::npos);
   EXPECT_NE(refusal("{\"active\":").find(path_ + ": not a design book"), std::string::npos);
   // Nothing was rewritten by a refusal.
   EXPECT_EQ(read(), "{\"active\":");
@@ -223,7 +244,8 @@ TEST_F(DesignBookTest, WhatCannotBeExplainedIsRefused) {
 
 TEST_F(DesignBookTest, ConfigLoadsTheDesignBesideItAndReportsItsLine) {
   std::ofstream(dir_ / "rug.csv") << "palette,R,#ff0000\nR,R\nR,Q\n";
-  std::ofstream(dir_ / "loom.toml") << "extends = \"default\"\n[knotting]\nmode = \"weaver\"\n[recipe]\ndesign = \"rug.csv\"\n";
+  std::ofstream(dir_ / "loom.toml")
+      << "extends = \"default\"\n[knotting]\nmode = \"weaver\"\n[recipe]\ndesign = \"rug.csv\"\n";
   try {
     loom::firmware::load_loom_config((dir_ / "loom.toml").string());
     FAIL() << "accepted";

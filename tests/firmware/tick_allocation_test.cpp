@@ -1,14 +1,14 @@
 // Proves the RT tick allocates nothing after start-up: global operator new is replaced in this test
-// executable (tests/support) and counts calls made on the loop's thread while ControlLoop::cycle runs, over a whole
-// weaving run (> 10,000 ticks) with telemetry publishing through real LCM on another thread.
+// executable (tests/support) and counts calls made on the loop's thread while ControlLoop::cycle runs, over a
+// whole weaving run (> 10,000 ticks) with telemetry publishing through real LCM on another thread.
 #include <gtest/gtest.h>
 
 #include <string>
 
+#include "alloc_counter.hpp"
 #include "loom/config/config.hpp"
 #include "loom/config/scene_config.hpp"
 #include "loom/firmware/machine.hpp"
-#include "alloc_counter.hpp"
 
 using namespace loom;
 

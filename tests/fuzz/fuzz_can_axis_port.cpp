@@ -109,8 +109,9 @@ struct Template {
       std::fprintf(stderr, "bring-up against the simulated drives failed: %s\n", s.message().c_str());
       std::abort();
     }
-    rig.run_until(test::DriveRig::hold(hal::AxisRequest::kEnable),
-                  [&] { return rig.all_in(hal::DriveState::kOperationEnabled); }, 100);
+    rig.run_until(
+        test::DriveRig::hold(hal::AxisRequest::kEnable),
+        [&] { return rig.all_in(hal::DriveState::kOperationEnabled); }, 100);
     if (!rig.all_in(hal::DriveState::kOperationEnabled)) {
       std::fprintf(stderr, "the simulated drives did not reach Operation Enabled\n");
       std::abort();
@@ -169,9 +170,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
           if (!std::isfinite(fb.position)) fail("position not finite", i, fb.position);
           if (!std::isfinite(fb.velocity)) fail("velocity not finite", i, fb.velocity);
           if (!std::isfinite(fb.effort)) fail("effort not finite", i, fb.effort);
-          if (fb.referenced && fb.homing_error) fail("referenced and in homing error at once", i, fb.position);
+          if (fb.referenced && fb.homing_error)
+            fail("referenced and in homing error at once", i, fb.position);
         }
-        if (bus_off_queued && bus.pending() == 0 && !link.link_fault) fail("bus-off read but no link fault", 0, 0.0);
+        if (bus_off_queued && bus.pending() == 0 && !link.link_fault)
+          fail("bus-off read but no link fault", 0, 0.0);
         test::DriveRig::hold(request)(feedback, commands);
         port.write_axes(now, commands);
         ++now;

@@ -23,13 +23,14 @@ namespace {
 using namespace loom::drivers;
 
 [[noreturn]] void fail(const char* what, const CanFrame& f) {
-  std::fprintf(stderr, "decoder property violated: %s (id 0x%X dlc %u flags %u data", what, f.id, f.dlc, f.flags);
+  std::fprintf(stderr, "decoder property violated: %s (id 0x%X dlc %u flags %u data", what, f.id, f.dlc,
+               f.flags);
   for (const auto b : f.data) std::fprintf(stderr, " %02X", b);
   std::fprintf(stderr, ")\n");
   std::abort();
 }
-#define CHECK(cond, f) \
-  do {                 \
+#define CHECK(cond, f)           \
+  do {                           \
     if (!(cond)) fail(#cond, f); \
   } while (0)
 
@@ -38,7 +39,9 @@ std::uint32_t le(const CanFrame& f, std::size_t at, std::size_t bytes) {
   for (std::size_t i = 0; i < bytes; ++i) v |= static_cast<std::uint32_t>(f.data[at + i]) << (8 * i);
   return v;
 }
-bool is_data(const CanFrame& f) { return !f.is_error() && !f.is_rtr(); }
+bool is_data(const CanFrame& f) {
+  return !f.is_error() && !f.is_rtr();
+}
 
 // The frame from the input: 2 bytes id (11 bits; all 32 bits of the class mask for error frames), 1 byte
 // flags, 1 byte DLC (0..8, as SocketCAN delivers classic frames), 8 data bytes. Short inputs are padded.
@@ -48,7 +51,8 @@ CanFrame frame_from(const std::uint8_t* data, std::size_t size) {
   CanFrame f;
   f.flags = static_cast<std::uint8_t>(b[2] & (CanFrame::kError | CanFrame::kRtr));
   const std::uint32_t raw = static_cast<std::uint32_t>(b[0]) | (static_cast<std::uint32_t>(b[1]) << 8);
-  f.id = f.is_error() ? raw | (size > 12 ? static_cast<std::uint32_t>(data[12]) << 16 : 0U) : raw & kMaxStandardId;
+  f.id = f.is_error() ? raw | (size > 12 ? static_cast<std::uint32_t>(data[12]) << 16 : 0U)
+                      : raw & kMaxStandardId;
   f.dlc = static_cast<std::uint8_t>(b[3] % 9);
   for (std::size_t i = 0; i < 8; ++i) f.data[i] = b[4 + i];
   return f;
@@ -61,7 +65,9 @@ void check_emcy(const CanFrame& f) {
   CHECK(e->node == f.id - 0x080 && e->code == le(f, 0, 2) && e->error_register == f.data[2], f);
   for (std::size_t i = 0; i < 5; ++i) CHECK(e->vendor[i] == f.data[3 + i], f);
   const auto again = parse_emcy(make_emcy(e->node, e->code, e->error_register));
-  CHECK(again && again->node == e->node && again->code == e->code && again->error_register == e->error_register, f);
+  CHECK(
+      again && again->node == e->node && again->code == e->code && again->error_register == e->error_register,
+      f);
   CHECK(fault_code_text(e->code) != nullptr, f);
 }
 
@@ -99,7 +105,8 @@ void check_pdos(const CanFrame& f) {
               p->torque_actual == static_cast<std::int16_t>(le(f, 4, 2)),
           f);
     const auto again = unpack_tpdo2(pack_tpdo2(node, *p), node);
-    CHECK(again && again->velocity_actual == p->velocity_actual && again->torque_actual == p->torque_actual, f);
+    CHECK(again && again->velocity_actual == p->velocity_actual && again->torque_actual == p->torque_actual,
+          f);
   }
   if (const auto p = unpack_rpdo1(f, node)) {
     CHECK(is_data(f) && f.id == 0x200u + node && f.dlc >= 6, f);
@@ -113,7 +120,8 @@ void check_sdo(const CanFrame& f) {
   const SdoReply r = parse_sdo_reply(f);
   if (r.kind != SdoReplyKind::kInvalid) {
     CHECK(is_data(f) && f.dlc == 8 && r.index == le(f, 1, 2) && r.sub == f.data[3], f);
-    if (r.kind == SdoReplyKind::kAbort) CHECK(r.value == le(f, 4, 4) && sdo_abort_text(r.value) != nullptr, f);
+    if (r.kind == SdoReplyKind::kAbort)
+      CHECK(r.value == le(f, 4, 4) && sdo_abort_text(r.value) != nullptr, f);
     if (r.kind == SdoReplyKind::kUploadExpedited) {
       CHECK(r.size >= 1 && r.size <= 4 && r.value == le(f, 4, r.size), f);
       const SdoReply again = parse_sdo_reply(make_sdo_upload_reply(1, r.index, r.sub, r.value, r.size));
@@ -129,7 +137,8 @@ void check_sdo(const CanFrame& f) {
     if (q.kind == SdoRequestKind::kDownloadExpedited && q.size > 0) {
       CHECK(q.size <= 4 && q.value == le(f, 4, q.size), f);
       const SdoRequest again = parse_sdo_request(make_sdo_download(1, q.index, q.sub, q.value, q.size));
-      CHECK(again.kind == q.kind && again.index == q.index && again.value == q.value && again.size == q.size, f);
+      CHECK(again.kind == q.kind && again.index == q.index && again.value == q.value && again.size == q.size,
+            f);
     }
     if (q.kind == SdoRequestKind::kAbort) CHECK(q.value == le(f, 4, 4), f);
   }
@@ -138,8 +147,8 @@ void check_sdo(const CanFrame& f) {
 void check_error_frame(const CanFrame& f) {
   const CanErrorInfo e = decode_error_frame(f);
   if (!f.is_error()) {
-    CHECK(!e.bus_off && !e.restarted && !e.error_passive && !e.warning && !e.overflow && !e.no_ack && !e.protocol &&
-              !e.tx_timeout,
+    CHECK(!e.bus_off && !e.restarted && !e.error_passive && !e.warning && !e.overflow && !e.no_ack &&
+              !e.protocol && !e.tx_timeout,
           f);
   }
 }
@@ -147,7 +156,8 @@ void check_error_frame(const CanFrame& f) {
 void check_cob(const CanFrame& f) {
   const CobDecoded c = decode_cob_id(f.id);
   if (f.is_error()) return;  // the id of an error frame is a class mask, not a COB-ID
-  if (c.function != CobFunction::kOther && c.function != CobFunction::kNmt && c.function != CobFunction::kSync) {
+  if (c.function != CobFunction::kOther && c.function != CobFunction::kNmt &&
+      c.function != CobFunction::kSync) {
     CHECK(c.node >= kMinNodeId && c.node <= kMaxNodeId && c.node == (f.id & 0x7F), f);
   }
 }

@@ -134,8 +134,8 @@ drivers::CanIoConfig wiring_32_bits() {
 drivers::CanIoConfig panel_module() {
   drivers::CanIoConfig c;
   drivers::IoWiring& w = c.wiring;
-  for (drivers::IoBit* b : {&w.lamp_green, &w.lamp_amber, &w.lamp_red, &w.buzzer, &w.button_start, &w.button_pause,
-                            &w.button_ack}) {
+  for (drivers::IoBit* b : {&w.lamp_green, &w.lamp_amber, &w.lamp_red, &w.buzzer, &w.button_start,
+                            &w.button_pause, &w.button_ack}) {
     b->module = 1;
   }
   w.button_ack.active_low = true;
@@ -146,9 +146,9 @@ drivers::CanIoConfig panel_module() {
 // By hand: what module 1 of panel_module() carries, nothing else.
 drivers::IoWiring panel_model() {
   drivers::IoWiring w;
-  for (drivers::IoBit* b : {&w.piston_a_extended, &w.piston_a_retracted, &w.piston_b_extended, &w.piston_b_retracted,
-                            &w.shuttle_at_left, &w.shuttle_at_right, &w.estop_ok, &w.row_knotted, &w.piston_a_extend,
-                            &w.piston_b_extend}) {
+  for (drivers::IoBit* b : {&w.piston_a_extended, &w.piston_a_retracted, &w.piston_b_extended,
+                            &w.piston_b_retracted, &w.shuttle_at_left, &w.shuttle_at_right, &w.estop_ok,
+                            &w.row_knotted, &w.piston_a_extend, &w.piston_b_extend}) {
     *b = {};
   }
   for (drivers::IoBit& b : w.second) b = {};
@@ -358,7 +358,8 @@ struct Checker {
     expect_input("shuttle_at_right", io.shuttle_at_right, m.input(w.shuttle_at_right), m);
     // The chain's module reads it closed before its first TPDO (no news is not an opened chain); a module
     // without it reads false (CanIoModules takes it from the one that has it).
-    expect_input("estop_ok", io.estop_ok, w.estop_ok.bit >= 0 && (m.inputs_refreshed == hal::kNeverTick || m.input(w.estop_ok)), m);
+    expect_input("estop_ok", io.estop_ok,
+                 w.estop_ok.bit >= 0 && (m.inputs_refreshed == hal::kNeverTick || m.input(w.estop_ok)), m);
     expect_input("button_start", io.button_start, m.input(w.button_start), m);
     expect_input("button_pause", io.button_pause, m.input(w.button_pause), m);
     expect_input("button_ack", io.button_ack, m.input(w.button_ack), m);
@@ -371,8 +372,9 @@ struct Checker {
       expect_input(kSecond[i], io.second_channel[i], m.input(w.second[i]), m);
     }
     static constexpr std::array<const char*, hal::kMaxKnottingHeads> kYarn{
-        "yarn_present[0]", "yarn_present[1]", "yarn_present[2]", "yarn_present[3]", "yarn_present[4]",  "yarn_present[5]",
-        "yarn_present[6]", "yarn_present[7]", "yarn_present[8]", "yarn_present[9]", "yarn_present[10]", "yarn_present[11]"};
+        "yarn_present[0]", "yarn_present[1]", "yarn_present[2]",  "yarn_present[3]",
+        "yarn_present[4]", "yarn_present[5]", "yarn_present[6]",  "yarn_present[7]",
+        "yarn_present[8]", "yarn_present[9]", "yarn_present[10]", "yarn_present[11]"};
     for (std::size_t h = 0; h < hal::kMaxKnottingHeads; ++h) {
       // A head the wiring does not use (or the loom lacks) never reads a knot.
       const bool want = static_cast<int>(h) < w.heads && m.input(w.yarn_present[h]);
@@ -494,9 +496,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const std::array<std::uint8_t, 8> want =
         rpdo_bytes(wiring, m.link_fault != 0 ? drivers::io_safe_outputs() : out);
     if (f.id != kRpdo1Id || f.dlc != t.layout.output_bytes || f.flags != 0 || f.data != want) {
-      fail("write_io sent 0x%03X [%u] %02X %02X %02X (link fault 0x%04X), expected 0x%03X [%u] %02X %02X %02X", f.id,
-           f.dlc, f.data[0], f.data[1], f.data[2], m.link_fault, kRpdo1Id, t.layout.output_bytes, want[0], want[1],
-           want[2]);
+      fail(
+          "write_io sent 0x%03X [%u] %02X %02X %02X (link fault 0x%04X), expected 0x%03X [%u] %02X %02X %02X",
+          f.id, f.dlc, f.data[0], f.data[1], f.data[2], m.link_fault, kRpdo1Id, t.layout.output_bytes,
+          want[0], want[1], want[2]);
     }
     ++now;
   };

@@ -13,8 +13,9 @@
 
 namespace {
 void check(const loom::design::Design& d) {
-  if (d.width() < 1 || d.width() > loom::design::kMaxWidth || d.height() < 1 || d.height() > loom::design::kMaxHeight ||
-      d.palette().empty() || d.palette().size() > static_cast<std::size_t>(loom::design::kMaxColours)) {
+  if (d.width() < 1 || d.width() > loom::design::kMaxWidth || d.height() < 1 ||
+      d.height() > loom::design::kMaxHeight || d.palette().empty() ||
+      d.palette().size() > static_cast<std::size_t>(loom::design::kMaxColours)) {
     std::abort();
   }
   for (int r = 0; r < d.height(); ++r) {

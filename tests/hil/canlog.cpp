@@ -62,7 +62,9 @@ std::uint32_t Frame::u32(std::size_t at) const {
          (static_cast<std::uint32_t>(data[at + 3]) << 24U);
 }
 
-std::int32_t Frame::i32(std::size_t at) const { return static_cast<std::int32_t>(u32(at)); }
+std::int32_t Frame::i32(std::size_t at) const {
+  return static_cast<std::int32_t>(u32(at));
+}
 
 std::optional<Frame> parse_candump_line(std::string_view line, std::string& error) {
   std::istringstream words{std::string(line)};

@@ -16,14 +16,14 @@ namespace loom::hil {
 
 // One classic CAN frame as candump -L logged it.
 struct Frame {
-  std::int64_t t_us = 0;         // candump's timestamp, microseconds since the epoch
-  std::uint32_t id = 0;          // 11-bit (or 29-bit when `extended`)
+  std::int64_t t_us = 0;  // candump's timestamp, microseconds since the epoch
+  std::uint32_t id = 0;   // 11-bit (or 29-bit when `extended`)
   bool extended = false;
   bool rtr = false;
-  bool error_frame = false;      // CAN_ERR_FLAG set: not a bus frame, a controller report
-  std::uint8_t len = 0;          // data bytes, 0..8
+  bool error_frame = false;  // CAN_ERR_FLAG set: not a bus frame, a controller report
+  std::uint8_t len = 0;      // data bytes, 0..8
   std::array<std::uint8_t, 8> data{};
-  std::size_t line = 0;          // 1-based line in the log, for messages
+  std::size_t line = 0;  // 1-based line in the log, for messages
 
   // Little-endian fields as CANopen lays them out. Callers check `len` first.
   std::uint16_t u16(std::size_t at) const;

@@ -1,6 +1,8 @@
 // Unit tests of the HIL judge (candump parser and protocol checks) on synthetic logs written from the
 // CiA 301/402 rules, so the HIL tests can be trusted to fail: each broken rule must be caught and
 // named, and a conforming exchange must pass.
+#include "canlog.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -10,7 +12,6 @@
 #include <string>
 #include <vector>
 
-#include "canlog.hpp"
 #include "protocol_checks.hpp"
 
 namespace loom::hil {
@@ -275,7 +276,7 @@ TEST(HilJudgeWeaveProtocol, MissingTpdosAreCaught) {
 // later and quick-stops (0x0002), holding the target.
 // ---------------------------------------------------------------------------------------------------
 struct Loss {
-  int detect_cycles = 40;          // 160 ms after the kill
+  int detect_cycles = 40;  // 160 ms after the kill
   bool moves_after_fault = false;
   bool reenables = false;
   bool reacts = true;
@@ -372,7 +373,8 @@ TEST(HilJudgeIo, EverySignalSeenPassesAndAMissingOneIsNamed) {
       "(1.000000) vcan0 204#01\n(1.002000) vcan0 204#02\n(1.004000) vcan0 184#4A00\n"
       "(1.006000) vcan0 184#5500\n(1.008000) vcan0 184#6000\n(1.010000) vcan0 284#2C01\n";
   EXPECT_TRUE(check_io_traffic(parse_log(full), 4).ok);
-  const std::string no_right = "(1.000000) vcan0 204#03\n(1.004000) vcan0 184#5F00\n(1.010000) vcan0 284#2C01\n";
+  const std::string no_right =
+      "(1.000000) vcan0 204#03\n(1.004000) vcan0 184#5F00\n(1.010000) vcan0 284#2C01\n";
   const CheckResult r = check_io_traffic(parse_log(no_right), 4);
   ASSERT_FALSE(r.ok);
   EXPECT_EQ(r.failure, "never seen on the bus: shuttle at right");
@@ -401,22 +403,23 @@ TEST(HilJudgeIo, SecondSwitchesMustBeCarriedSeenAndAgreeWithTheirFirst) {
       "(1.010000) vcan0 284#2C01\n";
   const CheckResult a = check_io_traffic(parse_log(apart), 4, true);
   ASSERT_FALSE(a.ok);
-  EXPECT_NE(a.failure.find("second switches 0x20 disagree with first switches 0x00"), std::string::npos) << a.failure;
+  EXPECT_NE(a.failure.find("second switches 0x20 disagree with first switches 0x00"), std::string::npos)
+      << a.failure;
 }
 
 // One head (gripper bit 8, cutter bit 20 in the I/O node's RPDO 0x204; yarn-present bit 24 in its TPDO
 // 0x184; selector node 21, carriage node 2), two knots: select, grip, cut, knot seen, open, carriage on.
 std::string knot_log(const std::string& middle = "") {
-  return "(1.000000) vcan0 215#0F0000000000\n"        // selector at slot 0
-         "(1.001000) vcan0 202#0F0000000000\n"        // carriage at knot 0
-         "(1.002000) vcan0 204#000100\n"              // gripper closes
-         "(1.003000) vcan0 204#000110\n"              // cutter fires
-         "(1.004000) vcan0 184#00000001\n"            // knot seen
-         "(1.005000) vcan0 204#000000\n"              // gripper opens, cutter back
+  return "(1.000000) vcan0 215#0F0000000000\n"  // selector at slot 0
+         "(1.001000) vcan0 202#0F0000000000\n"  // carriage at knot 0
+         "(1.002000) vcan0 204#000100\n"        // gripper closes
+         "(1.003000) vcan0 204#000110\n"        // cutter fires
+         "(1.004000) vcan0 184#00000001\n"      // knot seen
+         "(1.005000) vcan0 204#000000\n"        // gripper opens, cutter back
          + middle +
-         "(1.006000) vcan0 202#0F0010000000\n"        // carriage one pitch on
+         "(1.006000) vcan0 202#0F0010000000\n"  // carriage one pitch on
          "(1.007000) vcan0 184#00000000\n"
-         "(1.008000) vcan0 215#0F0000080000\n"        // selector to slot 1
+         "(1.008000) vcan0 215#0F0000080000\n"  // selector to slot 1
          "(1.009000) vcan0 204#000100\n"
          "(1.010000) vcan0 204#000110\n"
          "(1.011000) vcan0 184#00000001\n"
@@ -438,24 +441,32 @@ TEST(HilJudgeKnotting, EveryCutIsAKnotSeenAndNothingMovesUnderAClosedGripper) {
   EXPECT_TRUE(ok.ok) << ok.failure;
   KnottingWiring three = one_head();
   three.knots_per_head = 3;
-  EXPECT_EQ(check_knotting(parse_log(knot_log()), 4, three).failure, "head 1: 2 cuts and 2 knots seen, expected 3 of each");
+  EXPECT_EQ(check_knotting(parse_log(knot_log()), 4, three).failure,
+            "head 1: 2 cuts and 2 knots seen, expected 3 of each");
   // The carriage moved with the gripper closed.
   const CheckResult dragged =
       check_knotting(parse_log("(0.998000) vcan0 202#0F0030000000\n(0.999000) vcan0 204#000100\n"
-                               "(0.999500) vcan0 202#0F0000000000\n" + knot_log()),
+                               "(0.999500) vcan0 202#0F0000000000\n" +
+                               knot_log()),
                      4, one_head());
-  EXPECT_NE(dragged.failure.find("the carriage moved while a gripper was closed"), std::string::npos) << dragged.failure;
+  EXPECT_NE(dragged.failure.find("the carriage moved while a gripper was closed"), std::string::npos)
+      << dragged.failure;
   // The selector turned under held yarn.
   const CheckResult turned = check_knotting(
-      parse_log(knot_log("(1.005500) vcan0 204#000100\n(1.005600) vcan0 215#0F0000040000\n(1.005700) vcan0 204#000000\n")), 4,
-      one_head());
-  EXPECT_NE(turned.failure.find("head 1's selector turned under its closed gripper"), std::string::npos) << turned.failure;
+      parse_log(knot_log(
+          "(1.005500) vcan0 204#000100\n(1.005600) vcan0 215#0F0000040000\n(1.005700) vcan0 204#000000\n")),
+      4, one_head());
+  EXPECT_NE(turned.failure.find("head 1's selector turned under its closed gripper"), std::string::npos)
+      << turned.failure;
   // A cut with the gripper open, and a cut whose knot was never seen.
-  const CheckResult open_cut = check_knotting(parse_log("(0.500000) vcan0 204#000010\n(0.600000) vcan0 204#000000\n" + knot_log()), 4, one_head());
-  EXPECT_NE(open_cut.failure.find("head 1's cutter fired with its gripper open"), std::string::npos) << open_cut.failure;
+  const CheckResult open_cut = check_knotting(
+      parse_log("(0.500000) vcan0 204#000010\n(0.600000) vcan0 204#000000\n" + knot_log()), 4, one_head());
+  EXPECT_NE(open_cut.failure.find("head 1's cutter fired with its gripper open"), std::string::npos)
+      << open_cut.failure;
   std::string missed = knot_log();
   missed.replace(missed.find("(1.011000) vcan0 184#00000001\n"), 30, "(1.011000) vcan0 184#00000000\n");
-  EXPECT_EQ(check_knotting(parse_log(missed), 4, one_head()).failure, "head 1: 2 cuts and 1 knots seen, expected 2 of each");
+  EXPECT_EQ(check_knotting(parse_log(missed), 4, one_head()).failure,
+            "head 1: 2 cuts and 1 knots seen, expected 2 of each");
 }
 
 TEST(HilJudgeEmcy, EveryDriveStopsWithinOneCycleOfTheEmcyAndStaysStopped) {
@@ -491,7 +502,9 @@ TEST(HilJudgeEmcy, EveryDriveStopsWithinOneCycleOfTheEmcyAndStaysStopped) {
   EXPECT_NE(g.failure.find("re-enabled"), std::string::npos) << g.failure;
   // A drive the master stopped talking to, and a log that ends before the next cycle.
   EXPECT_FALSE(check_emcy_stop(parse_log(again), {1, 3}, 2).ok);
-  EXPECT_FALSE(check_emcy_stop(parse_log("(1.001000) vcan0 082#1023030000000000\n(1.004000) vcan0 080#\n"), {1}, 2).ok);
+  EXPECT_FALSE(
+      check_emcy_stop(parse_log("(1.001000) vcan0 082#1023030000000000\n(1.004000) vcan0 080#\n"), {1}, 2)
+          .ok);
 }
 
 TEST(HilJudgeFeedbackLag, ATpdoTrailingItsSyncIsCountedAndOverTheLimitFails) {
@@ -520,7 +533,8 @@ TEST(HilJudgeFeedbackLag, ATpdoTrailingItsSyncIsCountedAndOverTheLimitFails) {
 
 TEST(HilJudgeMasterLoss, EveryConsumerMustReactInTime) {
   const std::string ok =
-      "(1.000000) vcan0 77F#05\n(1.160000) vcan0 081#3081100000000000\n(1.170000) vcan0 084#3081110000000000\n";
+      "(1.000000) vcan0 77F#05\n(1.160000) vcan0 081#3081100000000000\n(1.170000) vcan0 "
+      "084#3081110000000000\n";
   EXPECT_TRUE(check_master_loss(parse_log(ok), {1, 4}, 127, 0.150, 0.05).ok);
   EXPECT_FALSE(check_master_loss(parse_log(ok), {1, 2}, 127, 0.150, 0.05).ok);  // node 2 silent
   EXPECT_FALSE(check_master_loss(parse_log(ok), {1, 4}, 127, 0.100, 0.01).ok);  // too late for 100 ms

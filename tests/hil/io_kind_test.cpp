@@ -55,14 +55,16 @@ TEST(IoKind, ExplicitSimulatedIoGetsPastTheRefusal) {
     EXPECT_EQ(std::string(e.what()), "CAN interface 'nosuchcan7' does not exist");
   }
   EXPECT_NE(std::string(kSimulatedIoBanner).find("SIMULATED I/O"), std::string::npos);
-  EXPECT_NE(std::string(kSimulatedIoBanner).find("interlocks are not protecting anything"), std::string::npos);
+  EXPECT_NE(std::string(kSimulatedIoBanner).find("interlocks are not protecting anything"),
+            std::string::npos);
 }
 
 // --iface names one interface per bus, bus 0 first; a count that does not match the machine's buses is
 // refused before any interface is opened, and the second name is the one opened for bus 1.
 TEST(Iface, OneInterfacePerBusCommaSeparated) {
   const LoomConfig four = parse_loom_config(
-      "extends = \"default\"\n[axes.take_up]\nrole = \"auxiliary\"\nbus = 1\nnode = 5\ncounts_per_rev = 4096\n"
+      "extends = \"default\"\n[axes.take_up]\nrole = \"auxiliary\"\nbus = 1\nnode = 5\ncounts_per_rev = "
+      "4096\n"
       "max_speed = 2.0\nferror_min = 0.1\nreferencing = \"absolute\"\n",
       "four.toml");
   const auto error_of = [&](const std::string& iface) -> std::string {
@@ -76,7 +78,8 @@ TEST(Iface, OneInterfacePerBusCommaSeparated) {
     return "accepted";
   };
   std::string e = error_of("nosuchcan7");
-  EXPECT_NE(e.find("--iface \"nosuchcan7\" names 1 interface(s), but four.toml puts its axes and I/O modules on 2 CAN bus(es)"),
+  EXPECT_NE(e.find("--iface \"nosuchcan7\" names 1 interface(s), but four.toml puts its axes and I/O modules "
+                   "on 2 CAN bus(es)"),
             std::string::npos)
       << e;
   e = error_of("nosuchcan7,nosuchcan7");
@@ -99,7 +102,8 @@ TEST(IoKind, BadWiringIsAConfigErrorAtTheLineThatIsWrong) {
   };
   const std::string e = error_of("extends = \"default\"\n[io]\nbutton_ack_bit = 6\n");
   EXPECT_EQ(e.rfind("loom.toml:3:18: io.button_ack_bit = 6:", 0), 0u) << e;
-  EXPECT_NE(e.find("io.inputs.button_ack.bit = 6 is already used by io.inputs.estop_ok"), std::string::npos) << e;
+  EXPECT_NE(e.find("io.inputs.button_ack.bit = 6 is already used by io.inputs.estop_ok"), std::string::npos)
+      << e;
   EXPECT_EQ(error_of("extends = \"default\"\n[io]\nnode = 2\n"),
             "loom.toml:3:8: io.node = 2: node id already used by axes.carriage.node");
 }

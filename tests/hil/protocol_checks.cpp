@@ -4,7 +4,6 @@
 #include "protocol_checks.hpp"
 
 #include <cmath>
-
 #include <cstdio>
 #include <functional>
 #include <optional>
@@ -20,9 +19,13 @@ constexpr std::uint8_t kNmtStart = 0x01;
 constexpr std::uint8_t kNmtResetNode = 0x81;
 constexpr std::uint16_t kCwEnableOperation = 0x000F;
 
-std::uint32_t cob(std::uint32_t base, int node) { return base + static_cast<std::uint32_t>(node); }
+std::uint32_t cob(std::uint32_t base, int node) {
+  return base + static_cast<std::uint32_t>(node);
+}
 
-bool standard(const Frame& f) { return !f.extended && !f.error_frame && !f.rtr; }
+bool standard(const Frame& f) {
+  return !f.extended && !f.error_frame && !f.rtr;
+}
 
 bool is_nmt(const Frame& f, std::uint8_t command, int node) {
   return standard(f) && f.id == 0x000 && f.len == 2 && f.data[0] == command &&
@@ -31,12 +34,18 @@ bool is_nmt(const Frame& f, std::uint8_t command, int node) {
 bool is_heartbeat(const Frame& f, int node) {
   return standard(f) && f.id == cob(0x700, node) && f.len == 1;
 }
-bool is_sync(const Frame& f) { return standard(f) && f.id == 0x080 && f.len <= 1; }
+bool is_sync(const Frame& f) {
+  return standard(f) && f.id == 0x080 && f.len <= 1;
+}
 bool is_sdo(const Frame& f, std::uint32_t base, int node, std::uint16_t index, std::uint8_t sub) {
   return standard(f) && f.id == cob(base, node) && f.len == 8 && f.u16(1) == index && f.data[3] == sub;
 }
-bool is_rpdo(const Frame& f, int node) { return standard(f) && f.id == cob(0x200, node); }
-bool is_tpdo(const Frame& f, int node) { return standard(f) && f.id == cob(0x180, node); }
+bool is_rpdo(const Frame& f, int node) {
+  return standard(f) && f.id == cob(0x200, node);
+}
+bool is_tpdo(const Frame& f, int node) {
+  return standard(f) && f.id == cob(0x180, node);
+}
 
 // Controlword the master sent to `node` in this frame: RPDO1, or an SDO download to 0x6040.
 std::optional<std::uint16_t> controlword(const Frame& f, int node, const PdoLayout& l) {
@@ -88,13 +97,17 @@ CheckResult fail(CheckResult r, std::string why) {
   return r;
 }
 
-std::string node_tag(int node) { return "node " + std::to_string(node) + ": "; }
+std::string node_tag(int node) {
+  return "node " + std::to_string(node) + ": ";
+}
 
 // Statusword decoding per CiA 402 (mask → value).
 bool ready_or_switched_on(std::uint16_t sw) {
   return (sw & 0x6FU) == 0x21U || (sw & 0x6FU) == 0x23U;
 }
-bool operation_enabled(std::uint16_t sw) { return (sw & 0x6FU) == 0x27U; }
+bool operation_enabled(std::uint16_t sw) {
+  return (sw & 0x6FU) == 0x27U;
+}
 
 }  // namespace
 
@@ -108,19 +121,34 @@ TrafficSummary summarize(const std::vector<Frame>& frames) {
     s.span_s = static_cast<double>(frames.back().t_us - frames.front().t_us) * 1e-6;
   }
   for (const Frame& f : frames) {
-    if (f.error_frame) { ++s.error_frames; continue; }
-    if (f.extended) { ++s.other; continue; }
+    if (f.error_frame) {
+      ++s.error_frames;
+      continue;
+    }
+    if (f.extended) {
+      ++s.other;
+      continue;
+    }
     const std::uint32_t fn = f.id & 0x780U;  // function code (upper 4 bits of the 11-bit id)
     const std::uint32_t node = f.id & 0x7FU;
-    if (f.id == 0x000) ++s.nmt;
-    else if (f.id == 0x080) ++s.sync;
-    else if (fn == 0x080 && node != 0) ++s.emcy;
-    else if ((fn == 0x180 || fn == 0x280 || fn == 0x380 || fn == 0x480) && node != 0) ++s.tpdo;
-    else if ((fn == 0x200 || fn == 0x300 || fn == 0x400 || fn == 0x500) && node != 0) ++s.rpdo;
-    else if (fn == 0x580 && node != 0) ++s.sdo_reply;
-    else if (fn == 0x600 && node != 0) ++s.sdo_request;
-    else if (fn == 0x700 && node != 0) ++s.heartbeat;
-    else ++s.other;
+    if (f.id == 0x000)
+      ++s.nmt;
+    else if (f.id == 0x080)
+      ++s.sync;
+    else if (fn == 0x080 && node != 0)
+      ++s.emcy;
+    else if ((fn == 0x180 || fn == 0x280 || fn == 0x380 || fn == 0x480) && node != 0)
+      ++s.tpdo;
+    else if ((fn == 0x200 || fn == 0x300 || fn == 0x400 || fn == 0x500) && node != 0)
+      ++s.rpdo;
+    else if (fn == 0x580 && node != 0)
+      ++s.sdo_reply;
+    else if (fn == 0x600 && node != 0)
+      ++s.sdo_request;
+    else if (fn == 0x700 && node != 0)
+      ++s.heartbeat;
+    else
+      ++s.other;
   }
   return s;
 }
@@ -129,10 +157,10 @@ std::string describe(const TrafficSummary& s) {
   std::ostringstream o;
   o.setf(std::ios::fixed);
   o.precision(2);
-  o << s.total << " frames in " << s.span_s << " s: nmt=" << s.nmt << " sync=" << s.sync
-    << " rpdo=" << s.rpdo << " tpdo=" << s.tpdo << " sdo_request=" << s.sdo_request
-    << " sdo_reply=" << s.sdo_reply << " heartbeat=" << s.heartbeat << " emcy=" << s.emcy
-    << " other=" << s.other << " error_frames=" << s.error_frames;
+  o << s.total << " frames in " << s.span_s << " s: nmt=" << s.nmt << " sync=" << s.sync << " rpdo=" << s.rpdo
+    << " tpdo=" << s.tpdo << " sdo_request=" << s.sdo_request << " sdo_reply=" << s.sdo_reply
+    << " heartbeat=" << s.heartbeat << " emcy=" << s.emcy << " other=" << s.other
+    << " error_frames=" << s.error_frames;
   return o.str();
 }
 
@@ -148,37 +176,47 @@ CheckResult check_weave_protocol(const std::vector<Frame>& fs, const std::vector
     const Index reset = find_from(fs, 0, [&](const Frame& f) { return is_nmt(f, kNmtResetNode, n); });
     if (!reset) return fail(r, tag + "no NMT reset-node (000#8100 or 000#81 with the node id)");
 
-    const Index boot = find_from(fs, *reset + 1, [&](const Frame& f) {
-      return is_heartbeat(f, n) && f.data[0] == 0x00;
-    });
-    if (!boot) return fail(r, tag + "no boot-up " + hex(cob(0x700, n), 3) + " [00] after the NMT reset at " + show(fs, *reset));
+    const Index boot =
+        find_from(fs, *reset + 1, [&](const Frame& f) { return is_heartbeat(f, n) && f.data[0] == 0x00; });
+    if (!boot)
+      return fail(r, tag + "no boot-up " + hex(cob(0x700, n), 3) + " [00] after the NMT reset at " +
+                         show(fs, *reset));
 
     const Index mode_dl = find_from(fs, *boot + 1, [&](const Frame& f) {
       return is_sdo(f, 0x600, n, 0x6060, 0) && f.data[0] == 0x2F && f.data[4] == 8;
     });
-    if (!mode_dl) return fail(r, tag + "no SDO download 0x6060:00 = 8 (cs 0x2F) after the boot-up at " + show(fs, *boot));
-    const Index mode_ack = find_from(fs, *mode_dl + 1, [&](const Frame& f) { return is_sdo(f, 0x580, n, 0x6060, 0); });
+    if (!mode_dl)
+      return fail(r, tag + "no SDO download 0x6060:00 = 8 (cs 0x2F) after the boot-up at " + show(fs, *boot));
+    const Index mode_ack =
+        find_from(fs, *mode_dl + 1, [&](const Frame& f) { return is_sdo(f, 0x580, n, 0x6060, 0); });
     if (!mode_ack) return fail(r, tag + "no SDO reply to the 0x6060 download at " + show(fs, *mode_dl));
     if (fs[*mode_ack].data[0] != 0x60) {
-      return fail(r, tag + "0x6060 download not acknowledged with 0x60 (abort " + hex(fs[*mode_ack].u32(4), 8) + "?) at " + show(fs, *mode_ack));
+      return fail(r, tag + "0x6060 download not acknowledged with 0x60 (abort " +
+                         hex(fs[*mode_ack].u32(4), 8) + "?) at " + show(fs, *mode_ack));
     }
 
     const Index mode_ul = find_from(fs, *mode_ack + 1, [&](const Frame& f) {
       return is_sdo(f, 0x600, n, 0x6061, 0) && f.data[0] == 0x40;
     });
-    if (!mode_ul) return fail(r, tag + "no SDO upload of 0x6061:00 (cs 0x40) after the mode was set at " + show(fs, *mode_ack));
-    const Index mode_up = find_from(fs, *mode_ul + 1, [&](const Frame& f) { return is_sdo(f, 0x580, n, 0x6061, 0); });
+    if (!mode_ul)
+      return fail(
+          r, tag + "no SDO upload of 0x6061:00 (cs 0x40) after the mode was set at " + show(fs, *mode_ack));
+    const Index mode_up =
+        find_from(fs, *mode_ul + 1, [&](const Frame& f) { return is_sdo(f, 0x580, n, 0x6061, 0); });
     if (!mode_up) return fail(r, tag + "no SDO reply to the 0x6061 upload at " + show(fs, *mode_ul));
     // Expedited upload reply: ccs 2 (0x40) with the expedited bit (0x02); size bits may vary.
     if ((fs[*mode_up].data[0] & 0xE2U) != 0x42U) {
       return fail(r, tag + "0x6061 upload not answered expedited (cs 0x4F/0x43…) at " + show(fs, *mode_up));
     }
     if (fs[*mode_up].data[4] != 8) {
-      return fail(r, tag + "0x6061 reads " + std::to_string(fs[*mode_up].data[4]) + ", not 8 (CSP), at " + show(fs, *mode_up));
+      return fail(r, tag + "0x6061 reads " + std::to_string(fs[*mode_up].data[4]) + ", not 8 (CSP), at " +
+                         show(fs, *mode_up));
     }
 
     const Index start = find_from(fs, *mode_up + 1, [&](const Frame& f) { return is_nmt(f, kNmtStart, n); });
-    if (!start) return fail(r, tag + "no NMT start (000#0100 or with the node id) after 0x6061 was confirmed at " + show(fs, *mode_up));
+    if (!start)
+      return fail(r, tag + "no NMT start (000#0100 or with the node id) after 0x6061 was confirmed at " +
+                         show(fs, *mode_up));
 
     const Index first_sync = find_from(fs, *start + 1, is_sync);
     if (!first_sync) return fail(r, tag + "no SYNC (080) after the NMT start at " + show(fs, *start));
@@ -207,11 +245,13 @@ CheckResult check_weave_protocol(const std::vector<Frame>& fs, const std::vector
     for (std::size_t i = *start + 1; i < *enable; ++i) {
       if (statusword(fs[i], n, l)) last_sw = i;
     }
-    if (!last_sw) return fail(r, tag + "0x000F sent before any statusword was received: " + show(fs, *enable));
+    if (!last_sw)
+      return fail(r, tag + "0x000F sent before any statusword was received: " + show(fs, *enable));
     const std::uint16_t sw_before = *statusword(fs[*last_sw], n, l);
     if (!ready_or_switched_on(sw_before)) {
       return fail(r, tag + "0x000F sent on statusword " + hex(sw_before, 4) +
-                         " (not Ready to switch on / Switched on): " + show(fs, *enable) + " after " + show(fs, *last_sw));
+                         " (not Ready to switch on / Switched on): " + show(fs, *enable) + " after " +
+                         show(fs, *last_sw));
     }
     if (const auto t = target(fs[*enable], n, l); t && fs[*last_sw].len >= l.position_at + 4) {
       const std::int32_t actual = fs[*last_sw].i32(l.position_at);
@@ -225,15 +265,19 @@ CheckResult check_weave_protocol(const std::vector<Frame>& fs, const std::vector
       const auto sw = statusword(f, n, l);
       return sw && operation_enabled(*sw);
     });
-    if (!op) return fail(r, tag + "statusword never reached Operation enabled (&0x6F = 0x27) after 0x000F at " + show(fs, *enable));
+    if (!op)
+      return fail(r, tag + "statusword never reached Operation enabled (&0x6F = 0x27) after 0x000F at " +
+                         show(fs, *enable));
 
-    r.notes.push_back(tag + "reset " + show(fs, *reset) + " → boot-up line " + std::to_string(fs[*boot].line) +
-                      " → 0x6060=8 line " + std::to_string(fs[*mode_dl].line) + "/" + std::to_string(fs[*mode_ack].line) +
-                      " → 0x6061=8 line " + std::to_string(fs[*mode_ul].line) + "/" + std::to_string(fs[*mode_up].line) +
-                      " → NMT start line " + std::to_string(fs[*start].line) + " → SYNC line " +
-                      std::to_string(fs[*first_sync].line) + " → 0x000F line " + std::to_string(fs[*enable].line) +
-                      " → Operation enabled line " + std::to_string(fs[*op].line) + "; after start " +
-                      std::to_string(syncs) + " SYNC, " + std::to_string(rpdos) + " RPDO, " + std::to_string(tpdos) + " TPDO");
+    r.notes.push_back(
+        tag + "reset " + show(fs, *reset) + " → boot-up line " + std::to_string(fs[*boot].line) +
+        " → 0x6060=8 line " + std::to_string(fs[*mode_dl].line) + "/" + std::to_string(fs[*mode_ack].line) +
+        " → 0x6061=8 line " + std::to_string(fs[*mode_ul].line) + "/" + std::to_string(fs[*mode_up].line) +
+        " → NMT start line " + std::to_string(fs[*start].line) + " → SYNC line " +
+        std::to_string(fs[*first_sync].line) + " → 0x000F line " + std::to_string(fs[*enable].line) +
+        " → Operation enabled line " + std::to_string(fs[*op].line) + "; after start " +
+        std::to_string(syncs) + " SYNC, " + std::to_string(rpdos) + " RPDO, " + std::to_string(tpdos) +
+        " TPDO");
   }
   return r;
 }
@@ -256,7 +300,8 @@ CheckResult check_heartbeat_loss(const std::vector<Frame>& fs, const std::vector
       operational_hbs += fs[i].data[0] == 0x05 ? 1U : 0U;
     }
     if (!last_hb) return fail(r, tag + "no heartbeat " + hex(cob(0x700, n), 3) + " in the log");
-    if (operational_hbs < 2) return fail(r, tag + "fewer than two operational heartbeats (05): the node never ran");
+    if (operational_hbs < 2)
+      return fail(r, tag + "fewer than two operational heartbeats (05): the node never ran");
     if (fs[*last_hb].data[0] != 0x05) {
       return fail(r, tag + "last heartbeat before the loss is not operational (05): " + show(fs, *last_hb));
     }
@@ -265,7 +310,9 @@ CheckResult check_heartbeat_loss(const std::vector<Frame>& fs, const std::vector
       return controlword(f, n, l) == std::optional<std::uint16_t>(kCwEnableOperation);
     });
     if (!enable || *enable > *last_hb) {
-      return fail(r, tag + "the master had not enabled the node (controlword 0x000F) before its last heartbeat at " + show(fs, *last_hb));
+      return fail(
+          r, tag + "the master had not enabled the node (controlword 0x000F) before its last heartbeat at " +
+                 show(fs, *last_hb));
     }
     for (std::size_t i = *enable; i < *last_hb; ++i) {
       const auto cw = controlword(fs[i], n, l);
@@ -280,8 +327,8 @@ CheckResult check_heartbeat_loss(const std::vector<Frame>& fs, const std::vector
       return cw && *cw != kCwEnableOperation;
     });
     if (!fault) {
-      return fail(r, tag + "no quick-stop/disable controlword after the last heartbeat at " + show(fs, *last_hb) +
-                         ": the loss was not acted on");
+      return fail(r, tag + "no quick-stop/disable controlword after the last heartbeat at " +
+                         show(fs, *last_hb) + ": the loss was not acted on");
     }
     const std::int64_t latency_us = fs[*fault].t_us - fs[*last_hb].t_us;
     std::size_t cycles = 0;
@@ -289,13 +336,16 @@ CheckResult check_heartbeat_loss(const std::vector<Frame>& fs, const std::vector
     if (master_cycle_s > 0.0) {
       const auto limit_cycles = static_cast<std::size_t>(std::ceil(heartbeat_s * periods / master_cycle_s));
       if (cycles > limit_cycles) {
-        return fail(r, tag + "fault reaction " + std::to_string(cycles) + " master cycles (SYNCs) after the last heartbeat, limit " +
-                           std::to_string(limit_cycles) + " (" + std::to_string(limit_us / 1000) + " ms of master time; " +
-                           std::to_string(latency_us / 1000) + " ms wall): " + show(fs, *last_hb) + " → " + show(fs, *fault));
+        return fail(r, tag + "fault reaction " + std::to_string(cycles) +
+                           " master cycles (SYNCs) after the last heartbeat, limit " +
+                           std::to_string(limit_cycles) + " (" + std::to_string(limit_us / 1000) +
+                           " ms of master time; " + std::to_string(latency_us / 1000) +
+                           " ms wall): " + show(fs, *last_hb) + " → " + show(fs, *fault));
       }
     } else if (latency_us > limit_us) {
-      return fail(r, tag + "fault reaction " + std::to_string(latency_us / 1000) + " ms after the last heartbeat, limit " +
-                         std::to_string(limit_us / 1000) + " ms: " + show(fs, *last_hb) + " → " + show(fs, *fault));
+      return fail(r, tag + "fault reaction " + std::to_string(latency_us / 1000) +
+                         " ms after the last heartbeat, limit " + std::to_string(limit_us / 1000) +
+                         " ms: " + show(fs, *last_hb) + " → " + show(fs, *fault));
     }
 
     // The target in force when the fault was raised: the fault RPDO's own, else the last one before.
@@ -313,8 +363,8 @@ CheckResult check_heartbeat_loss(const std::vector<Frame>& fs, const std::vector
       if (!t) continue;
       ++rpdos_after;
       if (held && *t != *held) {
-        return fail(r, tag + "RPDO after the fault commands target " + std::to_string(*t) + " instead of the held " +
-                           std::to_string(*held) + ": " + show(fs, i));
+        return fail(r, tag + "RPDO after the fault commands target " + std::to_string(*t) +
+                           " instead of the held " + std::to_string(*held) + ": " + show(fs, i));
       }
     }
     char ms[32];
@@ -364,7 +414,8 @@ CheckResult check_io_traffic(const std::vector<Frame>& frames, int io_node, bool
                          std::to_string(f.line) + ": no 0x6000:03 (second switches)";
         } else if ((f.data[2] & 0x3F) != (f.data[0] & 0x3F)) {
           char buf[128];
-          std::snprintf(buf, sizeof buf, "second switches 0x%02X disagree with first switches 0x%02X at log line %zu",
+          std::snprintf(buf, sizeof buf,
+                        "second switches 0x%02X disagree with first switches 0x%02X at log line %zu",
                         f.data[2] & 0x3F, f.data[0] & 0x3F, f.line);
           second_wrong = buf;
         }
@@ -377,8 +428,9 @@ CheckResult check_io_traffic(const std::vector<Frame>& frames, int io_node, bool
   }
   r.notes.push_back("I/O node " + std::to_string(io_node) + ": " + std::to_string(n_out) + " output RPDOs, " +
                     std::to_string(n_in) + " input TPDOs, " + std::to_string(n_an) + " load-cell TPDOs");
-  const char* const in_names[] = {"piston A extended", "piston A retracted", "piston B extended",
-                                  "piston B retracted", "shuttle at left", "shuttle at right", "e-stop chain closed"};
+  const char* const in_names[] = {"piston A extended",  "piston A retracted", "piston B extended",
+                                  "piston B retracted", "shuttle at left",    "shuttle at right",
+                                  "e-stop chain closed"};
   std::string missing;
   if ((out_seen & 1) == 0) missing += ", valve A on";
   if ((out_seen & 2) == 0) missing += ", valve B on";
@@ -411,7 +463,8 @@ bool pdo_bit(const Frame& f, int bit) {
 CheckResult check_knotting(const std::vector<Frame>& frames, int io_node, const KnottingWiring& w) {
   CheckResult r;
   const std::size_t heads = w.gripper_bits.size();
-  if (heads == 0 || w.cutter_bits.size() != heads || w.yarn_bits.size() != heads || w.selector_nodes.size() != heads) {
+  if (heads == 0 || w.cutter_bits.size() != heads || w.yarn_bits.size() != heads ||
+      w.selector_nodes.size() != heads) {
     r.ok = false;
     r.failure = "the wiring needs one gripper, cutter and yarn-present bit and one selector node per head";
     return r;
@@ -449,7 +502,8 @@ CheckResult check_knotting(const std::vector<Frame>& frames, int io_node, const 
         const std::string head = "head " + std::to_string(k + 1);
         if (cutter && !h[k].cutter) {
           if (!gripper) fail(f, head + "'s cutter fired with its gripper open");
-          if (h[k].awaiting_knot) fail(f, head + " cut again before the yarn-present switch showed its last knot");
+          if (h[k].awaiting_knot)
+            fail(f, head + " cut again before the yarn-present switch showed its last knot");
           ++h[k].cuts;
           h[k].awaiting_knot = true;
         }
@@ -478,7 +532,8 @@ CheckResult check_knotting(const std::vector<Frame>& frames, int io_node, const 
         if (f.id != static_cast<std::uint32_t>(0x200 + w.selector_nodes[k])) continue;
         const auto target = static_cast<std::int32_t>(f.u32(2));
         if (h[k].selector_known && target != h[k].selector_target) {
-          if (h[k].gripper) fail(f, "head " + std::to_string(k + 1) + "'s selector turned under its closed gripper");
+          if (h[k].gripper)
+            fail(f, "head " + std::to_string(k + 1) + "'s selector turned under its closed gripper");
           ++h[k].selector_moves;
         }
         h[k].selector_known = true;
@@ -501,7 +556,8 @@ CheckResult check_knotting(const std::vector<Frame>& frames, int io_node, const 
       r.failure = head + "'s selector never turned (the stripe has more than one colour)";
     }
   }
-  r.notes.push_back("carriage target changed in " + std::to_string(carriage_steps) + " RPDOs, none with a gripper closed");
+  r.notes.push_back("carriage target changed in " + std::to_string(carriage_steps) +
+                    " RPDOs, none with a gripper closed");
   return r;
 }
 
@@ -510,7 +566,8 @@ CheckResult check_emcy_stop(const std::vector<Frame>& frames, const std::vector<
   std::size_t k = 0;
   for (; k < frames.size(); ++k) {
     const Frame& f = frames[k];
-    if (!f.error_frame && f.id == static_cast<std::uint32_t>(0x80 + emcy_node) && f.len == 8 && f.u16(0) != 0) break;
+    if (!f.error_frame && f.id == static_cast<std::uint32_t>(0x80 + emcy_node) && f.len == 8 && f.u16(0) != 0)
+      break;
   }
   if (k == frames.size()) {
     r.ok = false;
@@ -519,7 +576,8 @@ CheckResult check_emcy_stop(const std::vector<Frame>& frames, const std::vector<
   }
   const Frame& emcy = frames[k];
   char buf[200];
-  std::snprintf(buf, sizeof(buf), "EMCY 0x%04X from node %d at %s", emcy.u16(0), emcy_node, at_line(emcy).c_str());
+  std::snprintf(buf, sizeof(buf), "EMCY 0x%04X from node %d at %s", emcy.u16(0), emcy_node,
+                at_line(emcy).c_str());
   r.notes.push_back(buf);
   // The master reads the bus, ticks, then sends SYNC and the RPDOs. An EMCY that lands after the read is
   // seen by the next cycle: the RPDOs of the cycle in progress (up to the second SYNC after the EMCY)
@@ -534,7 +592,8 @@ CheckResult check_emcy_stop(const std::vector<Frame>& frames, const std::vector<
     return r;
   }
   std::snprintf(buf, sizeof(buf), "one cycle to react: the second SYNC after the EMCY at %s (%.1f ms later)",
-                at_line(frames[deadline]).c_str(), static_cast<double>(frames[deadline].t_us - emcy.t_us) * 1e-3);
+                at_line(frames[deadline]).c_str(),
+                static_cast<double>(frames[deadline].t_us - emcy.t_us) * 1e-3);
   r.notes.push_back(buf);
   for (int node : nodes) {
     const Frame* first_stop = nullptr;  // the reaction: this node's first quick stop / disable after the EMCY
@@ -551,7 +610,8 @@ CheckResult check_emcy_stop(const std::vector<Frame>& frames, const std::vector<
         if (!stop) {
           r.ok = false;
           std::snprintf(buf, sizeof(buf),
-                        "node %d: first RPDO1 of the next cycle at %s (%.1f ms after the EMCY): controlword 0x%04X is not "
+                        "node %d: first RPDO1 of the next cycle at %s (%.1f ms after the EMCY): controlword "
+                        "0x%04X is not "
                         "quick stop (0x0002) or disable voltage",
                         node, at_line(f).c_str(), static_cast<double>(f.t_us - emcy.t_us) * 1e-3, cw);
           r.failure = buf;
@@ -572,14 +632,16 @@ CheckResult check_emcy_stop(const std::vector<Frame>& frames, const std::vector<
     }
     int syncs = 0;  // which cycle after the EMCY stopped the drive (1 = the first SYNC after it)
     for (const Frame* f = &emcy; f != first_stop; ++f) syncs += is_sync(*f) ? 1 : 0;
-    std::snprintf(buf, sizeof(buf), "node %d: quick stop at %s, %.1f ms after the EMCY, in cycle %d after it", node,
-                  at_line(*first_stop).c_str(), static_cast<double>(first_stop->t_us - emcy.t_us) * 1e-3, syncs);
+    std::snprintf(buf, sizeof(buf), "node %d: quick stop at %s, %.1f ms after the EMCY, in cycle %d after it",
+                  node, at_line(*first_stop).c_str(),
+                  static_cast<double>(first_stop->t_us - emcy.t_us) * 1e-3, syncs);
     r.notes.push_back(buf);
   }
   return r;
 }
 
-CheckResult check_feedback_lag(const std::vector<Frame>& frames, const std::vector<int>& nodes, int max_cycles_late) {
+CheckResult check_feedback_lag(const std::vector<Frame>& frames, const std::vector<int>& nodes,
+                               int max_cycles_late) {
   CheckResult r;
   char buf[200];
   for (int node : nodes) {
@@ -602,10 +664,12 @@ CheckResult check_feedback_lag(const std::vector<Frame>& frames, const std::vect
       std::snprintf(buf, sizeof(buf), "node %d: no TPDO1 in the log", node);
       if (r.ok) r.ok = false, r.failure = buf;
     } else if (late == 0) {
-      std::snprintf(buf, sizeof(buf), "node %d: %zu TPDO1s, each answering the SYNC right before it", node, tpdos);
+      std::snprintf(buf, sizeof(buf), "node %d: %zu TPDO1s, each answering the SYNC right before it", node,
+                    tpdos);
     } else {
-      std::snprintf(buf, sizeof(buf), "node %d: %zu TPDO1s, %zu of them late (worst %d cycle(s) behind, at %s)", node,
-                    tpdos, late, worst, at_line(*worst_at).c_str());
+      std::snprintf(buf, sizeof(buf),
+                    "node %d: %zu TPDO1s, %zu of them late (worst %d cycle(s) behind, at %s)", node, tpdos,
+                    late, worst, at_line(*worst_at).c_str());
     }
     r.notes.push_back(buf);
     if (worst > max_cycles_late && r.ok) {
@@ -632,8 +696,8 @@ CheckResult check_master_loss(const std::vector<Frame>& frames, const std::vecto
   for (int node : nodes) {
     const Frame* emcy = nullptr;
     for (const Frame& f : frames) {
-      if (f.line > last_hb->line && !f.error_frame && f.id == static_cast<std::uint32_t>(0x80 + node) && f.len == 8 &&
-          f.u16(0) == 0x8130) {
+      if (f.line > last_hb->line && !f.error_frame && f.id == static_cast<std::uint32_t>(0x80 + node) &&
+          f.len == 8 && f.u16(0) == 0x8130) {
         emcy = &f;
         break;
       }

@@ -79,7 +79,7 @@ CheckResult check_io_traffic(const std::vector<Frame>& frames, int io_node, bool
 // bytes (bit b in byte b / 8); drive RPDO1 layout as PdoLayout.
 struct KnottingWiring {
   std::vector<int> gripper_bits, cutter_bits, yarn_bits;  // one per head
-  std::vector<int> selector_nodes;                         // one per head
+  std::vector<int> selector_nodes;                        // one per head
   int carriage_node = 2;
   int knots_per_head = 0;
 };
@@ -97,7 +97,8 @@ CheckResult check_emcy_stop(const std::vector<Frame>& frames, const std::vector<
 // trail by more (a TPDO1 with k SYNCs outstanding since that node's previous one is k − 1 cycles late;
 // the first after a silence counts from that silence). Fails when one trails by more than
 // `max_cycles_late` cycles, or a node sent no TPDO1 at all (nothing to judge).
-CheckResult check_feedback_lag(const std::vector<Frame>& frames, const std::vector<int>& nodes, int max_cycles_late);
+CheckResult check_feedback_lag(const std::vector<Frame>& frames, const std::vector<int>& nodes,
+                               int max_cycles_late);
 
 // The master's heartbeat (0x700 + master) stops (it was killed): every node in `nodes` sends an EMCY
 // 0x8130 (heartbeat consumer) within `consumer_s` + `slack_s` of the master's last heartbeat.

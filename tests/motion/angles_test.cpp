@@ -1,6 +1,8 @@
 // wrap_two_pi against libm's fmod (the independent truth): bit for bit on random angles across the
 // unwrapped range a loom reaches (a crank turning for years), at and around multiples of 2π where the
 // quotient's rounding bites, and on the special values.
+#include "loom/motion/angles.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -8,8 +10,6 @@
 #include <cstring>
 #include <limits>
 #include <random>
-
-#include "loom/motion/angles.hpp"
 
 using loom::motion::kTwoPi;
 using loom::motion::wrap_two_pi;
@@ -21,7 +21,9 @@ double reference(double a) {
   if (r < 0.0) r += kTwoPi;
   return r >= kTwoPi ? 0.0 : r;
 }
-bool same_bits(double x, double y) { return std::memcmp(&x, &y, sizeof x) == 0 || (std::isnan(x) && std::isnan(y)); }
+bool same_bits(double x, double y) {
+  return std::memcmp(&x, &y, sizeof x) == 0 || (std::isnan(x) && std::isnan(y));
+}
 }  // namespace
 
 TEST(Angles, WrapTwoPiIsFmodBitForBit) {

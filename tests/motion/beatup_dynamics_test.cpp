@@ -40,8 +40,9 @@ TEST(BeatUpDynamics, NewtonEulerTorqueEqualsLagrangianReducedModel) {
     const BeatUpSample s = d.inverse(c, contact);
     const ReducedTerms t = d.reduced(c.theta_rad);
     const double q = d.contact_generalized_force(c, contact);
-    const double lagrange = t.inertia_kg_m2 * c.alpha_rad_s2 + 0.5 * t.dinertia_kg_m2_rad * c.omega_rad_s * c.omega_rad_s +
-                            t.gravity_torque_nm - q;
+    const double lagrange = t.inertia_kg_m2 * c.alpha_rad_s2 +
+                            0.5 * t.dinertia_kg_m2_rad * c.omega_rad_s * c.omega_rad_s + t.gravity_torque_nm -
+                            q;
     EXPECT_NEAR(s.forces.crank_torque_nm, lagrange, 1e-9 * (1.0 + std::abs(lagrange))) << c.theta_rad;
   }
 }
@@ -74,7 +75,8 @@ TEST(BeatUpDynamics, FrameReactionsBalanceTheShakingLoad) {
     const ShakingLoad sh = shaking_load(d.bodies(), mo, Eigen::Vector2d::Zero());
     const Eigen::Vector2d f = s.forces.pin_a0_n + s.forces.pin_b0_n + total_mass * g + s.contact_force_n;
     EXPECT_NEAR((sh.force_n - f).norm(), 0.0, 1e-9 * (1.0 + sh.force_n.norm()));
-    double n = s.forces.crank_torque_nm + cross2(mo[2].origin_m, s.forces.pin_b0_n) + cross2(s.tip_m, s.contact_force_n);
+    double n = s.forces.crank_torque_nm + cross2(mo[2].origin_m, s.forces.pin_b0_n) +
+               cross2(s.tip_m, s.contact_force_n);
     for (int k = 0; k < 3; ++k) n += cross2(mo[k].point(d.bodies()[k].centre_m), d.bodies()[k].mass_kg * g);
     EXPECT_NEAR(sh.moment_nm, n, 1e-9 * (1.0 + std::abs(n)));
   }
@@ -110,7 +112,9 @@ TEST(BeatUpDynamics, CrankWorkEqualsEnergyChangePlusClothWorkOverAPartialTurn) {
   const WarpWindow& win = d.head().warp();
   const double a = park + win.enter - 0.6, b = park + win.fell + 0.9;
   const auto omega = [&](double th) { return std::sqrt(w0 * w0 + 2.0 * alpha * (th - a)); };
-  const auto torque = [&](double th) { return d.inverse({th, omega(th), alpha}, contact).forces.crank_torque_nm; };
+  const auto torque = [&](double th) {
+    return d.inverse({th, omega(th), alpha}, contact).forces.crank_torque_nm;
+  };
   const auto cloth = [&](double th) {
     const BeatUpSample s = d.inverse({th, omega(th), alpha}, contact);
     return s.contact_force_n.dot(s.tip_vel_m_s) / omega(th);  // F·dr/dθ
@@ -200,7 +204,8 @@ TEST(BeatUpDynamics, SingularForceSystemIsATypedErrorNotNaN) {
   p.theta2 = 0.0;
   p.theta3 = 0.0;  // A=(0.05,0) → B=(0.3,0): rocker from B0=(0.2,0) at θ4 = 0, colinear with AB
   p.theta4 = 0.0;
-  const BeatUpMasses bm = beatup_masses(BeatUpGeometry{m, Branch::kPositive, 0.15, FellSide::kExtended, 0.01});
+  const BeatUpMasses bm =
+      beatup_masses(BeatUpGeometry{m, Branch::kPositive, 0.15, FellSide::kExtended, 0.01});
   const FourBarInertias in{bm.crank, bm.coupler, bm.rocker_with_beater()};
   try {
     (void)four_bar_forces(m, in, p, 10.0, 0.0, {0.0, -9.81});

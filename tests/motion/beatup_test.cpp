@@ -1,11 +1,12 @@
 // Beat-up head: the default thesis linkage, its warp window, the carriage cam that steps only while
 // the beater is clear, and the smooth step's derivatives against finite differences.
+#include "loom/motion/beatup.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "loom/motion/angles.hpp"
-#include "loom/motion/beatup.hpp"
 #include "loom/motion/carriage_cam.hpp"
 #include "loom/motion/errors.hpp"
 #include "loom/motion/phase_table.hpp"

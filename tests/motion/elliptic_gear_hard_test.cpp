@@ -56,10 +56,10 @@ TEST(EllipticGearHard, EccentricityNearOneIsFiniteMonotoneAndFlagged) {
   }
   EXPECT_FALSE(EllipticGearPair(0.05, 0.2, 2).near_degenerate());
   // The threshold, from the closed form (1+e)/(1-e) > 100 <=> e > 99/101, on both sides of it.
-  EXPECT_TRUE(EllipticGearPair(0.05, 0.99, 2).near_degenerate());   // (1.99/0.01) = 199: flagged
+  EXPECT_TRUE(EllipticGearPair(0.05, 0.99, 2).near_degenerate());  // (1.99/0.01) = 199: flagged
   EXPECT_NEAR(EllipticGearPair(0.05, 0.99, 2).max_speed_ratio(), 199.0, 199.0 * 1e-13);
   EXPECT_TRUE(EllipticGearPair(0.05, std::nextafter(99.0 / 101.0, 1.0), 2).near_degenerate());
-  EXPECT_FALSE(EllipticGearPair(0.05, 0.98, 2).near_degenerate());   // 1.98/0.02 = 99: not flagged
+  EXPECT_FALSE(EllipticGearPair(0.05, 0.98, 2).near_degenerate());  // 1.98/0.02 = 99: not flagged
 }
 
 TEST(EllipticGearHard, NearOneStillRollsWithoutSlip) {

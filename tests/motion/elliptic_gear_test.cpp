@@ -1,13 +1,14 @@
 // Elliptic k-lobed gear of seed 004 against independent truth: numerical quadrature of eqn 5, the
 // printed gear-ratio function (eqn 6), rolling without slip, the identical-mating-pinion property,
 // finite differences of φ2, and the exact reduction to a circular gear at e = 0.
+#include "loom/motion/elliptic_gear.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "finite_diff.hpp"
 #include "loom/motion/angles.hpp"
-#include "loom/motion/elliptic_gear.hpp"
 
 namespace loom::motion {
 namespace {

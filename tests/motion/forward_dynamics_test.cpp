@@ -1,12 +1,13 @@
 // Forward dynamics: the table model against the exact reduced model, energy conservation and the
 // work of a constant torque, the integrators' orders of accuracy, and the round trip — a motion's
 // torque from Newton–Euler inverse dynamics, fed to the forward model, gives the motion back.
+#include "loom/motion/forward_dynamics.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "loom/motion/dynamics.hpp"
-#include "loom/motion/forward_dynamics.hpp"
 
 using namespace loom::motion;
 
@@ -100,7 +101,9 @@ TEST(ForwardDynamics, IntegratorsConvergeAtTheirOrders) {
   const CrankState s0{0.2, 14.0};
   const double T = 0.4, tau = 0.5;
   const CrankState ref = run_rk4(f, s0, T / 64000, 64000, tau);
-  const auto rk4_err = [&](int n) { return std::abs(run_rk4(f, s0, T / n, n, tau).theta_rad - ref.theta_rad); };
+  const auto rk4_err = [&](int n) {
+    return std::abs(run_rk4(f, s0, T / n, n, tau).theta_rad - ref.theta_rad);
+  };
   const auto euler_err = [&](int n) {
     CrankState s = s0;
     for (int i = 0; i < n; ++i) s = step_semi_implicit_euler(f, s, T / n, tau);

@@ -292,7 +292,6 @@ TEST(SliderCrankHard, NoNaNOrInfForAnyValidInput) {
   EXPECT_GT(evaluated, 1000);
 }
 
-
 // Issue 13: a linkage is the same at every scale a double holds. Squares of 1e150-long links overflow
 // and of 1e-150-long links underflow unless the solver works in units of the largest link; before it
 // did, a valid 1e80 linkage came out as a toggle.
@@ -365,7 +364,6 @@ TEST(SliderCrankHard, ScaleFreeAtOneE155) {
   }
 }
 
-
 // A double-rocker (Grashof, the coupler shortest): the knotting-chain example with links r0 = 78.105
 // (ground), r1 = 82.345 (input), r2 = 15.688 (coupler), r3 = 65.426 (output) mm at the pose θ1 = 135°,
 // θ2 = 10° in the drawing's frame. Independent values in long double, written out here: the diagonal
@@ -394,11 +392,10 @@ TEST(FourBarDoubleRocker, AnalysedAtThePosesItReaches) {
   // A whole turn: the reachable poses come out, the rest are counted, never thrown.
   std::vector<FourBarPose> poses;
   std::vector<int> index;
-  const ReachableSweep cover =
-      fourbar_sweep_reachable(m, branch, 360, 0.0, [&](int i, const FourBarPose& q) {
-        index.push_back(i);
-        poses.push_back(q);
-      });
+  const ReachableSweep cover = fourbar_sweep_reachable(m, branch, 360, 0.0, [&](int i, const FourBarPose& q) {
+    index.push_back(i);
+    poses.push_back(q);
+  });
   EXPECT_EQ(cover.solved + cover.unreachable + cover.at_toggle, 360);
   EXPECT_GT(cover.solved, 0);
   EXPECT_GT(cover.unreachable, 0);

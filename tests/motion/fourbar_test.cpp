@@ -1,5 +1,7 @@
 // Four-bar analysis against independent truth: loop closure, finite differences of the closed-form
 // positions, the rocker at rest at the dead centres, and textbook Grashof classes.
+#include "loom/motion/fourbar.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -7,7 +9,6 @@
 #include "loom/motion/angles.hpp"
 #include "loom/motion/beatup.hpp"
 #include "loom/motion/errors.hpp"
-#include "loom/motion/fourbar.hpp"
 
 using namespace loom::motion;
 
@@ -17,7 +18,8 @@ const FourBar kThesis = default_beatup_geometry().bar;
 double closure_residual(const FourBar& m, const FourBarPose& p) {
   const double x = m.crank * std::cos(p.theta2) + m.coupler * std::cos(p.theta3) - m.ground -
                    m.rocker * std::cos(p.theta4);
-  const double y = m.crank * std::sin(p.theta2) + m.coupler * std::sin(p.theta3) - m.rocker * std::sin(p.theta4);
+  const double y =
+      m.crank * std::sin(p.theta2) + m.coupler * std::sin(p.theta3) - m.rocker * std::sin(p.theta4);
   return std::hypot(x, y);
 }
 }  // namespace
@@ -46,7 +48,8 @@ TEST(FourBar, CoefficientsMatchFiniteDifferences) {
   for (Branch br : {Branch::kPositive, Branch::kNegative}) {
     for (int i = 0; i < 360; i += 7) {
       const double t = rad(i);
-      const FourBarPose p = solve(kThesis, t, br), pp = solve(kThesis, t + h, br), pm = solve(kThesis, t - h, br);
+      const FourBarPose p = solve(kThesis, t, br), pp = solve(kThesis, t + h, br),
+                        pm = solve(kThesis, t - h, br);
       const double k4_fd = wrap_pi(pp.theta4 - pm.theta4) / (2 * h);
       const double k3_fd = wrap_pi(pp.theta3 - pm.theta3) / (2 * h);
       const double k4p_fd = (pp.k4 - pm.k4) / (2 * h);

@@ -1,11 +1,12 @@
 // Jerk-limited move: reaches the distance exactly, respects every limit, and its derivatives agree
 // with finite differences of its position, in all three planning cases.
+#include "loom/motion/jerk_move.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "loom/motion/errors.hpp"
-#include "loom/motion/jerk_move.hpp"
 
 using namespace loom::motion;
 

@@ -2,6 +2,8 @@
 // and its numbers written out, the four-bar's rigid-body closure from plain circle geometry, the
 // table's rates against finite differences, the servo torque by the energy method (d/dt of kinetic
 // plus potential energy = τω, from finite differences of the links' positions), typed refusals.
+#include "loom/motion/knot_cycle.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
@@ -13,10 +15,10 @@
 
 #include "loom/motion/angles.hpp"
 #include "loom/motion/errors.hpp"
-#include "loom/motion/knot_cycle.hpp"
 
 namespace {
 
+using Eigen::Vector2d;
 using loom::motion::Branch;
 using loom::motion::ErrorCode;
 using loom::motion::KnotCycle;
@@ -25,11 +27,12 @@ using loom::motion::KnotLimit;
 using loom::motion::MotionError;
 using loom::motion::rad;
 using loom::motion::seed001_knot_cycle_spec;
-using Eigen::Vector2d;
 
 constexpr double kPi = 3.14159265358979323846;
 
-Vector2d u(double a) { return {std::cos(a), std::sin(a)}; }
+Vector2d u(double a) {
+  return {std::cos(a), std::sin(a)};
+}
 
 template <class F>
 ErrorCode code_of(F&& f) {
@@ -55,7 +58,9 @@ std::vector<Chain> eliminate() {
   const double th0 = rad(275);
   double R[2], X[2], Y[2], C[2];
   auto dot0 = [&](int i) { return kPts[i][0] * std::cos(th0) + kPts[i][1] * std::sin(th0); };
-  auto dot2 = [&](int i) { return kPts[i][0] * std::cos(rad(kPts[i][2])) + kPts[i][1] * std::sin(rad(kPts[i][2])); };
+  auto dot2 = [&](int i) {
+    return kPts[i][0] * std::cos(rad(kPts[i][2])) + kPts[i][1] * std::sin(rad(kPts[i][2]));
+  };
   auto r2 = [&](int i) { return kPts[i][0] * kPts[i][0] + kPts[i][1] * kPts[i][1]; };
   auto cs = [&](int i) { return std::cos(rad(kPts[i][2]) - th0); };
   for (int j = 0; j < 2; ++j) {
@@ -106,7 +111,8 @@ TEST(KnotCycleSeed, SynthesisNumbersAndTheSharedCoupler) {
   // from point to point by far more than its rounding.
   double lo = 1e9, hi = 0;
   for (int i = 0; i < 3; ++i) {
-    const double l = (Vector2d(kPts[i][0], kPts[i][1]) - 78.492 * u(th0) - 32.637 * u(rad(kPts[i][2]))).norm();
+    const double l =
+        (Vector2d(kPts[i][0], kPts[i][1]) - 78.492 * u(th0) - 32.637 * u(rad(kPts[i][2]))).norm();
     lo = std::min(lo, l);
     hi = std::max(hi, l);
   }
@@ -167,12 +173,16 @@ TEST(KnotCycle, DefaultBuildsAndPassesThePoints) {
   const auto& r = kc.report();
   const std::array<double, 3> theta1_deg{-174.1791, 63.4044, 33.7328};
   for (int i = 0; i < 3; ++i) {
-    EXPECT_NEAR(std::remainder(r.crank_angles_rad[static_cast<std::size_t>(i)] * 180 / kPi - theta1_deg[static_cast<std::size_t>(i)], 360.0), 0.0, 1e-4);
+    EXPECT_NEAR(std::remainder(r.crank_angles_rad[static_cast<std::size_t>(i)] * 180 / kPi -
+                                   theta1_deg[static_cast<std::size_t>(i)],
+                               360.0),
+                0.0, 1e-4);
     const Pose p = pose_of(s, r.crank_angles_rad[static_cast<std::size_t>(i)]);
     EXPECT_NEAR(p.grip.x(), s.points[static_cast<std::size_t>(i)].x_m, 1e-9);
     EXPECT_NEAR(p.grip.y(), s.points[static_cast<std::size_t>(i)].y_m, 1e-9);
     // The coupler line along the gripper angle (the gripper lies beyond the crank joint: +π).
-    EXPECT_NEAR(std::remainder(p.th3 - s.points[static_cast<std::size_t>(i)].gripper_rad - kPi, 2 * kPi), 0.0, 1e-9);
+    EXPECT_NEAR(std::remainder(p.th3 - s.points[static_cast<std::size_t>(i)].gripper_rad - kPi, 2 * kPi), 0.0,
+                1e-9);
   }
   EXPECT_EQ(r.grashof, loom::motion::GrashofClass::kTripleRocker);
   EXPECT_FALSE(r.full_turn);
@@ -218,14 +228,18 @@ double energy(const KnotCycleSpec& s, const KnotCycle& kc, double t, double h) {
   auto state = [&](double tt) { return pose_of(s, kc.take_angle_rad() + kc.exact(tt).angle_rad); };
   const Pose m = state(t - h), p = state(t + h), c = state(t);
   const double w1 = kc.exact(t).velocity_rad_s;
-  const double w3 = std::remainder(p.th3 - m.th3, 2 * kPi) / (2 * h), w4 = std::remainder(p.th4 - m.th4, 2 * kPi) / (2 * h);
+  const double w3 = std::remainder(p.th3 - m.th3, 2 * kPi) / (2 * h),
+               w4 = std::remainder(p.th4 - m.th4, 2 * kPi) / (2 * h);
   const Vector2d v2 = (p.cg_coupler - m.cg_coupler) / (2 * h), v3 = (p.cg_rocker - m.cg_rocker) / (2 * h);
   const Vector2d a0(s.crank_pivot_x_m, s.crank_pivot_y_m);
   const Vector2d cg1 = a0 + s.crank.cg_m * (c.a - a0) / s.crank.length_m;
-  const double j1 = s.rotor_inertia_kg_m2 + s.crank.inertia_kg_m2 + s.crank.mass_kg * s.crank.cg_m * s.crank.cg_m;
-  const double ke = 0.5 * j1 * w1 * w1 + 0.5 * s.coupler.mass_kg * v2.squaredNorm() + 0.5 * s.coupler.inertia_kg_m2 * w3 * w3 +
-                    0.5 * s.rocker.mass_kg * v3.squaredNorm() + 0.5 * s.rocker.inertia_kg_m2 * w4 * w4;
-  const double pe = s.gravity_m_s2 * (s.crank.mass_kg * cg1.y() + s.coupler.mass_kg * c.cg_coupler.y() + s.rocker.mass_kg * c.cg_rocker.y());
+  const double j1 =
+      s.rotor_inertia_kg_m2 + s.crank.inertia_kg_m2 + s.crank.mass_kg * s.crank.cg_m * s.crank.cg_m;
+  const double ke = 0.5 * j1 * w1 * w1 + 0.5 * s.coupler.mass_kg * v2.squaredNorm() +
+                    0.5 * s.coupler.inertia_kg_m2 * w3 * w3 + 0.5 * s.rocker.mass_kg * v3.squaredNorm() +
+                    0.5 * s.rocker.inertia_kg_m2 * w4 * w4;
+  const double pe = s.gravity_m_s2 * (s.crank.mass_kg * cg1.y() + s.coupler.mass_kg * c.cg_coupler.y() +
+                                      s.rocker.mass_kg * c.cg_rocker.y());
   return ke + pe;
 }
 
@@ -238,7 +252,8 @@ void expect_torque_within(const KnotCycleSpec& s, const KnotCycle& kc, double* p
     const double w = kc.exact(t).velocity_rad_s;
     if (std::fabs(w) < 0.3) continue;  // τ = Ė/ω is ill-conditioned near rest
     bool near_piece_edge = false;
-    for (const auto& seg : kc.report().segments) near_piece_edge |= std::fabs(t - seg.begin_s) < 4 * H || std::fabs(t - seg.end_s) < 4 * H;
+    for (const auto& seg : kc.report().segments)
+      near_piece_edge |= std::fabs(t - seg.begin_s) < 4 * H || std::fabs(t - seg.end_s) < 4 * H;
     if (near_piece_edge) continue;
     const double tau = (energy(s, kc, t + H, h) - energy(s, kc, t - H, h)) / (2 * H) / w;
     const auto e = kc.exact(t);
@@ -288,8 +303,10 @@ TEST(KnotCycle, WindowsOrderedAndFromTheGeometry) {
     EXPECT_LE(win.end_s, T);
   }
   EXPECT_EQ(g.begin_s, 0.0);
-  EXPECT_NEAR(c.begin_s, s.grip_s + kc.report().segments[1].end_s - kc.report().segments[1].begin_s +
-                             kc.report().segments[2].end_s - kc.report().segments[2].begin_s, 1e-12);
+  EXPECT_NEAR(c.begin_s,
+              s.grip_s + kc.report().segments[1].end_s - kc.report().segments[1].begin_s +
+                  kc.report().segments[2].end_s - kc.report().segments[2].begin_s,
+              1e-12);
   EXPECT_NEAR(c.end_s - c.begin_s, s.cut_s, 1e-12);
   EXPECT_EQ(g.end_s, c.end_s);  // released after the cut
   EXPECT_LE(y.begin_s, c.begin_s);
@@ -313,16 +330,21 @@ TEST(KnotCycle, WindowsOrderedAndFromTheGeometry) {
 TEST(KnotCycle, SampleIsFiniteForAnyTime) {
   const KnotCycle kc = KnotCycle::build(seed001_knot_cycle_spec());
   const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
-  for (double t : {nan, -nan, inf, -inf, -1.0, -1e-300, 0.0, 1e-300, 1e300, -1e300, kc.duration_s(), 2 * kc.duration_s()}) {
+  for (double t : {nan, -nan, inf, -inf, -1.0, -1e-300, 0.0, 1e-300, 1e300, -1e300, kc.duration_s(),
+                   2 * kc.duration_s()}) {
     const auto s = kc.sample(t);
-    EXPECT_TRUE(std::isfinite(s.angle_rad) && std::isfinite(s.velocity_rad_s) && std::isfinite(s.accel_rad_s2)) << t;
+    EXPECT_TRUE(std::isfinite(s.angle_rad) && std::isfinite(s.velocity_rad_s) &&
+                std::isfinite(s.accel_rad_s2))
+        << t;
   }
   EXPECT_EQ(kc.sample(nan).angle_rad, kc.sample(0).angle_rad);
   EXPECT_EQ(kc.sample(inf).angle_rad, kc.sample(kc.duration_s()).angle_rad);
   EXPECT_EQ(kc.sample(-inf).angle_rad, kc.sample(0).angle_rad);
   for (int k = 0; k <= 100000; ++k) {
     const auto s = kc.sample(kc.duration_s() * k / 100000.0);
-    ASSERT_TRUE(std::isfinite(s.angle_rad) && std::isfinite(s.velocity_rad_s) && std::isfinite(s.accel_rad_s2)) << k;
+    ASSERT_TRUE(std::isfinite(s.angle_rad) && std::isfinite(s.velocity_rad_s) &&
+                std::isfinite(s.accel_rad_s2))
+        << k;
   }
 }
 
@@ -386,14 +408,18 @@ TEST(KnotCycleRefuses, WarpEntryOutsideTakeToWrap) {
 TEST(KnotCycleRefuses, NonFiniteAndNegativeFields) {
   const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
   const KnotCycleSpec base = seed001_knot_cycle_spec();
-  std::vector<double KnotCycleSpec::*> any_finite{&KnotCycleSpec::theta0_rad, &KnotCycleSpec::crank_pivot_x_m,
-                                                  &KnotCycleSpec::rocker_pivot_y_m, &KnotCycleSpec::gripper_along_m,
-                                                  &KnotCycleSpec::gripper_normal_m, &KnotCycleSpec::warp_entry_x_m};
-  std::vector<double KnotCycleSpec::*> positive{&KnotCycleSpec::max_speed_rad_s, &KnotCycleSpec::max_accel_rad_s2,
-                                                &KnotCycleSpec::jerk_rad_s3, &KnotCycleSpec::max_torque_nm};
-  std::vector<double KnotCycleSpec::*> non_negative{&KnotCycleSpec::rotor_inertia_kg_m2, &KnotCycleSpec::grip_s,
-                                                    &KnotCycleSpec::cut_s, &KnotCycleSpec::release_s,
-                                                    &KnotCycleSpec::gravity_m_s2, &KnotCycleSpec::min_transmission_rad};
+  std::vector<double KnotCycleSpec::*> any_finite{
+      &KnotCycleSpec::theta0_rad,      &KnotCycleSpec::crank_pivot_x_m,  &KnotCycleSpec::rocker_pivot_y_m,
+      &KnotCycleSpec::gripper_along_m, &KnotCycleSpec::gripper_normal_m, &KnotCycleSpec::warp_entry_x_m};
+  std::vector<double KnotCycleSpec::*> positive{&KnotCycleSpec::max_speed_rad_s,
+                                                &KnotCycleSpec::max_accel_rad_s2, &KnotCycleSpec::jerk_rad_s3,
+                                                &KnotCycleSpec::max_torque_nm};
+  std::vector<double KnotCycleSpec::*> non_negative{&KnotCycleSpec::rotor_inertia_kg_m2,
+                                                    &KnotCycleSpec::grip_s,
+                                                    &KnotCycleSpec::cut_s,
+                                                    &KnotCycleSpec::release_s,
+                                                    &KnotCycleSpec::gravity_m_s2,
+                                                    &KnotCycleSpec::min_transmission_rad};
   for (auto f : any_finite) {
     for (double v : {nan, inf, -inf}) {
       KnotCycleSpec s = base;

@@ -1,11 +1,12 @@
 // Link mass properties: the plate formula against an independent numerical integration, the
 // parallel-axis combination, and what thesis Table 5.1 actually computed.
+#include "loom/motion/mass_properties.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "loom/motion/errors.hpp"
-#include "loom/motion/mass_properties.hpp"
 
 using namespace loom::motion;
 
@@ -64,7 +65,7 @@ TEST(MassProperties, ThesisTable51MassesAreRhoLwtButInertiasUseHalfTheWidth) {
   for (int i = 0; i < 3; ++i) {
     const double half_width = ours[i]->mass_kg * (lens[i] * lens[i] + 0.25 * s.width_m * s.width_m) / 12.0;
     EXPECT_NEAR(half_width, printed[i], 1e-6 * printed[i]) << i;  // printed to 6-7 digits
-    EXPECT_GT(ours[i]->inertia_kg_m2, printed[i] * 1.005) << i;  // ours uses the full width
+    EXPECT_GT(ours[i]->inertia_kg_m2, printed[i] * 1.005) << i;   // ours uses the full width
   }
   EXPECT_NEAR(1.0 - t.j2_kg_m2 / m.crank.inertia_kg_m2, 0.158, 0.001);
 }

@@ -1,16 +1,19 @@
 // Phase table: exact at the samples, fourth-order convergent between them, and safe at the wrap and
 // for non-finite input.
+#include "loom/motion/phase_table.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "loom/motion/angles.hpp"
-#include "loom/motion/phase_table.hpp"
 
 using namespace loom::motion;
 
 namespace {
-PhaseTable::Exact wave(double p) { return {std::sin(p) + 0.3 * std::cos(3 * p), std::cos(p) - 0.9 * std::sin(3 * p)}; }
+PhaseTable::Exact wave(double p) {
+  return {std::sin(p) + 0.3 * std::cos(3 * p), std::cos(p) - 0.9 * std::sin(3 * p)};
+}
 double max_err(std::size_t n) {
   const PhaseTable t(n, wave);
   double e = 0;

@@ -31,9 +31,17 @@ double golden_extremum(const SliderCrank& m, double lo, double hi, double sign) 
   double f1 = sign * slider_x(m, x1), f2 = sign * slider_x(m, x2);
   for (int i = 0; i < 200; ++i) {
     if (f1 > f2) {
-      hi = x2; x2 = x1; f2 = f1; x1 = hi - r * (hi - lo); f1 = sign * slider_x(m, x1);
+      hi = x2;
+      x2 = x1;
+      f2 = f1;
+      x1 = hi - r * (hi - lo);
+      f1 = sign * slider_x(m, x1);
     } else {
-      lo = x1; x1 = x2; f1 = f2; x2 = lo + r * (hi - lo); f2 = sign * slider_x(m, x2);
+      lo = x1;
+      x1 = x2;
+      f1 = f2;
+      x2 = lo + r * (hi - lo);
+      f2 = sign * slider_x(m, x2);
     }
   }
   return 0.5 * (lo + hi);
@@ -115,8 +123,8 @@ TEST(SliderCrankAnalysis, DeadCentresAreTheSlidersExtremes) {
       mu_sampled = std::fmin(mu_sampled, loom::motion::slider_state(m, th, 1, 0).transmission_rad);
     }
     EXPECT_NEAR(dc.mu_min_rad, mu_sampled, 1e-9);
-    EXPECT_NEAR(loom::motion::slider_state(m, dc.theta_mu_min_rad, 1, 0).transmission_rad,
-                dc.mu_min_rad, 1e-12);
+    EXPECT_NEAR(loom::motion::slider_state(m, dc.theta_mu_min_rad, 1, 0).transmission_rad, dc.mu_min_rad,
+                1e-12);
   }
 }
 

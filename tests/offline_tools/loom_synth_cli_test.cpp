@@ -1,12 +1,11 @@
 // loom-synth as a loom builder runs it: CSV headers and rows, the thesis' tables, the 12 cm / 169°
 // round trip to Table 4.3, and bad input → stderr naming the argument, exit code 2.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
-#include <cstdio>
-#include <sys/wait.h>
-
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <map>
@@ -138,10 +137,13 @@ TEST_F(LoomSynthCli, CrankRockerTableIsTable48) {
     // our 8-decimal text again to 6 would double-round: ...4499 → ...45 → ...5); the library test
     // checks the exact digits of the unrounded value.
     for (int k = 1; k <= 3; ++k) {
-      EXPECT_LE(std::fabs(std::stod(rows[i][static_cast<std::size_t>(k)]) - std::stod(p[static_cast<std::size_t>(k)])), 0.5e-6 + 0.5e-8)
+      EXPECT_LE(std::fabs(std::stod(rows[i][static_cast<std::size_t>(k)]) -
+                          std::stod(p[static_cast<std::size_t>(k)])),
+                0.5e-6 + 0.5e-8)
           << rows[i][0] << " col " << k;
     }
-    for (int k = 1; k <= 3; ++k) EXPECT_EQ(loom::test::decimals_of(rows[i][static_cast<std::size_t>(k)]), 8) << rows[i][0];
+    for (int k = 1; k <= 3; ++k)
+      EXPECT_EQ(loom::test::decimals_of(rows[i][static_cast<std::size_t>(k)]), 8) << rows[i][0];
     if (p[4] != "∞") {
       EXPECT_TRUE(loom::test::same_at_decimals(std::stod(rows[i][4]), p[4], 2)) << rows[i][0];
     }
@@ -273,11 +275,13 @@ TEST_F(LoomSynthCli, ExtremeStrokeIsFiniteOrRefused) {
 // (25, 15), (30, 1) mm at θ2 = 10°, 3°, −25°): both real solutions, each closing its loop — checked
 // here by walking the printed chain to every precision point.
 TEST_F(LoomSynthCli, ThreePointSeedExampleSolutionsCloseTheLoop) {
-  const CliRun r = run("three-point --theta0-deg 275 --point 0,0,10 --point 25,15,3 --point 30,1,-25 --full-precision");
+  const CliRun r =
+      run("three-point --theta0-deg 275 --point 0,0,10 --point 25,15,3 --point 30,1,-25 --full-precision");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto rows = csv(r.out);
   ASSERT_EQ(rows.size(), 3u) << r.out;
-  EXPECT_EQ(r.out.substr(0, r.out.find('\n')), "lambda,a0,a1,a2,theta1_1_deg,theta1_2_deg,theta1_3_deg,closure_residual");
+  EXPECT_EQ(r.out.substr(0, r.out.find('\n')),
+            "lambda,a0,a1,a2,theta1_1_deg,theta1_2_deg,theta1_3_deg,closure_residual");
   const double d2r = 3.14159265358979323846 / 180.0;
   const double pts[3][3] = {{0, 0, 10}, {25, 15, 3}, {30, 1, -25}};
   for (std::size_t i = 1; i < rows.size(); ++i) {
@@ -303,14 +307,14 @@ TEST_F(LoomSynthCli, ThreePointRefusesPointsThatDoNotDetermineTheChain) {
   EXPECT_TRUE(same.out.empty());
 }
 
-
 // The λ quadratic's root λ = 0 (an infinite link) is named, not dropped silently; a negative signed
 // length is explained. Points (0,0), (10,0), (0,10) with θ2 = 0 and θ0 = 90°: by hand, A = rows
 // [1, 2y, 2x], F = 0, ρ² = (0, 100, 100) give M = (0, 5, 5), p = 25, q = −1, r = 0, so λ ∈ {0, 1/25}
 // and λ = 1/25 gives a0 = a2 = 5, a1 = √50. With θ0 = 270° the ground column flips sign: λ = −1/25,
 // a0 = −5 (the same link pointing along 90°).
 TEST_F(LoomSynthCli, ThreePointNamesTheInfiniteRootAndNegativeLengths) {
-  const CliRun r = run("three-point --theta0-deg 90 --point 0,0,0 --point 10,0,0 --point 0,10,0 --full-precision");
+  const CliRun r =
+      run("three-point --theta0-deg 90 --point 0,0,0 --point 10,0,0 --point 0,10,0 --full-precision");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   auto rows = csv(r.out);
   ASSERT_EQ(rows.size(), 2u) << r.out;
@@ -319,7 +323,8 @@ TEST_F(LoomSynthCli, ThreePointNamesTheInfiniteRootAndNegativeLengths) {
   EXPECT_NEAR(std::stod(rows[1][2]), std::sqrt(50.0), 1e-12);
   EXPECT_NEAR(std::stod(rows[1][3]), 5.0, 1e-12);
   EXPECT_NE(r.err.find("1 real root of the lambda quadratic left out"), std::string::npos) << r.err;
-  const CliRun n = run("three-point --theta0-deg 270 --point 0,0,0 --point 10,0,0 --point 0,10,0 --full-precision");
+  const CliRun n =
+      run("three-point --theta0-deg 270 --point 0,0,0 --point 10,0,0 --point 0,10,0 --full-precision");
   ASSERT_EQ(n.exit_code, 0) << n.err;
   rows = csv(n.out);
   ASSERT_EQ(rows.size(), 2u) << n.out;
@@ -393,11 +398,36 @@ TEST_F(LoomSynthCli, KnotterPrintsTheSeedLinkageAsConfig) {
   const CliRun r = run("knotter");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto kv = config_lines(r.out);
-  for (const char* k : {"take_x_m", "take_y_m", "take_gripper_deg", "wrap_x_m", "wrap_y_m", "wrap_gripper_deg", "pull_x_m",
-                        "pull_y_m", "pull_gripper_deg", "theta0_deg", "crank_pivot_x_m", "crank_pivot_y_m", "rocker_pivot_x_m",
-                        "rocker_pivot_y_m", "crank_m", "coupler_m", "rocker_m", "gripper_along_m", "gripper_normal_m", "branch",
-                        "crank_mass_kg", "crank_cg_m", "crank_inertia_kg_m2", "coupler_mass_kg", "coupler_cg_m",
-                        "coupler_inertia_kg_m2", "rocker_mass_kg", "rocker_cg_m", "rocker_inertia_kg_m2", "warp_entry_x_m"}) {
+  for (const char* k : {"take_x_m",
+                        "take_y_m",
+                        "take_gripper_deg",
+                        "wrap_x_m",
+                        "wrap_y_m",
+                        "wrap_gripper_deg",
+                        "pull_x_m",
+                        "pull_y_m",
+                        "pull_gripper_deg",
+                        "theta0_deg",
+                        "crank_pivot_x_m",
+                        "crank_pivot_y_m",
+                        "rocker_pivot_x_m",
+                        "rocker_pivot_y_m",
+                        "crank_m",
+                        "coupler_m",
+                        "rocker_m",
+                        "gripper_along_m",
+                        "gripper_normal_m",
+                        "branch",
+                        "crank_mass_kg",
+                        "crank_cg_m",
+                        "crank_inertia_kg_m2",
+                        "coupler_mass_kg",
+                        "coupler_cg_m",
+                        "coupler_inertia_kg_m2",
+                        "rocker_mass_kg",
+                        "rocker_cg_m",
+                        "rocker_inertia_kg_m2",
+                        "warp_entry_x_m"}) {
     EXPECT_EQ(kv.count(k), 1u) << k;
   }
   EXPECT_EQ(kv.size(), 30u);
@@ -412,12 +442,14 @@ TEST_F(LoomSynthCli, KnotterPrintsTheSeedLinkageAsConfig) {
   EXPECT_EQ(kv.at("theta0_deg"), "275");
   // The printed linkage closes at the three points: the crank joint A and rocker joint B, placed back
   // from the gripper along the gripper-link angle, sit on their circles about the ground pivots.
-  const double a0x = num("crank_pivot_x_m"), a0y = num("crank_pivot_y_m"), b0x = num("rocker_pivot_x_m"), b0y = num("rocker_pivot_y_m");
+  const double a0x = num("crank_pivot_x_m"), a0y = num("crank_pivot_y_m"), b0x = num("rocker_pivot_x_m"),
+               b0y = num("rocker_pivot_y_m");
   for (const char* p : {"take", "wrap", "pull"}) {
     const std::string s(p);
     const double th = (num((s + "_gripper_deg").c_str()) + 180.0) * M_PI / 180.0;  // coupler x axis
     const double px = num((s + "_x_m").c_str()), py = num((s + "_y_m").c_str());
-    const double ax = px - num("gripper_along_m") * std::cos(th), ay = py - num("gripper_along_m") * std::sin(th);
+    const double ax = px - num("gripper_along_m") * std::cos(th),
+                 ay = py - num("gripper_along_m") * std::sin(th);
     const double bx = ax + num("coupler_m") * std::cos(th), by = ay + num("coupler_m") * std::sin(th);
     EXPECT_NEAR(std::hypot(ax - a0x, ay - a0y), num("crank_m"), 1e-9) << p;
     EXPECT_NEAR(std::hypot(bx - b0x, by - b0y), num("rocker_m"), 1e-9) << p;

@@ -54,8 +54,8 @@ void expect_constant_memory(std::vector<std::string> argv, const std::string& sa
 }
 
 TEST(CliStreaming, LoomKinFourbarRunsInConstantMemory) {
-  expect_constant_memory({LOOM_KIN_EXE, "fourbar", "--ground", "0.213", "--crank", "0.058", "--coupler", "0.189",
-                          "--rocker", "0.232"},
+  expect_constant_memory({LOOM_KIN_EXE, "fourbar", "--ground", "0.213", "--crank", "0.058", "--coupler",
+                          "0.189", "--rocker", "0.232"},
                          "--samples");
 }
 

@@ -55,22 +55,24 @@ TEST(ReportMemory, RssIsFlatOverTenThousandRows) {
   m.sequencer().request_start();
   firmware::RunOptions ro;
   ro.period_s = cfg.sequencer.period_s;
-  const firmware::RunResult res = firmware::run_loop(m.loop(), m.sequencer(), ro, [&](const firmware::RunEvent& e) {
-    if (e.kind != firmware::RunEvent::Kind::kRowDone) return;
-    w.add_row(e.row, e.counters.picks - picks_before, static_cast<double>(e.tick) * ro.period_s);
-    picks_before = e.counters.picks;
-    if (e.counters.rows == 100) rss_at_100 = vm_rss_kb();
-    if (e.counters.rows == kRows) rss_at_last = vm_rss_kb();
-  });
+  const firmware::RunResult res =
+      firmware::run_loop(m.loop(), m.sequencer(), ro, [&](const firmware::RunEvent& e) {
+        if (e.kind != firmware::RunEvent::Kind::kRowDone) return;
+        w.add_row(e.row, e.counters.picks - picks_before, static_cast<double>(e.tick) * ro.period_s);
+        picks_before = e.counters.picks;
+        if (e.counters.rows == 100) rss_at_100 = vm_rss_kb();
+        if (e.counters.rows == kRows) rss_at_last = vm_rss_kb();
+      });
   ASSERT_EQ(m.sequencer().counters().rows, kRows);
   report::RunEnd end;
   end.counters = m.sequencer().counters();
   end.machine_s = static_cast<double>(res.ticks) * ro.period_s;
   w.finish(end);
   rss_at_end = vm_rss_kb();
-  std::printf("VmRSS after 100 rows %ld kB, after %u rows %ld kB, after the report %ld kB (rows.jsonl %ju bytes)\n",
-              rss_at_100, kRows, rss_at_last, rss_at_end,
-              static_cast<std::uintmax_t>(std::filesystem::file_size(dir / "rows.jsonl")));
+  std::printf(
+      "VmRSS after 100 rows %ld kB, after %u rows %ld kB, after the report %ld kB (rows.jsonl %ju bytes)\n",
+      rss_at_100, kRows, rss_at_last, rss_at_end,
+      static_cast<std::uintmax_t>(std::filesystem::file_size(dir / "rows.jsonl")));
   ASSERT_GT(rss_at_100, 0);
   EXPECT_LE(rss_at_last - rss_at_100, 1024) << "resident memory grew with the rows";
   // Writing summary.json and the plots streams the rows back: bounded too.

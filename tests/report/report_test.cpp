@@ -45,7 +45,8 @@ report::RunHeader header() {
   return h;
 }
 
-nlohmann::json two_rows(const std::filesystem::path& dir, bool measured, std::optional<report::FaultSummary> fault) {
+nlohmann::json two_rows(const std::filesystem::path& dir, bool measured,
+                        std::optional<report::FaultSummary> fault) {
   report::ReportWriter w(dir.string(), header());
   w.add_row(row(1, measured), 1, 7.4);
   w.add_row(row(2, measured), 1, 14.8);
@@ -83,14 +84,16 @@ TEST(RunReport, SummaryFollowsTheContract) {
   std::ifstream rows(dir / "rows.jsonl");
   std::string line;
   int n = 0;
-  while (std::getline(rows, line)) EXPECT_EQ(nlohmann::json::parse(line), j.at("rows")[static_cast<std::size_t>(n++)]);
+  while (std::getline(rows, line))
+    EXPECT_EQ(nlohmann::json::parse(line), j.at("rows")[static_cast<std::size_t>(n++)]);
   EXPECT_EQ(n, 2);
 }
 
 TEST(RunReport, FaultAndMissingLoadCellAreExplicit) {
   const auto dir = fresh_dir("fault");
-  const nlohmann::json j =
-      two_rows(dir, false, report::FaultSummary{"drive_fault", 0x1002, "carriage", 0x8611, 16.0, "drive_fault", "a drive"});
+  const nlohmann::json j = two_rows(
+      dir, false,
+      report::FaultSummary{"drive_fault", 0x1002, "carriage", 0x8611, 16.0, "drive_fault", "a drive"});
   EXPECT_TRUE(j.at("totals").at("beat_force_n").is_null());
   EXPECT_TRUE(j.at("rows")[0].at("beats")[0].at("peak_force_n").is_null());
   EXPECT_EQ(j.at("result"), "fault");
@@ -117,7 +120,8 @@ TEST(RunReport, PlotsAreZoomedToTheDataWithOneSeriesPerRow) {
   EXPECT_NE(text.find("</svg>"), std::string::npos);
   EXPECT_NE(text.find(">row 1</text>"), std::string::npos);
   EXPECT_NE(text.find(">row 2</text>"), std::string::npos);
-  EXPECT_EQ(text.find("text-anchor='end'>0</text>"), std::string::npos);  // the force axis does not start at 0 N
+  EXPECT_EQ(text.find("text-anchor='end'>0</text>"),
+            std::string::npos);  // the force axis does not start at 0 N
   EXPECT_NE(text.find("target 80–100 N"), std::string::npos);
   // Every row is on the timeline.
   const std::string tl = read(dir / "row_timeline.svg");

@@ -1,9 +1,10 @@
 // Each interlock trips on exactly the motion it forbids and allows holding still.
+#include "loom/sequencer/interlocks.hpp"
+
 #include <gtest/gtest.h>
 
 #include "loom/motion/angles.hpp"
 #include "loom/motion/beatup.hpp"
-#include "loom/sequencer/interlocks.hpp"
 
 using namespace loom;
 using namespace loom::sequencer;
@@ -83,7 +84,8 @@ TEST(KnotInterlocks, NothingCrossesAGripperInTheWarp) {
   f.next.axes[hal::index(hal::CoreAxis::kBeatCrank)].target_position = 0.01;
   EXPECT_EQ(check_interlocks(f.ctx, f.in, f.prev, f.next), Fault::kGripperInWarp);
   f.next = f.prev;
-  f.next.io.piston_a_extend = true;  // a shed change (the shuttle is at a selvedge: only the gripper forbids it)
+  f.next.io.piston_a_extend =
+      true;  // a shed change (the shuttle is at a selvedge: only the gripper forbids it)
   EXPECT_EQ(check_interlocks(f.ctx, f.in, f.prev, f.next), Fault::kGripperInWarp);
   // Out of the warp (at TAKE, or past the far end), all three may move.
   for (const double clear : {0.0, 0.99, 2.01}) {

@@ -1,12 +1,12 @@
 // The knot plan against numbers worked out by hand: the thesis' carpet classes (Table 2.1), knots per
 // row and stripe, carriage steps and selector moves, and the refusals that name what is wrong.
+#include "loom/sequencer/knot_plan.hpp"
+
 #include <gtest/gtest.h>
 
 #include <array>
 #include <string>
 #include <vector>
-
-#include "loom/sequencer/knot_plan.hpp"
 
 using namespace loom::sequencer;
 
@@ -34,7 +34,8 @@ TEST(KnotPlan, CarpetClassesFollowTheThesisTable) {
   EXPECT_EQ(carpet_class(215.0), CarpetClass::kCoarse);
   EXPECT_EQ(carpet_class(700.0), CarpetClass::kCoarse);
   EXPECT_EQ(carpet_class(701.0), CarpetClass::kMedium);
-  EXPECT_EQ(carpet_class(900.0), CarpetClass::kMedium);  // 30 x 30: the "medium class, about 30 knots/dm"
+  EXPECT_EQ(carpet_class(900.0),
+            CarpetClass::kMedium);  // 30 x 30: the "medium class, about 30 knots/dm"
   EXPECT_EQ(carpet_class(1400.0), CarpetClass::kMedium);
   EXPECT_EQ(carpet_class(1401.0), CarpetClass::kFine);
   EXPECT_EQ(carpet_class(1850.0), CarpetClass::kFine);
@@ -59,8 +60,8 @@ TEST(KnotPlan, TheDefaultLoomsRowAtThirtyKnotsPerDecimetre) {
   EXPECT_EQ(p.knots, 360);
   EXPECT_EQ(p.head_knots[0], 180);
   EXPECT_EQ(p.head_knots[1], 180);
-  EXPECT_EQ(p.knot_cycles, 180);    // both heads at once
-  EXPECT_EQ(p.carriage_steps, 179);  // one pitch between consecutive knots
+  EXPECT_EQ(p.knot_cycles, 180);      // both heads at once
+  EXPECT_EQ(p.carriage_steps, 179);   // one pitch between consecutive knots
   EXPECT_EQ(p.selector_moves[0], 1);  // from "unknown" to red once
   EXPECT_EQ(p.selector_moves[1], 1);
   EXPECT_EQ(slots[0], 0);
@@ -107,9 +108,11 @@ TEST(KnotPlan, RefusalsNameWhatIsWrong) {
     (void)plan_row(s, 1.2, row, kPalette, slots);
     FAIL() << "a colour without a slot was planned";
   } catch (const std::invalid_argument& e) {
-    EXPECT_EQ(std::string(e.what()), "colour \"G\" (knot 251, head 2) is in no magazine slot (knotting.slot_colours)");
+    EXPECT_EQ(std::string(e.what()),
+              "colour \"G\" (knot 251, head 2) is in no magazine slot (knotting.slot_colours)");
   }
-  EXPECT_THROW((void)plan_row(s, 1.2, std::vector<std::uint16_t>(359, 0), kPalette, slots), std::invalid_argument);
+  EXPECT_THROW((void)plan_row(s, 1.2, std::vector<std::uint16_t>(359, 0), kPalette, slots),
+               std::invalid_argument);
   s.head_spacing_m = 0.5;  // 2 x 150 knots cover 300 of 360
   EXPECT_NE(validate(s, 1.2).find("cover 300 of the row's 360 knots"), std::string::npos) << validate(s, 1.2);
   s = heads_spec();
@@ -163,7 +166,9 @@ TEST(KnotProgram, ADesignTheMagazinesCannotHoldIsRefusedNamingTheRowAndColour) {
     (void)KnotProgram::build(s, 1.2, 120, 2, knots, kPalette, 0, 0);
     FAIL() << "accepted";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("design row 2: colour \"G\" (knot 71, head 2) is in no magazine slot"), std::string::npos)
+    EXPECT_NE(
+        std::string(e.what()).find("design row 2: colour \"G\" (knot 71, head 2) is in no magazine slot"),
+        std::string::npos)
         << e.what();
   }
 }

@@ -34,7 +34,8 @@ struct Rig {
     if (start) seq->request_start();
   }
   // Runs `ticks` ticks or until `until` says stop.
-  void run(hal::Tick ticks, const std::function<bool()>& until = [] { return false; }) {
+  void run(
+      hal::Tick ticks, const std::function<bool()>& until = [] { return false; }) {
     hal::PortHal hal(*world, *world);
     for (const hal::Tick end = now + ticks; now < end; ++now) {
       hal.read(now, in);
@@ -54,7 +55,8 @@ struct Rig {
 TEST(SequencerFaults, NonFiniteAxisFeedbackIsAFaultOnThatAxis) {
   Rig r;
   r.tamper = [](hal::Tick t, hal::HalInputs& in) {
-    if (t >= 3000) in.axes[hal::index(hal::CoreAxis::kCarriage)].velocity = std::numeric_limits<double>::quiet_NaN();
+    if (t >= 3000)
+      in.axes[hal::index(hal::CoreAxis::kCarriage)].velocity = std::numeric_limits<double>::quiet_NaN();
   };
   r.build(3);
   r.run(5000);
@@ -76,7 +78,8 @@ TEST(SequencerFaults, EmcyFromAnEnabledDriveStopsInTheSameTick) {
   EXPECT_EQ(r.seq->first_fault(), Fault::kDriveEmcy);
   EXPECT_EQ(r.seq->fault_detail(), 0x2310);
   EXPECT_EQ(r.seq->fault_tick(), 3000);
-  for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k) EXPECT_EQ(r.out.axes[k].request, hal::AxisRequest::kQuickStop);
+  for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k)
+    EXPECT_EQ(r.out.axes[k].request, hal::AxisRequest::kQuickStop);
 }
 
 TEST(SequencerFaults, ALoadCellThatVanishesOrReadsNaNIsAFault) {
@@ -115,7 +118,8 @@ TEST(SequencerFaults, StopNowStopsAtOnceKeepsTheCountersAndAcknowledgeRearms) {
   r.run(1);
   EXPECT_EQ(r.seq->state(), State::kIdle);
   EXPECT_EQ(r.seq->first_fault(), Fault::kNone);
-  for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k) EXPECT_EQ(r.out.axes[k].request, hal::AxisRequest::kFaultReset);
+  for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k)
+    EXPECT_EQ(r.out.axes[k].request, hal::AxisRequest::kFaultReset);
   EXPECT_TRUE(r.out.io.lamp_amber);
   r.seq->request_start();
   r.run(200000, [&] { return r.seq->finished(); });
@@ -197,7 +201,8 @@ TEST(SequencerFaults, AnAcknowledgementBeforeTheFaultIsDiscardedAndOneWhileTheCh
     r.run(1);
     EXPECT_EQ(r.seq->state(), State::kFault);
     EXPECT_EQ(r.seq->first_fault(), Fault::kEStop);
-    for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k) EXPECT_EQ(r.out.axes[k].request, hal::AxisRequest::kQuickStop);
+    for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k)
+      EXPECT_EQ(r.out.axes[k].request, hal::AxisRequest::kQuickStop);
     r.run(300);
     EXPECT_EQ(r.seq->state(), State::kFault) << "the stale acknowledgement was taken";
     EXPECT_TRUE(r.out.io.lamp_red);
@@ -262,7 +267,7 @@ TEST(DualChannelSensors, ASensorIsOnOnlyWhileBothChannelsSayOnWhereASecondIsWire
   EXPECT_FALSE(v[1]);  // second off: not confirmed
   EXPECT_FALSE(v[2]);  // first off: not confirmed, whatever the second says
   EXPECT_FALSE(v[3]);
-  EXPECT_TRUE(v[4]);   // no second channel: the first alone
+  EXPECT_TRUE(v[4]);  // no second channel: the first alone
   EXPECT_FALSE(v[5]);
 }
 
@@ -375,7 +380,8 @@ TEST(SequencerFaults, ASecondChannelThatNeverSwitchesIsFoundAtTheFirstStroke) {
 TEST(SequencerFaults, ConfigurationRefusalsCarryTheirField) {
   const motion::ProfileSet p{motion::ProfileSpec{}};
   EXPECT_FALSE(sequencer::find_fault(sequencer::SequencerConfig{}, p).has_value());
-  const auto expect = [&](const sequencer::SequencerConfig& c, sequencer::SequencerField field, const char* names) {
+  const auto expect = [&](const sequencer::SequencerConfig& c, sequencer::SequencerField field,
+                          const char* names) {
     const std::optional<sequencer::SequencerFault> f = sequencer::find_fault(c, p);
     ASSERT_TRUE(f.has_value());
     EXPECT_EQ(f->field, field) << f->message;

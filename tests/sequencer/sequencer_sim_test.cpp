@@ -88,8 +88,11 @@ TEST(SequencerSim, ServoLagStillWeavesWithoutInterlockTrips) {
 
 TEST(SequencerSim, DriveFaultStopsEveryAxisAndKeepsCounters) {
   Rig r;
-  r.scene.faults.push_back({.at_s = 12.0, .kind = sim_hal::InjectedFault::kDriveFault,
-                            .axis_name = "carriage", .axis = hal::index(hal::CoreAxis::kCarriage), .code = 0x8611});
+  r.scene.faults.push_back({.at_s = 12.0,
+                            .kind = sim_hal::InjectedFault::kDriveFault,
+                            .axis_name = "carriage",
+                            .axis = hal::index(hal::CoreAxis::kCarriage),
+                            .code = 0x8611});
   r.build(5);
   r.run(200000, [] {});
   ASSERT_EQ(r.seq->state(), State::kFault);
@@ -100,7 +103,8 @@ TEST(SequencerSim, DriveFaultStopsEveryAxisAndKeepsCounters) {
   EXPECT_GE(counters.rows, 1u);
   // After the fault: every axis is asked to quick-stop and no target moves any more.
   const hal::HalOutputs at_fault = r.out;
-  for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k) EXPECT_EQ(at_fault.axes[k].request, hal::AxisRequest::kQuickStop);
+  for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k)
+    EXPECT_EQ(at_fault.axes[k].request, hal::AxisRequest::kQuickStop);
   hal::PortHal hal(*r.world, *r.world);
   for (int i = 0; i < 1000; ++i, ++r.now) {
     hal.read(r.now, r.in);
@@ -151,7 +155,8 @@ TEST(SequencerSim, EStopMidRowIsLatchedAndStopsEverything) {
     r.seq->step(r.now, r.in, r.out);
     hal.write(r.now, r.out);
     for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k) {
-      ASSERT_EQ(r.out.axes[k].target_position, at_fault.axes[k].target_position) << "axis " << k << ", tick " << i;
+      ASSERT_EQ(r.out.axes[k].target_position, at_fault.axes[k].target_position)
+          << "axis " << k << ", tick " << i;
       ASSERT_EQ(r.out.axes[k].request, hal::AxisRequest::kQuickStop) << "axis " << k << ", tick " << i;
     }
     ASSERT_EQ(r.out.io.piston_a_extend, at_fault.io.piston_a_extend);
@@ -335,7 +340,8 @@ TEST(SequencerSim, EachRowWaitsUntilTheOneBeforeIsOnDisk) {
       if (row_end_at < 0) row_end_at = r.now;
     }
     for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k) {
-      moved_while_waiting = moved_while_waiting || r.out.axes[k].target_position != parked.axes[k].target_position;
+      moved_while_waiting =
+          moved_while_waiting || r.out.axes[k].target_position != parked.axes[k].target_position;
     }
     // The reporter confirms row 1 one second (500 ticks) after it ended.
     if (r.now - row_end_at == 500) r.seq->note_rows_saved(1, false);
@@ -373,7 +379,8 @@ TEST(SequencerSim, ASaveNeverConfirmedTimesOutWithCountersNotSaved) {
   });
   EXPECT_EQ(r.seq->first_fault(), Fault::kCountersNotSaved);
   EXPECT_EQ(r.seq->counters().rows, 1u);
-  EXPECT_NEAR(static_cast<double>(r.seq->fault_tick() - row_end_at) * r.cfg.period_s, 0.5, 2.0 * r.cfg.period_s);
+  EXPECT_NEAR(static_cast<double>(r.seq->fault_tick() - row_end_at) * r.cfg.period_s, 0.5,
+              2.0 * r.cfg.period_s);
 }
 
 // Knotting mode: before every new row the loom parks and waits for the weaver's "row knotted" — the
@@ -404,7 +411,8 @@ TEST(SequencerSim, KnottingModeWaitsBeforeEveryRowForTheWeaver) {
         ++waits;
       }
       for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k) {
-        moved_while_waiting = moved_while_waiting || r.out.axes[k].target_position != parked.axes[k].target_position;
+        moved_while_waiting =
+            moved_while_waiting || r.out.axes[k].target_position != parked.axes[k].target_position;
       }
       EXPECT_TRUE(r.out.io.lamp_amber);
     } else if (pedal_ticks >= 20) {

@@ -1,8 +1,8 @@
 // The sequencer's shed monitor against hand-made sensor pictures: a consistent picture opens the shed,
 // an impossible one is a named verdict, and a whole stroke is trusted only once the frame can have made it.
-#include <gtest/gtest.h>
-
 #include "loom/sequencer/shed_monitor.hpp"
+
+#include <gtest/gtest.h>
 
 using namespace loom;
 using loom::sequencer::PistonEnds;
@@ -10,7 +10,8 @@ using loom::sequencer::ShedMonitor;
 using loom::sequencer::ShedVerdict;
 
 namespace {
-constexpr PistonEnds kExtended{true, false}, kRetracted{false, true}, kBetween{false, false}, kBoth{true, true};
+constexpr PistonEnds kExtended{true, false}, kRetracted{false, true}, kBetween{false, false},
+    kBoth{true, true};
 
 motion::ShedSpec spec() {
   motion::ShedSpec s;  // 0.25 s stroke, earliest 0.4, release 0.15 s, timeout 1.5 s, settle 20 ms
@@ -26,7 +27,8 @@ Result stroke_a_up(ShedMonitor& m, double arrive_s) {
   m.start(true, false, kRetracted, kRetracted);
   for (int i = 1; i < 1000; ++i) {
     const double t = i * 0.002;
-    const ShedVerdict v = m.update(spec(), t, t < arrive_s ? (t < 0.01 ? kRetracted : kBetween) : kExtended, kRetracted);
+    const ShedVerdict v =
+        m.update(spec(), t, t < arrive_s ? (t < 0.01 ? kRetracted : kBetween) : kExtended, kRetracted);
     if (v != ShedVerdict::kMoving && v != ShedVerdict::kSettling) return {v, t};
   }
   return {ShedVerdict::kMoving, 2.0};
@@ -52,7 +54,7 @@ TEST(ShedMonitor, AnEndSensorAtTheProfilesEarliestWindowIsNotTrustedBeforeTheFra
 
 TEST(ShedMonitor, AStrokeFarFasterThanThisFrameLastMadeIsASensorFault) {
   ShedMonitor m;
-  ASSERT_EQ(stroke_a_up(m, 0.30).v, ShedVerdict::kOpen);  // learns 0.30 s
+  ASSERT_EQ(stroke_a_up(m, 0.30).v, ShedVerdict::kOpen);      // learns 0.30 s
   EXPECT_EQ(stroke_a_up(m, 0.20).v, ShedVerdict::kTooEarly);  // < 0.8 × 0.30
   ShedMonitor fresh;
   EXPECT_EQ(stroke_a_up(fresh, 0.05).v, ShedVerdict::kTooEarly);  // < 0.4 × 0.25 (the profiles' window)

@@ -9,8 +9,8 @@
 
 #include "campaign.hpp"
 #include "loom/config/config.hpp"
-#include "loom/firmware/machine.hpp"
 #include "loom/config/scene_config.hpp"
+#include "loom/firmware/machine.hpp"
 
 using namespace loom;
 
@@ -39,7 +39,8 @@ value = true
 TEST(DoubleFaults, SlipWithTheArrivalSwitchStuckAtArrivalNeedsTheSecondSwitch) {
   const firmware::Scene scene = firmware::parse_scene(kSlipAndStuckArrival, "slip_and_stuck_arrival.toml");
   const safety::RunOutcome single = safety::run_one(single_channel_loom(), scene.spec, 2);
-  EXPECT_TRUE(single.violated) << "the single-channel loom was expected to be fooled; first fault " << single.first_fault;
+  EXPECT_TRUE(single.violated) << "the single-channel loom was expected to be fooled; first fault "
+                               << single.first_fault;
   const safety::RunOutcome dual = safety::run_one(firmware::default_loom_config(), scene.spec, 2);
   EXPECT_FALSE(dual.violated) << dual.what;
   EXPECT_EQ(dual.first_fault, "sensor_discrepancy");
@@ -81,7 +82,8 @@ TEST(DoubleFaults, APistonSeizedMidStrokeWithItsEndSwitchStuckOnNeedsTheSecondSw
   stuck.at_s = static_cast<double>(end) * period;
   spec.faults = {seize, stuck};
   const safety::RunOutcome single = safety::run_one(single_channel_loom(), spec, 2);
-  EXPECT_TRUE(single.violated) << "the single-channel loom was expected to be fooled; first fault " << single.first_fault;
+  EXPECT_TRUE(single.violated) << "the single-channel loom was expected to be fooled; first fault "
+                               << single.first_fault;
   const safety::RunOutcome dual = safety::run_one(cfg, spec, 2);
   EXPECT_FALSE(dual.violated) << dual.what;
   EXPECT_EQ(dual.first_fault, "sensor_discrepancy");

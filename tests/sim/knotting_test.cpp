@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "loom/firmware/carpet_png.hpp"
 #include "loom/config/config.hpp"
+#include "loom/firmware/carpet_png.hpp"
 #include "loom/firmware/machine.hpp"
 #include "loom/firmware/runner.hpp"
 #include "loom/hal/motion_outputs.hpp"
@@ -23,11 +23,14 @@ using namespace loom;
 namespace {
 const std::string kDir = std::string(LOOM_SOURCE_DIR) + "/tests/sim/";
 
-firmware::LoomConfig knotting_loom() { return firmware::load_loom_config(kDir + "knotting_sample_loom.toml"); }
+firmware::LoomConfig knotting_loom() {
+  return firmware::load_loom_config(kDir + "knotting_sample_loom.toml");
+}
 
 firmware::Scene scene(const std::string& knotter, const std::string& faults = "") {
-  return firmware::parse_scene("name = \"knots\"\nseed = 3\neffects = [\"ideal\", \"knotter\"]\n[knotter]\n" + knotter + faults,
-                               "knots.toml");
+  return firmware::parse_scene(
+      "name = \"knots\"\nseed = 3\neffects = [\"ideal\", \"knotter\"]\n[knotter]\n" + knotter + faults,
+      "knots.toml");
 }
 
 // The design file as a weaver reads it: palette codes to colours, rows top line first.
@@ -117,8 +120,10 @@ int expect_equals_design(const Woven& w, int rows) {
     // Carpet row r (woven r-th) is design row r from the bottom; both pictures draw it from the bottom.
     const auto& want = d.rows_top_down[static_cast<std::size_t>(h - 1 - r)];
     for (int k = 0; k < 90; ++k) {
-      const png_byte* p = &w.png.px[(static_cast<std::size_t>(rows - 1 - r) * 90 + static_cast<std::size_t>(k)) * 4];
-      const std::uint32_t rgb = static_cast<std::uint32_t>(p[0]) << 16 | static_cast<std::uint32_t>(p[1]) << 8 | p[2];
+      const png_byte* p =
+          &w.png.px[(static_cast<std::size_t>(rows - 1 - r) * 90 + static_cast<std::size_t>(k)) * 4];
+      const std::uint32_t rgb =
+          static_cast<std::uint32_t>(p[0]) << 16 | static_cast<std::uint32_t>(p[1]) << 8 | p[2];
       EXPECT_EQ(rgb, want[static_cast<std::size_t>(k)]) << "row " << r + 1 << " knot " << k + 1;
       EXPECT_NE(p[3], 0) << "row " << r + 1 << " knot " << k + 1 << " not tied";
       by_hand += p[3] == 128;
@@ -134,7 +139,8 @@ TEST(Knotting, TheHeadsTieTheDesignKnotForKnot) {
   EXPECT_EQ(w.counters.rows, 2u);
   EXPECT_EQ(w.counters.knot.tied, 180u);
   EXPECT_EQ(w.counters.knot.by_hand, 0u);
-  EXPECT_TRUE(w.requests.empty() || w.requests[0].ask == sequencer::WeaverAsk::kReload);  // 40-knot slots: reloads only
+  EXPECT_TRUE(w.requests.empty() ||
+              w.requests[0].ask == sequencer::WeaverAsk::kReload);  // 40-knot slots: reloads only
   EXPECT_TRUE(w.check.equal());
   EXPECT_EQ(expect_equals_design(w, 2), 0);
 }
@@ -142,11 +148,14 @@ TEST(Knotting, TheHeadsTieTheDesignKnotForKnot) {
 TEST(Knotting, MissedKnotsAndAnEmptySlotEndWithTheDesignAndTheWeaversKnotsMarked) {
   // Knots slip off one time in six; slot 2 (indigo) of head 1 runs dry early.
   const Woven w = weave(knotting_loom(),
-                        scene("miss_probability = 0.17\nweaver_s = 2.0\n", "[[fault]]\nkind = \"yarn_out\"\nat_s = 5.0\nhead = 1\nslot = 2\n"), 3);
+                        scene("miss_probability = 0.17\nweaver_s = 2.0\n",
+                              "[[fault]]\nkind = \"yarn_out\"\nat_s = 5.0\nhead = 1\nslot = 2\n"),
+                        3);
   EXPECT_EQ(w.state, sequencer::State::kDone) << sequencer::fault_name(w.fault);
   EXPECT_GT(w.counters.knot.retried, 0u);
   EXPECT_GT(w.counters.knot.by_hand, 0u);
-  EXPECT_EQ(w.counters.knot.tied + w.counters.knot.by_hand, 270u);  // every knot once: none skipped, none twice
+  EXPECT_EQ(w.counters.knot.tied + w.counters.knot.by_hand,
+            270u);  // every knot once: none skipped, none twice
   int asked_by_hand = 0, reloads = 0;
   for (const auto& r : w.requests) {
     asked_by_hand += r.ask == sequencer::WeaverAsk::kTieByHand;
@@ -155,13 +164,15 @@ TEST(Knotting, MissedKnotsAndAnEmptySlotEndWithTheDesignAndTheWeaversKnotsMarked
   }
   EXPECT_EQ(static_cast<std::uint32_t>(asked_by_hand), w.counters.knot.by_hand);
   EXPECT_GT(reloads, 0);
-  EXPECT_TRUE(w.check.equal()) << w.check.missing << " missing, " << w.check.wrong << " wrong, " << w.check.doubled << " doubled";
+  EXPECT_TRUE(w.check.equal()) << w.check.missing << " missing, " << w.check.wrong << " wrong, "
+                               << w.check.doubled << " doubled";
   EXPECT_EQ(expect_equals_design(w, 3), static_cast<int>(w.counters.knot.by_hand));
 }
 
 TEST(Knotting, AJammedSelectorIsANamedFault) {
   const firmware::LoomConfig cfg = knotting_loom();
-  const Woven w = weave(cfg, scene("weaver_s = 1.0\n", "[[fault]]\nkind = \"selector_jam\"\nat_s = 3.0\nhead = 2\n"), 2);
+  const Woven w =
+      weave(cfg, scene("weaver_s = 1.0\n", "[[fault]]\nkind = \"selector_jam\"\nat_s = 3.0\nhead = 2\n"), 2);
   EXPECT_EQ(w.state, sequencer::State::kFault);
   EXPECT_EQ(w.fault, sequencer::Fault::kSelectorJam);
   EXPECT_EQ(w.fault_axis, cfg.sequencer.heads.selector_axis[1]);
@@ -196,7 +207,8 @@ struct Stepped {
 // while the weaver knots a row in weaver mode; it does not wait for a row end that needs the weaver.
 TEST(Knotting, AStopWhileTheHeadsWaitForTheWeaverEndsTheRun) {
   Stepped s(knotting_loom(), scene("miss_probability = 1.0\n"), 2);  // every knot slips: the weaver is asked
-  ASSERT_TRUE(s.run([&] { return s.m.sequencer().weaver_request().ask == sequencer::WeaverAsk::kTieByHand; }, 100000));
+  ASSERT_TRUE(s.run([&] { return s.m.sequencer().weaver_request().ask == sequencer::WeaverAsk::kTieByHand; },
+                    100000));
   EXPECT_EQ(s.m.sequencer().state(), sequencer::State::kKnotting);
   s.m.sequencer().request_stop();
   ASSERT_TRUE(s.run([&] { return s.m.sequencer().state() == sequencer::State::kDone; }, 10));
@@ -208,7 +220,11 @@ TEST(Knotting, AStopWhileTheHeadsWaitForTheWeaverEndsTheRun) {
 // on knotting the same row from the next knot — the row is then tied in full, every knot once.
 TEST(Knotting, APauseWhileTheHeadsTieHoldsAfterTheKnotCycleInProgress) {
   Stepped s(knotting_loom(), scene(""), 2);
-  ASSERT_TRUE(s.run([&] { return s.m.sequencer().state() == sequencer::State::kKnotting && s.m.sequencer().knot_cycle() == 2; }, 100000));
+  ASSERT_TRUE(s.run(
+      [&] {
+        return s.m.sequencer().state() == sequencer::State::kKnotting && s.m.sequencer().knot_cycle() == 2;
+      },
+      100000));
   s.m.sequencer().request_pause();
   const auto pistons = s.m.sim().pistons();
   ASSERT_TRUE(s.run([&] { return s.m.sequencer().state() != sequencer::State::kKnotting; }, 100000));
@@ -222,7 +238,8 @@ TEST(Knotting, APauseWhileTheHeadsTieHoldsAfterTheKnotCycleInProgress) {
   // Standing: nothing moves while paused.
   const hal::HalOutputs before = s.m.loop().outputs();
   ASSERT_FALSE(s.run([&] { return s.m.sequencer().state() != sequencer::State::kPaused; }, 2000));
-  EXPECT_FALSE(hal::motion_started(before, s.m.loop().outputs(), s.m.sequencer().axes().count, s.m.knot_program()->heads()));
+  EXPECT_FALSE(hal::motion_started(before, s.m.loop().outputs(), s.m.sequencer().axes().count,
+                                   s.m.knot_program()->heads()));
   s.m.sequencer().request_resume();
   ASSERT_TRUE(s.run([&] { return s.m.sequencer().counters().picks > 0; }, 100000));
   EXPECT_EQ(s.m.sequencer().counters().knot.tied + s.m.sequencer().counters().knot.by_hand,
@@ -243,6 +260,7 @@ TEST(Knotting, AScenelessHeadsLoomAndAHeadlessKnotterAreRefused) {
   EXPECT_NE(error(knotting_loom(), firmware::parse_scene("name = \"t\"\neffects = [\"ideal\"]\n", "t.toml"))
                 .find("the scene must name the effect \"knotter\""),
             std::string::npos);
-  EXPECT_NE(error(firmware::default_loom_config(), scene("weaver_s = 1.0\n")).find("has none (knotting.mode = \"none\")"),
+  EXPECT_NE(error(firmware::default_loom_config(), scene("weaver_s = 1.0\n"))
+                .find("has none (knotting.mode = \"none\")"),
             std::string::npos);
 }

@@ -13,7 +13,9 @@ using namespace loom;
 namespace {
 constexpr std::size_t kTakeUp = 3;  // slot of the added axis (after the core three)
 
-firmware::LoomConfig four_axis_loom() { return firmware::load_loom_config(std::string(LOOM_SOURCE_DIR) + "/tests/sim/four_axis_loom.toml"); }
+firmware::LoomConfig four_axis_loom() {
+  return firmware::load_loom_config(std::string(LOOM_SOURCE_DIR) + "/tests/sim/four_axis_loom.toml");
+}
 
 firmware::Scene scene_with(const std::string& faults) {
   return firmware::parse_scene("name = \"t\"\nseed = 1\neffects = [\"ideal\"]\n" + faults, "t.toml");
@@ -56,7 +58,8 @@ Outcome run(const firmware::LoomConfig& cfg, const firmware::Scene& scene, std::
     m.loop().cycle(200001);
     r.every_axis_quick_stopped = true;
     for (std::size_t i = 0; i < cfg.axes.size(); ++i) {
-      r.every_axis_quick_stopped = r.every_axis_quick_stopped && m.loop().outputs().axes[i].request == hal::AxisRequest::kQuickStop;
+      r.every_axis_quick_stopped =
+          r.every_axis_quick_stopped && m.loop().outputs().axes[i].request == hal::AxisRequest::kQuickStop;
     }
   }
   return r;
@@ -76,7 +79,9 @@ TEST(MachineAxes, AFourAxisLoomWeavesWithItsAddedAxisEnabledAndHeld) {
 
 TEST(MachineAxes, AFaultOnTheAddedAxisStopsTheWholeLoom) {
   const firmware::LoomConfig cfg = four_axis_loom();
-  const Outcome r = run(cfg, scene_with("[[fault]]\nat_s = 3.0\nkind = \"drive_fault\"\naxis = \"take_up\"\ncode = 0x7500\n"), 3);
+  const Outcome r = run(
+      cfg, scene_with("[[fault]]\nat_s = 3.0\nkind = \"drive_fault\"\naxis = \"take_up\"\ncode = 0x7500\n"),
+      3);
   EXPECT_EQ(r.state, sequencer::State::kFault);
   EXPECT_EQ(r.fault, sequencer::Fault::kDriveFault);
   EXPECT_EQ(r.fault_axis, static_cast<int>(kTakeUp));
@@ -87,7 +92,9 @@ TEST(MachineAxes, AFaultOnTheAddedAxisStopsTheWholeLoom) {
 TEST(MachineAxes, AnEncoderJumpOnTheAddedAxisIsCaughtByItsOwnSpeedLimit) {
   const firmware::LoomConfig cfg = four_axis_loom();
   // 2 rad/s top speed: 0.05 rad in one 2 ms tick is 12x what the roller can do.
-  const Outcome r = run(cfg, scene_with("[[fault]]\nat_s = 3.0\nkind = \"encoder_glitch\"\naxis = \"take_up\"\njump = 0.05\n"), 3);
+  const Outcome r = run(
+      cfg, scene_with("[[fault]]\nat_s = 3.0\nkind = \"encoder_glitch\"\naxis = \"take_up\"\njump = 0.05\n"),
+      3);
   EXPECT_EQ(r.fault, sequencer::Fault::kEncoderJump);
   EXPECT_EQ(r.fault_axis, static_cast<int>(kTakeUp));
 }
@@ -98,8 +105,11 @@ TEST(MachineAxes, ASceneNamingAnAxisTheLoomLacksIsRefusedAtItsLine) {
     (void)firmware::check_scene_fits(s, firmware::default_loom_config());
     FAIL() << "accepted a fault on an axis the default loom does not have";
   } catch (const firmware::ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("t.toml:4:1: fault[0].axis = \"take_up\": the loom"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("its axes: beat_crank, carriage, helix"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("t.toml:4:1: fault[0].axis = \"take_up\": the loom"),
+              std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("its axes: beat_crank, carriage, helix"), std::string::npos)
+        << e.what();
   }
   EXPECT_NO_THROW((void)firmware::check_scene_fits(s, four_axis_loom()));
 }

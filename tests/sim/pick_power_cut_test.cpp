@@ -3,7 +3,6 @@
 // slipped shuttle (the docs promise "a cut pick is finished on restart"). The issue found 23 of 3,482
 // swept ticks — the first and last few of a pick — restarting into a false shuttle_slipped.
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <filesystem>
@@ -33,7 +32,8 @@ struct Cut {
 // Weaves from `resume` on the machine in `path` until `rows` rows are done or `cut_at` ticks have run
 // (the cut: the process is gone, the machine stays where it physically was).
 Cut weave(const firmware::LoomConfig& cfg, const firmware::Scene& scene, const std::string& path,
-          sequencer::Counters resume, std::uint32_t rows, hal::Tick cut_at, std::vector<hal::Tick>* pick_ticks) {
+          sequencer::Counters resume, std::uint32_t rows, hal::Tick cut_at,
+          std::vector<hal::Tick>* pick_ticks) {
   firmware::MachineOptions opt;
   opt.telemetry = false;
   opt.rows = rows;
@@ -65,7 +65,8 @@ TEST(PickPowerCut, EveryTickOfAPickRestartsIntoTheSamePickFinished) {
   for (std::size_t i = 0; i < pick_ticks.size(); ++i) {
     if (i == 0 || pick_ticks[i - 1] != pick_ticks[i] - 1) cuts.push_back(pick_ticks[i] - 1);
     cuts.push_back(pick_ticks[i]);
-    if (i + 1 == pick_ticks.size() || pick_ticks[i + 1] != pick_ticks[i] + 1) cuts.push_back(pick_ticks[i] + 1);
+    if (i + 1 == pick_ticks.size() || pick_ticks[i + 1] != pick_ticks[i] + 1)
+      cuts.push_back(pick_ticks[i] + 1);
   }
   int false_faults = 0;
   for (const hal::Tick cut_at : cuts) {
@@ -82,6 +83,7 @@ TEST(PickPowerCut, EveryTickOfAPickRestartsIntoTheSamePickFinished) {
                     << ", rows " << after.counters.rows << ", picks " << after.counters.picks;
     }
   }
-  std::printf("power cuts at %zu ticks in and around %u picks: %d restarts wrong\n", cuts.size(), picks, false_faults);
+  std::printf("power cuts at %zu ticks in and around %u picks: %d restarts wrong\n", cuts.size(), picks,
+              false_faults);
   std::filesystem::remove(path);
 }

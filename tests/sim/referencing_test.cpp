@@ -25,12 +25,13 @@ firmware::LoomConfig incremental_loom() {
 }
 
 firmware::Scene scene(std::uint64_t seed, const std::string& extra = "") {
-  return firmware::parse_scene("name = \"t\"\nseed = " + std::to_string(seed) + "\neffects = [\"ideal\"]\n" + extra, "t.toml");
+  return firmware::parse_scene(
+      "name = \"t\"\nseed = " + std::to_string(seed) + "\neffects = [\"ideal\"]\n" + extra, "t.toml");
 }
 
 struct Trace {
-  std::vector<State> states;               // each state once, in the order entered
-  std::vector<int> homing_order;           // the axes asked to home, in order
+  std::vector<State> states;      // each state once, in the order entered
+  std::vector<int> homing_order;  // the axes asked to home, in order
   double first_crank_reading = 0.0, first_carriage_reading = 0.0;
   bool carriage_moved_while_beater_in_warp = false;
   bool anything_moved_before_referenced = false;
@@ -42,8 +43,8 @@ struct Trace {
 
 // `crank_at`, `carriage_at`: where the machine truly stands at power-up (away from its home switches,
 // so the homing runs have to move).
-Trace run(const firmware::LoomConfig& cfg, const firmware::Scene& s, std::uint32_t rows, double crank_at = 1.0,
-          double carriage_at = 0.3) {
+Trace run(const firmware::LoomConfig& cfg, const firmware::Scene& s, std::uint32_t rows,
+          double crank_at = 1.0, double carriage_at = 0.3) {
   firmware::MachineOptions opt;
   opt.telemetry = false;
   opt.rows = rows;
@@ -60,7 +61,9 @@ Trace run(const firmware::LoomConfig& cfg, const firmware::Scene& s, std::uint32
     const State st = m.sequencer().state();
     if (tr.states.empty() || tr.states.back() != st) tr.states.push_back(st);
     const hal::HalInputs& in = m.loop().inputs();
-    if (t == 0) tr.first_crank_reading = in.axes[kCrank].position, tr.first_carriage_reading = in.axes[kCarriage].position;
+    if (t == 0)
+      tr.first_crank_reading = in.axes[kCrank].position,
+      tr.first_carriage_reading = in.axes[kCarriage].position;
     for (std::size_t i = 0; i < cfg.axes.size(); ++i) {
       if (m.loop().outputs().axes[i].request == hal::AxisRequest::kHome &&
           (tr.homing_order.empty() || tr.homing_order.back() != static_cast<int>(i))) {
@@ -69,7 +72,8 @@ Trace run(const firmware::LoomConfig& cfg, const firmware::Scene& s, std::uint32
     }
     // Ground truth: the carriage never moves while the true beater is in the warp.
     const double c = m.sim().axis(kCarriage).position;
-    if (std::abs(c - carriage_truth) > 1e-9 && m.sim().beater_in_warp()) tr.carriage_moved_while_beater_in_warp = true;
+    if (std::abs(c - carriage_truth) > 1e-9 && m.sim().beater_in_warp())
+      tr.carriage_moved_while_beater_in_warp = true;
     carriage_truth = c;
     // No production state before every axis is referenced.
     const bool producing = st == State::kPositioning || st == State::kShedTest || st == State::kShed ||
@@ -120,8 +124,8 @@ TEST(Referencing, AnAbsoluteLoomNeverHomes) {
 
 TEST(Referencing, AHomingRunThatNeverFindsItsReferenceIsAFaultNamingTheAxis) {
   firmware::LoomConfig cfg = incremental_loom();
-  cfg.axes[kCarriage].home_offset = 0.5;     // the switch 0.2 m away from where the carriage stands
-  cfg.axes[kCarriage].homing_speed = 1e-4;   // 0.1 mm/s: it is not reached in time
+  cfg.axes[kCarriage].home_offset = 0.5;    // the switch 0.2 m away from where the carriage stands
+  cfg.axes[kCarriage].homing_speed = 1e-4;  // 0.1 mm/s: it is not reached in time
   cfg.axes[kCarriage].homing_timeout_s = 0.5;
   firmware::rederive_and_check(cfg, "test");
   const Trace tr = run(cfg, scene(7), 1);
@@ -140,18 +144,25 @@ TEST(Referencing, ConfigRefusesWhatCannotBeHomedSafely) {
     }
     return "";
   };
-  const std::string homing = "referencing = \"homing\"\nhoming_method = 19\nhome_offset = 0\nhoming_speed = 1\n"
-                             "homing_accel = 10\nhoming_timeout_s = 5\n";
+  const std::string homing =
+      "referencing = \"homing\"\nhoming_method = 19\nhome_offset = 0\nhoming_speed = 1\n"
+      "homing_accel = 10\nhoming_timeout_s = 5\n";
   EXPECT_NE(error("[axes.helix]\n" + homing).find("the helix cannot home"), std::string::npos);
   // The crank's home point inside the warp: the beater would rest in the warp.
-  const std::string in_warp = error("[axes.beat_crank]\nreferencing = \"homing\"\nhoming_method = 19\nhome_offset = 3.3\n"
-                                    "homing_speed = 1\nhoming_accel = 10\nhoming_timeout_s = 5\n");
-  EXPECT_NE(in_warp.find("axes.beat_crank.home_offset = 3.3: the beater is inside the warp"), std::string::npos) << in_warp;
-  EXPECT_NE(error("[axes.carriage]\nreferencing = \"homing\"\nhoming_method = 19\n").find("home_offset = (missing)"),
+  const std::string in_warp = error(
+      "[axes.beat_crank]\nreferencing = \"homing\"\nhoming_method = 19\nhome_offset = 3.3\n"
+      "homing_speed = 1\nhoming_accel = 10\nhoming_timeout_s = 5\n");
+  EXPECT_NE(in_warp.find("axes.beat_crank.home_offset = 3.3: the beater is inside the warp"),
+            std::string::npos)
+      << in_warp;
+  EXPECT_NE(error("[axes.carriage]\nreferencing = \"homing\"\nhoming_method = 19\n")
+                .find("home_offset = (missing)"),
             std::string::npos);
-  EXPECT_NE(error("[axes.carriage]\nhoming_speed = 1\n").find("only an axis with referencing = \"homing\""), std::string::npos);
-  EXPECT_NE(error("[axes.carriage]\n" + std::string("referencing = \"homing\"\nhoming_method = 7\nhome_offset = 0\n"
-                                                    "homing_speed = 1\nhoming_accel = 10\nhoming_timeout_s = 5\n"))
-                .find("supported CiA 402 methods"),
+  EXPECT_NE(error("[axes.carriage]\nhoming_speed = 1\n").find("only an axis with referencing = \"homing\""),
             std::string::npos);
+  EXPECT_NE(
+      error("[axes.carriage]\n" + std::string("referencing = \"homing\"\nhoming_method = 7\nhome_offset = 0\n"
+                                              "homing_speed = 1\nhoming_accel = 10\nhoming_timeout_s = 5\n"))
+          .find("supported CiA 402 methods"),
+      std::string::npos);
 }

@@ -2,11 +2,11 @@
 // in-process: every one must now end in a safe stop with a named fault — or, where the machine's state
 // proves what happened, in a correct pick — never a pick through a half-open shed or a beat without weft.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
 #include <string>
-#include <unistd.h>
 
 #include "loom/config/config.hpp"
 #include "loom/firmware/machine.hpp"
@@ -27,19 +27,21 @@ struct Outcome {
 // `max_ticks`, or when `stop_when` says so.
 template <class Stop>
 Outcome weave(const firmware::LoomConfig& cfg, const firmware::Scene& scene, const std::string& state_file,
-          sequencer::Counters resume, std::uint32_t rows, hal::Tick max_ticks, Stop stop_when) {
+              sequencer::Counters resume, std::uint32_t rows, hal::Tick max_ticks, Stop stop_when) {
   firmware::MachineOptions opt;
   opt.telemetry = false;
   opt.rows = resume.rows + rows;
   opt.sim_state_path = state_file;
   firmware::Machine m(cfg, scene, opt, resume);
   m.sequencer().request_start();
-  const double helix0 = m.sim().axis(hal::CoreAxis::kHelix).position, crank0 = m.sim().axis(hal::CoreAxis::kBeatCrank).position;
+  const double helix0 = m.sim().axis(hal::CoreAxis::kHelix).position,
+               crank0 = m.sim().axis(hal::CoreAxis::kBeatCrank).position;
   Outcome r;
   for (hal::Tick t = 0; t < max_ticks && !m.sequencer().finished(); ++t) {
     m.loop().cycle(t);
     r.helix_moved = r.helix_moved || std::abs(m.sim().axis(hal::CoreAxis::kHelix).position - helix0) > 1e-6;
-    r.crank_moved = r.crank_moved || std::abs(m.sim().axis(hal::CoreAxis::kBeatCrank).position - crank0) > 1e-3;
+    r.crank_moved =
+        r.crank_moved || std::abs(m.sim().axis(hal::CoreAxis::kBeatCrank).position - crank0) > 1e-3;
     if (stop_when(m.sequencer())) break;
   }
   r.state = m.sequencer().state();
@@ -50,8 +52,8 @@ Outcome weave(const firmware::LoomConfig& cfg, const firmware::Scene& scene, con
 auto never = [](const sequencer::Sequencer&) { return false; };
 
 std::string temp_file(const char* name) {
-  const auto p = std::filesystem::temp_directory_path() / (std::string("loom-repro-") + name + "-" +
-                                                            std::to_string(::getpid()));
+  const auto p = std::filesystem::temp_directory_path() /
+                 (std::string("loom-repro-") + name + "-" + std::to_string(::getpid()));
   std::filesystem::remove(p);
   return p.string();
 }
@@ -71,7 +73,8 @@ at_s = 0.15
 kind = "stuck_sensor"
 sensor = "piston_a_extended"
 value = true
-)", "stuck.toml");
+)",
+                                                      "stuck.toml");
   // With the default loom's second switch beside it, the stuck switch disagrees with its partner; on a
   // loom without second switches the shed monitor sees piston A never leave its retracted end.
   firmware::LoomConfig single = firmware::default_loom_config();
@@ -80,7 +83,8 @@ value = true
   const struct {
     firmware::LoomConfig cfg;
     Fault expected;
-  } looms[] = {{firmware::default_loom_config(), Fault::kSensorDiscrepancy}, {single, Fault::kShedNotReleased}};
+  } looms[] = {{firmware::default_loom_config(), Fault::kSensorDiscrepancy},
+               {single, Fault::kShedNotReleased}};
   for (const auto& loom : looms) {
     const Outcome r = weave(loom.cfg, scene, "", {}, 3, 100000, never);
     EXPECT_EQ(r.state, State::kFault);
@@ -115,8 +119,8 @@ TEST(Reproductions, RestartWithResetCountersIsRefusedNotBeatenWithoutWeft) {
 
 TEST(Reproductions, ImpossiblePicksInRowAreRefused) {
   // "picks_in_row": 99 used to skip straight to a beat sweep without weft.
-  const Outcome r = weave(firmware::default_loom_config(), ideal(), "", {.rows = 0, .picks = 99, .beats = 0, .picks_in_row = 99},
-                      1, 10000, never);
+  const Outcome r = weave(firmware::default_loom_config(), ideal(), "",
+                          {.rows = 0, .picks = 99, .beats = 0, .picks_in_row = 99}, 1, 10000, never);
   EXPECT_EQ(r.state, State::kFault);
   EXPECT_EQ(r.first_fault, Fault::kCountersInconsistent) << sequencer::fault_name(r.first_fault);
   EXPECT_FALSE(r.crank_moved);
@@ -129,7 +133,7 @@ TEST(Reproductions, APickWhoseCountWasLostIsRecognisedFromTheMachine) {
   const std::string state = temp_file("lost-count");
   const auto cfg = firmware::default_loom_config();
   const Outcome cut = weave(cfg, ideal(), state, {}, 1, 100000,
-                        [](const sequencer::Sequencer& s) { return s.state() == State::kBeatSweep; });
+                            [](const sequencer::Sequencer& s) { return s.state() == State::kBeatSweep; });
   ASSERT_EQ(cut.counters.picks, 1u);
   const Outcome resumed = weave(cfg, ideal(), state, {}, 1, 100000, never);
   EXPECT_EQ(resumed.state, State::kDone) << sequencer::fault_name(resumed.first_fault);
@@ -142,10 +146,12 @@ TEST(Reproductions, APickWhoseCountWasLostIsRecognisedFromTheMachine) {
 TEST(Reproductions, RunawayCrankDynamicsAreANamedFaultNotAWovenRow) {
   // joint_friction.coulomb_nm = 1e6 in the dynamics scene: the crank went NaN and the run said
   // "woven 1 rows", exit 0.
-  const firmware::Scene scene = firmware::parse_scene(R"(effects = ["inertia", "joint_friction", "pneumatics", "beat_contact"]
+  const firmware::Scene scene =
+      firmware::parse_scene(R"(effects = ["inertia", "joint_friction", "pneumatics", "beat_contact"]
 [joint_friction]
 coulomb_nm = 1e6
-)", "dynamics.toml");
+)",
+                            "dynamics.toml");
   const Outcome r = weave(firmware::default_loom_config(), scene, "", {}, 1, 100000, never);
   EXPECT_EQ(r.state, State::kFault);
   EXPECT_TRUE(r.first_fault == Fault::kNonFiniteFeedback || r.first_fault == Fault::kEncoderJump)

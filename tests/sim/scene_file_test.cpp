@@ -34,7 +34,8 @@ TEST(SceneFile, AnEmptyFaultIsRefusedNotADriveFaultAtZero) {
 }
 
 TEST(SceneFile, EachKindNeedsItsFieldsAndTakesNoOthers) {
-  EXPECT_NE(error_of("effects = [\"ideal\"]\n[[fault]]\nkind = \"stuck_sensor\"\nat_s = 1.0\nsensor = \"shuttle_at_left\"\n")
+  EXPECT_NE(error_of("effects = [\"ideal\"]\n[[fault]]\nkind = \"stuck_sensor\"\nat_s = 1.0\nsensor = "
+                     "\"shuttle_at_left\"\n")
                 .find("fault[0].value = (missing)"),
             std::string::npos);
   EXPECT_NE(error_of("effects = [\"ideal\"]\n[[fault]]\nkind = \"estop\"\nat_s = 1.0\naxis = \"helix\"\n")
@@ -42,19 +43,24 @@ TEST(SceneFile, EachKindNeedsItsFieldsAndTakesNoOthers) {
             std::string::npos);
   EXPECT_NE(error_of("effects = [\"ideal\"]\n[[fault]]\nkind = \"power_cut\"\nat_s = 1.0\n").find("at_tick"),
             std::string::npos);
-  EXPECT_NE(error_of("effects = [\"ideal\"]\n[[fault]]\nkind = \"load_cell_failure\"\nat_s = 1.0\nmode = \"nan\"\n")
-                .find("beat_contact"),
-            std::string::npos);
-  EXPECT_NE(error_of("effects = [\"ideal\"]\n[[fault]]\nkind = \"emcy\"\nat_s = 1.0\naxis = \"helix\"\ncode = 0\n")
-                .find("fault[0].code = 0"),
-            std::string::npos);
-  EXPECT_NE(error_of("effects = [\"ideal\"]\n[[fault]]\nkind = \"warp_break\"\nat_s = 1.0\n").find("must be one of"),
+  EXPECT_NE(
+      error_of("effects = [\"ideal\"]\n[[fault]]\nkind = \"load_cell_failure\"\nat_s = 1.0\nmode = \"nan\"\n")
+          .find("beat_contact"),
+      std::string::npos);
+  EXPECT_NE(
+      error_of("effects = [\"ideal\"]\n[[fault]]\nkind = \"emcy\"\nat_s = 1.0\naxis = \"helix\"\ncode = 0\n")
+          .find("fault[0].code = 0"),
+      std::string::npos);
+  EXPECT_NE(error_of("effects = [\"ideal\"]\n[[fault]]\nkind = \"warp_break\"\nat_s = 1.0\n")
+                .find("must be one of"),
             std::string::npos);
 }
 
 TEST(SceneFile, DuplicatesAreRefused) {
-  EXPECT_NE(error_of("effects = [\"ideal\", \"servo_lag\", \"servo_lag\"]\n").find("named twice"), std::string::npos);
-  EXPECT_NE(error_of("effects = [\"ideal\"]\n[[fault]]\nkind = \"estop\"\nat_s = 1.0\n[[fault]]\nkind = \"estop\"\nat_s = 1.0\n")
+  EXPECT_NE(error_of("effects = [\"ideal\", \"servo_lag\", \"servo_lag\"]\n").find("named twice"),
+            std::string::npos);
+  EXPECT_NE(error_of("effects = [\"ideal\"]\n[[fault]]\nkind = \"estop\"\nat_s = 1.0\n[[fault]]\nkind = "
+                     "\"estop\"\nat_s = 1.0\n")
                 .find("s.toml:5:1: fault[1]"),
             std::string::npos);
   EXPECT_NE(error_of("effects = []\n"), "");
@@ -107,7 +113,8 @@ TEST(SceneFile, HeadsNeedTheKnotterEffectOnlyWhenTheirIoIsSimulated) {
 
 TEST(SceneFile, AFaultInASecondSwitchTheLoomDoesNotHaveIsRefusedAtTheFault) {
   const firmware::Scene scene = firmware::parse_scene(
-      "effects = [\"ideal\"]\n[[fault]]\nkind = \"stuck_sensor\"\nat_s = 1.0\nsensor = \"shuttle_at_right_2\"\nvalue = true\n",
+      "effects = [\"ideal\"]\n[[fault]]\nkind = \"stuck_sensor\"\nat_s = 1.0\nsensor = "
+      "\"shuttle_at_right_2\"\nvalue = true\n",
       "s.toml");
   EXPECT_NO_THROW(firmware::check_scene_fits(scene, firmware::default_loom_config()));
   firmware::LoomConfig single = firmware::default_loom_config();
@@ -117,7 +124,8 @@ TEST(SceneFile, AFaultInASecondSwitchTheLoomDoesNotHaveIsRefusedAtTheFault) {
     firmware::check_scene_fits(scene, single);
     FAIL() << "a fault in a switch the loom does not have was accepted";
   } catch (const firmware::ConfigError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("s.toml:2:1: fault[0].sensor = \"shuttle_at_right_2\": the loom", 0), 0u)
+    EXPECT_EQ(
+        std::string(e.what()).rfind("s.toml:2:1: fault[0].sensor = \"shuttle_at_right_2\": the loom", 0), 0u)
         << e.what();
     EXPECT_NE(std::string(e.what()).find("io.shuttle_at_right_2_bit = -1"), std::string::npos) << e.what();
   }
@@ -131,13 +139,16 @@ TEST(SceneFile, WarpTensionIsCheckedAtItsLineAndRoundTrips) {
   EXPECT_EQ(error_of(effects + "drift_per_row = nan\n"),
             "s.toml:3:17: warp_tension.drift_per_row = nan: must be finite");
   EXPECT_EQ(error_of(effects + "points = [1.0]\n"),
-            "s.toml:3:10: warp_tension.points = [...]: expected 2..64 relative tensions, equally spaced from the left "
+            "s.toml:3:10: warp_tension.points = [...]: expected 2..64 relative tensions, equally spaced from "
+            "the left "
             "selvedge to the right");
   EXPECT_EQ(error_of(effects + "points = [1.0, -2.0]\n"),
             "s.toml:3:16: warp_tension.points = -2: each relative tension must be a number in [0.05, 5]");
-  EXPECT_NE(error_of(effects + "points = [1.0, 0.9]\ncentre_ratio = 0.9\n").find("not both"), std::string::npos);
+  EXPECT_NE(error_of(effects + "points = [1.0, 0.9]\ncentre_ratio = 0.9\n").find("not both"),
+            std::string::npos);
   EXPECT_NE(error_of(effects + "tilt = 1\n").find("warp_tension.tilt"), std::string::npos);  // unknown key
-  EXPECT_NE(error_of("effects = [\"ideal\", \"warp_tension\"]\n").find("name \"beat_contact\" too"), std::string::npos);
+  EXPECT_NE(error_of("effects = [\"ideal\", \"warp_tension\"]\n").find("name \"beat_contact\" too"),
+            std::string::npos);
   EXPECT_NE(error_of("effects = [\"ideal\", \"beat_contact\"]\n[warp_tension]\nnoise = 0.1\n")
                 .find("parameters given for an effect the scene does not name"),
             std::string::npos);
@@ -145,7 +156,8 @@ TEST(SceneFile, WarpTensionIsCheckedAtItsLineAndRoundTrips) {
     sim_hal::SceneSpec s;
     s.effects = {"ideal", "beat_contact", "warp_tension"};
     s.beat_contact = sim_hal::BeatContact{};
-    s.warp_tension = sim_hal::WarpTension{.centre_ratio = 0.8125, .points = {}, .drift_per_row = -0.0015, .noise = 0.03};
+    s.warp_tension =
+        sim_hal::WarpTension{.centre_ratio = 0.8125, .points = {}, .drift_per_row = -0.0015, .noise = 0.03};
     if (with_points) s.warp_tension->points = {1.1, 0.875, 1.0};
     const std::string text = firmware::scene_to_toml(s);
     const firmware::Scene back = firmware::parse_scene(text, "written.toml");

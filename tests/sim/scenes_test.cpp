@@ -29,7 +29,8 @@ enum class Sensing { kDualChannel, kSingleChannel };
 // second switches (io.<sensor>_2_bit = -1), so only the sequencer's plausibility checks stand guard.
 Outcome run_scene(const std::string& name, std::uint32_t rows, double period_ms = 0.0,
                   Sensing sensing = Sensing::kDualChannel) {
-  const firmware::Scene scene = firmware::load_scene(std::string(LOOM_SOURCE_DIR) + "/sim_hal/scenes/" + name + ".toml");
+  const firmware::Scene scene =
+      firmware::load_scene(std::string(LOOM_SOURCE_DIR) + "/sim_hal/scenes/" + name + ".toml");
   firmware::MachineOptions opt;
   opt.telemetry = false;
   opt.rows = rows;
@@ -38,7 +39,8 @@ Outcome run_scene(const std::string& name, std::uint32_t rows, double period_ms 
   if (sensing == Sensing::kSingleChannel) {
     for (auto& b : cfg.io.wiring.second) b.bit = -1;
   }
-  if (period_ms > 0.0 || sensing == Sensing::kSingleChannel) firmware::rederive_and_check(cfg, "test variant");
+  if (period_ms > 0.0 || sensing == Sensing::kSingleChannel)
+    firmware::rederive_and_check(cfg, "test variant");
   firmware::Machine m(cfg, scene, opt, {});
   Outcome o;
   m.sim().on_power_cut([](void* cut) { *static_cast<bool*>(cut) = true; }, &o.power_cut);
@@ -56,7 +58,8 @@ Outcome run_scene(const std::string& name, std::uint32_t rows, double period_ms 
   if (o.power_cut) {
     // The machine lost its power: whatever the controller (were it alive) commands, nothing moves.
     std::array<double, hal::kCoreAxisCount> at_cut{};
-    for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k) at_cut[k] = m.sim().axis(static_cast<hal::CoreAxis>(k)).position;
+    for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k)
+      at_cut[k] = m.sim().axis(static_cast<hal::CoreAxis>(k)).position;
     for (int i = 0; i < 500; ++i, ++t) {
       m.loop().cycle(t);
       for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k) {
@@ -70,7 +73,8 @@ Outcome run_scene(const std::string& name, std::uint32_t rows, double period_ms 
   for (int i = 0; i < 500; ++i, ++t) {
     m.loop().cycle(t);
     for (std::size_t k = 0; k < hal::kCoreAxisCount; ++k) {
-      if (m.loop().outputs().axes[k].target_position != at_end.axes[k].target_position) o.moved_after_fault = true;
+      if (m.loop().outputs().axes[k].target_position != at_end.axes[k].target_position)
+        o.moved_after_fault = true;
       if (m.sequencer().state() == State::kFault &&
           m.loop().outputs().axes[k].request != hal::AxisRequest::kQuickStop) {
         o.moved_after_fault = true;
@@ -101,7 +105,8 @@ TEST(Scenes, DefaultSceneBeatsEveryPointOfTheWidthWithin80To100N) {
     EXPECT_NEAR(std::min(first, last), 0.0, 1e-6);
     EXPECT_NEAR(std::max(first, last), 1.1, 1e-6);
   }
-  EXPECT_LT(static_cast<double>(o.rows[0].total_ticks) * 0.002, 300.0 / 20.0);  // ≥ 20× faster than weaving by hand
+  EXPECT_LT(static_cast<double>(o.rows[0].total_ticks) * 0.002,
+            300.0 / 20.0);  // ≥ 20× faster than weaving by hand
 }
 
 // The shuttle's follow checks compare sensor edges with the carrier's position; both are samples, so the
@@ -123,7 +128,9 @@ TEST_P(LoopPeriods, ShuttleChecksHoldAtThisPeriod) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllowedRange, LoopPeriods, ::testing::Values(2.0, 5.0, 10.0, 10.8),
-                         [](const auto& period) { return std::to_string(static_cast<int>(period.param * 100)) + "0us"; });
+                         [](const auto& period) {
+                           return std::to_string(static_cast<int>(period.param * 100)) + "0us";
+                         });
 
 // Each fault scene on the default loom (dual-channel safety sensors) and on the same loom with single-
 // channel sensors: a stuck switch is a sensor_discrepancy with a second switch beside it, and is caught
@@ -149,24 +156,25 @@ TEST_P(FaultScenes, EndInASafeStopWithTheExpectedFirstFault) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Shipped, FaultScenes,
-                         ::testing::Values(FaultCase{"drive_fault", Fault::kDriveFault, Fault::kDriveFault},
-                                           FaultCase{"stuck_piston", Fault::kShedNotReleased, Fault::kShedNotReleased},
-                                           FaultCase{"shuttle_slip", Fault::kShuttleSlipped, Fault::kShuttleSlipped},
-                                           FaultCase{"stuck_sensor", Fault::kSensorDiscrepancy, Fault::kShuttleLost},
-                                           FaultCase{"estop", Fault::kEStop, Fault::kEStop},
-                                           FaultCase{"stuck_end_sensor", Fault::kSensorDiscrepancy, Fault::kShedNotReleased},
-                                           FaultCase{"can_frame_loss", Fault::kStaleFeedback, Fault::kStaleFeedback},
-                                           FaultCase{"can_latency", Fault::kStaleFeedback, Fault::kStaleFeedback},
-                                           FaultCase{"bus_off", Fault::kLinkFault, Fault::kLinkFault},
-                                           FaultCase{"heartbeat_loss", Fault::kHeartbeatLost, Fault::kHeartbeatLost},
-                                           FaultCase{"emcy", Fault::kDriveEmcy, Fault::kDriveEmcy},
-                                           FaultCase{"intermittent_sensor", Fault::kSensorDiscrepancy, Fault::kShedSensorConflict},
-                                           FaultCase{"encoder_glitch", Fault::kEncoderJump, Fault::kEncoderJump},
-                                           FaultCase{"load_cell", Fault::kLoadCellFault, Fault::kLoadCellFault},
-                                           FaultCase{"air_loss", Fault::kAirLost, Fault::kAirLost},
-                                           FaultCase{"loop_stall", Fault::kLoopStall, Fault::kLoopStall}),
-                         [](const auto& param_info) { return std::string(param_info.param.scene); });
+INSTANTIATE_TEST_SUITE_P(
+    Shipped, FaultScenes,
+    ::testing::Values(FaultCase{"drive_fault", Fault::kDriveFault, Fault::kDriveFault},
+                      FaultCase{"stuck_piston", Fault::kShedNotReleased, Fault::kShedNotReleased},
+                      FaultCase{"shuttle_slip", Fault::kShuttleSlipped, Fault::kShuttleSlipped},
+                      FaultCase{"stuck_sensor", Fault::kSensorDiscrepancy, Fault::kShuttleLost},
+                      FaultCase{"estop", Fault::kEStop, Fault::kEStop},
+                      FaultCase{"stuck_end_sensor", Fault::kSensorDiscrepancy, Fault::kShedNotReleased},
+                      FaultCase{"can_frame_loss", Fault::kStaleFeedback, Fault::kStaleFeedback},
+                      FaultCase{"can_latency", Fault::kStaleFeedback, Fault::kStaleFeedback},
+                      FaultCase{"bus_off", Fault::kLinkFault, Fault::kLinkFault},
+                      FaultCase{"heartbeat_loss", Fault::kHeartbeatLost, Fault::kHeartbeatLost},
+                      FaultCase{"emcy", Fault::kDriveEmcy, Fault::kDriveEmcy},
+                      FaultCase{"intermittent_sensor", Fault::kSensorDiscrepancy, Fault::kShedSensorConflict},
+                      FaultCase{"encoder_glitch", Fault::kEncoderJump, Fault::kEncoderJump},
+                      FaultCase{"load_cell", Fault::kLoadCellFault, Fault::kLoadCellFault},
+                      FaultCase{"air_loss", Fault::kAirLost, Fault::kAirLost},
+                      FaultCase{"loop_stall", Fault::kLoopStall, Fault::kLoopStall}),
+    [](const auto& param_info) { return std::string(param_info.param.scene); });
 
 TEST(Scenes, SensorNoiseIsDebouncedAwayAndTheRunIsDeterministic) {
   const Outcome a = run_scene("sensor_noise", 2), b = run_scene("sensor_noise", 2);
@@ -195,7 +203,8 @@ TEST(Scenes, PowerCutEndsTheRunAtItsTickWithNothingMovingAfterwards) {
 }
 
 TEST(Scenes, EveryShippedSceneParses) {
-  for (const auto& e : std::filesystem::directory_iterator(std::string(LOOM_SOURCE_DIR) + "/sim_hal/scenes")) {
+  for (const auto& e :
+       std::filesystem::directory_iterator(std::string(LOOM_SOURCE_DIR) + "/sim_hal/scenes")) {
     EXPECT_NO_THROW(firmware::load_scene(e.path().string())) << e.path();
   }
 }

@@ -1,18 +1,19 @@
 // The simulated devices: an effect that is not named is not built; each effect does what its physics
 // says (checked against closed forms where there is one); the machine state survives in its file.
+#include "loom/sim_hal/sim_world.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <filesystem>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "loom/motion/angles.hpp"
-#include "loom/sim_hal/sim_world.hpp"
 
 using namespace loom;
 using namespace loom::sim_hal;
@@ -50,7 +51,8 @@ TEST(SimWorld, UnnamedEffectsAreNotBuilt) {
   EXPECT_EQ(SimWorld(m, scene({"ideal", "beat_contact"})).effect_count(), 1u);
   EXPECT_EQ(SimWorld(m, scene({"ideal", "beat_contact", "warp_tension"})).effect_count(), 2u);
   EXPECT_EQ(SimWorld(m, scene({"ideal", "beat_contact"})).warp_tension(), nullptr);
-  EXPECT_THROW(SimWorld(m, scene({"ideal", "warp_tension"})), std::invalid_argument);  // it scales beat_contact's force
+  EXPECT_THROW(SimWorld(m, scene({"ideal", "warp_tension"})),
+               std::invalid_argument);  // it scales beat_contact's force
 }
 
 TEST(SimWorld, ServoLagIsTheExactFirstOrderStepResponse) {
@@ -58,7 +60,7 @@ TEST(SimWorld, ServoLagIsTheExactFirstOrderStepResponse) {
   s.servo_lag = ServoLag{0.01};
   SimWorld w(SimMachine{}, s);
   hal::Tick now = 0;
-  drive(w, hal::CoreAxis::kCarriage, 0.0, 1, now);  // enable
+  drive(w, hal::CoreAxis::kCarriage, 0.0, 1, now);   // enable
   drive(w, hal::CoreAxis::kCarriage, 0.1, 10, now);  // step of 0.1 m held 10 ticks = 20 ms = 2 τ
   EXPECT_NEAR(w.axis(hal::CoreAxis::kCarriage).position, 0.1 * (1.0 - std::exp(-2.0)), 1e-12);
 }
@@ -126,7 +128,7 @@ TEST(SimWorld, SensorNoiseIsDeterministicForASeed) {
   EXPECT_NE(flips(3), flips(4));
   const auto f = flips(3);
   const auto bounces = std::count(f.begin(), f.end(), false);
-  EXPECT_GT(bounces, 5);   // p = 0.05 over 400 ticks: about 20
+  EXPECT_GT(bounces, 5);  // p = 0.05 over 400 ticks: about 20
   EXPECT_LT(bounces, 45);
 }
 
@@ -233,11 +235,12 @@ TEST(SimWorld, WarpTensionScalesTheBeatByProfileAndDrift) {
   const std::vector<double> f1 = beat_peaks(taut, omega, pitch, turns);
   for (int j = 0; j < turns; ++j) {
     ASSERT_GT(f0[static_cast<std::size_t>(j)], 50.0) << "turn " << j;  // every turn beats
-    const double x = pitch * j;                                          // one-way: the carriage keeps going
+    const double x = pitch * j;                                        // one-way: the carriage keeps going
     const double u = std::min(1.0, (x + 0.05) / 1.2);
     const double profile = 0.8 + 0.2 * ((2.0 * u - 1.0) * (2.0 * u - 1.0));  // 1 at the selvedges, 0.8 mid
     const double rows = x / 1.1;
-    EXPECT_NEAR(f1[static_cast<std::size_t>(j)] / f0[static_cast<std::size_t>(j)], profile * (1.0 + 0.05 * rows), 1e-9)
+    EXPECT_NEAR(f1[static_cast<std::size_t>(j)] / f0[static_cast<std::size_t>(j)],
+                profile * (1.0 + 0.05 * rows), 1e-9)
         << "turn " << j;
   }
 }

@@ -2,10 +2,10 @@
 // the call returned) or its message, so a test can say which typed error an impossible input gets.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <optional>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "loom/motion/errors.hpp"
 

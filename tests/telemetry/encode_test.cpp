@@ -237,13 +237,15 @@ TEST(Encode, ASensorDiscrepancyNamesItsSensorInTheText) {
   e.sensor = static_cast<std::int8_t>(loom::hal::SafetySensor::kShuttleAtRight);
   const auto m = round_trip(to_fault(e, "L7", 9));
   EXPECT_EQ(m.name, "sensor_discrepancy");
-  EXPECT_EQ(m.text,
-            "the two channels of a safety sensor disagree (a stuck switch or a wiring fault): shuttle_at_right");
+  EXPECT_EQ(
+      m.text,
+      "the two channels of a safety sensor disagree (a stuck switch or a wiring fault): shuttle_at_right");
   Snapshot s = sample();
   s.first_fault = test_support::byte_of(sequencer::Fault::kSensorDiscrepancy);
   s.fault_sensor = static_cast<std::int8_t>(loom::hal::SafetySensor::kPistonBExtended);
-  EXPECT_EQ(round_trip(to_status(s, "L7", 9)).fault_text,
-            "the two channels of a safety sensor disagree (a stuck switch or a wiring fault): piston_b_extended");
+  EXPECT_EQ(
+      round_trip(to_status(s, "L7", 9)).fault_text,
+      "the two channels of a safety sensor disagree (a stuck switch or a wiring fault): piston_b_extended");
 }
 
 TEST(Encode, RowEventSplitsTimeInSeconds) {
@@ -295,7 +297,8 @@ TEST(Snapshot, CopyInUseCopiesEveryFieldAndOnlyTheMachinesAxes) {
   from.stopped_by = test_support::byte_of(sequencer::Fault::kEStop);
   from.first_fault_code = 7;
   from.row = 11, from.pick = 22, from.beat = 33, from.row_in_progress = 12, from.rows_target = 40;
-  from.crank_phase_rad = 1.25, from.beater_angle_rad = -0.5, from.beat_force_n = 91.0, from.beat_force_valid = true;
+  from.crank_phase_rad = 1.25, from.beater_angle_rad = -0.5, from.beat_force_n = 91.0,
+  from.beat_force_valid = true;
   from.axis_count = 3;
   for (std::size_t i = 0; i < from.axes.size(); ++i) {
     from.axes[i].position = 1.0 + static_cast<double>(i);

@@ -131,9 +131,10 @@ TEST(Knots, KnotsMessageNamesEachHeadsKnotColourAndMagazine) {
   EXPECT_EQ(m.ask_knot, 67);
   EXPECT_EQ(m.ask_head, 1);
   EXPECT_EQ(m.ask_slot, 2);
-  EXPECT_EQ(m.ask_text,
-            "row 1 (design row 1): tie knot 68 (head 2) by hand in colour W (the head missed it twice: look at "
-            "slot 2's yarn and the gripper)");
+  EXPECT_EQ(
+      m.ask_text,
+      "row 1 (design row 1): tie knot 68 (head 2) by hand in colour W (the head missed it twice: look at "
+      "slot 2's yarn and the gripper)");
 }
 
 TEST(Knots, OutsideKnottingNoHeadTiesAndNothingIsAsked) {
@@ -248,22 +249,25 @@ TEST(Knots, MonitorPrintsRowKnotsAndEachRequest) {
             "force_min=- force_mean=- force_max=- in_band=- knotting=0.00s knots_tied=358 knots_retried=23 "
             "knots_by_hand=2 knot_time=67.84s weaver_time=30.01s");
   loom::monitor::EventView v;
-  EXPECT_EQ(v.on_row(r).at(0),
-            "L7 t=188.340s row 2 done in 105.35 s (shed 0.27, pick 1.29, beat 5.93 s), 15 beats, knots 358 tied, "
-            "23 retried, 2 by hand (heads 67.8 s, weaver 30.0 s)");
+  EXPECT_EQ(
+      v.on_row(r).at(0),
+      "L7 t=188.340s row 2 done in 105.35 s (shed 0.27, pick 1.29, beat 5.93 s), 15 beats, knots 358 tied, "
+      "23 retried, 2 by hand (heads 67.8 s, weaver 30.0 s)");
 
   const seq::KnotProgram p = program();
   const auto w = to_weaver_request(weaver_event(), &p, "L7", 0);
   EXPECT_EQ(loom::monitor::weaver_line(w),
             "weaver loom=L7 t=10.000s n=2 ask=reload row=4 design_row=1 knot=-1 head=0 slot=1 colour=B "
             "text=\"row 4 (design row 2): reload colour B into slot 1 of head 1\"");
-  EXPECT_EQ(v.on_weaver(w).at(0), "L7 t=10.000s WEAVER reload: row 4 (design row 2): reload colour B into slot 1 of head 1");
+  EXPECT_EQ(v.on_weaver(w).at(0),
+            "L7 t=10.000s WEAVER reload: row 4 (design row 2): reload colour B into slot 1 of head 1");
 
   const auto k = to_knots(knotting_sample(), p, "L7", 0);
-  EXPECT_EQ(loom::monitor::knots_line(k),
-            "knots loom=L7 tick=1000 t=2.000s state=knotting row=1 design_row=0 cycle=7/60 cycles_done=7 tied=14 "
-            "retried=2 by_hand=1 row_tied=13 row_retried=1 row_by_hand=1 requests=3 ask=tie_by_hand"
-            " | head0 knot=7 colour=B stock=1,11,21 | head1 knot=67 colour=W stock=101,111,121");
+  EXPECT_EQ(
+      loom::monitor::knots_line(k),
+      "knots loom=L7 tick=1000 t=2.000s state=knotting row=1 design_row=0 cycle=7/60 cycles_done=7 tied=14 "
+      "retried=2 by_hand=1 row_tied=13 row_retried=1 row_by_hand=1 requests=3 ask=tie_by_hand"
+      " | head0 knot=7 colour=B stock=1,11,21 | head1 knot=67 colour=W stock=101,111,121");
 }
 
 }  // namespace

@@ -27,7 +27,8 @@ loomlcm::status_t status() {
 
 TEST(MonitorLines, StatusLineHasTheDocumentedFields) {
   EXPECT_EQ(status_line(status()),
-            "loom=hall-3 tick=1500 t=3.000s state=pick row=13 done=12 pick=13 beat=48 fault=none fault_code=0x0000");
+            "loom=hall-3 tick=1500 t=3.000s state=pick row=13 done=12 pick=13 beat=48 fault=none "
+            "fault_code=0x0000");
   auto m = status();
   m.first_fault = "drive_fault";
   m.first_fault_code = 0x1002;
@@ -91,7 +92,8 @@ TEST(MonitorLines, RtLineInMicroseconds) {
   m.wake_latency_max_ns = 250'000;
   EXPECT_EQ(rt_line(m),
             "rt loom=L tick=500 t=1.000s overruns=2 tick_cost_us=12.3 max_tick_cost_us=45.0 wake_p50_us=0.0 "
-            "wake_p99_us=0.0 wake_max_us=250.0 dropped=4 dropped_events=0 backlog=1 can_tx_dropped=3 can_rx_errors=0");
+            "wake_p99_us=0.0 wake_max_us=250.0 dropped=4 dropped_events=0 backlog=1 can_tx_dropped=3 "
+            "can_rx_errors=0");
 }
 
 loomlcm::beat_t beat(int row, int index, double force, bool in_band) {
@@ -130,9 +132,10 @@ TEST(MonitorLines, BeatFaultAndRowLines) {
             "fault loom=L t=12.000s kind=first name=drive_fault code=0x1002 axis=carriage device_code=0x8611 "
             "state=beat_sweep row=2 pick=2 beat=20 text=\"a servo drive reported a fault\"");
   EventView v;
-  EXPECT_EQ(v.on_fault(f).at(0),
-            "L t=12.000s FAULT drive_fault (0x1002) axis carriage device code 0x8611: a servo drive reported a "
-            "fault [first; in beat_sweep, row 2, picks 2, beats 20]");
+  EXPECT_EQ(
+      v.on_fault(f).at(0),
+      "L t=12.000s FAULT drive_fault (0x1002) axis carriage device code 0x8611: a servo drive reported a "
+      "fault [first; in beat_sweep, row 2, picks 2, beats 20]");
   loomlcm::row_t r{};
   r.loom_id = "L";
   r.time_s = 7.564;
@@ -151,19 +154,23 @@ TEST(MonitorLines, BeatFaultAndRowLines) {
   EXPECT_EQ(row_line(r),
             "row loom=L t=7.564s row=1 time=7.56s shed=0.33s pick=1.29s beat=5.93s beats=15 steps=14 "
             "force_min=89.3N force_mean=89.5N force_max=89.7N in_band=15/15 knotting=0.00s");
-  EXPECT_EQ(v.on_row(r).at(0),
-            "L t=7.564s row 1 done in 7.56 s (shed 0.33, pick 1.29, beat 5.93 s), 15 beats, force min/mean/max "
-            "89.3/89.5/89.7 N, 15/15 in band");
+  EXPECT_EQ(
+      v.on_row(r).at(0),
+      "L t=7.564s row 1 done in 7.56 s (shed 0.33, pick 1.29, beat 5.93 s), 15 beats, force min/mean/max "
+      "89.3/89.5/89.7 N, 15/15 in band");
   r.knotting_s = 212.4;  // knotting mode: the weaver's time before the row
-  EXPECT_EQ(v.on_row(r).at(0),
-            "L t=7.564s row 1 done in 7.56 s (shed 0.33, pick 1.29, beat 5.93 s), 15 beats, force min/mean/max "
-            "89.3/89.5/89.7 N, 15/15 in band, knotted in 212.4 s before it");
+  EXPECT_EQ(
+      v.on_row(r).at(0),
+      "L t=7.564s row 1 done in 7.56 s (shed 0.33, pick 1.29, beat 5.93 s), 15 beats, force min/mean/max "
+      "89.3/89.5/89.7 N, 15/15 in band, knotted in 212.4 s before it");
 }
 
 TEST(MonitorLines, EventViewSaysBandAndKeepsStatusSparse) {
   EventView v(1.0);
-  EXPECT_EQ(v.on_beat(beat(2, 0, 75.0, false)).at(0), "L t=2.500s beat  row 2 #1/15 at x=0.079 m: 75.0 N BELOW band 80-100 N");
-  EXPECT_EQ(v.on_beat(beat(2, 1, 89.0, true)).at(0), "L t=2.500s beat  row 2 #2/15 at x=0.079 m: 89.0 N in band 80-100 N");
+  EXPECT_EQ(v.on_beat(beat(2, 0, 75.0, false)).at(0),
+            "L t=2.500s beat  row 2 #1/15 at x=0.079 m: 75.0 N BELOW band 80-100 N");
+  EXPECT_EQ(v.on_beat(beat(2, 1, 89.0, true)).at(0),
+            "L t=2.500s beat  row 2 #2/15 at x=0.079 m: 89.0 N in band 80-100 N");
   // A state change is always a line; the same state again only once per second of loop time.
   auto m = status();
   m.loom_id = "L";
@@ -184,9 +191,9 @@ TEST(MonitorLines, EventViewSaysBandAndKeepsStatusSparse) {
 
 TEST(MonitorLines, DesignShowsTheRowToKnotAsRunsOnceEachRow) {
   const auto d = loom::telemetry::test_support::design_message("L", {{0, 0, 0, 0, 0}, {1, 1, 0, 0, 1}});
-  EXPECT_EQ(loom::monitor::design_line(d), "design loom=L name=rug.csv next_row=2/6 repeat=1 rows_done=1 width=5 knots=Bx2 Rx2 Bx1");
+  EXPECT_EQ(loom::monitor::design_line(d),
+            "design loom=L name=rug.csv next_row=2/6 repeat=1 rows_done=1 width=5 knots=Bx2 Rx2 Bx1");
   loom::monitor::EventView v;
   EXPECT_EQ(v.on_design(d).at(0), "L knot row 2/6 of rug.csv: Bx2 Rx2 Bx1");
   EXPECT_TRUE(v.on_design(d).empty());  // the once-a-second repeat of the same row prints nothing
 }
-

@@ -125,7 +125,8 @@ TEST(LoopEvents, EveryBeatOfATwoRowRunIsOneBeatMessage) {
 }
 
 TEST(LoopEvents, DriveFaultIsReportedWithAxisDeviceCodeAndText) {
-  firmware::Scene scene = firmware::load_scene(std::string(LOOM_SOURCE_DIR) + "/sim_hal/scenes/drive_fault.toml");
+  firmware::Scene scene =
+      firmware::load_scene(std::string(LOOM_SOURCE_DIR) + "/sim_hal/scenes/drive_fault.toml");
   const WovenRun r = weave(scene, 3, "fault");
   ASSERT_EQ(r.log.decode_errors, 0);
   ASSERT_EQ(r.state, sequencer::State::kFault);

@@ -2,19 +2,19 @@
 // become the previous row's when the next row starts, a restarted loop starts its loom afresh, JSON
 // never carries NaN; and its udpm receiver reads what a real LCM publisher sends.
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <unistd.h>
+#include <lcm/lcm-cpp.hpp>
 #include <limits>
 
 #include "fault_history.hpp"
-#include "recorder.hpp"
 #include "hall.hpp"
-#include "udpm_receiver.hpp"
+#include "recorder.hpp"
 #include "synthetic_loom.hpp"
+#include "udpm_receiver.hpp"
 
 using namespace loom::panel;
 
@@ -341,11 +341,14 @@ TEST(PanelHall, AReplayedRecordingIsKeptApartFromTheLiveLoomAndMarked) {
 // The lines are written out here as FaultHistory's documented format, not produced by it.
 TEST(PanelFaultHistory, LinesAreSplitAndTheNewestKept) {
   const std::string reply =
-      "2026-11-23T20:15:03Z fault loom1 drive_fault 0x1002 axis=carriage device=0x7310 rows=3 picks=3 beats=45: "
+      "2026-11-23T20:15:03Z fault loom1 drive_fault 0x1002 axis=carriage device=0x7310 rows=3 picks=3 "
+      "beats=45: "
       "a servo drive reported a fault\n"
-      "2026-11-23T20:16:10Z ack loom1 drive_fault 0x1002 device=0x0000 rows=3 picks=3 beats=45: acknowledged by local "
+      "2026-11-23T20:16:10Z ack loom1 drive_fault 0x1002 device=0x0000 rows=3 picks=3 beats=45: acknowledged "
+      "by local "
       "user anna (uid 1000, pid 42); re-arming from the measured positions\n"
-      "2026-11-23T20:17:00Z command loom1 start 0x0000 device=0x0000 rows=0 picks=0 beats=0: by local user anna: ok start\n"
+      "2026-11-23T20:17:00Z command loom1 start 0x0000 device=0x0000 rows=0 picks=0 beats=0: by local user "
+      "anna: ok start\n"
       "garbage \xff\xfe line\n";
   const auto j = fault_history_json(reply, 3);
   EXPECT_EQ(j["total"], 4);
@@ -356,9 +359,11 @@ TEST(PanelFaultHistory, LinesAreSplitAndTheNewestKept) {
   EXPECT_EQ(j["lines"][0]["name"], "drive_fault");
   EXPECT_EQ(j["lines"][1]["kind"], "command");
   EXPECT_EQ(j["lines"][1]["name"], "start");
-  EXPECT_EQ(j["lines"][1]["detail"], "0x0000 device=0x0000 rows=0 picks=0 beats=0: by local user anna: ok start");
+  EXPECT_EQ(j["lines"][1]["detail"],
+            "0x0000 device=0x0000 rows=0 picks=0 beats=0: by local user anna: ok start");
   EXPECT_FALSE(j["lines"][2].contains("kind"));  // not a history line: kept whole, not trusted
-  EXPECT_EQ(json_text(j["lines"][2]["line"]), "\"garbage \xEF\xBF\xBD\xEF\xBF\xBD line\"");  // U+FFFD, never thrown
+  EXPECT_EQ(json_text(j["lines"][2]["line"]),
+            "\"garbage \xEF\xBF\xBD\xEF\xBF\xBD line\"");  // U+FFFD, never thrown
   const auto none = fault_history_json("no faults recorded in /var/lib/loomctl/faults.log\n", 50);
   EXPECT_EQ(none["total"], 0);
   EXPECT_EQ(none["note"], "no faults recorded in /var/lib/loomctl/faults.log");
@@ -372,7 +377,8 @@ loomlcm::axes_t axes_at(const std::string& id, double t, const std::vector<std::
   for (std::size_t i = 0; i < names.size(); ++i) {
     loomlcm::axis_t a{};
     a.name = names[i];
-    // Written out so the test knows each value: position = t + i, velocity = 1, following error = 1e-4 * (i + 1).
+    // Written out so the test knows each value: position = t + i, velocity = 1, following error = 1e-4 * (i +
+    // 1).
     a.position = t + static_cast<double>(i);
     a.velocity = 1.0;
     a.following_error = 1e-4 * static_cast<double>(i + 1);
@@ -452,13 +458,17 @@ TEST(PanelHall, TheRowReportIsCsvOfEveryRowKept) {
   EXPECT_EQ(h.loom_json("A").value()["rows"].size(), 2u);  // the page's table
   const std::string csv = h.rows_csv("A").value();
   const std::string want =
-      "utc,loop_time_s,row,row_s,shed_s,pick_s,beat_s,beats,carriage_steps,force_min_n,force_mean_n,force_max_n,"
-      "beats_in_band,band_min_n,band_max_n,knotting_s,knot_s,weaver_s,knots_tied,knots_retried,knots_by_hand\n"
-      "2026-09-21T14:13:22Z,20.000000,2,9.500000,0.500000,1.250000,7.750000,15,14,0.000010,89.500000,91.000000,15,"
+      "utc,loop_time_s,row,row_s,shed_s,pick_s,beat_s,beats,carriage_steps,force_min_n,force_mean_n,force_"
+      "max_n,"
+      "beats_in_band,band_min_n,band_max_n,knotting_s,knot_s,weaver_s,knots_tied,knots_retried,knots_by_"
+      "hand\n"
+      "2026-09-21T14:13:22Z,20.000000,2,9.500000,0.500000,1.250000,7.750000,15,14,0.000010,89.500000,91."
+      "000000,15,"
       "80.000000,100.000000,0.000000,0.000000,0.000000,0,0,0\n"
       "2026-09-21T14:13:23Z,30.000000,3,9.500000,0.500000,1.250000,7.750000,15,14,,,,15,"
       "80.000000,100.000000,0.000000,0.000000,0.000000,0,0,0\n"
-      "2026-09-21T14:13:24Z,40.000000,4,9.500000,0.500000,1.250000,7.750000,15,14,0.000010,89.500000,91.000000,15,"
+      "2026-09-21T14:13:24Z,40.000000,4,9.500000,0.500000,1.250000,7.750000,15,14,0.000010,89.500000,91."
+      "000000,15,"
       "80.000000,100.000000,0.000000,0.000000,0.000000,0,0,0\n";
   EXPECT_EQ(csv, want);
   EXPECT_FALSE(h.rows_csv("B").has_value());
@@ -471,12 +481,14 @@ TEST(PanelRecorder, TheLastMinutesAreAnLcmLogLcmReads) {
   const std::int64_t t0 = 1'790'000'000'000'000;
   for (int k = 0; k < 130; ++k) {  // one message a second for 130 s, payload "m<k>"
     const std::string payload = "m" + std::to_string(k);
-    rec.add("A", k % 2 ? "LOOM.A.STATUS" : "LOOM.A.AXES", payload.data(), payload.size(), t0 + k * 1'000'000LL);
+    rec.add("A", k % 2 ? "LOOM.A.STATUS" : "LOOM.A.AXES", payload.data(), payload.size(),
+            t0 + k * 1'000'000LL);
   }
   rec.add("B", "LOOM.B.STATUS", "b", 1, t0);
   const auto bytes = rec.lcmlog("A", t0 + 129 * 1'000'000LL);
   ASSERT_TRUE(bytes.has_value());
-  const std::string path = (std::filesystem::temp_directory_path() / ("panel_rec_" + std::to_string(::getpid()))).string();
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("panel_rec_" + std::to_string(::getpid()))).string();
   {
     std::FILE* f = std::fopen(path.c_str(), "wb");
     ASSERT_NE(f, nullptr);
@@ -488,7 +500,8 @@ TEST(PanelRecorder, TheLastMinutesAreAnLcmLogLcmReads) {
   std::vector<std::string> got;
   std::int64_t first_us = 0, last_us = 0;
   while (const lcm::LogEvent* ev = log.readNextEvent()) {
-    got.push_back(ev->channel + "=" + std::string(static_cast<const char*>(ev->data), static_cast<std::size_t>(ev->datalen)));
+    got.push_back(ev->channel + "=" +
+                  std::string(static_cast<const char*>(ev->data), static_cast<std::size_t>(ev->datalen)));
     if (got.size() == 1) first_us = ev->timestamp;
     last_us = ev->timestamp;
   }
@@ -503,7 +516,8 @@ TEST(PanelRecorder, TheLastMinutesAreAnLcmLogLcmReads) {
   EXPECT_FALSE(rec.lcmlog("C", t0).has_value());
   // The byte budget for all looms: the loom holding the most gives up its oldest messages.
   Recorder small(600.0, 10 * (64 + 16));
-  for (int k = 0; k < 20; ++k) small.add("A", "LOOM.A.AXES", "0123456789abcdef", 0, t0 + k);  // 11 + 0 + 64 each
+  for (int k = 0; k < 20; ++k)
+    small.add("A", "LOOM.A.AXES", "0123456789abcdef", 0, t0 + k);  // 11 + 0 + 64 each
   EXPECT_LE(small.bytes(), 10u * (64 + 16));
   small.add("B", "LOOM.B.AXES", "x", 1, t0 + 30);
   EXPECT_TRUE(small.lcmlog("B", t0 + 30).has_value());  // B kept: A, the largest, gave way

@@ -35,8 +35,12 @@ struct WeaveScript {
 };
 
 // The snapshot carries the sequencer's enums as bytes.
-inline std::uint8_t byte_of(sequencer::State s) { return static_cast<std::uint8_t>(s); }
-inline std::uint8_t byte_of(sequencer::Fault f) { return static_cast<std::uint8_t>(f); }
+inline std::uint8_t byte_of(sequencer::State s) {
+  return static_cast<std::uint8_t>(s);
+}
+inline std::uint8_t byte_of(sequencer::Fault f) {
+  return static_cast<std::uint8_t>(f);
+}
 
 // State at `tick` (before a fault): shed → pick → beat_sweep → row_end, repeating.
 inline sequencer::State script_state(const WeaveScript& w, std::int64_t tick) {
@@ -89,7 +93,8 @@ inline Snapshot script_snapshot(const WeaveScript& w, std::int64_t tick) {
 
 // A DESIGN message: design "rug.csv", 6 rows, two colours (R madder, B), row 1 woven, carrying row 1
 // (knotted last) and row 2 (next) with the given knots.
-inline loomlcm::design_t design_message(const std::string& loom_id, std::vector<std::vector<std::int16_t>> knots) {
+inline loomlcm::design_t design_message(const std::string& loom_id,
+                                        std::vector<std::vector<std::int16_t>> knots) {
   loomlcm::design_t d{};
   d.loom_id = loom_id;
   d.name = "rug.csv";

@@ -7,9 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
-#include <cstdlib>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <random>
 #include <string>
 #include <thread>
@@ -35,8 +35,8 @@ LoomConfig recipe_with_crank_speed(double rad_s) {
 
 TEST(LoopThreads, LoopPublisherReporterAndRecipeSwapsShareNoUnsynchronisedState) {
   std::random_device rd;
-  const unsigned seed = std::getenv("LOOM_TSAN_SEED") ? static_cast<unsigned>(std::stoul(std::getenv("LOOM_TSAN_SEED")))
-                                                      : rd();
+  const unsigned seed =
+      std::getenv("LOOM_TSAN_SEED") ? static_cast<unsigned>(std::stoul(std::getenv("LOOM_TSAN_SEED"))) : rd();
   std::mt19937 rng(seed);
   const int port = std::uniform_int_distribution<int>(20000, 60000)(rng);
   std::printf("seed %u (LOOM_TSAN_SEED), LCM port %d\n", seed, port);
@@ -85,7 +85,8 @@ TEST(LoopThreads, LoopPublisherReporterAndRecipeSwapsShareNoUnsynchronisedState)
   ro.grace_ticks = 50;
   ro.max_ticks = static_cast<hal::Tick>(kRows * 30.0 / cfg.sequencer.period_s);  // a safety net, ~10x a row
   m.sequencer().request_start();
-  const RunResult res = run_loop(m.loop(), m.sequencer(), ro, [&](const RunEvent& e) { events.push_back(e); });
+  const RunResult res =
+      run_loop(m.loop(), m.sequencer(), ro, [&](const RunEvent& e) { events.push_back(e); });
   run_over.store(true, std::memory_order_release);
   swapper.join();
   m.telemetry()->stop();
@@ -105,12 +106,13 @@ TEST(LoopThreads, LoopPublisherReporterAndRecipeSwapsShareNoUnsynchronisedState)
   const telemetry::PublisherStats st = m.telemetry()->stats();
   EXPECT_GT(st.status, 0u);
   EXPECT_GT(st.axes, 0u);
-  std::printf("ticks %lld in %.2f s wall, %d recipe swaps, crank %.2f -> %.2f rad/s, LCM status %llu axes %llu, "
-              "publish errors %llu, dropped %llu\n",
-              static_cast<long long>(res.ticks), res.wall_s, swaps.load(), initial_speed, final_speed,
-              static_cast<unsigned long long>(st.status), static_cast<unsigned long long>(st.axes),
-              static_cast<unsigned long long>(st.publish_errors),
-              static_cast<unsigned long long>(m.telemetry()->dropped()));
+  std::printf(
+      "ticks %lld in %.2f s wall, %d recipe swaps, crank %.2f -> %.2f rad/s, LCM status %llu axes %llu, "
+      "publish errors %llu, dropped %llu\n",
+      static_cast<long long>(res.ticks), res.wall_s, swaps.load(), initial_speed, final_speed,
+      static_cast<unsigned long long>(st.status), static_cast<unsigned long long>(st.axes),
+      static_cast<unsigned long long>(st.publish_errors),
+      static_cast<unsigned long long>(m.telemetry()->dropped()));
 }
 
 }  // namespace

@@ -16,9 +16,12 @@ namespace {
 std::string cell(const std::string& s) {
   std::string out;
   for (char c : s) {
-    if (c == '|') out += "\\|";
-    else if (c == '\n') out += ' ';
-    else out += c;
+    if (c == '|')
+      out += "\\|";
+    else if (c == '\n')
+      out += ' ';
+    else
+      out += c;
   }
   return out;
 }
@@ -35,8 +38,9 @@ void print_faults() {
   std::printf("| code | fault | meaning | recovery |\n|---|---|---|---|\n");
   const auto row = [](Fault f) {
     if (f == Fault::kNone) return;
-    std::printf("| 0x%04X | `%s` | %s | %s |\n", loom::sequencer::fault_code(f), loom::sequencer::fault_name(f),
-                cell(loom::sequencer::fault_text(f)).c_str(), cell(loom::sequencer::fault_recovery(f)).c_str());
+    std::printf("| 0x%04X | `%s` | %s | %s |\n", loom::sequencer::fault_code(f),
+                loom::sequencer::fault_name(f), cell(loom::sequencer::fault_text(f)).c_str(),
+                cell(loom::sequencer::fault_recovery(f)).c_str());
   };
 #define LOOM_DOC_FAULT_ROW(id, code, name, text) row(Fault::id);
   LOOM_FAULT_TABLE(LOOM_DOC_FAULT_ROW)
@@ -44,20 +48,22 @@ void print_faults() {
 }
 
 int usage(std::FILE* out, int code) {
-  std::fprintf(out,
-               "loom-doc-tables: the READMEs' generated tables as Markdown, from the code's own tables\n"
-               "Usage: loom-doc-tables SUBCOMMAND\n\n"
-               "Subcommands:\n"
-               "  config-keys  every config key with its class and range (firmware::config_keys)\n"
-               "  faults       every fault: code, name, meaning, recovery (LOOM_FAULT_TABLE, fault_recovery)\n\n"
-               "tools/doctables/regen.sh BUILD_DIR writes them into the READMEs between their markers.\n");
+  std::fprintf(
+      out,
+      "loom-doc-tables: the READMEs' generated tables as Markdown, from the code's own tables\n"
+      "Usage: loom-doc-tables SUBCOMMAND\n\n"
+      "Subcommands:\n"
+      "  config-keys  every config key with its class and range (firmware::config_keys)\n"
+      "  faults       every fault: code, name, meaning, recovery (LOOM_FAULT_TABLE, fault_recovery)\n\n"
+      "tools/doctables/regen.sh BUILD_DIR writes them into the READMEs between their markers.\n");
   return code;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc == 2 && (std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0)) return usage(stdout, 0);
+  if (argc == 2 && (std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0))
+    return usage(stdout, 0);
   if (argc != 2) return usage(stderr, 2);
   const std::string what = argv[1];
   if (what == "config-keys") {
@@ -65,7 +71,8 @@ int main(int argc, char** argv) {
   } else if (what == "faults") {
     print_faults();
   } else {
-    std::fprintf(stderr, "loom-doc-tables: unknown subcommand '%s' (has: config-keys faults)\n", what.c_str());
+    std::fprintf(stderr, "loom-doc-tables: unknown subcommand '%s' (has: config-keys faults)\n",
+                 what.c_str());
     return 2;
   }
   return std::fflush(stdout) == 0 ? 0 : 1;

@@ -20,22 +20,41 @@ using cli::non_negative_number;
 using cli::positive_number;
 
 CLI::App* add_balance(CLI::App& app, BalanceArgs& a) {
-  CLI::App* c = app.add_subcommand("balance", "Shaking-force/moment balancing of the beat-up (003), before/after (CSV)");
-  c->add_option("--w1", a.w1, "Weight of RMS shaking force (relative to unbalanced)")->check(non_negative_number())->capture_default_str();
-  c->add_option("--w2", a.w2, "Weight of RMS shaking moment (relative to unbalanced)")->check(non_negative_number())->capture_default_str();
+  CLI::App* c = app.add_subcommand("balance",
+                                   "Shaking-force/moment balancing of the beat-up (003), before/after (CSV)");
+  c->add_option("--w1", a.w1, "Weight of RMS shaking force (relative to unbalanced)")
+      ->check(non_negative_number())
+      ->capture_default_str();
+  c->add_option("--w2", a.w2, "Weight of RMS shaking moment (relative to unbalanced)")
+      ->check(non_negative_number())
+      ->capture_default_str();
   c->add_option("--method", a.method, "counterweight, redistribution or both")
-      ->check(CLI::IsMember({"counterweight", "redistribution", "both"}))->capture_default_str();
-  c->add_option("--crank-rad-s", a.crank_rad_s, "Constant crank speed of the balanced motion")->check(positive_number())->capture_default_str();
-  c->add_option("--samples", a.samples, "Instants per crank turn (003's delta)")->check(CLI::Range(3, 1000000))->capture_default_str();
+      ->check(CLI::IsMember({"counterweight", "redistribution", "both"}))
+      ->capture_default_str();
+  c->add_option("--crank-rad-s", a.crank_rad_s, "Constant crank speed of the balanced motion")
+      ->check(positive_number())
+      ->capture_default_str();
+  c->add_option("--samples", a.samples, "Instants per crank turn (003's delta)")
+      ->check(CLI::Range(3, 1000000))
+      ->capture_default_str();
   c->add_option("--max-counterweight-kg", a.max_counterweight_kg, "Upper bound on each counterweight")
-      ->check(positive_number())->capture_default_str();
-  c->add_option("--counterweight-thickness-m", a.counterweight_thickness_m, "Thickness of the cast-iron counterweight discs")
-      ->check(positive_number())->capture_default_str();
-  c->add_option("--xtol", a.xtol_rel, "SLSQP relative tolerance on the design variables")->check(cli::finite_range(1e-15, 0.5))->capture_default_str();
-  c->add_option("--max-evaluations", a.max_evaluations, "SLSQP evaluation budget per start")->check(CLI::Range(1, 10000000))->capture_default_str();
+      ->check(positive_number())
+      ->capture_default_str();
+  c->add_option("--counterweight-thickness-m", a.counterweight_thickness_m,
+                "Thickness of the cast-iron counterweight discs")
+      ->check(positive_number())
+      ->capture_default_str();
+  c->add_option("--xtol", a.xtol_rel, "SLSQP relative tolerance on the design variables")
+      ->check(cli::finite_range(1e-15, 0.5))
+      ->capture_default_str();
+  c->add_option("--max-evaluations", a.max_evaluations, "SLSQP evaluation budget per start")
+      ->check(CLI::Range(1, 10000000))
+      ->capture_default_str();
   c->add_option("--trace", a.trace, "Write every objective evaluation (convergence) as CSV to this file");
-  c->add_option("--svg-force", a.svg_force, "Plot shaking force magnitude vs crank angle, before/after, to this SVG");
-  c->add_option("--svg-moment", a.svg_moment, "Plot shaking moment vs crank angle, before/after, to this SVG");
+  c->add_option("--svg-force", a.svg_force,
+                "Plot shaking force magnitude vs crank angle, before/after, to this SVG");
+  c->add_option("--svg-moment", a.svg_moment,
+                "Plot shaking moment vs crank angle, before/after, to this SVG");
   add_linkage_options(c, a.linkage);
   return c;
 }
@@ -48,7 +67,8 @@ std::vector<ShakingLoad> history(const LinkageMotionSamples& s, const std::vecto
   for (std::size_t i = 0; i < s.links.size(); ++i) total.push_back(combine(bodies[i], s.links[i].payload));
   std::vector<ShakingLoad> h;
   for (std::size_t k = 0; k < s.samples; ++k) {
-    h.push_back(shaking_load(total, std::span(s.motion).subspan(k * s.links.size(), s.links.size()), s.moment_about_m));
+    h.push_back(shaking_load(total, std::span(s.motion).subspan(k * s.links.size(), s.links.size()),
+                             s.moment_about_m));
   }
   return h;
 }
@@ -69,8 +89,10 @@ void run_balance(const CLI::App& cmd, const BalanceArgs& a) {
   const BeatUpDynamics d(linkage.geometry, linkage.masses);
   // The crank speed: the option, else the config's speed or the speed of its beat-force target.
   double speed = a.crank_rad_s;
-  if (cmd.count("--crank-rad-s") == 0 && linkage.config_crank_speed_rad_s) speed = *linkage.config_crank_speed_rad_s;
-  if (cmd.count("--crank-rad-s") == 0 && !linkage.config_crank_speed_rad_s && linkage.config_beat_force_target_n) {
+  if (cmd.count("--crank-rad-s") == 0 && linkage.config_crank_speed_rad_s)
+    speed = *linkage.config_crank_speed_rad_s;
+  if (cmd.count("--crank-rad-s") == 0 && !linkage.config_crank_speed_rad_s &&
+      linkage.config_beat_force_target_n) {
     speed = d.crank_speed_for_beat_force(*linkage.config_beat_force_target_n);
   }
   const LinkageMotionSamples s = beatup_balancing_samples(d, speed, a.samples);
@@ -93,7 +115,12 @@ void run_balance(const CLI::App& cmd, const BalanceArgs& a) {
     if (r.method == "counterweight") {
       // One row per counterweight: its mass, where its centre sits, and its own (disc) inertia.
       for (const Counterweight& c : r.counterweights) {
-        out.text(r.method).text(c.link).num(c.mass_kg).num(c.radius_m).num(deg(c.angle_rad)).num(c.inertia_kg_m2);
+        out.text(r.method)
+            .text(c.link)
+            .num(c.mass_kg)
+            .num(c.radius_m)
+            .num(deg(c.angle_rad))
+            .num(c.inertia_kg_m2);
         common_columns(out, r);
       }
     } else {
@@ -115,7 +142,8 @@ void run_balance(const CLI::App& cmd, const BalanceArgs& a) {
       for (const OptimiserStep& st : r.trace) {
         // The optimiser probes designs the model cannot evaluate (a link mass or inertia driven out of
         // its domain gives NaN/inf): those evaluations are left out of the file and counted, never written.
-        if (!std::isfinite(st.objective) || !std::isfinite(st.rms.force_n) || !std::isfinite(st.rms.moment_nm)) {
+        if (!std::isfinite(st.objective) || !std::isfinite(st.rms.force_n) ||
+            !std::isfinite(st.rms.moment_nm)) {
           ++non_finite;
           continue;
         }
@@ -126,10 +154,11 @@ void run_balance(const CLI::App& cmd, const BalanceArgs& a) {
     f << t;
     if (!f.flush()) throw UsageError("--trace: cannot write '" + a.trace + "'");
     if (non_finite > 0) {
-      std::fprintf(stderr,
-                   "loom-dynamics: note: --trace: %zu evaluations with a non-finite objective (the optimiser probing "
-                   "outside the model's domain) left out of %s; their numbers are gaps in the evaluation column\n",
-                   non_finite, a.trace.c_str());
+      std::fprintf(
+          stderr,
+          "loom-dynamics: note: --trace: %zu evaluations with a non-finite objective (the optimiser probing "
+          "outside the model's domain) left out of %s; their numbers are gaps in the evaluation column\n",
+          non_finite, a.trace.c_str());
     }
   }
   if (!a.svg_force.empty() || !a.svg_moment.empty()) {
@@ -137,7 +166,8 @@ void run_balance(const CLI::App& cmd, const BalanceArgs& a) {
     for (const BalancingLink& l : s.links) original.push_back(l.body);
     Chart force{"Beat-up shaking force", "crank angle (deg)", "|shaking force| (N)", {}, {}};
     Chart moment{"Beat-up shaking moment about A0", "crank angle (deg)", "shaking moment (N m)", {}, {}};
-    for (std::size_t k = 0; k < s.samples; ++k) force.x.push_back(360.0 * static_cast<double>(k) / static_cast<double>(s.samples));
+    for (std::size_t k = 0; k < s.samples; ++k)
+      force.x.push_back(360.0 * static_cast<double>(k) / static_cast<double>(s.samples));
     moment.x = force.x;
     const auto add = [&](const std::string& name, const std::vector<PlanarInertia>& bodies) {
       Series f{name, {}}, m{name, {}};
@@ -150,8 +180,10 @@ void run_balance(const CLI::App& cmd, const BalanceArgs& a) {
     };
     add("unbalanced", original);
     for (const BalanceResult& r : results) add(r.method, r.links_after);
-    if (!a.svg_force.empty() && !write_svg(force, a.svg_force)) throw UsageError("--svg-force: cannot write '" + a.svg_force + "'");
-    if (!a.svg_moment.empty() && !write_svg(moment, a.svg_moment)) throw UsageError("--svg-moment: cannot write '" + a.svg_moment + "'");
+    if (!a.svg_force.empty() && !write_svg(force, a.svg_force))
+      throw UsageError("--svg-force: cannot write '" + a.svg_force + "'");
+    if (!a.svg_moment.empty() && !write_svg(moment, a.svg_moment))
+      throw UsageError("--svg-moment: cannot write '" + a.svg_moment + "'");
   }
   out.finish();
 }

@@ -23,25 +23,40 @@ using namespace loom::motion;
 
 CLI::App* add_beatup(CLI::App& app, BeatupArgs& a) {
   CLI::App* c = app.add_subcommand("beatup", "Beat-up four-bar inverse dynamics over one crank turn (CSV)");
-  CLI::Option* speed = c->add_option("--crank-rad-s", a.crank_rad_s, "Crank speed (rad/s; the mean speed under --cam-e)")
-                           ->check(cli::positive_number());
-  CLI::Option* target = c->add_option("--target-force-n", a.target_force_n,
-                                      "Print the constant crank speed whose peak beat force (in the warp) is this")
-                            ->check(cli::positive_number());
+  CLI::Option* speed =
+      c->add_option("--crank-rad-s", a.crank_rad_s, "Crank speed (rad/s; the mean speed under --cam-e)")
+          ->check(cli::positive_number());
+  CLI::Option* target =
+      c->add_option("--target-force-n", a.target_force_n,
+                    "Print the constant crank speed whose peak beat force (in the warp) is this")
+          ->check(cli::positive_number());
   speed->excludes(target);
-  c->add_option("--samples", a.samples, "Samples over one crank turn")->check(CLI::Range(1, 100000000))->capture_default_str();
-  c->add_option("--contact-n", a.contact_n, "Cloth resistance on the beater while it advances through the warp (N)")
-      ->check(cli::non_negative_number())->capture_default_str();
+  c->add_option("--samples", a.samples, "Samples over one crank turn")
+      ->check(CLI::Range(1, 100000000))
+      ->capture_default_str();
+  c->add_option("--contact-n", a.contact_n,
+                "Cloth resistance on the beater while it advances through the warp (N)")
+      ->check(cli::non_negative_number())
+      ->capture_default_str();
   c->add_option("--gravity-deg", a.gravity_deg, "Direction of gravity in the linkage frame (A0->B0 is 0 deg)")
-      ->check(cli::finite_number())->capture_default_str();
-  c->add_option("--cam-e", a.cam_e, "Drive the crank by the elliptic-gear law of this eccentricity (004; 0 = constant)")
-      ->check(cli::eccentricity())->capture_default_str()->excludes(target);
-  c->add_option("--cam-phi02-rad", a.cam_phi02_rad, "Crank orientation on the driven pinion for --cam-e")
-      ->check(cli::finite_number())->capture_default_str()->excludes(target);
-  c->add_option("--svg", a.svg, "Also plot beater force, crank torque and pin loads vs crank angle to this SVG file")
+      ->check(cli::finite_number())
+      ->capture_default_str();
+  c->add_option("--cam-e", a.cam_e,
+                "Drive the crank by the elliptic-gear law of this eccentricity (004; 0 = constant)")
+      ->check(cli::eccentricity())
+      ->capture_default_str()
       ->excludes(target);
-  c->add_flag("--extra", a.extra,
-              "Append crank_rad_s,in_warp,contact_force_n,transmission_deg,near_toggle,shaking_force_n,shaking_moment_nm");
+  c->add_option("--cam-phi02-rad", a.cam_phi02_rad, "Crank orientation on the driven pinion for --cam-e")
+      ->check(cli::finite_number())
+      ->capture_default_str()
+      ->excludes(target);
+  c->add_option("--svg", a.svg,
+                "Also plot beater force, crank torque and pin loads vs crank angle to this SVG file")
+      ->excludes(target);
+  c->add_flag(
+      "--extra", a.extra,
+      "Append "
+      "crank_rad_s,in_warp,contact_force_n,transmission_deg,near_toggle,shaking_force_n,shaking_moment_nm");
   add_linkage_options(c, a.linkage);
   return c;
 }
@@ -50,7 +65,8 @@ namespace {
 
 BeatUpDynamics make_dynamics(const BeatupArgs& a, const Linkage& l) {
   BeatUpDynamics::Options o;
-  o.gravity_m_s2 = kStandardGravity_m_s2 * Eigen::Vector2d(std::cos(rad(a.gravity_deg)), std::sin(rad(a.gravity_deg)));
+  o.gravity_m_s2 =
+      kStandardGravity_m_s2 * Eigen::Vector2d(std::cos(rad(a.gravity_deg)), std::sin(rad(a.gravity_deg)));
   return BeatUpDynamics(l.geometry, l.masses, o);
 }
 
@@ -83,18 +99,23 @@ void run_beatup(const CLI::App& cmd, const BeatupArgs& a) {
   }
   const EllipticGearPair gear(kBatten004GearA_m, a.cam_e, 2);
   if (gear.near_degenerate()) {
-    std::fprintf(stderr,
-                 "loom-dynamics: warning: extreme ratio: --cam-e %.17g is near 1: the crank speed swings by %.3g:1 "
-                 "and forces by its square; the results are finite but ill-conditioned\n",
-                 a.cam_e, gear.max_speed_ratio() * gear.max_speed_ratio());
+    std::fprintf(
+        stderr,
+        "loom-dynamics: warning: extreme ratio: --cam-e %.17g is near 1: the crank speed swings by %.3g:1 "
+        "and forces by its square; the results are finite but ill-conditioned\n",
+        a.cam_e, gear.max_speed_ratio() * gear.max_speed_ratio());
   }
   const BeatContact contact{a.contact_n};
-  std::string header = "crank_deg,tip_acc_m_s2,beater_force_n,crank_torque_nm,pin_a0_n,pin_a_n,pin_b_n,pin_b0_n";
-  if (a.extra) header += ",crank_rad_s,in_warp,contact_force_n,transmission_deg,near_toggle,shaking_force_n,shaking_moment_nm";
+  std::string header =
+      "crank_deg,tip_acc_m_s2,beater_force_n,crank_torque_nm,pin_a0_n,pin_a_n,pin_b_n,pin_b0_n";
+  if (a.extra)
+    header +=
+        ",crank_rad_s,in_warp,contact_force_n,transmission_deg,near_toggle,shaking_force_n,shaking_moment_nm";
   cli::CsvWriter out(header);
   const bool plot = !a.svg.empty();
   Chart chart{"Beat-up at " + cli::format_number(speed) + " rad/s", "crank angle (deg)", "N, N m", {}, {}};
-  chart.series = {{"beater force (N)", {}}, {"crank torque (N m)", {}}, {"pin A0 (N)", {}}, {"pin B0 (N)", {}}};
+  chart.series = {
+      {"beater force (N)", {}}, {"crank torque (N m)", {}}, {"pin A0 (N)", {}}, {"pin B0 (N)", {}}};
   long near_toggle = 0;
   for (int i = 0; i < a.samples; ++i) {
     const double phi1 = kTwoPi * i / a.samples;
@@ -103,12 +124,21 @@ void run_beatup(const CLI::App& cmd, const BeatupArgs& a) {
                                         : CrankMotion{phi1, speed, 0.0};
     const BeatUpSample s = d.inverse(c, contact);
     near_toggle += s.near_toggle ? 1 : 0;
-    out.num(deg(wrap_two_pi(c.theta_rad))).num(s.tip_acc_abs_m_s2).num(s.beater_force_n).num(s.forces.crank_torque_nm);
-    out.num(s.forces.pin_a0_n.norm()).num(s.forces.pin_a_n.norm()).num(s.forces.pin_b_n.norm()).num(s.forces.pin_b0_n.norm());
+    out.num(deg(wrap_two_pi(c.theta_rad)))
+        .num(s.tip_acc_abs_m_s2)
+        .num(s.beater_force_n)
+        .num(s.forces.crank_torque_nm);
+    out.num(s.forces.pin_a0_n.norm())
+        .num(s.forces.pin_a_n.norm())
+        .num(s.forces.pin_b_n.norm())
+        .num(s.forces.pin_b0_n.norm());
     if (a.extra) {
       const std::array<BodyMotion, 3> mo = d.motion(c);
       const ShakingLoad sh = shaking_load(d.bodies(), mo, Eigen::Vector2d::Zero());
-      out.num(c.omega_rad_s).num(s.in_warp ? 1.0 : 0.0).num(s.contact_force_n.norm()).num(deg(s.transmission_rad));
+      out.num(c.omega_rad_s)
+          .num(s.in_warp ? 1.0 : 0.0)
+          .num(s.contact_force_n.norm())
+          .num(deg(s.transmission_rad));
       out.num(s.near_toggle ? 1.0 : 0.0).num(sh.force_n.norm()).num(sh.moment_nm);
     }
     out.end_row();
@@ -123,10 +153,11 @@ void run_beatup(const CLI::App& cmd, const BeatupArgs& a) {
   if (plot && !write_svg(chart, a.svg)) throw UsageError("--svg: cannot write '" + a.svg + "'");
   out.finish();
   if (near_toggle > 0) {
-    std::fprintf(stderr,
-                 "loom-dynamics: warning: %ld of %d samples are within %.1f deg of a toggle; pin forces there "
-                 "are large\n",
-                 near_toggle, a.samples, deg(d.options().near_toggle_rad));
+    std::fprintf(
+        stderr,
+        "loom-dynamics: warning: %ld of %d samples are within %.1f deg of a toggle; pin forces there "
+        "are large\n",
+        near_toggle, a.samples, deg(d.options().near_toggle_rad));
   }
 }
 

@@ -49,13 +49,15 @@ constexpr std::array<TableLink, 7> kBalanced{{
 }};
 
 void write_link(cli::CsvWriter& out, const TableLink& t, double offset_deg) {
-  const Eigen::Vector2d centre = t.d_m * Eigen::Vector2d(std::cos(rad(t.theta_deg)), std::sin(rad(t.theta_deg)));
+  const Eigen::Vector2d centre =
+      t.d_m * Eigen::Vector2d(std::cos(rad(t.theta_deg)), std::sin(rad(t.theta_deg)));
   const EquimomentalSystem e = equimomental_three_origin(t.mass_kg, centre, t.inertia_kg_m2, rad(offset_deg));
   if (t.inertia_kg_m2 < t.mass_kg * t.d_m * t.d_m) {
-    std::fprintf(stderr,
-                 "loom-dynamics: warning: link %s: inertia about the origin %.6g kg m^2 is below m d^2 = %.6g kg m^2 "
-                 "(no rigid body has it; rounded at the m d^2 <= I bound?): a point mass is negative\n",
-                 t.name, t.inertia_kg_m2, t.mass_kg * t.d_m * t.d_m);
+    std::fprintf(
+        stderr,
+        "loom-dynamics: warning: link %s: inertia about the origin %.6g kg m^2 is below m d^2 = %.6g kg m^2 "
+        "(no rigid body has it; rounded at the m d^2 <= I bound?): a point mass is negative\n",
+        t.name, t.inertia_kg_m2, t.mass_kg * t.d_m * t.d_m);
   }
   const PlanarInertia back = from_point_masses(e.points);
   out.text(t.name).num(t.mass_kg).num(t.d_m).num(t.theta_deg).num(t.inertia_kg_m2).num(e.radius_m);
@@ -79,12 +81,14 @@ CLI::App* add_equimomental(CLI::App& app, EquimomentalArgs& a) {
       ->check(cli::non_negative_number())
       ->needs(mass)
       ->capture_default_str();
-  c->add_option("--centre-theta-deg", a.centre_theta_deg, "Direction of the mass centre in the link frame, deg")
+  c->add_option("--centre-theta-deg", a.centre_theta_deg,
+                "Direction of the mass centre in the link frame, deg")
       ->check(cli::finite_number())
       ->needs(mass)
       ->capture_default_str();
   CLI::Option* inertia =
-      c->add_option("--inertia", a.inertia_kg_m2, "Moment of inertia about the link origin (the point masses' I = sum m_j l^2), kg m^2")
+      c->add_option("--inertia", a.inertia_kg_m2,
+                    "Moment of inertia about the link origin (the point masses' I = sum m_j l^2), kg m^2")
           ->check(cli::non_negative_number())
           ->needs(mass);
   mass->needs(inertia);
@@ -101,7 +105,8 @@ CLI::App* add_equimomental(CLI::App& app, EquimomentalArgs& a) {
 
 void run_equimomental(const CLI::App& cmd, const EquimomentalArgs& a) {
   cli::CsvWriter out(
-      "link,mass_kg,centre_d_m,centre_theta_deg,inertia_origin_kg_m2,l_m,m1_kg,m2_kg,m3_kg,offset_deg,all_positive,"
+      "link,mass_kg,centre_d_m,centre_theta_deg,inertia_origin_kg_m2,l_m,m1_kg,m2_kg,m3_kg,offset_deg,all_"
+      "positive,"
       "rebuilt_mass_kg,rebuilt_centre_d_m,rebuilt_centre_theta_deg,rebuilt_inertia_origin_kg_m2");
   const bool offset_given = cmd.count("--offset-deg") > 0;
   const auto offset_for = [&](const TableLink& t) { return offset_given ? a.offset_deg : t.theta_deg; };
@@ -109,7 +114,8 @@ void run_equimomental(const CLI::App& cmd, const EquimomentalArgs& a) {
     const TableLink t{"link", a.mass_kg, a.centre_d_m, a.centre_theta_deg, a.inertia_kg_m2};
     write_link(out, t, offset_for(t));
   } else {
-    for (const TableLink& t : a.table == "balanced" ? kBalanced : kOriginal) write_link(out, t, offset_for(t));
+    for (const TableLink& t : a.table == "balanced" ? kBalanced : kOriginal)
+      write_link(out, t, offset_for(t));
   }
   out.finish();
 }

@@ -1,9 +1,9 @@
 // See linkage_options.hpp. Order of precedence: explicit option > config file > the thesis' loom.
 #include "linkage_options.hpp"
 
-#include "loom/config/config.hpp"
 #include "loom/cli/numbers.hpp"
 #include "loom/cli/run.hpp"
+#include "loom/config/config.hpp"
 
 namespace loom::dyncli {
 
@@ -19,21 +19,29 @@ void add_linkage_options(CLI::App* c, LinkageArgs& a) {
   len("--coupler-m", a.coupler_m, "Coupler AB (default: config or thesis 0.189)");
   len("--rocker-m", a.rocker_m, "Rocker B0B (default: config or thesis 0.232)");
   len("--ground-m", a.ground_m, "Ground A0B0 (default: config or thesis 0.213)");
-  len("--beater-arm-m", a.beater_arm_m, "Beater tip distance from the rocker pivot (default: config or 0.301)");
+  len("--beater-arm-m", a.beater_arm_m,
+      "Beater tip distance from the rocker pivot (default: config or 0.301)");
   len("--warp-depth-m", a.warp_depth_m, "Beater travel inside the warp (default: config or 0.05)");
   c->add_option("--branch", a.branch, "Assembly branch (default: config or positive)")
       ->check(CLI::IsMember({"positive", "negative"}));
-  c->add_option("--fell-at", a.fell_at, "Dead centre at which the beater meets the fell (default: config or extended)")
+  c->add_option("--fell-at", a.fell_at,
+                "Dead centre at which the beater meets the fell (default: config or extended)")
       ->check(CLI::IsMember({"extended", "folded"}));
-  c->add_option("--beater-kg", a.beater_kg, "Beater mass at the beater arm (default: config's beater_mass_kg or 2.5)")
+  c->add_option("--beater-kg", a.beater_kg,
+                "Beater mass at the beater arm (default: config's beater_mass_kg or 2.5)")
       ->check(cli::non_negative_number());
   len("--crank-kg", a.crank_kg, "Crank mass, as a uniform bar (default: cast-iron bar of the section)");
   len("--coupler-kg", a.coupler_kg, "Coupler mass, as a uniform bar");
   len("--rocker-kg", a.rocker_kg, "Rocker bar mass (without the beater), as a uniform bar");
   c->add_option("--bar-width-m", a.bar_width_m, "Link bar width in the plane of motion")
-      ->check(cli::positive_number())->capture_default_str();
-  c->add_option("--bar-thickness-m", a.bar_thickness_m, "Link bar thickness")->check(cli::positive_number())->capture_default_str();
-  c->add_option("--density-kg-m3", a.density_kg_m3, "Link material density")->check(cli::positive_number())->capture_default_str();
+      ->check(cli::positive_number())
+      ->capture_default_str();
+  c->add_option("--bar-thickness-m", a.bar_thickness_m, "Link bar thickness")
+      ->check(cli::positive_number())
+      ->capture_default_str();
+  c->add_option("--density-kg-m3", a.density_kg_m3, "Link material density")
+      ->check(cli::positive_number())
+      ->capture_default_str();
 }
 
 namespace {

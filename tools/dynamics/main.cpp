@@ -7,8 +7,9 @@
 
 int main(int argc, char** argv) {
   using namespace loom::dyncli;
-  CLI::App app{"loom-dynamics: beat-up forces and crank speed, needle reactions (002), batten gain (004), "
-               "shaking balance (003), link mass properties, equimomental point masses (003)"};
+  CLI::App app{
+      "loom-dynamics: beat-up forces and crank speed, needle reactions (002), batten gain (004), "
+      "shaking balance (003), link mass properties, equimomental point masses (003)"};
   app.require_subcommand(1);
   BeatupArgs beatup;
   NeedleArgs needle;

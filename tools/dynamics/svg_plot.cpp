@@ -33,10 +33,14 @@ std::string num(double v) {
 std::string escape(const std::string& s) {
   std::string o;
   for (const char c : s) {
-    if (c == '<') o += "&lt;";
-    else if (c == '>') o += "&gt;";
-    else if (c == '&') o += "&amp;";
-    else o += c;
+    if (c == '<')
+      o += "&lt;";
+    else if (c == '>')
+      o += "&gt;";
+    else if (c == '&')
+      o += "&amp;";
+    else
+      o += c;
   }
   return o;
 }
@@ -59,11 +63,20 @@ std::string render_svg(const Chart& c) {
       }
     }
   }
-  if (!(x1 > x0)) { x0 = 0; x1 = 1; }
-  if (!(y1 > y0)) { const double m = std::isfinite(y0) ? y0 : 0.0; y0 = m - 1; y1 = m + 1; }
+  if (!(x1 > x0)) {
+    x0 = 0;
+    x1 = 1;
+  }
+  if (!(y1 > y0)) {
+    const double m = std::isfinite(y0) ? y0 : 0.0;
+    y0 = m - 1;
+    y1 = m + 1;
+  }
   const double xs = nice_step(x1 - x0, 8), ys = nice_step(y1 - y0, 6);
-  x0 = std::floor(x0 / xs) * xs; x1 = std::ceil(x1 / xs) * xs;
-  y0 = std::floor(y0 / ys) * ys; y1 = std::ceil(y1 / ys) * ys;
+  x0 = std::floor(x0 / xs) * xs;
+  x1 = std::ceil(x1 / xs) * xs;
+  y0 = std::floor(y0 / ys) * ys;
+  y1 = std::ceil(y1 / ys) * ys;
   const double pw = kW - kLeft - kRight, ph = kH - kTop - kBottom;
   const auto px = [&](double x) { return kLeft + (x - x0) / (x1 - x0) * pw; };
   const auto py = [&](double y) { return kTop + (y1 - y) / (y1 - y0) * ph; };
@@ -72,21 +85,24 @@ std::string render_svg(const Chart& c) {
   o += "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + num(kW) + "\" height=\"" + num(kH) +
        "\" font-family=\"sans-serif\" font-size=\"12\">\n";
   o += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  o += "<text x=\"" + num(kW / 2) + "\" y=\"24\" text-anchor=\"middle\" font-size=\"15\">" + escape(c.title) + "</text>\n";
+  o += "<text x=\"" + num(kW / 2) + "\" y=\"24\" text-anchor=\"middle\" font-size=\"15\">" + escape(c.title) +
+       "</text>\n";
   for (double x = x0; x <= x1 + 0.5 * xs; x += xs) {
-    o += "<line x1=\"" + num(px(x)) + "\" y1=\"" + num(kTop) + "\" x2=\"" + num(px(x)) + "\" y2=\"" + num(kTop + ph) +
-         "\" stroke=\"#ddd\"/>\n";
-    o += "<text x=\"" + num(px(x)) + "\" y=\"" + num(kTop + ph + 16) + "\" text-anchor=\"middle\">" + num(x) + "</text>\n";
+    o += "<line x1=\"" + num(px(x)) + "\" y1=\"" + num(kTop) + "\" x2=\"" + num(px(x)) + "\" y2=\"" +
+         num(kTop + ph) + "\" stroke=\"#ddd\"/>\n";
+    o += "<text x=\"" + num(px(x)) + "\" y=\"" + num(kTop + ph + 16) + "\" text-anchor=\"middle\">" + num(x) +
+         "</text>\n";
   }
   for (double y = y0; y <= y1 + 0.5 * ys; y += ys) {
-    o += "<line x1=\"" + num(kLeft) + "\" y1=\"" + num(py(y)) + "\" x2=\"" + num(kLeft + pw) + "\" y2=\"" + num(py(y)) +
-         "\" stroke=\"#ddd\"/>\n";
-    o += "<text x=\"" + num(kLeft - 6) + "\" y=\"" + num(py(y) + 4) + "\" text-anchor=\"end\">" + num(y) + "</text>\n";
+    o += "<line x1=\"" + num(kLeft) + "\" y1=\"" + num(py(y)) + "\" x2=\"" + num(kLeft + pw) + "\" y2=\"" +
+         num(py(y)) + "\" stroke=\"#ddd\"/>\n";
+    o += "<text x=\"" + num(kLeft - 6) + "\" y=\"" + num(py(y) + 4) + "\" text-anchor=\"end\">" + num(y) +
+         "</text>\n";
   }
-  o += "<rect x=\"" + num(kLeft) + "\" y=\"" + num(kTop) + "\" width=\"" + num(pw) + "\" height=\"" + num(ph) +
-       "\" fill=\"none\" stroke=\"black\"/>\n";
-  o += "<text x=\"" + num(kLeft + pw / 2) + "\" y=\"" + num(kH - 16) + "\" text-anchor=\"middle\">" + escape(c.x_label) +
-       "</text>\n";
+  o += "<rect x=\"" + num(kLeft) + "\" y=\"" + num(kTop) + "\" width=\"" + num(pw) + "\" height=\"" +
+       num(ph) + "\" fill=\"none\" stroke=\"black\"/>\n";
+  o += "<text x=\"" + num(kLeft + pw / 2) + "\" y=\"" + num(kH - 16) + "\" text-anchor=\"middle\">" +
+       escape(c.x_label) + "</text>\n";
   o += "<text transform=\"translate(18," + num(kTop + ph / 2) + ") rotate(-90)\" text-anchor=\"middle\">" +
        escape(c.y_label) + "</text>\n";
   for (std::size_t k = 0; k < c.series.size(); ++k) {
@@ -94,7 +110,9 @@ std::string render_svg(const Chart& c) {
     const std::string colour = kColours[k % (sizeof kColours / sizeof *kColours)];
     std::string pts;
     const auto flush = [&] {
-      if (!pts.empty()) o += "<polyline fill=\"none\" stroke=\"" + colour + "\" stroke-width=\"1.5\" points=\"" + pts + "\"/>\n";
+      if (!pts.empty())
+        o += "<polyline fill=\"none\" stroke=\"" + colour + "\" stroke-width=\"1.5\" points=\"" + pts +
+             "\"/>\n";
       pts.clear();
     };
     for (std::size_t i = 0; i < c.x.size() && i < s.y.size(); ++i) {
@@ -106,8 +124,9 @@ std::string render_svg(const Chart& c) {
     }
     flush();
     const double ly = kTop + 16 + 16 * static_cast<double>(k);
-    o += "<line x1=\"" + num(kLeft + pw - 150) + "\" y1=\"" + num(ly - 4) + "\" x2=\"" + num(kLeft + pw - 130) +
-         "\" y2=\"" + num(ly - 4) + "\" stroke=\"" + colour + "\" stroke-width=\"2\"/>\n";
+    o += "<line x1=\"" + num(kLeft + pw - 150) + "\" y1=\"" + num(ly - 4) + "\" x2=\"" +
+         num(kLeft + pw - 130) + "\" y2=\"" + num(ly - 4) + "\" stroke=\"" + colour +
+         "\" stroke-width=\"2\"/>\n";
     o += "<text x=\"" + num(kLeft + pw - 125) + "\" y=\"" + num(ly) + "\">" + escape(s.name) + "</text>\n";
   }
   o += "</svg>\n";

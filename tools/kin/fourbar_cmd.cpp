@@ -3,10 +3,10 @@
 // summarised in one row. Geometric refusals name the length options they come from.
 #include "fourbar_cmd.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
-#include <cmath>
 
 #include "loom/cli/csv.hpp"
 #include "loom/cli/numbers.hpp"
@@ -37,11 +37,12 @@ void warn_near_toggle(const loom::motion::FourBar& m) {
   if (cls != GrashofClass::kCrankRocker && cls != GrashofClass::kDoubleCrank) return;
   const TransmissionRange r = transmission_range(m);
   if (r.near_toggle) {
-    std::fprintf(stderr,
-                 "loom-kin: warning: near toggle: the transmission angle reaches %.6g deg (|sin mu| = %.3g < %g); "
-                 "rates there are amplified by 1/|sin mu| and small length errors move the linkage a long way\n",
-                 deg(std::sin(r.mu_min) <= std::sin(r.mu_max) ? r.mu_min : r.mu_max), r.min_abs_sin_mu,
-                 kNearToggleSine);
+    std::fprintf(
+        stderr,
+        "loom-kin: warning: near toggle: the transmission angle reaches %.6g deg (|sin mu| = %.3g < %g); "
+        "rates there are amplified by 1/|sin mu| and small length errors move the linkage a long way\n",
+        deg(std::sin(r.mu_min) <= std::sin(r.mu_max) ? r.mu_min : r.mu_max), r.min_abs_sin_mu,
+        kNearToggleSine);
   }
 }
 
@@ -80,31 +81,34 @@ void write_sweep(const FourBarArgs& a, const loom::motion::FourBar& m, loom::mot
   // Every class but the change point: a linkage whose crank cannot turn fully (double-rocker,
   // rocker-crank, triple-rocker) is analysed at the crank angles it reaches; the others are left out
   // and counted. The crank angle column is the pose's own, so a gap shows where they were.
-  const ReachableSweep cover = fourbar_sweep_reachable(m, branch, a.samples, rad(a.start_deg), [&](int i, const FourBarPose& p) {
-    out.num(a.start_deg + 360.0 * static_cast<double>(i) / static_cast<double>(a.samples));
-    out.num(deg(p.theta3)).num(deg(p.theta4)).num(p.k3).num(p.k4).num(p.k3p).num(p.k4p);
-    out.num(deg(p.transmission));
-    if (point) {
-      const PointMotion pm = point_motion(
-          point_coefficients(m, p, link_of(a.point_link), {a.point_x, a.point_y}), a.omega, a.alpha);
-      out.num(pm.position.x()).num(pm.position.y()).num(pm.velocity.x()).num(pm.velocity.y());
-      out.num(pm.acceleration.x()).num(pm.acceleration.y());
-    }
-    out.end_row();
-  });
+  const ReachableSweep cover =
+      fourbar_sweep_reachable(m, branch, a.samples, rad(a.start_deg), [&](int i, const FourBarPose& p) {
+        out.num(a.start_deg + 360.0 * static_cast<double>(i) / static_cast<double>(a.samples));
+        out.num(deg(p.theta3)).num(deg(p.theta4)).num(p.k3).num(p.k4).num(p.k3p).num(p.k4p);
+        out.num(deg(p.transmission));
+        if (point) {
+          const PointMotion pm = point_motion(
+              point_coefficients(m, p, link_of(a.point_link), {a.point_x, a.point_y}), a.omega, a.alpha);
+          out.num(pm.position.x()).num(pm.position.y()).num(pm.velocity.x()).num(pm.velocity.y());
+          out.num(pm.acceleration.x()).num(pm.acceleration.y());
+        }
+        out.end_row();
+      });
   if (cover.solved == 0) {
     throw MotionError(ErrorCode::kNotAssemblable,
-                      std::string("the ") + grashof_class_name(classify(m)) + " cannot be assembled at any of the " +
-                          std::to_string(a.samples) + " crank angles asked for (--start-deg " +
-                          cli::format_number(a.start_deg) + ", --samples " + std::to_string(a.samples) + ")");
+                      std::string("the ") + grashof_class_name(classify(m)) +
+                          " cannot be assembled at any of the " + std::to_string(a.samples) +
+                          " crank angles asked for (--start-deg " + cli::format_number(a.start_deg) +
+                          ", --samples " + std::to_string(a.samples) + ")");
   }
   out.finish();
   if (cover.unreachable + cover.at_toggle > 0) {
-    std::fprintf(stderr,
-                 "loom-kin: note: the %s's crank cannot reach every angle: %d of %d samples left out (%d beyond its "
-                 "reach, %d at a toggle)\n",
-                 grashof_class_name(classify(m)), cover.unreachable + cover.at_toggle, a.samples, cover.unreachable,
-                 cover.at_toggle);
+    std::fprintf(
+        stderr,
+        "loom-kin: note: the %s's crank cannot reach every angle: %d of %d samples left out (%d beyond its "
+        "reach, %d at a toggle)\n",
+        grashof_class_name(classify(m)), cover.unreachable + cover.at_toggle, a.samples, cover.unreachable,
+        cover.at_toggle);
   }
 }
 

@@ -10,8 +10,9 @@
 #include "slider_crank_cmd.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"loom-kin: four-bar, slider-crank, needle six-bar (002) and elliptic-gear batten drive (004) "
-               "kinematics as CSV"};
+  CLI::App app{
+      "loom-kin: four-bar, slider-crank, needle six-bar (002) and elliptic-gear batten drive (004) "
+      "kinematics as CSV"};
   app.require_subcommand(1);
   loom::kin::FourBarArgs fourbar;
   loom::kin::SliderCrankArgs slider;

@@ -19,7 +19,9 @@ using cli::positive_number;
 
 CLI::App* add_needle_command(CLI::App& app, NeedleArgs& a) {
   CLI::App* c = app.add_subcommand("needle", "Tufting-needle six-bar (002) over one main-shaft turn");
-  c->add_option("--samples", a.samples, "Samples over one turn")->check(CLI::Range(1, 10000000))->capture_default_str();
+  c->add_option("--samples", a.samples, "Samples over one turn")
+      ->check(CLI::Range(1, 10000000))
+      ->capture_default_str();
   const auto len = [&](const char* name, double& v, const char* what) {
     c->add_option(name, v, what)->check(positive_number())->capture_default_str();
   };
@@ -30,21 +32,29 @@ CLI::App* add_needle_command(CLI::App& app, NeedleArgs& a) {
   len("--l5-mm", a.l5_mm, "Connecting rod DE");
   len("--l6-mm", a.l6_mm, "Needle bar EF");
   c->add_option("--x1-mm", a.x1_mm, "Horizontal offset of rocker pivot C from the main shaft O")
-      ->check(finite_number())->capture_default_str();
+      ->check(finite_number())
+      ->capture_default_str();
   c->add_option("--h1-mm", a.h1_mm, "Vertical offset of rocker pivot C from the main shaft O")
-      ->check(finite_number())->capture_default_str();
+      ->check(finite_number())
+      ->capture_default_str();
   c->add_option("--x2-mm", a.x2_mm, "Horizontal offset of the needle line from C")
-      ->check(finite_number())->capture_default_str();
+      ->check(finite_number())
+      ->capture_default_str();
   c->add_option("--beta1-deg", a.beta1_deg, "Fixed angle between l3 and l4")
-      ->check(finite_number())->capture_default_str();
+      ->check(finite_number())
+      ->capture_default_str();
   c->add_option("--rocker-side", a.rocker_side,
                 "Rocker pin B on the side of the line O-C away from the needle (002) or toward it")
-      ->check(CLI::IsMember({"away", "toward"}))->capture_default_str();
+      ->check(CLI::IsMember({"away", "toward"}))
+      ->capture_default_str();
   c->add_option("--rod-side", a.rod_side,
                 "Rod D-E hanging from the arm down to the needle bar (002's Fig. 2, theta5 in the third "
                 "quadrant) or standing above it (the mirror image)")
-      ->check(CLI::IsMember({"hanging", "standing"}))->capture_default_str();
-  c->add_option("--rpm", a.rpm, "Main-shaft speed for --rates")->check(positive_number())->capture_default_str();
+      ->check(CLI::IsMember({"hanging", "standing"}))
+      ->capture_default_str();
+  c->add_option("--rpm", a.rpm, "Main-shaft speed for --rates")
+      ->check(positive_number())
+      ->capture_default_str();
   c->add_flag("--rates", a.rates, "Append angular velocities/accelerations and needle velocity/acceleration");
   return c;
 }
@@ -63,15 +73,17 @@ void run_needle(const NeedleArgs& a) {
   d.h1_m = a.h1_mm * 1e-3;
   d.beta1_rad = rad(a.beta1_deg);
   NeedleBranch b;
-  b.rocker = a.rocker_side == "toward" ? NeedleRockerSide::kPinTowardNeedle : NeedleRockerSide::kPinAwayFromNeedle;
+  b.rocker =
+      a.rocker_side == "toward" ? NeedleRockerSide::kPinTowardNeedle : NeedleRockerSide::kPinAwayFromNeedle;
   b.rod = a.rod_side == "standing" ? NeedleRodSide::kStandingRod : NeedleRodSide::kHangingRod;
   const NeedleLinkage n(d, b);
   const double omega1 = a.rpm * kTwoPi / 60.0;
 
   std::string header = "theta1_deg,theta2_deg,theta3_deg,theta4_deg,theta5_deg,needle_mm";
   if (a.rates) {
-    header += ",omega2_rad_s,omega3_rad_s,omega4_rad_s,omega5_rad_s,alpha2_rad_s2,alpha3_rad_s2,"
-              "alpha4_rad_s2,alpha5_rad_s2,needle_v_m_s,needle_a_m_s2";
+    header +=
+        ",omega2_rad_s,omega3_rad_s,omega4_rad_s,omega5_rad_s,alpha2_rad_s2,alpha3_rad_s2,"
+        "alpha4_rad_s2,alpha5_rad_s2,needle_v_m_s,needle_a_m_s2";
   }
   cli::CsvWriter out(header);
   long i = 0;

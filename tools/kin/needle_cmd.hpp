@@ -12,9 +12,9 @@ struct NeedleArgs {
   // Table 1 of 002, mm and degrees as printed there.
   double l1_mm = 15, l2_mm = 138, l3_mm = 115, l4_mm = 125, l5_mm = 120, l6_mm = 440;
   double x1_mm = 70, x2_mm = 100, h1_mm = 155, beta1_deg = 168;
-  std::string rocker_side = "away";    // 002: B away from the needle side of O-C
-  std::string rod_side = "hanging";    // 002: the rod hangs from D down to the needle bar
-  double rpm = 160;  // 002's experiment; only matters with --rates
+  std::string rocker_side = "away";  // 002: B away from the needle side of O-C
+  std::string rod_side = "hanging";  // 002: the rod hangs from D down to the needle bar
+  double rpm = 160;                  // 002's experiment; only matters with --rates
   bool rates = false;
 };
 

@@ -48,10 +48,11 @@ void warn_near_toggle(const loom::motion::SliderCrank& m) {
   using namespace loom::motion;
   const double mu_min = slider_dead_centres(m).mu_min_rad;
   if (std::sin(mu_min) < kNearToggleSine) {
-    std::fprintf(stderr,
-                 "loom-kin: warning: near toggle: the transmission angle reaches %.6g deg (|sin mu| = %.3g < %g); "
-                 "rates there are amplified by 1/|sin mu| and small length errors move the linkage a long way\n",
-                 deg(mu_min), std::sin(mu_min), kNearToggleSine);
+    std::fprintf(
+        stderr,
+        "loom-kin: warning: near toggle: the transmission angle reaches %.6g deg (|sin mu| = %.3g < %g); "
+        "rates there are amplified by 1/|sin mu| and small length errors move the linkage a long way\n",
+        deg(mu_min), std::sin(mu_min), kNearToggleSine);
   }
 }
 
@@ -67,9 +68,9 @@ void run_slider_crank(const SliderCrankArgs& a) {
       cli::CsvWriter out(
           "theta_extended_deg,theta_folded_deg,x_extended,x_folded,stroke,phi_extend_to_fold_deg,"
           "phi_fold_to_extend_deg,time_ratio,mu_min_deg");
-      for (double v : {deg(dc.theta_extended_rad), deg(dc.theta_folded_rad), dc.x_extended, dc.x_folded, dc.stroke,
-                       deg(dc.phi_extend_to_fold_rad), deg(dc.phi_fold_to_extend_rad), dc.time_ratio,
-                       deg(dc.mu_min_rad)}) {
+      for (double v : {deg(dc.theta_extended_rad), deg(dc.theta_folded_rad), dc.x_extended, dc.x_folded,
+                       dc.stroke, deg(dc.phi_extend_to_fold_rad), deg(dc.phi_fold_to_extend_rad),
+                       dc.time_ratio, deg(dc.mu_min_rad)}) {
         out.num(v);
       }
       out.end_row();

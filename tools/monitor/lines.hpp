@@ -32,11 +32,13 @@ std::string status_line(const loomlcm::status_t& m);
 // non-zero; no unit= from a publisher that sends none)
 std::string axes_line(const loomlcm::axes_t& m);
 // rt loom=<id> tick=<n> t=<s>s overruns=<n> tick_cost_us=<us> max_tick_cost_us=<us> wake_p50_us=..
-//   wake_p99_us=.. wake_max_us=.. dropped=<n> dropped_events=<n> backlog=<n> can_tx_dropped=<n> can_rx_errors=<n>
+//   wake_p99_us=.. wake_max_us=.. dropped=<n> dropped_events=<n> backlog=<n> can_tx_dropped=<n>
+//   can_rx_errors=<n>
 std::string rt_line(const loomlcm::rt_stats_t& m);
 // beat loom=<id> t=<s>s row=<n> index=<k> x=<m>m force=<N>N in_band=yes|no|unmeasured
 std::string beat_line(const loomlcm::beat_t& m);
-// fault loom=<id> t=<s>s kind=<first|diagnosis|device> name=<n> code=0x<hhhh> axis=<name|-> device_code=0x<hhhh>
+// fault loom=<id> t=<s>s kind=<first|diagnosis|device> name=<n> code=0x<hhhh> axis=<name|->
+// device_code=0x<hhhh>
 //   state=<s> row=<n> pick=<n> beat=<n> text="<operator text>"
 std::string fault_line(const loomlcm::fault_t& m);
 // row loom=<id> t=<s>s row=<n> time=<s>s shed=<s>s pick=<s>s beat=<s>s beats=<n> steps=<n>
@@ -48,8 +50,9 @@ std::string row_line(const loomlcm::row_t& m);
 //   knot=<0-based|-1> head=<0-based> slot=<n> colour=<code|-> text="<the request in the weaver's words>"
 std::string weaver_line(const loomlcm::weaver_request_t& m);
 // knots loom=<id> tick=<n> t=<s>s state=<name> row=<n> design_row=<0-based> cycle=<j|-1>/<stripe>
-//   cycles_done=<n> tied=<n> retried=<n> by_hand=<n> row_tied=<n> row_retried=<n> row_by_hand=<n> requests=<n>
-//   ask=<name|-> then per head " | head<h> knot=<k|-1> colour=<code|-> stock=<slot0>,<slot1>,..."
+//   cycles_done=<n> tied=<n> retried=<n> by_hand=<n> row_tied=<n> row_retried=<n> row_by_hand=<n>
+//   requests=<n> ask=<name|-> then per head " | head<h> knot=<k|-1> colour=<code|->
+//   stock=<slot0>,<slot1>,..."
 std::string knots_line(const loomlcm::knots_t& m);
 std::string design_line(const loomlcm::design_t& m);
 

@@ -49,7 +49,8 @@ struct Options {
 };
 
 std::int64_t wall_utime() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
       .count();
 }
 
@@ -59,7 +60,8 @@ class Printer {
   using View = loom::monitor::EventView;
 
  public:
-  Printer(bool event_view, std::set<std::string> raw, double status_every_s, bool show_beats, double replay_after_s)
+  Printer(bool event_view, std::set<std::string> raw, double status_every_s, bool show_beats,
+          double replay_after_s)
       : event_view_(event_view),
         raw_(std::move(raw)),
         view_(status_every_s, show_beats),
@@ -73,16 +75,25 @@ class Printer {
   std::int64_t printed = 0;
 
  private:
-  void handle(const loomlcm::status_t& m) { dispatch("status", m, &loom::monitor::status_line, &View::on_status); }
+  void handle(const loomlcm::status_t& m) {
+    dispatch("status", m, &loom::monitor::status_line, &View::on_status);
+  }
   void handle(const loomlcm::axes_t& m) {
-    dispatch("axes", m, &loom::monitor::axes_line, static_cast<std::vector<std::string> (View::*)(const loomlcm::axes_t&)>(nullptr));
+    dispatch("axes", m, &loom::monitor::axes_line,
+             static_cast<std::vector<std::string> (View::*)(const loomlcm::axes_t&)>(nullptr));
   }
   void handle(const loomlcm::rt_stats_t& m) { dispatch("rt", m, &loom::monitor::rt_line, &View::on_rt); }
   void handle(const loomlcm::beat_t& m) { dispatch("beat", m, &loom::monitor::beat_line, &View::on_beat); }
-  void handle(const loomlcm::fault_t& m) { dispatch("fault", m, &loom::monitor::fault_line, &View::on_fault); }
+  void handle(const loomlcm::fault_t& m) {
+    dispatch("fault", m, &loom::monitor::fault_line, &View::on_fault);
+  }
   void handle(const loomlcm::row_t& m) { dispatch("row", m, &loom::monitor::row_line, &View::on_row); }
-  void handle(const loomlcm::design_t& m) { dispatch("design", m, &loom::monitor::design_line, &View::on_design); }
-  void handle(const loomlcm::weaver_request_t& m) { dispatch("weaver", m, &loom::monitor::weaver_line, &View::on_weaver); }
+  void handle(const loomlcm::design_t& m) {
+    dispatch("design", m, &loom::monitor::design_line, &View::on_design);
+  }
+  void handle(const loomlcm::weaver_request_t& m) {
+    dispatch("weaver", m, &loom::monitor::weaver_line, &View::on_weaver);
+  }
   void handle(const loomlcm::knots_t& m) {
     dispatch("knots", m, &loom::monitor::knots_line,
              static_cast<std::vector<std::string> (View::*)(const loomlcm::knots_t&)>(nullptr));
@@ -98,7 +109,8 @@ class Printer {
     if (event_view_) {
       if (view_lines != nullptr) {
         View& v = replayed ? replay_view_ : view_;
-        for (const auto& line : (v.*view_lines)(m)) print(replayed ? "REPLAY recorded " + ago + " s ago: " + line : line);
+        for (const auto& line : (v.*view_lines)(m))
+          print(replayed ? "REPLAY recorded " + ago + " s ago: " + line : line);
       }
     } else if (raw_.count(kind) != 0) {
       print(replayed ? raw_line(m) + " replayed=1 recorded_s_ago=" + ago : raw_line(m));
@@ -108,10 +120,11 @@ class Printer {
   // otherwise look like the loom itself).
   void note_replay(const std::string& loom_id, const std::string& ago) {
     if (!replay_noted_.insert(loom_id).second) return;
-    std::fprintf(stderr,
-                 "loom-monitor: %s: replayed messages (recorded %s s ago) on this group; marked REPLAY and kept "
-                 "apart from the live loom (replay recordings onto their own group: tools/README.md)\n",
-                 loom::monitor::printable_field(loom_id).c_str(), ago.c_str());
+    std::fprintf(
+        stderr,
+        "loom-monitor: %s: replayed messages (recorded %s s ago) on this group; marked REPLAY and kept "
+        "apart from the live loom (replay recordings onto their own group: tools/README.md)\n",
+        loom::monitor::printable_field(loom_id).c_str(), ago.c_str());
   }
   // Flushed per line so `loom-monitor | grep` and scripts see each message as it arrives.
   void print(const std::string& line) {
@@ -144,15 +157,17 @@ std::string upper(std::string s) {
 int main(int argc, char** argv) {
   Options o;
   CLI::App app{
-      "Print a loom's LCM telemetry: by default one line per event (state change, beat, row done, fault) and a "
+      "Print a loom's LCM telemetry: by default one line per event (state change, beat, row done, fault) and "
+      "a "
       "compact status once per second; with --channel one key=value line per message."};
   app.add_option("--lcm-url", o.lcm_url,
                  "LCM URL, e.g. udpm://239.255.76.67:7667?ttl=0 or file:///x.lcmlog?mode=r (default: "
                  "$LCM_DEFAULT_URL or LCM's own default)");
   app.add_option("--loom-id", o.loom_id, "Only this loom (default: every loom on the URL)");
-  app.add_option("--channel", o.channels,
-                 "Print every message of these channels as key=value lines: status, axes, rt, beat, fault, row, "
-                 "design, weaver, knots (repeat or comma-separate)")
+  app.add_option(
+         "--channel", o.channels,
+         "Print every message of these channels as key=value lines: status, axes, rt, beat, fault, row, "
+         "design, weaver, knots (repeat or comma-separate)")
       ->delimiter(',');
   app.add_option("--count", o.count, "Exit 0 after printing this many lines (0: no limit)");
   app.add_option("--timeout-s", o.timeout_s,
@@ -162,9 +177,10 @@ int main(int argc, char** argv) {
                  "Event view: a compact status line at most this often, in seconds of loop time")
       ->capture_default_str();
   app.add_flag("--no-beats", o.no_beats, "Event view: leave out the per-beat lines");
-  app.add_option("--replay-after-s", o.replay_after_s,
-                 "Messages stamped more than this many seconds ago are replayed recordings: marked REPLAY and "
-                 "kept apart from the live loom")
+  app.add_option(
+         "--replay-after-s", o.replay_after_s,
+         "Messages stamped more than this many seconds ago are replayed recordings: marked REPLAY and "
+         "kept apart from the live loom")
       ->capture_default_str();
   app.add_option("--channel-prefix", o.channel_prefix, "First field of the channel names")
       ->capture_default_str();
@@ -180,10 +196,12 @@ int main(int argc, char** argv) {
                        " must be a number of seconds in [0, 1e7]");
   }
   if (!std::isfinite(o.status_every_s) || o.status_every_s < 0.0 || o.status_every_s > kMaxTimeoutS) {
-    return usage_error("--status-every-s " + std::to_string(o.status_every_s) + " must be a number of seconds >= 0");
+    return usage_error("--status-every-s " + std::to_string(o.status_every_s) +
+                       " must be a number of seconds >= 0");
   }
   if (!std::isfinite(o.replay_after_s) || o.replay_after_s < 0.0 || o.replay_after_s > kMaxTimeoutS) {
-    return usage_error("--replay-after-s " + std::to_string(o.replay_after_s) + " must be a number of seconds >= 0");
+    return usage_error("--replay-after-s " + std::to_string(o.replay_after_s) +
+                       " must be a number of seconds >= 0");
   }
   if (!o.loom_id.empty()) {
     if (auto e = loom::telemetry::loom_id_error(o.loom_id); !e.empty()) return usage_error("--loom-id: " + e);
@@ -193,9 +211,11 @@ int main(int argc, char** argv) {
   }
   std::set<std::string> raw;
   for (const auto& c : o.channels) {
-    static const std::set<std::string> kKnown = {"status", "axes", "rt", "beat", "fault", "row", "design", "weaver", "knots"};
+    static const std::set<std::string> kKnown = {"status", "axes",   "rt",     "beat", "fault",
+                                                 "row",    "design", "weaver", "knots"};
     if (kKnown.count(c) == 0) {
-      return usage_error("--channel '" + c + "' is not one of status, axes, rt, beat, fault, row, design, weaver, knots");
+      return usage_error("--channel '" + c +
+                         "' is not one of status, axes, rt, beat, fault, row, design, weaver, knots");
     }
     raw.insert(c);
   }
@@ -210,7 +230,9 @@ int main(int argc, char** argv) {
   // LCM keeps 30 unhandled messages per subscription by default; a log replayed fast or a burst of
   // row-end changes can exceed that, so allow a generous queue.
   constexpr int kQueue = 10000;
-  const auto re = [&](const char* kind) { return loom::telemetry::channel_regex(o.channel_prefix, o.loom_id, kind); };
+  const auto re = [&](const char* kind) {
+    return loom::telemetry::channel_regex(o.channel_prefix, o.loom_id, kind);
+  };
   const auto wanted = [&](const char* kind, bool in_view) {
     return event_view ? in_view : raw.count(kind) != 0;
   };

@@ -28,19 +28,14 @@ std::string hex(std::int64_t code) {
 }
 
 json status_json(const loomlcm::status_t& m) {
-  json j = {{"tick", m.tick},
-            {"time_s", num(m.time_s)},
-            {"state", m.state},
-            {"row", m.row},
-            {"rows_done", m.rows_done},
-            {"rows_target", m.rows_target},
-            {"picks", m.pick},
-            {"beats", m.beat},
-            {"beats_per_row", m.beats_per_row}};
+  json j = {{"tick", m.tick},  {"time_s", num(m.time_s)},  {"state", m.state},
+            {"row", m.row},    {"rows_done", m.rows_done}, {"rows_target", m.rows_target},
+            {"picks", m.pick}, {"beats", m.beat},          {"beats_per_row", m.beats_per_row}};
   if (!m.first_fault.empty()) {
-    j["fault"] = {{"name", m.first_fault}, {"code", hex(m.first_fault_code)},  {"axis", m.fault_axis},
-                  {"device_code", hex(m.fault_device_code)}, {"text", m.fault_text},
-                  {"time_s", num(m.fault_time_s)}, {"stopped_by", m.stopped_by}};
+    j["fault"] = {{"name", m.first_fault},     {"code", hex(m.first_fault_code)},
+                  {"axis", m.fault_axis},      {"device_code", hex(m.fault_device_code)},
+                  {"text", m.fault_text},      {"time_s", num(m.fault_time_s)},
+                  {"stopped_by", m.stopped_by}};
   } else {
     j["fault"] = nullptr;
   }
@@ -84,10 +79,18 @@ json rt_json(const loomlcm::rt_stats_t& m) {
 }
 
 json row_json(const loomlcm::row_t& m) {
-  json j = {{"row", m.row},       {"time_s", num(m.row_s)}, {"shed_s", num(m.shed_s)}, {"pick_s", num(m.pick_s)},
-            {"beat_s", num(m.beat_s)}, {"knotting_s", num(m.knotting_s)}, {"knot_s", num(m.knot_s)},
-            {"weaver_s", num(m.weaver_s)}, {"knots_tied", m.knots_tied}, {"knots_retried", m.knots_retried},
-            {"knots_by_hand", m.knots_by_hand}, {"beats", m.beats},
+  json j = {{"row", m.row},
+            {"time_s", num(m.row_s)},
+            {"shed_s", num(m.shed_s)},
+            {"pick_s", num(m.pick_s)},
+            {"beat_s", num(m.beat_s)},
+            {"knotting_s", num(m.knotting_s)},
+            {"knot_s", num(m.knot_s)},
+            {"weaver_s", num(m.weaver_s)},
+            {"knots_tied", m.knots_tied},
+            {"knots_retried", m.knots_retried},
+            {"knots_by_hand", m.knots_by_hand},
+            {"beats", m.beats},
             {"carriage_steps", m.carriage_steps},
             {"beats_in_band", m.beats_in_band}};
   if (m.force_measured) {
@@ -109,29 +112,33 @@ std::string rgb_hex(std::int32_t rgb) {
 json design_json(const loomlcm::design_t& m) {
   json palette = json::array();
   for (int i = 0; i < m.n_colours; ++i) {
-    palette.push_back({{"code", m.code[static_cast<std::size_t>(i)]}, {"name", m.colour_name[static_cast<std::size_t>(i)]},
+    palette.push_back({{"code", m.code[static_cast<std::size_t>(i)]},
+                       {"name", m.colour_name[static_cast<std::size_t>(i)]},
                        {"rgb", rgb_hex(m.rgb[static_cast<std::size_t>(i)])}});
   }
   json rows = json::array();
   for (int r = 0; r < m.n_rows; ++r) {
     json knots = json::array();
-    for (std::int16_t k : m.knots[static_cast<std::size_t>(r)]) knots.push_back(k >= 0 && k < m.n_colours ? json(k) : json(nullptr));
-    rows.push_back({{"row", m.row_number[static_cast<std::size_t>(r)]}, {"next", r == m.next_index}, {"knots", knots}});
+    for (std::int16_t k : m.knots[static_cast<std::size_t>(r)])
+      knots.push_back(k >= 0 && k < m.n_colours ? json(k) : json(nullptr));
+    rows.push_back(
+        {{"row", m.row_number[static_cast<std::size_t>(r)]}, {"next", r == m.next_index}, {"knots", knots}});
   }
-  return {{"name", m.name},           {"width", m.width},   {"height", m.height}, {"rows_done", m.rows_done},
-          {"next_row", m.next_row},   {"repeat", m.repeat}, {"palette", palette}, {"rows", rows}};
+  return {{"name", m.name},         {"width", m.width},   {"height", m.height}, {"rows_done", m.rows_done},
+          {"next_row", m.next_row}, {"repeat", m.repeat}, {"palette", palette}, {"rows", rows}};
 }
 
 json weaver_json(const loomlcm::weaver_request_t& m) {
-  return {{"time_s", num(m.time_s)}, {"number", m.number}, {"ask", m.ask},   {"row", m.row},
-          {"design_row", m.design_row}, {"knot", m.knot}, {"head", m.head}, {"slot", m.slot},
-          {"colour", m.colour}, {"text", m.text}};
+  return {{"time_s", num(m.time_s)},    {"number", m.number}, {"ask", m.ask},   {"row", m.row},
+          {"design_row", m.design_row}, {"knot", m.knot},     {"head", m.head}, {"slot", m.slot},
+          {"colour", m.colour},         {"text", m.text}};
 }
 
 json fault_json(const loomlcm::fault_t& m) {
-  return {{"time_s", num(m.time_s)}, {"utime", m.utime}, {"kind", m.kind},   {"name", m.name},   {"code", hex(m.code)},
-          {"text", m.text},          {"axis", m.axis},   {"device_code", hex(m.device_code)},
-          {"state", m.state},        {"row", m.row},     {"picks", m.pick},  {"beats", m.beat}};
+  return {
+      {"time_s", num(m.time_s)}, {"utime", m.utime}, {"kind", m.kind},  {"name", m.name},
+      {"code", hex(m.code)},     {"text", m.text},   {"axis", m.axis},  {"device_code", hex(m.device_code)},
+      {"state", m.state},        {"row", m.row},     {"picks", m.pick}, {"beats", m.beat}};
 }
 
 }  // namespace
@@ -141,7 +148,8 @@ Hall::Hall(HallLimits limits, std::function<std::int64_t()> wall_now_us)
   if (!wall_now_us_) {
     wall_now_us_ = [] {
       return std::chrono::duration_cast<std::chrono::microseconds>(
-                 std::chrono::system_clock::now().time_since_epoch()).count();
+                 std::chrono::system_clock::now().time_since_epoch())
+          .count();
     };
   }
 }
@@ -179,7 +187,8 @@ void Hall::changed() {
 void Hall::on_status(const loomlcm::status_t& m) {
   std::lock_guard lock(mu_);
   if (Loom* l = loom(m.loom_id, m.utime)) {
-    if (l->status && m.tick < l->status->tick) {  // the loop restarted: what was kept belongs to the previous run
+    if (l->status &&
+        m.tick < l->status->tick) {  // the loop restarted: what was kept belongs to the previous run
       const Loom keep = *l;
       *l = Loom{};
       l->heard = keep.heard;
@@ -305,8 +314,8 @@ json Hall::knots_json(const loomlcm::knots_t& m) const {
   const auto count = [](std::int64_t n, std::size_t have, std::size_t cap) {
     return std::min<std::size_t>({n > 0 ? static_cast<std::size_t>(n) : 0, have, cap});
   };
-  const std::size_t heads = count(m.heads, std::min({m.head_knot.size(), m.head_slot.size(), m.head_colour.size(),
-                                                     m.stock.size()}), 12);
+  const std::size_t heads = count(
+      m.heads, std::min({m.head_knot.size(), m.head_slot.size(), m.head_colour.size(), m.stock.size()}), 12);
   const std::size_t slots = count(m.slots, m.slot_colour.size(), 16);
   const std::size_t knots = count(m.knots_per_row, m.knot_slot.size(), limits_.knots_per_row);
   json slot_colours = json::array();
@@ -320,19 +329,40 @@ json Hall::knots_json(const loomlcm::knots_t& m) const {
   for (std::size_t h = 0; h < heads; ++h) {
     json stock = json::array();
     for (std::size_t s = 0; s < slots && s < m.stock[h].size(); ++s) stock.push_back(m.stock[h][s]);
-    hs.push_back({{"head", h}, {"knot", m.head_knot[h]}, {"slot", m.head_slot[h]}, {"colour", m.head_colour[h]},
+    hs.push_back({{"head", h},
+                  {"knot", m.head_knot[h]},
+                  {"slot", m.head_slot[h]},
+                  {"colour", m.head_colour[h]},
                   {"stock", stock}});
   }
   json ask = m.ask.empty() ? json(nullptr)
-                           : json{{"ask", m.ask}, {"knot", m.ask_knot}, {"head", m.ask_head}, {"slot", m.ask_slot},
+                           : json{{"ask", m.ask},
+                                  {"knot", m.ask_knot},
+                                  {"head", m.ask_head},
+                                  {"slot", m.ask_slot},
                                   {"text", m.ask_text}};
-  return {{"time_s", num(m.time_s)},     {"state", m.state},           {"knotting", m.knotting != 0},
-          {"row", m.row},                {"design_row", m.design_row}, {"heads", hs},
-          {"stripe", m.stripe},          {"knots_per_row", m.knots_per_row}, {"cut", knots < static_cast<std::size_t>(std::max<int>(m.knots_per_row, 0))},
-          {"knots_per_slot", m.knots_per_slot}, {"cycle", m.cycle}, {"cycles_done", m.cycles_done},
-          {"tied", m.tied},              {"retried", m.retried},       {"by_hand", m.by_hand},
-          {"row_tied", m.row_tied},      {"row_retried", m.row_retried}, {"row_by_hand", m.row_by_hand},
-          {"requests", m.requests},      {"slot_colours", slot_colours}, {"row_slots", row}, {"request", ask}};
+  return {{"time_s", num(m.time_s)},
+          {"state", m.state},
+          {"knotting", m.knotting != 0},
+          {"row", m.row},
+          {"design_row", m.design_row},
+          {"heads", hs},
+          {"stripe", m.stripe},
+          {"knots_per_row", m.knots_per_row},
+          {"cut", knots < static_cast<std::size_t>(std::max<int>(m.knots_per_row, 0))},
+          {"knots_per_slot", m.knots_per_slot},
+          {"cycle", m.cycle},
+          {"cycles_done", m.cycles_done},
+          {"tied", m.tied},
+          {"retried", m.retried},
+          {"by_hand", m.by_hand},
+          {"row_tied", m.row_tied},
+          {"row_retried", m.row_retried},
+          {"row_by_hand", m.row_by_hand},
+          {"requests", m.requests},
+          {"slot_colours", slot_colours},
+          {"row_slots", row},
+          {"request", ask}};
 }
 
 json Hall::summary(const std::string& id, const Loom& l, Clock::time_point now) {
@@ -346,7 +376,9 @@ json Hall::summary(const std::string& id, const Loom& l, Clock::time_point now) 
             {"faults_seen", l.faults_seen}};
   j["status"] = l.status ? status_json(*l.status) : json(nullptr);
   j["last_row"] = l.rows.empty() ? json(nullptr) : row_json(l.rows.back());
-  j["design"] = l.design ? json{{"name", l.design->name}, {"next_row", l.design->next_row}, {"height", l.design->height},
+  j["design"] = l.design ? json{{"name", l.design->name},
+                                {"next_row", l.design->next_row},
+                                {"height", l.design->height},
                                 {"repeat", l.design->repeat}}
                          : json(nullptr);
   return j;
@@ -373,8 +405,10 @@ std::optional<json> Hall::loom_json(const std::string& id) const {
   const auto beats = [](const BeatRow& r) {
     json b = json::array();
     for (const auto& x : r.beats) {
-      b.push_back({{"index", x.index}, {"x_m", num(x.x_m)},
-                   {"force_n", x.measured ? num(x.force_n) : json(nullptr)}, {"in_band", x.in_band}});
+      b.push_back({{"index", x.index},
+                   {"x_m", num(x.x_m)},
+                   {"force_n", x.measured ? num(x.force_n) : json(nullptr)},
+                   {"in_band", x.in_band}});
     }
     return json{{"row", r.row}, {"beats", b}};
   };
@@ -397,7 +431,8 @@ std::optional<json> Hall::loom_json(const std::string& id) const {
 }
 
 namespace {
-// A number for the CSV: fixed notation with 6 decimals (a spreadsheet reads it; no 1e-05), empty when not finite.
+// A number for the CSV: fixed notation with 6 decimals (a spreadsheet reads it; no 1e-05), empty when not
+// finite.
 std::string csv_num(double v) {
   if (!std::isfinite(v)) return "";
   char buf[64];
@@ -420,18 +455,20 @@ std::optional<std::string> Hall::rows_csv(const std::string& id) const {
   const auto it = looms_.find(id);
   if (it == looms_.end()) return std::nullopt;
   std::string out =
-      "utc,loop_time_s,row,row_s,shed_s,pick_s,beat_s,beats,carriage_steps,force_min_n,force_mean_n,force_max_n,"
-      "beats_in_band,band_min_n,band_max_n,knotting_s,knot_s,weaver_s,knots_tied,knots_retried,knots_by_hand\n";
+      "utc,loop_time_s,row,row_s,shed_s,pick_s,beat_s,beats,carriage_steps,force_min_n,force_mean_n,force_"
+      "max_n,"
+      "beats_in_band,band_min_n,band_max_n,knotting_s,knot_s,weaver_s,knots_tied,knots_retried,knots_by_"
+      "hand\n";
   for (const loomlcm::row_t& r : it->second.rows) {
     const bool f = r.force_measured;
-    out += utc_of(r.utime) + "," + csv_num(r.time_s) + "," + std::to_string(r.row) + "," + csv_num(r.row_s) + "," +
-           csv_num(r.shed_s) + "," + csv_num(r.pick_s) + "," + csv_num(r.beat_s) + "," + std::to_string(r.beats) + "," +
-           std::to_string(r.carriage_steps) + "," + (f ? csv_num(r.force_min_n) : "") + "," +
-           (f ? csv_num(r.force_mean_n) : "") + "," + (f ? csv_num(r.force_max_n) : "") + "," +
-           std::to_string(r.beats_in_band) + "," + csv_num(r.band_min_n) + "," + csv_num(r.band_max_n) + "," +
-           csv_num(r.knotting_s) + "," + csv_num(r.knot_s) + "," + csv_num(r.weaver_s) + "," +
-           std::to_string(r.knots_tied) + "," + std::to_string(r.knots_retried) + "," + std::to_string(r.knots_by_hand) +
-           "\n";
+    out += utc_of(r.utime) + "," + csv_num(r.time_s) + "," + std::to_string(r.row) + "," + csv_num(r.row_s) +
+           "," + csv_num(r.shed_s) + "," + csv_num(r.pick_s) + "," + csv_num(r.beat_s) + "," +
+           std::to_string(r.beats) + "," + std::to_string(r.carriage_steps) + "," +
+           (f ? csv_num(r.force_min_n) : "") + "," + (f ? csv_num(r.force_mean_n) : "") + "," +
+           (f ? csv_num(r.force_max_n) : "") + "," + std::to_string(r.beats_in_band) + "," +
+           csv_num(r.band_min_n) + "," + csv_num(r.band_max_n) + "," + csv_num(r.knotting_s) + "," +
+           csv_num(r.knot_s) + "," + csv_num(r.weaver_s) + "," + std::to_string(r.knots_tied) + "," +
+           std::to_string(r.knots_retried) + "," + std::to_string(r.knots_by_hand) + "\n";
   }
   return out;
 }
@@ -452,9 +489,9 @@ std::optional<json> Hall::scope_json(const std::string& id, const std::string& a
       fe.push_back(num(static_cast<double>(s.axes[i][2])));
     }
   }
-  return json{{"loom", id},           {"axis", axis},     {"axes", l.scope_names},
-              {"window_s", num(limits_.scope_window_s)}, {"t", t}, {"position", pos},
-              {"velocity", vel},      {"following_error", fe}};
+  return json{
+      {"loom", id}, {"axis", axis},    {"axes", l.scope_names}, {"window_s", num(limits_.scope_window_s)},
+      {"t", t},     {"position", pos}, {"velocity", vel},       {"following_error", fe}};
 }
 
 std::uint64_t Hall::version() const {

@@ -30,11 +30,11 @@
 namespace loom::panel {
 
 struct HallLimits {
-  std::size_t looms = 256;        // loom ids kept; more are counted as ignored
-  std::size_t rows_kept = 20;     // row summaries per loom in its JSON (the page's table)
-  std::size_t rows_report = 500;  // row summaries per loom for the row report download (rows.csv)
-  std::size_t faults_kept = 50;   // faults per loom
-  std::size_t beats_per_row = 512;  // beats kept per row (the firmware caps a row at 256)
+  std::size_t looms = 256;                // loom ids kept; more are counted as ignored
+  std::size_t rows_kept = 20;             // row summaries per loom in its JSON (the page's table)
+  std::size_t rows_report = 500;          // row summaries per loom for the row report download (rows.csv)
+  std::size_t faults_kept = 50;           // faults per loom
+  std::size_t beats_per_row = 512;        // beats kept per row (the firmware caps a row at 256)
   std::size_t weaver_requests_kept = 20;  // weaver requests per loom (knotting heads)
   std::size_t knots_per_row = 4096;       // knots of a row shown (a wider one is cut, and says so)
   // > 0: a message stamped (utime, the publisher's wall clock) longer ago than this is a recording being
@@ -115,15 +115,15 @@ class Hall {
     double band_min_n = 80.0, band_max_n = 100.0;
     std::deque<loomlcm::row_t> rows;
     std::deque<loomlcm::fault_t> faults;
-    std::optional<loomlcm::design_t> design;  // the weaver's next row (looms weaving a design)
-    std::optional<loomlcm::knots_t> knots;    // the knotting heads' progress (looms with heads)
+    std::optional<loomlcm::design_t> design;       // the weaver's next row (looms weaving a design)
+    std::optional<loomlcm::knots_t> knots;         // the knotting heads' progress (looms with heads)
     std::deque<loomlcm::weaver_request_t> weaver;  // the last requests made of the weaver
     std::uint64_t beats_seen = 0, beats_in_band = 0, faults_seen = 0;
   };
   Loom* loom(const std::string& id);  // nullptr when over the loom limit; caller holds mu_
   // The live loom `id`, or its replay when `utime` is older than the limit; caller holds mu_.
   Loom* loom(const std::string& id, std::int64_t utime);
-  void changed();                      // caller holds mu_
+  void changed();                                                  // caller holds mu_
   void add_scope_sample(Loom& l, const loomlcm::axes_t& m) const;  // caller holds mu_
   static nlohmann::json summary(const std::string& id, const Loom& l, Clock::time_point now);
   nlohmann::json knots_json(const loomlcm::knots_t& m) const;

@@ -18,35 +18,35 @@
 // a client paired with that loom (request_gate.hpp), each sent to that loom's local control socket
 // DIR/<id>.sock (loomctl serve's) tagged with the client's address, the page's device secret and its
 // token, so the loom decides and audits who pressed; never published on LCM. With --tls-cert it serves
-// HTTPS only and the pairing cookie is Secure (README.md: the hall's threat model). Host and Origin are checked, bodies, connections and
-// event streams bounded (README.md). Binds to 127.0.0.1 unless --bind says otherwise (a hall network).
-// A recording replayed onto the group (stamped older than --replay-after-s) is shown apart as
-// <id>~replay, marked, without buttons; it never mixes into the live loom of that id.
-// Exit 2 on bad arguments, 1 when it cannot listen or open LCM.
+// HTTPS only and the pairing cookie is Secure (README.md: the hall's threat model). Host and Origin are
+// checked, bodies, connections and event streams bounded (README.md). Binds to 127.0.0.1 unless --bind says
+// otherwise (a hall network). A recording replayed onto the group (stamped older than --replay-after-s) is
+// shown apart as <id>~replay, marked, without buttons; it never mixes into the live loom of that id. Exit 2
+// on bad arguments, 1 when it cannot listen or open LCM.
 #include <httplib.h>
 #include <sys/stat.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <algorithm>
-#include <map>
-#include <memory>
-#include <mutex>
-#include <vector>
 #include <csignal>
 #include <cstdio>
 #include <lcm/lcm-cpp.hpp>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "fault_history.hpp"
 #include "hall.hpp"
+#include "loom/firmware/serve/control_socket.hpp"
+#include "loom/telemetry/channels.hpp"
 #include "recorder.hpp"
 #include "request_gate.hpp"
 #include "udpm_receiver.hpp"
-#include "loom/firmware/serve/control_socket.hpp"
-#include "loom/telemetry/channels.hpp"
 
 namespace loom::panel {
 extern const char* const kPanelHtml;
@@ -165,7 +165,8 @@ bool controls_for(const PanelOptions& o, const std::string& loom) {
   // A replayed recording has no loom behind it to command.
   if (loom.find('~') != std::string::npos) return false;
   struct stat st {};
-  return !o.control_dir.empty() && ::stat(control_socket_of(o, loom).c_str(), &st) == 0 && S_ISSOCK(st.st_mode);
+  return !o.control_dir.empty() && ::stat(control_socket_of(o, loom).c_str(), &st) == 0 &&
+         S_ISSOCK(st.st_mode);
 }
 
 // Routes one received message by its channel, <prefix>.<loom id>.<KIND>, to the hall. AXES comes at
@@ -189,15 +190,18 @@ class Router {
     if (recorder_.enabled()) {
       recorder_.add(id, channel, data, size,
                     std::chrono::duration_cast<std::chrono::microseconds>(
-                        std::chrono::system_clock::now().time_since_epoch()).count());
+                        std::chrono::system_clock::now().time_since_epoch())
+                        .count());
     }
     const int len = static_cast<int>(size);
     if (kind == "STATUS") {
       decode<loomlcm::status_t>(data, len, [&](const auto& m) { hall_.on_status(m); });
     } else if (kind == "AXES") {
-      const auto now = throttle_axes_ ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
+      const auto now =
+          throttle_axes_ ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
       auto it = last_axes_.find(id);
-      if (it == last_axes_.end()) it = last_axes_.emplace(std::string(id), now - std::chrono::seconds(1)).first;
+      if (it == last_axes_.end())
+        it = last_axes_.emplace(std::string(id), now - std::chrono::seconds(1)).first;
       if (throttle_axes_ && now - it->second < std::chrono::milliseconds(100)) return;
       it->second = now;
       decode<loomlcm::axes_t>(data, len, [&](const auto& m) { hall_.on_axes(m); });
@@ -263,38 +267,50 @@ int main(int argc, char** argv) {
   app.add_option("--port", o.port, "TCP port (0: any free port, printed on start)")
       ->check(CLI::Range(0, 65535))
       ->capture_default_str();
-  app.add_option("--bind", o.bind, "address to listen on (0.0.0.0 for a hall network)")->capture_default_str();
-  app.add_option("--lcm-url", o.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or udpm://239.255.76.67:7667?ttl=0)");
-  app.add_option("--channel-prefix", o.channel_prefix, "first field of the channel names")->capture_default_str();
-  app.add_option("--control-dir", o.control_dir,
-                 "operator buttons: send them to the looms' control sockets DIR/<loom id>.sock (loomctl serve; "
-                 "on a board /run/loomctl). Without it the panel is read-only");
-  app.add_option("--host", o.hosts,
-                 "a name the hall uses for this panel (repeatable); requests naming any other host are refused")
-      ->check([](const std::string& h) { return h.empty() || h.size() > 253 ? std::string("bad host name") : std::string(); });
+  app.add_option("--bind", o.bind, "address to listen on (0.0.0.0 for a hall network)")
+      ->capture_default_str();
+  app.add_option("--lcm-url", o.lcm_url,
+                 "LCM URL (default: $LCM_DEFAULT_URL or udpm://239.255.76.67:7667?ttl=0)");
+  app.add_option("--channel-prefix", o.channel_prefix, "first field of the channel names")
+      ->capture_default_str();
+  app.add_option(
+      "--control-dir", o.control_dir,
+      "operator buttons: send them to the looms' control sockets DIR/<loom id>.sock (loomctl serve; "
+      "on a board /run/loomctl). Without it the panel is read-only");
+  app.add_option(
+         "--host", o.hosts,
+         "a name the hall uses for this panel (repeatable); requests naming any other host are refused")
+      ->check([](const std::string& h) {
+        return h.empty() || h.size() > 253 ? std::string("bad host name") : std::string();
+      });
   app.add_option("--max-streams", o.max_streams, "live pages (event streams) served at once")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
-  app.add_option("--min-push-interval-s", o.min_push_interval_s, "shortest gap between two live updates of a page")
+  app.add_option("--min-push-interval-s", o.min_push_interval_s,
+                 "shortest gap between two live updates of a page")
       ->check(CLI::Range(0.01, 60.0))
       ->capture_default_str();
-  app.add_option("--lcmlog-minutes", o.lcmlog_minutes,
-                 "keep every message of the last this many minutes per loom, downloadable as an lcmlog (0: off)")
+  app.add_option(
+         "--lcmlog-minutes", o.lcmlog_minutes,
+         "keep every message of the last this many minutes per loom, downloadable as an lcmlog (0: off)")
       ->check(CLI::Range(0.0, 60.0))
       ->capture_default_str();
   app.add_option("--lcmlog-mib", o.lcmlog_mib, "memory for those messages, all looms together (MiB)")
       ->check(CLI::Range(1.0, 4096.0))
       ->capture_default_str();
-  auto* cert = app.add_option("--tls-cert", o.tls_cert,
-                               "serve HTTPS with this certificate (PEM; a board's is /etc/loomctl/panel.crt, made at "
-                               "install when the builder gave none); pairing cookies become Secure")
-                   ->check(CLI::ExistingFile);
-  auto* key = app.add_option("--tls-key", o.tls_key, "the private key of --tls-cert (PEM)")->check(CLI::ExistingFile);
+  auto* cert =
+      app.add_option("--tls-cert", o.tls_cert,
+                     "serve HTTPS with this certificate (PEM; a board's is /etc/loomctl/panel.crt, made at "
+                     "install when the builder gave none); pairing cookies become Secure")
+          ->check(CLI::ExistingFile);
+  auto* key =
+      app.add_option("--tls-key", o.tls_key, "the private key of --tls-cert (PEM)")->check(CLI::ExistingFile);
   cert->needs(key);
   key->needs(cert);
-  app.add_option("--replay-after-s", o.replay_after_s,
-                 "a message stamped longer ago than this is a replayed recording: shown apart as <id>~replay and "
-                 "marked REPLAY (0: every message is live)")
+  app.add_option(
+         "--replay-after-s", o.replay_after_s,
+         "a message stamped longer ago than this is a replayed recording: shown apart as <id>~replay and "
+         "marked REPLAY (0: every message is live)")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
   try {
@@ -313,7 +329,8 @@ int main(int argc, char** argv) {
   loom::panel::HallLimits limits;
   limits.replay_after_s = o.replay_after_s;
   Hall hall(limits);
-  loom::panel::Recorder recorder(o.lcmlog_minutes * 60.0, static_cast<std::size_t>(o.lcmlog_mib * 1024 * 1024));
+  loom::panel::Recorder recorder(o.lcmlog_minutes * 60.0,
+                                 static_cast<std::size_t>(o.lcmlog_mib * 1024 * 1024));
   Router router(hall, recorder, o.channel_prefix);
   // udpm (the normal case): the lean batched receiver. Anything else: LCM's own provider.
   std::unique_ptr<loom::panel::UdpmReceiver> udpm;
@@ -341,7 +358,8 @@ int main(int argc, char** argv) {
   if (o.tls()) {
     auto ssl = std::make_unique<httplib::SSLServer>(o.tls_cert.c_str(), o.tls_key.c_str());
     if (!ssl->is_valid()) {
-      std::fprintf(stderr, "loom-panel: --tls-cert %s / --tls-key %s: not a usable certificate and key (PEM)\n",
+      std::fprintf(stderr,
+                   "loom-panel: --tls-cert %s / --tls-key %s: not a usable certificate and key (PEM)\n",
                    o.tls_cert.c_str(), o.tls_key.c_str());
       return 2;
     }
@@ -358,7 +376,8 @@ int main(int argc, char** argv) {
   svr.set_keep_alive_timeout(5);
   svr.set_keep_alive_max_count(100);
   for (std::string& h : o.hosts) {
-    std::transform(h.begin(), h.end(), h.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    std::transform(h.begin(), h.end(), h.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   }
   loom::panel::GateConfig gate{o.bind, o.port, o.hosts};
   // Every request: its Host must name this panel (DNS rebinding); a POST must come from this panel's own
@@ -367,13 +386,15 @@ int main(int argc, char** argv) {
     const auto refuse = [&](int status, const std::string& why) {
       res.status = status;
       res.set_content(loom::panel::json_text({{"error", why}}), "application/json");
-      std::fprintf(stderr, "loom-panel: refused %s %s from %s: %s\n", req.method.c_str(), req.path.substr(0, 80).c_str(),
-                   req.remote_addr.c_str(), why.c_str());
+      std::fprintf(stderr, "loom-panel: refused %s %s from %s: %s\n", req.method.c_str(),
+                   req.path.substr(0, 80).c_str(), req.remote_addr.c_str(), why.c_str());
       return httplib::Server::HandlerResponse::Handled;
     };
-    if (auto why = loom::panel::host_refusal(gate, req.get_header_value("Host")); !why.empty()) return refuse(421, why);
+    if (auto why = loom::panel::host_refusal(gate, req.get_header_value("Host")); !why.empty())
+      return refuse(421, why);
     if (req.method != "GET" && req.method != "HEAD") {
-      if (auto why = loom::panel::origin_refusal(req.get_header_value("Origin"), req.get_header_value("Host"));
+      if (auto why =
+              loom::panel::origin_refusal(req.get_header_value("Origin"), req.get_header_value("Host"));
           !why.empty()) {
         return refuse(403, why);
       }
@@ -394,32 +415,37 @@ int main(int argc, char** argv) {
   svr.Get("/api/hall", [&](const httplib::Request&, httplib::Response& res) {
     res.set_content(loom::panel::json_text(hall.hall_json()), "application/json");
   });
-  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32}(?:~replay)?))", [&](const httplib::Request& req, httplib::Response& res) {
-    const auto j = loom_json(hall, o, req.matches[1]);
-    if (!j) {
-      res.status = 404;
-      res.set_content(loom::panel::json_text({{"error", "loom not heard"}, {"id", std::string(req.matches[1])}}),
-                      "application/json");
-      return;
-    }
-    res.set_content(loom::panel::json_text(*j), "application/json");
-  });
+  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32}(?:~replay)?))",
+          [&](const httplib::Request& req, httplib::Response& res) {
+            const auto j = loom_json(hall, o, req.matches[1]);
+            if (!j) {
+              res.status = 404;
+              res.set_content(
+                  loom::panel::json_text({{"error", "loom not heard"}, {"id", std::string(req.matches[1])}}),
+                  "application/json");
+              return;
+            }
+            res.set_content(loom::panel::json_text(*j), "application/json");
+          });
   // The scope strip of one axis (?axis=NAME; the first axis when none): the last seconds of its position,
   // velocity and following error. The page polls it once a second for the axis the technician picked.
-  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32}(?:~replay)?)/scope)", [&](const httplib::Request& req, httplib::Response& res) {
-    const std::string loom = req.matches[1];
-    res.set_header("Cache-Control", "no-store");
-    std::string axis = req.has_param("axis") ? req.get_param_value("axis") : std::string();
-    if (axis.size() > 64) axis.clear();
-    auto j = hall.scope_json(loom, axis);
-    if (j && axis.empty() && !(*j)["axes"].empty()) j = hall.scope_json(loom, (*j)["axes"][0].get<std::string>());
-    if (!j) {
-      res.status = 404;
-      res.set_content(loom::panel::json_text({{"error", "loom not heard"}, {"id", loom}}), "application/json");
-      return;
-    }
-    res.set_content(loom::panel::json_text(*j), "application/json");
-  });
+  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32}(?:~replay)?)/scope)",
+          [&](const httplib::Request& req, httplib::Response& res) {
+            const std::string loom = req.matches[1];
+            res.set_header("Cache-Control", "no-store");
+            std::string axis = req.has_param("axis") ? req.get_param_value("axis") : std::string();
+            if (axis.size() > 64) axis.clear();
+            auto j = hall.scope_json(loom, axis);
+            if (j && axis.empty() && !(*j)["axes"].empty())
+              j = hall.scope_json(loom, (*j)["axes"][0].get<std::string>());
+            if (!j) {
+              res.status = 404;
+              res.set_content(loom::panel::json_text({{"error", "loom not heard"}, {"id", loom}}),
+                              "application/json");
+              return;
+            }
+            res.set_content(loom::panel::json_text(*j), "application/json");
+          });
   // An operator button, forwarded to the loom on behalf of this client (its address and pairing token):
   // the loom decides and audits. A starting command without a token is refused here and never forwarded.
   svr.Post(R"(/api/loom/([A-Za-z0-9_-]{1,32})/ctl/([a-z]{1,16}))", [&](const httplib::Request& req,
@@ -427,21 +453,28 @@ int main(int argc, char** argv) {
     const std::string loom = req.matches[1], cmd = req.matches[2];
     const auto reply = [&](int status, const std::string& text) {
       res.status = status;
-      res.set_content(loom::panel::json_text({{"loom", loom}, {"command", cmd}, {"reply", text}}), "application/json");
-      std::fprintf(stderr, "loom-panel: %s %s by %s%s -> %s\n", loom.c_str(), cmd.c_str(), req.remote_addr.c_str(),
-                   token_of(req, loom).empty() ? " (not paired)" : " (token)", text.c_str());
+      res.set_content(loom::panel::json_text({{"loom", loom}, {"command", cmd}, {"reply", text}}),
+                      "application/json");
+      std::fprintf(stderr, "loom-panel: %s %s by %s%s -> %s\n", loom.c_str(), cmd.c_str(),
+                   req.remote_addr.c_str(), token_of(req, loom).empty() ? " (not paired)" : " (token)",
+                   text.c_str());
     };
-    if (o.control_dir.empty()) return reply(403, "read-only panel (start it with --control-dir to offer buttons)");
+    if (o.control_dir.empty())
+      return reply(403, "read-only panel (start it with --control-dir to offer buttons)");
     const auto cls = loom::panel::panel_command(cmd);
-    if (cls == loom::panel::PanelCommand::kUnknown) return reply(400, "unknown command (pause, stop, resume, ack, next)");
+    if (cls == loom::panel::PanelCommand::kUnknown)
+      return reply(400, "unknown command (pause, stop, resume, ack, next)");
     const std::string token = token_of(req, loom);
     if (cls == loom::panel::PanelCommand::kStarting && token.empty()) {
-      return reply(403, "refused: " + cmd + ": this device is not paired with loom " + loom +
-                            " (a command that starts motion or resets a fault needs pairing: ctl pair NAME at the loom)");
+      return reply(
+          403,
+          "refused: " + cmd + ": this device is not paired with loom " + loom +
+              " (a command that starts motion or resets a fault needs pairing: ctl pair NAME at the loom)");
     }
     std::string text;
     try {
-      text = trimmed(loom::firmware::serve::control_request(control_socket_of(o, loom), on_behalf(cmd, req, token), 3000));
+      text = trimmed(loom::firmware::serve::control_request(control_socket_of(o, loom),
+                                                            on_behalf(cmd, req, token), 3000));
     } catch (const std::exception& e) {
       return reply(503, e.what());
     }
@@ -449,121 +482,137 @@ int main(int argc, char** argv) {
   });
   // Pairing: the code shown at the loom (`loomctl ctl pair NAME`) becomes this client's token, kept in an
   // HttpOnly, SameSite=Strict cookie for that loom only.
-  svr.Post(R"(/api/loom/([A-Za-z0-9_-]{1,32})/pair)", [&](const httplib::Request& req, httplib::Response& res) {
-    const std::string loom = req.matches[1];
-    std::string code = req.has_param("code") ? req.get_param_value("code") : req.body;
-    code = trimmed(code);
-    const auto reply = [&](int status, const std::string& text) {
-      res.status = status;
-      res.set_content(loom::panel::json_text({{"loom", loom}, {"reply", text}}), "application/json");
-      std::fprintf(stderr, "loom-panel: %s pair by %s -> %s\n", loom.c_str(), req.remote_addr.c_str(), text.c_str());
-    };
-    if (o.control_dir.empty()) return reply(403, "read-only panel");
-    if (code.empty() || code.size() > 8 || code.find_first_not_of("0123456789") != std::string::npos) {
-      return reply(400, "a pairing code is the digits `loomctl ctl pair NAME` printed at the loom");
-    }
-    std::string text;
-    try {
-      text = trimmed(loom::firmware::serve::control_request(control_socket_of(o, loom),
-                                                            on_behalf("redeem", req, "") + " code=" + code, 3000));
-    } catch (const std::exception& e) {
-      return reply(503, e.what());
-    }
-    if (text.rfind("ok redeem ", 0) != 0) return reply(403, text);
-    const std::string token = reply_field(text, "token");
-    if (!loom::panel::token_shape(token)) return reply(502, "the loom's reply carried no token");
-    // The cookie lasts as long as the pairing (the loom's valid_s), not a fixed week.
-    const std::string valid = reply_field(text, "valid_s");
-    if (valid.empty() || valid.size() > 9 || valid.find_first_not_of("0123456789") != std::string::npos) {
-      return reply(502, "the loom's reply carried no validity");
-    }
-    res.set_header("Set-Cookie", loom::panel::token_cookie(loom, token, std::stoll(valid), o.tls()));
-    const std::string name = text.substr(10, text.find(' ', 10) - 10);
-    reply(200, "paired as " + name + " until " + reply_field(text, "expires"));
-  });
-  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32})/authority)", [&](const httplib::Request& req, httplib::Response& res) {
-    const std::string loom = req.matches[1];
-    res.set_header("Cache-Control", "no-store");
-    const std::string token = token_of(req, loom);
-    std::string text = "not paired";
-    bool may_start = false;
-    if (!o.control_dir.empty() && !token.empty()) {
-      try {
-        text = trimmed(loom::firmware::serve::control_request(control_socket_of(o, loom), on_behalf("whoami", req, token), 3000));
-        may_start = text.rfind("ok whoami paired ", 0) == 0;
-      } catch (const std::exception& e) {
-        text = e.what();
-      }
-    }
-    res.set_content(loom::panel::json_text({{"loom", loom}, {"may_start", may_start}, {"client", req.remote_addr}, {"reply", text}}),
-                    "application/json");
-  });
+  svr.Post(
+      R"(/api/loom/([A-Za-z0-9_-]{1,32})/pair)", [&](const httplib::Request& req, httplib::Response& res) {
+        const std::string loom = req.matches[1];
+        std::string code = req.has_param("code") ? req.get_param_value("code") : req.body;
+        code = trimmed(code);
+        const auto reply = [&](int status, const std::string& text) {
+          res.status = status;
+          res.set_content(loom::panel::json_text({{"loom", loom}, {"reply", text}}), "application/json");
+          std::fprintf(stderr, "loom-panel: %s pair by %s -> %s\n", loom.c_str(), req.remote_addr.c_str(),
+                       text.c_str());
+        };
+        if (o.control_dir.empty()) return reply(403, "read-only panel");
+        if (code.empty() || code.size() > 8 || code.find_first_not_of("0123456789") != std::string::npos) {
+          return reply(400, "a pairing code is the digits `loomctl ctl pair NAME` printed at the loom");
+        }
+        std::string text;
+        try {
+          text = trimmed(loom::firmware::serve::control_request(
+              control_socket_of(o, loom), on_behalf("redeem", req, "") + " code=" + code, 3000));
+        } catch (const std::exception& e) {
+          return reply(503, e.what());
+        }
+        if (text.rfind("ok redeem ", 0) != 0) return reply(403, text);
+        const std::string token = reply_field(text, "token");
+        if (!loom::panel::token_shape(token)) return reply(502, "the loom's reply carried no token");
+        // The cookie lasts as long as the pairing (the loom's valid_s), not a fixed week.
+        const std::string valid = reply_field(text, "valid_s");
+        if (valid.empty() || valid.size() > 9 || valid.find_first_not_of("0123456789") != std::string::npos) {
+          return reply(502, "the loom's reply carried no validity");
+        }
+        res.set_header("Set-Cookie", loom::panel::token_cookie(loom, token, std::stoll(valid), o.tls()));
+        const std::string name = text.substr(10, text.find(' ', 10) - 10);
+        reply(200, "paired as " + name + " until " + reply_field(text, "expires"));
+      });
+  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32})/authority)",
+          [&](const httplib::Request& req, httplib::Response& res) {
+            const std::string loom = req.matches[1];
+            res.set_header("Cache-Control", "no-store");
+            const std::string token = token_of(req, loom);
+            std::string text = "not paired";
+            bool may_start = false;
+            if (!o.control_dir.empty() && !token.empty()) {
+              try {
+                text = trimmed(loom::firmware::serve::control_request(control_socket_of(o, loom),
+                                                                      on_behalf("whoami", req, token), 3000));
+                may_start = text.rfind("ok whoami paired ", 0) == 0;
+              } catch (const std::exception& e) {
+                text = e.what();
+              }
+            }
+            res.set_content(
+                loom::panel::json_text(
+                    {{"loom", loom}, {"may_start", may_start}, {"client", req.remote_addr}, {"reply", text}}),
+                "application/json");
+          });
   // The flight recorder's last minutes of one loom, as an lcmlog to replay (loom-replay) or open in lcm-spy.
-  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32})/last\.lcmlog)", [&](const httplib::Request& req, httplib::Response& res) {
-    const std::string loom = req.matches[1];
-    res.set_header("Cache-Control", "no-store");
-    const auto log = recorder.lcmlog(loom, std::chrono::duration_cast<std::chrono::microseconds>(
-                                               std::chrono::system_clock::now().time_since_epoch()).count());
-    if (!log) {
-      res.status = 404;
-      res.set_content(recorder.enabled() ? "nothing of loom " + loom + " heard in the last minutes\n"
-                                         : std::string("the recorder is off (--lcmlog-minutes 0)\n"),
-                      "text/plain; charset=utf-8");
-      return;
-    }
-    res.set_header("Content-Disposition", "attachment; filename=\"" + loom + "-last.lcmlog\"");
-    res.set_content(*log, "application/octet-stream");
-  });
+  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32})/last\.lcmlog)",
+          [&](const httplib::Request& req, httplib::Response& res) {
+            const std::string loom = req.matches[1];
+            res.set_header("Cache-Control", "no-store");
+            const auto log = recorder.lcmlog(loom, std::chrono::duration_cast<std::chrono::microseconds>(
+                                                       std::chrono::system_clock::now().time_since_epoch())
+                                                       .count());
+            if (!log) {
+              res.status = 404;
+              res.set_content(recorder.enabled() ? "nothing of loom " + loom + " heard in the last minutes\n"
+                                                 : std::string("the recorder is off (--lcmlog-minutes 0)\n"),
+                              "text/plain; charset=utf-8");
+              return;
+            }
+            res.set_header("Content-Disposition", "attachment; filename=\"" + loom + "-last.lcmlog\"");
+            res.set_content(*log, "application/octet-stream");
+          });
   // The row report: every row summary the panel kept for this loom (the newest 500) as CSV to download.
-  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32}(?:~replay)?)/rows\.csv)", [&](const httplib::Request& req, httplib::Response& res) {
-    const std::string loom = req.matches[1];
-    res.set_header("Cache-Control", "no-store");
-    const auto csv = hall.rows_csv(loom);
-    if (!csv) {
-      res.status = 404;
-      res.set_content("loom " + loom + " not heard\n", "text/plain; charset=utf-8");
-      return;
-    }
-    res.set_header("Content-Disposition", "attachment; filename=\"" + loom + "-rows.csv\"");
-    res.set_content(*csv, "text/csv; charset=utf-8");
-  });
+  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32}(?:~replay)?)/rows\.csv)",
+          [&](const httplib::Request& req, httplib::Response& res) {
+            const std::string loom = req.matches[1];
+            res.set_header("Cache-Control", "no-store");
+            const auto csv = hall.rows_csv(loom);
+            if (!csv) {
+              res.status = 404;
+              res.set_content("loom " + loom + " not heard\n", "text/plain; charset=utf-8");
+              return;
+            }
+            res.set_header("Content-Disposition", "attachment; filename=\"" + loom + "-rows.csv\"");
+            res.set_content(*csv, "text/csv; charset=utf-8");
+          });
   // The loom's persisted fault history (faults.log, through serve's `faults` request): it survives a
   // restart of the panel, serve or the board, unlike what the panel heard on LCM. A GET: reading only.
-  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32})/history)", [&](const httplib::Request& req, httplib::Response& res) {
-    const std::string loom = req.matches[1];
-    res.set_header("Cache-Control", "no-store");
-    const auto error = [&](int status, const std::string& why) {
-      res.status = status;
-      res.set_content(loom::panel::json_text({{"loom", loom}, {"error", why}}), "application/json");
-    };
-    if (o.control_dir.empty()) {
-      return error(404, "read-only panel: the loom's fault history is read through its control socket (--control-dir)");
-    }
-    std::string text;
-    try {
-      text = loom::firmware::serve::control_request(control_socket_of(o, loom), on_behalf("faults", req, ""), 3000);
-    } catch (const std::exception& e) {
-      return error(503, e.what());
-    }
-    if (text.rfind("error:", 0) == 0 || text.rfind("refused:", 0) == 0) return error(502, trimmed(text));
-    auto j = loom::panel::fault_history_json(text, kHistoryShown);
-    j["loom"] = loom;
-    res.set_content(loom::panel::json_text(j), "application/json");
-  });
+  svr.Get(
+      R"(/api/loom/([A-Za-z0-9_-]{1,32})/history)", [&](const httplib::Request& req, httplib::Response& res) {
+        const std::string loom = req.matches[1];
+        res.set_header("Cache-Control", "no-store");
+        const auto error = [&](int status, const std::string& why) {
+          res.status = status;
+          res.set_content(loom::panel::json_text({{"loom", loom}, {"error", why}}), "application/json");
+        };
+        if (o.control_dir.empty()) {
+          return error(
+              404,
+              "read-only panel: the loom's fault history is read through its control socket (--control-dir)");
+        }
+        std::string text;
+        try {
+          text = loom::firmware::serve::control_request(control_socket_of(o, loom),
+                                                        on_behalf("faults", req, ""), 3000);
+        } catch (const std::exception& e) {
+          return error(503, e.what());
+        }
+        if (text.rfind("error:", 0) == 0 || text.rfind("refused:", 0) == 0) return error(502, trimmed(text));
+        auto j = loom::panel::fault_history_json(text, kHistoryShown);
+        j["loom"] = loom;
+        res.set_content(loom::panel::json_text(j), "application/json");
+      });
   // The whole faults.log as a file for the technician's report (the page offers the link): the same
   // text as `loomctl ctl faults`, through serve's socket.
-  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32})/faults\.log)", [&](const httplib::Request& req, httplib::Response& res) {
+  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32})/faults\.log)", [&](const httplib::Request& req,
+                                                                httplib::Response& res) {
     const std::string loom = req.matches[1];
     res.set_header("Cache-Control", "no-store");
     if (o.control_dir.empty()) {
       res.status = 404;
-      res.set_content("read-only panel: the loom's faults.log is read through its control socket (--control-dir)\n",
-                      "text/plain; charset=utf-8");
+      res.set_content(
+          "read-only panel: the loom's faults.log is read through its control socket (--control-dir)\n",
+          "text/plain; charset=utf-8");
       return;
     }
     std::string text;
     try {
-      text = loom::firmware::serve::control_request(control_socket_of(o, loom), on_behalf("faults", req, ""), 3000);
+      text = loom::firmware::serve::control_request(control_socket_of(o, loom), on_behalf("faults", req, ""),
+                                                    3000);
     } catch (const std::exception& e) {
       res.status = 503;
       res.set_content(std::string(e.what()) + "\n", "text/plain; charset=utf-8");
@@ -580,9 +629,10 @@ int main(int argc, char** argv) {
   StreamSlots slots(o.max_streams, o.max_streams_per_client);
   svr.Get("/events", [&](const httplib::Request& req, httplib::Response& res) {
     const std::string loom = req.has_param("loom") ? req.get_param_value("loom") : std::string();
-    const std::string live_id = loom.size() > 7 && loom.compare(loom.size() - 7, 7, loom::panel::kReplaySuffix) == 0
-                                    ? loom.substr(0, loom.size() - 7)
-                                    : loom;
+    const std::string live_id =
+        loom.size() > 7 && loom.compare(loom.size() - 7, 7, loom::panel::kReplaySuffix) == 0
+            ? loom.substr(0, loom.size() - 7)
+            : loom;
     if (!loom.empty() && !loom::telemetry::loom_id_error(live_id).empty()) {
       res.status = 400;
       res.set_content("bad loom id\n", "text/plain");
@@ -600,24 +650,27 @@ int main(int argc, char** argv) {
     // Each call of the provider sends one event: the current JSON, once it differs from the last sent.
     auto seen = std::make_shared<std::uint64_t>(~std::uint64_t{0});
     const std::string client = req.remote_addr;
-    res.set_chunked_content_provider("text/event-stream", [&hall, &o, loom, gap, seen](std::size_t, httplib::DataSink& sink) {
-      const auto t0 = std::chrono::steady_clock::now();
-      // Wake every second to notice a closed page or a stopping server; a comment keeps proxies awake.
-      for (;;) {
-        if (g_stop.load() || !sink.is_writable()) return false;
-        const std::uint64_t v = hall.wait_for_change(*seen, std::chrono::milliseconds(1000));
-        if (v != *seen) break;
-        if (std::chrono::steady_clock::now() - t0 > std::chrono::seconds(15)) {
-          static const char kKeepAlive[] = ": keep-alive\n\n";
-          return sink.write(kKeepAlive, sizeof kKeepAlive - 1);
-        }
-      }
-      *seen = hall.version();
-      const std::string msg = "data: " + json_for(hall, o, loom) + "\n\n";
-      if (!sink.write(msg.data(), msg.size())) return false;
-      std::this_thread::sleep_for(gap);  // coalesce: a busy loom costs at most one update per gap
-      return true;
-    }, [&slots, client](bool) { slots.give(client); });
+    res.set_chunked_content_provider(
+        "text/event-stream",
+        [&hall, &o, loom, gap, seen](std::size_t, httplib::DataSink& sink) {
+          const auto t0 = std::chrono::steady_clock::now();
+          // Wake every second to notice a closed page or a stopping server; a comment keeps proxies awake.
+          for (;;) {
+            if (g_stop.load() || !sink.is_writable()) return false;
+            const std::uint64_t v = hall.wait_for_change(*seen, std::chrono::milliseconds(1000));
+            if (v != *seen) break;
+            if (std::chrono::steady_clock::now() - t0 > std::chrono::seconds(15)) {
+              static const char kKeepAlive[] = ": keep-alive\n\n";
+              return sink.write(kKeepAlive, sizeof kKeepAlive - 1);
+            }
+          }
+          *seen = hall.version();
+          const std::string msg = "data: " + json_for(hall, o, loom) + "\n\n";
+          if (!sink.write(msg.data(), msg.size())) return false;
+          std::this_thread::sleep_for(gap);  // coalesce: a busy loom costs at most one update per gap
+          return true;
+        },
+        [&slots, client](bool) { slots.give(client); });
   });
 
   int port = o.port;
@@ -639,7 +692,8 @@ int main(int argc, char** argv) {
   sigaction(SIGTERM, &sa, nullptr);
 
   std::thread http([&] { svr.listen_after_bind(); });
-  std::fprintf(stderr, "loom-panel: serving %s://%s:%d/ (%s), LCM %s\n", o.tls() ? "https" : "http", o.bind.c_str(), port,
+  std::fprintf(stderr, "loom-panel: serving %s://%s:%d/ (%s), LCM %s\n", o.tls() ? "https" : "http",
+               o.bind.c_str(), port,
                o.control_dir.empty() ? "read-only" : ("operator buttons via " + o.control_dir).c_str(),
                o.lcm_url.empty() ? "default URL" : o.lcm_url.c_str());
   const auto on_packet = [&](const loom::panel::LcmPacket& p) { router.route(p.channel, p.data, p.size); };

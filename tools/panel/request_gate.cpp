@@ -10,7 +10,8 @@ namespace loom::panel {
 namespace {
 
 std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return s;
 }
 
@@ -29,7 +30,8 @@ bool split_host(const std::string& h, std::string& host, std::string& port) {
     host = h.substr(0, colon);
     port = colon == std::string::npos ? "" : h.substr(colon + 1);
   }
-  return !host.empty() && std::all_of(port.begin(), port.end(), [](unsigned char c) { return std::isdigit(c); });
+  return !host.empty() &&
+         std::all_of(port.begin(), port.end(), [](unsigned char c) { return std::isdigit(c); });
 }
 
 bool ip_literal(const std::string& h) {
@@ -55,7 +57,8 @@ std::string host_refusal(const GateConfig& g, const std::string& host_header) {
   // Bound to every address: any IP literal reaches the panel only through that address; a name (which
   // an attacker's DNS can point anywhere) must be one given with --host.
   if ((bind == "0.0.0.0" || bind == "::" || bind.empty()) && ip_literal(host)) return "";
-  return "Host '" + host_header.substr(0, 80) + "' is not this panel (give the hall's name for it with --host)";
+  return "Host '" + host_header.substr(0, 80) +
+         "' is not this panel (give the hall's name for it with --host)";
 }
 
 std::string origin_refusal(const std::string& origin, const std::string& host_header) {
@@ -84,8 +87,9 @@ bool device_shape(const std::string& s) {
 }
 
 std::string token_cookie(const std::string& loom, const std::string& token, long long valid_s, bool tls) {
-  return "loom_token_" + loom + "=" + token + "; Path=/; HttpOnly; SameSite=Strict; Max-Age=" +
-         std::to_string(valid_s < 0 ? 0 : valid_s) + (tls ? "; Secure" : "");
+  return "loom_token_" + loom + "=" + token +
+         "; Path=/; HttpOnly; SameSite=Strict; Max-Age=" + std::to_string(valid_s < 0 ? 0 : valid_s) +
+         (tls ? "; Secure" : "");
 }
 
 }  // namespace loom::panel

@@ -44,7 +44,8 @@ std::optional<UdpmAddress> parse_udpm_url(const std::string& url_in) {
   }
   a.port = static_cast<std::uint16_t>(port);
   in_addr probe{};
-  if (inet_pton(AF_INET, a.group.c_str(), &probe) != 1 || !IN_MULTICAST(ntohl(probe.s_addr))) return std::nullopt;
+  if (inet_pton(AF_INET, a.group.c_str(), &probe) != 1 || !IN_MULTICAST(ntohl(probe.s_addr)))
+    return std::nullopt;
   return a;
 }
 

@@ -12,7 +12,9 @@
 int main(int argc, char** argv) {
   CLI::App app{"loom-plot — plots of a loomctl run report"};
   std::string summary, out;
-  app.add_option("--summary", summary, "summary.json written by loomctl weave --report")->required()->check(CLI::ExistingFile);
+  app.add_option("--summary", summary, "summary.json written by loomctl weave --report")
+      ->required()
+      ->check(CLI::ExistingFile);
   app.add_option("--out", out, "output directory (default: next to the summary)");
   try {
     app.parse(argc, argv);

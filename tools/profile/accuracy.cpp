@@ -35,9 +35,9 @@ std::vector<std::size_t> default_sizes() {
 
 std::string csv_line(const AccuracyRow& r) {
   char buf[512];
-  std::snprintf(buf, sizeof buf, "%s,%s,%zu,%s,%.6g,%.6g,%.6g,%.6g,%.4g,%.4g,%zu", r.profile.c_str(), r.interp.c_str(),
-                r.table_size, r.precision.c_str(), r.max_pos_err, r.max_vel_err, r.max_acc_err, r.rms_pos_err,
-                r.lookup_ns, r.build_us, r.bytes);
+  std::snprintf(buf, sizeof buf, "%s,%s,%zu,%s,%.6g,%.6g,%.6g,%.6g,%.4g,%.4g,%zu", r.profile.c_str(),
+                r.interp.c_str(), r.table_size, r.precision.c_str(), r.max_pos_err, r.max_vel_err,
+                r.max_acc_err, r.rms_pos_err, r.lookup_ns, r.build_us, r.bytes);
   return buf;
 }
 
@@ -48,7 +48,9 @@ std::vector<AccuracyRow> measure_accuracy(const Catalogue& cat, const AccuracyOp
   std::vector<TimedCase> cases;
 
   for (const ReportProfile& prof : cat.profiles) {
-    if (opt.progress) std::fprintf(stderr, "loom-profile: %s: exact reference at %zu phases\n", prof.name.c_str(), opt.check_points);
+    if (opt.progress)
+      std::fprintf(stderr, "loom-profile: %s: exact reference at %zu phases\n", prof.name.c_str(),
+                   opt.check_points);
     std::vector<std::uint64_t> fracs(opt.check_points);
     std::vector<motion::PhaseExact> truth(opt.check_points);
     for (std::size_t j = 0; j < opt.check_points; ++j) {
@@ -66,7 +68,8 @@ std::vector<AccuracyRow> measure_accuracy(const Catalogue& cat, const AccuracyOp
                        }
                      }});
     for (motion::Precision prec : {motion::Precision::kDouble, motion::Precision::kFloat}) {
-      for (motion::Interp interp : {motion::Interp::kLinear, motion::Interp::kCubic, motion::Interp::kQuintic}) {
+      for (motion::Interp interp :
+           {motion::Interp::kLinear, motion::Interp::kCubic, motion::Interp::kQuintic}) {
         for (std::size_t n : sizes) {
           const motion::TableSpec spec{.size = n, .interp = interp, .precision = prec, .rise = prof.rise};
           // Build time: the best of a few builds (one for the big tables, which take milliseconds).
@@ -90,7 +93,8 @@ std::vector<AccuracyRow> measure_accuracy(const Catalogue& cat, const AccuracyOp
             const double ep = std::abs(s.value - truth[j].value);
             r.max_pos_err = std::max(r.max_pos_err, ep);
             r.max_vel_err = std::max(r.max_vel_err, std::abs(s.d1 - truth[j].d1) * prof.phase_rate);
-            r.max_acc_err = std::max(r.max_acc_err, std::abs(s.d2 - truth[j].d2) * prof.phase_rate * prof.phase_rate);
+            r.max_acc_err =
+                std::max(r.max_acc_err, std::abs(s.d2 - truth[j].d2) * prof.phase_rate * prof.phase_rate);
             sum_sq += ep * ep;
           }
           r.rms_pos_err = std::sqrt(sum_sq / static_cast<double>(fracs.size()));
@@ -109,7 +113,8 @@ std::vector<AccuracyRow> measure_accuracy(const Catalogue& cat, const AccuracyOp
       }
     }
   }
-  if (opt.progress) std::fprintf(stderr, "loom-profile: timing %zu lookups with Google Benchmark\n", cases.size());
+  if (opt.progress)
+    std::fprintf(stderr, "loom-profile: timing %zu lookups with Google Benchmark\n", cases.size());
   const std::vector<double> ns = time_cases(cases, opt.timing);
   for (std::size_t i = 0; i < rows.size(); ++i) rows[i].lookup_ns = ns[i];
   return rows;

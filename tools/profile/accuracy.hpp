@@ -15,7 +15,7 @@ namespace loom::profile {
 
 struct AccuracyRow {
   std::string profile;
-  std::string interp;     // linear, cubic, quintic, or exact (the closed form, no table)
+  std::string interp;  // linear, cubic, quintic, or exact (the closed form, no table)
   std::size_t table_size = 0;
   std::string precision;  // double, float32
   double max_pos_err = 0.0, max_vel_err = 0.0, max_acc_err = 0.0, rms_pos_err = 0.0;
@@ -37,7 +37,8 @@ std::vector<AccuracyRow> measure_accuracy(const Catalogue& cat, const AccuracyOp
 
 // The exact CSV header of the command-line contract.
 inline constexpr const char* kAccuracyHeader =
-    "profile,interp,table_size,precision,max_pos_err,max_vel_err,max_acc_err,rms_pos_err,lookup_ns,build_us,bytes";
+    "profile,interp,table_size,precision,max_pos_err,max_vel_err,max_acc_err,rms_pos_err,lookup_ns,build_us,"
+    "bytes";
 std::string csv_line(const AccuracyRow& r);
 
 }  // namespace loom::profile

@@ -2,12 +2,12 @@
 // form, or a table that is exact to the last bit) sit on the panel's floor so they stay visible.
 #include "chart.hpp"
 
-#include "summary.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+
+#include "summary.hpp"
 
 namespace loom::profile {
 
@@ -35,16 +35,17 @@ std::string marker(double x, double y, const AccuracyRow& r, bool front, bool de
   const char* c = colour(r.interp);
   std::string style = front ? std::string("fill='") + c + "' stroke='#000' stroke-width='0.8'"
                             : std::string("fill='") + c + "' fill-opacity='0.35' stroke='none'";
-  if (!derivatives_ok) style = std::string("fill='white' fill-opacity='0' stroke='") + c + "' stroke-width='1.2'";
+  if (!derivatives_ok)
+    style = std::string("fill='white' fill-opacity='0' stroke='") + c + "' stroke-width='1.2'";
   const double s = front ? 5.0 : 3.5;
   std::string title = "<title>" + r.interp + " " + std::to_string(r.table_size) + " " + r.precision + ": " +
                       fmt("%.3g", r.max_pos_err) + ", " + fmt("%.3g ns", r.lookup_ns) + "</title>";
   if (r.precision == "float32") {
-    return "<path d='M" + fmt("%.1f", x) + "," + fmt("%.1f", y - s) + " l" + fmt("%.1f", s) + "," + fmt("%.1f", 1.8 * s) +
-           " h" + fmt("%.1f", -2 * s) + " z' " + style + ">" + title + "</path>\n";
+    return "<path d='M" + fmt("%.1f", x) + "," + fmt("%.1f", y - s) + " l" + fmt("%.1f", s) + "," +
+           fmt("%.1f", 1.8 * s) + " h" + fmt("%.1f", -2 * s) + " z' " + style + ">" + title + "</path>\n";
   }
-  return "<circle cx='" + fmt("%.1f", x) + "' cy='" + fmt("%.1f", y) + "' r='" + fmt("%.1f", s) + "' " + style + ">" +
-         title + "</circle>\n";
+  return "<circle cx='" + fmt("%.1f", x) + "' cy='" + fmt("%.1f", y) + "' r='" + fmt("%.1f", s) + "' " +
+         style + ">" + title + "</circle>\n";
 }
 
 }  // namespace
@@ -78,16 +79,18 @@ std::string pareto_svg(const Catalogue& cat, const std::vector<AccuracyRow>& row
   // Legend.
   double lx = 20;
   for (const char* i : {"linear", "cubic", "quintic", "exact"}) {
-    svg += "<circle cx='" + fmt("%.0f", lx) + "' cy='20' r='5' fill='" + colour(i) + "'/><text x='" + fmt("%.0f", lx + 9) +
-           "' y='24'>" + i + "</text>\n";
+    svg += "<circle cx='" + fmt("%.0f", lx) + "' cy='20' r='5' fill='" + colour(i) + "'/><text x='" +
+           fmt("%.0f", lx + 9) + "' y='24'>" + i + "</text>\n";
     lx += 90;
   }
   svg += "<circle cx='" + fmt("%.0f", lx) + "' cy='20' r='5' fill='#888'/><text x='" + fmt("%.0f", lx + 9) +
          "' y='24'>double</text>\n";
-  svg += "<path d='M" + fmt("%.0f", lx + 80) + ",15 l5,9 h-10 z' fill='#888'/><text x='" + fmt("%.0f", lx + 89) +
-         "' y='24'>float32</text>\n";
-  svg += "<text x='20' y='42'>joined: Pareto front; hollow: misses the velocity/acceleration bounds; dashed: requirement; "
-         "red ring: default; floor: zero error</text>\n";
+  svg += "<path d='M" + fmt("%.0f", lx + 80) + ",15 l5,9 h-10 z' fill='#888'/><text x='" +
+         fmt("%.0f", lx + 89) + "' y='24'>float32</text>\n";
+  svg +=
+      "<text x='20' y='42'>joined: Pareto front; hollow: misses the velocity/acceleration bounds; dashed: "
+      "requirement; "
+      "red ring: default; floor: zero error</text>\n";
 
   for (int k = 0; k < n; ++k) {
     const ReportProfile& prof = cat.profiles[static_cast<std::size_t>(k)];
@@ -110,31 +113,34 @@ std::string pareto_svg(const Catalogue& cat, const std::vector<AccuracyRow>& row
     const double y0 = std::floor(std::log10(emin)) - 1, y1 = std::max(y0 + 1, std::ceil(std::log10(emax)));
     const double pw = kPanelW - kLeft - kRight, ph = kPanelH - kTop - kBottom;
     const auto X = [&](double ns) { return ox + kLeft + (std::log10(ns) - x0) / (x1 - x0) * pw; };
-    const auto Y = [&](double e) { return oy + kTop + (y1 - std::log10(std::max(e, std::pow(10.0, y0)))) / (y1 - y0) * ph; };
-    svg += "<text x='" + fmt("%.0f", ox + kLeft) + "' y='" + fmt("%.0f", oy + 28) + "' font-weight='bold'>" + prof.name +
-           "</text><text x='" + fmt("%.0f", ox + kLeft + 130) + "' y='" + fmt("%.0f", oy + 28) + "'>" + prof.what + "</text>\n";
-    svg += "<rect x='" + fmt("%.1f", ox + kLeft) + "' y='" + fmt("%.1f", oy + kTop) + "' width='" + fmt("%.1f", pw) +
-           "' height='" + fmt("%.1f", ph) + "' fill='none' stroke='#444'/>\n";
+    const auto Y = [&](double e) {
+      return oy + kTop + (y1 - std::log10(std::max(e, std::pow(10.0, y0)))) / (y1 - y0) * ph;
+    };
+    svg += "<text x='" + fmt("%.0f", ox + kLeft) + "' y='" + fmt("%.0f", oy + 28) + "' font-weight='bold'>" +
+           prof.name + "</text><text x='" + fmt("%.0f", ox + kLeft + 130) + "' y='" + fmt("%.0f", oy + 28) +
+           "'>" + prof.what + "</text>\n";
+    svg += "<rect x='" + fmt("%.1f", ox + kLeft) + "' y='" + fmt("%.1f", oy + kTop) + "' width='" +
+           fmt("%.1f", pw) + "' height='" + fmt("%.1f", ph) + "' fill='none' stroke='#444'/>\n";
     for (double d = x0; d <= x1 + 1e-9; d += 1) {
       for (int m = 1; m <= 9; ++m) {
         const double v = m * std::pow(10.0, d);
         if (std::log10(v) > x1 + 1e-9) break;
         const double x = X(v);
-        svg += "<line x1='" + fmt("%.1f", x) + "' x2='" + fmt("%.1f", x) + "' y1='" + fmt("%.1f", oy + kTop) + "' y2='" +
-               fmt("%.1f", oy + kTop + ph) + "' stroke='#" + (m == 1 ? "ccc" : "eee") + "'/>\n";
+        svg += "<line x1='" + fmt("%.1f", x) + "' x2='" + fmt("%.1f", x) + "' y1='" + fmt("%.1f", oy + kTop) +
+               "' y2='" + fmt("%.1f", oy + kTop + ph) + "' stroke='#" + (m == 1 ? "ccc" : "eee") + "'/>\n";
         if (m == 1 || m == 2 || m == 5) {
-          svg += "<text x='" + fmt("%.1f", x) + "' y='" + fmt("%.1f", oy + kTop + ph + 16) + "' text-anchor='middle'>" +
-                 fmt("%g", v) + "</text>\n";
+          svg += "<text x='" + fmt("%.1f", x) + "' y='" + fmt("%.1f", oy + kTop + ph + 16) +
+                 "' text-anchor='middle'>" + fmt("%g", v) + "</text>\n";
         }
       }
     }
     for (double d = y0; d <= y1 + 1e-9; d += 1) {
       const double y = Y(std::pow(10.0, d));
-      svg += "<line x1='" + fmt("%.1f", ox + kLeft) + "' x2='" + fmt("%.1f", ox + kLeft + pw) + "' y1='" + fmt("%.1f", y) +
-             "' y2='" + fmt("%.1f", y) + "' stroke='#ddd'/>\n";
+      svg += "<line x1='" + fmt("%.1f", ox + kLeft) + "' x2='" + fmt("%.1f", ox + kLeft + pw) + "' y1='" +
+             fmt("%.1f", y) + "' y2='" + fmt("%.1f", y) + "' stroke='#ddd'/>\n";
       if (static_cast<long>(d - y0) % 2 == 0) {
-        svg += "<text x='" + fmt("%.1f", ox + kLeft - 6) + "' y='" + fmt("%.1f", y + 4) + "' text-anchor='end'>1e" +
-               fmt("%.0f", d) + "</text>\n";
+        svg += "<text x='" + fmt("%.1f", ox + kLeft - 6) + "' y='" + fmt("%.1f", y + 4) +
+               "' text-anchor='end'>1e" + fmt("%.0f", d) + "</text>\n";
       }
     }
     svg += "<text x='" + fmt("%.1f", ox + kLeft + pw / 2) + "' y='" + fmt("%.1f", oy + kPanelH - 12) +
@@ -142,11 +148,13 @@ std::string pareto_svg(const Catalogue& cat, const std::vector<AccuracyRow>& row
     svg += "<text transform='translate(" + fmt("%.1f", ox + 16) + "," + fmt("%.1f", oy + kTop + ph / 2) +
            ") rotate(-90)' text-anchor='middle'>max position error (" + prof.unit + ")</text>\n";
     const double ry = Y(prof.requirement);
-    svg += "<line x1='" + fmt("%.1f", ox + kLeft) + "' x2='" + fmt("%.1f", ox + kLeft + pw) + "' y1='" + fmt("%.1f", ry) +
-           "' y2='" + fmt("%.1f", ry) + "' stroke='#d62728' stroke-dasharray='6,4'/>\n";
+    svg += "<line x1='" + fmt("%.1f", ox + kLeft) + "' x2='" + fmt("%.1f", ox + kLeft + pw) + "' y1='" +
+           fmt("%.1f", ry) + "' y2='" + fmt("%.1f", ry) + "' stroke='#d62728' stroke-dasharray='6,4'/>\n";
     const std::vector<const AccuracyRow*> front = pareto_front(mine);
     std::string path;
-    for (const AccuracyRow* r : front) path += (path.empty() ? "M" : " L") + fmt("%.1f", X(r->lookup_ns)) + "," + fmt("%.1f", Y(r->max_pos_err));
+    for (const AccuracyRow* r : front)
+      path +=
+          (path.empty() ? "M" : " L") + fmt("%.1f", X(r->lookup_ns)) + "," + fmt("%.1f", Y(r->max_pos_err));
     const auto ok = [&](const AccuracyRow* r) {
       return r->max_vel_err <= prof.vel_requirement() && r->max_acc_err <= prof.acc_requirement();
     };
@@ -161,7 +169,8 @@ std::string pareto_svg(const Catalogue& cat, const std::vector<AccuracyRow>& row
       svg += "<circle cx='" + fmt("%.1f", X(d->lookup_ns)) + "' cy='" + fmt("%.1f", Y(d->max_pos_err)) +
              "' r='10' fill='none' stroke='#d62728' stroke-width='2'><title>default: " + choice_label(*d) +
              "</title></circle>\n<text x='" + fmt("%.1f", X(d->lookup_ns) + 13) + "' y='" +
-             fmt("%.1f", Y(d->max_pos_err) - 8) + "' fill='#d62728'>default: " + choice_label(*d) + "</text>\n";
+             fmt("%.1f", Y(d->max_pos_err) - 8) + "' fill='#d62728'>default: " + choice_label(*d) +
+             "</text>\n";
     }
   }
   svg += "</svg>\n";

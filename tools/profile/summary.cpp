@@ -18,11 +18,13 @@ std::string g(double v, const char* f = "%.2g") {
 }
 
 std::string kib(std::size_t bytes) {
-  return bytes == 0 ? std::string("0") : bytes < 1024 ? std::to_string(bytes) + " B" : g(static_cast<double>(bytes) / 1024.0, "%.3g") + " KiB";
+  return bytes == 0     ? std::string("0")
+         : bytes < 1024 ? std::to_string(bytes) + " B"
+                        : g(static_cast<double>(bytes) / 1024.0, "%.3g") + " KiB";
 }
 
-const AccuracyRow* find(const std::vector<AccuracyRow>& rows, const std::string& prof, const std::string& interp,
-                        std::size_t n, const std::string& prec) {
+const AccuracyRow* find(const std::vector<AccuracyRow>& rows, const std::string& prof,
+                        const std::string& interp, std::size_t n, const std::string& prec) {
   for (const AccuracyRow& r : rows) {
     if (r.profile == prof && r.interp == interp && r.table_size == n && r.precision == prec) return &r;
   }
@@ -34,14 +36,16 @@ double best_of(int reps, const motion::ProfileSpec& spec) {
   for (int i = 0; i < reps; ++i) {
     const auto t0 = std::chrono::steady_clock::now();
     const motion::ProfileSet set(spec);
-    best = std::min(best, std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count());
+    best = std::min(best,
+                    std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count());
   }
   return best;
 }
 
 }  // namespace
 
-Choice choose_default(const ReportProfile& prof, const std::vector<AccuracyRow>& rows, const std::string& precision) {
+Choice choose_default(const ReportProfile& prof, const std::vector<AccuracyRow>& rows,
+                      const std::string& precision) {
   std::vector<const AccuracyRow*> ok;
   for (const AccuracyRow& r : rows) {
     if (r.profile != prof.name || !std::isfinite(r.lookup_ns)) continue;
@@ -54,7 +58,8 @@ Choice choose_default(const ReportProfile& prof, const std::vector<AccuracyRow>&
   }
   Choice c;
   if (ok.empty()) {
-    c.why = "nothing meets " + g(prof.requirement) + " " + prof.unit + " with its velocity and acceleration bounds";
+    c.why = "nothing meets " + g(prof.requirement) + " " + prof.unit +
+            " with its velocity and acceleration bounds";
     return c;
   }
   // An exact closed form that fits the lookup budget needs no table at all.
@@ -74,18 +79,23 @@ Choice choose_default(const ReportProfile& prof, const std::vector<AccuracyRow>&
   for (const AccuracyRow* r : ok) fastest = std::min(fastest, r->lookup_ns);
   const double as_fast = fastest * 1.1 + 0.3;
   bool margin_exists = false;
-  for (const AccuracyRow* r : ok) margin_exists |= r->lookup_ns <= as_fast && r->max_pos_err <= 0.1 * prof.requirement;
+  for (const AccuracyRow* r : ok)
+    margin_exists |= r->lookup_ns <= as_fast && r->max_pos_err <= 0.1 * prof.requirement;
   for (const AccuracyRow* r : ok) {
     if (r->lookup_ns > as_fast || (margin_exists && r->max_pos_err > 0.1 * prof.requirement)) continue;
-    if (!c.row || r->bytes < c.row->bytes || (r->bytes == c.row->bytes && r->max_acc_err < c.row->max_acc_err)) c.row = r;
+    if (!c.row || r->bytes < c.row->bytes ||
+        (r->bytes == c.row->bytes && r->max_acc_err < c.row->max_acc_err))
+      c.row = r;
   }
-  c.why = "smallest table " + std::string(margin_exists ? "with 10x margin on " : "meeting ") + g(prof.requirement) +
-          " " + prof.unit + " among lookups within 10 % of the fastest qualifying (" + g(fastest, "%.3g") + " ns)";
+  c.why = "smallest table " + std::string(margin_exists ? "with 10x margin on " : "meeting ") +
+          g(prof.requirement) + " " + prof.unit + " among lookups within 10 % of the fastest qualifying (" +
+          g(fastest, "%.3g") + " ns)";
   return c;
 }
 
 std::string choice_label(const AccuracyRow& r) {
-  return r.interp == "exact" ? std::string("closed form") : r.interp + " " + std::to_string(r.table_size) + " " + r.precision;
+  return r.interp == "exact" ? std::string("closed form")
+                             : r.interp + " " + std::to_string(r.table_size) + " " + r.precision;
 }
 
 BuildTimes measure_build_times() {
@@ -100,13 +110,17 @@ BuildTimes measure_build_times() {
   return b;
 }
 
-std::string summary_markdown(const Catalogue& cat, const std::vector<AccuracyRow>& rows, const BuildTimes& build) {
+std::string summary_markdown(const Catalogue& cat, const std::vector<AccuracyRow>& rows,
+                             const BuildTimes& build) {
   std::string md;
   md += "Requirement: max position error as stated; velocity and acceleration errors below " +
         g(ReportProfile::kVelocityShare) + " and " + g(ReportProfile::kAccelerationShare) +
         " of the profile's peaks. Errors are measured at 262,144 phases against the exact kinematics at the "
-        "default crank speed; lookup time is the fastest of three Google Benchmark repetitions, random phase order.\n\n";
-  md += "| profile | default (report's choice) | max pos err | requirement | max vel err | max acc err | lookup | memory | why |\n";
+        "default crank speed; lookup time is the fastest of three Google Benchmark repetitions, random phase "
+        "order.\n\n";
+  md +=
+      "| profile | default (report's choice) | max pos err | requirement | max vel err | max acc err | "
+      "lookup | memory | why |\n";
   md += "|---|---|---|---|---|---|---|---|---|\n";
   for (const ReportProfile& p : cat.profiles) {
     const Choice c = choose_default(p, rows);
@@ -115,9 +129,10 @@ std::string summary_markdown(const Catalogue& cat, const std::vector<AccuracyRow
       continue;
     }
     const AccuracyRow& r = *c.row;
-    md += "| " + p.name + " | " + choice_label(r) + " | " + g(r.max_pos_err) + " " + p.unit + " | " + g(p.requirement) +
-          " " + p.unit + " (vel " + g(p.vel_requirement()) + ", acc " + g(p.acc_requirement()) + ") | " + g(r.max_vel_err) + " " + p.unit + "/s | " + g(r.max_acc_err) + " " + p.unit +
-          "/s² | " + g(r.lookup_ns, "%.3g") + " ns | " + kib(r.bytes) + " | " + c.why + " |\n";
+    md += "| " + p.name + " | " + choice_label(r) + " | " + g(r.max_pos_err) + " " + p.unit + " | " +
+          g(p.requirement) + " " + p.unit + " (vel " + g(p.vel_requirement()) + ", acc " +
+          g(p.acc_requirement()) + ") | " + g(r.max_vel_err) + " " + p.unit + "/s | " + g(r.max_acc_err) +
+          " " + p.unit + "/s² | " + g(r.lookup_ns, "%.3g") + " ns | " + kib(r.bytes) + " | " + c.why + " |\n";
   }
   md += "\nfloat32 against double knots (each the report's choice within that precision):\n\n";
   md += "| profile | double | float32 |\n|---|---|---|\n";
@@ -135,12 +150,13 @@ std::string summary_markdown(const Catalogue& cat, const std::vector<AccuracyRow
     for (const AccuracyRow& r : rows) {
       if (r.profile == p.name && r.precision == "float32") floor_err = std::min(floor_err, r.max_pos_err);
     }
-    md += "| " + p.name + " | " + cells[0] + " | " + cells[1] + " (best float32 error at any size: " + g(floor_err) +
-          " " + p.unit + ") |\n";
+    md += "| " + p.name + " | " + cells[0] + " | " + cells[1] +
+          " (best float32 error at any size: " + g(floor_err) + " " + p.unit + ") |\n";
   }
   if (!cat.profiles.empty()) {
     const ReportProfile& p = cat.profiles.front();
-    md += "\nWhat accuracy costs, " + p.name + " (" + p.unit + "), double knots — max position error / lookup ns:\n\n";
+    md += "\nWhat accuracy costs, " + p.name + " (" + p.unit +
+          "), double knots — max position error / lookup ns:\n\n";
     md += "| interp | 256 | 1024 | 4096 | 16384 | 65536 |\n|---|---|---|---|---|---|\n";
     for (const char* interp : {"linear", "cubic", "quintic"}) {
       md += std::string("| ") + interp + " |";

@@ -32,11 +32,12 @@ struct BuildTimes {
   double constant_us = 0.0;  // default loom, constant crank law: best of 20 builds
   double elliptic_us = 0.0;  // the same with the elliptic law (one more table)
   std::size_t table_bytes = 0;
-  std::string tables;        // "1024-knot cubic double"
+  std::string tables;  // "1024-knot cubic double"
 };
 BuildTimes measure_build_times();
 
 std::string choice_label(const AccuracyRow& r);  // "cubic 1024 double" or "closed form"
-std::string summary_markdown(const Catalogue& cat, const std::vector<AccuracyRow>& rows, const BuildTimes& build);
+std::string summary_markdown(const Catalogue& cat, const std::vector<AccuracyRow>& rows,
+                             const BuildTimes& build);
 
 }  // namespace loom::profile

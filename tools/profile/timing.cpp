@@ -17,7 +17,8 @@ class Collect : public benchmark::BenchmarkReporter {
   void ReportRuns(const std::vector<Run>& runs) override {
     for (const Run& r : runs) {
       if (r.run_type != Run::RT_Iteration || r.error_occurred) continue;
-      double& best = best_.try_emplace(r.run_name.function_name, std::numeric_limits<double>::infinity()).first->second;
+      double& best =
+          best_.try_emplace(r.run_name.function_name, std::numeric_limits<double>::infinity()).first->second;
       best = std::min(best, r.GetAdjustedCPUTime());
     }
   }

@@ -12,8 +12,8 @@
 namespace loom::profile {
 
 struct TimedCase {
-  std::string name;                               // unique
-  std::function<void(benchmark::State&)> body;    // one lookup per iteration
+  std::string name;                             // unique
+  std::function<void(benchmark::State&)> body;  // one lookup per iteration
 };
 
 struct TimingOptions {

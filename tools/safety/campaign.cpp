@@ -46,15 +46,16 @@ sim_hal::Sensor random_switch(std::mt19937_64& rng, std::initializer_list<hal::S
 }
 
 constexpr std::initializer_list<hal::SafetySensor> kAllSensors = {
-    hal::SafetySensor::kPistonAExtended, hal::SafetySensor::kPistonARetracted, hal::SafetySensor::kPistonBExtended,
-    hal::SafetySensor::kPistonBRetracted, hal::SafetySensor::kShuttleAtLeft,   hal::SafetySensor::kShuttleAtRight};
+    hal::SafetySensor::kPistonAExtended, hal::SafetySensor::kPistonARetracted,
+    hal::SafetySensor::kPistonBExtended, hal::SafetySensor::kPistonBRetracted,
+    hal::SafetySensor::kShuttleAtLeft,   hal::SafetySensor::kShuttleAtRight};
 
 // The kinds a loom without knotting heads can suffer (the heads' own faults come last in the enum).
 constexpr int kFaultKindsWithoutHeads = static_cast<int>(InjectedFault::kSelectorJam);
 
 sim_hal::FaultInjection random_fault(std::mt19937_64& rng, sim_hal::SceneSpec& s,
-                                     const std::array<bool, hal::kSafetySensorCount>& second_channel, int heads, int slots,
-                                     std::ostringstream& d) {
+                                     const std::array<bool, hal::kSafetySensorCount>& second_channel,
+                                     int heads, int slots, std::ostringstream& d) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   sim_hal::FaultInjection f;
   const int kinds = heads > 0 ? sim_hal::kInjectedFaultCount : kFaultKindsWithoutHeads;
@@ -68,7 +69,9 @@ sim_hal::FaultInjection random_fault(std::mt19937_64& rng, sim_hal::SceneSpec& s
   f.sensor = random_switch(rng, kAllSensors, second_channel);
   f.stuck_value = u(rng) < 0.5;
   switch (f.kind) {
-    case InjectedFault::kIntermittentSensor: f.duration_s = 0.002 + 0.5 * u(rng); break;
+    case InjectedFault::kIntermittentSensor:
+      f.duration_s = 0.002 + 0.5 * u(rng);
+      break;
     case InjectedFault::kCanFrameLoss:
       f.probability = u(rng) < 0.3 ? 1.0 : 0.05 + 0.95 * u(rng);
       f.duration_s = 0.01 + u(rng);
@@ -77,7 +80,9 @@ sim_hal::FaultInjection random_fault(std::mt19937_64& rng, sim_hal::SceneSpec& s
       f.latency_s = 0.002 + 0.1 * u(rng);
       f.duration_s = 0.05 + 2.0 * u(rng);
       break;
-    case InjectedFault::kEmcy: f.code = static_cast<std::uint16_t>(0x1000 + static_cast<int>(u(rng) * 0xE000)); break;
+    case InjectedFault::kEmcy:
+      f.code = static_cast<std::uint16_t>(0x1000 + static_cast<int>(u(rng) * 0xE000));
+      break;
     case InjectedFault::kEncoderGlitch: {
       const double scale = f.axis == hal::index(hal::CoreAxis::kCarriage) ? 0.1 : 2.0;
       f.jump = (u(rng) < 0.5 ? -1.0 : 1.0) * scale * (0.005 + u(rng));
@@ -89,11 +94,18 @@ sim_hal::FaultInjection random_fault(std::mt19937_64& rng, sim_hal::SceneSpec& s
       if (!s.beat_contact) s.beat_contact = sim_hal::BeatContact{};
       f.load_cell = u(rng) < 0.5 ? sim_hal::LoadCellMode::kNan : sim_hal::LoadCellMode::kLost;
       break;
-    case InjectedFault::kLoopStall: f.ticks = 1 + static_cast<int>(u(rng) * 100); break;
-    case InjectedFault::kPowerCut: f.at_tick = static_cast<hal::Tick>(u(rng) * (heads > 0 ? 30000.0 : 8000.0)); break;
+    case InjectedFault::kLoopStall:
+      f.ticks = 1 + static_cast<int>(u(rng) * 100);
+      break;
+    case InjectedFault::kPowerCut:
+      f.at_tick = static_cast<hal::Tick>(u(rng) * (heads > 0 ? 30000.0 : 8000.0));
+      break;
     case InjectedFault::kSelectorJam:
-    case InjectedFault::kYarnOut: f.at_s = 40.0 * u(rng); break;  // anywhere in the knotting of the first row
-    default: break;
+    case InjectedFault::kYarnOut:
+      f.at_s = 40.0 * u(rng);
+      break;  // anywhere in the knotting of the first row
+    default:
+      break;
   }
   d << sim_hal::injected_fault_name(f.kind);
   if (f.kind == InjectedFault::kPowerCut) {
@@ -106,7 +118,9 @@ sim_hal::FaultInjection random_fault(std::mt19937_64& rng, sim_hal::SceneSpec& s
 }
 
 constexpr double kMotionEpsilon = 1e-6;  // m or rad per tick
-bool moved(double a, double b) { return std::abs(a - b) > kMotionEpsilon; }
+bool moved(double a, double b) {
+  return std::abs(a - b) > kMotionEpsilon;
+}
 bool shed_open(const std::array<double, 2>& p) {
   return (p[0] >= 1.0 && p[1] <= 0.0) || (p[0] <= 0.0 && p[1] >= 1.0);
 }
@@ -114,8 +128,8 @@ bool shed_open(const std::array<double, 2>& p) {
 }  // namespace
 
 sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run,
-                                const std::array<bool, hal::kSafetySensorCount>& second_channel, int heads, int slots,
-                                std::string& description) {
+                                const std::array<bool, hal::kSafetySensorCount>& second_channel, int heads,
+                                int slots, std::string& description) {
   std::mt19937_64 rng(mix(seed ^ mix(run)));
   std::uniform_real_distribution<double> u(0.0, 1.0);
   sim_hal::SceneSpec s;
@@ -153,9 +167,12 @@ sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run,
     std::mt19937_64 wrng(mix(seed ^ mix(run) ^ 0x7E45105Eull));
     if (u(wrng) < 0.5) {
       s.effects.push_back(sim_hal::kEffectWarpTension);
-      s.warp_tension = sim_hal::WarpTension{.centre_ratio = 0.75 + 0.4 * u(wrng), .points = {},
-                                            .drift_per_row = -0.01 + 0.03 * u(wrng), .noise = 0.03 * u(wrng)};
-      d << "warp_tension(" << s.warp_tension->centre_ratio << ", " << s.warp_tension->drift_per_row << "/row) ";
+      s.warp_tension = sim_hal::WarpTension{.centre_ratio = 0.75 + 0.4 * u(wrng),
+                                            .points = {},
+                                            .drift_per_row = -0.01 + 0.03 * u(wrng),
+                                            .noise = 0.03 * u(wrng)};
+      d << "warp_tension(" << s.warp_tension->centre_ratio << ", " << s.warp_tension->drift_per_row
+        << "/row) ";
     }
   }
   if (u(rng) < 0.02) {
@@ -181,7 +198,8 @@ sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run,
     sim_hal::FaultInjection f;
     f.kind = InjectedFault::kStuckSensor;
     f.at_s = 16.0 * u(rng);
-    f.sensor = random_switch(rng, {hal::SafetySensor::kShuttleAtLeft, hal::SafetySensor::kShuttleAtRight}, second_channel);
+    f.sensor = random_switch(rng, {hal::SafetySensor::kShuttleAtLeft, hal::SafetySensor::kShuttleAtRight},
+                             second_channel);
     f.stuck_value = true;
     s.faults.push_back(f);
     d << "slip + stuck " << sim_hal::sensor_name(f.sensor) << " at " << f.at_s << " s";
@@ -202,7 +220,8 @@ sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run,
     const int count = n < 0.15 ? 0 : n < 0.8 ? 1 : 2;
     for (int i = 0; i < count; ++i) s.faults.push_back(random_fault(rng, s, second_channel, heads, slots, d));
     // One power cut per scene.
-    if (count == 2 && s.faults[0].kind == InjectedFault::kPowerCut && s.faults[1].kind == InjectedFault::kPowerCut) {
+    if (count == 2 && s.faults[0].kind == InjectedFault::kPowerCut &&
+        s.faults[1].kind == InjectedFault::kPowerCut) {
       s.faults.pop_back();
     }
     if (count == 0) d << "no fault";
@@ -213,15 +232,20 @@ sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run,
 
 const char* stopping_act_name(StoppingAct::Kind k) {
   switch (k) {
-    case StoppingAct::Kind::kStop: return "stop";
-    case StoppingAct::Kind::kPause: return "pause";
-    case StoppingAct::Kind::kExit: return "exit";
-    case StoppingAct::Kind::kStopNow: return "stop now";
+    case StoppingAct::Kind::kStop:
+      return "stop";
+    case StoppingAct::Kind::kPause:
+      return "pause";
+    case StoppingAct::Kind::kExit:
+      return "exit";
+    case StoppingAct::Kind::kStopNow:
+      return "stop now";
   }
   return "?";
 }
 
-std::vector<StoppingAct> random_stopping_acts(std::uint64_t seed, std::uint64_t run, int heads, std::string& description) {
+std::vector<StoppingAct> random_stopping_acts(std::uint64_t seed, std::uint64_t run, int heads,
+                                              std::string& description) {
   // An independent stream from the scene's (a different mix), so adding acts changed no scene.
   std::mt19937_64 rng(mix(mix(seed ^ 0x5709u) ^ mix(run)));
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -248,7 +272,9 @@ std::vector<StoppingAct> random_stopping_acts(std::uint64_t seed, std::uint64_t 
 }
 
 namespace {
-void note_power_cut(void* flag) { *static_cast<bool*>(flag) = true; }
+void note_power_cut(void* flag) {
+  *static_cast<bool*>(flag) = true;
+}
 
 // Gives `a` as its owner does: the runner's operator policy, or (stop now) the sequencer's safe stop.
 void give(firmware::Machine& m, const StoppingAct& a) {
@@ -259,7 +285,7 @@ void give(firmware::Machine& m, const StoppingAct& a) {
   firmware::PolicyInputs in;
   in.commands = static_cast<std::uint32_t>(a.kind == StoppingAct::Kind::kStop    ? firmware::Command::kStop
                                            : a.kind == StoppingAct::Kind::kPause ? firmware::Command::kPause
-                                                                                  : firmware::Command::kExit);
+                                                                                 : firmware::Command::kExit);
   in.state = m.sequencer().state();
   in.held_session = a.held_session;
   in.estop_ok = m.loop().inputs().io.estop_ok;
@@ -290,7 +316,8 @@ RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& sp
   const double window = cfg.machine.selvedge_sensor_window_m;
   RunOutcome o;
   std::ostringstream why;
-  double carriage = sim.axis(hal::CoreAxis::kCarriage).position, helix = sim.axis(hal::CoreAxis::kHelix).position;
+  double carriage = sim.axis(hal::CoreAxis::kCarriage).position,
+         helix = sim.axis(hal::CoreAxis::kHelix).position;
   double crank = sim.axis(hal::CoreAxis::kBeatCrank).position;
   std::array<double, 2> pistons = sim.pistons();
   // The heads' servos (true positions) and where a gripper is in the warp (the machine's geometry).
@@ -298,7 +325,8 @@ RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& sp
   const auto heads_axes = [&](std::array<double, 2 * hal::kMaxKnottingHeads>& at) {
     for (int h = 0; h < kn.heads; ++h) {
       at[static_cast<std::size_t>(2 * h)] = sim.axis(kn.knotter_axis[static_cast<std::size_t>(h)]).position;
-      at[static_cast<std::size_t>(2 * h + 1)] = sim.axis(kn.selector_axis[static_cast<std::size_t>(h)]).position;
+      at[static_cast<std::size_t>(2 * h + 1)] =
+          sim.axis(kn.selector_axis[static_cast<std::size_t>(h)]).position;
     }
   };
   std::array<double, 2 * hal::kMaxKnottingHeads> head_at{};
@@ -321,14 +349,15 @@ RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& sp
   const hal::Tick max_ticks = kn.heads > 0 ? 200000 : 60000;
   std::size_t next_act = 0;
   hal::Tick standing_ticks = 0;
-  bool stopped = false;        // a stopping command was given and no starting command since
-  bool stood_before = false;   // ... and the loom stood at the end of the last tick
+  bool stopped = false;       // a stopping command was given and no starting command since
+  bool stood_before = false;  // ... and the loom stood at the end of the last tick
   hal::HalOutputs out_before = m.loop().outputs();
   const std::size_t n_axes = m.sequencer().axes().count;
   for (; t < max_ticks; ++t) {
     // A run ends once the loom is done or faulted — or, after a stopping command, once it has stood a while.
     if (m.sequencer().finished() && (fault_at < 0 || t > fault_at + 300)) break;
-    if (stopped && stood_before && next_act >= acts.size() && m.sequencer().state() != sequencer::State::kKnotting &&
+    if (stopped && stood_before && next_act >= acts.size() &&
+        m.sequencer().state() != sequencer::State::kKnotting &&
         m.sequencer().state() != sequencer::State::kAwaitKnotting && standing_ticks > 2000) {
       break;
     }
@@ -348,17 +377,21 @@ RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& sp
     // The campaign owns the loop, as the runner does in a weave: the pedal the simulated weaver presses
     // becomes request_row_knotted() here (the sequencer only reports presses).
     sequencer::apply_presses(m.sequencer());
-    if (m.sequencer().events().has(sequencer::EventKind::kButton)) stopped = false;  // a starting press (the pedal)
+    if (m.sequencer().events().has(sequencer::EventKind::kButton))
+      stopped = false;  // a starting press (the pedal)
     if (stopped && stood_before) {
-      if (const hal::MotionChange mc = hal::motion_started(out_before, m.loop().outputs(), n_axes, kn.heads)) {
-        why << hal::motion_change_name(mc.what) << " (index " << mc.index << ") after a stopping command, the loom "
+      if (const hal::MotionChange mc =
+              hal::motion_started(out_before, m.loop().outputs(), n_axes, kn.heads)) {
+        why << hal::motion_change_name(mc.what) << " (index " << mc.index
+            << ") after a stopping command, the loom "
             << "standing, at tick " << t;
       }
     }
     stood_before = stopped && standing(m.sequencer());
     standing_ticks = stood_before ? standing_ticks + 1 : 0;
     out_before = m.loop().outputs();
-    if (m.sequencer().events().has(sequencer::EventKind::kWeaverRequest)) {  // the simulated weaver answers, as in a weave
+    if (m.sequencer().events().has(
+            sequencer::EventKind::kWeaverRequest)) {  // the simulated weaver answers, as in a weave
       if (m.sequencer().weaver_request().ask != sequencer::WeaverAsk::kNone) {
         firmware::Machine::simulated_weaver_sink(&m, m.sequencer().weaver_request());
       }
@@ -367,7 +400,8 @@ RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& sp
       o.power_cut = true;
       break;
     }
-    const double c2 = sim.axis(hal::CoreAxis::kCarriage).position, h2 = sim.axis(hal::CoreAxis::kHelix).position;
+    const double c2 = sim.axis(hal::CoreAxis::kCarriage).position,
+                 h2 = sim.axis(hal::CoreAxis::kHelix).position;
     const double k2 = sim.axis(hal::CoreAxis::kBeatCrank).position;
     const auto p2 = sim.pistons();
     std::array<double, 2 * hal::kMaxKnottingHeads> head2{};
@@ -379,30 +413,37 @@ RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& sp
       gripper_now |= in_warp(h, head2[k]);
       knotter_moved |= moved(head2[k], head_at[k]);
       head_moved |= moved(head2[k], head_at[k]) || moved(head2[sel], head_at[sel]);
-      if (moved(head2[sel], head_at[sel]) && (holding[static_cast<std::size_t>(h)] || knotter->gripper_closed(h))) selector_with_yarn = h;
+      if (moved(head2[sel], head_at[sel]) &&
+          (holding[static_cast<std::size_t>(h)] || knotter->gripper_closed(h)))
+        selector_with_yarn = h;
     }
     const bool frames_moved = moved(p2[0], pistons[0]) || moved(p2[1], pistons[1]);
     if (!why.str().empty()) {
       // already found (a stopping command's standing loom set moving)
     } else if (gripper_before && gripper_now && (moved(c2, carriage) || moved(k2, crank) || frames_moved)) {
-      why << (moved(c2, carriage) ? "carriage" : moved(k2, crank) ? "beater crank" : "heald frame")
+      why << (moved(c2, carriage) ? "carriage"
+              : moved(k2, crank)  ? "beater crank"
+                                  : "heald frame")
           << " moved while a knotting gripper was in the warp at tick " << t;
     } else if (knotter_moved && warp_before && sim.beater_in_warp()) {
       why << "a knotting servo moved while the beater was in the warp at tick " << t;
     } else if (selector_with_yarn >= 0) {
-      why << "the selector of head " << selector_with_yarn + 1 << " turned while its gripper held yarn at tick " << t;
+      why << "the selector of head " << selector_with_yarn + 1
+          << " turned while its gripper held yarn at tick " << t;
     } else if (fault_at >= 0 && t > fault_at + 1 && head_moved) {
-      why << "a knotting head's axis moved after the fault (" << sequencer::fault_name(m.sequencer().first_fault())
-          << ") at tick " << t;
+      why << "a knotting head's axis moved after the fault ("
+          << sequencer::fault_name(m.sequencer().first_fault()) << ") at tick " << t;
     } else if (moved(c2, carriage) && warp_before && sim.beater_in_warp()) {
       why << "carriage moved " << (c2 - carriage) << " m while the beater was in the warp at tick " << t;
     } else if (moved(h2, helix) && !(shed_before && shed_open(p2))) {
-      why << "pick motion (helix " << (h2 - helix) << " rad) without an open shed (frames " << p2[0] << ", " << p2[1]
-          << ") at tick " << t;
+      why << "pick motion (helix " << (h2 - helix) << " rad) without an open shed (frames " << p2[0] << ", "
+          << p2[1] << ") at tick " << t;
     } else if ((moved(p2[0], pistons[0]) || moved(p2[1], pistons[1])) && shuttle_in_shed) {
       why << "heald frame moved over the shuttle (x = " << x << " m) at tick " << t;
-    } else if (fault_at >= 0 && t > fault_at + 1 && (moved(c2, carriage) || moved(h2, helix) || moved(k2, crank))) {
-      why << "an axis moved after the fault (" << sequencer::fault_name(m.sequencer().first_fault()) << ") at tick " << t;
+    } else if (fault_at >= 0 && t > fault_at + 1 &&
+               (moved(c2, carriage) || moved(h2, helix) || moved(k2, crank))) {
+      why << "an axis moved after the fault (" << sequencer::fault_name(m.sequencer().first_fault())
+          << ") at tick " << t;
     }
     if (!why.str().empty()) {
       o.violated = true;
@@ -423,9 +464,10 @@ RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& sp
         const sim_hal::KnotCell& c = knotter->cell(r, k);
         if (c.ties > 1 || (static_cast<std::uint32_t>(r) < woven && c.ties == 0)) {
           o.violated = true;
-          o.what = "knot " + std::to_string(k + 1) + " of carpet row " + std::to_string(r + 1) +
-                   (c.ties > 1 ? " tied " + std::to_string(c.ties) + " times" : " never tied in a woven row") +
-                   " (first fault " + sequencer::fault_name(m.sequencer().first_fault()) + ")";
+          o.what =
+              "knot " + std::to_string(k + 1) + " of carpet row " + std::to_string(r + 1) +
+              (c.ties > 1 ? " tied " + std::to_string(c.ties) + " times" : " never tied in a woven row") +
+              " (first fault " + sequencer::fault_name(m.sequencer().first_fault()) + ")";
           break;
         }
       }
@@ -465,7 +507,9 @@ CampaignResult run_campaign(const CampaignOptions& opt) {
       result.faulted += o.faulted;
       result.completed += o.completed;
       result.power_cuts += o.power_cut;
-      if (o.violated) result.violations.push_back({run, description, o.what, firmware::scene_to_toml(scene, opt.config_path)});
+      if (o.violated)
+        result.violations.push_back(
+            {run, description, o.what, firmware::scene_to_toml(scene, opt.config_path)});
       if (opt.on_run) opt.on_run(result, o.violated ? &result.violations.back() : nullptr);
     }
   };

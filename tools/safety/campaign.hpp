@@ -34,7 +34,7 @@ namespace loom::safety {
 
 struct RunOutcome {
   bool violated = false;
-  std::string what;     // the violation, with its tick
+  std::string what;  // the violation, with its tick
   bool faulted = false;
   bool completed = false;
   bool power_cut = false;
@@ -48,8 +48,8 @@ struct RunOutcome {
 // `heads` and `slots`: the loom's knotting heads and their magazine slots (0 without heads): the scene then
 // simulates them and draws their faults too.
 sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run,
-                                const std::array<bool, hal::kSafetySensorCount>& second_channel, int heads, int slots,
-                                std::string& description);
+                                const std::array<bool, hal::kSafetySensorCount>& second_channel, int heads,
+                                int slots, std::string& description);
 
 // A stopping command an operator gives at a tick: stop (weave's SIGTERM or the service's ctl/panel stop),
 // pause, exit (the service's SIGTERM), or stop now (a second SIGTERM).
@@ -63,7 +63,8 @@ const char* stopping_act_name(StoppingAct::Kind k);
 
 // The stopping commands of run `run` (none, one or two, at random ticks within the run's usual length),
 // appended to `description`.
-std::vector<StoppingAct> random_stopping_acts(std::uint64_t seed, std::uint64_t run, int heads, std::string& description);
+std::vector<StoppingAct> random_stopping_acts(std::uint64_t seed, std::uint64_t run, int heads,
+                                              std::string& description);
 
 // Weave `rows` rows of `scene` on `cfg`, giving `acts` at their ticks, and check the true state every tick.
 RunOutcome run_one(const firmware::LoomConfig& cfg, const sim_hal::SceneSpec& scene, std::uint32_t rows,

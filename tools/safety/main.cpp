@@ -13,7 +13,9 @@
 
 namespace {
 std::atomic<bool> g_stop{false};
-extern "C" void on_signal(int) { g_stop.store(true); }
+extern "C" void on_signal(int) {
+  g_stop.store(true);
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -21,7 +23,8 @@ int main(int argc, char** argv) {
   loom::safety::CampaignOptions opt;
   std::string out = "safety-violations";
   bool seed_given = false;
-  app.add_option("--runs", opt.runs, "number of random runs")->check(CLI::Range(std::uint64_t{1}, std::uint64_t{100'000'000}));
+  app.add_option("--runs", opt.runs, "number of random runs")
+      ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{100'000'000}));
   app.add_option_function<std::uint64_t>(
       "--seed", [&](const std::uint64_t& s) { opt.seed = s, seed_given = true; },
       "campaign seed (default: from the clock, printed)");
@@ -40,13 +43,16 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (!seed_given) {
-    opt.seed = static_cast<std::uint64_t>(std::chrono::system_clock::now().time_since_epoch().count()) % 1'000'000'007ull;
+    opt.seed = static_cast<std::uint64_t>(std::chrono::system_clock::now().time_since_epoch().count()) %
+               1'000'000'007ull;
   }
   if (!opt.config_path.empty()) opt.config_path = std::filesystem::absolute(opt.config_path).string();
-  std::printf("loom-safety: seed %llu, %llu runs of %u rows, %d threads, loom %s (replay this campaign with --seed %llu)\n",
-              static_cast<unsigned long long>(opt.seed), static_cast<unsigned long long>(opt.runs), opt.rows,
-              opt.threads, opt.config_path.empty() ? "embedded default" : opt.config_path.c_str(),
-              static_cast<unsigned long long>(opt.seed));
+  std::printf(
+      "loom-safety: seed %llu, %llu runs of %u rows, %d threads, loom %s (replay this campaign with --seed "
+      "%llu)\n",
+      static_cast<unsigned long long>(opt.seed), static_cast<unsigned long long>(opt.runs), opt.rows,
+      opt.threads, opt.config_path.empty() ? "embedded default" : opt.config_path.c_str(),
+      static_cast<unsigned long long>(opt.seed));
   std::fflush(stdout);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
@@ -56,7 +62,8 @@ int main(int argc, char** argv) {
   const auto write_scene = [&](const loom::safety::Violation& v) {
     std::error_code ec;
     std::filesystem::create_directories(out, ec);
-    const std::string file = out + "/violation-" + std::to_string(opt.seed) + "-" + std::to_string(v.run) + ".toml";
+    const std::string file =
+        out + "/violation-" + std::to_string(opt.seed) + "-" + std::to_string(v.run) + ".toml";
     std::ofstream f(file);
     f << "# loom-safety seed " << opt.seed << " run " << v.run << ": " << v.description << "\n# " << v.what
       << "\n# replay: loomctl weave --scene " << file << " --rows " << opt.rows << " --no-telemetry\n"
@@ -83,10 +90,14 @@ int main(int argc, char** argv) {
     return 2;
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("runs %llu, violations %zu (%llu ended in a fault, %llu completed, %llu power cuts) in %.1f s, %.0f runs/s\n",
-              static_cast<unsigned long long>(r.runs), r.violations.size(), static_cast<unsigned long long>(r.faulted),
-              static_cast<unsigned long long>(r.completed), static_cast<unsigned long long>(r.power_cuts), wall,
-              static_cast<double>(r.runs) / std::max(wall, 1e-9));
-  if (g_stop.load()) std::printf("loom-safety: interrupted after %llu runs\n", static_cast<unsigned long long>(r.runs));
+  std::printf(
+      "runs %llu, violations %zu (%llu ended in a fault, %llu completed, %llu power cuts) in %.1f s, %.0f "
+      "runs/s\n",
+      static_cast<unsigned long long>(r.runs), r.violations.size(),
+      static_cast<unsigned long long>(r.faulted), static_cast<unsigned long long>(r.completed),
+      static_cast<unsigned long long>(r.power_cuts), wall,
+      static_cast<double>(r.runs) / std::max(wall, 1e-9));
+  if (g_stop.load())
+    std::printf("loom-safety: interrupted after %llu runs\n", static_cast<unsigned long long>(r.runs));
   return r.violations.empty() ? 0 : 1;
 }

@@ -22,7 +22,8 @@ constexpr int kLengthDecimals = 8;
 
 void note_near_special_case(std::ostream& err, double psi_deg, double phi_deg) {
   err << "loom-synth: warning: near special case: phi = " << input_value(phi_deg) << " deg is within "
-      << input_value(motion::deg(motion::kNearSpecialCase_rad)) << " deg of 180 + psi = " << input_value(180.0 + psi_deg)
+      << input_value(motion::deg(motion::kNearSpecialCase_rad))
+      << " deg of 180 + psi = " << input_value(180.0 + psi_deg)
       << " deg: b and c grow like 1/|phi - 180 - psi| towards a limit that depends on the path, not the "
          "case-III linkage (use --phi "
       << input_value(180.0 + psi_deg) << " for that); these lengths are ill-conditioned\n";
@@ -63,11 +64,13 @@ void run_crank_rocker(const CrankRockerArgs& args, std::ostream& out, std::ostre
       continue;
     }
     std::ostringstream row;
-    write_row(row, {f.input(beta_deg), f.length(d.crank, kLengthDecimals), f.length(d.coupler, kLengthDecimals),
-                    f.length(d.rocker, kLengthDecimals), f.angle_deg(motion::deg(d.mu_min_rad))});
+    write_row(row,
+              {f.input(beta_deg), f.length(d.crank, kLengthDecimals), f.length(d.coupler, kLengthDecimals),
+               f.length(d.rocker, kLengthDecimals), f.angle_deg(motion::deg(d.mu_min_rad))});
     rows.push_back(row.str());
     if (d.flags & motion::kDesignChangePoint) {
-      err << "loom-synth: note: beta_deg=" << input_value(beta_deg) << ": beta at a bound, change-point linkage, mu_min = 0\n";
+      err << "loom-synth: note: beta_deg=" << input_value(beta_deg)
+          << ": beta at a bound, change-point linkage, mu_min = 0\n";
     }
     near_special = near_special || (d.flags & motion::kDesignNearSpecialCase) != 0;
   }

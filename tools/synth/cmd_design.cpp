@@ -6,9 +6,9 @@
 
 #include "commands.hpp"
 #include "loom/motion/angles.hpp"
+#include "loom/motion/design/synthesis.hpp"
 #include "loom/motion/fourbar.hpp"
 #include "loom/motion/slider_crank.hpp"
-#include "loom/motion/design/synthesis.hpp"
 
 namespace loom::synth {
 
@@ -43,10 +43,9 @@ void design_slider_crank(const DesignArgs& args, std::ostream& out, std::ostream
   const CsvFormat f(args.full_precision);
   // The row is formatted before anything is printed: a value that is not finite prints nothing.
   std::ostringstream row;
-  write_row(row, {"slider-crank", f.input(args.phi_deg), f.length(dc.stroke),
-                  f.length(d.mechanism.crank), f.length(d.mechanism.coupler),
-                  f.length(d.mechanism.offset), f.ratio(d.lambda), f.angle_deg(deg(d.mu_min_rad)),
-                  change_point ? "change-point" : "crank-slider",
+  write_row(row, {"slider-crank", f.input(args.phi_deg), f.length(dc.stroke), f.length(d.mechanism.crank),
+                  f.length(d.mechanism.coupler), f.length(d.mechanism.offset), f.ratio(d.lambda),
+                  f.angle_deg(deg(d.mu_min_rad)), change_point ? "change-point" : "crank-slider",
                   f.angle_deg(deg(dc.theta_extended_rad)), f.angle_deg(deg(dc.theta_folded_rad)),
                   f.length(dc.x_extended), f.length(dc.x_folded)});
   out << "mechanism,phi_deg,stroke,a,b,c,lambda,mu_min_deg,grashof,crank_extended_deg,"
@@ -73,13 +72,11 @@ void design_crank_rocker(const DesignArgs& args, std::ostream& out, std::ostream
         [&] { return motion::khare_dave_beta_bounds(psi, phi); });
   motion::CrankRockerDesign d;
   if (args.has_beta) {
-    d = blame("--beta " + input_value(args.beta_deg), [&] {
-      return motion::khare_dave_crank_rocker(psi, phi, rad(args.beta_deg), args.ground);
-    });
+    d = blame("--beta " + input_value(args.beta_deg),
+              [&] { return motion::khare_dave_crank_rocker(psi, phi, rad(args.beta_deg), args.ground); });
   } else if (args.has_lambda) {
-    d = blame("--lambda " + input_value(args.lambda), [&] {
-      return motion::khare_dave_for_ratio(psi, phi, args.lambda, args.ground);
-    });
+    d = blame("--lambda " + input_value(args.lambda),
+              [&] { return motion::khare_dave_for_ratio(psi, phi, args.lambda, args.ground); });
   } else {
     d = blame("--phi " + input_value(args.phi_deg) + " (give --beta or --lambda)",
               [&] { return motion::khare_dave_best_beta(psi, phi, args.ground); });
@@ -89,9 +86,8 @@ void design_crank_rocker(const DesignArgs& args, std::ostream& out, std::ostream
   const double lambda = d.coupler > 0.0 ? d.crank / d.coupler : 0.0;
   std::ostringstream row;
   write_row(row, {"crank-rocker", f.input(args.swing_deg), f.input(args.phi_deg),
-                  f.angle_deg(deg(d.beta_rad)), f.length(d.crank), f.length(d.coupler),
-                  f.length(d.rocker), f.length(d.ground), f.ratio(lambda),
-                  f.angle_deg(deg(d.mu_min_rad)), grashof_name(d),
+                  f.angle_deg(deg(d.beta_rad)), f.length(d.crank), f.length(d.coupler), f.length(d.rocker),
+                  f.length(d.ground), f.ratio(lambda), f.angle_deg(deg(d.mu_min_rad)), grashof_name(d),
                   f.angle_deg(deg(d.crank_extended_rad)), f.angle_deg(deg(d.crank_folded_rad)),
                   f.angle_deg(deg(d.rocker_extended_rad)), f.angle_deg(deg(d.rocker_folded_rad))});
   out << "mechanism,psi_deg,phi_deg,beta_deg,a,b,c,d,lambda,mu_min_deg,grashof,crank_extended_deg,"

@@ -31,11 +31,14 @@ using motion::ThreePointSolution;
 // The seed's coupler (link 2 with holder and gripper): mass, I_G, cg 13.337 mm from the gripper.
 constexpr double kCouplerMassKg = 1.641e-3, kCouplerInertia = 208.94e-9, kCouplerCgFromGripper_m = 0.013337;
 
-motion::KnotLinkSpec side_link(double length_m) { return motion::delrin_link(length_m); }  // seed 001's Delrin links
+motion::KnotLinkSpec side_link(double length_m) {
+  return motion::delrin_link(length_m);
+}  // seed 001's Delrin links
 
 // The four-bar from the driven chain d and the other chain o (lengths in mm from the synthesis).
-KnotCycleSpec linkage_from(const std::array<motion::PrecisionPoint, 3>& pts, double theta0, const ThreePointSolution& d,
-                           const ThreePointSolution& o, const KnotCycleSpec& base) {
+KnotCycleSpec linkage_from(const std::array<motion::PrecisionPoint, 3>& pts, double theta0,
+                           const ThreePointSolution& d, const ThreePointSolution& o,
+                           const KnotCycleSpec& base) {
   KnotCycleSpec s = base;
   const double mm = 1e-3;
   for (std::size_t i = 0; i < 3; ++i) s.points[i] = {pts[i].x * mm, pts[i].y * mm, pts[i].theta2_rad};
@@ -46,7 +49,8 @@ KnotCycleSpec linkage_from(const std::array<motion::PrecisionPoint, 3>& pts, dou
   s.rocker_pivot_y_m = o.a0 * mm * std::sin(theta0);
   s.crank = side_link(d.a1 * mm);
   s.rocker = side_link(o.a1 * mm);
-  // Coupler frame: origin O2_d, x towards O2_o = sign(a2_d − a2_o)·u(θ2); the gripper is a2_d·u(θ2) from O2_d.
+  // Coupler frame: origin O2_d, x towards O2_o = sign(a2_d − a2_o)·u(θ2); the gripper is a2_d·u(θ2) from
+  // O2_d.
   const double sign = d.a2 - o.a2 >= 0.0 ? 1.0 : -1.0;
   const double coupler = std::fabs(d.a2 - o.a2) * mm;
   s.gripper_along_m = sign * d.a2 * mm;
@@ -60,7 +64,8 @@ KnotCycleSpec linkage_from(const std::array<motion::PrecisionPoint, 3>& pts, dou
   const double t2 = pts[0].theta2_rad;
   const double ax = pts[0].x * mm - d.a2 * mm * std::cos(t2), ay = pts[0].y * mm - d.a2 * mm * std::sin(t2);
   const double bx = pts[0].x * mm - o.a2 * mm * std::cos(t2), by = pts[0].y * mm - o.a2 * mm * std::sin(t2);
-  s.branch = motion::branch_of(std::atan2(by - ay, bx - ax), std::atan2(by - s.rocker_pivot_y_m, bx - s.rocker_pivot_x_m));
+  s.branch = motion::branch_of(std::atan2(by - ay, bx - ax),
+                               std::atan2(by - s.rocker_pivot_y_m, bx - s.rocker_pivot_x_m));
   return s;
 }
 
@@ -81,19 +86,25 @@ void key(std::ostream& out, const std::string& k, const std::string& v, const st
 
 void run_knotter(const KnotterArgs& args, std::ostream& out, std::ostream& err) {
   if (args.points.size() != 3) {
-    throw ArgError("--point: give exactly three precision points TAKE, WRAP, PULL (got " + std::to_string(args.points.size()) + ")");
+    throw ArgError("--point: give exactly three precision points TAKE, WRAP, PULL (got " +
+                   std::to_string(args.points.size()) + ")");
   }
-  if (!std::isfinite(args.theta0_deg)) throw ArgError("--theta0-deg " + input_value(args.theta0_deg) + ": must be a finite angle in degrees");
-  if (!std::isfinite(args.warp_entry_mm)) throw ArgError("--warp-entry-mm " + input_value(args.warp_entry_mm) + ": must be finite");
+  if (!std::isfinite(args.theta0_deg))
+    throw ArgError("--theta0-deg " + input_value(args.theta0_deg) + ": must be a finite angle in degrees");
+  if (!std::isfinite(args.warp_entry_mm))
+    throw ArgError("--warp-entry-mm " + input_value(args.warp_entry_mm) + ": must be finite");
   if (!(args.min_transmission_deg >= 0.0 && args.min_transmission_deg < 90.0)) {
-    throw ArgError("--min-transmission-deg " + input_value(args.min_transmission_deg) + ": must be in [0, 90)");
+    throw ArgError("--min-transmission-deg " + input_value(args.min_transmission_deg) +
+                   ": must be in [0, 90)");
   }
   if (args.drive != "auto" && args.drive != "first" && args.drive != "second") {
     throw ArgError("--drive " + args.drive + ": must be auto, first or second");
   }
   std::array<motion::PrecisionPoint, 3> pts{};
-  for (int i = 0; i < 3; ++i) pts[static_cast<std::size_t>(i)] = parse_precision_point(args.points[static_cast<std::size_t>(i)], i);
-  const std::string point_args = "--point " + args.points[0] + " --point " + args.points[1] + " --point " + args.points[2];
+  for (int i = 0; i < 3; ++i)
+    pts[static_cast<std::size_t>(i)] = parse_precision_point(args.points[static_cast<std::size_t>(i)], i);
+  const std::string point_args =
+      "--point " + args.points[0] + " --point " + args.points[1] + " --point " + args.points[2];
   const double theta0 = motion::rad(args.theta0_deg);
   motion::ThreePointResult r;
   try {
@@ -111,7 +122,8 @@ void run_knotter(const KnotterArgs& args, std::ostream& out, std::ostream& err) 
   base.min_transmission_rad = motion::rad(args.min_transmission_deg);
   auto servo = [](const char* opt, double v, double& field) {
     if (v == 0.0) return;  // keep the default
-    if (!std::isfinite(v) || !(v > 0.0)) throw ArgError(std::string(opt) + " " + input_value(v) + ": must be finite and > 0");
+    if (!std::isfinite(v) || !(v > 0.0))
+      throw ArgError(std::string(opt) + " " + input_value(v) + ": must be finite and > 0");
     field = v;
   };
   servo("--max-speed-rad-s", args.max_speed_rad_s, base.max_speed_rad_s);
@@ -124,7 +136,8 @@ void run_knotter(const KnotterArgs& args, std::ostream& out, std::ostream& err) 
     std::size_t driven;
     std::optional<motion::KnotCycle> cycle;
     std::string refusal;
-    motion::KnotCycleField refused_for = motion::KnotCycleField::kLinkage;  // the spec fact the refusal is about
+    motion::KnotCycleField refused_for =
+        motion::KnotCycleField::kLinkage;  // the spec fact the refusal is about
   };
   std::vector<Candidate> cands;
   for (std::size_t k = 0; k < 2; ++k) {
@@ -148,12 +161,16 @@ void run_knotter(const KnotterArgs& args, std::ostream& out, std::ostream& err) 
   }
   const Candidate* best = nullptr;
   for (const Candidate& c : cands) {
-    if (c.cycle && (best == nullptr || c.cycle->report().min_transmission_rad > best->cycle->report().min_transmission_rad)) best = &c;
+    if (c.cycle && (best == nullptr ||
+                    c.cycle->report().min_transmission_rad > best->cycle->report().min_transmission_rad))
+      best = &c;
   }
   auto chain_name = [](std::size_t k) { return k == 0 ? "first" : "second"; };
   if (best == nullptr) {
     std::string why;
-    for (const Candidate& c : cands) why += std::string(why.empty() ? "" : "; ") + "driving the " + chain_name(c.driven) + " chain's side link: " + c.refusal;
+    for (const Candidate& c : cands)
+      why += std::string(why.empty() ? "" : "; ") + "driving the " + chain_name(c.driven) +
+             " chain's side link: " + c.refusal;
     // The option to blame is the refused fact's (KnotCycleError::field), never read from the message.
     const auto refused_for = [&](motion::KnotCycleField f) {
       return std::any_of(cands.begin(), cands.end(), [f](const Candidate& c) { return c.refused_for == f; });
@@ -171,7 +188,9 @@ void run_knotter(const KnotterArgs& args, std::ostream& out, std::ostream& err) 
     throw ArgError(blamed + ": no usable knotting linkage: " + why);
   }
   for (const Candidate& c : cands) {
-    if (&c != best && !c.cycle) err << "loom-synth: note: driving the " << chain_name(c.driven) << " chain's side link refused: " << c.refusal << "\n";
+    if (&c != best && !c.cycle)
+      err << "loom-synth: note: driving the " << chain_name(c.driven)
+          << " chain's side link refused: " << c.refusal << "\n";
   }
 
   const motion::KnotCycle& kc = *best->cycle;
@@ -180,29 +199,39 @@ void run_knotter(const KnotterArgs& args, std::ostream& out, std::ostream& err) 
   const ThreePointSolution& d = r.solutions[best->driven];
   const ThreePointSolution& o = r.solutions[1 - best->driven];
   out << "# loom-synth knotter: the knotting four-bar from the two three-point chains\n"
-      << "#   driven (crank) chain: a0 = " << g(d.a0) << " mm, a1 = " << g(d.a1) << " mm, a2 = " << g(d.a2) << " mm (lambda " << g(d.lambda) << ")\n"
-      << "#   other (rocker) chain: a0 = " << g(o.a0) << " mm, a1 = " << g(o.a1) << " mm, a2 = " << g(o.a2) << " mm (lambda " << g(o.lambda) << ")\n"
+      << "#   driven (crank) chain: a0 = " << g(d.a0) << " mm, a1 = " << g(d.a1) << " mm, a2 = " << g(d.a2)
+      << " mm (lambda " << g(d.lambda) << ")\n"
+      << "#   other (rocker) chain: a0 = " << g(o.a0) << " mm, a1 = " << g(o.a1) << " mm, a2 = " << g(o.a2)
+      << " mm (lambda " << g(o.lambda) << ")\n"
       << "#   Grashof class " << motion::grashof_class_name(rep.grashof) << ": "
-      << (rep.full_turn ? "the crank turns on through the turn to return" : "the servo swings back to return") << "\n"
-      << "#   crank angles TAKE/WRAP/PULL: " << g(motion::deg(rep.crank_angles_rad[0])) << " / " << g(motion::deg(rep.crank_angles_rad[1]))
-      << " / " << g(motion::deg(rep.crank_angles_rad[2])) << " deg; stroke " << g(motion::deg(rep.stroke_rad)) << " deg\n"
-      << "#   min transmission angle in the stroke " << g(motion::deg(rep.min_transmission_rad)) << " deg at crank "
-      << g(motion::deg(rep.min_transmission_at_rad)) << " deg; closure residual " << g(rep.closure_residual_m) << " m\n";
-  out << "#   cycle " << g(kc.duration_s()) << " s with servo " << g(s.max_speed_rad_s) << " rad/s, " << g(s.max_accel_rad_s2)
-      << " rad/s2, " << g(s.max_torque_nm) << " N m, rotor " << g(s.rotor_inertia_kg_m2) << " kg m2:";
-  for (const auto& seg : rep.segments) out << " " << seg.name << " " << g(seg.end_s - seg.begin_s) << " s (" << motion::knot_limit_name(seg.bound) << ")";
-  out << "\n#   peak servo torque " << g(rep.peak_torque_nm) << " N m at t = " << g(rep.peak_torque_t_s) << " s\n";
+      << (rep.full_turn ? "the crank turns on through the turn to return" : "the servo swings back to return")
+      << "\n"
+      << "#   crank angles TAKE/WRAP/PULL: " << g(motion::deg(rep.crank_angles_rad[0])) << " / "
+      << g(motion::deg(rep.crank_angles_rad[1])) << " / " << g(motion::deg(rep.crank_angles_rad[2]))
+      << " deg; stroke " << g(motion::deg(rep.stroke_rad)) << " deg\n"
+      << "#   min transmission angle in the stroke " << g(motion::deg(rep.min_transmission_rad))
+      << " deg at crank " << g(motion::deg(rep.min_transmission_at_rad)) << " deg; closure residual "
+      << g(rep.closure_residual_m) << " m\n";
+  out << "#   cycle " << g(kc.duration_s()) << " s with servo " << g(s.max_speed_rad_s) << " rad/s, "
+      << g(s.max_accel_rad_s2) << " rad/s2, " << g(s.max_torque_nm) << " N m, rotor "
+      << g(s.rotor_inertia_kg_m2) << " kg m2:";
+  for (const auto& seg : rep.segments)
+    out << " " << seg.name << " " << g(seg.end_s - seg.begin_s) << " s ("
+        << motion::knot_limit_name(seg.bound) << ")";
+  out << "\n#   peak servo torque " << g(rep.peak_torque_nm) << " N m at t = " << g(rep.peak_torque_t_s)
+      << " s\n";
   out << "[knotting.linkage]\n";
   static constexpr std::array<const char*, 3> kName{"take", "wrap", "pull"};
-  static constexpr std::array<const char*, 3> kWhat{"TAKE the yarn at the colour selector", "WRAP it round the warp pair",
-                                                    "PULL it down to the fell"};
+  static constexpr std::array<const char*, 3> kWhat{
+      "TAKE the yarn at the colour selector", "WRAP it round the warp pair", "PULL it down to the fell"};
   for (std::size_t i = 0; i < 3; ++i) {
     const std::string n(kName[i]);
     key(out, n + "_x_m", g(s.points[i].x_m), std::string(kWhat[i]) + ": gripper x (knot frame)");
     key(out, n + "_y_m", g(s.points[i].y_m), "gripper y");
     key(out, n + "_gripper_deg", g(motion::deg(s.points[i].gripper_rad)), "gripper-link angle there");
   }
-  key(out, "theta0_deg", g(args.theta0_deg), "the synthesis' fixed-link direction (both ground pivots on it)");
+  key(out, "theta0_deg", g(args.theta0_deg),
+      "the synthesis' fixed-link direction (both ground pivots on it)");
   key(out, "crank_pivot_x_m", g(s.crank_pivot_x_m), "servo shaft (crank ground pivot)");
   key(out, "crank_pivot_y_m", g(s.crank_pivot_y_m), "a0 of the driven chain along theta0");
   key(out, "rocker_pivot_x_m", g(s.rocker_pivot_x_m), "rocker ground pivot");
@@ -210,14 +239,18 @@ void run_knotter(const KnotterArgs& args, std::ostream& out, std::ostream& err) 
   key(out, "crank_m", g(s.crank.length_m), "servo-driven side link");
   key(out, "coupler_m", g(s.coupler.length_m), "between the moving pivots, gripper on its line");
   key(out, "rocker_m", g(s.rocker.length_m), "other side link");
-  key(out, "gripper_along_m", g(s.gripper_along_m), "gripper in the coupler frame: from the crank joint towards the rocker joint");
+  key(out, "gripper_along_m", g(s.gripper_along_m),
+      "gripper in the coupler frame: from the crank joint towards the rocker joint");
   key(out, "gripper_normal_m", g(s.gripper_normal_m), "and 90 deg counter-clockwise of that");
-  key(out, "branch", std::string("\"") + (s.branch == motion::Branch::kPositive ? "positive" : "negative") + "\"",
+  key(out, "branch",
+      std::string("\"") + (s.branch == motion::Branch::kPositive ? "positive" : "negative") + "\"",
       "assembly branch, the same at all three points");
-  const std::array<std::pair<const char*, const motion::KnotLinkSpec*>, 3> links{{{"crank", &s.crank}, {"coupler", &s.coupler}, {"rocker", &s.rocker}}};
+  const std::array<std::pair<const char*, const motion::KnotLinkSpec*>, 3> links{
+      {{"crank", &s.crank}, {"coupler", &s.coupler}, {"rocker", &s.rocker}}};
   for (const auto& [n, l] : links) {
     const std::string p(n);
-    key(out, p + "_mass_kg", g(l->mass_kg), p == "coupler" ? "seed 001's link with holder and gripper" : "Delrin 6 x 5 mm, seed's V rho");
+    key(out, p + "_mass_kg", g(l->mass_kg),
+        p == "coupler" ? "seed 001's link with holder and gripper" : "Delrin 6 x 5 mm, seed's V rho");
     key(out, p + "_cg_m", g(l->cg_m), "from its first pivot along the link");
     key(out, p + "_inertia_kg_m2", g(l->inertia_kg_m2), "about its cg");
   }

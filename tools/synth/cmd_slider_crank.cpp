@@ -68,8 +68,8 @@ void run_slider_crank(const SliderCrankArgs& args, std::ostream& out, std::ostre
     throw ArgError("--phi / --phi-range: give exactly one of them");
   }
   require_positive_length("--stroke", args.stroke);
-  const std::vector<double> phis = args.has_phi ? std::vector<double>{args.phi_deg}
-                                                : parse_range(args.phi_range);
+  const std::vector<double> phis =
+      args.has_phi ? std::vector<double>{args.phi_deg} : parse_range(args.phi_range);
 
   const CsvFormat f(args.full_precision);
   std::ostringstream table;
@@ -82,14 +82,16 @@ void run_slider_crank(const SliderCrankArgs& args, std::ostream& out, std::ostre
       d = args.has_lambda ? motion::soylemez_slider_crank(args.stroke, phi, args.lambda)
                           : motion::soylemez_slider_crank(args.stroke, phi);
     } catch (const motion::MotionError& e) {
-      const std::string arg = args.has_lambda ? "--phi " + input_value(phi_deg) + " --lambda " + input_value(args.lambda)
-                                              : "--phi " + input_value(phi_deg);
+      const std::string arg = args.has_lambda
+                                  ? "--phi " + input_value(phi_deg) + " --lambda " + input_value(args.lambda)
+                                  : "--phi " + input_value(phi_deg);
       if (args.has_phi) throw ArgError(arg + ": " + e.what());
       err << "loom-synth: note: phi_deg=" << input_value(phi_deg) << ": no row: " << e.what() << "\n";
       continue;
     }
-    write_row(table, {f.input(phi_deg), f.length(d.mechanism.crank), f.length(d.mechanism.coupler),
-                      f.length(d.mechanism.offset), f.angle_deg(motion::deg(d.mu_min_rad)), f.ratio(d.lambda)});
+    write_row(table,
+              {f.input(phi_deg), f.length(d.mechanism.crank), f.length(d.mechanism.coupler),
+               f.length(d.mechanism.offset), f.angle_deg(motion::deg(d.mu_min_rad)), f.ratio(d.lambda)});
     ++printed;
     if (d.flags & motion::kDesignChangePoint) {
       err << "loom-synth: note: phi_deg=" << input_value(phi_deg)

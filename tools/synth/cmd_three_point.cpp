@@ -44,21 +44,25 @@ motion::PrecisionPoint parse_precision_point(const std::string& text, int index)
       used = 0;
     }
     if (used == 0 || used != part.size() || !std::isfinite(x)) {
-      throw ArgError(arg + ": '" + part + "' is not a finite number (expected RX,RY,THETA2 in mm, mm, degrees)");
+      throw ArgError(arg + ": '" + part +
+                     "' is not a finite number (expected RX,RY,THETA2 in mm, mm, degrees)");
     }
     v[static_cast<std::size_t>(n++)] = x;
   }
-  if (n != 3) throw ArgError(arg + ": expected RX,RY,THETA2 (mm, mm, degrees), point " + std::to_string(index + 1));
+  if (n != 3)
+    throw ArgError(arg + ": expected RX,RY,THETA2 (mm, mm, degrees), point " + std::to_string(index + 1));
   return motion::PrecisionPoint{v[0], v[1], motion::rad(v[2])};
 }
 
 void run_three_point(const ThreePointArgs& args, std::ostream& out, std::ostream& err) {
   if (args.points.size() != 3) {
-    throw ArgError("--point: give exactly three precision points (got " + std::to_string(args.points.size()) + ")");
+    throw ArgError("--point: give exactly three precision points (got " + std::to_string(args.points.size()) +
+                   ")");
   }
   if (!std::isfinite(args.theta0_deg)) throw ArgError("--theta0-deg: must be a finite angle in degrees");
   std::array<motion::PrecisionPoint, 3> pts{};
-  for (int i = 0; i < 3; ++i) pts[static_cast<std::size_t>(i)] = parse_precision_point(args.points[static_cast<std::size_t>(i)], i);
+  for (int i = 0; i < 3; ++i)
+    pts[static_cast<std::size_t>(i)] = parse_precision_point(args.points[static_cast<std::size_t>(i)], i);
   double extent = 0.0;
   for (int i = 0; i < 3; ++i) {
     const auto& p = pts[static_cast<std::size_t>(i)];
@@ -78,8 +82,10 @@ void run_three_point(const ThreePointArgs& args, std::ostream& out, std::ostream
     r = motion::three_point_synthesis(pts, theta0);
   } catch (const motion::MotionError& e) {
     if (e.code() == motion::ErrorCode::kSingular) {
-      throw ArgError(std::string("--point: the three points do not determine the chain (collinear or repeated "
-                                 "positions with these angles): ") + e.what());
+      throw ArgError(
+          std::string("--point: the three points do not determine the chain (collinear or repeated "
+                      "positions with these angles): ") +
+          e.what());
     }
     throw ArgError(std::string("--point/--theta0-deg: ") + e.what());
   }
@@ -114,7 +120,8 @@ void run_three_point(const ThreePointArgs& args, std::ostream& out, std::ostream
     msg << "--point: no real solution: ";
     if (r.complex_roots > 0) msg << "the lambda quadratic has complex roots";
     if (r.complex_roots > 0 && r.rejected_roots + static_cast<int>(r.solutions.size()) > 0) msg << "; ";
-    if (r.rejected_roots > 0 || !r.solutions.empty()) msg << "its real roots give no finite chain (infinite link)";
+    if (r.rejected_roots > 0 || !r.solutions.empty())
+      msg << "its real roots give no finite chain (infinite link)";
     throw ArgError(msg.str());
   }
   const CsvFormat f(args.full_precision);

@@ -2,22 +2,24 @@
 // Khare–Dave crank-rocker tables as CSV, and a one-row beat-up linkage design. CSV on stdout,
 // notes and errors on stderr; bad arguments or impossible designs exit 2 naming the argument.
 #include <CLI/CLI.hpp>
-#include <stdexcept>
 #include <iostream>
+#include <stdexcept>
 
 #include "commands.hpp"
 
 int main(int argc, char** argv) {
   using namespace loom::synth;
-  CLI::App app{"Dimensional synthesis of the beat-up linkage (thesis 000 §4.5). Angles in degrees; "
-               "lengths relative to ground = 1 (crank-rocker) or stroke = 1 (slider-crank) unless "
-               "given."};
+  CLI::App app{
+      "Dimensional synthesis of the beat-up linkage (thesis 000 §4.5). Angles in degrees; "
+      "lengths relative to ground = 1 (crank-rocker) or stroke = 1 (slider-crank) unless "
+      "given."};
   app.require_subcommand(1);
 
   SliderCrankArgs sc;
-  CLI::App* sc_cmd = app.add_subcommand(
-      "slider-crank", "Söylemez slider-crank for a crank rotation phi between dead centres: "
-                      "phi_deg,a,b,c,mu_min_deg,lambda (Table 4.2)");
+  CLI::App* sc_cmd =
+      app.add_subcommand("slider-crank",
+                         "Söylemez slider-crank for a crank rotation phi between dead centres: "
+                         "phi_deg,a,b,c,mu_min_deg,lambda (Table 4.2)");
   CLI::Option* sc_phi = sc_cmd->add_option("--phi", sc.phi_deg, "Crank rotation, 90 <= phi < 180 deg");
   CLI::Option* sc_range =
       sc_cmd->add_option("--phi-range", sc.phi_range, "Table of phi: first:last[:step] deg, e.g. 90:179");
@@ -29,9 +31,10 @@ int main(int argc, char** argv) {
   sc_cmd->add_flag("--full-precision", sc.full_precision, "Print %.17g instead of the thesis' digits");
 
   CrankRockerArgs cr;
-  CLI::App* cr_cmd = app.add_subcommand(
-      "crank-rocker", "Khare-Dave crank-rocker for swing psi and crank rotation phi: "
-                      "beta_deg,a,b,c,mu_min_deg, one row per integer beta (Tables 4.6-4.9)");
+  CLI::App* cr_cmd =
+      app.add_subcommand("crank-rocker",
+                         "Khare-Dave crank-rocker for swing psi and crank rotation phi: "
+                         "beta_deg,a,b,c,mu_min_deg, one row per integer beta (Tables 4.6-4.9)");
   cr_cmd->add_option("--psi", cr.psi_deg, "Rocker swing angle, 0 < psi < 180 deg")->required();
   cr_cmd->add_option("--phi", cr.phi_deg, "Crank rotation from extended to folded dead centre, deg")
       ->required();
@@ -50,7 +53,8 @@ int main(int argc, char** argv) {
   ds_cmd->add_option("--phi", ds.phi_deg, "Crank rotation between dead centres, deg")->required();
   CLI::Option* ds_lambda = ds_cmd->add_option(
       "--lambda", ds.lambda, "Crank/coupler ratio a/b (default: the design maximising mu_min)");
-  CLI::Option* ds_beta = ds_cmd->add_option("--beta", ds.beta_deg, "Crank-rocker: crank angle at the extended dead centre, deg");
+  CLI::Option* ds_beta =
+      ds_cmd->add_option("--beta", ds.beta_deg, "Crank-rocker: crank angle at the extended dead centre, deg");
   ds_cmd->add_option("--ground", ds.ground, "Crank-rocker: ground link length")->capture_default_str();
   ds_cmd->add_flag("--thesis-rounding", ds.thesis_rounding,
                    "Slider-crank: scale the 6-decimal unit-stroke design, as the thesis' Table 4.3 did");
@@ -58,24 +62,36 @@ int main(int argc, char** argv) {
 
   ThreePointArgs tp;
   CLI::App* tp_cmd = app.add_subcommand(
-      "three-point", "Three-precision-point synthesis of the knotting chain (seed 001): "
-                     "lambda,a0,a1,a2,theta1_i_deg,closure_residual, one row per real solution (mm, deg)");
-  tp_cmd->add_option("--theta0-deg", tp.theta0_deg, "Fixed angle of the first link A0-O1, degrees")->required();
-  tp_cmd->add_option("--point", tp.points, "Precision point RX,RY,THETA2 (mm, mm, last link's angle in degrees); three times")
+      "three-point",
+      "Three-precision-point synthesis of the knotting chain (seed 001): "
+      "lambda,a0,a1,a2,theta1_i_deg,closure_residual, one row per real solution (mm, deg)");
+  tp_cmd->add_option("--theta0-deg", tp.theta0_deg, "Fixed angle of the first link A0-O1, degrees")
+      ->required();
+  tp_cmd
+      ->add_option("--point", tp.points,
+                   "Precision point RX,RY,THETA2 (mm, mm, last link's angle in degrees); three times")
       ->required();
   tp_cmd->add_flag("--full-precision", tp.full_precision, "Print %.17g instead of 6 decimals");
 
   KnotterArgs kn;
   CLI::App* kn_cmd = app.add_subcommand(
-      "knotter", "Seed 001's knotting four-bar from the two three-point chains (shared coupler), checked "
-                 "for branch, order, transmission and toggles, as [knotting.linkage] config lines (SI)");
-  kn_cmd->add_option("--theta0-deg", kn.theta0_deg, "Fixed-link direction of the synthesis, degrees")->capture_default_str();
-  kn_cmd->add_option("--point", kn.points, "Precision point RX,RY,THETA2 (mm, mm, deg): TAKE, WRAP, PULL (default seed 001's)");
-  kn_cmd->add_option("--warp-entry-mm", kn.warp_entry_mm, "Gripper inside the warp while its x >= this (mm)")->capture_default_str();
-  kn_cmd->add_option("--min-transmission-deg", kn.min_transmission_deg, "Least transmission angle allowed in the stroke")
+      "knotter",
+      "Seed 001's knotting four-bar from the two three-point chains (shared coupler), checked "
+      "for branch, order, transmission and toggles, as [knotting.linkage] config lines (SI)");
+  kn_cmd->add_option("--theta0-deg", kn.theta0_deg, "Fixed-link direction of the synthesis, degrees")
       ->capture_default_str();
-  kn_cmd->add_option("--drive", kn.drive, "Which chain's side link the servo drives: auto, first, second")->capture_default_str();
-  kn_cmd->add_option("--max-speed-rad-s", kn.max_speed_rad_s, "Servo speed limit for the cycle-time comment (default: micro servo)");
+  kn_cmd->add_option("--point", kn.points,
+                     "Precision point RX,RY,THETA2 (mm, mm, deg): TAKE, WRAP, PULL (default seed 001's)");
+  kn_cmd->add_option("--warp-entry-mm", kn.warp_entry_mm, "Gripper inside the warp while its x >= this (mm)")
+      ->capture_default_str();
+  kn_cmd
+      ->add_option("--min-transmission-deg", kn.min_transmission_deg,
+                   "Least transmission angle allowed in the stroke")
+      ->capture_default_str();
+  kn_cmd->add_option("--drive", kn.drive, "Which chain's side link the servo drives: auto, first, second")
+      ->capture_default_str();
+  kn_cmd->add_option("--max-speed-rad-s", kn.max_speed_rad_s,
+                     "Servo speed limit for the cycle-time comment (default: micro servo)");
   kn_cmd->add_option("--max-accel-rad-s2", kn.max_accel_rad_s2, "Servo acceleration limit");
   kn_cmd->add_option("--jerk-rad-s3", kn.jerk_rad_s3, "Servo jerk limit");
   kn_cmd->add_option("--max-torque-nm", kn.max_torque_nm, "Servo torque limit");

@@ -57,7 +57,8 @@ std::vector<Cell> split_cells(const std::string& line) {
 
 class CsvReader {
  public:
-  CsvReader(const std::string& text, const std::string& source, std::vector<std::size_t>* grid_lines = nullptr)
+  CsvReader(const std::string& text, const std::string& source,
+            std::vector<std::size_t>* grid_lines = nullptr)
       : text_(text), source_(source), grid_lines_(grid_lines) {}
 
   Design read() {
@@ -76,7 +77,8 @@ class CsvReader {
     // The file is the picture top line first; the carpet is woven from its bottom line up.
     std::vector<std::uint16_t> knots;
     knots.reserve(rows_.size() * static_cast<std::size_t>(width_));
-    for (auto it = rows_.rbegin(); it != rows_.rend(); ++it) knots.insert(knots.end(), it->begin(), it->end());
+    for (auto it = rows_.rbegin(); it != rows_.rend(); ++it)
+      knots.insert(knots.end(), it->begin(), it->end());
     return Design(source_, width_, std::move(palette_), std::move(knots));
   }
 
@@ -94,7 +96,8 @@ class CsvReader {
     if (line[first] == '#' && !hex_colour(cells.front().text, rgb)) return;
     for (std::size_t i = 0; i < line.size(); ++i) {
       const auto c = static_cast<unsigned char>(line[i]);
-      if (c < 0x20 && c != '\t') fail(line_no_, i + 1, "control character 0x" + hex2(c) + " in a design line");
+      if (c < 0x20 && c != '\t')
+        fail(line_no_, i + 1, "control character 0x" + hex2(c) + " in a design line");
     }
     if (cells.front().text == "palette") {
       palette_line(cells);
@@ -109,14 +112,18 @@ class CsvReader {
   }
 
   void palette_line(const std::vector<Cell>& cells) {
-    if (!rows_.empty()) fail(line_no_, 1, "palette line after the grid began (define every code before the first row)");
+    if (!rows_.empty())
+      fail(line_no_, 1, "palette line after the grid began (define every code before the first row)");
     if (cells.size() < 3 || cells.size() > 4) {
-      fail(line_no_, 1, "palette line has " + std::to_string(cells.size() - 1) +
-                            " fields: want palette,CODE,#RRGGBB[,name]");
+      fail(line_no_, 1,
+           "palette line has " + std::to_string(cells.size() - 1) +
+               " fields: want palette,CODE,#RRGGBB[,name]");
     }
     const Cell& code = cells[1];
     check_code(code);
-    if (code.text[0] == '#') fail(line_no_, code.col, "palette code '" + code.text + "' starts with '#' (reserved for literal colours)");
+    if (code.text[0] == '#')
+      fail(line_no_, code.col,
+           "palette code '" + code.text + "' starts with '#' (reserved for literal colours)");
     if (codes_.count(code.text)) fail(line_no_, code.col, "palette code '" + code.text + "' defined twice");
     std::uint32_t rgb = 0;
     if (!hex_colour(cells[2].text, rgb)) {
@@ -128,12 +135,15 @@ class CsvReader {
   void grid_line(const std::vector<Cell>& cells) {
     if (rows_.empty()) {
       width_ = static_cast<int>(cells.size());
-      if (width_ > kMaxWidth) fail(line_no_, 1, std::to_string(width_) + " knots per row: more than " + std::to_string(kMaxWidth));
+      if (width_ > kMaxWidth)
+        fail(line_no_, 1, std::to_string(width_) + " knots per row: more than " + std::to_string(kMaxWidth));
     } else if (static_cast<int>(cells.size()) != width_) {
-      fail(line_no_, 1, "row of " + std::to_string(cells.size()) + " knots; the design's rows have " +
-                            std::to_string(width_) + " (every row the same width)");
+      fail(line_no_, 1,
+           "row of " + std::to_string(cells.size()) + " knots; the design's rows have " +
+               std::to_string(width_) + " (every row the same width)");
     }
-    if (static_cast<int>(rows_.size()) >= kMaxHeight) fail(line_no_, 1, "more than " + std::to_string(kMaxHeight) + " rows");
+    if (static_cast<int>(rows_.size()) >= kMaxHeight)
+      fail(line_no_, 1, "more than " + std::to_string(kMaxHeight) + " rows");
     std::vector<std::uint16_t> row;
     row.reserve(cells.size());
     for (const Cell& c : cells) {
@@ -147,8 +157,9 @@ class CsvReader {
       }
       if (it == codes_.end()) {
         check_code(c);
-        fail(line_no_, c.col, "colour code '" + c.text + "' is not in the palette (" + known_codes() +
-                                  "); define it with palette," + c.text + ",#RRGGBB");
+        fail(line_no_, c.col,
+             "colour code '" + c.text + "' is not in the palette (" + known_codes() +
+                 "); define it with palette," + c.text + ",#RRGGBB");
       }
       row.push_back(it->second);
     }
@@ -160,8 +171,9 @@ class CsvReader {
     const bool literal = c.text.size() == 7 && c.text[0] == '#';
     if (c.text.empty() || c.text.size() > kMaxCodeLength ||
         (!literal && !std::all_of(c.text.begin(), c.text.end(), code_char))) {
-      fail(line_no_, c.col, "colour code '" + c.text.substr(0, 40) + "': want 1.." + std::to_string(kMaxCodeLength) +
-                                " letters, digits, '_', '-' or '.'");
+      fail(line_no_, c.col,
+           "colour code '" + c.text.substr(0, 40) + "': want 1.." + std::to_string(kMaxCodeLength) +
+               " letters, digits, '_', '-' or '.'");
     }
   }
 
@@ -194,32 +206,39 @@ class CsvReader {
 
 Design::Design(const std::string& source, int width, std::vector<Colour> palette,
                std::vector<std::uint16_t> knots_bottom_up)
-    : name_(base_name(source)), width_(width), palette_(std::move(palette)), knots_(std::move(knots_bottom_up)) {
-  if (width_ < 1 || width_ > kMaxWidth || knots_.empty() || knots_.size() % static_cast<std::size_t>(width_) != 0) {
+    : name_(base_name(source)),
+      width_(width),
+      palette_(std::move(palette)),
+      knots_(std::move(knots_bottom_up)) {
+  if (width_ < 1 || width_ > kMaxWidth || knots_.empty() ||
+      knots_.size() % static_cast<std::size_t>(width_) != 0) {
     throw DesignError(name_ + ": a design needs whole rows of 1.." + std::to_string(kMaxWidth) + " knots");
   }
   height_ = static_cast<int>(knots_.size() / static_cast<std::size_t>(width_));
   if (height_ > kMaxHeight) throw DesignError(name_ + ": more than " + std::to_string(kMaxHeight) + " rows");
   for (std::uint16_t k : knots_) {
-    if (k >= palette_.size()) throw DesignError(name_ + ": a knot refers to colour " + std::to_string(k) + " beyond the palette");
+    if (k >= palette_.size())
+      throw DesignError(name_ + ": a knot refers to colour " + std::to_string(k) + " beyond the palette");
   }
 }
 
 std::span<const std::uint16_t> Design::row(int r) const {
-  return std::span<const std::uint16_t>(knots_).subspan(static_cast<std::size_t>(r) * static_cast<std::size_t>(width_),
-                                                       static_cast<std::size_t>(width_));
+  return std::span<const std::uint16_t>(knots_).subspan(
+      static_cast<std::size_t>(r) * static_cast<std::size_t>(width_), static_cast<std::size_t>(width_));
 }
 
 Design parse_design_csv(const std::string& text, const std::string& source) {
   return CsvReader(text, source).read();
 }
 
-Design parse_design_csv(const std::string& text, const std::string& source, std::vector<std::size_t>& grid_lines) {
+Design parse_design_csv(const std::string& text, const std::string& source,
+                        std::vector<std::size_t>& grid_lines) {
   grid_lines.clear();
   return CsvReader(text, source, &grid_lines).read();
 }
 
-std::string design_csv_cell_at(const std::string& text, const std::string& source, std::size_t line, int knot) {
+std::string design_csv_cell_at(const std::string& text, const std::string& source, std::size_t line,
+                               int knot) {
   std::size_t pos = text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
   for (std::size_t n = 1; n < line && pos != std::string::npos; ++n) {
     pos = text.find('\n', pos);
@@ -229,7 +248,8 @@ std::string design_csv_cell_at(const std::string& text, const std::string& sourc
   if (pos != std::string::npos) {
     const std::size_t nl = text.find('\n', pos);
     const auto cells = split_cells(text.substr(pos, nl == std::string::npos ? std::string::npos : nl - pos));
-    if (knot >= 0 && static_cast<std::size_t>(knot) < cells.size()) col = cells[static_cast<std::size_t>(knot)].col;
+    if (knot >= 0 && static_cast<std::size_t>(knot) < cells.size())
+      col = cells[static_cast<std::size_t>(knot)].col;
   }
   return source + ":" + std::to_string(line) + ":" + std::to_string(col);
 }
@@ -238,14 +258,16 @@ Design parse_design(const std::string& bytes, const std::string& source) {
   const std::string ext = lower(source.size() >= 4 ? source.substr(source.size() - 4) : source);
   if (ext == ".csv") return parse_design_csv(bytes, source);
   if (ext == ".png") return parse_design_png(bytes, source);
-  throw DesignError(source + ": not a design file: want a .csv grid of colour codes or a .png with one pixel per knot");
+  throw DesignError(
+      source + ": not a design file: want a .csv grid of colour codes or a .png with one pixel per knot");
 }
 
 DesignPosition position_after(const Design& d, std::uint64_t rows_done) {
   const auto h = static_cast<std::uint64_t>(d.height());
   // Clamped before the +1: with one row and 2^64-1 rows done, rows_done / h + 1 wraps to repeat 0
   // (found by tests/fuzz/fuzz_design).
-  return {static_cast<int>(rows_done % h), static_cast<int>(std::min<std::uint64_t>(rows_done / h, INT32_MAX - 1) + 1)};
+  return {static_cast<int>(rows_done % h),
+          static_cast<int>(std::min<std::uint64_t>(rows_done / h, INT32_MAX - 1) + 1)};
 }
 
 }  // namespace loom::design

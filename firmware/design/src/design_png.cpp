@@ -17,19 +17,22 @@ Design parse_design_png(const std::string& bytes, const std::string& source) {
     // Pixel row 0 is the top of the picture; design row 0 (woven first) is its bottom.
     const int r = h - 1 - y;
     for (int x = 0; x < w; ++x) {
-      const std::uint32_t c = rgb[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)];
+      const std::uint32_t c =
+          rgb[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)];
       auto it = index.find(c);
       if (it == index.end()) {
         if (static_cast<int>(palette.size()) >= kMaxColours) {
-          throw DesignError(source + ": more than " + std::to_string(kMaxColours) + " distinct colours (pixel " +
-                            std::to_string(x) + "," + std::to_string(y) + "): a knot map uses one colour per yarn");
+          throw DesignError(source + ": more than " + std::to_string(kMaxColours) +
+                            " distinct colours (pixel " + std::to_string(x) + "," + std::to_string(y) +
+                            "): a knot map uses one colour per yarn");
         }
         char code[8];
         std::snprintf(code, sizeof code, "#%06x", c);
         it = index.emplace(c, static_cast<std::uint16_t>(palette.size())).first;
         palette.push_back(Colour{code, c, ""});
       }
-      knots[static_cast<std::size_t>(r) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] = it->second;
+      knots[static_cast<std::size_t>(r) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] =
+          it->second;
     }
   }
   return Design(source, w, std::move(palette), std::move(knots));

@@ -86,19 +86,23 @@ class PlotBuilder {
     force.zoom_to_data = true;
     force.title = "Peak beat force across the width (" + scene + ")";
     if (force_rows_ > force_.size()) {
-      force.title += ", last " + std::to_string(force_.size()) + " of " + std::to_string(force_rows_) + " rows";
+      force.title +=
+          ", last " + std::to_string(force_.size()) + " of " + std::to_string(force_rows_) + " rows";
     }
     force.x_label = "carriage position x (m)";
     force.y_label = "peak beat force (N)";
-    static const char* kColours[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#7f7f7f"};
+    static const char* kColours[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd",
+                                     "#8c564b", "#e377c2", "#17becf", "#7f7f7f"};
     std::size_t i = 0;
     for (const auto& s : force_) {
       Series c = s;
       c.colour = kColours[i++ % 8];
       force.series.push_back(std::move(c));
     }
-    const json* bf = summary_head.contains("totals") ? &summary_head.at("totals").at("beat_force_n") : nullptr;
-    const double band_lo = summary_head.value("beat_force_min_n", 80.0), band_hi = summary_head.value("beat_force_max_n", 100.0);
+    const json* bf =
+        summary_head.contains("totals") ? &summary_head.at("totals").at("beat_force_n") : nullptr;
+    const double band_lo = summary_head.value("beat_force_min_n", 80.0),
+                 band_hi = summary_head.value("beat_force_max_n", 100.0);
     force.bands.push_back({band_lo, band_hi, "target " + fmt0(band_lo) + "–" + fmt0(band_hi) + " N"});
     if (force.series.empty()) {
       if (bf != nullptr && bf->is_null()) {
@@ -120,7 +124,8 @@ class PlotBuilder {
     tl.height_px = 280;
     const std::uint64_t complete = rows_ - (incomplete_ ? 1 : 0);
     tl.title = rows_ > timeline_.size()
-                   ? "Row timeline, last " + std::to_string(timeline_.size()) + " of " + std::to_string(rows_) + " rows"
+                   ? "Row timeline, last " + std::to_string(timeline_.size()) + " of " +
+                         std::to_string(rows_) + " rows"
                    : "Row timeline, " + std::to_string(complete) + (complete == 1 ? " row" : " rows");
     if (incomplete_) tl.title += "; row " + std::to_string(incomplete_row_) + " stopped by a fault";
     double prev_end = 0.0;
@@ -141,13 +146,15 @@ class PlotBuilder {
         const double t0 = row_start + r.knotting_s;
         tl.bars.push_back({"shed", t0, t0 + r.shed_s, "#2ca02c", false, ""});
         tl.bars.push_back({"pick", t0 + r.shed_s, t0 + r.shed_s + r.pick_s, "#1f77b4", false, ""});
-        tl.bars.push_back({"beat sweep", t0 + r.shed_s + r.pick_s, t0 + r.shed_s + r.pick_s + r.beat_s, "#d62728", false, label});
+        tl.bars.push_back({"beat sweep", t0 + r.shed_s + r.pick_s, t0 + r.shed_s + r.pick_s + r.beat_s,
+                           "#d62728", false, label});
         prev_end = end;
       } else {
         // The row a fault stopped: from the end of the last row to the fault, outlined.
         double t_fault = prev_end;
         for (const auto& f : r.faults) t_fault = std::max(t_fault, f.first);
-        tl.bars.push_back({"", prev_end, std::max(t_fault, prev_end + 1e-3), "#d62728", true, label + " (incomplete)"});
+        tl.bars.push_back(
+            {"", prev_end, std::max(t_fault, prev_end + 1e-3), "#d62728", true, label + " (incomplete)"});
       }
       for (const auto& f : r.faults) tl.markers.push_back({f.first, f.second, "#d62728"});
     }
@@ -172,8 +179,10 @@ class PlotBuilder {
 };
 
 json fault_json(const FaultSummary& f) {
-  return {{"name", f.name}, {"code", f.code}, {"axis", f.axis}, {"device_code", f.device_code},
-          {"t_s", f.t_s}, {"stopped_by", f.stopped_by}, {"text", f.text}};
+  return {{"name", f.name}, {"code", f.code},
+          {"axis", f.axis}, {"device_code", f.device_code},
+          {"t_s", f.t_s},   {"stopped_by", f.stopped_by},
+          {"text", f.text}};
 }
 
 }  // namespace

@@ -35,10 +35,17 @@ std::string esc(const std::string& s) {
   std::string o;
   for (char c : s) {
     switch (c) {
-      case '<': o += "&lt;"; break;
-      case '>': o += "&gt;"; break;
-      case '&': o += "&amp;"; break;
-      default: o += c;
+      case '<':
+        o += "&lt;";
+        break;
+      case '>':
+        o += "&gt;";
+        break;
+      case '&':
+        o += "&amp;";
+        break;
+      default:
+        o += c;
     }
   }
   return o;
@@ -58,7 +65,8 @@ struct Frame {
   double py(double v) const { return h - bottom - (v - y.lo) / (y.hi - y.lo) * (h - top - bottom); }
 };
 
-void axes(std::ostringstream& os, const Frame& f, const std::string& xl, const std::string& yl, bool y_ticks) {
+void axes(std::ostringstream& os, const Frame& f, const std::string& xl, const std::string& yl,
+          bool y_ticks) {
   os << "<rect x='" << f.left << "' y='" << f.top << "' width='" << f.w - f.left - f.right << "' height='"
      << f.h - f.top - f.bottom << "' fill='none' stroke='#333'/>\n";
   const double xs = nice_step(f.x.hi - f.x.lo, 8);
@@ -70,8 +78,8 @@ void axes(std::ostringstream& os, const Frame& f, const std::string& xl, const s
   if (y_ticks) {
     const double ys = nice_step(f.y.hi - f.y.lo, 6);
     for (double v = f.y.lo; v <= f.y.hi + 1e-9 * ys; v += ys) {
-      os << "<line x1='" << f.left - 5 << "' x2='" << f.w - f.right << "' y1='" << f.py(v) << "' y2='" << f.py(v)
-         << "' stroke='#ddd'/><text x='" << f.left - 8 << "' y='" << f.py(v) + 4
+      os << "<line x1='" << f.left - 5 << "' x2='" << f.w - f.right << "' y1='" << f.py(v) << "' y2='"
+         << f.py(v) << "' stroke='#ddd'/><text x='" << f.left - 8 << "' y='" << f.py(v) + 4
          << "' font-size='11' text-anchor='end'>" << num(v) << "</text>\n";
     }
   }
@@ -110,15 +118,16 @@ std::string render_svg(const Chart& c) {
   std::ostringstream os;
   os << "<svg xmlns='http://www.w3.org/2000/svg' width='" << f.w << "' height='" << f.h
      << "' font-family='sans-serif'>\n<rect width='100%' height='100%' fill='white'/>\n";
-  os << "<text x='" << f.w / 2 << "' y='22' font-size='14' text-anchor='middle'>" << esc(c.title) << "</text>\n";
+  os << "<text x='" << f.w / 2 << "' y='22' font-size='14' text-anchor='middle'>" << esc(c.title)
+     << "</text>\n";
   for (const auto& b : c.bands) {
     // Clipped to the frame: with the axis zoomed to the data the band may cover all of it.
     const double y0 = std::max(b.y0, f.y.lo), y1 = std::min(b.y1, f.y.hi);
     if (y1 <= y0) continue;
-    os << "<rect x='" << f.left << "' y='" << f.py(y1) << "' width='" << f.w - f.left - f.right << "' height='"
-       << f.py(y0) - f.py(y1) << "' fill='#2ca02c' fill-opacity='0.12'/><text x='" << f.w - f.right - 4
-       << "' y='" << f.py(y1) + 13 << "' font-size='11' text-anchor='end' fill='#2ca02c'>" << esc(b.label)
-       << "</text>\n";
+    os << "<rect x='" << f.left << "' y='" << f.py(y1) << "' width='" << f.w - f.left - f.right
+       << "' height='" << f.py(y0) - f.py(y1) << "' fill='#2ca02c' fill-opacity='0.12'/><text x='"
+       << f.w - f.right - 4 << "' y='" << f.py(y1) + 13
+       << "' font-size='11' text-anchor='end' fill='#2ca02c'>" << esc(b.label) << "</text>\n";
   }
   axes(os, f, c.x_label, c.y_label, true);
   int legend = 0;
@@ -154,7 +163,8 @@ std::string render_svg(const Timeline& t) {
   std::ostringstream os;
   os << "<svg xmlns='http://www.w3.org/2000/svg' width='" << f.w << "' height='" << f.h
      << "' font-family='sans-serif'>\n<rect width='100%' height='100%' fill='white'/>\n";
-  os << "<text x='" << f.w / 2 << "' y='22' font-size='14' text-anchor='middle'>" << esc(t.title) << "</text>\n";
+  os << "<text x='" << f.w / 2 << "' y='22' font-size='14' text-anchor='middle'>" << esc(t.title)
+     << "</text>\n";
   axes(os, f, t.x_label, "", false);
   for (std::size_t i = 0; i < t.lanes.size(); ++i) {
     const double yc = f.y.hi - static_cast<double>(i) - 0.5;
@@ -170,19 +180,21 @@ std::string render_svg(const Timeline& t) {
       top = yc + 0.35, bottom = yc - 0.35;
     }
     const double w = std::max(1.0, f.px(b.t1) - f.px(b.t0));
-    os << "<rect x='" << f.px(b.t0) << "' y='" << f.py(top) << "' width='" << w << "' height='" << f.py(bottom) - f.py(top)
-       << (b.outline ? "' fill='none' stroke-dasharray='5,3' stroke-width='1.5' stroke='" : "' fill='") << b.colour
-       << "'/>\n";
+    os << "<rect x='" << f.px(b.t0) << "' y='" << f.py(top) << "' width='" << w << "' height='"
+       << f.py(bottom) - f.py(top)
+       << (b.outline ? "' fill='none' stroke-dasharray='5,3' stroke-width='1.5' stroke='" : "' fill='")
+       << b.colour << "'/>\n";
     // An outlined bar (a row that did not finish) is always labelled: that is the point of drawing it.
     if (!b.label.empty() && (b.outline || w >= 7.0 * static_cast<double>(b.label.size()) * 0.8)) {
-      os << "<text x='" << f.px(b.t0) + w / 2 << "' y='" << f.py(top) - 3 << "' font-size='10' text-anchor='middle' fill='"
-         << b.colour << "'>" << esc(b.label) << "</text>\n";
+      os << "<text x='" << f.px(b.t0) + w / 2 << "' y='" << f.py(top) - 3
+         << "' font-size='10' text-anchor='middle' fill='" << b.colour << "'>" << esc(b.label) << "</text>\n";
     }
   }
   for (const auto& m : t.markers) {
-    os << "<line x1='" << f.px(m.t) << "' x2='" << f.px(m.t) << "' y1='" << f.top << "' y2='" << f.h - f.bottom
-       << "' stroke='" << m.colour << "' stroke-width='2'/><text x='" << f.px(m.t) - 4 << "' y='" << f.top + 12
-       << "' font-size='11' text-anchor='end' fill='" << m.colour << "'>" << esc(m.label) << "</text>\n";
+    os << "<line x1='" << f.px(m.t) << "' x2='" << f.px(m.t) << "' y1='" << f.top << "' y2='"
+       << f.h - f.bottom << "' stroke='" << m.colour << "' stroke-width='2'/><text x='" << f.px(m.t) - 4
+       << "' y='" << f.top + 12 << "' font-size='11' text-anchor='end' fill='" << m.colour << "'>"
+       << esc(m.label) << "</text>\n";
   }
   os << "</svg>\n";
   return os.str();

@@ -19,7 +19,9 @@
 
 namespace loom::firmware::serve {
 
-const char* version() { return LOOM_VERSION; }
+const char* version() {
+  return LOOM_VERSION;
+}
 
 namespace {
 
@@ -80,7 +82,8 @@ std::string ctl_socket(const CtlArgs& a, std::string& how) {
     if (it->path().extension() == ".sock") socks.push_back(it->path().filename().string());
   }
   if (ec && ec != std::errc::no_such_file_or_directory) {
-    throw std::runtime_error("cannot list " + a.run_dir + ": " + ec.message() + ctl_permission_advice(a.run_dir));
+    throw std::runtime_error("cannot list " + a.run_dir + ": " + ec.message() +
+                             ctl_permission_advice(a.run_dir));
   }
   std::sort(socks.begin(), socks.end());
   if (socks.size() == 1) {
@@ -126,7 +129,8 @@ int ctl_main(const CtlArgs& a) {
   try {
     reply = control_request(path, request, a.timeout_ms);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "loomctl ctl: %s (%s)%s\n", e.what(), how.c_str(), ctl_permission_advice(path).c_str());
+    std::fprintf(stderr, "loomctl ctl: %s (%s)%s\n", e.what(), how.c_str(),
+                 ctl_permission_advice(path).c_str());
     return 1;
   }
   // Only `ok ...` (and the reading commands' text) means done: a refusal says why and exits 1.
@@ -165,12 +169,14 @@ BoardCommands::BoardCommands(CLI::App& app) {
   serve_ = app.add_subcommand("serve",
                               "run as the loom's service: configure, arm and wait for operator commands "
                               "(control socket, I/O-node buttons); what the systemd unit runs");
-  serve_->add_option("--config", s.config, "loom config (TOML); default /etc/loomctl/loom.toml, else embedded")
+  serve_
+      ->add_option("--config", s.config, "loom config (TOML); default /etc/loomctl/loom.toml, else embedded")
       ->check(CLI::ExistingFile);
   serve_->add_option("--scene", s.scene, "simulation scene (sim HAL)")->check(CLI::ExistingFile);
   serve_->add_option("--hal", s.hal, "sim | socketcan")->check(CLI::IsMember({"sim", "socketcan"}));
   serve_->add_option("--iface", s.iface, "SocketCAN interface (with --hal socketcan), e.g. can0");
-  serve_->add_option("--state-dir", s.state_dir, "counters, machine state and fault history (default /var/lib/loomctl)");
+  serve_->add_option("--state-dir", s.state_dir,
+                     "counters, machine state and fault history (default /var/lib/loomctl)");
   serve_->add_option("--socket", s.socket, "control socket path (default /run/loomctl/<loom-id>.sock)");
   serve_->add_option("--group", s.group, "group given the control socket (default loom; \"\" = none)");
   serve_->add_option("--loom-id", s.loom_id, "loom id (overrides the config)");
@@ -179,27 +185,35 @@ BoardCommands::BoardCommands(CLI::App& app) {
   serve_->add_option("--rows", s.rows, "rows woven per start (default 0: until stop)");
   serve_->add_option("--pace", s.pace, "sim HAL: run this many times faster than real time")
       ->check(CLI::Range(0.01, 1000.0));
-  serve_->add_option("--rt-priority", s.rt_priority, "SCHED_FIFO priority of the loop thread (0: SCHED_OTHER)")
+  serve_
+      ->add_option("--rt-priority", s.rt_priority, "SCHED_FIFO priority of the loop thread (0: SCHED_OTHER)")
       ->check(CLI::Range(0, 99));
-  serve_->add_option("--cpu", s.cpu, "pin the loop thread to this (isolated) CPU; -1 = any")->check(CLI::Range(-1, 1023));
-  serve_->add_option("--overrun-stop", s.overrun_stop, "consecutive overruns that stop the loom safely (0: never; default timing.overrun_stop_after on hardware, never in simulation)");
+  serve_->add_option("--cpu", s.cpu, "pin the loop thread to this (isolated) CPU; -1 = any")
+      ->check(CLI::Range(-1, 1023));
+  serve_->add_option("--overrun-stop", s.overrun_stop,
+                     "consecutive overruns that stop the loom safely (0: never; default "
+                     "timing.overrun_stop_after on hardware, never in simulation)");
   serve_->add_flag("--allow-degraded", s.allow_degraded, "arm on hardware even if mlockall/SCHED_FIFO fail");
 
   CtlArgs& c = *ctl_args_;
   ctl_ = app.add_subcommand("ctl", "send an operator command to a running `loomctl serve`");
-  ctl_->add_option("command", c.command,
-                   "start | pause | resume | stop (at row end) | ack (a fault) | status | faults (history and "
-                   "commands) | next | pair NAME (a code for a panel client) | unpair NAME | pairs")
+  ctl_->add_option(
+          "command", c.command,
+          "start | pause | resume | stop (at row end) | ack (a fault) | status | faults (history and "
+          "commands) | next | pair NAME (a code for a panel client) | unpair NAME | pairs")
       ->required()
-      ->check(CLI::IsMember({"start", "pause", "resume", "stop", "ack", "status", "faults", "next", "pair", "unpair",
-                             "pairs"}));
+      ->check(CLI::IsMember({"start", "pause", "resume", "stop", "ack", "status", "faults", "next", "pair",
+                             "unpair", "pairs"}));
   ctl_->add_option("name", c.name, "pair/unpair: the client's name (letters, digits, _ - .)");
-  ctl_->add_option("--hours", c.hours, "pair: how long the pairing lasts (default 12)")->check(CLI::Range(1, 168));
+  ctl_->add_option("--hours", c.hours, "pair: how long the pairing lasts (default 12)")
+      ->check(CLI::Range(1, 168));
   ctl_->add_option("--socket", c.socket, "control socket (default /run/loomctl/<loom-id>.sock)");
-  ctl_->add_option("--loom-id", c.loom_id,
-                   "loom id (default: the board's, LOOMCTL_LOOM_ID in /etc/loomctl/loom-id; without that file "
-                   "the only socket in /run/loomctl)");
-  ctl_->add_option("--timeout-ms", c.timeout_ms, "how long to wait for the reply")->check(CLI::Range(1, 600000));
+  ctl_->add_option(
+      "--loom-id", c.loom_id,
+      "loom id (default: the board's, LOOMCTL_LOOM_ID in /etc/loomctl/loom-id; without that file "
+      "the only socket in /run/loomctl)");
+  ctl_->add_option("--timeout-ms", c.timeout_ms, "how long to wait for the reply")
+      ->check(CLI::Range(1, 600000));
 }
 
 std::optional<int> BoardCommands::run() const {

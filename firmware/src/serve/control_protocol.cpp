@@ -6,7 +6,9 @@ namespace {
 
 constexpr std::size_t kMaxLine = 512, kMaxToken = 128, kMaxFields = 8;
 
-bool printable(char c) { return c > ' ' && c < 0x7F; }
+bool printable(char c) {
+  return c > ' ' && c < 0x7F;
+}
 
 std::optional<CommandClass> class_of(std::string_view w) {
   if (w == "stop" || w == "pause") return CommandClass::kStopping;

@@ -52,8 +52,10 @@ Peer peer_of(int fd) {
   passwd pw{};
   passwd* found = nullptr;
   char buf[1024];
-  if (::getpwuid_r(cred.uid, &pw, buf, sizeof buf, &found) == 0 && found != nullptr) p.user = found->pw_name;
-  else p.user = "uid " + std::to_string(cred.uid);
+  if (::getpwuid_r(cred.uid, &pw, buf, sizeof buf, &found) == 0 && found != nullptr)
+    p.user = found->pw_name;
+  else
+    p.user = "uid " + std::to_string(cred.uid);
   return p;
 }
 
@@ -74,7 +76,8 @@ std::string describe(const Peer& p) {
   return "local user " + p.user + " (uid " + std::to_string(p.uid) + ", pid " + std::to_string(p.pid) + ")";
 }
 
-ControlServer::ControlServer(std::string path, std::string group_name, RequestHandler handler, ControlLimits limits)
+ControlServer::ControlServer(std::string path, std::string group_name, RequestHandler handler,
+                             ControlLimits limits)
     : path_(std::move(path)), handler_(std::move(handler)), limits_(limits) {
   const sockaddr_un addr = make_addr(path_);
   const std::filesystem::path dir = std::filesystem::path(path_).parent_path();
@@ -86,15 +89,18 @@ ControlServer::ControlServer(std::string path, std::string group_name, RequestHa
   }
   // Something already at the path: a live server → refuse; a stale socket (connect refused) → replace;
   // anything that is not a socket (a file, a link, a folder) is never deleted.
-  struct stat st{};
+  struct stat st {};
   if (::lstat(path_.c_str(), &st) == 0) {
     if (!S_ISSOCK(st.st_mode)) {
-      throw std::runtime_error("control socket path " + path_ + " exists and is not a socket: refusing to replace it");
+      throw std::runtime_error("control socket path " + path_ +
+                               " exists and is not a socket: refusing to replace it");
     }
     const int probe = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
-    const bool live = probe >= 0 && ::connect(probe, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) == 0;
+    const bool live =
+        probe >= 0 && ::connect(probe, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) == 0;
     if (probe >= 0) ::close(probe);
-    if (live) throw std::runtime_error("control socket " + path_ + " is in use: another loomctl serve is running");
+    if (live)
+      throw std::runtime_error("control socket " + path_ + " is in use: another loomctl serve is running");
     ::unlink(path_.c_str());
   }
   fd_ = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
@@ -115,10 +121,12 @@ ControlServer::ControlServer(std::string path, std::string group_name, RequestHa
         group_note_ = "cannot give " + path_ + " to group '" + group_name + "': " + std::strerror(errno);
       }
     } else {
-      group_note_ = "group '" + group_name + "' does not exist; " + path_ + " stays with the service's own group";
+      group_note_ =
+          "group '" + group_name + "' does not exist; " + path_ + " stays with the service's own group";
     }
   }
-  alive_ns_.store(std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count());
+  alive_ns_.store(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count());
   thread_ = std::thread([this] { serve(); });
 }
 
@@ -157,11 +165,13 @@ void ControlServer::serve() {
     return true;
   };
   while (!stop_.load()) {
-    alive_ns_.store(std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count(),
-                    std::memory_order_relaxed);
+    alive_ns_.store(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count(),
+        std::memory_order_relaxed);
     fds.clear();
     fds.push_back({clients.size() < limits_.max_clients ? fd_ : -1, POLLIN, 0});
-    Clock::time_point next = Clock::now() + std::chrono::milliseconds(100);  // notice stop_ at least this often
+    Clock::time_point next =
+        Clock::now() + std::chrono::milliseconds(100);  // notice stop_ at least this often
     for (const Client& c : clients) {
       fds.push_back({c.fd, static_cast<short>(c.replying ? POLLOUT : POLLIN), 0});
       if (c.deadline < next) next = c.deadline;
@@ -195,7 +205,8 @@ void ControlServer::serve() {
         continue;
       }
       if (c.replying && (rev & (POLLOUT | POLLHUP | POLLERR)) != 0) {
-        const ssize_t w = ::send(c.fd, c.out.data() + c.written, c.out.size() - c.written, MSG_NOSIGNAL | MSG_DONTWAIT);
+        const ssize_t w =
+            ::send(c.fd, c.out.data() + c.written, c.out.size() - c.written, MSG_NOSIGNAL | MSG_DONTWAIT);
         if (w < 0 && (errno == EAGAIN || errno == EINTR)) continue;
         if (w <= 0) {
           drop(k, true);

@@ -20,9 +20,12 @@ bool journal_prefix_enabled() {
 std::string journal_line(Severity s, const std::string& text, bool prefix) {
   if (prefix) return "<" + std::to_string(static_cast<int>(s)) + ">" + text;
   switch (s) {
-    case Severity::kErr: return "ERROR: " + text;
-    case Severity::kWarning: return "WARNING: " + text;
-    default: return text;
+    case Severity::kErr:
+      return "ERROR: " + text;
+    case Severity::kWarning:
+      return "WARNING: " + text;
+    default:
+      return text;
   }
 }
 

@@ -82,12 +82,16 @@ std::string OperatorDesk::refuse_for_state(const ParsedRequest& r, const LoomVie
     return v.state == State::kPaused ? "" : "not paused (state " + state + ")";
   }
   if (w == "stop") {
-    return weaving(v.state) || v.state == State::kPaused ? "" : "not weaving (state " + state + "): nothing to stop";
+    return weaving(v.state) || v.state == State::kPaused
+               ? ""
+               : "not weaving (state " + state + "): nothing to stop";
   }
   if (w == "next") {
     // The knotting heads' request (a knot to tie by hand, a slot to reload) is answered the same way.
     if (v.state == State::kKnotting) {
-      return v.weaver_ask != sequencer::WeaverAsk::kNone ? "" : "the knotting heads are not waiting for the weaver";
+      return v.weaver_ask != sequencer::WeaverAsk::kNone
+                 ? ""
+                 : "the knotting heads are not waiting for the weaver";
     }
     if (!v.knotting) return "this loom has no weaver's knotting (knotting.mode is not \"weaver\")";
     return v.state == State::kAwaitKnotting ? "" : "not waiting for the weaver (state " + state + ")";
@@ -96,7 +100,8 @@ std::string OperatorDesk::refuse_for_state(const ParsedRequest& r, const LoomVie
     if (v.state != State::kFault) return "no fault is latched (state " + state + ")";
     if (!v.estop_ok) return "the e-stop chain is still open: close it (release the e-stop), then acknowledge";
     if (v.counters_unsaved) {
-      return "the counters woven are not on disk yet (the last save failed): free space in the state directory; "
+      return "the counters woven are not on disk yet (the last save failed): free space in the state "
+             "directory; "
              "the save is retried every second, then acknowledge";
     }
     if (v.recovery == hal::LinkRecovery::kBusOff) {
@@ -136,7 +141,8 @@ Decision OperatorDesk::decide(const ControlRequest& req, const LoomView& v, std:
       unpaired_why = elsewhere ? "token of another device" : "token unknown or expired";
     }
     d.who = "panel client " + r.field("client") +
-            (paired ? " paired as " + paired->name : " (" + unpaired_why + ")") + " via " + describe(req.peer);
+            (paired ? " paired as " + paired->name : " (" + unpaired_why + ")") + " via " +
+            describe(req.peer);
   }
   const auto refuse = [&](const std::string& why) {
     d.reply = "refused: " + r.word + ": " + why + "\n";
@@ -144,12 +150,18 @@ Decision OperatorDesk::decide(const ControlRequest& req, const LoomView& v, std:
   };
   switch (r.cls) {
     case CommandClass::kReading:
-      if (r.word == "status") d.read = Decision::Read::kStatus;
-      else if (r.word == "faults") d.read = Decision::Read::kFaults;
+      if (r.word == "status")
+        d.read = Decision::Read::kStatus;
+      else if (r.word == "faults")
+        d.read = Decision::Read::kFaults;
       else if (r.word == "whoami") {
-        if (!r.via_panel()) d.reply = "ok whoami local " + d.who + " may_start=1\n";
-        else if (paired) d.reply = "ok whoami paired " + paired->name + " expires=" + utc(paired->expires_s) + " may_start=1\n";
-        else return refuse("not paired: stopping commands only");
+        if (!r.via_panel())
+          d.reply = "ok whoami local " + d.who + " may_start=1\n";
+        else if (paired)
+          d.reply =
+              "ok whoami paired " + paired->name + " expires=" + utc(paired->expires_s) + " may_start=1\n";
+        else
+          return refuse("not paired: stopping commands only");
       } else {  // pairs
         std::string out;
         for (const Pairing& p : pairings_.list(now_s)) {
@@ -170,7 +182,8 @@ Decision OperatorDesk::decide(const ControlRequest& req, const LoomView& v, std:
                   " valid_s=" + std::to_string(p->expires_s - now_s) + "\n";
         return d;
       }
-      if (r.via_panel()) return refuse("pairing is done at the loom (its local socket), never through a panel");
+      if (r.via_panel())
+        return refuse("pairing is done at the loom (its local socket), never through a panel");
       if (r.word == "pair") {
         int hours = Pairings::kDefaultHours;
         if (!r.field("hours").empty()) {
@@ -182,8 +195,9 @@ Decision OperatorDesk::decide(const ControlRequest& req, const LoomView& v, std:
           hours = std::stoi(h);
         }
         const std::string code = pairings_.new_code(r.arg, hours, now_s);
-        d.reply = "ok pair " + r.arg + " code=" + code + " valid=" + std::to_string(Pairings::kCodeLifetimeS) +
-                  "s hours=" + std::to_string(hours) + " (enter the code on the panel's pairing field)\n";
+        d.reply = "ok pair " + r.arg + " code=" + code +
+                  " valid=" + std::to_string(Pairings::kCodeLifetimeS) + "s hours=" + std::to_string(hours) +
+                  " (enter the code on the panel's pairing field)\n";
         return d;
       }
       {  // unpair
@@ -205,12 +219,18 @@ Decision OperatorDesk::decide(const ControlRequest& req, const LoomView& v, std:
                   "; pair it with `loomctl ctl pair NAME` at the loom)");
   }
   if (auto why = refuse_for_state(r, v); !why.empty()) return refuse(why);
-  if (r.word == "start") d.post = Command::kStart;
-  else if (r.word == "pause") d.post = Command::kPause;
-  else if (r.word == "resume") d.post = Command::kResume;
-  else if (r.word == "stop") d.post = Command::kStop;
-  else if (r.word == "ack") d.post = Command::kAck;
-  else d.post = Command::kNext;
+  if (r.word == "start")
+    d.post = Command::kStart;
+  else if (r.word == "pause")
+    d.post = Command::kPause;
+  else if (r.word == "resume")
+    d.post = Command::kResume;
+  else if (r.word == "stop")
+    d.post = Command::kStop;
+  else if (r.word == "ack")
+    d.post = Command::kAck;
+  else
+    d.post = Command::kNext;
   d.reply = "ok " + r.word + "\n";
   return d;
 }

@@ -19,7 +19,8 @@ bool same(const std::string& a, const std::string& b) {
 }
 
 void expire(std::vector<Pairing>& v, std::int64_t now_s) {
-  v.erase(std::remove_if(v.begin(), v.end(), [&](const Pairing& p) { return p.expires_s <= now_s; }), v.end());
+  v.erase(std::remove_if(v.begin(), v.end(), [&](const Pairing& p) { return p.expires_s <= now_s; }),
+          v.end());
 }
 
 }  // namespace
@@ -30,7 +31,8 @@ std::string random_hex(std::size_t bytes) {
   while (got < bytes) {
     const ssize_t n = ::getrandom(raw.data() + got, bytes - got, 0);
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) throw std::runtime_error(std::string("no random bytes from the kernel: ") + std::strerror(errno));
+    if (n <= 0)
+      throw std::runtime_error(std::string("no random bytes from the kernel: ") + std::strerror(errno));
     got += static_cast<std::size_t>(n);
   }
   static const char kHex[] = "0123456789abcdef";
@@ -43,8 +45,9 @@ std::string random_hex(std::size_t bytes) {
 }
 
 bool device_secret_shape(const std::string& s) {
-  return s.size() >= 32 && s.size() <= 64 &&
-         std::all_of(s.begin(), s.end(), [](char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'); });
+  return s.size() >= 32 && s.size() <= 64 && std::all_of(s.begin(), s.end(), [](char c) {
+           return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f');
+         });
 }
 
 std::string Pairings::new_code(const std::string& name, int hours, std::int64_t now_s) {
@@ -62,8 +65,8 @@ std::string Pairings::new_code(const std::string& name, int hours, std::int64_t 
   return code_;
 }
 
-std::optional<Pairing> Pairings::redeem(const std::string& code, const std::string& client, const std::string& device,
-                                        std::int64_t now_s, std::string& error) {
+std::optional<Pairing> Pairings::redeem(const std::string& code, const std::string& client,
+                                        const std::string& device, std::int64_t now_s, std::string& error) {
   if (!device_secret_shape(device)) {
     error = "no device secret came with the code (the panel's page keeps one: reload the page and try again)";
     return std::nullopt;
@@ -76,7 +79,8 @@ std::optional<Pairing> Pairings::redeem(const std::string& code, const std::stri
   if (now_s >= code_expires_s_) {
     code_.clear();
     tries_.clear();
-    error = "the pairing code expired (codes last " + std::to_string(kCodeLifetimeS) + " s): ask for a new one";
+    error =
+        "the pairing code expired (codes last " + std::to_string(kCodeLifetimeS) + " s): ask for a new one";
     return std::nullopt;
   }
   // This address' wrong tries: out of them, or still waiting after the last one. Judged before the code
@@ -88,7 +92,8 @@ std::optional<Pairing> Pairings::redeem(const std::string& code, const std::stri
       return std::nullopt;
     }
     if (now_s < t->second.next_s) {
-      error = "wrong codes from this device: wait " + std::to_string(t->second.next_s - now_s) + " s, then try again";
+      error = "wrong codes from this device: wait " + std::to_string(t->second.next_s - now_s) +
+              " s, then try again";
       return std::nullopt;
     }
   }
@@ -104,8 +109,8 @@ std::optional<Pairing> Pairings::redeem(const std::string& code, const std::stri
     } else if (t.wrong >= kCodeTries) {
       error = "wrong pairing code; no tries left from this device: ask for a new code at the loom";
     } else {
-      error = "wrong pairing code (" + std::to_string(kCodeTries - t.wrong) + " tries left from this device; the next in " +
-              std::to_string(t.next_s - now_s) + " s)";
+      error = "wrong pairing code (" + std::to_string(kCodeTries - t.wrong) +
+              " tries left from this device; the next in " + std::to_string(t.next_s - now_s) + " s)";
     }
     return std::nullopt;
   }
@@ -113,13 +118,14 @@ std::optional<Pairing> Pairings::redeem(const std::string& code, const std::stri
   tries_.clear();
   expire(pairings_, now_s);
   if (pairings_.size() >= kMaxPairings) pairings_.erase(pairings_.begin());  // the oldest goes
-  Pairing p{code_name_, random_hex(16), now_s + static_cast<std::int64_t>(code_hours_) * 3600, client, device};
+  Pairing p{code_name_, random_hex(16), now_s + static_cast<std::int64_t>(code_hours_) * 3600, client,
+            device};
   pairings_.push_back(p);
   return p;
 }
 
-std::optional<Pairing> Pairings::find(const std::string& token, const std::string& client, const std::string& device,
-                                      std::int64_t now_s, bool* elsewhere) const {
+std::optional<Pairing> Pairings::find(const std::string& token, const std::string& client,
+                                      const std::string& device, std::int64_t now_s, bool* elsewhere) const {
   if (elsewhere != nullptr) *elsewhere = false;
   if (token.size() != 32) return std::nullopt;
   std::lock_guard<std::mutex> lock(mu_);
@@ -141,8 +147,9 @@ std::optional<Pairing> Pairings::find(const std::string& token, const std::strin
 int Pairings::revoke(const std::string& name) {
   std::lock_guard<std::mutex> lock(mu_);
   const auto before = pairings_.size();
-  pairings_.erase(std::remove_if(pairings_.begin(), pairings_.end(), [&](const Pairing& p) { return p.name == name; }),
-                  pairings_.end());
+  pairings_.erase(
+      std::remove_if(pairings_.begin(), pairings_.end(), [&](const Pairing& p) { return p.name == name; }),
+      pairings_.end());
   if (code_name_ == name) code_.clear();
   return static_cast<int>(before - pairings_.size());
 }

@@ -12,13 +12,16 @@ namespace loom::firmware::serve {
 
 SystemdNotifier::SystemdNotifier() {
   const char* sock = std::getenv("NOTIFY_SOCKET");
-  if (sock == nullptr || (sock[0] != '/' && sock[0] != '@') || std::strlen(sock) >= sizeof(sockaddr_un::sun_path)) return;
+  if (sock == nullptr || (sock[0] != '/' && sock[0] != '@') ||
+      std::strlen(sock) >= sizeof(sockaddr_un::sun_path))
+    return;
   address_ = sock;
   fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
   const char* usec = std::getenv("WATCHDOG_USEC");
   const char* wpid = std::getenv("WATCHDOG_PID");
   // WATCHDOG_PID, when set, names the process the watchdog is meant for (not a child we might run).
-  const bool for_me = wpid == nullptr || std::strtoll(wpid, nullptr, 10) == static_cast<long long>(::getpid());
+  const bool for_me =
+      wpid == nullptr || std::strtoll(wpid, nullptr, 10) == static_cast<long long>(::getpid());
   if (usec != nullptr && for_me) {
     char* end = nullptr;
     const long long us = std::strtoll(usec, &end, 10);
@@ -37,8 +40,8 @@ bool SystemdNotifier::notify(const std::string& state) const {
   std::memcpy(sa.sun_path, address_.data(), address_.size());
   if (address_[0] == '@') sa.sun_path[0] = '\0';  // abstract namespace
   const auto len = static_cast<socklen_t>(offsetof(sockaddr_un, sun_path) + address_.size());
-  return ::sendto(fd_, state.data(), state.size(), MSG_NOSIGNAL, reinterpret_cast<const sockaddr*>(&sa), len) ==
-         static_cast<ssize_t>(state.size());
+  return ::sendto(fd_, state.data(), state.size(), MSG_NOSIGNAL, reinterpret_cast<const sockaddr*>(&sa),
+                  len) == static_cast<ssize_t>(state.size());
 }
 
 void LoopWatchdog::poll(std::int64_t loop_tick, std::int64_t now_ns, std::int64_t control_idle_ns) {

@@ -24,7 +24,8 @@ double seconds(hal::Tick ticks, std::int64_t period_ns) noexcept {
 }
 
 std::string axis_or_empty(const hal::AxisLayout& axes, int axis) {
-  return axis >= 0 && static_cast<std::size_t>(axis) < axes.count ? axes.name(static_cast<std::size_t>(axis)) : std::string();
+  return axis >= 0 && static_cast<std::size_t>(axis) < axes.count ? axes.name(static_cast<std::size_t>(axis))
+                                                                  : std::string();
 }
 
 }  // namespace
@@ -72,7 +73,8 @@ loomlcm::status_t to_status(const Snapshot& s, const std::string& loom_id, std::
   m.first_fault_code = s.first_fault_code;
   m.fault_axis = faulted ? axis_or_empty(axes, s.fault_axis) : std::string();
   m.fault_device_code = faulted ? s.fault_device_code : 0;
-  m.fault_text = faulted ? with_sensor(sequencer::fault_text(fault_of(s.first_fault)), s.fault_sensor) : std::string();
+  m.fault_text =
+      faulted ? with_sensor(sequencer::fault_text(fault_of(s.first_fault)), s.fault_sensor) : std::string();
   m.fault_time_s = faulted && s.fault_tick >= 0 ? seconds(s.fault_tick, s.period_ns) : 0.0;
   m.stopped_by = faulted ? sequencer::fault_name(fault_of(s.stopped_by)) : "";
   m.outputs = s.outputs;
@@ -138,9 +140,12 @@ loomlcm::rt_stats_t to_rt_stats(const Snapshot& s, const std::string& loom_id, s
 
 const char* fault_kind_name(Event::FaultKind k) noexcept {
   switch (k) {
-    case Event::FaultKind::kFirst: return "first";
-    case Event::FaultKind::kDiagnosis: return "diagnosis";
-    case Event::FaultKind::kDevice: return "device";
+    case Event::FaultKind::kFirst:
+      return "first";
+    case Event::FaultKind::kDiagnosis:
+      return "diagnosis";
+    case Event::FaultKind::kDevice:
+      return "device";
   }
   return "unknown";
 }
@@ -217,8 +222,9 @@ loomlcm::row_t to_row(const Event& e, const std::string& loom_id, std::int64_t u
 
 namespace {
 sequencer::WeaverAsk ask_of(std::uint8_t v) noexcept {
-  return v <= static_cast<std::uint8_t>(sequencer::WeaverAsk::kCheckKnot) ? static_cast<sequencer::WeaverAsk>(v)
-                                                                          : sequencer::WeaverAsk::kNone;
+  return v <= static_cast<std::uint8_t>(sequencer::WeaverAsk::kCheckKnot)
+             ? static_cast<sequencer::WeaverAsk>(v)
+             : sequencer::WeaverAsk::kNone;
 }
 std::string slot_colour_or_empty(const sequencer::KnotProgram* p, int slot) {
   return p != nullptr && slot >= 0 && slot < p->slots() ? p->slot_colour(slot) : std::string();
@@ -258,7 +264,8 @@ loomlcm::knots_t to_knots(const Snapshot& s, const sequencer::KnotProgram& p, co
   m.head_knot.resize(static_cast<std::size_t>(m.heads));
   m.head_slot.resize(static_cast<std::size_t>(m.heads));
   m.head_colour.resize(static_cast<std::size_t>(m.heads));
-  m.stock.assign(static_cast<std::size_t>(m.heads), std::vector<std::int32_t>(static_cast<std::size_t>(m.slots)));
+  m.stock.assign(static_cast<std::size_t>(m.heads),
+                 std::vector<std::int32_t>(static_cast<std::size_t>(m.slots)));
   for (int h = 0; h < m.heads; ++h) {
     const auto hh = static_cast<std::size_t>(h);
     const int knot = k.cycle >= 0 ? p.knot_of(h, k.cycle) : -1;
@@ -266,7 +273,8 @@ loomlcm::knots_t to_knots(const Snapshot& s, const sequencer::KnotProgram& p, co
     m.head_knot[hh] = static_cast<std::int16_t>(knot);
     m.head_slot[hh] = static_cast<std::int16_t>(slot);
     m.head_colour[hh] = slot_colour_or_empty(&p, slot);
-    for (int sl = 0; sl < m.slots; ++sl) m.stock[hh][static_cast<std::size_t>(sl)] = k.stock[hh][static_cast<std::size_t>(sl)];
+    for (int sl = 0; sl < m.slots; ++sl)
+      m.stock[hh][static_cast<std::size_t>(sl)] = k.stock[hh][static_cast<std::size_t>(sl)];
   }
   m.slot_colour.resize(static_cast<std::size_t>(m.slots));
   for (int sl = 0; sl < m.slots; ++sl) m.slot_colour[static_cast<std::size_t>(sl)] = p.slot_colour(sl);
@@ -315,8 +323,8 @@ loomlcm::weaver_request_t to_weaver_request(const Event& e, const sequencer::Kno
   if (p != nullptr) {
     m.text = sequencer::describe(q, *p);
   } else {
-    m.text = "row " + std::to_string(e.row) + ": " + m.ask + " knot " + std::to_string(e.knot + 1) + " head " +
-             std::to_string(e.head + 1) + " slot " + std::to_string(e.slot);
+    m.text = "row " + std::to_string(e.row) + ": " + m.ask + " knot " + std::to_string(e.knot + 1) +
+             " head " + std::to_string(e.head + 1) + " slot " + std::to_string(e.slot);
   }
   return m;
 }

@@ -1,9 +1,9 @@
 #include "loom/telemetry/identity.hpp"
 
+#include <lcm/lcm.h>
 #include <poll.h>
 #include <unistd.h>
 
-#include <lcm/lcm.h>
 #include <random>
 #include <stdexcept>
 
@@ -16,7 +16,8 @@ namespace loom::telemetry {
 std::int64_t process_instance() {
   static const std::int64_t instance = [] {
     std::random_device rd;
-    const std::uint64_t v = (static_cast<std::uint64_t>(rd()) << 32) ^ rd() ^ static_cast<std::uint64_t>(::getpid());
+    const std::uint64_t v =
+        (static_cast<std::uint64_t>(rd()) << 32) ^ rd() ^ static_cast<std::uint64_t>(::getpid());
     return static_cast<std::int64_t>(v >> 1) + 1;  // never 0
   }();
   return instance;
@@ -63,8 +64,10 @@ void on_status(const lcm_recv_buf_t* rbuf, const char* channel, void* user) {
   if (m.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) < 0) return;
   l.status_seen = true;
   const std::int64_t age_s = (l.now_utime - m.utime) / 1'000'000;
-  l.status_note = "a publisher that sends no IDENTITY (" + std::string(channel) + " heard, state " + m.state +
-                  (age_s > 60 || age_s < -60 ? ", stamped " + std::to_string(age_s) + " s ago: a replayed recording?)" : ")");
+  l.status_note =
+      "a publisher that sends no IDENTITY (" + std::string(channel) + " heard, state " + m.state +
+      (age_s > 60 || age_s < -60 ? ", stamped " + std::to_string(age_s) + " s ago: a replayed recording?)"
+                                 : ")");
 }
 
 }  // namespace
@@ -72,18 +75,21 @@ void on_status(const lcm_recv_buf_t* rbuf, const char* channel, void* user) {
 std::string other_publisher(const std::string& lcm_url, const std::string& prefix, const std::string& loom_id,
                             std::chrono::milliseconds window) {
   lcm_t* lcm = lcm_create(lcm_url.empty() ? nullptr : lcm_url.c_str());
-  if (lcm == nullptr) throw std::invalid_argument("telemetry lcm_url '" + lcm_url + "' could not be opened by LCM");
+  if (lcm == nullptr)
+    throw std::invalid_argument("telemetry lcm_url '" + lcm_url + "' could not be opened by LCM");
   const ChannelNames ch = channel_names(prefix, loom_id);
   Listener l;
   l.now_utime = std::chrono::duration_cast<std::chrono::microseconds>(
-                    std::chrono::system_clock::now().time_since_epoch()).count();
+                    std::chrono::system_clock::now().time_since_epoch())
+                    .count();
   lcm_subscription_t* s1 = lcm_subscribe(lcm, ch.identity.c_str(), on_identity, &l);
   lcm_subscription_t* s2 = lcm_subscribe(lcm, ch.status.c_str(), on_status, &l);
   const auto end = std::chrono::steady_clock::now() + window;
   // Our own STATUS never comes in here: nothing of this process publishes while it listens (a previous
   // session's publisher was stopped before), and IDENTITY of our own instance is ignored.
   while (l.heard.empty()) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now());
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now());
     if (left.count() <= 0) break;
     pollfd p{lcm_get_fileno(lcm), POLLIN, 0};
     if (::poll(&p, 1, static_cast<int>(left.count())) > 0) lcm_handle(lcm);

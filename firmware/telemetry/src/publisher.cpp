@@ -8,9 +8,9 @@
 #include <span>
 #include <stdexcept>
 
+#include "loom/sequencer/knot_program.hpp"
 #include "loom/telemetry/encode.hpp"
 #include "loom/telemetry/identity.hpp"
-#include "loom/sequencer/knot_program.hpp"
 
 namespace loom::telemetry {
 
@@ -161,9 +161,15 @@ void Publisher::publish_event(const Event& e) {
   const std::int64_t utime = wall_utime();
   try {
     switch (e.kind) {
-      case Event::Kind::kBeat: send(channels_.beat, to_beat(e, cfg_.loom_id, utime), n_beat_); break;
-      case Event::Kind::kFault: send(channels_.fault, to_fault(e, cfg_.loom_id, utime, cfg_.axes), n_fault_); break;
-      case Event::Kind::kRow: send(channels_.row, to_row(e, cfg_.loom_id, utime), n_row_); break;
+      case Event::Kind::kBeat:
+        send(channels_.beat, to_beat(e, cfg_.loom_id, utime), n_beat_);
+        break;
+      case Event::Kind::kFault:
+        send(channels_.fault, to_fault(e, cfg_.loom_id, utime, cfg_.axes), n_fault_);
+        break;
+      case Event::Kind::kRow:
+        send(channels_.row, to_row(e, cfg_.loom_id, utime), n_row_);
+        break;
       case Event::Kind::kWeaver:
         send(channels_.weaver, to_weaver_request(e, cfg_.knot_program, cfg_.loom_id, utime), n_weaver_);
         break;
@@ -204,7 +210,9 @@ void Publisher::publish(const Snapshot& s) {
     }
     if (due.axes) send(channels_.axes, to_axes(s, cfg_.loom_id, utime, cfg_.axes), n_axes_);
     if (due.rt) {
-      send(channels_.rt, to_rt_stats(s, cfg_.loom_id, utime, ring_.dropped(), ring_.size_approx(), events_.dropped()), n_rt_);
+      send(channels_.rt,
+           to_rt_stats(s, cfg_.loom_id, utime, ring_.dropped(), ring_.size_approx(), events_.dropped()),
+           n_rt_);
     }
   } catch (const std::exception&) {
     // Out of memory while encoding: lose this message, keep the thread (and the loop) alive.

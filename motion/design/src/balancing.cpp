@@ -24,22 +24,36 @@ namespace {
   throw MotionError(ErrorCode::kInvalidInput, "balancing: " + what);
 }
 
-Eigen::Vector2d perp(const Eigen::Vector2d& v) { return {-v.y(), v.x()}; }
+Eigen::Vector2d perp(const Eigen::Vector2d& v) {
+  return {-v.y(), v.x()};
+}
 
 const char* nlopt_result_name(nlopt_result r) {
   switch (r) {
-    case NLOPT_SUCCESS: return "success";
-    case NLOPT_STOPVAL_REACHED: return "stopval reached";
-    case NLOPT_FTOL_REACHED: return "ftol reached";
-    case NLOPT_XTOL_REACHED: return "xtol reached";
-    case NLOPT_MAXEVAL_REACHED: return "evaluation budget spent";
-    case NLOPT_MAXTIME_REACHED: return "time budget spent";
-    case NLOPT_FAILURE: return "generic failure";
-    case NLOPT_INVALID_ARGS: return "invalid arguments";
-    case NLOPT_OUT_OF_MEMORY: return "out of memory";
-    case NLOPT_ROUNDOFF_LIMITED: return "round-off limited";
-    case NLOPT_FORCED_STOP: return "forced stop";
-    default: return "unknown";
+    case NLOPT_SUCCESS:
+      return "success";
+    case NLOPT_STOPVAL_REACHED:
+      return "stopval reached";
+    case NLOPT_FTOL_REACHED:
+      return "ftol reached";
+    case NLOPT_XTOL_REACHED:
+      return "xtol reached";
+    case NLOPT_MAXEVAL_REACHED:
+      return "evaluation budget spent";
+    case NLOPT_MAXTIME_REACHED:
+      return "time budget spent";
+    case NLOPT_FAILURE:
+      return "generic failure";
+    case NLOPT_INVALID_ARGS:
+      return "invalid arguments";
+    case NLOPT_OUT_OF_MEMORY:
+      return "out of memory";
+    case NLOPT_ROUNDOFF_LIMITED:
+      return "round-off limited";
+    case NLOPT_FORCED_STOP:
+      return "forced stop";
+    default:
+      return "unknown";
   }
 }
 
@@ -87,7 +101,7 @@ struct Problem {
   std::vector<double> q_fixed;  // mass parameters that the design does not change
   std::vector<double> lb, ub;
   double w1 = 0.5, w2 = 0.5;
-  ShakingRms ref;  // the unbalanced RMS values (normalisation)
+  ShakingRms ref;            // the unbalanced RMS values (normalisation)
   std::vector<double> cost;  // per design variable: objective per unit (the added-mass tie-break)
   // q(x) added to q_fixed, and the Jacobian dq/dx (rows: q index, cols: x index) into `jac`.
   virtual void map(const std::vector<double>& x, std::vector<double>& q, Eigen::MatrixXd& jac) const = 0;
@@ -115,7 +129,8 @@ struct Problem {
       grad_x->assign(x.size(), 0.0);
       for (std::size_t j = 0; j < x.size(); ++j) {
         double g = j < cost.size() ? cost[j] : 0.0;
-        for (std::size_t k = 0; k < q.size(); ++k) g += (sf * df[k] + sn * dn[k]) * jac(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j));
+        for (std::size_t k = 0; k < q.size(); ++k)
+          g += (sf * df[k] + sn * dn[k]) * jac(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j));
         (*grad_x)[j] = g;
       }
     }
@@ -124,7 +139,8 @@ struct Problem {
 
   // The reported objective: w1·F/F0 + w2·N/N0.
   double shaking_objective(const ShakingRms& r) const {
-    return w1 * r.force_n / std::max(ref.force_n, 1e-300) + w2 * r.moment_nm / std::max(ref.moment_nm, 1e-300);
+    return w1 * r.force_n / std::max(ref.force_n, 1e-300) +
+           w2 * r.moment_nm / std::max(ref.moment_nm, 1e-300);
   }
 
   ShakingRms rms_at(const std::vector<double>& x) const {
@@ -212,8 +228,9 @@ std::vector<double> fixed_parameters(const LinkageMotionSamples& s, bool include
 
 void finish(BalanceResult& b, const Problem& p, const RunResult& best, int evaluations) {
   if (best.x.empty()) {
-    throw MotionError(ErrorCode::kNoConvergence,
-                      "balancing: no optimiser start reached a finite objective (the shaking load overflows)");
+    throw MotionError(
+        ErrorCode::kNoConvergence,
+        "balancing: no optimiser start reached a finite objective (the shaking load overflows)");
   }
   b.after = p.rms_at(best.x);
   b.objective_after = p.shaking_objective(b.after);
@@ -221,11 +238,12 @@ void finish(BalanceResult& b, const Problem& p, const RunResult& best, int evalu
   b.evaluations = evaluations;
   b.nlopt_code = static_cast<int>(best.code);
   b.stop_reason = nlopt_result_name(best.code);
-  b.converged = best.code == NLOPT_SUCCESS || best.code == NLOPT_FTOL_REACHED || best.code == NLOPT_XTOL_REACHED ||
-                best.code == NLOPT_STOPVAL_REACHED;
+  b.converged = best.code == NLOPT_SUCCESS || best.code == NLOPT_FTOL_REACHED ||
+                best.code == NLOPT_XTOL_REACHED || best.code == NLOPT_STOPVAL_REACHED;
   if (best.code < 0 && best.code != NLOPT_ROUNDOFF_LIMITED) {
     std::ostringstream os;
-    os << "balancing (" << b.method << "): SLSQP failed: " << b.stop_reason << " (NLopt code " << b.nlopt_code << ")";
+    os << "balancing (" << b.method << "): SLSQP failed: " << b.stop_reason << " (NLopt code " << b.nlopt_code
+       << ")";
     throw MotionError(ErrorCode::kNoConvergence, os.str());
   }
 }
@@ -233,7 +251,9 @@ void finish(BalanceResult& b, const Problem& p, const RunResult& best, int evalu
 // ---- counterweights -------------------------------------------------------------------------------
 
 // A cast-iron disc of mass m and thickness t: central inertia ½mR² with πR²tρ = m, i.e. m²/(2πtρ).
-double disc_inertia(double m, double thickness, double density) { return m * m / (2.0 * kPi * thickness * density); }
+double disc_inertia(double m, double thickness, double density) {
+  return m * m / (2.0 * kPi * thickness * density);
+}
 
 struct CounterweightProblem : Problem {
   std::vector<std::size_t> link_of;  // per counterweight: the link it sits on
@@ -252,10 +272,15 @@ struct CounterweightProblem : Problem {
       const auto J = [&](std::size_t k, std::size_t j) -> double& {
         return jac(static_cast<Eigen::Index>(base + k), static_cast<Eigen::Index>(3 * c + j));
       };
-      J(0, 0) = 1.0; J(1, 0) = r * cs; J(2, 0) = r * sn;
+      J(0, 0) = 1.0;
+      J(1, 0) = r * cs;
+      J(2, 0) = r * sn;
       J(3, 0) = r * r + 2.0 * m / (2.0 * kPi * thickness * density);
-      J(1, 1) = m * cs; J(2, 1) = m * sn; J(3, 1) = 2.0 * m * r;
-      J(1, 2) = -m * r * sn; J(2, 2) = m * r * cs;
+      J(1, 1) = m * cs;
+      J(2, 1) = m * sn;
+      J(3, 1) = 2.0 * m * r;
+      J(1, 2) = -m * r * sn;
+      J(2, 2) = m * r * cs;
     }
   }
 };
@@ -281,13 +306,18 @@ struct RedistributionProblem : Problem {
         const double mj = x[4 * i + j];
         msum += mj;
         su += mj * u;
-        J(0, j) = 1.0; J(1, j) = l * u.x(); J(2, j) = l * u.y(); J(3, j) = l * l;
+        J(0, j) = 1.0;
+        J(1, j) = l * u.x();
+        J(2, j) = l * u.y();
+        J(3, j) = l * l;
       }
       q[4 * i] += msum;
       q[4 * i + 1] += l * su.x();
       q[4 * i + 2] += l * su.y();
       q[4 * i + 3] += l * l * msum;
-      J(1, 3) = su.x(); J(2, 3) = su.y(); J(3, 3) = 2.0 * l * msum;
+      J(1, 3) = su.x();
+      J(2, 3) = su.y();
+      J(3, 3) = 2.0 * l * msum;
     }
   }
 };
@@ -295,7 +325,8 @@ struct RedistributionProblem : Problem {
 }  // namespace
 
 MassParameters mass_parameters(const PlanarInertia& b) {
-  return {b.mass_kg, b.mass_kg * b.centre_m.x(), b.mass_kg * b.centre_m.y(), b.inertia_about(Eigen::Vector2d::Zero())};
+  return {b.mass_kg, b.mass_kg * b.centre_m.x(), b.mass_kg * b.centre_m.y(),
+          b.inertia_about(Eigen::Vector2d::Zero())};
 }
 
 ShakingModel::ShakingModel(const LinkageMotionSamples& s) : links_(s.links.size()), samples_(s.samples) {
@@ -311,7 +342,8 @@ ShakingModel::ShakingModel(const LinkageMotionSamples& s) : links_(s.links.size(
       E << 0, -1, 1, 0;
       // force = m a_o + K μ_world-from-local, K = (αE − ω²)R; moment about P:
       // (o−P)×force + (Rμ)×a_o + α I_O.
-      const Eigen::Matrix2d K = (m.alpha_rad_s2 * E - m.omega_rad_s * m.omega_rad_s * Eigen::Matrix2d::Identity()) * R;
+      const Eigen::Matrix2d K =
+          (m.alpha_rad_s2 * E - m.omega_rad_s * m.omega_rad_s * Eigen::Matrix2d::Identity()) * R;
       const Eigen::Vector2d r = m.origin_m - s.moment_about_m;
       const Eigen::Vector2d a = m.origin_acc_m_s2;
       Eigen::Matrix<double, 3, 4> M = Eigen::Matrix<double, 3, 4>::Zero();
@@ -336,7 +368,8 @@ ShakingLoad ShakingModel::load(std::size_t sample, std::span<const double> q) co
   return {out.head<2>(), out(2)};
 }
 
-ShakingRms ShakingModel::rms(std::span<const double> q, std::span<double> d_force, std::span<double> d_moment) const {
+ShakingRms ShakingModel::rms(std::span<const double> q, std::span<double> d_force,
+                             std::span<double> d_moment) const {
   const bool grad_f = d_force.size() >= 4 * links_, grad_n = d_moment.size() >= 4 * links_;
   if (grad_f) std::fill(d_force.begin(), d_force.end(), 0.0);
   if (grad_n) std::fill(d_moment.begin(), d_moment.end(), 0.0);
@@ -377,7 +410,11 @@ LinkageMotionSamples beatup_balancing_samples(const BeatUpDynamics& d, double om
   s.links = {
       {"crank", m.crank, {}, g.bar.crank, true},
       {"coupler", m.coupler, {}, g.bar.coupler, false},
-      {"rocker", m.rocker, {m.beater_kg, m.beater_at_m, 0.0}, std::max(g.bar.rocker, m.beater_at_m.norm()), true},
+      {"rocker",
+       m.rocker,
+       {m.beater_kg, m.beater_at_m, 0.0},
+       std::max(g.bar.rocker, m.beater_at_m.norm()),
+       true},
   };
   s.samples = static_cast<std::size_t>(samples);
   s.motion.reserve(s.samples * s.links.size());
@@ -413,7 +450,8 @@ BalanceResult balance_with_counterweights(const LinkageMotionSamples& s, const B
   }
   if (p.link_of.empty()) invalid("no link is pivoted on the frame: nowhere to put a counterweight");
   b.objective_before = p.shaking_objective(b.before);
-  if (!std::isfinite(b.before.force_n) || !std::isfinite(b.before.moment_nm) || !std::isfinite(b.objective_before)) {
+  if (!std::isfinite(b.before.force_n) || !std::isfinite(b.before.moment_nm) ||
+      !std::isfinite(b.objective_before)) {
     std::ostringstream os;
     os << "the unbalanced shaking load is not finite (RMS force " << b.before.force_n << " N, moment "
        << b.before.moment_nm << " N m): the motion (crank speed) is beyond what double precision can balance";
@@ -433,7 +471,8 @@ BalanceResult balance_with_counterweights(const LinkageMotionSamples& s, const B
       const MassParameters q = mass_parameters(link.body) + mass_parameters(link.payload);
       const Eigen::Vector2d mu(q(1), q(2));
       const double r0 = 0.5 * link.length_m;
-      const double m0 = std::clamp(mu.norm() / r0, 0.05 * o.counterweight_max_kg, 0.5 * o.counterweight_max_kg);
+      const double m0 =
+          std::clamp(mu.norm() / r0, 0.05 * o.counterweight_max_kg, 0.5 * o.counterweight_max_kg);
       const double phi0 = mu.norm() > 0.0 ? std::atan2(-mu.y(), -mu.x()) : kPi;
       x0.insert(x0.end(), {m0, r0, wrap_pi(phi0 + turn)});
     }
@@ -454,8 +493,9 @@ BalanceResult balance_with_counterweights(const LinkageMotionSamples& s, const B
     PlanarInertia body = s.links[i].body;
     for (const Counterweight& cw : b.counterweights) {
       if (cw.link == s.links[i].name) {
-        body = combine(body, {cw.mass_kg, cw.radius_m * Eigen::Vector2d(std::cos(cw.angle_rad), std::sin(cw.angle_rad)),
-                              cw.inertia_kg_m2});
+        body = combine(
+            body, {cw.mass_kg, cw.radius_m * Eigen::Vector2d(std::cos(cw.angle_rad), std::sin(cw.angle_rad)),
+                   cw.inertia_kg_m2});
       }
     }
     b.links_after.push_back(body);
@@ -483,14 +523,16 @@ BalanceResult balance_by_redistribution(const LinkageMotionSamples& s, const Bal
     if (!(link.body.mass_kg > 0.0)) invalid("link '" + link.name + "' has no mass to redistribute");
     if (!(link.length_m > 0.0)) invalid("link '" + link.name + "' length must be > 0");
     const EquimomentalSystem e = equimomental_three(link.body, 0.0);
-    if (!e.all_positive) invalid("link '" + link.name + "': its equimomental masses at 0/120/240 deg are not all >= 0");
+    if (!e.all_positive)
+      invalid("link '" + link.name + "': its equimomental masses at 0/120/240 deg are not all >= 0");
     const double m0 = link.body.mass_kg, l0 = e.radius_m;
     for (const PointMass& pm : e.points) x0.push_back(pm.mass_kg);
     x0.push_back(l0);
     p.lb.insert(p.lb.end(), {0.0, 0.0, 0.0, o.radius_factor_min * l0});
     const double mmax = o.mass_factor_max * m0;
     p.ub.insert(p.ub.end(), {mmax, mmax, mmax, o.radius_factor_max * l0});
-    p.cost.insert(p.cost.end(), {o.added_mass_cost_per_kg, o.added_mass_cost_per_kg, o.added_mass_cost_per_kg, 0.0});
+    p.cost.insert(p.cost.end(),
+                  {o.added_mass_cost_per_kg, o.added_mass_cost_per_kg, o.added_mass_cost_per_kg, 0.0});
     const std::size_t base = 4 * i;
     // m0 <= Σm_j <= factor·m0 (003 eqn 20b), scaled by m0.
     constraints.push_back({&p, [base, m0](const std::vector<double>& x, std::vector<double>& g) {
@@ -523,7 +565,8 @@ BalanceResult balance_by_redistribution(const LinkageMotionSamples& s, const Bal
                            }});
   }
   b.objective_before = p.shaking_objective(b.before);
-  if (!std::isfinite(b.before.force_n) || !std::isfinite(b.before.moment_nm) || !std::isfinite(b.objective_before)) {
+  if (!std::isfinite(b.before.force_n) || !std::isfinite(b.before.moment_nm) ||
+      !std::isfinite(b.objective_before)) {
     std::ostringstream os;
     os << "the unbalanced shaking load is not finite (RMS force " << b.before.force_n << " N, moment "
        << b.before.moment_nm << " N m): the motion (crank speed) is beyond what double precision can balance";

@@ -19,8 +19,12 @@ namespace {
 
 constexpr const char* kWho = "batten linkage";
 
-Eigen::Vector2d rocker_pivot(const BattenDims& d) { return {-d.l7_m, d.l6_m}; }
-Eigen::Vector2d batten_pivot(const BattenDims& d) { return {d.l9_m, 2.0 * d.l6_m + d.l8_m}; }
+Eigen::Vector2d rocker_pivot(const BattenDims& d) {
+  return {-d.l7_m, d.l6_m};
+}
+Eigen::Vector2d batten_pivot(const BattenDims& d) {
+  return {d.l9_m, 2.0 * d.l6_m + d.l8_m};
+}
 
 }  // namespace
 
@@ -83,8 +87,8 @@ BattenLinkage::BattenLinkage(const BattenDims& dims, BattenBranch branch) : d_(d
   if (bp_min < lo - tol || bp_max > hi + tol) {
     std::ostringstream os;
     os << "loop 2 cannot close: over the L3 swing |BP| spans [" << bp_min << ", " << bp_max
-       << "] m but L4 = " << d_.l4_m << " m and L5 = " << d_.l5_m << " m reach only [" << lo << ", "
-       << hi << "] m";
+       << "] m but L4 = " << d_.l4_m << " m and L5 = " << d_.l5_m << " m reach only [" << lo << ", " << hi
+       << "] m";
     detail::fail(kWho, ErrorCode::kNotAssemblable, os.str());
   }
   if (bp_min <= lo + tol || bp_max >= hi - tol) {
@@ -116,8 +120,7 @@ Eigen::Vector4d BattenLinkage::residual(double crank_rad, const BattenPose& x) c
   const double s3 = std::sin(x.gamma3_rad), c3 = std::cos(x.gamma3_rad);
   const double s4 = std::sin(x.gamma4_rad), c4 = std::cos(x.gamma4_rad);
   const double ss = std::sin(x.psi_rad), cs = std::cos(x.psi_rad);
-  return {d.l1_m * cp + d.l2_m * s2 - d.l3_m * c3 + d.l7_m,
-          d.l1_m * sp + d.l2_m * c2 - d.l3_m * s3 - d.l6_m,
+  return {d.l1_m * cp + d.l2_m * s2 - d.l3_m * c3 + d.l7_m, d.l1_m * sp + d.l2_m * c2 - d.l3_m * s3 - d.l6_m,
           -d.l5_m * ss + d.l4_m * c4 - d.l3_m * c3 + d.l7_m + d.l9_m,
           d.l5_m * cs + d.l4_m * s4 - d.l3_m * s3 + d.l6_m + d.l8_m};
 }
@@ -129,9 +132,9 @@ Eigen::Matrix4d BattenLinkage::jacobian(const BattenPose& x) const {
   const double s4 = std::sin(x.gamma4_rad), c4 = std::cos(x.gamma4_rad);
   const double ss = std::sin(x.psi_rad), cs = std::cos(x.psi_rad);
   Eigen::Matrix4d j;
-  j << d.l2_m * c2, d.l3_m * s3, 0.0, 0.0,             //
-      -d.l2_m * s2, -d.l3_m * c3, 0.0, 0.0,            //
-      0.0, d.l3_m * s3, -d.l4_m * s4, -d.l5_m * cs,    //
+  j << d.l2_m * c2, d.l3_m * s3, 0.0, 0.0,           //
+      -d.l2_m * s2, -d.l3_m * c3, 0.0, 0.0,          //
+      0.0, d.l3_m * s3, -d.l4_m * s4, -d.l5_m * cs,  //
       0.0, -d.l3_m * c3, d.l4_m * c4, -d.l5_m * ss;
   return j;
 }

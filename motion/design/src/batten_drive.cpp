@@ -1,15 +1,14 @@
 // The geared batten drive of seed 004: driving pinion φ1 -> elliptic gear -> crank φ2 = φ02 + φ2(φ1)
 // (eqn 8) -> linkage eqns (7) -> batten ψ. Chain rule: φ2' = (dφ2/dφ1)·ω1 and
 // φ2'' = (d²φ2/dφ1²)·ω1² + (dφ2/dφ1)·α1 feed the linkage's exact rates.
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
-#include <algorithm>
-
+#include "checks.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/design/batten.hpp"
 #include "loom/motion/errors.hpp"
-#include "checks.hpp"
 
 namespace loom::motion {
 
@@ -36,7 +35,9 @@ BattenSample assemble(const BattenLinkage& linkage, double phi1, const CrankMoti
   return s;
 }
 
-double unwrap(double prev, double now) { return prev + wrap_pi(now - prev); }
+double unwrap(double prev, double now) {
+  return prev + wrap_pi(now - prev);
+}
 
 }  // namespace
 
@@ -66,7 +67,8 @@ std::vector<BattenSample> batten_sweep(const BattenDrive& drive, int samples, do
                                        BattenSolver solver, const NewtonOptions& opt) {
   std::vector<BattenSample> out;
   out.reserve(static_cast<std::size_t>(std::max(samples, 0)));
-  batten_sweep(drive, samples, omega1_rad_s, [&](const BattenSample& s) { out.push_back(s); }, solver, opt);
+  batten_sweep(
+      drive, samples, omega1_rad_s, [&](const BattenSample& s) { out.push_back(s); }, solver, opt);
   return out;
 }
 

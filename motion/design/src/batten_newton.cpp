@@ -13,9 +13,13 @@ namespace loom::motion {
 
 namespace {
 
-const char* side_name(LoopSide s) { return s == LoopSide::kLeft ? "left" : "right"; }
+const char* side_name(LoopSide s) {
+  return s == LoopSide::kLeft ? "left" : "right";
+}
 
-double principal(double a) { return std::atan2(std::sin(a), std::cos(a)); }
+double principal(double a) {
+  return std::atan2(std::sin(a), std::cos(a));
+}
 
 }  // namespace
 
@@ -33,8 +37,8 @@ NewtonResult BattenLinkage::solve_newton(double crank_rad, const BattenPose& gue
   const BattenBranch got = branch_of(out.pose);
   if (!(got == branch_)) {
     std::ostringstream os;
-    os << "batten Newton converged to the wrong assembly branch at crank " << crank_rad
-       << " rad: loop 1 " << side_name(got.loop1) << " / loop 2 " << side_name(got.loop2) << ", wanted "
+    os << "batten Newton converged to the wrong assembly branch at crank " << crank_rad << " rad: loop 1 "
+       << side_name(got.loop1) << " / loop 2 " << side_name(got.loop2) << ", wanted "
        << side_name(branch_.loop1) << " / " << side_name(branch_.loop2);
     throw MotionError(ErrorCode::kWrongBranch, os.str());
   }

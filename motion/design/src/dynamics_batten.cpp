@@ -24,7 +24,9 @@ void require_speed(double omega1) {
 
 }  // namespace
 
-const char* batten_beat_side_name(BattenBeatSide s) { return s == BattenBeatSide::kPsiMax ? "psi-max" : "psi-min"; }
+const char* batten_beat_side_name(BattenBeatSide s) {
+  return s == BattenBeatSide::kPsiMax ? "psi-max" : "psi-min";
+}
 
 BattenBeat batten_beat(const BattenDrive& drive, BattenBeatSide side, double omega1, int samples) {
   require_speed(omega1);
@@ -40,23 +42,27 @@ BattenBeat batten_beat(const BattenDrive& drive, BattenBeatSide side, double ome
     }
   }
   if (b.beats_per_turn == 0) {
-    throw MotionError(ErrorCode::kInvalidInput,
-                      std::string("batten beat: the batten has no turning point on side ") + batten_beat_side_name(side));
+    throw MotionError(
+        ErrorCode::kInvalidInput,
+        std::string("batten beat: the batten has no turning point on side ") + batten_beat_side_name(side));
   }
   return b;
 }
 
 BattenBeatSide batten_front_side(const BattenLinkage& linkage, double omega1, int samples) {
   const BattenDrive circular(EllipticGearPair(kBatten004GearA_m, 0.0, 2), linkage, 0.0);
-  const double at_max = std::abs(batten_beat(circular, BattenBeatSide::kPsiMax, omega1, samples).psi_ddot_rad_s2);
-  const double at_min = std::abs(batten_beat(circular, BattenBeatSide::kPsiMin, omega1, samples).psi_ddot_rad_s2);
+  const double at_max =
+      std::abs(batten_beat(circular, BattenBeatSide::kPsiMax, omega1, samples).psi_ddot_rad_s2);
+  const double at_min =
+      std::abs(batten_beat(circular, BattenBeatSide::kPsiMin, omega1, samples).psi_ddot_rad_s2);
   return at_max >= at_min ? BattenBeatSide::kPsiMax : BattenBeatSide::kPsiMin;
 }
 
 namespace {
 
 // The turning points on one side, each with the crank angle that identifies it.
-std::vector<BattenVisit> visits_of(const BattenDrive& drive, BattenBeatSide side, double omega1, int samples) {
+std::vector<BattenVisit> visits_of(const BattenDrive& drive, BattenBeatSide side, double omega1,
+                                   int samples) {
   std::vector<BattenVisit> v;
   const bool want_max = side == BattenBeatSide::kPsiMax;
   for (const BattenExtreme& x : batten_extremes(drive, samples, omega1)) {
@@ -67,14 +73,15 @@ std::vector<BattenVisit> visits_of(const BattenDrive& drive, BattenBeatSide side
     b.accel_rad_s2 = std::abs(x.psi_ddot_rad_s2);
     v.push_back(b);
   }
-  std::sort(v.begin(), v.end(), [](const BattenVisit& a, const BattenVisit& b) { return a.crank_rad < b.crank_rad; });
+  std::sort(v.begin(), v.end(),
+            [](const BattenVisit& a, const BattenVisit& b) { return a.crank_rad < b.crank_rad; });
   return v;
 }
 
 }  // namespace
 
-BattenGain batten_gain(const BattenLinkage& linkage, const EllipticGearPair& gear, double phi02, BattenBeatSide side,
-                       double omega1, int samples) {
+BattenGain batten_gain(const BattenLinkage& linkage, const EllipticGearPair& gear, double phi02,
+                       BattenBeatSide side, double omega1, int samples) {
   const EllipticGearPair circular(gear.half_centre_distance_m(), 0.0, gear.lobes());
   const BattenBeat ref = batten_beat(BattenDrive(circular, linkage, 0.0), side, omega1, samples);
   const BattenBeat b = batten_beat(BattenDrive(gear, linkage, phi02), side, omega1, samples);
@@ -94,7 +101,8 @@ BattenGain batten_gain(const BattenLinkage& linkage, const EllipticGearPair& gea
     BattenVisit& v = g.visits[i];
     const BattenVisit* match = nullptr;
     for (const BattenVisit& c : circ) {
-      if (match == nullptr || std::abs(wrap_pi(c.crank_rad - v.crank_rad)) < std::abs(wrap_pi(match->crank_rad - v.crank_rad))) {
+      if (match == nullptr ||
+          std::abs(wrap_pi(c.crank_rad - v.crank_rad)) < std::abs(wrap_pi(match->crank_rad - v.crank_rad))) {
         match = &c;
       }
     }
@@ -109,8 +117,8 @@ BattenGain batten_gain(const BattenLinkage& linkage, const EllipticGearPair& gea
   return g;
 }
 
-BattenSearch batten_best_phi02(const BattenLinkage& linkage, const EllipticGearPair& gear, BattenBeatSide side,
-                               double omega1, int scan_points, int samples) {
+BattenSearch batten_best_phi02(const BattenLinkage& linkage, const EllipticGearPair& gear,
+                               BattenBeatSide side, double omega1, int scan_points, int samples) {
   if (scan_points < 3) {
     throw MotionError(ErrorCode::kInvalidInput,
                       "batten phi02 search: scan points = " + std::to_string(scan_points) + ": must be >= 3");
@@ -136,9 +144,17 @@ BattenSearch batten_best_phi02(const BattenLinkage& linkage, const EllipticGearP
   double f1 = accel(x1), f2 = accel(x2);
   while (hi - lo > 1e-10) {
     if (f1 < f2) {
-      lo = x1; x1 = x2; f1 = f2; x2 = lo + inv_phi * (hi - lo); f2 = accel(x2);
+      lo = x1;
+      x1 = x2;
+      f1 = f2;
+      x2 = lo + inv_phi * (hi - lo);
+      f2 = accel(x2);
     } else {
-      hi = x2; x2 = x1; f2 = f1; x1 = hi - inv_phi * (hi - lo); f1 = accel(x1);
+      hi = x2;
+      x2 = x1;
+      f2 = f1;
+      x1 = hi - inv_phi * (hi - lo);
+      f1 = accel(x1);
     }
   }
   const double phi = 0.5 * (lo + hi);
@@ -150,7 +166,8 @@ BattenSearch batten_best_phi02(const BattenLinkage& linkage, const EllipticGearP
   return s;
 }
 
-CrankMotion elliptic_gear_crank(const EllipticGearPair& gear, double phi02, double phi1, double omega1, double alpha1) {
+CrankMotion elliptic_gear_crank(const EllipticGearPair& gear, double phi02, double phi1, double omega1,
+                                double alpha1) {
   const GearPhase g = gear.phase(phi1);
   return {phi02 + g.phi2_rad, g.dphi2 * omega1, g.d2phi2 * omega1 * omega1 + g.dphi2 * alpha1};
 }

@@ -23,11 +23,13 @@ void put_arm(Eigen::Matrix<double, N, N>& a, int row, int col, const Eigen::Vect
 }
 
 template <int N>
-Eigen::Matrix<double, N, 1> solve_checked(const Eigen::Matrix<double, N, N>& a, const Eigen::Matrix<double, N, 1>& b,
-                                          const char* which, double theta1) {
+Eigen::Matrix<double, N, 1> solve_checked(const Eigen::Matrix<double, N, N>& a,
+                                          const Eigen::Matrix<double, N, 1>& b, const char* which,
+                                          double theta1) {
   const Eigen::PartialPivLU<Eigen::Matrix<double, N, N>> lu(a);
   const Eigen::Matrix<double, N, N> inv = lu.inverse();
-  const double rcond = 1.0 / (a.cwiseAbs().colwise().sum().maxCoeff() * inv.cwiseAbs().colwise().sum().maxCoeff());
+  const double rcond =
+      1.0 / (a.cwiseAbs().colwise().sum().maxCoeff() * inv.cwiseAbs().colwise().sum().maxCoeff());
   if (!(rcond > kSingularRcond)) {
     std::ostringstream os;
     os << "needle six-bar: force system " << which << " is singular at theta1 = " << deg(theta1)
@@ -36,7 +38,8 @@ Eigen::Matrix<double, N, 1> solve_checked(const Eigen::Matrix<double, N, N>& a, 
   }
   const Eigen::Matrix<double, N, 1> x = lu.solve(b);
   if (!x.allFinite()) {
-    throw MotionError(ErrorCode::kSingular, std::string("needle six-bar: force system ") + which + " gave non-finite forces");
+    throw MotionError(ErrorCode::kSingular,
+                      std::string("needle six-bar: force system ") + which + " gave non-finite forces");
   }
   return x;
 }
@@ -139,18 +142,23 @@ NeedleSystems needle_systems(const NeedleLinkage& linkage, const NeedleMasses& m
   Eigen::Matrix<double, 8, 1>& D = sys.D;
   C.setZero();
   // l4: F_C4 + F_54 = m a − m g; (C−G)×F_C4 + (D−G)×F_54 + M_r = I α.
-  C(0, 0) = 1; C(0, 2) = 1;
-  C(1, 1) = 1; C(1, 3) = 1;
+  C(0, 0) = 1;
+  C(0, 2) = 1;
+  C(1, 1) = 1;
+  C(1, 3) = 1;
   put_arm<8>(C, 2, 0, c - g[3], k);
   put_arm<8>(C, 2, 2, dp - g[3], k);
   C(2, 7) = 1;
   // l5: −F_54 + F_65 = m a − m g; (D−G)×(−F_54) + (E−G)×F_65 = I α.
-  C(3, 2) = -1; C(3, 4) = 1;
-  C(4, 3) = -1; C(4, 5) = 1;
+  C(3, 2) = -1;
+  C(3, 4) = 1;
+  C(4, 3) = -1;
+  C(4, 5) = 1;
   put_arm<8>(C, 5, 2, -(dp - g[4]), k);
   put_arm<8>(C, 5, 4, e - g[4], k);
   // l6 (translation only; the guide takes its moment): −F_65 + (N, friction) = m a − m g.
-  C(6, 4) = -1; C(6, 6) = 1;
+  C(6, 4) = -1;
+  C(6, 6) = 1;
   C(7, 5) = -1;
   const double fric = backing_friction(s, loads);
   const Eigen::Vector2d f4 = newton(3), f5 = newton(4), f6 = newton(5);
@@ -161,28 +169,35 @@ NeedleSystems needle_systems(const NeedleLinkage& linkage, const NeedleMasses& m
   Eigen::Matrix<double, 9, 1>& B = sys.B;
   A.setZero();
   // l1: F_21 + F_O1 = m a − m g; (A−G)×F_21 + (O−G)×F_O1 + M_b = I α.
-  A(0, 0) = 1; A(0, 2) = 1;
-  A(1, 1) = 1; A(1, 3) = 1;
+  A(0, 0) = 1;
+  A(0, 2) = 1;
+  A(1, 1) = 1;
+  A(1, 3) = 1;
   put_arm<9>(A, 2, 0, a - g[0], k);
   put_arm<9>(A, 2, 2, o - g[0], k);
   A(2, 8) = 1;
   // l2: −F_21 + F_32 = m a − m g; (A−G)×(−F_21) + (B−G)×F_32 = I α.
-  A(3, 0) = -1; A(3, 4) = 1;
-  A(4, 1) = -1; A(4, 5) = 1;
+  A(3, 0) = -1;
+  A(3, 4) = 1;
+  A(4, 1) = -1;
+  A(4, 5) = 1;
   put_arm<9>(A, 5, 0, -(a - g[1]), k);
   put_arm<9>(A, 5, 4, b - g[1], k);
   // l3: −F_32 + F_C3 = m a − m g; (B−G)×(−F_32) + (C−G)×F_C3 − M_r = I α.
-  A(6, 4) = -1; A(6, 6) = 1;
-  A(7, 5) = -1; A(7, 7) = 1;
+  A(6, 4) = -1;
+  A(6, 6) = 1;
+  A(7, 5) = -1;
+  A(7, 7) = 1;
   put_arm<9>(A, 8, 4, -(b - g[2]), k);
   put_arm<9>(A, 8, 6, c - g[2], k);
   const Eigen::Vector2d f1 = newton(0), f2 = newton(1), f3 = newton(2);
-  B << f1.x(), f1.y(), euler(0), f2.x(), f2.y(), euler(1), f3.x(), f3.y(), euler(2);  // + M_r/L added on solve
+  B << f1.x(), f1.y(), euler(0), f2.x(), f2.y(), euler(1), f3.x(), f3.y(),
+      euler(2);  // + M_r/L added on solve
   return sys;
 }
 
-NeedleForces needle_inverse_dynamics(const NeedleLinkage& linkage, const NeedleMasses& m, const NeedleState& s,
-                                     const NeedleLoads& loads) {
+NeedleForces needle_inverse_dynamics(const NeedleLinkage& linkage, const NeedleMasses& m,
+                                     const NeedleState& s, const NeedleLoads& loads) {
   NeedleSystems sys = needle_systems(linkage, m, s, loads);
   const Eigen::Matrix<double, 8, 1> y = solve_checked<8>(sys.C, sys.D, "C F = D", s.theta1_rad);
   sys.B(8) += y(7);  // l3 receives −M_r: moved to the right-hand side it adds M_r/L
@@ -204,8 +219,8 @@ NeedleForces needle_inverse_dynamics(const NeedleLinkage& linkage, const NeedleM
   return f;
 }
 
-std::vector<NeedleForces> needle_dynamics_sweep(const NeedleLinkage& linkage, const NeedleMasses& m, int samples,
-                                                double omega1, const NeedleLoads& loads) {
+std::vector<NeedleForces> needle_dynamics_sweep(const NeedleLinkage& linkage, const NeedleMasses& m,
+                                                int samples, double omega1, const NeedleLoads& loads) {
   const std::vector<NeedleState> states = needle_sweep(linkage, samples, omega1);
   std::vector<NeedleForces> out;
   out.reserve(states.size());

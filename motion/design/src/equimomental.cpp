@@ -56,7 +56,8 @@ EquimomentalSystem equimomental_three(const PlanarInertia& body, double offset) 
        << " kg m^2, angle offset " << offset << " rad: mass must be > 0, all finite";
     throw MotionError(ErrorCode::kInvalidInput, os.str());
   }
-  return equimomental_three_origin(body.mass_kg, body.centre_m, body.inertia_about(Eigen::Vector2d::Zero()), offset);
+  return equimomental_three_origin(body.mass_kg, body.centre_m, body.inertia_about(Eigen::Vector2d::Zero()),
+                                   offset);
 }
 
 PlanarInertia from_point_masses(std::span<const PointMass> points) {

@@ -25,7 +25,9 @@ const char* needle_rocker_side_name(NeedleRockerSide s) {
   return s == NeedleRockerSide::kPinAwayFromNeedle ? "away" : "toward";
 }
 
-const char* needle_rod_side_name(NeedleRodSide s) { return s == NeedleRodSide::kHangingRod ? "hanging" : "standing"; }
+const char* needle_rod_side_name(NeedleRodSide s) {
+  return s == NeedleRodSide::kHangingRod ? "hanging" : "standing";
+}
 
 NeedleDims needle_table1() {
   NeedleDims d{};
@@ -57,13 +59,14 @@ NeedleLinkage::NeedleLinkage(const NeedleDims& dims, NeedleBranch branch) : d_(d
   if (d_.l1_m >= g || turn == detail::CrankTurn::kBlocked) {
     std::ostringstream os;
     os << "l1 = " << d_.l1_m << " m cannot turn fully: a crank-rocker needs l1 < |OC| = " << g
-       << " m, |OC| - l1 > |l2 - l3| and |OC| + l1 < l2 + l3 (l2 = " << d_.l2_m
-       << " m, l3 = " << d_.l3_m << " m)";
+       << " m, |OC| - l1 > |l2 - l3| and |OC| + l1 < l2 + l3 (l2 = " << d_.l2_m << " m, l3 = " << d_.l3_m
+       << " m)";
     detail::fail(kWho, ErrorCode::kNotCrank, os.str());
   }
   if (turn == detail::CrankTurn::kChangePoint) {
-    detail::fail(kWho, ErrorCode::kSingular, "change-point crank-rocker (|OC| ± l1 equals l2 ± l3): the "
-                                             "coupler and rocker fold flat once per turn");
+    detail::fail(kWho, ErrorCode::kSingular,
+                 "change-point crank-rocker (|OC| ± l1 equals l2 ± l3): the "
+                 "coupler and rocker fold flat once per turn");
   }
 
   // Rocker swing limits at the two dead centres.
@@ -117,8 +120,7 @@ NeedleState NeedleLinkage::evaluate(double theta1_rad, double omega1_rad_s, doub
   const double s5_abs = std::sqrt(std::max(0.0, (l5 - c5) * (l5 + c5)));
   s.theta5_rad = std::atan2(branch_.rod == NeedleRodSide::kStandingRod ? s5_abs : -s5_abs, c5);
 
-  const double t1 = s.theta1_rad, t2 = s.theta2_rad, t3 = s.theta3_rad, t4 = s.theta4_rad,
-               t5 = s.theta5_rad;
+  const double t1 = s.theta1_rad, t2 = s.theta2_rad, t3 = s.theta3_rad, t4 = s.theta4_rad, t5 = s.theta5_rad;
   const double w1 = omega1_rad_s, a1 = alpha1_rad_s2;
 
   // ---- velocities: d/dt of l1 e^{iθ1} + l2 e^{iθ2} - l3 e^{iθ3} = C, projected to kill one unknown
@@ -139,9 +141,8 @@ NeedleState NeedleLinkage::evaluate(double theta1_rad, double omega1_rad_s, doub
                     (l3 * std::sin(t3 - t2));
   s.alpha4_rad_s2 = s.alpha3_rad_s2;
   const double a4 = s.alpha4_rad_s2;
-  s.alpha5_rad_s2 =
-      -(l4 * a4 * std::sin(t4) + l4 * w4 * w4 * std::cos(t4) + l5 * w5 * w5 * std::cos(t5)) /
-      (l5 * std::sin(t5));
+  s.alpha5_rad_s2 = -(l4 * a4 * std::sin(t4) + l4 * w4 * w4 * std::cos(t4) + l5 * w5 * w5 * std::cos(t5)) /
+                    (l5 * std::sin(t5));
   const double a5 = s.alpha5_rad_s2;
 
   // ---- needle point F: l_CF' = l6 - l4 sin θ4 - l5 sin θ5 and its time derivatives -------------

@@ -4,14 +4,14 @@
 // b = sin(ψ/2)·cos γ / sin h (the thesis' eq. 4.27 rewritten so that φ = 180° and the bounds are exact).
 #include <algorithm>
 #include <cmath>
-#include <string>
 #include <sstream>
+#include <string>
 
 #include "checks.hpp"
 #include "geometry.hpp"
 #include "loom/motion/angles.hpp"
-#include "loom/motion/errors.hpp"
 #include "loom/motion/design/synthesis.hpp"
+#include "loom/motion/errors.hpp"
 
 namespace loom::motion {
 
@@ -51,8 +51,8 @@ Problem classify(double psi, const CrankRotation& rotation) {
   if (!(phi > phi_min + kSynthesisSnap_rad) || !(phi < phi_max - kSynthesisSnap_rad)) {
     std::ostringstream msg;
     msg << "crank-rocker synthesis: no crank-rocker has " << describe(psi, phi)
-        << ": phi must lie in (90 + psi/2, 270 + psi/2) = (" << deg(phi_min) << ", "
-        << deg(phi_max) << ") deg";
+        << ": phi must lie in (90 + psi/2, 270 + psi/2) = (" << deg(phi_min) << ", " << deg(phi_max)
+        << ") deg";
     throw MotionError(ErrorCode::kInvalidInput, msg.str());
   }
   Problem p{psi, phi, sup, CrankRockerCase::kPhi180, 0.0, 0.5 * kPi - 0.5 * psi};
@@ -135,8 +135,7 @@ UnitLinkage special_linkage(const Problem& p, double coupler) {
   return u;
 }
 
-CrankRockerDesign finish(const Problem& p, double beta, const UnitLinkage& u, double ground,
-                         unsigned flags) {
+CrankRockerDesign finish(const Problem& p, double beta, const UnitLinkage& u, double ground, unsigned flags) {
   CrankRockerDesign d;
   d.crank = ground * u.a;
   d.coupler = ground * u.b;
@@ -167,8 +166,8 @@ double mu_min_at(const Problem& p, double beta) {
 
 [[noreturn]] void throw_beta_out_of_bounds(const Problem& p, double beta) {
   std::ostringstream msg;
-  msg << "crank-rocker synthesis: beta = " << deg(beta) << " deg is outside its bounds ["
-      << deg(p.lower) << ", " << deg(p.upper) << "] deg for " << describe(p.psi, p.phi) << " ("
+  msg << "crank-rocker synthesis: beta = " << deg(beta) << " deg is outside its bounds [" << deg(p.lower)
+      << ", " << deg(p.upper) << "] deg for " << describe(p.psi, p.phi) << " ("
       << crank_rocker_case_name(p.design_case) << ")";
   throw MotionError(ErrorCode::kOutOfBounds, msg.str());
 }
@@ -211,17 +210,26 @@ CrankRockerDesign design_for_beta(const Problem& p, double beta, double ground) 
 
 const char* crank_rocker_case_name(CrankRockerCase c) {
   switch (c) {
-    case CrankRockerCase::kPhiBelow180: return "phi < 180";
-    case CrankRockerCase::kPhi180: return "phi = 180";
-    case CrankRockerCase::kPhiAbove180: return "180 < phi < 180 + psi";
-    case CrankRockerCase::kPhi180PlusPsi: return "phi = 180 + psi";
-    case CrankRockerCase::kPhiBeyond180PlusPsi: return "phi > 180 + psi";
+    case CrankRockerCase::kPhiBelow180:
+      return "phi < 180";
+    case CrankRockerCase::kPhi180:
+      return "phi = 180";
+    case CrankRockerCase::kPhiAbove180:
+      return "180 < phi < 180 + psi";
+    case CrankRockerCase::kPhi180PlusPsi:
+      return "phi = 180 + psi";
+    case CrankRockerCase::kPhiBeyond180PlusPsi:
+      return "phi > 180 + psi";
   }
   return "?";
 }
 
-CrankRotation CrankRotation::degrees(double phi_deg) { return {rad(phi_deg), rad(180.0 - phi_deg)}; }
-CrankRotation CrankRotation::radians(double phi_rad) { return {phi_rad, kPi - phi_rad}; }
+CrankRotation CrankRotation::degrees(double phi_deg) {
+  return {rad(phi_deg), rad(180.0 - phi_deg)};
+}
+CrankRotation CrankRotation::radians(double phi_rad) {
+  return {phi_rad, kPi - phi_rad};
+}
 
 BetaBounds khare_dave_beta_bounds(double psi_rad, double phi_rad) {
   return khare_dave_beta_bounds(psi_rad, CrankRotation::radians(phi_rad));
@@ -330,8 +338,8 @@ CrankRockerDesign khare_dave_for_ratio(double psi_rad, const CrankRotation& phi_
     const UnitLinkage hi = general_linkage(p, p.upper);
     std::ostringstream msg;
     msg << "crank-rocker synthesis: lambda = a/b = " << lambda << " is outside its bounds ["
-        << std::min(lo.a / lo.b, hi.a / hi.b) << ", " << std::max(lo.a / lo.b, hi.a / hi.b)
-        << "] for " << describe(p.psi, p.phi);
+        << std::min(lo.a / lo.b, hi.a / hi.b) << ", " << std::max(lo.a / lo.b, hi.a / hi.b) << "] for "
+        << describe(p.psi, p.phi);
     throw MotionError(ErrorCode::kOutOfBounds, msg.str());
   }
   return design_for_beta(p, std::clamp(beta, p.lower, p.upper), ground);

@@ -6,8 +6,8 @@
 
 #include "checks.hpp"
 #include "loom/motion/angles.hpp"
-#include "loom/motion/errors.hpp"
 #include "loom/motion/design/synthesis.hpp"
+#include "loom/motion/errors.hpp"
 
 namespace loom::motion {
 
@@ -60,9 +60,8 @@ void check_stroke(double stroke) {
 
 // Shared tail of both entry points. one_minus_lambda2 and k2_minus_lambda_s2 are passed in because
 // for λ_opt they have cancellation-free closed forms the generic differences would lose.
-SliderCrankDesign assemble(double stroke, double phi_rad, const HalfAngles& h, double lambda,
-                           double lambda2, double one_minus_lambda2, double k2_minus_lambda_s2,
-                           bool at_bound) {
+SliderCrankDesign assemble(double stroke, double phi_rad, const HalfAngles& h, double lambda, double lambda2,
+                           double one_minus_lambda2, double k2_minus_lambda_s2, bool at_bound) {
   const double D = h.k * h.k + lambda2 * h.s * h.s;  // cos²(φ/2) + λ² sin²(φ/2), eq. 4.11
   const double b_unit = 0.5 / std::sqrt(D);
   const double c_unit = one_minus_lambda2 * h.s * h.k / (2.0 * D);  // eq. 4.10
@@ -77,8 +76,8 @@ SliderCrankDesign assemble(double stroke, double phi_rad, const HalfAngles& h, d
 
   // 1 − cos μ_min = 1 − λ − c/b = (1 − λ)·G, G = (k² − λs²)² / (D·(1 + b(1+λ) sin φ)).
   const double one_minus_lambda = one_minus_lambda2 / (1.0 + lambda);
-  const double G = k2_minus_lambda_s2 * k2_minus_lambda_s2 /
-                   (D * (1.0 + b_unit * (1.0 + lambda) * h.sin_phi));
+  const double G =
+      k2_minus_lambda_s2 * k2_minus_lambda_s2 / (D * (1.0 + b_unit * (1.0 + lambda) * h.sin_phi));
   const double one_minus_cos = std::fmax(0.0, one_minus_lambda * G);
   d.mu_min_rad = 2.0 * std::asin(std::fmin(1.0, std::sqrt(0.5 * one_minus_cos)));
   if (at_bound) {
@@ -153,8 +152,12 @@ SliderCrankDesign soylemez_slider_crank(double stroke, CrankRotation phi_rad, do
   return assemble(stroke, phi.phi_rad, h, lam, lam * lam, one_minus_lambda2, k2_minus_lambda_s2, at_bound);
 }
 
-LambdaBounds soylemez_lambda_bounds(double phi_rad) { return soylemez_lambda_bounds(CrankRotation::radians(phi_rad)); }
-double soylemez_lambda_opt(double phi_rad) { return soylemez_lambda_opt(CrankRotation::radians(phi_rad)); }
+LambdaBounds soylemez_lambda_bounds(double phi_rad) {
+  return soylemez_lambda_bounds(CrankRotation::radians(phi_rad));
+}
+double soylemez_lambda_opt(double phi_rad) {
+  return soylemez_lambda_opt(CrankRotation::radians(phi_rad));
+}
 SliderCrankDesign soylemez_slider_crank(double stroke, double phi_rad) {
   return soylemez_slider_crank(stroke, CrankRotation::radians(phi_rad));
 }

@@ -19,7 +19,9 @@ using Eigen::Matrix3d;
 using Eigen::Vector2d;
 using Eigen::Vector3d;
 
-Vector2d unit(double angle) { return {std::cos(angle), std::sin(angle)}; }
+Vector2d unit(double angle) {
+  return {std::cos(angle), std::sin(angle)};
+}
 
 // The vector from the fixed pivot O1 = a0·u(θ0) to the moving pivot O2 = P_i − a2·u(θ2_i); its
 // length must be a1 at every precision point.
@@ -76,22 +78,20 @@ void polish(const std::array<PrecisionPoint, 3>& points, double theta0, ThreePoi
   s.a2 = x(2);
 }
 
-void measure_closure(const std::array<PrecisionPoint, 3>& points, double theta0,
-                     ThreePointSolution& s) {
+void measure_closure(const std::array<PrecisionPoint, 3>& points, double theta0, ThreePointSolution& s) {
   s.closure_residual = 0.0;
   for (std::size_t i = 0; i < 3; ++i) {
     const Vector2d r = free_link(points[i], theta0, s.a0, s.a2);
     s.theta1_rad[i] = std::atan2(r.y(), r.x());
-    const Vector2d end = s.a0 * unit(theta0) + s.a1 * unit(s.theta1_rad[i]) +
-                         s.a2 * unit(points[i].theta2_rad);
+    const Vector2d end =
+        s.a0 * unit(theta0) + s.a1 * unit(s.theta1_rad[i]) + s.a2 * unit(points[i].theta2_rad);
     s.closure_residual = std::max(s.closure_residual, (end - Vector2d(points[i].x, points[i].y)).norm());
   }
 }
 
 }  // namespace
 
-ThreePointResult three_point_synthesis(const std::array<PrecisionPoint, 3>& points,
-                                       double theta0_rad) {
+ThreePointResult three_point_synthesis(const std::array<PrecisionPoint, 3>& points, double theta0_rad) {
   check_input(points, theta0_rad);
   const Vector2d u0 = unit(theta0_rad);
 

@@ -22,6 +22,7 @@
 // sticks one switch of a safety sensor, `_2` its second, e.g. stuck=shuttle_at_right_2:on), for HIL
 // fault tests; io_control.hpp describes them.
 #include <poll.h>
+#include <sys/stat.h>
 #include <time.h>
 
 #include <CLI/CLI.hpp>
@@ -31,24 +32,23 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <deque>
+#include <fstream>
 #include <iostream>
 #include <limits>
 #include <random>
-#include <deque>
-#include <fstream>
 #include <set>
 #include <sstream>
 #include <string>
-#include <sys/stat.h>
 #include <vector>
 
-#include "loom/drivers/can_axis_port.hpp"
 #include "loom/config/config.hpp"
-#include "loom/firmware/sim_heads.hpp"
+#include "loom/drivers/can_axis_port.hpp"
 #include "loom/drivers/nmt.hpp"
 #include "loom/drivers/socket_can_bus.hpp"
-#include "loom/sim_can/io_control.hpp"
+#include "loom/firmware/sim_heads.hpp"
 #include "loom/sim_can/eds_dictionary.hpp"
+#include "loom/sim_can/io_control.hpp"
 #include "loom/sim_can/sim_drive_rack.hpp"
 
 namespace {
@@ -77,13 +77,15 @@ class RetryingBus final : public loom::drivers::CanBus {
   explicit RetryingBus(loom::drivers::CanBus& inner) : inner_(inner) {}
   loom::drivers::SendResult send(const loom::drivers::CanFrame& f) override {
     flush();
-    if (pending_.empty() && inner_.send(f) == loom::drivers::SendResult::kOk) return loom::drivers::SendResult::kOk;
+    if (pending_.empty() && inner_.send(f) == loom::drivers::SendResult::kOk)
+      return loom::drivers::SendResult::kOk;
     if (pending_.size() < 4096) pending_.push_back(f);
     return loom::drivers::SendResult::kOk;
   }
   bool receive(loom::drivers::CanFrame& f) override { return inner_.receive(f); }
   void flush() {
-    while (!pending_.empty() && inner_.send(pending_.front()) == loom::drivers::SendResult::kOk) pending_.pop_front();
+    while (!pending_.empty() && inner_.send(pending_.front()) == loom::drivers::SendResult::kOk)
+      pending_.pop_front();
   }
   bool pending() const { return !pending_.empty(); }
 
@@ -105,7 +107,9 @@ void print_carpet(const loom::sim_hal::SimKnotter& k) {
     std::string line;
     for (int j = 0; j < k.knots_per_row(); ++j) {
       const loom::sim_hal::KnotCell& c = k.cell(r, j);
-      line += c.ties == 0 ? '.' : c.ties > 1 ? static_cast<char>('0' + std::min<int>(c.ties, 9)) : static_cast<char>('A' + c.slot);
+      line += c.ties == 0  ? '.'
+              : c.ties > 1 ? static_cast<char>('0' + std::min<int>(c.ties, 9))
+                           : static_cast<char>('A' + c.slot);
     }
     std::cerr << "loom-sim-drive: knotted row " << r << ": " << line << "\n";
   }
@@ -133,21 +137,24 @@ int main(int argc, char** argv) {
   int loom_bus = 0;
   std::string eds_file;
   app.add_option("--iface", iface, "CAN interface, e.g. vcan0")->required();
-  auto* loom_opt = app.add_option("--loom", loom_file,
-                                  "the machine description: simulate bus --bus's drives and (bus 0) its I/O node with "
-                                  "the loom's facts, knotting heads included");
+  auto* loom_opt =
+      app.add_option("--loom", loom_file,
+                     "the machine description: simulate bus --bus's drives and (bus 0) its I/O node with "
+                     "the loom's facts, knotting heads included");
   app.add_option("--bus", loom_bus, "with --loom: which of the loom's buses this interface is (default 0)")
       ->check(CLI::Range(0, 15))
       ->needs(loom_opt);
   auto* io_node_opt =
       app.add_option("--io-node", io_node, "also simulate the CiA 401 I/O node with this node id (1..127)");
-  app.add_option("--io-control", io_control,
-                 "file of words for the I/O node, re-read when it changes: estop start pause ack knotted silent, "
-                 "stuck=<sensor>[_2]:on|off (one switch of a safety sensor stuck, _2 = its second switch, e.g. "
-                 "stuck=shuttle_at_right_2:on)");
-  auto* width_opt = app.add_option("--width-m", width_m, "loom width for the I/O node's shuttle sensors (default 0.6)");
-  auto* lead_opt =
-      app.add_option("--helix-lead-m", helix_lead_m, "helix lead for the I/O node's shuttle sensors (default 0.1)");
+  app.add_option(
+      "--io-control", io_control,
+      "file of words for the I/O node, re-read when it changes: estop start pause ack knotted silent, "
+      "stuck=<sensor>[_2]:on|off (one switch of a safety sensor stuck, _2 = its second switch, e.g. "
+      "stuck=shuttle_at_right_2:on)");
+  auto* width_opt =
+      app.add_option("--width-m", width_m, "loom width for the I/O node's shuttle sensors (default 0.6)");
+  auto* lead_opt = app.add_option("--helix-lead-m", helix_lead_m,
+                                  "helix lead for the I/O node's shuttle sensors (default 0.1)");
   app.add_option("--personality", personality,
                  "standard | fixed (read-only PDO mappings, no TPDO3/4, no 0x1016, slow boot and start)")
       ->check(CLI::IsMember({"standard", "fixed"}));
@@ -159,9 +166,10 @@ int main(int argc, char** argv) {
   app.add_option("--operational-delay-ms", operational_delay_ms,
                  "NMT start → operational delay (default 0; fixed personality 400)");
   auto* nodes_opt = app.add_option("--nodes", nodes, "node ids, comma separated (1..127)")->delimiter(',');
-  auto* cpu_opt = app.add_option("--counts-per-unit", counts_per_unit,
-                                 "counts per SI unit per node (rad or m); default 2^20/2π, 2^20/0.01 m, 2^20/2π")
-                      ->delimiter(',');
+  auto* cpu_opt =
+      app.add_option("--counts-per-unit", counts_per_unit,
+                     "counts per SI unit per node (rad or m); default 2^20/2π, 2^20/0.01 m, 2^20/2π")
+          ->delimiter(',');
   app.add_option("--initial-position", initial_position, "initial position per node in SI units")
       ->delimiter(',');
   app.add_option("--plant-cycle-ms", plant_cycle_ms,
@@ -170,12 +178,15 @@ int main(int argc, char** argv) {
   app.add_option("--max-step-counts", max_step_counts,
                  "largest target step per SYNC before a following-error fault (0 = off)");
   auto* homing_opt =
-      app.add_option("--homing-nodes", homing_nodes,
-                     "drives with an incremental encoder: CiA 402 homing offered, a random count at every power-up")
+      app.add_option(
+             "--homing-nodes", homing_nodes,
+             "drives with an incremental encoder: CiA 402 homing offered, a random count at every power-up")
           ->delimiter(',');
   // The machine description says these; giving both would be two sources for one fact.
-  for (CLI::Option* o : {nodes_opt, cpu_opt, io_node_opt, width_opt, lead_opt, homing_opt}) o->excludes(loom_opt);
-  app.add_option("--power-up-seed", power_up_seed, "seed of the random power-up counts (default: chosen, printed)");
+  for (CLI::Option* o : {nodes_opt, cpu_opt, io_node_opt, width_opt, lead_opt, homing_opt})
+    o->excludes(loom_opt);
+  app.add_option("--power-up-seed", power_up_seed,
+                 "seed of the random power-up counts (default: chosen, printed)");
   app.add_flag("--verbose", verbose, "print NMT and drive state changes");
   try {
     app.parse(argc, argv);
@@ -208,7 +219,8 @@ int main(int argc, char** argv) {
         for (std::size_t k = 0; k < modules.size(); ++k) {
           if (buses[k] != static_cast<std::size_t>(loom_bus)) continue;
           io_nodes.push_back(modules[k].node_id);
-          if (cfg.knotting.mode == loom::sequencer::KnottingMode::kHeads && cfg.io.gripper_close.module == k) {
+          if (cfg.knotting.mode == loom::sequencer::KnottingMode::kHeads &&
+              cfg.io.gripper_close.module == k) {
             heads_io_node = modules[k].node_id;
           }
         }
@@ -218,7 +230,8 @@ int main(int argc, char** argv) {
       if (heads_io_node != 0) {
         heads = std::make_unique<loom::firmware::SimHeads>(loom::firmware::sim_heads(cfg));
         const loom::sim_hal::SimKnotting& k = heads->knotting;
-        std::vector<std::size_t> needed{static_cast<std::size_t>(loom::hal::index(loom::hal::CoreAxis::kCarriage))};
+        std::vector<std::size_t> needed{
+            static_cast<std::size_t>(loom::hal::index(loom::hal::CoreAxis::kCarriage))};
         for (int h = 0; h < k.heads; ++h) {
           needed.push_back(k.knotter_axis[static_cast<std::size_t>(h)]);
           needed.push_back(k.selector_axis[static_cast<std::size_t>(h)]);
@@ -226,7 +239,8 @@ int main(int argc, char** argv) {
         for (std::size_t slot : needed) {
           if (cfg.axes[slot].bus != loom_bus) {
             return usage_error("--loom " + loom_file + ": axes." + cfg.axes[slot].name + " is on bus " +
-                               std::to_string(cfg.axes[slot].bus) + "; the simulated knotting heads behind the I/O "
+                               std::to_string(cfg.axes[slot].bus) +
+                               "; the simulated knotting heads behind the I/O "
                                "node follow the carriage and every head's servos, so they must be on bus " +
                                std::to_string(loom_bus) + " with it");
           }
@@ -237,7 +251,8 @@ int main(int argc, char** argv) {
       return 2;
     }
     if (nodes.empty() && io_nodes.empty()) {
-      return usage_error("--loom " + loom_file + ": no axis and no I/O module is on bus " + std::to_string(loom_bus));
+      return usage_error("--loom " + loom_file + ": no axis and no I/O module is on bus " +
+                         std::to_string(loom_bus));
     }
   } else if (io_node != 0) {
     io_nodes.push_back(io_node);
@@ -271,7 +286,8 @@ int main(int argc, char** argv) {
                        std::to_string(nodes.size()) + " nodes");
   }
   for (int n : homing_nodes) {
-    if (seen.count(n) == 0) return usage_error("--homing-nodes: node id " + std::to_string(n) + " is not in --nodes");
+    if (seen.count(n) == 0)
+      return usage_error("--homing-nodes: node id " + std::to_string(n) + " is not in --nodes");
   }
   if (!homing_nodes.empty()) {
     if (power_up_seed == 0) power_up_seed = (static_cast<std::uint64_t>(std::random_device{}()) << 1) | 1U;
@@ -346,12 +362,15 @@ int main(int argc, char** argv) {
     std::size_t crank = 0, helix = 2;
     if (!loom_file.empty()) {
       const auto at = [&](std::size_t slot) {
-        return static_cast<std::size_t>(std::find(slot_of_node.begin(), slot_of_node.end(), slot) - slot_of_node.begin());
+        return static_cast<std::size_t>(std::find(slot_of_node.begin(), slot_of_node.end(), slot) -
+                                        slot_of_node.begin());
       };
       crank = at(0);
       helix = at(2);
     }
-    const auto cpr = [&](std::size_t i) { return i < counts_per_unit.size() ? counts_per_unit[i] : default_counts_per_unit(i); };
+    const auto cpr = [&](std::size_t i) {
+      return i < counts_per_unit.size() ? counts_per_unit[i] : default_counts_per_unit(i);
+    };
     loom::sim_can::SimDriveRack::IoPlantSource source{crank, helix, cpr(crank), cpr(helix), {}};
     for (std::size_t i = 0; i < slot_of_node.size(); ++i) {  // every drive's position, by the loom's slot
       source.axes.push_back({i, slot_of_node[i], counts_per_unit[i]});
@@ -374,11 +393,13 @@ int main(int argc, char** argv) {
     }
     // One line per re-read (HIL tests wait for it), also for an empty file or a last word without newline.
     std::string applied = words.str();
-    while (!applied.empty() && std::isspace(static_cast<unsigned char>(applied.back())) != 0) applied.pop_back();
+    while (!applied.empty() && std::isspace(static_cast<unsigned char>(applied.back())) != 0)
+      applied.pop_back();
     std::cerr << "loom-sim-drive: I/O controls now: " << applied << "\n";
   };
   rack.power_on(monotonic_us());
-  std::cerr << "loom-sim-drive: " << nodes.size() << " " << personality << " drive(s) on " << iface << ", nodes";
+  std::cerr << "loom-sim-drive: " << nodes.size() << " " << personality << " drive(s) on " << iface
+            << ", nodes";
   for (int n : nodes) std::cerr << ' ' << n;
   for (int n : io_nodes) std::cerr << ", I/O node " << n;
   std::cerr << std::endl;

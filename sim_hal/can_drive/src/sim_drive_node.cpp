@@ -45,10 +45,10 @@ constexpr std::uint16_t kSupportedModes = 0x6502;
 constexpr std::uint32_t kDeviceTypeServo402 = 0x00020192;  // profile 402, servo drive
 constexpr std::int8_t kModeCsp = 8;
 constexpr std::int8_t kModeHoming = 6;
-constexpr std::uint32_t kModesPpPv = 0x05;          // 0x6502 bits 0 (pp) and 2 (pv)
-constexpr std::uint32_t kModeCspBit = 1U << 7;      // 0x6502 bit 7 (csp)
-constexpr std::uint32_t kModeHomingBit = 1U << 5;   // 0x6502 bit 5 (hm)
-constexpr std::uint16_t kCwHomingStart = 1U << 4;   // controlword bit 4 in homing mode
+constexpr std::uint32_t kModesPpPv = 0x05;         // 0x6502 bits 0 (pp) and 2 (pv)
+constexpr std::uint32_t kModeCspBit = 1U << 7;     // 0x6502 bit 7 (csp)
+constexpr std::uint32_t kModeHomingBit = 1U << 5;  // 0x6502 bit 5 (hm)
+constexpr std::uint16_t kCwHomingStart = 1U << 4;  // controlword bit 4 in homing mode
 constexpr std::uint16_t kSwHomingAttained = 1U << 12;
 constexpr std::uint16_t kSwHomingError = 1U << 13;
 constexpr std::int8_t kInterpolationIndexMin = -6;  // 0x60C2:02, 10^index s: µs … s
@@ -148,7 +148,8 @@ void SimDriveNode::reset_application() {
   od_.reset_application();
   if (config_.dictionary.empty()) {  // a described drive's 0x6502 is its description's
     od_.set(kSupportedModes, 0,
-            kModesPpPv | (config_.supports_csp ? kModeCspBit : 0U) | (config_.supports_homing ? kModeHomingBit : 0U));
+            kModesPpPv | (config_.supports_csp ? kModeCspBit : 0U) |
+                (config_.supports_homing ? kModeHomingBit : 0U));
   }
   homing_running_ = homing_attained_ = homing_error_ = false;
   state_ = drive_settle(DriveState::kNotReadyToSwitchOn);
@@ -320,7 +321,8 @@ void SimDriveNode::set_home() {
 // One SYNC of a homing run: travel at the search speed toward the home point of the method.
 void SimDriveNode::run_homing() {
   if (!homing_running_) return;
-  if (state_ != DriveState::kOperationEnabled || mode() != kModeHoming || (controlword_ & kCwHomingStart) == 0) {
+  if (state_ != DriveState::kOperationEnabled || mode() != kModeHoming ||
+      (controlword_ & kCwHomingStart) == 0) {
     homing_running_ = false;  // interrupted (bit 4 dropped, mode changed, power stage off)
     return;
   }
@@ -332,7 +334,8 @@ void SimDriveNode::run_homing() {
   ++homing_syncs_;
   const double period_s = static_cast<double>(od_.get(kInterpolationPeriod, 1)) *
                           std::pow(10.0, static_cast<std::int8_t>(od_.get(kInterpolationPeriod, 2)));
-  const auto step = std::max<std::int64_t>(1, std::llround(static_cast<double>(od_.get(kHomingSpeeds, 1)) * period_s));
+  const auto step =
+      std::max<std::int64_t>(1, std::llround(static_cast<double>(od_.get(kHomingSpeeds, 1)) * period_s));
   const std::int64_t here = physical_position();
   std::int64_t goal = here;
   if (method == 19 || method == 21) {

@@ -36,10 +36,12 @@ void SimDriveRack::step(std::int64_t now_us, int max_frames) {
   if (!io_.empty()) {
     IoPlant p = io_controls_;
     if (io_source_.crank < nodes_.size()) {
-      p.crank_rad = static_cast<double>(nodes_[io_source_.crank]->position()) / io_source_.crank_counts_per_rad;
+      p.crank_rad =
+          static_cast<double>(nodes_[io_source_.crank]->position()) / io_source_.crank_counts_per_rad;
     }
     if (io_source_.helix < nodes_.size()) {
-      p.helix_rad = static_cast<double>(nodes_[io_source_.helix]->position()) / io_source_.helix_counts_per_rad;
+      p.helix_rad =
+          static_cast<double>(nodes_[io_source_.helix]->position()) / io_source_.helix_counts_per_rad;
     }
     for (const IoPlantSource::Axis& a : io_source_.axes) {
       if (a.node < nodes_.size() && a.slot < p.axis_position.size()) {

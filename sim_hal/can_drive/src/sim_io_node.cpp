@@ -43,7 +43,8 @@ constexpr int kOutValveA = 0, kOutValveB = 1;
 // The knotting heads' terminals: head h's gripper and cutter outputs, its yarn-present input.
 constexpr int kOutGripperFirst = 8, kOutCutterFirst = 20, kInYarnPresentFirst = 24;
 static_assert(kOutCutterFirst + static_cast<int>(hal::kMaxKnottingHeads) <= 32, "four 8-bit output groups");
-static_assert(kInYarnPresentFirst + static_cast<int>(hal::kMaxKnottingHeads) <= 64, "eight 8-bit input groups");
+static_assert(kInYarnPresentFirst + static_cast<int>(hal::kMaxKnottingHeads) <= 64,
+              "eight 8-bit input groups");
 
 constexpr slave::Objects<5> kCommunicationObjects = slave::communication_objects(kDeviceType);
 

@@ -1,5 +1,7 @@
 // The fixed-size latency histogram against exact percentiles of the same samples (sorted), over
 // random log-uniform samples. Seed: LOOM_TEST_SEED (printed).
+#include "loom/firmware/latency_histogram.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -7,8 +9,6 @@
 #include <cstdlib>
 #include <random>
 #include <vector>
-
-#include "loom/firmware/latency_histogram.hpp"
 
 using loom::firmware::LatencyHistogram;
 
@@ -43,7 +43,8 @@ TEST(LatencyHistogram, PercentilesMatchSortedSamplesWithin3Percent) {
     for (double q : {0.5, 0.9, 0.99, 0.999}) {
       const auto k = static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size()))) - 1;
       const double exact = static_cast<double>(v[k]);
-      EXPECT_NEAR(static_cast<double>(h.percentile(q)), exact, std::max(1.0, exact / 32)) << "q " << q << " seed " << seed;
+      EXPECT_NEAR(static_cast<double>(h.percentile(q)), exact, std::max(1.0, exact / 32))
+          << "q " << q << " seed " << seed;
     }
     EXPECT_EQ(h.max(), v.back());
     EXPECT_EQ(h.count(), v.size());

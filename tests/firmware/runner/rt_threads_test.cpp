@@ -57,7 +57,8 @@ std::map<int, TaskInfo> read_tasks() {
 
 TEST(RtThreads, SetupRealtimeLeavesTheProcessAtSchedOther) {
   const firmware::RtSetup rt = firmware::setup_realtime(80, 1u << 20);
-  std::printf("setup_realtime: memory_locked=%d fifo=%d %s\n", rt.memory_locked, rt.fifo, rt.problems.c_str());
+  std::printf("setup_realtime: memory_locked=%d fifo=%d %s\n", rt.memory_locked, rt.fifo,
+              rt.problems.c_str());
   EXPECT_EQ(sched_getscheduler(0), SCHED_OTHER);
   int policy = -1;
   std::thread([&] {
@@ -102,16 +103,19 @@ TEST(RtThreads, OnlyTheLoopThreadIsSchedFifo) {
   o.fifo_priority = 80;
   o.max_ticks = 250;  // half a second at 2 ms
   m.sequencer().request_start();
-  const firmware::RunResult res = firmware::run_loop(m.loop(), m.sequencer(), o, [](const firmware::RunEvent&) {});
+  const firmware::RunResult res =
+      firmware::run_loop(m.loop(), m.sequencer(), o, [](const firmware::RunEvent&) {});
   stop.store(true);
   observer.join();
   m.telemetry()->stop();
 
   ASSERT_TRUE(saw_loop) << "the observer never saw the loop thread";
-  std::printf("case: %s\n", rt.fifo ? "SCHED_FIFO granted" : "SCHED_FIFO not granted (checking the fallback)");
+  std::printf("case: %s\n",
+              rt.fifo ? "SCHED_FIFO granted" : "SCHED_FIFO not granted (checking the fallback)");
   int others = 0;
   for (const auto& [tid, t] : seen_while_running) {
-    std::printf("  tid %d %-16s policy %d%s\n", tid, t.comm.c_str(), t.policy, tid == reporter_tid ? " (reporter)" : "");
+    std::printf("  tid %d %-16s policy %d%s\n", tid, t.comm.c_str(), t.policy,
+                tid == reporter_tid ? " (reporter)" : "");
     if (t.comm == "loom-rt") {
       EXPECT_EQ(t.policy, rt.fifo ? SCHED_FIFO : SCHED_OTHER);
     } else {
@@ -145,7 +149,8 @@ TEST(RtThreads, RequiredFifoThatIsRefusedIsAnErrorNotASilentFallback) {
   o.max_ticks = 10;
   o.require_fifo = true;
   o.cpu = 1000;
-  const firmware::RunResult res = firmware::run_loop(m.loop(), m.sequencer(), o, [](const firmware::RunEvent&) {});
+  const firmware::RunResult res =
+      firmware::run_loop(m.loop(), m.sequencer(), o, [](const firmware::RunEvent&) {});
   EXPECT_EQ(res.end, firmware::RunResult::End::kError);
   EXPECT_NE(res.error.find("CPU 1000"), std::string::npos) << res.error;
   EXPECT_EQ(res.ticks, 0);

@@ -1,20 +1,22 @@
 // The persistent fault history: lines appended survive a reopen, read back oldest first, and the file
 // is bounded — rotation keeps one generation, so the history never exceeds twice the limit and always
 // holds the newest lines.
+#include "loom/firmware/serve/fault_history.hpp"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
 
-#include "loom/firmware/serve/fault_history.hpp"
 #include "loom/firmware/serve/journal.hpp"
 
 using namespace loom::firmware::serve;
 
 namespace {
 std::string temp_dir() {
-  const auto d = std::filesystem::temp_directory_path() / ("loom_fh_" + std::to_string(getpid()) + "_" +
-                                                           ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  const auto d = std::filesystem::temp_directory_path() /
+                 ("loom_fh_" + std::to_string(getpid()) + "_" +
+                  ::testing::UnitTest::GetInstance()->current_test_info()->name());
   std::filesystem::remove_all(d);
   std::filesystem::create_directories(d);
   return d.string();
@@ -36,7 +38,8 @@ FaultRecord record(std::uint32_t rows) {
 
 TEST(FaultHistory, FormatNamesEverythingATechnicianNeeds) {
   EXPECT_EQ(FaultHistory::format(record(3), 1'795'000'000),
-            "2026-11-18T11:06:40Z fault loom1 drive_fault 0x1002 axis=carriage device=0x7310 rows=3 picks=3 beats=45: "
+            "2026-11-18T11:06:40Z fault loom1 drive_fault 0x1002 axis=carriage device=0x7310 rows=3 picks=3 "
+            "beats=45: "
             "a servo drive reported a fault");
 }
 

@@ -2,12 +2,12 @@
 // station — a local socket user, an unpaired panel client, a paired one — answers `ok` (and hands the
 // command to the loop) only when it changes something and the station may give it; else `refused: why`.
 // The expected table is written out here by hand from the rules (operator_desk.hpp), not computed.
+#include "loom/firmware/serve/operator_desk.hpp"
+
 #include <gtest/gtest.h>
 
 #include <map>
 #include <string>
-
-#include "loom/firmware/serve/operator_desk.hpp"
 
 using namespace loom;
 using namespace loom::firmware::serve;
@@ -45,7 +45,9 @@ const Row kTable[] = {
 };
 const char* const kCommands[] = {"start", "pause", "resume", "stop", "ack", "next"};
 
-bool listed(const std::string& list, const std::string& w) { return (" " + list + " ").find(" " + w + " ") != std::string::npos; }
+bool listed(const std::string& list, const std::string& w) {
+  return (" " + list + " ").find(" " + w + " ") != std::string::npos;
+}
 
 LoomView view(State s) {
   LoomView v;
@@ -55,7 +57,9 @@ LoomView view(State s) {
   return v;
 }
 
-ControlRequest local(const std::string& line) { return {line, Peer{4242, 1000, 1000, "anna"}}; }
+ControlRequest local(const std::string& line) {
+  return {line, Peer{4242, 1000, 1000, "anna"}};
+}
 
 }  // namespace
 
@@ -72,13 +76,14 @@ TEST(OperatorDesk, EveryCommandInEveryStateFromEveryStationIsTrue) {
       struct Station {
         std::string suffix;
         bool may;
-      } stations[] = {{"", true},
-                      {" via=panel client=10.0.0.7", !starting},
-                      {" via=panel client=10.0.0.7 device=" + std::string(kDevice) + " token=" + token, true},
-                      {" via=panel client=10.0.0.7 token=00000000000000000000000000000000", !starting},
-                      // The token replayed from another address, or without the device's secret.
-                      {" via=panel client=10.0.0.8 device=" + std::string(kDevice) + " token=" + token, !starting},
-                      {" via=panel client=10.0.0.7 token=" + token, !starting}};
+      } stations[] = {
+          {"", true},
+          {" via=panel client=10.0.0.7", !starting},
+          {" via=panel client=10.0.0.7 device=" + std::string(kDevice) + " token=" + token, true},
+          {" via=panel client=10.0.0.7 token=00000000000000000000000000000000", !starting},
+          // The token replayed from another address, or without the device's secret.
+          {" via=panel client=10.0.0.8 device=" + std::string(kDevice) + " token=" + token, !starting},
+          {" via=panel client=10.0.0.7 token=" + token, !starting}};
       for (const Station& st : stations) {
         SCOPED_TRACE(std::string(row.name) + ": " + cmd + st.suffix);
         const Decision d = desk.decide(local(cmd + st.suffix), view(row.state), kNow);
@@ -102,8 +107,9 @@ TEST(OperatorDesk, RefusalsSayWhy) {
   OperatorDesk desk(pairings, "can1");
   LoomView fault = view(State::kFault);
   fault.estop_ok = false;
-  EXPECT_EQ(desk.decide(local("ack"), fault, kNow).reply,
-            "refused: ack: the e-stop chain is still open: close it (release the e-stop), then acknowledge\n");
+  EXPECT_EQ(
+      desk.decide(local("ack"), fault, kNow).reply,
+      "refused: ack: the e-stop chain is still open: close it (release the e-stop), then acknowledge\n");
   fault.estop_ok = true;
   fault.recovery = hal::LinkRecovery::kNodeSilent;
   fault.silent_node = 3;
@@ -112,45 +118,54 @@ TEST(OperatorDesk, RefusalsSayWhy) {
   EXPECT_NE(desk.decide(local("ack"), fault, kNow).reply.find("ip link set can1"), std::string::npos);
   EXPECT_EQ(desk.decide(local("start"), fault, kNow).reply,
             "refused: start: drive_fault is latched: acknowledge it first (ctl ack)\n");
-  EXPECT_EQ(desk.decide(local("ack"), view(State::kPick), kNow).reply, "refused: ack: no fault is latched (state pick)\n");
+  EXPECT_EQ(desk.decide(local("ack"), view(State::kPick), kNow).reply,
+            "refused: ack: no fault is latched (state pick)\n");
   // The counters woven are not yet on disk (full disk): an ack would re-arm from the file's older counts,
   // so the loop refuses it; the reply must say so, not `ok ack` (issue 22, item 6).
   LoomView unsaved = view(State::kFault);
   unsaved.fault = sequencer::Fault::kCountersNotSaved;
   unsaved.counters_unsaved = true;
   const Decision ack_unsaved = desk.decide(local("ack"), unsaved, kNow);
-  EXPECT_EQ(ack_unsaved.reply,
-            "refused: ack: the counters woven are not on disk yet (the last save failed): free space in the state "
-            "directory; the save is retried every second, then acknowledge\n");
+  EXPECT_EQ(
+      ack_unsaved.reply,
+      "refused: ack: the counters woven are not on disk yet (the last save failed): free space in the state "
+      "directory; the save is retried every second, then acknowledge\n");
   EXPECT_FALSE(ack_unsaved.post.has_value());
   EXPECT_TRUE(ack_unsaved.audit);
   unsaved.counters_unsaved = false;  // the retried save went through
   EXPECT_EQ(desk.decide(local("ack"), unsaved, kNow).reply, "ok ack\n");
   LoomView idle = view(State::kIdle);
   idle.estop_ok = false;
-  EXPECT_EQ(desk.decide(local("start"), idle, kNow).reply, "refused: start: the e-stop chain is open: close it first\n");
+  EXPECT_EQ(desk.decide(local("start"), idle, kNow).reply,
+            "refused: start: the e-stop chain is open: close it first\n");
   LoomView plain = view(State::kAwaitKnotting);
   plain.knotting = false;
   EXPECT_NE(desk.decide(local("next"), plain, kNow).reply.find("no weaver's knotting"), std::string::npos);
   // The knotting heads asking the weaver (a knot to tie by hand, a slot to reload): next answers them.
   LoomView heads = view(State::kKnotting);
   heads.knotting = false;
-  EXPECT_NE(desk.decide(local("next"), heads, kNow).reply.find("not waiting for the weaver"), std::string::npos);
+  EXPECT_NE(desk.decide(local("next"), heads, kNow).reply.find("not waiting for the weaver"),
+            std::string::npos);
   heads.weaver_ask = sequencer::WeaverAsk::kTieByHand;
   EXPECT_EQ(desk.decide(local("next"), heads, kNow).reply.rfind("refused", 0), std::string::npos)
       << desk.decide(local("next"), heads, kNow).reply;
   EXPECT_EQ(desk.decide(local("dance"), idle, kNow).reply.rfind("error: unknown command 'dance'", 0), 0u);
-  EXPECT_EQ(desk.decide(local("start now"), idle, kNow).reply, "error: start takes no argument (got 'now')\n");
+  EXPECT_EQ(desk.decide(local("start now"), idle, kNow).reply,
+            "error: start takes no argument (got 'now')\n");
   EXPECT_EQ(desk.decide(local("start hours=3"), idle, kNow).reply, "error: hours= is for pair only\n");
-  EXPECT_EQ(desk.decide(local("start via=lan client=x"), idle, kNow).reply, "error: via=lan: only via=panel\n");
+  EXPECT_EQ(desk.decide(local("start via=lan client=x"), idle, kNow).reply,
+            "error: via=lan: only via=panel\n");
   EXPECT_EQ(desk.decide(local("start via=panel"), idle, kNow).reply, "error: via=panel needs client=ADDR\n");
-  EXPECT_EQ(desk.decide(local(std::string("start\x01")), idle, kNow).reply.rfind("error: request has a character", 0), 0u);
+  EXPECT_EQ(desk.decide(local(std::string("start\x01")), idle, kNow)
+                .reply.rfind("error: request has a character", 0),
+            0u);
 }
 
 TEST(OperatorDesk, WhoGaveTheCommandIsTheKernelsWordAndThePanelsClient) {
   Pairings pairings;
   OperatorDesk desk(pairings, "");
-  EXPECT_EQ(desk.decide(local("pause"), view(State::kPick), kNow).who, "local user anna (uid 1000, pid 4242)");
+  EXPECT_EQ(desk.decide(local("pause"), view(State::kPick), kNow).who,
+            "local user anna (uid 1000, pid 4242)");
   EXPECT_EQ(desk.decide(local("pause via=panel client=10.0.0.7"), view(State::kPick), kNow).who,
             "panel client 10.0.0.7 (not paired) via local user anna (uid 1000, pid 4242)");
   // The COMMAND event's station.
@@ -164,9 +179,11 @@ TEST(OperatorDesk, AButtonPressIsAnsweredAsTheSameCommandWouldBe) {
   Pairings pairings;
   OperatorDesk desk(pairings, "");
   EXPECT_EQ(desk.answer_in_state("start", view(State::kIdle)), "ok start");
-  EXPECT_EQ(desk.answer_in_state("start", view(State::kPick)), "refused: start: already weaving (state pick)");
+  EXPECT_EQ(desk.answer_in_state("start", view(State::kPick)),
+            "refused: start: already weaving (state pick)");
   EXPECT_EQ(desk.answer_in_state("pause", view(State::kPick)), "ok pause");
-  EXPECT_EQ(desk.answer_in_state("ack", view(State::kPick)), "refused: ack: no fault is latched (state pick)");
+  EXPECT_EQ(desk.answer_in_state("ack", view(State::kPick)),
+            "refused: ack: no fault is latched (state pick)");
   LoomView open = view(State::kFault);
   open.estop_ok = false;
   EXPECT_EQ(desk.answer_in_state("ack", open),
@@ -179,7 +196,9 @@ TEST(OperatorDesk, PairingIsDoneAtTheLoomCodesExpireAndTokensAreRevocable) {
   OperatorDesk desk(pairings, "");
   const LoomView paused = view(State::kPaused);
   // Never through a panel: a panel client cannot pair itself or others.
-  EXPECT_EQ(desk.decide(local("pair x via=panel client=1.2.3.4"), paused, kNow).reply.rfind("refused: pair:", 0), 0u);
+  EXPECT_EQ(
+      desk.decide(local("pair x via=panel client=1.2.3.4"), paused, kNow).reply.rfind("refused: pair:", 0),
+      0u);
   const std::string reply = desk.decide(local("pair tab2 hours=2"), paused, kNow).reply;
   ASSERT_EQ(reply.rfind("ok pair tab2 code=", 0), 0u) << reply;
   const std::string code = reply.substr(18, 6);
@@ -189,26 +208,31 @@ TEST(OperatorDesk, PairingIsDoneAtTheLoomCodesExpireAndTokensAreRevocable) {
             std::string::npos);
   EXPECT_NE(desk.decide(local(redeem + code), paused, kNow).reply.find("wait 1 s"), std::string::npos);
   for (int i = 1; i < Pairings::kCodeTries; ++i) {
-    EXPECT_EQ(desk.decide(local(redeem + "x"), paused, kNow + 20 * i).reply.rfind("refused: redeem: wrong pairing code", 0),
+    EXPECT_EQ(desk.decide(local(redeem + "x"), paused, kNow + 20 * i)
+                  .reply.rfind("refused: redeem: wrong pairing code", 0),
               0u);
   }
-  EXPECT_NE(desk.decide(local(redeem + code), paused, kNow + 100).reply.find("wrong codes: ask for a new code"),
-            std::string::npos);
+  EXPECT_NE(
+      desk.decide(local(redeem + code), paused, kNow + 100).reply.find("wrong codes: ask for a new code"),
+      std::string::npos);
   // Without the page's device secret nothing is redeemed.
-  EXPECT_NE(desk.decide(local("redeem via=panel client=1.2.3.4 code=" + code), paused, kNow).reply.find("device secret"),
+  EXPECT_NE(desk.decide(local("redeem via=panel client=1.2.3.4 code=" + code), paused, kNow)
+                .reply.find("device secret"),
             std::string::npos);
   // A fresh code, redeemed in time: a token valid 2 h.
   const std::string code2 = desk.decide(local("pair tab2 hours=2"), paused, kNow).reply.substr(18, 6);
   EXPECT_NE(desk.decide(local(redeem + code2), paused, kNow + Pairings::kCodeLifetimeS).reply.find("expired"),
             std::string::npos);
-  EXPECT_NE(desk.decide(local(redeem + code2), paused, kNow).reply.find("no pairing code"), std::string::npos);
+  EXPECT_NE(desk.decide(local(redeem + code2), paused, kNow).reply.find("no pairing code"),
+            std::string::npos);
   const std::string code3 = desk.decide(local("pair tab2 hours=2"), paused, kNow).reply.substr(18, 6);
   const std::string ok = desk.decide(local(redeem + code3), paused, kNow + 10).reply;
   ASSERT_EQ(ok.rfind("ok redeem tab2 token=", 0), 0u) << ok;
   // The cookie's Max-Age: what is left of the pairing.
   EXPECT_NE(ok.find(" valid_s=7200\n"), std::string::npos) << ok;
   const std::string token = ok.substr(21, 32);
-  const std::string resume = "resume via=panel client=1.2.3.4 device=" + std::string(kDevice) + " token=" + token;
+  const std::string resume =
+      "resume via=panel client=1.2.3.4 device=" + std::string(kDevice) + " token=" + token;
   EXPECT_TRUE(desk.decide(local(resume), paused, kNow + 7199).accepted());
   EXPECT_FALSE(desk.decide(local(resume), paused, kNow + 7210).accepted());  // expired after 2 h
   EXPECT_TRUE(desk.decide(local(resume), paused, kNow + 100).accepted());

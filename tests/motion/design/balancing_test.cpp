@@ -2,12 +2,13 @@
 // against finite differences, force-only balancing against the Berkof–Lowen closed form (a four-bar
 // is fully force-balanced by two counterweights whose first moments are known), and the reductions
 // on the default beat-up with converged SLSQP runs that respect their bounds.
+#include "loom/motion/design/balancing.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
 
-#include "loom/motion/design/balancing.hpp"
 #include "loom/motion/errors.hpp"
 
 using namespace loom::motion;
@@ -39,8 +40,8 @@ TEST(Balancing, LinearShakingModelEqualsRigidBodySum) {
   for (std::size_t k = 0; k < s.samples; ++k) {
     std::vector<PlanarInertia> bodies;
     for (const BalancingLink& l : s.links) bodies.push_back(combine(l.body, l.payload));
-    const ShakingLoad direct =
-        shaking_load(bodies, std::span(s.motion).subspan(k * s.links.size(), s.links.size()), s.moment_about_m);
+    const ShakingLoad direct = shaking_load(
+        bodies, std::span(s.motion).subspan(k * s.links.size(), s.links.size()), s.moment_about_m);
     const ShakingLoad linear = model.load(k, q);
     EXPECT_NEAR((direct.force_n - linear.force_n).norm(), 0.0, 1e-12 * (1.0 + direct.force_n.norm()));
     EXPECT_NEAR(direct.moment_nm, linear.moment_nm, 1e-12 * (1.0 + std::abs(direct.moment_nm)));
@@ -108,7 +109,8 @@ TEST(Balancing, CounterweightsReduceBothOnTheBeatUp) {
   std::vector<ShakingLoad> h;
   for (std::size_t k = 0; k < s.samples; ++k) {
     std::vector<PlanarInertia> bodies;
-    for (std::size_t i = 0; i < s.links.size(); ++i) bodies.push_back(combine(r.links_after[i], s.links[i].payload));
+    for (std::size_t i = 0; i < s.links.size(); ++i)
+      bodies.push_back(combine(r.links_after[i], s.links[i].payload));
     h.push_back(shaking_load(bodies, std::span(s.motion).subspan(k * 3, 3), s.moment_about_m));
   }
   const ShakingRms direct = shaking_rms(h);

@@ -8,9 +8,9 @@
 #include <cmath>
 #include <vector>
 
+#include "bench_sweep.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/design/batten.hpp"
-#include "bench_sweep.hpp"
 #include "markdown_reporter.hpp"
 
 namespace {
@@ -27,10 +27,14 @@ const BattenLinkage& linkage() {
   return l;
 }
 
-std::vector<double> cranks() { return loom::test::sweep_angles(kSamples); }
+std::vector<double> cranks() {
+  return loom::test::sweep_angles(kSamples);
+}
 
 double max_error(const BattenPose& a, const BattenPose& b) {
-  return (a.vec() - b.vec()).unaryExpr([](double v) { return std::abs(loom::motion::wrap_pi(v)); }).maxCoeff();
+  return (a.vec() - b.vec())
+      .unaryExpr([](double v) { return std::abs(loom::motion::wrap_pi(v)); })
+      .maxCoeff();
 }
 
 void BM_ClosedForm(benchmark::State& state) {
@@ -116,7 +120,8 @@ BENCHMARK(BM_Rates);
 
 // One full drive sample: gear law, closed-form pose and rates.
 void BM_DriveSample(benchmark::State& state) {
-  const BattenDrive d(loom::motion::EllipticGearPair(loom::motion::kBatten004GearA_m, 0.2, 2), linkage(), 1.0);
+  const BattenDrive d(loom::motion::EllipticGearPair(loom::motion::kBatten004GearA_m, 0.2, 2), linkage(),
+                      1.0);
   const auto c = cranks();
   std::size_t i = 0;
   for (auto _ : state) {
@@ -130,6 +135,6 @@ BENCHMARK(BM_DriveSample);
 }  // namespace
 
 int main(int argc, char** argv) {
-  return loom::kinreport::run_benchmarks(argc, argv,
-                                         "Batten linkage (004 eqns 7): closed form vs Newton (errors against the closed form)");
+  return loom::kinreport::run_benchmarks(
+      argc, argv, "Batten linkage (004 eqns 7): closed form vs Newton (errors against the closed form)");
 }

@@ -39,7 +39,8 @@ TEST(BattenDynamics, FrontSideIsTheHarderTurningPointWithTheCircularGear) {
   const BattenLinkage l(batten_004_dims());
   const BattenDrive circular(EllipticGearPair(kBatten004GearA_m, 0.0, 2), l, 0.0);
   const BattenBeatSide front = batten_front_side(l);
-  const BattenBeatSide back = front == BattenBeatSide::kPsiMax ? BattenBeatSide::kPsiMin : BattenBeatSide::kPsiMax;
+  const BattenBeatSide back =
+      front == BattenBeatSide::kPsiMax ? BattenBeatSide::kPsiMin : BattenBeatSide::kPsiMax;
   const BattenBeat f = batten_beat(circular, front, 1.0), b = batten_beat(circular, back, 1.0);
   EXPECT_GE(std::abs(f.psi_ddot_rad_s2), std::abs(b.psi_ddot_rad_s2));
   EXPECT_EQ(f.beats_per_turn, 2);  // 004's double swing: two beats per crank turn

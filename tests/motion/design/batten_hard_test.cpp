@@ -62,9 +62,9 @@ TEST(BattenHard, LoopTwoToggleIsSingularAndBeyondItNotAssemblable) {
     bp_max = std::max(bp_max, (o3 + base.l3_m * Eigen::Vector2d(std::cos(g3), std::sin(g3)) - p).norm());
   }
   // ... and no interior γ3 reaches farther: the far side of the circle (O3P reversed) is outside the swing.
-  for (const BattenSample& s :
-       batten_sweep(BattenDrive(EllipticGearPair(0.05, 0.0, 2), l, 0.0), 3600, 1.0)) {
-    const Eigen::Vector2d b = o3 + base.l3_m * Eigen::Vector2d(std::cos(s.pose.gamma3_rad), std::sin(s.pose.gamma3_rad));
+  for (const BattenSample& s : batten_sweep(BattenDrive(EllipticGearPair(0.05, 0.0, 2), l, 0.0), 3600, 1.0)) {
+    const Eigen::Vector2d b =
+        o3 + base.l3_m * Eigen::Vector2d(std::cos(s.pose.gamma3_rad), std::sin(s.pose.gamma3_rad));
     ASSERT_LE((b - p).norm(), bp_max + 1e-15);
   }
   BattenDims d = base;
@@ -74,8 +74,10 @@ TEST(BattenHard, LoopTwoToggleIsSingularAndBeyondItNotAssemblable) {
   EXPECT_EQ(code_of(d), ErrorCode::kNotAssemblable);
   d.l5_m = bp_max - d.l4_m + 1e-9;  // just clear of the toggle: valid and finite everywhere
   const BattenLinkage near(d);
-  for (const BattenSample& s : batten_sweep(BattenDrive(EllipticGearPair(0.05, 0.2, 2), near, 0.3), 3600, 1.0)) {
-    ASSERT_TRUE(std::isfinite(s.psi_rad) && std::isfinite(s.psi_dot_rad_s) && std::isfinite(s.psi_ddot_rad_s2));
+  for (const BattenSample& s :
+       batten_sweep(BattenDrive(EllipticGearPair(0.05, 0.2, 2), near, 0.3), 3600, 1.0)) {
+    ASSERT_TRUE(std::isfinite(s.psi_rad) && std::isfinite(s.psi_dot_rad_s) &&
+                std::isfinite(s.psi_ddot_rad_s2));
   }
 }
 
@@ -103,7 +105,8 @@ TEST(BattenHard, ScaleFreeFromMicrometreToKilometre) {
   const BattenLinkage ref(base);
   for (double k : {1e-5, 1e4}) {
     BattenDims d = base;
-    for (double* v : {&d.l1_m, &d.l2_m, &d.l3_m, &d.l4_m, &d.l5_m, &d.l6_m, &d.l7_m, &d.l8_m, &d.l9_m}) *v *= k;
+    for (double* v : {&d.l1_m, &d.l2_m, &d.l3_m, &d.l4_m, &d.l5_m, &d.l6_m, &d.l7_m, &d.l8_m, &d.l9_m})
+      *v *= k;
     const BattenLinkage l(d);
     for (int i = 0; i < 360; ++i) {
       const double crank = kTwoPi * i / 360.0;
@@ -123,13 +126,15 @@ TEST(BattenHard, PerturbedDesignsAreFiniteOrRejected) {
   const auto next = [&draw] { return draw.next(); };
   for (int trial = 0; trial < 200; ++trial) {
     BattenDims d = batten_004_dims();
-    for (double* v : {&d.l1_m, &d.l2_m, &d.l3_m, &d.l4_m, &d.l5_m, &d.l6_m, &d.l7_m, &d.l8_m, &d.l9_m}) *v *= next();
+    for (double* v : {&d.l1_m, &d.l2_m, &d.l3_m, &d.l4_m, &d.l5_m, &d.l6_m, &d.l7_m, &d.l8_m, &d.l9_m})
+      *v *= next();
     try {
       const BattenLinkage l(d);
       ++accepted;
       const BattenDrive drv(EllipticGearPair(0.05, 0.3, 2), l, 0.7);
       for (const BattenSample& s : batten_sweep(drv, 720, 1.0)) {
-        ASSERT_TRUE(std::isfinite(s.psi_rad) && std::isfinite(s.psi_dot_rad_s) && std::isfinite(s.psi_ddot_rad_s2))
+        ASSERT_TRUE(std::isfinite(s.psi_rad) && std::isfinite(s.psi_dot_rad_s) &&
+                    std::isfinite(s.psi_ddot_rad_s2))
             << "trial " << trial;
         ASSERT_TRUE(s.rates.dot.allFinite() && s.rates.ddot.allFinite());
         ASSERT_LE(l.residual(s.phi2_rad, s.pose).cwiseAbs().maxCoeff(), 1e-12 * l.largest_link_m());

@@ -1,6 +1,8 @@
 // Batten drive of seed 004 against independent truth: eqns (7) residuals, the documented frame and
 // branch sides checked on explicit points, the batten's extremes against dead-centre geometry of
 // either loop, finite differences of ψ in time, and Newton (the paper's route) against the closed form.
+#include "loom/motion/design/batten.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
@@ -9,7 +11,6 @@
 
 #include "finite_diff.hpp"
 #include "loom/motion/angles.hpp"
-#include "loom/motion/design/batten.hpp"
 #include "loom/motion/errors.hpp"
 
 namespace loom::motion {
@@ -25,7 +26,9 @@ Vector2d circle_point(const Vector2d& c0, double r0, const Vector2d& c1, double 
   return c0 + a * ex + sign * h * ey;
 }
 
-double cross(const Vector2d& a, const Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+double cross(const Vector2d& a, const Vector2d& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
 
 struct Points {
   Vector2d a, b, d, o3, p;
@@ -44,7 +47,8 @@ Points points(const BattenDims& dm, double crank, const BattenPose& x) {
 
 TEST(Batten, ClosedFormClosesEquationsSevenOnItsBranch) {
   const BattenDims dm = batten_004_dims();
-  for (BattenBranch br : {BattenBranch{LoopSide::kRight, LoopSide::kRight}, BattenBranch{LoopSide::kRight, LoopSide::kLeft}}) {
+  for (BattenBranch br :
+       {BattenBranch{LoopSide::kRight, LoopSide::kRight}, BattenBranch{LoopSide::kRight, LoopSide::kLeft}}) {
     const BattenLinkage l(dm, br);
     for (int i = 0; i < 3600; ++i) {
       const double crank = kTwoPi * i / 3600.0;
@@ -92,7 +96,9 @@ double refine_extreme(const BattenDrive& d, double lo, double hi) {
 std::vector<double> dead_centre_psis(const BattenLinkage& l) {
   const BattenDims& dm = l.dims();
   const Vector2d o1(0, 0), o3(-dm.l7_m, dm.l6_m), p(dm.l9_m, 2 * dm.l6_m + dm.l8_m);
-  const auto psi_of = [&](const Vector2d& d) { return wrap_two_pi(std::atan2(-(d.x() - p.x()), d.y() - p.y())); };
+  const auto psi_of = [&](const Vector2d& d) {
+    return wrap_two_pi(std::atan2(-(d.x() - p.x()), d.y() - p.y()));
+  };
   std::vector<double> out;
   for (int s : {-1, 1}) {
     // Loop 2 stretched: |O3 D| = L3 + L4.

@@ -4,9 +4,9 @@
 #include <benchmark/benchmark.h>
 
 #include "loom/motion/angles.hpp"
-#include "loom/motion/slider_crank.hpp"
 #include "loom/motion/design/synthesis.hpp"
 #include "loom/motion/design/three_point.hpp"
+#include "loom/motion/slider_crank.hpp"
 
 namespace {
 
@@ -52,9 +52,9 @@ void BM_KhareDaveBestBeta(benchmark::State& state) {
 BENCHMARK(BM_KhareDaveBestBeta);
 
 void BM_ThreePoint(benchmark::State& state) {
-  const std::array<loom::motion::PrecisionPoint, 3> pts = {
-      loom::motion::PrecisionPoint{0, 0, rad(10)}, loom::motion::PrecisionPoint{25, 15, rad(3)},
-      loom::motion::PrecisionPoint{30, 1, rad(-25)}};
+  const std::array<loom::motion::PrecisionPoint, 3> pts = {loom::motion::PrecisionPoint{0, 0, rad(10)},
+                                                           loom::motion::PrecisionPoint{25, 15, rad(3)},
+                                                           loom::motion::PrecisionPoint{30, 1, rad(-25)}};
   for (auto _ : state) benchmark::DoNotOptimize(loom::motion::three_point_synthesis(pts, rad(275)));
 }
 BENCHMARK(BM_ThreePoint);

@@ -18,7 +18,9 @@ namespace {
 
 // Benchmark 1.7's DoNotOptimize on a non-const lvalue uses a "+r,m" asm constraint that GCC may
 // satisfy with a general register and hand back a clobbered double; a const reference only reads.
-void keep(const double& v) { benchmark::DoNotOptimize(v); }
+void keep(const double& v) {
+  benchmark::DoNotOptimize(v);
+}
 
 const BeatUpDynamics& beatup() {
   static const BeatUpDynamics d = [] {
@@ -100,7 +102,8 @@ void BM_ForwardOneSecondExactModel(benchmark::State& state) {
   }
   state.counters["angle_err_rad"] = std::abs(s.theta_rad - reference_end(1).theta_rad);
   const double e0 = exact.energy_j(kStart);
-  state.counters["energy_drift_rel"] = std::abs(exact.energy_j(s) - e0) / (e0 - beatup().potential_energy(kStart.theta_rad));
+  state.counters["energy_drift_rel"] =
+      std::abs(exact.energy_j(s) - e0) / (e0 - beatup().potential_energy(kStart.theta_rad));
 }
 BENCHMARK(BM_ForwardOneSecondExactModel)->Unit(benchmark::kMillisecond);
 

@@ -1,6 +1,8 @@
 // Equimomental three-point systems (003 eqns 1–4): they keep the link's mass, centre of mass and
 // inertia to 1e-12, their masses are non-negative when the first point faces the centre, and — what
 // the equivalence is for — they give the same shaking force and moment as the rigid link in any motion.
+#include "loom/motion/design/equimomental.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -8,7 +10,6 @@
 
 #include "loom/motion/angles.hpp"
 #include "loom/motion/dynamics_body.hpp"
-#include "loom/motion/design/equimomental.hpp"
 #include "loom/motion/errors.hpp"
 
 using namespace loom::motion;

@@ -24,7 +24,8 @@ TEST(NeedleDynamics, BalancingTorquePowerEqualsEnergyRatePlusFrictionLoss) {
     const std::array<BodyMotion, 6> mo = needle_motion(nl, f.state);
     double de = 0.0;
     for (std::size_t i = 0; i < 6; ++i) {
-      const Eigen::Vector2d v = mo[i].velocity(bodies[i].centre_m), a = mo[i].acceleration(bodies[i].centre_m);
+      const Eigen::Vector2d v = mo[i].velocity(bodies[i].centre_m),
+                            a = mo[i].acceleration(bodies[i].centre_m);
       de += bodies[i].mass_kg * (v.dot(a) - loads.gravity_m_s2.dot(v)) +
             bodies[i].inertia_kg_m2 * mo[i].omega_rad_s * mo[i].alpha_rad_s2;
     }

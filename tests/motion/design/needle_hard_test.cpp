@@ -10,8 +10,8 @@
 #include <string>
 
 #include "loom/motion/angles.hpp"
-#include "loom/motion/errors.hpp"
 #include "loom/motion/design/needle.hpp"
+#include "loom/motion/errors.hpp"
 #include "motion_error.hpp"
 #include "perturb.hpp"
 
@@ -102,7 +102,8 @@ TEST(NeedleHard, ScaleFreeFromNanometreToKilometre) {
   const NeedleLinkage ref(base);
   for (double k : {1e-6, 1e4}) {
     NeedleDims d = base;
-    for (double* v : {&d.l1_m, &d.l2_m, &d.l3_m, &d.l4_m, &d.l5_m, &d.l6_m, &d.x1_m, &d.x2_m, &d.h1_m}) *v *= k;
+    for (double* v : {&d.l1_m, &d.l2_m, &d.l3_m, &d.l4_m, &d.l5_m, &d.l6_m, &d.x1_m, &d.x2_m, &d.h1_m})
+      *v *= k;
     const NeedleLinkage n(d);
     for (int i = 0; i < 360; ++i) {
       const double t1 = kTwoPi * i / 360.0;
@@ -130,9 +131,10 @@ TEST(NeedleHard, PerturbedDesignsAreFiniteOrRejected) {
       const NeedleLinkage n(d);
       ++accepted;
       for (const NeedleState& s : needle_sweep(n, 720, 16.0)) {
-        const double all[] = {s.theta2_rad, s.theta3_rad, s.theta4_rad, s.theta5_rad, s.omega2_rad_s,
-                              s.omega3_rad_s, s.omega5_rad_s, s.alpha2_rad_s2, s.alpha3_rad_s2,
-                              s.alpha5_rad_s2, s.needle_m, s.needle_v_m_s, s.needle_a_m_s2};
+        const double all[] = {s.theta2_rad,    s.theta3_rad,    s.theta4_rad,   s.theta5_rad,
+                              s.omega2_rad_s,  s.omega3_rad_s,  s.omega5_rad_s, s.alpha2_rad_s2,
+                              s.alpha3_rad_s2, s.alpha5_rad_s2, s.needle_m,     s.needle_v_m_s,
+                              s.needle_a_m_s2};
         for (double v : all) ASSERT_TRUE(std::isfinite(v)) << "trial " << trial;
         ASSERT_LE(n.closure_residual_m(s), 1e-12 * std::max(d.l6_m, d.l2_m));
       }
@@ -163,7 +165,8 @@ TEST(Needle, DefaultAssemblyIsThePapersWithThetaFiveInTheThirdQuadrant) {
     // Independent of the solver: eqn 14's cosine, with the sine's sign of a hanging rod.
     const double c5 = (d.x2_m - d.l4_m * std::cos(s.theta4_rad)) / d.l5_m;
     EXPECT_NEAR(std::cos(s.theta5_rad), c5, 1e-14);
-    EXPECT_NEAR(s.needle_m, d.l6_m - d.l4_m * std::sin(s.theta4_rad) + d.l5_m * std::sqrt(1.0 - c5 * c5), 1e-14);
+    EXPECT_NEAR(s.needle_m, d.l6_m - d.l4_m * std::sin(s.theta4_rad) + d.l5_m * std::sqrt(1.0 - c5 * c5),
+                1e-14);
     lo = std::min(lo, s.needle_m);
     hi = std::max(hi, s.needle_m);
   }

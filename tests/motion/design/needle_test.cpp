@@ -1,6 +1,8 @@
 // Tufting-needle six-bar (seed 002) against independent truth: the paper's own triangle route for
 // θ3 (eqns 2-8), loop closure, dead-centre geometry, scale invariance, and finite differences of
 // positions for every velocity and acceleration — with a constant and an accelerating main shaft.
+#include "loom/motion/design/needle.hpp"
+
 #include <gtest/gtest.h>
 
 #include <array>
@@ -10,7 +12,6 @@
 #include "finite_diff.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/errors.hpp"
-#include "loom/motion/design/needle.hpp"
 
 namespace loom::motion {
 namespace {
@@ -57,7 +58,8 @@ TEST(Needle, LoopClosureWithinOneTrillionthOfLargestLink) {
   const NeedleDims d = needle_table1();
   const NeedleLinkage n(d);
   double worst = 0.0;
-  for (const NeedleState& s : needle_sweep(n, 3600, kOmega160rpm)) worst = std::max(worst, n.closure_residual_m(s));
+  for (const NeedleState& s : needle_sweep(n, 3600, kOmega160rpm))
+    worst = std::max(worst, n.closure_residual_m(s));
   EXPECT_LE(worst, 1e-12 * d.l6_m);
 }
 
@@ -132,15 +134,20 @@ void check_rates_against_fd(const NeedleLinkage& n, double omega0, double alpha)
   };
   const std::array<Channel, 5> ch{{
       {"theta2", [](const NeedleState& s) { return s.theta2_rad; },
-       [](const NeedleState& s) { return s.omega2_rad_s; }, [](const NeedleState& s) { return s.alpha2_rad_s2; }, true},
+       [](const NeedleState& s) { return s.omega2_rad_s; },
+       [](const NeedleState& s) { return s.alpha2_rad_s2; }, true},
       {"theta3", [](const NeedleState& s) { return s.theta3_rad; },
-       [](const NeedleState& s) { return s.omega3_rad_s; }, [](const NeedleState& s) { return s.alpha3_rad_s2; }, true},
+       [](const NeedleState& s) { return s.omega3_rad_s; },
+       [](const NeedleState& s) { return s.alpha3_rad_s2; }, true},
       {"theta4", [](const NeedleState& s) { return s.theta4_rad; },
-       [](const NeedleState& s) { return s.omega4_rad_s; }, [](const NeedleState& s) { return s.alpha4_rad_s2; }, true},
+       [](const NeedleState& s) { return s.omega4_rad_s; },
+       [](const NeedleState& s) { return s.alpha4_rad_s2; }, true},
       {"theta5", [](const NeedleState& s) { return s.theta5_rad; },
-       [](const NeedleState& s) { return s.omega5_rad_s; }, [](const NeedleState& s) { return s.alpha5_rad_s2; }, true},
+       [](const NeedleState& s) { return s.omega5_rad_s; },
+       [](const NeedleState& s) { return s.alpha5_rad_s2; }, true},
       {"needle", [](const NeedleState& s) { return s.needle_m; },
-       [](const NeedleState& s) { return s.needle_v_m_s; }, [](const NeedleState& s) { return s.needle_a_m_s2; }, false},
+       [](const NeedleState& s) { return s.needle_v_m_s; },
+       [](const NeedleState& s) { return s.needle_a_m_s2; }, false},
   }};
   constexpr int kPoints = 360;
   const double period = kTwoPi / omega0;

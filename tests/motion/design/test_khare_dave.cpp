@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "loom/motion/angles.hpp"
-#include "loom/motion/errors.hpp"
 #include "loom/motion/design/synthesis.hpp"
+#include "loom/motion/errors.hpp"
 #include "motion_error.hpp"
 #include "table_rows.hpp"
 #include "thesis_tables.hpp"
@@ -27,8 +27,8 @@ using loom::motion::deg;
 using loom::motion::ErrorCode;
 using loom::motion::kDesignChangePoint;
 using loom::motion::kDesignNearSpecialCase;
-using loom::motion::kNearSpecialCase_rad;
 using loom::motion::khare_dave_crank_rocker;
+using loom::motion::kNearSpecialCase_rad;
 using loom::motion::kPi;
 using loom::motion::kTwoPi;
 using loom::motion::MotionError;
@@ -39,9 +39,9 @@ using loom::motion::rad;
 // line. At the extended dead centre |A0B| = a + b and the crank points at B; at the folded one
 // |A0B| = b − a and the crank points away from B.
 struct Forward {
-  double beta;   // crank angle at the extended dead centre
-  double phi;    // counter-clockwise crank travel extended → folded
-  double psi;    // rocker swing between the dead centres
+  double beta;             // crank angle at the extended dead centre
+  double phi;              // counter-clockwise crank travel extended → folded
+  double psi;              // rocker swing between the dead centres
   double rocker_extended;  // rocker direction B0→B at the extended dead centre, from +x
 };
 
@@ -139,8 +139,10 @@ TEST(KhareDave, Table48EveryPrintedDigit) {
     const CrankRockerDesign d = khare_dave_crank_rocker(rad(30.0), rad(180.0), rad(beta_deg));
     EXPECT_EQ(d.design_case, CrankRockerCase::kPhi180);
     EXPECT_TRUE(loom::test::same_at_decimals(d.crank, row[1], 6)) << "beta " << beta_deg << " a " << d.crank;
-    EXPECT_TRUE(loom::test::same_at_decimals(d.coupler, row[2], 6)) << "beta " << beta_deg << " b " << d.coupler;
-    EXPECT_TRUE(loom::test::same_at_decimals(d.rocker, row[3], 6)) << "beta " << beta_deg << " c " << d.rocker;
+    EXPECT_TRUE(loom::test::same_at_decimals(d.coupler, row[2], 6))
+        << "beta " << beta_deg << " b " << d.coupler;
+    EXPECT_TRUE(loom::test::same_at_decimals(d.rocker, row[3], 6))
+        << "beta " << beta_deg << " c " << d.rocker;
     EXPECT_TRUE(loom::test::same_at_decimals(deg(d.mu_min_rad), row[4], 2))
         << "beta " << beta_deg << " mu " << deg(d.mu_min_rad);
     EXPECT_EQ(d.flags, beta_deg == 75.0 ? kDesignChangePoint : 0u) << "beta " << beta_deg;
@@ -185,7 +187,8 @@ TEST(KhareDave, NearTheSpecialCaseIsFlaggedNotSilent) {
   // Away from it: no flag.
   for (double phi_deg : {200.0, 209.9, 210.1, 220.0}) {
     const double beta_deg = phi_deg < 210.0 ? 60.0 : 100.0;
-    EXPECT_EQ(khare_dave_crank_rocker(rad(30.0), rad(phi_deg), rad(beta_deg)).flags & kDesignNearSpecialCase, 0u)
+    EXPECT_EQ(khare_dave_crank_rocker(rad(30.0), rad(phi_deg), rad(beta_deg)).flags & kDesignNearSpecialCase,
+              0u)
         << phi_deg;
   }
   EXPECT_NEAR(deg(kNearSpecialCase_rad), 1e-4, 1e-18);
@@ -239,10 +242,10 @@ TEST(KhareDave, BoundsOfEveryCase) {
     CrankRockerCase kind;
   };
   const Case cases[] = {
-      {30, 120, 60, 75, CrankRockerCase::kPhiBelow180},  // thesis case study 1
-      {30, 160, 20, 75, CrankRockerCase::kPhiBelow180},  // case study 2 (the print's "60" is a typo)
-      {30, 180, 0, 75, CrankRockerCase::kPhi180},        // case study 3
-      {30, 200, 0, 75, CrankRockerCase::kPhiAbove180},   // case study 4
+      {30, 120, 60, 75, CrankRockerCase::kPhiBelow180},    // thesis case study 1
+      {30, 160, 20, 75, CrankRockerCase::kPhiBelow180},    // case study 2 (the print's "60" is a typo)
+      {30, 180, 0, 75, CrankRockerCase::kPhi180},          // case study 3
+      {30, 200, 0, 75, CrankRockerCase::kPhiAbove180},     // case study 4
       {30, 210, 75, 75, CrankRockerCase::kPhi180PlusPsi},  // case study 5
       {30, 220, 75, 140, CrankRockerCase::kPhiBeyond180PlusPsi},
       {60, 250, 60, 110, CrankRockerCase::kPhiBeyond180PlusPsi},
@@ -288,8 +291,7 @@ TEST(KhareDave, BetaOutsideTheBoundsIsOutOfBoundsNamingThem) {
             ErrorCode::kOutOfBounds);
   EXPECT_EQ(code_of_call([] { khare_dave_crank_rocker(rad(30.0), rad(210.0), rad(70.0)); }),
             ErrorCode::kOutOfBounds);
-  const std::string msg =
-      message_of([] { khare_dave_crank_rocker(rad(30.0), rad(120.0), rad(80.0)); });
+  const std::string msg = message_of([] { khare_dave_crank_rocker(rad(30.0), rad(120.0), rad(80.0)); });
   EXPECT_NE(msg.find("beta = 80"), std::string::npos) << msg;
   EXPECT_NE(msg.find("[60, 75]"), std::string::npos) << msg;
   EXPECT_EQ(code_of_call([] { khare_dave_crank_rocker(rad(30.0), rad(120.0), std::nan("")); }),
@@ -409,12 +411,19 @@ TEST(KhareDave, NoNaNOrInfAnywhereInTheDomain) {
       for (int k = 0; k <= 10; ++k) {
         const double beta = bounds.lower_rad + (bounds.upper_rad - bounds.lower_rad) * k / 10.0;
         if (bounds.design_case == CrankRockerCase::kPhi180 && beta == 0.0) {
-          EXPECT_THROW(khare_dave_crank_rocker(psi, phi, beta, 0.2), loom::motion::MotionError);  // null crank
+          EXPECT_THROW(khare_dave_crank_rocker(psi, phi, beta, 0.2),
+                       loom::motion::MotionError);  // null crank
           continue;
         }
         const CrankRockerDesign d = khare_dave_crank_rocker(psi, phi, beta, 0.2);
-        const double v[] = {d.crank, d.coupler, d.rocker, d.mu_min_rad, d.crank_extended_rad,
-                            d.crank_folded_rad, d.rocker_extended_rad, d.rocker_folded_rad};
+        const double v[] = {d.crank,
+                            d.coupler,
+                            d.rocker,
+                            d.mu_min_rad,
+                            d.crank_extended_rad,
+                            d.crank_folded_rad,
+                            d.rocker_extended_rad,
+                            d.rocker_folded_rad};
         for (double x : v) ASSERT_TRUE(std::isfinite(x)) << deg(psi) << " " << deg(phi) << " " << deg(beta);
         ASSERT_GE(d.mu_min_rad, 0.0);
         ASSERT_LE(d.mu_min_rad, 0.5 * kPi);

@@ -8,9 +8,9 @@
 #include <string>
 
 #include "loom/motion/angles.hpp"
+#include "loom/motion/design/synthesis.hpp"
 #include "loom/motion/errors.hpp"
 #include "loom/motion/slider_crank.hpp"
-#include "loom/motion/design/synthesis.hpp"
 #include "motion_error.hpp"
 #include "table_rows.hpp"
 #include "thesis_tables.hpp"
@@ -151,7 +151,8 @@ TEST(Soylemez, PhiIn180DegreesMinusATinyBitKeepsItsDigits) {
     const auto dc = loom::motion::slider_dead_centres(d.mechanism);
     EXPECT_NEAR(dc.stroke, 1.0, 1e-9) << phi_deg;
     EXPECT_NEAR(static_cast<double>(dc.phi_half_difference_rad / eps), 1.0, 1e-9) << phi_deg;
-    EXPECT_NEAR(static_cast<double>(d.mechanism.coupler * std::sqrt(2.0L * eps)), 1.0, 1e-9 + 2.0 * static_cast<double>(eps))
+    EXPECT_NEAR(static_cast<double>(d.mechanism.coupler * std::sqrt(2.0L * eps)), 1.0,
+                1e-9 + 2.0 * static_cast<double>(eps))
         << phi_deg;
   }
 }
@@ -161,8 +162,7 @@ TEST(Soylemez, Phi180IsAnErrorWithTheRightLimits) {
   EXPECT_EQ(code_of_call([] { soylemez_slider_crank(1.0, rad(180.0)); }), ErrorCode::kInvalidInput);
   EXPECT_EQ(code_of_call([] { soylemez_slider_crank(1.0, std::nextafter(kPi, 0.0)); }),
             ErrorCode::kInvalidInput);  // within the 1e-14 rad snap of 180°
-  EXPECT_NE(message_of([] { soylemez_slider_crank(1.0, kPi); }).find("phi = 180"),
-            std::string::npos);
+  EXPECT_NE(message_of([] { soylemez_slider_crank(1.0, kPi); }).find("phi = 180"), std::string::npos);
   EXPECT_EQ(code_of_call([] { soylemez_slider_crank(1.0, rad(181.0)); }), ErrorCode::kInvalidInput);
   EXPECT_EQ(code_of_call([] { soylemez_slider_crank(1.0, rad(89.0)); }), ErrorCode::kInvalidInput);
   EXPECT_EQ(code_of_call([] { soylemez_slider_crank(1.0, std::nan("")); }), ErrorCode::kInvalidInput);
@@ -217,8 +217,7 @@ TEST(Soylemez, GivenLambdaBoundsAndChangePoints) {
   const std::string msg = message_of([&] { soylemez_slider_crank(1.0, phi, 1.01); });
   EXPECT_NE(msg.find("lambda"), std::string::npos) << msg;
   EXPECT_NE(msg.find(", 1]"), std::string::npos) << msg;
-  EXPECT_EQ(code_of_call([&] { soylemez_slider_crank(1.0, phi, std::nan("")); }),
-            ErrorCode::kInvalidInput);
+  EXPECT_EQ(code_of_call([&] { soylemez_slider_crank(1.0, phi, std::nan("")); }), ErrorCode::kInvalidInput);
 }
 
 TEST(Soylemez, NoNaNOrInfAnywhereInTheDomain) {
@@ -228,15 +227,15 @@ TEST(Soylemez, NoNaNOrInfAnywhereInTheDomain) {
     const double phi = 0.5 * kPi + (0.5 * kPi - 2e-14) * (0.5 - 0.5 * std::cos(kPi * u));
     const auto check = [&](const SliderCrankDesign& d) {
       EXPECT_TRUE(std::isfinite(d.mechanism.crank) && std::isfinite(d.mechanism.coupler) &&
-                  std::isfinite(d.mechanism.offset) && std::isfinite(d.mu_min_rad) &&
-                  std::isfinite(d.lambda))
+                  std::isfinite(d.mechanism.offset) && std::isfinite(d.mu_min_rad) && std::isfinite(d.lambda))
           << "phi " << phi;
       EXPECT_GE(d.mu_min_rad, 0.0);
       EXPECT_LE(d.mu_min_rad, 0.5 * kPi);
     };
     check(soylemez_slider_crank(1.0, phi));
     const auto lb = loom::motion::soylemez_lambda_bounds(phi);
-    for (double f : {0.0, 1e-12, 0.5, 1.0 - 1e-12, 1.0}) check(soylemez_slider_crank(1.0, phi, lb.lower + f * (lb.upper - lb.lower)));
+    for (double f : {0.0, 1e-12, 0.5, 1.0 - 1e-12, 1.0})
+      check(soylemez_slider_crank(1.0, phi, lb.lower + f * (lb.upper - lb.lower)));
   }
 }
 

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "loom/motion/angles.hpp"
-#include "loom/motion/errors.hpp"
 #include "loom/motion/design/three_point.hpp"
+#include "loom/motion/errors.hpp"
 
 namespace {
 
@@ -26,7 +26,9 @@ struct Lengths {
 // equations bilinear in (a0, a2); eliminating a2 gives a quadratic in a0.
 std::vector<Lengths> solve_by_elimination(const std::array<PrecisionPoint, 3>& p, double th0) {
   auto dot0 = [&](const PrecisionPoint& q) { return q.x * std::cos(th0) + q.y * std::sin(th0); };
-  auto dot2 = [&](const PrecisionPoint& q) { return q.x * std::cos(q.theta2_rad) + q.y * std::sin(q.theta2_rad); };
+  auto dot2 = [&](const PrecisionPoint& q) {
+    return q.x * std::cos(q.theta2_rad) + q.y * std::sin(q.theta2_rad);
+  };
   auto r2 = [&](const PrecisionPoint& q) { return q.x * q.x + q.y * q.y; };
   auto cs = [&](const PrecisionPoint& q) { return std::cos(q.theta2_rad - th0); };
   // E_j − E_1:  −Δρ² + 2 a0 ΔX + 2 a2 ΔY − 2 a0 a2 ΔC = 0  →  a2 = (Δρ² − 2a0ΔX) / (2ΔY − 2a0ΔC)
@@ -48,8 +50,8 @@ std::vector<Lengths> solve_by_elimination(const std::array<PrecisionPoint, 3>& p
   for (double sgn : {1.0, -1.0}) {
     const double a0 = (-B + sgn * std::sqrt(disc)) / (2 * A);
     const double a2 = (R[0] - 2 * a0 * X[0]) / (2 * Y[0] - 2 * a0 * C[0]);
-    const double a1sq = a0 * a0 + a2 * a2 + r2(p[0]) - 2 * a0 * dot0(p[0]) - 2 * a2 * dot2(p[0]) +
-                        2 * a0 * a2 * cs(p[0]);
+    const double a1sq =
+        a0 * a0 + a2 * a2 + r2(p[0]) - 2 * a0 * dot0(p[0]) - 2 * a2 * dot2(p[0]) + 2 * a0 * a2 * cs(p[0]);
     if (a1sq > 0) out.push_back({a0, std::sqrt(a1sq), a2});
   }
   return out;

@@ -8,9 +8,8 @@
 #include <limits>
 
 #include "loom/motion/angles.hpp"
-#include "loom/motion/errors.hpp"
 #include "loom/motion/design/three_point.hpp"
-
+#include "loom/motion/errors.hpp"
 #include "motion_error.hpp"
 
 namespace {

@@ -18,11 +18,14 @@ const double kFell = BeatUp(default_beatup_geometry()).warp().fell;
 const TableSpec kTable{.size = 256, .interp = Interp::kCubic, .precision = Precision::kDouble};
 
 CrankLaw elliptic(double e, int lobes = 1, double phi02 = kPi, const TableSpec& t = kTable) {
-  return CrankLaw({.kind = CrankLawKind::kElliptic, .ellipse_e = e, .ellipse_lobes = lobes, .ellipse_phi02_rad = phi02},
-                  kFell, t);
+  return CrankLaw(
+      {.kind = CrankLawKind::kElliptic, .ellipse_e = e, .ellipse_lobes = lobes, .ellipse_phi02_rad = phi02},
+      kFell, t);
 }
 
-Phase weyl(int j) { return Phase{j % 7 - 3, 0x9E3779B97F4A7C15ull * static_cast<std::uint64_t>(j + 1)}; }
+Phase weyl(int j) {
+  return Phase{j % 7 - 3, 0x9E3779B97F4A7C15ull * static_cast<std::uint64_t>(j + 1)};
+}
 
 // Master phase at which the crank reaches `crank` (the law is increasing).
 double master_at(const CrankLaw& law, double crank) {

@@ -48,7 +48,8 @@ bool same_file(const fs::path& golden, const fs::path& fresh) {
   }
   std::string lg, lf;
   for (int line = 1;; ++line) {
-    const bool more_g = static_cast<bool>(std::getline(g, lg)), more_f = static_cast<bool>(std::getline(f, lf));
+    const bool more_g = static_cast<bool>(std::getline(g, lg)),
+               more_f = static_cast<bool>(std::getline(f, lf));
     if (!more_g && !more_f) return true;
     if (more_g != more_f) {
       std::printf("%s:%d: %s has more rows\n", golden.c_str(), line, more_g ? "golden" : "fresh dump");
@@ -56,12 +57,14 @@ bool same_file(const fs::path& golden, const fs::path& fresh) {
     }
     const std::vector<std::string> cg = split(lg), cf = split(lf);
     if (cg.size() != cf.size()) {
-      std::printf("%s:%d: %zu columns in golden, %zu in the fresh dump\n", golden.c_str(), line, cg.size(), cf.size());
+      std::printf("%s:%d: %zu columns in golden, %zu in the fresh dump\n", golden.c_str(), line, cg.size(),
+                  cf.size());
       return false;
     }
     for (std::size_t c = 0; c < cg.size(); ++c) {
       if (!same_cell(cg[c], cf[c])) {
-        std::printf("%s:%d: column %zu: golden %s, fresh %s\n", golden.c_str(), line, c + 1, cg[c].c_str(), cf[c].c_str());
+        std::printf("%s:%d: column %zu: golden %s, fresh %s\n", golden.c_str(), line, c + 1, cg[c].c_str(),
+                    cf[c].c_str());
         return false;
       }
     }

@@ -45,11 +45,14 @@ constexpr Precision kPrecisions[] = {Precision::kDouble, Precision::kFloat};
 const double kFell = BeatUp(default_beatup_geometry()).warp().fell;
 
 CrankLaw elliptic(double e, int lobes, double phi02, const TableSpec& t) {
-  return CrankLaw({.kind = CrankLawKind::kElliptic, .ellipse_e = e, .ellipse_lobes = lobes, .ellipse_phi02_rad = phi02},
-                  kFell, t);
+  return CrankLaw(
+      {.kind = CrankLawKind::kElliptic, .ellipse_e = e, .ellipse_lobes = lobes, .ellipse_phi02_rad = phi02},
+      kFell, t);
 }
 
-Phase weyl(int j) { return Phase{j % 7 - 3, 0x9E3779B97F4A7C15ull * static_cast<std::uint64_t>(j + 1)}; }
+Phase weyl(int j) {
+  return Phase{j % 7 - 3, 0x9E3779B97F4A7C15ull * static_cast<std::uint64_t>(j + 1)};
+}
 
 std::string build_error(const ProfileSpec& s) {
   try {
@@ -134,10 +137,11 @@ TEST(CrankLawHard, SmallEccentricityApproachesConstantLinearly) {
   const double es[2] = {1e-6, 2e-6};
   for (int k = 0; k < 2; ++k) {
     const CrankLaw law = elliptic(es[k], 1, kPi, {.size = 256});
-    for (int i = 0; i < 3600; ++i) worst[k] = std::max(worst[k], std::abs(law.exact(kTwoPi * i / 3600.0).offset));
+    for (int i = 0; i < 3600; ++i)
+      worst[k] = std::max(worst[k], std::abs(law.exact(kTwoPi * i / 3600.0).offset));
   }
   EXPECT_GT(worst[0], 0.0);
-  EXPECT_LT(worst[0], 4.1e-6);          // |φ2 − φ1| ≤ 2e/k to first order, twice that for the two brackets
+  EXPECT_LT(worst[0], 4.1e-6);  // |φ2 − φ1| ≤ 2e/k to first order, twice that for the two brackets
   EXPECT_NEAR(worst[1] / worst[0], 2.0, 1e-4);  // linear in e
 }
 
@@ -150,8 +154,9 @@ TEST(ProfileSetHard, TooShortBeatWindowNamesTheLimits) {
   s.crank.jerk = 1e5;
   const std::string msg = build_error(s);
   ASSERT_FALSE(msg.empty());
-  for (const char* needle : {"carriage.max_speed_m_s = 1 (exceeded)", "carriage.max_accel_m_s2 = 20",
-                             "carriage.max_jerk_m_s3 = 2000", "recipe.crank_speed_rad_s", "deg of crank", "40 rad/s"}) {
+  for (const char* needle :
+       {"carriage.max_speed_m_s = 1 (exceeded)", "carriage.max_accel_m_s2 = 20",
+        "carriage.max_jerk_m_s3 = 2000", "recipe.crank_speed_rad_s", "deg of crank", "40 rad/s"}) {
     EXPECT_NE(msg.find(needle), std::string::npos) << needle << " not in: " << msg;
   }
   // The named speed is the boundary: just below builds, just above is refused.
@@ -212,4 +217,3 @@ TEST(ProfileSetHard, ZeroLengthMoves) {
   for (int i = 0; i < 1000; ++i) still.tick();
   EXPECT_EQ(still.phase(), (Phase{7, 123}));
 }
-

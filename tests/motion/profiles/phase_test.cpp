@@ -1,6 +1,8 @@
 // Fixed-point phase: exact wrap at one turn and across it, exact negation and n-fold steps, and a
 // 10⁹-tick run whose accumulated phase equals the closed form N·step to the last unit — the
 // property that lets the loop run for years without phase drift.
+#include "loom/motion/phase.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,7 +11,6 @@
 #include <numbers>
 
 #include "loom/motion/angles.hpp"
-#include "loom/motion/phase.hpp"
 
 using namespace loom::motion;
 
@@ -62,7 +63,8 @@ TEST(Phase, SmallOffsetsAddWithinRounding) {
     for (double r : {0.0, 1e-12, -1e-12, 0.3, -0.3, 3.1, -3.1, 6.2, -6.2, 12.5, -12.5}) {
       const Phase got = base.plus_small_rad(r), want = base + Phase::from_rad(r);
       const Phase diff = got - want;
-      const bool within = (diff.turns == 0 && diff.frac <= 16384) || (diff.turns == -1 && diff.frac >= kMax - 16384);
+      const bool within =
+          (diff.turns == 0 && diff.frac <= 16384) || (diff.turns == -1 && diff.frac >= kMax - 16384);
       EXPECT_TRUE(within) << r << ": " << diff.turns << " turns + " << diff.frac;
     }
   }
@@ -112,7 +114,8 @@ TEST(PhaseDrift, BillionTicksAtCrankSpeedStayOnTheExactPhase) {
   for (std::int64_t k = 0; k < kTicks; ++k) clock.tick();
   EXPECT_EQ(clock.phase(), step.times(kTicks));
   if constexpr (sizeof(long double) > sizeof(double)) {
-    const long double exact_turns = static_cast<long double>(kTicks) * 15.5L * static_cast<long double>(0.002) /
+    const long double exact_turns = static_cast<long double>(kTicks) * 15.5L *
+                                    static_cast<long double>(0.002) /
                                     (2.0L * std::numbers::pi_v<long double>);
     const long double got = static_cast<long double>(clock.phase().turns) +
                             static_cast<long double>(clock.phase().frac) * 0x1p-64L;

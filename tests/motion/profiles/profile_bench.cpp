@@ -16,10 +16,11 @@ constexpr std::uint64_t kGolden = 0x9E3779B97F4A7C15ull;
 template <Interp I, Precision P>
 void BM_RockerLookup(benchmark::State& state) {
   const BeatUp b(default_beatup_geometry());
-  const PhaseTable t({.size = static_cast<std::size_t>(state.range(0)), .interp = I, .precision = P}, [&](double p) {
-    const BeaterState s = b.at(p);
-    return PhaseExact{s.rocker_angle, s.d1, s.d2};
-  });
+  const PhaseTable t({.size = static_cast<std::size_t>(state.range(0)), .interp = I, .precision = P},
+                     [&](double p) {
+                       const BeaterState s = b.at(p);
+                       return PhaseExact{s.rocker_angle, s.d1, s.d2};
+                     });
   std::uint64_t x = 0;
   for (auto _ : state) {
     x += kGolden;
@@ -68,5 +69,10 @@ BENCHMARK(BM_RockerLookup<Interp::kCubic, Precision::kFloat>)->RangeMultiplier(1
 BENCHMARK(BM_RockerLookup<Interp::kQuintic, Precision::kFloat>)->RangeMultiplier(16)->Range(256, 65536);
 BENCHMARK(BM_RockerExactSolve);
 BENCHMARK(BM_BeaterThroughEllipticLaw);
-BENCHMARK(BM_ProfileSetBuild)->Args({0, 256})->Args({1, 256})->Args({0, 4096})->Args({1, 4096})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ProfileSetBuild)
+    ->Args({0, 256})
+    ->Args({1, 256})
+    ->Args({0, 4096})
+    ->Args({1, 4096})
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK_MAIN();

@@ -1,13 +1,14 @@
 // The profile set as the loop sees it: default tables within their bound against the exact linkage,
 // carriage-step peaks that agree with finite differences of the cam played in time, the helix pick
 // held under the carrier's limit, and the beater through the crank law by the chain rule.
+#include "loom/motion/profile_set.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "loom/motion/angles.hpp"
 #include "loom/motion/errors.hpp"
-#include "loom/motion/profile_set.hpp"
 
 using namespace loom::motion;
 
@@ -60,7 +61,8 @@ TEST(ProfileSet, DefaultTablesMeetTheirBoundAgainstTheExactLinkage) {
       worst = std::max(worst, std::abs(p.rocker().at(m).value - p.beatup().at(m.frac_rad()).rocker_angle));
       // The beater through the crank law, against the exact linkage at the exact crank phase.
       const double crank = m.frac_rad() + p.crank_law().exact(m.frac_rad()).offset;
-      worst_master = std::max(worst_master, std::abs(p.rocker_at(m).value - p.beatup().at(crank).rocker_angle));
+      worst_master =
+          std::max(worst_master, std::abs(p.rocker_at(m).value - p.beatup().at(crank).rocker_angle));
     }
     EXPECT_LT(worst, 1e-7);
     EXPECT_LT(worst_master, 1e-7);
@@ -99,7 +101,8 @@ TEST(ProfileSet, HelixPickStaysUnderTheCarrierLimit) {
   const double limit_rad_s2 = 5.0 / 0.4 * kTwoPi / s.helix_lead_m;
   EXPECT_NEAR(p.helix_accel_limit(), limit_rad_s2, 1e-9);
   double peak = 0;
-  for (double t = 0; t <= p.pick().duration(); t += 1e-4) peak = std::max(peak, std::abs(p.pick().at(t).acceleration));
+  for (double t = 0; t <= p.pick().duration(); t += 1e-4)
+    peak = std::max(peak, std::abs(p.pick().at(t).acceleration));
   EXPECT_LE(peak, limit_rad_s2 * (1 + 1e-12));
   EXPECT_GT(peak, 0.99 * limit_rad_s2);  // the limit binds
   EXPECT_NEAR(p.pick().at(p.pick().duration()).position, kTwoPi * s.width_m / s.helix_lead_m, 1e-12);

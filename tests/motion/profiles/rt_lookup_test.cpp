@@ -74,7 +74,8 @@ TEST(RtLookups, AllocateNothing) {
           sink += c.phase + p.crank_law().crank_phase(m).to_rad();
           sink += p.cam().at(c.phase).position + p.pick().at(i * 1e-4).position;
           if (i % 500 == 0) shed.start(true, false, {false, true}, {true, false});
-          sink += static_cast<double>(shed.update(p.shed(), (i % 500) * 0.002, {false, false}, {false, false}));
+          sink +=
+              static_cast<double>(shed.update(p.shed(), (i % 500) * 0.002, {false, false}, {false, false}));
         }
       });
       EXPECT_EQ(n, 0u) << interp_name(interp) << " " << precision_name(prec);

@@ -87,8 +87,9 @@ TEST(Shed, SensorsConfirmingFasterThanAStrokeAreAFault) {
   EXPECT_LT(o.at_s, s.earliest_fraction * s.piston_travel_s);
   // A stroke just slower than the earliest bound is healthy.
   const Piston quick{.start = 0.0, .stroke_s = 0.45 * s.piston_travel_s, .extend = true};
-  EXPECT_EQ(run(s, quick, Piston{.start = 1.0, .stroke_s = 0.45 * s.piston_travel_s, .extend = false}).verdict,
-            ShedVerdict::kOpen);
+  EXPECT_EQ(
+      run(s, quick, Piston{.start = 1.0, .stroke_s = 0.45 * s.piston_travel_s, .extend = false}).verdict,
+      ShedVerdict::kOpen);
 }
 
 TEST(Shed, FramesLeftMidStrokeMayArriveEarly) {
@@ -99,9 +100,10 @@ TEST(Shed, FramesLeftMidStrokeMayArriveEarly) {
   EXPECT_EQ(o.verdict, ShedVerdict::kOpen);
   EXPECT_LT(o.at_s, s.earliest_fraction * s.piston_travel_s);
   // A frame that starts on its start sensor still must take a plausible stroke time.
-  const Outcome miswired = run(s, kRising, Piston{.start = 0.2, .extend = false}, [](double t, PistonEnds& a, PistonEnds&) {
-    if (t > 0) a = {true, false};
-  });
+  const Outcome miswired =
+      run(s, kRising, Piston{.start = 0.2, .extend = false}, [](double t, PistonEnds& a, PistonEnds&) {
+        if (t > 0) a = {true, false};
+      });
   EXPECT_EQ(miswired.verdict, ShedVerdict::kTooEarly);
 }
 
@@ -161,8 +163,10 @@ TEST(Shed, ContradictoryWindowsAreConfigErrorsNamingTheKey) {
   };
   EXPECT_EQ(message(ShedSpec{}), "");
   EXPECT_NE(message(ShedSpec{.piston_travel_s = 2.0}).find("shedding.timeout_s = 1.5"), std::string::npos);
-  EXPECT_NE(message(ShedSpec{.release_timeout_s = 2.0}).find("shedding.release_timeout_s = 2"), std::string::npos);
-  EXPECT_NE(message(ShedSpec{.earliest_fraction = 1.0}).find("shedding.earliest_fraction"), std::string::npos);
+  EXPECT_NE(message(ShedSpec{.release_timeout_s = 2.0}).find("shedding.release_timeout_s = 2"),
+            std::string::npos);
+  EXPECT_NE(message(ShedSpec{.earliest_fraction = 1.0}).find("shedding.earliest_fraction"),
+            std::string::npos);
   EXPECT_NE(message(ShedSpec{.debounce_s = -1}).find("shedding.debounce_s"), std::string::npos);
   EXPECT_NE(message(ShedSpec{.piston_travel_s = NAN}).find("shedding.piston_travel_s"), std::string::npos);
 }

@@ -81,7 +81,8 @@ TEST(PhaseTable, KernelsReproducePolynomialsOfTheirDegree) {
       const double p = last_inner * (i + 0.5) / 1000.0;
       const PhaseSample s = t.at(p);
       const PhaseExact x = f(p);
-      EXPECT_NEAR(s.value, x.value, 1e-11 * std::max(1.0, std::abs(x.value))) << interp_name(interp) << " at " << p;
+      EXPECT_NEAR(s.value, x.value, 1e-11 * std::max(1.0, std::abs(x.value)))
+          << interp_name(interp) << " at " << p;
       EXPECT_NEAR(s.d1, x.d1, 1e-10 * std::max(1.0, std::abs(x.d1))) << interp_name(interp) << " at " << p;
       if (interp != Interp::kLinear) {
         EXPECT_NEAR(s.d2, x.d2, 1e-8 * std::max(1.0, std::abs(x.d2))) << interp_name(interp) << " at " << p;
@@ -96,9 +97,8 @@ TEST(PhaseTable, ErrorsConvergeAtEachOrder) {
     std::size_t n;
     double value_ratio, d1_ratio, d2_ratio;  // ideal ratios e(n)/e(2n)
   };
-  const Expect cases[] = {{Interp::kLinear, 256, 4, 2, 0},
-                          {Interp::kCubic, 64, 16, 8, 4},
-                          {Interp::kQuintic, 32, 64, 32, 16}};
+  const Expect cases[] = {
+      {Interp::kLinear, 256, 4, 2, 0}, {Interp::kCubic, 64, 16, 8, 4}, {Interp::kQuintic, 32, 64, 32, 16}};
   for (const Expect& c : cases) {
     const Errors a = errors(table(c.n, c.interp), wave), b = errors(table(2 * c.n, c.interp), wave);
     EXPECT_GT(a.value / b.value, 0.75 * c.value_ratio) << interp_name(c.interp);
@@ -157,7 +157,9 @@ TEST(PhaseTable, Float32KnotsKeepTheirPrecisionFarFromZero) {
 TEST(PhaseTable, ConstantFunctionIsExact) {
   for (Precision prec : kPrecisions) {
     for (Interp interp : kOrders) {
-      const PhaseTable t({.size = 64, .interp = interp, .precision = prec}, [](double) { return PhaseExact{0.125, 0, 0}; });
+      const PhaseTable t({.size = 64, .interp = interp, .precision = prec}, [](double) {
+        return PhaseExact{0.125, 0, 0};
+      });
       for (int i = 0; i < 1000; ++i) {
         const PhaseSample s = t.at(Phase{i - 500, 0x9E3779B97F4A7C15ull * static_cast<std::uint64_t>(i)});
         EXPECT_EQ(s.value, 0.125);
@@ -196,7 +198,11 @@ TEST(PhaseTable, RejectsBadSpecsNamingTheValue) {
   EXPECT_NE(message({.size = 3}, wave).find("size 3"), std::string::npos);
   EXPECT_NE(message({.size = PhaseTable::kMaxSize + 1}, wave).find("must be between 4"), std::string::npos);
   EXPECT_NE(message({.size = 64, .rise = NAN}, wave).find("rise"), std::string::npos);
-  EXPECT_NE(message({.size = 64}, [](double p) { return PhaseExact{p > 3.0 ? NAN : 0.0, 0, 0}; }).find("not finite"),
+  EXPECT_NE(message({.size = 64},
+                    [](double p) {
+                      return PhaseExact{p > 3.0 ? NAN : 0.0, 0, 0};
+                    })
+                .find("not finite"),
             std::string::npos);
 }
 

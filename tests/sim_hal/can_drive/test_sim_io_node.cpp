@@ -80,8 +80,8 @@ class SimIoNodeTest : public ::testing::Test {
   // 1/2/4 bytes carries the value, 0x80 is an abort.
   std::optional<std::uint32_t> read(std::uint16_t index, std::uint8_t sub) {
     take();
-    send(frame(kSdoRequest, {0x40, static_cast<std::uint8_t>(index & 0xFF), static_cast<std::uint8_t>(index >> 8),
-                             sub, 0, 0, 0, 0}));
+    send(frame(kSdoRequest, {0x40, static_cast<std::uint8_t>(index & 0xFF),
+                             static_cast<std::uint8_t>(index >> 8), sub, 0, 0, 0, 0}));
     for (const CanFrame& f : take()) {
       if (f.id != kSdoReply || f.dlc != 8) continue;
       EXPECT_EQ(f.data[1] | f.data[2] << 8, index);
@@ -99,8 +99,8 @@ class SimIoNodeTest : public ::testing::Test {
   // Expedited SDO download of one byte (0x2F); 0 or the abort code.
   std::uint32_t write_u8(std::uint16_t index, std::uint8_t sub, std::uint8_t value) {
     take();
-    send(frame(kSdoRequest, {0x2F, static_cast<std::uint8_t>(index & 0xFF), static_cast<std::uint8_t>(index >> 8),
-                             sub, value, 0, 0, 0}));
+    send(frame(kSdoRequest, {0x2F, static_cast<std::uint8_t>(index & 0xFF),
+                             static_cast<std::uint8_t>(index >> 8), sub, value, 0, 0, 0}));
     for (const CanFrame& f : take()) {
       if (f.id != kSdoReply) continue;
       if (f.data[0] == 0x80) {
@@ -114,9 +114,10 @@ class SimIoNodeTest : public ::testing::Test {
   // Expedited SDO download of four bytes (0x23); 0 or the abort code.
   std::uint32_t write_u32(std::uint16_t index, std::uint8_t sub, std::uint32_t value) {
     take();
-    send(frame(kSdoRequest, {0x23, static_cast<std::uint8_t>(index & 0xFF), static_cast<std::uint8_t>(index >> 8),
-                             sub, static_cast<std::uint8_t>(value), static_cast<std::uint8_t>(value >> 8),
-                             static_cast<std::uint8_t>(value >> 16), static_cast<std::uint8_t>(value >> 24)}));
+    send(frame(kSdoRequest,
+               {0x23, static_cast<std::uint8_t>(index & 0xFF), static_cast<std::uint8_t>(index >> 8), sub,
+                static_cast<std::uint8_t>(value), static_cast<std::uint8_t>(value >> 8),
+                static_cast<std::uint8_t>(value >> 16), static_cast<std::uint8_t>(value >> 24)}));
     for (const CanFrame& f : take()) {
       if (f.id != kSdoReply) continue;
       if (f.data[0] == 0x80) {
@@ -141,7 +142,9 @@ class SimIoNodeTest : public ::testing::Test {
     }
     return std::nullopt;
   }
-  static std::vector<std::uint8_t> payload(const CanFrame& f) { return {f.data.begin(), f.data.begin() + f.dlc}; }
+  static std::vector<std::uint8_t> payload(const CanFrame& f) {
+    return {f.data.begin(), f.data.begin() + f.dlc};
+  }
 
   test::FakeCanNetwork net_;
   test::FakeCanNetwork::Endpoint& tester_ = net_.add_endpoint();

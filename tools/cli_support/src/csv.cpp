@@ -10,8 +10,8 @@ CsvWriter::CsvWriter(std::string_view header, bool full_precision, std::FILE* ou
   std::size_t start = 0;
   while (true) {
     const std::size_t comma = header.find(',', start);
-    columns_.emplace_back(header.substr(start, comma == std::string_view::npos ? std::string_view::npos
-                                                                                 : comma - start));
+    columns_.emplace_back(
+        header.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
     if (comma == std::string_view::npos) break;
     start = comma + 1;
   }

@@ -1,6 +1,7 @@
 // Bus-load arithmetic for classic CAN 2.0A: bits per frame (nominal and with worst-case bit stuffing),
 // bits per cycle and utilisation at a bitrate and cycle period, and the configure-time refusal of a
-// cycle whose worst case exceeds the budget. Formula: Davis, Burns, Bril, Lukkien 2007 (CAN schedulability analysis).
+// cycle whose worst case exceeds the budget. Formula: Davis, Burns, Bril, Lukkien 2007 (CAN schedulability
+// analysis).
 #pragma once
 
 #include <cstdint>

@@ -113,8 +113,8 @@ class CanIoPort final : public hal::IoPort, public CanNode {
   // 8-bit subs of 0x6200 the master can write (kIoMaxOutputBits).
   static constexpr std::size_t kMaxOutputSubs = kIoMaxOutputBits / 8;
 
-  std::array<Slot, kMaxInputSubs> input_slot_{};  // 0x6000:01..08 (pdo −1: not read)
-  int input_pdo_ = -1;                             // the one TPDO carrying the digital inputs
+  std::array<Slot, kMaxInputSubs> input_slot_{};    // 0x6000:01..08 (pdo −1: not read)
+  int input_pdo_ = -1;                              // the one TPDO carrying the digital inputs
   std::array<Slot, kMaxOutputSubs> output_slot_{};  // 0x6200:01..08
   Slot analog_slot_{};
   int output_pdo_ = -1;

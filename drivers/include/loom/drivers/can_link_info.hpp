@@ -12,7 +12,7 @@
 namespace loom::drivers {
 
 struct CanLinkInfo {
-  std::string kind;              // IFLA_INFO_KIND: "can", "vcan", "vxcan", "" when none
+  std::string kind;               // IFLA_INFO_KIND: "can", "vcan", "vxcan", "" when none
   std::uint32_t bitrate_bps = 0;  // 0 when the link has no bit timing (vcan) or is down/unset
   bool up = false;                // IFF_UP
 };

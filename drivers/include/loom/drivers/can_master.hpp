@@ -77,9 +77,9 @@ class CanNode {
 };
 
 struct CanMasterConfig {
-  double cycle_period_s = 0.002;         // SYNC period = tick period
+  double cycle_period_s = 0.002;  // SYNC period = tick period
   double sdo_timeout_s = 0.100;
-  double boot_timeout_s = 2.0;           // default window for nodes that give none
+  double boot_timeout_s = 2.0;  // default window for nodes that give none
   double operational_timeout_s = 1.0;
   // The master's own heartbeat (0x700 + id, operational) every master_heartbeat_s; 0 = none.
   std::uint8_t master_node_id = 0x7F;

@@ -42,7 +42,8 @@ class Cia402Axis final : public CanNode {
   bool faulted() const;
   // RT-safe. The next step toward `command` (quick stop when `stop_all` and the request is not a reset
   // or disable; always quick stop while the drive cannot be supervised); returns its RPDO1.
-  CanFrame command(const hal::AxisCommand& command, bool stop_all, bool bus_down, std::uint32_t state_timeout_ticks);
+  CanFrame command(const hal::AxisCommand& command, bool stop_all, bool bus_down,
+                   std::uint32_t state_timeout_ticks);
 
   // Diagnostics; RT-safe.
   std::uint8_t bus() const { return bus_; }
@@ -101,8 +102,8 @@ class Cia402Axis final : public CanNode {
   bool cmd_valid_ = false;
   bool ferror_fault_ = false;  // latched until acknowledged
   double ferror_high_water_ = 0.0;
-  bool has_consumer_ = false;  // the drive watches our heartbeat (0x1016)
-  bool has_tpdo2_ = false;     // velocity/torque PDO configured
+  bool has_consumer_ = false;      // the drive watches our heartbeat (0x1016)
+  bool has_tpdo2_ = false;         // velocity/torque PDO configured
   std::int8_t mode_display_ = 8;   // 0x6061 from TPDO1 (always CSP for an absolute axis)
   bool referenced_ = true;         // absolute, or homed since the last bring-up
   bool homing_error_ = false;      // the drive said homing error (latched until acknowledged)

@@ -51,15 +51,16 @@ inline constexpr std::uint16_t kRpdoComm = 0x1400;  // + pdo-1
 inline constexpr std::uint16_t kRpdoMap = 0x1600;
 inline constexpr std::uint16_t kTpdoComm = 0x1800;
 inline constexpr std::uint16_t kTpdoMap = 0x1A00;
-inline constexpr std::int8_t kModeCsp = 8;                 // cyclic synchronous position
-inline constexpr std::int8_t kModeHoming = 6;              // homing mode
-inline constexpr std::uint32_t kSupportsCspBit = 1U << 7;  // in 0x6502
+inline constexpr std::int8_t kModeCsp = 8;                    // cyclic synchronous position
+inline constexpr std::int8_t kModeHoming = 6;                 // homing mode
+inline constexpr std::uint32_t kSupportsCspBit = 1U << 7;     // in 0x6502
 inline constexpr std::uint32_t kSupportsHomingBit = 1U << 5;  // in 0x6502
-inline constexpr std::uint16_t kHomeOffset = 0x607C;       // i32, counts: the reading at the home point
-inline constexpr std::uint16_t kHomingMethod = 0x6098;     // i8
-inline constexpr std::uint16_t kHomingSpeeds = 0x6099;     // :01 search for switch, :02 search for zero, counts/s
+inline constexpr std::uint16_t kHomeOffset = 0x607C;          // i32, counts: the reading at the home point
+inline constexpr std::uint16_t kHomingMethod = 0x6098;        // i8
+inline constexpr std::uint16_t kHomingSpeeds =
+    0x6099;  // :01 search for switch, :02 search for zero, counts/s
 inline constexpr std::uint16_t kHomingAcceleration = 0x609A;  // u32, counts/s²
-inline constexpr std::uint32_t kPdoInvalidBit = 1U << 31;  // in 0x14xx/0x18xx:01
+inline constexpr std::uint32_t kPdoInvalidBit = 1U << 31;     // in 0x14xx/0x18xx:01
 }  // namespace od
 
 // RT-safe. Human-readable name of an object the master touches ("modes of operation"), or "object".

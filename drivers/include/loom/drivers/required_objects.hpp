@@ -12,7 +12,7 @@ namespace loom::drivers {
 struct RequiredObject {
   std::uint16_t index;
   const char* name;
-  bool optional;        // used when present, reported when absent
+  bool optional;  // used when present, reported when absent
   std::string why;
   // An array object whose size depends on the wiring: the master uses sub-indices 1..subs (0 = the
   // object as a whole, nothing to count).

@@ -13,8 +13,8 @@
 namespace loom::firmware {
 
 struct CarpetCheck {
-  int rows = 0;        // rows compared: every row knotted and every row woven, whichever is more
-  int knots = 0;       // knots tied (by heads and by hand)
+  int rows = 0;   // rows compared: every row knotted and every row woven, whichever is more
+  int knots = 0;  // knots tied (by heads and by hand)
   int by_hand = 0;
   int missing = 0;     // knots of those rows not tied
   int doubled = 0;     // knot positions tied more than once

@@ -37,7 +37,7 @@ struct LoopStats {
 struct TelemetryContext {
   double beat_force_min_n = 80.0;
   double beat_force_max_n = 100.0;
-  std::uint32_t rows_target = 0;  // 0 = until stopped / unknown
+  std::uint32_t rows_target = 0;                              // 0 = until stopped / unknown
   std::array<double, hal::kMaxAxes> following_error_limit{};  // SI per axis; 0 = not checked
   // The knotting heads' design as magazine slots (Machine::knot_program(); null: no heads, and the
   // snapshot's knots stay empty at no cost per tick). Must outlive the loop.
@@ -49,8 +49,8 @@ class ControlLoop {
   // Configure-time only. `telemetry` may be null (no publishing). With `lossless_telemetry` the cycle
   // waits for ring space instead of dropping: only for virtual time, where nothing is real-time.
   // `period_ns` is the loop's period as the config derives it (LoomConfig::timing).
-  ControlLoop(hal::Hal& hal, sequencer::Sequencer& seq, telemetry::Telemetry* telemetry, std::int64_t period_ns,
-              bool lossless_telemetry);
+  ControlLoop(hal::Hal& hal, sequencer::Sequencer& seq, telemetry::Telemetry* telemetry,
+              std::int64_t period_ns, bool lossless_telemetry);
 
   // Configure-time only.
   void set_telemetry_context(const TelemetryContext& c) noexcept { ctx_ = c; }
@@ -73,8 +73,8 @@ class ControlLoop {
   void push_beat(const sequencer::BeatEvent& b, hal::Tick now) noexcept;
   void push_row(hal::Tick now) noexcept;
   void push_weaver_request(hal::Tick now) noexcept;
-  void push_fault(telemetry::Event::FaultKind kind, sequencer::Fault which, int axis, std::uint16_t device_code,
-                  int sensor, hal::Tick now) noexcept;
+  void push_fault(telemetry::Event::FaultKind kind, sequencer::Fault which, int axis,
+                  std::uint16_t device_code, int sensor, hal::Tick now) noexcept;
   void push_device_faults(int first_axis_reported, bool link_reported, hal::Tick now) noexcept;
   bool any_device_fault() const noexcept;
   void push_event(const telemetry::Event& e) noexcept;

@@ -13,7 +13,7 @@ namespace loom::firmware {
 
 class LatencyHistogram {
  public:
-  static constexpr int kSubBits = 5;                       // 32 buckets per octave
+  static constexpr int kSubBits = 5;                        // 32 buckets per octave
   static constexpr std::uint64_t kLinear = 2u << kSubBits;  // values below this are exact (64)
   static constexpr int kMaxExp = 40;
   static constexpr std::size_t kBuckets = kLinear + (kMaxExp - kSubBits) * (1u << kSubBits);
@@ -52,7 +52,8 @@ class LatencyHistogram {
     const int exp = static_cast<int>(std::bit_width(v)) - 1;  // >= kSubBits + 1
     if (exp >= kMaxExp + 1) return kBuckets - 1;
     const std::uint64_t sub = (v >> (exp - kSubBits)) & ((1u << kSubBits) - 1);
-    return static_cast<std::size_t>(kLinear + static_cast<std::uint64_t>(exp - kSubBits - 1) * (1u << kSubBits) + sub);
+    return static_cast<std::size_t>(kLinear +
+                                    static_cast<std::uint64_t>(exp - kSubBits - 1) * (1u << kSubBits) + sub);
   }
   static std::uint64_t lower(std::size_t i) noexcept {
     if (i < kLinear) return i;

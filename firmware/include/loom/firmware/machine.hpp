@@ -8,11 +8,11 @@
 #include <string>
 #include <vector>
 
+#include "loom/config/config.hpp"
 #include "loom/drivers/can_axis_port.hpp"
 #include "loom/drivers/can_io_modules.hpp"
 #include "loom/drivers/can_io_port.hpp"
 #include "loom/drivers/socket_can_bus.hpp"
-#include "loom/config/config.hpp"
 #include "loom/firmware/control_loop.hpp"
 #include "loom/motion/profile_set.hpp"
 #include "loom/motion/profile_slot.hpp"
@@ -27,7 +27,7 @@ class SimWeaver;
 
 struct MachineOptions {
   HalKind hal = HalKind::kSim;
-  std::string iface;             // SocketCAN interface(s) for kSocketCan: "can0" or "can0,can1" (bus i = i-th)
+  std::string iface;  // SocketCAN interface(s) for kSocketCan: "can0" or "can0,can1" (bus i = i-th)
   bool telemetry = true;
   bool lossless_telemetry = true;  // virtual time only: wait for ring space instead of dropping
   std::uint32_t rows = 3;
@@ -85,13 +85,14 @@ class Machine {
   const motion::KnotCycle* knot_cycle() const { return knot_cycle_.get(); }  // null without heads
 
  private:
-  void build_knotting(const MachineOptions& opt, std::uint32_t counter_rows, sequencer::SequencerConfig& scfg);
+  void build_knotting(const MachineOptions& opt, std::uint32_t counter_rows,
+                      sequencer::SequencerConfig& scfg);
   void build_can_hal(const MachineOptions& opt);
 
   LoomConfig cfg_;
   std::unique_ptr<motion::ProfileSlot> slot_;
   std::unique_ptr<const sequencer::KnotProgram> knot_program_;  // the design as magazine slots (heads)
-  std::unique_ptr<const motion::KnotCycle> knot_cycle_;          // the knotting servo's cycle (heads)
+  std::unique_ptr<const motion::KnotCycle> knot_cycle_;         // the knotting servo's cycle (heads)
   std::unique_ptr<sequencer::Sequencer> sequencer_;
   std::unique_ptr<sim_hal::SimStateFile> sim_state_;
   std::unique_ptr<sim_hal::SimWorld> sim_;
@@ -99,7 +100,7 @@ class Machine {
   std::vector<std::unique_ptr<drivers::SocketCanBus>> buses_;  // bus i = the i-th --iface name
   std::unique_ptr<drivers::CanAxisPort> can_port_;
   std::vector<std::unique_ptr<drivers::CanIoPort>> io_modules_;  // module k = can_io_configs()[k]
-  std::unique_ptr<drivers::CanIoModules> io_port_;                // the modules as the loop's one I/O port
+  std::unique_ptr<drivers::CanIoModules> io_port_;               // the modules as the loop's one I/O port
   std::string banner_;
   std::vector<std::string> notes_;
   std::unique_ptr<hal::PortHal> hal_;

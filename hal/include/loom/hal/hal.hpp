@@ -25,7 +25,10 @@ class IoPort {
   // position to decide when the shuttle arrives; real I/O ignores it.
   virtual void read_io(Tick now, const AxisFeedbacks& axes, DigitalInputs& io) = 0;
   // RT-safe. Analog channels (beater load cell). Default: none fitted.
-  virtual void read_analog(Tick now, AnalogInputs& analog) { analog = AnalogInputs{}; (void)now; }
+  virtual void read_analog(Tick now, AnalogInputs& analog) {
+    analog = AnalogInputs{};
+    (void)now;
+  }
   // RT-safe.
   virtual void write_io(Tick now, const DigitalOutputs& io) = 0;
 };
@@ -34,7 +37,7 @@ class IoPort {
 class Hal {
  public:
   virtual ~Hal() = default;
-  virtual void read(Tick now, HalInputs& in) = 0;         // RT-safe
+  virtual void read(Tick now, HalInputs& in) = 0;           // RT-safe
   virtual void write(Tick now, const HalOutputs& out) = 0;  // RT-safe
 };
 

@@ -29,15 +29,17 @@ enum class CoreAxis : std::uint8_t {
   kHelix = 2,      // helix shaft carrying the shuttle's magnetic carrier, position in rad (unwrapped)
 };
 inline constexpr std::size_t kCoreAxisCount = 3;
-inline constexpr std::size_t index(CoreAxis a) { return static_cast<std::size_t>(a); }
+inline constexpr std::size_t index(CoreAxis a) {
+  return static_cast<std::size_t>(a);
+}
 const char* axis_name(CoreAxis a);  // the core axes' default names: "beat_crank", "carriage", "helix"
 
 // What an axis is for. The core roles are held by exactly one axis each (slots 0..2).
 enum class AxisRole : std::uint8_t { kBeatCrank, kCarriage, kHelix, kKnotter, kSelector, kAuxiliary };
 inline constexpr std::size_t kAxisRoleCount = 6;
-const char* axis_role_name(AxisRole r);                     // "beat_crank", ..., "auxiliary"
-bool parse_axis_role(const char* text, AxisRole& role);     // false for an unknown name
-bool is_rotary(AxisRole r);                                 // rad (true) or m (the carriage)
+const char* axis_role_name(AxisRole r);                  // "beat_crank", ..., "auxiliary"
+bool parse_axis_role(const char* text, AxisRole& role);  // false for an unknown name
+bool is_rotary(AxisRole r);                              // rad (true) or m (the carriage)
 // The SI unit of an axis' position: "rad" for a rotary axis, "m" for a linear one (is_rotary). The one
 // place it is decided: the config's checks, commissioning and telemetry (AXES, for the panel and monitor)
 // all take it from here.
@@ -104,13 +106,13 @@ const char* fault_kind_name(FaultKind k);
 
 struct AxisFeedback {
   DriveState state = DriveState::kUnknown;
-  double position = 0.0;        // SI: rad (crank, helix) or m (carriage)
-  double velocity = 0.0;        // SI per second
-  double effort = 0.0;          // N·m (rotary) or N (linear); 0 when the drive does not report it
-  std::uint16_t fault_code = 0; // raw device code for display (a CiA 301 EMCY code on CAN; 0 = none)
+  double position = 0.0;         // SI: rad (crank, helix) or m (carriage)
+  double velocity = 0.0;         // SI per second
+  double effort = 0.0;           // N·m (rotary) or N (linear); 0 when the drive does not report it
+  std::uint16_t fault_code = 0;  // raw device code for display (a CiA 301 EMCY code on CAN; 0 = none)
   FaultKind fault_kind = FaultKind::kNone;  // what the fault is; kNone while healthy
-  bool fault = false;           // drive reports Fault / Fault reaction, or the HAL lost the node
-  bool following_error = false; // statusword bit 13 in CSP
+  bool fault = false;                       // drive reports Fault / Fault reaction, or the HAL lost the node
+  bool following_error = false;             // statusword bit 13 in CSP
   // The axis' position is referenced to the machine: always for an absolute axis; for a homed axis only
   // after a homing run since its drive powered up (kHome). An unreferenced axis never moves in production.
   bool referenced = true;
@@ -137,9 +139,9 @@ struct DigitalOutputs {
   bool piston_a_extend = false;
   bool piston_b_extend = false;
   // Stack light and buzzer (operator signalling only; nothing safety-relevant depends on them).
-  bool lamp_green = false;   // weaving
-  bool lamp_amber = false;   // waiting for the operator (armed, paused, waiting for the knotter)
-  bool lamp_red = false;     // fault latched, waiting for acknowledgement
+  bool lamp_green = false;  // weaving
+  bool lamp_amber = false;  // waiting for the operator (armed, paused, waiting for the knotter)
+  bool lamp_red = false;    // fault latched, waiting for acknowledgement
   bool buzzer = false;
   // Knotting heads (the first `heads` entries): gripper closed on the yarn, cutter blade firing. Safe state
   // (false) opens the grippers and retracts the cutters.
@@ -150,7 +152,12 @@ struct DigitalOutputs {
 // The six safety sensors — the ones whose word lets a frame move or a pick start — in a fixed order
 // (debouncing, second channels, diagnostics).
 enum class SafetySensor : std::uint8_t {
-  kPistonAExtended, kPistonARetracted, kPistonBExtended, kPistonBRetracted, kShuttleAtLeft, kShuttleAtRight
+  kPistonAExtended,
+  kPistonARetracted,
+  kPistonBExtended,
+  kPistonBRetracted,
+  kShuttleAtLeft,
+  kShuttleAtRight
 };
 inline constexpr std::size_t kSafetySensorCount = 6;
 const char* safety_sensor_name(SafetySensor s);  // "shuttle_at_right", as in the config's io keys
@@ -160,15 +167,15 @@ struct DigitalInputs {
   bool piston_a_retracted = false;
   bool piston_b_extended = false;
   bool piston_b_retracted = false;
-  bool shuttle_at_left = false;    // shuttle-arrival sensors at each selvedge
+  bool shuttle_at_left = false;  // shuttle-arrival sensors at each selvedge
   bool shuttle_at_right = false;
-  bool estop_ok = false;           // e-stop chain closed (true = healthy; broken wire reads as e-stop)
+  bool estop_ok = false;  // e-stop chain closed (true = healthy; broken wire reads as e-stop)
   // Operator inputs (push buttons / foot pedal on the I/O node): true while pressed. They request;
   // the sequencer decides when a request is acted on. Not safety inputs (the e-stop chain is).
   bool button_start = false;
   bool button_pause = false;
-  bool button_ack = false;         // reset / acknowledge a latched fault
-  bool row_knotted = false;        // the weaver's "row knotted" pedal (knotting mode)
+  bool button_ack = false;   // reset / acknowledge a latched fault
+  bool row_knotted = false;  // the weaver's "row knotted" pedal (knotting mode)
   // Second channels of the safety sensors, in SafetySensor order: an independent switch at the same
   // place on its own input, where the machine has one (io.<sensor>_2_bit). One stuck switch then cannot
   // confirm a shed or an arrival that did not happen: the two must agree. False where not wired.
@@ -181,7 +188,7 @@ struct DigitalInputs {
 
 // The primary channels of the safety sensors, in SafetySensor order, and back.
 inline std::array<bool, kSafetySensorCount> safety_sensors(const DigitalInputs& io) {
-  return {io.piston_a_extended, io.piston_a_retracted, io.piston_b_extended,
+  return {io.piston_a_extended,  io.piston_a_retracted, io.piston_b_extended,
           io.piston_b_retracted, io.shuttle_at_left,    io.shuttle_at_right};
 }
 inline void set_safety_sensors(DigitalInputs& io, const std::array<bool, kSafetySensorCount>& v) {
@@ -197,8 +204,8 @@ inline void set_safety_sensors(DigitalInputs& io, const std::array<bool, kSafety
 // Analog inputs: the beater's load cell (force the comb exerts on the cloth fell), when fitted.
 // ---------------------------------------------------------------------------------------------------
 struct AnalogInputs {
-  double beat_force_n = 0.0;     // ≥ 0; meaningful only when beat_force_valid
-  bool beat_force_valid = false; // false when no load cell is fitted / simulated
+  double beat_force_n = 0.0;      // ≥ 0; meaningful only when beat_force_valid
+  bool beat_force_valid = false;  // false when no load cell is fitted / simulated
   Tick refreshed = kNeverTick;
 };
 
@@ -217,13 +224,13 @@ enum class LinkRecovery : std::uint8_t {
 const char* link_recovery_name(LinkRecovery r);
 
 struct LinkStatus {
-  bool link_fault = false;          // bus-off, heartbeat lost, socket error: motion must stop
+  bool link_fault = false;  // bus-off, heartbeat lost, socket error: motion must stop
   FaultKind link_fault_kind = FaultKind::kNone;
   std::uint16_t link_fault_code = 0;  // raw code for display
   LinkRecovery recovery = LinkRecovery::kHealthy;
-  std::uint8_t silent_node = 0;     // kNodeSilent: the first node still missing
-  std::uint32_t tx_dropped = 0;     // frames not sent (ENOBUFS/EAGAIN), cumulative
-  std::uint32_t rx_errors = 0;      // error frames / malformed frames, cumulative
+  std::uint8_t silent_node = 0;  // kNodeSilent: the first node still missing
+  std::uint32_t tx_dropped = 0;  // frames not sent (ENOBUFS/EAGAIN), cumulative
+  std::uint32_t rx_errors = 0;   // error frames / malformed frames, cumulative
 };
 
 struct HalInputs {

@@ -14,11 +14,11 @@ namespace loom::motion {
 enum class FellSide : std::uint8_t { kExtended, kFolded };
 
 struct BeatUpGeometry {
-  FourBar bar;                        // thesis Table 5.1 by default (see default_beatup_geometry)
+  FourBar bar;  // thesis Table 5.1 by default (see default_beatup_geometry)
   Branch branch = Branch::kPositive;
-  double beater_arm_m = 0.301;        // beater tip distance from the rocker pivot B0
+  double beater_arm_m = 0.301;             // beater tip distance from the rocker pivot B0
   FellSide fell_at = FellSide::kExtended;  // the dead centre at which the beater meets the fell
-  double warp_depth_m = 0.05;         // tip arc distance from the fell inside which the teeth are in the warp
+  double warp_depth_m = 0.05;  // tip arc distance from the fell inside which the teeth are in the warp
 };
 
 // Thesis Table 5.1 / DESIGN.md: crank 0.058, coupler 0.189, rocker 0.232, ground 0.213, arm 0.301 m.

@@ -22,7 +22,8 @@ class CarriageCam {
   // [warp.exit + margin, warp.enter + 2π - margin] after every `beats_per_position`-th turn, so each
   // position is beaten that many times. Throws MotionError(kInvalidInput) when the margins leave no
   // window, the pitch is not positive or beats_per_position < 1.
-  CarriageCam(const WarpWindow& warp, double margin_rad, double pitch_m, int steps, int beats_per_position = 1);
+  CarriageCam(const WarpWindow& warp, double margin_rad, double pitch_m, int steps,
+              int beats_per_position = 1);
 
   // RT-safe. Φ = unwrapped crank phase since the sweep began.
   CamSample at(double crank_phase) const noexcept;

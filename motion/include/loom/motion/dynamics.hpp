@@ -89,9 +89,9 @@ struct BeatUpSample {
 // The one-coordinate model with the crank angle θ as generalised coordinate:
 // M(θ)θ̈ + ½M'(θ)θ̇² + dV/dθ = τ + Q.
 struct ReducedTerms {
-  double inertia_kg_m2 = 0.0;         // M = Σ m|∂r_G/∂θ|² + I(∂φ/∂θ)²
-  double dinertia_kg_m2_rad = 0.0;    // M' = dM/dθ
-  double gravity_torque_nm = 0.0;     // dV/dθ = −Σ m g·∂r_G/∂θ
+  double inertia_kg_m2 = 0.0;       // M = Σ m|∂r_G/∂θ|² + I(∂φ/∂θ)²
+  double dinertia_kg_m2_rad = 0.0;  // M' = dM/dθ
+  double gravity_torque_nm = 0.0;   // dV/dθ = −Σ m g·∂r_G/∂θ
 };
 
 // Largest beater force while the teeth are in the warp, at constant crank speed.

@@ -38,7 +38,9 @@ struct BodyMotion {
 };
 
 // RT-safe. z-component of the planar cross product a × b.
-inline double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+inline double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
 
 // RT-safe. ½ m v_G² + ½ I_G ω².
 double kinetic_energy(const PlanarInertia& body, const BodyMotion& m);

@@ -8,9 +8,9 @@ namespace loom::motion {
 
 // Driven-pinion angle and its derivatives with respect to the driving pinion angle φ1.
 struct GearPhase {
-  double phi2_rad;   // φ2(φ1), continuous and unbounded (one driven turn per driver turn)
-  double dphi2;      // dφ2/dφ1 = 1/i12 (dimensionless)
-  double d2phi2;     // d²φ2/dφ1² (1/rad)
+  double phi2_rad;  // φ2(φ1), continuous and unbounded (one driven turn per driver turn)
+  double dphi2;     // dφ2/dφ1 = 1/i12 (dimensionless)
+  double d2phi2;    // d²φ2/dφ1² (1/rad)
 };
 
 class EllipticGearPair {

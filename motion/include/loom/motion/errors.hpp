@@ -9,13 +9,13 @@
 namespace loom::motion {
 
 enum class ErrorCode {
-  kInvalidInput,     // a parameter outside its domain (negative length, e >= 1, φ = 180° exactly, ...)
-  kNotAssemblable,   // the linkage cannot close at this input (no real solution)
-  kNotCrank,         // Grashof says the input link cannot fully rotate
-  kOutOfBounds,      // a design variable outside its feasible bounds (e.g. β beyond its limits)
-  kSingular,         // a linear system or Jacobian is singular (toggle, change point)
-  kNoConvergence,    // an iterative solver did not converge within its budget
-  kWrongBranch,      // an iterative solver converged to the other assembly branch
+  kInvalidInput,    // a parameter outside its domain (negative length, e >= 1, φ = 180° exactly, ...)
+  kNotAssemblable,  // the linkage cannot close at this input (no real solution)
+  kNotCrank,        // Grashof says the input link cannot fully rotate
+  kOutOfBounds,     // a design variable outside its feasible bounds (e.g. β beyond its limits)
+  kSingular,        // a linear system or Jacobian is singular (toggle, change point)
+  kNoConvergence,   // an iterative solver did not converge within its budget
+  kWrongBranch,     // an iterative solver converged to the other assembly branch
 };
 
 const char* error_code_name(ErrorCode c);

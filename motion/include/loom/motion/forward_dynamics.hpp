@@ -33,8 +33,9 @@ class BeatUpForwardModel {
   // Hermite with exact slopes). viscous_nm_s is a crank bearing's viscous friction (N·m·s/rad);
   // drive_inertia_kg_m2 the motor, gears and any flywheel reflected to the crank (added to M).
   // Throws MotionError(kInvalidInput) for samples < 4, negative/non-finite friction, inertia or force.
-  explicit BeatUpForwardModel(const BeatUpDynamics& d, std::size_t samples = 4096, const BeatContact& contact = {},
-                              double viscous_nm_s = 0.0, double drive_inertia_kg_m2 = 0.0);
+  explicit BeatUpForwardModel(const BeatUpDynamics& d, std::size_t samples = 4096,
+                              const BeatContact& contact = {}, double viscous_nm_s = 0.0,
+                              double drive_inertia_kg_m2 = 0.0);
 
   // RT-safe. Reduced-model terms at crank angle θ (any real).
   ReducedTerms terms(double theta_rad) const noexcept;
@@ -57,8 +58,8 @@ class BeatUpForwardModel {
   double fell_theta4_ = 0.0;
   double away_sign_ = 1.0;
   double warp_depth_m_ = 0.0;
-  double arm_m_ = 0.0;       // beater arm used for the warp test (BeatUp's definition)
-  double lever_m_ = 0.0;     // distance of the contact point from B0
+  double arm_m_ = 0.0;    // beater arm used for the warp test (BeatUp's definition)
+  double lever_m_ = 0.0;  // distance of the contact point from B0
   double contact_n_ = 0.0;
   double viscous_ = 0.0;
   double drive_inertia_ = 0.0;
@@ -69,8 +70,8 @@ class BeatUpForwardModel {
 class BeatUpExactForwardModel {
  public:
   // Configure-time only; keeps a reference to `d`, which must outlive the model.
-  explicit BeatUpExactForwardModel(const BeatUpDynamics& d, const BeatContact& contact = {}, double viscous_nm_s = 0.0,
-                                   double drive_inertia_kg_m2 = 0.0)
+  explicit BeatUpExactForwardModel(const BeatUpDynamics& d, const BeatContact& contact = {},
+                                   double viscous_nm_s = 0.0, double drive_inertia_kg_m2 = 0.0)
       : d_(&d), contact_(contact), viscous_(viscous_nm_s), drive_inertia_(drive_inertia_kg_m2) {}
   // Configure-time only. As BeatUpForwardModel's, evaluated exactly.
   double acceleration(const CrankState& s, double torque_nm) const;

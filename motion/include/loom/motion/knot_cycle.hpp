@@ -37,7 +37,7 @@ struct KnotPoint {
 };
 
 struct KnotLinkSpec {
-  double length_m = 0.0;       // pivot to pivot
+  double length_m = 0.0;  // pivot to pivot
   double mass_kg = 0.0;
   double cg_m = 0.0;           // from its first pivot, along the link (may be negative: overhang)
   double inertia_kg_m2 = 0.0;  // about its cg
@@ -59,7 +59,7 @@ struct KnotCycleSpec {
   double warp_entry_x_m = 0.0;  // the gripper is inside the warp while its x >= this
   // Least transmission angle (min(μ, π − μ)) allowed within the stroke TAKE→PULL.
   double min_transmission_rad = 0.0;
-  double gravity_m_s2 = 9.81;   // along −y of the knot frame; 0 for a horizontal head
+  double gravity_m_s2 = 9.81;  // along −y of the knot frame; 0 for a horizontal head
 
   // The knotting servo (output shaft).
   double max_speed_rad_s = 0.0, max_accel_rad_s2 = 0.0, jerk_rad_s3 = 0.0;
@@ -95,11 +95,11 @@ const char* knot_limit_name(KnotLimit l);
 
 struct KnotCycleReport {
   struct Segment {
-    const char* name = "";     // "grip", "take_to_wrap", "wrap_to_pull", "cut", "release", "return"
+    const char* name = "";  // "grip", "take_to_wrap", "wrap_to_pull", "cut", "release", "return"
     double begin_s = 0.0, end_s = 0.0;
-    double distance_rad = 0.0;    // signed servo travel (0 for a dwell)
+    double distance_rad = 0.0;  // signed servo travel (0 for a dwell)
     double peak_speed_rad_s = 0.0;
-    double time_scale = 1.0;      // > 1: slowed by the torque limit by this factor
+    double time_scale = 1.0;  // > 1: slowed by the torque limit by this factor
     KnotLimit bound = KnotLimit::kDwell;
   };
   std::array<Segment, 6> segments{};
@@ -113,8 +113,8 @@ struct KnotCycleReport {
   double min_transmission_return_rad = 0.0;  // the same over the return (differs when turning on)
   double peak_torque_nm = 0.0;               // max |τ| over the cycle (signed value at that instant)
   double peak_torque_t_s = 0.0;
-  double peak_torque_angle_rad = 0.0;        // relative to TAKE
-  double max_inertia_kg_m2 = 0.0;            // largest effective inertia at the servo over the stroke
+  double peak_torque_angle_rad = 0.0;  // relative to TAKE
+  double max_inertia_kg_m2 = 0.0;      // largest effective inertia at the servo over the stroke
   double min_inertia_kg_m2 = 0.0;
   // The phase table against the exact piecewise evaluation, on a grid off the knots.
   double table_angle_error_rad = 0.0;
@@ -185,9 +185,9 @@ class KnotCycle {
   // Configure-time: the dynamics the planner uses, for checks and tools. At absolute crank angle θ
   // (throws MotionError off the linkage's range or at a toggle).
   struct Dynamics {
-    double inertia_kg_m2 = 0.0;   // J(θ): rotor + links reflected to the servo
-    double dinertia = 0.0;        // dJ/dθ
-    double gravity_nm = 0.0;      // dV/dθ: torque that holds the links against gravity
+    double inertia_kg_m2 = 0.0;  // J(θ): rotor + links reflected to the servo
+    double dinertia = 0.0;       // dJ/dθ
+    double gravity_nm = 0.0;     // dV/dθ: torque that holds the links against gravity
     double gripper_x_m = 0.0, gripper_y_m = 0.0;
     double transmission_rad = 0.0;  // μ
   };
@@ -198,7 +198,7 @@ class KnotCycle {
  private:
   struct Piece {
     double t0 = 0.0, t1 = 0.0, start_rad = 0.0;  // relative to TAKE
-    JerkMove move;                                // zero-length for a dwell
+    JerkMove move;                               // zero-length for a dwell
   };
   KnotCycleSpec spec_{};
   FourBar fourbar_{};

@@ -10,8 +10,8 @@
 namespace loom::motion {
 
 struct Phase {
-  std::int64_t turns = 0;   // whole turns (a phase before the origin has turns < 0)
-  std::uint64_t frac = 0;   // fraction of a turn in units of 2^-64 turn, always in [0, 2^64)
+  std::int64_t turns = 0;  // whole turns (a phase before the origin has turns < 0)
+  std::uint64_t frac = 0;  // fraction of a turn in units of 2^-64 turn, always in [0, 2^64)
 
   static constexpr double kUnitsPerTurn = 18446744073709551616.0;  // 2^64
   static constexpr double kTurnsPerUnit = 0x1p-64;
@@ -55,7 +55,9 @@ struct Phase {
   double to_turns() const noexcept;
   double to_rad() const noexcept;
   // RT-safe. The fraction as a real in [0, 1] (from its top 63 bits: branch-free on x86-64).
-  double frac_turns() const noexcept { return static_cast<double>(static_cast<std::int64_t>(frac >> 1)) * 0x1p-63; }
+  double frac_turns() const noexcept {
+    return static_cast<double>(static_cast<std::int64_t>(frac >> 1)) * 0x1p-63;
+  }
   double frac_rad() const noexcept;  // [0, 2π]
 };
 

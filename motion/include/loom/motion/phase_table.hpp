@@ -28,10 +28,10 @@ struct PhaseExact {
 };
 
 struct TableSpec {
-  std::size_t size = 4096;                   // knots per turn (>= 4)
+  std::size_t size = 4096;  // knots per turn (>= 4)
   Interp interp = Interp::kCubic;
   Precision precision = Precision::kDouble;
-  double rise = 0.0;                          // f(φ + 2π) - f(φ): 0 for a periodic function
+  double rise = 0.0;  // f(φ + 2π) - f(φ): 0 for a periodic function
 };
 
 class PhaseTable {
@@ -74,9 +74,9 @@ class PhaseTable {
   std::size_t n_ = 0;
   std::vector<double> knots_d_;  // interleaved per knot: value, h·slope, h²·curvature (as the order needs)
   std::vector<float> knots_f_;
-  double base_ = 0.0;            // added to every value (the float32 knots store the offset from it)
-  double slope_ = 0.0;           // rise / 2π: the linear part taken out of a rising function
-  double inv_h_ = 0.0;           // knots per rad
+  double base_ = 0.0;   // added to every value (the float32 knots store the offset from it)
+  double slope_ = 0.0;  // rise / 2π: the linear part taken out of a rising function
+  double inv_h_ = 0.0;  // knots per rad
   Lookup lookup_ = &lookup_empty;
 };
 

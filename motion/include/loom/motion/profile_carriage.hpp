@@ -33,6 +33,6 @@ CarriagePeaks carriage_step_peaks(const CarriageCam& cam, const CrankLaw& law, d
 // Configure-time only. The peaks, or MotionError(kInvalidInput) when a step breaks a limit; the message
 // names the step, the window, the needed peaks, the limits (config keys) and the fastest crank speed.
 CarriagePeaks check_carriage_step(const CarriageCam& cam, const CrankLaw& law, double master_speed_rad_s,
-                         const CarriageLimits& limits);
+                                  const CarriageLimits& limits);
 
 }  // namespace loom::motion

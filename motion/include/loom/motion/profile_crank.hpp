@@ -61,10 +61,13 @@ class CrankLaw {
   // RT-safe. at(master).phase alone. The constant law's table holds zeros only (exact() is the identity),
   // and x + ±0 is x for every x to_rad() returns, so its phase is the master's without the lookup.
   double phase_at(const Phase& master) const noexcept {
-    return spec_.kind == CrankLawKind::kConstant ? master.to_rad() : master.to_rad() + table_.at(master).value;
+    return spec_.kind == CrankLawKind::kConstant ? master.to_rad()
+                                                 : master.to_rad() + table_.at(master).value;
   }
   // RT-safe. The crank phase in fixed point, for indexing the rocker table.
-  Phase crank_phase(const Phase& master) const noexcept { return master.plus_small_rad(table_.at(master).value); }
+  Phase crank_phase(const Phase& master) const noexcept {
+    return master.plus_small_rad(table_.at(master).value);
+  }
 
   // RT-safe accessors.
   const CrankLawSpec& spec() const noexcept { return spec_; }

@@ -14,7 +14,9 @@ enum class Interp : std::uint8_t { kLinear, kCubic, kQuintic };
 enum class Precision : std::uint8_t { kDouble, kFloat };
 
 // RT-safe. Stored numbers per knot: value; + h·slope; + h²·curvature.
-constexpr std::size_t knot_fields(Interp i) { return i == Interp::kLinear ? 1 : i == Interp::kCubic ? 2 : 3; }
+constexpr std::size_t knot_fields(Interp i) {
+  return i == Interp::kLinear ? 1 : i == Interp::kCubic ? 2 : 3;
+}
 // RT-safe. Names as the config and the report spell them.
 const char* interp_name(Interp i);        // "linear", "cubic", "quintic"
 const char* precision_name(Precision p);  // "double", "float32"
@@ -59,7 +61,8 @@ inline SegmentValue<T> interpolate(const T* a, T t) noexcept {
     const T m0 = a[1], m1 = b[1];
     const T a2 = T(3) * d - T(2) * m0 - m1;
     const T a3 = m0 + m1 - T(2) * d;
-    return {y0 + t * (m0 + t * (a2 + t * a3)), m0 + t * (T(2) * a2 + t * (T(3) * a3)), T(2) * a2 + T(6) * a3 * t};
+    return {y0 + t * (m0 + t * (a2 + t * a3)), m0 + t * (T(2) * a2 + t * (T(3) * a3)),
+            T(2) * a2 + T(6) * a3 * t};
   } else {
     const T m0 = a[1], m1 = b[1], c0 = a[2], c1 = b[2];
     const T a2 = T(0.5) * c0;

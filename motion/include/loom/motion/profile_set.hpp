@@ -19,20 +19,20 @@ namespace loom::motion {
 
 struct ProfileSpec {
   BeatUpGeometry beatup = default_beatup_geometry();
-  double width_m = 1.2;              // weaving width
-  double beater_width_m = 0.10;      // comb width (5–10 cm in handmade looms)
-  double overlap_m = 0.02;           // overlap between neighbouring beats
-  int beats_per_position = 1;        // beats at each carriage position before it steps on
+  double width_m = 1.2;          // weaving width
+  double beater_width_m = 0.10;  // comb width (5–10 cm in handmade looms)
+  double overlap_m = 0.02;       // overlap between neighbouring beats
+  int beats_per_position = 1;    // beats at each carriage position before it steps on
   // The master phase's sweep (the crank itself with the constant law): rad/s, rad/s², rad/s³.
   JerkLimits crank{.velocity = 15.5, .acceleration = 400.0, .jerk = 2.0e4};
-  CrankLawSpec crank_law{};          // constant speed, or the elliptic-gear law of seed 004
-  double cam_margin_rad = 0.3491;    // 20°: carriage keeps this far from the warp boundaries
+  CrankLawSpec crank_law{};        // constant speed, or the elliptic-gear law of seed 004
+  double cam_margin_rad = 0.3491;  // 20°: carriage keeps this far from the warp boundaries
   double carriage_max_speed_m_s = 1.0;
   double carriage_max_accel_m_s2 = 20.0;
   double carriage_max_jerk_m_s3 = 2000.0;
-  double helix_lead_m = 0.10;        // carrier travel per shaft turn
+  double helix_lead_m = 0.10;  // carrier travel per shaft turn
   JerkLimits helix{.velocity = 60.0, .acceleration = 3000.0, .jerk = 2.0e5};
-  double carrier_force_n = 20.0;     // magnetic coupling force before the shuttle slips
+  double carrier_force_n = 20.0;  // magnetic coupling force before the shuttle slips
   double shuttle_mass_kg = 0.40;
   ShedSpec shed{};
   // Every phase table (rocker, crank law): knots per turn, interpolation order, knot precision.
@@ -57,12 +57,16 @@ class ProfileSet {
   // RT-safe accessors.
   const ProfileSpec& spec() const noexcept { return spec_; }
   const BeatUp& beatup() const noexcept { return beatup_; }
-  const PhaseTable& rocker() const noexcept { return rocker_; }    // rocker angle θ4 vs crank phase from park
+  const PhaseTable& rocker() const noexcept { return rocker_; }  // rocker angle θ4 vs crank phase from park
   const CrankLaw& crank_law() const noexcept { return crank_law_; }  // crank phase vs master phase
   const CarriageCam& cam() const noexcept { return cam_; }
-  const CarriagePeaks& carriage_peaks() const noexcept { return carriage_peaks_; }  // per step, at cruise speed
-  const JerkMove& crank_sweep() const noexcept { return sweep_; }  // one row's beat sweep of the master: beats turns
-  const JerkMove& pick() const noexcept { return pick_; }            // one pick, left → right (helix +)
+  const CarriagePeaks& carriage_peaks() const noexcept {
+    return carriage_peaks_;
+  }  // per step, at cruise speed
+  const JerkMove& crank_sweep() const noexcept {
+    return sweep_;
+  }                                                        // one row's beat sweep of the master: beats turns
+  const JerkMove& pick() const noexcept { return pick_; }  // one pick, left → right (helix +)
   const JerkMove& pick_back() const noexcept { return pick_back_; }  // one pick, right → left (helix −)
   const ShedSpec& shed() const noexcept { return spec_.shed; }
   int beats_per_row() const noexcept { return beats_; }
@@ -80,7 +84,9 @@ class ProfileSet {
   // RT-safe. Where the crank and the beater are at a master phase (sweep position from park);
   // the rocker's derivatives are with respect to the master phase (chain rule through the law).
   CrankSample crank_at(const Phase& master) const noexcept { return crank_law_.at(master); }
-  double crank_phase_at(const Phase& master) const noexcept { return crank_law_.phase_at(master); }  // crank_at().phase
+  double crank_phase_at(const Phase& master) const noexcept {
+    return crank_law_.phase_at(master);
+  }  // crank_at().phase
   PhaseSample rocker_at(const Phase& master) const noexcept;
 
  private:

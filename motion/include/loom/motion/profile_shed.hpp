@@ -10,14 +10,14 @@
 namespace loom::motion {
 
 struct ShedSpec {
-  double piston_travel_s = 0.25;   // nominal frame stroke time at supply pressure
-  double earliest_fraction = 0.4;  // confirming before this fraction of the stroke time is a sensor fault
-  double release_timeout_s = 0.15; // a moving frame must have left its start end sensor by then
-  double timeout_s = 1.5;          // the shed must be confirmed by then
+  double piston_travel_s = 0.25;    // nominal frame stroke time at supply pressure
+  double earliest_fraction = 0.4;   // confirming before this fraction of the stroke time is a sensor fault
+  double release_timeout_s = 0.15;  // a moving frame must have left its start end sensor by then
+  double timeout_s = 1.5;           // the shed must be confirmed by then
   // The confirmed pattern must hold this long (contact bounce). 0 when the caller already debounces
   // its inputs, as the sequencer does (timing.debounce_ticks).
   double debounce_s = 0.0;
-  double settle_s = 0.02;          // after confirmation, before the pick (frames bounce on the stops)
+  double settle_s = 0.02;  // after confirmation, before the pick (frames bounce on the stops)
 };
 
 // Configure-time only. Throws MotionError(kInvalidInput) naming the field (its config key) when a

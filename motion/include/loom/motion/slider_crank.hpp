@@ -24,11 +24,11 @@ struct SliderCrank {
 void validate_slider_crank(const SliderCrank& m);
 
 struct SliderState {
-  double x = 0.0;                  // slider pin position along +x
-  double x_dot = 0.0;              // d x / dt
-  double x_ddot = 0.0;             // d² x / dt²
-  double coupler_angle_rad = 0.0;  // direction A → B, counter-clockwise from +x
-  double transmission_rad = 0.0;   // acute angle between the coupler and the slider line's normal
+  double x = 0.0;                     // slider pin position along +x
+  double x_dot = 0.0;                 // d x / dt
+  double x_ddot = 0.0;                // d² x / dt²
+  double coupler_angle_rad = 0.0;     // direction A → B, counter-clockwise from +x
+  double transmission_rad = 0.0;      // acute angle between the coupler and the slider line's normal
   double coupler_rate_rad_s = 0.0;    // d(coupler angle)/dt
   double coupler_accel_rad_s2 = 0.0;  // d²(coupler angle)/dt²
 };
@@ -45,18 +45,18 @@ PointCoefficients slider_coupler_point(const SliderCrank& m, double theta_rad,
                                        const Eigen::Vector2d& local) noexcept;
 
 struct SliderDeadCentres {
-  double theta_extended_rad = 0.0;  // crank angle, crank and coupler extended in line, [0, 2π)
-  double theta_folded_rad = 0.0;    // crank angle, crank folded back over the coupler, [0, 2π)
-  double x_extended = 0.0;          // slider position at the extended dead centre (farthest)
-  double x_folded = 0.0;            // slider position at the folded dead centre (nearest)
-  double stroke = 0.0;              // x_extended − x_folded
-  double phi_extend_to_fold_rad = 0.0;  // counter-clockwise crank travel, extended → folded
-  double phi_fold_to_extend_rad = 0.0;  // counter-clockwise crank travel, folded → extended
+  double theta_extended_rad = 0.0;       // crank angle, crank and coupler extended in line, [0, 2π)
+  double theta_folded_rad = 0.0;         // crank angle, crank folded back over the coupler, [0, 2π)
+  double x_extended = 0.0;               // slider position at the extended dead centre (farthest)
+  double x_folded = 0.0;                 // slider position at the folded dead centre (nearest)
+  double stroke = 0.0;                   // x_extended − x_folded
+  double phi_extend_to_fold_rad = 0.0;   // counter-clockwise crank travel, extended → folded
+  double phi_fold_to_extend_rad = 0.0;   // counter-clockwise crank travel, folded → extended
   double phi_half_difference_rad = 0.0;  // (extend→fold − fold→extend)/2, sign of the offset. Kept
                                          // apart: π ± a tiny value rounds it away (φ → 180°).
-  double time_ratio = 1.0;          // longer over shorter of the two travels (≥ 1)
-  double mu_min_rad = 0.0;          // minimum transmission angle over a turn
-  double theta_mu_min_rad = 0.0;    // crank angle where it occurs
+  double time_ratio = 1.0;               // longer over shorter of the two travels (≥ 1)
+  double mu_min_rad = 0.0;               // minimum transmission angle over a turn
+  double theta_mu_min_rad = 0.0;         // crank angle where it occurs
 };
 
 // configure-time only. Throws as validate_slider_crank, except that the change-point limit

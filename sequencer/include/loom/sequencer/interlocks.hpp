@@ -30,7 +30,7 @@ struct KnotGuard {
   std::array<std::int8_t, hal::kMaxKnottingHeads> selector{};  // and of its colour selector
   double take_position_rad = 0.0;  // knotting servo reading at the TAKE pose (commissioning)
   double in_warp_from_rad = 0.0, in_warp_to_rad = 0.0;
-  bool full_turn = false;          // the cycle turns the servo on by a full turn: angles wrap to [0, 2π)
+  bool full_turn = false;  // the cycle turns the servo on by a full turn: angles wrap to [0, 2π)
 };
 
 struct InterlockContext {
@@ -43,8 +43,8 @@ struct InterlockContext {
 bool gripper_in_warp(const KnotGuard& g, double knotter_position);
 
 // Returns Fault::kNone when `next` may be written after `prev` given the measured inputs.
-Fault check_interlocks(const InterlockContext& ctx, const hal::HalInputs& measured, const hal::HalOutputs& prev,
-                       const hal::HalOutputs& next);
+Fault check_interlocks(const InterlockContext& ctx, const hal::HalInputs& measured,
+                       const hal::HalOutputs& prev, const hal::HalOutputs& next);
 
 // Measured beater-in-warp test from the crank axis position (rad).
 bool beater_in_warp(const InterlockContext& ctx, double crank_position);

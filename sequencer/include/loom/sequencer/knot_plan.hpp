@@ -86,11 +86,11 @@ int knots_per_stripe(const KnottingSpec& spec);
 
 // One row as the heads tie it.
 struct RowKnotPlan {
-  int knots = 0;                                     // in the row
-  std::array<int, kMaxKnottingHeads> head_knots{};   // tied by each head
+  int knots = 0;                                        // in the row
+  std::array<int, kMaxKnottingHeads> head_knots{};      // tied by each head
   std::array<int, kMaxKnottingHeads> selector_moves{};  // slot changes of each head's selector
-  int carriage_steps = 0;                            // pitches the carriage steps between knots
-  int knot_cycles = 0;                               // sequential knot cycles (the longest stripe)
+  int carriage_steps = 0;                               // pitches the carriage steps between knots
+  int knot_cycles = 0;                                  // sequential knot cycles (the longest stripe)
 };
 
 // The selector slot holding palette code `code`, or -1.
@@ -101,6 +101,7 @@ int slot_of(const KnottingSpec& spec, const std::string& code);
 // left where it stands after. Throws std::invalid_argument when the row's width is not the loom's or a
 // colour has no slot (the message names the colour and where it is first needed).
 RowKnotPlan plan_row(const KnottingSpec& spec, double width_m, std::span<const std::uint16_t> row,
-                     std::span<const std::string> palette_codes, std::array<int, kMaxKnottingHeads>& slot_before);
+                     std::span<const std::string> palette_codes,
+                     std::array<int, kMaxKnottingHeads>& slot_before);
 
 }  // namespace loom::sequencer

@@ -22,14 +22,15 @@ class KnotProgram {
   // row `counter_rows_at_start`. Throws std::invalid_argument (naming the colour and knot, or the width)
   // when the design does not fit the loom or its magazines (plan_row's checks), or validate(spec) refuses.
   static KnotProgram build(const KnottingSpec& spec, double width_m, int design_width, int design_height,
-                           std::span<const std::uint16_t> knots_bottom_up, std::span<const std::string> palette_codes,
-                           std::uint64_t design_rows_done, std::uint32_t counter_rows_at_start);
+                           std::span<const std::uint16_t> knots_bottom_up,
+                           std::span<const std::string> palette_codes, std::uint64_t design_rows_done,
+                           std::uint32_t counter_rows_at_start);
 
   bool empty() const noexcept { return design_rows_ == 0; }
   int heads() const noexcept { return heads_; }
   int knots_per_row() const noexcept { return knots_; }
-  int stripe() const noexcept { return stripe_; }          // knots per head's stripe (cycles per row)
-  int slots() const noexcept { return slots_; }            // magazine slots per head
+  int stripe() const noexcept { return stripe_; }  // knots per head's stripe (cycles per row)
+  int slots() const noexcept { return slots_; }    // magazine slots per head
   double pitch_m() const noexcept { return pitch_m_; }
   int knots_per_slot() const noexcept { return knots_per_slot_; }
   int design_rows() const noexcept { return design_rows_; }

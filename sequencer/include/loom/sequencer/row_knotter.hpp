@@ -38,19 +38,19 @@ using MagazineLevels = std::array<std::array<std::int32_t, kMaxMagazineSlots>, h
 // `ctl next` once done.
 enum class WeaverAsk : std::uint8_t {
   kNone,
-  kTieByHand,   // the head missed this knot twice: tie it by hand in the slot's colour
-  kReload,      // the slot is out of yarn: reload it
-  kCheckKnot,   // the power failed while this knot was being tied: check it, finish or tie it by hand
+  kTieByHand,  // the head missed this knot twice: tie it by hand in the slot's colour
+  kReload,     // the slot is out of yarn: reload it
+  kCheckKnot,  // the power failed while this knot was being tied: check it, finish or tie it by hand
 };
 const char* weaver_ask_name(WeaverAsk a);
 
 struct WeaverRequest {
   WeaverAsk ask = WeaverAsk::kNone;
-  std::uint32_t row = 0;   // 1-based production row
-  int design_row = 0;      // 0-based row of the design (bottom = 0)
-  int knot = -1;           // 0-based knot in the row (left selvedge = 0); -1 for a reload
-  int head = -1;           // 0-based head
-  int slot = -1;           // magazine slot (its colour: the knot's, or the one to reload)
+  std::uint32_t row = 0;  // 1-based production row
+  int design_row = 0;     // 0-based row of the design (bottom = 0)
+  int knot = -1;          // 0-based knot in the row (left selvedge = 0); -1 for a reload
+  int head = -1;          // 0-based head
+  int slot = -1;          // magazine slot (its colour: the knot's, or the one to reload)
 };
 
 // Not RT (allocates). What the request asks, in the weaver's words, naming the colour by its palette code:
@@ -63,11 +63,11 @@ struct KnottingConfig {
   const motion::KnotCycle* cycle = nullptr;
   std::array<int, hal::kMaxKnottingHeads> knotter_axis{};   // slot of each head's knotting servo
   std::array<int, hal::kMaxKnottingHeads> selector_axis{};  // slot of each head's colour selector
-  double take_position_rad = 0.0;   // knotting servo reading at the TAKE pose (commissioning)
-  double selector_zero_rad = 0.0;   // selector reading with slot 0 at the TAKE point (commissioning)
+  double take_position_rad = 0.0;  // knotting servo reading at the TAKE pose (commissioning)
+  double selector_zero_rad = 0.0;  // selector reading with slot 0 at the TAKE point (commissioning)
   motion::JerkLimits selector{.velocity = 20.0, .acceleration = 400.0, .jerk = 20000.0};  // rad, s
   double servo_tolerance_rad = 0.05;  // a servo further than this from where it was sent is lagging
-  double settle_s = 0.05;             // after a move's plan ends, how long it may take to get within tolerance
+  double settle_s = 0.05;  // after a move's plan ends, how long it may take to get within tolerance
 };
 
 // Configure-time. The interlocks' picture of the heads (which axes, where the gripper is in the warp as
@@ -83,8 +83,9 @@ struct RowKnots {
 
 // The knot progress the counters keep (Counters carries these; see sequencer.hpp).
 struct KnotCounters {
-  std::uint32_t tied = 0, retried = 0, by_hand = 0;   // production totals: knots tied by the heads, knot
-                                                      // cycles run again after a miss, knots tied by the weaver
+  std::uint32_t tied = 0, retried = 0,
+                by_hand = 0;  // production totals: knots tied by the heads, knot
+                              // cycles run again after a miss, knots tied by the weaver
   std::uint32_t cycles_started = 0, cycles_done = 0;  // of the row in progress (written ahead: see check)
   // The heads (bit h) whose knot of the cycle in progress (cycle `cycles_done`) is counted already — tied by
   // the head, or by the weaver — while another head of it still waits: a restart then asks the weaver to
@@ -95,12 +96,13 @@ struct KnotCounters {
 class RowKnotter {
  public:
   // kHeld: asked to hold, the heads stand between two knot cycles (the next cycle's carriage step and
-  // selectors arrived, nothing taken, nothing written ahead); the next step without `hold` goes on from there.
+  // selectors arrived, nothing taken, nothing written ahead); the next step without `hold` goes on from
+  // there.
   enum class Status : std::uint8_t { kRunning, kAwaitingWeaver, kDone, kFault, kHeld };
 
   // Configure-time. `carriage_home_m`: the carriage reading at the left selvedge; `carriage` its limits.
-  // `guard`: where a knotting servo holds its gripper in the warp (the interlocks' own test): no carriage move
-  // starts while a measured gripper is there. Must outlive the knotter.
+  // `guard`: where a knotting servo holds its gripper in the warp (the interlocks' own test): no carriage
+  // move starts while a measured gripper is there. Must outlive the knotter.
   void configure(const KnottingConfig& k, const KnotGuard* guard, double period_s, double carriage_home_m,
                  const motion::JerkLimits& carriage);
   bool fitted() const noexcept { return k_.program != nullptr && k_.cycle != nullptr; }
@@ -113,9 +115,9 @@ class RowKnotter {
              const hal::HalOutputs& cmd) noexcept;
   // What the sequencer tells the heads each tick.
   struct StepInputs {
-    bool weaver_done = false;  // the weaver answered the request (only read while one is open)
-    bool hold = false;         // a stop or a pause: stand at the next point between two knot cycles
-    bool await_disk = false;   // no cycle starts before its start is on disk ...
+    bool weaver_done = false;           // the weaver answered the request (only read while one is open)
+    bool hold = false;                  // a stop or a pause: stand at the next point between two knot cycles
+    bool await_disk = false;            // no cycle starts before its start is on disk ...
     std::uint32_t on_disk_started = 0;  // ... as the counters file holds the row's cycles-started count
     hal::Tick disk_timeout_ticks = 0;   // ... within this many ticks, else counters_not_saved (0: no limit)
   };
@@ -155,19 +157,23 @@ class RowKnotter {
     double origin = 0.0;
     motion::JerkMove move;
   };
-  void plan_travel(int j, hal::Tick now, const hal::HalOutputs& cmd) noexcept;  // carriage and selectors to cycle j
+  void plan_travel(int j, hal::Tick now,
+                   const hal::HalOutputs& cmd) noexcept;  // carriage and selectors to cycle j
   void plan_selectors(int j, hal::Tick now, const hal::HalOutputs& cmd) noexcept;
   void plan_carriage(int j, hal::Tick now, const hal::HalOutputs& cmd) noexcept;
-  void enter_cycle(int j, hal::Tick now, const hal::HalOutputs& cmd) noexcept;  // cycle j: travel (if not begun), check
+  void enter_cycle(int j, hal::Tick now,
+                   const hal::HalOutputs& cmd) noexcept;  // cycle j: travel (if not begun), check
   void start_cycle(hal::Tick now) noexcept;
   void finish_cycle(hal::Tick now, const hal::HalOutputs& cmd, KnotCounters& counters) noexcept;
   void cycle_done(hal::Tick now, const hal::HalOutputs& cmd, KnotCounters& counters) noexcept;
   void ask(WeaverAsk a, int head, int knot, int slot, hal::Tick now) noexcept;
   Status check(hal::Tick now, const hal::HalInputs& in, const hal::HalOutputs& cmd, KnotCounters& counters,
                const StepInputs& s) noexcept;
-  void run_cycle(hal::Tick now, const hal::HalInputs& in, hal::HalOutputs& cmd, KnotCounters& counters) noexcept;
+  void run_cycle(hal::Tick now, const hal::HalInputs& in, hal::HalOutputs& cmd,
+                 KnotCounters& counters) noexcept;
   Status weaver(hal::Tick now, const hal::HalOutputs& cmd, KnotCounters& counters, bool weaver_done) noexcept;
-  bool play(Move& m, hal::Tick now, double& target) const noexcept;  // true when it moved the target this tick
+  bool play(Move& m, hal::Tick now,
+            double& target) const noexcept;  // true when it moved the target this tick
   bool fail(Fault f, int axis) noexcept;
   double seconds(hal::Tick dt) const noexcept { return static_cast<double>(dt) * period_s_; }
   double selector_goal(int slot, double from) const noexcept;
@@ -181,21 +187,24 @@ class RowKnotter {
   int heads_ = 0, stripe_ = 0;
   Phase phase_ = Phase::kDone;
   hal::Tick phase_since_ = 0, row_since_ = 0, weaver_since_ = 0;
-  hal::Tick disk_wait_since_ = hal::kNeverTick;  // the write-ahead of the cycle in check is waiting for the disk
-  int j_ = 0;                 // knot cycle in progress
-  int attempt_ = 0;           // 0 first try, 1 the retry
-  bool interrupted_ = false;  // cycle j_ was started before a power cut: ask the weaver first
+  hal::Tick disk_wait_since_ =
+      hal::kNeverTick;                   // the write-ahead of the cycle in check is waiting for the disk
+  int j_ = 0;                            // knot cycle in progress
+  int attempt_ = 0;                      // 0 first try, 1 the retry
+  bool interrupted_ = false;             // cycle j_ was started before a power cut: ask the weaver first
   std::uint32_t heads_done_at_cut_ = 0;  // ... except of these heads, whose knots the counters hold
-  int ask_head_ = 0;          // next head to consider for a request in kWeaver
+  int ask_head_ = 0;                     // next head to consider for a request in kWeaver
   WeaverAsk hand_ask_ = WeaverAsk::kTieByHand;  // what kWeaver asks for the heads in missed_
   Move carriage_move_{};
   std::array<Move, hal::kMaxKnottingHeads> selector_move_{};
   std::array<double, hal::kMaxKnottingHeads> knotter_origin_{};
-  std::array<int, hal::kMaxKnottingHeads> slot_{};       // slot each head's selector is at (or going to), -1 unknown
-  std::array<bool, hal::kMaxKnottingHeads> active_{};    // head ties in this cycle
-  std::array<bool, hal::kMaxKnottingHeads> seen_{};      // its yarn-present switch was seen in the window
-  std::array<bool, hal::kMaxKnottingHeads> missed_{};    // needs the weaver's hand after the second miss
-  std::array<std::array<std::int32_t, kMaxMagazineSlots>, hal::kMaxKnottingHeads> stock_{};  // knots left per slot
+  std::array<int, hal::kMaxKnottingHeads>
+      slot_{};  // slot each head's selector is at (or going to), -1 unknown
+  std::array<bool, hal::kMaxKnottingHeads> active_{};  // head ties in this cycle
+  std::array<bool, hal::kMaxKnottingHeads> seen_{};    // its yarn-present switch was seen in the window
+  std::array<bool, hal::kMaxKnottingHeads> missed_{};  // needs the weaver's hand after the second miss
+  std::array<std::array<std::int32_t, kMaxMagazineSlots>, hal::kMaxKnottingHeads>
+      stock_{};  // knots left per slot
   bool stock_known_ = false;
   bool next_selectors_ = false;  // the next cycle's selector moves began inside this one
   bool next_carriage_ = false;   // and its carriage step

@@ -21,7 +21,7 @@ struct BeatRecord {
 };
 
 struct RowStats {
-  std::uint32_t row = 0;     // 1-based number of the row just completed
+  std::uint32_t row = 0;  // 1-based number of the row just completed
   hal::Tick shed_ticks = 0, pick_ticks = 0, beat_ticks = 0, total_ticks = 0;  // shed/pick summed over picks
   hal::Tick knotting_ticks = 0;  // knotting mode: how long the weaver knotted before this row (not in total)
   // Knotting heads: the machine's knotting time (in total), the time waiting for the weaver's hand (in

@@ -35,10 +35,10 @@ enum class State : std::uint8_t {
   kBeatSweep,    // crank beats while the carriage steps across the width
   kRowEnd,       // row woven, beater parked: waiting until its counters are on disk (when asked to)
   kAwaitKnotting,  // knotting mode: parked before a new row until the weaver says the row is knotted
-  kKnotting,     // knotting heads: tying the row knot by knot before its shed change (or asking the weaver)
-  kPaused,       // holding at a safe point (before a shed change), drives enabled, until resumed
-  kDone,         // all requested rows woven, or stopped at a hold point: holding, enabled
-  kFault,        // latched fault: quick stop, valves hold, counters kept
+  kKnotting,       // knotting heads: tying the row knot by knot before its shed change (or asking the weaver)
+  kPaused,         // holding at a safe point (before a shed change), drives enabled, until resumed
+  kDone,           // all requested rows woven, or stopped at a hold point: holding, enabled
+  kFault,          // latched fault: quick stop, valves hold, counters kept
 };
 const char* state_name(State s);
 
@@ -62,17 +62,17 @@ struct SequencerConfig {
   // reports unreferenced is homed when the loom arms, beat crank first (its home point is clear of the
   // warp), then the carriage, then the added axes; it never moves in production unreferenced.
   std::array<double, hal::kMaxAxes> homing_timeout_s{};
-  std::uint32_t rows_to_weave = 3;       // 0 = weave until stopped (absolute row count to reach)
-  std::uint32_t picks_per_row = 1;       // weft picks (each with its own shed change) before the beat sweep
-  int debounce_ticks = 3;                // a sensor must read the same this many ticks to count (not e-stop)
+  std::uint32_t rows_to_weave = 3;  // 0 = weave until stopped (absolute row count to reach)
+  std::uint32_t picks_per_row = 1;  // weft picks (each with its own shed change) before the beat sweep
+  int debounce_ticks = 3;           // a sensor must read the same this many ticks to count (not e-stop)
   // Which safety sensors have a second channel (hal::SafetySensor order; see dual_channel.hpp), and how
   // long (after each channel's debounce) the two may disagree before that is the fault sensor_discrepancy
   // (never less than debounce_ticks + 1 ticks).
   std::array<bool, hal::kSafetySensorCount> second_channel{};
   double sensor_discrepancy_s = 0.02;
   double enable_timeout_s = 2.0;
-  double pick_timeout_margin_s = 0.5;    // beyond the planned pick duration
-  double stale_timeout_s = 0.05;         // feedback older than this is a fault
+  double pick_timeout_margin_s = 0.5;  // beyond the planned pick duration
+  double stale_timeout_s = 0.05;       // feedback older than this is a fault
   // After motion stops on a symptom (stale feedback, an interlock trip), a root cause reported within
   // this window (a drive fault, a lost heartbeat) becomes the first fault. Set it to the heartbeat
   // consumer time plus a few periods on CAN, so a dead drive is reported as such, not as its symptom.
@@ -91,13 +91,13 @@ struct SequencerConfig {
   // the carrier passes the sensor's switching point, within this distance (the sensors' switching-point
   // spread). A shuttle that lags its carrier by more has slipped off the magnet.
   double shuttle_follow_tolerance_m = 0.002;
-  double beat_force_min_n = 80.0;         // the band every beat must hit (thesis: 80–100 N)
+  double beat_force_min_n = 80.0;  // the band every beat must hit (thesis: 80–100 N)
   double beat_force_max_n = 100.0;
   // The per-beat regulator (beat_regulator.hpp): from each measured beat it sets the next beat's crank
   // speed, aiming at the band's middle. It acts only on measured beats: a loom without a load cell runs
   // open loop, every beat at the recipe's speed.
   BeatRegulatorConfig beat_regulator{};
-  double load_cell_max_n = 5000.0;        // a load-cell reading beyond this is a failed cell, not a beat
+  double load_cell_max_n = 5000.0;  // a load-cell reading beyond this is a failed cell, not a beat
   motion::JerkLimits carriage{.velocity = 0.5, .acceleration = 5.0, .jerk = 100.0};  // re-arm moves
   // Row-boundary handshake: with await_row_saved, no row starts before the reporter has confirmed that
   // the row before it is on disk (note_rows_saved); a save that fails, or is not confirmed within
@@ -239,7 +239,7 @@ class Sequencer {
   // The fault that actually stopped motion; differs from first_fault() when a symptom (stale feedback,
   // an interlock) stopped the machine and the root cause was identified within the diagnosis window.
   Fault stopped_by() const noexcept { return stopped_by_; }
-  int fault_axis() const noexcept { return fault_axis_; }              // -1 when not axis-specific
+  int fault_axis() const noexcept { return fault_axis_; }                // -1 when not axis-specific
   std::uint16_t fault_detail() const noexcept { return fault_detail_; }  // device code (EMCY) if any
   // The safety sensor (hal::SafetySensor) the first fault is about, or -1 (sensor_discrepancy names one).
   int fault_sensor() const noexcept { return fault_sensor_; }
@@ -299,7 +299,8 @@ class Sequencer {
   void enter(State s, hal::Tick now) noexcept;
   bool reconcile_at_arming(hal::Tick now, const hal::HalInputs& in) noexcept;
   void finish_arming(hal::Tick now, const hal::HalInputs& in) noexcept;  // every axis enabled and referenced
-  void begin_homing(hal::Tick now, const hal::HalInputs& in) noexcept;   // the next unreferenced axis, or finish
+  void begin_homing(hal::Tick now,
+                    const hal::HalInputs& in) noexcept;  // the next unreferenced axis, or finish
   bool shuttle_where_counters_say(hal::Tick now) noexcept;
   void begin_row(hal::Tick now) noexcept;  // a row boundary: adopt a published recipe, else shed
   void begin_shed(hal::Tick now) noexcept;
@@ -315,9 +316,10 @@ class Sequencer {
   void publish_beat(int k) noexcept;
   int beat_position(int k) const noexcept;  // carriage position (0 = left selvedge) of beat k of this sweep
   void regulate_after(int k, const BeatEvent& e) noexcept;  // the regulator's turn, once per beat
-  void add_fault_event(EventKind kind) noexcept;  // kFaultLatched / kDiagnosisRefined with the first fault's details
+  void add_fault_event(
+      EventKind kind) noexcept;  // kFaultLatched / kDiagnosisRefined with the first fault's details
   bool expect_shuttle_left() const noexcept { return counters_.picks % 2 == 0; }  // it starts at the left
-  bool row_starts_left() const noexcept { return counters_.rows % 2 == 0; }      // sweeps alternate
+  bool row_starts_left() const noexcept { return counters_.rows % 2 == 0; }       // sweeps alternate
   PistonEnds ends_a() const noexcept { return {io_.piston_a_extended, io_.piston_a_retracted}; }
   PistonEnds ends_b() const noexcept { return {io_.piston_b_extended, io_.piston_b_retracted}; }
 
@@ -340,7 +342,8 @@ class Sequencer {
   Fault first_fault_ = Fault::kNone;
   Fault stopped_by_ = Fault::kNone;
   hal::Tick armed_since_ = 0;
-  int homing_axis_ = -1;  // the axis being homed (kHoming)  // tick the drives were first asked to enable (staleness of never-seen data)
+  int homing_axis_ = -1;  // the axis being homed (kHoming)  // tick the drives were first asked to enable
+                          // (staleness of never-seen data)
   int fault_axis_ = -1;
   int fault_sensor_ = -1;
   std::uint16_t fault_detail_ = 0;
@@ -360,8 +363,9 @@ class Sequencer {
   };
   ActiveMove crank_move_, carriage_move_, helix_move_;
   std::array<ActiveMove, hal::kMaxKnottingHeads> knot_park_{};  // knotting servos back to rest (positioning)
-  motion::JerkLimits knot_park_limits_{.velocity = 2.0, .acceleration = 20.0, .jerk = 1000.0};  // slow: a gripper may hold yarn
-  bool sweeping_ = false;          // carriage follows the cam on the crank move
+  motion::JerkLimits knot_park_limits_{
+      .velocity = 2.0, .acceleration = 20.0, .jerk = 1000.0};  // slow: a gripper may hold yarn
+  bool sweeping_ = false;                                      // carriage follows the cam on the crank move
   double carriage_sweep_origin_ = 0.0;
   double carriage_sweep_dir_ = 1.0;
   double crank_sweep_origin_ = 0.0;
@@ -376,9 +380,9 @@ class Sequencer {
   hal::Tick carrier_at_selvedge_ = hal::kNeverTick;
   double pick_start_rad_ = 0.0;
   bool pick_resumed_ = false;
-  hal::Tick carrier_left_ = hal::kNeverTick;   // tick the carrier left the start sensor's reach
-  double raw_arrival_at_m_ = -1.0;             // carrier distance from the goal when the raw sensor came on
-  double raw_arrival_lateness_m_ = 0.0;        // how far the carrier may have gone past the edge, unseen
+  hal::Tick carrier_left_ = hal::kNeverTick;  // tick the carrier left the start sensor's reach
+  double raw_arrival_at_m_ = -1.0;            // carrier distance from the goal when the raw sensor came on
+  double raw_arrival_lateness_m_ = 0.0;       // how far the carrier may have gone past the edge, unseen
   // The carrier's travel per tick, so that position tests on sensor edges scale with the period and the
   // carrier's speed (a sensor edge is only seen at the next sample).
   double prev_helix_rad_ = 0.0;
@@ -396,19 +400,19 @@ class Sequencer {
   DualChannelSensors dual_;
   Debouncer<4> buttons_;  // start, pause, ack, row knotted
   RisingEdge start_edge_, pause_edge_, ack_edge_, knotted_edge_;
-  bool knot_requested_ = false;  // "row knotted" since the loom last started waiting for it
+  bool knot_requested_ = false;      // "row knotted" since the loom last started waiting for it
   bool paused_in_knotting_ = false;  // the pause holds between two knot cycles: resuming goes on knotting
-  bool row_knotted_ = false;     // the row about to start has been knotted
+  bool row_knotted_ = false;         // the row about to start has been knotted
   hal::Tick knotting_ticks_ = 0;
-  RowKnotter knotter_;                     // the knotting heads (fitted() when the machine has them)
+  RowKnotter knotter_;                       // the knotting heads (fitted() when the machine has them)
   std::uint32_t knotter_requests_seen_ = 0;  // a new weaver request clears an earlier pedal press
   std::uint32_t knots_on_disk_rows_ = 0, knots_on_disk_started_ = 0;
-  bool knotters_parked_ = false;           // positioning brought every knotting servo to rest
-  bool knot_park_planned_ = false;         // their moves back to rest are planned
-  bool crank_parking_planned_ = false;     // positioning planned the crank's move to park
+  bool knotters_parked_ = false;        // positioning brought every knotting servo to rest
+  bool knot_park_planned_ = false;      // their moves back to rest are planned
+  bool crank_parking_planned_ = false;  // positioning planned the crank's move to park
   hal::DigitalInputs io_{};
   hal::DigitalInputs raw_io_{};
-  int sensed_ticks_ = 0;                       // picture checks wait until the debouncer has history
+  int sensed_ticks_ = 0;                      // picture checks wait until the debouncer has history
   std::size_t n_axes_ = hal::kCoreAxisCount;  // cfg_.axes.count
   // This tick's inputs with debounced sensors (in_[cur_], step) and the last tick's (in_[cur_ ^ 1]): the
   // fault checks compare each axis' position, refresh tick and referenced flag with the last sample's
@@ -416,7 +420,7 @@ class Sequencer {
   std::array<hal::HalInputs, 2> in_{};
   std::size_t cur_ = 0;
   const hal::AxisFeedback& last(std::size_t i) const noexcept { return in_[cur_ ^ 1].axes[i]; }
-  std::uint32_t rows_on_disk_ = 0;   // the row-boundary handshake (note_rows_saved)
+  std::uint32_t rows_on_disk_ = 0;  // the row-boundary handshake (note_rows_saved)
   bool last_save_failed_ = false;
   bool positions_primed_ = false;
   std::array<double, hal::kMaxAxes> max_step_{};  // the most an axis can move in one tick (m or rad)
@@ -429,9 +433,9 @@ class Sequencer {
   RowRecorder row_;
   hal::Tick phase_start_ = 0, sweep_start_ = 0;
   int row_beats_ = 0;
-  int beats_published_ = 0;        // beats of this row already published as BeatEvents
-  TickEvents events_;              // this tick's (step() clears it)
-  RowStats last_row_{};  // the last completed row
+  int beats_published_ = 0;  // beats of this row already published as BeatEvents
+  TickEvents events_;        // this tick's (step() clears it)
+  RowStats last_row_{};      // the last completed row
 };
 
 }  // namespace loom::sequencer

@@ -14,6 +14,7 @@ std::unique_ptr<AxisEffect> make_servo_lag(const ServoLag& p);
 
 // The beat-up crank as a rigid-body linkage behind a torque-limited position loop (see Inertia).
 // `friction` may be null. Configure-time only (builds the tabulated forward model).
-std::unique_ptr<AxisEffect> make_crank_inertia(const SimMachine& machine, const Inertia& p, const JointFriction* friction);
+std::unique_ptr<AxisEffect> make_crank_inertia(const SimMachine& machine, const Inertia& p,
+                                               const JointFriction* friction);
 
 }  // namespace loom::sim_hal

@@ -4,9 +4,9 @@
 // switch seeing a knot at the head's knot position, and a simulated weaver who does what the loom asks
 // (ties a knot by hand, reloads a slot) after a while and then presses the pedal. It records the carpet it
 // actually knotted, one cell per knot, so a run can be compared with its design knot for knot. The carpet is
-// as long as the carpet being woven: its room is sized at configure time (never in the tick) from the rows the
-// run will weave, and a knot beyond that room is counted (rows_beyond()), never silently dropped.
-// Built only when a scene names the effect: a scene without it pays nothing per tick.
+// as long as the carpet being woven: its room is sized at configure time (never in the tick) from the rows
+// the run will weave, and a knot beyond that room is counted (rows_beyond()), never silently dropped. Built
+// only when a scene names the effect: a scene without it pays nothing per tick.
 #pragma once
 
 #include <array>
@@ -24,9 +24,9 @@ namespace loom::sim_hal {
 struct SimKnotting {
   int heads = 0;
   int knots_per_row = 0;
-  int stripe = 0;            // knots per head's stripe
-  int slots = 0;             // magazine slots per head
-  int knots_per_slot = 0;    // yarn in a full slot
+  int stripe = 0;          // knots per head's stripe
+  int slots = 0;           // magazine slots per head
+  int knots_per_slot = 0;  // yarn in a full slot
   double pitch_m = 0.0;
   double carriage_home_m = 0.0;
   std::array<std::size_t, hal::kMaxKnottingHeads> knotter_axis{};
@@ -55,9 +55,9 @@ struct Knotter {
 
 // One knot of the carpet as tied.
 struct KnotCell {
-  std::int8_t slot = -1;    // magazine slot whose yarn it is (-1: no knot)
-  std::uint8_t ties = 0;    // knots tied here (more than one is a defect; counted up to 3)
-  bool by_hand = false;     // tied by the weaver
+  std::int8_t slot = -1;  // magazine slot whose yarn it is (-1: no knot)
+  std::uint8_t ties = 0;  // knots tied here (more than one is a defect; counted up to 3)
+  bool by_hand = false;   // tied by the weaver
 };
 
 // The knotter's state as it persists across a power cut (in the sim-state file, or owned): the carpet's
@@ -65,20 +65,23 @@ struct KnotCell {
 // byte per knot (packed KnotCell), follow it in the same memory (knot_cells()).
 struct PersistedCarpet {
   static constexpr std::uint64_t kMagic = 0x4b4e4f5453494d32ull;  // "KNOTSIM2"
-  static constexpr int kMaxSlots = 16;  // magazine slots a head's stock holds (a cell packs slot + 1 in 5 bits)
+  static constexpr int kMaxSlots =
+      16;  // magazine slots a head's stock holds (a cell packs slot + 1 in 5 bits)
   std::uint64_t magic = 0;
-  std::uint32_t first_row = 0;       // production row (counters) of carpet row 0
-  std::int32_t knots_per_row = 0;    // the carpet's width (a different loom starts a new carpet)
-  std::int32_t row = 0;              // the row being knotted
+  std::uint32_t first_row = 0;     // production row (counters) of carpet row 0
+  std::int32_t knots_per_row = 0;  // the carpet's width (a different loom starts a new carpet)
+  std::int32_t row = 0;            // the row being knotted
   std::int32_t row_has_knots = 0;
-  std::uint32_t knots_beyond = 0;    // knots tied in rows beyond the record's room (a record too short)
+  std::uint32_t knots_beyond = 0;  // knots tied in rows beyond the record's room (a record too short)
   std::uint32_t reserved = 0;
   std::array<std::array<std::int32_t, kMaxSlots>, hal::kMaxKnottingHeads> stock{};
 };
 static_assert(sizeof(PersistedCarpet) % 8 == 0, "the cells follow the header 8-byte aligned");
 
 // The carpet's cells (one byte per knot) right after its header.
-inline std::uint8_t* knot_cells(PersistedCarpet& c) noexcept { return reinterpret_cast<std::uint8_t*>(&c + 1); }
+inline std::uint8_t* knot_cells(PersistedCarpet& c) noexcept {
+  return reinterpret_cast<std::uint8_t*>(&c + 1);
+}
 inline const std::uint8_t* knot_cells(const PersistedCarpet& c) noexcept {
   return reinterpret_cast<const std::uint8_t*>(&c + 1);
 }
@@ -105,8 +108,8 @@ struct WeaverTask {
   enum class Kind : std::uint8_t { kTieByHand, kCheckKnot, kReload };
   Kind kind = Kind::kTieByHand;
   int head = 0;
-  int knot = 0;   // 0-based knot of the row being knotted (tie / check)
-  int slot = 0;   // its colour's slot (tie, check) or the slot to reload
+  int knot = 0;  // 0-based knot of the row being knotted (tie / check)
+  int slot = 0;  // its colour's slot (tie, check) or the slot to reload
 };
 
 class SimKnotter {
@@ -147,8 +150,12 @@ class SimKnotter {
   std::uint32_t knots_beyond() const noexcept { return st_->knots_beyond; }
   std::uint32_t tasks_done() const noexcept { return tasks_done_; }
   // Ground truth for checkers: is head h's gripper (its servo at `knotter` rad) in the warp, is it closed.
-  bool gripper_in_warp(int head, double knotter) const noexcept { return head >= 0 && head < m_.heads && in_warp(knotter); }
-  bool gripper_closed(int head) const noexcept { return head >= 0 && head < m_.heads && gripper_[static_cast<std::size_t>(head)]; }
+  bool gripper_in_warp(int head, double knotter) const noexcept {
+    return head >= 0 && head < m_.heads && in_warp(knotter);
+  }
+  bool gripper_closed(int head) const noexcept {
+    return head >= 0 && head < m_.heads && gripper_[static_cast<std::size_t>(head)];
+  }
 
  private:
   class OwnCarpet;
@@ -164,18 +171,19 @@ class SimKnotter {
   SimKnotting m_;
   Knotter k_;
   double period_s_;
-  std::unique_ptr<OwnCarpet> own_;   // the carpet's memory when no sim-state file keeps it
-  PersistedCarpet* st_ = nullptr;    // where it is kept
-  std::uint8_t* cells_ = nullptr;    // its cells (knot_cells(*st_))
-  int capacity_rows_ = 0;            // rows of carpet recorded (the room, in rows)
-  std::vector<std::uint8_t> beyond_; // one scratch row for knots beyond the room (so the heads still see them)
+  std::unique_ptr<OwnCarpet> own_;  // the carpet's memory when no sim-state file keeps it
+  PersistedCarpet* st_ = nullptr;   // where it is kept
+  std::uint8_t* cells_ = nullptr;   // its cells (knot_cells(*st_))
+  int capacity_rows_ = 0;           // rows of carpet recorded (the room, in rows)
+  std::vector<std::uint8_t>
+      beyond_;  // one scratch row for knots beyond the room (so the heads still see them)
   std::array<int, hal::kMaxKnottingHeads> holding_{};  // slot of the yarn in the gripper, -1 none
   std::array<bool, hal::kMaxKnottingHeads> gripper_{}, cutter_{};
   // The weaver: one task at a time.
   bool task_pending_ = false;
   WeaverTask task_{};
-  std::int64_t task_left_ = 0;   // ticks until done
-  int pedal_left_ = 0;           // ticks the pedal stays pressed
+  std::int64_t task_left_ = 0;  // ticks until done
+  int pedal_left_ = 0;          // ticks the pedal stays pressed
   std::uint32_t tasks_done_ = 0;
 };
 

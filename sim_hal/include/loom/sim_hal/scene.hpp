@@ -14,16 +14,18 @@
 namespace loom::sim_hal {
 
 // Names of every effect this simulator knows; a scene naming anything else is rejected.
-inline constexpr const char* kEffectIdeal = "ideal";                // axes track their targets exactly
-inline constexpr const char* kEffectServoLag = "servo_lag";         // first-order lag of each servo axis
-inline constexpr const char* kEffectPneumatics = "pneumatics";      // valve fill time and piston breakaway
-inline constexpr const char* kEffectShuttleSlip = "shuttle_slip";   // shuttle lost above the carrier force
-inline constexpr const char* kEffectSensorNoise = "sensor_noise";   // end/arrival sensors bounce
-inline constexpr const char* kEffectBeatContact = "beat_contact";   // beater load cell at the cloth fell
-inline constexpr const char* kEffectInertia = "inertia";             // rigid-body beat-up behind a torque-limited servo
-inline constexpr const char* kEffectJointFriction = "joint_friction"; // crank bearing friction (needs inertia)
-inline constexpr const char* kEffectKnotter = "knotter";             // the knotting heads, their yarn and the weaver
-inline constexpr const char* kEffectWarpTension = "warp_tension";   // uneven, drifting warp tension (needs beat_contact)
+inline constexpr const char* kEffectIdeal = "ideal";               // axes track their targets exactly
+inline constexpr const char* kEffectServoLag = "servo_lag";        // first-order lag of each servo axis
+inline constexpr const char* kEffectPneumatics = "pneumatics";     // valve fill time and piston breakaway
+inline constexpr const char* kEffectShuttleSlip = "shuttle_slip";  // shuttle lost above the carrier force
+inline constexpr const char* kEffectSensorNoise = "sensor_noise";  // end/arrival sensors bounce
+inline constexpr const char* kEffectBeatContact = "beat_contact";  // beater load cell at the cloth fell
+inline constexpr const char* kEffectInertia = "inertia";  // rigid-body beat-up behind a torque-limited servo
+inline constexpr const char* kEffectJointFriction =
+    "joint_friction";                                     // crank bearing friction (needs inertia)
+inline constexpr const char* kEffectKnotter = "knotter";  // the knotting heads, their yarn and the weaver
+inline constexpr const char* kEffectWarpTension =
+    "warp_tension";  // uneven, drifting warp tension (needs beat_contact)
 const std::vector<std::string>& known_effects();
 
 struct ServoLag {
@@ -80,7 +82,7 @@ struct Inertia {
   double motor_torque_limit_nm = 30.0;
   double drive_inertia_kg_m2 = 0.01;  // motor and gearbox reflected to the crank
   double bandwidth_hz = 25.0;
-  int substeps = 8;                   // RK4 steps per tick (the free linkage needs ≤ 0.25 ms steps)
+  int substeps = 8;  // RK4 steps per tick (the free linkage needs ≤ 0.25 ms steps)
   double beater_mass_kg = 2.5;
 };
 
@@ -99,17 +101,17 @@ enum class InjectedFault : std::uint8_t {
   kStuckSensor,         // `sensor` reads `value` for ever
   kIntermittentSensor,  // `sensor` reads `value` for `duration_s`, then recovers
   kCanFrameLoss,        // a fraction `probability` of the axes' feedback frames is lost for `duration_s`
-  kCanLatency,          // axis feedback arrives `latency_s` late (stamped with its sample tick) for `duration_s`
-  kBusOff,              // the CAN controller goes bus-off: link fault, no more feedback
-  kHeartbeatLoss,       // the node of `axis` falls silent; after the heartbeat time it is reported lost
-  kEmcy,                // the drive of `axis` sends EMCY `code` but stays enabled
-  kEncoderGlitch,       // the position of `axis` reads `jump` (m or rad) off for `ticks` ticks
-  kLoadCellFailure,     // the beater's load cell reads NaN (`mode` "nan") or disappears ("lost")
-  kAirLoss,             // the air supply fails: neither piston moves any more
-  kLoopStall,           // the loop stalls for `ticks` ticks: no input refreshed, `ticks` overruns counted
-  kPowerCut,            // the power fails at tick `at_tick`: the run ends as if the process were killed
-  kSelectorJam,         // the colour selector of `head` jams where it stands (needs the knotter effect)
-  kYarnOut,             // slot `slot` of `head`'s magazine runs out of yarn early (needs the knotter effect)
+  kCanLatency,       // axis feedback arrives `latency_s` late (stamped with its sample tick) for `duration_s`
+  kBusOff,           // the CAN controller goes bus-off: link fault, no more feedback
+  kHeartbeatLoss,    // the node of `axis` falls silent; after the heartbeat time it is reported lost
+  kEmcy,             // the drive of `axis` sends EMCY `code` but stays enabled
+  kEncoderGlitch,    // the position of `axis` reads `jump` (m or rad) off for `ticks` ticks
+  kLoadCellFailure,  // the beater's load cell reads NaN (`mode` "nan") or disappears ("lost")
+  kAirLoss,          // the air supply fails: neither piston moves any more
+  kLoopStall,        // the loop stalls for `ticks` ticks: no input refreshed, `ticks` overruns counted
+  kPowerCut,         // the power fails at tick `at_tick`: the run ends as if the process were killed
+  kSelectorJam,      // the colour selector of `head` jams where it stands (needs the knotter effect)
+  kYarnOut,          // slot `slot` of `head`'s magazine runs out of yarn early (needs the knotter effect)
 };
 inline constexpr int kInjectedFaultCount = 17;
 const char* injected_fault_name(InjectedFault f);  // the scene file's `kind`
@@ -117,8 +119,18 @@ const char* injected_fault_name(InjectedFault f);  // the scene file's `kind`
 // Every switch a scene can fail: the six safety sensors' first channels, then their second channels
 // ("<sensor>_2", in the same order: second channel of sensor i is 6 + i).
 enum class Sensor : std::uint8_t {
-  kPistonAExtended, kPistonARetracted, kPistonBExtended, kPistonBRetracted, kShuttleLeft, kShuttleRight,
-  kPistonAExtended2, kPistonARetracted2, kPistonBExtended2, kPistonBRetracted2, kShuttleLeft2, kShuttleRight2
+  kPistonAExtended,
+  kPistonARetracted,
+  kPistonBExtended,
+  kPistonBRetracted,
+  kShuttleLeft,
+  kShuttleRight,
+  kPistonAExtended2,
+  kPistonARetracted2,
+  kPistonBExtended2,
+  kPistonBRetracted2,
+  kShuttleLeft2,
+  kShuttleRight2
 };
 inline constexpr int kSensorCount = 12;
 const char* sensor_name(Sensor s);
@@ -133,25 +145,25 @@ inline constexpr std::uint16_t kEmcyHeartbeat = 0x8130;  // CiA 301 life guard /
 inline constexpr std::uint16_t kEmcyBusOff = 0x8140;     // CiA 301 recovered from bus-off (bus-off)
 
 struct FaultInjection {
-  double at_s = 0.0;                       // virtual time from start
+  double at_s = 0.0;  // virtual time from start
   InjectedFault kind = InjectedFault::kDriveFault;
   // Drive faults, heartbeat loss, EMCY, encoder glitch: the axis by its machine name, and its slot
   // (the core axes' at parse time; others once the scene is checked against the loom's axes).
   std::string axis_name = "beat_crank";
   std::size_t axis = 0;
-  std::uint16_t code = 0x8611;             // EMCY code reported (default: following error)
-  int piston = 0;                          // stuck piston: 0 = A, 1 = B
-  Sensor sensor = Sensor::kShuttleRight;   // stuck / intermittent sensor
+  std::uint16_t code = 0x8611;            // EMCY code reported (default: following error)
+  int piston = 0;                         // stuck piston: 0 = A, 1 = B
+  Sensor sensor = Sensor::kShuttleRight;  // stuck / intermittent sensor
   bool stuck_value = false;
-  double duration_s = 0.0;                 // intermittent sensor, frame loss, latency (0: for ever)
-  double probability = 1.0;                // frame loss
-  double latency_s = 0.0;                  // CAN latency
-  double jump = 0.0;                       // encoder glitch, SI (m or rad)
-  int ticks = 1;                           // encoder glitch, loop stall
+  double duration_s = 0.0;   // intermittent sensor, frame loss, latency (0: for ever)
+  double probability = 1.0;  // frame loss
+  double latency_s = 0.0;    // CAN latency
+  double jump = 0.0;         // encoder glitch, SI (m or rad)
+  int ticks = 1;             // encoder glitch, loop stall
   LoadCellMode load_cell = LoadCellMode::kNan;
-  hal::Tick at_tick = -1;                  // power cut: the tick it strikes (at_s is ignored)
-  int head = 0;                            // selector jam, yarn out: 0-based head
-  int slot = 0;                            // yarn out: magazine slot
+  hal::Tick at_tick = -1;  // power cut: the tick it strikes (at_s is ignored)
+  int head = 0;            // selector jam, yarn out: 0-based head
+  int slot = 0;            // yarn out: magazine slot
 };
 
 // Physical facts of the simulated machine that are not effects (they come from the loom config).
@@ -163,24 +175,24 @@ struct FaultInjection {
 // index pulses sit where the machine's own coordinate reads `home_offset` (+ whole pitches), so a
 // correctly homed axis reads the machine position again.
 struct SimReferencing {
-  int method = 0;             // 0 = absolute encoder
-  double home_offset = 0.0;   // reading at the home point once homed (SI)
-  double speed = 0.0;         // homing speed (SI/s)
-  double index_pitch = 0.0;   // axis travel per index pulse (2 pi rad, or a linear axis' lead)
+  int method = 0;            // 0 = absolute encoder
+  double home_offset = 0.0;  // reading at the home point once homed (SI)
+  double speed = 0.0;        // homing speed (SI/s)
+  double index_pitch = 0.0;  // axis travel per index pulse (2 pi rad, or a linear axis' lead)
 };
 
 struct SimMachine {
   double period_s = 0.002;
-  std::size_t axis_count = hal::kCoreAxisCount;  // the machine's axes (hal::AxisLayout::count)
+  std::size_t axis_count = hal::kCoreAxisCount;             // the machine's axes (hal::AxisLayout::count)
   std::array<SimReferencing, hal::kMaxAxes> referencing{};  // per axis; default absolute
   double width_m = 1.2;
   double beater_width_m = 0.10;  // the comb (warp_tension: where across the width it beats)
   double carriage_home_m = 0.0;  // carriage axis reading at the left selvedge
   double helix_lead_m = 0.10;
-  double piston_travel_s = 0.25;          // heald frame stroke time with the nominal air supply
+  double piston_travel_s = 0.25;  // heald frame stroke time with the nominal air supply
   double selvedge_sensor_window_m = 0.005;
   motion::BeatUpGeometry beatup = motion::default_beatup_geometry();
-  double crank_park_position_rad = 0.0;   // crank axis reading at the park pose
+  double crank_park_position_rad = 0.0;  // crank axis reading at the park pose
   // Which safety sensors have a second switch (hal::SafetySensor order): each sees the same truth as the
   // first and fails on its own (its own stuck faults, its own noise).
   std::array<bool, hal::kSafetySensorCount> second_channel{};

@@ -14,12 +14,13 @@
 namespace loom::sim_hal {
 
 struct PersistedMachine {
-  std::uint64_t magic = 0;  // kMagic once written
+  std::uint64_t magic = 0;                // kMagic once written
   std::array<double, 3> axis_position{};  // the core axes (this layout first: tools read it with od)
   std::array<double, 2> piston{};
   double shuttle_x = 0.0;
   std::uint64_t tick = 0;
-  std::array<double, hal::kMaxAxes - hal::kCoreAxisCount> added_axis_position{};  // slots 3.. (knotting heads)
+  std::array<double, hal::kMaxAxes - hal::kCoreAxisCount>
+      added_axis_position{};                                      // slots 3.. (knotting heads)
   static constexpr std::uint64_t kMagic = 0x4c4f4f4d53494d32ull;  // "LOOMSIM2"
 };
 
@@ -44,7 +45,8 @@ class SimStateFile final : public CarpetKeeper {
   // effect keeps them there directly: the carpet survives the power cut as the real one would).
   CarpetKeeper* carpet() noexcept { return this; }
   // Configure-time (CarpetKeeper). Grows the file (blocks allocated, never a sparse hole) and maps it again;
-  // throws std::runtime_error naming the path and size when the disk has no room (the file is left as it was).
+  // throws std::runtime_error naming the path and size when the disk has no room (the file is left as it
+  // was).
   PersistedCarpet& reserve(std::size_t cells) override;
   std::size_t room() const noexcept override { return room_; }
 

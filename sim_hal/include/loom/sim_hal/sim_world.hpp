@@ -1,7 +1,7 @@
-// The simulated loom behind the HAL: its servo axes (the three core axes and any the machine adds), two pistons with end sensors, the shuttle on its
-// magnetic carrier with arrival sensors, the e-stop chain, and (when named) the beater's load cell.
-// Stepped in virtual time by the loop's own tick (write() integrates one period), so it runs as fast as
-// the machine allows. Every effect is built only if the scene names it.
+// The simulated loom behind the HAL: its servo axes (the three core axes and any the machine adds), two
+// pistons with end sensors, the shuttle on its magnetic carrier with arrival sensors, the e-stop chain, and
+// (when named) the beater's load cell. Stepped in virtual time by the loop's own tick (write() integrates one
+// period), so it runs as fast as the machine allows. Every effect is built only if the scene names it.
 #pragma once
 
 #include <array>
@@ -32,14 +32,14 @@ struct SimAxis {
   hal::DriveState state = hal::DriveState::kSwitchOnDisabled;
   double position = 0.0;  // the machine's true position (SI)
   double velocity = 0.0;
-  double target = 0.0;    // true position commanded
+  double target = 0.0;  // true position commanded
   std::uint16_t fault_code = 0;
   // The drive's reading is position + offset: 0 for an absolute encoder; for a homed axis a random
   // count from power-up until a homing run references it.
   double offset = 0.0;
   bool referenced = true;
-  bool homing = false;        // a homing run is under way
-  double homing_goal = 0.0;   // the true position of its reference point
+  bool homing = false;                               // a homing run is under way
+  double homing_goal = 0.0;                          // the true position of its reference point
   std::vector<std::unique_ptr<AxisEffect>> effects;  // built once from the scene
 };
 
@@ -78,11 +78,14 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   // (SIGKILL): counters and the machine state file keep what they had, as after a real power loss.
   // In-process users (tests, loom-safety) install a handler instead; the world then freezes (nothing
   // moves, no input is refreshed) and power_cut() tells. Configure-time only.
-  void on_power_cut(void (*handler)(void* ctx), void* ctx) { power_cut_handler_ = handler, power_cut_ctx_ = ctx; }
+  void on_power_cut(void (*handler)(void* ctx), void* ctx) {
+    power_cut_handler_ = handler, power_cut_ctx_ = ctx;
+  }
   bool power_cut() const { return powered_off_; }
   // Overruns injected by loop_stall faults (the ticks the loop was stalled), for the loop's statistics.
   std::uint32_t injected_overruns() const { return injected_overruns_; }
-  // The knotting heads (scene effect "knotter"; null without it): the carpet as knotted, for reports and tests.
+  // The knotting heads (scene effect "knotter"; null without it): the carpet as knotted, for reports and
+  // tests.
   const SimKnotter* knotter() const { return knotter_.get(); }
   // The warp's tension (scene effect "warp_tension"; null without it): rows counted, the last beat's factor.
   const WarpTensionModel* warp_tension() const { return warp_tension_.get(); }
@@ -122,7 +125,7 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   bool carrier_primed_ = false;
   bool estop_ok_ = true;
   std::size_t next_fault_ = 0;
-  std::vector<hal::Tick> fault_tick_;          // the tick each scene fault strikes (sorted like the faults)
+  std::vector<hal::Tick> fault_tick_;  // the tick each scene fault strikes (sorted like the faults)
   // State of the injected faults (see InjectedFault).
   std::array<hal::Tick, kSensorCount> sensor_until_{};  // intermittent: stuck until then (-1: for ever)
   double frame_loss_p_ = 0.0;
@@ -142,12 +145,12 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   hal::Tick stall_until_ = 0;
   std::uint32_t injected_overruns_ = 0;
   bool powered_off_ = false;
-  std::unique_ptr<SimKnotter> knotter_;         // scene effect "knotter"
+  std::unique_ptr<SimKnotter> knotter_;             // scene effect "knotter"
   std::unique_ptr<WarpTensionModel> warp_tension_;  // scene effect "warp_tension"
-  std::array<bool, hal::kMaxAxes> jammed_{};    // a jammed axis no longer follows its target
-  int shuttle_side_ = 0;                        // the selvedge it last arrived at: -1 left, +1 right, 0 none yet
-  static constexpr int kMidPick = 2;            // restarted with the shuttle in the shed: any arrival is a weft
-  bool drives_simulated_ = false;  // this world's axes are the drives (not real ones beside it)
+  std::array<bool, hal::kMaxAxes> jammed_{};        // a jammed axis no longer follows its target
+  int shuttle_side_ = 0;              // the selvedge it last arrived at: -1 left, +1 right, 0 none yet
+  static constexpr int kMidPick = 2;  // restarted with the shuttle in the shed: any arrival is a weft
+  bool drives_simulated_ = false;     // this world's axes are the drives (not real ones beside it)
   void (*power_cut_handler_)(void*) = nullptr;
   void* power_cut_ctx_ = nullptr;
   SimRandom rng_;

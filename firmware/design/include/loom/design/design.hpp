@@ -39,7 +39,8 @@ struct Colour {
 class Design {
  public:
   // `source` is the file it came from; its base name becomes the design's name.
-  Design(const std::string& source, int width, std::vector<Colour> palette, std::vector<std::uint16_t> knots_bottom_up);
+  Design(const std::string& source, int width, std::vector<Colour> palette,
+         std::vector<std::uint16_t> knots_bottom_up);
 
   const std::string& name() const { return name_; }  // the file's name: the key of its remembered row
   int width() const { return width_; }               // knots per row
@@ -57,14 +58,17 @@ class Design {
 };
 
 // Configure-time only. `source` names the file in messages; its base name becomes the design's name.
-//   CSV: lines starting with '#' are comments (unless they start with a #RRGGBB cell); `palette,CODE,#RRGGBB[,name]` lines define the colour
-//   codes (before the grid); every other non-empty line is one row of the picture, one cell per knot,
-//   each a palette code or a literal #RRGGBB. Every row has the same number of knots.
+//   CSV: lines starting with '#' are comments (unless they start with a #RRGGBB cell);
+//   `palette,CODE,#RRGGBB[,name]` lines define the colour codes (before the grid); every other non-empty line
+//   is one row of the picture, one cell per knot, each a palette code or a literal #RRGGBB. Every row has the
+//   same number of knots.
 Design parse_design_csv(const std::string& text, const std::string& source);
 // The same, noting the file line of each grid line, top line first (for messages that point at a knot).
-Design parse_design_csv(const std::string& text, const std::string& source, std::vector<std::size_t>& grid_lines);
+Design parse_design_csv(const std::string& text, const std::string& source,
+                        std::vector<std::size_t>& grid_lines);
 // "source:line:col" of knot `knot` (0-based, left to right) on the grid line at file line `line` (1-based).
-std::string design_csv_cell_at(const std::string& text, const std::string& source, std::size_t line, int knot);
+std::string design_csv_cell_at(const std::string& text, const std::string& source, std::size_t line,
+                               int knot);
 //   PNG: one pixel per knot (alpha ignored); each distinct colour becomes a code "#rrggbb".
 Design parse_design_png(const std::string& bytes, const std::string& source);
 // By the file's extension (.csv or .png, any case); anything else is a DesignError.

@@ -13,16 +13,16 @@ namespace loom::firmware::serve {
 const char* version();  // e.g. "0.1.0", from the CMake project version
 
 struct ServeArgs {
-  std::string config;              // "" → /etc/loomctl/loom.toml when present, else the embedded default
-  std::string scene;               // sim HAL only
+  std::string config;  // "" → /etc/loomctl/loom.toml when present, else the embedded default
+  std::string scene;   // sim HAL only
   std::string hal = "sim";
   std::string iface;
   std::string state_dir = "/var/lib/loomctl";
-  std::string socket;              // "" → /run/loomctl/<loom-id>.sock
+  std::string socket;  // "" → /run/loomctl/<loom-id>.sock
   std::string group = "loom";
   std::string loom_id, lcm_url;
-  std::uint32_t rows = 0;          // rows per `start` (0: until `stop`)
-  double pace = 1.0;               // sim only: run this many times faster than real time
+  std::uint32_t rows = 0;  // rows per `start` (0: until `stop`)
+  double pace = 1.0;       // sim only: run this many times faster than real time
   int rt_priority = 80;
   int cpu = -1;
   // Consecutive overruns that latch loop_overrun; unset → timing.overrun_stop_after on hardware, never in

@@ -21,9 +21,9 @@ namespace loom::firmware::serve {
 enum class CommandClass { kStopping, kStarting, kReading, kPairing };
 
 struct ParsedRequest {
-  std::string word;                          // "start", "pair", ...
-  std::string arg;                           // the positional argument (pair/unpair NAME), else ""
-  std::map<std::string, std::string> fields; // key=value pairs (via, client, token, device, code, hours)
+  std::string word;                           // "start", "pair", ...
+  std::string arg;                            // the positional argument (pair/unpair NAME), else ""
+  std::map<std::string, std::string> fields;  // key=value pairs (via, client, token, device, code, hours)
   CommandClass cls = CommandClass::kReading;
   bool via_panel() const { return fields.count("via") != 0 && fields.at("via") == "panel"; }
   std::string field(const std::string& k) const {
@@ -33,8 +33,9 @@ struct ParsedRequest {
 };
 
 // The command words, in the order help lists them.
-inline constexpr const char* kCommandWords[] = {"start", "pause", "resume", "stop",   "ack",    "next",  "status",
-                                                "faults", "pair", "unpair", "pairs", "redeem", "whoami"};
+inline constexpr const char* kCommandWords[] = {"start", "pause",  "resume", "stop", "ack",
+                                                "next",  "status", "faults", "pair", "unpair",
+                                                "pairs", "redeem", "whoami"};
 
 // Parses one request line. nullopt and `error` set ("unknown command 'x' (start, ...)", "bad field ...")
 // when the line is not a request; never throws on any input.

@@ -40,9 +40,9 @@ struct ControlRequest {
 using RequestHandler = std::function<std::string(const ControlRequest& request)>;
 
 struct ControlLimits {
-  int request_deadline_ms = 2000;      // from accept to the request's newline (or EOF)
-  int reply_deadline_ms = 5000;        // to write the whole reply, once the request is complete
-  std::size_t max_clients = 16;        // connections served at once; more wait in the listen backlog
+  int request_deadline_ms = 2000;  // from accept to the request's newline (or EOF)
+  int reply_deadline_ms = 5000;    // to write the whole reply, once the request is complete
+  std::size_t max_clients = 16;    // connections served at once; more wait in the listen backlog
   std::size_t max_request_bytes = 1024;
   std::size_t max_reply_bytes = 2u << 20;  // longer replies are cut, with a last line saying so
 };

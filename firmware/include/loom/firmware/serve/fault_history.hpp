@@ -14,13 +14,13 @@ namespace loom::firmware::serve {
 
 struct FaultRecord {
   std::string loom_id;
-  std::string kind = "fault";   // "fault" | "ack" | "overrun_stop"
-  std::string name;             // fault name from the one fault table, e.g. "drive_fault"
+  std::string kind = "fault";  // "fault" | "ack" | "overrun_stop"
+  std::string name;            // fault name from the one fault table, e.g. "drive_fault"
   std::uint16_t code = 0;
-  std::string axis;             // "" when not axis-specific
+  std::string axis;  // "" when not axis-specific
   std::uint16_t device_code = 0;
   std::uint32_t rows = 0, picks = 0, beats = 0;
-  std::string text;             // operator text
+  std::string text;  // operator text
 };
 
 class FaultHistory {

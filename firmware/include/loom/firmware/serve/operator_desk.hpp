@@ -41,12 +41,12 @@ LoomView view_of(const OperatorLink& link, bool knotting);
 
 struct Decision {
   enum class Read { kNone, kStatus, kFaults };
-  std::string reply;                 // complete unless read != kNone (then the caller answers)
-  std::optional<Command> post;       // the command to hand to the loop
+  std::string reply;            // complete unless read != kNone (then the caller answers)
+  std::optional<Command> post;  // the command to hand to the loop
   Read read = Read::kNone;
-  std::string who;                   // "local user anna (uid 1000, pid 42)", "panel client 10.0.0.5 paired as tab1 ..."
-  std::string station;               // "local" (the socket) or "panel" (a loom-panel client): the COMMAND event's station
-  bool audit = false;                // a command that changes or would change the loom: log and record it
+  std::string who;      // "local user anna (uid 1000, pid 42)", "panel client 10.0.0.5 paired as tab1 ..."
+  std::string station;  // "local" (the socket) or "panel" (a loom-panel client): the COMMAND event's station
+  bool audit = false;   // a command that changes or would change the loom: log and record it
   bool accepted() const { return reply.rfind("ok", 0) == 0; }
 };
 

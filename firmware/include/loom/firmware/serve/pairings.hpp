@@ -27,10 +27,10 @@ namespace loom::firmware::serve {
 
 struct Pairing {
   std::string name;
-  std::string token;            // 32 hex digits
-  std::int64_t expires_s = 0;   // unix seconds
-  std::string client;           // the address that redeemed the code
-  std::string device;           // the secret the redeeming page keeps (compared in constant time)
+  std::string token;           // 32 hex digits
+  std::int64_t expires_s = 0;  // unix seconds
+  std::string client;          // the address that redeemed the code
+  std::string device;          // the secret the redeeming page keeps (compared in constant time)
 };
 
 class Pairings {
@@ -64,7 +64,8 @@ class Pairings {
   std::string code_, code_name_;
   int code_hours_ = kDefaultHours, code_wrong_all_ = 0;
   std::int64_t code_expires_s_ = 0;
-  std::map<std::string, Tries> tries_;  // per client address, for the code waiting (bounded by kCodeWrongTriesAll)
+  std::map<std::string, Tries>
+      tries_;  // per client address, for the code waiting (bounded by kCodeWrongTriesAll)
 };
 
 // `bytes` random bytes from the kernel (getrandom), as hex. Throws std::runtime_error when unavailable.

@@ -1,7 +1,8 @@
 // LCM channel names for one loom: <prefix>.<loom id>.STATUS / .AXES / .RT (samples, decimated) and
-// .BEAT / .FAULT / .ROW / .WEAVER / .COMMAND (events, each sent once), .DESIGN (the weaver's next row, when the
-// recipe names a design) and .KNOTS (the knotting heads' progress, looms with heads). The loom id is in the name
-// so a hall of looms can share one multicast group and a technician can subscribe to one loom or all.
+// .BEAT / .FAULT / .ROW / .WEAVER / .COMMAND (events, each sent once), .DESIGN (the weaver's next row, when
+// the recipe names a design) and .KNOTS (the knotting heads' progress, looms with heads). The loom id is in
+// the name so a hall of looms can share one multicast group and a technician can subscribe to one loom or
+// all.
 #pragma once
 
 #include <string>
@@ -24,18 +25,19 @@ struct ChannelNames {
   std::string status;
   std::string axes;
   std::string rt;
-  std::string beat;   // events, never decimated
+  std::string beat;  // events, never decimated
   std::string fault;
   std::string row;
-  std::string design;  // the weaver's next row, from the publisher (looms with a design only)
+  std::string design;    // the weaver's next row, from the publisher (looms with a design only)
   std::string identity;  // who publishes (host, pid, instance): one loom id, one publisher
-  std::string knots;   // the knotting heads' progress, with STATUS (looms with heads only)
-  std::string weaver;  // each request the knotting heads make of the weaver (event)
-  std::string command;  // the audit of each operator command: who gave it, the reply (event, from serve)
+  std::string knots;     // the knotting heads' progress, with STATUS (looms with heads only)
+  std::string weaver;    // each request the knotting heads make of the weaver (event)
+  std::string command;   // the audit of each operator command: who gave it, the reply (event, from serve)
 };
 
 // Every channel kind, in the order a reader lists them.
-inline constexpr std::string_view kChannelKinds[] = {"STATUS", "AXES", "RT", "BEAT", "FAULT", "ROW", "DESIGN", "KNOTS", "WEAVER", "COMMAND"};
+inline constexpr std::string_view kChannelKinds[] = {"STATUS", "AXES",   "RT",    "BEAT",   "FAULT",
+                                                     "ROW",    "DESIGN", "KNOTS", "WEAVER", "COMMAND"};
 
 // Configure-time only (allocates). Assumes both parts passed the checks above.
 ChannelNames channel_names(std::string_view prefix, std::string_view loom_id);

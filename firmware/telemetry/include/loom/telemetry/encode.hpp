@@ -7,9 +7,9 @@
 
 #include "loom/design/design.hpp"
 #include "loom/telemetry/snapshot.hpp"
-#include "loomlcm/design_t.hpp"
 #include "loomlcm/axes_t.hpp"
 #include "loomlcm/beat_t.hpp"
+#include "loomlcm/design_t.hpp"
 #include "loomlcm/fault_t.hpp"
 #include "loomlcm/knots_t.hpp"
 #include "loomlcm/row_t.hpp"
@@ -34,7 +34,8 @@ loomlcm::axes_t to_axes(const Snapshot& s, const std::string& loom_id, std::int6
                         const hal::AxisLayout& axes = hal::core_axis_layout());
 // `dropped` and `backlog` come from the ring, which knows about snapshots the loop never got to send.
 loomlcm::rt_stats_t to_rt_stats(const Snapshot& s, const std::string& loom_id, std::int64_t utime,
-                                std::uint64_t dropped, std::uint64_t backlog, std::uint64_t dropped_events = 0);
+                                std::uint64_t dropped, std::uint64_t backlog,
+                                std::uint64_t dropped_events = 0);
 
 // Not RT-safe (allocates strings): publisher thread only. One message per event of that kind.
 loomlcm::beat_t to_beat(const Event& e, const std::string& loom_id, std::int64_t utime);
@@ -47,8 +48,8 @@ loomlcm::design_t to_design(const design::Design& d, std::uint64_t rows_done, co
                             std::int64_t utime);
 // Not RT-safe: publisher thread only. The knotting heads' progress in `s` (KNOTS), the knots and colours
 // from `program` (the machine's design as magazine slots).
-loomlcm::knots_t to_knots(const Snapshot& s, const sequencer::KnotProgram& program, const std::string& loom_id,
-                          std::int64_t utime);
+loomlcm::knots_t to_knots(const Snapshot& s, const sequencer::KnotProgram& program,
+                          const std::string& loom_id, std::int64_t utime);
 // Not RT-safe: publisher thread only. A weaver request event (WEAVER), worded with `program`'s colours
 // (null: colour "" and the text without them).
 loomlcm::weaver_request_t to_weaver_request(const Event& e, const sequencer::KnotProgram* program,

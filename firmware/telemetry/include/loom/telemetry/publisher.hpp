@@ -73,7 +73,8 @@ struct PublisherStats {
   std::uint64_t row = 0;
   std::uint64_t weaver = 0;
   std::uint64_t design = 0;
-  std::uint64_t knots = 0;   // KNOTS messages (with STATUS, looms with knotting heads)  // DESIGN messages (not events: sent by the publisher)
+  std::uint64_t knots = 0;  // KNOTS messages (with STATUS, looms with knotting heads)  // DESIGN messages
+                            // (not events: sent by the publisher)
   std::uint64_t publish_errors = 0;  // lcm publish() failures (e.g. no multicast route)
 };
 
@@ -116,7 +117,7 @@ class Publisher {
 
   SnapshotRing& ring_;
   EventRing& events_;
-  Event pending_{};             // popped from the event ring, waiting for its turn
+  Event pending_{};  // popped from the event ring, waiting for its turn
   bool have_pending_ = false;
   PublisherConfig cfg_;
   ChannelNames channels_;

@@ -44,7 +44,8 @@ class Telemetry {
   // RT-safe (producer thread). Whether a snapshot and `events` more events fit without waiting: a
   // virtual-time runner waits for this between ticks, so the wait is measured apart from the tick.
   bool has_room(std::size_t events) const noexcept {
-    return ring_->size_approx() < SnapshotRing::capacity() && events_->size_approx() + events <= EventRing::capacity();
+    return ring_->size_approx() < SnapshotRing::capacity() &&
+           events_->size_approx() + events <= EventRing::capacity();
   }
   // RT-safe, any thread. Whether the publisher is draining the rings (nobody makes room otherwise).
   bool publishing() const noexcept { return publisher_.running(); }

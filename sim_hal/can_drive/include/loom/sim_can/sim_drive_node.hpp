@@ -46,9 +46,9 @@ struct SimDriveConfig {
   bool supports_homing = false;  // 0x6502 bit 5 (off: the drive announces what it always did)
   std::uint64_t power_up_seed = 0;
   std::int32_t power_up_range = 1 << 20;
-  std::int32_t home_switch_at = 0;  // physical position (counts) of the home switch's edge
-  std::int32_t index_every = 4096;  // an index pulse at every multiple of this (physical counts)
-  bool home_switch_missing = false; // methods 19/21 never see the switch: homing error after a while
+  std::int32_t home_switch_at = 0;   // physical position (counts) of the home switch's edge
+  std::int32_t index_every = 4096;   // an index pulse at every multiple of this (physical counts)
+  bool home_switch_missing = false;  // methods 19/21 never see the switch: homing error after a while
   // A drive described by an EDS (eds_dictionary.hpp): its own dictionary table (sorted, 1/2/4-byte
   // entries) instead of the built-in one, 0x6502 as the table says. Empty = the built-in drive.
   std::vector<slave::Entry> dictionary;

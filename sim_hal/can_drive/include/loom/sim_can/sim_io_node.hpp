@@ -154,7 +154,7 @@ class SimIoNode : private slave::ObjectHooks, private slave::FrameHandlers {
   std::array<double, 2> piston_{0.0, 0.0};
   static constexpr std::size_t kInputGroups = 8;
   static constexpr double kKnotterPeriodS = 0.01;  // the plant steps at least every 10 ms (weaver timing)
-  std::array<std::uint8_t, kInputGroups> in_{};  // terminals 0..63
+  std::array<std::uint8_t, kInputGroups> in_{};    // terminals 0..63
   std::unique_ptr<sim_hal::SimKnotter> knotter_;
   sim_hal::SimRandom rng_{1};
   int shuttle_side_ = 0;  // -1 left, +1 right, 0 not yet seen at a selvedge

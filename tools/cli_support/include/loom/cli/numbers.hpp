@@ -42,8 +42,8 @@ inline CLI::Validator non_negative_number() {
 inline CLI::Validator finite_range(double lo, double hi) {
   std::ostringstream bounds;
   bounds << "[" << lo << ", " << hi << "]";
-  return number_check([lo, hi](double v) { return v >= lo && v <= hi; }, "must be a finite number in " + bounds.str(),
-                      "FLOAT in " + bounds.str());
+  return number_check([lo, hi](double v) { return v >= lo && v <= hi; },
+                      "must be a finite number in " + bounds.str(), "FLOAT in " + bounds.str());
 }
 
 // Eccentricity of the elliptic pitch curves: [0, 1).

@@ -53,7 +53,8 @@ class ShakingModel {
   ShakingLoad load(std::size_t sample, std::span<const double> q) const;
   // RT-safe (no allocation). RMS force and moment over the samples; optional gradients d(RMS)/dq
   // (same layout as q).
-  ShakingRms rms(std::span<const double> q, std::span<double> d_force = {}, std::span<double> d_moment = {}) const;
+  ShakingRms rms(std::span<const double> q, std::span<double> d_force = {},
+                 std::span<double> d_moment = {}) const;
   // RT-safe accessors.
   std::size_t links() const { return links_; }
   std::size_t samples() const { return samples_; }
@@ -65,33 +66,33 @@ class ShakingModel {
 };
 
 struct BalanceOptions {
-  double w1 = 0.5;                         // weight of the RMS shaking force
-  double w2 = 0.5;                         // weight of the RMS shaking moment
-  double counterweight_max_kg = 10.0;      // per counterweight (003 leaves it open; 4× the beater)
+  double w1 = 0.5;                     // weight of the RMS shaking force
+  double w2 = 0.5;                     // weight of the RMS shaking moment
+  double counterweight_max_kg = 10.0;  // per counterweight (003 leaves it open; 4× the beater)
   // Counterweights are cast-iron discs of this thickness: a disc of mass m has its own central
   // inertia m²/(2πtρ), so a heavy counterweight cannot hide at a tiny radius as a point mass could.
   double counterweight_thickness_m = 0.02;
   double counterweight_density_kg_m3 = kCastIronDensity_kg_m3;
-  double mass_factor_max = 5.0;            // redistribution: m0 <= m <= factor·m0 (003 §4.1)
-  double radius_factor_min = 0.5;          // redistribution: factor·l0 <= l ... (003 §4.1)
-  double radius_factor_max = 1.5;          // ... <= factor·l0
+  double mass_factor_max = 5.0;    // redistribution: m0 <= m <= factor·m0 (003 §4.1)
+  double radius_factor_min = 0.5;  // redistribution: factor·l0 <= l ... (003 §4.1)
+  double radius_factor_max = 1.5;  // ... <= factor·l0
   // Tie-break: every kilogram added costs this much objective. Some directions leave the shaking load
   // unchanged (at constant crank speed a counterweight's mass on the crank matters only through its
   // first moment), and this picks the lightest of the equally good designs. Small enough that the
   // reported RMS values do not notice (objective ~1).
   double added_mass_cost_per_kg = 1e-4;
-  double xtol_rel = 1e-10;                 // SLSQP stop on relative design-variable change
-  double ftol_rel = 1e-14;                 // ... and on relative objective change
+  double xtol_rel = 1e-10;  // SLSQP stop on relative design-variable change
+  double ftol_rel = 1e-14;  // ... and on relative objective change
   int max_evaluations = 4000;
 };
 
 struct Counterweight {
   std::string link;
   double mass_kg = 0.0;
-  double radius_m = 0.0;   // of its centre from the link's frame pivot
-  double angle_rad = 0.0;  // from the link's x axis (the line to its next joint)
-  double disc_radius_m = 0.0;        // of the cast-iron disc (BalanceOptions thickness and density)
-  double inertia_kg_m2 = 0.0;        // about its own centre
+  double radius_m = 0.0;       // of its centre from the link's frame pivot
+  double angle_rad = 0.0;      // from the link's x axis (the line to its next joint)
+  double disc_radius_m = 0.0;  // of the cast-iron disc (BalanceOptions thickness and density)
+  double inertia_kg_m2 = 0.0;  // about its own centre
 };
 
 struct OptimiserStep {
@@ -101,18 +102,20 @@ struct OptimiserStep {
 };
 
 struct BalanceResult {
-  std::string method;          // "counterweight" or "redistribution"
+  std::string method;  // "counterweight" or "redistribution"
   ShakingRms before, after;
   double objective_before = 0.0, objective_after = 0.0;  // w1·F/F0 + w2·N/N0 (without the tie-break)
-  std::vector<Counterweight> counterweights;  // counterweight method
-  std::vector<PlanarInertia> links_after;     // every link's own body after balancing (no payload)
-  std::vector<OptimiserStep> trace;           // every objective evaluation of the kept run
-  int evaluations = 0;                        // over all starts
+  std::vector<Counterweight> counterweights;             // counterweight method
+  std::vector<PlanarInertia> links_after;                // every link's own body after balancing (no payload)
+  std::vector<OptimiserStep> trace;                      // every objective evaluation of the kept run
+  int evaluations = 0;                                   // over all starts
   int nlopt_code = 0;
   std::string stop_reason;
   bool converged = false;  // SLSQP stopped on a tolerance (not on the budget or an error)
   double force_reduction() const { return before.force_n > 0 ? 1.0 - after.force_n / before.force_n : 0.0; }
-  double moment_reduction() const { return before.moment_nm > 0 ? 1.0 - after.moment_nm / before.moment_nm : 0.0; }
+  double moment_reduction() const {
+    return before.moment_nm > 0 ? 1.0 - after.moment_nm / before.moment_nm : 0.0;
+  }
 };
 
 // Configure-time only. Throws MotionError kInvalidInput for bad options/samples (naming the field),

@@ -22,7 +22,7 @@ const char* batten_beat_side_name(BattenBeatSide s);
 // The batten's acceleration at the beat: the largest |ψ''| among the turning points on one side
 // (004's double-swing drive beats twice per crank turn).
 struct BattenBeat {
-  double phi1_rad = 0.0;         // driving-pinion angle of that turning point
+  double phi1_rad = 0.0;  // driving-pinion angle of that turning point
   double psi_rad = 0.0;
   double psi_ddot_rad_s2 = 0.0;  // signed; its magnitude is the beat acceleration
   int beats_per_turn = 0;        // turning points on the side, per driving turn
@@ -41,9 +41,9 @@ BattenBeatSide batten_front_side(const BattenLinkage& linkage, double omega1_rad
 // law), so each visit has its own gain: at a turning point ψ'' = (d²ψ/dθ2²)·ω2², the gain of a visit
 // is (ω2/ω1)² of the gear there — between ((1-e)/(1+e))² and ((1+e)/(1-e))².
 struct BattenVisit {
-  double crank_rad = 0.0;              // crank (driven pinion) angle of the visit, [0, 2π): fixed by the linkage
-  double phi1_rad = 0.0;               // driving-pinion angle at which it happens with the gear
-  double accel_rad_s2 = 0.0;           // |ψ''| there with the elliptic gear
+  double crank_rad = 0.0;     // crank (driven pinion) angle of the visit, [0, 2π): fixed by the linkage
+  double phi1_rad = 0.0;      // driving-pinion angle at which it happens with the gear
+  double accel_rad_s2 = 0.0;  // |ψ''| there with the elliptic gear
   double circular_accel_rad_s2 = 0.0;  // ... with e = 0 at the same visit
   double gain = 0.0;                   // accel / circular, of this visit alone
 };
@@ -73,12 +73,13 @@ struct BattenSearch {
 
 // Configure-time only. Scan φ02 over one period (2π/k: shifting φ02 and φ1 together by 2π/k repeats
 // the motion) at scan_points, then refine the best by golden section between its neighbours.
-BattenSearch batten_best_phi02(const BattenLinkage& linkage, const EllipticGearPair& gear, BattenBeatSide side,
-                               double omega1_rad_s = 1.0, int scan_points = 360, int samples = 720);
+BattenSearch batten_best_phi02(const BattenLinkage& linkage, const EllipticGearPair& gear,
+                               BattenBeatSide side, double omega1_rad_s = 1.0, int scan_points = 360,
+                               int samples = 720);
 
 // RT-safe. The geared crank's motion at driving angle φ1, speed ω1, acceleration α1: the crank law a
 // servo follows to reproduce the gear electronically.
-CrankMotion elliptic_gear_crank(const EllipticGearPair& gear, double phi02_rad, double phi1_rad, double omega1_rad_s,
-                                double alpha1_rad_s2 = 0.0);
+CrankMotion elliptic_gear_crank(const EllipticGearPair& gear, double phi02_rad, double phi1_rad,
+                                double omega1_rad_s, double alpha1_rad_s2 = 0.0);
 
 }  // namespace loom::motion

@@ -15,9 +15,9 @@
 #include <array>
 #include <vector>
 
+#include "loom/motion/design/needle.hpp"
 #include "loom/motion/dynamics.hpp"
 #include "loom/motion/dynamics_body.hpp"
-#include "loom/motion/design/needle.hpp"
 
 namespace loom::motion {
 
@@ -51,7 +51,7 @@ struct NeedleSystems {
 
 struct NeedleForces {
   NeedleState state;
-  double friction_n = 0.0;           // signed: the backing's vertical force on the needle bar
+  double friction_n = 0.0;  // signed: the backing's vertical force on the needle bar
   Eigen::Vector2d pin_a_n = Eigen::Vector2d::Zero();   // l2 on l1 at A
   Eigen::Vector2d pin_o_n = Eigen::Vector2d::Zero();   // frame on l1 at O (main shaft bearing)
   Eigen::Vector2d pin_b_n = Eigen::Vector2d::Zero();   // l3 on l2 at B
@@ -59,9 +59,9 @@ struct NeedleForces {
   Eigen::Vector2d pin_c4_n = Eigen::Vector2d::Zero();  // frame on l4 at C
   Eigen::Vector2d pin_d_n = Eigen::Vector2d::Zero();   // l5 on l4 at D
   Eigen::Vector2d pin_e_n = Eigen::Vector2d::Zero();   // l6 on l5 at E
-  double guide_n = 0.0;             // guide on the needle bar, horizontal
-  double weld_torque_nm = 0.0;      // M_r: l3 on l4 through the rigid joint at C
-  double balancing_torque_nm = 0.0; // M_b: torque the main shaft must apply to l1
+  double guide_n = 0.0;                                // guide on the needle bar, horizontal
+  double weld_torque_nm = 0.0;                         // M_r: l3 on l4 through the rigid joint at C
+  double balancing_torque_nm = 0.0;                    // M_b: torque the main shaft must apply to l1
   // Total frame reaction at the rocker pivot C (l3 and l4 share it).
   Eigen::Vector2d pin_c_n() const { return pin_c3_n + pin_c4_n; }
 };
@@ -76,10 +76,11 @@ std::array<PlanarInertia, 6> needle_bodies(const NeedleLinkage& linkage, const N
 NeedleSystems needle_systems(const NeedleLinkage& linkage, const NeedleMasses& m, const NeedleState& s,
                              const NeedleLoads& loads = {});
 // Configure-time only. Solve them. Throws kSingular if either system is singular.
-NeedleForces needle_inverse_dynamics(const NeedleLinkage& linkage, const NeedleMasses& m, const NeedleState& s,
-                                     const NeedleLoads& loads = {});
+NeedleForces needle_inverse_dynamics(const NeedleLinkage& linkage, const NeedleMasses& m,
+                                     const NeedleState& s, const NeedleLoads& loads = {});
 // Configure-time only (allocates). One main-shaft turn at constant ω1, θ1 = 2πi/samples.
-std::vector<NeedleForces> needle_dynamics_sweep(const NeedleLinkage& linkage, const NeedleMasses& m, int samples,
-                                                double omega1_rad_s, const NeedleLoads& loads = {});
+std::vector<NeedleForces> needle_dynamics_sweep(const NeedleLinkage& linkage, const NeedleMasses& m,
+                                                int samples, double omega1_rad_s,
+                                                const NeedleLoads& loads = {});
 
 }  // namespace loom::motion

@@ -19,7 +19,7 @@ struct PointMass {
 
 struct EquimomentalSystem {
   std::array<PointMass, 3> points;
-  double radius_m = 0.0;      // l = sqrt(I_O / m): the common distance from the link origin
+  double radius_m = 0.0;  // l = sqrt(I_O / m): the common distance from the link origin
   // Every point mass >= 0. Always so when the offset points at the centre of mass (d <= l holds for
   // any body); for other offsets guaranteed only when d <= l/2.
   bool all_positive = false;

@@ -11,11 +11,12 @@ namespace loom::motion {
 // ---------------------------------------------------------------------------------------------
 // Degenerate designs are returned and flagged (bits of `flags`), not thrown.
 inline constexpr unsigned kDesignChangePoint = 1u << 0;  // design variable at a bound: links can
-                                                        // lie collinear (Grashof equality), μ_min = 0
-inline constexpr unsigned kDesignNearSpecialCase = 1u << 2;  // φ within kNearSpecialCase_rad of 180° + ψ
-                                                        // (but not on it): b and c grow like 1/|φ − 180° − ψ|
-                                                        // towards a path-dependent limit that is not the
-                                                        // case-III linkage; the design is ill-conditioned
+                                                         // lie collinear (Grashof equality), μ_min = 0
+inline constexpr unsigned kDesignNearSpecialCase = 1u
+                                                   << 2;  // φ within kNearSpecialCase_rad of 180° + ψ
+                                                          // (but not on it): b and c grow like 1/|φ − 180° −
+                                                          // ψ| towards a path-dependent limit that is not the
+                                                          // case-III linkage; the design is ill-conditioned
 
 // φ closer than this to 180° + ψ (and farther than kSynthesisSnap_rad) is flagged kDesignNearSpecialCase:
 // there b ≈ sin(ψ/2)·cos γ / |h| exceeds ~1e4 ground lengths and its digits follow φ's last digits.
@@ -31,11 +32,11 @@ inline constexpr double kSynthesisSnap_rad = 1e-14;
 // with the offset e = c ≥ 0. λ = a/b.
 
 struct SliderCrankDesign {
-  SliderCrank mechanism;     // a, b, c in the stroke's unit
+  SliderCrank mechanism;  // a, b, c in the stroke's unit
   double stroke = 0.0;
   double phi_rad = 0.0;
-  double lambda = 0.0;       // a / b
-  double mu_min_rad = 0.0;   // minimum transmission angle, acos((a + c) / b)
+  double lambda = 0.0;      // a / b
+  double mu_min_rad = 0.0;  // minimum transmission angle, acos((a + c) / b)
   unsigned flags = 0;
 };
 
@@ -43,8 +44,8 @@ struct SliderCrankDesign {
 // φ = 180° the designs depend on π − φ, which `π − φ_rad` gets only to ulp(π)/|π − φ| (9.5e-9 relative at
 // 179.999999°, 1 % at 180° − 1e-12°); from degrees the supplement is exact (Sterbenz) before conversion.
 struct CrankRotation {
-  double phi_rad = 0.0;         // φ
-  double supplement_rad = 0.0;  // π − φ
+  double phi_rad = 0.0;                          // φ
+  double supplement_rad = 0.0;                   // π − φ
   static CrankRotation degrees(double phi_deg);  // supplement from 180 − φ_deg, converted after
   static CrankRotation radians(double phi_rad);  // supplement from π − φ_rad (as accurate as φ_rad is)
 };
@@ -82,11 +83,11 @@ SliderCrankDesign soylemez_slider_crank(double stroke, CrankRotation phi, double
 // coupler B above the ground line) to the folded one while the rocker swings through ψ.
 
 enum class CrankRockerCase {
-  kPhiBelow180,        // π/2 + ψ/2 < φ < π:      β ∈ [π − φ, π/2 − ψ/2]           (thesis case II)
-  kPhi180,             // φ = π, centric linkage:  β ∈ [0, π/2 − ψ/2]; β = 0 is the null crank
-  kPhiAbove180,        // π < φ < π + ψ:           β ∈ [0, π/2 − ψ/2]               (thesis case I)
-  kPhi180PlusPsi,      // φ = π + ψ: β fixed at π/2 − ψ/2, a = sin(ψ/2), b free     (case III)
-  kPhiBeyond180PlusPsi,// π + ψ < φ < 3π/2 + ψ/2:  β ∈ [π/2 − ψ/2, 2π − φ]  (beyond the thesis)
+  kPhiBelow180,    // π/2 + ψ/2 < φ < π:      β ∈ [π − φ, π/2 − ψ/2]           (thesis case II)
+  kPhi180,         // φ = π, centric linkage:  β ∈ [0, π/2 − ψ/2]; β = 0 is the null crank
+  kPhiAbove180,    // π < φ < π + ψ:           β ∈ [0, π/2 − ψ/2]               (thesis case I)
+  kPhi180PlusPsi,  // φ = π + ψ: β fixed at π/2 − ψ/2, a = sin(ψ/2), b free     (case III)
+  kPhiBeyond180PlusPsi,  // π + ψ < φ < 3π/2 + ψ/2:  β ∈ [π/2 − ψ/2, 2π − φ]  (beyond the thesis)
 };
 
 // RT-safe. A short fixed name for messages and CSV.
@@ -106,15 +107,14 @@ struct CrankRockerDesign {
   double psi_rad = 0.0;
   double phi_rad = 0.0;
   double beta_rad = 0.0;
-  double mu_min_rad = 0.0;            // minimum transmission angle over a turn (acute, ≤ π/2)
-  double crank_extended_rad = 0.0;    // crank angle at the extended dead centre (= β)
-  double crank_folded_rad = 0.0;      // crank angle at the folded dead centre (β + φ), [0, 2π)
-  double rocker_extended_rad = 0.0;   // rocker direction B0 → B, counter-clockwise from +x
+  double mu_min_rad = 0.0;           // minimum transmission angle over a turn (acute, ≤ π/2)
+  double crank_extended_rad = 0.0;   // crank angle at the extended dead centre (= β)
+  double crank_folded_rad = 0.0;     // crank angle at the folded dead centre (β + φ), [0, 2π)
+  double rocker_extended_rad = 0.0;  // rocker direction B0 → B, counter-clockwise from +x
   double rocker_folded_rad = 0.0;
   CrankRockerCase design_case = CrankRockerCase::kPhi180;
   unsigned flags = 0;
 };
-
 
 // configure-time only. Feasible β for (ψ, φ); for φ = π + ψ lower = upper. Throws kInvalidInput
 // unless 0 < ψ < π and π/2 + ψ/2 < φ < 3π/2 + ψ/2 (no crank-rocker exists outside).
@@ -137,8 +137,7 @@ CrankRockerDesign khare_dave_best_beta(double psi_rad, double phi_rad, double gr
 // configure-time only. The design with crank/coupler ratio λ = a/b (the thesis' sley-eccentricity
 // criterion, a/b ≤ 0.3). For φ = π + ψ, λ selects the member of the family (b = a/λ).
 // kOutOfBounds when no feasible β gives that ratio.
-CrankRockerDesign khare_dave_for_ratio(double psi_rad, double phi_rad, double lambda,
-                                       double ground = 1.0);
+CrankRockerDesign khare_dave_for_ratio(double psi_rad, double phi_rad, double lambda, double ground = 1.0);
 
 // The same four with φ and its supplement given apart (CrankRotation::degrees for degree input).
 BetaBounds khare_dave_beta_bounds(double psi_rad, const CrankRotation& phi);

@@ -28,8 +28,8 @@ struct ThreePointSolution {
 
 struct ThreePointResult {
   std::vector<ThreePointSolution> solutions;  // every real solution (0, 1 or 2), λ descending
-  int complex_roots = 0;    // roots of the λ quadratic with no real value
-  int rejected_roots = 0;   // real roots without a finite chain (λ = 0, or a1² ≤ 0)
+  int complex_roots = 0;                      // roots of the λ quadratic with no real value
+  int rejected_roots = 0;                     // real roots without a finite chain (λ = 0, or a1² ≤ 0)
 };
 
 // configure-time only. The λ method of 001: the three loop equations are linear in
@@ -37,7 +37,6 @@ struct ThreePointResult {
 // Each solution is polished by Newton on the loop equations so closure ≤ 1e-12 of the largest link.
 // Throws MotionError kInvalidInput for non-finite input and kSingular when the points do not
 // determine the linear system (e.g. two identical precision points).
-ThreePointResult three_point_synthesis(const std::array<PrecisionPoint, 3>& points,
-                                       double theta0_rad);
+ThreePointResult three_point_synthesis(const std::array<PrecisionPoint, 3>& points, double theta0_rad);
 
 }  // namespace loom::motion
