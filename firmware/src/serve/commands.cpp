@@ -154,7 +154,8 @@ FILES
   /usr/share/loomctl/lcmtypes/  the LCM message types of the telemetry channels
 
 SIGNALS
-  weave: SIGUSR1 pause, SIGUSR2 resume, SIGINT/SIGTERM stop (at the next hold point), SIGHUP reload the recipe.
+  weave: SIGUSR1 pause, SIGUSR2 resume, SIGINT/SIGTERM stop (at the next hold point),
+         SIGHUP reload the recipe.
   serve: SIGINT/SIGTERM stop at the next hold point (a row's end, between picks or knot cycles), then exit.
 
 SEE ALSO

@@ -70,7 +70,8 @@ constexpr slave::Objects<29> kIoObjects{{
     {kDigitalOutputs, 3, 1, Access::kRw, Pdo::kRx, 0},
     {kDigitalOutputs, 4, 1, Access::kRw, Pdo::kRx, 0},
     {kOutputErrorMode, 0, 1, Access::kConst, Pdo::kNone, 4},
-    {kOutputErrorMode, 1, 1, Access::kRw, Pdo::kNone, 0xFF},  // CiA 401 default: every output to its error value
+    // CiA 401 default: every output to its error value.
+    {kOutputErrorMode, 1, 1, Access::kRw, Pdo::kNone, 0xFF},
     {kOutputErrorMode, 2, 1, Access::kRw, Pdo::kNone, 0xFF},
     {kOutputErrorMode, 3, 1, Access::kRw, Pdo::kNone, 0xFF},
     {kOutputErrorMode, 4, 1, Access::kRw, Pdo::kNone, 0xFF},
