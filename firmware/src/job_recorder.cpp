@@ -88,6 +88,9 @@ void JobRecorder::on_event(const RunEvent& e, const sequencer::KnotProgram* prog
       rec_->row_done(r, t);
       return;
     }
+    case RunEvent::Kind::kReloaded:
+      return;  // the levels changed, not the machine's state (a reload that answers a request: the
+               // knotting goes on, and its next event says so)
     default:
       break;
   }

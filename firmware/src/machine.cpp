@@ -42,7 +42,7 @@ Machine::Machine(const LoomConfig& cfg, const Scene& scene, const MachineOptions
     }
     sim_->attach_state_file(*sim_state_);
   }
-  sim_->persist_carpet(resume.rows);
+  sim_->persist_carpet(resume.rows, opt.carpet_began);
 
   if (opt.hal == HalKind::kSocketCan) {
     build_can_hal(opt);

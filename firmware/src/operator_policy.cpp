@@ -28,6 +28,7 @@ Decision decide(const PolicyInputs& in) noexcept {
   if (stopping) return d;
 
   if (has(Command::kNext)) d.row_knotted = true;
+  if (has(Command::kReload)) d.reload = true;  // in any state: the level is a fact; it may answer a request
   if (has(Command::kResume)) d.resume = true;
   if (has(Command::kStart)) {
     if (s == State::kDone && in.held_session) {

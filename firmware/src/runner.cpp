@@ -251,6 +251,7 @@ class LoopBody {
     in.nothing_to_weave = opt_.nothing_to_weave;
     const Decision d = decide(in);
     apply(d, seq_);
+    if ((cmds & static_cast<std::uint32_t>(Command::kReload)) != 0) take_reloads(d.reload, tick);
     RunResult& res = rt_.result;
     res.commands_overridden += d.overridden != 0 ? 1u : 0u;
     switch (d.refusal) {
@@ -378,6 +379,36 @@ class LoopBody {
     }
   }
 
+  // The weaver's reloads posted since the last tick: each taken off the link (so none is applied later by
+  // surprise); applied unless a stopping command of the same tick overrode them (the weaver gives it
+  // again: the level stays as the loom counted it, low, never high). One kReloaded event with the levels
+  // after them, which the reporter keeps with the magazines.
+  void take_reloads(bool apply_them, hal::Tick tick) noexcept {
+    if (opt_.link == nullptr) return;
+    bool taken = false;
+    for (int h = 0; h < sequencer::kMaxKnottingHeads; ++h) {
+      for (int sl = 0; sl < sequencer::kMaxMagazineSlots; ++sl) {
+        const std::optional<std::int32_t> knots = opt_.link->take_reload(h, sl);
+        if (knots && apply_them) taken |= seq_.reload_magazine(h, sl, *knots);
+      }
+    }
+    if (!taken) return;
+    RunEvent e = base_event(RunEvent::Kind::kReloaded, tick);
+    fill_stock(e);
+    emit(e);
+  }
+
+  // The magazines' levels as the loom counts them now (unknown before the first row or without heads).
+  void fill_stock(RunEvent& e) const noexcept {
+    const sequencer::RowKnotter& k = seq_.knotter();
+    e.stock_known = k.stock(0, 0) >= 0;
+    for (int h = 0; e.stock_known && h < sequencer::kMaxKnottingHeads; ++h) {
+      for (int sl = 0; sl < sequencer::kMaxMagazineSlots; ++sl) {
+        e.stock[static_cast<std::size_t>(h)][static_cast<std::size_t>(sl)] = k.stock(h, sl);
+      }
+    }
+  }
+
   // The sequencer's events of this tick as run events, in the reporter's order: the row or pick (saved with
   // the counters), the knots, the weaver's request, a pause or resume, the fault. Each carries the counters
   // and the fault as they are at the end of the tick.
@@ -388,13 +419,7 @@ class LoopBody {
     if (ev.has(EventKind::kRow)) {
       RunEvent e = base_event(RunEvent::Kind::kRowDone, tick);
       e.row = seq_.last_row();
-      const sequencer::RowKnotter& k = seq_.knotter();
-      e.stock_known = k.stock(0, 0) >= 0;
-      for (int h = 0; e.stock_known && h < sequencer::kMaxKnottingHeads; ++h) {
-        for (int sl = 0; sl < sequencer::kMaxMagazineSlots; ++sl) {
-          e.stock[static_cast<std::size_t>(h)][static_cast<std::size_t>(sl)] = k.stock(h, sl);
-        }
-      }
+      fill_stock(e);
       emit(e);
     } else if (ev.has(EventKind::kPick)) {
       emit(base_event(RunEvent::Kind::kPickDone, tick));

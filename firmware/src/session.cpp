@@ -196,6 +196,37 @@ void ProductionRecord::save_magazines(const RunEvent& e) const {
   s.save(magazines_path_);
 }
 
+void ProductionRecord::say_yarn_forecast(const sequencer::KnotProgram* program,
+                                         const std::optional<sequencer::MagazineLevels>& levels,
+                                         std::uint32_t next_row, std::uint64_t rows, const Say& say) const {
+  if (magazines_path_.empty() || program == nullptr || rows == 0) return;
+  job::YarnStock stock(heads_, slots_, knots_per_slot_);
+  for (int h = 0; levels && h < heads_; ++h) {
+    for (int sl = 0; sl < slots_; ++sl) {
+      stock.set(h, sl, std::max(0, (*levels)[static_cast<std::size_t>(h)][static_cast<std::size_t>(sl)]));
+    }
+  }
+  const std::vector<job::SlotEmpty> empties = job::forecast_empty_slots(stock, *program, next_row, rows);
+  if (empties.empty()) {
+    say(Severity::kNotice, "yarn: every magazine slot lasts the " + std::to_string(rows) + " rows to weave");
+    return;
+  }
+  constexpr std::size_t kShown = 8;  // the first ones; the loom forecasts again at every row
+  for (std::size_t i = 0; i < empties.size() && i < kShown; ++i) {
+    const job::SlotEmpty& e = empties[i];
+    say(Severity::kNotice, "yarn: head " + std::to_string(e.head + 1) + " slot " + std::to_string(e.slot) +
+                               " (colour " + e.colour + ", " + std::to_string(e.knots_left) +
+                               " knots left) runs out in row " + std::to_string(e.counter_row + 1) + " (" +
+                               (e.rows_from_now == 0 ? std::string("the next row")
+                                                     : std::to_string(e.rows_from_now) + " rows from now") +
+                               "): the loom asks for its reload before that row");
+  }
+  if (empties.size() > kShown) {
+    say(Severity::kNotice, "yarn: and " + std::to_string(empties.size() - kShown) + " more slots in the " +
+                               std::to_string(rows) + " rows to weave");
+  }
+}
+
 std::string design_position(const design::Design& d, std::uint64_t rows_done) {
   const design::DesignPosition pos = design::position_after(d, rows_done);
   char buf[256];

@@ -152,7 +152,7 @@ class WeaveReporter {
     if (recorder_ != nullptr) record_event(e);
     // The magazines before the counters: a cut between the two leaves the levels low (a reload asked
     // early), never high (a slot running dry in a row).
-    if (e.kind == RunEvent::Kind::kRowDone) save_magazines(e);
+    if (e.kind == RunEvent::Kind::kRowDone || e.kind == RunEvent::Kind::kReloaded) save_magazines(e);
     // Saved after the reload above, so a row that waits for this save starts with the new recipe.
     if (record_.kept()) save(e.counters);
   }
@@ -512,8 +512,10 @@ int weave(const WeaveArgs& a, const Say& say) {
   mo.sim_state_path = st.sim_state;
   mo.await_row_saved = record.kept();  // no row starts before the one before it is on disk
   mo.design_rows_done = design_rows;
+  if (job != nullptr) mo.carpet_began = carpet_began(resume.rows, design_rows);
   Machine& machine = session.build(in.cfg, in.scene, mo, resume);
-  if (const auto levels = record.load_magazines(say)) machine.sequencer().restore_magazines(*levels);
+  const auto levels = record.load_magazines(say);
+  if (levels) machine.sequencer().restore_magazines(*levels);
   if (!a.quiet) print_header(machine, in.scene, a);
   if (resume.rows > 0) {
     std::printf("  resuming after row %u (picks %u, beats %u)\n", resume.rows, resume.picks, resume.beats);
@@ -528,6 +530,7 @@ int weave(const WeaveArgs& a, const Say& say) {
     std::printf("  %s%s\n", design_position(*d, design_rows).c_str(),
                 record.kept() ? "" : " (no --counters: the row reached is not remembered)");
   }
+  if (!a.quiet) record.say_yarn_forecast(machine.knot_program(), levels, resume.rows, rows, say);
 
   // ---- run ----
   WeaveReporter reporter(a, in, machine, record, open_report(a, in, so.hardware()), resume, rows);

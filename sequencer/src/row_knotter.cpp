@@ -36,6 +36,11 @@ std::string describe(const WeaverRequest& r, const KnotProgram& p) {
              " (the head missed it twice: look at slot " + std::to_string(r.slot) +
              "'s yarn and the gripper)";
     case WeaverAsk::kReload:
+      if (r.knots_needed > 0) {
+        return where + "reload colour " + colour + " into slot " + std::to_string(r.slot) + " of " + head +
+               " before the row: it needs " + std::to_string(r.knots_needed) + " knots of it, " +
+               std::to_string(r.knots_left) + " left";
+      }
       return where + "reload colour " + colour + " into slot " + std::to_string(r.slot) + " of " + head;
     case WeaverAsk::kCheckKnot:
       return where + "check " + knot +
@@ -101,6 +106,21 @@ void RowKnotter::restore_stock(const MagazineLevels& levels) noexcept {
   stock_known_ = true;
 }
 
+bool RowKnotter::reload(int head, int slot, std::int32_t knots) noexcept {
+  if (!fitted() || head < 0 || head >= heads_ || slot < 0 || slot >= k_.program->slots()) return false;
+  const std::int32_t full = k_.program->knots_per_slot();
+  if (!stock_known_) {  // before the first row: the other slots are the full magazines loaded at the start
+    for (int h = 0; h < heads_; ++h) stock_[static_cast<std::size_t>(h)].fill(full);
+    stock_known_ = true;
+  }
+  stock_[static_cast<std::size_t>(head)][static_cast<std::size_t>(slot)] =
+      knots < 0 || knots > full ? full : knots;
+  if (request_.ask == WeaverAsk::kReload && request_.head == head && request_.slot == slot) {
+    reload_answered_ = true;
+  }
+  return true;
+}
+
 double RowKnotter::rest_behind(double position) const noexcept {
   if (!fitted()) return position;
   const double turn = k_.cycle->end_offset_rad();
@@ -143,6 +163,7 @@ void RowKnotter::begin(std::uint32_t row0, const KnotCounters& progress, double 
   interrupted_ = progress.cycles_started > progress.cycles_done &&
                  progress.cycles_done < static_cast<std::uint32_t>(stripe_);
   heads_done_at_cut_ = interrupted_ ? progress.cycle_heads_done : 0;
+  forecast_due_ = true;
   enter_cycle(static_cast<int>(progress.cycles_done), now, cmd);
 }
 
@@ -215,6 +236,8 @@ void RowKnotter::ask(WeaverAsk a, int head, int knot, int slot, hal::Tick now) n
   request_.knot = knot;
   request_.head = head;
   request_.slot = slot;
+  request_.knots_needed = request_.knots_left = 0;
+  reload_answered_ = false;
   weaver_since_ = now;
   ++requests_;
 }
@@ -259,10 +282,20 @@ RowKnotter::Status RowKnotter::check(hal::Tick now, const hal::HalInputs& in, co
     phase_ = Phase::kWeaver;
     return Status::kAwaitingWeaver;
   }
+  // Before the row's first knot cycle (and again after each reload): a slot that cannot give the rest of
+  // the row its knots is reloaded now, the heads at rest, not when it runs dry in the middle of the row.
+  if (forecast_due_) {
+    if (ask_reload_for_row(now)) {
+      phase_ = Phase::kWeaver;
+      return Status::kAwaitingWeaver;
+    }
+    forecast_due_ = false;
+  }
   for (int h = 0; h < heads_; ++h) {
     const auto hh = static_cast<std::size_t>(h);
     if (!active_[hh]) continue;
-    // Yarn for the knot: an empty slot is reloaded before the knot that needs it.
+    // Yarn for the knot: a slot that ran dry all the same (a retried knot takes yarn twice) is reloaded
+    // before the knot that needs it.
     if (stock_[hh][static_cast<std::size_t>(slot_[hh])] <= 0) {
       ask(WeaverAsk::kReload, h, -1, slot_[hh], now);
       phase_ = Phase::kWeaver;
@@ -379,13 +412,17 @@ void RowKnotter::cycle_done(hal::Tick now, const hal::HalOutputs& cmd, KnotCount
 RowKnotter::Status RowKnotter::weaver(hal::Tick now, const hal::HalOutputs& cmd, KnotCounters& counters,
                                       bool weaver_done) noexcept {
   if (request_.ask != WeaverAsk::kNone) {
-    if (!weaver_done) return Status::kAwaitingWeaver;
+    if (!weaver_done && !reload_answered_) return Status::kAwaitingWeaver;
     row_.weaver_ticks += now - weaver_since_;
     const WeaverAsk done = request_.ask;
     request_.ask = WeaverAsk::kNone;
-    if (done == WeaverAsk::kReload) {  // the slot is full again: check the cycle again
-      stock_[static_cast<std::size_t>(request_.head)][static_cast<std::size_t>(request_.slot)] =
-          k_.program->knots_per_slot();
+    if (done == WeaverAsk::kReload) {  // check the cycle (and the row's yarn) again
+      // The pedal or `next` says the slot was filled; a reload() said how much it now holds.
+      if (!reload_answered_) {
+        stock_[static_cast<std::size_t>(request_.head)][static_cast<std::size_t>(request_.slot)] =
+            k_.program->knots_per_slot();
+      }
+      reload_answered_ = false;
       phase_ = Phase::kCheck;
       phase_since_ = now;
       return Status::kRunning;
@@ -404,6 +441,31 @@ RowKnotter::Status RowKnotter::weaver(hal::Tick now, const hal::HalOutputs& cmd,
   }
   cycle_done(now, cmd, counters);  // every knot of the cycle is tied, by the heads or by hand
   return Status::kRunning;
+}
+
+bool RowKnotter::ask_reload_for_row(hal::Tick now) noexcept {
+  // Bounded: one pass over the row's remaining knots (at most knots_per_row lookups), once per row and
+  // once per reload answered.
+  const std::int32_t full = k_.program->knots_per_slot();
+  const int slots = k_.program->slots();
+  for (int h = 0; h < heads_; ++h) {
+    std::array<std::int32_t, kMaxMagazineSlots> need{};
+    for (int j = j_; j < stripe_; ++j) {
+      const int k = k_.program->knot_of(h, j);
+      if (k >= 0) ++need[static_cast<std::size_t>(k_.program->slot(row0_, k))];
+    }
+    for (int s = 0; s < slots; ++s) {
+      const std::int32_t left = stock_[static_cast<std::size_t>(h)][static_cast<std::size_t>(s)];
+      // A full slot is never asked for again: a stripe that needs more than a slot holds is reloaded
+      // when it runs dry.
+      if (need[static_cast<std::size_t>(s)] <= left || left >= full) continue;
+      ask(WeaverAsk::kReload, h, -1, s, now);
+      request_.knots_needed = need[static_cast<std::size_t>(s)];
+      request_.knots_left = left;
+      return true;
+    }
+  }
+  return false;
 }
 
 RowKnotter::Status RowKnotter::step(hal::Tick now, const hal::HalInputs& in, hal::HalOutputs& cmd,

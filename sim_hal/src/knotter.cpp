@@ -79,13 +79,15 @@ int SimKnotter::rows_needed(std::uint32_t first_row, int rows_knotted) const noe
   return static_cast<int>(std::clamp<long long>(std::max<long long>(rows, rows_knotted), 1, 1'000'000));
 }
 
-void SimKnotter::keep_in(CarpetKeeper& keeper, std::uint32_t counter_rows, bool adopt) {
+void SimKnotter::keep_in(CarpetKeeper& keeper, std::uint32_t counter_rows, bool adopt,
+                         std::optional<std::uint32_t> carpet_began) {
   const std::size_t width = static_cast<std::size_t>(std::max(1, m_.knots_per_row));
   const std::size_t had = keeper.room();
   const PersistedCarpet* old = had > 0 ? &keeper.reserve(had) : nullptr;
   const bool ours = adopt && old != nullptr && old->magic == PersistedCarpet::kMagic &&
                     old->knots_per_row == m_.knots_per_row && old->row >= 0 && old->row_has_knots >= 0 &&
-                    (static_cast<std::size_t>(old->row) <= had / width || old->knots_beyond > 0);
+                    (static_cast<std::size_t>(old->row) <= had / width || old->knots_beyond > 0) &&
+                    (!carpet_began || old->first_row >= *carpet_began);
   const std::uint32_t first = ours ? old->first_row : counter_rows;
   const int knotted = ours ? old->row + (old->row_has_knots ? 1 : 0) : 0;
   const std::size_t rows = static_cast<std::size_t>(rows_needed(first, knotted));
@@ -99,8 +101,9 @@ void SimKnotter::keep_in(CarpetKeeper& keeper, std::uint32_t counter_rows, bool 
   std::fill(beyond_.begin(), beyond_.end(), std::uint8_t{0});
 }
 
-void SimKnotter::persist_in(CarpetKeeper& keeper, std::uint32_t counter_rows) {
-  keep_in(keeper, counter_rows, true);
+void SimKnotter::persist_in(CarpetKeeper& keeper, std::uint32_t counter_rows,
+                            std::optional<std::uint32_t> carpet_began) {
+  keep_in(keeper, counter_rows, true, carpet_began);
   own_.reset();
 }
 

@@ -150,9 +150,9 @@ void SimWorld::attach_state_file(SimStateFile& file) {
   state_file_ = &file;
 }
 
-void SimWorld::persist_carpet(std::uint32_t counter_rows) {
+void SimWorld::persist_carpet(std::uint32_t counter_rows, std::optional<std::uint32_t> carpet_began) {
   if (knotter_ && state_file_ != nullptr && state_file_->carpet() != nullptr) {
-    knotter_->persist_in(*state_file_->carpet(), counter_rows);
+    knotter_->persist_in(*state_file_->carpet(), counter_rows, carpet_began);
   } else if (knotter_) {
     knotter_->start_at_row(counter_rows);
   }

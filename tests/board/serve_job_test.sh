@@ -2,7 +2,9 @@
 # serve weaves the carpet job queue of its state directory (simulated knotting loom, paced):
 #   1. armed with a queued job: `ctl status` names it (job=1 job_row=1/2 job_state=queued); `ctl start`
 #      starts it at the machine (journal: "started at the machine by local user ...");
-#   2. the weaver answers the heads' requests (ctl next) and the loom weaves the job's rows and no more:
+#   2. the weaver answers the heads' requests — a slot to reload with `ctl reload HEAD SLOT` (audited; the
+#      heads go on), the rest with ctl next — and the loom weaves the job's rows and no more (at arming
+#      the journal forecast which slots run out in which row):
 #      at its last row the journal says "carpet done", status says state=carpet_done, and with nothing
 #      queued a start is refused with the reason (exit 1) — the design does not repeat;
 #   3. a restart on the same state directory arms standing (carpet_done), a start still refused; the
@@ -55,13 +57,27 @@ grep -q "job 1 (design knot_sample.csv, sha256 [0-9a-f]*\.\.): row 1 of 2 next: 
   "$work/serve1.log" || fail "the job's start is not in the journal"
 
 # 2. the weaver answers the heads until the carpet is done
+grep -q "yarn: head [0-9] slot [0-9] (colour ., [0-9]* knots left) runs out in row [0-9]" "$work/serve1.log" ||
+  fail "no yarn forecast in the journal at arming"
+reloads=0
 end=$((SECONDS + 120))
 while ((SECONDS < end)); do
   out=$(ctl status)
   [[ $(sed -n 's/.* state=\([a-z_]*\) .*/\1/p' <<<"$out" | head -1) == carpet_done ]] && break
-  grep -q '^open: weaver' <<<"$out" && ctl next >/dev/null 2>&1 || true
+  ask=$(grep '^open: weaver' <<<"$out" || true)
+  if [[ $ask =~ "reload colour "[A-Z]" into slot "([0-9])" of head "([0-9]) ]]; then
+    head=${BASH_REMATCH[2]} slot=${BASH_REMATCH[1]}
+    reply=$(ctl reload "$head" "$slot" 2>&1) || fail "ctl reload $head $slot: $reply"
+    [[ $reply == "ok reload head $head slot $slot: full" ]] || fail "ctl reload $head $slot: $reply"
+    reloads=$((reloads + 1))
+  elif [[ -n $ask ]]; then
+    ctl next >/dev/null 2>&1 || true
+  fi
   sleep 0.1
 done
+((reloads > 0)) || fail "no reload was asked for and answered with ctl reload"
+ctl faults | grep -q "reload head=[0-9] slot=[0-9]" || fail "the reload is not audited: $(ctl faults | tail -5)"
+
 status=$(ctl status | head -1)
 [[ $status == *" state=carpet_done "* && $status == *" rows=2 "* && $status == *" carpet_done_job=1"* ]] ||
   fail "not carpet_done after the job's 2 rows: $status"

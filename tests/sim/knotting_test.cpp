@@ -80,6 +80,7 @@ struct Woven {
   int fault_axis = -1;
   sequencer::Counters counters{};
   std::vector<sequencer::WeaverRequest> requests;
+  std::vector<std::uint32_t> request_cycles;  // the row's knot cycles done when each request was made
   firmware::CarpetCheck check{};
   Rgba png;
 };
@@ -96,7 +97,10 @@ Woven weave(const firmware::LoomConfig& cfg, const firmware::Scene& sc, std::uin
   ro.sim_weaver = m.sim_weaver();
   Woven w;
   firmware::run_loop(m.loop(), m.sequencer(), ro, [&](const firmware::RunEvent& e) {
-    if (e.kind == firmware::RunEvent::Kind::kWeaverRequest) w.requests.push_back(e.request);
+    if (e.kind == firmware::RunEvent::Kind::kWeaverRequest) {
+      w.requests.push_back(e.request);
+      w.request_cycles.push_back(e.counters.knot.cycles_done);
+    }
   });
   w.state = m.sequencer().state();
   w.fault = m.sequencer().first_fault();
@@ -167,6 +171,25 @@ TEST(Knotting, MissedKnotsAndAnEmptySlotEndWithTheDesignAndTheWeaversKnotsMarked
   EXPECT_TRUE(w.check.equal()) << w.check.missing << " missing, " << w.check.wrong << " wrong, "
                                << w.check.doubled << " doubled";
   EXPECT_EQ(expect_equals_design(w, 3), static_cast<int>(w.counters.knot.by_hand));
+}
+
+// The yarn forecast: a slot that cannot give the rest of a row its knots is reloaded before the row's
+// first knot cycle, the heads at rest — never when it runs dry in the middle of the row. With no misses
+// (no knot takes yarn twice) the forecast is exact: every reload comes before a row, none mid-row.
+TEST(Knotting, AReloadIsAskedBeforeTheRowThatNeedsItNeverInItsMiddle) {
+  const firmware::LoomConfig cfg = knotting_loom();  // 40-knot slots, 30 knots per head and row
+  const Woven w = weave(cfg, scene("miss_probability = 0.0\nweaver_s = 1.0\n"), 6);
+  EXPECT_EQ(w.state, sequencer::State::kDone) << sequencer::fault_name(w.fault);
+  ASSERT_FALSE(w.requests.empty());
+  for (std::size_t i = 0; i < w.requests.size(); ++i) {
+    const sequencer::WeaverRequest& r = w.requests[i];
+    EXPECT_EQ(r.ask, sequencer::WeaverAsk::kReload) << "request " << i;
+    EXPECT_EQ(w.request_cycles[i], 0u) << "request " << i << " came in the middle of row " << r.row;
+    EXPECT_GT(r.knots_needed, r.knots_left) << "request " << i;
+    EXPECT_LT(r.knots_left, cfg.knotting.knots_per_slot) << "request " << i;
+  }
+  EXPECT_EQ(w.counters.knot.by_hand, 0u);
+  EXPECT_TRUE(w.check.equal());
 }
 
 TEST(Knotting, AJammedSelectorIsANamedFault) {
@@ -244,6 +267,37 @@ TEST(Knotting, APauseWhileTheHeadsTieHoldsAfterTheKnotCycleInProgress) {
   ASSERT_TRUE(s.run([&] { return s.m.sequencer().counters().picks > 0; }, 100000));
   EXPECT_EQ(s.m.sequencer().counters().knot.tied + s.m.sequencer().counters().knot.by_hand,
             static_cast<std::uint32_t>(s.m.knot_program()->knots_per_row()));
+}
+
+// `ctl reload HEAD SLOT [KNOTS]`: the weaver's count is the slot's level; a reload of the slot the heads
+// ask for answers their request (they go on), a reload of another slot only sets that slot's level, and a
+// reload short of what the row needs is asked again for the rest.
+TEST(Knotting, AReloadAnswersTheHeadsRequestWithTheWeaversCount) {
+  Stepped s(knotting_loom(), scene("miss_probability = 0.0\n"), 6);
+  sequencer::Sequencer& seq = s.m.sequencer();
+  const auto asked = [&] { return seq.weaver_request().ask == sequencer::WeaverAsk::kReload; };
+  ASSERT_TRUE(s.run(asked, 400000));
+  const sequencer::WeaverRequest r = seq.weaver_request();
+  ASSERT_GT(r.knots_needed, 1);
+  const int other = (r.slot + 1) % 3;
+  EXPECT_TRUE(seq.reload_magazine(r.head, other, 7));
+  s.run([] { return false; }, 5);
+  EXPECT_TRUE(asked());
+  EXPECT_EQ(seq.knotter().stock(r.head, other), 7);
+  EXPECT_FALSE(seq.reload_magazine(3, 0, 5));   // the sample loom has heads 0..2
+  EXPECT_FALSE(seq.reload_magazine(0, 3, 5));   // ... and slots 0..2
+  EXPECT_FALSE(seq.reload_magazine(-1, 0, 5));
+  const std::uint32_t requests = seq.knotter().requests();
+  EXPECT_TRUE(seq.reload_magazine(r.head, r.slot, r.knots_needed - 1));  // one knot short
+  ASSERT_TRUE(s.run([&] { return seq.knotter().requests() != requests; }, 10));
+  EXPECT_TRUE(asked());
+  EXPECT_EQ(seq.weaver_request().head, r.head);
+  EXPECT_EQ(seq.weaver_request().slot, r.slot);
+  EXPECT_EQ(seq.weaver_request().knots_left, r.knots_needed - 1);
+  EXPECT_TRUE(seq.reload_magazine(r.head, r.slot, 1000));  // more than a slot holds: full
+  s.run([] { return false; }, 1);
+  EXPECT_EQ(seq.knotter().stock(r.head, r.slot), s.m.knot_program()->knots_per_slot());
+  EXPECT_FALSE(asked() && seq.weaver_request().head == r.head && seq.weaver_request().slot == r.slot);
 }
 
 TEST(Knotting, AScenelessHeadsLoomAndAHeadlessKnotterAreRefused) {

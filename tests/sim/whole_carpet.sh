@@ -1,11 +1,14 @@
 #!/usr/bin/env bash
-# A whole carpet in the simulator: the six heads of the knotting loom tie a 1.2 × 1.8 m medium carpet
-# (360 × 540 knots = 194,400), made here from a fixed formula, through at least CUTS power cuts (the scene's
+# A whole carpet in the simulator, as a carpet job: the six heads of the knotting loom tie a 1.2 × 1.8 m
+# medium carpet (360 × 540 knots = 194,400), made here from a fixed formula, queued as a job (`loomctl job
+# add`: the design once, 540 rows) and woven with `loomctl weave --state-dir` (serve's state: job queue,
+# counters, magazines, production record, simulated machine) through at least CUTS power cuts (the scene's
 # power_cut fault: SIGKILL at a tick drawn per run), knots slipping off every head (miss_probability) and
-# small magazines (reloads on every head). Each restart resumes with the same counters file and the same
-# simulated machine, whose carpet survives the cut. At the end the carpet the simulator knotted — every row,
-# across every run — must equal the design knot for knot (each knot tied once, none missing, none doubled),
-# and the counters' tallies must be the carpet's.
+# small magazines (reloads on every head). Each restart resumes the job where the counters say. At the end
+# the job is carpet_done, the carpet the simulator knotted — every row, across every run — equals the design
+# knot for knot (each knot tied once, none missing, none doubled), the counters' tallies are the carpet's,
+# and the job's production record (SQLite) has its 540 rows and machine states whose times add up to its
+# wall time (±1 tick).
 # Usage: whole_carpet.sh LOOMCTL CONFIG [CUTS] [SEED]   (SEED replays a run; printed at the start)
 # Env: WHOLE_CARPET_ROWS (540) weaves a shorter carpet (a quick look, not the test); KEEP=1 keeps the work dir.
 set -euo pipefail
@@ -23,8 +26,9 @@ base=/dev/shm
 [[ -d $base && -w $base ]] || base=${TMPDIR:-/tmp}
 work=$(mktemp -d "$base/whole_carpet.XXXXXX")
 trap '[[ -n ${KEEP:-} ]] || rm -rf "$work"' EXIT
-counters=$work/counters.json
-state=$work/machine.state
+state=$work/state
+counters=$state/counters.json
+mkdir -p "$state"
 
 # The design: 540 rows of 360 knots in the loom's three yarns, a field with a border, diagonal bands and a
 # lozenge lattice, so that every head changes colour within its stripe on most rows.
@@ -54,6 +58,12 @@ grep -q '^design = "carpet.csv"' "$work/loom.toml" || { echo "FAIL: $config has 
 sed -i -e 's|^\[knotting\]$|[knotting]\nknots_per_slot = 150|' "$work/loom.toml"
 grep -q '^knots_per_slot = 150' "$work/loom.toml" || { echo "FAIL: $config has no [knotting] table"; exit 1; }
 
+# The job: the design once (its rows), yarn from the loom's magazines.
+"$loomctl" job add "$work/carpet.csv" --config "$work/loom.toml" --state-dir "$state" >"$work/job.log" ||
+  { echo "FAIL: job add: $(cat "$work/job.log")"; exit 1; }
+"$loomctl" job list --state-dir "$state" | grep -q "^1 .*queued.* of $rows_wanted next" ||
+  { echo "FAIL: the queued job: $("$loomctl" job list --state-dir "$state")"; exit 1; }
+
 field() { grep -o "\"$1\": *[0-9]*" "$counters" 2>/dev/null | grep -o '[0-9]*$' || echo 0; }
 rand30() { echo $(((RANDOM << 15) | RANDOM)); }
 
@@ -66,8 +76,8 @@ run() {  # run [cut_tick]; prints loomctl's exit code (137 when the power cut ki
     [[ -n ${1:-} ]] && printf '\n[[fault]]\nkind = "power_cut"\nat_tick = %s\n' "$1"
   } >"$work/scene.toml"
   local rc=0
-  "$loomctl" weave --config "$work/loom.toml" --scene "$work/scene.toml" --rows "$left" --counters "$counters" \
-    --sim-state "$state" --no-telemetry --quiet --report "$work/report" >>"$work/log" 2>&1 || rc=$?
+  "$loomctl" weave --config "$work/loom.toml" --scene "$work/scene.toml" --state-dir "$state" \
+    --no-telemetry --quiet --report "$work/report" >>"$work/log" 2>&1 || rc=$?
   echo "$rc"
 }
 
@@ -112,10 +122,32 @@ counted=$(($(field knots) + $(field knots_by_hand)))
 # Every head missed (the weaver tied for it) and had a slot reloaded, as the loom asked.
 for ((h = 1; h <= 6; h++)); do
   ties=$(grep -c "^weaver asked: .*(head $h) by hand" "$work/log" || true)
-  reloads=$(grep -c "^weaver asked: .*reload colour . into slot . of head $h\$" "$work/log" || true)
+  reloads=$(grep -cE "^weaver asked: .*reload colour . into slot . of head $h( before|\$)" "$work/log" || true)
   echo "head $h: $ties knots tied by hand, $reloads reloads asked"
   ((ties > 0 && reloads > 0)) || { echo "FAIL: head $h had no hand tie or no reload"; exit 1; }
 done
+# The job: done, and its production record (SQLite) adds up: every state's time to the job's wall time
+# (each state's time is whole ticks of the record's clock: a tick of slack, not a rounding of the sum).
+grep -q "^carpet done: " "$work/log" || { echo "FAIL: no carpet done line"; tail -5 "$work/log"; exit 1; }
+"$loomctl" job list --state-dir "$state" | grep -q "^1 .*carpet_done" ||
+  { echo "FAIL: the job is not carpet_done: $("$loomctl" job list --state-dir "$state")"; exit 1; }
+"$loomctl" report job 1 --state-dir "$state" --format json >"$work/record.json" ||
+  { echo "FAIL: no production record for the job"; exit 1; }
+python3 - "$work/record.json" "$rows_wanted" <<'PY' || { echo "FAIL: the job's record: $(head -c 2000 "$work/record.json")"; exit 1; }
+import json, sys
+r = json.load(open(sys.argv[1]))
+rows = int(sys.argv[2])
+states_ns = sum(v["ns"] for v in r["states"].values())
+wall_ns = round(r["wall_s"] * 1e9)
+tick_ns = 2_000_000
+assert r["rows"] == {"recorded": rows, "last": rows}, r["rows"]
+assert r["ended"], "the record has no end"
+assert abs(states_ns - wall_ns) <= tick_ns, f"states {states_ns} ns, wall {wall_ns} ns"
+assert r["knots"]["by_heads"] + r["knots"]["by_hand"] == rows * 360, r["knots"]
+print(f"record: {rows} rows, wall {r['wall_s']:.3f} s = {states_ns / 1e9:.3f} s in states "
+      f"({', '.join(f'{k} {v['ns'] / 1e9:.0f} s' for k, v in r['states'].items() if v['ns'])}); "
+      f"knots by heads {r['knots']['by_heads']}, by hand {r['knots']['by_hand']}")
+PY
 # Machine time: the runs that ended (their loop line) and the runs cut short (the tick the power failed at).
 # (The period from the loops' own lines: machine seconds over ticks.)
 machine_s=$(sed -n 's/^loop: \([0-9]*\) ticks (\([0-9.]*\) s machine time).*/\1 \2/p' "$work/log" |

@@ -114,6 +114,31 @@ std::string ctl_permission_advice(const std::string& path) {
          "account: for a new operator, sudo adduser NAME first";
 }
 
+std::string ctl_request_line(const CtlArgs& a, std::string& error) {
+  const std::size_t n = a.args.size();
+  std::string request = a.command;
+  if (a.command == "pair" || a.command == "unpair") {
+    if (n != 1) {
+      error = a.command + " takes one NAME (e.g. " + a.command + " tablet-1), got " + std::to_string(n);
+      return "";
+    }
+    request += " " + a.args[0];
+  } else if (a.command == "reload") {
+    if (n < 2 || n > 3) {
+      error = "reload takes HEAD SLOT [KNOTS] (as the heads' request names them: reload 2 1), got " +
+              std::to_string(n) + " word(s)";
+      return "";
+    }
+    request += " head=" + a.args[0] + " slot=" + a.args[1];
+    if (n == 3) request += " knots=" + a.args[2];
+  } else if (n != 0) {
+    error = a.command + " takes no argument (got '" + a.args[0] + "')";
+    return "";
+  }
+  if (a.hours > 0) request += " hours=" + std::to_string(a.hours);
+  return request;
+}
+
 int ctl_main(const CtlArgs& a) {
   std::string how, path;
   try {
@@ -122,9 +147,12 @@ int ctl_main(const CtlArgs& a) {
     std::fprintf(stderr, "loomctl ctl: %s\n", e.what());
     return 1;
   }
-  std::string request = a.command;
-  if (!a.name.empty()) request += " " + a.name;
-  if (a.hours > 0) request += " hours=" + std::to_string(a.hours);
+  std::string usage_error;
+  const std::string request = ctl_request_line(a, usage_error);
+  if (request.empty()) {
+    std::fprintf(stderr, "loomctl ctl: %s\n", usage_error.c_str());
+    return 2;
+  }
   std::string reply;
   try {
     reply = control_request(path, request, a.timeout_ms);
@@ -201,11 +229,13 @@ BoardCommands::BoardCommands(CLI::App& app) {
   ctl_->add_option(
           "command", c.command,
           "start | pause | resume | stop (at row end) | ack (a fault) | status | faults (history and "
-          "commands) | next | pair NAME (a code for a panel client) | unpair NAME | pairs")
+          "commands) | next | reload HEAD SLOT [KNOTS] (the weaver reloaded a magazine slot; full "
+          "without KNOTS) | pair NAME (a code for a panel client) | unpair NAME | pairs")
       ->required()
-      ->check(CLI::IsMember({"start", "pause", "resume", "stop", "ack", "status", "faults", "next", "pair",
-                             "unpair", "pairs"}));
-  ctl_->add_option("name", c.name, "pair/unpair: the client's name (letters, digits, _ - .)");
+      ->check(CLI::IsMember({"start", "pause", "resume", "stop", "ack", "status", "faults", "next", "reload",
+                             "pair", "unpair", "pairs"}));
+  ctl_->add_option("args", c.args,
+                   "pair/unpair: the client's name (letters, digits, _ - .); reload: HEAD SLOT [KNOTS]");
   ctl_->add_option("--hours", c.hours, "pair: how long the pairing lasts (default 12)")
       ->check(CLI::Range(1, 168));
   ctl_->add_option("--socket", c.socket, "control socket (default /run/loomctl/<loom-id>.sock)");

@@ -12,14 +12,17 @@ bool printable(char c) {
 
 std::optional<CommandClass> class_of(std::string_view w) {
   if (w == "stop" || w == "pause") return CommandClass::kStopping;
-  if (w == "start" || w == "resume" || w == "next" || w == "ack") return CommandClass::kStarting;
+  if (w == "start" || w == "resume" || w == "next" || w == "ack" || w == "reload") {
+    return CommandClass::kStarting;
+  }
   if (w == "status" || w == "faults" || w == "pairs" || w == "whoami") return CommandClass::kReading;
   if (w == "pair" || w == "unpair" || w == "redeem") return CommandClass::kPairing;
   return std::nullopt;
 }
 
 bool known_field(std::string_view k) {
-  return k == "via" || k == "client" || k == "token" || k == "code" || k == "hours" || k == "device";
+  return k == "via" || k == "client" || k == "token" || k == "code" || k == "hours" || k == "device" ||
+         k == "head" || k == "slot" || k == "knots";
 }
 
 std::string word_list() {
@@ -33,6 +36,35 @@ std::string shown(std::string_view s) {
   std::string out;
   for (char c : s.substr(0, 40)) out += printable(c) ? c : '?';
   return out + (s.size() > 40 ? "..." : "");
+}
+
+// A whole number 0..max written in decimal digits only (no sign, no spaces, at most 7 digits).
+bool small_number(const std::string& s, int max) {
+  if (s.empty() || s.size() > 7 || s.find_first_not_of("0123456789") != std::string::npos) return false;
+  return std::stol(s) <= max;
+}
+
+// reload needs head= and slot= (knots= optional); no other word takes them.
+std::string reload_fields_error(const ParsedRequest& r) {
+  const bool reload = r.word == "reload";
+  for (const char* k : {"head", "slot", "knots"}) {
+    if (r.fields.count(k) != 0 && !reload) return std::string(k) + "= is for reload only";
+  }
+  if (!reload) return "";
+  if (r.fields.count("head") == 0 || r.fields.count("slot") == 0) {
+    return "reload needs head=H slot=S (e.g. reload head=2 slot=1; knots=K when not full)";
+  }
+  if (!small_number(r.field("head"), 99) || std::stol(r.field("head")) < 1) {
+    return "head=" + shown(r.field("head")) + ": a head number from 1 (as the request names it)";
+  }
+  if (!small_number(r.field("slot"), 99)) {
+    return "slot=" + shown(r.field("slot")) + ": a slot number from 0 (as the request names it)";
+  }
+  if (r.fields.count("knots") != 0 && !small_number(r.field("knots"), kMaxReloadKnots)) {
+    return "knots=" + shown(r.field("knots")) + ": the knots now in the slot, 0 to " +
+           std::to_string(kMaxReloadKnots);
+  }
+  return "";
 }
 
 }  // namespace
@@ -88,7 +120,7 @@ std::optional<ParsedRequest> parse_request(std::string_view line, std::string& e
     }
     const std::string key(tok.substr(0, eq));
     if (!known_field(key)) {
-      error = "unknown field '" + shown(key) + "' (via, client, token, device, code, hours)";
+      error = "unknown field '" + shown(key) + "' (via, client, token, device, code, hours, head, slot, knots)";
       return std::nullopt;
     }
     if (r.fields.size() >= kMaxFields || r.fields.count(key) != 0) {
@@ -120,6 +152,10 @@ std::optional<ParsedRequest> parse_request(std::string_view line, std::string& e
   }
   if (r.fields.count("hours") != 0 && r.word != "pair") {
     error = "hours= is for pair only";
+    return std::nullopt;
+  }
+  if (auto e = reload_fields_error(r); !e.empty()) {
+    error = e;
     return std::nullopt;
   }
   if (r.fields.count("code") != 0 && r.word != "redeem") {

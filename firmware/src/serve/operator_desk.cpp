@@ -66,6 +66,21 @@ std::string OperatorDesk::answer_in_state(const std::string& word, const LoomVie
 std::string OperatorDesk::refuse_for_state(const ParsedRequest& r, const LoomView& v) const {
   const std::string& w = r.word;
   const std::string state = sequencer::state_name(v.state);
+  if (w == "reload") {  // in any state, a fault too: the yarn the weaver put in is a fact
+    if (v.heads == 0) return "this loom has no knotting heads (knotting.mode is not \"heads\")";
+    const int head = std::stoi(r.field("head")), slot = std::stoi(r.field("slot"));
+    if (head > v.heads) {
+      return "head=" + r.field("head") + ": this loom has heads 1 to " + std::to_string(v.heads);
+    }
+    if (slot >= v.slots) {
+      return "slot=" + r.field("slot") + ": the magazines have slots 0 to " + std::to_string(v.slots - 1);
+    }
+    if (!r.field("knots").empty() && std::stoi(r.field("knots")) > v.knots_per_slot) {
+      return "knots=" + r.field("knots") + ": a slot holds at most " + std::to_string(v.knots_per_slot) +
+             " knots (knotting.knots_per_slot)";
+    }
+    return "";
+  }
   if (v.state == State::kFault && w != "ack") {
     return fault_of(v) + " is latched: acknowledge it first (ctl ack)";
   }
@@ -229,7 +244,11 @@ Decision OperatorDesk::decide(const ControlRequest& req, const LoomView& v, std:
     d.post = Command::kStop;
   else if (r.word == "ack")
     d.post = Command::kAck;
-  else
+  else if (r.word == "reload") {
+    d.post = Command::kReload;
+    d.reload = Decision::Reload{std::stoi(r.field("head")) - 1, std::stoi(r.field("slot")),
+                                r.field("knots").empty() ? -1 : std::stoi(r.field("knots"))};
+  } else
     d.post = Command::kNext;
   d.reply = "ok " + r.word + "\n";
   return d;

@@ -271,6 +271,11 @@ class Service {
     LoomView view = view_of(link_, cfg_.sequencer.knotting);
     view.counters_unsaved = counters_unsaved_.load(std::memory_order_acquire);
     view.pause_pending = pause_pending_.load(std::memory_order_acquire);
+    if (cfg_.knotting.mode == sequencer::KnottingMode::kHeads) {
+      view.heads = cfg_.knotting.heads;
+      view.slots = static_cast<int>(cfg_.knotting.slot_colours.size());
+      view.knots_per_slot = cfg_.knotting.knots_per_slot;
+    }
     Decision d = desk_.decide(req, view, static_cast<std::int64_t>(std::time(nullptr)));
     if (d.post == Command::kStart &&
         (view.state == sequencer::State::kIdle || view.state == sequencer::State::kDone)) {
@@ -304,10 +309,17 @@ class Service {
         ack_at_ = std::chrono::steady_clock::now();
       }
       if (*d.post == Command::kStart) started_at_machine(d);
+      if (*d.post == Command::kReload && d.reload) {
+        link_.post_reload(d.reload->head, d.reload->slot, d.reload->knots);
+        d.reply = "ok reload head " + std::to_string(d.reload->head + 1) + " slot " +
+                  std::to_string(d.reload->slot) + ": " +
+                  (d.reload->knots < 0 ? std::string("full") : std::to_string(d.reload->knots) + " knots") +
+                  "\n";
+      }
       if (*d.post == Command::kPause) pause_pending_.store(true, std::memory_order_release);
       if (*d.post == Command::kResume || *d.post == Command::kStop)
         pause_pending_.store(false, std::memory_order_release);
-      link_.post(*d.post);
+      if (*d.post != Command::kReload) link_.post(*d.post);
     }
     if (d.audit) audit(history_, cfg_.loom_id, req.line, d, command_events_.get(), view.state, link_);
     return d.reply;
@@ -365,6 +377,9 @@ class Service {
     if (!a_.no_telemetry) refuse_a_twin();
     MachineOptions mo;
     mo.design_rows_done = design_rows;
+    if (record_.jobs() != nullptr && armed.refusal.empty()) {
+      mo.carpet_began = carpet_began(resume.rows, design_rows);
+    }
     mo.telemetry = !a_.no_telemetry;
     mo.rows = a_.rows == 0 ? 0 : resume.rows + a_.rows;
     if (armed.rows_left > 0) {
@@ -373,8 +388,14 @@ class Service {
     }
     mo.await_row_saved = true;  // the state dir always keeps the counters
     if (!so_.hardware()) mo.sim_state_path = state_ + "/sim-state.bin";
-    sequencer::Sequencer& seq = session.build(armed.cfg, scene_, mo, resume).sequencer();
-    if (const auto levels = record_.load_magazines(say_in_journal)) seq.restore_magazines(*levels);
+    Machine& machine = session.build(armed.cfg, scene_, mo, resume);
+    sequencer::Sequencer& seq = machine.sequencer();
+    const auto levels = record_.load_magazines(say_in_journal);
+    if (levels) seq.restore_magazines(*levels);
+    // The yarn for the job's rows left (or the run's rows; a loom weaving on without end: the next 100).
+    constexpr std::uint64_t kForecastRowsUnbounded = 100;
+    const std::uint64_t forecast_rows = mo.rows != 0 ? mo.rows - resume.rows : kForecastRowsUnbounded;
+    record_.say_yarn_forecast(machine.knot_program(), levels, resume.rows, forecast_rows, say_in_journal);
     {
       std::lock_guard<std::mutex> lock(job_mu_);
       armed_design_ = armed.cfg.recipe.design;
@@ -678,6 +699,14 @@ class Service {
         heard_weaver_request(e, machine);
         record_job_event(e, machine);
         return;  // nothing changed in the counters
+      case RunEvent::Kind::kReloaded:
+        // Kept at once: a power cut after a reload must not ask for it again.
+        try {
+          record_.save_magazines(e);
+        } catch (const std::exception& ex) {
+          log(Severity::kWarning, "the magazines' levels after a reload were not saved: %s", ex.what());
+        }
+        return;  // the counters did not change
       case RunEvent::Kind::kPickDone:
       case RunEvent::Kind::kKnotProgress:
       case RunEvent::Kind::kFinished:

@@ -1,7 +1,8 @@
 // The operator policy (firmware/include/loom/firmware/operator_policy.hpp) over every sequencer state × every
 // command, alone and with every other command in the same tick: what each command asks of the sequencer, when
 // the session ends, which acknowledgements are refused — and the rule the whole table keeps: a stopping
-// command (pause, stop, exit) never comes with a starting request (start, resume, row knotted, acknowledge)
+// command (pause, stop, exit) never comes with a starting request (start, resume, row knotted, reload,
+// acknowledge)
 // and never ends a session for a start.
 #include "loom/firmware/operator_policy.hpp"
 
@@ -23,7 +24,7 @@ constexpr std::array kStates = {
     State::kShed,     State::kPick,     State::kBeatSweep, State::kRowEnd,      State::kAwaitKnotting,
     State::kKnotting, State::kPaused,   State::kDone,      State::kFault};
 constexpr std::array kCommands = {Command::kStart, Command::kPause, Command::kResume, Command::kStop,
-                                  Command::kAck,   Command::kExit,  Command::kNext};
+                                  Command::kAck,   Command::kExit,  Command::kNext,   Command::kReload};
 
 std::uint32_t bit(Command c) {
   return static_cast<std::uint32_t>(c);
@@ -35,15 +36,16 @@ bool moving(State s) {
   return s != State::kIdle && s != State::kPaused && s != State::kDone && s != State::kFault;
 }
 std::string name(std::uint32_t cmds) {
-  static const char* names[] = {"start", "pause", "resume", "stop", "ack", "exit", "next"};
+  static const char* names[] = {"start", "pause", "resume", "stop", "ack", "exit", "next", "reload"};
   std::string out;
-  for (int i = 0; i < 7; ++i) {
+  for (int i = 0; i < 8; ++i) {
     if ((cmds & (1u << i)) != 0) out += (out.empty() ? "" : "+") + std::string(names[i]);
   }
   return out;
 }
 bool starts_anything(const Decision& d) {
-  return d.start || d.resume || d.row_knotted || d.acknowledge || d.end == Decision::End::kStartRequested ||
+  return d.start || d.resume || d.row_knotted || d.reload || d.acknowledge ||
+         d.end == Decision::End::kStartRequested ||
          d.end == Decision::End::kAckRequested;
 }
 
@@ -72,11 +74,12 @@ TEST(OperatorPolicy, AStoppingCommandNeverComesWithAStartingRequestInAnyState) {
       }
     }
   }
-  EXPECT_EQ(checked, 2 * 14 * (128 - 16));  // every set that holds pause, stop or exit
+  EXPECT_EQ(checked, 2 * 14 * (256 - 32));  // every set that holds pause, stop or exit
 }
 
 struct Expect {
   bool stop = false, pause = false, resume = false, start = false, acknowledge = false, row_knotted = false;
+  bool reload = false;
   bool exit_when_quiet = false;
   Decision::End end = Decision::End::kNone;
 };
@@ -102,6 +105,9 @@ Expect expected(Command c, State s, bool held) {
       break;
     case Command::kNext:
       e.row_knotted = true;
+      break;
+    case Command::kReload:
+      e.reload = true;  // in every state: the yarn put in is a fact (it answers only an open reload request)
       break;
     case Command::kStart:
       if (s == State::kDone && held) {
@@ -141,6 +147,7 @@ TEST(OperatorPolicy, EachCommandAloneInEachState) {
         EXPECT_EQ(d.start, e.start) << what;
         EXPECT_EQ(d.acknowledge, e.acknowledge) << what;
         EXPECT_EQ(d.row_knotted, e.row_knotted) << what;
+        EXPECT_EQ(d.reload, e.reload) << what;
         EXPECT_EQ(d.exit_when_quiet, e.exit_when_quiet) << what;
         EXPECT_EQ(d.end, e.end) << what;
         EXPECT_EQ(d.refusal, Decision::Refusal::kNone) << what;

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "loom/firmware/serve/commands.hpp"
 
@@ -77,4 +78,26 @@ TEST_F(CtlTarget, WithoutAnIdFileTheOnlySocketServedHere) {
   write(dir_ / "run" / "loom8.sock", "");
   EXPECT_NE(error_of().find("has 2 (loom7.sock, loom8.sock): give --loom-id ID"), std::string::npos)
       << error_of();
+}
+
+// The request line ctl sends: the words after the command as the socket takes them.
+TEST(CtlRequestLine, EachCommandTakesItsOwnWords) {
+  const auto line = [](const std::string& cmd, std::vector<std::string> args, int hours = 0) {
+    CtlArgs a;
+    a.command = cmd;
+    a.args = std::move(args);
+    a.hours = hours;
+    std::string error;
+    const std::string l = loom::firmware::serve::ctl_request_line(a, error);
+    return l.empty() ? "error: " + error : l;
+  };
+  EXPECT_EQ(line("reload", {"2", "1"}), "reload head=2 slot=1");
+  EXPECT_EQ(line("reload", {"2", "1", "120"}), "reload head=2 slot=1 knots=120");
+  EXPECT_EQ(line("reload", {"2"}),
+            "error: reload takes HEAD SLOT [KNOTS] (as the heads' request names them: reload 2 1), got 1 "
+            "word(s)");
+  EXPECT_EQ(line("pair", {"tablet-1"}, 12), "pair tablet-1 hours=12");
+  EXPECT_EQ(line("pair", {}), "error: pair takes one NAME (e.g. pair tablet-1), got 0");
+  EXPECT_EQ(line("status", {}), "status");
+  EXPECT_EQ(line("start", {"now"}), "error: start takes no argument (got 'now')");
 }

@@ -259,3 +259,56 @@ TEST(OperatorDesk, ResumeWithdrawsAPauseNotReachedYet) {
   v.state = State::kDone;
   EXPECT_FALSE(desk.decide(local("resume"), v, kNow).accepted());
 }
+
+// `reload head=H slot=S [knots=K]` (ctl reload HEAD SLOT [KNOTS]): the weaver put yarn in a magazine slot.
+// Accepted in every state (a fault too: the yarn is there), from a local user or a paired panel client only
+// (it answers the heads' request to reload that slot, and they go on); checked against the loom's heads,
+// slots and slot size; handed to the loop with the numbers 0-based.
+TEST(OperatorDesk, AReloadIsAFactInEveryStateFromAStationThatSeesTheLoom) {
+  Pairings pairings;
+  OperatorDesk desk(pairings, "can0");
+  const auto with_heads = [](State s) {
+    LoomView v = view(s);
+    v.heads = 3;
+    v.slots = 4;
+    v.knots_per_slot = 150;
+    return v;
+  };
+  for (const Row& row : kTable) {
+    SCOPED_TRACE(row.name);
+    const Decision d = desk.decide(local("reload head=2 slot=3 knots=40"), with_heads(row.state), kNow);
+    EXPECT_TRUE(d.accepted()) << d.reply;
+    ASSERT_TRUE(d.post.has_value());
+    EXPECT_EQ(*d.post, firmware::Command::kReload);
+    ASSERT_TRUE(d.reload.has_value());
+    EXPECT_EQ(d.reload->head, 1);
+    EXPECT_EQ(d.reload->slot, 3);
+    EXPECT_EQ(d.reload->knots, 40);
+    EXPECT_TRUE(d.audit);
+  }
+  const LoomView v = with_heads(State::kKnotting);
+  const Decision full = desk.decide(local("reload head=1 slot=0"), v, kNow);
+  ASSERT_TRUE(full.reload.has_value());
+  EXPECT_EQ(full.reload->knots, -1);  // full
+  const Decision unpaired = desk.decide(local("reload head=1 slot=0 via=panel client=10.0.0.7"), v, kNow);
+  EXPECT_FALSE(unpaired.post.has_value());
+  EXPECT_NE(unpaired.reply.find("paired panel client"), std::string::npos) << unpaired.reply;
+  EXPECT_EQ(desk.decide(local("reload head=4 slot=0"), v, kNow).reply,
+            "refused: reload: head=4: this loom has heads 1 to 3\n");
+  EXPECT_EQ(desk.decide(local("reload head=1 slot=4"), v, kNow).reply,
+            "refused: reload: slot=4: the magazines have slots 0 to 3\n");
+  EXPECT_EQ(desk.decide(local("reload head=1 slot=0 knots=151"), v, kNow).reply,
+            "refused: reload: knots=151: a slot holds at most 150 knots (knotting.knots_per_slot)\n");
+  EXPECT_NE(desk.decide(local("reload head=1 slot=0"), view(State::kKnotting), kNow)
+                .reply.find("no knotting heads"),
+            std::string::npos);
+  EXPECT_EQ(desk.decide(local("reload head=1"), v, kNow).reply,
+            "error: reload needs head=H slot=S (e.g. reload head=2 slot=1; knots=K when not full)\n");
+  EXPECT_EQ(desk.decide(local("reload head=0 slot=1"), v, kNow).reply,
+            "error: head=0: a head number from 1 (as the request names it)\n");
+  EXPECT_EQ(desk.decide(local("reload head=1 slot=-1"), v, kNow).reply,
+            "error: slot=-1: a slot number from 0 (as the request names it)\n");
+  EXPECT_EQ(desk.decide(local("reload head=1 slot=1 knots=9999999"), v, kNow).reply,
+            "error: knots=9999999: the knots now in the slot, 0 to 1000000\n");
+  EXPECT_EQ(desk.decide(local("start slot=1"), v, kNow).reply, "error: slot= is for reload only\n");
+}

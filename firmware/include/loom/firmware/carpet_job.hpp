@@ -18,6 +18,11 @@
 
 namespace loom::firmware {
 
+// The production row a job's carpet began at: `counter_rows` now, less the job's rows woven (`job_rows`).
+inline std::uint32_t carpet_began(std::uint32_t counter_rows, std::uint64_t job_rows) {
+  return job_rows >= counter_rows ? 0 : counter_rows - static_cast<std::uint32_t>(job_rows);
+}
+
 class CarpetJob {
  public:
   // The queue of `state_dir` (absent: empty). job::JobError on a bad file, naming file:line and field.

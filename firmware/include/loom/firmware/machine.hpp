@@ -40,6 +40,9 @@ struct MachineOptions {
   // The recipe's design: rows of it woven before this session (from the design book), so DESIGN
   // telemetry shows the weaver the right row to knot next.
   std::uint64_t design_rows_done = 0;
+  // A carpet job's first production row: the simulated carpet kept in the sim-state file is this job's
+  // only if it began there or later (the carpet before it was cut off; `job start-over` starts another).
+  std::optional<std::uint32_t> carpet_began;
 };
 
 // Printed on every start when real drives run beside simulated I/O.

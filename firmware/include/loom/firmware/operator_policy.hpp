@@ -7,8 +7,8 @@
 //   stopping  pause, stop, exit (and the second SIGINT/SIGTERM: stop now) — from anywhere; never lead to
 //             motion: a stopping command only ever keeps the next motion from starting
 //             (Sequencer::request_stop).
-//   starting  start, resume, next (row knotted / the weaver's answer), acknowledge — from where the loom is
-//             seen. A starting command given in the same tick as a stopping one is dropped: stopping wins.
+//   starting  start, resume, next (row knotted / the weaver's answer), reload, acknowledge — from where the
+//             loom is seen. A starting command given in the same tick as a stopping one is dropped: stopping wins.
 #pragma once
 
 #include <cstdint>
@@ -28,6 +28,9 @@ enum class Command : std::uint32_t {
   kAck = 1u << 4,   // acknowledge a latched fault (held session: kAckRequested, the owner re-arms)
   kExit = 1u << 5,  // leave the loop (service shutdown): a stop first when the loom is moving
   kNext = 1u << 6,  // knotting: the weaver has knotted the row, or done what the heads asked
+  // knotting heads: the weaver reloaded magazine slots (OperatorLink::post_reload says which and how much);
+  // answers the heads' request to reload that slot, so it is a starting command
+  kReload = 1u << 7,
 };
 
 constexpr std::uint32_t kStoppingCommands = static_cast<std::uint32_t>(Command::kPause) |
@@ -35,7 +38,8 @@ constexpr std::uint32_t kStoppingCommands = static_cast<std::uint32_t>(Command::
                                             static_cast<std::uint32_t>(Command::kExit);
 constexpr std::uint32_t kStartingCommands =
     static_cast<std::uint32_t>(Command::kStart) | static_cast<std::uint32_t>(Command::kResume) |
-    static_cast<std::uint32_t>(Command::kNext) | static_cast<std::uint32_t>(Command::kAck);
+    static_cast<std::uint32_t>(Command::kNext) | static_cast<std::uint32_t>(Command::kAck) |
+    static_cast<std::uint32_t>(Command::kReload);
 
 struct PolicyInputs {
   std::uint32_t commands = 0;  // Command bits of this tick
@@ -60,6 +64,7 @@ struct Decision {
   bool start = false;
   bool acknowledge = false;
   bool row_knotted = false;
+  bool reload = false;  // take the reloads posted (the runner: OperatorLink::take_reloads)
   bool exit_when_quiet = false;  // leave the loop once nothing is moving towards a goal
   enum class End : std::uint8_t {
     kNone,

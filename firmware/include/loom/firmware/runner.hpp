@@ -7,9 +7,11 @@
 // SCHED_OTHER. Only this module and main read the clock, through the injectable LoopClock.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "loom/firmware/control_loop.hpp"
@@ -65,6 +67,29 @@ struct OperatorLink {
   void post(Command c) noexcept {
     pending.fetch_or(static_cast<std::uint32_t>(c), std::memory_order_release);
   }
+  // The weaver reloaded slot `slot` of head `head` (0-based) with `knots` knots (negative: full): stored
+  // per slot before Command::kReload is posted, so two reloads of different slots are both taken, and a
+  // second of the same slot before the loop's next tick replaces the first (the weaver's latest word).
+  void post_reload(int head, int slot, std::int32_t knots) noexcept {
+    if (head < 0 || head >= static_cast<int>(hal::kMaxKnottingHeads) || slot < 0 ||
+        slot >= static_cast<int>(sequencer::kMaxMagazineSlots)) {
+      return;
+    }
+    reloads[static_cast<std::size_t>(head)][static_cast<std::size_t>(slot)].store(
+        knots < 0 ? kReloadFull : knots + kReloadOffset, std::memory_order_relaxed);
+    post(Command::kReload);
+  }
+  // The loop's side: the reload waiting for a slot, taken (nullopt: none; -1: full; else the knots).
+  std::optional<std::int32_t> take_reload(int head, int slot) noexcept {
+    const std::int32_t v = reloads[static_cast<std::size_t>(head)][static_cast<std::size_t>(slot)].exchange(
+        kNoReload, std::memory_order_acquire);
+    if (v == kNoReload) return std::nullopt;
+    return v == kReloadFull ? -1 : v - kReloadOffset;
+  }
+  // Stored as 0 (none: a default-constructed atomic), 1 (full) or knots + 2.
+  static constexpr std::int32_t kNoReload = 0, kReloadFull = 1, kReloadOffset = 2;
+  std::array<std::array<std::atomic<std::int32_t>, sequencer::kMaxMagazineSlots>, hal::kMaxKnottingHeads>
+      reloads{};
 
   std::atomic<std::uint8_t> state{0};        // sequencer::State
   std::atomic<std::uint8_t> first_fault{0};  // sequencer::Fault
@@ -95,7 +120,8 @@ struct RunEvent {
     kFinished,
     kButton,
     kKnotProgress,
-    kWeaverRequest
+    kWeaverRequest,
+    kReloaded,  // the weaver's reloads were taken: `stock` holds the magazines' levels after them
   };
   Kind kind = Kind::kRowDone;
   hal::Tick tick = 0;
@@ -111,7 +137,7 @@ struct RunEvent {
   Command button =
       Command::kStart;  // kButton: the I/O module's button pressed (audit_buttons); kNext: the pedal
   sequencer::WeaverRequest request{};  // kWeaverRequest
-  // kRowDone on a loom with knotting heads: the magazines' levels as the loom counts them at the row's end
+  // kRowDone (and kReloaded) on a loom with knotting heads: the magazines' levels as the loom counts them at the row's end
   // (kept in the state directory, so a restart starts from them).
   bool stock_known = false;
   sequencer::MagazineLevels stock{};

@@ -125,8 +125,15 @@ class ProductionRecord {
   // The levels to arm with; nullopt (start full) when there is no file yet or it is for other magazines,
   // said through `say`. ConfigError on a file that is not a magazines file.
   std::optional<sequencer::MagazineLevels> load_magazines(const Say& say) const;
-  // A row's end (kRowDone with stock_known): the levels written durably. Throws as the counters' save does.
+  // A row's end or a reload (kRowDone, kReloaded with stock_known): the levels written durably. Throws as
+  // the counters' save does.
   void save_magazines(const RunEvent& e) const;
+  // Arming: which slots run out in the `rows` rows from production row `next_row` (0-based) at the levels
+  // the loom arms with (`levels`; nullopt: full magazines), one line each through `say` — the loom asks
+  // for each reload before the row that needs it. Nothing said without kept magazines or without heads.
+  void say_yarn_forecast(const sequencer::KnotProgram* program,
+                         const std::optional<sequencer::MagazineLevels>& levels, std::uint32_t next_row,
+                         std::uint64_t rows, const Say& say) const;
   // Arming: the recipe's design made the active one at `counter_rows`; returns the rows of it woven
   // before (0 without a design or without a record). With a job: the job's rows woven. ConfigError when
   // the book cannot be read or written.

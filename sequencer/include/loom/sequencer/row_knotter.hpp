@@ -51,6 +51,9 @@ struct WeaverRequest {
   int knot = -1;          // 0-based knot in the row (left selvedge = 0); -1 for a reload
   int head = -1;          // 0-based head
   int slot = -1;          // magazine slot (its colour: the knot's, or the one to reload)
+  // kReload asked before a row (the forecast): the knots the rest of the row takes from the slot and those
+  // left in it; both 0 when the slot ran dry in the middle of a row (a retried knot took more yarn).
+  std::int32_t knots_needed = 0, knots_left = 0;
 };
 
 // Not RT (allocates). What the request asks, in the weaver's words, naming the colour by its palette code:
@@ -139,6 +142,10 @@ class RowKnotter {
   // Not RT (arming, before the first row): the magazines' levels kept from before a restart (knots per
   // slot, [head][slot]; a negative level is read as empty) instead of full magazines at the first row.
   void restore_stock(const MagazineLevels& levels) noexcept;
+  // RT-safe. The weaver put yarn in slot `slot` of head `head` (both 0-based): it now holds `knots` knots
+  // (negative: full; more than a full slot is read as full). It answers an open request to reload that
+  // slot (the heads go on). False, and nothing changed, when there is no such head or slot.
+  bool reload(int head, int slot, std::int32_t knots) noexcept;
   std::int32_t stock(int head, int slot) const noexcept {
     if (!stock_known_ || head < 0 || head >= heads_ || slot < 0 || slot >= kMaxMagazineSlots) return -1;
     return stock_[static_cast<std::size_t>(head)][static_cast<std::size_t>(slot)];
@@ -172,6 +179,7 @@ class RowKnotter {
   void run_cycle(hal::Tick now, const hal::HalInputs& in, hal::HalOutputs& cmd,
                  KnotCounters& counters) noexcept;
   Status weaver(hal::Tick now, const hal::HalOutputs& cmd, KnotCounters& counters, bool weaver_done) noexcept;
+  bool ask_reload_for_row(hal::Tick now) noexcept;  // the forecast before the row's knots: true when it asked
   bool play(Move& m, hal::Tick now,
             double& target) const noexcept;  // true when it moved the target this tick
   bool fail(Fault f, int axis) noexcept;
@@ -194,6 +202,8 @@ class RowKnotter {
   bool interrupted_ = false;             // cycle j_ was started before a power cut: ask the weaver first
   std::uint32_t heads_done_at_cut_ = 0;  // ... except of these heads, whose knots the counters hold
   int ask_head_ = 0;                     // next head to consider for a request in kWeaver
+  bool forecast_due_ = false;    // the row's yarn is not checked yet: no cycle of this begin() has started
+  bool reload_answered_ = false;  // reload() filled the slot the open kReload request names
   WeaverAsk hand_ask_ = WeaverAsk::kTieByHand;  // what kWeaver asks for the heads in missed_
   Move carriage_move_{};
   std::array<Move, hal::kMaxKnottingHeads> selector_move_{};

@@ -220,6 +220,11 @@ class Sequencer {
   const RowKnotter& knotter() const noexcept { return knotter_; }
   // Not RT (arming): the magazines' levels from before a restart (RowKnotter::restore_stock).
   void restore_magazines(const MagazineLevels& levels) noexcept { knotter_.restore_stock(levels); }
+  // RT-safe. The weaver reloaded a slot (RowKnotter::reload): in any state, it only sets the level; an open
+  // request to reload that slot is answered by it.
+  bool reload_magazine(int head, int slot, std::int32_t knots) noexcept {
+    return knotter_.reload(head, slot, knots);
+  }
   // RT-safe. The knot cycle the heads are on (0-based) while knotting.
   int knot_cycle() const noexcept { return knotter_.cycle(); }
 

@@ -13,6 +13,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "loom/hal/types.hpp"
@@ -122,8 +123,11 @@ class SimKnotter {
   // Configure-time. Keep the carpet and the magazines in `keeper` (a sim-state file's): a carpet found there
   // for this loom's width is adopted (the run after a power cut carries on knotting it), otherwise a fresh
   // one is started there at production row `counter_rows`; either way its room grows to the run's rows.
+  // `carpet_began`: the production row the carpet on the loom began at (a carpet job's first row): a kept
+  // carpet begun before it is another carpet, cut off the loom, and a fresh one starts.
   // Throws std::runtime_error when the keeper cannot have the room.
-  void persist_in(CarpetKeeper& keeper, std::uint32_t counter_rows);
+  void persist_in(CarpetKeeper& keeper, std::uint32_t counter_rows,
+                  std::optional<std::uint32_t> carpet_began = std::nullopt);
   // Configure-time, the knotter's own carpet (no keeper): a fresh carpet at production row `counter_rows`.
   void start_at_row(std::uint32_t counter_rows);
   std::uint32_t first_row() const noexcept { return st_->first_row; }
@@ -166,7 +170,8 @@ class SimKnotter {
   std::uint8_t current_cell(int knot) const noexcept;
   void tie(int knot, int slot, bool by_hand) noexcept;
   int rows_needed(std::uint32_t first_row, int rows_knotted) const noexcept;
-  void keep_in(CarpetKeeper& keeper, std::uint32_t counter_rows, bool adopt);
+  void keep_in(CarpetKeeper& keeper, std::uint32_t counter_rows, bool adopt,
+               std::optional<std::uint32_t> carpet_began = std::nullopt);
 
   SimKnotting m_;
   Knotter k_;

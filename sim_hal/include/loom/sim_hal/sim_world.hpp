@@ -63,7 +63,8 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   void attach_state_file(SimStateFile& file);
   // Configure-time, after attach_state_file (if any). The knotting heads' carpet begins (or, kept in the
   // state file from before a power cut, carries on) at production row `counter_rows`.
-  void persist_carpet(std::uint32_t counter_rows);
+  // `carpet_began`: see SimKnotter::persist_in (a carpet job's first row).
+  void persist_carpet(std::uint32_t counter_rows, std::optional<std::uint32_t> carpet_began = std::nullopt);
 
   // Ground truth for tests and reports (not what the controller sees).
   const SimAxis& axis(hal::CoreAxis a) const { return axes_[hal::index(a)]; }

@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace loom::firmware::serve {
 
@@ -34,7 +35,7 @@ int serve_main(const ServeArgs& a);
 
 struct CtlArgs {
   std::string command;
-  std::string name;  // pair/unpair NAME
+  std::vector<std::string> args;  // pair/unpair NAME; reload HEAD SLOT [KNOTS]
   int hours = 0;     // pair: 0 → the service's default
   std::string socket;
   std::string loom_id;  // "" → the board's (ctl_socket)
@@ -44,6 +45,9 @@ struct CtlArgs {
   std::string run_dir = "/run/loomctl";
 };
 int ctl_main(const CtlArgs& a);
+// The request line `a` sends (`pair tablet-1 hours=12`, `reload head=2 slot=1 knots=300`); "" and `error`
+// set when the words after the command do not fit it.
+std::string ctl_request_line(const CtlArgs& a, std::string& error);
 
 // The control socket `ctl` talks to: --socket; else <run_dir>/<id>.sock for --loom-id; else for the
 // board's id (LOOMCTL_LOOM_ID= in the loom-id file postinst writes); else the only socket in run_dir.

@@ -3,7 +3,8 @@
 // a command that starts motion or resets a fault is given where the hazard zone can be seen):
 //   stopping  stop, pause                     — from anyone allowed on the socket, paired or not
 //   starting  start, resume, next, ack        — only from a trusted station: a local socket user, or a
-//                                                panel client paired with this loom
+//             reload head=H slot=S [knots=K]    panel client paired with this loom (a reload answers the
+//                                                heads' request to reload that slot: they go on)
 //   reading   status, faults, pairs, whoami
 //   pairing   pair NAME [hours=H], unpair NAME — local socket users only (never through the panel)
 //             redeem code=CODE                — a panel client turns a pairing code into its token
@@ -23,7 +24,8 @@ enum class CommandClass { kStopping, kStarting, kReading, kPairing };
 struct ParsedRequest {
   std::string word;                           // "start", "pair", ...
   std::string arg;                            // the positional argument (pair/unpair NAME), else ""
-  std::map<std::string, std::string> fields;  // key=value pairs (via, client, token, device, code, hours)
+  // key=value pairs (via, client, token, device, code, hours; reload's head, slot, knots)
+  std::map<std::string, std::string> fields;
   CommandClass cls = CommandClass::kReading;
   bool via_panel() const { return fields.count("via") != 0 && fields.at("via") == "panel"; }
   std::string field(const std::string& k) const {
@@ -33,9 +35,13 @@ struct ParsedRequest {
 };
 
 // The command words, in the order help lists them.
-inline constexpr const char* kCommandWords[] = {"start", "pause",  "resume", "stop", "ack",
-                                                "next",  "status", "faults", "pair", "unpair",
-                                                "pairs", "redeem", "whoami"};
+inline constexpr const char* kCommandWords[] = {"start",  "pause",  "resume", "stop",   "ack",
+                                                "next",   "reload", "status", "faults", "pair",
+                                                "unpair", "pairs",  "redeem", "whoami"};
+
+// reload's numbers as the weaver reads them in the request ("reload colour R into slot 1 of head 2"):
+// head=2 slot=1; knots= optional (the slot is full without it).
+inline constexpr int kMaxReloadKnots = 1000000;
 
 // Parses one request line. nullopt and `error` set ("unknown command 'x' (start, ...)", "bad field ...")
 // when the line is not a request; never throws on any input.

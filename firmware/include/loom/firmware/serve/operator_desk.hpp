@@ -36,6 +36,8 @@ struct LoomView {
   // set by an accepted pause, cleared when the loom pauses, resumes, faults or a session ends). A resume
   // then withdraws it.
   bool pause_pending = false;
+  // The knotting heads' magazines (0 heads: none), for `reload`'s range check.
+  int heads = 0, slots = 0, knots_per_slot = 0;
 };
 LoomView view_of(const OperatorLink& link, bool knotting);
 
@@ -43,6 +45,11 @@ struct Decision {
   enum class Read { kNone, kStatus, kFaults };
   std::string reply;            // complete unless read != kNone (then the caller answers)
   std::optional<Command> post;  // the command to hand to the loop
+  struct Reload {
+    int head = 0, slot = 0;  // 0-based
+    std::int32_t knots = -1;  // -1: full
+  };
+  std::optional<Reload> reload;  // post == kReload: what to post with it (OperatorLink::post_reload)
   Read read = Read::kNone;
   std::string who;      // "local user anna (uid 1000, pid 42)", "panel client 10.0.0.5 paired as tab1 ..."
   std::string station;  // "local" (the socket) or "panel" (a loom-panel client): the COMMAND event's station
