@@ -284,8 +284,8 @@ TEST(Knotting, AReloadAnswersTheHeadsRequestWithTheWeaversCount) {
   s.run([] { return false; }, 5);
   EXPECT_TRUE(asked());
   EXPECT_EQ(seq.knotter().stock(r.head, other), 7);
-  EXPECT_FALSE(seq.reload_magazine(3, 0, 5));   // the sample loom has heads 0..2
-  EXPECT_FALSE(seq.reload_magazine(0, 3, 5));   // ... and slots 0..2
+  EXPECT_FALSE(seq.reload_magazine(3, 0, 5));  // the sample loom has heads 0..2
+  EXPECT_FALSE(seq.reload_magazine(0, 3, 5));  // ... and slots 0..2
   EXPECT_FALSE(seq.reload_magazine(-1, 0, 5));
   const std::uint32_t requests = seq.knotter().requests();
   EXPECT_TRUE(seq.reload_magazine(r.head, r.slot, r.knots_needed - 1));  // one knot short

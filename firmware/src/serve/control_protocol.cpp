@@ -120,7 +120,8 @@ std::optional<ParsedRequest> parse_request(std::string_view line, std::string& e
     }
     const std::string key(tok.substr(0, eq));
     if (!known_field(key)) {
-      error = "unknown field '" + shown(key) + "' (via, client, token, device, code, hours, head, slot, knots)";
+      error =
+          "unknown field '" + shown(key) + "' (via, client, token, device, code, hours, head, slot, knots)";
       return std::nullopt;
     }
     if (r.fields.size() >= kMaxFields || r.fields.count(key) != 0) {

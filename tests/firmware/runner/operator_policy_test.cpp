@@ -45,8 +45,7 @@ std::string name(std::uint32_t cmds) {
 }
 bool starts_anything(const Decision& d) {
   return d.start || d.resume || d.row_knotted || d.reload || d.acknowledge ||
-         d.end == Decision::End::kStartRequested ||
-         d.end == Decision::End::kAckRequested;
+         d.end == Decision::End::kStartRequested || d.end == Decision::End::kAckRequested;
 }
 
 // Every state, held session or not, every command alone and every pair: the stopping class never starts.

@@ -8,7 +8,8 @@
 //             motion: a stopping command only ever keeps the next motion from starting
 //             (Sequencer::request_stop).
 //   starting  start, resume, next (row knotted / the weaver's answer), reload, acknowledge — from where the
-//             loom is seen. A starting command given in the same tick as a stopping one is dropped: stopping wins.
+//             loom is seen. A starting command given in the same tick as a stopping one is dropped: stopping
+//             wins.
 #pragma once
 
 #include <cstdint>
@@ -64,7 +65,7 @@ struct Decision {
   bool start = false;
   bool acknowledge = false;
   bool row_knotted = false;
-  bool reload = false;  // take the reloads posted (the runner: OperatorLink::take_reloads)
+  bool reload = false;           // take the reloads posted (the runner: OperatorLink::take_reloads)
   bool exit_when_quiet = false;  // leave the loop once nothing is moving towards a goal
   enum class End : std::uint8_t {
     kNone,

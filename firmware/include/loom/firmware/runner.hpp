@@ -137,8 +137,8 @@ struct RunEvent {
   Command button =
       Command::kStart;  // kButton: the I/O module's button pressed (audit_buttons); kNext: the pedal
   sequencer::WeaverRequest request{};  // kWeaverRequest
-  // kRowDone (and kReloaded) on a loom with knotting heads: the magazines' levels as the loom counts them at the row's end
-  // (kept in the state directory, so a restart starts from them).
+  // kRowDone (and kReloaded) on a loom with knotting heads: the magazines' levels as the loom counts them at
+  // the row's end (kept in the state directory, so a restart starts from them).
   bool stock_known = false;
   sequencer::MagazineLevels stock{};
 };

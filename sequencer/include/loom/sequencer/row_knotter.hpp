@@ -202,7 +202,7 @@ class RowKnotter {
   bool interrupted_ = false;             // cycle j_ was started before a power cut: ask the weaver first
   std::uint32_t heads_done_at_cut_ = 0;  // ... except of these heads, whose knots the counters hold
   int ask_head_ = 0;                     // next head to consider for a request in kWeaver
-  bool forecast_due_ = false;    // the row's yarn is not checked yet: no cycle of this begin() has started
+  bool forecast_due_ = false;     // the row's yarn is not checked yet: no cycle of this begin() has started
   bool reload_answered_ = false;  // reload() filled the slot the open kReload request names
   WeaverAsk hand_ask_ = WeaverAsk::kTieByHand;  // what kWeaver asks for the heads in missed_
   Move carriage_move_{};

@@ -36,7 +36,7 @@ int serve_main(const ServeArgs& a);
 struct CtlArgs {
   std::string command;
   std::vector<std::string> args;  // pair/unpair NAME; reload HEAD SLOT [KNOTS]
-  int hours = 0;     // pair: 0 → the service's default
+  int hours = 0;                  // pair: 0 → the service's default
   std::string socket;
   std::string loom_id;  // "" → the board's (ctl_socket)
   int timeout_ms = 5000;

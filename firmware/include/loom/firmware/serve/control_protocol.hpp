@@ -22,8 +22,8 @@ namespace loom::firmware::serve {
 enum class CommandClass { kStopping, kStarting, kReading, kPairing };
 
 struct ParsedRequest {
-  std::string word;                           // "start", "pair", ...
-  std::string arg;                            // the positional argument (pair/unpair NAME), else ""
+  std::string word;  // "start", "pair", ...
+  std::string arg;   // the positional argument (pair/unpair NAME), else ""
   // key=value pairs (via, client, token, device, code, hours; reload's head, slot, knots)
   std::map<std::string, std::string> fields;
   CommandClass cls = CommandClass::kReading;

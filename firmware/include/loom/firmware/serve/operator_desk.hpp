@@ -46,7 +46,7 @@ struct Decision {
   std::string reply;            // complete unless read != kNone (then the caller answers)
   std::optional<Command> post;  // the command to hand to the loop
   struct Reload {
-    int head = 0, slot = 0;  // 0-based
+    int head = 0, slot = 0;   // 0-based
     std::int32_t knots = -1;  // -1: full
   };
   std::optional<Reload> reload;  // post == kReload: what to post with it (OperatorLink::post_reload)
