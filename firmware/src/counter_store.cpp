@@ -93,6 +93,12 @@ std::string CounterStore::format(const sequencer::Counters& c) {
   }
   // Only while a cycle's knots are partly counted (a file from before it existed has none: zero).
   if (k.cycle_heads_done != 0) os << ",\"knot_cycle_heads_done\":" << k.cycle_heads_done;
+  // Only while a row is partly knotted (a file from before they existed has none: its row counts from the
+  // restart).
+  if (k.row_tied != 0 || k.row_retried != 0 || k.row_by_hand != 0) {
+    os << ",\"row_knots\":" << k.row_tied << ",\"row_knots_retried\":" << k.row_retried
+       << ",\"row_knots_by_hand\":" << k.row_by_hand;
+  }
   os << "}\n";
   return os.str();
 }
@@ -113,7 +119,10 @@ sequencer::Counters CounterStore::parse(const std::string& text, const std::stri
                                                "knots_by_hand",
                                                "knot_cycles_started",
                                                "knot_cycles_done",
-                                               "knot_cycle_heads_done"};
+                                               "knot_cycle_heads_done",
+                                               "row_knots",
+                                               "row_knots_retried",
+                                               "row_knots_by_hand"};
       if (!known.count(k)) cur.fail("unknown field \"" + k + "\"");
       if (fields.count(k)) cur.fail("field \"" + k + "\" given twice");
       cur.expect(':');
@@ -147,7 +156,10 @@ sequencer::Counters CounterStore::parse(const std::string& text, const std::stri
             fields["knots_by_hand"],
             fields["knot_cycles_started"],
             fields["knot_cycles_done"],
-            fields["knot_cycle_heads_done"]};
+            fields["knot_cycle_heads_done"],
+            fields["row_knots"],
+            fields["row_knots_retried"],
+            fields["row_knots_by_hand"]};
   if (c.knot.cycle_heads_done >> hal::kMaxKnottingHeads != 0) {
     cur.fail("knot_cycle_heads_done = " + std::to_string(c.knot.cycle_heads_done) +
              " names a head beyond the " + std::to_string(hal::kMaxKnottingHeads) + " a loom may have");
@@ -168,6 +180,13 @@ sequencer::Counters CounterStore::parse(const std::string& text, const std::stri
                std::to_string(static_cast<std::uint64_t>(c.rows) + c.picks_in_row));
   }
   if (!contradict_early.empty()) contradict(contradict_early);
+  if (c.knot.row_tied > c.knot.tied || c.knot.row_retried > c.knot.retried ||
+      c.knot.row_by_hand > c.knot.by_hand) {
+    contradict("the row in progress's knots (row_knots " + std::to_string(c.knot.row_tied) + ", retried " +
+               std::to_string(c.knot.row_retried) + ", by hand " + std::to_string(c.knot.row_by_hand) +
+               ") exceed the totals (knots " + std::to_string(c.knot.tied) + ", retried " +
+               std::to_string(c.knot.retried) + ", by hand " + std::to_string(c.knot.by_hand) + ")");
+  }
   if (c.knot.cycles_done > c.knot.cycles_started) {
     contradict("knot_cycles_done = " + std::to_string(c.knot.cycles_done) +
                " exceeds knot_cycles_started = " + std::to_string(c.knot.cycles_started));

@@ -322,6 +322,7 @@ class LoopBody {
       RunEvent e = base_event(RunEvent::Kind::kButton, tick);
       e.button = command_of_button(ev.button);
       e.state = events.began_in();
+      e.request = seq_.weaver_request();  // the request open as the press is taken: the one it answers
       emit(e);
     }
     return cmds;
@@ -389,7 +390,9 @@ class LoopBody {
     for (int h = 0; h < sequencer::kMaxKnottingHeads; ++h) {
       for (int sl = 0; sl < sequencer::kMaxMagazineSlots; ++sl) {
         const std::optional<std::int32_t> knots = opt_.link->take_reload(h, sl);
-        if (knots && apply_them) taken |= seq_.reload_magazine(h, sl, *knots);
+        if (!knots || !apply_them || !seq_.reload_magazine(h, sl, *knots)) continue;
+        taken = true;
+        if (opt_.sim_weaver != nullptr) opt_.sim_weaver->reloaded(h, sl, *knots);
       }
     }
     if (!taken) return;

@@ -143,6 +143,10 @@ void RowKnotter::begin(std::uint32_t row0, const KnotCounters& progress, double 
   fault_ = Fault::kNone;
   fault_axis_ = -1;
   row_ = RowKnots{};
+  // A row resumed after a power cut: its knots tied before the cut are the row's too.
+  row_.tied = static_cast<int>(progress.row_tied);
+  row_.retried = static_cast<int>(progress.row_retried);
+  row_.by_hand = static_cast<int>(progress.row_by_hand);
   row_since_ = now;
   request_ = WeaverRequest{};
   if (!stock_known_) {
@@ -370,12 +374,14 @@ void RowKnotter::finish_cycle(hal::Tick now, const hal::HalOutputs& cmd, KnotCou
     knotter_origin_[hh] += k_.cycle->end_offset_rad();  // the servo is at rest again, a cycle on
     if (seen_[hh]) {
       ++counters.tied;
+      ++counters.row_tied;
       counters.cycle_heads_done |= 1u << h;
       ++row_.tied;
       counters_moved_ = true;
       active_[hh] = false;
     } else if (attempt_ == 0) {
       ++counters.retried;
+      ++counters.row_retried;
       ++row_.retried;
       counters_moved_ = true;
       retry = true;  // stays active: ties again
@@ -428,6 +434,7 @@ RowKnotter::Status RowKnotter::weaver(hal::Tick now, const hal::HalOutputs& cmd,
       return Status::kRunning;
     }
     ++counters.by_hand;  // tied (or checked and finished) by the weaver
+    ++counters.row_by_hand;
     counters.cycle_heads_done |= 1u << request_.head;
     ++row_.by_hand;
     counters_moved_ = true;

@@ -1133,8 +1133,11 @@ void Sequencer::end_row(hal::Tick now) noexcept {
   counters_.picks_in_row = 0;
   last_row_ = row_.finish(now, now - sweep_start_, row_beats_, profiles_->cam().steps());
   events_.add(EventKind::kRow);
-  if (counters_.knot.cycles_started != 0 || counters_.knot.cycles_done != 0) {
-    counters_.knot.cycles_started = counters_.knot.cycles_done = 0;  // the next row's knotting starts afresh
+  KnotCounters& k = counters_.knot;
+  if (k.cycles_started != 0 || k.cycles_done != 0 || k.row_tied != 0 || k.row_retried != 0 ||
+      k.row_by_hand != 0) {
+    k.cycles_started = k.cycles_done = 0;  // the next row's knotting starts afresh
+    k.row_tied = k.row_retried = k.row_by_hand = 0;
     events_.add(EventKind::kKnotProgress);
   }
   if (cfg_.await_row_saved) {

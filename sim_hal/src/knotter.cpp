@@ -239,6 +239,12 @@ void SimKnotter::ask(const WeaverTask& t) noexcept {
   task_left_ = std::max<std::int64_t>(1, std::llround(k_.weaver_s / period_s_));
 }
 
+void SimKnotter::reload(int head, int slot, std::int32_t knots) noexcept {
+  if (head < 0 || head >= m_.heads || slot < 0 || slot >= m_.slots) return;
+  st_->stock[static_cast<std::size_t>(head)][static_cast<std::size_t>(slot)] =
+      knots < 0 || knots > m_.knots_per_slot ? m_.knots_per_slot : knots;
+}
+
 void SimKnotter::yarn_out(int head, int slot) noexcept {
   if (head < 0 || head >= m_.heads || slot < 0 || slot >= m_.slots) return;
   st_->stock[static_cast<std::size_t>(head)][static_cast<std::size_t>(slot)] = 0;

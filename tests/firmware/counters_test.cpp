@@ -89,6 +89,28 @@ TEST(Counters, TheKnottingHeadsCountsComeTogetherAndAgree) {
       std::string::npos);
 }
 
+// The row in progress's own knot tallies (the production record's row after a power cut): written only
+// while a row is partly knotted, read back, and never more than the totals.
+TEST(Counters, TheRowInProgressKeepsItsKnotsAcrossARestart) {
+  loom::sequencer::Counters c{4, 8, 60, 0, {}};
+  c.knot = {1400, 12, 3, 17, 16, 0, 40, 2, 1};
+  const std::string text = CounterStore::format(c);
+  EXPECT_NE(text.find("\"row_knots\":40,\"row_knots_retried\":2,\"row_knots_by_hand\":1"), std::string::npos)
+      << text;
+  const loom::sequencer::Counters back = CounterStore::parse(text, "c.json");
+  EXPECT_EQ(back.knot.row_tied, 40u);
+  EXPECT_EQ(back.knot.row_retried, 2u);
+  EXPECT_EQ(back.knot.row_by_hand, 1u);
+  c.knot.row_tied = c.knot.row_retried = c.knot.row_by_hand = 0;
+  EXPECT_EQ(CounterStore::format(c).find("row_knots"), std::string::npos);  // between rows: as before
+  EXPECT_NE(
+      parse_error("{\"rows\":4,\"picks\":8,\"beats\":60,\"picks_in_row\":0,\"knots\":5,\"knots_retried\":0,"
+                  "\"knots_by_hand\":0,\"knot_cycles_started\":2,\"knot_cycles_done\":1,\"row_knots\":6,"
+                  "\"row_knots_retried\":0,\"row_knots_by_hand\":0}")
+          .find("exceed the totals (knots 5"),
+      std::string::npos);
+}
+
 TEST(Counters, ValuesAreWholeCountsNeverRoundedOrWrapped) {
   const auto bad = [](const std::string& rows) {
     return parse_error("{\"rows\":" + rows + ",\"picks\":5,\"beats\":5,\"picks_in_row\":0}");

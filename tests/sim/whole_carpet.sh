@@ -144,9 +144,9 @@ assert r["rows"] == {"recorded": rows, "last": rows}, r["rows"]
 assert r["ended"], "the record has no end"
 assert abs(states_ns - wall_ns) <= tick_ns, f"states {states_ns} ns, wall {wall_ns} ns"
 assert r["knots"]["by_heads"] + r["knots"]["by_hand"] == rows * 360, r["knots"]
-print(f"record: {rows} rows, wall {r['wall_s']:.3f} s = {states_ns / 1e9:.3f} s in states "
-      f"({', '.join(f'{k} {v['ns'] / 1e9:.0f} s' for k, v in r['states'].items() if v['ns'])}); "
-      f"knots by heads {r['knots']['by_heads']}, by hand {r['knots']['by_hand']}")
+split = ", ".join("%s %.0f s" % (k, v["ns"] / 1e9) for k, v in r["states"].items() if v["ns"])
+print("record: %d rows, wall %.3f s = %.3f s in states (%s); knots by heads %d, by hand %d"
+      % (rows, r["wall_s"], states_ns / 1e9, split, r["knots"]["by_heads"], r["knots"]["by_hand"]))
 PY
 # Machine time: the runs that ended (their loop line) and the runs cut short (the tick the power failed at).
 # (The period from the loops' own lines: machine seconds over ticks.)

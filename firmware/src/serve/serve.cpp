@@ -799,6 +799,7 @@ class Service {
                                                   : Press{"next", "the weaver's row-knotted pedal"};
     LoomView v = view_of(link_, cfg_.sequencer.knotting);
     v.state = e.state;
+    v.weaver_ask = e.request.ask;  // judged against the request open at the press, not the one open now
     v.counters_unsaved = counters_unsaved_.load(std::memory_order_acquire);
     // One start button and no resume button: a start press while paused resumes, and is judged as resume.
     const bool resumes = e.button == Command::kStart && e.state == sequencer::State::kPaused;

@@ -136,7 +136,7 @@ struct RunEvent {
   int fault_sensor = -1;  // hal::SafetySensor the fault names (sensor_discrepancy), or -1
   Command button =
       Command::kStart;  // kButton: the I/O module's button pressed (audit_buttons); kNext: the pedal
-  sequencer::WeaverRequest request{};  // kWeaverRequest
+  sequencer::WeaverRequest request{};  // kWeaverRequest; kButton: the request open when it was taken
   // kRowDone (and kReloaded) on a loom with knotting heads: the magazines' levels as the loom counts them at
   // the row's end (kept in the state directory, so a restart starts from them).
   bool stock_known = false;

@@ -25,6 +25,9 @@ class SimWeaver {
   void on_tick(sequencer::Sequencer& seq) noexcept;
   // RT-safe. A request the knotting heads made of the weaver.
   void answer(const sequencer::WeaverRequest& r) noexcept { sim_.ask_weaver(task_for(r)); }
+  // RT-safe. The operator's reload (`ctl reload`, the panel): the simulated machine gets the yarn the
+  // operator says was put in.
+  void reloaded(int head, int slot, std::int32_t knots) noexcept { sim_.reload_slot(head, slot, knots); }
   // The request as the simulated knotter's task.
   static sim_hal::WeaverTask task_for(const sequencer::WeaverRequest& r) noexcept;
 

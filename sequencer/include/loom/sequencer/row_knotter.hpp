@@ -94,6 +94,9 @@ struct KnotCounters {
   // the head, or by the weaver — while another head of it still waits: a restart then asks the weaver to
   // check only the others, and no knot is counted twice. Zero between cycles.
   std::uint32_t cycle_heads_done = 0;
+  // The row in progress's own tallies (zero between rows): after a power cut its RowKnots — what the
+  // production record keeps of the row — still count the knots tied before the cut.
+  std::uint32_t row_tied = 0, row_retried = 0, row_by_hand = 0;
 };
 
 class RowKnotter {

@@ -143,6 +143,9 @@ class SimKnotter {
   void ask(const WeaverTask& t) noexcept;
   // RT-safe. Scene faults: a slot runs out of yarn; a selector jams (its axis stops following: SimWorld).
   void yarn_out(int head, int slot) noexcept;
+  // RT-safe. The weaver (the operator's `reload`, not a task of the simulated weaver's) put yarn in a slot:
+  // `knots` knots (negative, or more than a slot holds: full). Out of range: ignored.
+  void reload(int head, int slot, std::int32_t knots) noexcept;
 
   // The carpet as knotted: rows() complete or in progress (the last may be partial), knots_per_row() each;
   // of them the first capacity_rows() are recorded (cell() of a later row is no knot) and knots_beyond()

@@ -95,6 +95,10 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   void ask_weaver(const WeaverTask& t) noexcept {
     if (knotter_) knotter_->ask(t);
   }
+  // RT-safe. The operator said a slot was reloaded (`ctl reload`): in simulation the yarn is put there.
+  void reload_slot(int head, int slot, std::int32_t knots) noexcept {
+    if (knotter_) knotter_->reload(head, slot, knots);
+  }
 
   // The crank phases (from park) inside which beat_contact solves the linkage for the load cell (both
   // 0 without beat_contact). Outside them the tip is never within the contact depth of the fell.
