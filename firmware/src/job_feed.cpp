@@ -2,6 +2,7 @@
 #include "loom/firmware/job_feed.hpp"
 
 #include <algorithm>
+#include <optional>
 #include <system_error>
 
 #include "loom/design/design.hpp"
@@ -46,19 +47,10 @@ void JobFeed::armed(const Machine& machine) {
     report_.stripe = p->stripe();
     report_.knots_per_slot = p->knots_per_slot();
     for (int s = 0; s < p->slots(); ++s) report_.slot_colours.push_back(p->slot_colour(s));
-    // The levels the session armed with: magazines.txt when it is this loom's, else full (as serve does).
-    std::optional<job::YarnStock> kept;
-    try {
-      kept = job::YarnStock::load(job::YarnStock::path_in(state_dir_));
-      if (kept && !kept->mismatch(p->heads(), p->slots(), p->knots_per_slot()).empty()) kept.reset();
-    } catch (const std::exception&) {
-      kept.reset();
-    }
-    for (int h = 0; h < p->heads(); ++h) {
-      std::vector<std::int32_t> levels;
-      for (int s = 0; s < p->slots(); ++s) levels.push_back(kept ? kept->knots(h, s) : p->knots_per_slot());
-      report_.stock.push_back(std::move(levels));
-    }
+    // Full until magazines.txt says otherwise (the session arms with full magazines without it).
+    report_.stock.assign(
+        static_cast<std::size_t>(p->heads()),
+        std::vector<std::int32_t>(static_cast<std::size_t>(p->slots()), p->knots_per_slot()));
   }
   carpet_key_.clear();  // sent again at arming: a panel started with the session has it at once
   try {
@@ -72,9 +64,10 @@ void JobFeed::on_event(const RunEvent& e) noexcept {
   std::lock_guard<std::mutex> lock(mu_);
   try {
     if (e.kind == RunEvent::Kind::kRowDone) {
-      if (e.stock_known) {
+      if (e.stock_known) {  // as the record keeps them (magazines.txt, read again below, is the authority)
         for (std::size_t h = 0; h < report_.stock.size(); ++h) {
-          for (std::size_t s = 0; s < report_.stock[h].size(); ++s) report_.stock[h][s] = e.stock[h][s];
+          for (std::size_t s = 0; s < report_.stock[h].size(); ++s)
+            report_.stock[h][s] = std::max(0, e.stock[h][s]);
         }
       }
       // A whole row: the knotting before it and the weaving (the heads' and the weaver's time are inside).
@@ -105,13 +98,37 @@ void JobFeed::on_event(const RunEvent& e) noexcept {
 void JobFeed::poll() noexcept {
   std::lock_guard<std::mutex> lock(mu_);
   try {
-    if (mtime_of(job::JobQueue::path_in(state_dir_)) != queue_mtime_) publish_locked();
+    if (mtime_of(job::JobQueue::path_in(state_dir_)) != queue_mtime_ ||
+        mtime_of(job::YarnStock::path_in(state_dir_)) != magazines_mtime_) {
+      publish_locked();
+    }
   } catch (const std::exception&) {
   }
   events_.repeat_carpet();
 }
 
+// The levels kept in magazines.txt (written at row ends and reloads), when they are for these magazines.
+void JobFeed::read_magazines() {
+  const std::string path = job::YarnStock::path_in(state_dir_);
+  magazines_mtime_ = mtime_of(path);
+  if (report_.stock.empty()) return;
+  std::optional<job::YarnStock> kept;
+  try {
+    kept = job::YarnStock::load(path);
+  } catch (const std::exception&) {
+    return;  // not a magazines file: serve says so at arming; the levels counted stand
+  }
+  const int heads = static_cast<int>(report_.stock.size()),
+            slots = static_cast<int>(report_.slot_colours.size());
+  if (!kept || !kept->mismatch(heads, slots, report_.knots_per_slot).empty()) return;
+  for (int h = 0; h < heads; ++h) {
+    for (int s = 0; s < slots; ++s)
+      report_.stock[static_cast<std::size_t>(h)][static_cast<std::size_t>(s)] = kept->knots(h, s);
+  }
+}
+
 void JobFeed::publish_locked() {
+  read_magazines();
   queue_mtime_ = mtime_of(job::JobQueue::path_in(state_dir_));
   const job::JobQueue q = job::JobQueue::load(job::JobQueue::path_in(state_dir_));
   telemetry::JobReport& r = report_;

@@ -1,7 +1,7 @@
 // What `loomctl serve` tells the weaver's panel about the carpet job (telemetry JOB and CARPET): the queue
 // and the current job as jobs.txt has them, the knot cycles of the row in progress, the magazines' levels
-// at the last row end, and an ETA from this job's whole rows timed so far. Non-RT: arming, the reporter's
-// run events and its poll; it reads the state directory's files, never the loop's memory.
+// as magazines.txt keeps them (the row ends' levels without it), and an ETA from this job's whole rows timed
+// so far. Non-RT: arming, the reporter's run events and its poll; the rest it reads from the state directory.
 #pragma once
 
 #include <chrono>
@@ -32,6 +32,7 @@ class JobFeed {
 
  private:
   void publish_locked();  // caller holds mu_
+  void read_magazines();  // caller holds mu_
 
   std::string state_dir_;
   telemetry::JobEvents events_;
@@ -42,7 +43,7 @@ class JobFeed {
   double timed_s_ = 0.0;
   std::uint64_t timed_rows_ = 0;
   std::chrono::steady_clock::time_point progress_sent_{};
-  std::filesystem::file_time_type queue_mtime_{};
+  std::filesystem::file_time_type queue_mtime_{}, magazines_mtime_{};
   std::string carpet_key_;  // job id and hash of the knot map on CARPET
 };
 
