@@ -98,8 +98,11 @@ void JobFeed::on_event(const RunEvent& e) noexcept {
 void JobFeed::poll() noexcept {
   std::lock_guard<std::mutex> lock(mu_);
   try {
+    // Again when a file changed, and every 10 s in any case: a panel that joins while the loom stands
+    // (waiting for the start, carpet_done) or an lcmlog replayed from its middle learns the job within 10 s.
     if (mtime_of(job::JobQueue::path_in(state_dir_)) != queue_mtime_ ||
-        mtime_of(job::YarnStock::path_in(state_dir_)) != magazines_mtime_) {
+        mtime_of(job::YarnStock::path_in(state_dir_)) != magazines_mtime_ ||
+        std::chrono::steady_clock::now() - job_sent_ >= telemetry::kCarpetRepeat) {
       publish_locked();
     }
   } catch (const std::exception&) {
@@ -150,6 +153,7 @@ void JobFeed::publish_locked() {
   r.row_mean_s =
       j && timed_job_ == j->id && timed_rows_ > 0 ? timed_s_ / static_cast<double>(timed_rows_) : -1.0;
   events_.publish_job(r);
+  job_sent_ = std::chrono::steady_clock::now();
   // The shown job's knot map, read from its file (checked against the job's hash) when the job changes.
   const std::string key = j ? std::to_string(j->id) + " " + j->sha256 : std::string();
   if (key == carpet_key_) return;

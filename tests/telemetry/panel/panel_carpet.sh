@@ -3,7 +3,8 @@
 # (the narrow sample loom of tests/sim, its 90 x 4 sample design, 6 rows; a second job queued behind it)
 # at 10x real time; loom-panel listens to its JOB and CARPET telemetry; headless Chromium checks the job
 # queue, the carpet canvas's pixels against the design file (woven rows in their colours, the rest grey),
-# rows and ETA advancing, and the yarn levels against magazines.txt (panel_carpet.mjs says how). Writes
+# rows and ETA advancing, and the yarn levels against magazines.txt (panel_carpet.mjs says how); a second
+# panel started late gets the job and the whole knot map within the 10 s repeat. Writes
 # <out>/loom_panel_carpet.png. Exit 77 (skip) without chromium or node.
 # Usage: panel_carpet.sh <loomctl> <loom-panel> <source dir> <out dir>
 set -euo pipefail
@@ -50,6 +51,24 @@ panel_up panel.log --lcm-url "$URL" --control-dir "$WORK/run"
 SOCK="$WORK/run/$ID.sock"
 panel_serve_up "$SOCK" serve.log --config "$LOOM" --scene "$WORK/scene.toml" --state-dir "$WORK/state" \
   --loom-id "$ID" --lcm-url "$URL" --pace 10
+
+# A panel that joins late (serve armed and standing, nothing changes): JOB and the whole knot map reach it
+# within the 10 s repeat.
+FIRST_BASE=$PANEL_BASE
+panel_up late.log --lcm-url "$URL"
+LATE_BASE=$PANEL_BASE
+PANEL_BASE=$FIRST_BASE
+late_ok=
+for _ in $(seq 1 150); do
+  if curl -s -m 2 "$LATE_BASE/api/loom/$ID" | python3 -c '
+import json, sys
+d = json.load(sys.stdin)
+sys.exit(0 if d.get("job") and d["job"]["id"] == 1 and d.get("carpet") and d["carpet"]["rows_heard"] == 4 else 1)' 2>/dev/null
+  then late_ok=1; break; fi
+  sleep 0.1
+done
+[[ -n $late_ok ]] || fail "a panel started late did not get JOB and the whole knot map within 15 s"
+echo "a panel started late got JOB and the 4-row knot map"
 
 # The weaver's answers, should the simulated weaver leave one open (ctl next, as a weaver at the loom).
 ( while sleep 0.5; do

@@ -27,7 +27,8 @@ class JobFeed {
   // After the service handled a run event: a row end (levels, the row's time, the credited rows), knot
   // progress (at most once a second). Never throws.
   void on_event(const RunEvent& e) noexcept;
-  // The reporter's poll: JOB again when jobs.txt changed, CARPET again every 10 s. Never throws.
+  // The reporter's poll: JOB again when jobs.txt or magazines.txt changed, and JOB and CARPET again every
+  // 10 s. Never throws.
   void poll() noexcept;
 
  private:
@@ -42,7 +43,7 @@ class JobFeed {
   std::uint32_t timed_job_ = 0;  // the job whose rows are timed below
   double timed_s_ = 0.0;
   std::uint64_t timed_rows_ = 0;
-  std::chrono::steady_clock::time_point progress_sent_{};
+  std::chrono::steady_clock::time_point progress_sent_{}, job_sent_{};
   std::filesystem::file_time_type queue_mtime_{}, magazines_mtime_{};
   std::string carpet_key_;  // job id and hash of the knot map on CARPET
 };
