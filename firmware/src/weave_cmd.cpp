@@ -16,6 +16,7 @@
 
 #include "loom/firmware/carpet_job.hpp"
 #include "loom/firmware/carpet_png.hpp"
+#include "loom/firmware/job_feed.hpp"
 #include "loom/firmware/job_recorder.hpp"
 #include "loom/firmware/serve/state_lock.hpp"
 #include "loom/firmware/session.hpp"
@@ -526,6 +527,12 @@ int weave(const WeaveArgs& a, const Say& say) {
     const bool started = job->start(resume.rows);
     std::printf("  %s%s\n", job->describe().c_str(), started ? " (started now)" : "");
   }
+  // The job for the weaver's panel (telemetry JOB and CARPET), as serve publishes it.
+  std::unique_ptr<JobFeed> job_feed;
+  if (job != nullptr && !a.no_telemetry) {
+    job_feed = std::make_unique<JobFeed>(a.state_dir, in.cfg.telemetry.lcm_url, in.cfg.loom_id);
+    job_feed->armed(machine);
+  }
   if (const auto& d = in.cfg.recipe.design; d && !a.quiet) {
     std::printf("  %s%s\n", design_position(*d, design_rows).c_str(),
                 record.kept() ? "" : " (no --counters: the row reached is not remembered)");
@@ -548,7 +555,10 @@ int weave(const WeaveArgs& a, const Say& say) {
   ro.pause_flag = &g_pause;
   if (ro.sim_weaver != nullptr) ro.sim_weaver->knot_rows_after(a.knotting_s);
   reporter.pace_retries(ro.realtime, ro.pace);
-  ro.reporter_poll = [&reporter] { reporter.retry_save(); };
+  ro.reporter_poll = [&reporter, &job_feed] {
+    reporter.retry_save();
+    if (job_feed) job_feed->poll();
+  };
   // The job's production record (production.sqlite in the state directory).
   std::unique_ptr<JobRecorder> job_record;
   if (job != nullptr) {
@@ -560,7 +570,10 @@ int weave(const WeaveArgs& a, const Say& say) {
       std::fprintf(stderr, "loomctl: WARNING: no production record for this run: %s\n", e.what());
     }
   }
-  const RunResult res = session.run(ro, [&reporter](const RunEvent& e) { reporter(e); });
+  const RunResult res = session.run(ro, [&reporter, &job_feed](const RunEvent& e) {
+    reporter(e);
+    if (job_feed) job_feed->on_event(e);
+  });
   const bool carpet_done = record.take_carpet_done();
   if (job_record) {
     try {

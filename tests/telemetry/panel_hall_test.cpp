@@ -140,6 +140,94 @@ TEST(PanelHall, DesignShowsTheNextRowAndOnlyANewRowIsAChange) {
   EXPECT_GT(hall.version(), v);
 }
 
+// Issue 29: the carpet job's knot map comes in CARPET bands; the panel puts them together, drops a band
+// that contradicts itself, starts afresh for another design, keeps nothing beyond its bound, and pushes
+// only a band that brought new rows (the 10 s repeat of a whole map changes nothing).
+loomlcm::carpet_t band(const std::string& hash, int first, int rows, int width, int height) {
+  loomlcm::carpet_t m{};
+  m.loom_id = "L1";
+  m.job_id = 3;
+  m.design_hash = hash;
+  m.design_name = "rug.csv";
+  m.width = width;
+  m.height = height;
+  m.n_colours = 2;
+  m.code = {"R", "B"};
+  m.rgb = {0xa52a2a, 0x1f3a6e};
+  m.first_row = first;
+  m.n_rows = rows;
+  for (int r = first; r < first + rows; ++r)
+    for (int k = 0; k < width; ++k) m.knots.push_back(static_cast<std::uint8_t>((r + k) % 2));
+  m.n_knots = static_cast<std::int32_t>(m.knots.size());
+  return m;
+}
+
+TEST(PanelHall, CarpetBandsMakeTheKnotMap) {
+  Hall hall;
+  hall.on_carpet(band("aaa", 2, 2, 3, 4));
+  auto j = *hall.carpet_json("L1");
+  EXPECT_EQ(j["rows_heard"], 2);
+  EXPECT_EQ(j["knots"], "ffffffffffff000100010001");  // rows 0-1 not heard yet; (r + k) % 2 from row 2
+  hall.on_carpet(band("aaa", 0, 2, 3, 4));
+  j = *hall.carpet_json("L1");
+  EXPECT_EQ(j["knots"], "000100010001000100010001");
+  EXPECT_EQ(j["palette"][1]["rgb"], "#1f3a6e");
+  EXPECT_EQ(j["width"], 3);
+  EXPECT_EQ(j["height"], 4);
+  const auto v = hall.version();
+  hall.on_carpet(band("aaa", 0, 2, 3, 4));  // the repeat
+  EXPECT_EQ(hall.version(), v);
+  auto bad = band("aaa", 3, 2, 3, 4);  // beyond the design's height
+  hall.on_carpet(bad);
+  bad = band("aaa", 0, 1, 3, 4);
+  bad.n_knots = 2;  // contradicts its rows x width
+  hall.on_carpet(bad);
+  EXPECT_EQ(hall.version(), v);
+  EXPECT_EQ((*hall.carpet_json("L1"))["knots"], "000100010001000100010001");
+  EXPECT_EQ((*hall.loom_json("L1"))["carpet"]["rows_heard"], 4);
+  hall.on_carpet(band("bbb", 0, 1, 3, 4));  // another design: afresh
+  EXPECT_EQ((*hall.carpet_json("L1"))["rows_heard"], 1);
+  HallLimits small;
+  small.carpet_knots = 11;
+  Hall bounded(small);
+  bounded.on_carpet(band("aaa", 0, 2, 3, 4));  // 12 knots
+  EXPECT_EQ((*bounded.carpet_json("L1"))["too_big"], true);
+  EXPECT_EQ((*bounded.carpet_json("L1"))["knots"], "");
+}
+
+TEST(PanelHall, JobShowsTheQueueEtaAndYarn) {
+  Hall hall;
+  loomlcm::job_t m{};
+  m.loom_id = "L1";
+  m.job_id = 1;
+  m.state = "current";
+  m.rows_done = 2;
+  m.rows_total = 6;
+  m.row_mean_s = -1;
+  m.eta_s = -1;
+  m.heads = 2;
+  m.slots = 2;
+  m.slot_colour = {"R", "B"};
+  m.stock = {{40, 3}, {-1, 12}};
+  m.n_jobs = 3;  // more than the arrays hold: only what is there is listed
+  m.queue_id = {1, 2};
+  m.queue_design = {"a.csv", "b.csv"};
+  m.queue_state = {"current", "queued"};
+  m.queue_rows_done = {2, 0};
+  m.queue_rows_total = {6, 2};
+  hall.on_job(m);
+  auto j = (*hall.loom_json("L1"))["job"];
+  EXPECT_TRUE(j["eta_s"].is_null());
+  EXPECT_EQ(j["stock"], nlohmann::json::parse("[[40,3],[-1,12]]"));
+  ASSERT_EQ(j["queue"].size(), 2u);
+  EXPECT_EQ(j["queue"][1]["design"], "b.csv");
+  m.eta_s = 120.0;
+  m.row_mean_s = 30.0;
+  hall.on_job(m);
+  j = (*hall.loom_json("L1"))["job"];
+  EXPECT_EQ(j["eta_s"], 120.0);
+}
+
 // Issue 22: one FAULT packet or palette name that is not UTF-8 aborted the panel (type_error 316).
 TEST(PanelHall, TextThatIsNotUtf8IsReplacedNeverThrown) {
   Hall hall;

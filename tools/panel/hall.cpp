@@ -299,6 +299,127 @@ void Hall::on_knots(const loomlcm::knots_t& m) {
   }
 }
 
+namespace {
+// The job and its queue as the page shows them; counts are not trusted beyond the arrays.
+json job_json(const loomlcm::job_t& m, std::size_t jobs_listed) {
+  const std::size_t heads = std::min<std::size_t>(m.heads > 0 ? static_cast<std::size_t>(m.heads) : 0,
+                                                  std::min<std::size_t>(m.stock.size(), 12));
+  const std::size_t slots = std::min<std::size_t>(m.slots > 0 ? static_cast<std::size_t>(m.slots) : 0,
+                                                  std::min<std::size_t>(m.slot_colour.size(), 16));
+  json stock = json::array();
+  for (std::size_t h = 0; h < heads; ++h) {
+    json levels = json::array();
+    for (std::size_t s = 0; s < slots && s < m.stock[h].size(); ++s) levels.push_back(m.stock[h][s]);
+    stock.push_back(levels);
+  }
+  json slot_colours = json::array();
+  for (std::size_t s = 0; s < slots; ++s) slot_colours.push_back(m.slot_colour[s]);
+  const std::size_t n = std::min({m.n_jobs > 0 ? static_cast<std::size_t>(m.n_jobs) : std::size_t{0},
+                                  m.queue_id.size(), m.queue_design.size(), m.queue_state.size(),
+                                  m.queue_rows_done.size(), m.queue_rows_total.size()});
+  const std::size_t first = n > jobs_listed ? n - jobs_listed : 0;
+  json queue = json::array();
+  for (std::size_t i = first; i < n; ++i) {
+    queue.push_back({{"id", m.queue_id[i]},
+                     {"design", m.queue_design[i]},
+                     {"state", m.queue_state[i]},
+                     {"rows_done", m.queue_rows_done[i]},
+                     {"rows", m.queue_rows_total[i]}});
+  }
+  return {{"id", m.job_id},
+          {"state", m.state},
+          {"design", m.design_name},
+          {"hash", m.design_hash},
+          {"width", m.width},
+          {"design_rows", m.design_rows},
+          {"rows_done", m.rows_done},
+          {"rows", m.rows_total},
+          {"stripe", m.stripe},
+          {"cycles_done", m.cycles_done},
+          {"row_mean_s", m.row_mean_s >= 0 ? num(m.row_mean_s) : json(nullptr)},
+          {"eta_s", m.eta_s >= 0 ? num(m.eta_s) : json(nullptr)},
+          {"knots_per_slot", m.knots_per_slot},
+          {"slot_colours", slot_colours},
+          {"stock", stock},
+          {"queue", queue},
+          {"queue_cut", first}};
+}
+}  // namespace
+
+void Hall::on_job(const loomlcm::job_t& m) {
+  std::lock_guard lock(mu_);
+  if (Loom* l = loom(m.loom_id, m.utime)) {
+    l->job = m;
+    changed();
+  }
+}
+
+void Hall::on_carpet(const loomlcm::carpet_t& m) {
+  std::lock_guard lock(mu_);
+  Loom* l = loom(m.loom_id, m.utime);
+  if (l == nullptr) return;
+  // A band that contradicts itself (a spoofed or corrupt CARPET) is dropped whole.
+  if (m.width <= 0 || m.height <= 0 || m.n_rows <= 0 || m.first_row < 0 ||
+      m.first_row + m.n_rows > m.height || static_cast<std::int64_t>(m.n_rows) * m.width != m.n_knots ||
+      m.knots.size() != static_cast<std::size_t>(m.n_knots) || m.code.size() != m.rgb.size() ||
+      m.code.size() != static_cast<std::size_t>(std::max<std::int16_t>(m.n_colours, 0))) {
+    return;
+  }
+  Carpet& c = l->carpet;
+  const auto knots = static_cast<std::size_t>(m.width) * static_cast<std::size_t>(m.height);
+  if (c.hash != m.design_hash || c.job_id != m.job_id || c.width != m.width || c.height != m.height) {
+    c = Carpet{};
+    c.hash = m.design_hash;
+    c.name = m.design_name;
+    c.job_id = m.job_id;
+    c.width = m.width;
+    c.height = m.height;
+    c.codes = m.code;
+    c.rgb = m.rgb;
+    c.too_big = knots > limits_.carpet_knots;
+    if (!c.too_big) {
+      c.knots.assign(knots, 0xFF);
+      c.have.assign(static_cast<std::size_t>(m.height), false);
+    }
+    changed();
+  }
+  if (c.too_big) return;
+  std::size_t fresh = 0;
+  for (std::int32_t r = 0; r < m.n_rows; ++r) {
+    const auto row = static_cast<std::size_t>(m.first_row + r);
+    const auto w = static_cast<std::size_t>(c.width);
+    std::copy_n(m.knots.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(r) * w), w,
+                c.knots.begin() + static_cast<std::ptrdiff_t>(row * w));
+    if (!c.have[row]) {
+      c.have[row] = true;
+      ++fresh;
+    }
+  }
+  c.rows_heard += fresh;
+  if (fresh > 0) changed();  // the periodic repeat of a map already whole pushes nothing
+}
+
+std::optional<json> Hall::carpet_json(const std::string& id) const {
+  std::lock_guard lock(mu_);
+  const auto it = looms_.find(id);
+  if (it == looms_.end() || it->second.carpet.hash.empty()) return std::nullopt;
+  const Carpet& c = it->second.carpet;
+  json palette = json::array();
+  for (std::size_t i = 0; i < c.codes.size(); ++i)
+    palette.push_back({{"code", c.codes[i]}, {"rgb", rgb_hex(c.rgb[i])}});
+  static const char kHex[] = "0123456789abcdef";
+  std::string knots;
+  knots.reserve(c.knots.size() * 2);
+  for (std::uint8_t k : c.knots) {
+    knots += kHex[k >> 4];
+    knots += kHex[k & 15];
+  }
+  return json{
+      {"loom", id},           {"job", c.job_id},    {"hash", c.hash},     {"design", c.name},
+      {"width", c.width},     {"height", c.height}, {"palette", palette}, {"rows_heard", c.rows_heard},
+      {"too_big", c.too_big}, {"knots", knots}};
+}
+
 void Hall::on_weaver(const loomlcm::weaver_request_t& m) {
   std::lock_guard lock(mu_);
   if (Loom* l = loom(m.loom_id, m.utime)) {
@@ -423,6 +544,14 @@ std::optional<json> Hall::loom_json(const std::string& id) const {
   j["faults"] = faults;
   j["design"] = l.design ? design_json(*l.design) : json(nullptr);
   j["knots"] = l.knots ? knots_json(*l.knots) : json(nullptr);
+  j["job"] = l.job ? job_json(*l.job, limits_.jobs_listed) : json(nullptr);
+  // The knot map itself is fetched apart (/api/loom/<id>/carpet) when this says it changed.
+  j["carpet"] = l.carpet.hash.empty() ? json(nullptr)
+                                      : json{{"job", l.carpet.job_id},
+                                             {"hash", l.carpet.hash},
+                                             {"height", l.carpet.height},
+                                             {"rows_heard", l.carpet.rows_heard},
+                                             {"too_big", l.carpet.too_big}};
   json weaver = json::array();
   for (const auto& w : l.weaver) weaver.push_back(weaver_json(w));
   j["weaver_requests"] = weaver;

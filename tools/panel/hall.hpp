@@ -19,8 +19,10 @@
 
 #include "loomlcm/axes_t.hpp"
 #include "loomlcm/beat_t.hpp"
+#include "loomlcm/carpet_t.hpp"
 #include "loomlcm/design_t.hpp"
 #include "loomlcm/fault_t.hpp"
+#include "loomlcm/job_t.hpp"
 #include "loomlcm/knots_t.hpp"
 #include "loomlcm/row_t.hpp"
 #include "loomlcm/rt_stats_t.hpp"
@@ -37,6 +39,10 @@ struct HallLimits {
   std::size_t beats_per_row = 512;        // beats kept per row (the firmware caps a row at 256)
   std::size_t weaver_requests_kept = 20;  // weaver requests per loom (knotting heads)
   std::size_t knots_per_row = 4096;       // knots of a row shown (a wider one is cut, and says so)
+  std::size_t jobs_listed = 200;          // jobs of a loom's queue listed (the newest; more are counted)
+  // Knots of a carpet's knot map kept per loom (a 1.2 x 1.8 m carpet is 194,400): a bigger design is not
+  // drawn, and the page says so.
+  std::size_t carpet_knots = 2'000'000;
   // > 0: a message stamped (utime, the publisher's wall clock) longer ago than this is a recording being
   // replayed onto this group (lcm-logplayer); it is kept apart under "<id>~replay" and marked, never mixed
   // into the live loom of that id. 0: every message is live (a log read through file://).
@@ -71,6 +77,8 @@ class Hall {
   void on_design(const loomlcm::design_t& m);
   void on_knots(const loomlcm::knots_t& m);
   void on_weaver(const loomlcm::weaver_request_t& m);
+  void on_job(const loomlcm::job_t& m);
+  void on_carpet(const loomlcm::carpet_t& m);
 
   // HTTP threads. The hall: every loom heard, one summary object each. A loom: everything kept, or
   // nullopt when that id was never heard.
@@ -83,6 +91,10 @@ class Hall {
   // time (UTC) and loop time first, SI units in the column names; nullopt when the loom was never heard.
   std::optional<std::string> rows_csv(const std::string& id) const;
   std::optional<nlohmann::json> scope_json(const std::string& id, const std::string& axis) const;
+  // The current job's knot map as CARPET brought it: width, height, palette, and every knot as two hex
+  // digits (its palette index), bottom row first; rows not heard yet are "ff". nullopt when the loom was
+  // never heard or no map came.
+  std::optional<nlohmann::json> carpet_json(const std::string& id) const;
   // Changes so far; wait_for_change returns the version once it differs from `seen` (or at timeout).
   std::uint64_t version() const;
   std::uint64_t wait_for_change(std::uint64_t seen, std::chrono::milliseconds timeout) const;
@@ -102,6 +114,17 @@ class Hall {
     double time_s = 0.0;
     std::vector<std::array<float, 3>> axes;  // position, velocity, following error, in `scope_names` order
   };
+  // A knot map assembled from CARPET bands of one design (its hash): a new hash starts it afresh.
+  struct Carpet {
+    std::string hash, name;
+    std::int32_t job_id = 0, width = 0, height = 0;
+    std::vector<std::string> codes;
+    std::vector<std::int32_t> rgb;
+    std::vector<std::uint8_t> knots;  // width x height, 0xFF = not heard
+    std::vector<bool> have;           // per design row
+    std::size_t rows_heard = 0;
+    bool too_big = false;
+  };
   struct Loom {
     Clock::time_point heard{};
     std::vector<std::string> scope_names;  // the axes of the samples kept (a new set starts the strip afresh)
@@ -118,6 +141,8 @@ class Hall {
     std::optional<loomlcm::design_t> design;       // the weaver's next row (looms weaving a design)
     std::optional<loomlcm::knots_t> knots;         // the knotting heads' progress (looms with heads)
     std::deque<loomlcm::weaver_request_t> weaver;  // the last requests made of the weaver
+    std::optional<loomlcm::job_t> job;             // the carpet job queue and progress (serve's JOB)
+    Carpet carpet;                                 // the job's knot map (CARPET bands)
     std::uint64_t beats_seen = 0, beats_in_band = 0, faults_seen = 0;
   };
   Loom* loom(const std::string& id);  // nullptr when over the loom limit; caller holds mu_

@@ -12,6 +12,8 @@
 //   GET  /api/loom/<id>/faults.log  all of it, as a file to download
 //   GET  /api/loom/<id>/rows.csv    the row report: every row the panel kept (newest 500), as CSV
 //   GET  /api/loom/<id>/last.lcmlog every message of that loom heard in the last 5 minutes (--lcmlog-minutes)
+//   GET  /api/loom/<id>/carpet      the current carpet job's knot map (JOB/CARPET), for the carpet view
+//   POST /api/loom/<id>/ctl/reload?head=H&slot=S[&knots=K]   "slot reloaded" (paired clients only)
 //   GET  /api/loom/<id>/scope?axis=NAME   the last 30 s of one axis' position, velocity, following error
 // Read-only by default: nothing it receives over HTTP reaches the loom. With --control-dir DIR the
 // page offers pause / stop at row end to every client, and resume / acknowledge / "row knotted" only to
@@ -219,6 +221,10 @@ class Router {
       decode<loomlcm::knots_t>(data, len, [&](const auto& m) { hall_.on_knots(m); });
     } else if (kind == "WEAVER") {
       decode<loomlcm::weaver_request_t>(data, len, [&](const auto& m) { hall_.on_weaver(m); });
+    } else if (kind == "JOB") {
+      decode<loomlcm::job_t>(data, len, [&](const auto& m) { hall_.on_job(m); });
+    } else if (kind == "CARPET") {
+      decode<loomlcm::carpet_t>(data, len, [&](const auto& m) { hall_.on_carpet(m); });
     }
   }
   std::uint64_t decode_errors() const { return decode_errors_; }
@@ -446,6 +452,18 @@ int main(int argc, char** argv) {
             }
             res.set_content(loom::panel::json_text(*j), "application/json");
           });
+  // The current carpet job's knot map (CARPET), fetched by the page when the loom's JSON says it changed.
+  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32}(?:~replay)?)/carpet)",
+          [&](const httplib::Request& req, httplib::Response& res) {
+            res.set_header("Cache-Control", "no-store");
+            const auto j = hall.carpet_json(req.matches[1]);
+            if (!j) {
+              res.status = 404;
+              res.set_content(loom::panel::json_text({{"error", "no knot map heard"}}), "application/json");
+              return;
+            }
+            res.set_content(loom::panel::json_text(*j), "application/json");
+          });
   // An operator button, forwarded to the loom on behalf of this client (its address and pairing token):
   // the loom decides and audits. A starting command without a token is refused here and never forwarded.
   svr.Post(R"(/api/loom/([A-Za-z0-9_-]{1,32})/ctl/([a-z]{1,16}))", [&](const httplib::Request& req,
@@ -463,7 +481,25 @@ int main(int argc, char** argv) {
       return reply(403, "read-only panel (start it with --control-dir to offer buttons)");
     const auto cls = loom::panel::panel_command(cmd);
     if (cls == loom::panel::PanelCommand::kUnknown)
-      return reply(400, "unknown command (pause, stop, resume, ack, next)");
+      return reply(400, "unknown command (pause, stop, resume, ack, next, reload)");
+    // "Slot reloaded": which head and slot (1-based, as the weaver counts them) and, optionally, the knots
+    // of yarn put in (a partly filled slot); only digits reach the loom's socket.
+    std::string line = cmd;
+    if (cmd == "reload") {
+      const auto digits = [&](const char* name, std::size_t max_len, bool required) {
+        const std::string v = req.has_param(name) ? req.get_param_value(name) : std::string();
+        if (v.empty()) return required ? std::string("?") : std::string();
+        if (v.size() > max_len || v.find_first_not_of("0123456789") != std::string::npos)
+          return std::string("?");
+        return v;
+      };
+      const std::string head = digits("head", 2, true), slot = digits("slot", 2, true),
+                        knots = digits("knots", 7, false);
+      if (head == "?" || slot == "?" || knots == "?") {
+        return reply(400, "reload needs head=H and slot=S (numbers, 1-based) and optionally knots=K");
+      }
+      line += " head=" + head + " slot=" + slot + (knots.empty() ? "" : " knots=" + knots);
+    }
     const std::string token = token_of(req, loom);
     if (cls == loom::panel::PanelCommand::kStarting && token.empty()) {
       return reply(
@@ -474,7 +510,7 @@ int main(int argc, char** argv) {
     std::string text;
     try {
       text = trimmed(loom::firmware::serve::control_request(control_socket_of(o, loom),
-                                                            on_behalf(cmd, req, token), 3000));
+                                                            on_behalf(line, req, token), 3000));
     } catch (const std::exception& e) {
       return reply(503, e.what());
     }

@@ -70,7 +70,8 @@ std::string origin_refusal(const std::string& origin, const std::string& host_he
 
 PanelCommand panel_command(const std::string& c) {
   if (c == "pause" || c == "stop") return PanelCommand::kStopping;
-  if (c == "resume" || c == "next" || c == "ack") return PanelCommand::kStarting;
+  // A reload acknowledges yarn put in a slot: the heads may go on (motion), so it is a starting command.
+  if (c == "resume" || c == "next" || c == "ack" || c == "reload") return PanelCommand::kStarting;
   return PanelCommand::kUnknown;
 }
 

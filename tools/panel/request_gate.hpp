@@ -4,9 +4,9 @@
 //         resolving to the panel) is refused with 421 before any handler runs.
 //   Origin: a state-changing request (POST) from a browser carries Origin; it must be this panel's own
 //         (http://<Host>). A POST also needs X-Loom-Panel: 1 (a plain cross-site form cannot send it).
-//   Commands: stopping ones (stop, pause) from any client; starting ones (resume, next, ack — `start`
-//         stays at the machine) only from a client paired with that loom (pairings.hpp in the firmware:
-//         the loom decides, the panel forwards the client's token and address and never forwards a
+//   Commands: stopping ones (stop, pause) from any client; starting ones (resume, next, ack, reload —
+//         `start` stays at the machine) only from a client paired with that loom (pairings.hpp in the
+//         firmware: the loom decides, the panel forwards the client's token and address and never forwards a
 //         starting command without a token).
 #pragma once
 
@@ -27,7 +27,7 @@ std::string host_refusal(const GateConfig& g, const std::string& host_header);
 std::string origin_refusal(const std::string& origin, const std::string& host_header);
 
 enum class PanelCommand { kUnknown, kStopping, kStarting };
-// The buttons the panel may send: pause, stop (stopping); resume, next, ack (starting). Not `start`.
+// The buttons the panel may send: pause, stop (stopping); resume, next, ack, reload (starting). Not `start`.
 PanelCommand panel_command(const std::string& c);
 
 // Whether `s` is a 32-hex-digit token (what a pairing cookie must hold before it is forwarded).

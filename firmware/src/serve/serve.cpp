@@ -25,6 +25,7 @@
 #include <utility>
 
 #include "loom/config/config.hpp"
+#include "loom/firmware/job_feed.hpp"
 #include "loom/firmware/job_recorder.hpp"
 #include "loom/firmware/serve/commands.hpp"
 #include "loom/firmware/serve/control_socket.hpp"
@@ -213,6 +214,7 @@ class Service {
       try {
         command_events_ = std::make_unique<telemetry::CommandEvents>(
             cfg_.telemetry.lcm_url, std::string(telemetry::kDefaultChannelPrefix), cfg_.loom_id);
+        job_feed_ = std::make_unique<JobFeed>(state_, cfg_.telemetry.lcm_url, cfg_.loom_id);  // JOB, CARPET
       } catch (const std::exception& e) {
         throw ConfigError(cfg_.source + ": telemetry: " + e.what());
       }
@@ -396,6 +398,7 @@ class Service {
     constexpr std::uint64_t kForecastRowsUnbounded = 100;
     const std::uint64_t forecast_rows = mo.rows != 0 ? mo.rows - resume.rows : kForecastRowsUnbounded;
     record_.say_yarn_forecast(machine.knot_program(), levels, resume.rows, forecast_rows, say_in_journal);
+    if (job_feed_) job_feed_->armed(machine);
     {
       std::lock_guard<std::mutex> lock(job_mu_);
       armed_design_ = armed.cfg.recipe.design;
@@ -643,6 +646,7 @@ class Service {
   }
 
   void poll() {
+    if (job_feed_) job_feed_->poll();
     const std::int64_t now = MonotonicClock{}.now_ns();
     const std::int64_t control_idle = std::chrono::duration_cast<std::chrono::nanoseconds>(
                                           std::chrono::steady_clock::now().time_since_epoch())
@@ -721,6 +725,7 @@ class Service {
       save_failed(e.counters);
     }
     record_job_event(e, machine);
+    if (job_feed_) job_feed_->on_event(e);  // after the save: the rows credited to the job are on disk
   }
 
   void log_row(const RunEvent& e) const {
@@ -940,6 +945,7 @@ class Service {
   Pairings pairings_;
   OperatorDesk desk_;
   std::unique_ptr<telemetry::CommandEvents> command_events_;
+  std::unique_ptr<JobFeed> job_feed_;
   std::unique_ptr<ControlServer> server_;  // last: its thread calls answer(), which uses all of the above
   bool start_at_once_ = false, ready_sent_ = false;
   bool control_hung_ = false;  // the control socket's thread was last seen hung (reporter thread)

@@ -51,8 +51,9 @@ std::string channel_prefix_error(std::string_view prefix) {
 
 ChannelNames channel_names(std::string_view prefix, std::string_view loom_id) {
   const std::string base = std::string(prefix) + "." + std::string(loom_id) + ".";
-  return {base + "STATUS", base + "AXES",     base + "RT",    base + "BEAT",   base + "FAULT",  base + "ROW",
-          base + "DESIGN", base + "IDENTITY", base + "KNOTS", base + "WEAVER", base + "COMMAND"};
+  return {base + "STATUS",  base + "AXES",   base + "RT",       base + "BEAT",  base + "FAULT",
+          base + "ROW",     base + "DESIGN", base + "IDENTITY", base + "KNOTS", base + "WEAVER",
+          base + "COMMAND", base + "JOB",    base + "CARPET"};
 }
 
 std::string channel_regex(std::string_view prefix, std::string_view loom_id, std::string_view kind) {

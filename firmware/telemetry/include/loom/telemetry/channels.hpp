@@ -1,6 +1,7 @@
 // LCM channel names for one loom: <prefix>.<loom id>.STATUS / .AXES / .RT (samples, decimated) and
 // .BEAT / .FAULT / .ROW / .WEAVER / .COMMAND (events, each sent once), .DESIGN (the weaver's next row, when
-// the recipe names a design) and .KNOTS (the knotting heads' progress, looms with heads). The loom id is in
+// the recipe names a design), .KNOTS (the knotting heads' progress, looms with heads) and .JOB / .CARPET
+// (the carpet job and its knot map, from serve). The loom id is in
 // the name so a hall of looms can share one multicast group and a technician can subscribe to one loom or
 // all.
 #pragma once
@@ -33,11 +34,13 @@ struct ChannelNames {
   std::string knots;     // the knotting heads' progress, with STATUS (looms with heads only)
   std::string weaver;    // each request the knotting heads make of the weaver (event)
   std::string command;   // the audit of each operator command: who gave it, the reply (event, from serve)
+  std::string job;       // the carpet job queue and the current job's progress (low rate, from serve)
+  std::string carpet;    // the current job's knot map in bands of rows (at arming and every 10 s, from serve)
 };
 
 // Every channel kind, in the order a reader lists them.
-inline constexpr std::string_view kChannelKinds[] = {"STATUS", "AXES",   "RT",    "BEAT",   "FAULT",
-                                                     "ROW",    "DESIGN", "KNOTS", "WEAVER", "COMMAND"};
+inline constexpr std::string_view kChannelKinds[] = {
+    "STATUS", "AXES", "RT", "BEAT", "FAULT", "ROW", "DESIGN", "KNOTS", "WEAVER", "COMMAND", "JOB", "CARPET"};
 
 // Configure-time only (allocates). Assumes both parts passed the checks above.
 ChannelNames channel_names(std::string_view prefix, std::string_view loom_id);
