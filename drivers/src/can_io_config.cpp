@@ -75,11 +75,11 @@ std::vector<NamedBit> outputs_of(const IoWiring& w) {
   return v;
 }
 
-const NamedBit* signal_in_sub(const std::vector<NamedBit>& bits, int sub) {
+const NamedBit* signal_in_sub(const std::vector<NamedBit>& bits, int sub, int group_bits) {
   const NamedBit* found = nullptr;
   for (const NamedBit& b : bits) {
     const int n = b.bit->bit;
-    if (n >= 0 && n / 8 + 1 == sub && (found == nullptr || n > found->bit->bit)) found = &b;
+    if (n >= 0 && n / group_bits + 1 == sub && (found == nullptr || n > found->bit->bit)) found = &b;
   }
   return found;
 }
@@ -154,10 +154,10 @@ int highest_bit(const std::vector<NamedBit>& bits) {
   return hi;
 }
 
-// The 8-bit subs a set of signals needs: up to the one holding the highest wired bit (at least one, so
-// the PDO exists even when nothing optional is wired).
-std::uint8_t subs_for(const std::vector<NamedBit>& bits) {
-  return static_cast<std::uint8_t>(std::max(highest_bit(bits), 0) / 8 + 1);
+// The groups of `group_bits` a set of signals needs: up to the one holding the highest wired bit (at
+// least one, so the PDO exists even when nothing optional is wired).
+std::uint8_t subs_for(const std::vector<NamedBit>& bits, int group_bits) {
+  return static_cast<std::uint8_t>(std::max(highest_bit(bits), 0) / group_bits + 1);
 }
 
 }  // namespace
@@ -223,6 +223,10 @@ std::optional<IoConfigFault> find_fault(const CanIoConfig& c) {
                                        std::to_string(kMaxIoModules - 1));
   }
   if (auto f = find_fault(c.wiring)) return f;
+  if (c.input_group_bits != kInputGroupBits8 && c.input_group_bits != kInputGroupBits16) {
+    return fault(IoField::kInputGroups, "io.input_group_bits = " + std::to_string(c.input_group_bits) +
+                                            " is neither 8 (0x6000) nor 16 (0x6100)");
+  }
   if (!(c.cycle_period_s > 0.0))
     return fault(IoField::kCyclePeriod, "io: cycle period " + seconds(c.cycle_period_s) + " must be > 0");
   const double producer_ms = c.heartbeat_producer_s * 1e3;
@@ -276,17 +280,19 @@ Status validate(const CanIoConfig& c) {
   return f ? Status::error(describe(*f)) : Status::ok();
 }
 
-std::uint8_t io_input_subs(const IoWiring& w) {
-  return subs_for(inputs_of(w));
+std::uint8_t io_input_subs(const IoWiring& w, int group_bits) {
+  return subs_for(inputs_of(w), group_bits == kInputGroupBits16 ? kInputGroupBits16 : kInputGroupBits8);
 }
 std::uint8_t io_output_subs(const IoWiring& w) {
-  return subs_for(outputs_of(w));
+  return subs_for(outputs_of(w), 8);
 }
 
-std::vector<FrameGroup> io_frames_per_cycle(const IoWiring& w) {
+std::vector<FrameGroup> io_frames_per_cycle(const IoWiring& w, int group_bits) {
+  const int bytes_per_group = group_bits == kInputGroupBits16 ? 2 : 1;
   std::vector<FrameGroup> g;
-  g.push_back({io_output_subs(w), 1});                // RPDO: digital outputs
-  g.push_back({io_input_subs(w), 1});                 // TPDO: digital inputs, one 8-bit sub per byte
+  g.push_back({io_output_subs(w), 1});  // RPDO: digital outputs
+  // TPDO: digital inputs, one group per sub
+  g.push_back({static_cast<std::uint8_t>(io_input_subs(w, group_bits) * bytes_per_group), 1});
   if (w.load_cell_channel != 0) g.push_back({2, 1});  // TPDO: load cell
   return g;
 }

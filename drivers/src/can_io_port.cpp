@@ -57,7 +57,13 @@ hal::DigitalOutputs io_safe_outputs() {
 }
 
 CanIoPort::CanIoPort(CanIoConfig config)
-    : config_(std::move(config)), wiring_(module_wiring(config_.wiring, config_.module)) {}
+    : config_(std::move(config)),
+      wiring_(module_wiring(config_.wiring, config_.module)),
+      group_bits_(config_.input_group_bits == kInputGroupBits16 ? kInputGroupBits16 : kInputGroupBits8) {}
+
+std::uint32_t CanIoPort::input_entry(std::uint8_t sub) const {
+  return entry(input_object(group_bits_), sub, static_cast<std::uint8_t>(group_bits_));
+}
 
 std::string CanIoPort::who() const {
   return label() + ": ";
@@ -175,12 +181,12 @@ Status CanIoPort::map_pdo(SdoClient& sdo, bool rx, int pdo, const std::vector<st
 
 Status CanIoPort::configure_mapping(SdoClient& sdo) {
   const IoWiring& w = wiring_;
-  const std::uint8_t in_subs = io_input_subs(w);
+  const std::uint8_t in_subs = io_input_subs(w, group_bits_);
   const std::uint8_t out_bytes = io_output_subs(w);
 
-  // 0x6000:01..n in TPDO1, in sub order, so the inputs are one sample in one frame.
+  // 0x6000:01..n (or 0x6100:01..n) in TPDO1, in sub order, so the inputs are one sample in one frame.
   std::vector<std::uint32_t> inputs;
-  for (std::uint8_t k = 1; k <= in_subs; ++k) inputs.push_back(entry(od401::kDigitalInputs8, k, 8));
+  for (std::uint8_t k = 1; k <= in_subs; ++k) inputs.push_back(input_entry(k));
   std::vector<std::uint32_t> outputs;
   for (std::uint8_t k = 1; k <= out_bytes; ++k) outputs.push_back(entry(od401::kDigitalOutputs8, k, 8));
   const bool analog = w.load_cell_channel != 0;
@@ -252,28 +258,28 @@ Status CanIoPort::locate(const std::array<PdoLayout, 4>& layouts, std::uint32_t 
 // wiring uses, so say which signal makes the master read that far (the highest one, in the last sub).
 Status CanIoPort::explain_refused_input(const Status& s, std::uint32_t entry, std::uint8_t subs) const {
   const std::vector<NamedBit> bits = inputs_of(wiring_);
-  const NamedBit* highest = signal_in_sub(bits, subs);
+  const NamedBit* highest = signal_in_sub(bits, subs, group_bits_);
   if (highest == nullptr) return s;
   char range[24];
-  std::snprintf(range, sizeof range, "0x%04X:01..%02X", od401::kDigitalInputs8, subs);
+  std::snprintf(range, sizeof range, "0x%04X:01..%02X", input_object(group_bits_), subs);
   return Status::error(s.message() + "; " + object_name(entry) + " is mapped because the wiring reads " +
                        range + " up to " + key_and_value(*highest) +
                        " (a module with fewer digital inputs needs that signal moved or unwired, -1)");
 }
 
-// 0x6000:01..`subs`. Every sub a wired input lives in must be carried, and all of them by ONE TPDO: the
-// inputs are one sample with one `refreshed` tick, so a sensor and its second channel (or a shed's end
-// switches) are compared as seen at the same instant, never one frame against another. A sub no signal
-// lives in is read when it comes in that TPDO and otherwise not needed.
+// 0x6000:01..`subs` (0x6100's with 16-bit groups). Every sub a wired input lives in must be carried, and all
+// of them by ONE TPDO: the inputs are one sample with one `refreshed` tick, so a sensor and its second
+// channel (or a shed's end switches) are compared as seen at the same instant, never one frame against
+// another. A sub no signal lives in is read when it comes in that TPDO and otherwise not needed.
 Status CanIoPort::locate_inputs(std::uint8_t subs) {
   const std::vector<NamedBit> bits = inputs_of(wiring_);
   input_slot_ = {};
   input_pdo_ = -1;
   std::uint32_t first = 0;  // the needed sub that fixed input_pdo_, for the message
   for (std::uint8_t k = 1; k <= subs; ++k) {
-    const std::uint32_t e = entry(od401::kDigitalInputs8, k, 8);
+    const std::uint32_t e = input_entry(k);
     Slot& slot = input_slot_[static_cast<std::size_t>(k - 1)];
-    const NamedBit* user = signal_in_sub(bits, k);
+    const NamedBit* user = signal_in_sub(bits, k, group_bits_);
     if (user == nullptr) {
       slot = find(tpdo_, e);
       continue;
@@ -291,7 +297,7 @@ Status CanIoPort::locate_inputs(std::uint8_t subs) {
     }
   }
   for (Slot& slot : input_slot_) {
-    if (slot.pdo != input_pdo_ || slot.bytes != 1) slot = {};
+    if (slot.pdo != input_pdo_ || slot.bytes != group_bits_ / 8) slot = {};
   }
   return Status::ok();
 }
@@ -439,14 +445,17 @@ void CanIoPort::on_profile_frame(hal::Tick now, const CanFrame& f) {
   std::uint32_t v = 0;
   if (input_pdo_ == tpdo) {
     // Every sub first, then all at once: a short frame changes nothing, so the inputs stay one sample.
-    std::array<std::uint8_t, kMaxInputSubs> sample = inputs_;
+    // A 16-bit group k holds the terminals of 8-bit groups 2k and 2k+1 (low byte first, as CiA 401 says).
+    std::array<std::uint8_t, kMaxInputBytes> sample = inputs_;
+    const auto group_bytes = static_cast<std::size_t>(group_bits_ / 8);
     for (std::size_t k = 0; k < input_slot_.size(); ++k) {
       if (input_slot_[k].pdo != tpdo) continue;
       if (!read_le(input_slot_[k], v)) {
         ++rx_errors_;
         return;
       }
-      sample[k] = static_cast<std::uint8_t>(v);
+      for (std::size_t b = 0; b < group_bytes && k * group_bytes + b < sample.size(); ++b)
+        sample[k * group_bytes + b] = static_cast<std::uint8_t>(v >> (8 * b));
     }
     inputs_ = sample;
     inputs_refreshed_ = now;

@@ -149,11 +149,12 @@ Status CanMaster::bring_up(CanBus& bus, ConfigureClock& clock) {
   for (std::size_t i = 0; i < n_nodes_; ++i) {
     // A node with an EDS: the right node (0x1018), then the description's configuration, only what differs.
     const NodeDescription* d = nodes_[i]->description();
+    const int downloads_before = sdo.downloads();
     if (d != nullptr) {
       Result<eds::Identity> id = read_identity(sdo, nodes_[i]->node_id());
       if (!id) return Status::error(nodes_[i]->label() + ": 0x1018 identity: " + id.error());
       if (Status s = eds::check_identity(d->eds, nodes_[i]->label(), id.value()); !s) return s;
-      Result<ApplyReport> applied = apply_configuration(sdo, nodes_[i]->node_id(), d->writes, d->store);
+      Result<ApplyReport> applied = apply_configuration(sdo, nodes_[i]->node_id(), d->writes, false);
       if (!applied) return Status::error(nodes_[i]->label() + ": " + applied.error());
     }
     sdo.set_skip_unchanged(d != nullptr);
@@ -161,6 +162,11 @@ Status CanMaster::bring_up(CanBus& bus, ConfigureClock& clock) {
     sdo.set_skip_unchanged(false);
     if (Status s = profile; !s) return s;
     if (bus_off) return Status::error(nodes_[i]->label() + ": CAN bus-off during configuration");
+    // Stored (0x1010) on the builder's request, after all of the node's configuration writes — the
+    // description's and the profile's — and only when one of them changed something.
+    if (d != nullptr && d->store && can_store(d->eds) && sdo.downloads() > downloads_before) {
+      if (Status s = store_parameters(sdo, nodes_[i]->node_id(), nodes_[i]->label()); !s) return s;
+    }
   }
 
   operational.fill(false);

@@ -11,8 +11,6 @@ namespace loom::drivers {
 namespace {
 
 constexpr std::uint16_t kIdentity = 0x1018;
-constexpr std::uint16_t kStoreParameters = 0x1010;
-constexpr std::uint32_t kSaveSignature = 0x65766173;  // "save", little-endian (CiA 301)
 
 bool is_map(std::uint16_t index) {
   return (index >= od::kRpdoMap && index < od::kRpdoMap + 0x200) ||
@@ -107,10 +105,25 @@ Result<ApplyReport> apply_configuration(SdoClient& sdo, std::uint8_t node,
     if (Status s = write(comm, 1, valid, 4); !s) return s;
   }
   if (store && report.written > 0) {
-    if (Status s = write(kStoreParameters, 1, kSaveSignature, 4); !s) return s;
+    if (Status s = write(od::kStoreParameters, 1, od::kSaveSignature, 4); !s) return s;
     report.stored = true;
   }
   return report;
+}
+
+bool can_store(const eds::Description& description) {
+  const eds::Entry* e = description.entry(od::kStoreParameters, 1);
+  return e != nullptr && eds::writable(e->access);
+}
+
+Status store_parameters(SdoClient& sdo, std::uint8_t node, const std::string& label) {
+  if (Status s = sdo.write(node, od::kStoreParameters, 1, od::kSaveSignature, 4); !s) {
+    return Status::error(label +
+                         ": storing the configuration failed (bring-up fault store_refused): " + s.message() +
+                         " — the node holds what was written only until its next reset; bring-up stopped "
+                         "(store_config = false runs without storing)");
+  }
+  return Status::ok();
 }
 
 }  // namespace loom::drivers

@@ -57,6 +57,7 @@ constexpr TypeFact kTypes[] = {
     {od::kHomingSpeeds, DataType::kUnsigned32},
     {od::kHomingAcceleration, DataType::kUnsigned32},
     {od401::kDigitalInputs8, DataType::kUnsigned8},
+    {od401::kDigitalInputs16, DataType::kUnsigned16},
     {od401::kDigitalOutputs8, DataType::kUnsigned8},
     {od401::kOutputErrorMode, DataType::kUnsigned8},
     {od401::kOutputErrorValue, DataType::kUnsigned8},
@@ -227,7 +228,9 @@ NodeNeeds io_module_needs(const CanIoConfig& config) {
   needs.device_profile = 401;
   needs.heartbeat_ms = static_cast<std::uint16_t>(std::lround(config.heartbeat_producer_s * 1000.0));
   const IoWiring w = module_wiring(config.wiring, config.module);
-  add_objects(needs, io_module_objects(w));
+  const int group_bits = config.input_group_bits == kInputGroupBits16 ? kInputGroupBits16 : kInputGroupBits8;
+  const std::uint16_t input_index = input_object(group_bits);
+  add_objects(needs, io_module_objects(w, group_bits));
   if (ObjectNeed* n = find_need(needs, od::kHeartbeatProducer, 0)) n->value = needs.heartbeat_ms;
   if (ObjectNeed* n = find_need(needs, od401::kConsumerHeartbeat, 1);
       n != nullptr && config.master_node_id != 0) {
@@ -235,12 +238,12 @@ NodeNeeds io_module_needs(const CanIoConfig& config) {
                std::lround(config.master_consumer_s * 1000.0);
   }
   std::vector<MapEntry> inputs, outputs;
-  for (std::uint8_t s = 1; s <= io_input_subs(w); ++s)
-    inputs.push_back(MapEntry{od401::kDigitalInputs8, s, 8});
+  for (std::uint8_t s = 1; s <= io_input_subs(w, group_bits); ++s)
+    inputs.push_back(MapEntry{input_index, s, static_cast<std::uint8_t>(group_bits)});
   for (std::uint8_t s = 1; s <= io_output_subs(w); ++s)
     outputs.push_back(MapEntry{od401::kDigitalOutputs8, s, 8});
   for (ObjectNeed& n : needs.objects) {
-    if (n.index == od401::kDigitalInputs8 || n.index == od401::kAnalogInput16) n.pdo = PdoUse::kTpdo;
+    if (n.index == input_index || n.index == od401::kAnalogInput16) n.pdo = PdoUse::kTpdo;
     if (n.index == od401::kDigitalOutputs8) n.pdo = PdoUse::kRpdo;
     if (n.index == od401::kAnalogInput16) n.sub = static_cast<std::uint8_t>(w.load_cell_channel);
   }
@@ -258,6 +261,16 @@ NodeNeeds io_module_needs(const CanIoConfig& config) {
                 "the load cell"});
   }
   return needs;
+}
+
+int input_group_bits_of(const Description& eds, const IoWiring& wiring) {
+  for (const int bits : {kInputGroupBits8, kInputGroupBits16}) {
+    const std::uint8_t groups = io_input_subs(wiring, bits);
+    bool all = true;
+    for (std::uint8_t s = 1; s <= groups && all; ++s) all = eds.entry(input_object(bits), s) != nullptr;
+    if (all) return bits;
+  }
+  return 0;
 }
 
 NodeProfile profile_of(const Description& eds) {
@@ -328,6 +341,33 @@ class Checker {
   // An optional need's lack is a warning, a required one's an error.
   Level lack(bool optional) const { return optional ? Level::kWarning : Level::kError; }
 
+  // A digital input group the file lacks: the same terminals in the other form (8-bit group s is half of
+  // 16-bit group (s - 1) / 2 + 1) would do — the master uses 0x6100 whenever the file has every 16-bit
+  // group the wiring needs and 0x6000 does not (input_group_bits_of()) — so name both.
+  std::string input_groups_remedy(const ObjectNeed& n) const {
+    const bool eight = n.index == od401::kDigitalInputs8;
+    std::string other;
+    if (eight) {
+      other = object_text(od401::kDigitalInputs16, static_cast<std::uint8_t>((n.sub - 1) / 2 + 1), false);
+    } else {
+      other = object_text(od401::kDigitalInputs8, static_cast<std::uint8_t>(2 * n.sub - 1), false) + "/" +
+              object_text(od401::kDigitalInputs8, static_cast<std::uint8_t>(2 * n.sub), false).substr(7);
+    }
+    const bool has_other =
+        eight ? eds_.entry(od401::kDigitalInputs16, static_cast<std::uint8_t>((n.sub - 1) / 2 + 1))
+              : eds_.entry(od401::kDigitalInputs8, static_cast<std::uint8_t>(2 * n.sub));
+    if (eight && has_other) {
+      return "the file's 16-bit groups (0x6100) do not hold every wired input either: wire the signals "
+             "to lower bits (fewer groups) or choose a module with more I/O";
+    }
+    if (!eight && has_other) {
+      return "the file has these inputs as 8-bit groups " + other + ": leave io.input_group_bits out (or 8)";
+    }
+    return std::string("the file has ") + (eight ? "no 16-bit group " : "no 8-bit groups ") + other +
+           " for these inputs either: wire the signals to lower bits (fewer groups) or choose a module with "
+           "more I/O";
+  }
+
   std::string label(const ObjectNeed& n) const {
     const bool whole =
         n.sub == 0 && (eds_.object(n.index) == nullptr || eds_.object(n.index)->type == ObjectType::kVar);
@@ -364,7 +404,9 @@ class Checker {
         remedy = "the loom runs without it";
       } else if (n.index == od::kHeartbeatProducer) {
         remedy = "the loom supervises nodes by heartbeat only (no node guarding): choose a node with 0x1017";
-      } else if (n.index == od401::kDigitalInputs8 || n.index == od401::kDigitalOutputs8) {
+      } else if (n.index == od401::kDigitalInputs8 || n.index == od401::kDigitalInputs16) {
+        remedy = input_groups_remedy(n);
+      } else if (n.index == od401::kDigitalOutputs8) {
         remedy = "wire the signals to lower bits (fewer 8-bit groups) or choose a module with more I/O";
       } else if (n.index == od::kHomingMethod || n.index == od::kHomeOffset || n.index == od::kHomingSpeeds ||
                  n.index == od::kHomingAcceleration) {

@@ -23,6 +23,8 @@ const char* object_name(std::uint16_t index) {
       return "error register";
     case od::kHeartbeatProducer:
       return "producer heartbeat time";
+    case od::kStoreParameters:
+      return "store parameters";
     case od::kErrorCode:
       return "error code";
     case od::kControlword:

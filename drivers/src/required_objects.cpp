@@ -87,7 +87,7 @@ bool wired(const IoBit& b) {
 
 }  // namespace
 
-std::vector<RequiredObject> io_module_objects(const IoWiring& w) {
+std::vector<RequiredObject> io_module_objects(const IoWiring& w, int input_group_bits) {
   // The group counts come from the same function configure() maps with, so a module checked against
   // this list is one the master accepts (a module with fewer groups cannot map what the wiring asks for).
   const auto heads =
@@ -108,7 +108,11 @@ std::vector<RequiredObject> io_module_objects(const IoWiring& w) {
     const bool load_cell_object = o.index == od401::kAnalogInput16 || o.index == od::kTpdoComm + 1;
     if (load_cell_object && w.load_cell_channel == 0) continue;  // not on this module
     if (o.index == od401::kDigitalInputs8) {
-      o.subs = io_input_subs(w);
+      if (input_group_bits == kInputGroupBits16) {
+        o.index = od401::kDigitalInputs16;
+        o.name = "read digital inputs, 16-bit";
+      }
+      o.subs = io_input_subs(w, input_group_bits);
       o.why = joined({{sensors, seconds ? "sensors and their second channels" : "sensors"},
                       {!sensors && seconds, "the sensors' second channels"},
                       {wired(w.estop_ok), "e-stop chain"},

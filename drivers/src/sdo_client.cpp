@@ -96,6 +96,7 @@ Status SdoClient::write(std::uint8_t node, std::uint16_t index, std::uint8_t sub
   if (r.value().kind != SdoReplyKind::kDownloadAck) {
     return Status::error(what + ": the server answered with an upload reply instead of a download ack");
   }
+  ++downloads_;
   return Status::ok();
 }
 

@@ -371,7 +371,8 @@ void print_plan(const LoomConfig& c) {
                   m.module == 0 ? "every signal no other module lists"
                                 : ("signals " + io_module_signals(c.io.modules[m.module - 1u])).c_str());
     }
-    for (const auto& o : drivers::io_module_objects(drivers::module_wiring(m.wiring, m.module))) {
+    for (const auto& o :
+         drivers::io_module_objects(drivers::module_wiring(m.wiring, m.module), m.input_group_bits)) {
       std::printf("    %s\n", drivers::describe(o).c_str());
     }
   }

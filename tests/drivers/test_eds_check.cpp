@@ -186,8 +186,11 @@ TEST(EdsCheck, AnIoModuleWithTwoInputGroupsServesAWiringWithinThem) {
     ASSERT_EQ(e.size(), 1u) << all(d, needs, c);
     EXPECT_EQ(e[0].line, line_of(text, "[6000]"));
     EXPECT_EQ(e[0].message.substr(0, 55), "0x6000:03 read digital inputs, 8-bit has no sub-index 3");
-    EXPECT_EQ(e[0].remedy,
-              "wire the signals to lower bits (fewer 8-bit groups) or choose a module with more I/O");
+    // Its 0x6100 (16-bit groups) has sub 1 only: no other form of bits 16..21 either.
+    EXPECT_EQ(
+        e[0].remedy,
+        "the file has no 16-bit group 0x6100:02 for these inputs either: wire the signals to lower bits "
+        "(fewer groups) or choose a module with more I/O");
   }
   for (IoBit& b : io.wiring.second) b = IoBit{};  // single-channel sensors: inputs 0..11, two groups
   const NodeNeeds needs = io_module_needs(io);

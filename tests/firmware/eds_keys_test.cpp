@@ -14,6 +14,7 @@
 #include "loom/config/eds_nodes.hpp"
 #include "loom/drivers/eds.hpp"
 #include "loom/drivers/eds_dcf.hpp"
+#include "loom/drivers/node_description.hpp"
 
 using namespace loom::firmware;
 namespace eds = loom::drivers::eds;
@@ -168,4 +169,45 @@ TEST(EdsNodes, EachNodesDcfReadsBackToTheSameConfiguration) {
     // And the node the DCF describes is the EDS's node.
     EXPECT_EQ(eds::profile_of(dcf).fixed_mapping, n.check.profile.fixed_mapping);
   }
+}
+
+TEST(EdsKeys, SixteenBitInputGroupsComeFromTheModulesEdsAndAKeyItContradictsIsRefused) {
+  // kordis_dio32w.eds: inputs as 0x6100:01..02 only ([6100], CompactSubObj=2).
+  const LoomConfig c = parse_loom_config(ext("[io]\neds = \"kordis_dio32w.eds\"\n"), kSource);
+  EXPECT_EQ(c.io.input_group_bits, 0);  // not said: the EDS decides
+  const std::vector<loom::drivers::CanIoConfig> modules = can_io_configs(c);
+  EXPECT_EQ(modules[0].input_group_bits, 16);
+  const std::vector<EdsNode> nodes = eds_nodes(c);
+  ASSERT_EQ(nodes.size(), 1u);
+  EXPECT_TRUE(nodes[0].check.ok());
+  // 0x6100:03 (bits 32..47) is not in the file: a yarn-present switch on bit 40 cannot be read.
+  const std::string e = config_error(
+      ext("[io]\neds = \"kordis_dio32w.eds\"\ninput_group_bits = 16\nrow_knotted_bit = 40\n"), kSource);
+  EXPECT_TRUE(has(e, "io.input_group_bits = 16")) << e;
+  EXPECT_TRUE(has(e, "kordis_dio32w.eds:")) << e;
+  EXPECT_TRUE(has(e, "0x6100:03")) << e;
+  // 8-bit groups asked of a module that has none.
+  const std::string eight =
+      config_error(ext("[io]\neds = \"kordis_dio32w.eds\"\ninput_group_bits = 8\n"), kSource);
+  EXPECT_TRUE(has(eight, "io.input_group_bits = 8")) << eight;
+  EXPECT_TRUE(has(eight, "has no 0x6000")) << eight;
+  // Without an EDS the key says it; 12 is no CiA 401 form.
+  const LoomConfig k = parse_loom_config(ext("[io]\ninput_group_bits = 16\n"), kSource);
+  EXPECT_EQ(can_io_configs(k)[0].input_group_bits, 16);
+  EXPECT_TRUE(has(config_error(ext("[io]\ninput_group_bits = 12\n"), kSource), "io.input_group_bits = 12"));
+}
+
+TEST(EdsKeys, StoreConfigNeedsAnEdsWithAWritable1010) {
+  const LoomConfig c =
+      parse_loom_config(ext("[io]\neds = \"kordis_dio32w.eds\"\nstore_config = true\n"), kSource);
+  ASSERT_NE(can_io_configs(c)[0].description, nullptr);
+  EXPECT_TRUE(can_io_configs(c)[0].description->store);
+  // tecto_io16.eds has no 0x1010; no EDS at all cannot say so either.
+  const std::string none =
+      config_error(ext("[io]\neds = \"tecto_io16.eds\"\nstore_config = true\n"), kSource);
+  EXPECT_TRUE(has(none, "io.store_config = true")) << none;
+  EXPECT_TRUE(has(none, "tecto_io16.eds: the node has no 0x1010 store parameters")) << none;
+  const std::string bare = config_error(ext("[axes.helix]\nstore_config = true\n"), kSource);
+  EXPECT_TRUE(has(bare, "axes.helix.store_config = true")) << bare;
+  EXPECT_TRUE(has(bare, "needs axes.helix.eds")) << bare;
 }

@@ -1,5 +1,6 @@
 // libFuzzer harness: the EDS/DCF reader (drivers/eds.hpp) on arbitrary text, and everything built on a
-// description it accepts: the PDO descriptions, the comparison with a drive's and an I/O module's needs,
+// description it accepts: the PDO descriptions, the comparison with a drive's and an I/O module's needs
+// (8- and 16-bit input groups),
 // the loom's writes, the DCF writer and the concise DCF. A bug is a crash, a hang, a sanitizer report,
 // or a broken promise:
 //  - strict and non-strict reads give the same diagnostics, strict ones all errors;
@@ -8,6 +9,7 @@
 //    ParameterValues give back the writes it was written with (and the description's own others);
 //  - the concise DCF of those writes decodes to them.
 #include <algorithm>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -46,16 +48,23 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   (void)eds::pdos(d);
   (void)eds::profile_of(d);
-  const loom::drivers::CanAxisPortConfig port;
-  loom::drivers::CanAxisPortConfig port2 = port;
-  port2.tpdo2 = true;
-  loom::drivers::CanAxisConfig homed = port.axes[0];
-  homed.homing_method = 34;
-  const eds::NodeNeeds needs[] = {eds::drive_needs(port.axes[1], port), eds::drive_needs(homed, port2),
-                                  eds::io_module_needs(loom::drivers::CanIoConfig{})};
-  // The DCF round trip (the costly part) for one of the three needs per input, chosen by its size.
-  const std::size_t round_trip = size % 3;
-  for (std::size_t k = 0; k < 3; ++k) {
+  (void)eds::input_group_bits_of(d, loom::drivers::IoWiring{});
+  // The needs do not depend on the input: built once, not per execution.
+  static const std::array<eds::NodeNeeds, 4> needs = [] {
+    const loom::drivers::CanAxisPortConfig port;
+    loom::drivers::CanAxisPortConfig port2 = port;
+    port2.tpdo2 = true;
+    loom::drivers::CanAxisConfig homed = port.axes[0];
+    homed.homing_method = 34;
+    loom::drivers::CanIoConfig words;  // an I/O module read as 16-bit input groups (0x6100)
+    words.input_group_bits = 16;
+    return std::array<eds::NodeNeeds, 4>{eds::drive_needs(port.axes[1], port), eds::drive_needs(homed, port2),
+                                         eds::io_module_needs(loom::drivers::CanIoConfig{}),
+                                         eds::io_module_needs(words)};
+  }();
+  // The DCF round trip (the costly part) for one of the needs per input, chosen by its size.
+  const std::size_t round_trip = size % needs.size();
+  for (std::size_t k = 0; k < needs.size(); ++k) {
     const eds::NodeNeeds& n = needs[k];
     const eds::NodeCheck c = eds::check_node(d, n);
     for (const eds::Finding& f : c.findings) (void)eds::format(d, n, f);

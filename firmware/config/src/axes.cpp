@@ -87,6 +87,9 @@ const std::vector<AxisKeyInfo>& axis_keys() {
       {"axes.<name>.homing_timeout_s", "[0.1, 600]"},
       {"axes.<name>.eds",
        "path of the drive's EDS (CiA 306), relative to this file; checked, and used at bring-up"},
+      {"axes.<name>.store_config",
+       "true | false; default false: after a bring-up that wrote anything, 0x1010:01 = \"save\" (needs "
+       "its eds with a writable 0x1010:01)"},
   };
   return k;
 }
@@ -104,6 +107,7 @@ std::string axes_text(const LoomConfig& c) {
          << fmt_num(a.homing_timeout_s) << "s";
     }
     if (!a.eds.empty()) os << " eds " << a.eds;
+    if (a.store_config) os << " store";
     os << "]";
   }
   return os.str();
@@ -198,6 +202,7 @@ void read_axes(TomlReader& r, LoomConfig& c, bool extending) {
     a.operational_ms = static_cast<std::uint32_t>(op);
     read_referencing(r, node, p, a, is_new);
     read_eds_key(r, p + "eds", a.eds);
+    r.boolean(p + "store_config", a.store_config);
   }
   // Slot order: the core roles first (slots 0..2), then the others by name (toml++ keeps keys sorted).
   std::stable_sort(c.axes.begin(), c.axes.end(), [](const AxisSpec& x, const AxisSpec& y) {

@@ -79,6 +79,51 @@ void check_heartbeat(const TomlReader& r, const LoomConfig& c, const eds::Descri
   }
 }
 
+// store_config = true: the node's EDS must say it can store (a writable 0x1010:01), so the master never
+// asks a node that would abort.
+void check_store(const TomlReader& r, const std::string& table, const std::string& path, bool store) {
+  if (!store) return;
+  if (path.empty()) {
+    r.fail(table + ".store_config", "true",
+           "needs " + table +
+               ".eds: the master stores a node's configuration (0x1010:01 = \"save\") only "
+               "where its EDS says it has 0x1010");
+  }
+  const eds::Description d = eds::read_eds_file(path);
+  const eds::Entry* e = d.entry(drivers::od::kStoreParameters, 1);
+  if (e != nullptr && eds::writable(e->access)) return;
+  const eds::Object* o = d.object(drivers::od::kStoreParameters);
+  r.fail(
+      table + ".store_config", "true",
+      (o == nullptr   ? d.at(0) + ": the node has no 0x1010 store parameters"
+       : e == nullptr ? d.at(o->line) + ": the node's 0x1010 store parameters has no sub-index 1 (save all)"
+                      : d.at(e->access_line) + ": the node's 0x1010:01 store parameters is " +
+                            eds::access_name(e->access)) +
+          ": it cannot store its configuration; leave store_config out (the master configures it at "
+          "every bring-up anyway)");
+}
+
+// io.input_group_bits = 8 | 16 with an EDS: the module must have every input group of that form the
+// wiring reads.
+void check_input_groups(const TomlReader& r, const LoomConfig& c, const std::string& table,
+                        const eds::Description& d, int bits, std::uint8_t module) {
+  if (bits == 0) return;
+  const drivers::IoWiring w = drivers::module_wiring(c.io.wiring, module);
+  const std::uint16_t index = drivers::input_object(bits);
+  const std::uint8_t groups = drivers::io_input_subs(w, bits);
+  const eds::Object* o = d.object(index);
+  for (std::uint8_t s = 1; s <= groups; ++s) {
+    if (o != nullptr && o->entry(s) != nullptr) continue;
+    char obj[16];
+    std::snprintf(obj, sizeof obj, "0x%04X:%02X", index, s);
+    r.fail(table + ".input_group_bits", std::to_string(bits),
+           (o == nullptr ? d.at(0) + ": the module has no " + std::string(obj).substr(0, 6)
+                         : d.at(o->line) + ": the module has no " + obj) +
+               " (" + std::to_string(bits) + "-bit input groups), which the wiring reads: leave " + table +
+               ".input_group_bits out (the EDS says which form it has)");
+  }
+}
+
 void check_axis(const TomlReader& r, const LoomConfig& c, const AxisSpec& a) {
   const std::string p = "axes." + a.name + ".";
   const eds::Description d = read_or_fail(r, p + "eds", a.eds);
@@ -96,9 +141,10 @@ void check_axis(const TomlReader& r, const LoomConfig& c, const AxisSpec& a) {
 }
 
 void check_module(const TomlReader& r, const LoomConfig& c, const std::string& key, const std::string& path,
-                  std::uint8_t module) {
+                  std::uint8_t module, int input_group_bits) {
   const eds::Description d = read_or_fail(r, key + ".eds", path);
   check_profile(r, key + ".eds", path, d, false);
+  check_input_groups(r, c, key, d, input_group_bits, module);
   const drivers::IoWiring& w = c.io.wiring;
   if (w.load_cell_channel > 0 && w.load_cell_module == module) {
     const eds::Object* o = d.object(drivers::od401::kAnalogInput16);
@@ -128,15 +174,30 @@ void read_eds_key(TomlReader& r, const std::string& path, std::string& out) {
   out = p.lexically_normal().string();
 }
 
+void read_input_group_bits(TomlReader& r, const std::string& path, int& out) {
+  std::int64_t v = out;  // stays 0 (from the EDS) when the key is absent
+  r.integer(path, v, 8, 16);
+  if (v != out && v != 8 && v != 16) {
+    r.fail(path, std::to_string(v),
+           "the digital inputs are read as 8-bit (0x6000) or 16-bit (0x6100) groups");
+  }
+  out = static_cast<int>(v);
+}
+
 void check_eds_keys(const TomlReader& r, const LoomConfig& c) {
   for (const AxisSpec& a : c.axes) {
     if (!a.eds.empty()) check_axis(r, c, a);
+    check_store(r, "axes." + a.name, a.eds, a.store_config);
   }
   if (c.io.kind != IoKind::kCan) return;
-  if (!c.io.eds.empty()) check_module(r, c, "io", c.io.eds, 0);
+  if (!c.io.eds.empty()) check_module(r, c, "io", c.io.eds, 0, c.io.input_group_bits);
+  check_store(r, "io", c.io.eds, c.io.store_config);
   for (std::size_t k = 0; k < c.io.modules.size(); ++k) {
     const IoModuleSpec& m = c.io.modules[k];
-    if (!m.eds.empty()) check_module(r, c, "io_modules." + m.name, m.eds, static_cast<std::uint8_t>(k + 1));
+    const std::string table = "io_modules." + m.name;
+    if (!m.eds.empty())
+      check_module(r, c, table, m.eds, static_cast<std::uint8_t>(k + 1), m.input_group_bits);
+    check_store(r, table, m.eds, m.store_config);
   }
 }
 

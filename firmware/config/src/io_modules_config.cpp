@@ -101,6 +101,11 @@ const std::vector<IoModuleKeyInfo>& io_module_keys() {
       {"io_modules.<name>.signals",
        "io signal names (piston_a_extended … buzzer, load_cell, gripper_close, cutter, yarn_present)"},
       {"io_modules.<name>.eds", "path of the module's EDS (CiA 306), relative to this file"},
+      {"io_modules.<name>.store_config",
+       "true | false; default false: after a bring-up that wrote anything, 0x1010:01 = \"save\" (needs "
+       "its eds with a writable 0x1010:01)"},
+      {"io_modules.<name>.input_group_bits",
+       "8 (0x6000) | 16 (0x6100); default: from its eds (8-bit groups when it has them all), else 8"},
   };
   return k;
 }
@@ -155,6 +160,8 @@ void read_io_modules(TomlReader& r, LoomConfig& c) {
       r.integer(p + "operational_timeout_ms", v, 10, 60000);
       m.operational_timeout_ms = static_cast<std::uint32_t>(v);
       detail::read_eds_key(r, p + "eds", m.eds);
+      r.boolean(p + "store_config", m.store_config);
+      detail::read_input_group_bits(r, p + "input_group_bits", m.input_group_bits);
       r.string_list(p + "signals", m.signals);
       const std::string shown = "[" + quoted_list(m.signals) + "]";
       if (m.signals.empty()) r.fail(p + "signals", shown, "a module carries at least one signal");
@@ -197,6 +204,8 @@ std::string io_modules_text(const LoomConfig& c) {
     os << "[" << m.name << " node " << int{m.node} << " bus " << int{m.bus} << " boot " << m.boot_timeout_ms
        << " op " << m.operational_timeout_ms << " signals " << quoted_list(m.signals);
     if (!m.eds.empty()) os << " eds " << m.eds;
+    if (m.store_config) os << " store";
+    if (m.input_group_bits != 0) os << " inputs " << m.input_group_bits << "-bit";
     os << "]";
   }
   return os.str();

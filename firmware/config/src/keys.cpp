@@ -338,6 +338,24 @@ const std::vector<Key>& keys() {
       eds.read = [](TomlReader& r, LoomConfig& c) { read_eds_key(r, "io.eds", c.io.eds); };
       eds.value = [](const LoomConfig& c) { return c.io.eds; };
       v.push_back(eds);
+      Key store =
+          boolean("io.store_config", M::kMachine, [](LoomConfig& c) -> bool& { return c.io.store_config; });
+      store.required = false;
+      store.range =
+          "true | false; default false: after a bring-up that wrote anything, 0x1010:01 = \"save\" "
+          "(needs io.eds with a writable 0x1010:01)";
+      v.push_back(store);
+      Key groups{"io.input_group_bits",
+                 M::kMachine,
+                 "8 (0x6000) | 16 (0x6100); default: from io.eds (8-bit groups when it has them all), else 8",
+                 false,
+                 nullptr,
+                 nullptr};
+      groups.read = [](TomlReader& r, LoomConfig& c) {
+        read_input_group_bits(r, "io.input_group_bits", c.io.input_group_bits);
+      };
+      groups.value = [](const LoomConfig& c) { return std::to_string(c.io.input_group_bits); };
+      v.push_back(groups);
     }
     v.push_back(integer<std::uint32_t>("io.boot_timeout_ms", M::kMachine, 10, 60000,
                                        [](LoomConfig& c) -> std::uint32_t& { return c.io.boot_timeout_ms; }));

@@ -16,14 +16,28 @@ namespace {
 // what the loom needs: the profile's own bring-up then refuses the node as without an EDS). Null for a
 // file that cannot be read (the config was refused for it when read).
 std::shared_ptr<const drivers::NodeDescription> node_description(const std::string& path,
-                                                                 const drivers::eds::NodeNeeds& needs) {
+                                                                 const drivers::eds::NodeNeeds& needs,
+                                                                 bool store) {
   if (path.empty()) return nullptr;
   auto d = std::make_shared<drivers::NodeDescription>();
   d->eds = drivers::eds::read_eds_file(path);
   if (d->eds.has_errors()) return nullptr;
   const drivers::eds::NodeCheck check = drivers::eds::check_node(d->eds, needs);
   if (check.ok()) d->writes = drivers::eds::loom_writes(d->eds, needs, check);
+  d->store = store;
   return d;
+}
+
+// The module's input groups: io(_modules.<name>).input_group_bits when set, else what its EDS offers for
+// the module's wiring (8-bit groups when it has them all, else 16-bit: drivers::eds::input_group_bits_of),
+// else 8. A file with neither form keeps 8, whose missing group check_node() then names.
+int input_group_bits(const std::string& eds_path, int key, const drivers::IoWiring& module_wiring) {
+  if (key != 0) return key;
+  if (eds_path.empty()) return drivers::kInputGroupBits8;
+  const drivers::eds::Description d = drivers::eds::read_eds_file(eds_path);
+  if (d.has_errors()) return drivers::kInputGroupBits8;
+  const int bits = drivers::eds::input_group_bits_of(d, module_wiring);
+  return bits != 0 ? bits : drivers::kInputGroupBits8;
 }
 
 }  // namespace
@@ -59,14 +73,15 @@ drivers::CanAxisPortConfig can_axis_config(const LoomConfig& c) {
   cc.master_heartbeat_s = c.can.master_heartbeat_ms * 1e-3;
   cc.master_consumer_s = c.can.master_consumer_ms * 1e-3;
   for (std::size_t i = 0; i < c.axes.size(); ++i) {
-    cc.axes[i].description = node_description(c.axes[i].eds, drivers::eds::drive_needs(cc.axes[i], cc));
+    cc.axes[i].description =
+        node_description(c.axes[i].eds, drivers::eds::drive_needs(cc.axes[i], cc), c.axes[i].store_config);
   }
   if (c.io.kind == IoKind::kCan) {
     const std::vector<drivers::CanIoConfig> modules = can_io_configs(c);
     const std::vector<std::size_t> buses = can_io_buses(c);
     for (std::size_t k = 0; k < modules.size(); ++k) {
-      const auto frames =
-          drivers::io_frames_per_cycle(drivers::module_wiring(modules[k].wiring, modules[k].module));
+      const auto frames = drivers::io_frames_per_cycle(
+          drivers::module_wiring(modules[k].wiring, modules[k].module), modules[k].input_group_bits);
       std::vector<drivers::FrameGroup>& on_bus =
           cc.other_frames_per_cycle[std::min(buses[k], drivers::kMaxBuses - 1)];
       on_bus.insert(on_bus.end(), frames.begin(), frames.end());
@@ -109,7 +124,9 @@ std::vector<drivers::CanIoConfig> can_io_configs(const LoomConfig& c) {
   ic.master_node_id = c.can.master_node;
   ic.master_consumer_s = c.can.master_consumer_ms * 1e-3;
   std::vector<drivers::CanIoConfig> out{ic};
-  out[0].description = node_description(c.io.eds, drivers::eds::io_module_needs(out[0]));
+  out[0].input_group_bits =
+      input_group_bits(c.io.eds, c.io.input_group_bits, drivers::module_wiring(ic.wiring, 0));
+  out[0].description = node_description(c.io.eds, drivers::eds::io_module_needs(out[0]), c.io.store_config);
   for (std::size_t k = 0; k < c.io.modules.size(); ++k) {
     const IoModuleSpec& m = c.io.modules[k];
     drivers::CanIoConfig mc = ic;  // the same wiring, bus timing and master; its own node and windows
@@ -118,7 +135,9 @@ std::vector<drivers::CanIoConfig> can_io_configs(const LoomConfig& c) {
     mc.node_id = m.node;
     mc.boot_timeout_s = m.boot_timeout_ms * 1e-3;
     mc.operational_timeout_s = m.operational_timeout_ms * 1e-3;
-    mc.description = node_description(m.eds, drivers::eds::io_module_needs(mc));
+    mc.input_group_bits =
+        input_group_bits(m.eds, m.input_group_bits, drivers::module_wiring(mc.wiring, mc.module));
+    mc.description = node_description(m.eds, drivers::eds::io_module_needs(mc), m.store_config);
     out.push_back(std::move(mc));
   }
   return out;

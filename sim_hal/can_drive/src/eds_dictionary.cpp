@@ -1,6 +1,8 @@
 // Slave dictionary tables from an EDS (eds_dictionary.hpp).
 #include "loom/sim_can/eds_dictionary.hpp"
 
+#include <algorithm>
+
 namespace loom::sim_can {
 
 namespace eds = drivers::eds;
@@ -36,6 +38,22 @@ SimDriveConfig drive_from_eds(const eds::Description& d, std::uint8_t node_id) {
   if (const eds::Entry* e = d.entry(0x6502, 0)) modes = e->default_value.bits(0, e->type).value_or(0);
   c.supports_csp = (modes & (1U << 7)) != 0;
   c.supports_homing = (modes & (1U << 5)) != 0;
+  return c;
+}
+
+SimIoConfig io_from_eds(const eds::Description& d, std::uint8_t node_id) {
+  SimIoConfig c;
+  c.node_id = node_id;
+  c.dictionary = dictionary_from_eds(d);
+  const auto subs = [&](std::uint16_t index) {
+    const eds::Object* o = d.object(index);
+    int n = 0;
+    if (o != nullptr) {
+      for (const auto& [sub, e] : o->entries) n += sub >= 1 ? 1 : 0;
+    }
+    return n;
+  };
+  c.digital_input_groups = std::min(8, std::max(subs(0x6000), 2 * subs(0x6100)));
   return c;
 }
 

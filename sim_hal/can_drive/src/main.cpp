@@ -5,6 +5,7 @@
 //                  [--counts-per-unit A,B,C] [--initial-position a,b,c] [--io-control FILE]
 //                  [--homing-nodes 1,2 [--power-up-seed N]]
 //   loom-sim-drive --iface vcan0 --nodes 1,2,3 --eds VENDOR.eds   (every drive as the EDS describes it)
+//   loom-sim-drive ... --io-node 4 --io-eds MODULE.eds               (the I/O module as its EDS describes it)
 //   loom-sim-drive --iface vcan0 --loom LOOM.toml [--bus N] [--io-control FILE] ...
 // --loom: the nodes of bus N (default 0) as the machine description has them — drives in axis-slot order
 // with their scaling and referencing, the I/O modules on that bus (io.kind = "can": the [io] one on bus 0,
@@ -135,7 +136,7 @@ int main(int argc, char** argv) {
   std::uint64_t power_up_seed = 0;
   std::string loom_file;
   int loom_bus = 0;
-  std::string eds_file;
+  std::string eds_file, io_eds_file;
   app.add_option("--iface", iface, "CAN interface, e.g. vcan0")->required();
   auto* loom_opt =
       app.add_option("--loom", loom_file,
@@ -162,6 +163,10 @@ int main(int argc, char** argv) {
                  "build every drive's object dictionary from this CiA 306 EDS: its objects, access, fixed or "
                  "dynamic PDO mapping, PDO count, supported modes (0x6502) and identity (0x1018)")
       ->excludes("--personality");
+  app.add_option("--io-eds", io_eds_file,
+                 "build the I/O module's object dictionary from this CiA 306 EDS: its objects, access, PDO "
+                 "mapping, identity and input groups (0x6000 8-bit and/or 0x6100 16-bit)")
+      ->needs(io_node_opt);
   app.add_option("--boot-delay-ms", boot_delay_ms, "boot-up delay (default 0; fixed personality 300)");
   app.add_option("--operational-delay-ms", operational_delay_ms,
                  "NMT start → operational delay (default 0; fixed personality 400)");
@@ -302,6 +307,14 @@ int main(int argc, char** argv) {
     }
     if (description.has_errors()) return 2;
   }
+  loom::drivers::eds::Description io_description;
+  if (!io_eds_file.empty()) {
+    io_description = loom::drivers::eds::read_eds_file(io_eds_file);
+    for (const loom::drivers::eds::Diagnostic& d : io_description.diagnostics) {
+      std::cerr << "loom-sim-drive: " << loom::drivers::eds::format(io_description.file, d) << "\n";
+    }
+    if (io_description.has_errors()) return 2;
+  }
   std::vector<loom::sim_can::SimDriveConfig> configs;
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     const double cpu = counts_per_unit.empty() ? default_counts_per_unit(i) : counts_per_unit[i];
@@ -351,6 +364,7 @@ int main(int argc, char** argv) {
   std::vector<std::unique_ptr<loom::sim_can::SimIoNode>> ios;
   for (int n : io_nodes) {
     loom::sim_can::SimIoConfig ic;
+    if (!io_eds_file.empty()) ic = loom::sim_can::io_from_eds(io_description, static_cast<std::uint8_t>(n));
     ic.node_id = static_cast<std::uint8_t>(n);
     ic.width_m = width_m;
     ic.helix_lead_m = helix_lead_m;

@@ -27,6 +27,7 @@ constexpr std::uint16_t kErrorRegister = slave::kErrorRegisterObject;
 constexpr std::uint16_t kConsumerHeartbeat = slave::kConsumerHeartbeatObject;
 constexpr std::uint16_t kProducerHeartbeat = slave::kProducerHeartbeatObject;
 constexpr std::uint16_t kDigitalInputs = 0x6000;
+constexpr std::uint16_t kDigitalInputs16 = 0x6100;  // read input 16-bit: terminals 16(k-1)..16k-1 in sub k
 constexpr std::uint16_t kDigitalOutputs = 0x6200;
 constexpr std::uint16_t kOutputErrorMode = 0x6206;
 constexpr std::uint16_t kOutputErrorValue = 0x6207;
@@ -117,10 +118,12 @@ static_assert(slave::sorted(kTable), "the dictionary is binary-searched: list ob
 SimIoNode::SimIoNode(drivers::CanBus& bus, SimIoConfig config)
     : bus_(bus),
       config_(std::move(config)),
-      od_(kTable, slave::OdOptions{config_.absent_objects, config_.fixed_mapping}) {
+      od_(config_.dictionary.empty() ? std::span<const slave::Entry>(kTable)
+                                     : std::span<const slave::Entry>(config_.dictionary),
+          slave::OdOptions{config_.absent_objects, config_.fixed_mapping}) {
   // A module with fewer than the table's three mapped input groups pre-defines TPDO1 with the ones it
-  // has (resolved here, so resets allocate nothing).
-  if (config_.tpdo1_factory_mapping.empty() && input_groups() < 3) {
+  // has (resolved here, so resets allocate nothing). A described module's mapping is its description's.
+  if (config_.dictionary.empty() && config_.tpdo1_factory_mapping.empty() && input_groups() < 3) {
     for (int k = 1; k <= input_groups(); ++k) {
       config_.tpdo1_factory_mapping.push_back(map_entry(kDigitalInputs, static_cast<std::uint8_t>(k), 8));
     }
@@ -168,7 +171,7 @@ void SimIoNode::set_factory_mapping(int tpdo, const std::vector<std::uint32_t>& 
 
 void SimIoNode::reset_application() {
   od_.reset_application();
-  od_.set(kDigitalInputs, 0, static_cast<std::uint32_t>(input_groups()));
+  if (config_.dictionary.empty()) od_.set(kDigitalInputs, 0, static_cast<std::uint32_t>(input_groups()));
 }
 
 void SimIoNode::power_on(std::int64_t now_us) {
@@ -329,8 +332,13 @@ void SimIoNode::update_inputs() {
   for (std::size_t k = static_cast<std::size_t>(input_groups()); k < in.size(); ++k)
     in[k] = 0;  // no terminals
   in_ = in;
+  // The same terminals in both of CiA 401's forms (a module has one or both; set() ignores the other).
   for (std::size_t k = 0; k < in.size(); ++k)
     od_.set(kDigitalInputs, static_cast<std::uint8_t>(k + 1), in[k]);
+  for (std::size_t k = 0; k < in.size() / 2; ++k) {
+    od_.set(kDigitalInputs16, static_cast<std::uint8_t>(k + 1),
+            static_cast<std::uint32_t>(in[2 * k]) | static_cast<std::uint32_t>(in[2 * k + 1]) << 8);
+  }
   // Load cell: a narrow pulse around the crank angle at which the beater meets the fell.
   const double two_pi = 2.0 * 3.14159265358979323846;
   double d = std::fmod(plant_.crank_rad - config_.fell_crank_rad, two_pi);

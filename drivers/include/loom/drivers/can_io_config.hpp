@@ -22,6 +22,7 @@ struct NodeDescription;  // node_description.hpp
 // CiA 401 objects.
 namespace od401 {
 inline constexpr std::uint16_t kDigitalInputs8 = 0x6000;   // read input 8-bit, sub 1..n
+inline constexpr std::uint16_t kDigitalInputs16 = 0x6100;  // read input 16-bit, sub 1..n
 inline constexpr std::uint16_t kDigitalOutputs8 = 0x6200;  // write output 8-bit, sub 1..n
 inline constexpr std::uint16_t kOutputErrorMode = 0x6206;  // 1 = output goes to 0x6207 on failure
 inline constexpr std::uint16_t kOutputErrorValue = 0x6207;
@@ -33,17 +34,27 @@ inline constexpr std::uint16_t kDeviceProfile401 = 0x0191;  // low word of 0x100
 // The I/O modules one loom can have (module 0 = the [io] table's, the others [io_modules.<name>]).
 inline constexpr std::size_t kMaxIoModules = 4;
 
-// One signal on a digital input or output: which module, bit number across that module's 8-bit objects
-// (bit b lives in sub-index b/8 + 1, bit b%8), and polarity. bit = −1: not wired.
+// One signal on a digital input or output: which module, bit number across that module's terminals
+// (bit b lives in 8-bit group b/8 + 1, bit b%8 — or in 16-bit group b/16 + 1, bit b%16: CiA 401 packs
+// both the same way, 0x6100:01 = 0x6000:02 << 8 | 0x6000:01), and polarity. bit = −1: not wired.
 struct IoBit {
   int bit = -1;
   bool active_low = false;  // the signal is true when the electrical bit is 0
   std::uint8_t module = 0;  // 0..kMaxIoModules-1
 };
 
-// Inputs read from 0x6000:01..08 (64 bits) and outputs written to 0x6200:01..08 (64 bits), each in one
-// PDO of at most 8 bytes; a wiring uses as many 8-bit subs as its highest bit needs (the default loom
-// without knotting heads: three input subs, one output sub).
+// How the module's digital inputs are read: 8-bit groups (0x6000, CiA 401's usual form) or 16-bit groups
+// (0x6100, modules that offer only that). The input bits mean the same terminals either way.
+inline constexpr int kInputGroupBits8 = 8;
+inline constexpr int kInputGroupBits16 = 16;
+// The object of the input groups of `group_bits` (8: 0x6000, 16: 0x6100).
+constexpr std::uint16_t input_object(int group_bits) {
+  return group_bits == kInputGroupBits16 ? od401::kDigitalInputs16 : od401::kDigitalInputs8;
+}
+
+// Inputs read from 0x6000:01..08 or 0x6100:01..04 (64 bits) and outputs written to 0x6200:01..08 (64 bits),
+// each in one PDO of at most 8 bytes; a wiring uses as many 8-bit subs as its highest bit needs (the default
+// loom without knotting heads: three input subs, one output sub).
 inline constexpr int kIoMaxInputBits = 64;
 inline constexpr int kIoMaxOutputBits = 64;
 
@@ -100,6 +111,7 @@ enum class IoField {
   kHeads,
   kSignalBit,     // a signal's bit: required and unwired, out of range, or used twice on one module
   kSignalModule,  // a signal's module
+  kInputGroups,   // 8- or 16-bit input groups
   kLoadCellModule,
   kLoadCellChannel,
   kLoadCellGain,
@@ -155,6 +167,9 @@ struct CanIoConfig {
   // their safe state (0x6206/0x6207) when the host dies. 0 = do not configure a consumer.
   std::uint8_t master_node_id = 0x7F;
   double master_consumer_s = 0.500;
+  // The module's digital inputs as 8-bit groups (0x6000) or 16-bit groups (0x6100): from its EDS when it
+  // has one (the loom config derives it), else io.input_group_bits.
+  int input_group_bits = kInputGroupBits8;
   // The module's EDS (node_description.hpp), as CanAxisConfig::description. Null: none.
   std::shared_ptr<const NodeDescription> description{};
 };
@@ -164,15 +179,16 @@ std::optional<IoConfigFault> find_fault(const CanIoConfig& config);
 // Configure-time only. describe(find_fault()).
 Status validate(const CanIoConfig& config);
 
-// Configure-time only. The 8-bit subs of 0x6000 (inputs) and of 0x6200 (outputs) the wiring uses: 1 up
-// to the one holding its highest wired bit (0x6000:01..03 for the default wiring's second channels).
-// Of one module's wiring (module_wiring()) when the loom has several.
-std::uint8_t io_input_subs(const IoWiring& wiring);
+// Configure-time only. The input groups of `group_bits` (0x6000's 8-bit subs, or 0x6100's 16-bit ones)
+// and the 8-bit subs of 0x6200 (outputs) the wiring uses: 1 up to the one holding its highest wired bit
+// (0x6000:01..03, or 0x6100:01..02, for the default wiring's second channels). Of one module's wiring
+// (module_wiring()) when the loom has several.
+std::uint8_t io_input_subs(const IoWiring& wiring, int group_bits = kInputGroupBits8);
 std::uint8_t io_output_subs(const IoWiring& wiring);
 
 // The frames this node adds to every cycle with `wiring` (one RPDO, one or two TPDOs): the inputs' TPDO
-// carries one byte per 8-bit sub up to the highest wired input (3 with the default second channels).
-// `wiring` is the node's own (module_wiring()).
-std::vector<FrameGroup> io_frames_per_cycle(const IoWiring& wiring);
+// carries one group per sub up to the highest wired input (3 bytes with the default second channels in
+// 8-bit groups, 4 in 16-bit groups). `wiring` is the node's own (module_wiring()).
+std::vector<FrameGroup> io_frames_per_cycle(const IoWiring& wiring, int group_bits = kInputGroupBits8);
 
 }  // namespace loom::drivers

@@ -1,7 +1,8 @@
 // The loom's I/O node as a CANopen CiA 401 generic I/O module behind hal::IoPort: valve coils and the
 // stack light through 0x6200 in an RPDO, end sensors, shuttle sensors, the e-stop chain and the operator
-// buttons through 0x6000 in a TPDO, the beater's load cell through 0x6401 in a TPDO. Which bit is which
-// signal, its polarity and the load-cell scaling are wiring (config), so any module can be used.
+// buttons through 0x6000 (8-bit groups) or 0x6100 (16-bit groups, CanIoConfig::input_group_bits) in a TPDO,
+// the beater's load cell through 0x6401 in a TPDO. Which bit is which signal, its polarity and the load-cell
+// scaling are wiring (config), so any module can be used.
 //
 // A loom may spread its signals over several modules (IoBit::module; CanIoModules joins them into one
 // hal::IoPort). Each module is a CanNode of its bus' CanMaster (can_master.hpp): the master brings it up
@@ -86,10 +87,13 @@ class CanIoPort final : public hal::IoPort, public CanNode {
     std::array<std::uint32_t, kMaxPdoEntries> entries{};
   };
 
-  // 8-bit subs of 0x6000 the master can read (kIoMaxInputBits).
+  // Subs of 0x6000 (8-bit groups) the master can read (kIoMaxInputBits); 0x6100 (16-bit) uses half.
   static constexpr std::size_t kMaxInputSubs = kIoMaxInputBits / 8;
+  static constexpr std::size_t kMaxInputBytes = kIoMaxInputBits / 8;
 
   Status configure_mapping(class SdoClient& sdo);
+  // The mapping entry of input group `sub` (0x6000:sub/8 or 0x6100:sub/16).
+  std::uint32_t input_entry(std::uint8_t sub) const;
   Status locate(const std::array<PdoLayout, 4>& layouts, std::uint32_t wanted, const std::string& what,
                 Slot& slot) const;
   Status locate_inputs(std::uint8_t subs);
@@ -104,6 +108,7 @@ class CanIoPort final : public hal::IoPort, public CanNode {
 
   CanIoConfig config_;
   IoWiring wiring_;  // this module's signals: module_wiring(config_.wiring, config_.module)
+  int group_bits_;   // its digital inputs as 8-bit (0x6000) or 16-bit (0x6100) groups
   CanBus* bus_ = nullptr;
   bool configured_ = false;
   std::vector<std::string> notes_;
@@ -113,7 +118,7 @@ class CanIoPort final : public hal::IoPort, public CanNode {
   // 8-bit subs of 0x6200 the master can write (kIoMaxOutputBits).
   static constexpr std::size_t kMaxOutputSubs = kIoMaxOutputBits / 8;
 
-  std::array<Slot, kMaxInputSubs> input_slot_{};    // 0x6000:01..08 (pdo −1: not read)
+  std::array<Slot, kMaxInputSubs> input_slot_{};    // 0x6000:01..08 / 0x6100:01..04 (pdo −1: not read)
   int input_pdo_ = -1;                              // the one TPDO carrying the digital inputs
   std::array<Slot, kMaxOutputSubs> output_slot_{};  // 0x6200:01..08
   Slot analog_slot_{};
@@ -121,7 +126,7 @@ class CanIoPort final : public hal::IoPort, public CanNode {
   std::uint8_t output_pdo_bytes_ = 0;
 
   // RT state.
-  std::array<std::uint8_t, kMaxInputSubs> inputs_{};
+  std::array<std::uint8_t, kMaxInputBytes> inputs_{};  // terminals 0..63, 8 per byte, whatever the groups
   hal::Tick inputs_refreshed_ = hal::kNeverTick;
   std::int16_t analog_counts_ = 0;
   hal::Tick analog_refreshed_ = hal::kNeverTick;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "loom/drivers/eds_dcf.hpp"
@@ -28,5 +29,13 @@ struct ApplyReport {
 // valid again. `store`: 0x1010:01 = "save" when anything was written. Errors name the node and object.
 Result<ApplyReport> apply_configuration(SdoClient& sdo, std::uint8_t node,
                                         const std::vector<eds::SdoWrite>& writes, bool store);
+
+// Configure-time only. The description has a writable 0x1010:01 (store parameters): the only case in
+// which the master asks the node to store (a node without it could not, and would abort).
+bool can_store(const eds::Description& description);
+// Configure-time only. 0x1010:01 = "save" (0x65766173), after the bring-up's configuration writes; an
+// abort or a missing reply is the bring-up fault "store_refused", naming `label` (the node), the object,
+// the abort code and what to do.
+Status store_parameters(SdoClient& sdo, std::uint8_t node, const std::string& label);
 
 }  // namespace loom::drivers

@@ -66,6 +66,12 @@ NodeNeeds drive_needs(const CanAxisConfig& axis, const CanAxisPortConfig& port);
 // Configure-time only. What an I/O module must offer for its wiring (module_wiring(config.wiring, module)).
 NodeNeeds io_module_needs(const CanIoConfig& config);
 
+// Configure-time only. How the module `eds` describes serves the inputs of `wiring` (its own,
+// module_wiring()): 8 when 0x6000 has every 8-bit group they need (CiA 401's usual form, preferred), else
+// 16 when 0x6100 has every 16-bit group, else 0 (neither form: check_node() with 8-bit groups then names
+// the first group missing, at the file's line, and both forms in the remedy).
+int input_group_bits_of(const Description& eds, const IoWiring& wiring);
+
 // The node as its EDS describes it: what configuration keys would otherwise have to say by hand.
 struct NodeProfile {
   std::optional<std::uint32_t> device_type;      // 0x1000 value

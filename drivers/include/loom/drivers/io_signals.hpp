@@ -24,9 +24,10 @@ int used_heads(const IoWiring& w);
 // are inputs like any other, so a bit shared between a first and a second channel is refused.
 std::vector<NamedBit> inputs_of(const IoWiring& w);
 std::vector<NamedBit> outputs_of(const IoWiring& w);
-// The wired signal with the highest bit in 8-bit sub `sub` (1-based), the one named when the module
-// cannot deliver that sub; nullptr when no signal lives there (then the master can do without it).
-const NamedBit* signal_in_sub(const std::vector<NamedBit>& bits, int sub);
+// The wired signal with the highest bit in sub `sub` (1-based) of the groups of `group_bits` (8: 0x6000,
+// 16: 0x6100), the one named when the module cannot deliver that sub; nullptr when no signal lives there
+// (then the master can do without it).
+const NamedBit* signal_in_sub(const std::vector<NamedBit>& bits, int sub, int group_bits = 8);
 // The config key an operator edits for a signal ("io.inputs.shuttle_at_right_2" →
 // "io.shuttle_at_right_2_bit", "io.inputs.yarn_present.head2" → "io.yarn_present_bits (head 2)") and its
 // value: a bring-up refusal points at the TOML line that asks for the input the module cannot deliver.

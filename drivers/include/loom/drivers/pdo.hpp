@@ -47,7 +47,10 @@ inline constexpr std::uint16_t kErrorCode = 0x603F;
 inline constexpr std::uint16_t kDeviceType = 0x1000;
 inline constexpr std::uint16_t kErrorRegister = 0x1001;
 inline constexpr std::uint16_t kHeartbeatProducer = 0x1017;
-inline constexpr std::uint16_t kRpdoComm = 0x1400;  // + pdo-1
+// Store parameters (CiA 301): writing "save" to sub 1 makes the node keep its configuration over a reset.
+inline constexpr std::uint16_t kStoreParameters = 0x1010;
+inline constexpr std::uint32_t kSaveSignature = 0x65766173;  // "save", little-endian
+inline constexpr std::uint16_t kRpdoComm = 0x1400;           // + pdo-1
 inline constexpr std::uint16_t kRpdoMap = 0x1600;
 inline constexpr std::uint16_t kTpdoComm = 0x1800;
 inline constexpr std::uint16_t kTpdoMap = 0x1A00;

@@ -32,7 +32,8 @@ std::vector<RequiredObject> io_module_objects();
 // and output groups (0x6000:01..n, 0x6200:01..n) the module must have, e.g. 0x6000:01..03 when second
 // channels sit on bits 16..21, and what each object carries on this module; the load cell's objects only
 // when it is wired here.
-std::vector<RequiredObject> io_module_objects(const IoWiring& wiring);
+// With `input_group_bits` 16 the inputs are 0x6100's 16-bit groups instead of 0x6000's.
+std::vector<RequiredObject> io_module_objects(const IoWiring& wiring, int input_group_bits = 8);
 // "0x6041 statusword (TPDO1)" etc., one line per object; "0x6000:01..03 …" for a counted array.
 std::string describe(const RequiredObject& o);
 

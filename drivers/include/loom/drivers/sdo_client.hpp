@@ -39,6 +39,8 @@ class SdoClient {
   void set_skip_unchanged(bool on) { skip_unchanged_ = on; }
   bool skips_unchanged() const { return skip_unchanged_; }
   int skipped_writes() const { return skipped_writes_; }
+  // Downloads the node acknowledged so far (what it really took: skipped and aborted ones not counted).
+  int downloads() const { return downloads_; }
 
  private:
   Result<SdoReply> exchange(std::uint8_t node, const CanFrame& request, const std::string& what);
@@ -50,6 +52,7 @@ class SdoClient {
   std::uint32_t last_abort_ = 0;
   bool skip_unchanged_ = false;
   int skipped_writes_ = 0;
+  int downloads_ = 0;
 };
 
 // "0x60C2:01 (interpolation time period)". Configure-time only.

@@ -82,6 +82,9 @@ struct AxisSpec {
   // The drive's electronic data sheet (CiA 306 EDS or DCF), axes.<name>.eds: its path (a relative one in
   // the file is relative to the file); "" = none (the loom assumes a drive with every object it needs).
   std::string eds{};
+  // axes.<name>.store_config: after a bring-up that wrote anything, the master makes the drive store it
+  // (0x1010:01 = "save"); needs an EDS with a writable 0x1010:01.
+  bool store_config = false;
 
   // Drive counts per SI unit (per rad, or per m on a linear axis).
   double counts_per_unit() const;
@@ -110,6 +113,8 @@ struct IoModuleSpec {
   std::uint32_t operational_timeout_ms = 500;
   std::vector<std::string> signals;  // io signal names as the file lists them ("lamp_green", "cutter", ...)
   std::string eds{};                 // io_modules.<name>.eds: the module's EDS path ("" = none)
+  bool store_config = false;         // io_modules.<name>.store_config: as IoSettings::store_config
+  int input_group_bits = 0;          // io_modules.<name>.input_group_bits: as IoSettings's
 };
 
 struct IoSettings {
@@ -118,6 +123,12 @@ struct IoSettings {
   // in `modules` lists it (module k + 1 is modules[k]; the signal's IoBit::module says which).
   std::uint8_t node = 4;
   std::string eds{};  // io.eds: the [io] module's EDS path ("" = none)
+  // io.store_config: the module stores its configuration (0x1010:01 = "save") after a bring-up that wrote
+  // anything; needs an EDS with a writable 0x1010:01.
+  bool store_config = false;
+  // io.input_group_bits: the digital inputs as 8-bit (0x6000) or 16-bit (0x6100) groups; 0 = from the
+  // module's EDS (8-bit groups when it has them all, else 16-bit), 8 without an EDS.
+  int input_group_bits = 0;
   std::uint32_t boot_timeout_ms = 2000;
   std::uint32_t operational_timeout_ms = 500;
   drivers::IoWiring wiring;  // bit per signal, polarity, load-cell channel and scaling

@@ -8,6 +8,7 @@
 
 #include "loom/drivers/eds.hpp"
 #include "loom/sim_can/sim_drive_node.hpp"
+#include "loom/sim_can/sim_io_node.hpp"
 #include "loom/sim_can/slave_od.hpp"
 
 namespace loom::sim_can {
@@ -20,5 +21,9 @@ std::vector<slave::Entry> dictionary_from_eds(const drivers::eds::Description& d
 
 // A simulated drive at `node_id` described by `d`: its dictionary, CSP and homing as 0x6502 says.
 SimDriveConfig drive_from_eds(const drivers::eds::Description& d, std::uint8_t node_id);
+
+// A simulated CiA 401 module at `node_id` described by `d`: its dictionary, and as many input terminals
+// as its 0x6000 (8 per sub) or 0x6100 (16 per sub) has, whichever is more (at most 64).
+SimIoConfig io_from_eds(const drivers::eds::Description& d, std::uint8_t node_id);
 
 }  // namespace loom::sim_can

@@ -82,7 +82,11 @@ struct SimIoConfig {
   // groups read 0 and cannot be mapped (abort 0x06040041).
   int digital_input_groups = 8;
   std::vector<std::uint16_t> absent_objects;  // e.g. 0x1016, 0x6206, 0x1802
-  std::int64_t boot_delay_us = 0;             // power-on / reset → boot-up
+  // A module described by an EDS (eds_dictionary.hpp: io_from_eds()): its own dictionary table (sorted,
+  // 1/2/4-byte entries) instead of the built-in one — its objects, access, PDO mapping and identity, e.g.
+  // digital inputs only as 16-bit groups (0x6100). Empty: the built-in module.
+  std::vector<slave::Entry> dictionary;
+  std::int64_t boot_delay_us = 0;  // power-on / reset → boot-up
 };
 
 class SimIoNode : private slave::ObjectHooks, private slave::FrameHandlers {
@@ -103,7 +107,7 @@ class SimIoNode : private slave::ObjectHooks, private slave::FrameHandlers {
   std::uint8_t node_id() const { return config_.node_id; }
   std::uint8_t nmt_state() const { return nmt_; }  // 0x00, 0x04, 0x05, 0x7F as on the wire
   std::uint8_t outputs(int byte) const;            // what drives the valve coils now (error state applied)
-  std::uint8_t inputs(int byte) const { return in_[static_cast<std::size_t>(byte)]; }  // 0x6000:01..08
+  std::uint8_t inputs(int byte) const { return in_[static_cast<std::size_t>(byte)]; }  // terminals 8·byte..
   std::int16_t analog_counts() const { return analog_; }
   bool comm_lost() const { return comm_lost_; }   // master heartbeat consumer expired
   double piston_a() const { return piston_[0]; }  // 0 = retracted … 1 = extended
