@@ -199,13 +199,13 @@ TEST(Config, LoopPeriodMustResolveTheBeat) {
       0u)
       << e20;
   EXPECT_NE(e20.find("the load cell, read once per tick, can miss its peak"), std::string::npos) << e20;
-  // A slower crank allows a longer period: 12.5 rad/s (14.38 at the fastest beat) turns 9.9 deg in 12 ms.
+  // A slower crank allows a longer period: 12.5 rad/s (14.37 at the fastest beat) turns 9.9 deg in 12 ms.
   EXPECT_EQ(
       config_error("extends = \"default\"\n[recipe]\ncrank_speed_rad_s = 12.5\n[timing]\nperiod_ms = 12\n"),
       "");
   EXPECT_NE(
       config_error("extends = \"default\"\n[recipe]\ncrank_speed_rad_s = 12.5\n[timing]\nperiod_ms = 15\n")
-          .find("timing.period_ms = 15: the crank turns 12.4 deg per tick at the fastest beat (14.38 rad/s"),
+          .find("timing.period_ms = 15: the crank turns 12.4 deg per tick at the fastest beat (14.37 rad/s"),
       std::string::npos);
 }
 

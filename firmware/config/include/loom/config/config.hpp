@@ -222,8 +222,9 @@ struct LoomConfig {
   MachineSpec machine_spec;
   // The axes in slot order (hal::AxisLayout): beat crank, carriage, helix, then the others by name.
   std::vector<AxisSpec> axes = default_axes();
-  // The servo drives the axes name, by model.
-  std::vector<DriveModel> drives;
+  // The servo drives the axes name, by model: the default loom describes the knotting heads' servo
+  // (default_loom.toml's [drives.servo_100w_10to1]; a test holds the two equal).
+  std::vector<DriveModel> drives = {{"servo_100w_10to1", motion::shipped_knotter_drive()}};
   // The pile: none (a flat weave), knotted by the weaver while the loom waits, or by the heads.
   sequencer::KnottingSpec knotting;
   // The knotting servo's cycle through seed 001's linkage: its precision points, dimensions, masses and the
