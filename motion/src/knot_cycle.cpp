@@ -470,7 +470,8 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
 
   // --- The moves: each the time-optimal move under the torque–speed line for the largest inertia the
   // linkage reflects over its sweep and the largest load torque there (½|J'|ω² at the no-load speed plus
-  // |dV/dθ|), so that J(θ)α + ½J'ω² + dV/dθ stays within the line at every pose. Checked densely after.
+  // |dV/dθ|), so that J(θ)α + ½J'ω² + dV/dθ stays within the line at every pose. Checked densely
+  // after.
   const TorqueSpeedLine line{spec.no_load_speed_rad_s, spec.peak_torque_nm};
   auto plan = [&](double start_rel, double distance) {
     const double start_abs = kc.take_angle_ + start_rel;

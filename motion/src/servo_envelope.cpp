@@ -14,8 +14,8 @@ namespace loom::motion {
 
 namespace {
 
-// Driving phase from rest, x = t/τc: distance ω∞τc·(x − (1 − e^(−x))), written so that it keeps its
-// digits for small x (where it is ~x²/2).
+// Driving phase from rest, x = t/τc: distance ω∞τc·(x − (1 − e^(−x))), written so that it keeps
+// its digits for small x (where it is ~x²/2).
 double drive_distance(double w_inf, double tau, double t) noexcept {
   const double x = t / tau;
   const double g = x < 1e-3 ? x * x * (0.5 - x * (1.0 / 6.0 - x / 24.0)) : x + std::expm1(-x);
@@ -74,7 +74,8 @@ EnvelopeLimits EnvelopeMove::limits_for(const TorqueSpeedLine& line, double iner
     os << "the load torque " << load_nm << " N m takes the drive's whole " << usable << " N m";
     throw MotionError(ErrorCode::kOutOfBounds, os.str());
   }
-  // J·a + L ≤ s·τp(1 − ω/ω0) is the line (s·τp − L)(1 − ω/ω∞) with ω∞ = ω0(1 − L/(s·τp)).
+  // J·a + L ≤ s·τp(1 − ω/ω0) is the line (s·τp − L)(1 − ω/ω∞) with ω∞ = ω0(1 −
+  // L/(s·τp)).
   EnvelopeLimits l;
   l.stall_accel = (usable - load_nm) / inertia_kg_m2;
   l.asymptote_speed = line.no_load_speed_rad_s * (1.0 - load_nm / usable);

@@ -73,13 +73,14 @@ TEST(ServoDrives, TodaysHeadIsRefused) {
                                          kConfigDir + "/today.toml");
   EXPECT_NEAR(c.knot_cycle.no_load_speed_rad_s, 100 * 2 * M_PI / 60, 1e-12);
   const loom::motion::KnotCycle kc = loom::motion::KnotCycle::build(c.knot_cycle);
-  EXPECT_GT(kc.duration_s(), 0.856);  // ≥ the dwells and the travel at 10.47 rad/s with no acceleration time
+  // ≥ the dwells and the travel at 10.47 rad/s with no acceleration time
+  EXPECT_GT(kc.duration_s(), 0.856);
 }
 
 TEST(ServoDrives, TheShippedHeadIsAcceptedAndItsCycleRidesTheLine) {
   const LoomConfig c = load_loom_config(kConfigDir + "/knotting_loom.toml");
-  // The knot cycle's servo is the drive's output: 6000 rpm / 10, 0.95 N m × 10 × 0.95, (0.051 + 0.03) kg cm²
-  // × 10².
+  // The knot cycle's servo is the drive's output: 6000 rpm / 10, 0.95 N m × 10 × 0.95, (0.051 + 0.03) kg
+  // cm² × 10².
   EXPECT_NEAR(c.knot_cycle.no_load_speed_rad_s, 6000 * 2 * M_PI / 60 / 10, 1e-12);
   EXPECT_NEAR(c.knot_cycle.peak_torque_nm, 9.025, 1e-12);
   EXPECT_NEAR(c.knot_cycle.continuous_torque_nm, 3.04, 1e-12);

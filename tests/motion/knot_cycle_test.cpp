@@ -240,8 +240,8 @@ TEST(KnotCycle, RatesMatchFiniteDifferencesOfTheAngle) {
 }
 
 // The produced profile against the drive's envelope, from nothing but finite differences of the angle it
-// commands: at every sample the torque the linkage needs (the model's J α + ½J'ω² + dV/dθ, with ω and α
-// from central differences) lies within the torque–speed line.
+// commands: at every sample the torque the linkage needs (the model's J α + ½J'ω² + dV/dθ, with ω and
+// α from central differences) lies within the torque–speed line.
 TEST(KnotCycle, NoSampleExceedsTheTorqueSpeedLine) {
   const KnotCycleSpec s = seed001_knot_cycle_spec();
   const KnotCycle kc = KnotCycle::build(s);

@@ -36,9 +36,9 @@ double beat_speed_ratio(const LoomConfig& c) {
 namespace {
 
 // A selector's cruise speed: its max_speed, and with a drive no faster than the speed at which the drive's
-// torque-speed line still gives the recipe's selector acceleration to the rotor and gears alone
-// (J a ≤ τp (1 − ω/ω0)): the point-to-point move's box lies inside the drive's envelope. (The magazine's
-// own inertia is not described; check_axis_drives refuses an acceleration the rotor alone cannot take.)
+// torque-speed line still gives the recipe's selector acceleration to the rotor and gears alone (J a ≤ τp
+// (1 − ω/ω0)): the point-to-point move's box lies inside the drive's envelope. (The magazine's own
+// inertia is not described; check_axis_drives refuses an acceleration the rotor alone cannot take.)
 double selector_top_speed(const LoomConfig& c, const AxisSpec& a) {
   const DriveModel* m = a.drive.empty() ? nullptr : find_drive(c, a.drive);
   if (m == nullptr) return a.max_speed;

@@ -1,13 +1,12 @@
 // What a servo drive can do at its output, as a drive is sold (motor speed and torque, rotor inertia, a
-// gearbox), and the time-optimal rest-to-rest move of a rigid inertia within it.
-//
-// The envelope is the torque–speed line: driving (torque along the motion) the drive gives at most
-// τ_peak·(1 − |ω|/ω_0), falling linearly from its peak torque at standstill to nothing at the no-load speed
-// ω_0 (the back-EMF eats the supply voltage); braking (torque against the motion) the line lies above the
-// peak, so the peak torque caps it. A move of an inertia J within it accelerates on the line and brakes at
-// the peak: ω(t) = ω∞(1 − e^(−t/τc)) with τc = ω∞/a₀, then a constant deceleration b to rest. That is the
-// bang-bang solution (the fastest move with acceleration bounded above by a function of ω that falls with
-// ω and below by a constant), so it is time-optimal. An optional speed cap below ω∞ inserts a cruise.
+// gearbox), and the time-optimal rest-to-rest move of a rigid inertia within it.  The envelope is the
+// torque–speed line: driving (torque along the motion) the drive gives at most τ_peak·(1 − |ω|/ω_0),
+// falling linearly from its peak torque at standstill to nothing at the no-load speed ω_0 (the back-EMF eats
+// the supply voltage); braking (torque against the motion) the line lies above the peak, so the peak torque
+// caps it. A move of an inertia J within it accelerates on the line and brakes at the peak: ω(t) = ω∞(1
+// − e^(−t/τc)) with τc = ω∞/a₀, then a constant deceleration b to rest. That is the bang-bang
+// solution (the fastest move with acceleration bounded above by a function of ω that falls with ω and below
+// by a constant), so it is time-optimal. An optional speed cap below ω∞ inserts a cruise.
 #pragma once
 
 #include "loom/motion/jerk_move.hpp"
@@ -63,9 +62,9 @@ class EnvelopeMove {
   EnvelopeMove() = default;
 
   // Configure-time. The bounds of an inertia `inertia_kg_m2` under `line` at `share` of its torque, with a
-  // load torque of at most `load_nm` in either direction at any speed (gravity, the velocity-squared term
-  // of a linkage): a₀ = (s·τp − L)/J, ω∞ = ω_0 (1 − L/(s·τp)), b = a₀. Throws MotionError(kOutOfBounds)
-  // when the load takes the whole torque.
+  // load torque of at most `load_nm` in either direction at any speed (gravity, the velocity-squared term of
+  // a linkage): a₀ = (s·τp − L)/J, ω∞ = ω_0 (1 − L/(s·τp)), b = a₀. Throws
+  // MotionError(kOutOfBounds) when the load takes the whole torque.
   static EnvelopeLimits limits_for(const TorqueSpeedLine& line, double inertia_kg_m2, double load_nm,
                                    double share, double speed_cap_rad_s);
 
