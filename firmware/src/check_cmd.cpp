@@ -159,13 +159,38 @@ void print_knotting(const LoomConfig& c, const std::optional<motion::KnotCycle>&
   for (const auto& seg : rep.segments) {
     std::printf(" %s %.3f s (%s)", seg.name, seg.end_s - seg.begin_s, motion::knot_limit_name(seg.bound));
   }
+  // Which limit binds: the speed cap where a move cruises at it, else the drive's torque-speed line (every
+  // move drives on it and brakes at the peak); the continuous torque as the cycle's rms share of it.
+  const motion::KnotCycleSpec& ks = c.knot_cycle;
+  bool capped = false;
+  for (const auto& seg : rep.segments) capped |= seg.bound == motion::KnotLimit::kSpeedCap;
+  std::string drive = "the embedded default's";
+  for (const AxisSpec& a : c.axes) {
+    if (a.role == hal::AxisRole::kKnotter && !a.drive.empty()) {
+      drive = "drives." + a.drive + " (axes." + a.name + ".drive)";
+      break;
+    }
+  }
+  char cap[32] = "none";
+  if (ks.max_speed_rad_s > 0.0) std::snprintf(cap, sizeof cap, "%.3g rad/s", ks.max_speed_rad_s);
   std::printf(
-      "\n    servo %.3g rad/s (the knotter axes' max_speed), %.3g rad/s^2, %.3g N m: peak torque %.3g N m at "
-      "%.3f s; "
-      "gripper in the warp %.3f..%.3f s, cutter %.3f..%.3f s, yarn-present sampled %.3f..%.3f s\n",
-      c.knot_cycle.max_speed_rad_s, c.knot_cycle.max_accel_rad_s2, c.knot_cycle.max_torque_nm,
-      std::abs(rep.peak_torque_nm), rep.peak_torque_t_s, cycle.in_warp().begin_s, cycle.in_warp().end_s,
-      cycle.cutter().begin_s, cycle.cutter().end_s, cycle.yarn_sample().begin_s, cycle.yarn_sample().end_s);
+      "\n    servo at the output, %s: no-load %.3g rad/s, peak %.3g N m, continuous %.3g N m, rotor and "
+      "gears "
+      "%.3g kg m^2; speed cap %s\n",
+      drive.c_str(), ks.no_load_speed_rad_s, ks.peak_torque_nm, ks.continuous_torque_nm,
+      ks.rotor_inertia_kg_m2, cap);
+  std::printf(
+      "    binding: %s; fastest %.3g rad/s (%.0f %% of no-load), peak torque %.3g N m at %.3f s, rms torque "
+      "%.3g N m (%.0f %% of the continuous)\n",
+      capped ? "the speed cap (a knotter axis' max_speed below its drive's)"
+             : "the torque-speed line (each move drives on it and brakes at the peak torque)",
+      rep.peak_speed_rad_s, 100.0 * rep.peak_speed_rad_s / ks.no_load_speed_rad_s,
+      std::abs(rep.peak_torque_nm), rep.peak_torque_t_s, rep.rms_torque_nm,
+      100.0 * rep.rms_torque_nm / ks.continuous_torque_nm);
+  std::printf(
+      "    gripper in the warp %.3f..%.3f s, cutter %.3f..%.3f s, yarn-present sampled %.3f..%.3f s\n",
+      cycle.in_warp().begin_s, cycle.in_warp().end_s, cycle.cutter().begin_s, cycle.cutter().end_s,
+      cycle.yarn_sample().begin_s, cycle.yarn_sample().end_s);
   const int cycles = std::min(stripe, per_row);
   std::printf(
       "  knotting about %.1f s per row (%d cycles; the carriage steps and the selectors index while the "

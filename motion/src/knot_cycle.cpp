@@ -1,6 +1,6 @@
-// The knot cycle: check the linkage against the precision points, plan the jerk-limited moves slowed
-// to the servo's torque, and tabulate the servo angle over the cycle. Everything here but sample()
-// is configure-time; sample() reads the phase table.
+// The knot cycle: check the linkage against the precision points and plan each move time-optimally under
+// the servo's torque–speed line. Everything here but sample() is configure-time; sample() evaluates the
+// planned pieces.
 #include "loom/motion/knot_cycle.hpp"
 
 #include <Eigen/Core>
@@ -27,16 +27,14 @@ constexpr double kPointTolerance_m = 1e-6;
 constexpr double kAngleTolerance_rad = 1e-6;
 // Dense checks along the stroke and the return: crank-angle step (rad).
 constexpr double kSweepStep_rad = 1e-3;
-// Samples per move for the torque check; the planned move is re-checked and nudged slower if a
-// sample still exceeds the limit.
+// Samples per move for the inertia and load bounds and for the envelope check of the planned move.
 constexpr int kTorqueSamples = 2048;
-// Moves slowed by the torque limit are planned to this share of it: the peak between samples and
-// the table's interpolation stay below the limit itself.
-constexpr double kTorquePlanShare = 0.998;
+// Moves are planned to this share of the peak torque: what the linkage's bounds miss between samples
+// stays within the line itself (the planned move is checked densely and re-planned lower if not).
+constexpr double kTorquePlanShare = 0.995;
 // The in-warp window is widened by this much gripper travel in x (m) each side: the jaws have width.
 constexpr double kWarpMargin_m = 1e-3;
 constexpr int kPathSamples = 256;
-constexpr int kAccuracySamples = 20011;  // prime: off the table's knots
 
 using Eigen::Vector2d;
 
@@ -111,18 +109,14 @@ void check_spec(const KnotCycleSpec& s) {
          KnotCycleField::kMinTransmission);
   }
   require_non_negative("gravity_m_s2", s.gravity_m_s2);
-  require_positive("max_speed_rad_s", s.max_speed_rad_s);
-  require_positive("max_accel_rad_s2", s.max_accel_rad_s2);
-  require_positive("jerk_rad_s3", s.jerk_rad_s3);
-  require_positive("max_torque_nm", s.max_torque_nm, KnotCycleField::kMaxTorque);
+  require_positive("no_load_speed_rad_s", s.no_load_speed_rad_s);
+  require_positive("peak_torque_nm", s.peak_torque_nm, KnotCycleField::kMaxTorque);
+  require_positive("continuous_torque_nm", s.continuous_torque_nm, KnotCycleField::kMaxTorque);
   require_non_negative("rotor_inertia_kg_m2", s.rotor_inertia_kg_m2);
+  require_non_negative("max_speed_rad_s", s.max_speed_rad_s);
   require_non_negative("grip_s", s.grip_s);
   require_non_negative("cut_s", s.cut_s);
   require_non_negative("release_s", s.release_s);
-  if (s.table_size < 16 || static_cast<std::size_t>(s.table_size) > PhaseTable::kMaxSize) {
-    fail(ErrorCode::kInvalidInput,
-         "table_size = " + std::to_string(s.table_size) + ": must be in [16, 2^24]");
-  }
   const double pivots =
       std::hypot(s.rocker_pivot_x_m - s.crank_pivot_x_m, s.rocker_pivot_y_m - s.crank_pivot_y_m);
   if (!(pivots > 0.0))
@@ -149,14 +143,10 @@ const char* knot_limit_name(KnotLimit l) {
   switch (l) {
     case KnotLimit::kDwell:
       return "dwell";
-    case KnotLimit::kSpeed:
-      return "speed";
-    case KnotLimit::kAcceleration:
-      return "acceleration";
-    case KnotLimit::kJerk:
-      return "jerk";
-    case KnotLimit::kTorque:
-      return "torque";
+    case KnotLimit::kSpeedCap:
+      return "speed cap";
+    case KnotLimit::kTorqueSpeedLine:
+      return "torque-speed line";
   }
   return "?";
 }
@@ -197,23 +187,39 @@ KnotCycleSpec seed001_knot_cycle_spec() {
   // 30°: below it the joint forces grow as 1/sin μ past twice their best; the design has 38.2° at TAKE.
   s.min_transmission_rad = rad(30.0);
   s.gravity_m_s2 = 9.81;
-  // A metal-gear micro servo (MG90S class) at 5 V: no-load 0.1 s/60° (10.5 rad/s) and stall
-  // 1.8 kg·cm (0.18 N·m). Derated: 7 rad/s is its speed under load, 0.06 N·m a third of stall (what it
-  // gives continuously without overheating). Its internal position loop settles a step in ~30 ms:
-  // 400 rad/s² and a 20 ms acceleration ramp (2e4 rad/s³) keep the commanded profile trackable.
-  // Rotor: a 7 mm coreless motor, ~1e-9 kg m², behind a ~1:130 gear train: 1.7e-5 kg m² at the output.
-  s.max_speed_rad_s = 7.0;
-  s.max_accel_rad_s2 = 400.0;
-  s.jerk_rad_s3 = 2.0e4;
-  s.max_torque_nm = 0.06;
-  s.rotor_inertia_kg_m2 = 1.7e-5;
+  // The shipped head's drive (shipped_knotter_drive), no speed cap below what it can reach.
+  set_servo(s, shipped_knotter_drive());
+  s.max_speed_rad_s = 0.0;
   // Gripper jaws (a second micro servo or a solenoid) close in 150 ms; the hot-wire/blade cut 100 ms;
   // the jaws open in 100 ms.
   s.grip_s = 0.15;
   s.cut_s = 0.10;
   s.release_s = 0.10;
-  s.table_size = 1024;
   return s;
+}
+
+ServoDrive shipped_knotter_drive() {
+  // A 100 W, 40 mm-flange AC servo motor of the common 200 V class (the figures its makers' catalogues
+  // share to a few per cent): 3000 rpm rated, 6000 rpm maximum, 0.32 N m rated and 0.95 N m peak torque,
+  // rotor 0.051 kg cm² without brake; behind a 40 mm single-stage 10:1 precision planetary gearbox
+  // (0.03 kg cm² at its input, 95 % efficient at full load). At the output: 62.8 rad/s no-load, 9.03 N m
+  // peak, 3.04 N m continuous, 8.1e-4 kg m².
+  ServoDrive d;
+  d.motor_speed_rad_s = 6000.0 * 2.0 * kPi / 60.0;
+  d.motor_rated_torque_nm = 0.32;
+  d.motor_peak_torque_nm = 0.95;
+  d.rotor_inertia_kg_m2 = 0.051e-4;
+  d.gear_ratio = 10.0;
+  d.gear_inertia_kg_m2 = 0.03e-4;
+  d.gear_efficiency = 0.95;
+  return d;
+}
+
+void set_servo(KnotCycleSpec& spec, const ServoDrive& d) {
+  spec.no_load_speed_rad_s = d.output_speed_rad_s();
+  spec.peak_torque_nm = d.output_peak_torque_nm();
+  spec.continuous_torque_nm = d.output_rated_torque_nm();
+  spec.rotor_inertia_kg_m2 = d.output_inertia_kg_m2();
 }
 
 KnotCycle::Dynamics KnotCycle::dynamics_at(double crank_abs_rad) const {
@@ -254,23 +260,16 @@ double KnotCycle::torque_at(double crank_abs_rad, double omega, double alpha) co
   return d.inertia_kg_m2 * alpha + 0.5 * d.dinertia * omega * omega + d.gravity_nm;
 }
 
-KnotCycle::Sample KnotCycle::exact(double t_s) const noexcept {
-  double t = std::isnan(t_s) ? 0.0 : std::clamp(t_s, 0.0, duration_);
+KnotCycle::Sample KnotCycle::sample(double t_s) const noexcept {
+  // NaN → the rest pose; +inf → the end (at rest, end_offset from TAKE).
+  const double t = std::isnan(t_s) ? 0.0 : std::clamp(t_s, 0.0, duration_);
   for (const Piece& p : pieces_) {
-    if (t <= p.t1 || &p == &pieces_.back()) {
+    if (t < p.t1 || &p == &pieces_.back()) {
       const MoveSample m = p.move.at(t - p.t0);
       return {p.start_rad + m.position, m.velocity, m.acceleration};
     }
   }
   return {};
-}
-
-KnotCycle::Sample KnotCycle::sample(double t_s) const noexcept {
-  // NaN → the rest pose; clamping keeps the phase within one turn (the end reads f(0) + rise).
-  const double t = std::isnan(t_s) ? 0.0 : std::clamp(t_s, 0.0, duration_);
-  const PhaseSample s = table_.at(Phase::from_turns(t * inv_duration_));
-  const double rate = kTwoPi * inv_duration_;  // phase per second
-  return {s.value, s.d1 * rate, s.d2 * rate * rate};
 }
 
 namespace {
@@ -461,91 +460,77 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
   // --- Can the servo hold the links at all? (gravity alone, at the points)
   for (std::size_t i = 0; i < 3; ++i) {
     const double hold = std::fabs(kc.dynamics_at(crank_abs[i]).gravity_nm);
-    if (!(hold < spec.max_torque_nm)) {
+    if (!(hold < spec.peak_torque_nm)) {
       fail(ErrorCode::kOutOfBounds,
-           "max_torque_nm = " + num(spec.max_torque_nm) + ": holding the links against gravity at " +
+           "peak_torque_nm = " + num(spec.peak_torque_nm) + ": holding the links against gravity at " +
                point_name(i) + " takes " + num(hold) + " N m",
            KnotCycleField::kMaxTorque);
     }
   }
 
-  // --- The moves, each slowed until the torque fits.
-  const JerkLimits limits{spec.max_speed_rad_s, spec.max_accel_rad_s2, spec.jerk_rad_s3};
-  struct Planned {
-    JerkMove move;
-    double scale = 1.0;
-  };
+  // --- The moves: each the time-optimal move under the torque–speed line for the largest inertia the
+  // linkage reflects over its sweep and the largest load torque there (½|J'|ω² at the no-load speed plus
+  // |dV/dθ|), so that J(θ)α + ½J'ω² + dV/dθ stays within the line at every pose. Checked densely
+  // after.
+  const TorqueSpeedLine line{spec.no_load_speed_rad_s, spec.peak_torque_nm};
   auto plan = [&](double start_rel, double distance) {
     const double start_abs = kc.take_angle_ + start_rel;
-    const JerkMove fast = JerkMove::plan(distance, limits);
-    const double T = fast.duration();
-    // τ(t) = τ_in(t) + τ_g(θ): stretching time by s scales τ_in by 1/s² at the same pose, so each
-    // sample needs s² ≥ τ_in / (±τ_max − τ_g); the largest is the move's scale.
-    const double limit = kTorquePlanShare * spec.max_torque_nm;
-    double s2 = 1.0;
+    double j_max = 0.0, load = 0.0;
+    const double w0 = spec.no_load_speed_rad_s;
     for (int k = 0; k <= kTorqueSamples; ++k) {
-      const MoveSample m = fast.at(T * k / kTorqueSamples);
-      const Dynamics d = kc.dynamics_at(start_abs + m.position);
-      const double in = d.inertia_kg_m2 * m.acceleration + 0.5 * d.dinertia * m.velocity * m.velocity;
-      const double total = in + d.gravity_nm;
-      if (std::fabs(total) > limit) {
-        const double room = std::copysign(limit, in) - d.gravity_nm;
-        if (!(room * in > 0.0)) {
-          fail(ErrorCode::kOutOfBounds,
-               "max_torque_nm = " + num(spec.max_torque_nm) + ": gravity alone needs " + num(d.gravity_nm) +
-                   " N m at servo angle " + num(deg(start_rel + m.position)) + " deg from TAKE",
-               KnotCycleField::kMaxTorque);
-        }
-        s2 = std::max(s2, in / room);
-      }
+      const Dynamics d = kc.dynamics_at(start_abs + distance * k / kTorqueSamples);
+      j_max = std::max(j_max, d.inertia_kg_m2);
+      load = std::max(load, 0.5 * std::fabs(d.dinertia) * w0 * w0 + std::fabs(d.gravity_nm));
     }
-    Planned p;
-    p.scale = std::sqrt(s2);
-    for (int attempt = 0; attempt < 8; ++attempt) {
-      const double s = p.scale;
-      p.move = JerkMove::plan(distance, JerkLimits{limits.velocity / s, limits.acceleration / (s * s),
-                                                   limits.jerk / (s * s * s)});
-      if (s == 1.0) break;
-      double peak = 0.0;
-      const double Ts = p.move.duration();
-      for (int k = 0; k <= 4 * kTorqueSamples; ++k) {
-        const double t = Ts * (k + 0.5) / (4 * kTorqueSamples + 1);  // between the first pass's samples
-        const MoveSample m = p.move.at(t);
-        peak = std::max(peak, std::fabs(kc.torque_at(start_abs + m.position, m.velocity, m.acceleration)));
+    // What the drive has left at the speed and torque of a sample, as a share of what it gives there.
+    auto margin_of = [&](const EnvelopeMove& mv, double t) {
+      const MoveSample m = mv.at(t);
+      const double tau = kc.torque_at(start_abs + m.position, m.velocity, m.acceleration);
+      const double avail = line.available_nm(m.velocity, tau < 0.0 ? -1.0 : 1.0);
+      return avail > 0.0 ? (avail - std::fabs(tau)) / avail : -1.0;
+    };
+    double share = kTorquePlanShare;
+    EnvelopeMove move;
+    for (int attempt = 0; attempt < 8; ++attempt, share *= 0.99) {
+      EnvelopeLimits lim;
+      try {
+        lim = EnvelopeMove::limits_for(line, j_max, load, share, spec.max_speed_rad_s);
+      } catch (const MotionError& e) {
+        fail(ErrorCode::kOutOfBounds,
+             "peak_torque_nm = " + num(spec.peak_torque_nm) + ": moving the linkage from " +
+                 num(deg(start_rel)) + " deg past TAKE by " + num(deg(distance)) + " deg: " + e.what(),
+             KnotCycleField::kMaxTorque);
       }
-      if (peak <= spec.max_torque_nm) break;
-      p.scale *= 1.01;
+      move = EnvelopeMove::plan(distance, lim);
+      double worst = 1.0;
+      const double T = move.duration();
+      for (int k = 0; k <= 4 * kTorqueSamples; ++k)
+        worst = std::min(worst, margin_of(move, T * (k + 0.5) / (4 * kTorqueSamples + 1)));
+      if (worst >= 0.0) break;
     }
-    return p;
+    return move;
   };
-
-  auto bound_of = [&](const Planned& p) {
-    if (p.scale > 1.0) return KnotLimit::kTorque;
-    if (std::fabs(p.move.peak_velocity()) >= spec.max_speed_rad_s * (1.0 - 1e-9)) return KnotLimit::kSpeed;
-    double peak_acc = 0.0;
-    for (int k = 0; k <= 256; ++k)
-      peak_acc = std::max(peak_acc, std::fabs(p.move.at(p.move.duration() * k / 256).acceleration));
-    // The acceleration plateau is flat: a sample on it reads the limit to rounding.
-    return peak_acc >= spec.max_accel_rad_s2 * (1.0 - 1e-9) ? KnotLimit::kAcceleration : KnotLimit::kJerk;
+  auto bound_of = [&](const EnvelopeMove& m) {
+    return m.cruises() ? KnotLimit::kSpeedCap : KnotLimit::kTorqueSpeedLine;
   };
 
   const double d1 = dir * to_wrap, d2 = dir * (to_pull - to_wrap);
-  const Planned m1 = plan(0.0, d1);
-  const Planned m2 = plan(d1, d2);
-  const Planned m3 = plan(rep.stroke_rad, back);
+  const EnvelopeMove m1 = plan(0.0, d1);
+  const EnvelopeMove m2 = plan(d1, d2);
+  const EnvelopeMove m3 = plan(rep.stroke_rad, back);
 
   struct Seg {
     const char* name;
     double dt;
     double start;
-    const Planned* move;
+    const EnvelopeMove* move;
   };
   const std::array<Seg, 6> segs{{{"grip", spec.grip_s, 0.0, nullptr},
-                                 {"take_to_wrap", m1.move.duration(), 0.0, &m1},
-                                 {"wrap_to_pull", m2.move.duration(), d1, &m2},
+                                 {"take_to_wrap", m1.duration(), 0.0, &m1},
+                                 {"wrap_to_pull", m2.duration(), d1, &m2},
                                  {"cut", spec.cut_s, rep.stroke_rad, nullptr},
                                  {"release", spec.release_s, rep.stroke_rad, nullptr},
-                                 {"return", m3.move.duration(), rep.stroke_rad, &m3}}};
+                                 {"return", m3.duration(), rep.stroke_rad, &m3}}};
   double t = 0.0;
   for (std::size_t i = 0; i < segs.size(); ++i) {
     Piece& pc = kc.pieces_[i];
@@ -556,18 +541,19 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
     rs.name = segs[i].name;
     rs.begin_s = pc.t0;
     rs.end_s = pc.t1;
+    rs.switch_s = rs.brake_s = pc.t0;
     if (segs[i].move != nullptr) {
-      pc.move = segs[i].move->move;
+      rs.switch_s = pc.t0 + segs[i].move->switch_time();
+      rs.brake_s = pc.t0 + segs[i].move->brake_time();
+      pc.move = *segs[i].move;
       rs.distance_rad = pc.move.distance();
       rs.peak_speed_rad_s = std::fabs(pc.move.peak_velocity());
-      rs.time_scale = segs[i].move->scale;
-      rs.bound = bound_of(*segs[i].move);
+      rs.bound = bound_of(pc.move);
     }
     t = pc.t1;
   }
   kc.duration_ = t;
   if (!(kc.duration_ > 0.0)) fail(ErrorCode::kInvalidInput, "the cycle has no duration");
-  kc.inv_duration_ = 1.0 / kc.duration_;
 
   // --- Windows.
   const double t_pull = kc.pieces_[3].t0, t_cut_end = kc.pieces_[3].t1, t_release_end = kc.pieces_[4].t1;
@@ -613,30 +599,15 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
     kc.in_warp_ = {begin, end};
   }
 
-  // --- The table and its accuracy.
+  // --- Peak and rms torque, the envelope margin, inertia range and the gripper path.
   const double T = kc.duration_;
-  kc.table_ = PhaseTable(TableSpec{static_cast<std::size_t>(spec.table_size), Interp::kQuintic,
-                                   Precision::kDouble, kc.end_offset_},
-                         [&](double phi) {
-                           const Sample e = kc.exact(phi / kTwoPi * T);
-                           const double sc = T / kTwoPi;
-                           return PhaseExact{e.angle_rad, e.velocity_rad_s * sc, e.accel_rad_s2 * sc * sc};
-                         });
-  for (int k = 0; k < kAccuracySamples; ++k) {
-    const double tt = T * (k + 0.5) / kAccuracySamples;
-    const Sample a = kc.sample(tt), e = kc.exact(tt);
-    rep.table_angle_error_rad = std::max(rep.table_angle_error_rad, std::fabs(a.angle_rad - e.angle_rad));
-    rep.table_velocity_error_rad_s =
-        std::max(rep.table_velocity_error_rad_s, std::fabs(a.velocity_rad_s - e.velocity_rad_s));
-    rep.table_accel_error_rad_s2 =
-        std::max(rep.table_accel_error_rad_s2, std::fabs(a.accel_rad_s2 - e.accel_rad_s2));
-  }
-
-  // --- Peak torque, inertia range and the gripper path along the exact motion.
   rep.min_inertia_kg_m2 = std::numeric_limits<double>::infinity();
-  for (int k = 0; k <= 4 * kTorqueSamples; ++k) {
-    const double tt = T * k / (4 * kTorqueSamples);
-    const Sample e = kc.exact(tt);
+  rep.envelope_margin = 1.0;
+  double sum_sq = 0.0;
+  const int n_torque = 16 * kTorqueSamples;
+  for (int k = 0; k <= n_torque; ++k) {
+    const double tt = T * k / n_torque;
+    const Sample e = kc.sample(tt);
     const Dynamics d = kc.dynamics_at(kc.take_angle_ + e.angle_rad);
     const double tau = d.inertia_kg_m2 * e.accel_rad_s2 +
                        0.5 * d.dinertia * e.velocity_rad_s * e.velocity_rad_s + d.gravity_nm;
@@ -645,8 +616,21 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
       rep.peak_torque_t_s = tt;
       rep.peak_torque_angle_rad = e.angle_rad;
     }
+    if (k > 0) sum_sq += tau * tau;
+    rep.peak_speed_rad_s = std::max(rep.peak_speed_rad_s, std::fabs(e.velocity_rad_s));
+    const double avail = line.available_nm(e.velocity_rad_s, tau < 0.0 ? -1.0 : 1.0);
+    rep.envelope_margin =
+        std::min(rep.envelope_margin, avail > 0.0 ? (avail - std::fabs(tau)) / avail : -1.0);
     rep.max_inertia_kg_m2 = std::max(rep.max_inertia_kg_m2, d.inertia_kg_m2);
     rep.min_inertia_kg_m2 = std::min(rep.min_inertia_kg_m2, d.inertia_kg_m2);
+  }
+  rep.rms_torque_nm = std::sqrt(sum_sq / n_torque);
+  if (rep.rms_torque_nm > spec.continuous_torque_nm) {
+    fail(ErrorCode::kOutOfBounds,
+         "continuous_torque_nm = " + num(spec.continuous_torque_nm) +
+             ": knot after knot the cycle's rms torque is " + num(rep.rms_torque_nm) +
+             " N m: the motor would overheat",
+         KnotCycleField::kMaxTorque);
   }
   rep.path.reserve(kPathSamples);
   for (int k = 0; k < kPathSamples; ++k) {

@@ -71,8 +71,8 @@ RowTime one_row(const std::string& dir, const Class& c, int heads, double period
     for (const char* role : {"knotter", "selector"}) {
       cfg += std::string("[axes.") + role + "_" + (h < 10 ? "0" : "") + std::to_string(h) + "]\nrole = \"" +
              role + "\"\nbus = " + std::to_string(bus) +
-             "\nnode = " + std::to_string((role[0] == 'k' ? 20 : 50) + h) +
-             "\ncounts_per_rev = 4096\nmax_speed = " + (role[0] == 'k' ? "60.0" : "20.0") +
+             "\nnode = " + std::to_string((role[0] == 'k' ? 20 : 50) + h) + "\ncounts_per_rev = 4096\n" +
+             (role[0] == 'k' ? "drive = \"servo_100w_10to1\"" : "max_speed = 20.0") +
              "\nferror_min = 0.2\nreferencing = \"absolute\"\n";
     }
   }

@@ -2,7 +2,8 @@
 # loomctl check prints the objects each kind of node must support, from the machine description: the
 # homing objects for the drives referenced by a homing run (and only then), and the I/O module's input and
 # output groups widened by the knotting heads' signals when the heads are fitted, and each module's own when the
-# loom has several.
+# loom has several; the knot cycle's servo and which limit binds, and a knotting head whose max_speed
+# exceeds its drive refused.
 # usage: check_cli.sh LOOMCTL SOURCE_DIR
 set -euo pipefail
 loomctl=$1
@@ -26,6 +27,16 @@ expect "$out/default.txt" "0x6200:01 write digital outputs, 8-bit: valves, stack
 "$loomctl" check --config "$src/firmware/config/knotting_loom.toml" >"$out/heads.txt"
 expect "$out/heads.txt" "0x6200:01..04 write digital outputs, 8-bit: valves, stack light, buzzer, the heads' grippers and cutters"
 expect "$out/heads.txt" "0x6000:01..04 read digital inputs, 8-bit: sensors and their second channels, e-stop chain, buttons, the heads' yarn-present switches"
+# The knot cycle under the shipped servo's torque-speed line, and which limit binds.
+expect "$out/heads.txt" "servo at the output, drives.servo_100w_10to1 (axes.knotter_1.drive): no-load 62.8 rad/s, peak 9.03 N m, continuous 3.04 N m"
+expect "$out/heads.txt" "binding: the torque-speed line (each move drives on it and brakes at the peak torque)"
+# Today's head: a micro servo asked for 60 rad/s is refused at the axis' max_speed, with the drive's figure.
+sed -e 's/^drive = "servo_100w_10to1" .*$/drive = "micro_servo"\nmax_speed = 60.0/' \
+  "$src/firmware/config/knotting_loom.toml" >"$out/today.toml"
+printf '\n[drives.micro_servo]\nmotor_speed_rpm = 100\nrated_torque_nm = 0.06\npeak_torque_nm = 0.18\nrotor_inertia_kg_m2 = 1.7e-5\n' >>"$out/today.toml"
+mkdir -p "$out/designs" && cp "$src/firmware/config/designs/knot_demo.csv" "$out/designs/"
+if "$loomctl" check --config "$out/today.toml" >"$out/today.txt" 2>&1; then fail "today's head (60 rad/s on a micro servo) was accepted"; fi
+expect "$out/today.txt" "axes.knotter_1.max_speed = 60 rad/s: exceeds the drive's 10.5 rad/s at the output"
 echo "check_cli: PASS"
 
 # A second I/O module (the operator panel's, on bus 1): its node, bus and signals, its own bus load, and the

@@ -176,46 +176,50 @@ TEST(Config, BeatsPerPositionMultipliesTheBeatsOfARow) {
 
 // The loop period must resolve the beat: the load cell is read once per tick and a beat's contact with
 // the fell lasts only a few ticks, so at most 10 deg of crank per tick at the beat (at 20 ms the default
-// recipe's beats came out down to 78.8 N, under the 80 N band). Default recipe: 16.06 rad/s at the beat,
-// so 10.8 ms (9.9 deg) is the longest representable period (0x60C2: value·10^index) still accepted.
+// recipe's beats came out down to 78.8 N, under the 80 N band) — at the fastest beat the loom may run: the
+// beat regulator may beat up to its bound (x1.15) above the recipe's speed. Default recipe: 16.06 rad/s at
+// the beat, 18.47 rad/s at the fastest, so 9.4 ms (9.95 deg) is the longest representable period (0x60C2:
+// value·10^index) still accepted; 10 ms, accepted before the regulator, is refused.
 TEST(Config, LoopPeriodMustResolveTheBeat) {
   const std::string head = "extends = \"default\"\n[timing]\n";
-  EXPECT_EQ(config_error(head + "period_ms = 10.8\n"), "");
-  EXPECT_EQ(config_error(head + "period_ms = 10\n"), "");
-  const std::string e = config_error(head + "period_ms = 10.9\n");
-  EXPECT_EQ(e.rfind("loom.toml:3:13: timing.period_ms = 10.9: the crank turns 10.0 deg per tick at the beat "
-                    "(16.06 rad/s); "
-                    "at most 10 deg per tick, i.e. period_ms <= 10.86 for this recipe",
-                    0),
-            0u)
+  EXPECT_EQ(config_error(head + "period_ms = 9.4\n"), "");
+  const std::string e = config_error(head + "period_ms = 9.5\n");
+  EXPECT_EQ(
+      e.rfind("loom.toml:3:13: timing.period_ms = 9.5: the crank turns 10.1 deg per tick at the fastest "
+              "beat (18.47 rad/s, the beat regulator's bound x1.15 on the recipe's speed); at most 10 deg "
+              "per tick, i.e. period_ms <= 9.44 for this recipe",
+              0),
+      0u)
       << e;
+  EXPECT_NE(config_error(head + "period_ms = 10\n"), "");
   const std::string e20 = config_error(head + "period_ms = 20\n");
   EXPECT_EQ(
-      e20.rfind("loom.toml:3:13: timing.period_ms = 20: the crank turns 18.4 deg per tick at the beat", 0),
+      e20.rfind(
+          "loom.toml:3:13: timing.period_ms = 20: the crank turns 21.2 deg per tick at the fastest beat", 0),
       0u)
       << e20;
   EXPECT_NE(e20.find("the load cell, read once per tick, can miss its peak"), std::string::npos) << e20;
-  // A slower crank allows a longer period: 12.5 rad/s turns 8.6 deg in 12 ms.
+  // A slower crank allows a longer period: 12.5 rad/s (14.37 at the fastest beat) turns 9.9 deg in 12 ms.
   EXPECT_EQ(
       config_error("extends = \"default\"\n[recipe]\ncrank_speed_rad_s = 12.5\n[timing]\nperiod_ms = 12\n"),
       "");
   EXPECT_NE(
       config_error("extends = \"default\"\n[recipe]\ncrank_speed_rad_s = 12.5\n[timing]\nperiod_ms = 15\n")
-          .find("timing.period_ms = 15: the crank turns 10.7 deg per tick at the beat (12.50 rad/s)"),
+          .find("timing.period_ms = 15: the crank turns 12.4 deg per tick at the fastest beat (14.37 rad/s"),
       std::string::npos);
 }
 
 TEST(Config, LoopPeriodFromTheCommandLineIsCheckedToo) {
   LoomConfig c = default_loom_config();
-  c.run.period_s = 0.0108;
-  EXPECT_NO_THROW(rederive_and_check(c, "--period-ms 10.8"));
+  c.run.period_s = 0.0094;
+  EXPECT_NO_THROW(rederive_and_check(c, "--period-ms 9.4"));
   c.run.period_s = 0.02;
   try {
     rederive_and_check(c, "--period-ms 20");
     ADD_FAILURE() << "20 ms accepted";
   } catch (const ConfigError& e) {
     EXPECT_EQ(std::string(e.what()).rfind(
-                  "--period-ms 20: with it, timing.period_ms = 20: the crank turns 18.4 deg", 0),
+                  "--period-ms 20: with it, timing.period_ms = 20: the crank turns 21.2 deg", 0),
               0u)
         << e.what();
   }
@@ -224,18 +228,18 @@ TEST(Config, LoopPeriodFromTheCommandLineIsCheckedToo) {
 TEST(LoomctlCli, CoarseLoopPeriodIsRefusedByCheckAndWeave) {
   const CliRun w = run_loomctl("weave --rows 1 --no-telemetry --period-ms 20");
   EXPECT_EQ(w.exit_code, 2) << w.output;
-  EXPECT_NE(w.output.find("timing.period_ms = 20: the crank turns 18.4 deg per tick at the beat"),
+  EXPECT_NE(w.output.find("timing.period_ms = 20: the crank turns 21.2 deg per tick at the fastest beat"),
             std::string::npos)
       << w.output;
   const std::string path =
       write_temp("loom_period20.toml", "extends = \"default\"\n[timing]\nperiod_ms = 20\n");
   const CliRun c = run_loomctl("check --config " + path);
   EXPECT_EQ(c.exit_code, 2) << c.output;
-  EXPECT_NE(
-      c.output.find(path + ":3:13: timing.period_ms = 20: the crank turns 18.4 deg per tick at the beat"),
-      std::string::npos)
+  EXPECT_NE(c.output.find(
+                path + ":3:13: timing.period_ms = 20: the crank turns 21.2 deg per tick at the fastest beat"),
+            std::string::npos)
       << c.output;
-  EXPECT_EQ(run_loomctl("weave --rows 1 --no-telemetry --period-ms 10").exit_code, 0);
+  EXPECT_EQ(run_loomctl("weave --rows 1 --no-telemetry --period-ms 9").exit_code, 0);
 }
 
 // One default, not two: the embedded default TOML and a default-constructed LoomConfig must say the same

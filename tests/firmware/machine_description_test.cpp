@@ -71,7 +71,13 @@ TEST(MachineDescription, TheDefaultFileIsCompleteAndExtendingItChangesNothing) {
     }
     if (std::string(k.path).rfind("axes.<name>.", 0) == 0) {  // per-axis keys: in the axis tables
       const std::string key = std::string(k.path).substr(12);
-      if (key == "max_speed" || key.rfind("hom", 0) == 0) continue;  // added axes / homed axes only
+      if (key == "max_speed" || key == "drive" || key.rfind("hom", 0) == 0)
+        continue;  // added axes / homed axes only
+      EXPECT_NE(std::string(kDefaultLoomToml).find("\n" + key + " "), std::string::npos) << k.path;
+      continue;
+    }
+    if (std::string(k.path).rfind("drives.<model>.", 0) == 0) {  // the shipped drive's table
+      const std::string key = std::string(k.path).substr(15);
       EXPECT_NE(std::string(kDefaultLoomToml).find("\n" + key + " "), std::string::npos) << k.path;
       continue;
     }
@@ -355,7 +361,8 @@ TEST(MachineKnotting, HeadsNeedAMagazineThatHoldsEveryColourOfTheDesign) {
     static int node = 10;
     head_axes += std::string("[axes.") + a + "]\nrole = \"" + (a[0] == 'k' ? "knotter" : "selector") +
                  "\"\nbus = 1\nnode = " + std::to_string(++node) +
-                 "\ncounts_per_rev = 4096\nmax_speed = 20.0\nferror_min = 0.2\nreferencing = \"absolute\"\n";
+                 "\ncounts_per_rev = 4096\nmax_speed = 20.0\nferror_min = 0.2\nreferencing = \"absolute\"\n" +
+                 (a[0] == 'k' ? "drive = \"servo_100w_10to1\"\n" : "");
   }
   std::ofstream(dir + "/bad.toml") << ext(heads + "slot_colours = [\"R\", \"W\"]\n" + head_axes +
                                           "[recipe]\ndesign = \"rug.csv\"\n");

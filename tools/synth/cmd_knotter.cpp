@@ -127,9 +127,9 @@ void run_knotter(const KnotterArgs& args, std::ostream& out, std::ostream& err) 
     field = v;
   };
   servo("--max-speed-rad-s", args.max_speed_rad_s, base.max_speed_rad_s);
-  servo("--max-accel-rad-s2", args.max_accel_rad_s2, base.max_accel_rad_s2);
-  servo("--jerk-rad-s3", args.jerk_rad_s3, base.jerk_rad_s3);
-  servo("--max-torque-nm", args.max_torque_nm, base.max_torque_nm);
+  servo("--no-load-speed-rad-s", args.no_load_speed_rad_s, base.no_load_speed_rad_s);
+  servo("--max-torque-nm", args.max_torque_nm, base.peak_torque_nm);
+  base.continuous_torque_nm = std::min(base.continuous_torque_nm, base.peak_torque_nm);
 
   // Try each chain's side link as the driven one; keep the checked one with the best transmission.
   struct Candidate {
@@ -212,9 +212,11 @@ void run_knotter(const KnotterArgs& args, std::ostream& out, std::ostream& err) 
       << "#   min transmission angle in the stroke " << g(motion::deg(rep.min_transmission_rad))
       << " deg at crank " << g(motion::deg(rep.min_transmission_at_rad)) << " deg; closure residual "
       << g(rep.closure_residual_m) << " m\n";
-  out << "#   cycle " << g(kc.duration_s()) << " s with servo " << g(s.max_speed_rad_s) << " rad/s, "
-      << g(s.max_accel_rad_s2) << " rad/s2, " << g(s.max_torque_nm) << " N m, rotor "
-      << g(s.rotor_inertia_kg_m2) << " kg m2:";
+  out << "#   cycle " << g(kc.duration_s())
+      << " s, the time-optimal moves under the servo's torque-speed line (" << g(s.no_load_speed_rad_s)
+      << " rad/s no-load, " << g(s.peak_torque_nm) << " N m peak, rotor and gears "
+      << g(s.rotor_inertia_kg_m2) << " kg m2 at the output"
+      << (s.max_speed_rad_s > 0.0 ? ", capped at " + g(s.max_speed_rad_s) + " rad/s" : std::string()) << "):";
   for (const auto& seg : rep.segments)
     out << " " << seg.name << " " << g(seg.end_s - seg.begin_s) << " s ("
         << motion::knot_limit_name(seg.bound) << ")";

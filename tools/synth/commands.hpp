@@ -103,8 +103,9 @@ struct KnotterArgs {
   double warp_entry_mm = 20.0;
   double min_transmission_deg = 30.0;
   std::string drive = "auto";  // "auto", "first", "second": which chain's side link the servo drives
-  // Servo limits for the cycle-time comment (defaults: loom::motion::seed001_knot_cycle_spec()).
-  double max_speed_rad_s = 0.0, max_accel_rad_s2 = 0.0, jerk_rad_s3 = 0.0, max_torque_nm = 0.0;
+  // The servo at its output for the cycle-time comment (defaults: loom::motion::seed001_knot_cycle_spec()):
+  // a speed cap, the torque-speed line's no-load speed and its peak torque.
+  double max_speed_rad_s = 0.0, no_load_speed_rad_s = 0.0, max_torque_nm = 0.0;
 };
 // configure-time only (offline tool). The knotting four-bar from the two three-point chains, checked
 // (branch, order, transmission, toggle) by the knot cycle, as [knotting.linkage] config lines.

@@ -91,10 +91,10 @@ int main(int argc, char** argv) {
   kn_cmd->add_option("--drive", kn.drive, "Which chain's side link the servo drives: auto, first, second")
       ->capture_default_str();
   kn_cmd->add_option("--max-speed-rad-s", kn.max_speed_rad_s,
-                     "Servo speed limit for the cycle-time comment (default: micro servo)");
-  kn_cmd->add_option("--max-accel-rad-s2", kn.max_accel_rad_s2, "Servo acceleration limit");
-  kn_cmd->add_option("--jerk-rad-s3", kn.jerk_rad_s3, "Servo jerk limit");
-  kn_cmd->add_option("--max-torque-nm", kn.max_torque_nm, "Servo torque limit");
+                     "Servo speed cap below its no-load speed, for the cycle-time comment (default: none)");
+  kn_cmd->add_option("--no-load-speed-rad-s", kn.no_load_speed_rad_s,
+                     "Servo no-load speed at the output (default: the shipped 100 W servo behind 10:1)");
+  kn_cmd->add_option("--max-torque-nm", kn.max_torque_nm, "Servo peak torque at the output");
 
   return loom::cli::run_cli("loom-synth", app, argc, argv, [&] {
     if (*sc_cmd) {

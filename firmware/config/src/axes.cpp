@@ -74,7 +74,9 @@ const std::vector<AxisKeyInfo>& axis_keys() {
       {"axes.<name>.bus", "[0, 3] (integer): 0 = the first CAN interface; default 0"},
       {"axes.<name>.counts_per_rev", "[16, 2147483648]"},
       {"axes.<name>.lead_m", "[0.0001, 1] (linear axes only)"},
-      {"axes.<name>.max_speed", "[0.001, 1000] rad/s or m/s (added axes only)"},
+      {"axes.<name>.drive", "a [drives.<model>] name (added axes; knotters with heads must name one)"},
+      {"axes.<name>.max_speed",
+       "[0.001, 1000] rad/s or m/s (added axes only; with a drive: at most its output speed, default it)"},
       {"axes.<name>.ferror_min", "[0, 100] rad, [0, 1] m; 0 = off"},
       {"axes.<name>.ferror_k_s", "[0, 10]"},
       {"axes.<name>.boot_ms", "[0, 60000] (integer); 0 = 2000 ms"},
@@ -99,8 +101,9 @@ std::string axes_text(const LoomConfig& c) {
   for (const AxisSpec& a : c.axes) {
     os << "[" << a.name << " " << hal::axis_role_name(a.role) << " node " << int{a.node} << " "
        << fmt_num(a.counts_per_rev) << "/rev bus " << int{a.bus} << " lead " << fmt_num(a.lead_m) << " vmax "
-       << fmt_num(a.max_speed) << " ferror " << fmt_num(a.ferror_min) << "+" << fmt_num(a.ferror_k_s)
-       << "s boot " << a.boot_ms << " op " << a.operational_ms;
+       << fmt_num(a.max_speed) << (a.drive.empty() ? "" : " drive " + a.drive) << " ferror "
+       << fmt_num(a.ferror_min) << "+" << fmt_num(a.ferror_k_s) << "s boot " << a.boot_ms << " op "
+       << a.operational_ms;
     if (a.homing) {
       os << " homing " << a.homing_method << " at " << fmt_num(a.home_offset) << " "
          << fmt_num(a.homing_speed) << "/s " << fmt_num(a.homing_accel) << "/s2 "
@@ -184,9 +187,18 @@ void read_axes(TomlReader& r, LoomConfig& c, bool extending) {
              "the core axes' speed limits are facts of their mechanisms: [carriage] max_speed_m_s, "
              "[helix] max_speed_rad_s, the recipe's crank speed");
     }
+    if (core && has("drive")) {
+      r.fail(p + "drive", "",
+             "the core axes' limits are facts of their mechanisms ([carriage], [helix], the recipe's crank "
+             "speed); a drive is described for the added axes");
+    }
     if (!core) {
-      need("max_speed", std::string("missing: the axis' top speed (") + (linear ? "m/s" : "rad/s") + ")");
+      r.string(p + "drive", a.drive);
+      if (a.drive.empty())
+        need("max_speed", std::string("missing: the axis' top speed (") + (linear ? "m/s" : "rad/s") +
+                              "), or its drive (axes." + name + ".drive)");
       r.number(p + "max_speed", a.max_speed, [](double v) { return in_range(v, 1e-3, 1e3); });
+      if (has("max_speed")) a.max_speed_set = true;
     } else {
       a.max_speed = 0.0;
     }

@@ -266,6 +266,19 @@ void check_relations(const TomlReader& r, const LoomConfig& c) {
     // checks).
     try {
       (void)motion::KnotCycle::build(c.knot_cycle);
+    } catch (const motion::KnotCycleError& e) {
+      // About the servo's torque: the knotting servo's drive is the fact to change.
+      if (e.field() == motion::KnotCycleField::kMaxTorque) {
+        const auto knotter = std::find_if(c.axes.begin(), c.axes.end(), [](const AxisSpec& a) {
+          return a.role == hal::AxisRole::kKnotter;
+        });
+        if (knotter != c.axes.end() && !knotter->drive.empty()) {
+          r.fail("axes." + knotter->name + ".drive", "\"" + knotter->drive + "\"",
+                 std::string("the knotting servo's drive: ") + e.what());
+        }
+      }
+      r.fail("knotting.linkage.crank_m", fmt_num(c.knot_cycle.crank.length_m),
+             std::string("the knotting linkage: ") + e.what());
     } catch (const motion::MotionError& e) {
       r.fail("knotting.linkage.crank_m", fmt_num(c.knot_cycle.crank.length_m),
              std::string("the knotting linkage: ") + e.what());
@@ -415,7 +428,11 @@ void check_motion(const LoomConfig& c, const Fail& fail) {
 }
 
 void check_beat_resolution(const LoomConfig& c, const Fail& fail) {
-  const double omega = c.profile.crank.velocity * beat_speed_ratio(c);  // crank speed at the fell (rad/s)
+  // The crank speed at the fell (rad/s), at the fastest beat the loom may run: the beat regulator may
+  // beat up to its speed bound above the recipe's (sequencer::BeatRegulatorConfig; open loop: 1).
+  const sequencer::BeatRegulatorConfig& reg = c.sequencer.beat_regulator;
+  const double fastest = reg.enabled ? std::max(1.0, reg.max_speed_scale) : 1.0;
+  const double omega = c.profile.crank.velocity * beat_speed_ratio(c) * fastest;
   const double deg_per_tick = motion::deg(omega * c.run.period_s);
   if (!(deg_per_tick > kMaxBeatCrankDegPerTick)) return;
   // The largest period this recipe allows, rounded down to 0.01 ms so that it is itself accepted.
@@ -423,11 +440,12 @@ void check_beat_resolution(const LoomConfig& c, const Fail& fail) {
   char why[512];
   std::snprintf(
       why, sizeof why,
-      "the crank turns %.1f deg per tick at the beat (%.2f rad/s); at most %.0f deg per tick, i.e. "
+      "the crank turns %.1f deg per tick at the fastest beat (%.2f rad/s, the beat regulator's bound x%.2f "
+      "on the recipe's speed); at most %.0f deg per tick, i.e. "
       "period_ms <= %.2f for this recipe: a beat's contact with the fell lasts only a few ticks and the "
       "load cell, read once per tick, can miss its peak by up to a tick of crank travel (simulated at "
       "20 ms with the default recipe: beats down to 78.8 N against the 80 N minimum)",
-      deg_per_tick, omega, kMaxBeatCrankDegPerTick, max_period_ms);
+      deg_per_tick, omega, fastest, kMaxBeatCrankDegPerTick, max_period_ms);
   fail("timing.period_ms", fmt_num(c.run.period_s * 1e3), why);
 }
 

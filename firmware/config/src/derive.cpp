@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "drives.hpp"
 #include "loom/motion/dynamics.hpp"
 #include "loom/motion/errors.hpp"
 #include "loom/motion/mass_properties.hpp"
@@ -33,6 +34,19 @@ double beat_speed_ratio(const LoomConfig& c) {
 }
 
 namespace {
+
+// A selector's cruise speed: its max_speed, and with a drive no faster than the speed at which the drive's
+// torque-speed line still gives the recipe's selector acceleration to the rotor and gears alone (J a ≤ τp
+// (1 − ω/ω0)): the point-to-point move's box lies inside the drive's envelope. (The magazine's own
+// inertia is not described; check_axis_drives refuses an acceleration the rotor alone cannot take.)
+double selector_top_speed(const LoomConfig& c, const AxisSpec& a) {
+  const DriveModel* m = a.drive.empty() ? nullptr : find_drive(c, a.drive);
+  if (m == nullptr) return a.max_speed;
+  const motion::ServoDrive& d = m->drive;
+  const double room =
+      1.0 - d.output_inertia_kg_m2() * c.knotting.selector_accel_rad_s2 / d.output_peak_torque_nm();
+  return std::min(a.max_speed, d.output_speed_rad_s() * std::max(room, 0.0));
+}
 
 // Crank (master) speed for the recipe: given, or from the beat-force target through the linkage's
 // inverse dynamics (the beater force is inertial, so it scales with ω²) and the crank law.
@@ -114,15 +128,9 @@ void derive(LoomConfig& c, const Fail& fail) {
         k.knotter_axis[static_cast<std::size_t>(knotters++)] = static_cast<int>(i);
       } else if (c.axes[i].role == hal::AxisRole::kSelector && selectors < sequencer::kMaxKnottingHeads) {
         k.selector_axis[static_cast<std::size_t>(selectors++)] = static_cast<int>(i);
-        selector_speed = std::min(selector_speed, c.axes[i].max_speed);
+        selector_speed = std::min(selector_speed, selector_top_speed(c, c.axes[i]));
       }
     }
-    double knotter_speed = 1e300;
-    for (int h = 0; h < knotters; ++h)
-      knotter_speed =
-          std::min(knotter_speed,
-                   c.axes[static_cast<std::size_t>(k.knotter_axis[static_cast<std::size_t>(h)])].max_speed);
-    if (knotters > 0) c.knot_cycle.max_speed_rad_s = knotter_speed;
     k.take_position_rad = c.knotting.take_position_rad;
     k.selector_zero_rad = c.knotting.selector_zero_rad;
     if (selectors > 0) {

@@ -434,14 +434,9 @@ const std::vector<Key>& keys() {
                        [](LoomConfig& c) -> double& { return c.knotting.selector_accel_rad_s2; }));
     v.push_back(number("knotting.selector_jerk_rad_s3", M::kMachine, 10.0, 1e9,
                        [](LoomConfig& c) -> double& { return c.knotting.selector_jerk_rad_s3; }));
-    // The knotting servo (its top speed is the knotter axes' max_speed) and the gripper's dwells.
+    // The gripper's dwells (the knotting servo itself is its axes' drive, [drives.<model>]).
     using KC = motion::KnotCycleSpec;
     const auto kc = [](double KC::*f) { return [f](LoomConfig& c) -> double& { return c.knot_cycle.*f; }; };
-    v.push_back(number("knotting.servo_accel_rad_s2", M::kMachine, 1.0, 1e6, kc(&KC::max_accel_rad_s2)));
-    v.push_back(number("knotting.servo_jerk_rad_s3", M::kMachine, 10.0, 1e9, kc(&KC::jerk_rad_s3)));
-    v.push_back(number("knotting.servo_torque_nm", M::kMachine, 1e-5, 100.0, kc(&KC::max_torque_nm)));
-    v.push_back(
-        number("knotting.servo_rotor_inertia_kg_m2", M::kMachine, 0.0, 1.0, kc(&KC::rotor_inertia_kg_m2)));
     v.push_back(millis("knotting.grip_ms", M::kMachine, 1.0, 5000.0, kc(&KC::grip_s)));
     v.push_back(millis("knotting.cut_ms", M::kMachine, 1.0, 5000.0, kc(&KC::cut_s)));
     v.push_back(millis("knotting.release_ms", M::kMachine, 1.0, 5000.0, kc(&KC::release_s)));
@@ -605,6 +600,7 @@ const std::set<std::string>& known_sections() {
     for (const Key& k : keys()) out.insert(k.path.substr(0, k.path.find('.')));
     out.insert("axes");        // [axes.<name>] tables, read by read_axes()
     out.insert("io_modules");  // [io_modules.<name>] tables, read by read_io_modules()
+    out.insert("drives");      // [drives.<model>] tables, read by read_drives()
     return out;
   }();
   return s;
@@ -646,6 +642,15 @@ void refuse_moved_keys(TomlReader& r) {
       {"can.helix_ferror_min_rad", "axes.helix.ferror_min"},
       {"can.helix_ferror_k_s", "axes.helix.ferror_k_s"},
       {"recipe.knotting", "knotting.mode (\"none\", \"weaver\" or \"heads\")"},
+      {"knotting.servo_accel_rad_s2",
+       "the knotting servo's drive: axes.<knotter>.drive and its [drives.<model>] table (the knot cycle "
+       "is the time-optimal move under the drive's torque-speed line, not a speed/acceleration box)"},
+      {"knotting.servo_jerk_rad_s3",
+       "the drive's envelope: the knot cycle is the time-optimal move under its torque-speed line"},
+      {"knotting.servo_torque_nm",
+       "drives.<model>.rated_torque_nm and peak_torque_nm (the motor's, through gear_ratio)"},
+      {"knotting.servo_rotor_inertia_kg_m2",
+       "drives.<model>.rotor_inertia_kg_m2 and gear_inertia_kg_m2 (at the motor, through gear_ratio)"},
   };
   for (const auto& m : moved) {
     if (const toml::node* n = r.root().at_path(m.old_key).node()) {

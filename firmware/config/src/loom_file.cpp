@@ -5,6 +5,7 @@
 #include "axes.hpp"
 #include "checks.hpp"
 #include "derive.hpp"
+#include "drives.hpp"
 #include "eds_keys.hpp"
 #include "io_modules_config.hpp"
 #include "keys.hpp"
@@ -48,7 +49,9 @@ LoomConfig parse_complete(const std::string& text, const std::string& source, co
                    "missing: give beat_force_target_n (N) or crank_speed_rad_s (rad/s)");
   }
   refuse_moved_keys(r);
+  read_drives(r, c);
   read_axes(r, c, base != nullptr);
+  check_axis_drives(r, c);
   read_io_modules(r, c);
   r.reject_unknown(known_sections());
   check_relations(r, c);
@@ -123,6 +126,9 @@ std::string restart_only_changes(const LoomConfig& running, const LoomConfig& ne
   if (const std::string a = axes_text(running), b = axes_text(next); a != b) {
     out += (out.empty() ? "" : ", ") + std::string("axes ") + a + " -> " + b;
   }
+  if (const std::string a = drives_text(running), b = drives_text(next); a != b) {
+    out += (out.empty() ? "" : ", ") + std::string("drives ") + a + " -> " + b;
+  }
   if (const std::string a = io_modules_text(running), b = io_modules_text(next); a != b) {
     out += (out.empty() ? "" : ", ") + std::string("io_modules ") + a + " -> " + b;
   }
@@ -135,6 +141,7 @@ std::vector<KeyInfo> config_keys() {
     out.push_back({k.path.c_str(), klass_name(k.klass), k.range});
     if (k.path == "can.master_consumer_ms") {
       for (const AxisKeyInfo& a : axis_keys()) out.push_back({a.path, "machine", a.range});
+      for (const DriveKeyInfo& d : drive_keys()) out.push_back({d.path, "machine", d.range});
     }
     if (k.path == "io.yarn_present_active_low") {
       for (const IoModuleKeyInfo& m : io_module_keys()) out.push_back({m.path, "machine", m.range});

@@ -1,16 +1,18 @@
 // One knot of a knotting head: the servo-driven four-bar that carries the gripper through the three
 // precision positions of the knot (TAKE the yarn at the colour selector, WRAP it round the warp pair,
 // PULL it down to the fell), and the timed cycle around it — close the gripper, TAKE→WRAP, WRAP→PULL,
-// cut, release, back to TAKE. Each move is jerk-limited and then slowed, by time-scaling, until the
-// servo torque the linkage needs (its configuration-dependent inertia reflected to the servo, the
-// velocity-squared term of the equation of motion, gravity) fits the servo: the cycle time follows
-// from the servo's limits and the links' mass properties, it is not a constant.
+// cut, release, back to TAKE. Each move is the time-optimal move under the servo's torque–speed line
+// (servo_envelope.hpp: drive on the line, brake at the peak torque), planned for the largest inertia the
+// linkage reflects to the servo over the move and the largest load torque it adds there (the
+// velocity-squared term of the equation of motion, gravity): the cycle time follows from the drive's
+// facts and the links' mass properties, it is not a constant.
 //
 // The linkage is given explicitly (what `loom-synth knotter` prints) and checked against the
 // precision positions at configure time: the gripper must pass through every point with the coupler
 // at the prescribed gripper-link angle, on one assembly branch, reached in the order TAKE, WRAP, PULL
 // turning one way, with no toggle within the stroke. build() is configure-time and throws MotionError
-// naming what is wrong; sample() is an O(1) phase-table lookup, RT-safe.
+// naming what is wrong; sample() evaluates the six closed-form pieces, O(1) and RT-safe. (A phase table
+// cannot carry the move: its acceleration jumps where the drive switches from driving to braking.)
 //
 // Frames: the knot frame is the precision points' frame (x towards the fell side, y up: gravity acts
 // along −y). Servo angles are crank angles in the knot frame (from +x, counter-clockwise).
@@ -23,8 +25,7 @@
 
 #include "loom/motion/errors.hpp"
 #include "loom/motion/fourbar.hpp"
-#include "loom/motion/jerk_move.hpp"
-#include "loom/motion/phase_table.hpp"
+#include "loom/motion/servo_envelope.hpp"
 
 namespace loom::motion {
 
@@ -61,36 +62,41 @@ struct KnotCycleSpec {
   double min_transmission_rad = 0.0;
   double gravity_m_s2 = 9.81;  // along −y of the knot frame; 0 for a horizontal head
 
-  // The knotting servo (output shaft).
-  double max_speed_rad_s = 0.0, max_accel_rad_s2 = 0.0, jerk_rad_s3 = 0.0;
-  double max_torque_nm = 0.0;
-  double rotor_inertia_kg_m2 = 0.0;  // motor rotor and gears, reflected to the output shaft
+  // The knotting servo at its output shaft (ServoDrive's output facts: the motor through its gearbox).
+  double no_load_speed_rad_s = 0.0;   // the torque–speed line falls to 0 here
+  double peak_torque_nm = 0.0;        // at standstill; the cap when braking
+  double continuous_torque_nm = 0.0;  // the cycle's rms torque must stay within it
+  double rotor_inertia_kg_m2 = 0.0;   // motor rotor and gears, reflected to the output shaft
+  double max_speed_rad_s = 0.0;       // an explicit speed cap below the no-load speed; 0 = none
 
   // Dwells (s): the gripper closing at TAKE, the cutter at PULL, the gripper opening after the cut.
   double grip_s = 0.0, cut_s = 0.0, release_s = 0.0;
-
-  int table_size = 0;  // phase-table knots over the cycle (quintic Hermite)
 };
 
 // Seed 001's knotting design, synthesised right (see motion/README.md "Knot cycle"): the two
 // three-point chains through (0, 0, 10°), (25, 15, 3°), (30, 1, −25°) mm with θ0 = 275° share the
 // coupler; the servo drives the shorter side link. Delrin links 6 × 5 mm; the coupler with its
 // holder and gripper keeps the seed's 1.641 g and I_G = 208.94e-9 kg m²; crank and rocker use the
-// seed's V·ρ and I_G = m(6² + L²)/12 formulas on the correct lengths. A micro servo's limits.
+// seed's V·ρ and I_G = m(6² + L²)/12 formulas on the correct lengths.
 // Configure-time. A side link of seed 001's Delrin (ρ = 1415.9 kg/m³), 6 × 5 mm section, `length_m` pivot to
 // pivot: m = w·h·L·ρ, cg at mid-length, I_G = m (w² + L²)/12 (the seed's formulas).
+// The servo: a 100 W class AC servo behind a 10:1 planetary (shipped_knotter_drive()).
 KnotLinkSpec delrin_link(double length_m);
 KnotCycleSpec seed001_knot_cycle_spec();
+// The knotting head's drive as firmware/config/knotting_loom.toml ships it (the figures and their source
+// are there and in servo_envelope.cpp's caller, knot_cycle.cpp): a 100 W, 3000 rpm class AC servo behind a
+// 10:1 planetary gearbox.
+ServoDrive shipped_knotter_drive();
+// Configure-time: put the drive's output facts into the spec's servo fields (not the speed cap).
+void set_servo(KnotCycleSpec& spec, const ServoDrive& drive);
 
 // What bounds a segment of the cycle.
 enum class KnotLimit : std::uint8_t {
-  kDwell,         // a timed dwell (gripper, cutter)
-  kSpeed,         // the move cruises at the servo's speed limit
-  kAcceleration,  // it reaches the acceleration limit, too short to cruise
-  kJerk,          // too short to reach either: the jerk limit alone
-  kTorque,        // slowed below the servo's kinematic limits until its torque fits
+  kDwell,            // a timed dwell (gripper, cutter)
+  kSpeedCap,         // the move cruises at the explicit speed cap (below what the drive could reach)
+  kTorqueSpeedLine,  // it drives on the torque–speed line and brakes at the peak torque throughout
 };
-// RT-safe. "dwell", "speed", "acceleration", "jerk", "torque".
+// RT-safe. "dwell", "speed cap", "torque-speed line".
 const char* knot_limit_name(KnotLimit l);
 
 struct KnotCycleReport {
@@ -99,7 +105,9 @@ struct KnotCycleReport {
     double begin_s = 0.0, end_s = 0.0;
     double distance_rad = 0.0;  // signed servo travel (0 for a dwell)
     double peak_speed_rad_s = 0.0;
-    double time_scale = 1.0;  // > 1: slowed by the torque limit by this factor
+    // Where the move's acceleration jumps inside it: driving ends (the speed cap reached, or braking
+    // starts), and braking starts (== switch_s without a cruise). Both begin_s for a dwell.
+    double switch_s = 0.0, brake_s = 0.0;
     KnotLimit bound = KnotLimit::kDwell;
   };
   std::array<Segment, 6> segments{};
@@ -116,10 +124,11 @@ struct KnotCycleReport {
   double peak_torque_angle_rad = 0.0;  // relative to TAKE
   double max_inertia_kg_m2 = 0.0;      // largest effective inertia at the servo over the stroke
   double min_inertia_kg_m2 = 0.0;
-  // The phase table against the exact piecewise evaluation, on a grid off the knots.
-  double table_angle_error_rad = 0.0;
-  double table_velocity_error_rad_s = 0.0;
-  double table_accel_error_rad_s2 = 0.0;
+  double rms_torque_nm = 0.0;     // over the cycle: what heats the motor (within the continuous torque)
+  double peak_speed_rad_s = 0.0;  // max |ω| over the cycle (of the no-load speed)
+  // The least ratio over the cycle of the torque the drive has left to what it gives at that speed:
+  // min (available(ω) − |τ|) / available(ω); 0 means the move touches the envelope.
+  double envelope_margin = 0.0;
   struct PathSample {
     double t_s = 0.0, servo_rad = 0.0, x_m = 0.0, y_m = 0.0;  // servo relative to TAKE
   };
@@ -150,8 +159,8 @@ class KnotCycle {
   //                    the warp entry not between TAKE and WRAP along x
   //   kNotAssemblable  the linkage misses a precision point, or the gripper angle there
   //   kWrongBranch     branch defect: a point lies on the other assembly branch
-  //   kOutOfBounds     order defect (PULL before WRAP turning one way), or the servo cannot hold
-  //                    the linkage against gravity
+  //   kOutOfBounds     order defect (PULL before WRAP turning one way), the servo cannot hold
+  //                    the linkage against gravity, or the cycle's rms torque exceeds the continuous
   //   kSingular        a toggle / dead centre, or a transmission angle below the minimum, within
   //                    the stroke (or a toggle on a full-turn return)
   static KnotCycle build(const KnotCycleSpec& spec);
@@ -162,8 +171,8 @@ class KnotCycle {
   // RT-safe, O(1), no allocation. Servo angle relative to TAKE at t into the cycle; t is clamped to
   // [0, duration]; a NaN t reads t = 0 (the rest pose), +inf the end.
   Sample sample(double t_s) const noexcept;
-  // Configure-time reference (and the tests'): the same from the piecewise jerk moves, not the table.
-  Sample exact(double t_s) const noexcept;
+  // The same (kept for the tools that name the reference evaluation).
+  Sample exact(double t_s) const noexcept { return sample(t_s); }
 
   double duration_s() const noexcept { return duration_; }
   // Angle at the end relative to the start: 0 when it swings back, ±2π when it turns on.
@@ -198,14 +207,13 @@ class KnotCycle {
  private:
   struct Piece {
     double t0 = 0.0, t1 = 0.0, start_rad = 0.0;  // relative to TAKE
-    JerkMove move;                               // zero-length for a dwell
+    EnvelopeMove move;                           // zero-length for a dwell
   };
   KnotCycleSpec spec_{};
   FourBar fourbar_{};
   double ground_angle_ = 0.0;  // direction crank pivot → rocker pivot (knot frame)
   std::array<Piece, 6> pieces_{};
-  PhaseTable table_{};
-  double duration_ = 0.0, inv_duration_ = 0.0, end_offset_ = 0.0, take_angle_ = 0.0;
+  double duration_ = 0.0, end_offset_ = 0.0, take_angle_ = 0.0;
   Window gripper_closed_{}, cutter_{}, yarn_sample_{}, in_warp_{};
   KnotCycleReport report_{};
 };

@@ -62,7 +62,11 @@ struct AxisSpec {
   double lead_m = 0.0;                // linear axes: travel per motor revolution (m); rotary axes: 0
   // Added axes' top speed (rad/s or m/s; bounds the plausible feedback step). The core axes' limits are
   // facts of their mechanisms ([beatup] via the recipe, [carriage], [helix]) and are not repeated here.
+  // With a drive, the drive's no-load speed at the output unless the file caps it lower (max_speed_set).
   double max_speed = 0.0;
+  bool max_speed_set = false;
+  // The drive model that moves it (a [drives.<model>] table), "" = none described.
+  std::string drive{};
   // Following-error supervision (LinuxCNC rule): fault when |commanded − actual| >
   // max(ferror_min, ferror_k_s · |commanded velocity|); rad or m, and s. ferror_min = 0 turns it off.
   double ferror_min = 0.0;
@@ -99,6 +103,13 @@ inline std::vector<AxisSpec> default_axes() {
       {.name = "helix", .role = hal::AxisRole::kHelix, .node = 3, .ferror_min = 0.5},
   };
 }
+
+// A servo drive as it is sold, a table [drives.<model>]: the motor and its gearbox (see
+// motion::ServoDrive for what it gives at the output). Axes name it by `drive`.
+struct DriveModel {
+  std::string name;
+  motion::ServoDrive drive{};
+};
 
 // Where the valves, sensors, e-stop chain, buttons and load cell come from on the CAN HAL.
 enum class IoKind { kCan, kSimulated };
@@ -222,10 +233,13 @@ struct LoomConfig {
   MachineSpec machine_spec;
   // The axes in slot order (hal::AxisLayout): beat crank, carriage, helix, then the others by name.
   std::vector<AxisSpec> axes = default_axes();
+  // The servo drives the axes name, by model: the default loom describes the knotting heads' servo
+  // (default_loom.toml's [drives.servo_100w_10to1]; a test holds the two equal).
+  std::vector<DriveModel> drives = {{"servo_100w_10to1", motion::shipped_knotter_drive()}};
   // The pile: none (a flat weave), knotted by the weaver while the loom waits, or by the heads.
   sequencer::KnottingSpec knotting;
   // The knotting servo's cycle through seed 001's linkage: its precision points, dimensions, masses and the
-  // servo's limits ([knotting.linkage], [knotting] servo keys).
+  // dwells ([knotting.linkage], [knotting]); its servo fields derived from the knotter axes' drives.
   motion::KnotCycleSpec knot_cycle = motion::seed001_knot_cycle_spec();
   CanSettings can;
   IoSettings io;
