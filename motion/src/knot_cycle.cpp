@@ -502,6 +502,15 @@ KnotCycle KnotCycle::build(const KnotCycleSpec& spec) {
              KnotCycleField::kMaxTorque);
       }
       move = EnvelopeMove::plan(distance, lim);
+      // A top speed so small (a denormal no-load speed or cap) that the move never ends: a typed error,
+      // never an infinite cycle (its samples would be NaN).
+      if (!std::isfinite(move.duration())) {
+        fail(ErrorCode::kOutOfBounds,
+             "moving the linkage by " + num(deg(distance)) + " deg at the drive's top speed (no-load " +
+                 num(spec.no_load_speed_rad_s) + " rad/s, cap " + num(spec.max_speed_rad_s) +
+                 " rad/s) takes no finite time",
+             KnotCycleField::kMaxTorque);
+      }
       double worst = 1.0;
       const double T = move.duration();
       for (int k = 0; k <= 4 * kTorqueSamples; ++k)

@@ -1131,6 +1131,13 @@ void Sequencer::end_row(hal::Tick now) noexcept {
   while (beats_published_ < row_beats_) publish_beat(beats_published_);
   ++counters_.rows;
   counters_.picks_in_row = 0;
+  // The row's knots from the counters' tallies of the row in progress: whole even when a power cut came
+  // after (or in) its knotting, whose RowKnots then started again from the restart.
+  if (knotter_.fitted()) {
+    const KnotCounters& k = counters_.knot;
+    row_.set_knot_counts(static_cast<int>(k.row_tied), static_cast<int>(k.row_retried),
+                         static_cast<int>(k.row_by_hand));
+  }
   last_row_ = row_.finish(now, now - sweep_start_, row_beats_, profiles_->cam().steps());
   events_.add(EventKind::kRow);
   KnotCounters& k = counters_.knot;

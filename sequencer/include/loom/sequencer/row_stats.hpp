@@ -50,6 +50,11 @@ class RowRecorder {
   }
   void add_shed(hal::Tick ticks) noexcept { stats_.shed_ticks += ticks; }
   void set_knotting(hal::Tick ticks) noexcept { stats_.knotting_ticks = ticks; }
+  void set_knot_counts(int tied, int retried, int by_hand) noexcept {
+    stats_.knots_tied = tied;
+    stats_.knots_retried = retried;
+    stats_.knots_by_hand = by_hand;
+  }
   void set_knots(hal::Tick knot_ticks, hal::Tick weaver_ticks, int tied, int retried, int by_hand) noexcept {
     stats_.knot_ticks = knot_ticks;
     stats_.weaver_ticks = weaver_ticks;
