@@ -48,6 +48,10 @@ declare -A base=(
 declare -A numeric_text=([--point]=1 [--phi-range]=1)
 
 values=(nan -nan inf -inf 0 -0 4.9e-324 -4.9e-324 1e-300 1e300 -1e300)
+# LOOM_SWEEP_VALUES="v1 v2 ..." sweeps a subset (the sanitizer build's, see CMakeLists.txt); "all" or unset: all.
+if [[ -n ${LOOM_SWEEP_VALUES:-} && $LOOM_SWEEP_VALUES != all ]]; then
+  read -r -a values <<<"$LOOM_SWEEP_VALUES"
+fi
 bad_token='(^|[^a-z])[-+]?(nan|inf|infinity)([^a-z]|$)'
 
 subcommands() {  # the names under "Subcommands:" in a tool's --help
@@ -167,5 +171,5 @@ run_group b loom-kin loom-profile &
 wait
 read -r runs_a failures_a <"$work_root/a.count" || failures_a=1
 read -r runs_b failures_b <"$work_root/b.count" || failures_b=1
-echo "option sweep: $((runs_a + runs_b)) runs, $((failures_a + failures_b)) failures"
+echo "option sweep: $((runs_a + runs_b)) runs (values: ${values[*]}), $((failures_a + failures_b)) failures"
 ((failures_a + failures_b == 0))
