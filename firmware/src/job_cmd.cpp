@@ -62,6 +62,12 @@ int show(const job::Job& j) {
   std::printf("  length      %llu rows (the design %llu time%s%s)\n",
               static_cast<unsigned long long>(j.length_rows), static_cast<unsigned long long>(repeats),
               repeats == 1 ? "" : "s", extra ? (" and " + std::to_string(extra) + " rows").c_str() : "");
+  if (j.weaving > 1) {
+    std::printf(
+        "  weaving     %u (started over %u time%s; the record keeps each: loomctl report job %u --weaving "
+        "K)\n",
+        j.weaving, j.weaving - 1, j.weaving == 2 ? "" : "s", j.id);
+  }
   std::printf("  progress    %s (design row %d); knot cycles of that row started %u, done %u\n",
               progress_text(j).c_str(), j.next_design_row() + 1, j.progress.cycles_started,
               j.progress.cycles_done);
@@ -131,7 +137,9 @@ int run_verb(const JobArgs& a) {
     std::printf("removed job %u\n", a.id);
   } else if (a.verb == "start-over") {
     q.start_over(a.id);
-    std::printf("job %u starts over at row 1 (%s)\n", a.id, job::job_state_name(q.job(a.id).state));
+    const job::Job& j = q.job(a.id);
+    std::printf("job %u starts over at row 1 (%s, weaving %u)\n", a.id, job::job_state_name(j.state),
+                j.weaving);
   }
   return 0;
 }

@@ -49,17 +49,14 @@ JobRecorder::JobRecorder(const std::string& state_dir, const job::Job& job, std:
       period_ns_(static_cast<std::int64_t>(std::llround(period_s * 1e9))) {
   wall0_ = wall_now();
   if (virtual_time) {
-    // The last run's instants ran ahead of the wall clock by its machine time: start after them.
-    try {
-      if (const auto r = record::read_job_report(record::ProductionRecord::path_in(state_dir), job.id)) {
-        wall0_ = std::max(wall0_, r->recorded_until);
-      }
-    } catch (const record::RecordError&) {
-      // a record without this job yet: the wall clock it is
+    // A simulated loom's instants run ahead of the wall clock by its machine time: this run starts after
+    // the latest the record holds (any job, any weaving), so the loom's record never goes back in time.
+    if (const auto latest = record::read_latest_instant(record::ProductionRecord::path_in(state_dir))) {
+      wall0_ = std::max(wall0_, *latest);
     }
   }
-  rec_->begin_job({job.id, job.design_name, job.sha256, job.length_rows}, record::MachineState::kIdle,
-                  wall0_);
+  rec_->begin_job({job.id, job.weaving, job.design_name, job.sha256, job.length_rows},
+                  record::MachineState::kIdle, wall0_);
 }
 
 void JobRecorder::on_event(const RunEvent& e, const sequencer::KnotProgram* program,

@@ -16,6 +16,7 @@ struct ReportArgs {
   std::string format = "text";
   std::string what;  // "job" (the one report so far)
   std::uint32_t id = 0;
+  std::uint32_t weaving = 0;  // 0: the job's latest
 };
 
 ReportCommands::ReportCommands(CLI::App& app) : args_(std::make_unique<ReportArgs>()) {
@@ -28,6 +29,8 @@ ReportCommands::ReportCommands(CLI::App& app) : args_(std::make_unique<ReportArg
   report_->add_option("job", a.id, "the job's number (loomctl job list)")
       ->required()
       ->check(CLI::Range(1u, 4294967295u));
+  report_->add_option("--weaving", a.weaving, "which weaving of a job started over (default: its latest)")
+      ->check(CLI::Range(1u, 4294967295u));
   report_->add_option("--format", a.format, "text | csv | json")
       ->check(CLI::IsMember({"text", "csv", "json"}));
   report_->add_option("--state-dir", a.state_dir, "the service's state directory (default /var/lib/loomctl)");
@@ -39,7 +42,12 @@ std::optional<int> ReportCommands::run() const {
   if (!report_->parsed()) return std::nullopt;
   const ReportArgs& a = *args_;
   try {
-    const auto r = record::read_job_report(record::ProductionRecord::path_in(a.state_dir), a.id);
+    const auto r = record::read_job_report(record::ProductionRecord::path_in(a.state_dir), a.id, a.weaving);
+    if (!r && a.weaving != 0) {
+      std::fprintf(stderr, "loomctl report: --weaving %u: job %u has no such weaving in %s\n", a.weaving,
+                   a.id, record::ProductionRecord::path_in(a.state_dir).c_str());
+      return kExitBadInput;
+    }
     if (!r) {
       std::fprintf(stderr, "loomctl report: job %u has no production record in %s (never started?)\n", a.id,
                    record::ProductionRecord::path_in(a.state_dir).c_str());

@@ -17,16 +17,18 @@
 namespace loom::job {
 namespace {
 
-constexpr const char* kFormat = "loomctl-jobs 1";
+constexpr const char* kFormat = "loomctl-jobs 2";
+// Version 1 had no `weaving` (every job was in its first): read, and written back as version 2.
+constexpr const char* kFormatV1 = "loomctl-jobs 1";
 constexpr std::size_t kMaxQueueBytes = 16u << 20;
 constexpr std::size_t kMaxDesignBytes = 256u << 20;  // a 4000 × 20000 CSV of short codes fits
 
 const char* const kStateNames[] = {"queued", "current", "carpet_done", "removed"};
 
 // The fields of a [job N] stanza, in the order format() writes them.
-const char* const kJobFields[] = {"state",          "design_path", "design_name",    "sha256",
-                                  "knots_per_row",  "design_rows", "length_rows",    "rows_done",
-                                  "cycles_started", "cycles_done", "at_counter_rows"};
+const char* const kJobFields[] = {"state",         "design_path",    "design_name", "sha256",
+                                  "knots_per_row", "design_rows",    "length_rows", "weaving",
+                                  "rows_done",     "cycles_started", "cycles_done", "at_counter_rows"};
 
 std::string yarn_text(const HeadYarn& y) {
   std::string s;
@@ -129,7 +131,7 @@ std::string JobQueue::format(const std::vector<Job>& jobs, std::uint32_t next_id
        << "state = " << job_state_name(j.state) << "\ndesign_path = " << j.design_path
        << "\ndesign_name = " << j.design_name << "\nsha256 = " << j.sha256
        << "\nknots_per_row = " << j.knots_per_row << "\ndesign_rows = " << j.design_rows
-       << "\nlength_rows = " << j.length_rows << "\n";
+       << "\nlength_rows = " << j.length_rows << "\nweaving = " << j.weaving << "\n";
     for (std::size_t h = 0; h < j.yarn.size(); ++h)
       os << "yarn." << h + 1 << " = " << yarn_text(j.yarn[h]) << "\n";
     os << "rows_done = " << j.progress.rows_done << "\ncycles_started = " << j.progress.cycles_started
@@ -143,6 +145,7 @@ JobQueue JobQueue::parse(const std::string& text, const std::string& source) {
   const Reader r{source};
   JobQueue q(source);
   std::map<std::string, std::size_t> header;             // field → line
+  bool format_v1 = false;                                // an older loomctl's queue: no weaving field
   std::vector<std::map<std::string, std::size_t>> seen;  // per job: field → line
   std::vector<std::size_t> job_line;
   std::uint64_t next_id = 0;
@@ -180,8 +183,9 @@ JobQueue JobQueue::parse(const std::string& text, const std::string& source) {
                "field \"" + field + "\" given twice (first on line " + std::to_string(header[field]) + ")");
       header[field] = n;
       if (field == "format") {
-        if (value != kFormat)
+        if (value != kFormat && value != kFormatV1)
           r.bad(n, field, value, std::string("want \"") + kFormat + "\" (another loomctl's queue?)");
+        format_v1 = value == kFormatV1;
       } else if (field == "next_id") {
         if (!whole(value, 1, UINT32_MAX, next_id))
           r.bad(n, field, value, "want a job number in 1..4294967295");
@@ -242,6 +246,10 @@ JobQueue JobQueue::parse(const std::string& text, const std::string& source) {
     } else if (field == "length_rows") {
       if (!whole(value, 1, UINT32_MAX, v)) r.bad(n, field, value, "want 1..4294967295 rows");
       j.length_rows = v;
+    } else if (field == "weaving") {
+      if (format_v1) r.fail(n, "unknown field \"weaving\" in a \"" + std::string(kFormatV1) + "\" queue");
+      if (!whole(value, 1, UINT32_MAX, v)) r.bad(n, field, value, "want 1..4294967295");
+      j.weaving = static_cast<std::uint32_t>(v);
     } else if (field == "rows_done") {
       if (!whole(value, 0, UINT32_MAX, v)) r.bad(n, field, value, "want 0..4294967295 rows");
       j.progress.rows_done = v;
@@ -262,6 +270,7 @@ JobQueue JobQueue::parse(const std::string& text, const std::string& source) {
     const std::size_t at = job_line[i];
     const std::string name = "[job " + std::to_string(j.id) + "]";
     for (const char* f : kJobFields) {
+      if (format_v1 && std::string(f) == "weaving") continue;  // version 1: the first weaving
       if (!seen[i].count(f)) r.fail(at, name + " lacks field \"" + f + "\"");
     }
     const auto line_of = [&](const char* f) { return seen[i].at(f); };
@@ -460,6 +469,14 @@ void JobQueue::start_over(std::uint32_t id) {
   Job& j = next.mutable_job(id);
   if (j.state == JobState::kRemoved)
     throw JobError("job " + std::to_string(id) + " is removed: add the design again");
+  // A job the loom began is woven again as its next weaving (the record keeps each); one never begun is
+  // only reset.
+  const bool begun =
+      j.state != JobState::kQueued || j.progress.rows_done != 0 || j.progress.cycles_started != 0;
+  if (begun && j.weaving == UINT32_MAX) {
+    throw JobError("job " + std::to_string(id) + " was woven 4294967295 times: add the design as a new job");
+  }
+  if (begun) ++j.weaving;
   const std::uint32_t base = j.progress.at_counter_rows;
   j.progress = JobProgress{};
   j.progress.at_counter_rows = base;

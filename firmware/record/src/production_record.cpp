@@ -17,7 +17,9 @@ namespace {
 const char* const kStateNames[kMachineStates] = {
     "weaving", "knotting", "waiting_for_weaver", "paused", "faulted", "idle", "off"};
 
-constexpr const char* kSchema = R"sql(
+// Version 1, as the first loomctl with a record wrote it. A new file is made as version 1 and migrated,
+// so a new record and an upgraded one have exactly the same shape.
+constexpr const char* kSchemaV1 = R"sql(
 CREATE TABLE schema_version (version INTEGER NOT NULL);
 CREATE TABLE jobs (
   id INTEGER PRIMARY KEY,
@@ -57,6 +59,18 @@ CREATE TABLE faults (
   at_ns INTEGER NOT NULL,
   cleared_ns INTEGER
 );
+)sql";
+
+// Version 2: a job is woven again after `job start-over`, so the record keeps one entry per weaving.
+// jobs.id becomes the record's own key of one weaving (every other table's job_id refers to it); the
+// queue's job number moves to jobs.job, beside the weaving's number (1, 2, ...). A version-1 job was its
+// first weaving, under the same key.
+constexpr const char* kMigrateV1ToV2 = R"sql(
+ALTER TABLE jobs ADD COLUMN job INTEGER NOT NULL DEFAULT 0;
+ALTER TABLE jobs ADD COLUMN weaving INTEGER NOT NULL DEFAULT 1;
+UPDATE jobs SET job = id;
+CREATE UNIQUE INDEX jobs_by_weaving ON jobs (job, weaving);
+UPDATE schema_version SET version = 2;
 )sql";
 
 // One prepared statement, finalized on scope exit.
@@ -134,10 +148,11 @@ int schema_version(sqlite3* db, const std::string& path) {
     throw RecordError(path + ": production record's schema_version has " + std::to_string(versions.size()) +
                       " rows, want 1 (refusing to touch it)");
   }
-  if (versions[0] != ProductionRecord::kSchemaVersion) {
+  if (versions[0] < 1 || versions[0] > ProductionRecord::kSchemaVersion) {
     throw RecordError(path + ": production record of schema version " + std::to_string(versions[0]) +
-                      "; this loomctl reads and writes version " +
-                      std::to_string(ProductionRecord::kSchemaVersion) + " (refusing to touch it)");
+                      "; this loomctl reads versions 1.." + std::to_string(ProductionRecord::kSchemaVersion) +
+                      " and writes version " + std::to_string(ProductionRecord::kSchemaVersion) +
+                      " (refusing to touch it)");
   }
   return static_cast<int>(versions[0]);
 }
@@ -213,10 +228,13 @@ ProductionRecord::ProductionRecord(const std::string& path) : path_(path) {
     exec("PRAGMA journal_mode = WAL");
     exec("PRAGMA synchronous = FULL");
     exec("PRAGMA foreign_keys = ON");
-    if (version == 0) {
+    if (version < kSchemaVersion) {  // a new file, or an older loomctl's record: one transaction
       exec("BEGIN IMMEDIATE");
-      exec(kSchema);
-      Stmt(db_, path_, "INSERT INTO schema_version (version) VALUES (?)").bind(1, kSchemaVersion).run();
+      if (version == 0) {
+        exec(kSchemaV1);
+        exec("INSERT INTO schema_version (version) VALUES (1)");
+      }
+      exec(kMigrateV1ToV2);
       exec("COMMIT");
     }
     Stmt wal(db_, path_, "PRAGMA journal_mode");
@@ -240,14 +258,18 @@ void ProductionRecord::exec(const char* sql) {
   exec_on(db_, path_, sql);
 }
 
+std::string ProductionRecord::weaving_name(std::uint32_t job, std::uint32_t weaving) {
+  return "job " + std::to_string(job) + (weaving > 1 ? " (weaving " + std::to_string(weaving) + ")" : "");
+}
+
 void ProductionRecord::need_job(const char* what) const {
   if (job_ == 0) throw RecordError(path_ + ": no job begun to " + what);
 }
 
 void ProductionRecord::credit(WallNs at) {
   if (at < since_) {
-    throw RecordError(path_ + ": job " + std::to_string(job_) + ": time went back from " +
-                      std::to_string(since_) + " ns to " + std::to_string(at) +
+    throw RecordError(path_ + ": " + job_name_ + ": time went back from " + std::to_string(since_) +
+                      " ns to " + std::to_string(at) +
                       " ns (the record's instants come from the tick count)");
   }
   pending_[static_cast<std::size_t>(state_)] += at - since_;
@@ -298,49 +320,71 @@ struct Txn {
 
 void ProductionRecord::begin_job(const JobInfo& job, MachineState s, WallNs at) {
   if (job.id == 0) throw RecordError(path_ + ": job 0: job numbers start at 1");
+  if (job.weaving == 0)
+    throw RecordError(path_ + ": job " + std::to_string(job.id) + ": weavings start at 1");
+  const std::string name = weaving_name(job.id, job.weaving);
   std::array<std::int64_t, kMachineStates> pending{};
   WallNs since = at;
   Txn t(db_, path_, pending, since);
-  Stmt q(db_, path_, "SELECT sha256, ended_ns, recorded_until_ns FROM jobs WHERE id = ?");
-  q.bind(1, job.id);
-  if (q.row()) {
-    if (q.text(0) != job.sha256) {
-      throw RecordError(path_ + ": job " + std::to_string(job.id) + " is recorded with design hash " +
-                        q.text(0) + ", not " + job.sha256 + " (another queue's job?)");
+  {
+    // The job's number names one design for ever (the queue never reuses it), whichever weaving.
+    Stmt other(db_, path_, "SELECT sha256, max(weaving) FROM jobs WHERE job = ?");
+    other.bind(1, job.id);
+    if (other.row() && !other.null(0)) {
+      if (other.text(0) != job.sha256) {
+        throw RecordError(path_ + ": job " + std::to_string(job.id) + " is recorded with design hash " +
+                          other.text(0) + ", not " + job.sha256 + " (another queue's job?)");
+      }
+      if (other.i64(1) > job.weaving) {
+        throw RecordError(path_ + ": " + name + " begun, but weaving " + std::to_string(other.i64(1)) +
+                          " is recorded already (an older job queue?)");
+      }
     }
-    if (!q.null(1)) throw RecordError(path_ + ": job " + std::to_string(job.id) + " is recorded as ended");
+  }
+  std::int64_t key = 0;
+  Stmt q(db_, path_, "SELECT id, ended_ns, recorded_until_ns FROM jobs WHERE job = ? AND weaving = ?");
+  q.bind(1, job.id).bind(2, job.weaving);
+  if (q.row()) {
+    key = q.i64(0);
+    if (!q.null(1)) {
+      throw RecordError(path_ + ": " + name +
+                        " is recorded as ended (its carpet was cut off: `job start-over` weaves it again)");
+    }
     const WallNs until = q.i64(2);
     if (at < until) {
-      throw RecordError(path_ + ": job " + std::to_string(job.id) + " resumed at " + std::to_string(at) +
+      throw RecordError(path_ + ": " + name + " resumed at " + std::to_string(at) +
                         " ns, before its last record at " + std::to_string(until) + " ns");
     }
     // The gap since the last commit: nobody ran the job (power off, service stopped, or rows lost with
     // the power — their time is kept as off, never invented as weaving).
     Stmt(db_, path_, "UPDATE state_time SET ns = ns + ? WHERE job_id = ? AND state = 'off'")
         .bind(1, at - until)
-        .bind(2, job.id)
+        .bind(2, key)
         .run();
-    Stmt(db_, path_, "UPDATE jobs SET recorded_until_ns = ? WHERE id = ?").bind(1, at).bind(2, job.id).run();
+    Stmt(db_, path_, "UPDATE jobs SET recorded_until_ns = ? WHERE id = ?").bind(1, at).bind(2, key).run();
   } else {
     Stmt(db_, path_,
-         "INSERT INTO jobs (id, design_name, sha256, length_rows, started_ns, recorded_until_ns) VALUES (?, "
-         "?, ?, ?, ?, ?)")
+         "INSERT INTO jobs (job, weaving, design_name, sha256, length_rows, started_ns, recorded_until_ns) "
+         "VALUES (?, ?, ?, ?, ?, ?, ?)")
         .bind(1, job.id)
-        .bind(2, job.design_name)
-        .bind(3, job.sha256)
-        .bind(4, static_cast<std::int64_t>(job.length_rows))
-        .bind(5, at)
+        .bind(2, job.weaving)
+        .bind(3, job.design_name)
+        .bind(4, job.sha256)
+        .bind(5, static_cast<std::int64_t>(job.length_rows))
         .bind(6, at)
+        .bind(7, at)
         .run();
-    for (const char* name : kStateNames) {
+    key = sqlite3_last_insert_rowid(db_);
+    for (const char* state : kStateNames) {
       Stmt(db_, path_, "INSERT INTO state_time (job_id, state, ns) VALUES (?, ?, 0)")
-          .bind(1, job.id)
-          .bind(2, name)
+          .bind(1, key)
+          .bind(2, state)
           .run();
     }
   }
   t.commit();
-  job_ = job.id;
+  job_ = key;
+  job_name_ = name;
   state_ = s;
   since_ = at;
   pending_.fill(0);
@@ -384,7 +428,7 @@ void ProductionRecord::row_done(const RowDone& r, WallNs at) {
     Stmt dup(db_, path_, "SELECT count(*) FROM rows WHERE job_id = ? AND row = ?");
     dup.bind(1, job_).bind(2, static_cast<std::int64_t>(r.row));
     if (dup.row() && dup.i64(0) != 0) {
-      throw RecordError(path_ + ": row " + std::to_string(r.row) + " of job " + std::to_string(job_) +
+      throw RecordError(path_ + ": row " + std::to_string(r.row) + " of " + job_name_ +
                         " is recorded already (a row is woven once)");
     }
   }
@@ -426,7 +470,7 @@ void ProductionRecord::end_job(WallNs at) {
   job_ = 0;
 }
 
-std::optional<JobReport> read_job_report(const std::string& path, std::uint32_t id) {
+std::optional<JobReport> read_job_report(const std::string& path, std::uint32_t id, std::uint32_t weaving) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) {
     throw RecordError(path + ": no production record (nothing was woven with this state directory yet)");
@@ -437,26 +481,39 @@ std::optional<JobReport> read_job_report(const std::string& path, std::uint32_t 
     ~Closer() { sqlite3_close(db); }
   } closer{db};
   sqlite3_busy_timeout(db, 2000);  // the writer's commit is short
-  checked_version(db, path);
+  const int version = checked_version(db, path);
   exec_on(db, path, "BEGIN");  // one snapshot for every query below
   JobReport r;
+  std::int64_t key = 0;
   {
-    Stmt q(db, path,
-           "SELECT design_name, sha256, length_rows, started_ns, ended_ns, recorded_until_ns FROM jobs WHERE "
-           "id = ?");
-    q.bind(1, id);
+    // Read-only: a version-1 record (not yet opened by this loomctl's writer) is read as it is, each of
+    // its jobs the first weaving.
+    const char* sql =
+        version == 1
+            ? "SELECT id, 1, design_name, sha256, length_rows, started_ns, ended_ns, recorded_until_ns, 1 "
+              "FROM "
+              "jobs WHERE id = ?1 AND ?2 IN (0, 1)"
+            : "SELECT id, weaving, design_name, sha256, length_rows, started_ns, ended_ns, "
+              "recorded_until_ns, "
+              "(SELECT max(weaving) FROM jobs WHERE job = ?1) FROM jobs WHERE job = ?1 AND weaving = "
+              "(CASE ?2 WHEN 0 THEN (SELECT max(weaving) FROM jobs WHERE job = ?1) ELSE ?2 END)";
+    Stmt q(db, path, sql);
+    q.bind(1, id).bind(2, weaving);
     if (!q.row()) return std::nullopt;
+    key = q.i64(0);
     r.id = id;
-    r.design_name = q.text(0);
-    r.sha256 = q.text(1);
-    r.length_rows = static_cast<std::uint64_t>(q.i64(2));
-    r.started = q.i64(3);
-    if (!q.null(4)) r.ended = q.i64(4);
-    r.recorded_until = q.i64(5);
+    r.weaving = static_cast<std::uint32_t>(q.i64(1));
+    r.design_name = q.text(2);
+    r.sha256 = q.text(3);
+    r.length_rows = static_cast<std::uint64_t>(q.i64(4));
+    r.started = q.i64(5);
+    if (!q.null(6)) r.ended = q.i64(6);
+    r.recorded_until = q.i64(7);
+    r.weavings = static_cast<std::uint32_t>(q.i64(8));
   }
   {
     Stmt q(db, path, "SELECT state, ns FROM state_time WHERE job_id = ?");
-    q.bind(1, id);
+    q.bind(1, key);
     while (q.row()) {
       const std::string name = q.text(0);
       for (int s = 0; s < kMachineStates; ++s) {
@@ -469,7 +526,7 @@ std::optional<JobReport> read_job_report(const std::string& path, std::uint32_t 
            "SELECT count(*), coalesce(max(row), 0), coalesce(sum(knots_by_heads), 0), "
            "coalesce(sum(knots_retried), 0), "
            "coalesce(sum(knots_by_hand), 0) FROM rows WHERE job_id = ?");
-    q.bind(1, id);
+    q.bind(1, key);
     if (q.row()) {
       r.rows = static_cast<std::uint64_t>(q.i64(0));
       r.last_row = static_cast<std::uint64_t>(q.i64(1));
@@ -480,12 +537,12 @@ std::optional<JobReport> read_job_report(const std::string& path, std::uint32_t 
   }
   {
     Stmt q(db, path, "SELECT colour, knots FROM yarn WHERE job_id = ? ORDER BY colour");
-    q.bind(1, id);
+    q.bind(1, key);
     while (q.row()) r.yarn[q.text(0)] = static_cast<std::uint64_t>(q.i64(1));
   }
   {
     Stmt q(db, path, "SELECT at_ns, name, code, cleared_ns FROM faults WHERE job_id = ? ORDER BY id");
-    q.bind(1, id);
+    q.bind(1, key);
     while (q.row()) {
       FaultRecord f{q.i64(0), q.text(1), static_cast<int>(q.i64(2)), std::nullopt};
       if (!q.null(3)) f.cleared = q.i64(3);
@@ -494,6 +551,21 @@ std::optional<JobReport> read_job_report(const std::string& path, std::uint32_t 
   }
   exec_on(db, path, "COMMIT");
   return r;
+}
+
+std::optional<WallNs> read_latest_instant(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return std::nullopt;
+  sqlite3* db = open_db(path, SQLITE_OPEN_READONLY);
+  struct Closer {
+    sqlite3* db;
+    ~Closer() { sqlite3_close(db); }
+  } closer{db};
+  sqlite3_busy_timeout(db, 2000);
+  if (checked_version(db, path) == 0) return std::nullopt;
+  Stmt q(db, path, "SELECT max(recorded_until_ns) FROM jobs");
+  if (!q.row() || q.null(0)) return std::nullopt;
+  return q.i64(0);
 }
 
 }  // namespace loom::record

@@ -51,10 +51,16 @@ std::string report_text(const JobReport& r) {
   std::ostringstream os;
   os << "job " << r.id << ": " << r.design_name << " (sha256 " << r.sha256.substr(0, 12) << "...), "
      << r.length_rows << " rows\n";
+  if (r.weavings > 1) {
+    os << "  weaving   " << r.weaving << " of " << r.weavings << " (the job was started over; report job "
+       << r.id << " --weaving K shows another)\n";
+  }
   os << "  started   " << iso_utc(r.started) << "\n";
+  const bool started_over = !r.ended && r.weaving < r.weavings;
   os << "  "
-     << (r.ended ? "ended     " + iso_utc(*r.ended)
-                 : "recorded  to " + iso_utc(r.recorded_until) + " (not ended)")
+     << (r.ended        ? "ended     " + iso_utc(*r.ended)
+         : started_over ? "recorded  to " + iso_utc(r.recorded_until) + " (started over before its end)"
+                        : "recorded  to " + iso_utc(r.recorded_until) + " (not ended)")
      << "\n";
   os << "  wall time " << fixed(seconds(r.wall_ns()), 3) << " s\n";
   os << "  rows      " << r.rows << " recorded (last row " << r.last_row << " of " << r.length_rows << ")\n";
@@ -94,6 +100,7 @@ std::string report_csv(const JobReport& r) {
   };
   os << "item,name,value,detail\n";
   line("job", "id", std::to_string(r.id));
+  line("job", "weaving", std::to_string(r.weaving), "of " + std::to_string(r.weavings));
   line("job", "design", r.design_name);
   line("job", "sha256", r.sha256);
   line("job", "length_rows", std::to_string(r.length_rows));
@@ -122,6 +129,8 @@ std::string report_csv(const JobReport& r) {
 std::string report_json(const JobReport& r) {
   nlohmann::ordered_json j;
   j["job"] = r.id;
+  j["weaving"] = r.weaving;
+  j["weavings"] = r.weavings;
   j["design"] = r.design_name;
   j["sha256"] = r.sha256;
   j["length_rows"] = r.length_rows;

@@ -59,8 +59,11 @@ grep -qF "the design file changed under job 2: hash $(sha256sum <"$out/a/knot_de
 # Progress back to row 1; a removed job stays listed as removed.
 sed -i '0,/^rows_done = 0/s//rows_done = 5/' "$state/jobs.txt"
 "$loomctl" job show 1 --state-dir "$state" | grep -qF "row 6 of 8 next" || fail "progress"
-"$loomctl" job start-over 1 --state-dir "$state" | grep -qF "job 1 starts over at row 1 (queued)" || fail "start-over"
-"$loomctl" job show 1 --state-dir "$state" | grep -qF "row 1 of 8 next" || fail "start-over did not reach row 1"
+"$loomctl" job start-over 1 --state-dir "$state" | grep -qF "job 1 starts over at row 1 (queued, weaving 2)" ||
+  fail "start-over"
+"$loomctl" job show 1 --state-dir "$state" >"$out/show1"
+grep -qF "row 1 of 8 next" "$out/show1" || fail "start-over did not reach row 1"
+grep -qF "weaving     2 (started over 1 time;" "$out/show1" || fail "start-over: no weaving 2: $(cat "$out/show1")"
 "$loomctl" job remove 3 --state-dir "$state" | grep -qF "removed job 3" || fail "remove"
 "$loomctl" job list --state-dir "$state" | grep -qE "^3 +removed" || fail "removed job not listed as removed"
 

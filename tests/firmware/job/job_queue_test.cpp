@@ -204,9 +204,13 @@ TEST(JobQueue, AJobsLifeFromStartToCarpetDoneAndOverAgain) {
   q.start_over(2);
   EXPECT_EQ(q.job(2).next_row(), 1u);
   EXPECT_EQ(q.job(2).state, JobState::kCurrent);
+  EXPECT_EQ(q.job(2).weaving, 2u);  // the loom had begun it: its record keeps the first weaving apart
   q.start_over(1);
   EXPECT_EQ(q.job(1).state, JobState::kQueued);
   EXPECT_EQ(q.job(1).progress.rows_done, 0u);
+  EXPECT_EQ(JobQueue::load(q.path()).job(1).weaving, 2u);
+  q.start_over(1);  // queued, never begun since: only reset, no empty weaving
+  EXPECT_EQ(q.job(1).weaving, 2u);
   q.remove(1);
   EXPECT_EQ(JobQueue::load(q.path()).job(1).state, JobState::kRemoved);
   EXPECT_NE(error_of([&] { q.start_over(1); }).find("is removed"), std::string::npos);
@@ -240,17 +244,21 @@ TEST(JobQueue, ABadFileIsRefusedWithLineFieldAndValue) {
       {"knots_per_row = 360", "knots_per_row = 0360", "field \"knots_per_row\" = \"0360\""},
       {"state = queued", "state = weaving", ":6: field \"state\" = \"weaving\": want queued, current"},
       {"length_rows = 8", "length_rows = -8", ":12: field \"length_rows\" = \"-8\""},
-      {"rows_done = 0", "rows_done = 9", ":19: field \"rows_done\" = \"9\": beyond length_rows = 8"},
+      {"rows_done = 0", "rows_done = 9", ":20: field \"rows_done\" = \"9\": beyond length_rows = 8"},
       {"cycles_done = 0", "cycles_done = 1",
-       ":21: field \"cycles_done\" = \"1\": exceeds cycles_started = 0"},
+       ":22: field \"cycles_done\" = \"1\": exceeds cycles_started = 0"},
       {"yarn.2 = B:2 I:1 R:0", "yarn.2 = B:2 I:1 R:16",
-       ":14: field \"yarn.2\" = \"B:2 I:1 R:16\": want CODE:SLOT"},
-      {"yarn.2 = B:2 I:1 R:0", "yarn.3 = B:2 I:1 R:0", ":14: field \"yarn.3\": want yarn.1, yarn.2"},
+       ":15: field \"yarn.2\" = \"B:2 I:1 R:16\": want CODE:SLOT"},
+      {"yarn.2 = B:2 I:1 R:0", "yarn.3 = B:2 I:1 R:0", ":15: field \"yarn.3\": want yarn.1, yarn.2"},
+      {"weaving = 1", "weaving = 0", ":13: field \"weaving\" = \"0\": want 1..4294967295"},
+      {"weaving = 1\n", "", ":5: [job 1] lacks field \"weaving\""},
+      {"format = loomctl-jobs 2", "format = loomctl-jobs 1",
+       ":13: unknown field \"weaving\" in a \"loomctl-jobs 1\" queue"},
       {"sha256 = ", "sha256 = X", ":9: field \"sha256\""},
-      {"format = loomctl-jobs 1", "format = loomctl-jobs 2", ":2: field \"format\" = \"loomctl-jobs 2\""},
+      {"format = loomctl-jobs 2", "format = loomctl-jobs 3", ":2: field \"format\" = \"loomctl-jobs 3\""},
       {"next_id = 2", "next_id = 1", "field \"next_id\" = \"1\": not beyond job 1"},
-      {"at_counter_rows = 0", "at_counter_rows = 0\nbogus = 1", ":23: unknown field \"bogus\" in [job 1]"},
-      {"at_counter_rows = 0", "at_counter_rows = 0\nrows_done = 0", ":23: field \"rows_done\" given twice"},
+      {"at_counter_rows = 0", "at_counter_rows = 0\nbogus = 1", ":24: unknown field \"bogus\" in [job 1]"},
+      {"at_counter_rows = 0", "at_counter_rows = 0\nrows_done = 0", ":24: field \"rows_done\" given twice"},
       {"design_rows = 8\n", "", ":5: [job 1] lacks field \"design_rows\""},
       {"[job 1]", "[job one]", ":5: \"[job one]\": want a stanza header [job N]"},
       {"design_path = /", "design_path = ", ":7: field \"design_path\""},
@@ -276,4 +284,23 @@ TEST(JobQueue, ABadFileIsRefusedWithLineFieldAndValue) {
   write(q.path(), s);
   EXPECT_NE(error_of([&] { JobQueue::load(q.path()); }).find("\"state\" = \"current\": job 1 is current too"),
             std::string::npos);
+}
+
+// A queue written by the loomctl before weavings (format 1, no `weaving`) is read as every job in its first
+// weaving, and written back as format 2.
+TEST(JobQueue, AFormatOneQueueReadsAsFirstWeavings) {
+  TempDir t;
+  JobQueue q = JobQueue::load(JobQueue::path_in(t.dir.string()));
+  q.add(kDemo, knotting_loom(), {});
+  std::string v1 = slurp(q.path());
+  const auto at = v1.find("weaving = 1\n");
+  ASSERT_NE(at, std::string::npos);
+  v1.erase(at, 12);
+  v1.replace(v1.find("loomctl-jobs 2"), 14, "loomctl-jobs 1");
+  write(q.path(), v1);
+  JobQueue old = JobQueue::load(q.path());
+  EXPECT_EQ(old.job(1).weaving, 1u);
+  old.start(1, 0);
+  EXPECT_NE(slurp(q.path()).find("format = loomctl-jobs 2"), std::string::npos);
+  EXPECT_NE(slurp(q.path()).find("weaving = 1\n"), std::string::npos);
 }

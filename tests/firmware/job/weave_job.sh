@@ -100,9 +100,30 @@ grep -q '^head.1 = ' "$state/magazines.txt" || fail "no magazines' levels kept: 
 sed -i 's/^head.1 = [0-9]*/head.1 = 0/' "$state/magazines.txt"
 job start-over 1 >/dev/null
 job list | grep -q '^1 .*queued .*row 1 of 3 next' || fail "start-over: $(job list)"
-weave --scene "$work/scene.toml" >"$work/w8.log" || fail "job 1 again: $(tail -5 "$work/w8.log")"
+weave --scene "$work/scene.toml" >"$work/w8.log" 2>&1 || fail "job 1 again: $(tail -5 "$work/w8.log")"
 grep -q "job 1 (design rug.csv, sha256 [0-9a-f]*\.\.): row 1 of 3 next (started now)" "$work/w8.log" || fail "job 1 again did not start at its row 1"
 [[ $(counter rows) == 8 ]] || fail "the counters went back or skipped: rows $(counter rows), want 8"
 grep -q "weaver asked: row [0-9]* (design row 1): reload colour R into slot 0 of head 1" "$work/w8.log" ||
   fail "the emptied slot kept over the restart was not asked for in row 1: $(grep 'weaver asked' "$work/w8.log")"
-echo "weave_job: ok (jobs $h1 / $h2; one power cut; carpet_done twice; start-over)"
+# The second weaving has a record of its own from row 1; the first is kept as it was (3 rows, ended).
+grep -q "WARNING" "$work/w8.log" && fail "job 1 again: $(grep WARNING "$work/w8.log")"
+job show 1 | grep -qF "weaving     2 (started over 1 time;" || fail "job 1 is not in its weaving 2: $(job show 1)"
+"$loomctl" report job 1 --state-dir "$state" >"$work/r2.txt" || fail "no record of job 1's second weaving"
+grep -qF "weaving   2 of 2" "$work/r2.txt" || fail "the report does not say weaving 2 of 2: $(cat "$work/r2.txt")"
+for w in 1 2; do
+  "$loomctl" report job 1 --weaving $w --state-dir "$state" --format json >"$work/rw$w.json" ||
+    fail "report job 1 --weaving $w"
+done
+python3 - "$work/rw1.json" "$work/rw2.json" "$work/r1.json" <<'PY' || fail "job 1's two weavings: $(cat "$work/rw1.json" "$work/rw2.json")"
+import json, sys
+w1, w2, before = (json.load(open(p)) for p in sys.argv[1:])
+assert w1 == {**before, "weaving": 1, "weavings": 2}, "the first weaving's record changed"
+assert (w2["weaving"], w2["weavings"]) == (2, 2), w2
+assert w2["rows"] == {"recorded": 3, "last": 3} and w2["ended"], w2
+assert w2["started"] > w1["ended"], (w2["started"], w1["ended"])
+states = sum(v["ns"] for v in w2["states"].values())
+assert abs(states / 1e9 - w2["wall_s"]) <= 0.0015, (states, w2["wall_s"])
+PY
+"$loomctl" report job 1 --weaving 3 --state-dir "$state" >/dev/null 2>"$work/rw3.err" && fail "weaving 3 reported"
+grep -qF -- "--weaving 3: job 1 has no such weaving" "$work/rw3.err" || fail "weaving 3: $(cat "$work/rw3.err")"
+echo "weave_job: ok (jobs $h1 / $h2; one power cut; carpet_done twice; start-over as weaving 2, both recorded)"

@@ -51,7 +51,7 @@ unsigned test_seed() {
   return seed;
 }
 
-const JobInfo kJob{3, "knot_demo.csv", std::string(64, 'a'), 540};
+const JobInfo kJob{3, 1, "knot_demo.csv", std::string(64, 'a'), 540};
 constexpr WallNs kT0 = 1'796'000'000'000'000'000;  // 2026-11-30
 
 template <typename F>
@@ -175,6 +175,130 @@ TEST(ProductionRecord, EndedJobAndItsRefusals) {
   EXPECT_FALSE(read_job_report(t.db(), 4).has_value());
 }
 
+// `job start-over` of a job the loom began weaves it again as its next weaving: a record of its own, from
+// row 1, beside the first (kept as it was); the first is never reopened.
+TEST(ProductionRecord, AJobStartedOverIsRecordedAsItsNextWeaving) {
+  TempDir t;
+  ProductionRecord rec(t.db());
+  rec.begin_job(kJob, MachineState::kKnotting, kT0);
+  rec.row_done({1, 360, 0, 0, {{"R", 360}}}, kT0 + 50'000'000'000);
+  rec.row_done({2, 359, 1, 1, {{"R", 361}}}, kT0 + 100'000'000'000);
+  rec.commit(kT0 + 110'000'000'000);  // stopped; then started over, not ended
+  JobInfo second = kJob;
+  second.weaving = 2;
+  rec.begin_job(second, MachineState::kIdle, kT0 + 200'000'000'000);
+  rec.set_state(MachineState::kWeaving, kT0 + 210'000'000'000);
+  rec.row_done({1, 360, 0, 0, {{"R", 360}}}, kT0 + 260'000'000'000);  // row 1 again: another weaving's
+  EXPECT_NE(error_of([&] {
+              rec.row_done({1, 0, 0, 0, {}}, kT0 + 270'000'000'000);
+            }).find("row 1 of job 3 (weaving 2) is recorded already"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] {
+              rec.begin_job(kJob, MachineState::kIdle, kT0 + 300'000'000'000);
+            }).find("job 3 begun, but weaving 2 is recorded already"),
+            std::string::npos);
+  JobInfo other = second;
+  other.weaving = 3;
+  other.sha256 = std::string(64, 'b');
+  EXPECT_NE(
+      error_of([&] { rec.begin_job(other, MachineState::kIdle, kT0 + 300'000'000'000); }).find("design hash"),
+      std::string::npos);
+
+  const auto latest = read_job_report(t.db(), kJob.id);
+  ASSERT_TRUE(latest.has_value());
+  EXPECT_EQ(latest->weaving, 2u);
+  EXPECT_EQ(latest->weavings, 2u);
+  EXPECT_EQ(latest->rows, 1u);
+  EXPECT_EQ(latest->started, kT0 + 200'000'000'000);
+  EXPECT_EQ(latest->yarn.at("R"), 360u);
+  EXPECT_EQ(latest->state_ns[static_cast<std::size_t>(MachineState::kIdle)], 10'000'000'000);
+  const auto first = read_job_report(t.db(), kJob.id, 1);
+  ASSERT_TRUE(first.has_value());
+  EXPECT_EQ(first->weaving, 1u);
+  EXPECT_EQ(first->rows, 2u);
+  EXPECT_EQ(first->knots_by_heads, 719u);
+  EXPECT_EQ(first->yarn.at("R"), 721u);
+  EXPECT_EQ(first->wall_ns(), 110'000'000'000);  // as it was left: the second weaving's time is its own
+  EXPECT_FALSE(first->ended.has_value());
+  EXPECT_NE(report_text(*first).find("weaving   1 of 2"), std::string::npos) << report_text(*first);
+  EXPECT_NE(report_text(*first).find("(started over before its end)"), std::string::npos);
+  EXPECT_FALSE(read_job_report(t.db(), kJob.id, 3).has_value());
+}
+
+// A record written by the loomctl before weavings (schema version 1) is read as it is, read-only and
+// untouched, each job its first weaving; its writer's next open migrates it in place, keeping every figure.
+TEST(ProductionRecord, AVersionOneRecordIsReadAndThenMigrated) {
+  TempDir t;
+  {
+    // The version-1 file as that loomctl made it (its schema, written out here as the fixture).
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(t.db().c_str(), &db), SQLITE_OK);
+    const char* v1 = R"sql(
+      CREATE TABLE schema_version (version INTEGER NOT NULL);
+      CREATE TABLE jobs (id INTEGER PRIMARY KEY, design_name TEXT NOT NULL, sha256 TEXT NOT NULL,
+        length_rows INTEGER NOT NULL, started_ns INTEGER NOT NULL, ended_ns INTEGER,
+        recorded_until_ns INTEGER NOT NULL);
+      CREATE TABLE state_time (job_id INTEGER NOT NULL REFERENCES jobs(id), state TEXT NOT NULL,
+        ns INTEGER NOT NULL, PRIMARY KEY (job_id, state));
+      CREATE TABLE rows (job_id INTEGER NOT NULL REFERENCES jobs(id), row INTEGER NOT NULL,
+        ended_ns INTEGER NOT NULL, knots_by_heads INTEGER NOT NULL, knots_retried INTEGER NOT NULL,
+        knots_by_hand INTEGER NOT NULL, PRIMARY KEY (job_id, row));
+      CREATE TABLE yarn (job_id INTEGER NOT NULL REFERENCES jobs(id), colour TEXT NOT NULL,
+        knots INTEGER NOT NULL, PRIMARY KEY (job_id, colour));
+      CREATE TABLE faults (id INTEGER PRIMARY KEY, job_id INTEGER NOT NULL REFERENCES jobs(id),
+        name TEXT NOT NULL, code INTEGER NOT NULL, at_ns INTEGER NOT NULL, cleared_ns INTEGER);
+      INSERT INTO schema_version VALUES (1);
+      INSERT INTO jobs VALUES (3, 'knot_demo.csv',
+        'aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa',
+        540, 1796000000000000000, NULL, 1796000090000000000);
+      INSERT INTO state_time VALUES (3, 'weaving', 30000000000), (3, 'knotting', 60000000000),
+        (3, 'waiting_for_weaver', 0), (3, 'paused', 0), (3, 'faulted', 0), (3, 'idle', 0), (3, 'off', 0);
+      INSERT INTO rows VALUES (3, 1, 1796000090000000000, 358, 2, 2);
+      INSERT INTO yarn VALUES (3, 'R', 362);
+    )sql";
+    ASSERT_EQ(sqlite3_exec(db, v1, nullptr, nullptr, nullptr), SQLITE_OK) << sqlite3_errmsg(db);
+    sqlite3_close(db);
+  }
+  const std::string before = slurp(t.db());
+  const auto check = [&](const char* when) {
+    const auto r = read_job_report(t.db(), 3);
+    ASSERT_TRUE(r.has_value()) << when;
+    EXPECT_EQ(r->weaving, 1u) << when;
+    EXPECT_EQ(r->weavings, 1u) << when;
+    EXPECT_EQ(r->rows, 1u) << when;
+    EXPECT_EQ(r->knots_by_heads, 358u) << when;
+    EXPECT_EQ(r->yarn.at("R"), 362u) << when;
+    EXPECT_EQ(r->wall_ns(), 90'000'000'000) << when;
+    EXPECT_EQ(r->state_ns[static_cast<std::size_t>(MachineState::kKnotting)], 60'000'000'000) << when;
+    EXPECT_FALSE(read_job_report(t.db(), 3, 2).has_value()) << when;
+  };
+  check("version 1, read-only");
+  EXPECT_EQ(slurp(t.db()), before);  // a reader never migrates
+  {
+    ProductionRecord rec(t.db());  // the writer migrates
+    check("migrated");
+    rec.begin_job(kJob, MachineState::kKnotting, kT0 + 100'000'000'000);  // resumes weaving 1
+    rec.row_done({2, 360, 0, 0, {{"R", 360}}}, kT0 + 150'000'000'000);
+    JobInfo second = kJob;
+    second.weaving = 2;
+    rec.begin_job(second, MachineState::kIdle, kT0 + 200'000'000'000);
+    rec.row_done({1, 360, 0, 0, {{"R", 360}}}, kT0 + 250'000'000'000);
+  }
+  const auto first = read_job_report(t.db(), 3, 1);
+  ASSERT_TRUE(first.has_value());
+  EXPECT_EQ(first->rows, 2u);
+  EXPECT_EQ(first->state_ns[static_cast<std::size_t>(MachineState::kOff)], 10'000'000'000);
+  EXPECT_EQ(read_job_report(t.db(), 3)->weaving, 2u);
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(t.db().c_str(), &db), SQLITE_OK);
+  sqlite3_stmt* q = nullptr;
+  ASSERT_EQ(sqlite3_prepare_v2(db, "SELECT version FROM schema_version", -1, &q, nullptr), SQLITE_OK);
+  ASSERT_EQ(sqlite3_step(q), SQLITE_ROW);
+  EXPECT_EQ(sqlite3_column_int(q, 0), ProductionRecord::kSchemaVersion);
+  sqlite3_finalize(q);
+  sqlite3_close(db);
+}
+
 // A child writes rows and says which it committed; it is killed at a random moment, mid-transaction or
 // between; the record reopens with every row it reported (and no half row), its states adding up.
 TEST(ProductionRecord, AKillMidWriteKeepsTheLastCommittedRow) {
@@ -245,14 +369,15 @@ TEST(ProductionRecord, AnotherSchemaVersionOrNotADatabaseIsRefusedAndLeftAlone) 
   { ProductionRecord rec(t.db()); }
   sqlite3* db = nullptr;
   ASSERT_EQ(sqlite3_open(t.db().c_str(), &db), SQLITE_OK);
-  ASSERT_EQ(sqlite3_exec(db, "UPDATE schema_version SET version = 2", nullptr, nullptr, nullptr), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db, "UPDATE schema_version SET version = 3", nullptr, nullptr, nullptr), SQLITE_OK);
   sqlite3_close(db);
   const std::string before = slurp(t.db());
   const std::string e = error_of([&] { ProductionRecord rec(t.db()); });
-  EXPECT_NE(e.find("production record of schema version 2; this loomctl reads and writes version 1"),
-            std::string::npos)
+  EXPECT_NE(
+      e.find("production record of schema version 3; this loomctl reads versions 1..2 and writes version 2"),
+      std::string::npos)
       << e;
-  EXPECT_NE(error_of([&] { read_job_report(t.db(), 1); }).find("schema version 2"), std::string::npos);
+  EXPECT_NE(error_of([&] { read_job_report(t.db(), 1); }).find("schema version 3"), std::string::npos);
   EXPECT_EQ(slurp(t.db()), before);
 
   const std::string text = t.dir.string() + "/notes.sqlite";

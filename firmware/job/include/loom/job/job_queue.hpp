@@ -55,6 +55,8 @@ struct Job {
   int knots_per_row = 0;    // the design's width = the loom's knots per row
   int design_rows = 0;      // the design's height
   std::uint64_t length_rows = 0;
+  std::uint32_t weaving = 1;  // 1, then +1 at each `job start-over` of a job the loom began (the record keeps
+                              // each weaving apart)
   std::vector<HeadYarn> yarn;  // head 1 first; empty on a loom without knotting heads
   JobProgress progress;
 
@@ -99,7 +101,9 @@ class JobQueue {
   const Job& add(const std::string& design_path, const firmware::LoomConfig& loom, const JobLength& length);
   // Removed from the queue (kept as `removed`). Refused for the current job and for a removed one.
   void remove(std::uint32_t id);
-  // Back to row 1: progress cleared; a carpet_done job is queued again. Refused for a removed job.
+  // Back to row 1: progress cleared; a carpet_done job is queued again; a job the loom began (current, done,
+  // or with progress) gets its next weaving number, so the production record keeps the earlier weaving as it
+  // was. Refused for a removed job.
   void start_over(std::uint32_t id);
   // At the machine: `id` (queued) becomes current, its progress based at production row `counter_rows`.
   // Refused when another job is current, or the job is not queued.

@@ -56,7 +56,8 @@ const char* opcua_machinery_state(
 using WallNs = std::int64_t;
 
 struct JobInfo {
-  std::uint32_t id = 0;  // the job queue's number
+  std::uint32_t id = 0;       // the job queue's number
+  std::uint32_t weaving = 1;  // 1 the first time; each `job start-over` weaves the job again as the next
   std::string design_name;
   std::string sha256;
   std::uint64_t length_rows = 0;
@@ -73,18 +74,20 @@ class ProductionRecord {
  public:
   static constexpr const char* kFileName = "production.sqlite";
   static std::string path_in(const std::string& state_dir) { return state_dir + "/" + kFileName; }
-  static constexpr int kSchemaVersion = 1;
+  static constexpr int kSchemaVersion = 2;
 
-  // Opens `path` for writing, creating the schema in a new file. RecordError naming the path when it is not
-  // a loomctl record of kSchemaVersion, another writer has it open (flock on PATH.writer), or SQLite refuses.
+  // Opens `path` for writing, creating the schema in a new file and migrating an older version's (version 1:
+  // no weavings) in one transaction. RecordError naming the path when it is not a loomctl record of a version
+  // up to kSchemaVersion, another writer has it open (flock on PATH.writer), or SQLite refuses.
   explicit ProductionRecord(const std::string& path);
   ~ProductionRecord();
   ProductionRecord(const ProductionRecord&) = delete;
   ProductionRecord& operator=(const ProductionRecord&) = delete;
 
-  // The job is woven from `at` in state `s`: a job new to the record starts at `at`; a job recorded before
-  // (a restart) has the time since its last commit credited to kOff. Committed. RecordError when the job
-  // is recorded as ended, `at` is before its last commit, or its id names another design.
+  // The job's weaving is woven from `at` in state `s`: a weaving new to the record starts at `at`; one
+  // recorded before (a restart) has the time since its last commit credited to kOff. Committed. RecordError
+  // when that weaving is recorded as ended, `at` is before its last commit, its id names another design, or
+  // a later weaving of the job is recorded already.
   void begin_job(const JobInfo& job, MachineState s, WallNs at);
   // From `at` the machine is in `s` (kept in memory; committed with the next row, fault or commit).
   void set_state(MachineState s, WallNs at);
@@ -107,11 +110,13 @@ class ProductionRecord {
   void flush(WallNs at);   // credit, then write the pending state times and the job's recorded_until
   void need_job(const char* what) const;
   void exec(const char* sql);
+  static std::string weaving_name(std::uint32_t job, std::uint32_t weaving);  // "job 3", "job 3 (weaving 2)"
 
   std::string path_;
   int writer_lock_ = -1;  // flock on PATH.writer: one writer
   sqlite3* db_ = nullptr;
-  std::uint32_t job_ = 0;
+  std::int64_t job_ = 0;  // the record's key of the weaving begun (jobs.id); 0: none
+  std::string job_name_;  // as messages name it
   MachineState state_ = MachineState::kIdle;
   WallNs since_ = 0;
   std::array<std::int64_t, kMachineStates> pending_{};
@@ -126,6 +131,8 @@ struct FaultRecord {
 };
 struct JobReport {
   std::uint32_t id = 0;
+  std::uint32_t weaving = 1;   // which weaving of the job this is
+  std::uint32_t weavings = 1;  // how many the record holds (a weaving before the last was started over)
   std::string design_name, sha256;
   std::uint64_t length_rows = 0;
   WallNs started = 0;
@@ -141,8 +148,13 @@ struct JobReport {
   WallNs wall_ns() const { return (ended ? *ended : recorded_until) - started; }
 };
 
-// Reads job `id` from the record at `path`, opened read-only (the writer may be running). nullopt when the
-// record has no such job; RecordError when the file is missing or not a loomctl record of this schema.
-std::optional<JobReport> read_job_report(const std::string& path, std::uint32_t id);
+// Reads weaving `weaving` of job `id` (0: its latest) from the record at `path`, opened read-only (the
+// writer may be running). nullopt when the record has no such job or weaving; RecordError when the file is
+// missing or not a loomctl record of a version this loomctl reads.
+std::optional<JobReport> read_job_report(const std::string& path, std::uint32_t id,
+                                         std::uint32_t weaving = 0);
+// The latest instant the record at `path` holds, over every job and weaving (nullopt: no file, or no job
+// yet). A simulated loom, whose instants run ahead of the wall clock, starts its next job after it.
+std::optional<WallNs> read_latest_instant(const std::string& path);
 
 }  // namespace loom::record
