@@ -333,36 +333,45 @@ TEST_F(LoomSynthCli, ThreePointNamesTheInfiniteRootAndNegativeLengths) {
   EXPECT_NE(n.err.find("a0 = -5 < 0: that link points the other way"), std::string::npos) << n.err;
 }
 
-// φ → 180° through the CLI: the supplement is taken in degrees, so the change-point design at β = the
-// lower bound 180° − φ has a = sin(ψ/2)·sin(s/2)/cos(s/2 + ψ/2) to full precision (s = 1e-6° here;
-// computed in long double).
+// φ → 180° through the CLI: the supplement is 180 − φ of the text as typed, so the change-point design at
+// β = the lower bound 180° − φ has a = sin(ψ/2)·sin(s/2)/cos(s/2 + ψ/2) to full precision (s = 1e-6°
+// exactly here, not the 1e-6° ± 2.8e-8 relative of the double nearest 179.999999; computed in long double).
 TEST_F(LoomSynthCli, CrankRockerNear180KeepsItsDigits) {
   const CliRun r = run("design --swing 45 --phi 179.999999 --beta 0.000001 --full-precision");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto rows = csv(r.out);
   ASSERT_EQ(rows.size(), 2u) << r.out;
   const long double d2r = 3.141592653589793238462643383279502884L / 180.0L;
-  const long double s = (180.0L - static_cast<long double>(179.999999)) * d2r;
+  const long double s = 1e-6L * d2r;
   const long double hp = 22.5L * d2r;
   const long double a = std::sin(hp) * std::sin(s / 2.0L) / std::cos(s / 2.0L + hp);
   EXPECT_NEAR(std::stod(rows[1][4]), static_cast<double>(a), 1e-13 * static_cast<double>(a)) << r.out;
 }
 
-// Hard case A2 through the CLI: the slider-crank's π − φ is taken in degrees too, so at φ = 180° − 1e-12° the
-// coupler b = 1/(2√(k² + λ²s²)) (k = sin(ε/2), s = cos(ε/2), λ² = 2k/(s²(w + k)), w = √(4 + k²)) keeps its
-// digits; computed here in long double from the exact ε. Before: 1 % off (π − rad(φ) lost ulp(π) of ε).
+// Hard case A2 through the CLI: the slider-crank's π − φ is 180 − φ of the text as typed, subtracted in
+// decimal, so at φ = 180° − 1e-12° the coupler b = 1/(2√(k² + λ²s²)) (k = sin(ε/2), s = cos(ε/2),
+// λ² = 2k/(s²(w + k)), w = √(4 + k²)) keeps its digits; computed here in long double from the written ε.
+// Before: 1 % off (π − rad(φ) lost ulp(π) of ε), then 0.26 % (the double nearest the text is not 1e-12° from
+// 180°). The same through `design --stroke`.
 TEST_F(LoomSynthCli, SliderCrankNear180KeepsItsDigits) {
-  for (const char* phi : {"179.999999", "179.999999999", "179.999999999999"}) {
+  const std::pair<const char*, long double> cases[] = {
+      {"179.999999", 1e-6L}, {"179.999999999", 1e-9L}, {"179.999999999999", 1e-12L}};
+  for (const auto& [phi, eps_deg] : cases) {
     const CliRun r = run(std::string("slider-crank --phi ") + phi + " --full-precision");
     ASSERT_EQ(r.exit_code, 0) << phi << ": " << r.err;
     const auto rows = csv(r.out);
     ASSERT_EQ(rows.size(), 2u) << r.out;
     const long double d2r = 3.141592653589793238462643383279502884L / 180.0L;
-    const long double eps = (180.0L - static_cast<long double>(std::stod(phi))) * d2r;
+    const long double eps = eps_deg * d2r;
     const long double k = std::sin(eps / 2.0L), s = std::cos(eps / 2.0L), w = std::sqrt(4.0L + k * k);
     const long double lambda2 = 2.0L * k / (s * s * (w + k));
     const long double b = 0.5L / std::sqrt(k * k + lambda2 * s * s);
     EXPECT_NEAR(std::stod(rows[1][2]) / static_cast<double>(b), 1.0, 1e-9) << phi << ": " << r.out;
+    const CliRun d = run(std::string("design --stroke 1 --phi ") + phi + " --full-precision");
+    ASSERT_EQ(d.exit_code, 0) << phi << ": " << d.err;
+    const auto drows = csv(d.out);
+    ASSERT_EQ(drows.size(), 2u) << d.out;
+    EXPECT_NEAR(std::stod(drows[1][4]) / static_cast<double>(b), 1.0, 1e-9) << phi << ": " << d.out;
   }
 }
 }  // namespace

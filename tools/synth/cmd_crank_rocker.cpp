@@ -32,7 +32,7 @@ void note_near_special_case(std::ostream& err, double psi_deg, double phi_deg) {
 void run_crank_rocker(const CrankRockerArgs& args, std::ostream& out, std::ostream& err) {
   require_positive_length("--ground", args.ground);
   const double psi = motion::rad(args.psi_deg);
-  const motion::CrankRotation phi = motion::CrankRotation::degrees(args.phi_deg);
+  const motion::CrankRotation phi = crank_rotation(args.phi_deg, args.phi_text);
   const motion::BetaBounds bounds =
       blame("--psi " + input_value(args.psi_deg) + " --phi " + input_value(args.phi_deg),
             [&] { return motion::khare_dave_beta_bounds(psi, phi); });

@@ -24,7 +24,7 @@ double thesis_scaled(double unit_length, double stroke) {
 
 void design_slider_crank(const DesignArgs& args, std::ostream& out, std::ostream& err) {
   require_positive_length("--stroke", args.stroke);
-  const motion::CrankRotation phi = motion::CrankRotation::degrees(args.phi_deg);  // π − φ exact near 180°
+  const motion::CrankRotation phi = crank_rotation(args.phi_deg, args.phi_text);  // π − φ exact near 180°
   blame("--phi " + input_value(args.phi_deg), [&] { return motion::soylemez_lambda_bounds(phi); });
   const double stroke = args.thesis_rounding ? 1.0 : args.stroke;
   motion::SliderCrankDesign d =
@@ -67,7 +67,7 @@ void design_crank_rocker(const DesignArgs& args, std::ostream& out, std::ostream
   require_positive_length("--ground", args.ground);
   if (args.has_beta && args.has_lambda) throw ArgError("--beta / --lambda: give at most one of them");
   const double psi = rad(args.swing_deg);
-  const motion::CrankRotation phi = motion::CrankRotation::degrees(args.phi_deg);
+  const motion::CrankRotation phi = crank_rotation(args.phi_deg, args.phi_text);
   blame("--swing " + input_value(args.swing_deg) + " --phi " + input_value(args.phi_deg),
         [&] { return motion::khare_dave_beta_bounds(psi, phi); });
   motion::CrankRockerDesign d;

@@ -75,7 +75,8 @@ void run_slider_crank(const SliderCrankArgs& args, std::ostream& out, std::ostre
   std::ostringstream table;
   std::size_t printed = 0;
   for (double phi_deg : phis) {
-    const motion::CrankRotation phi = motion::CrankRotation::degrees(phi_deg);  // π − φ exact near 180°
+    // π − φ exact near 180°: in decimal from --phi's text, from the double for a range's values
+    const motion::CrankRotation phi = crank_rotation(phi_deg, args.has_phi ? args.phi_text : std::string());
     motion::SliderCrankDesign d;
     try {
       motion::soylemez_lambda_bounds(phi);

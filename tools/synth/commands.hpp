@@ -10,6 +10,7 @@
 
 #include "loom/cli/run.hpp"
 #include "loom/cli/table_format.hpp"
+#include "loom/motion/design/synthesis.hpp"
 #include "loom/motion/design/three_point.hpp"
 #include "loom/motion/errors.hpp"
 
@@ -36,8 +37,15 @@ auto blame(const std::string& arg, F&& f) -> decltype(f()) {
   }
 }
 
+// φ from --phi as typed: its supplement 180 − φ exact in decimal when the text is plain decimal (hard
+// case A2: "179.999999999999" is 1e-12° from 180°, not the double nearest it), else from the double.
+inline motion::CrankRotation crank_rotation(double phi_deg, const std::string& phi_text) {
+  return motion::CrankRotation::decimal_degrees(phi_text).value_or(motion::CrankRotation::degrees(phi_deg));
+}
+
 struct SliderCrankArgs {
   double phi_deg = 0.0;
+  std::string phi_text;  // --phi as typed (crank_rotation)
   bool has_phi = false;
   std::string phi_range;  // "first:last[:step]" in degrees
   double stroke = 1.0;
@@ -51,6 +59,7 @@ void run_slider_crank(const SliderCrankArgs& args, std::ostream& out, std::ostre
 struct CrankRockerArgs {
   double psi_deg = 0.0;
   double phi_deg = 0.0;
+  std::string phi_text;  // --phi as typed (crank_rotation)
   double beta_deg = 0.0;
   bool has_beta = false;
   double ground = 1.0;
@@ -66,6 +75,7 @@ struct DesignArgs {
   double swing_deg = 0.0;
   bool has_swing = false;
   double phi_deg = 0.0;
+  std::string phi_text;  // --phi as typed (crank_rotation)
   double lambda = 0.0;
   bool has_lambda = false;
   double beta_deg = 0.0;

@@ -20,7 +20,8 @@ int main(int argc, char** argv) {
       app.add_subcommand("slider-crank",
                          "Söylemez slider-crank for a crank rotation phi between dead centres: "
                          "phi_deg,a,b,c,mu_min_deg,lambda (Table 4.2)");
-  CLI::Option* sc_phi = sc_cmd->add_option("--phi", sc.phi_deg, "Crank rotation, 90 <= phi < 180 deg");
+  CLI::Option* sc_phi = sc_cmd->add_option("--phi", sc.phi_deg, "Crank rotation, 90 <= phi < 180 deg")
+                            ->each([&sc](const std::string& v) { sc.phi_text = v; });
   CLI::Option* sc_range =
       sc_cmd->add_option("--phi-range", sc.phi_range, "Table of phi: first:last[:step] deg, e.g. 90:179");
   sc_phi->excludes(sc_range);
@@ -37,7 +38,8 @@ int main(int argc, char** argv) {
                          "beta_deg,a,b,c,mu_min_deg, one row per integer beta (Tables 4.6-4.9)");
   cr_cmd->add_option("--psi", cr.psi_deg, "Rocker swing angle, 0 < psi < 180 deg")->required();
   cr_cmd->add_option("--phi", cr.phi_deg, "Crank rotation from extended to folded dead centre, deg")
-      ->required();
+      ->required()
+      ->each([&cr](const std::string& v) { cr.phi_text = v; });
   CLI::Option* cr_beta =
       cr_cmd->add_option("--beta", cr.beta_deg, "Crank angle at the extended dead centre (one design)");
   cr_cmd->add_option("--ground", cr.ground, "Ground link length; lengths come out in its unit")
@@ -50,7 +52,9 @@ int main(int argc, char** argv) {
   CLI::Option* ds_stroke = ds_cmd->add_option("--stroke", ds.stroke, "Beater stroke (slider-crank)");
   CLI::Option* ds_swing = ds_cmd->add_option("--swing", ds.swing_deg, "Rocker swing psi, deg (crank-rocker)");
   ds_stroke->excludes(ds_swing);
-  ds_cmd->add_option("--phi", ds.phi_deg, "Crank rotation between dead centres, deg")->required();
+  ds_cmd->add_option("--phi", ds.phi_deg, "Crank rotation between dead centres, deg")
+      ->required()
+      ->each([&ds](const std::string& v) { ds.phi_text = v; });
   CLI::Option* ds_lambda = ds_cmd->add_option(
       "--lambda", ds.lambda, "Crank/coupler ratio a/b (default: the design maximising mu_min)");
   CLI::Option* ds_beta =

@@ -4,8 +4,11 @@
 // b = sin(ψ/2)·cos γ / sin h (the thesis' eq. 4.27 rewritten so that φ = 180° and the bounds are exact).
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <optional>
 #include <sstream>
 #include <string>
+#include <string_view>
 
 #include "checks.hpp"
 #include "geometry.hpp"
@@ -229,6 +232,37 @@ CrankRotation CrankRotation::degrees(double phi_deg) {
 }
 CrankRotation CrankRotation::radians(double phi_rad) {
   return {phi_rad, kPi - phi_rad};
+}
+
+std::optional<CrankRotation> CrankRotation::decimal_degrees(std::string_view text) {
+  const std::size_t point = text.find('.');
+  if (text.empty() || text.size() > 60 || text == ".") return std::nullopt;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (i != point && (text[i] < '0' || text[i] > '9')) return std::nullopt;
+  }
+  // Both numbers as digit strings with the same number of fraction digits, then |180 − φ| by schoolbook
+  // subtraction (the larger minus the smaller), its sign kept aside.
+  const std::string_view whole = point == std::string_view::npos ? text : text.substr(0, point);
+  const std::string_view frac = point == std::string_view::npos ? std::string_view{} : text.substr(point + 1);
+  std::string phi = std::string(whole) + std::string(frac);
+  std::string ref = "180" + std::string(frac.size(), '0');
+  const std::size_t width = std::max(phi.size(), ref.size());
+  phi.insert(0, width - phi.size(), '0');
+  ref.insert(0, width - ref.size(), '0');
+  const bool negative = phi > ref;  // same width: the digit strings compare as the numbers
+  const std::string& big = negative ? phi : ref;
+  const std::string& small = negative ? ref : phi;
+  std::string diff(width, '0');
+  int borrow = 0;
+  for (std::size_t i = width; i-- > 0;) {
+    int d = (big[i] - '0') - (small[i] - '0') - borrow;
+    borrow = d < 0 ? 1 : 0;
+    diff[i] = static_cast<char>('0' + d + 10 * borrow);
+  }
+  diff.insert(diff.size() - frac.size(), ".");
+  const double supplement_deg = std::strtod(diff.c_str(), nullptr);  // correctly rounded, once
+  const double phi_deg = std::strtod(std::string(text).c_str(), nullptr);
+  return CrankRotation{rad(phi_deg), rad(negative ? -supplement_deg : supplement_deg)};
 }
 
 BetaBounds khare_dave_beta_bounds(double psi_rad, double phi_rad) {

@@ -157,6 +157,51 @@ TEST(Soylemez, PhiIn180DegreesMinusATinyBitKeepsItsDigits) {
   }
 }
 
+// φ as a person writes it: 180 − φ subtracted in decimal, so "179.999999999999" is 1e-12° from 180° to full
+// relative precision (the double nearest the text is 1e-12° ± 0.14 %), and the A2 design at the written φ is
+// right to 1e-9 against the closed form of b in long double. Text that is not plain decimal is left to
+// `degrees` (nullopt).
+TEST(Soylemez, PhiWrittenInDecimalKeepsItsSupplementExact) {
+  using loom::motion::CrankRotation;
+  const long double d2r = 3.141592653589793238462643383279502884L / 180.0L;
+  const struct {
+    const char* text;
+    long double supplement_deg;
+  } cases[] = {{"179.999999999999", 1e-12L},
+               {"179.999999", 1e-6L},
+               {"90", 90.0L},
+               {"180", 0.0L},
+               {"180.", 0.0L},
+               {".5", 179.5L},
+               {"0179.25", 0.75L},
+               {"180.000001", -1e-6L},
+               {"359.9", -179.9L},
+               {"100.125", 79.875L}};
+  for (const auto& c : cases) {
+    const auto r = CrankRotation::decimal_degrees(c.text);
+    ASSERT_TRUE(r.has_value()) << c.text;
+    const long double want = c.supplement_deg * d2r;
+    if (want == 0.0L) {
+      EXPECT_EQ(r->supplement_rad, 0.0) << c.text;
+    } else {
+      EXPECT_NEAR(static_cast<double>(r->supplement_rad / want), 1.0, 4e-16) << c.text;
+    }
+    EXPECT_EQ(r->phi_rad, loom::motion::rad(std::strtod(c.text, nullptr))) << c.text;
+  }
+  for (const char* bad : {"", ".", "1e2", "-5", "+5", "nan", "inf", "1.2.3", " 90", "90 ", "0x10"}) {
+    EXPECT_FALSE(CrankRotation::decimal_degrees(bad).has_value()) << "'" << bad << "'";
+  }
+  EXPECT_FALSE(CrankRotation::decimal_degrees(std::string(61, '1')).has_value());
+
+  const long double eps = 1e-12L * d2r;  // hard case A2 as written: 180° − 1e-12°
+  const long double k = std::sin(eps / 2.0L), s = std::cos(eps / 2.0L), w = std::sqrt(4.0L + k * k);
+  const long double b = 0.5L / std::sqrt(k * k + 2.0L * k / (s * s * (w + k)) * s * s);
+  const SliderCrankDesign d = soylemez_slider_crank(1.0, *CrankRotation::decimal_degrees("179.999999999999"));
+  EXPECT_NEAR(static_cast<double>(d.mechanism.coupler / b), 1.0, 1e-9);
+  const SliderCrankDesign from_double = soylemez_slider_crank(1.0, CrankRotation::degrees(179.999999999999));
+  EXPECT_GT(std::abs(static_cast<double>(from_double.mechanism.coupler / b) - 1.0), 1e-4);  // why it exists
+}
+
 TEST(Soylemez, Phi180IsAnErrorWithTheRightLimits) {
   EXPECT_EQ(code_of_call([] { soylemez_slider_crank(1.0, kPi); }), ErrorCode::kInvalidInput);
   EXPECT_EQ(code_of_call([] { soylemez_slider_crank(1.0, rad(180.0)); }), ErrorCode::kInvalidInput);

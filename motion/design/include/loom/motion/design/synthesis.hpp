@@ -4,6 +4,9 @@
 // All functions are configure-time only: they throw MotionError for impossible input, never NaN.
 #pragma once
 
+#include <optional>
+#include <string_view>
+
 #include "loom/motion/slider_crank.hpp"
 
 namespace loom::motion {
@@ -48,6 +51,12 @@ struct CrankRotation {
   double supplement_rad = 0.0;                   // π − φ
   static CrankRotation degrees(double phi_deg);  // supplement from 180 − φ_deg, converted after
   static CrankRotation radians(double phi_rad);  // supplement from π − φ_rad (as accurate as φ_rad is)
+  // φ as a person writes it ("179.999999999999"): the supplement is 180 − φ subtracted exactly in decimal,
+  // then rounded once, so it is the written value's to full relative precision — `degrees` can only have
+  // the double nearest the text, whose 180 − φ is off by up to ulp(180)/2 (0.14 % at 180° − 1e-12°).
+  // nullopt unless the text is plain decimal: digits, at most one '.', at most 60 characters (no sign,
+  // exponent, nan or inf: those go through `degrees`).
+  static std::optional<CrankRotation> decimal_degrees(std::string_view phi_deg);
 };
 
 struct LambdaBounds {
