@@ -7,9 +7,9 @@
 
 #include "loom/drivers/can_link_info.hpp"
 #include "loom/drivers/configure_clock.hpp"
-#include "loom/firmware/sim_heads.hpp"
 #include "loom/firmware/sim_weaver.hpp"
 #include "loom/motion/errors.hpp"
+#include "loom/sim_heads/sim_heads.hpp"
 
 namespace loom::firmware {
 

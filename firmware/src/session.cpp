@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "loom/design/design.hpp"
+#include "loom/firmware/run_summary.hpp"
 #include "loom/job/yarn_stock.hpp"
 
 namespace loom::firmware {

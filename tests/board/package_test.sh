@@ -13,13 +13,8 @@
 set -euo pipefail
 build=$1
 src=$2
-work=$(mktemp -d /tmp/loom_pkg_test.XXXXXX)
-pid=
-cleanup() {
-  [[ -n $pid ]] && kill -9 "$pid" 2>/dev/null || true
-  rm -rf "$work"
-}
-trap cleanup EXIT
+. "$(dirname "$0")/lib.sh"  # board_work
+board_work pkg_test
 fail() { echo "FAIL: $*" >&2; cat "$work/serve.log" >&2 2>/dev/null || true; exit 1; }
 
 # ---- build the package ----
@@ -117,7 +112,6 @@ fi
 
 # ---- the extracted loomctl serves ----
 "$root/usr/bin/loomctl" --version | grep -qx "loomctl $version" || fail "--version"
-sock=$work/loom.sock
 ctl() { "$root/usr/bin/loomctl" ctl --socket "$sock" "$@"; }
 field() { ctl status | tr ' ' '\n' | sed -n "s/^$1=//p"; }
 wait_for() {  # bounded in seconds; rows counted as "at least" (a row may pass between two polls)

@@ -13,17 +13,9 @@
 set -euo pipefail
 loomctl=$1
 src=$2
-work=$(mktemp -d /tmp/loom_serve_job.XXXXXX)
-pid=
-cleanup() {
-  [[ -n $pid ]] && kill -9 "$pid" 2>/dev/null || true
-  rm -rf "$work"
-}
-trap cleanup EXIT
-sock=$work/loom.sock
+. "$(dirname "$0")/lib.sh"  # board_work, fail, ctl
+board_work serve_job
 loom=$src/tests/sim/knotting_sample_loom.toml
-fail() { echo "FAIL: $*" >&2; echo "--- serve log:" >&2; cat "$work"/serve*.log >&2 || true; exit 1; }
-ctl() { "$loomctl" ctl --socket "$sock" "$@"; }
 field() { ctl status | head -1 | tr ' ' '\n' | sed -n "s/^$1=//p"; }
 cat >"$work/scene.toml" <<'TOML'
 name = "serve_job"

@@ -35,6 +35,24 @@ trap cleanup EXIT
 fail() { echo "FAIL: $*" >&2; for f in "$work"/*.log; do echo "--- $f" >&2; tail -20 "$f" >&2; done; exit 1; }
 ctl() { "$loomctl" ctl --socket "$1" "${@:2}"; }
 field() { ctl "$1" status | tr ' ' '\n' | sed -n "s/^$2=//p"; }
+# Stops one thread of serve (PTRACE_SEIZE + PTRACE_INTERRUPT stop one thread, not the process) from a
+# helper process ($stall, killed at exit) that holds it for 60 s; WHAT names the thread in the failure.
+stop_thread() {  # stop_thread TID WHAT
+  rm -f "$work/stalled"
+  python3 - "$1" "$work/stalled" <<'PY' &
+import ctypes, sys, time
+libc = ctypes.CDLL(None, use_errno=True)
+tid = int(sys.argv[1])
+if libc.ptrace(0x4206, tid, 0, 0) != 0 or libc.ptrace(0x4207, tid, 0, 0) != 0:
+    sys.exit(f"ptrace: errno {ctypes.get_errno()}")
+open(sys.argv[2], "w").close()
+time.sleep(60)
+PY
+  stall=$!
+  pids+=("$stall")
+  for _ in $(seq 1 200); do [[ -e $work/stalled ]] && break; sleep 0.05; done
+  [[ -e $work/stalled ]] || fail "could not stop $2"
+}
 # Waits are bounded in seconds, not in polls: under a sanitizer on a loaded machine one `ctl status` can
 # take longer than a row (0.3 s at --pace 25), so a row count is waited for as "at least" (wait_rows).
 wait_for() {  # wait_for SOCKET FIELD VALUE SECONDS
@@ -101,20 +119,7 @@ pings_before=$(grep -c "WATCHDOG=1" "$work/notify.txt" || true)
 ((pings_before >= 2)) || fail "the watchdog was not fed while the loop ran ($pings_before pings)"
 rt=$(grep -l '^loom-rt$' /proc/"$w"/task/*/comm | head -1 | cut -d/ -f5)
 [[ -n $rt ]] || fail "no loom-rt thread in serve $w"
-# Stop the loop thread only (PTRACE_SEIZE + PTRACE_INTERRUPT stop one thread, not the process).
-python3 - "$rt" "$work/stalled" <<'PY' &
-import ctypes, sys, time
-libc = ctypes.CDLL(None, use_errno=True)
-tid = int(sys.argv[1])
-if libc.ptrace(0x4206, tid, 0, 0) != 0 or libc.ptrace(0x4207, tid, 0, 0) != 0:
-    sys.exit(f"ptrace: errno {ctypes.get_errno()}")
-open(sys.argv[2], "w").close()
-time.sleep(60)
-PY
-stall=$!
-pids+=("$stall")
-for _ in $(seq 1 200); do [[ -e $work/stalled ]] && break; sleep 0.05; done
-[[ -e $work/stalled ]] || fail "could not stop the loop thread"
+stop_thread "$rt" "the loop thread"
 for _ in $(seq 1 40); do [[ $(cut -d' ' -f3 /proc/"$w"/task/"$rt"/stat) == t ]] && break; sleep 0.05; done
 [[ $(cut -d' ' -f3 /proc/"$w"/task/"$rt"/stat) == t ]] || fail "the loop thread did not stop"
 sleep 0.5
@@ -140,20 +145,7 @@ ctl "$work/w.sock" start >/dev/null
 wait_rows "$work/w.sock" $((rows_at_stall + 1)) 30
 cth=$(grep -l '^loom-ctl$' /proc/"$last"/task/*/comm | head -1 | cut -d/ -f5)
 [[ -n $cth ]] || fail "no loom-ctl thread in serve $last"
-rm -f "$work/stalled"
-python3 - "$cth" "$work/stalled" <<'PY' &
-import ctypes, sys, time
-libc = ctypes.CDLL(None, use_errno=True)
-tid = int(sys.argv[1])
-if libc.ptrace(0x4206, tid, 0, 0) != 0 or libc.ptrace(0x4207, tid, 0, 0) != 0:
-    sys.exit(f"ptrace: errno {ctypes.get_errno()}")
-open(sys.argv[2], "w").close()
-time.sleep(60)
-PY
-stall=$!
-pids+=("$stall")
-for _ in $(seq 1 200); do [[ -e $work/stalled ]] && break; sleep 0.05; done
-[[ -e $work/stalled ]] || fail "could not stop the control socket's thread"
+stop_thread "$cth" "the control socket's thread"
 sleep 1
 c0=$(grep -c "WATCHDOG=1" "$work/notify.txt" || true)
 sleep 2.5

@@ -29,16 +29,8 @@
 set -euo pipefail
 loomctl=$1
 src=$2
-work=$(mktemp -d /tmp/loom_serve_test.XXXXXX)
-pid=
-cleanup() {
-  [[ -n $pid ]] && kill -9 "$pid" 2>/dev/null || true
-  rm -rf "$work"
-}
-trap cleanup EXIT
-sock=$work/loom.sock
-fail() { echo "FAIL: $*" >&2; echo "--- serve log:" >&2; cat "$work"/serve*.log >&2 || true; exit 1; }
-ctl() { "$loomctl" ctl --socket "$sock" "$@"; }
+. "$(dirname "$0")/lib.sh"  # board_work, fail, ctl
+board_work serve_test
 field() { ctl status | tr ' ' '\n' | sed -n "s/^$1=//p"; }
 start_serve() {  # start_serve LOG [extra args]
   local log=$1; shift

@@ -47,10 +47,10 @@
 #include "loom/drivers/can_axis_port.hpp"
 #include "loom/drivers/nmt.hpp"
 #include "loom/drivers/socket_can_bus.hpp"
-#include "loom/firmware/sim_heads.hpp"
 #include "loom/sim_can/eds_dictionary.hpp"
 #include "loom/sim_can/io_control.hpp"
 #include "loom/sim_can/sim_drive_rack.hpp"
+#include "loom/sim_heads/sim_heads.hpp"
 
 namespace {
 

@@ -11,6 +11,7 @@
 
 #include "loom/config/config.hpp"
 #include "loom/firmware/control_loop.hpp"
+#include "loom/firmware/run_summary.hpp"
 #include "loom/firmware/runner.hpp"
 #include "loom/sim_hal/sim_world.hpp"
 

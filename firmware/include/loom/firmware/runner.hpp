@@ -262,9 +262,4 @@ using EventHandler = std::function<void(const RunEvent&)>;
 RunResult run_loop(ControlLoop& loop, sequencer::Sequencer& seq, const RunOptions& opt,
                    const EventHandler& on_event);
 
-// One line for the end of a run: ticks, wall time, achieved ratio, tick cost p50/p99.9/max in µs, the
-// telemetry wait apart (virtual time), wake-up latency p50/p99/max, overruns, dropped events; and a
-// WARNING line when it fell behind.
-std::string describe_run(const RunResult& r, const RunOptions& opt);
-
 }  // namespace loom::firmware

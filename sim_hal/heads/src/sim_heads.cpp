@@ -1,5 +1,5 @@
 // The knotting heads as the simulators see them (see sim_heads.hpp).
-#include "loom/firmware/sim_heads.hpp"
+#include "loom/sim_heads/sim_heads.hpp"
 
 #include <stdexcept>
 

@@ -12,27 +12,14 @@ PANEL=$2
 SRC=$3
 OUT=$4
 here=$(dirname "$0")
-fail() { echo "FAIL: $*" >&2; for f in "$WORK"/*.log; do echo "--- $f" >&2; tail -20 "$f" >&2; done; exit 1; }
-. "$(dirname "$0")/browser_lib.sh"
+. "$(dirname "$0")/browser_lib.sh"  # fail, have_browser, panel_work, panel_lcm_url, panel_and_serve
 have_browser || exit 77
 mkdir -p "$OUT"
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/loom_panel_weaver.XXXXXX")
-PIDS=()
-cleanup() {
-  for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null || true; done
-  for p in "${PIDS[@]}"; do wait "$p" 2>/dev/null || true; done
-  rm -rf "$WORK" || true
-}
-trap cleanup EXIT
-
-PORT=$((20000 + ($$ * 17) % 20000))
-URL="udpm://239.255.76.67:${PORT}?ttl=0"
+panel_work weaver
+panel_lcm_url 17
 ID="weaver$$"
-mkdir -p "$WORK/run"
-panel_up panel.log --lcm-url "$URL" --control-dir "$WORK/run"
-SOCK="$WORK/run/$ID.sock"
-panel_serve_up "$SOCK" serve.log --config "$SRC/firmware/config/knotting_loom.toml" \
-  --scene "$SRC/sim_hal/scenes/knotting_faults.toml" --state-dir "$WORK/state" --loom-id "$ID" --lcm-url "$URL" --pace 4
+panel_and_serve --config "$SRC/firmware/config/knotting_loom.toml" \
+  --scene "$SRC/sim_hal/scenes/knotting_faults.toml" --pace 4
 CODE=$("$LOOMCTL" ctl --socket "$SOCK" pair weaver-tablet | sed -n 's/.*code=\([0-9]*\).*/\1/p')
 [ -n "$CODE" ] || fail "ctl pair printed no code"
 "$LOOMCTL" ctl --socket "$SOCK" start >/dev/null || fail "serve did not take start"

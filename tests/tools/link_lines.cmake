@@ -3,9 +3,12 @@
 # the build system has it (build.ninja's LINK_LIBRARIES, or a Makefile build's link.txt), not the
 # targets' declared dependencies, so a library pulled in transitively is caught too.
 #
-# cmake -DBUILD_DIR=<build> -DTARGETS="loom-profile;loom-dynamics" [-DEXPECT=forbidden] -P link_lines.cmake
+# cmake -DBUILD_DIR=<build> -DTARGETS="loom-profile;loom-dynamics" [-DEXPECT=forbidden] [-DFORBIDDEN=...]
+#       -P link_lines.cmake
 #   EXPECT=clean (default): fails naming every target whose link line holds a forbidden library.
 #   EXPECT=forbidden: the check's own check — fails unless every target's line holds one (loomctl does).
+#   FORBIDDEN: another list of library names for another rule (loom-sim-drive: the simulator and the CAN
+#   runtime are its job, the firmware, telemetry and LCM are not).
 # A target whose link line cannot be found fails either way, so a renamed target cannot pass unseen.
 
 cmake_minimum_required(VERSION 3.25)
@@ -13,9 +16,16 @@ cmake_minimum_required(VERSION 3.25)
 # By library name (lib<name>.a / lib<name>.so* / -l<name>): the SocketCAN CANopen runtime, the simulator,
 # the simulated CAN drive, telemetry and LCM, and the firmware that links them all.
 set(forbidden loom_drivers loom_sim_hal loom_sim_can_drive loom_telemetry lcm loom_firmware)
+set(rule "an offline tool links loom::config, not the runtime")
+if(DEFINED FORBIDDEN)
+  set(forbidden ${FORBIDDEN})
+  list(JOIN forbidden ", " rule)
+  set(rule "forbidden here: ${rule}")
+endif()
 
 if(NOT DEFINED BUILD_DIR OR NOT DEFINED TARGETS)
-  message(FATAL_ERROR "usage: cmake -DBUILD_DIR=... -DTARGETS=... [-DEXPECT=forbidden] -P link_lines.cmake")
+  message(FATAL_ERROR
+          "usage: cmake -DBUILD_DIR=... -DTARGETS=... [-DEXPECT=forbidden] [-DFORBIDDEN=...] -P link_lines.cmake")
 endif()
 if(NOT DEFINED EXPECT)
   set(EXPECT clean)
@@ -74,7 +84,7 @@ foreach(target IN LISTS TARGETS)
   endforeach()
   if(EXPECT STREQUAL "clean" AND found)
     list(JOIN found ", " names)
-    string(APPEND failures "  ${target} links ${names} (an offline tool links loom::config, not the runtime)\n")
+    string(APPEND failures "  ${target} links ${names} (${rule})\n")
   elseif(EXPECT STREQUAL "forbidden" AND NOT found)
     string(APPEND failures "  ${target}: no forbidden library found, yet it links the runtime: the check is blind\n")
   else()

@@ -9,16 +9,8 @@
 # Usage: panel_reload_gate.sh <loom-panel>
 set -euo pipefail
 PANEL=$1
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/loom_panel_reload.XXXXXX")
-PIDS=()
-cleanup() {
-  for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null || true; done
-  for p in "${PIDS[@]}"; do wait "$p" 2>/dev/null || true; done
-  rm -rf "$WORK" || true
-}
-trap cleanup EXIT
-fail() { echo "FAIL: $*" >&2; for f in "$WORK"/*.log; do echo "--- $f" >&2; tail -20 "$f" >&2; done; exit 1; }
-. "$(dirname "$0")/browser_lib.sh"
+. "$(dirname "$0")/browser_lib.sh"  # fail, panel_work, panel_up
+panel_work reload
 ID=gate$$
 mkdir -p "$WORK/run"
 python3 - "$WORK/run/$ID.sock" "$WORK/lines.txt" <<'PY' &

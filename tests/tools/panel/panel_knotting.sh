@@ -11,23 +11,12 @@ PANEL=$2
 DESIGN=$3
 OUT=$4
 here=$(dirname "$0")
-fail() { echo "FAIL: $*" >&2; for f in "$WORK"/*.log; do echo "--- $f" >&2; tail -20 "$f" >&2; done; exit 1; }
-. "$(dirname "$0")/browser_lib.sh"
+. "$(dirname "$0")/browser_lib.sh"  # fail, have_browser, panel_work, panel_lcm_url, panel_and_serve
 have_browser || exit 77
 mkdir -p "$OUT"
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/loom_panel_knotting.XXXXXX")
-PIDS=()
-cleanup() {
-  for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null || true; done
-  for p in "${PIDS[@]}"; do wait "$p" 2>/dev/null || true; done  # serve writes its state until it exits
-  rm -rf "$WORK" || true
-}
-trap cleanup EXIT
-
-PORT=$((20000 + ($$ * 11) % 20000))
-URL="udpm://239.255.76.67:${PORT}?ttl=0"
+panel_work knotting
+panel_lcm_url 11
 ID="knot$$"
-mkdir -p "$WORK/run"
 cp "$DESIGN" "$WORK/$(basename "$DESIGN")"
 printf 'extends = "default"\n[knotting]\nmode = "weaver"\n[recipe]\ndesign = "%s"\n' "$(basename "$DESIGN")" >"$WORK/loom.toml"
 
@@ -36,10 +25,7 @@ rows_json=$(grep -v '^[[:space:]]*#' "$DESIGN" | grep -v '^palette,' | grep -v '
   sed 's/[[:space:]]//g; s/,/","/g; s/^/["/; s/$/"]/' | paste -sd, | sed 's/^/[/; s/$/]/')
 height=$(grep -v '^[[:space:]]*#' "$DESIGN" | grep -v '^palette,' | grep -vc '^[[:space:]]*$')
 
-panel_up panel.log --lcm-url "$URL" --control-dir "$WORK/run"
-SOCK="$WORK/run/$ID.sock"
-panel_serve_up "$SOCK" serve.log --config "$WORK/loom.toml" --state-dir "$WORK/state" --loom-id "$ID" \
-  --lcm-url "$URL" --pace 4
+panel_and_serve --config "$WORK/loom.toml" --pace 4
 "$LOOMCTL" ctl --socket "$SOCK" start >/dev/null || fail "serve did not take start"
 # "Row knotted" starts motion: the panel offers it only to a device paired at the loom.
 CODE=$("$LOOMCTL" ctl --socket "$SOCK" pair knot-test | sed -n 's/.*code=\([0-9]*\).*/\1/p')

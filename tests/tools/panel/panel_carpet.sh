@@ -13,21 +13,11 @@ PANEL=$2
 SRC=$3
 OUT=$4
 here=$(dirname "$0")
-fail() { echo "FAIL: $*" >&2; for f in "$WORK"/*.log; do echo "--- $f" >&2; tail -20 "$f" >&2; done; exit 1; }
-. "$(dirname "$0")/browser_lib.sh"
+. "$(dirname "$0")/browser_lib.sh"  # fail, have_browser, panel_work, panel_lcm_url, panel_and_serve
 have_browser || exit 77
 mkdir -p "$OUT"
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/loom_panel_carpet.XXXXXX")
-PIDS=()
-cleanup() {
-  for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null || true; done
-  for p in "${PIDS[@]}"; do wait "$p" 2>/dev/null || true; done
-  rm -rf "$WORK" || true
-}
-trap cleanup EXIT
-
-PORT=$((20000 + ($$ * 17) % 20000))
-URL="udpm://239.255.76.67:${PORT}?ttl=0"
+panel_work carpet
+panel_lcm_url 17
 ID="carpet$$"
 LOOM=$SRC/tests/sim/knotting_sample_loom.toml
 DESIGN=$WORK/rug.csv
@@ -47,10 +37,7 @@ mkdir -p "$WORK/run" "$WORK/state"
 "$LOOMCTL" job add "$DESIGN" --config "$LOOM" --state-dir "$WORK/state" --rows 6 >/dev/null || fail "job add"
 "$LOOMCTL" job add "$WORK/other.csv" --config "$LOOM" --state-dir "$WORK/state" --rows 2 >/dev/null || fail "job add 2"
 
-panel_up panel.log --lcm-url "$URL" --control-dir "$WORK/run"
-SOCK="$WORK/run/$ID.sock"
-panel_serve_up "$SOCK" serve.log --config "$LOOM" --scene "$WORK/scene.toml" --state-dir "$WORK/state" \
-  --loom-id "$ID" --lcm-url "$URL" --pace 10
+panel_and_serve --config "$LOOM" --scene "$WORK/scene.toml" --pace 10
 
 # A panel that joins late (serve armed and standing, nothing changes): JOB and the whole knot map reach it
 # within the 10 s repeat.

@@ -5,7 +5,7 @@
 # Usage: logger_replay.sh <loom-monitor> <telemetry_feed>
 MONITOR=$1
 FEED=$2
-source "$(dirname "$0")/lcm_script_lib.sh"
+source "$(dirname "$0")/../../telemetry/lcm_script_lib.sh"
 
 ROWS=3
 ID="replay$$"

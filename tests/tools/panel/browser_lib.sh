@@ -1,12 +1,40 @@
 # Sourced by the panel's tests (it defines functions and runs nothing):
+#   fail MESSAGE — FAIL and the last 20 lines of every WORK/*.log, exit 1; a test that defined its own
+#                  fail before sourcing this keeps it.
+#   panel_work NAME — WORK (a scratch folder ${TMPDIR:-/tmp}/loom_panel_NAME.XXXXXX) and PIDS, with a
+#                  cleanup at exit that stops every PIDS process, waits for it and removes WORK.
+#   panel_lcm_url MULT — PORT and URL, an LCM udpm group on a port of this test's own (20000 + PID × MULT
+#                  mod 20000: tests that run side by side do not hear each other).
 #   have_browser — sets CHROMIUM; false, saying why, when headless Chromium or a node with a built-in
 #                  WebSocket (the DevTools client in cdp.mjs) is missing. Browser tests: `have_browser || exit 77`.
 #   panel_up, panel_serve_up — start loom-panel / `loomctl serve` and wait until they answer.
+#   panel_and_serve [serve args...] — both, as the knotting tests run them: loom-panel with its operator
+#                  buttons on WORK/run, `loomctl serve` as loom ID on WORK/run/ID.sock (sets SOCK) with its
+#                  state in WORK/state, both on URL.
 # The two start helpers need from the caller: WORK (a scratch folder, their output goes there), PIDS (an
 # array the caller's cleanup kills), fail (prints and exits), and PANEL / LOOMCTL (the programs). Their
 # names are their own (panel_history.sh and serve_test.sh have a start_panel / start_serve of their own).
 # The waits are long enough for a loaded machine (`ctest -j2` beside a build): they end as soon as the
 # program answers, and fail at once, with its output, when it exits instead.
+
+declare -F fail >/dev/null ||
+  fail() { echo "FAIL: $*" >&2; for f in "$WORK"/*.log; do echo "--- $f" >&2; tail -20 "$f" >&2; done; exit 1; }
+
+panel_work() {
+  WORK=$(mktemp -d "${TMPDIR:-/tmp}/loom_panel_$1.XXXXXX")
+  PIDS=()
+  trap panel_cleanup EXIT
+}
+panel_cleanup() {
+  for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null || true; done
+  for p in "${PIDS[@]}"; do wait "$p" 2>/dev/null || true; done  # serve writes its state until it exits
+  rm -rf "$WORK" || true
+}
+
+panel_lcm_url() {
+  PORT=$((20000 + ($$ * $1) % 20000))
+  URL="udpm://239.255.76.67:${PORT}?ttl=0"
+}
 
 have_browser() {
   CHROMIUM=$(command -v chromium || command -v chromium-browser || true)
@@ -51,4 +79,11 @@ panel_serve_up() {
     ((SECONDS < deadline)) || fail "serve's control socket did not answer within ${SERVE_UP_S:-60} s"
     sleep 0.05
   done
+}
+
+panel_and_serve() {
+  mkdir -p "$WORK/run"
+  panel_up panel.log --lcm-url "$URL" --control-dir "$WORK/run"
+  SOCK="$WORK/run/$ID.sock"
+  panel_serve_up "$SOCK" serve.log --state-dir "$WORK/state" --loom-id "$ID" --lcm-url "$URL" "$@"
 }

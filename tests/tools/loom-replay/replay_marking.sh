@@ -10,7 +10,7 @@
 MONITOR=$1
 FEED=$2
 REPLAY=$3
-source "$(dirname "$0")/lcm_script_lib.sh"
+source "$(dirname "$0")/../../telemetry/lcm_script_lib.sh"
 
 ID="marked$$"
 REC="$WORK/old.lcmlog"
