@@ -18,7 +18,9 @@
 #include "loom/motion/knot_cycle.hpp"
 #include "loom/motion/profile_set.hpp"
 #include "loom/sequencer/beat_regulator.hpp"
+#include "loom/sequencer/row_time.hpp"
 #include "loom/sim_hal/effects.hpp"
+#include "loom/sim_heads/sim_heads.hpp"
 
 namespace loom::firmware {
 namespace {
@@ -118,9 +120,43 @@ void print_axes(const LoomConfig& c) {
   }
 }
 
+// The heads' time per row. With a design: rows 1 and 2 tied by the heads' own sequence against an ideal
+// plant (sequencer/row_time.hpp), so every wait counts — a carriage step or selector turn that outlasts the
+// gripper's return, the settles, the first travel and the way back; rows alternate selvedges, so their mean.
+// Without a design (nothing to tie): the knot cycles alone.
+struct KnotRowTime {
+  int cycles = 0;
+  double cycles_s = 0.0;                 // the knot cycles back to back
+  std::optional<double> row1_s, row2_s;  // from the left selvedge, from the right
+  double mean_s() const { return row1_s && row2_s ? (*row1_s + *row2_s) / 2.0 : cycles_s; }
+};
+
+KnotRowTime knot_row_time(const LoomConfig& c, const motion::KnotCycle& cycle, double carriage_travel_m) {
+  KnotRowTime t;
+  t.cycles = std::min(sequencer::knots_per_stripe(c.knotting),
+                      sequencer::knots_per_row(c.knotting, c.machine_spec.width_m));
+  t.cycles_s = t.cycles * cycle.duration_s();
+  if (!c.recipe.design) return t;
+  const KnottingHeads heads = build_heads(c, 0, 0);
+  sequencer::SequencerConfig s = c.sequencer;
+  s.heads.program = heads.program.get();
+  s.heads.cycle = heads.cycle.get();
+  const double period = c.sequencer.period_s;
+  const auto limit = static_cast<hal::Tick>((t.cycles_s * 10.0 + 600.0) / period);
+  const auto seconds_of = [&](std::uint32_t row0) -> std::optional<double> {
+    const auto ticks = sequencer::ideal_row_knotting_ticks(s, carriage_travel_m, row0, limit);
+    if (!ticks) return std::nullopt;
+    return static_cast<double>(*ticks) * period;
+  };
+  t.row1_s = seconds_of(0);
+  t.row2_s = seconds_of(1);
+  return t;
+}
+
 // The knot plan: density and carpet class, and with knotting heads how a row is tied — knots per head,
 // knot cycles and carriage steps per row, and the design's selector moves.
-void print_knotting(const LoomConfig& c, const std::optional<motion::KnotCycle>& knot_cycle) {
+void print_knotting(const LoomConfig& c, const std::optional<motion::KnotCycle>& knot_cycle,
+                    const KnotRowTime& row_time) {
   const sequencer::KnottingSpec& k = c.knotting;
   const double density = k.knots_per_dm * k.rows_per_dm;
   std::printf("\nknotting: %s", sequencer::knotting_mode_name(k.mode));
@@ -191,12 +227,22 @@ void print_knotting(const LoomConfig& c, const std::optional<motion::KnotCycle>&
       "    gripper in the warp %.3f..%.3f s, cutter %.3f..%.3f s, yarn-present sampled %.3f..%.3f s\n",
       cycle.in_warp().begin_s, cycle.in_warp().end_s, cycle.cutter().begin_s, cycle.cutter().end_s,
       cycle.yarn_sample().begin_s, cycle.yarn_sample().end_s);
-  const int cycles = std::min(stripe, per_row);
-  std::printf(
-      "  knotting about %.1f s per row (%d cycles; the carriage steps and the selectors index while the "
-      "grippers "
-      "return)\n",
-      cycles * cycle.duration_s(), cycles);
+  if (row_time.row1_s && row_time.row2_s) {
+    const double extra = row_time.mean_s() - row_time.cycles_s;
+    std::printf(
+        "  knotting about %.1f s per row, from the heads' own sequence against an ideal plant: %.2f s from "
+        "the left selvedge, %.2f s from the right (the heads knot from the left: the carriage crosses "
+        "first)\n    the %d knot cycles take %.1f s; the other %.1f s are the carriage's steps and the "
+        "selectors' turns that outlast the grippers' return (%.3f s a knot), the settles and the way "
+        "back\n",
+        row_time.mean_s(), *row_time.row1_s, *row_time.row2_s, row_time.cycles, row_time.cycles_s, extra,
+        extra / row_time.cycles);
+  } else {
+    std::printf("  knotting at least %.1f s per row (%d knot cycles back to back; %s)\n", row_time.cycles_s,
+                row_time.cycles,
+                c.recipe.design ? "the heads' sequence did not finish a row against an ideal plant"
+                                : "no design: the carriage's steps and the selectors' turns are not counted");
+  }
   std::string slots;
   for (std::size_t i = 0; i < k.slot_colours.size(); ++i)
     slots += (i ? ", " : "") + std::to_string(i) + "=" + k.slot_colours[i];
@@ -313,12 +359,11 @@ void print_plan(const LoomConfig& c) {
   // The knot cycle from the linkage and the servo's limits (checked when the config was read).
   std::optional<motion::KnotCycle> knot_cycle;
   if (c.knotting.mode == sequencer::KnottingMode::kHeads) knot_cycle = motion::KnotCycle::build(c.knot_cycle);
+  const KnotRowTime row_time =
+      knot_cycle ? knot_row_time(c, *knot_cycle, p.carriage_travel_m()) : KnotRowTime{};
   if (knot_cycle) {
     // A knotted row compares whole with the weaver's whole row (~5 min knotting + 2 shed and pick + 3 beat).
-    const motion::KnotCycle& cycle = *knot_cycle;
-    const int cycles = std::min(sequencer::knots_per_stripe(c.knotting),
-                                sequencer::knots_per_row(c.knotting, c.machine_spec.width_m));
-    const double knot = cycles * cycle.duration_s();
+    const double knot = row_time.mean_s();
     std::printf(
         "  about %.2f s per whole row: knotting %.2f s by %d heads + shed, pick and beat %.2f s (%.0fx "
         "faster than "
@@ -331,7 +376,7 @@ void print_plan(const LoomConfig& c) {
   print_safety_sensors(c);
 
   print_axes(c);
-  print_knotting(c, knot_cycle);
+  print_knotting(c, knot_cycle, row_time);
 
   std::printf("\nCAN (for --hal socketcan)\n");
   std::string io_nodes = "I/O module node " + std::to_string(c.io.node);
