@@ -46,7 +46,7 @@ start_serve serve1.log
 status=$(ctl status | head -1)
 [[ $status == *" job=1 job_row=1/2 job_state=queued"* ]] || fail "status does not name the queued job: $status"
 ctl start | grep -q '^ok start' || fail "start not accepted"
-grep -q "job 1 (design knot_sample.csv, sha256 [0-9a-f]*\.\.): row 1 of 2 next: started at the machine by local user" \
+logged "job 1 (design knot_sample.csv, sha256 [0-9a-f]*\.\.): row 1 of 2 next: started at the machine by local user" \
   "$work/serve1.log" || fail "the job's start is not in the journal"
 
 # 2. the weaver answers the heads until the carpet is done
@@ -74,7 +74,7 @@ ctl faults | grep -q " reload .*: ok reload head [0-9] slot [0-9]: full" || fail
 status=$(ctl status | head -1)
 [[ $status == *" state=carpet_done "* && $status == *" rows=2 "* && $status == *" carpet_done_job=1"* ]] ||
   fail "not carpet_done after the job's 2 rows: $status"
-grep -q "^carpet done: job 1, its last row woven (rows 2)" "$work/serve1.log" || fail "no carpet done line in the journal"
+logged "^carpet done: job 1, its last row woven (rows 2)" "$work/serve1.log" || fail "no carpet done line in the journal"
 rc=0
 reply=$(ctl start 2>&1) || rc=$?
 [[ $rc == 1 && $reply == "refused: start: no carpet job to weave: job 1 is carpet_done"* ]] ||

@@ -86,7 +86,7 @@ sleep 0.5
 [[ $(field state) == idle ]] || fail "not idle before start: $(ctl status)"
 [[ $(field tick) -gt 100 ]] || fail "the loop is not cycling while waiting: $(ctl status)"
 [[ $(stat -c %a "$sock") == 660 ]] || fail "socket mode $(stat -c %a "$sock"), want 660"
-grep -q '^<5>armed, waiting for the operator' "$work/serve1.log" || fail "no <5> armed line"
+logged '^<5>armed, waiting for the operator' "$work/serve1.log" || fail "no <5> armed line"
 
 # 2. start → a row → stop at row end
 ctl start | grep -q '^ok start' || fail "start not acknowledged"
@@ -95,7 +95,7 @@ ctl stop >/dev/null
 wait_for state done 30
 rows=$(field rows)
 [[ $rows -ge 1 ]] || fail "no row woven"
-grep -q '^<6>row 1 done' "$work/serve1.log" || fail "no <6> row line"
+logged '^<6>row 1 done' "$work/serve1.log" || fail "no <6> row line"
 ctl faults | grep -q ' fault loom1 ' && fail "a fault recorded on a clean run: $(ctl faults)"
 ctl faults | grep -q ' command loom1 start .*by local user' || fail "the start command is not in the history: $(ctl faults)"
 # A command's history line carries the counters it was given at (issue 30: they all said rows=0 picks=0).
@@ -119,7 +119,7 @@ rows=$(field rows)
 
 # 3. restart on the same state: armed at the same row, idle
 stop_serve
-grep -q '^<5>loomctl serve: stopped' "$work/serve1.log" || fail "no stop line"
+logged '^<5>loomctl serve: stopped' "$work/serve1.log" || fail "no stop line"
 [[ -f $work/state/counters.json ]] || fail "no counters in the state dir"
 start_serve serve2.log
 [[ $(field state) == idle ]] || fail "restart is not idle: $(ctl status)"
@@ -148,7 +148,7 @@ rm -rf "$work/state"
 start_serve serve4.log --scene "$src/sim_hal/scenes/drive_fault.toml"
 ctl start >/dev/null
 wait_for state fault 60
-grep -q '^<3>FAULT drive_fault' "$work/serve4.log" || fail "no <3> FAULT line"
+logged '^<3>FAULT drive_fault' "$work/serve4.log" || fail "no <3> FAULT line"
 ctl faults | grep -q ' fault loom1 drive_fault 0x1002' || fail "fault not in the history: $(ctl faults)"
 ctl ack >/dev/null
 wait_for state idle 30
@@ -219,7 +219,7 @@ wait_weaving 30
 expect weaving stop ok
 wait_for state done 60
 for c in stop pause resume ack next; do expect done $c refused; done
-grep -q '^<4>operator: resume by local user .*: refused: resume: not paused' "$work/serve7.log" ||
+logged '^<4>operator: resume by local user .*: refused: resume: not paused' "$work/serve7.log" ||
   fail "a refusal is not in the journal with who gave it"
 ctl start | grep -q '^ok start' || fail "start after done (a new session) not accepted"
 wait_weaving 30
@@ -233,7 +233,7 @@ PACE=2 start_serve serve8.log --scene "$src/sim_hal/scenes/drive_fault.toml"
 ctl start >/dev/null
 ctl ack >/dev/null 2>&1 && fail "ack accepted while weaving without a fault: $(ctl status)"
 wait_for state fault 60
-grep -q '^<3>FAULT drive_fault' "$work/serve8.log" || fail "the fault after a stale ack was not logged"
+logged '^<3>FAULT drive_fault' "$work/serve8.log" || fail "the fault after a stale ack was not logged"
 ctl faults | grep -q ' fault loom1 drive_fault' || fail "the fault after a stale ack was not recorded"
 for c in start resume pause stop next; do expect fault $c refused; done
 sleep 0.5
@@ -348,7 +348,7 @@ stop_serve
 start_serve serve11b.log
 wait_for state fault 10
 [[ $(field fault) == drive_fault ]] || fail "the fault from before the restart is not latched: $(ctl status)"
-grep -q '^<3>FAULT drive_fault (0x1002).* latched before the restart, at 20[0-9-]*T[0-9:]*Z' "$work/serve11b.log" ||
+logged '^<3>FAULT drive_fault (0x1002).* latched before the restart, at 20[0-9-]*T[0-9:]*Z' "$work/serve11b.log" ||
   fail "the journal does not say the fault was latched again"
 for c in start resume next; do
   reply=$(ctl $c 2>&1) && fail "$c accepted with the fault from before the restart latched: $reply"
