@@ -28,7 +28,7 @@ weaver_s = 3600
 TOML
 start_serve() {
   "$loomctl" serve --config "$loom" --scene "$work/scene.toml" --state-dir "$work/state" --socket "$sock" \
-    --group "" --no-telemetry --pace 40 >"$work/$1" 2>&1 &
+    --group "" --no-telemetry --pace "${LOOM_BOARD_PACE:-40}" >"$work/$1" 2>&1 &
   pid=$!
   local end=$((SECONDS + 20))
   while ((SECONDS < end)); do
