@@ -43,6 +43,7 @@ std::string describe(const SdoWrite& w) {
 std::vector<SdoWrite> parameter_writes(const Description& dcf, std::uint8_t node_id) {
   std::vector<SdoWrite> out;
   for (const auto& [index, o] : dcf.objects) {
+    if (index < 0x1000) continue;  // data type definitions: not configured (write_dcf leaves them out too)
     for (const auto& [sub, e] : o.entries) {
       if (e.parameter_value.empty() || !writable(e.access) || !numeric(e.type)) continue;
       const auto bits = e.parameter_value.bits(node_id, e.type);

@@ -26,8 +26,9 @@ struct SdoWrite {
 // "0x1017:00 = 0x0064 (2 bytes)".
 std::string describe(const SdoWrite& w);
 
-// Configure-time only. Every ParameterValue of a DCF on a writable entry of an integer or real type, in
-// index/sub order, $NODEID resolved with `node_id` (an EDS has none: empty).
+// Configure-time only. Every ParameterValue of a DCF on a writable entry of an integer or real type of an
+// object from 0x1000 on (below it: data type definitions, never configured), in index/sub order, $NODEID
+// resolved with `node_id` (an EDS has none: empty).
 std::vector<SdoWrite> parameter_writes(const Description& dcf, std::uint8_t node_id);
 
 // Configure-time only. What the loom configures on the node: every value it writes (NodeNeeds::objects
