@@ -211,7 +211,10 @@ TEST(CountersCli, ASaveThatFailsMidRunStopsAtTheRowEndWithANamedFault) {
                    " weave --rows 3 --no-telemetry --realtime --pace 4 --counters " + counters + " 2>&1")
                       .c_str(),
                   "r");
-  std::this_thread::sleep_for(std::chrono::milliseconds(600));
+  // Once armed (its probe save wrote the file: a slow start, as under a sanitizer, must not meet the
+  // obstacle before it), the save at row 1's end finds its temp path taken.
+  for (int i = 0; i < 400 && !fs::exists(counters); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
   fs::create_directories(d / "c.json.tmp");
   std::string out;
   char buf[512];
