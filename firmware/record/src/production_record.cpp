@@ -470,17 +470,26 @@ void ProductionRecord::end_job(WallNs at) {
   job_ = 0;
 }
 
+namespace {
+// A read-only connection beside the writer (which may be running), closed on scope exit.
+struct Reader {
+  sqlite3* db;
+  explicit Reader(const std::string& path) : db(open_db(path, SQLITE_OPEN_READONLY)) {
+    sqlite3_busy_timeout(db, 2000);  // the writer's commit is short
+  }
+  ~Reader() { sqlite3_close(db); }
+  Reader(const Reader&) = delete;
+  Reader& operator=(const Reader&) = delete;
+};
+}  // namespace
+
 std::optional<JobReport> read_job_report(const std::string& path, std::uint32_t id, std::uint32_t weaving) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) {
     throw RecordError(path + ": no production record (nothing was woven with this state directory yet)");
   }
-  sqlite3* db = open_db(path, SQLITE_OPEN_READONLY);
-  struct Closer {
-    sqlite3* db;
-    ~Closer() { sqlite3_close(db); }
-  } closer{db};
-  sqlite3_busy_timeout(db, 2000);  // the writer's commit is short
+  const Reader reader(path);
+  sqlite3* db = reader.db;
   const int version = checked_version(db, path);
   exec_on(db, path, "BEGIN");  // one snapshot for every query below
   JobReport r;
@@ -556,12 +565,8 @@ std::optional<JobReport> read_job_report(const std::string& path, std::uint32_t 
 std::optional<WallNs> read_latest_instant(const std::string& path) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) return std::nullopt;
-  sqlite3* db = open_db(path, SQLITE_OPEN_READONLY);
-  struct Closer {
-    sqlite3* db;
-    ~Closer() { sqlite3_close(db); }
-  } closer{db};
-  sqlite3_busy_timeout(db, 2000);
+  const Reader reader(path);
+  sqlite3* db = reader.db;
   if (checked_version(db, path) == 0) return std::nullopt;
   Stmt q(db, path, "SELECT max(recorded_until_ns) FROM jobs");
   if (!q.row() || q.null(0)) return std::nullopt;
