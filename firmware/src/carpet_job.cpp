@@ -17,7 +17,44 @@ CarpetJob::CarpetJob(const std::string& state_dir)
 void CarpetJob::reload() {
   std::lock_guard<std::mutex> lock(mu_);
   queue_ = job::JobQueue::load(queue_.path());
+  armed_id_ = 0;  // a new session: arm() says which job it weaves
   refresh();
+}
+
+std::uint32_t CarpetJob::armed_id() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return armed_id_;
+}
+
+std::vector<job::Job> CarpetJob::all_jobs() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return queue_.jobs();
+}
+
+job::Job CarpetJob::job_numbered(std::uint32_t id) const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return queue_.job(id);
+}
+
+job::Job CarpetJob::add(const std::string& design_path, const LoomConfig& loom,
+                        const job::JobLength& length) {
+  std::lock_guard<std::mutex> lock(mu_);
+  const job::Job j = queue_.add(design_path, loom, length);
+  refresh();
+  return j;
+}
+
+void CarpetJob::remove(std::uint32_t id) {
+  std::lock_guard<std::mutex> lock(mu_);
+  queue_.remove(id);
+  refresh();
+}
+
+job::Job CarpetJob::start_over(std::uint32_t id) {
+  std::lock_guard<std::mutex> lock(mu_);
+  queue_.start_over(id);
+  refresh();
+  return queue_.job(id);
 }
 
 bool CarpetJob::in_use() const {
@@ -50,20 +87,26 @@ std::uint64_t CarpetJob::rows_left() const {
   return job_ ? job_->length_rows - job_->progress.rows_done : 0;
 }
 
-// The job to weave: the current one, else the lowest-numbered queued one (the queue's order).
+// The job to weave: the armed one while it is queued or current (a queue changed under a session keeps
+// what it weaves), else the current one, else the lowest-numbered queued one (the queue's order).
 void CarpetJob::refresh() {
   job_.reset();
   carpet_done_id_ = 0;
   if (const job::Job* c = queue_.current()) {
     job_ = *c;
-    return;
-  }
-  for (const job::Job& j : queue_.jobs()) {
-    if (j.state == job::JobState::kQueued) {
-      job_ = j;
-      return;
+  } else {
+    for (const job::Job& j : queue_.jobs()) {
+      if (j.state == job::JobState::kQueued) {
+        job_ = j;
+        break;
+      }
+      if (j.state == job::JobState::kCarpetDone) carpet_done_id_ = j.id;
     }
-    if (j.state == job::JobState::kCarpetDone) carpet_done_id_ = j.id;
+  }
+  if (armed_id_ == 0 || (job_ && job_->id == armed_id_)) return;
+  for (const job::Job& j : queue_.jobs()) {
+    if (j.id == armed_id_ && (j.state == job::JobState::kQueued || j.state == job::JobState::kCurrent))
+      job_ = j;
   }
 }
 
@@ -99,23 +142,33 @@ LoomConfig CarpetJob::config_for(const LoomConfig& loom) const {
 std::uint64_t CarpetJob::arm(std::uint32_t counter_rows) {
   std::lock_guard<std::mutex> lock(mu_);
   credited_rows_ = counter_rows;
-  if (!job_ || job_->state != job::JobState::kCurrent) return rows_done_locked();
-  if (counter_rows > job_->progress.at_counter_rows) {
+  armed_id_ = 0;
+  refresh();
+  if (job_ && job_->state == job::JobState::kCurrent && counter_rows > job_->progress.at_counter_rows) {
     // Rows whose counters reached the disk before a power cut kept the queue from hearing of them.
     if (queue_.advance(counter_rows)) {
       queue_.mark_carpet_done();
+      refresh();  // the next queued job, if any, is what this session weaves
+    } else {
       refresh();
-      return 0;
     }
-    refresh();
   }
+  armed_id_ = job_ ? job_->id : 0;
   return rows_done_locked();
+}
+
+// The armed job as the queue has it now, or null when the queue no longer holds it to weave (it was
+// removed or finished): then this session starts and credits nothing.
+const job::Job* CarpetJob::armed_locked() const {
+  if (armed_id_ == 0 || !job_ || job_->id != armed_id_) return nullptr;
+  return &*job_;
 }
 
 bool CarpetJob::start(std::uint32_t counter_rows) {
   std::lock_guard<std::mutex> lock(mu_);
-  if (!job_ || job_->state == job::JobState::kCurrent) return false;
-  queue_.start(job_->id, counter_rows);
+  const job::Job* j = armed_locked();
+  if (j == nullptr || j->state == job::JobState::kCurrent) return false;
+  queue_.start(j->id, counter_rows);
   credited_rows_ = counter_rows;
   refresh();
   return true;
@@ -123,8 +176,9 @@ bool CarpetJob::start(std::uint32_t counter_rows) {
 
 bool CarpetJob::row_saved(std::uint32_t counter_rows) {
   std::lock_guard<std::mutex> lock(mu_);
-  if (!job_ || counter_rows <= credited_rows_) return false;
-  if (job_->state != job::JobState::kCurrent) queue_.start(job_->id, credited_rows_);
+  const job::Job* j = armed_locked();
+  if (j == nullptr || counter_rows <= credited_rows_) return false;
+  if (j->state != job::JobState::kCurrent) queue_.start(j->id, credited_rows_);
   credited_rows_ = counter_rows;
   const bool last = queue_.advance(counter_rows);
   if (last) queue_.mark_carpet_done();

@@ -1,5 +1,6 @@
 // See job_cmd.hpp. Reading verbs (list, show) only read; changing verbs take the state directory's lock
-// (the one serve holds), so the queue has one writer, and refuse while serve runs.
+// (the one serve holds), so the queue has one writer, and refuse while serve runs (serve changes it then:
+// loomctl ctl job ...).
 #include "job_cmd.hpp"
 
 #include <sys/stat.h>
@@ -12,6 +13,7 @@
 #include "loom/firmware/serve/state_lock.hpp"
 #include "loom/firmware/session.hpp"
 #include "loom/job/job_queue.hpp"
+#include "loom/job/job_text.hpp"
 #include "loom/job/yarn_stock.hpp"
 
 namespace loom::firmware {
@@ -27,59 +29,6 @@ struct JobArgs {
 };
 
 namespace {
-
-std::string progress_text(const job::Job& j) {
-  if (j.state == job::JobState::kCarpetDone) return "all " + std::to_string(j.length_rows) + " rows woven";
-  return "row " + std::to_string(j.next_row()) + " of " + std::to_string(j.length_rows) + " next";
-}
-
-int list(const job::JobQueue& q) {
-  if (q.jobs().empty()) {
-    std::printf("no jobs in %s\n", q.path().c_str());
-    return 0;
-  }
-  std::printf("%-5s %-12s %-28s %-14s %s\n", "job", "state", "design", "sha256", "progress");
-  for (const job::Job& j : q.jobs()) {
-    std::printf("%-5u %-12s %-28s %-14s %s\n", j.id, job::job_state_name(j.state), j.design_name.c_str(),
-                (j.sha256.substr(0, 12) + "..").c_str(), progress_text(j).c_str());
-  }
-  return 0;
-}
-
-int show(const job::Job& j) {
-  std::printf("job %u: %s\n", j.id, job::job_state_name(j.state));
-  std::printf("  design      %s\n  file        %s\n  sha256      %s\n", j.design_name.c_str(),
-              j.design_path.c_str(), j.sha256.c_str());
-  try {
-    job::JobQueue::check_design(j);
-    std::printf("  file check  unchanged since the job was added\n");
-  } catch (const job::JobError& e) {
-    std::printf("  file check  %s\n", e.what());
-  }
-  std::printf("  size        %d knots per row x %d design rows\n", j.knots_per_row, j.design_rows);
-  const std::uint64_t repeats = j.length_rows / static_cast<std::uint64_t>(j.design_rows);
-  const std::uint64_t extra = j.length_rows % static_cast<std::uint64_t>(j.design_rows);
-  std::printf("  length      %llu rows (the design %llu time%s%s)\n",
-              static_cast<unsigned long long>(j.length_rows), static_cast<unsigned long long>(repeats),
-              repeats == 1 ? "" : "s", extra ? (" and " + std::to_string(extra) + " rows").c_str() : "");
-  if (j.weaving > 1) {
-    std::printf(
-        "  weaving     %u (started over %u time%s; the record keeps each: loomctl report job %u --weaving "
-        "K)\n",
-        j.weaving, j.weaving - 1, j.weaving == 2 ? "" : "s", j.id);
-  }
-  std::printf("  progress    %s (design row %d); knot cycles of that row started %u, done %u\n",
-              progress_text(j).c_str(), j.next_design_row() + 1, j.progress.cycles_started,
-              j.progress.cycles_done);
-  if (j.yarn.empty()) std::printf("  yarn        no knotting heads: the weaver ties every knot\n");
-  for (std::size_t h = 0; h < j.yarn.size(); ++h) {
-    std::string s;
-    for (const auto& [code, slot] : j.yarn[h])
-      s += (s.empty() ? "" : ", ") + code + " in slot " + std::to_string(slot);
-    std::printf("  yarn head %zu %s\n", h + 1, s.c_str());
-  }
-  return 0;
-}
 
 bool is_dir(const std::string& p) {
   struct stat st {};
@@ -116,14 +65,23 @@ int run_verb(const JobArgs& a) {
     return kExitBadInput;
   }
   const std::string path = job::JobQueue::path_in(a.state_dir);
-  if (a.verb == "list") return list(job::JobQueue::load(path));
-  if (a.verb == "show") return show(job::JobQueue::load(path).job(a.id));
+  if (a.verb == "list") {
+    std::fputs(job::list_text(job::JobQueue::load(path).jobs(), path).c_str(), stdout);
+    return 0;
+  }
+  if (a.verb == "show") {
+    std::fputs(job::show_text(job::JobQueue::load(path).job(a.id)).c_str(), stdout);
+    return 0;
+  }
   // Changing verbs: the queue's one writer is whoever holds the state directory.
   std::unique_ptr<serve::StateDirLock> lock;
   try {
     lock = std::make_unique<serve::StateDirLock>(a.state_dir, "loomctl-job", "");
   } catch (const std::runtime_error& e) {
-    std::fprintf(stderr, "loomctl job: the job queue was not changed: %s\n", e.what());
+    std::fprintf(stderr,
+                 "loomctl job: the job queue was not changed: %s (while serve runs, it keeps the queue: "
+                 "loomctl ctl job %s ...)\n",
+                 e.what(), a.verb.c_str());
     return kExitBadInput;
   }
   job::JobQueue q = job::JobQueue::load(path);

@@ -25,13 +25,20 @@ Decision decide(const PolicyInputs& in) noexcept {
     d.exit_when_quiet = true;
     if (!quiet(s)) d.stop = true;
   }
+  // A held session standing still ends for the service to arm again from a changed job queue. Not with
+  // exit (the service is going), and a start in the same tick has its own end (re-arm, then start).
+  const bool standing = s == State::kIdle || s == State::kDone;
+  if (has(Command::kRearm) && in.held_session && standing && !has(Command::kExit) &&
+      !(has(Command::kStart) && !stopping)) {
+    d.end = Decision::End::kRearmRequested;
+  }
   if (stopping) return d;
 
   if (has(Command::kNext)) d.row_knotted = true;
   if (has(Command::kReload)) d.reload = true;  // in any state: the level is a fact; it may answer a request
   if (has(Command::kResume)) d.resume = true;
   if (has(Command::kStart)) {
-    if (s == State::kDone && in.held_session) {
+    if (in.held_session && (s == State::kDone || (s == State::kIdle && has(Command::kRearm)))) {
       d.end = Decision::End::kStartRequested;
       return d;
     }

@@ -249,7 +249,15 @@ class LoopBody {
     in.link_recovery = rt_.loop.inputs().link.recovery;
     in.last_save_failed = last_save_failed;
     in.nothing_to_weave = opt_.nothing_to_weave;
-    const Decision d = decide(in);
+    Decision d = decide(in);
+    // serve: the session's first start from idle against a change of the armed job
+    // (OperatorLink::queue_gate): when the change came first, the start re-arms from the changed queue
+    // instead (then starts).
+    if (d.start && in.held_session && in.state == sequencer::State::kIdle && opt_.link != nullptr &&
+        !opt_.link->take_start()) {
+      d.start = false;
+      d.end = Decision::End::kStartRequested;
+    }
     apply(d, seq_);
     if ((cmds & static_cast<std::uint32_t>(Command::kReload)) != 0) take_reloads(d.reload, tick);
     RunResult& res = rt_.result;
@@ -278,6 +286,9 @@ class LoopBody {
         return true;
       case Decision::End::kAckRequested:
         res.end = RunResult::End::kAckRequested;
+        return true;
+      case Decision::End::kRearmRequested:
+        res.end = RunResult::End::kRearmRequested;
         return true;
     }
     return false;

@@ -139,8 +139,10 @@ void ProductionRecord::save(const sequencer::Counters& c) {
   if (!store_) return;
   try {
     store_->save(c);
-    if (CarpetJob* j = jobs()) {
-      if (j->row_saved(c.rows)) carpet_done_ = true;
+    // What the session was armed with is credited: its job, or the design book (a job added to the queue
+    // while the loom weaves without one waits for the next arming).
+    if (jobs_ && jobs_->armed_id() != 0) {
+      if (jobs_->row_saved(c.rows)) carpet_done_ = true;
     } else if (book_) {
       book_->record(c.rows);
     }

@@ -15,7 +15,7 @@ board_work() {
 }
 board_cleanup() {
   [[ -n $pid ]] && kill -9 "$pid" 2>/dev/null || true
-  rm -rf "$work"
+  [[ -n ${KEEP:-} ]] || rm -rf "$work"  # KEEP=1: leave it, to read the serve logs after a run
 }
 fail() { echo "FAIL: $*" >&2; echo "--- serve log:" >&2; cat "$work"/serve*.log >&2 || true; exit 1; }
 ctl() { "$loomctl" ctl --socket "$sock" "$@"; }

@@ -7,8 +7,12 @@
 #      the journal forecast which slots run out in which row):
 #      at its last row the journal says "carpet done", status says state=carpet_done, and with nothing
 #      queued a start is refused with the reason (exit 1) — the design does not repeat;
-#   3. a restart on the same state directory arms standing (carpet_done), a start still refused; the
-#      job queue says carpet_done with all its rows.
+#   3. a restart on the same state directory arms standing (carpet_done), a start still refused;
+#   4. the queue through serve's socket (the offline `loomctl job add` is refused while serve runs): ctl job
+#      list; ctl job add (a relative path, made absolute) arms the standing loom with it, without a start;
+#      ctl job remove of that armed job arms it standing again; ctl job start-over 1 queues the finished
+#      carpet again (weaving 2) and the loom arms it; while it weaves, start-over and remove of it are
+#      refused with the reason; every change is audited (ctl faults); the queue on disk says so after.
 # Usage: serve_job_test.sh LOOMCTL SOURCE_DIR
 set -euo pipefail
 loomctl=$1
@@ -90,7 +94,59 @@ status=$(ctl status | head -1)
 rc=0
 ctl start >/dev/null 2>&1 || rc=$?
 [[ $rc == 1 ]] || fail "start after the restart not refused (exit $rc)"
+
+# 4. the job queue through serve's socket
+rc=0
+out=$("$loomctl" job add "$src/tests/sim/knot_sample.csv" --config "$loom" --state-dir "$work/state" 2>&1) || rc=$?
+[[ $rc == 2 && $out == *"loomctl ctl job add"* ]] || fail "offline job add while serve runs: '$out' (exit $rc)"
+ctl job list | grep -q '^1 .*carpet_done .*all 2 rows woven' || fail "ctl job list: $(ctl job list)"
+# Wait until status shows `want` (the re-arm after a change takes a moment).
+status_has() {
+  local end=$((SECONDS + 30))
+  while ((SECONDS < end)); do
+    [[ $(ctl status | head -1) == *"$1"* ]] && return 0
+    sleep 0.05
+  done
+  fail "status never showed '$1': $(ctl status | head -1)"
+}
+reply=$(cd "$src/tests/sim" && ctl job add knot_sample.csv --rows 1) || fail "ctl job add: $reply"
+[[ $reply == "ok job add: job 2: knot_sample.csv (sha256 "*"), 1 row, queued; the loom arms it (start it at the machine)" ]] ||
+  fail "ctl job add: $reply"
+status_has " job=2 job_row=1/1 job_state=queued"
+logged "the job queue changed while the loom stood: arming again from it" "$work/serve2.log" ||
+  fail "no re-arm after job add"
+[[ $(field state) == idle && $(field rows) == 2 ]] || fail "job add moved the loom: $(ctl status | head -1)"
+ctl job show 2 | grep -q "^  file        $src/tests/sim/knot_sample.csv$" || fail "ctl job show 2: $(ctl job show 2)"
+reply=$(ctl job remove 2) || fail "ctl job remove 2: $reply"
+[[ $reply == "ok job remove: job 2 removed from the queue (its record stays)" ]] || fail "ctl job remove 2: $reply"
+status_has " state=carpet_done "
+rc=0
+reply=$(ctl job remove 2 2>&1) || rc=$?
+[[ $rc == 1 && $reply == "refused: job remove: "* ]] || fail "remove of a removed job: '$reply' (exit $rc)"
+reply=$(ctl job start-over 1) || fail "ctl job start-over 1: $reply"
+[[ $reply == "ok job start-over: job 1 starts over at row 1 (queued, weaving 2)" ]] || fail "start-over: $reply"
+status_has " job=1 job_row=1/2 job_state=queued"
+# At once: the start goes with the re-arm (it is not refused for the carpet_done the loom armed with).
+reply=$(ctl start 2>&1) || fail "start of the job started over not accepted: $reply; $(ctl status | head -1)"
+end=$((SECONDS + 30))
+while [[ $(field state) == idle || $(field state) == done ]]; do
+  ((SECONDS < end)) || fail "the job started over does not weave: $(ctl status | head -1)"
+  sleep 0.05
+done
+status_has " job=1 job_row=1/2"
+for verb in start-over remove; do
+  rc=0
+  reply=$(ctl job "$verb" 1 2>&1) || rc=$?
+  [[ $rc == 1 && $reply == "refused: job $verb: the loom is weaving job 1 (state "*"): stop it at the row end first (ctl stop)" ]] ||
+    [[ $rc == 1 && $verb == remove && $reply == "refused: job remove: "*"current"* ]] ||
+    fail "ctl job $verb 1 while weaving: '$reply' (exit $rc)"
+done
+ctl faults | grep -q " job add .*: ok job add: job 2" || fail "job add not audited: $(ctl faults | tail -5)"
+ctl faults | grep -q " job start-over .*: ok job start-over: job 1" || fail "start-over not audited"
+logged "operator: job remove by local user .*: refused: job remove" "$work/serve2.log" ||
+  fail "the refused remove is not in the journal"
 kill -TERM "$pid"; wait "$pid" || true; pid=
-"$loomctl" job list --state-dir "$work/state" | grep -q '^1 .*carpet_done .*all 2 rows woven' ||
-  fail "the queue: $("$loomctl" job list --state-dir "$work/state")"
+queue=$("$loomctl" job list --state-dir "$work/state")
+grep -q '^1 .*current ' <<<"$queue" && grep -q '^2 .*removed ' <<<"$queue" || fail "the queue: $queue"
+"$loomctl" job show 1 --state-dir "$work/state" | grep -q "^  weaving     2 " || fail "job 1 is not in its weaving 2"
 echo "serve_job: ok"

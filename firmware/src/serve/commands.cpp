@@ -114,6 +114,53 @@ std::string ctl_permission_advice(const std::string& path) {
          "account: for a new operator, sudo adduser NAME first";
 }
 
+namespace {
+
+// `job VERB [N | DESIGN]` as the socket's request: `job show id=3`, `job add design=/abs/path rows=40`.
+// The design's path is made absolute here (the service resolves nothing against its own directory).
+std::string job_request_line(const CtlArgs& a, std::string& error) {
+  const std::size_t n = a.args.size();
+  const std::string verb = n > 0 ? a.args[0] : "";
+  const bool add = verb == "add", numbered = verb == "show" || verb == "remove" || verb == "start-over";
+  if (!add && !numbered && verb != "list") {
+    error = "job takes a verb: list, show N, add DESIGN, remove N, start-over N" +
+            (verb.empty() ? std::string() : " (got '" + verb + "')");
+    return "";
+  }
+  const std::size_t want = verb == "list" ? 1 : 2;
+  if (n != want) {
+    error = "job " + verb +
+            (want == 1 ? " takes no more words"
+             : add     ? " takes DESIGN (the design file)"
+                       : " takes N (the job's number)") +
+            ", got " + std::to_string(n - 1);
+    return "";
+  }
+  if (!add && (!a.rows.empty() || !a.metres.empty() || !a.repeat.empty())) {
+    error = "--rows, --metres and --repeat are for job add only";
+    return "";
+  }
+  std::string line = "job " + verb;
+  if (numbered) line += " id=" + a.args[1];
+  if (add) {
+    std::error_code ec;
+    const std::string path = std::filesystem::absolute(a.args[1], ec).lexically_normal().string();
+    if (ec || path.find_first_of(" \t\r\n") != std::string::npos) {
+      error = "job add " + a.args[1] +
+              ": the control socket takes a design path without spaces (rename the file, or add the job with "
+              "serve stopped: loomctl job add)";
+      return "";
+    }
+    line += " design=" + path;
+    if (!a.rows.empty()) line += " rows=" + a.rows;
+    if (!a.metres.empty()) line += " metres=" + a.metres;
+    if (!a.repeat.empty()) line += " repeat=" + a.repeat;
+  }
+  return line;
+}
+
+}  // namespace
+
 std::string ctl_request_line(const CtlArgs& a, std::string& error) {
   const std::size_t n = a.args.size();
   std::string request = a.command;
@@ -131,8 +178,14 @@ std::string ctl_request_line(const CtlArgs& a, std::string& error) {
     }
     request += " head=" + a.args[0] + " slot=" + a.args[1];
     if (n == 3) request += " knots=" + a.args[2];
+  } else if (a.command == "job") {
+    return job_request_line(a, error);
   } else if (n != 0) {
     error = a.command + " takes no argument (got '" + a.args[0] + "')";
+    return "";
+  }
+  if (!a.rows.empty() || !a.metres.empty() || !a.repeat.empty()) {
+    error = "--rows, --metres and --repeat are for job add only";
     return "";
   }
   if (a.hours > 0) request += " hours=" + std::to_string(a.hours);
@@ -230,12 +283,21 @@ BoardCommands::BoardCommands(CLI::App& app) {
           "command", c.command,
           "start | pause | resume | stop (at row end) | ack (a fault) | status | faults (history and "
           "commands) | next | reload HEAD SLOT [KNOTS] (the weaver reloaded a magazine slot; full "
-          "without KNOTS) | pair NAME (a code for a panel client) | unpair NAME | pairs")
+          "without KNOTS) | job list|show N|add DESIGN|remove N|start-over N (the carpet job queue) | "
+          "pair NAME (a code for a panel client) | unpair NAME | pairs")
       ->required()
       ->check(CLI::IsMember({"start", "pause", "resume", "stop", "ack", "status", "faults", "next", "reload",
-                             "pair", "unpair", "pairs"}));
+                             "job", "pair", "unpair", "pairs"}));
   ctl_->add_option("args", c.args,
-                   "pair/unpair: the client's name (letters, digits, _ - .); reload: HEAD SLOT [KNOTS]");
+                   "pair/unpair: the client's name (letters, digits, _ - .); reload: HEAD SLOT [KNOTS]; "
+                   "job: VERB [N | DESIGN]");
+  auto* rows =
+      ctl_->add_option("--rows", c.rows, "job add: the carpet's length in rows (default: the design once)");
+  auto* metres = ctl_->add_option("--metres", c.metres,
+                                  "job add: the carpet's length in metres, at the loom's rows_per_dm");
+  auto* repeat = ctl_->add_option("--repeat", c.repeat, "job add: weave the design this many times");
+  rows->excludes(metres)->excludes(repeat);
+  metres->excludes(repeat);
   ctl_->add_option("--hours", c.hours, "pair: how long the pairing lasts (default 12)")
       ->check(CLI::Range(1, 168));
   ctl_->add_option("--socket", c.socket, "control socket (default /run/loomctl/<loom-id>.sock)");

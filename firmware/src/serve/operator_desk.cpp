@@ -165,7 +165,10 @@ Decision OperatorDesk::decide(const ControlRequest& req, const LoomView& v, std:
   };
   switch (r.cls) {
     case CommandClass::kReading:
-      if (r.word == "status")
+      if (r.word == "job") {
+        d.read = Decision::Read::kJob;
+        d.request = r;
+      } else if (r.word == "status")
         d.read = Decision::Read::kStatus;
       else if (r.word == "faults")
         d.read = Decision::Read::kFaults;
@@ -223,15 +226,28 @@ Decision OperatorDesk::decide(const ControlRequest& req, const LoomView& v, std:
       }
     case CommandClass::kStarting:
     case CommandClass::kStopping:
+    case CommandClass::kQueue:
       break;
   }
   d.audit = true;
+  const auto unpaired = [&] {
+    return std::string(r.field("token").empty() ? "not paired"
+                       : elsewhere              ? "not paired: its token was redeemed on another device"
+                                                : "not paired: token unknown or expired");
+  };
+  if (r.cls == CommandClass::kQueue) {
+    // What the loom weaves next is decided where it can be seen, as its starts are.
+    if (r.via_panel() && !paired) {
+      return refuse(r.arg + ": changing the job queue needs a paired panel client (this one is " +
+                    unpaired() + "; pair it with `loomctl ctl pair NAME` at the loom)");
+    }
+    d.read = Decision::Read::kJob;
+    d.request = r;
+    return d;
+  }
   if (r.cls == CommandClass::kStarting && r.via_panel() && !paired) {
     return refuse("a command that starts motion or resets a fault needs a paired panel client (this one is " +
-                  std::string(r.field("token").empty() ? "not paired"
-                              : elsewhere ? "not paired: its token was redeemed on another device"
-                                          : "not paired: token unknown or expired") +
-                  "; pair it with `loomctl ctl pair NAME` at the loom)");
+                  unpaired() + "; pair it with `loomctl ctl pair NAME` at the loom)");
   }
   if (auto why = refuse_for_state(r, v); !why.empty()) return refuse(why);
   if (r.word == "start")

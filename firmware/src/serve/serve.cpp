@@ -30,6 +30,7 @@
 #include "loom/firmware/serve/commands.hpp"
 #include "loom/firmware/serve/control_socket.hpp"
 #include "loom/firmware/serve/fault_history.hpp"
+#include "loom/firmware/serve/job_verbs.hpp"
 #include "loom/firmware/serve/journal.hpp"
 #include "loom/firmware/serve/latched_fault.hpp"
 #include "loom/firmware/serve/operator_desk.hpp"
@@ -106,6 +107,7 @@ void audit(FaultHistory& history, const std::string& loom_id, const std::string&
     if (at != std::string::npos) verdict.erase(at, verdict.find(' ', at + 1) - at);
   }
   std::string word = line.substr(0, line.find(' '));
+  if (d.request && d.request->word == "job") word += " " + d.request->arg;  // "job add", "job remove"
   log(d.accepted() ? Severity::kNotice : Severity::kWarning, "operator: %s by %s: %s", word.c_str(),
       d.who.c_str(), verdict.c_str());
   if (events != nullptr) {
@@ -282,7 +284,10 @@ class Service {
     if (d.post == Command::kStart &&
         (view.state == sequencer::State::kIdle || view.state == sequencer::State::kDone)) {
       std::lock_guard<std::mutex> lock(job_mu_);
-      if (!start_refusal_.empty()) {  // the loom stands: nothing to weave, or the job's design changed
+      // The loom stands (nothing to weave, or the job's design changed) — unless the queue changed since it
+      // armed: then the re-arm decides, and the start goes with it (start and rearm in one tick re-arm,
+      // then start; a start the new session takes is judged by it).
+      if (!start_refusal_.empty() && queue_changes_ == queue_changes_armed_) {
         d.reply = "refused: start: " + start_refusal_ + "\n";
         d.post.reset();
       }
@@ -298,6 +303,17 @@ class Service {
     if (d.read == Decision::Read::kStatus) {
       return job_status(status_text(link_, cfg_.loom_id, armed_design().get(), design_progress_), view) +
              open_requests(view);
+    }
+    if (d.read == Decision::Read::kJob) {
+      {
+        std::lock_guard<std::mutex> lock(job_mu_);  // against an arming reading the queue
+        const JobVerbResult res =
+            carry_out_job_verb(*d.request, *record_.job_queue(), cfg_, link_, view.state);
+        d.reply = res.reply;
+        if (res.rearm) ++queue_changes_;
+      }
+      if (d.audit) audit(history_, cfg_.loom_id, req.line, d, command_events_.get(), view.state, link_);
+      return d.reply;
     }
     if (d.read == Decision::Read::kFaults) {
       std::string out;
@@ -403,10 +419,13 @@ class Service {
       std::lock_guard<std::mutex> lock(job_mu_);
       armed_design_ = armed.cfg.recipe.design;
       start_refusal_ = armed.refusal;
+      queue_changes_armed_ = armed.queue_changes;
     }
     if (start_at_once_) {
       start_at_once_ = false;
-      if (armed.refusal.empty()) {
+      if (armed.refusal.empty() && !link_.take_start()) {
+        log(Severity::kWarning, "start not taken: the job queue changed while the loom armed; start again");
+      } else if (armed.refusal.empty()) {
         started_at_machine(std::nullopt);
         seq.request_start();
       } else {
@@ -443,21 +462,28 @@ class Service {
 
   // ---- the carpet job ----
   struct ArmedJob {
-    LoomConfig cfg;                 // the loom with the job's design (or the recipe's, without a job)
-    std::uint64_t design_rows = 0;  // rows of the design (or the job's carpet) woven
-    std::uint64_t rows_left = 0;    // of the job's carpet (0: no job, no limit from it)
-    std::string refusal;            // why a start is refused ("" when the loom may weave)
+    LoomConfig cfg;                   // the loom with the job's design (or the recipe's, without a job)
+    std::uint64_t design_rows = 0;    // rows of the design (or the job's carpet) woven
+    std::uint64_t rows_left = 0;      // of the job's carpet (0: no job, no limit from it)
+    std::string refusal;              // why a start is refused ("" when the loom may weave)
+    std::uint64_t queue_changes = 0;  // the control socket's queue changes this arming has seen
   };
 
   // The job queue read again (only this service changes it while it runs), the rows a power cut kept
   // from it credited, and the loom described with the job's design. A queue with nothing to weave, or a
   // job whose design file changed, arms the loom standing: every start refused with the reason.
   ArmedJob arm_job(const sequencer::Counters& resume) {
-    ArmedJob a{cfg_, 0, 0, ""};
+    ArmedJob a{cfg_, 0, 0, "", 0};
     job_record_refused_ = false;  // each session tries the record again
     CarpetJob& q = *record_.job_queue();
-    q.reload();
-    a.design_rows = record_.activate_design(resume.rows);
+    {
+      // The control socket's job verbs wait while the session's job is chosen; the gate opens for it.
+      std::lock_guard<std::mutex> lock(job_mu_);
+      q.reload();
+      a.design_rows = record_.activate_design(resume.rows);
+      link_.queue_gate.store(OperatorLink::kGateOpen, std::memory_order_release);
+      a.queue_changes = queue_changes_;
+    }
     if (CarpetJob* job = record_.jobs()) {
       try {
         a.cfg = job->config_for(cfg_);
@@ -465,13 +491,12 @@ class Service {
         log(Severity::kNotice, "%s", job->describe().c_str());
       } catch (const job::JobError& e) {
         a.refusal =
-            std::string(e.what()) + " (the loom stands; loomctl job start-over or remove with serve stopped)";
+            std::string(e.what()) + " (the loom stands: loomctl ctl job start-over N, or job remove N)";
         a.design_rows = 0;
       }
     } else if (const std::uint32_t done = q.carpet_done_id(); done != 0) {
-      a.refusal =
-          "no carpet job to weave: job " + std::to_string(done) +
-          " is carpet_done and none is queued (add the next with loomctl job add while serve is stopped)";
+      a.refusal = "no carpet job to weave: job " + std::to_string(done) +
+                  " is carpet_done and none is queued (add the next: loomctl ctl job add DESIGN)";
     }
     if (!a.refusal.empty()) log(Severity::kWarning, "%s", a.refusal.c_str());
     return a;
@@ -508,10 +533,8 @@ class Service {
       std::lock_guard<std::mutex> lock(job_mu_);
       carpet_done_job_ = id;
       if (!next_queued) {
-        start_refusal_ =
-            "no carpet job to weave: job " + std::to_string(id) +
-            " is carpet_done and none is queued (add the next with loomctl job add while serve is "
-            "stopped)";
+        start_refusal_ = "no carpet job to weave: job " + std::to_string(id) +
+                         " is carpet_done and none is queued (add the next: loomctl ctl job add DESIGN)";
       }
     }
     carpet_finished_ = true;  // the record ends the job with the row's event
@@ -845,6 +868,9 @@ class Service {
       case RunResult::End::kAckRequested:
         acknowledged(seq);
         return true;
+      case RunResult::End::kRearmRequested:
+        log(Severity::kNotice, "the job queue changed while the loom stood: arming again from it");
+        return true;
       case RunResult::End::kError:  // Session::run threw already
       case RunResult::End::kExitRequested:
       case RunResult::End::kFinished:
@@ -919,6 +945,9 @@ class Service {
   std::shared_ptr<const design::Design> armed_design_;  // the design the armed loom ties
   std::string start_refusal_;          // why a start is refused now ("" when the loom may weave)
   std::uint32_t carpet_done_job_ = 0;  // the job whose carpet was finished in this service, until a start
+  // Queue changes that asked for a re-arm (the control socket's job verbs), and how many the armed session
+  // has seen: while they differ, a standing loom is about to arm again and a start is not refused here.
+  std::uint64_t queue_changes_ = 0, queue_changes_armed_ = 0;
   // The production record of the job being woven (reporter thread only).
   std::unique_ptr<JobRecorder> job_record_;
   bool job_record_refused_ = false;

@@ -23,8 +23,9 @@ constexpr std::array kStates = {
     State::kIdle,     State::kEnabling, State::kHoming,    State::kPositioning, State::kShedTest,
     State::kShed,     State::kPick,     State::kBeatSweep, State::kRowEnd,      State::kAwaitKnotting,
     State::kKnotting, State::kPaused,   State::kDone,      State::kFault};
-constexpr std::array kCommands = {Command::kStart, Command::kPause, Command::kResume, Command::kStop,
-                                  Command::kAck,   Command::kExit,  Command::kNext,   Command::kReload};
+constexpr std::array kCommands = {Command::kStart, Command::kPause,  Command::kResume,
+                                  Command::kStop,  Command::kAck,    Command::kExit,
+                                  Command::kNext,  Command::kReload, Command::kRearm};
 
 std::uint32_t bit(Command c) {
   return static_cast<std::uint32_t>(c);
@@ -36,9 +37,9 @@ bool moving(State s) {
   return s != State::kIdle && s != State::kPaused && s != State::kDone && s != State::kFault;
 }
 std::string name(std::uint32_t cmds) {
-  static const char* names[] = {"start", "pause", "resume", "stop", "ack", "exit", "next", "reload"};
+  static const char* names[] = {"start", "pause", "resume", "stop", "ack", "exit", "next", "reload", "rearm"};
   std::string out;
-  for (int i = 0; i < 8; ++i) {
+  for (int i = 0; i < 9; ++i) {
     if ((cmds & (1u << i)) != 0) out += (out.empty() ? "" : "+") + std::string(names[i]);
   }
   return out;
@@ -73,7 +74,7 @@ TEST(OperatorPolicy, AStoppingCommandNeverComesWithAStartingRequestInAnyState) {
       }
     }
   }
-  EXPECT_EQ(checked, 2 * 14 * (256 - 32));  // every set that holds pause, stop or exit
+  EXPECT_EQ(checked, 2 * 14 * (512 - 64));  // every set that holds pause, stop or exit
 }
 
 struct Expect {
@@ -114,6 +115,9 @@ Expect expected(Command c, State s, bool held) {
       } else {
         e.start = true;
       }
+      break;
+    case Command::kRearm:
+      if (held && (s == State::kIdle || s == State::kDone)) e.end = Decision::End::kRearmRequested;
       break;
     case Command::kAck:
       if (s == State::kFault) {
@@ -203,4 +207,54 @@ TEST(OperatorPolicy, NothingToWeaveRefusesAStartFromIdleOnly) {
   // Paused in a row of a job: a start resumes it (the job is being woven; nothing_to_weave is not set then,
   // and if it were, a resume is not a new carpet).
   EXPECT_TRUE(start(State::kPaused, true, true).start);
+}
+
+// The job queue changed (serve): a standing held session ends to arm again, and nothing else ever follows
+// from it — no start, no acknowledgement, not in any state, whatever comes with it in the same tick but a
+// start (which then re-arms and starts: the start's doing, from a station allowed to start).
+TEST(OperatorPolicy, ARearmNeverStartsAndOnlyEndsAStandingHeldSession) {
+  int checked = 0;
+  for (const bool held : {false, true}) {
+    for (const State s : kStates) {
+      for (std::uint32_t cmds = 0; cmds < (1u << kCommands.size()); ++cmds) {
+        if ((cmds & bit(Command::kRearm)) == 0) continue;
+        PolicyInputs in;
+        in.commands = cmds;
+        in.state = s;
+        in.held_session = held;
+        const Decision with = firmware::decide(in);
+        in.commands = cmds & ~bit(Command::kRearm);
+        const Decision without = firmware::decide(in);
+        const std::string what =
+            name(cmds) + " in " + sequencer::state_name(s) + (held ? " (serve)" : " (weave)");
+        const bool standing = held && (s == State::kIdle || s == State::kDone);
+        const bool exits = (cmds & bit(Command::kExit)) != 0;
+        const bool starts = (cmds & bit(Command::kStart)) != 0 && !stopping(cmds);
+        // The sequencer is asked what it is asked without the rearm — but a start from a standing session,
+        // which goes to the session armed from the changed queue.
+        if (standing && starts) {
+          EXPECT_FALSE(with.start) << what;
+        } else {
+          EXPECT_EQ(with.start, without.start) << what;
+        }
+        EXPECT_EQ(with.resume, without.resume) << what;
+        EXPECT_EQ(with.acknowledge, without.acknowledge) << what;
+        EXPECT_EQ(with.row_knotted, without.row_knotted) << what;
+        EXPECT_EQ(with.stop, without.stop) << what;
+        EXPECT_EQ(with.pause, without.pause) << what;
+        if (!standing || exits) {
+          EXPECT_EQ(with.end, without.end) << what;
+        } else if (starts) {
+          EXPECT_EQ(with.end, Decision::End::kStartRequested) << what;  // re-arm from the queue, then start
+        } else {
+          EXPECT_EQ(with.end, Decision::End::kRearmRequested) << what;
+        }
+        if (stopping(cmds)) {
+          EXPECT_NE(with.end, Decision::End::kStartRequested) << what;
+        }
+        ++checked;
+      }
+    }
+  }
+  EXPECT_EQ(checked, 2 * 14 * 256);
 }

@@ -518,3 +518,47 @@ TEST(ControlLoopButtons, TheLoopAloneActsOnNoPress) {
     }
   }
 }
+
+// serve's job queue against a start (OperatorLink::queue_gate): a change of the armed job that came first
+// keeps the loom from starting it in this session (the start re-arms from the changed queue); a start that
+// came first keeps the queue from changing that job under it.
+TEST(RunnerCommands, AStartAfterTheArmedJobChangedReArmsInsteadOfStartingIt) {
+  Rig r;
+  firmware::OperatorLink link;
+  ASSERT_TRUE(link.close_for_queue_change());
+  link.post(firmware::Command::kRearm);
+  link.post(firmware::Command::kStart);
+  const RunResult res = run_virtual(r, 100, link);
+  EXPECT_EQ(res.end, RunResult::End::kStartRequested);
+  EXPECT_EQ(r.seq->state(), sequencer::State::kIdle);
+  // A start alone, the gate closed by a change whose rearm was not taken yet: the same.
+  Rig r2;
+  firmware::OperatorLink link2;
+  ASSERT_TRUE(link2.close_for_queue_change());
+  link2.post(firmware::Command::kStart);
+  EXPECT_EQ(run_virtual(r2, 100, link2).end, RunResult::End::kStartRequested);
+  EXPECT_EQ(r2.seq->state(), sequencer::State::kIdle);
+}
+
+TEST(RunnerCommands, AStartedJobIsNotChangedUnderTheLoomAndARearmWhileWeavingIsNothing) {
+  Rig r;
+  firmware::OperatorLink link;
+  link.post(firmware::Command::kStart);
+  run_virtual(r, 20, link);
+  ASSERT_NE(r.seq->state(), sequencer::State::kIdle);
+  EXPECT_EQ(link.queue_gate.load(), firmware::OperatorLink::kGateStarted);
+  EXPECT_FALSE(link.close_for_queue_change());
+  link.post(firmware::Command::kRearm);
+  EXPECT_EQ(run_virtual(r, 100, link).end, RunResult::End::kMaxTicks);  // the session weaves on
+  EXPECT_NE(r.seq->state(), sequencer::State::kFault);
+}
+
+TEST(RunnerCommands, ARearmEndsAStandingSessionWithoutMotion) {
+  Rig r;
+  firmware::OperatorLink link;
+  link.post(firmware::Command::kRearm);
+  const RunResult res = run_virtual(r, 100, link);
+  EXPECT_EQ(res.end, RunResult::End::kRearmRequested);
+  EXPECT_EQ(r.seq->state(), sequencer::State::kIdle);
+  EXPECT_EQ(link.queue_gate.load(), firmware::OperatorLink::kGateOpen);
+}

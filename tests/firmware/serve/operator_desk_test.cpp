@@ -312,3 +312,82 @@ TEST(OperatorDesk, AReloadIsAFactInEveryStateFromAStationThatSeesTheLoom) {
             "error: knots=9999999: the knots now in the slot, 0 to 1000000\n");
   EXPECT_EQ(desk.decide(local("start slot=1"), v, kNow).reply, "error: slot= is for reload only\n");
 }
+
+// `job VERB` (ctl job ..., the panel's job buttons): list and show are reading, from anyone; add, remove
+// and start-over change what the loom weaves next, so they come only from a local user or a paired panel
+// client, and are audited. The service carries them out (Read::kJob, the request as parsed); the desk never
+// posts a command for them: a job is started by `start`.
+TEST(OperatorDesk, JobVerbsReadFromAnyoneAndChangeTheQueueOnlyFromAStationThatSeesTheLoom) {
+  Pairings pairings;
+  OperatorDesk desk(pairings, "");
+  const std::string unpaired = " via=panel client=10.0.0.7";
+  for (const Row& row : kTable) {
+    SCOPED_TRACE(row.name);
+    for (const std::string line : {"job list", "job show id=3"}) {
+      for (const std::string& from : {std::string(), unpaired}) {
+        const Decision d = desk.decide(local(line + from), view(row.state), kNow);
+        EXPECT_EQ(d.read, Decision::Read::kJob) << line + from << ": " << d.reply;
+        EXPECT_FALSE(d.post.has_value());
+        EXPECT_FALSE(d.audit);
+      }
+    }
+    for (const std::string line :
+         {"job add design=/srv/designs/rug.csv rows=40", "job remove id=2", "job start-over id=2"}) {
+      const Decision d = desk.decide(local(line), view(row.state), kNow);
+      EXPECT_EQ(d.read, Decision::Read::kJob) << line;
+      ASSERT_TRUE(d.request.has_value());
+      EXPECT_EQ(d.request->cls, CommandClass::kQueue);
+      EXPECT_FALSE(d.post.has_value());
+      EXPECT_TRUE(d.audit);
+      const Decision panel = desk.decide(local(line + unpaired), view(row.state), kNow);
+      EXPECT_EQ(panel.read, Decision::Read::kNone) << line;
+      EXPECT_FALSE(panel.post.has_value());
+      EXPECT_TRUE(panel.audit);  // a refused change is audited too
+      EXPECT_EQ(panel.reply.rfind("refused: job: ", 0), 0u) << panel.reply;
+      EXPECT_NE(panel.reply.find("needs a paired panel client (this one is not paired"), std::string::npos)
+          << panel.reply;
+    }
+  }
+}
+
+// The request's shape is checked before anything is carried out; each refusal names the field and value.
+TEST(OperatorDesk, AJobRequestOfTheWrongShapeIsAnErrorNamingIt) {
+  Pairings pairings;
+  OperatorDesk desk(pairings, "");
+  const std::map<std::string, std::string> errors = {
+      {"job", "job needs a verb (list, show, add, remove, start-over)"},
+      {"job weave", "job weave: not a verb (list, show, add, remove, start-over)"},
+      {"job show", "job show needs id=N (the job's number, as job list shows it)"},
+      {"job list id=2", "id= is not for job list"},
+      {"job remove id=0", "id=0: not a job number (1, 2, ...)"},
+      {"job remove id=x1", "id=x1: not a job number (1, 2, ...)"},
+      {"job remove id=99999999999", "id=99999999999: not a job number (1, 2, ...)"},
+      {"job add", "job add needs design=PATH (the design file, an absolute path)"},
+      {"job add design=rug.csv", "design=rug.csv: an absolute path (the loom's service resolves nothing)"},
+      {"job show id=1 design=/a.csv", "design= is for job add only"},
+      {"job add design=/a.csv rows=2 repeat=3", "one of rows=, metres=, repeat= (the carpet's length)"},
+      {"job add design=/a.csv rows=0", "rows=0: the carpet's rows, 1 to 4294967295"},
+      {"job add design=/a.csv repeat=1000001", "repeat=1000001: the design's repeats, 1 to 1000000"},
+      {"job add design=/a.csv metres=-1",
+       "metres=-1: the carpet's length in metres, a decimal number above 0 "
+       "and at most 1000000"},
+      {"job add design=/a.csv metres=1e3",
+       "metres=1e3: the carpet's length in metres, a decimal number above "
+       "0 and at most 1000000"},
+      {"job remove id=2 rows=3", "rows=, metres= and repeat= are for job add only"},
+      {"start id=2", "id= is for job only"},
+      {"status rows=2", "rows= is for job only"},
+  };
+  for (const auto& [line, why] : errors) {
+    const Decision d = desk.decide(local(line), view(State::kIdle), kNow);
+    EXPECT_EQ(d.reply, "error: " + why + "\n") << line;
+    EXPECT_EQ(d.read, Decision::Read::kNone) << line;
+    EXPECT_FALSE(d.audit) << line;
+  }
+  // A design's path may be longer than any other word (up to the request's 512 bytes).
+  const std::string deep = "/srv/" + std::string(300, 'd') + "/rug.csv";
+  EXPECT_EQ(desk.decide(local("job add design=" + deep), view(State::kIdle), kNow).request->field("design"),
+            deep);
+  EXPECT_EQ(desk.decide(local("job add design=/a.csv metres=1.25"), view(State::kIdle), kNow).read,
+            Decision::Read::kJob);
+}

@@ -12,6 +12,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "loom/config/config.hpp"
 #include "loom/job/job_queue.hpp"
@@ -32,6 +33,19 @@ class CarpetJob {
   // directory). job::JobError on a bad file; the queue read before stays.
   void reload();
 
+  // The job the session was armed with (arm()), 0 when none: only it is started and credited in this
+  // session, whatever the queue's verbs do meanwhile (a job added, another started over).
+  std::uint32_t armed_id() const;
+
+  // serve's queue verbs (the control socket's `job ...`), on the queue kept here and written through
+  // (job::JobQueue's checks and refusals, as job::JobError). The service decides first whether the armed
+  // job may be changed (OperatorLink::queue_gate).
+  std::vector<job::Job> all_jobs() const;
+  job::Job job_numbered(std::uint32_t id) const;
+  job::Job add(const std::string& design_path, const LoomConfig& loom, const job::JobLength& length);
+  void remove(std::uint32_t id);
+  job::Job start_over(std::uint32_t id);
+
   // The queue has a job to weave: the current one, or a queued one a start at the machine begins.
   bool in_use() const;
   // The last job woven to its end when nothing is current or queued (the loom waits for the cut-off and
@@ -46,7 +60,8 @@ class CarpetJob {
   // naming the job, the file and the reason otherwise — a changed design is never silently mixed.
   LoomConfig config_for(const LoomConfig& loom) const;
   // Arming: rows counted since the job's last write (a power cut between the counters' save and the
-  // queue's) are credited to it. Returns the rows of the carpet woven.
+  // queue's) are credited to it, and the job to weave becomes the armed one. Returns the rows of the
+  // carpet woven.
   std::uint64_t arm(std::uint32_t counter_rows);
   std::uint64_t rows_done() const;
   std::uint64_t rows_left() const;
@@ -67,6 +82,7 @@ class CarpetJob {
 
  private:
   void refresh();
+  const job::Job* armed_locked() const;
   std::uint64_t rows_done_locked() const { return job_ ? job_->progress.rows_done : 0; }
 
   mutable std::mutex mu_;  // the control thread starts a job, the reporter credits rows
@@ -74,6 +90,7 @@ class CarpetJob {
   std::optional<job::Job> job_;  // a copy of the queue's current or next job
   std::uint32_t carpet_done_id_ = 0;
   std::uint32_t credited_rows_ = 0;  // production rows last credited
+  std::uint32_t armed_id_ = 0;       // the job this session weaves (0: none)
 };
 
 }  // namespace loom::firmware

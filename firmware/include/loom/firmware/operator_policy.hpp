@@ -10,6 +10,10 @@
 //   starting  start, resume, next (row knotted / the weaver's answer), reload, acknowledge — from where the
 //             loom is seen. A starting command given in the same tick as a stopping one is dropped: stopping
 //             wins.
+// and one that is neither:
+//   rearm     the service changed its job queue (loomctl ctl job add/remove/start-over): a held session
+//             standing idle or done ends, so the service arms again from the queue. Never motion: the
+//             new session waits for a start like any other; a start in the same tick is the start's.
 #pragma once
 
 #include <cstdint>
@@ -32,6 +36,10 @@ enum class Command : std::uint32_t {
   // knotting heads: the weaver reloaded magazine slots (OperatorLink::post_reload says which and how much);
   // answers the heads' request to reload that slot, so it is a starting command
   kReload = 1u << 7,
+  // The job queue changed under a held session (serve): standing idle or done, the session ends for the
+  // owner to arm again from the queue (Decision::End::kRearmRequested); in any other state nothing (the
+  // armed job goes on; the next session boundary reads the queue). Never a start.
+  kRearm = 1u << 8,
 };
 
 constexpr std::uint32_t kStoppingCommands = static_cast<std::uint32_t>(Command::kPause) |
@@ -72,6 +80,7 @@ struct Decision {
     kStopped,         // weave: a stop while idle (nothing moved): the run ends here
     kStartRequested,  // held session, done: the owner starts a new session
     kAckRequested,    // held session, faulted: the owner re-arms
+    kRearmRequested,  // held session, idle or done, the job queue changed: the owner arms again, no start
   };
   End end = End::kNone;
   enum class Refusal : std::uint8_t {

@@ -91,6 +91,27 @@ struct OperatorLink {
   std::array<std::array<std::atomic<std::int32_t>, sequencer::kMaxMagazineSlots>, hal::kMaxKnottingHeads>
       reloads{};
 
+  // The armed job against this session's start (serve). The service opens the gate at each arming; the
+  // loop's first start from idle closes it as kStarted; a change of the job queue that touches the armed
+  // job (ctl job remove/start-over) closes it as kQueueChanged, and from then on no start is taken in this
+  // session: a start ends it for the service to arm again from the changed queue (then start). One
+  // compare-exchange decides which came first, so a job is never changed under a loom that began it, and
+  // a loom never begins a job that was changed after it was armed.
+  enum Gate : std::uint8_t { kGateOpen = 0, kGateStarted = 1, kGateQueueChanged = 2 };
+  std::atomic<std::uint8_t> queue_gate{kGateOpen};
+  // The loop's side: a start from idle is about to be taken; false when the queue changed first.
+  bool take_start() noexcept {
+    std::uint8_t open = kGateOpen;
+    return queue_gate.compare_exchange_strong(open, kGateStarted, std::memory_order_acq_rel) ||
+           open == kGateStarted;
+  }
+  // The service's side: close the gate for a change of the armed job; false when the loom started it.
+  bool close_for_queue_change() noexcept {
+    std::uint8_t open = kGateOpen;
+    return queue_gate.compare_exchange_strong(open, kGateQueueChanged, std::memory_order_acq_rel) ||
+           open == kGateQueueChanged;
+  }
+
   std::atomic<std::uint8_t> state{0};        // sequencer::State
   std::atomic<std::uint8_t> first_fault{0};  // sequencer::Fault
   std::atomic<std::uint32_t> rows{0}, picks{0}, beats{0};
@@ -218,6 +239,7 @@ struct RunResult {
     kExitRequested,
     kStartRequested,
     kAckRequested,
+    kRearmRequested,  // the service's job queue changed while the loom stood: arm again, no start
     kError
   };
   End end = End::kFinished;

@@ -35,8 +35,10 @@ int serve_main(const ServeArgs& a);
 
 struct CtlArgs {
   std::string command;
-  std::vector<std::string> args;  // pair/unpair NAME; reload HEAD SLOT [KNOTS]
+  std::vector<std::string> args;  // pair/unpair NAME; reload HEAD SLOT [KNOTS]; job VERB [N|DESIGN]
   int hours = 0;                  // pair: 0 → the service's default
+  // job add: the carpet's length, at most one (none: the design once). Text as given (the service checks).
+  std::string rows, metres, repeat;
   std::string socket;
   std::string loom_id;  // "" → the board's (ctl_socket)
   int timeout_ms = 5000;

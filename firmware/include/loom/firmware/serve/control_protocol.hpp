@@ -5,7 +5,10 @@
 //   starting  start, resume, next, ack        — only from a trusted station: a local socket user, or a
 //             reload head=H slot=S [knots=K]    panel client paired with this loom (a reload answers the
 //                                                heads' request to reload that slot: they go on)
-//   reading   status, faults, pairs, whoami
+//   reading   status, faults, pairs, whoami, job list, job show id=N
+//   queue     job add design=/ABS/PATH [rows=R | metres=M | repeat=K], job remove id=N,
+//             job start-over id=N     — the carpet job queue: only from a trusted station (as starting
+//                                       commands); never motion (a job is started by `start`)
 //   pairing   pair NAME [hours=H], unpair NAME — local socket users only (never through the panel)
 //             redeem code=CODE                — a panel client turns a pairing code into its token
 // A panel forwarding for one of its clients adds `via=panel client=ADDR [token=TOKEN]`: the command then
@@ -19,11 +22,11 @@
 
 namespace loom::firmware::serve {
 
-enum class CommandClass { kStopping, kStarting, kReading, kPairing };
+enum class CommandClass { kStopping, kStarting, kReading, kPairing, kQueue };
 
 struct ParsedRequest {
   std::string word;  // "start", "pair", ...
-  std::string arg;   // the positional argument (pair/unpair NAME), else ""
+  std::string arg;   // the positional argument (pair/unpair NAME, job's verb), else ""
   // key=value pairs (via, client, token, device, code, hours; reload's head, slot, knots)
   std::map<std::string, std::string> fields;
   CommandClass cls = CommandClass::kReading;
@@ -35,9 +38,11 @@ struct ParsedRequest {
 };
 
 // The command words, in the order help lists them.
-inline constexpr const char* kCommandWords[] = {"start",  "pause",  "resume", "stop",   "ack",
-                                                "next",   "reload", "status", "faults", "pair",
-                                                "unpair", "pairs",  "redeem", "whoami"};
+inline constexpr const char* kCommandWords[] = {"start", "pause",  "resume", "stop",   "ack",
+                                                "next",  "reload", "status", "faults", "job",
+                                                "pair",  "unpair", "pairs",  "redeem", "whoami"};
+// job's verbs (loomctl job's, on the control socket).
+inline constexpr const char* kJobVerbs[] = {"list", "show", "add", "remove", "start-over"};
 
 // reload's numbers as the weaver reads them in the request ("reload colour R into slot 1 of head 2"):
 // head=2 slot=1; knots= optional (the slot is full without it).

@@ -42,7 +42,9 @@ struct LoomView {
 LoomView view_of(const OperatorLink& link, bool knotting);
 
 struct Decision {
-  enum class Read { kNone, kStatus, kFaults };
+  // kJob: a `job VERB` request the service carries out on its queue (it knows the armed job); the
+  // changing verbs come here only from a trusted station, with audit set.
+  enum class Read { kNone, kStatus, kFaults, kJob };
   std::string reply;            // complete unless read != kNone (then the caller answers)
   std::optional<Command> post;  // the command to hand to the loop
   struct Reload {
@@ -51,6 +53,7 @@ struct Decision {
   };
   std::optional<Reload> reload;  // post == kReload: what to post with it (OperatorLink::post_reload)
   Read read = Read::kNone;
+  std::optional<ParsedRequest> request;  // read == kJob: the request as parsed
   std::string who;      // "local user anna (uid 1000, pid 42)", "panel client 10.0.0.5 paired as tab1 ..."
   std::string station;  // "local" (the socket) or "panel" (a loom-panel client): the COMMAND event's station
   bool audit = false;   // a command that changes or would change the loom: log and record it
