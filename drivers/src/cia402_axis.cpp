@@ -400,7 +400,10 @@ void Cia402Axis::fill_feedback(hal::AxisFeedback& fb, bool bus_off, bool bus_con
   fb.following_error = state_ == DriveState::kOperationEnabled && mode_display_ == od::kModeCsp &&
                        (statusword_ & statusword::kCspFollowingError) != 0;
   const bool in_fault_state = state_ == DriveState::kFault || state_ == DriveState::kFaultReactionActive;
-  const bool drive_fault = in_fault_state || emcy != 0 || ferror_fault_;
+  // An EMCY from a drive that stays enabled is reported by its kind and code alone (the HAL's contract:
+  // the sequencer latches drive_emcy and stops every axis, as for a drive fault); `fault` means the drive
+  // itself is in Fault (or the link or our own supervision says so).
+  const bool drive_fault = in_fault_state || ferror_fault_;
   fb.fault = link_down || link_fault != 0 || drive_fault || tracker_.timed_out;
   if (link_fault != 0) {
     fb.fault_code = link_fault;

@@ -707,7 +707,10 @@ TEST(FaultReaction, EmcyFromAnEnabledDriveQuickStopsEveryAxisInTheSameTick) {
   r.rig.drives.send(drivers::make_emcy(2, 0x2310, 0x03));  // over-current; the drive stays enabled
   r.rig.advance(100);
   r.tick(AxisRequest::kEnable);
-  EXPECT_TRUE(r.in.axes[1].fault);
+  // Reported as what it is (the HAL's contract: the sequencer latches drive_emcy): its kind and code; the
+  // drive is not in Fault.
+  EXPECT_FALSE(r.in.axes[1].fault);
+  EXPECT_EQ(r.in.axes[1].fault_kind, hal::FaultKind::kEmcy);
   EXPECT_EQ(r.in.axes[1].fault_code, 0x2310);
   for (hal::CoreAxis a : {hal::CoreAxis::kBeatCrank, hal::CoreAxis::kCarriage, hal::CoreAxis::kHelix}) {
     EXPECT_EQ(r.rig.port.last_controlword(hal::index(a)), drivers::controlword::kQuickStop)

@@ -303,9 +303,8 @@ TYPED_TEST_P(PortConformance, ADriveFaultArrivesAsADriveFaultWithItsCode) {
   EXPECT_EQ(this->in_.axes[plan.axis].state, hal::DriveState::kFault);
 }
 
-// 3. An EMCY from a drive that stays enabled arrives as FaultKind::kEmcy with its code. (Whether `fault` is
-// set beside it differs between the ports today: SimWorld leaves it false, so the sequencer latches
-// drive_emcy; CanAxisPort sets it, so drive_fault. The kind and the code are the shared promise.)
+// 3. An EMCY from a drive that stays enabled arrives as FaultKind::kEmcy with its code, without `fault`
+// (the drive is not in Fault): the sequencer latches drive_emcy, whichever port.
 TYPED_TEST_P(PortConformance, AnEmcyFromAnEnabledDriveArrivesAsEmcyWithItsCode) {
   if (const char* why = this->rig_.skip_reason(Check::kEmcy)) GTEST_SKIP() << why;
   PortPlan plan;
@@ -320,6 +319,7 @@ TYPED_TEST_P(PortConformance, AnEmcyFromAnEnabledDriveArrivesAsEmcyWithItsCode) 
   EXPECT_EQ(a.fault_kind, hal::FaultKind::kEmcy);
   EXPECT_EQ(a.fault_code, plan.code);
   EXPECT_NE(a.state, hal::DriveState::kFault) << "an EMCY alone does not put the drive in Fault";
+  EXPECT_FALSE(a.fault) << "an EMCY from an enabled drive is its kind and code, not `fault` (drive_emcy)";
   EXPECT_FALSE(this->in_.link.link_fault) << "a drive's EMCY is not a link fault";
 }
 

@@ -5,7 +5,8 @@
 #   estop     — the I/O node's e-stop input opens → exit 3, first fault estop, counters kept;
 #   io_silent — the I/O node goes silent → exit 3, first fault heartbeat_lost, counters kept;
 #   emcy      — an EMCY 0x2310 from drive 2 while its statusword stays Operation Enabled → exit 3,
-#               drive_fault; judged from candump: within one cycle every drive gets quick stop;
+#               drive_emcy (the drive is not in Fault); judged from candump: within one cycle every drive
+#               gets quick stop;
 #   stuck     — the second switch of shuttle_at_left sticks on (loom-sim-drive's io-control word
 #               stuck=shuttle_at_left_2:on) → exit 3, first fault sensor_discrepancy naming
 #               shuttle_at_left: the two-channel check over the real CAN path (terminal 20, in TPDO1's third byte);
@@ -62,7 +63,7 @@ sleep 0.2
 # --- EMCY while the drive stays enabled ---------------------------------------------------------------
 run_until_armed emcy
 cansend "$HIL_IFACE" 082#1023030000000000
-expect_fault emcy 'drive_fault.*0x2310|0x2310.*drive_fault'
+expect_fault emcy 'drive_emcy.*0x2310|0x2310.*drive_emcy'
 "$HIL_CANLOG" emcy-stop "$HIL_LOG" --nodes "$HIL_NODES" --emcy-node 2 ||
   hil_fail "emcy: the bus does not show a quick stop of every drive right after the EMCY; log: $HIL_LOG"
 
