@@ -13,6 +13,7 @@
 #include "config_error.hpp"
 #include "loom/config/config.hpp"
 #include "loom/sequencer/sequencer.hpp"
+#include "loom/sim_heads/sim_heads.hpp"
 
 using namespace loom::firmware;
 
@@ -375,15 +376,27 @@ TEST(MachineKnotting, HeadsNeedAMagazineThatHoldsEveryColourOfTheDesign) {
   std::ofstream(dir + "/good.toml") << ext(heads + "slot_colours = [\"R\", \"W\", \"B\"]\n" + head_axes +
                                            "[recipe]\ndesign = \"rug.csv\"\n");
   EXPECT_EQ(load_error(dir + "/good.toml"), "");
-  // Heads without a design to tie: refused where the file says heads, by check as by weave (issue 30: check
-  // passed it and weave refused it without a line).
+  // Heads without a design to tie: the config loads (a carpet job brings the design), and building the
+  // heads without one — weave or serve with no job — is refused where the file says heads (issue 30: it was
+  // said without a line).
   std::ofstream(dir + "/no_design.toml") << ext(heads + "slot_colours = [\"R\", \"W\", \"B\"]\n" + head_axes);
-  EXPECT_NE(
-      load_error(dir + "/no_design.toml")
-          .find(
-              "no_design.toml:3:8: knotting.mode = heads: the heads tie a design's knots: set recipe.design"),
-      std::string::npos)
-      << load_error(dir + "/no_design.toml");
+  EXPECT_EQ(load_error(dir + "/no_design.toml"), "");
+  {
+    const LoomConfig no_design = load_loom_config(dir + "/no_design.toml");
+    EXPECT_EQ(no_design.recipe.design, nullptr);
+    std::string why;
+    try {
+      (void)build_heads(no_design, 0, 0);
+    } catch (const ConfigError& e) {
+      why = e.what();
+    }
+    EXPECT_NE(
+        why.find(
+            "no_design.toml:3:8: knotting.mode = heads: the heads tie a design's knots: set recipe.design"),
+        std::string::npos)
+        << why;
+    EXPECT_NE(why.find("or give the loom a carpet job (loomctl job add DESIGN"), std::string::npos) << why;
+  }
   // The heads' signals on the I/O module: one bit per head, refused at the list's own line otherwise.
   const auto with_io = [&](const std::string& from, const std::string& to) {
     std::string axes = head_axes;

@@ -298,13 +298,6 @@ void check_relations(const TomlReader& r, const LoomConfig& c) {
       }
     }
   }
-  if (c.knotting.mode == sequencer::KnottingMode::kHeads && !c.recipe.design) {
-    // Checked here, at the mode's line, not first when a weave builds the heads (it said so without a line).
-    r.fail("knotting.mode", "heads",
-           "the heads tie a design's knots: set recipe.design to its knot map (loomctl design fit makes one "
-           "from "
-           "a picture)");
-  }
   if (m.shed.release_timeout_s >= m.shed.timeout_s) {
     r.fail("shedding.release_timeout_s", fmt_num(m.shed.release_timeout_s),
            "must be shorter than shedding.timeout_s = " + fmt_num(m.shed.timeout_s));

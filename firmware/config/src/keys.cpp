@@ -492,12 +492,14 @@ const std::vector<Key>& keys() {
         integer<std::uint32_t>("recipe.picks_per_row", M::kRecipe, 1, 16,
                                [](LoomConfig& c) -> std::uint32_t& { return c.recipe.picks_per_row; }));
     {
-      Key design{"recipe.design",
-                 M::kRecipe,
-                 "file: .csv grid of colour codes or .png, one pixel per knot; \"\" = none",
-                 false,
-                 nullptr,
-                 nullptr};
+      Key design{
+          "recipe.design",
+          M::kRecipe,
+          "file: .csv grid of colour codes or .png, one pixel per knot; \"\" = none (knotting heads: "
+          "each carpet job brings its design; with neither, weaving is refused at knotting.mode's line)",
+          false,
+          nullptr,
+          nullptr};
       design.read = [](TomlReader& r, LoomConfig& c) {
         r.string("recipe.design", c.recipe.design_file);
         c.recipe.design = load_design_for(r, c.recipe.design_file);

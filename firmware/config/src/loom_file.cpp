@@ -55,6 +55,15 @@ LoomConfig parse_complete(const std::string& text, const std::string& source, co
   read_io_modules(r, c);
   r.reject_unknown(known_sections());
   check_relations(r, c);
+  if (c.knotting.mode == sequencer::KnottingMode::kHeads && !c.recipe.design) {
+    // Not refused here: a carpet job brings the design (the queue is read when the loom arms). Said at the
+    // mode's line when the loom arms with neither (issue 30: said without a line, it was no help).
+    c.recipe.design_missing = r.message(
+        "knotting.mode", "heads",
+        "the heads tie a design's knots: set recipe.design to its knot map (loomctl design fit makes "
+        "one from a picture), or give the loom a carpet job (loomctl job add DESIGN, then weave or "
+        "serve with that --state-dir)");
+  }
   check_eds_keys(r, c);
   // `key` may name two facts that clash ("axes.helix.node|can.master_node", values likewise): the one the
   // file says is the line to point at (the first when it says both).

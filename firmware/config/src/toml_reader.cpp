@@ -437,10 +437,14 @@ const toml::node* TomlReader::find(const std::string& path) const {
   return root_.at_path(path).node();
 }
 
-void TomlReader::fail(const std::string& path, const std::string& value, const std::string& why) const {
+std::string TomlReader::message(const std::string& path, const std::string& value,
+                                const std::string& why) const {
   const toml::node* n = find(path);
-  if (n) fail_at(*n, path, value, why);
-  throw ConfigError(source_ + ":1:1: " + path + " = " + value + ": " + why);
+  return (n ? where(source_, n->source()) : source_ + ":1:1") + ": " + path + " = " + value + ": " + why;
+}
+
+void TomlReader::fail(const std::string& path, const std::string& value, const std::string& why) const {
+  throw ConfigError(message(path, value, why));
 }
 
 void TomlReader::fail_at(const toml::node& node, const std::string& field, const std::string& value,

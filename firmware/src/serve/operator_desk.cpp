@@ -238,8 +238,10 @@ Decision OperatorDesk::decide(const ControlRequest& req, const LoomView& v, std:
   if (r.cls == CommandClass::kQueue) {
     // What the loom weaves next is decided where it can be seen, as its starts are.
     if (r.via_panel() && !paired) {
-      return refuse(r.arg + ": changing the job queue needs a paired panel client (this one is " +
-                    unpaired() + "; pair it with `loomctl ctl pair NAME` at the loom)");
+      d.reply = "refused: job " + r.arg +
+                ": changing the job queue needs a paired panel client (this one is " + unpaired() +
+                "; pair it with `loomctl ctl pair NAME` at the loom)\n";
+      return d;
     }
     d.read = Decision::Read::kJob;
     d.request = r;

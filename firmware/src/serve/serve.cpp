@@ -22,6 +22,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <thread>
 #include <utility>
 
 #include "loom/config/config.hpp"
@@ -247,7 +248,10 @@ class Service {
     for (;;) {
       watchdog_.ping_outside_loop();  // re-arming: no loop runs, this thread is the proof of life
       Session session(so_, say_in_journal);
-      arm(session);
+      if (!arm(session)) {
+        if (!stand_until_the_queue_changes()) break;
+        continue;
+      }
       const RunResult res = run_session(session);
       if (!next_session(session, res)) break;
     }
@@ -368,8 +372,38 @@ class Service {
     return out;
   }
 
+  // A loom with knotting heads and no design to tie (none in the recipe, no carpet job): there is no
+  // machine to build. The service stands without a session — `ctl status` answers (state idle), a start is
+  // refused with the reason at the config's line — until the job queue changes (ctl job add) or it is told
+  // to stop. False when told to stop.
+  bool stand_until_the_queue_changes() {
+    std::uint64_t seen = 0;
+    {
+      std::lock_guard<std::mutex> lock(job_mu_);
+      seen = queue_changes_armed_ = queue_changes_;
+    }
+    if (!ready_sent_) {
+      systemd_.notify("READY=1\nSTATUS=standing: no design to weave (loomctl ctl job add DESIGN)");
+      ready_sent_ = true;
+    }
+    constexpr auto kLook = std::chrono::milliseconds(50);
+    for (;;) {
+      watchdog_.ping_outside_loop();
+      if ((link_.pending.load(std::memory_order_acquire) & static_cast<std::uint32_t>(Command::kExit)) != 0) {
+        log(Severity::kNotice, "loomctl serve: stopped (standing, no design to weave)");
+        return false;
+      }
+      {
+        std::lock_guard<std::mutex> lock(job_mu_);
+        if (queue_changes_ != seen) return true;
+      }
+      std::this_thread::sleep_for(kLook);
+    }
+  }
+
   // ---- build and arm one session from what is on disk ----
-  void arm(Session& session) {
+  // False when there is nothing to build (knotting heads with no design and no job): the loom stands.
+  bool arm(Session& session) {
     // Room for the latched-fault record on a full disk: a loom whose fault could not be kept would forget
     // it at the next restart. A disk too full to keep it refuses to arm, as unwritable counters do.
     try {
@@ -386,6 +420,13 @@ class Service {
     if (unsaved_) resume = *std::exchange(unsaved_, std::nullopt);
     show_counters(resume);
     const ArmedJob armed = arm_job(resume);
+    if (!armed.cfg.recipe.design && !armed.cfg.recipe.design_missing.empty()) {
+      std::lock_guard<std::mutex> lock(job_mu_);
+      start_refusal_ = armed.refusal.empty() ? armed.cfg.recipe.design_missing : armed.refusal;
+      log(Severity::kWarning, "standing, no session armed: %s", start_refusal_.c_str());
+      unsaved_ = arm_unsaved;  // counters held in memory stay for the arming that follows
+      return false;
+    }
     const std::uint64_t design_rows = armed.design_rows;
     if (const design::Design* d = armed.cfg.recipe.design.get()) {
       design_progress_.rows_at_arm.store(design_rows);
@@ -458,6 +499,7 @@ class Service {
     failed_save_.reset();
     last_retry_ns_ = 0;
     if (arm_unsaved) save_failed(*arm_unsaved);  // armed from memory: the disk lags until a retry succeeds
+    return true;
   }
 
   // ---- the carpet job ----
@@ -482,6 +524,8 @@ class Service {
       q.reload();
       a.design_rows = record_.activate_design(resume.rows);
       link_.queue_gate.store(OperatorLink::kGateOpen, std::memory_order_release);
+      // The queue is read now: a rearm asked before this has what it asked for (a later one stays).
+      link_.pending.fetch_and(~static_cast<std::uint32_t>(Command::kRearm), std::memory_order_acq_rel);
       a.queue_changes = queue_changes_;
     }
     if (CarpetJob* job = record_.jobs()) {

@@ -44,8 +44,11 @@ KnottingHeads build_heads(const LoomConfig& c, std::uint64_t design_rows_done, s
                       "\": the loom has no knotting heads");
   }
   if (!c.recipe.design) {
-    throw ConfigError(c.source +
-                      ": knotting.mode = \"heads\": the heads tie the design's knots; set recipe.design");
+    throw ConfigError(!c.recipe.design_missing.empty()
+                          ? c.recipe.design_missing
+                          : c.source +
+                                ": knotting.mode = \"heads\": the heads tie the design's knots; set "
+                                "recipe.design");
   }
   KnottingHeads out;
   try {

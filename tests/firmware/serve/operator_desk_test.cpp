@@ -343,7 +343,8 @@ TEST(OperatorDesk, JobVerbsReadFromAnyoneAndChangeTheQueueOnlyFromAStationThatSe
       EXPECT_EQ(panel.read, Decision::Read::kNone) << line;
       EXPECT_FALSE(panel.post.has_value());
       EXPECT_TRUE(panel.audit);  // a refused change is audited too
-      EXPECT_EQ(panel.reply.rfind("refused: job: ", 0), 0u) << panel.reply;
+      EXPECT_EQ(panel.reply.rfind("refused: job " + line.substr(4, line.find(' ', 4) - 4) + ": ", 0), 0u)
+          << panel.reply;
       EXPECT_NE(panel.reply.find("needs a paired panel client (this one is not paired"), std::string::npos)
           << panel.reply;
     }

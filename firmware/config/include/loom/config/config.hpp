@@ -189,6 +189,9 @@ struct Recipe {
   // file's folder) and what was loaded from it (null when the recipe names none).
   std::string design_file;
   std::shared_ptr<const design::Design> design;
+  // Knotting heads and no design here: a carpet job brings one (loomctl job add). Without a job too, arming
+  // is refused with this, at knotting.mode's line ("" when the recipe has a design or the loom no heads).
+  std::string design_missing;
   int beats_per_position = 1;
   double overlap_m = 0.02;
   double cam_margin_rad = 20.0 * 3.141592653589793 / 180.0;   // cam_margin_deg = 20

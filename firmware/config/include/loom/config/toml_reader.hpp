@@ -30,6 +30,9 @@ class TomlReader {
   // Every entry an integer in lo..hi; at most max_size of them.
   void integer_list(const std::string& path, std::vector<int>& out, int lo, int hi, std::size_t max_size);
 
+  // "file:line:col: path = value: why" at the node for `path` (or the file start when absent): what fail()
+  // throws, for a refusal said later (e.g. when the loom arms).
+  std::string message(const std::string& path, const std::string& value, const std::string& why) const;
   // Error at the node for `path` (or the file start when absent).
   [[noreturn]] void fail(const std::string& path, const std::string& value, const std::string& why) const;
   [[noreturn]] void fail_at(const toml::node& node, const std::string& field, const std::string& value,
