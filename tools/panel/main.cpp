@@ -14,6 +14,9 @@
 //   GET  /api/loom/<id>/last.lcmlog every message of that loom heard in the last 5 minutes (--lcmlog-minutes)
 //   GET  /api/loom/<id>/carpet      the current carpet job's knot map (JOB/CARPET), for the carpet view
 //   POST /api/loom/<id>/ctl/reload?head=H&slot=S[&knots=K]   "slot reloaded" (paired clients only)
+//   GET  /api/loom/<id>/jobs[?id=N]   the loom's job queue (`job list`, as rows) or one job (`job show`)
+//   POST /api/loom/<id>/job/<add|remove|start-over>   change the job queue (paired clients only):
+//        add: design=/PATH on the loom's board [rows=R|metres=M|repeat=K]; remove, start-over: id=N
 //   GET  /api/loom/<id>/scope?axis=NAME   the last 30 s of one axis' position, velocity, following error
 // Read-only by default: nothing it receives over HTTP reaches the loom. With --control-dir DIR the
 // page offers pause / stop at row end to every client, and resume / acknowledge / "row knotted" only to
@@ -44,6 +47,7 @@
 
 #include "fault_history.hpp"
 #include "hall.hpp"
+#include "job_request.hpp"
 #include "loom/firmware/serve/control_socket.hpp"
 #include "loom/telemetry/channels.hpp"
 #include "recorder.hpp"
@@ -506,6 +510,81 @@ int main(int argc, char** argv) {
           403,
           "refused: " + cmd + ": this device is not paired with loom " + loom +
               " (a command that starts motion or resets a fault needs pairing: ctl pair NAME at the loom)");
+    }
+    std::string text;
+    try {
+      text = trimmed(loom::firmware::serve::control_request(control_socket_of(o, loom),
+                                                            on_behalf(line, req, token), 3000));
+    } catch (const std::exception& e) {
+      return reply(503, e.what());
+    }
+    reply(text.rfind("ok", 0) == 0 ? 200 : text.rfind("refused:", 0) == 0 ? 403 : 409, text);
+  });
+  // The job queue (issue 29), through the loom's socket as `ctl job` at the loom. Reading is for anyone:
+  // the queue as rows (the loom's `job list`), or one job's `job show` text with ?id=N.
+  svr.Get(R"(/api/loom/([A-Za-z0-9_-]{1,32})/jobs)", [&](const httplib::Request& req,
+                                                         httplib::Response& res) {
+    const std::string loom = req.matches[1];
+    res.set_header("Cache-Control", "no-store");
+    const auto error = [&](int status, const std::string& why) {
+      res.status = status;
+      res.set_content(loom::panel::json_text({{"loom", loom}, {"error", why}}), "application/json");
+    };
+    if (o.control_dir.empty()) {
+      return error(
+          404, "read-only panel: the loom's job queue is read through its control socket (--control-dir)");
+    }
+    std::string line = "job list";
+    if (req.has_param("id")) {
+      const std::string id = req.get_param_value("id");
+      if (id.empty() || id.size() > 10 || id.find_first_not_of("0123456789") != std::string::npos)
+        return error(400, "id: a job number (1, 2, ...)");
+      line = "job show id=" + id;
+    }
+    std::string text;
+    try {
+      text =
+          loom::firmware::serve::control_request(control_socket_of(o, loom), on_behalf(line, req, ""), 3000);
+    } catch (const std::exception& e) {
+      return error(503, e.what());
+    }
+    if (text.rfind("error:", 0) == 0 || text.rfind("refused:", 0) == 0) return error(502, trimmed(text));
+    auto j = req.has_param("id") ? nlohmann::json{{"text", text}} : loom::panel::job_list_json(text);
+    j["loom"] = loom;
+    res.set_content(loom::panel::json_text(j), "application/json");
+  });
+  // Changing the queue: add a job, remove one, start one over. Like a starting button, only for a paired
+  // client: without a token the panel refuses it here and never forwards it; the loom decides and audits.
+  // A job is never started from here (`start` stays at the machine).
+  svr.Post(R"(/api/loom/([A-Za-z0-9_-]{1,32})/job/([a-z-]{1,16}))", [&](const httplib::Request& req,
+                                                                        httplib::Response& res) {
+    const std::string loom = req.matches[1], verb = req.matches[2];
+    const auto reply = [&](int status, const std::string& text) {
+      res.status = status;
+      res.set_content(loom::panel::json_text({{"loom", loom}, {"command", "job " + verb}, {"reply", text}}),
+                      "application/json");
+      std::fprintf(stderr, "loom-panel: %s job %s by %s%s -> %s\n", loom.c_str(), verb.c_str(),
+                   req.remote_addr.c_str(), token_of(req, loom).empty() ? " (not paired)" : " (token)",
+                   text.c_str());
+    };
+    if (o.control_dir.empty())
+      return reply(403, "read-only panel (start it with --control-dir to offer buttons)");
+    const auto v = loom::panel::job_verb(verb);
+    if (v == loom::panel::JobVerb::kUnknown) return reply(400, "unknown job verb (add, remove, start-over)");
+    std::string why;
+    const std::string line = loom::panel::job_line(
+        v,
+        [&](const char* name) -> std::optional<std::string> {
+          if (!req.has_param(name) || req.get_param_value(name).empty()) return std::nullopt;
+          return req.get_param_value(name);
+        },
+        why);
+    if (line.empty()) return reply(400, "refused: job " + verb + ": " + why);
+    const std::string token = token_of(req, loom);
+    if (token.empty()) {
+      return reply(403,
+                   "refused: job " + verb + ": this device is not paired with loom " + loom +
+                       " (changing the job queue needs pairing, as a start does: ctl pair NAME at the loom)");
     }
     std::string text;
     try {

@@ -1,6 +1,7 @@
 // loom-panel's model of the hall: bounded per loom (rows, faults, beats), the current row's beats
 // become the previous row's when the next row starts, a restarted loop starts its loom afresh, JSON
-// never carries NaN; and its udpm receiver reads what a real LCM publisher sends.
+// never carries NaN; and its udpm receiver reads what a real LCM publisher sends. The job queue's POSTs
+// become well-formed socket lines or are refused, and the loom's own `job list` text reads back as rows.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -9,9 +10,14 @@
 #include <filesystem>
 #include <lcm/lcm-cpp.hpp>
 #include <limits>
+#include <map>
+#include <optional>
+#include <vector>
 
 #include "fault_history.hpp"
 #include "hall.hpp"
+#include "job_request.hpp"
+#include "loom/job/job_text.hpp"
 #include "recorder.hpp"
 #include "synthetic_loom.hpp"
 #include "udpm_receiver.hpp"
@@ -613,4 +619,94 @@ TEST(PanelRecorder, TheLastMinutesAreAnLcmLogLcmReads) {
   Recorder off(0.0, 1 << 20);
   off.add("A", "LOOM.A.AXES", "x", 1, t0);
   EXPECT_FALSE(off.lcmlog("A", t0).has_value());
+}
+
+namespace {
+// The request parameters of a POST, as the route gives them to job_line.
+ParamOf params(std::map<std::string, std::string> m) {
+  return [m](const char* name) -> std::optional<std::string> {
+    const auto it = m.find(name);
+    return it == m.end() ? std::nullopt : std::optional<std::string>(it->second);
+  };
+}
+}  // namespace
+
+TEST(PanelJobRequest, WellFormedRequestsBecomeTheLoomsSocketLines) {
+  std::string why;
+  EXPECT_EQ(job_line(JobVerb::kAdd, params({{"design", "/srv/designs/rug.csv"}}), why),
+            "job add design=/srv/designs/rug.csv");
+  EXPECT_EQ(job_line(JobVerb::kAdd, params({{"design", "/d/a.png"}, {"rows", "540"}}), why),
+            "job add design=/d/a.png rows=540");
+  EXPECT_EQ(job_line(JobVerb::kAdd, params({{"design", "/d/a.png"}, {"metres", "1.8"}}), why),
+            "job add design=/d/a.png metres=1.8");
+  EXPECT_EQ(job_line(JobVerb::kAdd, params({{"design", "/d/a.png"}, {"repeat", "3"}}), why),
+            "job add design=/d/a.png repeat=3");
+  EXPECT_EQ(job_line(JobVerb::kRemove, params({{"id", "2"}}), why), "job remove id=2");
+  EXPECT_EQ(job_line(JobVerb::kStartOver, params({{"id", "4294967295"}}), why),
+            "job start-over id=4294967295");
+  EXPECT_EQ(why, "");
+  EXPECT_EQ(job_verb("start-over"), JobVerb::kStartOver);
+  EXPECT_EQ(job_verb("start"), JobVerb::kUnknown);  // a job is started at the machine only
+  EXPECT_EQ(job_verb("list"), JobVerb::kUnknown);   // read with GET
+}
+
+TEST(PanelJobRequest, MalformedRequestsAreRefusedWithTheReasonAndNoLine) {
+  const std::vector<std::pair<JobVerb, std::map<std::string, std::string>>> bad = {
+      {JobVerb::kAdd, {}},
+      {JobVerb::kAdd, {{"design", "rug.csv"}}},                      // relative
+      {JobVerb::kAdd, {{"design", "/a b.csv"}}},                     // a space ends the field
+      {JobVerb::kAdd, {{"design", "/a.csv token=0123"}}},            // ... and would smuggle another
+      {JobVerb::kAdd, {{"design", "/a\n.csv"}}},                     // not printable
+      {JobVerb::kAdd, {{"design", "/" + std::string(256, 'a')}}},    // too long
+      {JobVerb::kAdd, {{"design", "/a.csv"}, {"rows", "-1"}}},       // not digits
+      {JobVerb::kAdd, {{"design", "/a.csv"}, {"rows", "1e3"}}},      // not digits
+      {JobVerb::kAdd, {{"design", "/a.csv"}, {"metres", "1.2.3"}}},  // two points
+      {JobVerb::kAdd, {{"design", "/a.csv"}, {"metres", "."}}},      // no digit
+      {JobVerb::kAdd, {{"design", "/a.csv"}, {"rows", "2"}, {"repeat", "2"}}},  // two lengths
+      {JobVerb::kAdd, {{"design", "/a.csv"}, {"id", "1"}}},
+      {JobVerb::kRemove, {}},
+      {JobVerb::kRemove, {{"id", "0"}}},
+      {JobVerb::kRemove, {{"id", "4294967296"}}},
+      {JobVerb::kRemove, {{"id", "1 "}}},
+      {JobVerb::kStartOver, {{"id", "1"}, {"rows", "2"}}},
+      {JobVerb::kUnknown, {{"id", "1"}}},
+  };
+  for (const auto& [verb, m] : bad) {
+    std::string why;
+    EXPECT_EQ(job_line(verb, params(m), why), "") << (m.count("design") ? m.at("design") : "");
+    EXPECT_NE(why, "");
+  }
+}
+
+TEST(PanelJobRequest, TheLoomsJobListReadsBackAsRows) {
+  // The text is the loom's own (loom::job::list_text, what serve answers to `job list`).
+  loom::job::Job a;
+  a.id = 1;
+  a.state = loom::job::JobState::kCarpetDone;
+  a.design_name = "knot sample.csv";  // a name with a space: the columns are found by the hash
+  a.sha256 = "0123456789abcdef0123456789abcdef0123456789abcdef0123456789abcdef";
+  a.design_rows = 4;
+  a.length_rows = 2;
+  a.progress.rows_done = 2;
+  loom::job::Job b = a;
+  b.id = 12;
+  b.state = loom::job::JobState::kQueued;
+  b.design_name = "rug.csv";
+  b.sha256 = "fedcba9876543210fedcba9876543210fedcba9876543210fedcba9876543210";
+  b.length_rows = 540;
+  b.progress.rows_done = 0;
+  const std::string text = loom::job::list_text({a, b}, "this loom's job queue");
+  const auto j = job_list_json(text);
+  ASSERT_EQ(j["jobs"].size(), 2u) << text;
+  EXPECT_EQ(j["jobs"][0]["id"], 1);
+  EXPECT_EQ(j["jobs"][0]["state"], "carpet_done");
+  EXPECT_EQ(j["jobs"][0]["design"], "knot sample.csv");
+  EXPECT_EQ(j["jobs"][0]["sha256"], "0123456789ab");
+  EXPECT_EQ(j["jobs"][0]["progress"], "all 2 rows woven");
+  EXPECT_EQ(j["jobs"][1]["id"], 12);
+  EXPECT_EQ(j["jobs"][1]["state"], "queued");
+  EXPECT_EQ(j["jobs"][1]["design"], "rug.csv");
+  EXPECT_EQ(j["jobs"][1]["progress"], "row 1 of 540 next");
+  EXPECT_EQ(j["text"], text);
+  EXPECT_EQ(job_list_json(loom::job::list_text({}, "this loom's job queue"))["jobs"].size(), 0u);
 }
