@@ -188,7 +188,7 @@ void print_knotting(const LoomConfig& c, const std::optional<motion::KnotCycle>&
       "  a knot cycle starts with the carriage measured within %.3f mm of its knot (%s); not there %.0f ms "
       "after its step: carriage_not_at_knot\n",
       tol * 1e3, k.placement_tolerance_m > 0.0 ? "knotting.placement_tolerance_m" : "a quarter of the pitch",
-      (heads.settle_s + c.sequencer.stale_timeout_s) * 1e3);
+      sequencer::carriage_arrival_s(heads, c.sequencer.stale_timeout_s) * 1e3);
   // The knot cycle: built (and checked) from the linkage and the servo's limits.
   const motion::KnotCycle& cycle = *knot_cycle;  // built (and checked) once, in print_plan
   const motion::KnotCycleReport& rep = cycle.report();

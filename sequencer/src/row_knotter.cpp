@@ -99,9 +99,8 @@ void RowKnotter::configure(const KnottingConfig& k, const KnotGuard* guard, doub
   tolerance_m_ = k.placement_tolerance_m > 0.0 || k.program == nullptr
                      ? k.placement_tolerance_m
                      : default_placement_tolerance_m(k.program->pitch_m());
-  // The servos' settle time, and the age a measured position may have without being stale: a carriage
-  // measured short of its knot after both has not arrived (rounded up to whole ticks).
-  arrival_ticks_ = static_cast<hal::Tick>(std::ceil((k.settle_s + feedback_age_s) / period_s - 1e-9));
+  // (rounded up to whole ticks)
+  arrival_ticks_ = static_cast<hal::Tick>(std::ceil(carriage_arrival_s(k, feedback_age_s) / period_s - 1e-9));
   guard_ = guard;
   period_s_ = period_s;
   carriage_home_m_ = carriage_home_m;

@@ -91,6 +91,13 @@ struct CarriageMiss {
 // of its stripe), tolerance 2.5 mm"; "" when `m` names no cycle.
 std::string describe(const CarriageMiss& m);
 
+// How long after its step ends the carriage may take to be measured at its knot: the servos' settle time
+// plus the age a feedback value may have without being stale (`feedback_age_s`, the sequencer's
+// stale_timeout_s). Later, still outside the placement tolerance, it has not arrived (carriage_not_at_knot).
+inline double carriage_arrival_s(const KnottingConfig& k, double feedback_age_s) noexcept {
+  return k.settle_s + feedback_age_s;
+}
+
 // Configure-time. The interlocks' picture of the heads (which axes, where the gripper is in the warp as
 // knotting-servo angles), derived from `heads`' knot cycle; also what the simulated heads are told.
 KnotGuard knot_guard(const KnottingConfig& heads);
