@@ -180,6 +180,15 @@ void print_knotting(const LoomConfig& c, const std::optional<motion::KnotCycle>&
       "of one pitch per row\n",
       k.heads, k.head_spacing_m, stripe, std::min(stripe, per_row),
       std::max(0, std::min(stripe, per_row) - 1));
+  // Knot placement: the tolerance the heads use (given, or derived from the pitch) and how long a carriage
+  // may take to be measured there (the heads' settle time and the feedback's allowed age).
+  const sequencer::KnottingConfig& heads = c.sequencer.heads;
+  const double tol = sequencer::placement_tolerance_m(k);
+  std::printf(
+      "  a knot cycle starts with the carriage measured within %.3f mm of its knot (%s); not there %.0f ms "
+      "after its step: carriage_not_at_knot\n",
+      tol * 1e3, k.placement_tolerance_m > 0.0 ? "knotting.placement_tolerance_m" : "a quarter of the pitch",
+      sequencer::carriage_arrival_s(heads, c.sequencer.stale_timeout_s) * 1e3);
   // The knot cycle: built (and checked) from the linkage and the servo's limits.
   const motion::KnotCycle& cycle = *knot_cycle;  // built (and checked) once, in print_plan
   const motion::KnotCycleReport& rep = cycle.report();

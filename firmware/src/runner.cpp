@@ -375,6 +375,7 @@ class LoopBody {
     e.fault_axis = seq_.fault_axis();
     e.fault_detail = seq_.fault_detail();
     e.fault_sensor = seq_.fault_sensor();
+    e.carriage_miss = seq_.knotter().carriage_miss();
     return e;
   }
 

@@ -250,6 +250,7 @@ FaultReport FaultReport::of(const sequencer::Sequencer& seq) {
   r.axis = seq.fault_axis() >= 0 ? seq.axes().name(static_cast<std::size_t>(seq.fault_axis())) : "";
   r.device_code = seq.fault_detail();
   r.sensor = seq.fault_sensor();
+  r.carriage_miss = seq.knotter().carriage_miss();
   r.tick = seq.fault_tick();
   return r;
 }
@@ -261,6 +262,7 @@ FaultReport FaultReport::of(const RunEvent& e, const hal::AxisLayout& axes) {
   r.axis = e.fault_axis >= 0 ? axes.name(static_cast<std::size_t>(e.fault_axis)) : "";
   r.device_code = e.fault_detail;
   r.sensor = e.fault_sensor;
+  r.carriage_miss = e.carriage_miss;
   r.tick = e.tick;
   return r;
 }
@@ -274,9 +276,14 @@ std::string FaultReport::stopped_note() const {
   return std::string("(motion stopped on ") + sequencer::fault_name(stopped_by) + ")";
 }
 
+std::string FaultReport::where() const {
+  return fault == sequencer::Fault::kCarriageNotAtKnot ? sequencer::describe(carriage_miss) : "";
+}
+
 std::string FaultReport::text() const {
   std::string t = sequencer::fault_text(fault);
   if (sensor >= 0) t += std::string(": ") + sensor_name();
+  if (const std::string w = where(); !w.empty()) t += ": " + w;
   if (const std::string note = stopped_note(); !note.empty()) t += " " + note;
   return t;
 }

@@ -421,7 +421,8 @@ void write_carpet(const WeaveArgs& a, const LoomConfig& cfg, Machine& m) {
 }
 
 void print_fault(const FaultReport& f, double period, const sequencer::Counters& c) {
-  const std::string note = f.stopped_note();
+  std::string note = f.stopped_note();
+  if (const std::string w = f.where(); !w.empty()) note = w + (note.empty() ? "" : " " + note);
   std::printf(
       "FAULT %s (code 0x%04X%s%s%s%s, device code 0x%04X) at t=%.3f s%s%s: %s; rows completed %u, picks %u, "
       "beats %u\n",

@@ -70,6 +70,10 @@ const char* fault_recovery(Fault f) {
       return "check the air supply, the valves and both frames' end sensors (a switch that lets go reads "
              "like a frame "
              "that moved); ack (the knot being tied is asked of the weaver)";
+    case Fault::kCarriageNotAtKnot:
+      return "look along the carriage's rail for a jam or a stiff spot and at its drive's following error "
+             "and feedback delay (the FAULT line names the knot, how far off it was and the tolerance); "
+             "ack (no knot was tied there: the cycle had not started)";
     case Fault::kSelectorJam:
       return "clear the head's colour magazine (a yarn end caught between slots), check it indexes freely; "
              "ack";

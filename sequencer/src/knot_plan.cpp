@@ -96,6 +96,11 @@ int knots_per_stripe(const KnottingSpec& s) {
   return static_cast<int>(std::floor(s.head_spacing_m / knot_pitch_m(s) + 1e-9));
 }
 
+double placement_tolerance_m(const KnottingSpec& s) {
+  return s.placement_tolerance_m > 0.0 ? s.placement_tolerance_m
+                                       : default_placement_tolerance_m(knot_pitch_m(s));
+}
+
 std::optional<KnottingFault> find_fault(const KnottingSpec& s, double width_m) {
   using F = KnottingField;
   const auto fin = [](double v) { return std::isfinite(v); };
@@ -153,6 +158,15 @@ std::optional<KnottingFault> find_fault(const KnottingSpec& s, double width_m) {
   }
   if (s.knots_per_slot < 1)
     return KnottingFault{F::kKnotsPerSlot, "knotting.knots_per_slot must be at least 1"};
+  // 0 is "not given" (the default); a given tolerance is positive and below half a pitch.
+  if (const double p = knot_pitch_m(s), t = s.placement_tolerance_m; !fin(t) || t < 0.0 || t >= 0.5 * p) {
+    return KnottingFault{F::kPlacementTolerance,
+                         "knotting.placement_tolerance_m must be positive and below half the knot pitch (" +
+                             std::to_string(0.5 * p) +
+                             " m at knotting.knots_per_dm): half a pitch off, the gripper is over the "
+                             "neighbouring knot; leave it out for the default, a quarter of the pitch (" +
+                             std::to_string(default_placement_tolerance_m(p)) + " m)"};
+  }
   return std::nullopt;
 }
 

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "loom/motion/angles.hpp"
 
@@ -49,6 +50,17 @@ std::string describe(const WeaverRequest& r, const KnotProgram& p) {
   return "?";
 }
 
+std::string describe(const CarriageMiss& m) {
+  if (m.cycle < 0) return "";
+  char buf[200];
+  std::snprintf(buf, sizeof buf,
+                "the carriage measured %.1f mm %s of the knot of knot cycle %d (each head's knot %d of its "
+                "stripe), tolerance %.1f mm",
+                std::abs(m.error_m) * 1e3, m.error_m < 0.0 ? "left" : "right", m.cycle + 1, m.cycle + 1,
+                m.tolerance_m * 1e3);
+  return buf;
+}
+
 KnotGuard knot_guard(const KnottingConfig& heads) {
   // Where the gripper is inside the warp, as knotting-servo angles: the cycle's in-warp window, sampled
   // (a one-degree-of-freedom linkage puts its gripper in the same place at the same servo angle).
@@ -81,8 +93,14 @@ KnotGuard knot_guard(const KnottingConfig& heads) {
 }
 
 void RowKnotter::configure(const KnottingConfig& k, const KnotGuard* guard, double period_s,
-                           double carriage_home_m, const motion::JerkLimits& carriage) {
+                           double carriage_home_m, const motion::JerkLimits& carriage,
+                           double feedback_age_s) {
   k_ = k;
+  tolerance_m_ = k.placement_tolerance_m > 0.0 || k.program == nullptr
+                     ? k.placement_tolerance_m
+                     : default_placement_tolerance_m(k.program->pitch_m());
+  // (rounded up to whole ticks)
+  arrival_ticks_ = static_cast<hal::Tick>(std::ceil(carriage_arrival_s(k, feedback_age_s) / period_s - 1e-9));
   guard_ = guard;
   period_s_ = period_s;
   carriage_home_m_ = carriage_home_m;
@@ -142,6 +160,7 @@ void RowKnotter::begin(std::uint32_t row0, const KnotCounters& progress, double 
   return_to_m_ = return_to_m;
   fault_ = Fault::kNone;
   fault_axis_ = -1;
+  miss_ = CarriageMiss{};
   row_ = RowKnots{};
   // A row resumed after a power cut: its knots tied before the cut are the row's too.
   row_.tied = static_cast<int>(progress.row_tied);
@@ -272,6 +291,17 @@ RowKnotter::Status RowKnotter::check(hal::Tick now, const hal::HalInputs& in, co
     if (!sel_off && !kn_off) continue;
     if (!settled) return Status::kRunning;
     fail(sel_off ? Fault::kSelectorJam : Fault::kKnotServoLag, static_cast<int>(sel_off ? sel : kn));
+    return Status::kFault;
+  }
+  // The carriage at the knot as measured, not as commanded: a drive that trails its profile, or whose
+  // feedback arrives late, holds the cycle back (grippers open) until it is within the placement tolerance;
+  // one still outside it when the bound is up did not arrive.
+  const std::size_t car = hal::index(hal::CoreAxis::kCarriage);
+  const double off = in.axes[car].position - (carriage_home_m_ + k_.program->carriage_at(j_));
+  if (!(std::abs(off) <= tolerance_m_)) {  // (a NaN reading is never "there")
+    if (now - phase_since_ < arrival_ticks_) return Status::kRunning;
+    miss_ = {j_, off, tolerance_m_};
+    fail(Fault::kCarriageNotAtKnot, static_cast<int>(car));
     return Status::kFault;
   }
   if (interrupted_) {  // the power failed inside this cycle: the weaver checks its knots first

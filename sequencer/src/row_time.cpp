@@ -10,7 +10,7 @@ std::optional<hal::Tick> ideal_row_knotting_ticks(const SequencerConfig& cfg, do
   if (cfg.heads.program == nullptr || cfg.heads.cycle == nullptr) return std::nullopt;
   const KnotGuard guard = knot_guard(cfg.heads);
   RowKnotter heads;
-  heads.configure(cfg.heads, &guard, cfg.period_s, cfg.carriage_home_m, cfg.carriage);
+  heads.configure(cfg.heads, &guard, cfg.period_s, cfg.carriage_home_m, cfg.carriage, cfg.stale_timeout_s);
   // As the sequencer begins a row: the carriage at the row's start selvedge (even rows start at the left).
   const double start_m = row0 % 2 == 0 ? 0.0 : carriage_travel_m;
   hal::HalOutputs cmd{};

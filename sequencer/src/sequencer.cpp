@@ -201,6 +201,11 @@ std::optional<SequencerFault> find_fault(const SequencerConfig& c, const motion:
       return fault(F::kKnotterSettings,
                    "knotting: servo tolerance, settle time and commissioning offsets must be finite");
     }
+    if (const double t = c.heads.placement_tolerance_m, pitch = c.heads.program->pitch_m();
+        !std::isfinite(t) || t < 0.0 || t >= 0.5 * pitch) {
+      return fault(F::kKnotterSettings,
+                   "knotting.placement_tolerance_m must be below half the knot pitch (0: the default)");
+    }
   }
   return std::nullopt;
 }
@@ -236,7 +241,8 @@ Sequencer::Sequencer(const motion::ProfileSet& profiles, const SequencerConfig& 
   interlock_ctx_.warp = &profiles_->beatup().warp();
   interlock_ctx_.crank_park_position = cfg_.crank_park_position_rad;
   if (cfg_.heads.program != nullptr && cfg_.heads.cycle != nullptr) configure_knot_guard();
-  knotter_.configure(cfg_.heads, &interlock_ctx_.knot, cfg_.period_s, cfg_.carriage_home_m, cfg_.carriage);
+  knotter_.configure(cfg_.heads, &interlock_ctx_.knot, cfg_.period_s, cfg_.carriage_home_m, cfg_.carriage,
+                     cfg_.stale_timeout_s);
   adopt_limits();
 }
 

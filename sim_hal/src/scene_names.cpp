@@ -80,6 +80,8 @@ const char* injected_fault_name(InjectedFault f) {
       return "selector_jam";
     case InjectedFault::kYarnOut:
       return "yarn_out";
+    case InjectedFault::kAxisJam:
+      return "axis_jam";
   }
   return "?";
 }

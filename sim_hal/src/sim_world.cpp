@@ -231,6 +231,9 @@ void SimWorld::apply_injected_faults(hal::Tick now) noexcept {
       case InjectedFault::kYarnOut:
         if (knotter_) knotter_->yarn_out(f.head, f.slot);
         break;
+      case InjectedFault::kAxisJam:
+        jammed_[ax] = true;
+        break;
       case InjectedFault::kPowerCut:
         powered_off_ = true;
         if (power_cut_handler_ == nullptr) std::raise(SIGKILL);  // as if killed: nothing more is written

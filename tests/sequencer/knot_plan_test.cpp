@@ -203,4 +203,24 @@ TEST(KnotPlan, RefusalsCarryTheirField) {
   s = heads_spec();
   s.knots_per_slot = 0;
   EXPECT_EQ(field_of(s), KnottingField::kKnotsPerSlot);
+  s = heads_spec();  // 30 knots/dm: a 3.333 mm pitch, half of it 1.667 mm
+  s.placement_tolerance_m = 0.0017;
+  EXPECT_EQ(field_of(s), KnottingField::kPlacementTolerance);
+  s.placement_tolerance_m = -1e-4;
+  EXPECT_EQ(field_of(s), KnottingField::kPlacementTolerance);
+}
+
+// The knot-placement tolerance: a quarter of the pitch unless given; a given one is used as it is, up to
+// just below half the pitch.
+TEST(KnotPlan, PlacementToleranceIsAQuarterPitchUnlessGiven) {
+  KnottingSpec s = heads_spec();
+  EXPECT_DOUBLE_EQ(placement_tolerance_m(s), 0.1 / 30.0 / 4.0);
+  s.knots_per_dm = 40.0;  // 2.5 mm pitch
+  s.head_spacing_m = 0.6;
+  EXPECT_DOUBLE_EQ(placement_tolerance_m(s), 0.000625);
+  s.placement_tolerance_m = 0.0012;  // below half of 2.5 mm
+  EXPECT_FALSE(find_fault(s, 1.2).has_value());
+  EXPECT_DOUBLE_EQ(placement_tolerance_m(s), 0.0012);
+  s.placement_tolerance_m = 0.00125;  // half the pitch: refused
+  EXPECT_TRUE(find_fault(s, 1.2).has_value());
 }

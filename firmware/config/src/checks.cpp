@@ -123,6 +123,8 @@ const char* knotting_key(sequencer::KnottingField f) {
       return "knotting.slot_colours";
     case F::kKnotsPerSlot:
       return "knotting.knots_per_slot";
+    case F::kPlacementTolerance:
+      return "knotting.placement_tolerance_m";
   }
   return "knotting.mode";
 }

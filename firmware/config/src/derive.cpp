@@ -133,6 +133,7 @@ void derive(LoomConfig& c, const Fail& fail) {
     }
     k.take_position_rad = c.knotting.take_position_rad;
     k.selector_zero_rad = c.knotting.selector_zero_rad;
+    k.placement_tolerance_m = sequencer::placement_tolerance_m(c.knotting);
     if (selectors > 0) {
       k.selector = {.velocity = selector_speed,
                     .acceleration = c.knotting.selector_accel_rad_s2,

@@ -434,6 +434,21 @@ const std::vector<Key>& keys() {
                        [](LoomConfig& c) -> double& { return c.knotting.selector_accel_rad_s2; }));
     v.push_back(number("knotting.selector_jerk_rad_s3", M::kMachine, 10.0, 1e9,
                        [](LoomConfig& c) -> double& { return c.knotting.selector_jerk_rad_s3; }));
+    {
+      // Not given: a quarter of the knot pitch (derived from knots_per_dm); below half a pitch is
+      // checks.cpp's (sequencer::find_fault), where the pitch is known.
+      Key tol{"knotting.placement_tolerance_m",
+              M::kMachine,
+              "(0, half the knot pitch); default a quarter of the knot pitch",
+              false,
+              nullptr,
+              nullptr};
+      tol.read = [](TomlReader& r, LoomConfig& c) {
+        r.number("knotting.placement_tolerance_m", c.knotting.placement_tolerance_m, positive);
+      };
+      tol.value = [](const LoomConfig& c) { return fmt_num(sequencer::placement_tolerance_m(c.knotting)); };
+      v.push_back(tol);
+    }
     // The gripper's dwells (the knotting servo itself is its axes' drive, [drives.<model>]).
     using KC = motion::KnotCycleSpec;
     const auto kc = [](double KC::*f) { return [f](LoomConfig& c) -> double& { return c.knot_cycle.*f; }; };

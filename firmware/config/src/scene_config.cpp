@@ -64,6 +64,7 @@ const std::map<InjectedFault, KindFields>& kind_fields() {
       {InjectedFault::kPowerCut, {{}, {}}},
       {InjectedFault::kSelectorJam, {{"head"}, {}}},
       {InjectedFault::kYarnOut, {{"head", "slot"}, {}}},
+      {InjectedFault::kAxisJam, {{"axis"}, {}}},
   };
   return m;
 }
@@ -397,7 +398,8 @@ Scene check_scene_fits(Scene scene, const LoomConfig& cfg, bool simulated_io) {
     sim_hal::FaultInjection& f = scene.spec.faults[n];
     const std::string at = n < scene.fault_where.size() ? scene.fault_where[n] : scene.source;
     const bool names_axis = f.kind == InjectedFault::kDriveFault || f.kind == InjectedFault::kHeartbeatLoss ||
-                            f.kind == InjectedFault::kEmcy || f.kind == InjectedFault::kEncoderGlitch;
+                            f.kind == InjectedFault::kEmcy || f.kind == InjectedFault::kEncoderGlitch ||
+                            f.kind == InjectedFault::kAxisJam;
     if (names_axis) {
       const int slot = cfg.sequencer.axes.find(f.axis_name.c_str());
       if (slot < 0) {

@@ -154,7 +154,8 @@ struct RunEvent {
   sequencer::Fault stopped_by = sequencer::Fault::kNone;
   int fault_axis = -1;
   std::uint16_t fault_detail = 0;
-  int fault_sensor = -1;  // hal::SafetySensor the fault names (sensor_discrepancy), or -1
+  int fault_sensor = -1;                    // hal::SafetySensor the fault names (sensor_discrepancy), or -1
+  sequencer::CarriageMiss carriage_miss{};  // carriage_not_at_knot: the knot, how far off, the tolerance
   Command button =
       Command::kStart;  // kButton: the I/O module's button pressed (audit_buttons); kNext: the pedal
   sequencer::WeaverRequest request{};  // kWeaverRequest; kButton: the request open when it was taken

@@ -170,6 +170,7 @@ struct FaultReport {
   std::string axis;                                       // "" when the fault is not one axis'
   std::uint16_t device_code = 0;                          // what the drive or the link reported (0: nothing)
   int sensor = -1;                                        // hal::SafetySensor the fault names, or -1
+  sequencer::CarriageMiss carriage_miss{};                // carriage_not_at_knot: where (cycle -1: none)
   hal::Tick tick = 0;
 
   // The sequencer's first fault (at the end of a run), or the one a run event latched.
@@ -180,7 +181,10 @@ struct FaultReport {
   const char* sensor_name() const;  // "" when the fault names no sensor
   // "(motion stopped on X)" when diagnosis refined the symptom motion stopped on, else "".
   std::string stopped_note() const;
-  // The fault's text with the sensor it names and what motion stopped on.
+  // "the carriage measured 20.0 mm left of the knot of knot cycle 5 (...), tolerance 2.5 mm" for
+  // carriage_not_at_knot, else "".
+  std::string where() const;
+  // The fault's text with the sensor it names, where it struck and what motion stopped on.
   std::string text() const;
 };
 

@@ -76,7 +76,10 @@ namespace loom::sequencer {
   X(kSelectorWithYarn, 0x1028, "interlock_selector_with_yarn",                                              \
     "colour selector commanded while its gripper holds yarn")                                               \
   X(kShedLost, 0x1029, "shed_lost",                                                                         \
-    "a heald frame left its end position while the shed was held for knotting (air, valve or end sensor)")
+    "a heald frame left its end position while the shed was held for knotting (air, valve or end sensor)")  \
+  X(kCarriageNotAtKnot, 0x102A, "carriage_not_at_knot",                                                     \
+    "the carriage was not measured at the knot within its placement tolerance in time (jam, drive limit "   \
+    "or late feedback)")
 
 enum class Fault : std::uint8_t {
 #define LOOM_FAULT_ENUM(id, code, name, text) id,

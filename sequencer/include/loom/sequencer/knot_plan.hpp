@@ -56,6 +56,10 @@ struct KnottingSpec {
   double selector_zero_rad = 0.0;  // selector reading with slot 0 at the TAKE point
   double selector_accel_rad_s2 = 400.0;
   double selector_jerk_rad_s3 = 20000.0;
+  // Knot placement: a knot cycle starts only with the carriage's measured position within this of the
+  // knot's (m). 0: not given — the default, a fraction of the pitch (knot_tolerance_m()). Given, it must be
+  // positive and below half the pitch (half a pitch off, the gripper is over the neighbouring knot's warp).
+  double placement_tolerance_m = 0.0;
 };
 
 // The KnottingSpec fact a refusal is about: a caller maps it to its own input (the loom file's
@@ -67,6 +71,7 @@ enum class KnottingField : std::uint8_t {
   kHeadSpacing,
   kSlotColours,
   kKnotsPerSlot,
+  kPlacementTolerance,
 };
 struct KnottingFault {
   KnottingField field;
@@ -83,6 +88,16 @@ std::string validate(const KnottingSpec& spec, double width_m);
 int knots_per_row(const KnottingSpec& spec, double width_m);
 double knot_pitch_m(const KnottingSpec& spec);
 int knots_per_stripe(const KnottingSpec& spec);
+
+// The default knot-placement tolerance, as a fraction of the knot pitch: a quarter of a pitch off, the
+// gripper still enters the warp between the knot's own warp pair and a quarter-pitch from its neighbour's
+// (half a pitch off it would be over the neighbour's).
+inline constexpr double kPlacementToleranceOfPitch = 0.25;
+inline double default_placement_tolerance_m(double pitch_m) noexcept {
+  return kPlacementToleranceOfPitch * pitch_m;
+}
+// The tolerance the heads use: the spec's when given (> 0), else the default for its pitch.
+double placement_tolerance_m(const KnottingSpec& spec);
 
 // One row as the heads tie it.
 struct RowKnotPlan {

@@ -6,7 +6,10 @@
 //   travel   the carriage to knot j's position, each head's colour selector to the slot of its knot's colour
 //            (both start while the previous knot is still being tied — as soon as its yarn is released and
 //            its knots are verified; the carriage only once every gripper has left the warp);
-//   check    every servo where it was sent (else knot_servo_lag / selector_jam), yarn left in each needed
+//   check    every servo where it was sent (else knot_servo_lag / selector_jam), the carriage *measured*
+//   within
+//            the placement tolerance of the knot (waiting for it at most settle_s plus the feedback's allowed
+//            age after its move ended, else carriage_not_at_knot), yarn left in each needed
 //            slot (else the weaver is asked to reload colour X into slot s of head h), the knot position
 //            empty (a yarn-present switch already on is yarn_sensor_stuck: never a knot tied twice), and —
 //            when the counters are kept on disk — "cycle j started" on disk before it starts;
@@ -71,7 +74,29 @@ struct KnottingConfig {
   motion::JerkLimits selector{.velocity = 20.0, .acceleration = 400.0, .jerk = 20000.0};  // rad, s
   double servo_tolerance_rad = 0.05;  // a servo further than this from where it was sent is lagging
   double settle_s = 0.05;  // after a move's plan ends, how long it may take to get within tolerance
+  // The carriage's measured position must be this close to the knot's before its cycle starts (m); 0: the
+  // default for the program's pitch (default_placement_tolerance_m). At most half the pitch (excluded).
+  double placement_tolerance_m = 0.0;
 };
+
+// Where the carriage stood when it did not arrive at a knot (the fault carriage_not_at_knot): the knot
+// cycle (0-based; head h's knot h·stripe + cycle), the measured position minus the knot's (m; positive:
+// right of it, as the weaver faces the loom) and the tolerance it missed.
+struct CarriageMiss {
+  int cycle = -1;  // -1: none
+  double error_m = 0.0;
+  double tolerance_m = 0.0;
+};
+// Not RT (allocates). "the carriage measured 20.0 mm left of the knot of knot cycle 5 (each head's knot 5
+// of its stripe), tolerance 2.5 mm"; "" when `m` names no cycle.
+std::string describe(const CarriageMiss& m);
+
+// How long after its step ends the carriage may take to be measured at its knot: the servos' settle time
+// plus the age a feedback value may have without being stale (`feedback_age_s`, the sequencer's
+// stale_timeout_s). Later, still outside the placement tolerance, it has not arrived (carriage_not_at_knot).
+inline double carriage_arrival_s(const KnottingConfig& k, double feedback_age_s) noexcept {
+  return k.settle_s + feedback_age_s;
+}
 
 // Configure-time. The interlocks' picture of the heads (which axes, where the gripper is in the warp as
 // knotting-servo angles), derived from `heads`' knot cycle; also what the simulated heads are told.
@@ -108,9 +133,11 @@ class RowKnotter {
 
   // Configure-time. `carriage_home_m`: the carriage reading at the left selvedge; `carriage` its limits.
   // `guard`: where a knotting servo holds its gripper in the warp (the interlocks' own test): no carriage
-  // move starts while a measured gripper is there. Must outlive the knotter.
+  // move starts while a measured gripper is there. Must outlive the knotter. `feedback_age_s`: how old a
+  // feedback value may be without being stale (the sequencer's stale_timeout_s): a carriage whose
+  // measured position is not at its knot settle_s + feedback_age_s after its move ended has not arrived.
   void configure(const KnottingConfig& k, const KnotGuard* guard, double period_s, double carriage_home_m,
-                 const motion::JerkLimits& carriage);
+                 const motion::JerkLimits& carriage, double feedback_age_s = 0.0);
   bool fitted() const noexcept { return k_.program != nullptr && k_.cycle != nullptr; }
 
   // RT-safe. Start tying production row `row0` (0-based, = counters.rows) from the counters' progress;
@@ -133,6 +160,10 @@ class RowKnotter {
 
   Fault fault() const noexcept { return fault_; }
   int fault_axis() const noexcept { return fault_axis_; }
+  // RT-safe. The knot the carriage did not arrive at (cycle -1 unless the fault is carriage_not_at_knot).
+  const CarriageMiss& carriage_miss() const noexcept { return miss_; }
+  // The knot-placement tolerance in use (m).
+  double placement_tolerance_m() const noexcept { return tolerance_m_; }
   const WeaverRequest& request() const noexcept { return request_; }
   std::uint32_t requests() const noexcept { return requests_; }  // counts requests made (never reset)
   // RT-safe. The last step() changed `counters` (a cycle started or done, a knot tied, retried or tied by
@@ -224,6 +255,9 @@ class RowKnotter {
   hal::Tick cycle_t0_ = 0;
   Fault fault_ = Fault::kNone;
   int fault_axis_ = -1;
+  CarriageMiss miss_{};
+  double tolerance_m_ = 0.0;     // knot placement (the config's, or the default for the pitch)
+  hal::Tick arrival_ticks_ = 0;  // how long after its move the carriage may take to be measured there
   WeaverRequest request_{};
   std::uint32_t requests_ = 0;
   bool counters_moved_ = false;  // by the last step()

@@ -112,8 +112,10 @@ enum class InjectedFault : std::uint8_t {
   kPowerCut,         // the power fails at tick `at_tick`: the run ends as if the process were killed
   kSelectorJam,      // the colour selector of `head` jams where it stands (needs the knotter effect)
   kYarnOut,          // slot `slot` of `head`'s magazine runs out of yarn early (needs the knotter effect)
+  kAxisJam,          // the drive of `axis` stops following its target: it stays where it stands (a jammed
+                     // rail or a seized gearbox; the simulated drive reports no following error)
 };
-inline constexpr int kInjectedFaultCount = 17;
+inline constexpr int kInjectedFaultCount = 18;
 const char* injected_fault_name(InjectedFault f);  // the scene file's `kind`
 
 // Every switch a scene can fail: the six safety sensors' first channels, then their second channels
