@@ -7,6 +7,9 @@
 #                  mod 20000: tests that run side by side do not hear each other).
 #   have_browser — sets CHROMIUM; false, saying why, when headless Chromium or a node with a built-in
 #                  WebSocket (the DevTools client in cdp.mjs) is missing. Browser tests: `have_browser || exit 77`.
+#   panel_browser_test NAME MULT LOOMCTL PANEL SRC OUT — a browser test's start, from its own arguments:
+#                  LOOMCTL, PANEL, SRC, OUT set, exit 77 without a browser, OUT made, panel_work NAME,
+#                  panel_lcm_url MULT, ID=NAME<pid> (the loom id).
 #   panel_up, panel_serve_up — start loom-panel / `loomctl serve` and wait until they answer.
 #   panel_and_serve [serve args...] — both, as the knotting tests run them: loom-panel with its operator
 #                  buttons on WORK/run, `loomctl serve` as loom ID on WORK/run/ID.sock (sets SOCK) with its
@@ -19,6 +22,15 @@
 
 declare -F fail >/dev/null ||
   fail() { echo "FAIL: $*" >&2; for f in "$WORK"/*.log; do echo "--- $f" >&2; tail -20 "$f" >&2; done; exit 1; }
+
+panel_browser_test() {
+  LOOMCTL=$3 PANEL=$4 SRC=$5 OUT=$6
+  have_browser || exit 77
+  mkdir -p "$OUT"
+  panel_work "$1"
+  panel_lcm_url "$2"
+  ID="$1$$"
+}
 
 panel_work() {
   WORK=$(mktemp -d "${TMPDIR:-/tmp}/loom_panel_$1.XXXXXX")

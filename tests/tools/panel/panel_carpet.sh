@@ -8,17 +8,9 @@
 # <out>/loom_panel_carpet.png. Exit 77 (skip) without chromium or node.
 # Usage: panel_carpet.sh <loomctl> <loom-panel> <source dir> <out dir>
 set -euo pipefail
-LOOMCTL=$1
-PANEL=$2
-SRC=$3
-OUT=$4
 here=$(dirname "$0")
-. "$(dirname "$0")/browser_lib.sh"  # fail, have_browser, panel_work, panel_lcm_url, panel_and_serve
-have_browser || exit 77
-mkdir -p "$OUT"
-panel_work carpet
-panel_lcm_url 17
-ID="carpet$$"
+. "$here/browser_lib.sh"  # panel_browser_test, fail, panel_and_serve
+panel_browser_test carpet 17 "$@"  # LOOMCTL PANEL SRC OUT, WORK, URL, ID
 LOOM=$SRC/tests/sim/knotting_sample_loom.toml
 DESIGN=$WORK/rug.csv
 cp "$SRC/tests/sim/knot_sample.csv" "$DESIGN"

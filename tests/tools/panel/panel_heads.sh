@@ -6,17 +6,9 @@
 # loom's own counters say. Writes <out>/loom_panel_heads.png. Exit 77 (skip) without chromium or node.
 # Usage: panel_heads.sh <loomctl> <loom-panel> <source dir> <out dir>
 set -euo pipefail
-LOOMCTL=$1
-PANEL=$2
-SRC=$3
-OUT=$4
 here=$(dirname "$0")
-. "$(dirname "$0")/browser_lib.sh"  # fail, have_browser, panel_work, panel_lcm_url, panel_and_serve
-have_browser || exit 77
-mkdir -p "$OUT"
-panel_work heads
-panel_lcm_url 13
-ID="heads$$"
+. "$here/browser_lib.sh"  # panel_browser_test, fail, panel_and_serve
+panel_browser_test heads 13 "$@"  # LOOMCTL PANEL SRC OUT, WORK, URL, ID
 panel_and_serve --config "$SRC/firmware/config/knotting_loom.toml" --scene "$SRC/sim_hal/scenes/knotting.toml" \
   --pace 4
 "$LOOMCTL" ctl --socket "$SOCK" start >/dev/null || fail "serve did not take start"

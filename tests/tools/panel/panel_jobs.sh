@@ -10,17 +10,9 @@
 # <out>/loom_panel_jobs.png. Exit 77 (skip) without chromium or node.
 # Usage: panel_jobs.sh <loomctl> <loom-panel> <source dir> <out dir>
 set -euo pipefail
-LOOMCTL=$1
-PANEL=$2
-SRC=$3
-OUT=$4
 here=$(dirname "$0")
-. "$(dirname "$0")/browser_lib.sh"  # fail, have_browser, panel_work, panel_lcm_url, panel_and_serve
-have_browser || exit 77
-mkdir -p "$OUT"
-panel_work jobs
-panel_lcm_url 19
-ID="jobs$$"
+. "$here/browser_lib.sh"  # panel_browser_test, fail, panel_and_serve
+panel_browser_test jobs 19 "$@"  # LOOMCTL PANEL SRC OUT, WORK, URL, ID
 LOOM=$SRC/tests/sim/knotting_sample_loom.toml
 DESIGN=$WORK/rug.csv
 cp "$SRC/tests/sim/knot_sample.csv" "$DESIGN"

@@ -7,17 +7,9 @@
 # answered that request. Writes <out>/loom_panel_weaver.png. Exit 77 (skip) without chromium or node.
 # Usage: panel_weaver.sh <loomctl> <loom-panel> <source dir> <out dir>
 set -euo pipefail
-LOOMCTL=$1
-PANEL=$2
-SRC=$3
-OUT=$4
 here=$(dirname "$0")
-. "$(dirname "$0")/browser_lib.sh"  # fail, have_browser, panel_work, panel_lcm_url, panel_and_serve
-have_browser || exit 77
-mkdir -p "$OUT"
-panel_work weaver
-panel_lcm_url 17
-ID="weaver$$"
+. "$here/browser_lib.sh"  # panel_browser_test, fail, panel_and_serve
+panel_browser_test weaver 17 "$@"  # LOOMCTL PANEL SRC OUT, WORK, URL, ID
 panel_and_serve --config "$SRC/firmware/config/knotting_loom.toml" \
   --scene "$SRC/sim_hal/scenes/knotting_faults.toml" --pace 4
 CODE=$("$LOOMCTL" ctl --socket "$SOCK" pair weaver-tablet | sed -n 's/.*code=\([0-9]*\).*/\1/p')
