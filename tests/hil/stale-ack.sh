@@ -24,7 +24,9 @@ io_rpdo=$(printf '%03X' $((0x200 + HIL_IO_NODE)))  # outputs: lamp_amber = bit 5
 hil_start_candump
 hil_start_sim_drives
 counters=$HIL_WORK/counters.json
-hil_weave_until_armed stale_ack 2 "$counters"
+# Rows enough that the loom still weaves when the e-stop opens (it ends the run): with 2 rows (20 s of machine
+# time) a slow VM, whose shell steps starve beside the SCHED_FIFO loop, once saw the run end before the e-stop.
+hil_weave_until_armed stale_ack 8 "$counters"
 
 # --- the press while weaving, without a fault ----------------------------------------------------------
 mark=$(hil_mark)
