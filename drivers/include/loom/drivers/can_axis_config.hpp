@@ -25,6 +25,16 @@ inline constexpr double kDefaultCountsPerRad = kCountsPerRev / (2.0 * std::numbe
 inline constexpr double kDefaultCarriageLeadM = 0.010;
 inline constexpr double kDefaultCountsPerM = kCountsPerRev / kDefaultCarriageLeadM;
 
+// How the master commands a drive (CiA 402 modes of operation, 0x6060).
+enum class DriveMode : std::uint8_t {
+  // Cyclic synchronous position (8): a set-point every SYNC; RPDO1 and TPDO1 synchronous, every cycle.
+  kCyclicPosition,
+  // Profile position (1): the move's end target once, with the set-point handshake (controlword bit 4,
+  // statusword bit 12); the drive runs its own profile. For axes that move point to point between knots
+  // (the colour selectors): their PDOs are event-driven, so an idle axis costs the bus almost nothing.
+  kProfilePosition,
+};
+
 struct CanAxisConfig {
   std::string name = "axis";  // the machine description's name, for messages
   std::uint8_t bus = 0;       // which bus (0 = the first interface); node ids are unique per bus
@@ -49,6 +59,7 @@ struct CanAxisConfig {
   // The drive's EDS (node_description.hpp), when the machine description names one: its identity is
   // checked and its configuration written (only what differs) at bring-up. Null: none.
   std::shared_ptr<const NodeDescription> description{};
+  DriveMode mode = DriveMode::kCyclicPosition;
 };
 
 // Buses a port can drive (can0..can3): CanAxisConfig::bus is 0..kMaxBuses-1.
@@ -80,6 +91,12 @@ struct CanAxisPortConfig {
   // stage's own reaction (quick stop) and must not trip on a loaded host's scheduling stalls.
   double master_heartbeat_s = 0.100;
   double master_consumer_s = 0.500;
+  // Profile-position axes (DriveMode::kProfilePosition): their TPDO1 is event-driven (transmission type
+  // 255), sent when the statusword or position changes but at most once per inhibit time (0x1800:03) and
+  // at least once per event timer (0x1800:05) while nothing changes, so a still axis is still supervised.
+  // Their RPDO1 is sent only when the controlword or target changes. These set the bus-load plan's rates.
+  double profile_tpdo_inhibit_s = 0.010;
+  double profile_tpdo_event_timer_s = 0.100;
   bool tpdo2 = false;                   // velocity + torque PDO (adds 3 frames per cycle)
   std::uint8_t tpdo2_every_n_sync = 1;  // 1..240
   std::uint32_t bitrate_bps = 1'000'000;
