@@ -11,13 +11,15 @@ std::optional<hal::Tick> ideal_row_knotting_ticks(const SequencerConfig& cfg, do
   const KnotGuard guard = knot_guard(cfg.heads);
   RowKnotter heads;
   heads.configure(cfg.heads, &guard, cfg.period_s, cfg.carriage_home_m, cfg.carriage, cfg.stale_timeout_s);
-  // As the sequencer begins a row: the carriage at the row's start selvedge (even rows start at the left).
-  const double start_m = row0 % 2 == 0 ? 0.0 : carriage_travel_m;
+  // As the sequencer begins a row: the carriage at the left selvedge, where the last sweep ended (and where
+  // it waits before a first row); knotted, it goes to the row's sweep start.
+  const double start_m = 0.0;
+  const double return_to_m = row_sweep_starts_left(true, row0) ? 0.0 : carriage_travel_m;
   hal::HalOutputs cmd{};
   hal::HalInputs in{};
   cmd.axes[hal::index(hal::CoreAxis::kCarriage)].target_position = cfg.carriage_home_m + start_m;
   KnotCounters counters{};
-  heads.begin(row0, counters, start_m, 0, cmd);
+  heads.begin(row0, counters, return_to_m, 0, cmd);
   RowKnotter::StepInputs s;
   for (hal::Tick t = 0; t < max_ticks; ++t) {
     for (std::size_t a = 0; a < hal::kMaxAxes; ++a) in.axes[a].position = cmd.axes[a].target_position;

@@ -755,6 +755,18 @@ void Sequencer::finish_arming(hal::Tick now, const hal::HalInputs& in) noexcept 
   enter(State::kPositioning, now);
 }
 
+bool Sequencer::knots_of_row_on_record() const noexcept {
+  const KnotCounters& kc = counters_.knot;
+  return knotter_.fitted() && kc.cycles_done >= static_cast<std::uint32_t>(cfg_.heads.program->stripe()) &&
+         kc.cycles_started == kc.cycles_done;
+}
+
+double Sequencer::row_start_m() const noexcept {
+  const bool heads_to_tie = knotter_.fitted() && !row_knotted_ && !knots_of_row_on_record();
+  if (heads_to_tie && counters_.picks_in_row == 0) return 0.0;
+  return sweep_starts_left() ? 0.0 : profiles_->carriage_travel_m();
+}
+
 void Sequencer::positioning(hal::Tick now, const hal::HalInputs& in) noexcept {
   // Re-arm from measured positions: the knotting servos to rest (nothing may cross a gripper left in the
   // warp), then the crank to the nearest park, then the carriage to the row's start side.
@@ -774,10 +786,9 @@ void Sequencer::positioning(hal::Tick now, const hal::HalInputs& in) noexcept {
     return;
   }
   if (crank_move_.active || carriage_move_.active) return;
-  // Rows sweep in alternating directions: row n+1 starts at the left when n is even. The carriage goes
-  // there (a row cut mid-sweep is swept again from its start).
+  // The carriage goes to where the row starts (a row cut mid-sweep is swept again from its start).
   const double rel = in.axes[index(CoreAxis::kCarriage)].position - cfg_.carriage_home_m;
-  const double goal = row_starts_left() ? 0.0 : profiles_->carriage_travel_m();
+  const double goal = row_start_m();
   if (std::abs(rel - goal) > cfg_.selvedge_tolerance_m) {
     carriage_move_ = {true, now, cmd_.axes[index(CoreAxis::kCarriage)].target_position,
                       motion::JerkMove::plan(goal - rel, cfg_.carriage)};
@@ -1009,7 +1020,7 @@ bool Sequencer::reconcile_at_arming(hal::Tick now, const hal::HalInputs& in) noe
   const bool a_up = counters_.picks % 2 == 0;
   const bool shed_of_pick_n = shed_confirmed(io_) && io_.piston_a_extended == a_up;
   const double rel = in.axes[index(CoreAxis::kCarriage)].position - cfg_.carriage_home_m;
-  const double start = row_starts_left() ? 0.0 : profiles_->carriage_travel_m();
+  const double start = sweep_starts_left() ? 0.0 : profiles_->carriage_travel_m();
   const bool before_sweep = std::abs(rel - start) <= cfg_.selvedge_tolerance_m;
   if (counters_.picks_in_row < cfg_.picks_per_row && shed_of_pick_n && before_sweep) {
     ++counters_.picks;
@@ -1116,9 +1127,9 @@ void Sequencer::begin_pick(hal::Tick now, bool resumed) noexcept {
 
 void Sequencer::begin_sweep(hal::Tick now) noexcept {
   row_.begin(counters_.rows + 1, now);  // resumed after a restart with every pick of the row done
-  // The crank turns `beats` full turns from park; the carriage rides the cam on it from the row's start
-  // selvedge, so successive rows sweep in alternating directions.
-  carriage_sweep_dir_ = row_starts_left() ? 1.0 : -1.0;
+  // The crank turns `beats` full turns from park; the carriage rides the cam on it from the row's sweep
+  // start (row_sweep_starts_left) across to the other selvedge.
+  carriage_sweep_dir_ = sweep_starts_left() ? 1.0 : -1.0;
   carriage_sweep_origin_ = cmd_.axes[index(CoreAxis::kCarriage)].target_position;
   crank_sweep_origin_ = cmd_.axes[index(CoreAxis::kBeatCrank)].target_position;
   crank_move_ = {true, now, crank_sweep_origin_, profiles_->crank_sweep()};
@@ -1182,19 +1193,16 @@ void Sequencer::after_row(hal::Tick now) noexcept {
 }
 
 void Sequencer::next_row(hal::Tick now) noexcept {
-  const KnotCounters& kc = counters_.knot;
-  if (knotter_.fitted() && !row_knotted_ &&
-      kc.cycles_done >= static_cast<std::uint32_t>(cfg_.heads.program->stripe()) &&
-      kc.cycles_started == kc.cycles_done) {
+  if (!row_knotted_ && knots_of_row_on_record()) {
     row_knotted_ = true;  // every knot of this row was tied before a restart: on to its shed
   }
   if (knotter_.fitted() && !row_knotted_) {
     // The heads tie the row (from the counters' progress: a row cut by a power loss resumes at its first
-    // knot not known to be tied); the carriage comes back to the row's start selvedge afterwards.
+    // knot not known to be tied); the carriage then goes to the row's sweep start.
     row_.begin(counters_.rows + 1, now);
     knotter_requests_seen_ = knotter_.requests();
     knot_requested_ = false;
-    knotter_.begin(counters_.rows, counters_.knot, row_starts_left() ? 0.0 : profiles_->carriage_travel_m(),
+    knotter_.begin(counters_.rows, counters_.knot, sweep_starts_left() ? 0.0 : profiles_->carriage_travel_m(),
                    now, cmd_);
     if (knotter_.requests() != knotter_requests_seen_) events_.add(EventKind::kWeaverRequest);
     enter(State::kKnotting, now);

@@ -468,3 +468,55 @@ TEST(Knotting, ThePlacementToleranceKeyDefaultsToAQuarterPitchAndRefusesBadValue
   EXPECT_NE(half.find("below half the knot pitch (0.001667 m"), std::string::npos) << half;
   EXPECT_EQ(refusal("0.00166"), "(accepted)");
 }
+
+// Rows are knotted from the selvedge the carriage stands at, with no double crossing: the heads tie every
+// row from the left, where the last sweep left the carriage; the carriage then crosses once to the right
+// and the beat sweep brings it back. So each row crosses the width exactly twice — with sweeps alternating
+// as on a loom without heads, a row starting at the right would cross three times (to the knots, back to
+// its start, the sweep) and the next one once — and every row knots from the left selvedge.
+TEST(Knotting, EveryRowIsKnottedFromTheLeftAndCrossesTheWidthTwice) {
+  firmware::LoomConfig cfg = knotting_loom();
+  cfg.knotting.knots_per_slot = 1000;  // no reload: this test has no simulated weaver
+  constexpr std::uint32_t kRows = 4;
+  Stepped s(cfg, scene("miss_probability = 0.0\n"), kRows);
+  sequencer::Sequencer& seq = s.m.sequencer();
+  const std::size_t car = hal::index(hal::CoreAxis::kCarriage);
+  const double home = cfg.sequencer.carriage_home_m;
+  const double travel = s.m.profiles().carriage_travel_m();
+  const double tol = cfg.sequencer.selvedge_tolerance_m;
+  std::array<int, kRows> crossings{};
+  std::array<double, kRows> knot_start_m{};
+  knot_start_m.fill(-1.0);
+  int side = 0;  // -1 at the left selvedge, +1 at the right, 0 not yet known
+  double sweep_from = 0.0;
+  int sweeps = 0, sweeps_leftward = 0;
+  sequencer::State was = seq.state();
+  for (const hal::Tick end = s.t + 2'000'000; s.t < end && seq.state() != sequencer::State::kDone; ++s.t) {
+    s.m.loop().cycle(s.t);
+    ASSERT_NE(seq.state(), sequencer::State::kFault) << sequencer::fault_name(seq.first_fault());
+    const std::uint32_t row = std::min(seq.counters().rows, kRows - 1);  // the last row's sweep ends it
+    const double x = s.m.loop().outputs().axes[car].target_position - home;
+    const int at = x < 0.1 * travel ? -1 : x > 0.9 * travel ? 1 : 0;
+    if (at != 0 && side != 0 && at != side) ++crossings[row];
+    if (at != 0) side = at;
+    const sequencer::State now = seq.state();
+    if (now == sequencer::State::kKnotting && was != sequencer::State::kKnotting && knot_start_m[row] < 0.0)
+      knot_start_m[row] = s.m.loop().inputs().axes[car].position - home;
+    if (now == sequencer::State::kBeatSweep && was != sequencer::State::kBeatSweep) sweep_from = x;
+    if (now != sequencer::State::kBeatSweep && was == sequencer::State::kBeatSweep) {
+      ++sweeps;
+      sweeps_leftward += x < sweep_from;
+    }
+    was = now;
+  }
+  ASSERT_EQ(seq.counters().rows, kRows)
+      << sequencer::state_name(seq.state()) << " at tick " << s.t
+      << " (asked: " << sequencer::weaver_ask_name(seq.weaver_request().ask) << ")";
+  EXPECT_EQ(sweeps, static_cast<int>(kRows));
+  EXPECT_EQ(sweeps_leftward, sweeps);
+  for (std::uint32_t r = 0; r < kRows; ++r) {
+    EXPECT_EQ(crossings[r], 2) << "row " << r + 1;
+    EXPECT_NEAR(knot_start_m[r], 0.0, tol)
+        << "row " << r + 1 << " began knotting away from the left selvedge";
+  }
+}

@@ -154,6 +154,15 @@ std::optional<SequencerFault> find_fault(const SequencerConfig& cfg, const motio
 // Configure-time only. "" when the sequencer can run `profiles` with `cfg`, else find_fault()'s message.
 std::string validate(const SequencerConfig& cfg, const motion::ProfileSet& profiles);
 
+// Where production row `row0`'s (0-based) beat sweep starts: true at the left selvedge. Without knotting
+// heads rows sweep in alternating directions, so each row starts where the last one ended. With heads every
+// row starts at the right: the heads tie a row from the left selvedge, where the last sweep left the
+// carriage, and the carriage then crosses once to the right to beat the row back to the left. (Alternating
+// sweeps would cost a row that starts at the right two crossings before its sweep: to the knots, and back.)
+constexpr bool row_sweep_starts_left(bool knotting_heads, std::uint32_t row0) noexcept {
+  return !knotting_heads && row0 % 2 == 0;
+}
+
 class Sequencer {
  public:
   // Configure-time only. `profiles` must outlive the sequencer. `resume` seeds the counters (restart);
@@ -324,7 +333,12 @@ class Sequencer {
   void add_fault_event(
       EventKind kind) noexcept;  // kFaultLatched / kDiagnosisRefined with the first fault's details
   bool expect_shuttle_left() const noexcept { return counters_.picks % 2 == 0; }  // it starts at the left
-  bool row_starts_left() const noexcept { return counters_.rows % 2 == 0; }       // sweeps alternate
+  bool sweep_starts_left() const noexcept { return row_sweep_starts_left(knotter_.fitted(), counters_.rows); }
+  // Where the carriage waits before the row in progress: at its sweep's start, or — a row the heads are
+  // still to tie (or to finish tying) — at the left selvedge, where the heads' knotting starts.
+  double row_start_m() const noexcept;
+  // Every knot cycle of the row in progress is done as the counters say (tied before a restart).
+  bool knots_of_row_on_record() const noexcept;
   PistonEnds ends_a() const noexcept { return {io_.piston_a_extended, io_.piston_a_retracted}; }
   PistonEnds ends_b() const noexcept { return {io_.piston_b_extended, io_.piston_b_retracted}; }
 
