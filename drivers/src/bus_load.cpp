@@ -30,8 +30,8 @@ std::uint64_t whole_us(double s) {
   return s > 0.0 ? static_cast<std::uint64_t>(std::llround(s * 1e6)) : 0;
 }
 
-// ⌈count · bits · period / interval⌉ in whole bits. An interval shorter than 1 µs (or 0) would be a
-// frame on every bit: counted as one frame per cycle each, never less than the frames themselves.
+// ⌈count · bits · period / interval⌉ in whole bits. An interval that rounds to 0 µs bounds nothing: then
+// each frame is counted once per cycle.
 std::uint32_t rate_bits(const RateGroup& g, std::uint32_t frame_bits, std::uint64_t period_us) {
   const std::uint64_t bits = static_cast<std::uint64_t>(g.count) * frame_bits;
   const std::uint64_t interval_us = whole_us(g.min_interval_s);
