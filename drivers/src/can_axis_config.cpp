@@ -182,32 +182,66 @@ Status validate(const CanAxisPortConfig& c) {
 std::size_t bus_count(const CanAxisPortConfig& c) {
   std::size_t n = 1;
   for (const CanAxisConfig& a : c.axes) n = std::max<std::size_t>(n, a.bus + 1U);
-  for (std::size_t b = 0; b < c.other_frames_per_cycle.size(); ++b) {
-    if (!c.other_frames_per_cycle[b].empty()) n = std::max(n, b + 1);
+  for (std::size_t b = 0; b < kMaxBuses; ++b) {
+    if (!c.other_frames_per_cycle[b].empty() || c.other_nodes_per_bus[b] != 0) n = std::max(n, b + 1);
   }
   return n;
 }
 
 BusLoad planned_bus_load(const CanAxisPortConfig& c, std::size_t bus) {
-  std::uint32_t n = 0, homed = 0;  // homed axes carry the mode in RPDO1/TPDO1 (7 bytes instead of 6)
+  // Per mode, the axes on this bus; homed axes carry the mode in RPDO1/TPDO1 (7 bytes instead of 6).
+  std::uint32_t cyclic = 0, cyclic_homed = 0, profile = 0, profile_homed = 0;
   for (const CanAxisConfig& a : c.axes) {
-    n += a.bus == bus && a.homing_method == 0 ? 1U : 0U;
-    homed += a.bus == bus && a.homing_method != 0 ? 1U : 0U;
+    if (a.bus != bus) continue;
+    const bool homed = a.homing_method != 0;
+    if (a.mode == DriveMode::kProfilePosition) {
+      (homed ? profile_homed : profile) += 1;
+    } else {
+      (homed ? cyclic_homed : cyclic) += 1;
+    }
   }
-  std::vector<FrameGroup> frames{{0, 1}, {kRpdo1Bytes, n}, {kTpdo1Bytes, n}};
-  if (homed != 0) {
-    frames.push_back({kRpdo1HomingBytes, homed});
-    frames.push_back({kTpdo1HomingBytes, homed});
+  const std::uint32_t axes = cyclic + cyclic_homed + profile + profile_homed;
+  // Synchronous: SYNC; each cyclic-position drive's RPDO1 and TPDO1, every SYNC; TPDO2 of every drive when
+  // configured (synchronous, every n-th SYNC: all of them may fall on one, the worst cycle); the other
+  // nodes' PDOs (the I/O modules'); the master heartbeat, in full (bus_load.cpp says why).
+  std::vector<FrameGroup> synchronous{{0, 1}, {kRpdo1Bytes, cyclic}, {kTpdo1Bytes, cyclic}};
+  if (cyclic_homed != 0) {
+    synchronous.push_back({kRpdo1HomingBytes, cyclic_homed});
+    synchronous.push_back({kTpdo1HomingBytes, cyclic_homed});
   }
-  n += homed;
-  if (c.tpdo2) frames.push_back({kTpdo2Bytes, n});
+  if (c.tpdo2) synchronous.push_back({kTpdo2Bytes, axes});
   if (bus < kMaxBuses) {
     const std::vector<FrameGroup>& other = c.other_frames_per_cycle[bus];
-    frames.insert(frames.end(), other.begin(), other.end());
+    synchronous.insert(synchronous.end(), other.begin(), other.end());
   }
-  // The master heartbeat (1 byte) counted as if it were sent every cycle: the worst cycle holds it.
-  if (c.master_node_id != 0) frames.push_back({1, 1});
-  return compute_bus_load(frames, c.bitrate_bps, c.cycle_period_s);
+  if (c.master_node_id != 0) synchronous.push_back({kHeartbeatBytes, 1});
+  // Every node's own heartbeat: each drive's and each other node's (the loom writes the same producer time
+  // to all of them), at its rate (bus_load.cpp: one in progress is the blocking frame).
+  const RateGroup heartbeats[] = {
+      {kHeartbeatBytes, axes + (bus < kMaxBuses ? c.other_nodes_per_bus[bus] : 0U), c.heartbeat_producer_s}};
+  // Profile-position axes. Their TPDO1 is event-driven: sent on a change of statusword or position, at most
+  // once per inhibit time, and once per event timer when nothing changes; the fastest it can go is once per
+  // inhibit time (or per event timer, were that shorter), the rate counted. Their RPDO1 goes only when
+  // the controlword or target changes: a move's set-point, and its release once the drive has acknowledged
+  // the set-point (statusword bit 12, which arrives in that TPDO1). So the handshake spaces the master's
+  // RPDO1s by at least one drive response, and the drive's responses are inhibited: RPDO1 is bounded by the
+  // same rate. (A stop's controlword is one more frame, on a cycle whose motion stops anyway.)
+  double interval = c.profile_tpdo_inhibit_s;
+  if (c.profile_tpdo_event_timer_s > 0.0 && (interval <= 0.0 || c.profile_tpdo_event_timer_s < interval)) {
+    interval = c.profile_tpdo_event_timer_s;
+  }
+  if (!(interval > 0.0)) interval = c.cycle_period_s;  // no bound: one per cycle
+  const RateGroup events[] = {{kRpdo1Bytes, profile, interval},
+                              {kTpdo1Bytes, profile, interval},
+                              {kRpdo1HomingBytes, profile_homed, interval},
+                              {kTpdo1HomingBytes, profile_homed, interval}};
+  CycleTraffic traffic;
+  traffic.synchronous = synchronous;
+  traffic.heartbeats = heartbeats;
+  traffic.events = events;
+  traffic.blocking = true;    // the largest asynchronous frame (an SDO) may be on the wire at SYNC
+  traffic.emcy_headroom = 1;  // one EMCY per cycle (bus_load.cpp justifies the figure)
+  return compute_cycle_load(traffic, c.bitrate_bps, c.cycle_period_s);
 }
 
 }  // namespace loom::drivers

@@ -420,8 +420,10 @@ void print_plan(const LoomConfig& c) {
                   std::to_string(k == 0 ? c.io.node : c.io.modules[k - 1].node);
       }
     }
-    std::printf("  bus %zu (nodes %s) load: %s (budget %.0f %%)\n", b, on_bus.c_str(),
-                drivers::describe_bus_load(can_bus_load(c, b)).c_str(), c.can.bus_load_budget * 100.0);
+    const drivers::BusLoad load = can_bus_load(c, b);
+    std::printf("  bus %zu (nodes %s) load: %s (budget %.0f %%)\n    %s\n", b, on_bus.c_str(),
+                drivers::describe_bus_load(load).c_str(), c.can.bus_load_budget * 100.0,
+                drivers::describe_bus_load_terms(load).c_str());
   }
   std::string nodes;
   for (const AxisSpec& a : c.axes) {

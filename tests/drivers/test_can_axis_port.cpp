@@ -399,6 +399,7 @@ TEST(CanAxisPort, VelocityFromTpdo2OrFromFiniteDifferences) {
   for (bool tpdo2 : {false, true}) {
     CanAxisPortConfig cfg;
     cfg.tpdo2 = tpdo2;
+    cfg.bus_load_budget = 0.75;  // three drives with TPDO2 on one bus at 2 ms: 71.5 % (test_bus_load.cpp)
     cfg.axes[2].rated_effort = 2.0;
     DriveRig rig(three_drives(), cfg);
     ASSERT_TRUE(rig.configure().is_ok());
@@ -480,10 +481,12 @@ TEST(CanAxisPortConfigure, OverloadedBusIsRefusedBeforeAnyFrame) {
   DriveRig rig(three_drives(), cfg);
   const drivers::Status s = rig.configure();
   ASSERT_FALSE(s.is_ok());
-  // SYNC + 9 × 6 B + master heartbeat (1 B) at 1 ms: 55 + 9·115 + 65 = 1155 worst-case bits = 115.5 %.
-  EXPECT_TRUE(contains(s.message(), "11 frames/cycle")) << s.message();
-  EXPECT_TRUE(contains(s.message(), "1155 worst-case")) << s.message();
-  EXPECT_TRUE(contains(s.message(), "115.5 %")) << s.message();
+  // SYNC + 9 × 6 B + master heartbeat (1 B) at 1 ms: 55 + 9·115 + 65 = 1155 bits; + blocking 135 + EMCY 135
+  // + the three drives' heartbeats (100 ms) ⌈3 · 65 / 100⌉ = 2: 1427 worst-case bits = 142.7 %.
+  EXPECT_TRUE(contains(s.message(), "11 frames/cycle incl. blocking, EMCY headroom, 3 heartbeats"))
+      << s.message();
+  EXPECT_TRUE(contains(s.message(), "1427 worst-case")) << s.message();
+  EXPECT_TRUE(contains(s.message(), "142.7 %")) << s.message();
   EXPECT_TRUE(contains(s.message(), "budget of 70 %")) << s.message();
   for (const auto& l : rig.net.log()) EXPECT_NE(l.from, 0u) << "the master sent a frame";
 }
@@ -494,7 +497,8 @@ TEST(CanAxisPortConfigure, OtherNodesCountTowardTheBudget) {
   DriveRig rig(three_drives(), cfg);
   const drivers::Status s = rig.configure();
   ASSERT_FALSE(s.is_ok());
-  EXPECT_TRUE(contains(s.message(), "1890 worst-case")) << s.message();  // 745 + 65 + 1080
+  // 745 + 65 + 1080 + blocking 135 + EMCY 135 + the drives' heartbeats ⌈3 · 65 · 2 / 100⌉ = 4.
+  EXPECT_TRUE(contains(s.message(), "2164 worst-case")) << s.message();
 }
 
 TEST(CanAxisPortConfigure, InvalidFieldsAreNamed) {

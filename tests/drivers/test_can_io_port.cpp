@@ -656,6 +656,7 @@ std::vector<sim_can::SimDriveConfig> fixed_drives(std::int64_t boot_us, std::int
 TEST(Interop, FixedPersonalityDriveIsAcceptedWithNotes) {
   drivers::CanAxisPortConfig ac;
   ac.tpdo2 = true;                  // its fixed TPDO2 carries velocity + torque: used
+  ac.bus_load_budget = 0.85;        // 3 drives with TPDO2 + the I/O module on one bus at 2 ms: 82.7 %
   ac.operational_timeout_s = 0.25;  // the per-node windows below are what let the slow drives in
   ac.axes[0].operational_timeout_s = 0.6;
   ac.axes[1].operational_timeout_s = 0.6;

@@ -23,6 +23,9 @@ expect "$out/homing.txt" "0x6060 modes of operation: set to 6 (homing) for the r
 "$loomctl" check >"$out/default.txt"
 ! grep -q "homing drives" "$out/default.txt" || fail "the default loom (absolute encoders) was given homing objects"
 expect "$out/default.txt" "0x6200:01 write digital outputs, 8-bit: valves, stack light, buzzer"
+# The bus load with every term: the cycle's frames, blocking, EMCY headroom, the four nodes' heartbeats.
+expect "$out/default.txt" "bus 0 (nodes beat_crank 1, carriage 2, helix 3, I/O 4) load: 11 frames/cycle incl. blocking, EMCY headroom, 4 heartbeats: 1088 nominal / 1311 worst-case bits per 2 ms"
+expect "$out/default.txt" "worst-case bits: 11 cyclic frames 1035, blocking 135, EMCY 1 × 135, 4 heartbeats 6"
 
 "$loomctl" check --config "$src/firmware/config/knotting_loom.toml" >"$out/heads.txt"
 expect "$out/heads.txt" "0x6200:01..04 write digital outputs, 8-bit: valves, stack light, buzzer, the heads' grippers and cutters"

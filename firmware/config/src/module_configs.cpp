@@ -85,6 +85,7 @@ drivers::CanAxisPortConfig can_axis_config(const LoomConfig& c) {
       std::vector<drivers::FrameGroup>& on_bus =
           cc.other_frames_per_cycle[std::min(buses[k], drivers::kMaxBuses - 1)];
       on_bus.insert(on_bus.end(), frames.begin(), frames.end());
+      cc.other_nodes_per_bus[std::min(buses[k], drivers::kMaxBuses - 1)] += 1;  // its heartbeat
     }
   }
   return cc;

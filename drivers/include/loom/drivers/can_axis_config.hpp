@@ -104,6 +104,9 @@ struct CanAxisPortConfig {
   // The other nodes' frames per bus (the I/O modules), by bus index: a bus that carries only an I/O
   // module is still one of the port's buses, with its own master, SYNC and budget.
   std::array<std::vector<FrameGroup>, kMaxBuses> other_frames_per_cycle{};
+  // The other nodes on each bus (the I/O modules), by bus index: each sends its heartbeat with the same
+  // producer time as the drives (heartbeat_producer_s), which the bus-load plan counts.
+  std::array<std::uint32_t, kMaxBuses> other_nodes_per_bus{};
 };
 
 // Which setting a refusal of the configuration is about. The loom config maps it (with the axis) to the
@@ -150,13 +153,14 @@ struct CanAxisConfigFault {
 std::optional<CanAxisConfigFault> find_fault(const CanAxisPortConfig& config);
 // Configure-time only. Error naming the field and its value (find_fault()'s message).
 Status validate(const CanAxisPortConfig& config);
-// Configure-time only. The buses the configuration uses: 1 + the highest bus an axis or another node's
-// frames are on.
+// Configure-time only. The buses the configuration uses: 1 + the highest bus an axis or another node is on.
 std::size_t bus_count(const CanAxisPortConfig& config);
-// Configure-time only. The worst cycle this configuration puts on bus `bus`: SYNC, each of its drives'
-// RPDO1 and TPDO1 (and TPDO2), the other nodes' frames on that bus (the I/O modules) and the master
-// heartbeat. The same figure the port checks against its budget when it configures, and `loomctl check`
-// prints per bus.
+// Configure-time only. The worst cycle this configuration puts on bus `bus` (compute_cycle_load()): SYNC,
+// each cyclic-position drive's RPDO1 and TPDO1, every drive's TPDO2 when configured, the other nodes'
+// frames on that bus (the I/O modules) and the master heartbeat; one blocking 8-byte frame and one EMCY;
+// every node's heartbeat at its producer time; each profile-position drive's RPDO1 and TPDO1 at its
+// inhibit-time rate. The same figure the port checks against its budget when it configures, and
+// `loomctl check` prints per bus.
 BusLoad planned_bus_load(const CanAxisPortConfig& config, std::size_t bus = 0);
 
 }  // namespace loom::drivers
