@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 
 #include "drive_rig.hpp"
 #include "loom/drivers/cia402.hpp"
@@ -200,6 +201,76 @@ TEST(ProfilePosition, AQuickStopAbandonsTheMoveAndANewMoveAfterReEnablingIsOneSe
   EXPECT_EQ(rig.rack.node(1).position(), stopped);
   EXPECT_EQ(rig.rack.node(1).setpoints_latched(), 1u);
   for (const auto& r : rig.rpdos_to(kPpNode, mark)) EXPECT_EQ(r.controlword & 0x10, 0);
+}
+
+// Enabled and settled, ready for a move.
+void enable(DriveRig& rig) {
+  ASSERT_TRUE(rig.configure().is_ok());
+  rig.run_until(
+      hold_all, [&] { return rig.all_in(DriveState::kOperationEnabled); }, 50);
+  ASSERT_TRUE(rig.all_in(DriveState::kOperationEnabled));
+  for (int k = 0; k < 20; ++k) rig.tick(hold_all);
+}
+
+// Tick with a move of `distance` to the PP axis under way (its end given) until `done` or `max_ticks`.
+int move_until(DriveRig& rig, double distance, const std::function<bool()>& done, int max_ticks) {
+  const double from = rig.feedback[1].position;
+  return rig.run_until(
+      [&](const hal::AxisFeedbacks& fb, hal::AxisCommands& cmd) {
+        hold_all(fb, cmd);
+        cmd[1].target_position = from + distance;  // (a move of one tick: its end at once)
+        cmd[1].move_end = from + distance;
+      },
+      done, max_ticks);
+}
+
+TEST(ProfilePosition, ASetPointTheDriveNeverAcknowledgesIsANamedFaultWithinTheStateTimeout) {
+  DriveRig rig(two_drives(), csp_and_pp());
+  enable(rig);
+  // The drive's TPDO1 no longer reaches the master: no acknowledge is ever seen.
+  rig.net.drop = [](const drivers::CanFrame& f) { return f.id == drivers::cob::tpdo(1, kPpNode); };
+  const int n = move_until(
+      rig, 1.0, [&] { return rig.feedback[1].fault; }, 400);
+  ASSERT_TRUE(rig.feedback[1].fault);
+  EXPECT_EQ(rig.feedback[1].fault_code, drivers::fault_code::kSetpointNotAcknowledged);
+  EXPECT_EQ(rig.feedback[1].fault_kind, hal::FaultKind::kDrive);
+  // state_timeout_s = 0.5 s = 250 ticks after the set-point (sent in the first tick of the move).
+  EXPECT_GE(n, 250);
+  EXPECT_LE(n, 255);
+}
+
+TEST(ProfilePosition, ATargetNeverReportedReachedIsANamedFaultAfterTheMovesTimeAndMargin) {
+  DriveRig rig(two_drives(), csp_and_pp());
+  enable(rig);
+  // Every TPDO1 that says "target reached" (bit 10) is lost: the arrival is never seen.
+  rig.net.drop = [](const drivers::CanFrame& f) {
+    return f.id == drivers::cob::tpdo(1, kPpNode) && (f.data[1] & 0x04) != 0;
+  };
+  const int n = move_until(
+      rig, 1.0, [&] { return rig.feedback[1].fault; }, 1000);
+  ASSERT_TRUE(rig.feedback[1].fault);
+  EXPECT_EQ(rig.feedback[1].fault_code, drivers::fault_code::kTargetNotReached);
+  // 1 rad at 10 rad/s and 200 rad/s² (a linear ramp: the simulated drive has no jerk-limited profile):
+  // d/v + v/a = 0.15 s; × 1.25 + the 0.5 s state timeout = 0.6875 s = 344 ticks after the acknowledge.
+  EXPECT_GE(n, 344);
+  EXPECT_LE(n, 352);
+  // Every axis is stopped with it.
+  rig.tick(hold_all);
+  EXPECT_NE(rig.port.last_controlword(0), 0x000F);
+}
+
+TEST(ProfilePosition, AStillAxisWhoseTpdoStopsGoesStaleAfterTheEventTimerAndItsMargin) {
+  DriveRig rig(two_drives(), csp_and_pp());
+  enable(rig);
+  EXPECT_EQ(rig.feedback[1].refreshed, rig.tick_index - 1);
+  rig.net.drop = [](const drivers::CanFrame& f) { return f.id == drivers::cob::tpdo(1, kPpNode); };
+  for (int k = 0; k < 150; ++k) rig.tick(hold_all);
+  // Current for 1.5 event timer periods (150 ms = 75 ticks) after the last TPDO, then as old as that TPDO,
+  // which came at most one event period (50 ticks) before the cut.
+  const hal::Tick age = rig.tick_index - 1 - rig.feedback[1].refreshed;
+  EXPECT_GE(age, 150);
+  EXPECT_LE(age, 201);
+  EXPECT_EQ(rig.feedback[0].refreshed, rig.tick_index - 1);  // the CSP axis is fresh every tick
 }
 
 }  // namespace
