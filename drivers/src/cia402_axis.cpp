@@ -349,7 +349,10 @@ Status Cia402Axis::configure_profile_position(SdoClient& sdo) {
     if (abort != sdo_abort::kNoObject && abort != sdo_abort::kValueRange && abort != sdo_abort::kValueTooHigh)
       return fail(s);
     if (abort != sdo_abort::kNoObject) {
-      if (Status l = sdo.write(node_, od::kMotionProfileType, 0, 0, 2); !l) return fail(l);
+      if (Status l = sdo.write(node_, od::kMotionProfileType, 0,
+                               static_cast<std::uint16_t>(od::kProfileLinearRamp), 2);
+          !l)
+        return fail(l);
     }
     notes_.push_back(who + "0x6086 (motion profile type): no jerk-limited profile offered; the drive runs " +
                      "a linear ramp (trapezoid), no jerk limit");
