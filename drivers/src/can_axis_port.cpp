@@ -150,7 +150,7 @@ void CanAxisPort::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkSt
   for (std::size_t b = 0; b < d_.n_buses; ++b) d_.masters[b].report_link(link);
   for (std::size_t i = 0; i < d_.n_axes; ++i) {
     const CanMaster& m = d_.masters[d_.axes[i].bus()];
-    d_.axes[i].fill_feedback(axes[i], m.bus_off(), d_.configured && m.configured());
+    d_.axes[i].fill_feedback(now, axes[i], m.bus_off(), d_.configured && m.configured());
     link.rx_errors += d_.axes[i].rx_errors();
   }
   // The worst recovery state over the buses: a bus-off first, then a silent node, then ready.
@@ -189,7 +189,10 @@ void CanAxisPort::write_axes(hal::Tick now, const hal::AxisCommands& commands) {
   for (std::size_t b = 0; b < d_.n_buses; ++b) d_.masters[b].start_cycle(now);
   for (std::size_t i = 0; i < d_.n_axes; ++i) {
     CanMaster& m = d_.masters[d_.axes[i].bus()];
-    m.send(d_.axes[i].command(commands[i], stop_all, m.bus_off(), d_.state_timeout_ticks));
+    CanFrame rpdo1{};
+    // (A profile-position axis' RPDO1 goes out only when it changed.)
+    if (d_.axes[i].command(now, commands[i], stop_all, m.bus_off(), d_.state_timeout_ticks, rpdo1))
+      m.send(rpdo1);
   }
 }
 

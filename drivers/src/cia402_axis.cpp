@@ -44,6 +44,17 @@ void Cia402Axis::setup(const CanAxisConfig& a, const CanAxisPortConfig& port) {
   home_offset_counts_ = static_cast<std::int32_t>(std::llround(a.home_offset * a.counts_per_unit));
   homing_speed_ = a.homing_speed;
   homing_accel_ = a.homing_accel;
+  mode_ = a.mode;
+  run_mode_ = mode_ == DriveMode::kProfilePosition ? od::kModeProfilePosition : od::kModeCsp;
+  profile_velocity_ = a.profile_velocity;
+  profile_acceleration_ = a.profile_acceleration;
+  profile_jerk_ = a.profile_jerk;
+  tpdo_inhibit_s_ = port.profile_tpdo_inhibit_s;
+  tpdo_event_timer_s_ = port.profile_tpdo_event_timer_s;
+  state_timeout_s_ = port.state_timeout_s;
+  // A still PP axis' data stays current while its event-timer TPDO keeps coming: one event period, plus
+  // half of one for the drive's and the bus' timing.
+  fresh_ticks_ = static_cast<hal::Tick>(std::ceil(1.5 * tpdo_event_timer_s_ / cycle_period_s_ - 1e-9));
   bring_up_started();
 }
 
@@ -64,7 +75,16 @@ void Cia402Axis::bring_up_started() {
   // After every bring-up (a reset-node, a boot-up) an incremental encoder's count means nothing.
   referenced_ = homing_method_ == 0;
   homing_error_ = homing_commanded_ = false;
-  mode_display_ = od::kModeCsp;
+  mode_display_ = run_mode_;
+  sent_any_ = false;
+  last_sent_ = CanFrame{};
+  last_cmd_target_ = 0.0;
+  pp_have_ = pp_pending_ = pp_moving_ = false;
+  pp_target_ = 0;
+  pp_wait_ticks_ = pp_limit_ticks_ = 0;
+  pp_fault_ = 0;
+  pp_since_ = 0;
+  still_ = false;
 }
 
 void Cia402Axis::brought_up(CanBus& /*bus*/) {
@@ -79,10 +99,19 @@ Status Cia402Axis::configure_profile(SdoClient& sdo) {
   const std::string who = label_ + ": ";
   const auto fail = [&](const Status& s) { return Status::error(who + s.message()); };
 
-  // The drive must offer CSP before we select it.
+  // The drive must offer the mode before we select it.
   Result<std::uint32_t> modes = sdo.read(node, od::kSupportedDriveModes, 0);
   if (!modes) return fail(modes.status());
-  if ((modes.value() & od::kSupportsCspBit) == 0) {
+  const bool pp = mode_ == DriveMode::kProfilePosition;
+  if (pp && (modes.value() & od::kSupportsPpBit) == 0) {
+    char buf[160];
+    std::snprintf(buf, sizeof(buf),
+                  "drive_mode = \"profile\" but the drive does not support profile position (0x6502 = "
+                  "0x%08X, bit 0 clear)",
+                  modes.value());
+    return Status::error(who + buf);
+  }
+  if (!pp && (modes.value() & od::kSupportsCspBit) == 0) {
     char buf[128];
     std::snprintf(buf, sizeof(buf),
                   "the drive does not support cyclic synchronous position (0x6502 = 0x%08X, bit 7 clear)",
@@ -92,15 +121,19 @@ Status Cia402Axis::configure_profile(SdoClient& sdo) {
   if (homing_method_ != 0) {
     if (Status s = configure_homing(sdo, modes.value()); !s) return s;
   }
-  if (Status s = sdo.write(node, od::kModesOfOperation, 0, static_cast<std::uint8_t>(od::kModeCsp), 1); !s) {
+  if (Status s = sdo.write(node, od::kModesOfOperation, 0, static_cast<std::uint8_t>(run_mode_), 1); !s) {
     return fail(s);
   }
   Result<std::uint32_t> display = sdo.read(node, od::kModesOfOperationDisplay, 0);
   if (!display) return fail(display.status());
   const auto shown = static_cast<std::int8_t>(display.value() & 0xFF);
-  if (shown != od::kModeCsp) {
+  if (shown != run_mode_) {
     return Status::error(who + "0x6061 (modes of operation display) reads " + std::to_string(shown) +
-                         " after writing 8 (cyclic synchronous position) to 0x6060");
+                         (pp ? " after writing 1 (profile position) to 0x6060"
+                             : " after writing 8 (cyclic synchronous position) to 0x6060"));
+  }
+  if (pp) {
+    if (Status s = configure_profile_position(sdo); !s) return s;
   }
 
   const auto producer_ms = static_cast<std::uint32_t>(std::lround(sdo_cfg_.heartbeat_producer_s * 1e3));
@@ -175,13 +208,16 @@ Status Cia402Axis::configure_pdos(SdoClient& sdo) {
     std::uint8_t transmission_type;
     bool optional;  // used when the drive has it, noted when absent (TPDO2: velocity and torque)
   };
+  // Profile position: RPDO1 and TPDO1 event-driven (255); TPDO1 with its inhibit time and event timer.
+  const bool pp = mode_ == DriveMode::kProfilePosition;
+  const std::uint8_t pdo1_type = pp ? od::kTransmissionEvent : 1;
   const PdoPlan plans[] = {
       {od::kRpdoComm, od::kRpdoMap, cob::rpdo(1, node),
-       homed ? kRpdo1HomingMapping.data() : kRpdo1Mapping.data(), static_cast<std::uint8_t>(homed ? 3 : 2), 1,
-       false},
+       homed ? kRpdo1HomingMapping.data() : kRpdo1Mapping.data(), static_cast<std::uint8_t>(homed ? 3 : 2),
+       pdo1_type, false},
       {od::kTpdoComm, od::kTpdoMap, cob::tpdo(1, node),
-       homed ? kTpdo1HomingMapping.data() : kTpdo1Mapping.data(), static_cast<std::uint8_t>(homed ? 3 : 2), 1,
-       false},
+       homed ? kTpdo1HomingMapping.data() : kTpdo1Mapping.data(), static_cast<std::uint8_t>(homed ? 3 : 2),
+       pdo1_type, false},
       {static_cast<std::uint16_t>(od::kTpdoComm + 1), static_cast<std::uint16_t>(od::kTpdoMap + 1),
        cob::tpdo(2, node), sdo_cfg_.tpdo2 ? kTpdo2Mapping.data() : nullptr,
        static_cast<std::uint8_t>(sdo_cfg_.tpdo2 ? 2 : 0), sdo_cfg_.tpdo2_every_n_sync, true},
@@ -191,8 +227,9 @@ Status Cia402Axis::configure_pdos(SdoClient& sdo) {
   for (const PdoPlan& p : plans) {
     // A node configured from its EDS (only what differs is written): a PDO that already carries exactly
     // the layout is not re-mapped (no invalidate, no clear).
+    // (A PP drive's TPDO1 gets its inhibit time, which may change only while the PDO is invalid.)
     bool mapped = false;
-    if (sdo.skips_unchanged() && p.entries != nullptr) {
+    if (sdo.skips_unchanged() && p.entries != nullptr && !(pp && p.comm == od::kTpdoComm)) {
       std::array<std::uint32_t, 8> e{};
       Result<std::uint32_t> n = read_map(p.map, e);
       mapped = n && n.value() == p.n_entries;
@@ -258,10 +295,22 @@ Status Cia402Axis::configure_pdos(SdoClient& sdo) {
       if (!fixed_code()) return fail(s);
       Result<std::uint32_t> t = sdo.read(node, p.comm, 2);
       if (!t) return fail(t.status());
-      if (t.value() < 1 || t.value() > 240) {
+      const bool event = t.value() == 254 || t.value() == 255;
+      if (p.transmission_type == od::kTransmissionEvent && !event) {
+        return Status::error(
+            who + describe_object(p.comm, 2) + " = " + std::to_string(t.value()) +
+            " cannot be changed and is not event-driven (254/255), as profile position needs");
+      }
+      if (p.transmission_type != od::kTransmissionEvent && (t.value() < 1 || t.value() > 240)) {
         return Status::error(who + describe_object(p.comm, 2) + " = " + std::to_string(t.value()) +
                              " cannot be changed and is not synchronous (1..240)");
       }
+    }
+    if (pp && p.comm == od::kTpdoComm) {
+      const auto inhibit = static_cast<std::uint32_t>(std::lround(tpdo_inhibit_s_ * 1e4));    // 100 µs
+      const auto timer = static_cast<std::uint32_t>(std::lround(tpdo_event_timer_s_ * 1e3));  // ms
+      if (Status s = sdo.write(node, p.comm, od::kPdoInhibitSub, inhibit, 2); !s) return fail(s);
+      if (Status s = sdo.write(node, p.comm, od::kPdoEventTimerSub, timer, 2); !s) return fail(s);
     }
     if (Status s = sdo.write(node, p.comm, 1, p.cob_id, 4); !s) {
       if (!fixed_code()) return fail(s);
@@ -272,6 +321,42 @@ Status Cia402Axis::configure_pdos(SdoClient& sdo) {
       }
     }
     if (p.comm == od::kTpdoComm + 1) has_tpdo2_ = true;
+  }
+  return Status::ok();
+}
+
+// Profile position: the drive's own profile, from the limits the sequencer plans the axis' moves with
+// (in counts), and its shape as the drive offers it: jerk-limited when it takes 3, else a linear ramp.
+Status Cia402Axis::configure_profile_position(SdoClient& sdo) {
+  const std::string who = label_ + ": ";
+  const auto fail = [&](const Status& s) { return Status::error(who + s.message()); };
+  if (!(profile_velocity_ > 0.0) || !(profile_acceleration_ > 0.0)) {
+    return Status::error(who + "profile position needs the axis' speed and acceleration limits (0x6081, " +
+                         "0x6083): none were given");
+  }
+  const auto counts = [&](double si) {
+    const double c = std::min(si * counts_per_unit_, 4294967295.0);
+    return std::max<std::uint32_t>(1, static_cast<std::uint32_t>(std::llround(c)));
+  };
+  if (Status s = sdo.write(node_, od::kProfileVelocity, 0, counts(profile_velocity_), 4); !s) return fail(s);
+  if (Status s = sdo.write(node_, od::kProfileAcceleration, 0, counts(profile_acceleration_), 4); !s)
+    return fail(s);
+  if (Status s = sdo.write(node_, od::kProfileDeceleration, 0, counts(profile_acceleration_), 4); !s)
+    return fail(s);
+  const auto jerk_limited = static_cast<std::uint16_t>(od::kProfileJerkLimited);
+  if (Status s = sdo.write(node_, od::kMotionProfileType, 0, jerk_limited, 2); !s) {
+    const std::uint32_t abort = sdo.last_abort();
+    if (abort != sdo_abort::kNoObject && abort != sdo_abort::kValueRange && abort != sdo_abort::kValueTooHigh)
+      return fail(s);
+    if (abort != sdo_abort::kNoObject) {
+      if (Status l = sdo.write(node_, od::kMotionProfileType, 0,
+                               static_cast<std::uint16_t>(od::kProfileLinearRamp), 2);
+          !l)
+        return fail(l);
+    }
+    notes_.push_back(who + "0x6086 (motion profile type): no jerk-limited profile offered; the drive runs " +
+                     "a linear ramp (trapezoid), no jerk limit");
+    profile_jerk_ = 0.0;
   }
   return Status::ok();
 }
@@ -320,7 +405,7 @@ void Cia402Axis::on_profile_frame(hal::Tick now, const CanFrame& f) {
       Tpdo1Mode p{};
       if (homing_method_ == 0) {
         const auto q = unpack_tpdo1(f, node_);
-        if (q) p = Tpdo1Mode{q->statusword, q->position_actual, od::kModeCsp};
+        if (q) p = Tpdo1Mode{q->statusword, q->position_actual, run_mode_};
         if (!q) {
           ++rx_errors_;
           return;
@@ -357,6 +442,12 @@ void Cia402Axis::on_profile_frame(hal::Tick now, const CanFrame& f) {
       }
       last_position_si_ = pos;
       refreshed_ = now;
+      // PP: a drive that says it stands (power stage off, or target reached) sends again only on change.
+      const bool can_move = state_ == DriveState::kOperationEnabled ||
+                            state_ == DriveState::kQuickStopActive ||
+                            state_ == DriveState::kFaultReactionActive;
+      still_ = !can_move || (statusword_ & statusword::kTargetReached) != 0;
+      if (mode_ == DriveMode::kProfilePosition && still_ && !tpdo2_wanted_) velocity_ = 0.0;
       // Following error against the target commanded before this feedback (LinuxCNC's velocity-scaled rule).
       if (ferror_min_ > 0.0 && cmd_valid_ && state_ == DriveState::kOperationEnabled &&
           mode_display_ == od::kModeCsp) {
@@ -382,11 +473,12 @@ void Cia402Axis::on_profile_frame(hal::Tick now, const CanFrame& f) {
 }
 
 bool Cia402Axis::faulted() const {
-  return supervisor_.link_fault() != 0 || supervisor_.emcy_code() != 0 || ferror_fault_ ||
+  return supervisor_.link_fault() != 0 || supervisor_.emcy_code() != 0 || ferror_fault_ || pp_fault_ != 0 ||
          state_ == DriveState::kFault || state_ == DriveState::kFaultReactionActive;
 }
 
-void Cia402Axis::fill_feedback(hal::AxisFeedback& fb, bool bus_off, bool bus_configured) const {
+void Cia402Axis::fill_feedback(hal::Tick now, hal::AxisFeedback& fb, bool bus_off,
+                               bool bus_configured) const {
   const bool link_down = bus_off || !bus_configured || !up_;
   const std::uint16_t link_fault = supervisor_.link_fault();
   const std::uint16_t emcy = supervisor_.emcy_code();
@@ -395,6 +487,11 @@ void Cia402Axis::fill_feedback(hal::AxisFeedback& fb, bool bus_off, bool bus_con
   fb.velocity = velocity_;
   fb.effort = effort_;
   fb.refreshed = refreshed_;
+  if (mode_ == DriveMode::kProfilePosition && still_ && refreshed_ != hal::kNeverTick && now >= refreshed_ &&
+      now - refreshed_ <= fresh_ticks_) {
+    // Current now, or, with a set-point on its way, as of the tick it was raised (the drive stood then).
+    fb.refreshed = pp_pending_ || pp_moving_ ? std::max(refreshed_, std::min(now, pp_since_)) : now;
+  }
   fb.referenced = referenced_;
   fb.homing_error = homing_error_;
   fb.following_error = state_ == DriveState::kOperationEnabled && mode_display_ == od::kModeCsp &&
@@ -403,7 +500,7 @@ void Cia402Axis::fill_feedback(hal::AxisFeedback& fb, bool bus_off, bool bus_con
   // An EMCY from a drive that stays enabled is reported by its kind and code alone (the HAL's contract:
   // the sequencer latches drive_emcy and stops every axis, as for a drive fault); `fault` means the drive
   // itself is in Fault (or the link or our own supervision says so).
-  const bool drive_fault = in_fault_state || ferror_fault_;
+  const bool drive_fault = in_fault_state || ferror_fault_ || pp_fault_ != 0;
   fb.fault = link_down || link_fault != 0 || drive_fault || tracker_.timed_out;
   if (link_fault != 0) {
     fb.fault_code = link_fault;
@@ -416,6 +513,9 @@ void Cia402Axis::fill_feedback(hal::AxisFeedback& fb, bool bus_off, bool bus_con
     fb.fault_kind = in_fault_state ? hal::FaultKind::kDrive : hal::FaultKind::kEmcy;
   } else if (ferror_fault_) {
     fb.fault_code = fault_code::kFollowingError;
+    fb.fault_kind = hal::FaultKind::kDrive;
+  } else if (pp_fault_ != 0) {
+    fb.fault_code = pp_fault_;
     fb.fault_kind = hal::FaultKind::kDrive;
   } else if (tracker_.timed_out) {
     fb.fault_code = fault_code::kStateTimeout;
@@ -430,12 +530,13 @@ void Cia402Axis::fill_feedback(hal::AxisFeedback& fb, bool bus_off, bool bus_con
 // itself decided are cleared; a drive still in Fault gets its reset edge through the CiA 402 table.
 void Cia402Axis::acknowledge() {
   ferror_fault_ = false;
+  pp_fault_ = 0;
   homing_error_ = false;
   supervisor_.acknowledge(state_ == DriveState::kFault || state_ == DriveState::kFaultReactionActive);
 }
 
-CanFrame Cia402Axis::command(const hal::AxisCommand& cmd, bool stop_all, bool bus_down,
-                             std::uint32_t state_timeout_ticks) {
+bool Cia402Axis::command(hal::Tick now, const hal::AxisCommand& cmd, bool stop_all, bool bus_down,
+                         std::uint32_t state_timeout_ticks, CanFrame& rpdo1) {
   // A drive we cannot supervise (lost, rebooted, bus-off) gets quick stop, never an enable command.
   const bool lost = supervisor_.link_fault() != 0 || bus_down;
   // A homing run is an enabled drive in homing mode (6) with controlword bit 4 set; an absolute axis has
@@ -449,7 +550,7 @@ CanFrame Cia402Axis::command(const hal::AxisCommand& cmd, bool stop_all, bool bu
   const Cia402Step step = cia402_step(state_, request, tracker_, state_timeout_ticks);
   tracker_ = step.next;
   std::uint16_t controlword = step.controlword;
-  const std::int8_t mode = homing && request == AxisRequest::kEnable ? od::kModeHoming : od::kModeCsp;
+  const std::int8_t mode = homing && request == AxisRequest::kEnable ? od::kModeHoming : run_mode_;
   if (mode == od::kModeHoming && state_ == DriveState::kOperationEnabled &&
       mode_display_ == od::kModeHoming && controlword == controlword::kEnableOperation && !homing_error_) {
     controlword |=
@@ -458,21 +559,99 @@ CanFrame Cia402Axis::command(const hal::AxisCommand& cmd, bool stop_all, bool bu
   }
   if (mode != od::kModeHoming) homing_commanded_ = false;
 
-  // Outside Operation Enabled in CSP the target follows the actual position, so enabling never jumps;
-  // an unreferenced axis is never moved (its count means nothing yet).
+  const bool running = state_ == DriveState::kOperationEnabled &&
+                       step.controlword == controlword::kEnableOperation && mode == run_mode_ &&
+                       mode_display_ == run_mode_ && referenced_;
   std::int64_t target = position_.value();
-  const double wanted = cmd.target_position;
-  if (state_ == DriveState::kOperationEnabled && step.controlword == controlword::kEnableOperation &&
-      mode == od::kModeCsp && mode_display_ == od::kModeCsp && referenced_ && std::isfinite(wanted)) {
-    target = si_to_counts(wanted, counts_per_unit_);
+  if (mode_ == DriveMode::kProfilePosition) {
+    // The target field is the drive's set-point: it changes only with a new one (bit 4 rising), so an
+    // idle axis' RPDO1 stays the same and is not sent.
+    controlword |= profile_setpoint(now, cmd, running && mode != od::kModeHoming, state_timeout_ticks);
+    target = sent_any_ ? last_target_counts_ : position_.value();
+    if ((controlword & controlword::kNewSetpoint) != 0 && mode != od::kModeHoming) target = pp_target_;
+  } else {
+    // Outside Operation Enabled in CSP the target follows the actual position, so enabling never jumps;
+    // an unreferenced axis is never moved (its count means nothing yet).
+    const double wanted = cmd.target_position;
+    if (running && std::isfinite(wanted)) target = si_to_counts(wanted, counts_per_unit_);
   }
   const double cmd_si = counts_to_si(target, counts_per_unit_);
   cmd_velocity_ = cmd_valid_ ? (cmd_si - last_cmd_si_) / cycle_period_s_ : 0.0;
   last_cmd_si_ = cmd_si;
   cmd_valid_ = true;
   last_target_counts_ = target;
-  if (homing_method_ == 0) return pack_rpdo1(node_, Rpdo1{controlword, wire_counts(target)});
-  return pack_rpdo1_mode(node_, Rpdo1Mode{controlword, wire_counts(target), mode});
+  const CanFrame f = homing_method_ == 0
+                         ? pack_rpdo1(node_, Rpdo1{controlword, wire_counts(target)})
+                         : pack_rpdo1_mode(node_, Rpdo1Mode{controlword, wire_counts(target), mode});
+  rpdo1 = f;
+  if (mode_ == DriveMode::kProfilePosition && sent_any_ && f.id == last_sent_.id && f.dlc == last_sent_.dlc &&
+      f.data == last_sent_.data) {
+    return false;  // nothing changed: an event-driven RPDO is not repeated
+  }
+  sent_any_ = true;
+  last_sent_ = f;
+  return true;
+}
+
+// The trapezoid (or jerk-limited trapezoid) the drive runs from 0x6081/0x6083/0x6084 over `distance`,
+// plus a quarter of it and the state timeout for the drive's start and the last TPDO's way back.
+std::uint32_t Cia402Axis::profile_move_ticks(std::int64_t distance_counts) const {
+  const double d = std::abs(static_cast<double>(distance_counts)) / counts_per_unit_;
+  const double v = profile_velocity_, a = profile_acceleration_;
+  double t = d * a >= v * v ? d / v + v / a : 2.0 * std::sqrt(d / a);
+  if (profile_jerk_ > 0.0) t += a / profile_jerk_;
+  const double limit = 1.25 * t + state_timeout_s_;
+  return static_cast<std::uint32_t>(std::ceil(limit / cycle_period_s_));
+}
+
+// Profile position's set-point handshake (CiA 402): the target and bit 4 up; the drive acknowledges with
+// statusword bit 12; bit 4 down; the drive drops bit 12 and reports target reached with bit 10. The
+// set-point is the end of the move the sequencer's per-tick target is on (AxisCommand::move_end) while
+// that target moves or has arrived there, else the per-tick target itself (a hold, a stop: never the end
+// of a move no longer being played). Returns the bits to OR into the controlword.
+std::uint16_t Cia402Axis::profile_setpoint(hal::Tick now, const hal::AxisCommand& cmd, bool running,
+                                           std::uint32_t state_timeout_ticks) {
+  const double t = cmd.target_position;
+  const bool on_move = std::isfinite(cmd.move_end) && (t != last_cmd_target_ || t == cmd.move_end);
+  last_cmd_target_ = t;
+  if (!running) {  // quick stop, disable, fault, homing: the drive forgets its set-point
+    pp_have_ = pp_pending_ = pp_moving_ = false;
+    pp_wait_ticks_ = 0;
+    return 0;
+  }
+  const std::uint16_t handshake = controlword::kNewSetpoint | controlword::kChangeImmediately;
+  const bool ack = (statusword_ & statusword::kSetpointAcknowledge) != 0;
+  if (pp_pending_) {
+    if (!ack) {
+      if (++pp_wait_ticks_ > state_timeout_ticks && pp_fault_ == 0)
+        pp_fault_ = fault_code::kSetpointNotAcknowledged;
+      return handshake;
+    }
+    pp_pending_ = false;  // acknowledged: release bit 4 in this very tick
+    pp_moving_ = true;
+    pp_wait_ticks_ = 0;
+    return 0;
+  }
+  if (pp_moving_) {
+    if (!ack && (statusword_ & statusword::kTargetReached) != 0) {
+      pp_moving_ = false;
+    } else if (++pp_wait_ticks_ > pp_limit_ticks_) {
+      if (pp_fault_ == 0) pp_fault_ = fault_code::kTargetNotReached;
+      pp_moving_ = false;
+    }
+  }
+  const double wanted = on_move ? cmd.move_end : t;
+  if (ack || !std::isfinite(wanted)) return 0;  // the drive still shows the last acknowledge
+  const std::int64_t w = si_to_counts(wanted, counts_per_unit_);
+  if (w == (pp_have_ ? pp_target_ : position_.value())) return 0;
+  pp_limit_ticks_ = profile_move_ticks(w - position_.value());
+  pp_target_ = w;
+  pp_have_ = pp_pending_ = true;
+  pp_moving_ = false;
+  pp_wait_ticks_ = 0;
+  pp_since_ = now;
+  ++pp_setpoints_;
+  return handshake;
 }
 
 }  // namespace loom::drivers

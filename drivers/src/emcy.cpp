@@ -53,6 +53,10 @@ const char* fault_code_text(std::uint16_t code) {
       return "drive rebooted while operating (boot-up received)";
     case fault_code::kNodeNotOperational:
       return "drive left NMT operational";
+    case fault_code::kSetpointNotAcknowledged:
+      return "profile position set-point not acknowledged (statusword bit 12) in time";
+    case fault_code::kTargetNotReached:
+      return "profile position target not reached (statusword bit 10) within the move's time";
     default:
       break;
   }

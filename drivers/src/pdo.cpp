@@ -45,6 +45,14 @@ const char* object_name(std::uint16_t index) {
       return "target position";
     case od::kInterpolationPeriod:
       return "interpolation time period";
+    case od::kProfileVelocity:
+      return "profile velocity";
+    case od::kProfileAcceleration:
+      return "profile acceleration";
+    case od::kProfileDeceleration:
+      return "profile deceleration";
+    case od::kMotionProfileType:
+      return "motion profile type";
     case od::kSupportedDriveModes:
       return "supported drive modes";
     default:

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "loom/motion/angles.hpp"
 
@@ -278,8 +279,11 @@ void RowKnotter::start_cycle(hal::Tick now) noexcept {
 
 RowKnotter::Status RowKnotter::check(hal::Tick now, const hal::HalInputs& in, const hal::HalOutputs& cmd,
                                      KnotCounters& counters, const StepInputs& s) noexcept {
-  // Every servo where it was sent (a drive trails its command by a few ticks: settle_s).
-  const bool settled = seconds(now - phase_since_) >= k_.settle_s;
+  // Every servo where it was sent (a drive trails its command by a few ticks: settle_s; a selector whose
+  // drive runs its own profile, selector_settle_s).
+  const double since = seconds(now - phase_since_);
+  const bool settled = since >= k_.settle_s;
+  const bool selector_settled = since >= (k_.selector_settle_s > 0.0 ? k_.selector_settle_s : k_.settle_s);
   for (int h = 0; h < heads_; ++h) {
     const auto hh = static_cast<std::size_t>(h);
     const auto sel = static_cast<std::size_t>(k_.selector_axis[hh]);
@@ -289,7 +293,7 @@ RowKnotter::Status RowKnotter::check(hal::Tick now, const hal::HalInputs& in, co
     const bool kn_off =
         std::abs(in.axes[kn].position - cmd.axes[kn].target_position) > k_.servo_tolerance_rad;
     if (!sel_off && !kn_off) continue;
-    if (!settled) return Status::kRunning;
+    if ((sel_off && !selector_settled) || (kn_off && !settled)) return Status::kRunning;
     fail(sel_off ? Fault::kSelectorJam : Fault::kKnotServoLag, static_cast<int>(sel_off ? sel : kn));
     return Status::kFault;
   }
@@ -529,8 +533,12 @@ RowKnotter::Status RowKnotter::step(hal::Tick now, const hal::HalInputs& in, hal
   bool selectors_moving = false;
   for (int h = 0; h < heads_; ++h) {
     const auto hh = static_cast<std::size_t>(h);
-    selectors_moving |= play(selector_move_[hh], now,
-                             cmd.axes[static_cast<std::size_t>(k_.selector_axis[hh])].target_position);
+    hal::AxisCommand& sel = cmd.axes[static_cast<std::size_t>(k_.selector_axis[hh])];
+    const bool playing = play(selector_move_[hh], now, sel.target_position);
+    // The move's end, for a drive that takes one set-point per move (profile position); none otherwise.
+    sel.move_end = playing ? selector_move_[hh].origin + selector_move_[hh].move.distance()
+                           : std::numeric_limits<double>::quiet_NaN();
+    selectors_moving |= playing;
     cmd.io.gripper_close[hh] = false;
     cmd.io.cutter[hh] = false;
   }

@@ -540,5 +540,79 @@ TEST(HilJudgeMasterLoss, EveryConsumerMustReactInTime) {
   EXPECT_FALSE(check_master_loss(parse_log(ok), {1, 4}, 127, 0.100, 0.01).ok);  // too late for 100 ms
 }
 
+// ---------------------------------------------------------------------------------------------------
+// Profile position
+// ---------------------------------------------------------------------------------------------------
+// A profile-position drive (node 21): mode 1 and the 10 ms inhibit time written, started; then 2 ms SYNC
+// cycles in which the master sends an RPDO1 only on change: enable, one set-point (bit 4) that the drive
+// acknowledges (bit 12) before its release, the move, reported every 10 ms by the event-driven TPDO1.
+struct PpScript {
+  bool repeat_rpdo = false;  // the master sends the enabled RPDO1 again unchanged
+  bool release_before_ack = false;
+  std::int64_t tpdo_every_us = 10000;
+  unsigned inhibit = 100;  // 0x1800:03 written
+};
+
+std::vector<Frame> pp_log(const PpScript& s) {
+  Bus bus;
+  bus.frame(0x000, {0x81, 0x00});
+  bus.frame(0x715, {0x00});
+  bus.frame(0x615, {0x2F, 0x60, 0x60, 0x00, 0x01, 0, 0, 0});
+  bus.frame(0x595, {0x60, 0x60, 0x60, 0x00, 0, 0, 0, 0});
+  bus.frame(0x615, {0x2B, 0x00, 0x18, 0x03, s.inhibit & 0xFFU, s.inhibit >> 8U, 0, 0});
+  bus.frame(0x595, {0x60, 0x00, 0x18, 0x03, 0, 0, 0, 0});
+  bus.frame(0x000, {0x01, 0x00});
+  std::int64_t next_tpdo = 0, t = 0;
+  std::uint16_t sw = 0x0637;  // enabled, target reached
+  for (int k = 0; k < 300; ++k, t += 2000) {
+    bus.frame(0x080, {});
+    if (k == 20) sw = 0x1237;  // the set-point acknowledged, moving
+    if (k == 24) sw = 0x0237;
+    if (k == 80) sw = 0x0637;  // arrived
+    if (t >= next_tpdo) {
+      bus.pdo(0x195, sw, 1000 + (k >= 20 ? std::min(k - 20, 60) * 100 : 0));
+      next_tpdo = t + s.tpdo_every_us;
+    }
+    if (k == 2) bus.pdo(0x215, 0x000F, 1000);
+    if (k == 3 && s.repeat_rpdo) bus.pdo(0x215, 0x000F, 1000);
+    const int setpoint_k = s.release_before_ack ? 16 : 19;  // the acknowledge is in the TPDO of cycle 20
+    if (k == setpoint_k) bus.pdo(0x215, 0x003F, 7000);
+    if (k == setpoint_k + (s.release_before_ack ? 1 : 3)) bus.pdo(0x215, 0x000F, 7000);
+    bus.advance(2000 - 50 * 3);
+  }
+  return bus.frames();
+}
+
+TEST(HilJudgeProfilePosition, AConformingExchangePasses) {
+  const auto r = check_profile_position(pp_log({}), {21}, 0.010, 1);
+  EXPECT_TRUE(r.ok) << r.failure;
+  ASSERT_FALSE(r.notes.empty());
+  EXPECT_NE(r.notes[0].find("1 set-points"), std::string::npos) << r.notes[0];
+}
+
+TEST(HilJudgeProfilePosition, EachBrokenRuleIsCaughtAndNamed) {
+  PpScript repeat;
+  repeat.repeat_rpdo = true;
+  auto r = check_profile_position(pp_log(repeat), {21}, 0.010, 1);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.failure.find("repeated unchanged"), std::string::npos) << r.failure;
+  PpScript early;
+  early.release_before_ack = true;
+  r = check_profile_position(pp_log(early), {21}, 0.010, 1);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.failure.find("before the drive acknowledged"), std::string::npos) << r.failure;
+  PpScript close;
+  close.tpdo_every_us = 6000;
+  r = check_profile_position(pp_log(close), {21}, 0.010, 1);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.failure.find("inhibit time"), std::string::npos) << r.failure;
+  PpScript inhibit;
+  inhibit.inhibit = 50;
+  r = check_profile_position(pp_log(inhibit), {21}, 0.010, 1);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.failure.find("0x1800:03"), std::string::npos) << r.failure;
+  EXPECT_FALSE(check_profile_position(pp_log({}), {21}, 0.010, 2).ok);  // one set-point, two wanted
+}
+
 }  // namespace
 }  // namespace loom::hil

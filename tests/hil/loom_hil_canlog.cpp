@@ -121,6 +121,18 @@ int main(int argc, char** argv) {
       ->required()
       ->check(CLI::Range(1, 100000));
 
+  double inhibit_ms = 10.0;
+  int min_moves = 1;
+  auto* pp = app.add_subcommand("profile-position",
+                                "profile-position drives: RPDO1 on change only, set-point handshake, TPDO1 "
+                                "inhibit time");
+  pp->add_option("log", log, "candump -L log")->required();
+  pp->add_option("--nodes", nodes, "drive node ids")->required()->delimiter(',')->check(CLI::Range(1, 127));
+  pp->add_option("--inhibit-ms", inhibit_ms, "TPDO1 inhibit time the master writes (0x1800:03)")
+      ->check(CLI::Range(0.1, 6553.5));
+  pp->add_option("--min-moves", min_moves, "set-points each node must have had")
+      ->check(CLI::Range(0, 100000));
+
   int max_late = 1000000;
   auto* lag =
       app.add_subcommand("feedback-lag", "each drive's TPDO1 answers the SYNC right before it (the rig)");
@@ -147,6 +159,10 @@ int main(int argc, char** argv) {
   if (io->parsed())
     return report("I/O traffic", loom::hil::check_io_traffic(frames, io_node, second_switches));
   if (knotting->parsed()) return report("knotting", loom::hil::check_knotting(frames, io_node, knots));
+  if (pp->parsed()) {
+    return report("profile position",
+                  loom::hil::check_profile_position(frames, nodes, inhibit_ms * 1e-3, min_moves));
+  }
   if (lag->parsed()) return report("feedback lag", loom::hil::check_feedback_lag(frames, nodes, max_late));
   if (emcy->parsed()) return report("EMCY stop", loom::hil::check_emcy_stop(frames, nodes, emcy_node));
   if (mloss->parsed()) {

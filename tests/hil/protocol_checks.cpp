@@ -283,6 +283,132 @@ CheckResult check_weave_protocol(const std::vector<Frame>& fs, const std::vector
 }
 
 // ---------------------------------------------------------------------------------------------------
+// Profile position
+// ---------------------------------------------------------------------------------------------------
+CheckResult check_profile_position(const std::vector<Frame>& fs, const std::vector<int>& nodes,
+                                   double inhibit_s, int min_moves, double slack_s, const PdoLayout& l) {
+  CheckResult r;
+  if (fs.empty()) return fail(r, "the log holds no frames");
+  constexpr std::uint16_t kNewSetpoint = 1U << 4;
+  constexpr std::uint16_t kSetpointAck = 1U << 12;
+  const auto inhibit_100us = static_cast<std::uint32_t>(std::lround(inhibit_s * 1e4));
+  for (const int n : nodes) {
+    const std::string tag = node_tag(n);
+    // Expedited download request 0x2F/0x2B/0x23 (size bits vary) to 0x600+id, and its ack 0x60.
+    const Index mode_dl = find_from(fs, 0, [&](const Frame& f) {
+      return is_sdo(f, 0x600, n, 0x6060, 0) && (f.data[0] & 0xE3U) == 0x23U && f.data[4] == 1;
+    });
+    if (!mode_dl) return fail(r, tag + "no SDO download of 0x6060:00 = 1 (profile position)");
+    const Index mode_ack = find_from(fs, *mode_dl + 1, [&](const Frame& f) {
+      return is_sdo(f, 0x580, n, 0x6060, 0) && f.data[0] == 0x60;
+    });
+    if (!mode_ack) return fail(r, tag + "0x6060 = 1 not acknowledged after " + show(fs, *mode_dl));
+    const Index inhibit_dl = find_from(fs, 0, [&](const Frame& f) {
+      return is_sdo(f, 0x600, n, 0x1800, 3) && (f.data[0] & 0xE3U) == 0x23U;
+    });
+    if (!inhibit_dl) return fail(r, tag + "no SDO download of 0x1800:03 (TPDO1 inhibit time)");
+    if (fs[*inhibit_dl].u16(4) != inhibit_100us) {
+      return fail(r, tag + "0x1800:03 written " + std::to_string(fs[*inhibit_dl].u16(4)) + ", not " +
+                         std::to_string(inhibit_100us) + " (100 µs units): " + show(fs, *inhibit_dl));
+    }
+    const Index start = find_from(fs, *mode_ack + 1, [&](const Frame& f) { return is_nmt(f, kNmtStart, n); });
+    if (!start) return fail(r, tag + "no NMT start after 0x6060 = 1");
+
+    std::size_t syncs = 0, rpdos = 0, tpdos = 0;
+    int moves = 0;
+    Index last_rpdo, last_tpdo;
+    bool pending = false;        // a set-point RPDO not yet released
+    std::size_t pending_at = 0;  // its index
+    bool acked = false;
+    std::size_t syncs_at_last_rpdo = 0;
+    std::int64_t min_gap_us = -1;
+    for (std::size_t i = *start + 1; i < fs.size(); ++i) {
+      const Frame& f = fs[i];
+      if (is_sync(f)) {
+        ++syncs;
+        continue;
+      }
+      if (const auto sw = statusword(f, n, l)) {
+        ++tpdos;
+        if (last_tpdo) {
+          const std::int64_t gap = f.t_us - fs[*last_tpdo].t_us;
+          if (min_gap_us < 0 || gap < min_gap_us) min_gap_us = gap;
+          if (static_cast<double>(gap) < (inhibit_s - slack_s) * 1e6) {
+            return fail(r, tag + "TPDO1 " + std::to_string(gap) + " µs after the one before (inhibit time " +
+                               std::to_string(inhibit_s * 1e3) + " ms): " + show(fs, *last_tpdo) + " then " +
+                               show(fs, i));
+          }
+        }
+        last_tpdo = i;
+        if (pending && (*sw & kSetpointAck) != 0) acked = true;
+        continue;
+      }
+      const auto cw = controlword(f, n, l);
+      const auto tg = target(f, n, l);
+      if (!cw || !tg) continue;
+      ++rpdos;
+      if (last_rpdo) {
+        const auto pcw = *controlword(fs[*last_rpdo], n, l);
+        const auto ptg = *target(fs[*last_rpdo], n, l);
+        if (pcw == *cw && ptg == *tg) {
+          return fail(r, tag + "RPDO1 repeated unchanged (profile position sends on change only): " +
+                             show(fs, *last_rpdo) + " then " + show(fs, i));
+        }
+        if (syncs == syncs_at_last_rpdo) {
+          return fail(
+              r, tag + "two RPDO1s in one SYNC interval: " + show(fs, *last_rpdo) + " then " + show(fs, i));
+        }
+        const bool rising = (*cw & kNewSetpoint) != 0 && (pcw & kNewSetpoint) == 0;
+        const bool falling = (*cw & kNewSetpoint) == 0 && (pcw & kNewSetpoint) != 0;
+        if (falling && pending) {
+          if (!acked) {
+            return fail(
+                r, tag + "set-point released (bit 4 falling) before the drive acknowledged it (bit 12): " +
+                       show(fs, pending_at) + " then " + show(fs, i));
+          }
+          if (*tg != *target(fs[pending_at], n, l)) {
+            return fail(r, tag + "the release carries another target than its set-point: " + show(fs, i));
+          }
+          pending = false;
+        }
+        if (rising) {
+          if (pending) {
+            return fail(r, tag + "a new set-point before the last one was released: " + show(fs, i));
+          }
+          pending = true;
+          pending_at = i;
+          acked = false;
+          ++moves;
+        }
+      } else if ((*cw & kNewSetpoint) != 0) {
+        pending = true;
+        pending_at = i;
+        acked = false;
+        ++moves;
+      }
+      last_rpdo = i;
+      syncs_at_last_rpdo = syncs;
+    }
+    if (moves < min_moves) {
+      return fail(r, tag + std::to_string(moves) + " set-points after the NMT start (expected at least " +
+                         std::to_string(min_moves) + ")");
+    }
+    if (4 * rpdos > syncs) {
+      return fail(r, tag + std::to_string(rpdos) + " RPDO1s for " + std::to_string(syncs) +
+                         " SYNCs: not event-driven (more than one in four)");
+    }
+    if (tpdos == 0) return fail(r, tag + "no TPDO1 after the NMT start");
+    r.notes.push_back(tag + "0x6060=1 line " + std::to_string(fs[*mode_dl].line) +
+                      ", 0x1800:03=" + std::to_string(inhibit_100us) + " line " +
+                      std::to_string(fs[*inhibit_dl].line) + "; after start " + std::to_string(syncs) +
+                      " SYNC, " + std::to_string(rpdos) + " RPDO1 (" + std::to_string(moves) +
+                      " set-points, each acknowledged and released), " + std::to_string(tpdos) +
+                      " TPDO1, closest two " + std::to_string(min_gap_us) + " µs apart");
+  }
+  return r;
+}
+
+// ---------------------------------------------------------------------------------------------------
 // Heartbeat loss
 // ---------------------------------------------------------------------------------------------------
 CheckResult check_heartbeat_loss(const std::vector<Frame>& fs, const std::vector<int>& nodes,

@@ -57,6 +57,16 @@ CheckResult check_heartbeat_loss(const std::vector<Frame>& frames, const std::ve
                                  double heartbeat_s, int periods, const PdoLayout& layout = {},
                                  double master_cycle_s = 0.0);
 
+// Profile position (CiA 402 mode 1) drives, per node: 0x6060:00 = 1 downloaded and acknowledged, and
+// 0x1800:03 (TPDO1 inhibit time) = `inhibit_s` in 100 µs; after the NMT start, every RPDO1 to the node
+// differs from the one before (sent on change only) and none shares a SYNC interval with another; every
+// new set-point (controlword bit 4 rising) is acknowledged by a TPDO1 with statusword bit 12, and only
+// then released (bit 4 falling, same target); at least `min_moves` set-points; far fewer RPDO1s than
+// SYNCs (not cyclic); and no two TPDO1s closer than the inhibit time (less `slack_s` for timestamping).
+CheckResult check_profile_position(const std::vector<Frame>& frames, const std::vector<int>& nodes,
+                                   double inhibit_s, int min_moves, double slack_s = 0.001,
+                                   const PdoLayout& layout = {});
+
 }  // namespace loom::hil
 
 namespace loom::hil {

@@ -92,6 +92,9 @@ const std::vector<AxisKeyInfo>& axis_keys() {
       {"axes.<name>.store_config",
        "true | false; default false: after a bring-up that wrote anything, 0x1010:01 = \"save\" (needs "
        "its eds with a writable 0x1010:01)"},
+      {"axes.<name>.drive_mode",
+       "cyclic | profile; default cyclic (a set-point every SYNC); profile = CiA 402 profile position, "
+       "one set-point per move and event-driven PDOs (role selector only)"},
   };
   return k;
 }
@@ -111,6 +114,7 @@ std::string axes_text(const LoomConfig& c) {
     }
     if (!a.eds.empty()) os << " eds " << a.eds;
     if (a.store_config) os << " store";
+    if (a.profile_position) os << " profile";
     os << "]";
   }
   return os.str();
@@ -215,6 +219,15 @@ void read_axes(TomlReader& r, LoomConfig& c, bool extending) {
     read_referencing(r, node, p, a, is_new);
     read_eds_key(r, p + "eds", a.eds);
     r.boolean(p + "store_config", a.store_config);
+    std::string mode = a.profile_position ? "profile" : "cyclic";
+    r.string(p + "drive_mode", mode, {"cyclic", "profile"});
+    if (mode == "profile" && a.role != hal::AxisRole::kSelector) {
+      r.fail(p + "drive_mode", "\"profile\"",
+             "profile position is for axes that move point to point between knots: the colour selectors "
+             "(role = \"selector\"); this axis has role = \"" +
+                 std::string(hal::axis_role_name(a.role)) + "\"");
+    }
+    a.profile_position = mode == "profile";
   }
   // Slot order: the core roles first (slots 0..2), then the others by name (toml++ keeps keys sorted).
   std::stable_sort(c.axes.begin(), c.axes.end(), [](const AxisSpec& x, const AxisSpec& y) {

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "drives.hpp"
+#include "loom/drivers/can_axis_config.hpp"
 #include "loom/motion/dynamics.hpp"
 #include "loom/motion/errors.hpp"
 #include "loom/motion/mass_properties.hpp"
@@ -138,6 +139,15 @@ void derive(LoomConfig& c, const Fail& fail) {
       k.selector = {.velocity = selector_speed,
                     .acceleration = c.knotting.selector_accel_rad_s2,
                     .jerk = c.knotting.selector_jerk_rad_s3};
+    }
+    // Selectors in profile position: their drive's profile starts a tick or two after the plan's and is
+    // reported on change, at most once per TPDO inhibit time; they may be measured that much later.
+    bool profile_selectors = false;
+    for (const AxisSpec& a : c.axes)
+      profile_selectors |= a.role == hal::AxisRole::kSelector && a.profile_position;
+    if (profile_selectors) {
+      k.selector_settle_s =
+          k.settle_s + drivers::CanAxisPortConfig{}.profile_tpdo_inhibit_s + 2.0 * t.period_s;
     }
   }
   s.debounce_ticks = c.run.debounce_ticks;

@@ -56,6 +56,13 @@ drivers::CanAxisPortConfig can_axis_config(const LoomConfig& c) {
     d.ferror_k_s = a.ferror_k_s;
     d.boot_timeout_s = a.boot_ms * 1e-3;
     d.operational_timeout_s = a.operational_ms * 1e-3;
+    if (a.profile_position) {
+      // The drive runs the selectors' own move limits (the ones the sequencer plans their moves with).
+      d.mode = drivers::DriveMode::kProfilePosition;
+      d.profile_velocity = c.sequencer.heads.selector.velocity;
+      d.profile_acceleration = c.sequencer.heads.selector.acceleration;
+      d.profile_jerk = c.sequencer.heads.selector.jerk;
+    }
     if (a.homing) {  // CiA 402 homing run over CAN (0x6098, 0x607C, 0x6099, 0x609A)
       d.homing_method = static_cast<std::int8_t>(a.homing_method);
       d.home_offset = a.home_offset;

@@ -36,6 +36,10 @@ constexpr std::uint16_t kVelocityActual = 0x606C;
 constexpr std::uint16_t kTorqueActual = 0x6077;
 constexpr std::uint16_t kTargetPosition = 0x607A;
 constexpr std::uint16_t kHomeOffset = 0x607C;
+constexpr std::uint16_t kProfileVelocity = 0x6081;
+constexpr std::uint16_t kProfileAcceleration = 0x6083;
+constexpr std::uint16_t kProfileDeceleration = 0x6084;
+constexpr std::uint16_t kMotionProfileType = 0x6086;
 constexpr std::uint16_t kHomingMethod = 0x6098;
 constexpr std::uint16_t kHomingSpeeds = 0x6099;
 constexpr std::uint16_t kHomingAcceleration = 0x609A;
@@ -45,10 +49,15 @@ constexpr std::uint16_t kSupportedModes = 0x6502;
 constexpr std::uint32_t kDeviceTypeServo402 = 0x00020192;  // profile 402, servo drive
 constexpr std::int8_t kModeCsp = 8;
 constexpr std::int8_t kModeHoming = 6;
-constexpr std::uint32_t kModesPpPv = 0x05;         // 0x6502 bits 0 (pp) and 2 (pv)
-constexpr std::uint32_t kModeCspBit = 1U << 7;     // 0x6502 bit 7 (csp)
-constexpr std::uint32_t kModeHomingBit = 1U << 5;  // 0x6502 bit 5 (hm)
-constexpr std::uint16_t kCwHomingStart = 1U << 4;  // controlword bit 4 in homing mode
+constexpr std::int8_t kModePp = 1;
+constexpr std::uint32_t kModePpBit = 1U << 0;       // 0x6502 bit 0 (pp)
+constexpr std::uint32_t kModePvBit = 1U << 2;       // 0x6502 bit 2 (pv; announced, not simulated)
+constexpr std::uint16_t kCwNewSetpoint = 1U << 4;   // controlword bit 4 in profile position
+constexpr std::uint16_t kSwSetpointAck = 1U << 12;  // statusword bit 12 in profile position
+constexpr std::uint32_t kModesPpPv = 0x05;          // 0x6502 bits 0 (pp) and 2 (pv)
+constexpr std::uint32_t kModeCspBit = 1U << 7;      // 0x6502 bit 7 (csp)
+constexpr std::uint32_t kModeHomingBit = 1U << 5;   // 0x6502 bit 5 (hm)
+constexpr std::uint16_t kCwHomingStart = 1U << 4;   // controlword bit 4 in homing mode
 constexpr std::uint16_t kSwHomingAttained = 1U << 12;
 constexpr std::uint16_t kSwHomingError = 1U << 13;
 constexpr std::int8_t kInterpolationIndexMin = -6;  // 0x60C2:02, 10^index s: µs … s
@@ -61,7 +70,7 @@ namespace cob = slave::cob;
 
 constexpr slave::Objects<5> kCommunicationObjects = slave::communication_objects(kDeviceTypeServo402);
 
-constexpr slave::Objects<19> kDriveObjects{{
+constexpr slave::Objects<23> kDriveObjects{{
     {kErrorCode, 0, 2, Access::kRo, Pdo::kTx, 0},
     {kControlword, 0, 2, Access::kRw, Pdo::kRx, 0},
     {kStatusword, 0, 2, Access::kRo, Pdo::kTx, 0},
@@ -72,6 +81,10 @@ constexpr slave::Objects<19> kDriveObjects{{
     {kTorqueActual, 0, 2, Access::kRo, Pdo::kTx, 0},  // ideal tracking needs no torque: always 0
     {kTargetPosition, 0, 4, Access::kRw, Pdo::kRx, 0},
     {kHomeOffset, 0, 4, Access::kRw, Pdo::kNone, 0},
+    {kProfileVelocity, 0, 4, Access::kRw, Pdo::kNone, 100000},       // counts/s
+    {kProfileAcceleration, 0, 4, Access::kRw, Pdo::kNone, 1000000},  // counts/s²
+    {kProfileDeceleration, 0, 4, Access::kRw, Pdo::kNone, 1000000},  // counts/s²
+    {kMotionProfileType, 0, 2, Access::kRw, Pdo::kNone, 0},          // linear ramp
     {kHomingMethod, 0, 1, Access::kRw, Pdo::kNone, 37},
     {kHomingSpeeds, 0, 1, Access::kConst, Pdo::kNone, 2},
     {kHomingSpeeds, 1, 4, Access::kRw, Pdo::kNone, 10000},  // search for switch, counts/s
@@ -98,7 +111,7 @@ constexpr auto kTable = slave::concat(
     pdo_map(0x1601),
     pdo_map(0x1602),
     pdo_map(0x1603),
-    pdo_comm(0x1800, cob::kTpdo1, 1),
+    slave::tpdo_comm_timed(0x1800, cob::kTpdo1, 1),
     pdo_comm(0x1801, cob::kTpdo2, 1),
     pdo_comm(0x1802, cob::kTpdo3 | cob::kPdoInvalid, 1),
     pdo_comm(0x1803, cob::kTpdo4 | cob::kPdoInvalid, 1),
@@ -142,16 +155,23 @@ void SimDriveNode::reset_communication() {
   master_lost_ = false;
   rpdos_.clear();
   syncs_ = 0;
+  tpdo_sent_us_.fill(-1);
+  tpdo_dlc_.fill(0);
+  tpdo_held_.fill(false);
 }
 
 void SimDriveNode::reset_application() {
   od_.reset_application();
   if (config_.dictionary.empty()) {  // a described drive's 0x6502 is its description's
     od_.set(kSupportedModes, 0,
-            kModesPpPv | (config_.supports_csp ? kModeCspBit : 0U) |
+            kModePvBit | (config_.supports_pp ? kModePpBit : 0U) | (config_.supports_csp ? kModeCspBit : 0U) |
                 (config_.supports_homing ? kModeHomingBit : 0U));
   }
   homing_running_ = homing_attained_ = homing_error_ = false;
+  pp_latch_ = pp_ack_ = pp_active_ = false;
+  pp_goal_ = position_;
+  pp_pos_ = position_;
+  pp_vel_ = 0.0;
   state_ = drive_settle(DriveState::kNotReadyToSwitchOn);
   controlword_ = 0;
   od_.set(kTargetPosition, 0, static_cast<std::uint32_t>(position_));  // no jump when first enabled
@@ -249,18 +269,103 @@ void SimDriveNode::on_sdo(const CanFrame& f, std::int64_t now_us) {
 void SimDriveNode::on_rpdo(int pdo, const CanFrame& f, std::int64_t now_us) {
   if (!rpdos_.receive(od_, *this, pdo, f, now_us)) {
     send(slave::emcy(config_.node_id, slave::emcy_code::kPdoLength, error_register_));
+    return;
   }
+  latch_setpoint();  // (an event-driven RPDO's objects are all written now, target included)
+  send_event_tpdos(now_us);
 }
 
 void SimDriveNode::on_sync(std::int64_t now_us) {
   ++syncs_;
   rpdos_.apply_at_sync(od_, *this, now_us);
+  latch_setpoint();
   previous_position_ = position_;
   track_target();
   run_homing();
+  run_profile();
   send_tpdos();
+  send_event_tpdos(now_us);
   // The fault reaction (a ramp in a real drive) completes before the next SYNC.
   if (state_ == DriveState::kFaultReactionActive) state_ = drive_settle(state_);
+}
+
+// Profile position: the target becomes the set-point on bit 4's rising edge (with bit 5 or not: the
+// simulation always changes immediately, from where the axis is and at the speed it has), acknowledged
+// with bit 12 until bit 4 falls.
+void SimDriveNode::latch_setpoint() {
+  if (!pp_latch_) return;
+  pp_latch_ = false;
+  if (state_ != DriveState::kOperationEnabled || mode() != kModePp) return;
+  pp_goal_ = target();
+  pp_active_ = true;
+  pp_ack_ = true;
+  ++pp_latched_;
+}
+
+double SimDriveNode::sync_period_s() const {
+  return static_cast<double>(od_.get(kInterpolationPeriod, 1)) *
+         std::pow(10.0, static_cast<std::int8_t>(od_.get(kInterpolationPeriod, 2)));
+}
+
+// One SYNC of the drive's own trapezoidal profile (0x6081 speed, 0x6083 acceleration, 0x6084
+// deceleration): the speed that still stops at the goal, reached at the allowed rate.
+void SimDriveNode::run_profile() {
+  if (state_ != DriveState::kOperationEnabled || mode() != kModePp) {
+    pp_active_ = false;  // quick stop, disable, fault: the move is abandoned where the axis is
+    pp_vel_ = 0.0;
+    pp_pos_ = position_;
+    return;
+  }
+  if (!pp_active_) return;
+  const double dt = sync_period_s();
+  const double vmax = std::max(1.0, static_cast<double>(od_.get(kProfileVelocity, 0)));
+  const double acc = std::max(1.0, static_cast<double>(od_.get(kProfileAcceleration, 0)));
+  const double dec = std::max(1.0, static_cast<double>(od_.get(kProfileDeceleration, 0)));
+  const double d = static_cast<double>(pp_goal_) - pp_pos_;
+  const double dir = d >= 0.0 ? 1.0 : -1.0;
+  // Highest speed toward the goal from which deceleration still stops there (discrete: one step late).
+  const double v_stop = std::sqrt(2.0 * dec * std::abs(d)) - 0.5 * dec * dt;
+  const double wanted = dir * std::min(vmax, std::max(0.0, v_stop));
+  const double step = (wanted > pp_vel_ ? acc : dec) * dt;
+  pp_vel_ = std::clamp(wanted, pp_vel_ - step, pp_vel_ + step);
+  pp_pos_ += pp_vel_ * dt;
+  if (std::abs(static_cast<double>(pp_goal_) - pp_pos_) <= std::max(1.0, std::abs(pp_vel_) * dt * 0.5) ||
+      (static_cast<double>(pp_goal_) - pp_pos_) * dir < 0.0) {
+    pp_pos_ = pp_goal_;  // arrived (or would pass it): standing at the goal
+    pp_vel_ = 0.0;
+    pp_active_ = false;
+  }
+  position_ = static_cast<std::int32_t>(std::llround(pp_pos_));
+}
+
+// TPDOs with an event-driven transmission type: on change, never closer than the inhibit time, and at
+// least every event timer period (0 = no timer).
+void SimDriveNode::send_event_tpdos(std::int64_t now_us) {
+  if (nmt_ != nmt::kOperational) return;
+  publish();
+  for (int k = 0; k < slave::kPdos; ++k) {
+    const auto comm = static_cast<std::uint16_t>(slave::kTpdoComm + k);
+    const std::uint8_t type = od_.pdo_type(comm);
+    if (!od_.pdo_valid(comm) || (type != 254 && type != 255)) continue;
+    const auto kk = static_cast<std::size_t>(k);
+    std::array<std::uint8_t, 8> data{};
+    const std::uint8_t dlc = od_.pack_tpdo(k, data);
+    const std::int64_t inhibit_us = static_cast<std::int64_t>(od_.get(comm, 3)) * 100;
+    const std::int64_t timer_us = static_cast<std::int64_t>(od_.get(comm, 5)) * 1000;
+    const std::int64_t last = tpdo_sent_us_[kk];
+    const bool changed = last < 0 || dlc != tpdo_dlc_[kk] || data != tpdo_data_[kk] || tpdo_held_[kk];
+    const bool timer_due = timer_us > 0 && last >= 0 && now_us - last >= timer_us;
+    if (!changed && !timer_due) continue;
+    if (last >= 0 && now_us - last < inhibit_us) {
+      tpdo_held_[kk] = changed;  // sent when the inhibit time is over
+      continue;
+    }
+    send(slave::pdo_frame(od_.pdo_can_id(comm), dlc, data));
+    tpdo_sent_us_[kk] = now_us;
+    tpdo_data_[kk] = data;
+    tpdo_dlc_[kk] = dlc;
+    tpdo_held_[kk] = false;
+  }
 }
 
 // CSP with ideal tracking: the actual position becomes the target, unless the step is larger than the
@@ -302,6 +407,12 @@ std::uint16_t SimDriveNode::statusword() const {
     std::uint16_t sw = drive_statusword(state_, false, !homing_running_, false);
     if (homing_attained_) sw |= kSwHomingAttained;
     if (homing_error_) sw = static_cast<std::uint16_t>(sw | kSwHomingError);
+    return sw;
+  }
+  if (mode() == kModePp) {
+    // Bit 12 set-point acknowledge, bit 10 target reached (the profile is over, standing at its goal).
+    std::uint16_t sw = drive_statusword(state_, false, !pp_active_, false);
+    if (pp_ack_ && state_ == DriveState::kOperationEnabled) sw |= kSwSetpointAck;
     return sw;
   }
   return drive_statusword(state_, mode() == kModeCsp, position_ == target(), following_error_);
@@ -393,6 +504,9 @@ void SimDriveNode::set_controlword(std::uint16_t cw) {
     homing_attained_ = homing_error_ = false;
     homing_syncs_ = 0;
   }
+  if (mode() == kModePp && (cw & kCwNewSetpoint) != 0 && (controlword_ & kCwNewSetpoint) == 0)
+    pp_latch_ = true;
+  if ((cw & kCwNewSetpoint) == 0) pp_ack_ = false;  // the master released bit 4: ready for the next one
   state_ = drive_apply_controlword(state_, cw, controlword_);
   controlword_ = cw;
   if (before == DriveState::kFault && state_ != DriveState::kFault) {
@@ -429,9 +543,18 @@ std::uint32_t SimDriveNode::check(std::uint16_t index, std::uint8_t sub, std::ui
     const auto mode = static_cast<std::int8_t>(value);
     const bool csp_offered = (od_.get(kSupportedModes, 0) & kModeCspBit) != 0;
     const bool homing_offered = (od_.get(kSupportedModes, 0) & kModeHomingBit) != 0;
-    return (mode == 0 || (mode == kModeCsp && csp_offered) || (mode == kModeHoming && homing_offered))
+    const bool pp_offered = (od_.get(kSupportedModes, 0) & kModePpBit) != 0;
+    return (mode == 0 || (mode == kModeCsp && csp_offered) || (mode == kModeHoming && homing_offered) ||
+            (mode == kModePp && pp_offered))
                ? 0
                : slave::abort_code::kValueRange;
+  }
+  if (index == kMotionProfileType) {
+    return value == 0 ? 0 : slave::abort_code::kValueRange;  // a linear ramp only: no jerk limit
+  }
+  if ((index == kProfileVelocity || index == kProfileAcceleration || index == kProfileDeceleration) &&
+      value == 0) {
+    return slave::abort_code::kValueRange;
   }
   if (index == kHomingMethod) {
     const auto m = static_cast<std::int8_t>(value);
@@ -481,6 +604,7 @@ void SimDriveNode::step(std::int64_t now_us) {
   }
   watch_master(now_us);
   produce_heartbeat(now_us);
+  send_event_tpdos(now_us);
 }
 
 std::int64_t SimDriveNode::consumer_window_us() const {
@@ -511,6 +635,16 @@ std::int64_t SimDriveNode::next_deadline_us() const {
   std::int64_t t = heartbeat_ms() == 0 ? std::numeric_limits<std::int64_t>::max() : next_heartbeat_us_;
   if (boot_at_us_ >= 0) t = std::min(t, boot_at_us_);
   if (operational_at_us_ >= 0) t = std::min(t, operational_at_us_);
+  for (int k = 0; k < slave::kPdos; ++k) {  // event-driven TPDOs: the held one and the event timer
+    const auto comm = static_cast<std::uint16_t>(slave::kTpdoComm + k);
+    const auto kk = static_cast<std::size_t>(k);
+    const std::uint8_t type = od_.pdo_type(comm);
+    if (!od_.pdo_valid(comm) || (type != 254 && type != 255) || tpdo_sent_us_[kk] < 0) continue;
+    if (tpdo_held_[kk])
+      t = std::min(t, tpdo_sent_us_[kk] + static_cast<std::int64_t>(od_.get(comm, 3)) * 100);
+    if (od_.get(comm, 5) != 0)
+      t = std::min(t, tpdo_sent_us_[kk] + static_cast<std::int64_t>(od_.get(comm, 5)) * 1000);
+  }
   if (od_.get(kConsumerHeartbeat, 1) != 0 && master_seen_us_ >= 0 && !master_lost_) {
     t = std::min(t, master_seen_us_ + consumer_window_us() + 1);
   }

@@ -3,6 +3,7 @@
 // error. A raw test endpoint plays the master, so these checks do not depend on drivers::CanAxisPort.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <initializer_list>
 #include <optional>
 #include <vector>
@@ -463,6 +464,113 @@ TEST_F(SimDriveNodeRawTest, SlowPersonalityBootsAndStartsLate) {
   EXPECT_EQ(node_->nmt_state(), NmtState::kPreOperational);
   advance_to(now_ + 400'000);
   EXPECT_EQ(node_->nmt_state(), NmtState::kOperational);
+}
+
+// Profile position (mode 1), driven with frames built here byte by byte (CiA 301 little-endian): the
+// set-point handshake, the trapezoid against its closed form, and the event-driven TPDO1's timing.
+CanFrame rpdo1(std::uint8_t node, std::uint16_t controlword, std::int32_t target) {
+  CanFrame f;
+  f.id = 0x200u + node;
+  f.dlc = 6;
+  const auto t = static_cast<std::uint32_t>(target);
+  f.data = {static_cast<std::uint8_t>(controlword & 0xFF),
+            static_cast<std::uint8_t>(controlword >> 8),
+            static_cast<std::uint8_t>(t & 0xFF),
+            static_cast<std::uint8_t>((t >> 8) & 0xFF),
+            static_cast<std::uint8_t>((t >> 16) & 0xFF),
+            static_cast<std::uint8_t>(t >> 24),
+            0,
+            0};
+  return f;
+}
+std::uint16_t tpdo_statusword(const CanFrame& f) {
+  return static_cast<std::uint16_t>(f.data[0] | f.data[1] << 8);
+}
+
+TEST_F(SimDriveNodeTest, ProfilePositionRunsTheHandshakeAndATrapezoidWithTimedTpdos) {
+  node_.power_on(now_);
+  EXPECT_EQ(read(0x6502, 0).value() & 1u, 1u);     // profile position offered
+  EXPECT_EQ(write(0x6086, 0, 3, 2), 0x06090030u);  // jerk-limited: not offered (linear ramp only)
+  EXPECT_EQ(write(0x6060, 0, 1, 1), 0u);
+  EXPECT_EQ(read(0x6061, 0), 1u);
+  const double v = 100000.0, a = 1000000.0;  // counts/s, counts/s²
+  EXPECT_EQ(write(0x6081, 0, 100000, 4), 0u);
+  EXPECT_EQ(write(0x6083, 0, 1000000, 4), 0u);
+  EXPECT_EQ(write(0x6084, 0, 1000000, 4), 0u);
+  EXPECT_EQ(write(0x1400, 2, 255, 1), 0u);
+  EXPECT_EQ(write(0x1800, 2, 255, 1), 0u);
+  EXPECT_EQ(write(0x1800, 3, 100, 2), 0u);          // 10 ms
+  EXPECT_EQ(write(0x1800, 5, 100, 2), 0u);          // 100 ms
+  EXPECT_EQ(write(0x1801, 1, 0x80000285u, 4), 0u);  // TPDO2 off
+  send(drivers::make_nmt(NmtCommand::kStart, 5));
+  for (const int cw : {0x06, 0x07, 0x0F}) send(rpdo1(5, static_cast<std::uint16_t>(cw), 4242));
+  advance_to(now_ + 20000);
+  ASSERT_EQ(node_.drive_state(), hal::DriveState::kOperationEnabled);
+  take();
+
+  // Set-point: the drive acknowledges (bit 12) at once, event-driven, and keeps it until bit 4 falls.
+  const std::int32_t goal = 4242 + 20000;
+  send(rpdo1(5, 0x1F, goal));
+  auto frames = take();
+  ASSERT_FALSE(frames.empty());
+  EXPECT_EQ(frames.back().id, 0x185u);
+  EXPECT_NE(tpdo_statusword(frames.back()) & (1u << 12), 0u);
+  EXPECT_EQ(tpdo_statusword(frames.back()) & (1u << 10), 0u);  // a move to run: not reached
+  EXPECT_EQ(node_.setpoints_latched(), 1u);
+  send(rpdo1(5, 0x0F, goal));
+  EXPECT_EQ(node_.statusword() & (1u << 12), 0u);
+  send(rpdo1(5, 0x0F, goal));  // no rising edge: no new set-point
+  EXPECT_EQ(node_.setpoints_latched(), 1u);
+
+  // SYNC every 1 ms (0x60C2's default): the trapezoid d/v + v/a = 0.3 s, speed never above v.
+  std::vector<std::int64_t> tpdo_at;
+  const std::int64_t t0 = now_;
+  std::int64_t reached_at = -1;
+  std::int32_t last = node_.position();
+  for (int k = 0; k < 600; ++k) {
+    send(drivers::make_sync());
+    for (const CanFrame& f : take()) {
+      if (f.id == 0x185u) tpdo_at.push_back(now_);
+    }
+    EXPECT_LE(std::abs(node_.position() - last), static_cast<int>(v * 1e-3) + 1) << k;
+    last = node_.position();
+    if (reached_at < 0 && node_.position() == goal) reached_at = now_ - t0;
+    advance_to(now_ + 1000);
+    for (const CanFrame& f : take()) {
+      if (f.id == 0x185u) tpdo_at.push_back(now_);
+    }
+  }
+  const double t_closed = 20000.0 / v + v / a;
+  ASSERT_GT(reached_at, 0);
+  EXPECT_NEAR(static_cast<double>(reached_at) * 1e-6, t_closed, 0.004);
+  EXPECT_NE(node_.statusword() & (1u << 10), 0u);
+  // Never closer than the inhibit time; moving, about every inhibit time; still, every event timer period.
+  ASSERT_GE(tpdo_at.size(), 30u);
+  for (std::size_t k = 1; k < tpdo_at.size(); ++k) EXPECT_GE(tpdo_at[k] - tpdo_at[k - 1], 10000) << k;
+  EXPECT_LE(tpdo_at[1] - tpdo_at[0], 11000);
+  EXPECT_NEAR(static_cast<double>(tpdo_at.back() - tpdo_at[tpdo_at.size() - 2]), 100000.0, 1000.0);
+}
+
+TEST_F(SimDriveNodeTest, ADriveWithoutProfilePositionRefusesModeOne) {
+  SimDriveConfig c = config();
+  c.supports_pp = false;
+  test::FakeCanNetwork net;
+  auto& tester = net.add_endpoint();
+  auto& ep = net.add_endpoint();
+  SimDriveNode node(ep, c);
+  node.power_on(0);
+  CanFrame f;
+  while (tester.receive(f)) {
+  }
+  tester.send(drivers::make_sdo_download(5, 0x6060, 0, 1, 1));
+  while (ep.receive(f)) node.handle(f, 0);
+  bool aborted = false;
+  while (tester.receive(f)) {
+    const auto r = drivers::parse_sdo_reply(f);
+    aborted |= r.kind == drivers::SdoReplyKind::kAbort && r.value == 0x06090030u;
+  }
+  EXPECT_TRUE(aborted);
+  EXPECT_EQ(node.mode(), 0);
 }
 
 }  // namespace

@@ -60,6 +60,12 @@ struct CanAxisConfig {
   // checked and its configuration written (only what differs) at bring-up. Null: none.
   std::shared_ptr<const NodeDescription> description{};
   DriveMode mode = DriveMode::kCyclicPosition;
+  // Profile position only: the drive's own profile (0x6081, 0x6083 = 0x6084, 0x6086), SI/s and SI/s²,
+  // the limits the sequencer plans the axis' moves with (jerk: the drive's jerk-limited profile when it
+  // offers one). 0 = not given (refused for a profile-position axis).
+  double profile_velocity = 0.0;
+  double profile_acceleration = 0.0;
+  double profile_jerk = 0.0;
 };
 
 // Buses a port can drive (can0..can3): CanAxisConfig::bus is 0..kMaxBuses-1.

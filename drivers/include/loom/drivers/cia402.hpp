@@ -20,6 +20,10 @@ inline constexpr std::uint16_t kEnableOperation = 0x000F;  // 4, 16
 inline constexpr std::uint16_t kFaultReset = 0x0080;       // 15, acts on the rising edge of bit 7
 inline constexpr std::uint16_t kFaultResetBit = 0x0080;
 inline constexpr std::uint16_t kHomingStart = 0x0010;  // bit 4 in homing mode: start (rising edge) / run
+// Profile position: bit 4 "new set-point" (the drive latches the target on its rising edge), bit 5
+// "change set immediately" (the new set-point replaces a move in progress instead of queueing).
+inline constexpr std::uint16_t kNewSetpoint = 0x0010;
+inline constexpr std::uint16_t kChangeImmediately = 0x0020;
 }  // namespace controlword
 
 namespace statusword {
@@ -30,8 +34,9 @@ inline constexpr std::uint16_t kRemote = 1U << 9;
 inline constexpr std::uint16_t kTargetReached = 1U << 10;
 inline constexpr std::uint16_t kCspFollowsTarget = 1U << 12;
 inline constexpr std::uint16_t kCspFollowingError = 1U << 13;
-inline constexpr std::uint16_t kHomingAttained = 1U << 12;  // in homing mode (6)
-inline constexpr std::uint16_t kHomingError = 1U << 13;     // in homing mode (6)
+inline constexpr std::uint16_t kSetpointAcknowledge = 1U << 12;  // in profile position mode (1)
+inline constexpr std::uint16_t kHomingAttained = 1U << 12;       // in homing mode (6)
+inline constexpr std::uint16_t kHomingError = 1U << 13;          // in homing mode (6)
 }  // namespace statusword
 
 // RT-safe. kUnknown for bit patterns that match no state.

@@ -1,6 +1,8 @@
-// One CiA 402 servo drive in cyclic synchronous position mode as a node of a CanMaster: its profile
-// only (SDO configuration of CSP, interpolation period, heartbeat producer, master consumer and the PDO
-// mapping; the power-state machine; the RPDO1/TPDO1/TPDO2 exchange; following-error supervision).
+// One CiA 402 servo drive as a node of a CanMaster, in cyclic synchronous position (a set-point every
+// SYNC) or profile position (one set-point per move with the handshake, event-driven PDOs): its profile
+// only (SDO configuration of the mode, interpolation period, heartbeat producer, master consumer and the
+// PDO mapping; the power-state machine; the RPDO1/TPDO1/TPDO2 exchange; following-error supervision in
+// CSP, set-point acknowledge and target-reached supervision in PP).
 // Heartbeats, boot-ups and EMCYs are the master's NodeSupervisor's. CanAxisPort owns one per axis.
 #pragma once
 
@@ -9,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "loom/drivers/can_axis_config.hpp"
 #include "loom/drivers/can_master.hpp"
 #include "loom/drivers/cia402.hpp"
 #include "loom/drivers/position_scaling.hpp"
@@ -36,14 +39,18 @@ class Cia402Axis final : public CanNode {
   bool reports_own_emcy() const override { return true; }
   const NodeDescription* description() const override { return description_.get(); }
 
-  // RT-safe. This tick's feedback, given the state of the axis' bus.
-  void fill_feedback(hal::AxisFeedback& fb, bool bus_off, bool bus_configured) const;
+  // RT-safe. This tick's feedback, given the state of the axis' bus. A profile-position axis' TPDO1 is
+  // sent on change only: while its last one said the axis stands still, its data is current until the
+  // event timer (plus margin) has passed without one (`refreshed` = now); after that it ages as a CSP
+  // axis' does, so a PP drive whose TPDO stops is stale feedback for the sequencer too.
+  void fill_feedback(hal::Tick now, hal::AxisFeedback& fb, bool bus_off, bool bus_configured) const;
   // RT-safe. Any fault of this drive that must stop every axis.
   bool faulted() const;
   // RT-safe. The next step toward `command` (quick stop when `stop_all` and the request is not a reset
-  // or disable; always quick stop while the drive cannot be supervised); returns its RPDO1.
-  CanFrame command(const hal::AxisCommand& command, bool stop_all, bool bus_down,
-                   std::uint32_t state_timeout_ticks);
+  // or disable; always quick stop while the drive cannot be supervised) into `rpdo1`. True when it is to
+  // be sent: every tick in CSP; in PP only when the controlword or the target changed.
+  bool command(hal::Tick now, const hal::AxisCommand& command, bool stop_all, bool bus_down,
+               std::uint32_t state_timeout_ticks, CanFrame& rpdo1);
 
   // Diagnostics; RT-safe.
   std::uint8_t bus() const { return bus_; }
@@ -52,11 +59,19 @@ class Cia402Axis final : public CanNode {
   bool has_tpdo2() const { return has_tpdo2_; }
   std::uint16_t last_controlword() const { return tracker_.last_controlword; }
   std::int64_t last_target_counts() const { return last_target_counts_; }
+  DriveMode mode() const { return mode_; }
+  std::uint32_t setpoints_sent() const { return pp_setpoints_; }  // PP: set-points (bit 4 rising)
   const std::vector<std::string>& notes() const { return notes_; }
 
  private:
   Status configure_pdos(SdoClient& sdo);
   Status configure_homing(SdoClient& sdo, std::uint32_t supported_modes);
+  Status configure_profile_position(SdoClient& sdo);
+  // PP, RT-safe: the controlword bits and target of the set-point handshake for this tick.
+  std::uint16_t profile_setpoint(hal::Tick now, const hal::AxisCommand& cmd, bool enabled,
+                                 std::uint32_t state_timeout_ticks);
+  std::uint32_t profile_move_ticks(std::int64_t distance_counts) const;
+  bool profile_fault() const { return pp_fault_ != 0; }
 
   // Configuration (configure-time).
   // What configure_profile() writes (from CanAxisPortConfig).
@@ -83,6 +98,15 @@ class Cia402Axis final : public CanNode {
   std::int32_t home_offset_counts_ = 0;
   double homing_speed_ = 0.0;
   double homing_accel_ = 0.0;
+  DriveMode mode_ = DriveMode::kCyclicPosition;
+  std::int8_t run_mode_ = 8;       // 0x6060 outside homing: od::kModeCsp or od::kModeProfilePosition
+  double profile_velocity_ = 0.0;  // SI/s, SI/s² (PP)
+  double profile_acceleration_ = 0.0;
+  double profile_jerk_ = 0.0;
+  double tpdo_inhibit_s_ = 0.010;      // PP TPDO1 0x1800:03
+  double tpdo_event_timer_s_ = 0.100;  // PP TPDO1 0x1800:05
+  hal::Tick fresh_ticks_ = 0;          // PP: a still axis' last TPDO is current this long
+  double state_timeout_s_ = 0.5;
   std::vector<std::string> notes_;
   std::shared_ptr<const NodeDescription> description_;
 
@@ -108,6 +132,21 @@ class Cia402Axis final : public CanNode {
   bool referenced_ = true;         // absolute, or homed since the last bring-up
   bool homing_error_ = false;      // the drive said homing error (latched until acknowledged)
   bool homing_commanded_ = false;  // bit 4 sent in this homing run: attained/error bits are ours
+  // The RPDO1 last sent (PP sends one only when it differs).
+  bool sent_any_ = false;
+  CanFrame last_sent_{};
+  // Profile position's set-point handshake.
+  double last_cmd_target_ = 0.0;      // the sequencer's per-tick target last tick
+  bool pp_have_ = false;              // pp_target_ is the drive's current set-point
+  std::int64_t pp_target_ = 0;        // counts: the target RPDO1 carries
+  bool pp_pending_ = false;           // bit 4 up, waiting for the acknowledge (bit 12)
+  bool pp_moving_ = false;            // acknowledged, waiting for target reached (bit 10)
+  std::uint32_t pp_wait_ticks_ = 0;   // ticks in the current wait
+  std::uint32_t pp_limit_ticks_ = 0;  // the current move's planned duration and margin
+  std::uint16_t pp_fault_ = 0;        // latched until acknowledged (fault_code)
+  std::uint32_t pp_setpoints_ = 0;
+  hal::Tick pp_since_ = 0;  // tick the current set-point was raised
+  bool still_ = false;      // PP: the last TPDO1 said the axis stands still
 };
 
 }  // namespace loom::drivers

@@ -36,6 +36,10 @@ inline constexpr std::uint16_t kFollowingError = 0x8611;
 inline constexpr std::uint16_t kStateTimeout = 0xFF01;        // CiA 402 transition not confirmed in time
 inline constexpr std::uint16_t kNodeRebooted = 0xFF02;        // boot-up seen while operating: mapping lost
 inline constexpr std::uint16_t kNodeNotOperational = 0xFF03;  // heartbeat says stopped/pre-operational
+// Profile position: the drive did not acknowledge a set-point (statusword bit 12) within the state
+// timeout, or did not report target reached (bit 10) within the move's planned duration and its margin.
+inline constexpr std::uint16_t kSetpointNotAcknowledged = 0xFF04;
+inline constexpr std::uint16_t kTargetNotReached = 0xFF05;
 }  // namespace fault_code
 
 // RT-safe. The kind of a fault the master reports with `code` on a node's link: its own detections of

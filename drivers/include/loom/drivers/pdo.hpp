@@ -64,6 +64,18 @@ inline constexpr std::uint16_t kHomingSpeeds =
     0x6099;  // :01 search for switch, :02 search for zero, counts/s
 inline constexpr std::uint16_t kHomingAcceleration = 0x609A;  // u32, counts/s²
 inline constexpr std::uint32_t kPdoInvalidBit = 1U << 31;     // in 0x14xx/0x18xx:01
+// Profile position (mode 1): the drive's own profile toward a set-point given with the handshake.
+inline constexpr std::int8_t kModeProfilePosition = 1;
+inline constexpr std::uint32_t kSupportsPpBit = 1U << 0;       // in 0x6502
+inline constexpr std::uint16_t kProfileVelocity = 0x6081;      // u32, counts/s
+inline constexpr std::uint16_t kProfileAcceleration = 0x6083;  // u32, counts/s²
+inline constexpr std::uint16_t kProfileDeceleration = 0x6084;  // u32, counts/s²
+inline constexpr std::uint16_t kMotionProfileType = 0x6086;  // i16: 0 linear ramp (trapezoid), 3 jerk-limited
+inline constexpr std::int16_t kProfileLinearRamp = 0;
+inline constexpr std::int16_t kProfileJerkLimited = 3;
+inline constexpr std::uint8_t kTransmissionEvent = 255;  // 0x14xx/0x18xx:02: event-driven (profile specific)
+inline constexpr std::uint8_t kPdoInhibitSub = 3;        // 0x18xx:03, units of 100 µs
+inline constexpr std::uint8_t kPdoEventTimerSub = 5;     // 0x18xx:05, ms
 }  // namespace od
 
 // RT-safe. Human-readable name of an object the master touches ("modes of operation"), or "object".

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
 namespace loom::hal {
 
@@ -123,6 +124,9 @@ struct AxisFeedback {
 struct AxisCommand {
   AxisRequest request = AxisRequest::kDisable;
   double target_position = 0.0;  // SI; in CSP the drive interpolates to it within one cycle
+  // SI; the end of the planned move target_position is on, NaN when it is not on one (holding, jogging).
+  // A profile-position drive is sent this once, as its set-point, and runs its own profile to it.
+  double move_end = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Indexed by slot; entries at and beyond the layout's count are unused.

@@ -74,6 +74,10 @@ struct KnottingConfig {
   motion::JerkLimits selector{.velocity = 20.0, .acceleration = 400.0, .jerk = 20000.0};  // rad, s
   double servo_tolerance_rad = 0.05;  // a servo further than this from where it was sent is lagging
   double settle_s = 0.05;  // after a move's plan ends, how long it may take to get within tolerance
+  // The same for the colour selectors; 0 = settle_s. A selector in profile position runs its drive's own
+  // profile from one set-point and reports on change (at most once per TPDO inhibit time), so it may be
+  // measured at its slot a little later than a cyclic one; later still, still off, it is selector_jam.
+  double selector_settle_s = 0.0;
   // The carriage's measured position must be this close to the knot's before its cycle starts (m); 0: the
   // default for the program's pitch (default_placement_tolerance_m). At most half the pitch (excluded).
   double placement_tolerance_m = 0.0;

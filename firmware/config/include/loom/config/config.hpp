@@ -89,6 +89,9 @@ struct AxisSpec {
   // axes.<name>.store_config: after a bring-up that wrote anything, the master makes the drive store it
   // (0x1010:01 = "save"); needs an EDS with a writable 0x1010:01.
   bool store_config = false;
+  // axes.<name>.drive_mode: "cyclic" (CiA 402 cyclic synchronous position: a set-point every SYNC) or
+  // "profile" (profile position: one set-point per move, event-driven PDOs; the colour selectors only).
+  bool profile_position = false;
 
   // Drive counts per SI unit (per rad, or per m on a linear axis).
   double counts_per_unit() const;

@@ -31,7 +31,10 @@ struct SimDriveConfig {
   // Largest target step per SYNC the drive follows; a bigger jump trips following error (EMCY 0x8611).
   // 0 = unlimited.
   std::uint32_t max_step_counts = 0;
-  bool supports_csp = true;                    // 0x6502 bit 7; false refuses 0x6060 = 8
+  bool supports_csp = true;  // 0x6502 bit 7; false refuses 0x6060 = 8
+  // Profile position (0x6502 bit 0, 0x6060 = 1): the set-point handshake and a trapezoidal profile from
+  // 0x6081/0x6083/0x6084 (0x6086 takes 0, linear ramp, only); false refuses 0x6060 = 1.
+  bool supports_pp = true;
   std::vector<std::uint16_t> missing_objects;  // indices this drive lacks (SDO abort 0x06020000)
   // "Commercial" personality: PDO mapping objects read-only, sub-index 0 included (abort 0x06010002);
   // the factory TPDO1 mapping may be replaced (empty = statusword + position actual).
@@ -89,7 +92,11 @@ class SimDriveNode : private slave::ObjectHooks, private slave::FrameHandlers {
   // The axis' physical position (counts): what the count would read without the power-up offset.
   std::int64_t physical_position() const { return static_cast<std::int64_t>(position_) - count_offset_; }
   bool homing_attained() const { return homing_attained_; }
-  bool master_lost() const { return master_lost_; }  // 0x1016 consumer expired (the drive quick-stopped)
+  bool master_lost() const { return master_lost_; }
+  // Profile position: set-points latched (bit 4 rising edges taken) since power-on.
+  std::uint32_t setpoints_latched() const {
+    return pp_latched_;
+  }  // 0x1016 consumer expired (the drive quick-stopped)
 
  private:
   // The bus's writes reach the drive through the ObjectHooks (object rules beyond CiA 301, side effects).
@@ -111,6 +118,12 @@ class SimDriveNode : private slave::ObjectHooks, private slave::FrameHandlers {
   void run_homing();
   void set_home();
   void send_tpdos();
+  // Event-driven TPDOs (type 254/255): sent when their data changed, at most once per inhibit time
+  // (0x18xx:03) and at least once per event timer (0x18xx:05).
+  void send_event_tpdos(std::int64_t now_us);
+  void latch_setpoint();
+  void run_profile();
+  double sync_period_s() const;
   void publish();
   void set_controlword(std::uint16_t cw);
   void enter_fault(std::uint16_t code);
@@ -150,6 +163,19 @@ class SimDriveNode : private slave::ObjectHooks, private slave::FrameHandlers {
   bool homing_attained_ = false;
   bool homing_error_ = false;
   std::uint32_t homing_syncs_ = 0;
+  // Profile position.
+  bool pp_latch_ = false;     // bit 4 rose: take the target once the RPDO's objects are all written
+  bool pp_ack_ = false;       // statusword bit 12
+  bool pp_active_ = false;    // a move runs toward pp_goal_
+  std::int32_t pp_goal_ = 0;  // counts
+  double pp_pos_ = 0.0;       // counts, the profile's exact position
+  double pp_vel_ = 0.0;       // counts/s
+  std::uint32_t pp_latched_ = 0;
+  // Event-driven TPDOs.
+  std::array<std::int64_t, 4> tpdo_sent_us_{};
+  std::array<std::array<std::uint8_t, 8>, 4> tpdo_data_{};
+  std::array<std::uint8_t, 4> tpdo_dlc_{};
+  std::array<bool, 4> tpdo_held_{};  // changed while inhibited: due when the inhibit time is over
 };
 
 }  // namespace loom::sim_can

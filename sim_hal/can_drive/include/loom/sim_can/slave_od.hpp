@@ -121,6 +121,16 @@ constexpr Objects<3> pdo_comm(std::uint16_t index, std::uint32_t cob_id, std::ui
            {index, 2, 1, Access::kRw, Pdo::kNone, type}}};
 }
 
+// A transmit PDO's communication parameters with its inhibit time and event timer (CiA 301): :00 = 5,
+// :01 COB-ID, :02 transmission type, :03 inhibit time (100 µs units), :05 event timer (ms).
+constexpr Objects<5> tpdo_comm_timed(std::uint16_t index, std::uint32_t cob_id, std::uint8_t type) {
+  return {{{index, 0, 1, Access::kConst, Pdo::kNone, 5},
+           {index, 1, 4, Access::kRw, Pdo::kNone, cob_id},
+           {index, 2, 1, Access::kRw, Pdo::kNone, type},
+           {index, 3, 2, Access::kRw, Pdo::kNone, 0},
+           {index, 5, 2, Access::kRw, Pdo::kNone, 0}}};
+}
+
 // A PDO mapping object: :00 = number of entries, :01..:08 the entries (unused ones 0).
 constexpr Objects<1 + kMapEntries> pdo_map(std::uint16_t index,
                                            std::array<std::uint32_t, kMapEntries> entries = {}) {
