@@ -87,6 +87,11 @@ void print_axes(const LoomConfig& c) {
     if (a.max_speed > 0.0) std::snprintf(speed, sizeof speed, ", top speed %g %s/s", a.max_speed, unit);
     if (a.ferror_min > 0.0)
       std::snprintf(ferror, sizeof ferror, "> max(%g %s, %g s x |v|)", a.ferror_min, unit, a.ferror_k_s);
+    // A profile-position drive runs each move's ramp itself: the controller supervises its set-point
+    // acknowledge and "target reached" (drivers/README.md), not a following error against a ramp it sent.
+    if (a.profile_position) {
+      std::snprintf(ferror, sizeof ferror, "%s", "not used: profile position, one set-point a move");
+    }
     std::printf("  %zu %-12s %-10s bus %u node %3u  %.0f counts/%s%s; following error %s\n", i,
                 a.name.c_str(), hal::axis_role_name(a.role), a.bus, a.node, a.counts_per_unit(), unit, speed,
                 ferror);
@@ -122,12 +127,12 @@ void print_axes(const LoomConfig& c) {
 
 // The heads' time per row. With a design: rows 1 and 2 tied by the heads' own sequence against an ideal
 // plant (sequencer/row_time.hpp), so every wait counts — a carriage step or selector turn that outlasts the
-// gripper's return, the settles, the first travel and the way back; rows alternate selvedges, so their mean.
-// Without a design (nothing to tie): the knot cycles alone.
+// gripper's return, the settles, the first travel and the way to the sweep's start; the design's rows differ,
+// so their mean. Without a design (nothing to tie): the knot cycles alone.
 struct KnotRowTime {
   int cycles = 0;
   double cycles_s = 0.0;                 // the knot cycles back to back
-  std::optional<double> row1_s, row2_s;  // from the left selvedge, from the right
+  std::optional<double> row1_s, row2_s;  // design rows 1 and 2 (each knotted from the left selvedge)
   double mean_s() const { return row1_s && row2_s ? (*row1_s + *row2_s) / 2.0 : cycles_s; }
 };
 
@@ -239,11 +244,10 @@ void print_knotting(const LoomConfig& c, const std::optional<motion::KnotCycle>&
   if (row_time.row1_s && row_time.row2_s) {
     const double extra = row_time.mean_s() - row_time.cycles_s;
     std::printf(
-        "  knotting about %.1f s per row, from the heads' own sequence against an ideal plant: %.2f s from "
-        "the left selvedge, %.2f s from the right (the heads knot from the left: the carriage crosses "
-        "first)\n    the %d knot cycles take %.1f s; the other %.1f s are the carriage's steps and the "
-        "selectors' turns that outlast the grippers' return (%.3f s a knot), the settles and the way "
-        "back\n",
+        "  knotting about %.1f s per row, from the heads' own sequence against an ideal plant: row 1 "
+        "%.2f s, row 2 %.2f s (each from the left selvedge, then across to the sweep's start)\n    the %d "
+        "knot cycles take %.1f s; the other %.1f s are the carriage's steps and the selectors' turns that "
+        "outlast the grippers' return (%.3f s a knot), the settles and the way to the right selvedge\n",
         row_time.mean_s(), *row_time.row1_s, *row_time.row2_s, row_time.cycles, row_time.cycles_s, extra,
         extra / row_time.cycles);
   } else {

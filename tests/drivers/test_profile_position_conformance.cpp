@@ -98,7 +98,10 @@ TEST(ProfilePosition, BringUpSelectsModeOneWithEventDrivenPdosAndTheProfileInCou
   EXPECT_TRUE(noted);
   EXPECT_EQ(written(rig, kPpNode, 0x1400, 2), std::vector<std::uint32_t>{255});
   EXPECT_EQ(written(rig, kPpNode, 0x1800, 2), std::vector<std::uint32_t>{255});
-  EXPECT_EQ(written(rig, kPpNode, 0x1800, 3), std::vector<std::uint32_t>{100});  // 10 ms in 100 µs
+  EXPECT_EQ(written(rig, kPpNode, 0x1800, 3),  // the port's inhibit time (30 ms) in 100 µs
+            std::vector<std::uint32_t>{
+                static_cast<std::uint32_t>(std::lround(rig.port.config().profile_tpdo_inhibit_s * 1e4))});
+  EXPECT_EQ(written(rig, kPpNode, 0x1800, 3), std::vector<std::uint32_t>{300});
   EXPECT_EQ(written(rig, kPpNode, 0x1800, 5), std::vector<std::uint32_t>{100});  // ms
   // The CSP axis is as before: synchronous.
   EXPECT_EQ(written(rig, 1, 0x1400, 2), std::vector<std::uint32_t>{1});

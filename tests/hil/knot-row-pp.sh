@@ -4,7 +4,7 @@
 # As knot-row.sh, and judged from candump as well (loom-hil-canlog profile-position): the selectors'
 # RPDO1s only on change (none in a tick where the selector stands still, never two in one cycle), each
 # set-point acknowledged (statusword bit 12) before its release, their TPDO1s never closer than the
-# inhibit time (10 ms); the cyclic drives' exchange as before.
+# inhibit time (30 ms, the master's default); the cyclic drives' exchange as before.
 #
 # (knot-row.sh:) Two knotting heads tie a row over SocketCAN, then the loom sheds, picks and beats it. Everything is
 # on vcan0 (hil_knotting_loom.toml): the three loom drives, each head's knotting servo and colour selector
@@ -76,6 +76,6 @@ hil_note "the carpet knotted over CAN equals the design row: $knotted"
 "$HIL_CANLOG" knotting "$HIL_LOG" --node 4 --gripper-bits 8,9 --cutter-bits 20,21 --yarn-bits 24,25 \
   --selector-nodes 21,22 --carriage-node 2 --knots-per-head 15 || hil_fail "knotting judged from the bus failed; log: $HIL_LOG"
 "$HIL_CANLOG" weave "$HIL_LOG" --nodes "$cyclic_nodes" || hil_fail "bus protocol check failed; log: $HIL_LOG"
-"$HIL_CANLOG" profile-position "$HIL_LOG" --nodes "$profile_nodes" --inhibit-ms 10 --min-moves 2 ||
+"$HIL_CANLOG" profile-position "$HIL_LOG" --nodes "$profile_nodes" --inhibit-ms 30 --min-moves 2 ||
   hil_fail "the selectors' profile-position exchange judged from the bus failed; log: $HIL_LOG"
 hil_report_frames

@@ -2,8 +2,7 @@
 # `loomctl check`'s knotting time per row against the simulator's: the estimate runs the heads' own
 # sequence against an ideal plant (sequencer/row_time.hpp); the simulated loom (scene "knotting": ideal
 # drives, no misses) weaves rows 1 and 2 and its run report says how long the heads knotted each. They
-# must agree (the simulated drives trail their commands a little: 0.5 %), row by row, from each selvedge
-# — and the knot cycles alone, the estimate before, must not (the carriage's steps outlast the grippers'
+# must agree (the simulated drives trail their commands a little: 0.5 %), row by row — and the knot cycles alone, the estimate before, must not (the carriage's steps outlast the grippers'
 # return on the shipped loom), or this test would not tell the two apart.
 # Usage: knot_row_estimate.sh LOOMCTL SOURCE_DIR
 set -euo pipefail
@@ -19,7 +18,7 @@ python3 - "$work/check.txt" "$work/report/rows.jsonl" <<'PY'
 import json, re, sys
 check = open(sys.argv[1]).read()
 m = re.search(r"knotting about ([0-9.]+) s per row, from the heads' own sequence against an ideal plant: "
-              r"([0-9.]+) s from the left selvedge, ([0-9.]+) s from the right", check)
+              r"row 1 ([0-9.]+) s, row 2 ([0-9.]+) s", check)
 assert m, "no sequenced estimate in loomctl check:\n" + check
 cycles = re.search(r"the ([0-9]+) knot cycles take ([0-9.]+) s", check)
 assert cycles, check

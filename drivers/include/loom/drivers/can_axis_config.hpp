@@ -101,7 +101,11 @@ struct CanAxisPortConfig {
   // 255), sent when the statusword or position changes but at most once per inhibit time (0x1800:03) and
   // at least once per event timer (0x1800:05) while nothing changes, so a still axis is still supervised.
   // Their RPDO1 is sent only when the controlword or target changes. These set the bus-load plan's rates.
-  double profile_tpdo_inhibit_s = 0.010;
+  // 30 ms: with it four selectors share a 2 ms bus with four cyclic knotters within the 70 % budget (at
+  // 10 ms they would take 75 %). It costs a knot cycle at most that much of a selector's arrival being seen
+  // late (its set-point starts the move at once; only the ack and "target reached" wait for the inhibit),
+  // and the wait for a selector's arrival is derived from it (derive.cpp: selector_settle_s).
+  double profile_tpdo_inhibit_s = 0.030;
   double profile_tpdo_event_timer_s = 0.100;
   bool tpdo2 = false;                   // velocity + torque PDO (adds 3 frames per cycle)
   std::uint8_t tpdo2_every_n_sync = 1;  // 1..240
