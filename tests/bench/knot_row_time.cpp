@@ -3,7 +3,8 @@
 // default loom's six heads have theirs (grippers on outputs 8.., cutters on 20.., yarn-present switches on
 // inputs 24..: the shipped twelve-head loom's bits) —
 // woven three rows on the simulated machine (the knotter effect, no misses) in virtual time. A cell is the
-// steady state: the mean of rows 2 and 3, one from each selvedge (row 1 carries the shed test), each row's
+// steady state: the mean of rows 2 and 3 (row 1 carries the shed test; every row is knotted from the left
+// selvedge and swept back to it, so rows differ only by their design rows), each row's
 // machine time read from its RowStats — knotting, shed, pick and beat — against the weaver's ~600 s whole
 // row (thesis, ch. 6). Machine time, not CPU time: the numbers are the same on every host. The heads'
 // spacing is the smallest whole number of knot pitches whose stripes cover the width (the last head's
@@ -158,9 +159,8 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
   }
   std::printf(
-      "\nwhole row = knotting + shed + pick + beat, the mean of rows 2 and 3 (one from each selvedge), "
-      "machine "
-      "time at a %.3g ms period; (Nx) = ~600 s for the weaver's whole row / the loom's\n",
+      "\nwhole row = knotting + shed + pick + beat, the mean of rows 2 and 3, machine time at a %.3g ms "
+      "period; (Nx) = ~600 s for the weaver's whole row / the loom's\n",
       period_ms);
   std::filesystem::remove_all(dir);
   return status;
