@@ -128,3 +128,20 @@ TEST(CoreDrives, ACompleteFileMayLeaveTheCoreDrivesOut) {
   const loom::motion::ProfileSet set(c.profile);
   EXPECT_TRUE(core_drive_fits(c, set).empty());
 }
+
+TEST(CoreDrives, ARederivedConfigIsCheckedToo) {
+  // A config changed in code (as a recipe swap is re-derived): the crank's drive geared down to 40:1
+  // gives 15.7 rad/s; the default beat force asks 16.1 rad/s x 1.15 = 18.5 rad/s.
+  LoomConfig c = default_loom_config();
+  for (DriveModel& m : c.drives) {
+    if (m.name == "servo_400w_10to1") m.drive.gear_ratio = 40.0;
+  }
+  try {
+    rederive_and_check(c, "test");
+    FAIL() << "accepted";
+  } catch (const ConfigError& e) {
+    const std::string what = e.what();
+    EXPECT_TRUE(has(what, "needs 18.5 rad/s")) << what;
+    EXPECT_TRUE(has(what, "the drive servo_400w_10to1 (axes.beat_crank.drive) gives 15.7 rad/s")) << what;
+  }
+}
