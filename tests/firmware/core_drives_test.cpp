@@ -96,7 +96,9 @@ TEST(CoreDrives, ACarriageOnASlowerDriveIsRefusedAtTheLineNamingIt) {
   const std::string e = config_error(
       "extends = \"default\"\n[drives.slow_400w]\nmotor_speed_rpm = 3000\nrated_torque_nm = 1.27\n"
       "peak_torque_nm = 3.8\nrotor_inertia_kg_m2 = 0.27e-4\n[axes.carriage]\ndrive = \"slow_400w\"\n");
-  EXPECT_TRUE(has(e, "loom.toml:8:9: axes.carriage.drive = \"slow_400w\": needs 1 m/s (the carriage's moves"))
+  EXPECT_TRUE(has(e,
+                  "loom.toml:8:9: axes.carriage.drive = \"slow_400w\": needs 1 m/s (the carriage's re-arm "
+                  "moves cruise at it; its cam steps peak at 0.758 m/s)"))
       << e;
   EXPECT_TRUE(has(e,
                   "the drive slow_400w (axes.carriage.drive) gives 0.5 m/s at the output (3000 rpm / "
@@ -113,7 +115,9 @@ TEST(CoreDrives, ACarriageOnASlowerDriveIsRefusedAtTheLineNamingIt) {
 
 TEST(CoreDrives, AHelixAskingMoreThanItsDriveIsRefusedAtItsSpeed) {
   const std::string e = config_error("extends = \"default\"\n[helix]\nmax_speed_rad_s = 130.0\n");
-  EXPECT_TRUE(has(e, "loom.toml:3:19: helix.max_speed_rad_s = 130: needs 130 rad/s (the pick")) << e;
+  EXPECT_TRUE(
+      has(e, "loom.toml:3:19: helix.max_speed_rad_s = 130: needs 130 rad/s (the pick peaks at 130 rad/s)"))
+      << e;
   EXPECT_TRUE(has(e,
                   "the drive servo_200w_5to1 (axes.helix.drive) gives 126 rad/s at the output (6000 rpm / "
                   "gear_ratio 5)"))

@@ -74,8 +74,8 @@ std::vector<CoreDriveFit> core_drive_fits(const LoomConfig& c, const motion::Pro
         f.need_speed = c.machine_spec.carriage_max_speed_m_s;
         f.speed_key = "carriage.max_speed_m_s";
         f.speed_value = fmt_num(f.need_speed);
-        f.speed_what = "the carriage's moves (re-arm moves cruise at it; the cam's steps peak at " +
-                       figure(set.carriage_peaks().speed_m_s) + " m/s)";
+        f.speed_what = "the carriage's re-arm moves cruise at it; its cam steps peak at " +
+                       figure(set.carriage_peaks().speed_m_s) + " m/s";
         f.need_accel = c.machine_spec.carriage_max_accel_m_s2;
         f.accel_key = "carriage.max_accel_m_s2";
         f.accel_value = fmt_num(f.need_accel);
@@ -84,7 +84,7 @@ std::vector<CoreDriveFit> core_drive_fits(const LoomConfig& c, const motion::Pro
         f.need_speed = set.helix_limits().velocity;
         f.speed_key = "helix.max_speed_rad_s";
         f.speed_value = fmt_num(c.machine_spec.helix.velocity);
-        f.speed_what = "the pick (it peaks at " + figure(std::abs(set.pick().peak_velocity())) + " rad/s)";
+        f.speed_what = "the pick peaks at " + figure(std::abs(set.pick().peak_velocity())) + " rad/s";
         f.need_accel = set.helix_accel_limit();  // after the carrier's limit
         f.accel_key = "helix.max_accel_rad_s2";
         f.accel_value = fmt_num(c.machine_spec.helix.acceleration);
