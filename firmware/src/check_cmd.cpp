@@ -10,6 +10,7 @@
 #include <string>
 
 #include "loom/config/config.hpp"
+#include "loom/config/core_drives.hpp"
 #include "loom/config/eds_nodes.hpp"
 #include "loom/config/scene_config.hpp"
 #include "loom/drivers/bus_load.hpp"
@@ -78,7 +79,7 @@ void print_safety_sensors(const LoomConfig& c) {
 }
 
 // The configured axes: slot, name, role, drive node, scaling and supervision, one line each.
-void print_axes(const LoomConfig& c) {
+void print_axes(const LoomConfig& c, const motion::ProfileSet& set) {
   std::printf("\naxes (%zu of at most %zu)\n", c.axes.size(), hal::kMaxAxes);
   for (std::size_t i = 0; i < c.axes.size(); ++i) {
     const AxisSpec& a = c.axes[i];
@@ -95,6 +96,33 @@ void print_axes(const LoomConfig& c) {
     std::printf("  %zu %-12s %-10s bus %u node %3u  %.0f counts/%s%s; following error %s\n", i,
                 a.name.c_str(), hal::axis_role_name(a.role), a.bus, a.node, a.counts_per_unit(), unit, speed,
                 ferror);
+  }
+  // The core axes' drives: what each gives at the axis, what the motion asks, and which limit binds (the
+  // mechanism's key while it asks less than the drive gives; the config refuses more).
+  const std::vector<CoreDriveFit> fits = core_drive_fits(c, set);
+  if (!fits.empty())
+    std::printf("  core axes' drives (at the axis; the carriage's through its screw lead):\n");
+  for (const CoreDriveFit& f : fits) {
+    const bool rotary = hal::is_rotary(f.role);
+    const char* speed = rotary ? "rad/s" : "m/s";
+    const char* effort = rotary ? "N m" : "N";
+    std::printf(
+        "    %-12s drives.%s: no-load %.3g %s, peak %.4g %s, continuous %.4g %s, rotor and gears %.3g %s\n",
+        f.axis.c_str(), f.model.c_str(), f.at.top_speed, speed, f.at.peak_effort, effort, f.at.rated_effort,
+        effort, f.at.inertia, rotary ? "kg m^2" : "kg");
+    const double share = f.need_speed / f.at.top_speed;
+    std::printf("      speed: %s asks %.3g %s, %.0f %% of the drive's; binding: %s\n", f.speed_key.c_str(),
+                f.need_speed, speed, 100.0 * share,
+                share >= 1.0 - 1e-9 ? "the drive's no-load speed (the key equals it)" : "the key");
+    const std::string load = f.load_what.empty() ? "" : " and " + f.load_what;
+    const char* unknown = f.role == hal::AxisRole::kBeatCrank  ? "; the linkage's load is not counted"
+                          : f.role == hal::AxisRole::kCarriage ? "; the carriage's own mass is not counted"
+                                                               : "";
+    std::printf(
+        "      acceleration: %s = %.4g %s/s^2 takes %.3g %s for the rotor and gears%s, %.0f %% of the "
+        "peak%s\n",
+        f.accel_key.c_str(), f.need_accel, rotary ? "rad" : "m", f.need_effort(), effort, load.c_str(),
+        100.0 * f.need_effort() / f.at.peak_effort, unknown);
   }
   // Referencing: what the loom does with each axis after its drive powers up, in the order it arms.
   std::printf(
@@ -388,7 +416,7 @@ void print_plan(const LoomConfig& c) {
 
   print_safety_sensors(c);
 
-  print_axes(c);
+  print_axes(c, p);
   print_knotting(c, knot_cycle, row_time);
 
   std::printf("\nCAN (for --hal socketcan)\n");

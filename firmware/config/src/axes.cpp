@@ -74,7 +74,9 @@ const std::vector<AxisKeyInfo>& axis_keys() {
       {"axes.<name>.bus", "[0, 3] (integer): 0 = the first CAN interface; default 0"},
       {"axes.<name>.counts_per_rev", "[16, 2147483648]"},
       {"axes.<name>.lead_m", "[0.0001, 1] (linear axes only)"},
-      {"axes.<name>.drive", "a [drives.<model>] name (added axes; knotters with heads must name one)"},
+      {"axes.<name>.drive",
+       "a [drives.<model>] name (knotters with heads must name one; a core axis' limits are checked "
+       "against its drive's)"},
       {"axes.<name>.max_speed",
        "[0.001, 1000] rad/s or m/s (added axes only; with a drive: at most its output speed, default it)"},
       {"axes.<name>.ferror_min", "[0, 100] rad, [0, 1] m; 0 = off"},
@@ -191,13 +193,10 @@ void read_axes(TomlReader& r, LoomConfig& c, bool extending) {
              "the core axes' speed limits are facts of their mechanisms: [carriage] max_speed_m_s, "
              "[helix] max_speed_rad_s, the recipe's crank speed");
     }
-    if (core && has("drive")) {
-      r.fail(p + "drive", "",
-             "the core axes' limits are facts of their mechanisms ([carriage], [helix], the recipe's crank "
-             "speed); a drive is described for the added axes");
-    }
+    // A core axis may name its drive too: its limits stay the mechanism's keys ([carriage], [helix], the
+    // recipe's crank speed), and each is checked against what the drive gives (check_core_drives).
+    r.string(p + "drive", a.drive);
     if (!core) {
-      r.string(p + "drive", a.drive);
       if (a.drive.empty())
         need("max_speed", std::string("missing: the axis' top speed (") + (linear ? "m/s" : "rad/s") +
                               "), or its drive (axes." + name + ".drive)");

@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "derive.hpp"
+#include "drives.hpp"
 #include "loom/drivers/bus_load.hpp"
 #include "loom/motion/angles.hpp"
 #include "loom/motion/errors.hpp"
@@ -395,6 +396,7 @@ void check_motion(const LoomConfig& c, const Fail& fail) {
     const auto [key, value] = sequencer_key(c, *f);
     fail(key, value, f->message);
   }
+  check_core_drives(c, *set, fail);
   // A homed crank comes to rest at its home point before anything else moves: the beater must be clear
   // of the warp there, or the carriage could never home or move after it.
   const AxisSpec& crank = c.axes[hal::index(hal::CoreAxis::kBeatCrank)];

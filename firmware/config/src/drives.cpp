@@ -20,6 +20,10 @@ bool valid_model_name(const std::string& n) {
 
 constexpr double kRpm = 2.0 * M_PI / 60.0;  // rad/s per rpm
 
+bool is_core(hal::AxisRole r) {
+  return r == hal::AxisRole::kBeatCrank || r == hal::AxisRole::kCarriage || r == hal::AxisRole::kHelix;
+}
+
 // A drive's derived figure as a person reads it (3 significant digits).
 std::string figure(double v) {
   std::ostringstream os;
@@ -118,6 +122,7 @@ void check_axis_drives(TomlReader& r, LoomConfig& c) {
           p + "drive", "\"" + a.drive + "\"",
           "no [drives." + a.drive + "] table" + (known.empty() ? "" : " (the file describes " + known + ")"));
     }
+    if (is_core(a.role)) continue;  // its limits are its mechanism's keys: check_core_drives
     const double top = m->drive.output_speed_rad_s();
     if (a.role == hal::AxisRole::kSelector) {
       const double need = m->drive.output_inertia_kg_m2() * c.knotting.selector_accel_rad_s2;

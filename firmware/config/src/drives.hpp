@@ -7,8 +7,10 @@
 #include <string>
 #include <vector>
 
+#include "keys.hpp"
 #include "loom/config/config.hpp"
 #include "loom/config/toml_reader.hpp"
+#include "loom/motion/profile_set.hpp"
 
 namespace loom::firmware::detail {
 
@@ -29,6 +31,12 @@ void read_drives(TomlReader& r, LoomConfig& c);
 void check_axis_drives(TomlReader& r, LoomConfig& c);
 // The knot cycle's servo fields from the knotter axes' drives (the weakest of each fact) and speed caps.
 void set_knot_cycle_servo(LoomConfig& c);
+
+// After the profiles are built from `c`: each core axis that names a drive must get from it the speed its
+// motion asks (the crank's fastest beat with the law and the beat regulator's top scale, the carriage's and
+// the helix' speed limits) and the torque (force) to accelerate the drive's own rotor and gears (and the
+// helix' shuttle) at the axis' acceleration limit; refused at the key that asks it (or the drive's fact).
+void check_core_drives(const LoomConfig& c, const motion::ProfileSet& set, const Fail& fail);
 
 // The canonical text of the drives, to tell a restart-only change.
 std::string drives_text(const LoomConfig& c);

@@ -101,9 +101,22 @@ struct AxisSpec {
 // equal): 20-bit encoders, a 10 mm ball screw on the carriage.
 inline std::vector<AxisSpec> default_axes() {
   return {
-      {.name = "beat_crank", .role = hal::AxisRole::kBeatCrank, .node = 1, .ferror_min = 0.2},
-      {.name = "carriage", .role = hal::AxisRole::kCarriage, .node = 2, .lead_m = 0.010, .ferror_min = 0.002},
-      {.name = "helix", .role = hal::AxisRole::kHelix, .node = 3, .ferror_min = 0.5},
+      {.name = "beat_crank",
+       .role = hal::AxisRole::kBeatCrank,
+       .node = 1,
+       .drive = "servo_400w_10to1",
+       .ferror_min = 0.2},
+      {.name = "carriage",
+       .role = hal::AxisRole::kCarriage,
+       .node = 2,
+       .lead_m = 0.010,
+       .drive = "servo_400w_screw",
+       .ferror_min = 0.002},
+      {.name = "helix",
+       .role = hal::AxisRole::kHelix,
+       .node = 3,
+       .drive = "servo_200w_5to1",
+       .ferror_min = 0.5},
   };
 }
 
@@ -113,6 +126,19 @@ struct DriveModel {
   std::string name;
   motion::ServoDrive drive{};
 };
+
+// The default loom's drives, by name, as firmware/config/default_loom.toml states them (a test holds the
+// two equal; the comments above its tables say where the figures come from): the knotting heads' servo and
+// the core axes' (the beat crank's, the carriage's on its ball screw, the helix').
+inline std::vector<DriveModel> default_drives() {
+  constexpr double kRpm = 2.0 * 3.14159265358979323846 / 60.0;
+  return {
+      {"servo_100w_10to1", motion::shipped_knotter_drive()},
+      {"servo_200w_5to1", {6000 * kRpm, 0.64, 1.91, 0.14e-4, 5.0, 0.07e-4, 0.95}},
+      {"servo_400w_10to1", {6000 * kRpm, 1.27, 3.8, 0.27e-4, 10.0, 0.07e-4, 0.95}},
+      {"servo_400w_screw", {6000 * kRpm, 1.27, 3.8, 0.27e-4, 1.0, 0.66e-4, 0.90}},
+  };
+}
 
 // Where the valves, sensors, e-stop chain, buttons and load cell come from on the CAN HAL.
 enum class IoKind { kCan, kSimulated };
@@ -239,9 +265,8 @@ struct LoomConfig {
   MachineSpec machine_spec;
   // The axes in slot order (hal::AxisLayout): beat crank, carriage, helix, then the others by name.
   std::vector<AxisSpec> axes = default_axes();
-  // The servo drives the axes name, by model: the default loom describes the knotting heads' servo
-  // (default_loom.toml's [drives.servo_100w_10to1]; a test holds the two equal).
-  std::vector<DriveModel> drives = {{"servo_100w_10to1", motion::shipped_knotter_drive()}};
+  // The servo drives the axes name, by model (toml++ order: by name): default_drives().
+  std::vector<DriveModel> drives = default_drives();
   // The pile: none (a flat weave), knotted by the weaver while the loom waits, or by the heads.
   sequencer::KnottingSpec knotting;
   // The knotting servo's cycle through seed 001's linkage: its precision points, dimensions, masses and the
