@@ -400,9 +400,14 @@ void Sequencer::step(hal::Tick now, const hal::HalInputs& raw, hal::HalOutputs& 
   }
   signal();
   positions_primed_ = state_ != State::kIdle;
-  // The configured axes and the I/O to the HAL and kept for the interlocks (the arrays are sized for the
-  // capacity; the rest is never used), in one pass: two library memcpy calls cost more than the copying.
-  for (std::size_t i = 0; i < n_axes_; ++i) out.axes[i] = prev_cmd_.axes[i] = cmd_.axes[i];
+  // The configured axes and the I/O to the HAL (the arrays are sized for the capacity; the rest is never
+  // used), in one pass: two library memcpy calls cost more than the copying. The interlocks compare only
+  // the targets and the I/O with the last tick's, so only those are kept (a restored command is a quick
+  // stop: its requests are set anew and it is on no move).
+  for (std::size_t i = 0; i < n_axes_; ++i) {
+    out.axes[i] = cmd_.axes[i];
+    prev_cmd_.axes[i].target_position = cmd_.axes[i].target_position;
+  }
   out.io = prev_cmd_.io = cmd_.io;
 }
 

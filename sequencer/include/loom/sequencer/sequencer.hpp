@@ -370,7 +370,7 @@ class Sequencer {
 
   // Commanded state: what is written each tick.
   hal::HalOutputs cmd_{};
-  hal::HalOutputs prev_cmd_{};
+  hal::HalOutputs prev_cmd_{};  // the last tick's axis targets and I/O, what the interlocks compare; no more
   bool enabled_outputs_ = false;  // interlocks apply once drives may move
 
   // Active moves: origin position + move profile started at a tick.
