@@ -101,7 +101,8 @@ void print_axes(const LoomConfig& c, const motion::ProfileSet& set) {
   // mechanism's key while it asks less than the drive gives; the config refuses more).
   const std::vector<CoreDriveFit> fits = core_drive_fits(c, set);
   if (!fits.empty())
-    std::printf("  core axes' drives (at the axis; the carriage's through its screw lead):\n");
+    std::printf(
+        "  core axes' drives (at the axis; the carriage's through its lead, travel per motor turn):\n");
   for (const CoreDriveFit& f : fits) {
     const bool rotary = hal::is_rotary(f.role);
     const char* speed = rotary ? "rad/s" : "m/s";
@@ -110,19 +111,19 @@ void print_axes(const LoomConfig& c, const motion::ProfileSet& set) {
         "    %-12s drives.%s: no-load %.3g %s, peak %.4g %s, continuous %.4g %s, rotor and gears %.3g %s\n",
         f.axis.c_str(), f.model.c_str(), f.at.top_speed, speed, f.at.peak_effort, effort, f.at.rated_effort,
         effort, f.at.inertia, rotary ? "kg m^2" : "kg");
-    const double share = f.need_speed / f.at.top_speed;
-    std::printf("      speed: %s asks %.3g %s, %.0f %% of the drive's; binding: %s\n", f.speed_key.c_str(),
-                f.need_speed, speed, 100.0 * share,
-                share >= 1.0 - 1e-9 ? "the drive's no-load speed (the key equals it)" : "the key");
-    const std::string load = f.load_what.empty() ? "" : " and " + f.load_what;
-    const char* unknown = f.role == hal::AxisRole::kBeatCrank  ? "; the linkage's load is not counted"
-                          : f.role == hal::AxisRole::kCarriage ? "; the carriage's own mass is not counted"
-                                                               : "";
+    std::printf("      speed: %s asks %.3g %s, %.0f %% of the drive's no-load speed; binding: the key\n",
+                f.speed_key.c_str(), f.need_speed, speed, 100.0 * f.need_speed / f.at.top_speed);
+    // The config refuses a file whose need is over the line, so what is printed here fits.
     std::printf(
-        "      acceleration: %s = %.4g %s/s^2 takes %.3g %s for the rotor and gears%s, %.0f %% of the "
-        "peak%s\n",
-        f.accel_key.c_str(), f.need_accel, rotary ? "rad" : "m", f.need_effort(), effort, load.c_str(),
-        100.0 * f.need_effort() / f.at.peak_effort, unknown);
+        "      effort at that speed, accelerating at %s: %.3g %s (%s), %.0f %% of the %.3g %s its "
+        "torque-speed line gives there\n",
+        f.accel_key.c_str(), f.need_effort(), effort, effort_parts(f, effort).c_str(),
+        100.0 * f.need_effort() / f.line_effort(), f.line_effort(), effort);
+    if (f.load_rms_effort > 0.0) {
+      std::printf("      continuous: the linkage's %.3g %s rms over a turn, %.0f %% of the drive's %.4g %s\n",
+                  f.load_rms_effort, effort, 100.0 * f.load_rms_effort / f.at.rated_effort, f.at.rated_effort,
+                  effort);
+    }
   }
   // Referencing: what the loom does with each axis after its drive powers up, in the order it arms.
   std::printf(

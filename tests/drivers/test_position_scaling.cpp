@@ -15,7 +15,7 @@ namespace {
 TEST(PositionScaling, OneTurnIsTwoToTheTwentyCounts) {
   EXPECT_EQ(si_to_counts(2.0 * std::numbers::pi, kDefaultCountsPerRad), 1 << 20);
   EXPECT_EQ(si_to_counts(-std::numbers::pi, kDefaultCountsPerRad), -(1 << 19));
-  EXPECT_EQ(si_to_counts(0.010, kDefaultCountsPerM), 1 << 20);  // one screw lead
+  EXPECT_EQ(si_to_counts(0.020, kDefaultCountsPerM), 1 << 20);  // one motor turn of carriage travel
   EXPECT_DOUBLE_EQ(counts_to_si(1 << 20, kDefaultCountsPerRad), 2.0 * std::numbers::pi);
   // Round trip within half a count.
   for (double x : {0.0, 1e-6, 0.1234, -3.5, 1000.0}) {

@@ -251,7 +251,7 @@ TEST(Config, StructDefaultsAgreeWithTheEmbeddedDefaultToml) {
   EXPECT_EQ(restart_only_changes(built, parsed), "");
   ASSERT_EQ(built.axes.size(), 3u);
   EXPECT_DOUBLE_EQ(built.axes[1].counts_per_unit(),
-                   104857600.0);  // 2^20 counts per 10 mm, as the drives assume
+                   52428800.0);  // 2^20 counts per 20 mm, as the drives assume
   EXPECT_DOUBLE_EQ(built.axes[1].counts_per_unit(), loom::drivers::kDefaultCountsPerM);
   EXPECT_DOUBLE_EQ(built.axes[0].counts_per_unit(), loom::drivers::kDefaultCountsPerRad);
   // The recipe's numeric keys (restart_only_changes leaves the recipe out).

@@ -144,7 +144,7 @@ TEST(ServoDrives, RefusalsNameTheLine) {
   const std::string unknown =
       config_error(shipped_with(kKnotterDrive, "drive = \"servo_200w\""), kConfigDir + "/u.toml");
   EXPECT_NE(unknown.find("axes.knotter_1.drive = \"servo_200w\": no [drives.servo_200w] table (the file "
-                         "describes servo_100w_10to1, servo_200w_5to1, servo_400w_10to1, servo_400w_screw)"),
+                         "describes servo_100w_10to1, servo_200w_5to1, servo_400w_10to1, servo_400w_belt)"),
             std::string::npos)
       << unknown;
   // A data sheet whose rated torque exceeds its peak; a missing fact; a fact out of range.

@@ -3,10 +3,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "drives.hpp"
 #include "keys.hpp"
+#include "loom/motion/dynamics.hpp"
 #include "loom/sequencer/beat_regulator.hpp"
 
 namespace loom::firmware {
@@ -15,11 +17,35 @@ using detail::fmt_num;
 
 namespace {
 
+constexpr int kLinkageSamples = 360;  // a degree of crank apart: the torque's peak to well under 1 %
+
 std::string figure(double v) {  // 3 significant digits, as a person reads a data sheet
   std::ostringstream os;
   os.precision(3);
   os << v;
   return os.str();
+}
+
+// The beat-up linkage's load on the crank at its fastest speed: the inverse dynamics' crank torque over a
+// turn at that constant speed (the links' and beater's inertia and weight; the beat force is the
+// beater's own inertia, so it is in it), its peak and its rms (the crank turns through every beat).
+void linkage_load(const LoomConfig& c, CoreDriveFit& f) {
+  const MachineSpec& m = c.machine_spec;
+  try {
+    const motion::BeatUpDynamics dyn(m.beatup, motion::beatup_masses(m.beatup, m.beater_mass_kg));
+    double peak = 0.0, sum_sq = 0.0;
+    const std::vector<motion::BeatUpSample> turn = dyn.sweep(f.need_speed, kLinkageSamples);
+    for (const motion::BeatUpSample& s : turn) {
+      peak = std::max(peak, std::abs(s.forces.crank_torque_nm));
+      sum_sq += s.forces.crank_torque_nm * s.forces.crank_torque_nm;
+    }
+    f.load_effort = peak;
+    f.load_rms_effort = std::sqrt(sum_sq / static_cast<double>(turn.size()));
+    f.load_effort_what = "the linkage " + figure(peak) + " N m (its peak over a turn at that speed)";
+  } catch (const motion::MotionError& e) {
+    f.load_effort = f.load_rms_effort = std::numeric_limits<double>::quiet_NaN();
+    f.load_effort_what = std::string("the linkage (its load could not be computed: ") + e.what() + ")";
+  }
 }
 
 }  // namespace
@@ -67,6 +93,7 @@ std::vector<CoreDriveFit> core_drive_fits(const LoomConfig& c, const motion::Pro
         f.need_accel = c.profile.crank.acceleration;
         f.accel_key = "recipe.crank_accel_rad_s2";
         f.accel_value = fmt_num(c.recipe.crank_accel_rad_s2);
+        linkage_load(c, f);
         break;
       }
       case hal::AxisRole::kCarriage:
@@ -79,6 +106,10 @@ std::vector<CoreDriveFit> core_drive_fits(const LoomConfig& c, const motion::Pro
         f.need_accel = c.machine_spec.carriage_max_accel_m_s2;
         f.accel_key = "carriage.max_accel_m_s2";
         f.accel_value = fmt_num(f.need_accel);
+        f.load_inertia = c.machine_spec.carriage_mass_kg;
+        f.load_what = "the carriage's " + figure(f.load_inertia) + " kg (carriage.mass_kg)";
+        f.load_key = "carriage.mass_kg";
+        f.load_value = fmt_num(f.load_inertia);
         break;
       case hal::AxisRole::kHelix: {
         f.need_speed = set.helix_limits().velocity;
@@ -91,6 +122,8 @@ std::vector<CoreDriveFit> core_drive_fits(const LoomConfig& c, const motion::Pro
         const double r = c.machine_spec.helix_lead_m / (2.0 * M_PI);
         f.load_inertia = c.machine_spec.shuttle_mass_kg * r * r;
         f.load_what = "the shuttle";
+        f.load_key = "helix.shuttle_mass_kg";
+        f.load_value = fmt_num(c.machine_spec.shuttle_mass_kg);
         break;
       }
       default:
@@ -99,6 +132,15 @@ std::vector<CoreDriveFit> core_drive_fits(const LoomConfig& c, const motion::Pro
     out.push_back(std::move(f));
   }
   return out;
+}
+
+std::string effort_parts(const CoreDriveFit& f, const char* effort) {
+  std::string parts = "the drive's own rotor and gears";
+  if (!f.load_what.empty()) parts += " and " + f.load_what;
+  parts += " at " + figure(f.need_accel) + (hal::is_rotary(f.role) ? " rad/s^2: " : " m/s^2: ") +
+           figure((f.at.inertia + f.load_inertia) * f.need_accel) + " " + effort;
+  if (!f.load_effort_what.empty()) parts += "; " + f.load_effort_what;
+  return parts;
 }
 
 namespace detail {
@@ -122,12 +164,23 @@ void check_core_drives(const LoomConfig& c, const motion::ProfileSet& set, const
                ")");
     }
     const char* effort = rotary ? "N m" : "N";
-    if (!(f.need_effort() < f.at.peak_effort)) {
-      fail(f.accel_key + "|" + named, f.accel_value + "|\"" + f.model + "\"",
-           "needs " + figure(f.need_effort()) + " " + effort +
-               " to accelerate the drive's own rotor and gears" +
-               (f.load_what.empty() ? std::string() : " and " + f.load_what) + " alone; " + drive +
-               " gives " + figure(f.at.peak_effort) + " " + effort + " at the output");
+    if (!(f.need_effort() <= f.line_effort())) {
+      // The speed takes the line's share that the load then lacks: when the load alone is over the line,
+      // the speed (or the load) is what to lower, else the acceleration.
+      const bool speed_binds = !(f.load_effort < f.line_effort());
+      const std::string load_key = f.load_key.empty() ? "" : f.load_key + "|";
+      const std::string load_value = f.load_key.empty() ? "" : f.load_value + "|";
+      fail((speed_binds ? f.speed_key : f.accel_key) + "|" + load_key + named,
+           (speed_binds ? f.speed_value : f.accel_value) + "|" + load_value + "\"" + f.model + "\"",
+           "needs " + figure(f.need_effort()) + " " + effort + " at " + figure(f.need_speed) + " " + unit +
+               " (" + effort_parts(f, effort) + "); " + drive + " gives " + figure(f.line_effort()) + " " +
+               effort + " there (its torque-speed line: " + figure(f.at.peak_effort) + " " + effort +
+               " at standstill, 0 at its no-load " + figure(f.at.top_speed) + " " + unit + ")");
+    } else if (!(f.load_rms_effort <= f.at.rated_effort)) {
+      fail(f.speed_key + "|" + named, f.speed_value + "|\"" + f.model + "\"",
+           "needs " + figure(f.load_rms_effort) + " " + effort + " rms over a turn at " +
+               figure(f.need_speed) + " " + unit + " for the linkage; " + drive + " gives " +
+               figure(f.at.rated_effort) + " " + effort + " continuously");
     }
   }
 }

@@ -261,6 +261,8 @@ const std::vector<Key>& keys() {
     v.push_back(number("carriage.jerk_m_s3", M::kMachine, 1.0, 1.0e6, [](LoomConfig& c) -> double& {
       return c.machine_spec.carriage_reposition_jerk_m_s3;
     }));
+    v.push_back(number("carriage.mass_kg", M::kMachine, 0.0, 1000.0,
+                       [](LoomConfig& c) -> double& { return c.machine_spec.carriage_mass_kg; }));
     v.push_back(number("carriage.home_position_m", M::kMachine, -10.0, 10.0,
                        [](LoomConfig& c) -> double& { return c.machine_spec.calibration.carriage_home_m; }));
     // [helix]

@@ -1,6 +1,8 @@
 // Reading a loom file: the key table in file order, the axes and I/O modules, the cross-field checks,
 // the one derivation and each module's own validation; a recipe's restart-only changes; the key list.
+#include <algorithm>
 #include <string>
+#include <vector>
 
 #include "axes.hpp"
 #include "checks.hpp"
@@ -17,6 +19,17 @@ namespace loom::firmware {
 using namespace detail;
 
 namespace {
+
+// "a|b|c" -> {a, b, c}; never empty.
+std::vector<std::string> split_bars(const std::string& s) {
+  std::vector<std::string> parts;
+  for (std::size_t from = 0;;) {
+    const std::size_t bar = s.find('|', from);
+    parts.push_back(s.substr(from, bar == std::string::npos ? bar : bar - from));
+    if (bar == std::string::npos) return parts;
+    from = bar + 1;
+  }
+}
 
 LoomConfig parse_complete(const std::string& text, const std::string& source, const LoomConfig* base) {
   TomlReader r(text, source);
@@ -65,20 +78,14 @@ LoomConfig parse_complete(const std::string& text, const std::string& source, co
         "serve with that --state-dir)");
   }
   check_eds_keys(r, c);
-  // `key` may name two facts that clash ("axes.helix.node|can.master_node", values likewise): the one the
-  // file says is the line to point at (the first when it says both).
+  // `key` may name several facts that clash ("axes.helix.node|can.master_node", values likewise; a value
+  // list shorter than the keys repeats its last): the first the file says is the line to point at.
   const Fail fail = [&](const std::string& key, const std::string& value, const std::string& why) {
-    const std::size_t bar = key.find('|'), vbar = value.find('|');
-    if (bar != std::string::npos) {
-      const std::string k1 = key.substr(0, bar), v1 = value.substr(0, vbar);
-      const std::string k2 = key.substr(bar + 1),
-                        v2 = vbar == std::string::npos ? value : value.substr(vbar + 1);
-      if (present(k1)) r.fail(k1, v1, why);
-      if (present(k2)) r.fail(k2, v2, why);
-      throw ConfigError(source + ": " + k1 + " = " + v1 + " (from the embedded default): " + why);
+    const std::vector<std::string> keys = split_bars(key), values = split_bars(value);
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+      if (present(keys[i])) r.fail(keys[i], values[std::min(i, values.size() - 1)], why);
     }
-    if (present(key)) r.fail(key, value, why);
-    throw ConfigError(source + ": " + key + " = " + value + " (from the embedded default): " + why);
+    throw ConfigError(source + ": " + keys[0] + " = " + values[0] + " (from the embedded default): " + why);
   };
   derive(c, fail);
   check_can(c, fail);

@@ -19,10 +19,11 @@ namespace loom::drivers {
 
 struct NodeDescription;  // node_description.hpp
 
-// 20-bit single-turn encoders; the carriage's ball screw advances 10 mm per motor revolution.
+// 20-bit single-turn encoders; the carriage's belt advances 20 mm per motor revolution (a 100 mm pulley
+// behind a 5:1 gearbox).
 inline constexpr double kCountsPerRev = 1048576.0;  // 2^20
 inline constexpr double kDefaultCountsPerRad = kCountsPerRev / (2.0 * std::numbers::pi);
-inline constexpr double kDefaultCarriageLeadM = 0.010;
+inline constexpr double kDefaultCarriageLeadM = 0.020;
 inline constexpr double kDefaultCountsPerM = kCountsPerRev / kDefaultCarriageLeadM;
 
 // How the master commands a drive (CiA 402 modes of operation, 0x6060).

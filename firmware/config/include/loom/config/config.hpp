@@ -98,7 +98,7 @@ struct AxisSpec {
 };
 
 // The default loom's three axes, as firmware/config/default_loom.toml states them (a test holds the two
-// equal): 20-bit encoders, a 10 mm ball screw on the carriage.
+// equal): 20-bit encoders, the carriage on a toothed belt, 20 mm of travel per motor turn.
 inline std::vector<AxisSpec> default_axes() {
   return {
       {.name = "beat_crank",
@@ -109,8 +109,8 @@ inline std::vector<AxisSpec> default_axes() {
       {.name = "carriage",
        .role = hal::AxisRole::kCarriage,
        .node = 2,
-       .lead_m = 0.010,
-       .drive = "servo_400w_screw",
+       .lead_m = 0.020,
+       .drive = "servo_400w_belt",
        .ferror_min = 0.002},
       {.name = "helix",
        .role = hal::AxisRole::kHelix,
@@ -129,14 +129,14 @@ struct DriveModel {
 
 // The default loom's drives, by name, as firmware/config/default_loom.toml states them (a test holds the
 // two equal; the comments above its tables say where the figures come from): the knotting heads' servo and
-// the core axes' (the beat crank's, the carriage's on its ball screw, the helix').
+// the core axes' (the beat crank's, the carriage's on its belt, the helix').
 inline std::vector<DriveModel> default_drives() {
   constexpr double kRpm = 2.0 * 3.14159265358979323846 / 60.0;
   return {
       {"servo_100w_10to1", motion::shipped_knotter_drive()},
       {"servo_200w_5to1", {6000 * kRpm, 0.64, 1.91, 0.14e-4, 5.0, 0.07e-4, 0.95}},
       {"servo_400w_10to1", {6000 * kRpm, 1.27, 3.8, 0.27e-4, 10.0, 0.07e-4, 0.95}},
-      {"servo_400w_screw", {6000 * kRpm, 1.27, 3.8, 0.27e-4, 1.0, 0.66e-4, 0.90}},
+      {"servo_400w_belt", {6000 * kRpm, 1.27, 3.8, 0.27e-4, 5.0, 0.073e-4, 0.93}},
   };
 }
 
@@ -199,6 +199,7 @@ struct MachineSpec {
   double beater_width_m = 0.10;
   double carriage_max_speed_m_s = 1.0, carriage_max_accel_m_s2 = 20.0, carriage_max_jerk_m_s3 = 2000.0;
   double carriage_reposition_jerk_m_s3 = 100.0;  // re-arm moves
+  double carriage_mass_kg = 20.0;  // what the carriage's drive moves besides itself: the heads it carries
   double helix_lead_m = 0.10;
   motion::JerkLimits helix{.velocity = 60.0, .acceleration = 3000.0, .jerk = 2.0e5};
   double carrier_force_n = 20.0;
