@@ -51,18 +51,19 @@ constexpr std::initializer_list<hal::SafetySensor> kAllSensors = {
     hal::SafetySensor::kShuttleAtLeft,   hal::SafetySensor::kShuttleAtRight};
 
 // The kinds a loom without knotting heads can suffer (the heads' own faults come after them in the enum),
-// and with them (axis_jam, after the heads' faults, is a test's fault: a jammed core axis is not a case of
-// this campaign, whose draws stay those it had before axis_jam existed).
+// and with them; axis_jam, after the heads' faults, is drawn only when asked (--axis-jams), so that the
+// campaign's draws stay those it had before it existed.
 constexpr int kFaultKindsWithoutHeads = static_cast<int>(InjectedFault::kSelectorJam);
 constexpr int kFaultKindsWithHeads = static_cast<int>(InjectedFault::kYarnOut) + 1;
 
 sim_hal::FaultInjection random_fault(std::mt19937_64& rng, sim_hal::SceneSpec& s,
                                      const std::array<bool, hal::kSafetySensorCount>& second_channel,
-                                     int heads, int slots, std::ostringstream& d) {
+                                     int heads, int slots, bool axis_jams, std::ostringstream& d) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   sim_hal::FaultInjection f;
   const int kinds = heads > 0 ? kFaultKindsWithHeads : kFaultKindsWithoutHeads;
-  f.kind = static_cast<InjectedFault>(static_cast<int>(u(rng) * kinds));
+  const int drawn = static_cast<int>(u(rng) * (kinds + (axis_jams ? 1 : 0)));
+  f.kind = drawn == kinds ? InjectedFault::kAxisJam : static_cast<InjectedFault>(drawn);
   f.head = heads > 0 ? static_cast<int>(u(rng) * heads) : 0;
   f.slot = slots > 0 ? static_cast<int>(u(rng) * slots) : 0;
   f.at_s = 16.0 * u(rng);
@@ -107,6 +108,9 @@ sim_hal::FaultInjection random_fault(std::mt19937_64& rng, sim_hal::SceneSpec& s
     case InjectedFault::kYarnOut:
       f.at_s = 40.0 * u(rng);
       break;  // anywhere in the knotting of the first row
+    case InjectedFault::kAxisJam:
+      if (heads > 0) f.at_s = 40.0 * u(rng);  // the carriage's steps between knots too
+      break;
     default:
       break;
   }
@@ -132,7 +136,7 @@ bool shed_open(const std::array<double, 2>& p) {
 
 sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run,
                                 const std::array<bool, hal::kSafetySensorCount>& second_channel, int heads,
-                                int slots, std::string& description) {
+                                int slots, std::string& description, bool axis_jams) {
   std::mt19937_64 rng(mix(seed ^ mix(run)));
   std::uniform_real_distribution<double> u(0.0, 1.0);
   sim_hal::SceneSpec s;
@@ -221,7 +225,8 @@ sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run,
   } else {
     const double n = u(rng);
     const int count = n < 0.15 ? 0 : n < 0.8 ? 1 : 2;
-    for (int i = 0; i < count; ++i) s.faults.push_back(random_fault(rng, s, second_channel, heads, slots, d));
+    for (int i = 0; i < count; ++i)
+      s.faults.push_back(random_fault(rng, s, second_channel, heads, slots, axis_jams, d));
     // One power cut per scene.
     if (count == 2 && s.faults[0].kind == InjectedFault::kPowerCut &&
         s.faults[1].kind == InjectedFault::kPowerCut) {
@@ -499,9 +504,9 @@ CampaignResult run_campaign(const CampaignOptions& opt) {
       if (run >= opt.runs) return;
       std::string description;
       const bool with_heads = local.knotting.mode == sequencer::KnottingMode::kHeads;
-      const sim_hal::SceneSpec scene =
-          random_scene(opt.seed, run, local.sequencer.second_channel, with_heads ? local.knotting.heads : 0,
-                       with_heads ? static_cast<int>(local.knotting.slot_colours.size()) : 0, description);
+      const sim_hal::SceneSpec scene = random_scene(
+          opt.seed, run, local.sequencer.second_channel, with_heads ? local.knotting.heads : 0,
+          with_heads ? static_cast<int>(local.knotting.slot_colours.size()) : 0, description, opt.axis_jams);
       const std::vector<StoppingAct> acts =
           random_stopping_acts(opt.seed, run, with_heads ? local.knotting.heads : 0, description);
       const RunOutcome o = run_one(local, scene, opt.rows, acts);

@@ -46,10 +46,12 @@ struct RunOutcome {
 // into every switch the machine has: the six safety sensors' first channels, and their second channels
 // where `second_channel` says the machine has one.
 // `heads` and `slots`: the loom's knotting heads and their magazine slots (0 without heads): the scene then
-// simulates them and draws their faults too.
+// simulates them and draws their faults too. `axis_jams`: a jammed core axis (a seized gearbox, a blocked
+// rail: its drive stops following without reporting it) is one more fault kind drawn; without it the draws
+// are those the campaign had before that kind existed.
 sim_hal::SceneSpec random_scene(std::uint64_t seed, std::uint64_t run,
                                 const std::array<bool, hal::kSafetySensorCount>& second_channel, int heads,
-                                int slots, std::string& description);
+                                int slots, std::string& description, bool axis_jams = false);
 
 // A stopping command an operator gives at a tick: stop (weave's SIGTERM or the service's ctl/panel stop),
 // pause, exit (the service's SIGTERM), or stop now (a second SIGTERM).
@@ -81,6 +83,7 @@ struct CampaignOptions {
   int threads = 1;
   std::uint32_t rows = 2;
   std::string config_path;  // the loom description the runs weave on ("" = the embedded default loom)
+  bool axis_jams = false;   // draw jammed core axes too (random_scene)
   const std::atomic<bool>* stop = nullptr;  // set asynchronously: finish the runs in progress and return
   // Called (serialised) after each run with the totals so far and the run's violation, if any.
   std::function<void(const struct CampaignResult&, const struct Violation*)> on_run;

@@ -34,6 +34,8 @@ int main(int argc, char** argv) {
   app.add_option("--config", opt.config_path,
                  "the loom description to weave on (default: the embedded default loom); e.g. one whose "
                  "io.<sensor>_2_bit = -1 has single-channel safety sensors");
+  app.add_flag("--axis-jams", opt.axis_jams,
+               "draw jammed core axes too (a drive that stops following without a fault of its own)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -48,11 +50,12 @@ int main(int argc, char** argv) {
   }
   if (!opt.config_path.empty()) opt.config_path = std::filesystem::absolute(opt.config_path).string();
   std::printf(
-      "loom-safety: seed %llu, %llu runs of %u rows, %d threads, loom %s (replay this campaign with --seed "
-      "%llu)\n",
+      "loom-safety: seed %llu, %llu runs of %u rows, %d threads, loom %s%s (replay this campaign with --seed "
+      "%llu%s)\n",
       static_cast<unsigned long long>(opt.seed), static_cast<unsigned long long>(opt.runs), opt.rows,
       opt.threads, opt.config_path.empty() ? "embedded default" : opt.config_path.c_str(),
-      static_cast<unsigned long long>(opt.seed));
+      opt.axis_jams ? ", jammed axes drawn too" : "", static_cast<unsigned long long>(opt.seed),
+      opt.axis_jams ? " --axis-jams" : "");
   std::fflush(stdout);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
