@@ -11,6 +11,7 @@
 #include <string>
 
 #include "loom/drivers/eds.hpp"
+#include "text_file.hpp"
 
 namespace loom::drivers::eds {
 namespace {
@@ -20,10 +21,7 @@ std::string path_of(const std::string& name) {
 }
 
 std::string text_of(const std::string& name) {
-  std::ifstream in(path_of(name), std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+  return loom::test::read_text_file(path_of(name));
 }
 
 // The 1-based line of the first line of `text` that contains `needle` (after `after`, when given).

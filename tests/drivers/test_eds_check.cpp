@@ -9,6 +9,7 @@
 #include <string>
 
 #include "loom/drivers/eds_check.hpp"
+#include "text_file.hpp"
 
 namespace loom::drivers::eds {
 namespace {
@@ -18,10 +19,7 @@ std::string path_of(const std::string& name) {
 }
 
 std::string text_of(const std::string& name) {
-  std::ifstream in(path_of(name), std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+  return loom::test::read_text_file(path_of(name));
 }
 
 int line_of(const std::string& text, const std::string& needle, const std::string& after = "") {

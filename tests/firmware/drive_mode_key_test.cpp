@@ -10,6 +10,7 @@
 #include "config_error.hpp"
 #include "loom/config/config.hpp"
 #include "loom/drivers/can_axis_config.hpp"
+#include "text_file.hpp"
 
 using namespace loom::firmware;
 using loom::test::config_error;
@@ -19,10 +20,7 @@ namespace {
 const std::string kConfigDir = std::string(LOOM_SOURCE_DIR) + "/firmware/config";
 
 std::string knotting_loom() {
-  std::ifstream in(kConfigDir + "/knotting_loom.toml");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+  return loom::test::read_text_file(kConfigDir + "/knotting_loom.toml");
 }
 
 // The knotting loom with `line` added to axis `axis`'s table (the table's header line is followed by it).

@@ -12,25 +12,21 @@
 #include "config_error.hpp"
 #include "loom/config/config.hpp"
 #include "loom/motion/knot_cycle.hpp"
+#include "text_file.hpp"
 
 using namespace loom::firmware;
 
 namespace {
 
+using loom::test::read_text_file;
+
 using loom::test::config_error;
 
 const std::string kConfigDir = std::string(LOOM_SOURCE_DIR) + "/firmware/config";
 
-std::string read(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
 // The shipped knotting loom's text with every `from` line replaced by `to`.
 std::string shipped_with(const std::string& from, const std::string& to) {
-  std::string s = read(kConfigDir + "/knotting_loom.toml");
+  std::string s = read_text_file(kConfigDir + "/knotting_loom.toml");
   for (std::size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size()))
     s.replace(at, from.size(), to);
   return s;
@@ -162,9 +158,9 @@ TEST(ServoDrives, RefusalsNameTheLine) {
             std::string::npos);
   // The knot cycle's torque refusals blame the knotting servo's drive: a cycle whose rms torque is over the
   // continuous rating.
-  const std::string weak = config_error(
-      read(kConfigDir + "/knotting_loom.toml") + "\n[drives.servo_100w_10to1]\nrated_torque_nm = 0.05\n",
-      kConfigDir + "/w.toml");
+  const std::string weak = config_error(read_text_file(kConfigDir + "/knotting_loom.toml") +
+                                            "\n[drives.servo_100w_10to1]\nrated_torque_nm = 0.05\n",
+                                        kConfigDir + "/w.toml");
   EXPECT_NE(weak.find("axes.knotter_1.drive = \"servo_100w_10to1\": the knotting servo's drive: knot cycle: "
                       "continuous_torque_nm = 0.475"),
             std::string::npos)

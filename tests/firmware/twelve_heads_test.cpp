@@ -13,20 +13,16 @@
 #include "loom/drivers/bus_load.hpp"
 #include "loom/drivers/can_axis_config.hpp"
 #include "loom/sequencer/knot_plan.hpp"
+#include "text_file.hpp"
 
 using namespace loom;
 using namespace loom::firmware;
 
 namespace {
 
-const std::string kPath = std::string(LOOM_SOURCE_DIR) + "/firmware/config/knotting_loom_12_heads.toml";
+using loom::test::read_text_file;
 
-std::string read(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
+const std::string kPath = std::string(LOOM_SOURCE_DIR) + "/firmware/config/knotting_loom_12_heads.toml";
 
 // The file as the loom reads it, and the CAN master's config derived from it.
 struct Loaded {
@@ -36,7 +32,7 @@ struct Loaded {
 };
 
 Loaded load() {
-  const std::string text = read(kPath);
+  const std::string text = read_text_file(kPath);
   Loaded l;
   const std::string line = "\ndrive_mode = \"profile\"";  // a key at the start of its line
   for (std::size_t at = text.find(line); at != std::string::npos; at = text.find(line, at + 1))

@@ -13,6 +13,7 @@
 #include "cli_run.hpp"
 #include "loom/config/config.hpp"
 #include "loom/job/design_hash.hpp"
+#include "text_file.hpp"
 
 namespace fs = std::filesystem;
 using loom::job::Job;
@@ -23,12 +24,8 @@ using loom::job::JobState;
 
 namespace {
 
-std::string slurp(const std::string& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
+using loom::test::read_text_file;
+
 void write(const std::string& p, const std::string& text) {
   std::ofstream(p, std::ios::binary) << text;
 }
@@ -128,7 +125,7 @@ TEST(JobQueue, ChangedDesignFileIsRefusedNamingBothHashes) {
   const Job j = q.add(t / "rug.csv", knotting_loom(), {});
   EXPECT_NO_THROW(JobQueue::check_design(j));
   write(t / "rug.csv", design_csv(360, 4, "I"));
-  const std::string now = loom::job::sha256_hex(slurp(t / "rug.csv"));
+  const std::string now = loom::job::sha256_hex(read_text_file(t / "rug.csv"));
   EXPECT_EQ(error_of([&] { JobQueue::check_design(j); }),
             "the design file changed under job 1: hash " + now + ", was " + j.sha256 + " (" +
                 (t / "rug.csv") + "; add it as a new job to weave the new design)");
@@ -141,11 +138,11 @@ TEST(JobQueue, AddRefusesEveryColourInNoSlotAtOnceAndTouchesNothing) {
   write(t / "green.csv", design_csv(360, 3, "G", "Y"));
   JobQueue q = JobQueue::load(JobQueue::path_in(t.dir.string()));
   q.add(kDemo, knotting_loom(), {});
-  const std::string before = slurp(q.path());
+  const std::string before = read_text_file(q.path());
   const std::string e = error_of([&] { q.add(t / "green.csv", knotting_loom(), {}); });
   EXPECT_NE(e.find("colours in no magazine slot: G (720 knots), Y (360 knots)"), std::string::npos) << e;
   EXPECT_NE(e.find("R in slot 0, I in slot 1, B in slot 2"), std::string::npos) << e;
-  EXPECT_EQ(slurp(q.path()), before);
+  EXPECT_EQ(read_text_file(q.path()), before);
   EXPECT_EQ(q.jobs().size(), 1u);
 }
 
@@ -235,7 +232,7 @@ TEST(JobQueue, ABadFileIsRefusedWithLineFieldAndValue) {
   TempDir t;
   JobQueue q = JobQueue::load(JobQueue::path_in(t.dir.string()));
   q.add(kDemo, knotting_loom(), {});
-  const std::string good = slurp(q.path());
+  const std::string good = read_text_file(q.path());
   struct Case {
     std::string from, to, want;
   };
@@ -272,12 +269,12 @@ TEST(JobQueue, ABadFileIsRefusedWithLineFieldAndValue) {
     const std::string e = error_of([&] { JobQueue::load(q.path()); });
     EXPECT_NE(e.find(q.path()), std::string::npos) << e;
     EXPECT_NE(e.find(c.want), std::string::npos) << "want: " << c.want << "\ngot:  " << e;
-    EXPECT_EQ(slurp(q.path()), bad);  // refused, never rewritten
+    EXPECT_EQ(read_text_file(q.path()), bad);  // refused, never rewritten
   }
   // Two current jobs.
   JobQueue two = JobQueue::load((write(q.path(), good), q.path()));
   two.add(kDemo, knotting_loom(), {});
-  std::string s = slurp(q.path());
+  std::string s = read_text_file(q.path());
   for (std::size_t p = s.find("state = queued"); p != std::string::npos; p = s.find("state = queued")) {
     s.replace(p, 14, "state = current");
   }
@@ -292,7 +289,7 @@ TEST(JobQueue, AFormatOneQueueReadsAsFirstWeavings) {
   TempDir t;
   JobQueue q = JobQueue::load(JobQueue::path_in(t.dir.string()));
   q.add(kDemo, knotting_loom(), {});
-  std::string v1 = slurp(q.path());
+  std::string v1 = read_text_file(q.path());
   const auto at = v1.find("weaving = 1\n");
   ASSERT_NE(at, std::string::npos);
   v1.erase(at, 12);
@@ -301,6 +298,6 @@ TEST(JobQueue, AFormatOneQueueReadsAsFirstWeavings) {
   JobQueue old = JobQueue::load(q.path());
   EXPECT_EQ(old.job(1).weaving, 1u);
   old.start(1, 0);
-  EXPECT_NE(slurp(q.path()).find("format = loomctl-jobs 2"), std::string::npos);
-  EXPECT_NE(slurp(q.path()).find("weaving = 1\n"), std::string::npos);
+  EXPECT_NE(read_text_file(q.path()).find("format = loomctl-jobs 2"), std::string::npos);
+  EXPECT_NE(read_text_file(q.path()).find("weaving = 1\n"), std::string::npos);
 }

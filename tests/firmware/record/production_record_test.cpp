@@ -20,11 +20,14 @@
 
 #include "cli_run.hpp"
 #include "loom/record/report_format.hpp"
+#include "text_file.hpp"
 
 namespace fs = std::filesystem;
 using namespace loom::record;
 
 namespace {
+
+using loom::test::read_text_file;
 
 struct TempDir {
   fs::path dir;
@@ -35,13 +38,6 @@ struct TempDir {
   ~TempDir() { fs::remove_all(dir); }
   std::string db() const { return ProductionRecord::path_in(dir.string()); }
 };
-
-std::string slurp(const std::string& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
 
 unsigned test_seed() {
   const char* env = std::getenv("LOOM_TEST_SEED");
@@ -259,7 +255,7 @@ TEST(ProductionRecord, AVersionOneRecordIsReadAndThenMigrated) {
     ASSERT_EQ(sqlite3_exec(db, v1, nullptr, nullptr, nullptr), SQLITE_OK) << sqlite3_errmsg(db);
     sqlite3_close(db);
   }
-  const std::string before = slurp(t.db());
+  const std::string before = read_text_file(t.db());
   const auto check = [&](const char* when) {
     const auto r = read_job_report(t.db(), 3);
     ASSERT_TRUE(r.has_value()) << when;
@@ -273,7 +269,7 @@ TEST(ProductionRecord, AVersionOneRecordIsReadAndThenMigrated) {
     EXPECT_FALSE(read_job_report(t.db(), 3, 2).has_value()) << when;
   };
   check("version 1, read-only");
-  EXPECT_EQ(slurp(t.db()), before);  // a reader never migrates
+  EXPECT_EQ(read_text_file(t.db()), before);  // a reader never migrates
   {
     ProductionRecord rec(t.db());  // the writer migrates
     check("migrated");
@@ -371,19 +367,19 @@ TEST(ProductionRecord, AnotherSchemaVersionOrNotADatabaseIsRefusedAndLeftAlone) 
   ASSERT_EQ(sqlite3_open(t.db().c_str(), &db), SQLITE_OK);
   ASSERT_EQ(sqlite3_exec(db, "UPDATE schema_version SET version = 3", nullptr, nullptr, nullptr), SQLITE_OK);
   sqlite3_close(db);
-  const std::string before = slurp(t.db());
+  const std::string before = read_text_file(t.db());
   const std::string e = error_of([&] { ProductionRecord rec(t.db()); });
   EXPECT_NE(
       e.find("production record of schema version 3; this loomctl reads versions 1..2 and writes version 2"),
       std::string::npos)
       << e;
   EXPECT_NE(error_of([&] { read_job_report(t.db(), 1); }).find("schema version 3"), std::string::npos);
-  EXPECT_EQ(slurp(t.db()), before);
+  EXPECT_EQ(read_text_file(t.db()), before);
 
   const std::string text = t.dir.string() + "/notes.sqlite";
   std::ofstream(text) << "these are not the droids\n" << std::string(2000, 'x');
   EXPECT_NE(error_of([&] { ProductionRecord rec(text); }).find("not an SQLite database"), std::string::npos);
-  EXPECT_EQ(slurp(text).substr(0, 25), "these are not the droids\n");
+  EXPECT_EQ(read_text_file(text).substr(0, 25), "these are not the droids\n");
 
   const std::string other = t.dir.string() + "/other.sqlite";
   ASSERT_EQ(sqlite3_open(other.c_str(), &db), SQLITE_OK);

@@ -14,22 +14,18 @@
 #include <vector>
 
 #include "table_rows.hpp"
+#include "text_file.hpp"
 #include "thesis_tables.hpp"
 
 namespace {
+
+using loom::test::read_text_file;
 
 struct CliRun {
   int exit_code = -1;
   std::string out;
   std::string err;
 };
-
-std::string slurp(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
 
 #ifndef LOOM_SYNTH_EXE
 #error "LOOM_SYNTH_EXE must name the loom-synth executable under test"
@@ -45,8 +41,8 @@ CliRun run(const std::string& args) {
   const int status = std::system(cmd.c_str());
   CliRun r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
+  r.out = read_text_file(out);
+  r.err = read_text_file(err);
   std::remove(out.c_str());
   std::remove(err.c_str());
   return r;
