@@ -137,7 +137,7 @@ Status CanAxisPort::configure(std::span<CanBus* const> buses, ConfigureClock& cl
 // ---------------------------------------------------------------------------------------------------
 // Per tick (RT-safe)
 // ---------------------------------------------------------------------------------------------------
-void CanAxisPort::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) {
+void CanAxisPort::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) noexcept {
   if (d_.configured) {
     for (std::size_t b = 0; b < d_.n_buses; ++b) d_.masters[b].poll(now);
   }
@@ -165,7 +165,7 @@ void CanAxisPort::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkSt
   }
 }
 
-bool CanAxisPort::any_fault() const {
+bool CanAxisPort::any_fault() const noexcept {
   for (std::size_t b = 0; b < d_.n_buses; ++b) {
     if (d_.masters[b].any_fault()) return true;
   }
@@ -175,7 +175,7 @@ bool CanAxisPort::any_fault() const {
   return false;
 }
 
-void CanAxisPort::write_axes(hal::Tick now, const hal::AxisCommands& commands) {
+void CanAxisPort::write_axes(hal::Tick now, const hal::AxisCommands& commands) noexcept {
   if (!d_.configured) return;
   bool reset = false;
   for (std::size_t i = 0; i < d_.n_axes; ++i)

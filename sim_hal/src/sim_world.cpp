@@ -273,7 +273,7 @@ inline hal::AxisFeedback feedback_of(const SimAxis& s, double jump, hal::Tick no
 }
 }  // namespace
 
-void SimWorld::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) {
+void SimWorld::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) noexcept {
   // (the call only when a fault strikes now or has struck: before, it would do nothing)
   if (next_fault_ != 0 || (!fault_tick_.empty() && fault_tick_[0] <= now)) apply_injected_faults(now);
   if (powered_off_ || stalled(now)) return;  // nothing refreshed: the values keep their old ticks
@@ -414,7 +414,7 @@ void SimWorld::step_homing(std::size_t slot) noexcept {
   ax.homing = false;
 }
 
-void SimWorld::write_axes(hal::Tick, const hal::AxisCommands& axes) {
+void SimWorld::write_axes(hal::Tick, const hal::AxisCommands& axes) noexcept {
   if (powered_off_) return;
   drives_simulated_ = true;
   for (std::size_t i = 0; i < n_axes_; ++i) {
@@ -485,7 +485,7 @@ void SimWorld::step_beat_contact(double crank_position, double omega, const hal:
   }
 }
 
-void SimWorld::read_analog(hal::Tick now, hal::AnalogInputs& analog) {
+void SimWorld::read_analog(hal::Tick now, hal::AnalogInputs& analog) noexcept {
   if (powered_off_ || stalled(now)) return;
   analog.beat_force_valid = scene_.beat_contact.has_value();
   analog.beat_force_n = beat_force_n_;
@@ -523,7 +523,7 @@ void SimWorld::step_shuttle(double helix) noexcept {
   if (shuttle_v_ == 0.0 && std::abs(carrier - shuttle_x_) < 1e-3) shuttle_coupled_ = true;
 }
 
-void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::DigitalInputs& io) {
+void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::DigitalInputs& io) noexcept {
   if (powered_off_ || stalled(now)) return;
   // The shuttle rides the carrier on the helix shaft: one lead of travel per shaft turn. Taken from the
   // HAL's fresh helix feedback, so this I/O node also works beside real (CAN) drives.
@@ -593,7 +593,7 @@ void SimWorld::readings(std::array<double, hal::kMaxAxes>& out) const noexcept {
   for (std::size_t i = 0; i < n_axes_; ++i) out[i] = axes_[i].position + axes_[i].offset;
 }
 
-void SimWorld::write_io(hal::Tick, const hal::DigitalOutputs& io) {
+void SimWorld::write_io(hal::Tick, const hal::DigitalOutputs& io) noexcept {
   if (powered_off_) return;
   if (knotter_) {
     std::array<double, hal::kMaxAxes> at{};

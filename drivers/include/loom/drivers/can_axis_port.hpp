@@ -60,29 +60,31 @@ class CanAxisPort final : public hal::AxisPort {
   Status configure(CanBus& bus);                         // with MonotonicConfigureClock
 
   // RT-safe. Per bus: drains at most kMaxFramesPerRead frames; then reports every axis and the link.
-  void read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) override;
+  void read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) noexcept override;
   // RT-safe. Per bus: SYNC, then one RPDO1 per axis.
-  void write_axes(hal::Tick now, const hal::AxisCommands& axes) override;
+  void write_axes(hal::Tick now, const hal::AxisCommands& axes) noexcept override;
 
   // Diagnostics; RT-safe to read.
-  bool configured() const { return d_.configured; }
+  bool configured() const noexcept { return d_.configured; }
   // What configure() found optional and absent (0x1016, TPDO2) or accepted as read back; one line each.
   const std::vector<std::string>& notes() const { return d_.notes; }
   // Largest following error seen per axis since configure(), in SI units (telemetry high-water mark).
-  double ferror_high_water(std::size_t slot) const { return d_.axes[slot].ferror_high_water(); }
-  bool has_consumer(std::size_t slot) const { return d_.axes[slot].has_consumer(); }
-  bool has_tpdo2(std::size_t slot) const { return d_.axes[slot].has_tpdo2(); }
-  std::size_t axis_count() const { return d_.n_axes; }
-  std::size_t bus_count() const { return d_.n_buses; }
-  const BusLoad& bus_load(std::size_t bus = 0) const { return d_.bus_loads[bus]; }
+  double ferror_high_water(std::size_t slot) const noexcept { return d_.axes[slot].ferror_high_water(); }
+  bool has_consumer(std::size_t slot) const noexcept { return d_.axes[slot].has_consumer(); }
+  bool has_tpdo2(std::size_t slot) const noexcept { return d_.axes[slot].has_tpdo2(); }
+  std::size_t axis_count() const noexcept { return d_.n_axes; }
+  std::size_t bus_count() const noexcept { return d_.n_buses; }
+  const BusLoad& bus_load(std::size_t bus = 0) const noexcept { return d_.bus_loads[bus]; }
   const CanAxisPortConfig& config() const { return d_.config; }
-  std::uint16_t last_controlword(std::size_t slot) const { return d_.axes[slot].last_controlword(); }
-  std::int64_t last_target_counts(std::size_t slot) const { return d_.axes[slot].last_target_counts(); }
-  std::uint32_t heartbeat_consumer_ticks() const { return d_.consumer_ticks; }
+  std::uint16_t last_controlword(std::size_t slot) const noexcept { return d_.axes[slot].last_controlword(); }
+  std::int64_t last_target_counts(std::size_t slot) const noexcept {
+    return d_.axes[slot].last_target_counts();
+  }
+  std::uint32_t heartbeat_consumer_ticks() const noexcept { return d_.consumer_ticks; }
 
  private:
   void relink();  // the masters' node tables from the axes and the attached nodes
-  bool any_fault() const;
+  bool any_fault() const noexcept;
 
   struct Data {
     CanAxisPortConfig config;

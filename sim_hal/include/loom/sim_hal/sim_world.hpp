@@ -50,11 +50,13 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   SimWorld(const SimMachine& machine, const SceneSpec& scene);
   ~SimWorld() override;
 
-  void read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) override;       // RT-safe
-  void write_axes(hal::Tick now, const hal::AxisCommands& axes) override;                        // RT-safe
-  void read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::DigitalInputs& io) override;  // RT-safe
-  void write_io(hal::Tick now, const hal::DigitalOutputs& io) override;                          // RT-safe
-  void read_analog(hal::Tick now, hal::AnalogInputs& analog) override;                           // RT-safe
+  void read_axes(hal::Tick now, hal::AxisFeedbacks& axes,
+                 hal::LinkStatus& link) noexcept override;                          // RT-safe
+  void write_axes(hal::Tick now, const hal::AxisCommands& axes) noexcept override;  // RT-safe
+  void read_io(hal::Tick now, const hal::AxisFeedbacks& axes,
+               hal::DigitalInputs& io) noexcept override;                         // RT-safe
+  void write_io(hal::Tick now, const hal::DigitalOutputs& io) noexcept override;  // RT-safe
+  void read_analog(hal::Tick now, hal::AnalogInputs& analog) noexcept override;   // RT-safe
 
   // Start the machine where a previous run left it (restart after a power loss): axis positions in SI
   // and the heald frames' positions (0 retracted … 1 extended). Configure-time only.
