@@ -163,6 +163,7 @@ void CanAxisPort::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkSt
       link.silent_node = r == hal::LinkRecovery::kNodeSilent ? silent : 0;
     }
   }
+  d_.link_edge.raise(link);
 }
 
 bool CanAxisPort::any_fault() const noexcept {

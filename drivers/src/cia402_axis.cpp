@@ -478,7 +478,7 @@ bool Cia402Axis::faulted() const noexcept {
 }
 
 void Cia402Axis::fill_feedback(hal::Tick now, hal::AxisFeedback& fb, bool bus_off,
-                               bool bus_configured) const noexcept {
+                               bool bus_configured) noexcept {
   const bool link_down = bus_off || !bus_configured || !up_;
   const std::uint16_t link_fault = supervisor_.link_fault();
   const std::uint16_t emcy = supervisor_.emcy_code();
@@ -524,6 +524,7 @@ void Cia402Axis::fill_feedback(hal::Tick now, hal::AxisFeedback& fb, bool bus_of
     fb.fault_code = fault_code::kNone;
     fb.fault_kind = in_fault_state ? hal::FaultKind::kDrive : hal::FaultKind::kNone;
   }
+  fault_edge_.raise(fb);
 }
 
 // The operator acknowledged (the sequencer requests a fault reset): latches whose cause the master

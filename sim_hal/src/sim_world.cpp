@@ -276,17 +276,31 @@ inline hal::AxisFeedback feedback_of(const SimAxis& s, double jump, hal::Tick no
 void SimWorld::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) noexcept {
   // (the call only when a fault strikes now or has struck: before, it would do nothing)
   if (next_fault_ != 0 || (!fault_tick_.empty() && fault_tick_[0] <= now)) apply_injected_faults(now);
-  if (powered_off_ || stalled(now)) return;  // nothing refreshed: the values keep their old ticks
+  if (powered_off_ || stalled(now)) {  // nothing refreshed: the values keep their old ticks
+    raise_fault_events(axes, link);
+    return;
+  }
   // Until a fault strikes (no frame lost, no node silent, no bus-off) and without CAN latency, every
   // frame arrives as sampled: sample straight into `axes`, not into the history and then across.
   const bool direct = history_ticks_ == 1 && next_fault_ == 0;
   if (direct) {
     // No fault has struck, so no encoder glitch either (glitch_left_ is all 0): the loop below, on `axes`,
     // without the glitch's test and count.
+    // Nor a device fault: no event, and the edges stay clear.
     for (std::size_t i = 0; i < n_axes_; ++i) axes[i] = feedback_of(axes_[i], 0.0, now);
     link = hal::LinkStatus{};
     return;
   }
+  read_struck(now, axes, link);
+  raise_fault_events(axes, link);
+}
+
+void SimWorld::raise_fault_events(hal::AxisFeedbacks& axes, hal::LinkStatus& link) noexcept {
+  for (std::size_t i = 0; i < n_axes_; ++i) fault_edges_[i].raise(axes[i]);
+  link_edge_.raise(link);
+}
+
+void SimWorld::read_struck(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) noexcept {
   hal::AxisFeedback* truth = &history_[static_cast<std::size_t>(now) % history_ticks_ * n_axes_];
   for (std::size_t i = 0; i < n_axes_; ++i) {
     truth[i] = feedback_of(axes_[i], glitch_left_[i] > 0 ? glitch_jump_[i] : 0.0, now);

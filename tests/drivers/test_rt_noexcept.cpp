@@ -146,7 +146,7 @@ static_assert(noexcept(cobj<NodeSupervisor>().heard_again(now())));
 // ---- The CiA 402 axis -------------------------------------------------------------------------------
 static_assert(noexcept(obj<Cia402Axis>().on_profile_frame(now(), frame())));
 static_assert(noexcept(obj<Cia402Axis>().acknowledge()));
-static_assert(noexcept(cobj<Cia402Axis>().fill_feedback(now(), fb(), false, true)));
+static_assert(noexcept(obj<Cia402Axis>().fill_feedback(now(), fb(), false, true)));
 static_assert(noexcept(cobj<Cia402Axis>().faulted()));
 static_assert(noexcept(obj<Cia402Axis>().command(now(), cmd(), false, false, u32(), frame())));
 static_assert(noexcept(cobj<Cia402Axis>().last_controlword()));

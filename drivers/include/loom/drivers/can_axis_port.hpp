@@ -20,6 +20,7 @@
 #include "loom/drivers/configure_clock.hpp"
 #include "loom/drivers/position_scaling.hpp"
 #include "loom/drivers/status.hpp"
+#include "loom/hal/fault_events.hpp"
 #include "loom/hal/hal.hpp"
 
 namespace loom::drivers {
@@ -59,7 +60,8 @@ class CanAxisPort final : public hal::AxisPort {
   Status configure(CanBus& bus, ConfigureClock& clock);  // one bus
   Status configure(CanBus& bus);                         // with MonotonicConfigureClock
 
-  // RT-safe. Per bus: drains at most kMaxFramesPerRead frames; then reports every axis and the link.
+  // RT-safe. Per bus: drains at most kMaxFramesPerRead frames; then reports every axis and the link, with
+  // the fault events of this tick (each axis' fault_raised: Cia402Axis; the link's: its report begins).
   void read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) noexcept override;
   // RT-safe. Per bus: SYNC, then one RPDO1 per axis.
   void write_axes(hal::Tick now, const hal::AxisCommands& axes) noexcept override;
@@ -103,6 +105,7 @@ class CanAxisPort final : public hal::AxisPort {
     std::array<Attached, kMaxAttached> attached{};
     std::size_t n_attached = 0;
     std::vector<std::string> notes;
+    hal::LinkFaultEdge link_edge;  // the link report of the last read, for its event
   };
   Data d_;
 };

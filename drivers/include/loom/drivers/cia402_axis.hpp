@@ -15,6 +15,7 @@
 #include "loom/drivers/can_master.hpp"
 #include "loom/drivers/cia402.hpp"
 #include "loom/drivers/position_scaling.hpp"
+#include "loom/hal/fault_events.hpp"
 #include "loom/hal/types.hpp"
 
 namespace loom::drivers {
@@ -42,8 +43,9 @@ class Cia402Axis final : public CanNode {
   // RT-safe. This tick's feedback, given the state of the axis' bus. A profile-position axis' TPDO1 is
   // sent on change only: while its last one said the axis stands still, its data is current until the
   // event timer (plus margin) has passed without one (`refreshed` = now); after that it ages as a CSP
-  // axis' does, so a PP drive whose TPDO stops is stale feedback for the sequencer too.
-  void fill_feedback(hal::Tick now, hal::AxisFeedback& fb, bool bus_off, bool bus_configured) const noexcept;
+  // axis' does, so a PP drive whose TPDO stops is stale feedback for the sequencer too. Raises
+  // fb.fault_raised on the tick this axis' fault report begins or changes its code (once per tick).
+  void fill_feedback(hal::Tick now, hal::AxisFeedback& fb, bool bus_off, bool bus_configured) noexcept;
   // RT-safe. Any fault of this drive that must stop every axis.
   bool faulted() const noexcept;
   // RT-safe. The next step toward `command` (quick stop when `stop_all` and the request is not a reset
@@ -147,6 +149,9 @@ class Cia402Axis final : public CanNode {
   std::uint32_t pp_setpoints_ = 0;
   hal::Tick pp_since_ = 0;  // tick the current set-point was raised
   bool still_ = false;      // PP: the last TPDO1 said the axis stands still
+  // The fault report fill_feedback last gave, for its event; kept across bring-ups (a report that goes on
+  // after a reconfiguration is not a new one).
+  hal::AxisFaultEdge fault_edge_;
 };
 
 }  // namespace loom::drivers

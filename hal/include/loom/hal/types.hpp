@@ -119,6 +119,9 @@ struct AxisFeedback {
   bool referenced = true;
   bool homing_error = false;    // the last homing run failed (the drive's homing error, or its time-out)
   Tick refreshed = kNeverTick;  // tick this feedback was last received
+  // Event of this read: the fault report begins, or its code changes (fault_events.hpp). The loop reports
+  // it once; the port sets it on exactly one read.
+  bool fault_raised = false;
 };
 
 struct AxisCommand {
@@ -235,6 +238,8 @@ struct LinkStatus {
   std::uint8_t silent_node = 0;  // kNodeSilent: the first node still missing
   std::uint32_t tx_dropped = 0;  // frames not sent (ENOBUFS/EAGAIN), cumulative
   std::uint32_t rx_errors = 0;   // error frames / malformed frames, cumulative
+  // Event of this read: link_fault begins (fault_events.hpp).
+  bool fault_raised = false;
 };
 
 struct HalInputs {
