@@ -16,6 +16,7 @@
 #include "loom/drivers/can_io_modules.hpp"
 #include "loom/drivers/can_io_port.hpp"
 #include "loom/drivers/can_master.hpp"
+#include "loom/drivers/can_network.hpp"
 #include "loom/drivers/cia402.hpp"
 #include "loom/drivers/cia402_axis.hpp"
 #include "loom/drivers/cob_id.hpp"
@@ -119,7 +120,13 @@ static_assert(noexcept(obj<CanIoModules>().read_io(now(), fbs(), din())));
 static_assert(noexcept(obj<CanIoModules>().read_analog(now(), ain())));
 static_assert(noexcept(obj<CanIoModules>().write_io(now(), dout())));
 
-// ---- The master and its nodes -----------------------------------------------------------------------
+// ---- The network, the master and its nodes ----------------------------------------------------------
+static_assert(noexcept(obj<CanNetwork>().poll(now())));
+static_assert(noexcept(obj<CanNetwork>().read_link(now(), link())));
+static_assert(noexcept(obj<CanNetwork>().start_cycle(now())));
+static_assert(noexcept(obj<CanNetwork>().acknowledge()));
+static_assert(noexcept(cobj<CanNetwork>().any_fault()));
+static_assert(noexcept(cobj<CanNetwork>().configured()));
 static_assert(noexcept(obj<CanMaster>().poll(now())));
 static_assert(noexcept(obj<CanMaster>().start_cycle(now())));
 static_assert(noexcept(obj<CanMaster>().send(frame())));

@@ -39,9 +39,11 @@ class CanIoPort final : public hal::IoPort, public CanNode {
   // Configure-time only.
   explicit CanIoPort(CanIoConfig config);
 
-  // Configure-time only; blocks with timeouts. The module alone on a master of its own (a bus without
-  // drives; with drives, CanAxisPort::attach() brings it up with them): NMT reset-node → boot-up →
-  // configure_profile() → NMT start → operational heartbeat. Errors name node, object and step.
+  // Configure-time only; blocks with timeouts. The module alone on a master of its own, for a bring-up
+  // check only (nothing polls that master afterwards): NMT reset-node → boot-up → configure_profile() →
+  // NMT start → operational heartbeat. Errors name node, object and step. To use the module, register it
+  // on a CanNetwork (can_network.hpp; no axis port needed) or attach it to the CanAxisPort of its bus,
+  // whose network brings it up with the drives; the network then polls it every tick.
   Status configure(CanBus& bus, ConfigureClock& clock);
 
   // What configure() found optional and absent, or accepted instead of what it asked for (one line each).
