@@ -6,7 +6,7 @@
 
 namespace loom::drivers {
 
-CanErrorInfo decode_error_frame(const CanFrame& frame) {
+CanErrorInfo decode_error_frame(const CanFrame& frame) noexcept {
   CanErrorInfo info;
   if (!frame.is_error()) return info;
   const std::uint32_t cls = frame.id;
@@ -36,10 +36,10 @@ CanFrame error_frame(std::uint32_t error_class) {
 
 }  // namespace
 
-CanFrame make_bus_off_error_frame() {
+CanFrame make_bus_off_error_frame() noexcept {
   return error_frame(CAN_ERR_BUSOFF);
 }
-CanFrame make_restarted_error_frame() {
+CanFrame make_restarted_error_frame() noexcept {
   return error_frame(CAN_ERR_RESTARTED);
 }
 

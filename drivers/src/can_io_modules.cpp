@@ -11,7 +11,8 @@ void CanIoModules::add(CanIoPort& module) {
   if (module.has_load_cell()) load_cell_ = &module;
 }
 
-void CanIoModules::read_io(hal::Tick /*now*/, const hal::AxisFeedbacks& /*axes*/, hal::DigitalInputs& io) {
+void CanIoModules::read_io(hal::Tick /*now*/, const hal::AxisFeedbacks& /*axes*/,
+                           hal::DigitalInputs& io) noexcept {
   io = hal::DigitalInputs{};  // each signal comes from the one module it is wired to
   hal::Tick oldest = n_ == 0 ? hal::kNeverTick : modules_[0]->inputs_refreshed();
   for (std::size_t k = 0; k < n_; ++k) {
@@ -22,7 +23,7 @@ void CanIoModules::read_io(hal::Tick /*now*/, const hal::AxisFeedbacks& /*axes*/
   io.refreshed = oldest;
 }
 
-void CanIoModules::read_analog(hal::Tick now, hal::AnalogInputs& analog) {
+void CanIoModules::read_analog(hal::Tick now, hal::AnalogInputs& analog) noexcept {
   if (load_cell_ == nullptr) {
     analog = hal::AnalogInputs{};  // no load cell fitted
     return;
@@ -30,7 +31,7 @@ void CanIoModules::read_analog(hal::Tick now, hal::AnalogInputs& analog) {
   load_cell_->read_analog(now, analog);
 }
 
-void CanIoModules::write_io(hal::Tick now, const hal::DigitalOutputs& io) {
+void CanIoModules::write_io(hal::Tick now, const hal::DigitalOutputs& io) noexcept {
   for (std::size_t k = 0; k < n_; ++k) modules_[k]->write_io(now, io);
 }
 

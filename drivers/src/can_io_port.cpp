@@ -50,7 +50,7 @@ bool interop_readback_code(std::uint32_t abort) {
 
 }  // namespace
 
-hal::DigitalOutputs io_safe_outputs() {
+hal::DigitalOutputs io_safe_outputs() noexcept {
   hal::DigitalOutputs o;  // grippers open, cutters retracted: every head's outputs false
   o.lamp_red = true;
   return o;
@@ -411,7 +411,7 @@ Status CanIoPort::configure_profile(SdoClient& sdo) {
 // ---------------------------------------------------------------------------------------------------
 // Per tick (RT-safe)
 // ---------------------------------------------------------------------------------------------------
-void CanIoPort::on_profile_frame(hal::Tick now, const CanFrame& f) {
+void CanIoPort::on_profile_frame(hal::Tick now, const CanFrame& f) noexcept {
   const CobDecoded d = decode_cob_id(f.id);
   const auto read_le = [&](const Slot& s, std::uint32_t& v) {
     if (s.offset + s.bytes > f.dlc) return false;
@@ -473,7 +473,7 @@ void CanIoPort::on_profile_frame(hal::Tick now, const CanFrame& f) {
   if (!used) ++rx_errors_;  // a TPDO we disabled: the module ignores its configuration
 }
 
-bool CanIoPort::input(const IoBit& b) const {
+bool CanIoPort::input(const IoBit& b) const noexcept {
   // Never seen reads false whatever the polarity: the cleared inputs_ of an active-low signal would
   // otherwise read true (a break-contact sensor confirmed, a button pressed) before the first TPDO.
   if (b.bit < 0 || inputs_refreshed_ == hal::kNeverTick) return false;
@@ -481,7 +481,7 @@ bool CanIoPort::input(const IoBit& b) const {
   return level != b.active_low;
 }
 
-void CanIoPort::read_wired(hal::DigitalInputs& io) const {
+void CanIoPort::read_wired(hal::DigitalInputs& io) const noexcept {
   const IoWiring& w = wiring_;
   const auto take = [this](const IoBit& b, bool& to) {
     if (b.bit >= 0) to = input(b);
@@ -506,13 +506,14 @@ void CanIoPort::read_wired(hal::DigitalInputs& io) const {
     take(w.yarn_present[h], io.yarn_present[h]);
 }
 
-void CanIoPort::read_io(hal::Tick /*now*/, const hal::AxisFeedbacks& /*axes*/, hal::DigitalInputs& io) {
+void CanIoPort::read_io(hal::Tick /*now*/, const hal::AxisFeedbacks& /*axes*/,
+                        hal::DigitalInputs& io) noexcept {
   io = hal::DigitalInputs{};  // what this module does not carry reads false
   read_wired(io);
   io.refreshed = inputs_refreshed_;
 }
 
-void CanIoPort::read_analog(hal::Tick /*now*/, hal::AnalogInputs& analog) {
+void CanIoPort::read_analog(hal::Tick /*now*/, hal::AnalogInputs& analog) noexcept {
   const IoWiring& w = wiring_;
   analog.beat_force_valid = w.load_cell_channel != 0 && analog_refreshed_ != hal::kNeverTick;
   analog.beat_force_n =
@@ -522,7 +523,7 @@ void CanIoPort::read_analog(hal::Tick /*now*/, hal::AnalogInputs& analog) {
   analog.refreshed = analog_refreshed_;
 }
 
-void CanIoPort::write_io(hal::Tick /*now*/, const hal::DigitalOutputs& requested) {
+void CanIoPort::write_io(hal::Tick /*now*/, const hal::DigitalOutputs& requested) noexcept {
   if (!configured_) return;
   // A node we cannot supervise gets its safe outputs (it may still hear us).
   const hal::DigitalOutputs& o = supervisor_.link_fault() != 0 ? io_safe_outputs() : requested;

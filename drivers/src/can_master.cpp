@@ -19,7 +19,7 @@ namespace loom::drivers {
 // ---------------------------------------------------------------------------------------------------
 // CanNode
 // ---------------------------------------------------------------------------------------------------
-void CanNode::on_frame(hal::Tick now, const CanFrame& f) {
+void CanNode::on_frame(hal::Tick now, const CanFrame& f) noexcept {
   if (!supervisor_.armed() || f.is_error()) return;
   const CobDecoded d = decode_cob_id(f.id);
   if (d.node != node_id()) return;
@@ -200,7 +200,7 @@ Status CanMaster::bring_up(CanBus& bus, ConfigureClock& clock) {
 // ---------------------------------------------------------------------------------------------------
 // Per tick (RT-safe)
 // ---------------------------------------------------------------------------------------------------
-void CanMaster::handle_error_frame(const CanFrame& f) {
+void CanMaster::handle_error_frame(const CanFrame& f) noexcept {
   ++rx_errors_;
   const CanErrorInfo e = decode_error_frame(f);
   if (e.bus_off) {
@@ -210,7 +210,7 @@ void CanMaster::handle_error_frame(const CanFrame& f) {
   if (e.restarted && bus_off_) restarted_ = true;
 }
 
-void CanMaster::poll(hal::Tick now) {
+void CanMaster::poll(hal::Tick now) noexcept {
   if (!configured_) return;
   CanFrame f;
   for (int i = 0; i < kMaxFramesPerPoll && bus_->receive(f); ++i) {
@@ -232,11 +232,11 @@ void CanMaster::poll(hal::Tick now) {
   for (std::size_t i = 0; i < n_nodes_; ++i) nodes_[i]->supervise(now);
 }
 
-void CanMaster::send(const CanFrame& frame) {
+void CanMaster::send(const CanFrame& frame) noexcept {
   if (bus_ == nullptr || bus_->send(frame) != SendResult::kOk) ++tx_dropped_;
 }
 
-void CanMaster::start_cycle(hal::Tick now) {
+void CanMaster::start_cycle(hal::Tick now) noexcept {
   if (!configured_) return;
   send(make_sync());
   if (master_hb_ticks_ != 0 && now >= next_master_hb_) {
@@ -245,7 +245,7 @@ void CanMaster::start_cycle(hal::Tick now) {
   }
 }
 
-bool CanMaster::any_fault() const {
+bool CanMaster::any_fault() const noexcept {
   if (bus_off_ || foreign_emcy_code_ != 0) return true;
   for (std::size_t i = 0; i < n_nodes_; ++i) {
     const CanNode& n = *nodes_[i];
@@ -255,7 +255,7 @@ bool CanMaster::any_fault() const {
   return false;
 }
 
-void CanMaster::report_link(hal::LinkStatus& link) const {
+void CanMaster::report_link(hal::LinkStatus& link) const noexcept {
   link.tx_dropped += tx_dropped_;
   link.rx_errors += rx_errors_;
   if (link.link_fault) return;
@@ -284,7 +284,7 @@ void CanMaster::report_link(hal::LinkStatus& link) const {
   if (foreign_emcy_code_ != 0) set(foreign_emcy_code_, hal::FaultKind::kEmcy);
 }
 
-hal::LinkRecovery CanMaster::recovery(hal::Tick now, std::uint8_t& silent) const {
+hal::LinkRecovery CanMaster::recovery(hal::Tick now, std::uint8_t& silent) const noexcept {
   using R = hal::LinkRecovery;
   if (bus_off_ && !restarted_) return R::kBusOff;
   bool faulted = bus_off_ || !configured_ || foreign_emcy_code_ != 0;
@@ -300,7 +300,7 @@ hal::LinkRecovery CanMaster::recovery(hal::Tick now, std::uint8_t& silent) const
   return faulted ? R::kReady : R::kHealthy;
 }
 
-void CanMaster::acknowledge() {
+void CanMaster::acknowledge() noexcept {
   foreign_emcy_code_ = 0;
   for (std::size_t i = 0; i < n_nodes_; ++i) nodes_[i]->acknowledge();
 }

@@ -10,7 +10,7 @@ namespace loom::drivers {
 using hal::AxisRequest;
 using hal::DriveState;
 
-hal::DriveState decode_statusword(std::uint16_t sw) {
+hal::DriveState decode_statusword(std::uint16_t sw) noexcept {
   if ((sw & 0x4F) == 0x00) return DriveState::kNotReadyToSwitchOn;
   if ((sw & 0x4F) == 0x40) return DriveState::kSwitchOnDisabled;
   if ((sw & 0x6F) == 0x21) return DriveState::kReadyToSwitchOn;
@@ -22,7 +22,7 @@ hal::DriveState decode_statusword(std::uint16_t sw) {
   return DriveState::kUnknown;
 }
 
-bool cia402_goal_reached(DriveState state, AxisRequest request) {
+bool cia402_goal_reached(DriveState state, AxisRequest request) noexcept {
   switch (request) {
     case AxisRequest::kEnable:
     case AxisRequest::kHome:  // homing runs in Operation Enabled (mode 6)
@@ -76,7 +76,7 @@ Command command_for(DriveState state, AxisRequest request) {
 }  // namespace
 
 Cia402Step cia402_step(DriveState state, AxisRequest request, const Cia402Tracker& prev,
-                       std::uint32_t timeout_ticks) {
+                       std::uint32_t timeout_ticks) noexcept {
   Cia402Step out;
   Cia402Tracker& next = out.next;
   next = prev;

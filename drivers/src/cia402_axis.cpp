@@ -399,7 +399,7 @@ Status Cia402Axis::configure_homing(SdoClient& sdo, std::uint32_t supported_mode
 // ---------------------------------------------------------------------------------------------------
 // Per tick (RT-safe)
 // ---------------------------------------------------------------------------------------------------
-void Cia402Axis::on_profile_frame(hal::Tick now, const CanFrame& f) {
+void Cia402Axis::on_profile_frame(hal::Tick now, const CanFrame& f) noexcept {
   switch (decode_cob_id(f.id).function) {
     case CobFunction::kTpdo1: {
       Tpdo1Mode p{};
@@ -472,13 +472,13 @@ void Cia402Axis::on_profile_frame(hal::Tick now, const CanFrame& f) {
   }
 }
 
-bool Cia402Axis::faulted() const {
+bool Cia402Axis::faulted() const noexcept {
   return supervisor_.link_fault() != 0 || supervisor_.emcy_code() != 0 || ferror_fault_ || pp_fault_ != 0 ||
          state_ == DriveState::kFault || state_ == DriveState::kFaultReactionActive;
 }
 
 void Cia402Axis::fill_feedback(hal::Tick now, hal::AxisFeedback& fb, bool bus_off,
-                               bool bus_configured) const {
+                               bool bus_configured) noexcept {
   const bool link_down = bus_off || !bus_configured || !up_;
   const std::uint16_t link_fault = supervisor_.link_fault();
   const std::uint16_t emcy = supervisor_.emcy_code();
@@ -524,11 +524,12 @@ void Cia402Axis::fill_feedback(hal::Tick now, hal::AxisFeedback& fb, bool bus_of
     fb.fault_code = fault_code::kNone;
     fb.fault_kind = in_fault_state ? hal::FaultKind::kDrive : hal::FaultKind::kNone;
   }
+  fault_edge_.raise(fb);
 }
 
 // The operator acknowledged (the sequencer requests a fault reset): latches whose cause the master
 // itself decided are cleared; a drive still in Fault gets its reset edge through the CiA 402 table.
-void Cia402Axis::acknowledge() {
+void Cia402Axis::acknowledge() noexcept {
   ferror_fault_ = false;
   pp_fault_ = 0;
   homing_error_ = false;
@@ -536,7 +537,7 @@ void Cia402Axis::acknowledge() {
 }
 
 bool Cia402Axis::command(hal::Tick now, const hal::AxisCommand& cmd, bool stop_all, bool bus_down,
-                         std::uint32_t state_timeout_ticks, CanFrame& rpdo1) {
+                         std::uint32_t state_timeout_ticks, CanFrame& rpdo1) noexcept {
   // A drive we cannot supervise (lost, rebooted, bus-off) gets quick stop, never an enable command.
   const bool lost = supervisor_.link_fault() != 0 || bus_down;
   // A homing run is an enabled drive in homing mode (6) with controlword bit 4 set; an absolute axis has
@@ -610,7 +611,7 @@ std::uint32_t Cia402Axis::profile_move_ticks(std::int64_t distance_counts) const
 // that target moves or has arrived there, else the per-tick target itself (a hold, a stop: never the end
 // of a move no longer being played). Returns the bits to OR into the controlword.
 std::uint16_t Cia402Axis::profile_setpoint(hal::Tick now, const hal::AxisCommand& cmd, bool running,
-                                           std::uint32_t state_timeout_ticks) {
+                                           std::uint32_t state_timeout_ticks) noexcept {
   const double t = cmd.target_position;
   const bool on_move = std::isfinite(cmd.move_end) && (t != last_cmd_target_ || t == cmd.move_end);
   last_cmd_target_ = t;

@@ -6,7 +6,7 @@
 
 namespace loom::drivers {
 
-std::optional<Emcy> parse_emcy(const CanFrame& frame) {
+std::optional<Emcy> parse_emcy(const CanFrame& frame) noexcept {
   if (frame.is_error() || frame.is_rtr() || frame.dlc != 8) return std::nullopt;
   const CobDecoded c = decode_cob_id(frame.id);
   if (c.function != CobFunction::kEmcy) return std::nullopt;
@@ -18,7 +18,7 @@ std::optional<Emcy> parse_emcy(const CanFrame& frame) {
   return e;
 }
 
-CanFrame make_emcy(std::uint8_t node, std::uint16_t code, std::uint8_t error_register) {
+CanFrame make_emcy(std::uint8_t node, std::uint16_t code, std::uint8_t error_register) noexcept {
   CanFrame f;
   f.id = cob::emcy(node);
   f.dlc = 8;
@@ -27,7 +27,7 @@ CanFrame make_emcy(std::uint8_t node, std::uint16_t code, std::uint8_t error_reg
   return f;
 }
 
-const char* fault_code_text(std::uint16_t code) {
+const char* fault_code_text(std::uint16_t code) noexcept {
   switch (code) {
     case fault_code::kNone:
       return "no error";
@@ -106,7 +106,7 @@ const char* fault_code_text(std::uint16_t code) {
   }
 }
 
-hal::FaultKind link_fault_kind(std::uint16_t code) {
+hal::FaultKind link_fault_kind(std::uint16_t code) noexcept {
   switch (code) {
     case fault_code::kNone:
       return hal::FaultKind::kNone;

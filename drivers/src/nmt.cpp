@@ -5,7 +5,7 @@
 
 namespace loom::drivers {
 
-const char* nmt_state_name(NmtState s) {
+const char* nmt_state_name(NmtState s) noexcept {
   switch (s) {
     case NmtState::kBootUp:
       return "boot-up";
@@ -19,7 +19,7 @@ const char* nmt_state_name(NmtState s) {
   return "?";
 }
 
-CanFrame make_nmt(NmtCommand command, std::uint8_t node) {
+CanFrame make_nmt(NmtCommand command, std::uint8_t node) noexcept {
   CanFrame f;
   f.id = cob::kNmt;
   f.dlc = 2;
@@ -28,7 +28,7 @@ CanFrame make_nmt(NmtCommand command, std::uint8_t node) {
   return f;
 }
 
-std::optional<NmtMessage> parse_nmt(const CanFrame& frame) {
+std::optional<NmtMessage> parse_nmt(const CanFrame& frame) noexcept {
   if (frame.is_error() || frame.is_rtr() || frame.id != cob::kNmt || frame.dlc != 2) return std::nullopt;
   if (frame.data[1] > kMaxNodeId) return std::nullopt;
   switch (frame.data[0]) {
@@ -43,18 +43,18 @@ std::optional<NmtMessage> parse_nmt(const CanFrame& frame) {
   }
 }
 
-CanFrame make_sync() {
+CanFrame make_sync() noexcept {
   CanFrame f;
   f.id = cob::kSync;
   f.dlc = 0;
   return f;
 }
 
-bool is_sync(const CanFrame& frame) {
+bool is_sync(const CanFrame& frame) noexcept {
   return !frame.is_error() && !frame.is_rtr() && frame.id == cob::kSync && frame.dlc <= 1;
 }
 
-CanFrame make_heartbeat(std::uint8_t node, NmtState state) {
+CanFrame make_heartbeat(std::uint8_t node, NmtState state) noexcept {
   CanFrame f;
   f.id = cob::heartbeat(node);
   f.dlc = 1;
@@ -62,7 +62,7 @@ CanFrame make_heartbeat(std::uint8_t node, NmtState state) {
   return f;
 }
 
-std::optional<Heartbeat> parse_heartbeat(const CanFrame& frame) {
+std::optional<Heartbeat> parse_heartbeat(const CanFrame& frame) noexcept {
   if (frame.is_error() || frame.is_rtr() || frame.dlc != 1) return std::nullopt;
   const CobDecoded cob_fn = decode_cob_id(frame.id);
   if (cob_fn.function != CobFunction::kHeartbeat) return std::nullopt;

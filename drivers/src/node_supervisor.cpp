@@ -12,7 +12,7 @@ void NodeSupervisor::arm(std::uint32_t consumer_ticks) {
   consumer_ticks_ = consumer_ticks;
 }
 
-bool NodeSupervisor::on_heartbeat(hal::Tick now, const CanFrame& frame) {
+bool NodeSupervisor::on_heartbeat(hal::Tick now, const CanFrame& frame) noexcept {
   const auto hb = parse_heartbeat(frame);
   if (!hb) return false;
   last_heartbeat_ = now;
@@ -24,7 +24,7 @@ bool NodeSupervisor::on_heartbeat(hal::Tick now, const CanFrame& frame) {
   return true;
 }
 
-bool NodeSupervisor::on_emcy(const CanFrame& frame) {
+bool NodeSupervisor::on_emcy(const CanFrame& frame) noexcept {
   const auto e = parse_emcy(frame);
   if (!e) return false;
   if (e->code != 0) {
@@ -36,7 +36,7 @@ bool NodeSupervisor::on_emcy(const CanFrame& frame) {
   return true;
 }
 
-void NodeSupervisor::supervise(hal::Tick now) {
+void NodeSupervisor::supervise(hal::Tick now) noexcept {
   if (!armed_) return;
   // Heartbeats during bring-up carry no tick: the consumer starts counting at the first tick.
   if (last_heartbeat_ == hal::kNeverTick) last_heartbeat_ = now;
@@ -45,12 +45,12 @@ void NodeSupervisor::supervise(hal::Tick now) {
   }
 }
 
-void NodeSupervisor::acknowledge(bool still_in_fault) {
+void NodeSupervisor::acknowledge(bool still_in_fault) noexcept {
   acknowledged_ = true;
   if (!still_in_fault) emcy_code_ = 0;
 }
 
-bool NodeSupervisor::heard_again(hal::Tick now) const {
+bool NodeSupervisor::heard_again(hal::Tick now) const noexcept {
   return booted_ || (last_heartbeat_ != hal::kNeverTick &&
                      now - last_heartbeat_ <= static_cast<hal::Tick>(consumer_ticks_));
 }

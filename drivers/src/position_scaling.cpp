@@ -7,7 +7,7 @@
 
 namespace loom::drivers {
 
-std::int64_t si_to_counts(double si, double counts_per_unit) {
+std::int64_t si_to_counts(double si, double counts_per_unit) noexcept {
   const double c = std::round(si * counts_per_unit);
   if (!std::isfinite(c)) return 0;
   // ±2^62 is far beyond any mechanism and exactly representable as a double.
@@ -17,7 +17,7 @@ std::int64_t si_to_counts(double si, double counts_per_unit) {
   return static_cast<std::int64_t>(c);
 }
 
-double counts_to_si(std::int64_t counts, double counts_per_unit) {
+double counts_to_si(std::int64_t counts, double counts_per_unit) noexcept {
   return static_cast<double>(counts) / counts_per_unit;
 }
 

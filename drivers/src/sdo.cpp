@@ -36,7 +36,7 @@ std::uint32_t masked_value(const std::uint8_t* p, std::uint8_t size) {
 
 }  // namespace
 
-const char* sdo_abort_text(std::uint32_t code) {
+const char* sdo_abort_text(std::uint32_t code) noexcept {
   switch (code) {
     case sdo_abort::kToggleBit:
       return "toggle bit not alternated";
@@ -104,7 +104,7 @@ const char* sdo_abort_text(std::uint32_t code) {
 }
 
 CanFrame make_sdo_download(std::uint8_t node, std::uint16_t index, std::uint8_t sub, std::uint32_t value,
-                           std::uint8_t size) {
+                           std::uint8_t size) noexcept {
   if (size < 1) size = 1;
   if (size > 4) size = 4;
   CanFrame f = sdo_frame(cob::sdo_rx(node), expedited_command(kCcsDownloadInitiate, size), index, sub);
@@ -112,17 +112,18 @@ CanFrame make_sdo_download(std::uint8_t node, std::uint16_t index, std::uint8_t 
   return f;
 }
 
-CanFrame make_sdo_upload(std::uint8_t node, std::uint16_t index, std::uint8_t sub) {
+CanFrame make_sdo_upload(std::uint8_t node, std::uint16_t index, std::uint8_t sub) noexcept {
   return sdo_frame(cob::sdo_rx(node), static_cast<std::uint8_t>(kCcsUploadInitiate << 5), index, sub);
 }
 
-CanFrame make_sdo_abort(std::uint32_t cob_id, std::uint16_t index, std::uint8_t sub, std::uint32_t code) {
+CanFrame make_sdo_abort(std::uint32_t cob_id, std::uint16_t index, std::uint8_t sub,
+                        std::uint32_t code) noexcept {
   CanFrame f = sdo_frame(cob_id, static_cast<std::uint8_t>(kCsAbort << 5), index, sub);
   put_u32(&f.data[4], code);
   return f;
 }
 
-SdoReply parse_sdo_reply(const CanFrame& frame) {
+SdoReply parse_sdo_reply(const CanFrame& frame) noexcept {
   SdoReply r;
   if (frame.is_error() || frame.is_rtr() || frame.dlc != 8) return r;
   const std::uint8_t cmd = frame.data[0];
@@ -149,7 +150,7 @@ SdoReply parse_sdo_reply(const CanFrame& frame) {
   return r;
 }
 
-SdoRequest parse_sdo_request(const CanFrame& frame) {
+SdoRequest parse_sdo_request(const CanFrame& frame) noexcept {
   SdoRequest r;
   if (frame.is_error() || frame.is_rtr() || frame.dlc != 8) return r;
   const std::uint8_t cmd = frame.data[0];
@@ -175,12 +176,12 @@ SdoRequest parse_sdo_request(const CanFrame& frame) {
   return r;
 }
 
-CanFrame make_sdo_download_ack(std::uint8_t node, std::uint16_t index, std::uint8_t sub) {
+CanFrame make_sdo_download_ack(std::uint8_t node, std::uint16_t index, std::uint8_t sub) noexcept {
   return sdo_frame(cob::sdo_tx(node), static_cast<std::uint8_t>(kScsDownloadInitiate << 5), index, sub);
 }
 
 CanFrame make_sdo_upload_reply(std::uint8_t node, std::uint16_t index, std::uint8_t sub, std::uint32_t value,
-                               std::uint8_t size) {
+                               std::uint8_t size) noexcept {
   if (size < 1) size = 1;
   if (size > 4) size = 4;
   CanFrame f = sdo_frame(cob::sdo_tx(node), expedited_command(kScsUploadInitiate, size), index, sub);

@@ -91,7 +91,7 @@ SocketCanBus::~SocketCanBus() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-SendResult SocketCanBus::send(const CanFrame& frame) {
+SendResult SocketCanBus::send(const CanFrame& frame) noexcept {
   if (frame.is_error() || frame.dlc > CAN_MAX_DLEN || frame.id > kMaxStandardId) {
     ++tx_errors_;
     return SendResult::kError;
@@ -110,7 +110,7 @@ SendResult SocketCanBus::send(const CanFrame& frame) {
   return SendResult::kError;
 }
 
-bool SocketCanBus::receive(CanFrame& frame) {
+bool SocketCanBus::receive(CanFrame& frame) noexcept {
   for (int skipped = 0; skipped <= kMaxSkippedPerReceive; ++skipped) {
     can_frame cf{};
     const ssize_t n = ::recv(fd_, &cf, sizeof(cf), MSG_DONTWAIT);

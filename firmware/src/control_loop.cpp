@@ -24,10 +24,6 @@ std::uint8_t pack_flags(const unsigned char* first, std::size_t n) noexcept {
   std::memcpy(&w, first, n);
   return static_cast<std::uint8_t>((w * 0x0102040810204080ull) >> 56);
 }
-
-bool axis_faulted(const hal::AxisFeedback& a) noexcept {
-  return a.fault || a.state == hal::DriveState::kFault || a.state == hal::DriveState::kFaultReactionActive;
-}
 }  // namespace
 
 ControlLoop::ControlLoop(hal::Hal& hal, sequencer::Sequencer& seq, telemetry::Telemetry* telemetry,
@@ -46,7 +42,7 @@ void ControlLoop::cycle(hal::Tick now) noexcept {
   if (telemetry_ != nullptr) {
     // Events first: the publisher sends a tick's events before that tick's samples.
     // The usual tick has no event and no device reporting a fault: one branch-free pass over the flags.
-    if (!seq_.events().empty() || devices_reporting_ || any_device_fault()) push_events(now);
+    if (!seq_.events().empty() || any_device_event()) push_events(now);
     fill_snapshot(now);
     if (lossless_) {
       telemetry_->push_waiting(snap_);
@@ -83,19 +79,16 @@ void ControlLoop::fill_event_context(telemetry::Event& e, hal::Tick now) const n
   e.band_max_n = ctx_.beat_force_max_n;
 }
 
-// The sequencer's events of this tick, forwarded in its order (BEAT, ROW, WEAVER, FAULT), then what the
-// drives and the link report themselves (the HAL's own fault flags, not sequencer state).
-// True when a drive or the link reports a fault now. With it false and no report left from the last tick
-// (devices_reporting_), push_device_faults would find nothing to push or forget.
-bool ControlLoop::any_device_fault() const noexcept {
-  bool any = in_.link.link_fault;
-  for (std::size_t i = 0; i < n_axes_; ++i) {
-    const hal::AxisFeedback& a = in_.axes[i];
-    any |=
-        a.fault | (a.state == hal::DriveState::kFault) | (a.state == hal::DriveState::kFaultReactionActive);
-  }
+// True when a drive or the link raised a fault event in this tick's read (the HAL's events, not sequencer
+// state): one branch-free pass over the flags.
+bool ControlLoop::any_device_event() const noexcept {
+  bool any = in_.link.fault_raised;
+  for (std::size_t i = 0; i < n_axes_; ++i) any |= in_.axes[i].fault_raised;
   return any;
 }
+
+// The sequencer's events of this tick, forwarded in its order (BEAT, ROW, WEAVER, FAULT), then what the
+// drives and the link report themselves (the HAL's fault events).
 
 void ControlLoop::push_events(hal::Tick now) noexcept {
   const sequencer::TickEvents& events = seq_.events();
@@ -208,31 +201,21 @@ void ControlLoop::push_fault(telemetry::Event::FaultKind kind, sequencer::Fault 
   push_event(e);
 }
 
-// Every drive's and the link's own fault report, once per report (a new fault or a new code), except the
-// one the sequencer's first fault or diagnosis already names this tick. These edges are the HAL's inputs,
-// not sequencer state: only their last values are kept.
+// Every drive's and the link's own fault report, once: the HAL raises an event on the tick a report
+// begins (or, for a drive, changes its code; hal/fault_events.hpp). Pushed unless the sequencer's first
+// fault or diagnosis already names that axis or the link this tick.
 void ControlLoop::push_device_faults(int first_axis_reported, bool link_reported, hal::Tick now) noexcept {
-  bool any = false;
   for (std::size_t i = 0; i < n_axes_; ++i) {
     const hal::AxisFeedback& a = in_.axes[i];
-    const bool faulted = axis_faulted(a);
-    if (!faulted && !prev_axis_fault_[i])
-      continue;  // the usual tick: nothing to report or forget (code is 0)
-    const bool report = faulted && (!prev_axis_fault_[i] || a.fault_code != prev_axis_fault_code_[i]);
-    if (report && static_cast<int>(i) != first_axis_reported) {
+    if (a.fault_raised && static_cast<int>(i) != first_axis_reported) {
       push_fault(telemetry::Event::FaultKind::kDevice, sequencer::Fault::kDriveFault, static_cast<int>(i),
                  a.fault_code, -1, now);
     }
-    prev_axis_fault_[i] = faulted;
-    prev_axis_fault_code_[i] = faulted ? a.fault_code : 0;
-    any |= faulted;
   }
-  if (in_.link.link_fault && !prev_link_fault_ && !link_reported) {
+  if (in_.link.fault_raised && !link_reported) {
     push_fault(telemetry::Event::FaultKind::kDevice, sequencer::Fault::kLinkFault, -1,
                in_.link.link_fault_code, -1, now);
   }
-  prev_link_fault_ = in_.link.link_fault;
-  devices_reporting_ = any || prev_link_fault_;
 }
 
 void ControlLoop::fill_snapshot(hal::Tick now) noexcept {

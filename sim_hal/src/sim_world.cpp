@@ -254,8 +254,9 @@ void SimWorld::apply_injected_faults(hal::Tick now) noexcept {
 namespace {
 // One axis' feedback as its drive reports it; `jump` is an encoder glitch's offset (0.0 outside one: adding
 // it also turns a -0.0 sum into +0.0, the same on every path).
-inline hal::AxisFeedback feedback_of(const SimAxis& s, double jump, hal::Tick now) noexcept {
-  hal::AxisFeedback fb;
+// Written field by field into its place (every field: no event here, SimWorld::raise_fault_events sets it),
+// not built aside and copied: the loop's cheapest tick reads the axes this way.
+inline void feedback_into(hal::AxisFeedback& fb, const SimAxis& s, double jump, hal::Tick now) noexcept {
   fb.state = s.state;
   fb.position = s.position + s.offset + jump;
   fb.velocity = s.velocity;
@@ -268,28 +269,42 @@ inline hal::AxisFeedback feedback_of(const SimAxis& s, double jump, hal::Tick no
   fb.following_error = false;
   fb.referenced = s.referenced;
   fb.homing_error = false;
+  fb.fault_raised = false;
   fb.refreshed = now;
-  return fb;
 }
 }  // namespace
 
-void SimWorld::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) {
+void SimWorld::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) noexcept {
   // (the call only when a fault strikes now or has struck: before, it would do nothing)
   if (next_fault_ != 0 || (!fault_tick_.empty() && fault_tick_[0] <= now)) apply_injected_faults(now);
-  if (powered_off_ || stalled(now)) return;  // nothing refreshed: the values keep their old ticks
+  if (powered_off_ || stalled(now)) {  // nothing refreshed: the values keep their old ticks
+    raise_fault_events(axes, link);
+    return;
+  }
   // Until a fault strikes (no frame lost, no node silent, no bus-off) and without CAN latency, every
   // frame arrives as sampled: sample straight into `axes`, not into the history and then across.
   const bool direct = history_ticks_ == 1 && next_fault_ == 0;
   if (direct) {
     // No fault has struck, so no encoder glitch either (glitch_left_ is all 0): the loop below, on `axes`,
     // without the glitch's test and count.
-    for (std::size_t i = 0; i < n_axes_; ++i) axes[i] = feedback_of(axes_[i], 0.0, now);
+    // Nor a device fault: no event, and the edges stay clear.
+    for (std::size_t i = 0; i < n_axes_; ++i) feedback_into(axes[i], axes_[i], 0.0, now);
     link = hal::LinkStatus{};
     return;
   }
+  read_struck(now, axes, link);
+  raise_fault_events(axes, link);
+}
+
+void SimWorld::raise_fault_events(hal::AxisFeedbacks& axes, hal::LinkStatus& link) noexcept {
+  for (std::size_t i = 0; i < n_axes_; ++i) fault_edges_[i].raise(axes[i]);
+  link_edge_.raise(link);
+}
+
+void SimWorld::read_struck(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) noexcept {
   hal::AxisFeedback* truth = &history_[static_cast<std::size_t>(now) % history_ticks_ * n_axes_];
   for (std::size_t i = 0; i < n_axes_; ++i) {
-    truth[i] = feedback_of(axes_[i], glitch_left_[i] > 0 ? glitch_jump_[i] : 0.0, now);
+    feedback_into(truth[i], axes_[i], glitch_left_[i] > 0 ? glitch_jump_[i] : 0.0, now);
     if (glitch_left_[i] > 0) --glitch_left_[i];
   }
   link = hal::LinkStatus{};
@@ -414,7 +429,7 @@ void SimWorld::step_homing(std::size_t slot) noexcept {
   ax.homing = false;
 }
 
-void SimWorld::write_axes(hal::Tick, const hal::AxisCommands& axes) {
+void SimWorld::write_axes(hal::Tick, const hal::AxisCommands& axes) noexcept {
   if (powered_off_) return;
   drives_simulated_ = true;
   for (std::size_t i = 0; i < n_axes_; ++i) {
@@ -485,7 +500,7 @@ void SimWorld::step_beat_contact(double crank_position, double omega, const hal:
   }
 }
 
-void SimWorld::read_analog(hal::Tick now, hal::AnalogInputs& analog) {
+void SimWorld::read_analog(hal::Tick now, hal::AnalogInputs& analog) noexcept {
   if (powered_off_ || stalled(now)) return;
   analog.beat_force_valid = scene_.beat_contact.has_value();
   analog.beat_force_n = beat_force_n_;
@@ -523,7 +538,7 @@ void SimWorld::step_shuttle(double helix) noexcept {
   if (shuttle_v_ == 0.0 && std::abs(carrier - shuttle_x_) < 1e-3) shuttle_coupled_ = true;
 }
 
-void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::DigitalInputs& io) {
+void SimWorld::read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::DigitalInputs& io) noexcept {
   if (powered_off_ || stalled(now)) return;
   // The shuttle rides the carrier on the helix shaft: one lead of travel per shaft turn. Taken from the
   // HAL's fresh helix feedback, so this I/O node also works beside real (CAN) drives.
@@ -593,7 +608,7 @@ void SimWorld::readings(std::array<double, hal::kMaxAxes>& out) const noexcept {
   for (std::size_t i = 0; i < n_axes_; ++i) out[i] = axes_[i].position + axes_[i].offset;
 }
 
-void SimWorld::write_io(hal::Tick, const hal::DigitalOutputs& io) {
+void SimWorld::write_io(hal::Tick, const hal::DigitalOutputs& io) noexcept {
   if (powered_off_) return;
   if (knotter_) {
     std::array<double, hal::kMaxAxes> at{};

@@ -16,13 +16,13 @@ class RelayBus final : public drivers::CanBus {
 
   void set_passthrough(bool on) { passthrough_ = on; }
 
-  drivers::SendResult send(const drivers::CanFrame& f) override {
+  drivers::SendResult send(const drivers::CanFrame& f) noexcept override {
     if (passthrough_) return inner_.send(f);
     if (ntx_ == tx_.size()) return drivers::SendResult::kWouldBlock;
     tx_[ntx_++] = f;
     return drivers::SendResult::kOk;
   }
-  bool receive(drivers::CanFrame& f) override {
+  bool receive(drivers::CanFrame& f) noexcept override {
     if (passthrough_) return inner_.receive(f);
     if (rx_head_ == rx_tail_) return false;
     f = rx_[rx_head_++ % rx_.size()];

@@ -49,7 +49,7 @@ class FuzzBus final : public drivers::CanBus {
   drivers::CanBus* relay = nullptr;
   int tx_full = 0;
 
-  drivers::SendResult send(const drivers::CanFrame& f) override {
+  drivers::SendResult send(const drivers::CanFrame& f) noexcept override {
     if (relay != nullptr) return relay->send(f);
     if (tx_full > 0) {
       --tx_full;
@@ -57,7 +57,7 @@ class FuzzBus final : public drivers::CanBus {
     }
     return drivers::SendResult::kOk;
   }
-  bool receive(drivers::CanFrame& f) override {
+  bool receive(drivers::CanFrame& f) noexcept override {
     if (relay != nullptr) return relay->receive(f);
     if (head_ == tail_) return false;
     f = queue_[head_++ % queue_.size()];

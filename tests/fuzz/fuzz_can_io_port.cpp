@@ -87,7 +87,7 @@ class FuzzBus final : public drivers::CanBus {
   drivers::CanFrame last_sent{};
   std::uint32_t sent = 0;
 
-  drivers::SendResult send(const drivers::CanFrame& f) override {
+  drivers::SendResult send(const drivers::CanFrame& f) noexcept override {
     if (relay != nullptr) return relay->send(f);
     last_sent = f;
     ++sent;
@@ -97,7 +97,7 @@ class FuzzBus final : public drivers::CanBus {
     }
     return drivers::SendResult::kOk;
   }
-  bool receive(drivers::CanFrame& f) override { return relay != nullptr && relay->receive(f); }
+  bool receive(drivers::CanFrame& f) noexcept override { return relay != nullptr && relay->receive(f); }
   void reset() {
     tx_full = 0;
     sent = 0;

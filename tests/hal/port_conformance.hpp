@@ -21,6 +21,7 @@
 #include <cstdint>
 
 #include "alloc_counter.hpp"
+#include "loom/hal/fault_events.hpp"
 #include "loom/hal/hal.hpp"
 
 namespace loom::test {
@@ -102,6 +103,7 @@ class PortConformance : public ::testing::Test {
     count_allocations(true);
     hal.read(now_, in_);
     count_allocations(false);
+    tally_fault_events();
     decide();
     count_allocations(true);
     hal.write(now_, out_);
@@ -132,8 +134,25 @@ class PortConformance : public ::testing::Test {
   // enabled and settled), so the event always strikes an enabled machine.
   static constexpr hal::Tick after_enabling(int ahead) { return kEnableTicks + 10 + ahead; }
 
+  // The read's fault events (hal/fault_events.hpp), counted per axis and for the link; an event always
+  // comes with the fault it reports.
+  void tally_fault_events() {
+    for (std::size_t i = 0; i < rig_.axis_count(); ++i) {
+      if (!in_.axes[i].fault_raised) continue;
+      ++axis_events_[i];
+      EXPECT_TRUE(hal::axis_faulted(in_.axes[i]))
+          << "axis " << i << ": an event without a fault, tick " << now_;
+    }
+    if (in_.link.fault_raised) {
+      ++link_events_;
+      EXPECT_TRUE(in_.link.link_fault) << "a link event without a link fault, tick " << now_;
+    }
+  }
+
   Rig rig_;
   PortPlan plan_;
+  std::array<int, hal::kMaxAxes> axis_events_{};
+  int link_events_ = 0;
   hal::HalInputs in_{};
   hal::HalOutputs out_{};
   hal::Tick now_ = 0;
@@ -286,10 +305,15 @@ TYPED_TEST_P(PortConformance, ADriveFaultArrivesAsADriveFaultWithItsCode) {
   plan.code = 0x2310;
   this->make(plan);
   this->enable();
+  EXPECT_EQ(this->axis_events_[plan.axis], 0) << "a fault event before the fault";
   while (this->now_ < plan.at + this->kFaultTicks) this->hold(hal::AxisRequest::kEnable);
   const hal::AxisFeedback& a = this->in_.axes[plan.axis];
   EXPECT_TRUE(a.fault);
   EXPECT_EQ(a.state, hal::DriveState::kFault);
+  // One event when the report begins, and one more at most when the device's code follows its state.
+  const int events = this->axis_events_[plan.axis];
+  EXPECT_GE(events, 1);
+  EXPECT_LE(events, 2);
   EXPECT_EQ(a.fault_kind, hal::FaultKind::kDrive);
   EXPECT_EQ(a.fault_code, plan.code);
   EXPECT_FALSE(this->in_.link.link_fault) << "a drive fault is not a link fault";
@@ -298,9 +322,16 @@ TYPED_TEST_P(PortConformance, ADriveFaultArrivesAsADriveFaultWithItsCode) {
       EXPECT_EQ(this->in_.axes[i].fault_kind, hal::FaultKind::kNone) << "axis " << i;
     }
   }
-  // Asking for enable never clears it.
+  // Asking for enable never clears it; the standing report raises no further event.
   for (int k = 0; k < 20; ++k) this->hold(hal::AxisRequest::kEnable);
   EXPECT_EQ(this->in_.axes[plan.axis].state, hal::DriveState::kFault);
+  EXPECT_EQ(this->axis_events_[plan.axis], events);
+  EXPECT_EQ(this->link_events_, 0);
+  for (std::size_t i = 0; i < hal::kCoreAxisCount; ++i) {
+    if (i != plan.axis) {
+      EXPECT_EQ(this->axis_events_[i], 0) << "axis " << i;
+    }
+  }
 }
 
 // 3. An EMCY from a drive that stays enabled arrives as FaultKind::kEmcy with its code, without `fault`
@@ -337,6 +368,9 @@ TYPED_TEST_P(PortConformance, AnIoDeviceFaultArrivesOnTheLinkWithItsCode) {
   EXPECT_TRUE(this->in_.link.link_fault);
   EXPECT_EQ(this->in_.link.link_fault_kind, hal::FaultKind::kEmcy);
   EXPECT_EQ(this->in_.link.link_fault_code, plan.code);
+  // One event for the link's report, however long it stands.
+  for (int k = 0; k < 20; ++k) this->hold(hal::AxisRequest::kEnable);
+  EXPECT_EQ(this->link_events_, 1);
 }
 
 // 4. The stop path's outputs (DigitalOutputs{}: both valve coils off) reach the plant: extended frames

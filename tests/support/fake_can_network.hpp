@@ -18,8 +18,10 @@ class FakeCanNetwork {
   class Endpoint final : public drivers::CanBus {
    public:
     Endpoint(FakeCanNetwork& net, std::size_t id) : net_(net), id_(id) {}
-    drivers::SendResult send(const drivers::CanFrame& frame) override { return net_.transmit(id_, frame); }
-    bool receive(drivers::CanFrame& frame) override {
+    drivers::SendResult send(const drivers::CanFrame& frame) noexcept override {
+      return net_.transmit(id_, frame);
+    }
+    bool receive(drivers::CanFrame& frame) noexcept override {
       if (rx_.empty()) return false;
       frame = rx_.front();
       rx_.pop_front();

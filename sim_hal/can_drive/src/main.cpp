@@ -76,14 +76,14 @@ int usage_error(const std::string& message) {
 class RetryingBus final : public loom::drivers::CanBus {
  public:
   explicit RetryingBus(loom::drivers::CanBus& inner) : inner_(inner) {}
-  loom::drivers::SendResult send(const loom::drivers::CanFrame& f) override {
+  loom::drivers::SendResult send(const loom::drivers::CanFrame& f) noexcept override {
     flush();
     if (pending_.empty() && inner_.send(f) == loom::drivers::SendResult::kOk)
       return loom::drivers::SendResult::kOk;
     if (pending_.size() < 4096) pending_.push_back(f);
     return loom::drivers::SendResult::kOk;
   }
-  bool receive(loom::drivers::CanFrame& f) override { return inner_.receive(f); }
+  bool receive(loom::drivers::CanFrame& f) noexcept override { return inner_.receive(f); }
   void flush() {
     while (!pending_.empty() && inner_.send(pending_.front()) == loom::drivers::SendResult::kOk)
       pending_.pop_front();

@@ -44,7 +44,7 @@ class FakeClock final : public firmware::LoopClock {
 class SlowHal final : public hal::Hal {
  public:
   SlowHal(hal::Hal& inner, FakeClock& clock) : inner_(inner), clock_(clock) {}
-  void read(hal::Tick now, hal::HalInputs& in) override {
+  void read(hal::Tick now, hal::HalInputs& in) noexcept override {
     const auto i = static_cast<std::size_t>(now);
     clock_.advance(i < cost_ns.size() ? cost_ns[i] : default_cost_ns);
     inner_.read(now, in);
@@ -58,7 +58,7 @@ class SlowHal final : public hal::Hal {
       in.link.silent_node = silent_node;
     }
   }
-  void write(hal::Tick now, const hal::HalOutputs& out) override { inner_.write(now, out); }
+  void write(hal::Tick now, const hal::HalOutputs& out) noexcept override { inner_.write(now, out); }
   std::vector<std::int64_t> cost_ns;
   std::int64_t default_cost_ns = 10'000;
   std::optional<hal::LinkRecovery> recovery;

@@ -15,10 +15,10 @@ namespace loom::drivers {
 
 // Bits on the wire for one data frame with `data_bytes` (0..8), including the 3-bit interframe space.
 // Nominal: 44 + 8s + 3. Worst case adds ⌊(34 + 8s − 1)/4⌋ stuff bits (Davis et al. 2007). RT-safe.
-constexpr std::uint32_t frame_bits_nominal(std::uint32_t data_bytes) {
+constexpr std::uint32_t frame_bits_nominal(std::uint32_t data_bytes) noexcept {
   return 44 + 8 * data_bytes + 3;
 }
-constexpr std::uint32_t frame_bits_worst(std::uint32_t data_bytes) {
+constexpr std::uint32_t frame_bits_worst(std::uint32_t data_bytes) noexcept {
   return 44 + 8 * data_bytes + (34 + 8 * data_bytes - 1) / 4 + 3;
 }
 

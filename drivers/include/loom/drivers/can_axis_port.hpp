@@ -16,20 +16,22 @@
 #include "loom/drivers/can_frame.hpp"
 #include "loom/drivers/can_io_port.hpp"
 #include "loom/drivers/can_master.hpp"
+#include "loom/drivers/can_network.hpp"
 #include "loom/drivers/cia402_axis.hpp"
 #include "loom/drivers/configure_clock.hpp"
 #include "loom/drivers/position_scaling.hpp"
 #include "loom/drivers/status.hpp"
+#include "loom/hal/fault_events.hpp"
 #include "loom/hal/hal.hpp"
 
 namespace loom::drivers {
 
 class SdoClient;
 
-// The hal::AxisPort of the CAN servo axes: one CanMaster per bus (bus owner: drain, dispatch, SYNC,
-// master heartbeat, bus-off, NMT bring-up of its nodes in one sequence), one Cia402Axis per axis (the
-// CiA 402 profile), and the other nodes (the I/O modules) attached to their bus' master. A fault of any
-// node on any bus stops every axis in the same tick.
+// The hal::AxisPort of the CAN servo axes: one Cia402Axis per axis (the CiA 402 profile) registered on
+// the port's CanNetwork (can_network.hpp: one CanMaster per bus — drain, dispatch, SYNC, master heartbeat,
+// bus-off, NMT bring-up of its nodes in one sequence — and the link status), with the other nodes (the
+// I/O modules) attached to it. A fault of any node on any bus stops every axis in the same tick.
 class CanAxisPort final : public hal::AxisPort {
  public:
   // Bounds of the RT path (per bus).
@@ -37,7 +39,7 @@ class CanAxisPort final : public hal::AxisPort {
 
   // Configure-time only.
   explicit CanAxisPort(CanAxisPortConfig config);
-  // Copies rebind the masters to the copy's own axes (the fuzz harness copies a configured port).
+  // Copies rebind the network to the copy's own axes (the fuzz harness copies a configured port).
   CanAxisPort(const CanAxisPort& other);
   CanAxisPort& operator=(const CanAxisPort& other);
 
@@ -59,41 +61,43 @@ class CanAxisPort final : public hal::AxisPort {
   Status configure(CanBus& bus, ConfigureClock& clock);  // one bus
   Status configure(CanBus& bus);                         // with MonotonicConfigureClock
 
-  // RT-safe. Per bus: drains at most kMaxFramesPerRead frames; then reports every axis and the link.
-  void read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) override;
+  // RT-safe. Per bus: drains at most kMaxFramesPerRead frames; then reports every axis and the link (the
+  // network's), with the fault events of this tick (each axis' fault_raised: Cia402Axis; the link's:
+  // CanNetwork::read_link).
+  void read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) noexcept override;
   // RT-safe. Per bus: SYNC, then one RPDO1 per axis.
-  void write_axes(hal::Tick now, const hal::AxisCommands& axes) override;
+  void write_axes(hal::Tick now, const hal::AxisCommands& axes) noexcept override;
 
   // Diagnostics; RT-safe to read.
-  bool configured() const { return d_.configured; }
+  bool configured() const noexcept { return d_.network.configured(); }
   // What configure() found optional and absent (0x1016, TPDO2) or accepted as read back; one line each.
   const std::vector<std::string>& notes() const { return d_.notes; }
   // Largest following error seen per axis since configure(), in SI units (telemetry high-water mark).
-  double ferror_high_water(std::size_t slot) const { return d_.axes[slot].ferror_high_water(); }
-  bool has_consumer(std::size_t slot) const { return d_.axes[slot].has_consumer(); }
-  bool has_tpdo2(std::size_t slot) const { return d_.axes[slot].has_tpdo2(); }
-  std::size_t axis_count() const { return d_.n_axes; }
-  std::size_t bus_count() const { return d_.n_buses; }
-  const BusLoad& bus_load(std::size_t bus = 0) const { return d_.bus_loads[bus]; }
+  double ferror_high_water(std::size_t slot) const noexcept { return d_.axes[slot].ferror_high_water(); }
+  bool has_consumer(std::size_t slot) const noexcept { return d_.axes[slot].has_consumer(); }
+  bool has_tpdo2(std::size_t slot) const noexcept { return d_.axes[slot].has_tpdo2(); }
+  std::size_t axis_count() const noexcept { return d_.n_axes; }
+  std::size_t bus_count() const noexcept { return d_.network.bus_count(); }
+  const BusLoad& bus_load(std::size_t bus = 0) const noexcept { return d_.bus_loads[bus]; }
   const CanAxisPortConfig& config() const { return d_.config; }
-  std::uint16_t last_controlword(std::size_t slot) const { return d_.axes[slot].last_controlword(); }
-  std::int64_t last_target_counts(std::size_t slot) const { return d_.axes[slot].last_target_counts(); }
-  std::uint32_t heartbeat_consumer_ticks() const { return d_.consumer_ticks; }
+  std::uint16_t last_controlword(std::size_t slot) const noexcept { return d_.axes[slot].last_controlword(); }
+  std::int64_t last_target_counts(std::size_t slot) const noexcept {
+    return d_.axes[slot].last_target_counts();
+  }
+  std::uint32_t heartbeat_consumer_ticks() const noexcept { return d_.consumer_ticks; }
 
  private:
-  void relink();  // the masters' node tables from the axes and the attached nodes
-  bool any_fault() const;
+  void relink();  // the network's node tables from the axes and the attached nodes
+  bool any_fault() const noexcept;
 
   struct Data {
     CanAxisPortConfig config;
-    bool configured = false;
     std::array<BusLoad, kMaxBuses> bus_loads{};
     std::uint32_t consumer_ticks = 0;
     std::uint32_t state_timeout_ticks = 0;
     std::array<Cia402Axis, hal::kMaxAxes> axes{};
     std::size_t n_axes = 0;
-    std::array<CanMaster, kMaxBuses> masters{};
-    std::size_t n_buses = 0;
+    CanNetwork network;  // the masters, one per bus; configured() once every bus is up
     struct Attached {
       CanNode* node = nullptr;  // not owned
       std::size_t bus = 0;

@@ -21,12 +21,12 @@ struct CanErrorInfo {
 };
 
 // RT-safe. Decode an error frame (`frame.is_error()`); all false for a data frame.
-CanErrorInfo decode_error_frame(const CanFrame& frame);
+CanErrorInfo decode_error_frame(const CanFrame& frame) noexcept;
 
 // Error-frame content a simulated or fake bus injects to signal bus-off (same bits as the kernel's).
 // RT-safe.
-CanFrame make_bus_off_error_frame();
+CanFrame make_bus_off_error_frame() noexcept;
 // ... and that the controller restarted after bus-off (CAN_ERR_RESTARTED, as the kernel sends it).
-CanFrame make_restarted_error_frame();
+CanFrame make_restarted_error_frame() noexcept;
 
 }  // namespace loom::drivers

@@ -36,9 +36,9 @@ class CanBus {
  public:
   virtual ~CanBus() = default;
   // RT-safe. Queue one frame for transmission.
-  virtual SendResult send(const CanFrame& frame) = 0;
+  virtual SendResult send(const CanFrame& frame) noexcept = 0;
   // RT-safe. Take the next received frame (data or error frame); false when none is waiting.
-  virtual bool receive(CanFrame& frame) = 0;
+  virtual bool receive(CanFrame& frame) noexcept = 0;
 };
 
 }  // namespace loom::drivers

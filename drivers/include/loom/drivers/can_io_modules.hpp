@@ -24,9 +24,9 @@ class CanIoModules final : public hal::IoPort {
   std::size_t size() const { return n_; }
 
   // hal::IoPort (RT-safe).
-  void read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::DigitalInputs& io) override;
-  void read_analog(hal::Tick now, hal::AnalogInputs& analog) override;
-  void write_io(hal::Tick now, const hal::DigitalOutputs& io) override;
+  void read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::DigitalInputs& io) noexcept override;
+  void read_analog(hal::Tick now, hal::AnalogInputs& analog) noexcept override;
+  void write_io(hal::Tick now, const hal::DigitalOutputs& io) noexcept override;
 
  private:
   std::array<CanIoPort*, kMaxIoModules> modules_{};

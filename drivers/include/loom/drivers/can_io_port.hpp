@@ -30,7 +30,7 @@ namespace loom::drivers {
 // The output values the module is told to adopt by itself on failure (0x6206/0x6207): both valve coils
 // de-energised (frames retracted and vented; no shed, so no pick can start and nothing is trapped),
 // green/amber off, red on, buzzer off, every knotting head's gripper open and cutter retracted.
-hal::DigitalOutputs io_safe_outputs();
+hal::DigitalOutputs io_safe_outputs() noexcept;
 
 class CanIoPort final : public hal::IoPort, public CanNode {
  public:
@@ -39,23 +39,25 @@ class CanIoPort final : public hal::IoPort, public CanNode {
   // Configure-time only.
   explicit CanIoPort(CanIoConfig config);
 
-  // Configure-time only; blocks with timeouts. The module alone on a master of its own (a bus without
-  // drives; with drives, CanAxisPort::attach() brings it up with them): NMT reset-node → boot-up →
-  // configure_profile() → NMT start → operational heartbeat. Errors name node, object and step.
+  // Configure-time only; blocks with timeouts. The module alone on a master of its own, for a bring-up
+  // check only (nothing polls that master afterwards): NMT reset-node → boot-up → configure_profile() →
+  // NMT start → operational heartbeat. Errors name node, object and step. To use the module, register it
+  // on a CanNetwork (can_network.hpp; no axis port needed) or attach it to the CanAxisPort of its bus,
+  // whose network brings it up with the drives; the network then polls it every tick.
   Status configure(CanBus& bus, ConfigureClock& clock);
 
   // What configure() found optional and absent, or accepted instead of what it asked for (one line each).
   const std::vector<std::string>& notes() const { return notes_; }
 
   // hal::IoPort (RT-safe).
-  void read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::DigitalInputs& io) override;
+  void read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::DigitalInputs& io) noexcept override;
   // RT-safe. Only the signals wired to this module into `io` (the others untouched: another module's),
   // and when its inputs were last refreshed (kNeverTick before the first TPDO).
-  void read_wired(hal::DigitalInputs& io) const;
-  hal::Tick inputs_refreshed() const { return inputs_refreshed_; }
-  bool has_load_cell() const { return wiring_.load_cell_channel != 0; }
-  void read_analog(hal::Tick now, hal::AnalogInputs& analog) override;
-  void write_io(hal::Tick now, const hal::DigitalOutputs& io) override;
+  void read_wired(hal::DigitalInputs& io) const noexcept;
+  hal::Tick inputs_refreshed() const noexcept { return inputs_refreshed_; }
+  bool has_load_cell() const noexcept { return wiring_.load_cell_channel != 0; }
+  void read_analog(hal::Tick now, hal::AnalogInputs& analog) noexcept override;
+  void write_io(hal::Tick now, const hal::DigitalOutputs& io) noexcept override;
 
   // CanNode. configure_profile(): device type 0x1000 is CiA 401 → 0x1017 → 0x6206/0x6207 (safe outputs)
   // → 0x1016 consumer of the master heartbeat → PDO mapping (written, or read back when the module's
@@ -67,13 +69,13 @@ class CanIoPort final : public hal::IoPort, public CanNode {
   void bring_up_started() override;
   Status configure_profile(SdoClient& sdo) override;
   void brought_up(CanBus& bus) override;
-  void on_profile_frame(hal::Tick now, const CanFrame& frame) override;  // RT-safe
+  void on_profile_frame(hal::Tick now, const CanFrame& frame) noexcept override;  // RT-safe
 
   // Diagnostics; RT-safe.
-  bool configured() const { return configured_; }
+  bool configured() const noexcept { return configured_; }
   const CanIoConfig& config() const { return config_; }
-  std::uint16_t last_emcy_code() const { return supervisor_.emcy_code(); }
-  std::uint32_t tx_dropped() const { return tx_dropped_; }
+  std::uint16_t last_emcy_code() const noexcept { return supervisor_.emcy_code(); }
+  std::uint32_t tx_dropped() const noexcept { return tx_dropped_; }
 
  private:
   // Where one object sits in the PDOs the module actually uses (after configure()).
@@ -104,7 +106,7 @@ class CanIoPort final : public hal::IoPort, public CanNode {
   Status disable_pdo(SdoClient& sdo, bool rx, int pdo);
   static Slot find(const std::array<PdoLayout, 4>& layouts, std::uint32_t entry_without_len);
   std::string who() const;
-  bool input(const IoBit& b) const;
+  bool input(const IoBit& b) const noexcept;
 
   CanIoConfig config_;
   IoWiring wiring_;  // this module's signals: module_wiring(config_.wiring, config_.module)

@@ -47,12 +47,12 @@ class CanNode {
   // Configure-time. The whole bus is operational: the node's RT frames go to `bus` from now on.
   virtual void brought_up(CanBus& bus) = 0;
   // RT-safe. One of this node's frames that is neither its heartbeat nor its EMCY (PDOs).
-  virtual void on_profile_frame(hal::Tick now, const CanFrame& frame) = 0;
+  virtual void on_profile_frame(hal::Tick now, const CanFrame& frame) noexcept = 0;
   // RT-safe. The operator acknowledged: clear the latches whose cause is gone.
-  virtual void acknowledge() { supervisor_.acknowledge(false); }
+  virtual void acknowledge() noexcept { supervisor_.acknowledge(false); }
   // True when the profile reports the node's EMCY itself (a drive's in its axis feedback); otherwise the
   // master reports it as a link fault that stops every axis.
-  virtual bool reports_own_emcy() const { return false; }
+  virtual bool reports_own_emcy() const noexcept { return false; }
   // Configure-time. The node's EDS when the machine description names one (null: none): bring_up()
   // checks its 0x1018 identity against it and makes its writes (only those that differ) before
   // configure_profile(), which then writes only what still differs as well.
@@ -60,15 +60,15 @@ class CanNode {
 
   // RT-safe. A frame from the bus: heartbeat and EMCY to the supervisor, the rest to the profile. Frames
   // of other nodes and error frames are ignored; nothing is taken before the node was brought up.
-  void on_frame(hal::Tick now, const CanFrame& frame);
+  void on_frame(hal::Tick now, const CanFrame& frame) noexcept;
   // RT-safe. After the tick's frames: the heartbeat consumer.
-  void supervise(hal::Tick now) { supervisor_.supervise(now); }
+  void supervise(hal::Tick now) noexcept { supervisor_.supervise(now); }
   // RT-safe. 0 = healthy, else the master's link verdict on the node (node lost, rebooted, not operational).
-  std::uint16_t link_fault_code() const { return supervisor_.link_fault(); }
-  bool heard_again(hal::Tick now) const { return supervisor_.heard_again(now); }
-  const NodeSupervisor& supervisor() const { return supervisor_; }
+  std::uint16_t link_fault_code() const noexcept { return supervisor_.link_fault(); }
+  bool heard_again(hal::Tick now) const noexcept { return supervisor_.heard_again(now); }
+  const NodeSupervisor& supervisor() const noexcept { return supervisor_; }
   // Malformed frames of this node (PDO of the wrong length, bad heartbeat or EMCY), cumulative.
-  std::uint32_t rx_errors() const { return rx_errors_; }
+  std::uint32_t rx_errors() const noexcept { return rx_errors_; }
 
  protected:
   friend class CanMaster;  // arms the supervisor when the bus is up
@@ -105,32 +105,32 @@ class CanMaster {
 
   // RT-safe. Drains at most kMaxFramesPerPoll frames (error frames latch bus-off; the rest go to their
   // node by id; EMCYs of unknown nodes latch a foreign EMCY), then supervises every node.
-  void poll(hal::Tick now);
+  void poll(hal::Tick now) noexcept;
   // RT-safe. SYNC, and the master heartbeat when it is due.
-  void start_cycle(hal::Tick now);
+  void start_cycle(hal::Tick now) noexcept;
   // RT-safe. Sends and counts a dropped frame.
-  void send(const CanFrame& frame);
+  void send(const CanFrame& frame) noexcept;
 
   // RT-safe state.
-  bool configured() const { return configured_; }
-  bool bus_off() const { return bus_off_; }
+  bool configured() const noexcept { return configured_; }
+  bool bus_off() const noexcept { return bus_off_; }
   // Any fault on this bus that must stop every axis: bus-off, a node lost, an EMCY of a node that does
   // not report it itself, an EMCY of a node nobody owns.
-  bool any_fault() const;
+  bool any_fault() const noexcept;
   // RT-safe. Fills link_fault/link_fault_kind/link_fault_code when this bus has a link fault and `link`
   // has none yet (the first fault found is reported), and adds this bus' counters.
-  void report_link(hal::LinkStatus& link) const;
+  void report_link(hal::LinkStatus& link) const noexcept;
   // RT-safe. How far a link fault on this bus has recovered; `silent` names the node still missing.
-  hal::LinkRecovery recovery(hal::Tick now, std::uint8_t& silent) const;
+  hal::LinkRecovery recovery(hal::Tick now, std::uint8_t& silent) const noexcept;
   // RT-safe. The operator acknowledged: the foreign EMCY latch and every node's latches.
-  void acknowledge();
-  std::uint32_t tx_dropped() const { return tx_dropped_; }
-  std::uint32_t rx_errors() const { return rx_errors_; }
+  void acknowledge() noexcept;
+  std::uint32_t tx_dropped() const noexcept { return tx_dropped_; }
+  std::uint32_t rx_errors() const noexcept { return rx_errors_; }
   std::uint32_t consumer_ticks(const CanNode& node) const;
   const CanMasterConfig& config() const { return config_; }
 
  private:
-  void handle_error_frame(const CanFrame& frame);
+  void handle_error_frame(const CanFrame& frame) noexcept;
 
   CanMasterConfig config_{};
   std::array<CanNode*, kMaxNodes> nodes_{};

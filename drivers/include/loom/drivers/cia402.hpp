@@ -40,7 +40,7 @@ inline constexpr std::uint16_t kHomingError = 1U << 13;          // in homing mo
 }  // namespace statusword
 
 // RT-safe. kUnknown for bit patterns that match no state.
-hal::DriveState decode_statusword(std::uint16_t statusword);
+hal::DriveState decode_statusword(std::uint16_t statusword) noexcept;
 
 // Bookkeeping carried from one tick to the next (one per axis).
 struct Cia402Tracker {
@@ -65,10 +65,10 @@ struct Cia402Step {
 // Fault reset: bit 7 rises once per rising edge of a kFaultReset request and is held until the drive
 // leaves Fault; a drive that faults again is not reset until the sequencer asks again.
 Cia402Step cia402_step(hal::DriveState state, hal::AxisRequest request, const Cia402Tracker& prev,
-                       std::uint32_t timeout_ticks);
+                       std::uint32_t timeout_ticks) noexcept;
 
 // RT-safe. True when `state` is where `request` wants the drive to rest.
-bool cia402_goal_reached(hal::DriveState state, hal::AxisRequest request);
+bool cia402_goal_reached(hal::DriveState state, hal::AxisRequest request) noexcept;
 
 // 0x60C2 interpolation time period: period = value · 10^index s.
 struct InterpolationPeriod {

@@ -15,6 +15,7 @@
 #include "loom/drivers/can_master.hpp"
 #include "loom/drivers/cia402.hpp"
 #include "loom/drivers/position_scaling.hpp"
+#include "loom/hal/fault_events.hpp"
 #include "loom/hal/types.hpp"
 
 namespace loom::drivers {
@@ -34,33 +35,34 @@ class Cia402Axis final : public CanNode {
   void bring_up_started() override;
   Status configure_profile(SdoClient& sdo) override;
   void brought_up(CanBus& bus) override;
-  void on_profile_frame(hal::Tick now, const CanFrame& frame) override;
-  void acknowledge() override;
-  bool reports_own_emcy() const override { return true; }
+  void on_profile_frame(hal::Tick now, const CanFrame& frame) noexcept override;
+  void acknowledge() noexcept override;
+  bool reports_own_emcy() const noexcept override { return true; }
   const NodeDescription* description() const override { return description_.get(); }
 
   // RT-safe. This tick's feedback, given the state of the axis' bus. A profile-position axis' TPDO1 is
   // sent on change only: while its last one said the axis stands still, its data is current until the
   // event timer (plus margin) has passed without one (`refreshed` = now); after that it ages as a CSP
-  // axis' does, so a PP drive whose TPDO stops is stale feedback for the sequencer too.
-  void fill_feedback(hal::Tick now, hal::AxisFeedback& fb, bool bus_off, bool bus_configured) const;
+  // axis' does, so a PP drive whose TPDO stops is stale feedback for the sequencer too. Raises
+  // fb.fault_raised on the tick this axis' fault report begins or changes its code (once per tick).
+  void fill_feedback(hal::Tick now, hal::AxisFeedback& fb, bool bus_off, bool bus_configured) noexcept;
   // RT-safe. Any fault of this drive that must stop every axis.
-  bool faulted() const;
+  bool faulted() const noexcept;
   // RT-safe. The next step toward `command` (quick stop when `stop_all` and the request is not a reset
   // or disable; always quick stop while the drive cannot be supervised) into `rpdo1`. True when it is to
   // be sent: every tick in CSP; in PP only when the controlword or the target changed.
   bool command(hal::Tick now, const hal::AxisCommand& command, bool stop_all, bool bus_down,
-               std::uint32_t state_timeout_ticks, CanFrame& rpdo1);
+               std::uint32_t state_timeout_ticks, CanFrame& rpdo1) noexcept;
 
   // Diagnostics; RT-safe.
-  std::uint8_t bus() const { return bus_; }
-  double ferror_high_water() const { return ferror_high_water_; }
-  bool has_consumer() const { return has_consumer_; }
-  bool has_tpdo2() const { return has_tpdo2_; }
-  std::uint16_t last_controlword() const { return tracker_.last_controlword; }
-  std::int64_t last_target_counts() const { return last_target_counts_; }
-  DriveMode mode() const { return mode_; }
-  std::uint32_t setpoints_sent() const { return pp_setpoints_; }  // PP: set-points (bit 4 rising)
+  std::uint8_t bus() const noexcept { return bus_; }
+  double ferror_high_water() const noexcept { return ferror_high_water_; }
+  bool has_consumer() const noexcept { return has_consumer_; }
+  bool has_tpdo2() const noexcept { return has_tpdo2_; }
+  std::uint16_t last_controlword() const noexcept { return tracker_.last_controlword; }
+  std::int64_t last_target_counts() const noexcept { return last_target_counts_; }
+  DriveMode mode() const noexcept { return mode_; }
+  std::uint32_t setpoints_sent() const noexcept { return pp_setpoints_; }  // PP: set-points (bit 4 rising)
   const std::vector<std::string>& notes() const { return notes_; }
 
  private:
@@ -69,9 +71,9 @@ class Cia402Axis final : public CanNode {
   Status configure_profile_position(SdoClient& sdo);
   // PP, RT-safe: the controlword bits and target of the set-point handshake for this tick.
   std::uint16_t profile_setpoint(hal::Tick now, const hal::AxisCommand& cmd, bool enabled,
-                                 std::uint32_t state_timeout_ticks);
+                                 std::uint32_t state_timeout_ticks) noexcept;
   std::uint32_t profile_move_ticks(std::int64_t distance_counts) const;
-  bool profile_fault() const { return pp_fault_ != 0; }
+  bool profile_fault() const noexcept { return pp_fault_ != 0; }
 
   // Configuration (configure-time).
   // What configure_profile() writes (from CanAxisPortConfig).
@@ -147,6 +149,9 @@ class Cia402Axis final : public CanNode {
   std::uint32_t pp_setpoints_ = 0;
   hal::Tick pp_since_ = 0;  // tick the current set-point was raised
   bool still_ = false;      // PP: the last TPDO1 said the axis stands still
+  // The fault report fill_feedback last gave, for its event; kept across bring-ups (a report that goes on
+  // after a reconfiguration is not a new one).
+  hal::AxisFaultEdge fault_edge_;
 };
 
 }  // namespace loom::drivers

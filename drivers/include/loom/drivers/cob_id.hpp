@@ -20,22 +20,22 @@ inline constexpr std::uint32_t kSdoRxBase = 0x600;  // client → server (the ma
 inline constexpr std::uint32_t kHeartbeatBase = 0x700;
 
 // RT-safe. `pdo` is 1-based (TPDO1..4 / RPDO1..4), as the objects 0x1800+n-1 / 0x1400+n-1 count them.
-constexpr std::uint32_t emcy(std::uint8_t node) {
+constexpr std::uint32_t emcy(std::uint8_t node) noexcept {
   return kEmcyBase + node;
 }
-constexpr std::uint32_t tpdo(int pdo, std::uint8_t node) {
+constexpr std::uint32_t tpdo(int pdo, std::uint8_t node) noexcept {
   return kTpdoBase[pdo - 1] + node;
 }
-constexpr std::uint32_t rpdo(int pdo, std::uint8_t node) {
+constexpr std::uint32_t rpdo(int pdo, std::uint8_t node) noexcept {
   return kRpdoBase[pdo - 1] + node;
 }
-constexpr std::uint32_t sdo_tx(std::uint8_t node) {
+constexpr std::uint32_t sdo_tx(std::uint8_t node) noexcept {
   return kSdoTxBase + node;
 }
-constexpr std::uint32_t sdo_rx(std::uint8_t node) {
+constexpr std::uint32_t sdo_rx(std::uint8_t node) noexcept {
   return kSdoRxBase + node;
 }
-constexpr std::uint32_t heartbeat(std::uint8_t node) {
+constexpr std::uint32_t heartbeat(std::uint8_t node) noexcept {
   return kHeartbeatBase + node;
 }
 }  // namespace cob
@@ -64,7 +64,7 @@ struct CobDecoded {
 };
 
 // RT-safe.
-constexpr CobDecoded decode_cob_id(std::uint32_t id) {
+constexpr CobDecoded decode_cob_id(std::uint32_t id) noexcept {
   if (id == cob::kNmt) return {CobFunction::kNmt, 0};
   if (id == cob::kSync) return {CobFunction::kSync, 0};
   const auto node = static_cast<std::uint8_t>(id & 0x7F);

@@ -21,9 +21,9 @@ struct Emcy {
 };
 
 // RT-safe. nullopt unless id 0x081..0x0FF and DLC 8.
-std::optional<Emcy> parse_emcy(const CanFrame& frame);
+std::optional<Emcy> parse_emcy(const CanFrame& frame) noexcept;
 // RT-safe.
-CanFrame make_emcy(std::uint8_t node, std::uint16_t code, std::uint8_t error_register);
+CanFrame make_emcy(std::uint8_t node, std::uint16_t code, std::uint8_t error_register) noexcept;
 
 // Codes the master itself raises.
 namespace fault_code {
@@ -44,10 +44,10 @@ inline constexpr std::uint16_t kTargetNotReached = 0xFF05;
 
 // RT-safe. The kind of a fault the master reports with `code` on a node's link: its own detections of
 // a lost node (heartbeat lost, rebooted, not operational) and of the bus, else an EMCY the node sent.
-hal::FaultKind link_fault_kind(std::uint16_t code);
+hal::FaultKind link_fault_kind(std::uint16_t code) noexcept;
 
 // RT-safe (returns a static string). The specific text for codes in the table above and the common
 // drive codes, else the CiA 301 error class of the code ("current", "voltage", ...).
-const char* fault_code_text(std::uint16_t code);
+const char* fault_code_text(std::uint16_t code) noexcept;
 
 }  // namespace loom::drivers

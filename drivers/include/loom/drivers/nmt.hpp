@@ -26,28 +26,28 @@ enum class NmtState : std::uint8_t {
   kPreOperational = 0x7F,
 };
 // RT-safe (static string).
-const char* nmt_state_name(NmtState s);
+const char* nmt_state_name(NmtState s) noexcept;
 
 // RT-safe. NMT command for one node (1..127) or all nodes (0).
-CanFrame make_nmt(NmtCommand command, std::uint8_t node);
+CanFrame make_nmt(NmtCommand command, std::uint8_t node) noexcept;
 struct NmtMessage {
   NmtCommand command;
   std::uint8_t node;  // 0 = all nodes
 };
 // RT-safe. nullopt unless id 0x000, DLC 2 and a known command specifier.
-std::optional<NmtMessage> parse_nmt(const CanFrame& frame);
+std::optional<NmtMessage> parse_nmt(const CanFrame& frame) noexcept;
 
 // RT-safe. SYNC without counter (0x1019 = 0): id 0x080, DLC 0.
-CanFrame make_sync();
-bool is_sync(const CanFrame& frame);
+CanFrame make_sync() noexcept;
+bool is_sync(const CanFrame& frame) noexcept;
 
 // RT-safe. Heartbeat / boot-up frame of `node`.
-CanFrame make_heartbeat(std::uint8_t node, NmtState state);
+CanFrame make_heartbeat(std::uint8_t node, NmtState state) noexcept;
 struct Heartbeat {
   std::uint8_t node;
   NmtState state;
 };
 // RT-safe. nullopt unless id 0x701..0x77F, DLC 1 and a known state (toggle bit 7 is ignored).
-std::optional<Heartbeat> parse_heartbeat(const CanFrame& frame);
+std::optional<Heartbeat> parse_heartbeat(const CanFrame& frame) noexcept;
 
 }  // namespace loom::drivers

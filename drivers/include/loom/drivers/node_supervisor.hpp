@@ -21,26 +21,26 @@ class NodeSupervisor {
   void disarm() { *this = NodeSupervisor{}; }
 
   // RT-safe. A heartbeat (0x700 + id) of this node; false when malformed (counted by the caller).
-  bool on_heartbeat(hal::Tick now, const CanFrame& frame);
+  bool on_heartbeat(hal::Tick now, const CanFrame& frame) noexcept;
   // RT-safe. An EMCY (0x080 + id) of this node; false when malformed. A non-zero code latches (even
   // while the node says it is fine) until the operator acknowledges; the node's 0x0000 (error reset)
   // after that acknowledgement clears it.
-  bool on_emcy(const CanFrame& frame);
+  bool on_emcy(const CanFrame& frame) noexcept;
   // RT-safe. After the tick's frames: the heartbeat consumer.
-  void supervise(hal::Tick now);
+  void supervise(hal::Tick now) noexcept;
   // RT-safe. The operator acknowledged. `still_in_fault`: the node still says it is in Fault (a drive's
   // statusword), so its EMCY stays latched until its own error reset.
-  void acknowledge(bool still_in_fault);
+  void acknowledge(bool still_in_fault) noexcept;
 
   // RT-safe. The master's own link verdict on the node: 0, or kHeartbeatLost / kNodeRebooted /
   // kNodeNotOperational (emcy.hpp), latched until the next bring-up.
-  std::uint16_t link_fault() const { return link_fault_; }
+  std::uint16_t link_fault() const noexcept { return link_fault_; }
   // RT-safe. The latched EMCY code, 0 = none.
-  std::uint16_t emcy_code() const { return emcy_code_; }
+  std::uint16_t emcy_code() const noexcept { return emcy_code_; }
   // RT-safe. After a link fault: the node is on the bus again (heard within the consumer time, or booted
   // since), so a new bring-up can work.
-  bool heard_again(hal::Tick now) const;
-  bool armed() const { return armed_; }
+  bool heard_again(hal::Tick now) const noexcept;
+  bool armed() const noexcept { return armed_; }
 
  private:
   bool armed_ = false;

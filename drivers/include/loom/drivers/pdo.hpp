@@ -23,10 +23,10 @@ struct PdoMapEntry {
   std::uint8_t bits = 0;
 };
 // RT-safe.
-constexpr std::uint32_t encode_map_entry(PdoMapEntry e) {
+constexpr std::uint32_t encode_map_entry(PdoMapEntry e) noexcept {
   return (static_cast<std::uint32_t>(e.index) << 16) | (static_cast<std::uint32_t>(e.sub) << 8) | e.bits;
 }
-constexpr PdoMapEntry decode_map_entry(std::uint32_t v) {
+constexpr PdoMapEntry decode_map_entry(std::uint32_t v) noexcept {
   return PdoMapEntry{static_cast<std::uint16_t>(v >> 16), static_cast<std::uint8_t>((v >> 8) & 0xFF),
                      static_cast<std::uint8_t>(v & 0xFF)};
 }
@@ -79,7 +79,7 @@ inline constexpr std::uint8_t kPdoEventTimerSub = 5;     // 0x18xx:05, ms
 }  // namespace od
 
 // RT-safe. Human-readable name of an object the master touches ("modes of operation"), or "object".
-const char* object_name(std::uint16_t index);
+const char* object_name(std::uint16_t index) noexcept;
 
 inline constexpr std::array<PdoMapEntry, 2> kRpdo1Mapping{
     {{od::kControlword, 0, 16}, {od::kTargetPosition, 0, 32}}};
@@ -125,15 +125,15 @@ struct Tpdo2 {
 };
 
 // RT-safe. Pack/unpack with the mapping above; unpack returns nullopt for a wrong id or DLC.
-CanFrame pack_rpdo1(std::uint8_t node, const Rpdo1& p);
-std::optional<Rpdo1> unpack_rpdo1(const CanFrame& frame, std::uint8_t node);
-CanFrame pack_tpdo1(std::uint8_t node, const Tpdo1& p);
-std::optional<Tpdo1> unpack_tpdo1(const CanFrame& frame, std::uint8_t node);
-CanFrame pack_rpdo1_mode(std::uint8_t node, const Rpdo1Mode& p);
-std::optional<Rpdo1Mode> unpack_rpdo1_mode(const CanFrame& frame, std::uint8_t node);
-CanFrame pack_tpdo1_mode(std::uint8_t node, const Tpdo1Mode& p);
-std::optional<Tpdo1Mode> unpack_tpdo1_mode(const CanFrame& frame, std::uint8_t node);
-CanFrame pack_tpdo2(std::uint8_t node, const Tpdo2& p);
-std::optional<Tpdo2> unpack_tpdo2(const CanFrame& frame, std::uint8_t node);
+CanFrame pack_rpdo1(std::uint8_t node, const Rpdo1& p) noexcept;
+std::optional<Rpdo1> unpack_rpdo1(const CanFrame& frame, std::uint8_t node) noexcept;
+CanFrame pack_tpdo1(std::uint8_t node, const Tpdo1& p) noexcept;
+std::optional<Tpdo1> unpack_tpdo1(const CanFrame& frame, std::uint8_t node) noexcept;
+CanFrame pack_rpdo1_mode(std::uint8_t node, const Rpdo1Mode& p) noexcept;
+std::optional<Rpdo1Mode> unpack_rpdo1_mode(const CanFrame& frame, std::uint8_t node) noexcept;
+CanFrame pack_tpdo1_mode(std::uint8_t node, const Tpdo1Mode& p) noexcept;
+std::optional<Tpdo1Mode> unpack_tpdo1_mode(const CanFrame& frame, std::uint8_t node) noexcept;
+CanFrame pack_tpdo2(std::uint8_t node, const Tpdo2& p) noexcept;
+std::optional<Tpdo2> unpack_tpdo2(const CanFrame& frame, std::uint8_t node) noexcept;
 
 }  // namespace loom::drivers

@@ -9,11 +9,11 @@
 namespace loom::drivers {
 
 // RT-safe. Nearest count; non-finite input gives 0 and out-of-range saturates (callers guard first).
-std::int64_t si_to_counts(double si, double counts_per_unit);
+std::int64_t si_to_counts(double si, double counts_per_unit) noexcept;
 // RT-safe.
-double counts_to_si(std::int64_t counts, double counts_per_unit);
+double counts_to_si(std::int64_t counts, double counts_per_unit) noexcept;
 // RT-safe. The 32-bit value the drive sees for an unwrapped count (two's complement, modulo 2^32).
-inline std::int32_t wire_counts(std::int64_t counts) {
+inline std::int32_t wire_counts(std::int64_t counts) noexcept {
   return static_cast<std::int32_t>(counts);
 }
 
@@ -21,12 +21,12 @@ inline std::int32_t wire_counts(std::int64_t counts) {
 class PositionUnwrapper {
  public:
   // RT-safe. Start from a known wire value (e.g. 0x6064 read at configure time).
-  void reset(std::int32_t wire) {
+  void reset(std::int32_t wire) noexcept {
     last_wire_ = wire;
     value_ = wire;
   }
   // RT-safe. Returns the unwrapped position after this sample.
-  std::int64_t update(std::int32_t wire) {
+  std::int64_t update(std::int32_t wire) noexcept {
     const auto delta =
         static_cast<std::int32_t>(static_cast<std::uint32_t>(wire) - static_cast<std::uint32_t>(last_wire_));
     last_wire_ = wire;

@@ -39,16 +39,17 @@ inline constexpr std::uint32_t kNoData = 0x08000024;
 
 // RT-safe. Text of an abort code ("object does not exist in the object dictionary"); "unknown abort
 // code" for codes outside the table.
-const char* sdo_abort_text(std::uint32_t code);
+const char* sdo_abort_text(std::uint32_t code) noexcept;
 
 // ---- Client side (master) -------------------------------------------------------------------------
 // RT-safe. Expedited download of `size` (1..4) bytes of `value` (LE) into index:sub of `node`.
 CanFrame make_sdo_download(std::uint8_t node, std::uint16_t index, std::uint8_t sub, std::uint32_t value,
-                           std::uint8_t size);
+                           std::uint8_t size) noexcept;
 // RT-safe. Upload request for index:sub.
-CanFrame make_sdo_upload(std::uint8_t node, std::uint16_t index, std::uint8_t sub);
+CanFrame make_sdo_upload(std::uint8_t node, std::uint16_t index, std::uint8_t sub) noexcept;
 // RT-safe. Abort sent by the client (id 0x600+node) or by the server (id 0x580+node).
-CanFrame make_sdo_abort(std::uint32_t cob_id, std::uint16_t index, std::uint8_t sub, std::uint32_t code);
+CanFrame make_sdo_abort(std::uint32_t cob_id, std::uint16_t index, std::uint8_t sub,
+                        std::uint32_t code) noexcept;
 
 enum class SdoReplyKind : std::uint8_t {
   kDownloadAck,      // 0x60: the write was accepted
@@ -65,7 +66,7 @@ struct SdoReply {
   std::uint8_t size = 0;    // upload data bytes (1..4)
 };
 // RT-safe. Parse a server→client frame (caller checked the COB-ID); kInvalid for DLC ≠ 8.
-SdoReply parse_sdo_reply(const CanFrame& frame);
+SdoReply parse_sdo_reply(const CanFrame& frame) noexcept;
 
 // ---- Server side (simulated node) -----------------------------------------------------------------
 enum class SdoRequestKind : std::uint8_t {
@@ -83,10 +84,10 @@ struct SdoRequest {
   std::uint8_t size = 0;  // 1..4 for expedited downloads with size indicated, 0 otherwise
 };
 // RT-safe. Parse a client→server frame; kInvalid for DLC ≠ 8 or an unknown command specifier.
-SdoRequest parse_sdo_request(const CanFrame& frame);
+SdoRequest parse_sdo_request(const CanFrame& frame) noexcept;
 // RT-safe. Server replies (id 0x580 + node).
-CanFrame make_sdo_download_ack(std::uint8_t node, std::uint16_t index, std::uint8_t sub);
+CanFrame make_sdo_download_ack(std::uint8_t node, std::uint16_t index, std::uint8_t sub) noexcept;
 CanFrame make_sdo_upload_reply(std::uint8_t node, std::uint16_t index, std::uint8_t sub, std::uint32_t value,
-                               std::uint8_t size);
+                               std::uint8_t size) noexcept;
 
 }  // namespace loom::drivers

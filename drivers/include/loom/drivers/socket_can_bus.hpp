@@ -22,18 +22,18 @@ class SocketCanBus final : public CanBus {
   SocketCanBus(const SocketCanBus&) = delete;
   SocketCanBus& operator=(const SocketCanBus&) = delete;
 
-  SendResult send(const CanFrame& frame) override;  // RT-safe (one non-blocking send syscall)
-  bool receive(CanFrame& frame) override;           // RT-safe (bounded non-blocking recv syscalls)
+  SendResult send(const CanFrame& frame) noexcept override;  // RT-safe (one non-blocking send syscall)
+  bool receive(CanFrame& frame) noexcept override;           // RT-safe (bounded non-blocking recv syscalls)
 
   // Configure-time only (used by poll() loops in non-RT tools such as the simulated drive node).
   int fd() const { return fd_; }
   const std::string& iface() const { return iface_; }
 
   // Cumulative counters; RT-safe to read.
-  std::uint32_t tx_would_block() const { return tx_would_block_; }  // ENOBUFS / EAGAIN
-  std::uint32_t tx_errors() const { return tx_errors_; }            // any other send failure
-  std::uint32_t rx_errors() const { return rx_errors_; }            // failed or truncated reads
-  std::uint32_t rx_skipped() const { return rx_skipped_; }          // 29-bit frames (not CANopen)
+  std::uint32_t tx_would_block() const noexcept { return tx_would_block_; }  // ENOBUFS / EAGAIN
+  std::uint32_t tx_errors() const noexcept { return tx_errors_; }            // any other send failure
+  std::uint32_t rx_errors() const noexcept { return rx_errors_; }            // failed or truncated reads
+  std::uint32_t rx_skipped() const { return rx_skipped_; }                   // 29-bit frames (not CANopen)
 
  private:
   SocketCanBus(int fd, std::string iface) : fd_(fd), iface_(std::move(iface)) {}

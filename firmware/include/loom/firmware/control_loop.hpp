@@ -76,7 +76,7 @@ class ControlLoop {
   void push_fault(telemetry::Event::FaultKind kind, sequencer::Fault which, int axis,
                   std::uint16_t device_code, int sensor, hal::Tick now) noexcept;
   void push_device_faults(int first_axis_reported, bool link_reported, hal::Tick now) noexcept;
-  bool any_device_fault() const noexcept;
+  bool any_device_event() const noexcept;
   void push_event(const telemetry::Event& e) noexcept;
   void fill_event_context(telemetry::Event& e, hal::Tick now) const noexcept;
   std::uint32_t row_in_progress() const noexcept;
@@ -100,11 +100,6 @@ class ControlLoop {
   LoopStats stats_{};
   TelemetryContext ctx_{};
   bool knots_shown_ = false;  // snap_.knots was filled at least once
-  // The drives' and the link's last fault flags (HAL inputs), so each device report is pushed once.
-  bool devices_reporting_ = false;  // some prev_axis_fault_ or prev_link_fault_ is set
-  std::array<std::uint16_t, hal::kMaxAxes> prev_axis_fault_code_{};
-  std::array<bool, hal::kMaxAxes> prev_axis_fault_{};
-  bool prev_link_fault_ = false;
 };
 
 }  // namespace loom::firmware

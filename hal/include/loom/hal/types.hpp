@@ -117,7 +117,11 @@ struct AxisFeedback {
   // The axis' position is referenced to the machine: always for an absolute axis; for a homed axis only
   // after a homing run since its drive powered up (kHome). An unreferenced axis never moves in production.
   bool referenced = true;
-  bool homing_error = false;    // the last homing run failed (the drive's homing error, or its time-out)
+  bool homing_error = false;  // the last homing run failed (the drive's homing error, or its time-out)
+  // Event of this read: the fault report begins, or its code changes (fault_events.hpp). The loop reports
+  // it once; the port sets it on exactly one read. (Beside the other flags: in their padding, so the
+  // struct every tick copies does not grow.)
+  bool fault_raised = false;
   Tick refreshed = kNeverTick;  // tick this feedback was last received
 };
 
@@ -233,6 +237,7 @@ struct LinkStatus {
   std::uint16_t link_fault_code = 0;  // raw code for display
   LinkRecovery recovery = LinkRecovery::kHealthy;
   std::uint8_t silent_node = 0;  // kNodeSilent: the first node still missing
+  bool fault_raised = false;     // event of this read: link_fault begins (fault_events.hpp)
   std::uint32_t tx_dropped = 0;  // frames not sent (ENOBUFS/EAGAIN), cumulative
   std::uint32_t rx_errors = 0;   // error frames / malformed frames, cumulative
 };

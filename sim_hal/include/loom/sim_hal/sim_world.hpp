@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "loom/hal/fault_events.hpp"
 #include "loom/hal/hal.hpp"
 #include "loom/motion/beatup.hpp"
 #include "loom/sim_hal/knotter.hpp"
@@ -50,11 +51,13 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   SimWorld(const SimMachine& machine, const SceneSpec& scene);
   ~SimWorld() override;
 
-  void read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) override;       // RT-safe
-  void write_axes(hal::Tick now, const hal::AxisCommands& axes) override;                        // RT-safe
-  void read_io(hal::Tick now, const hal::AxisFeedbacks& axes, hal::DigitalInputs& io) override;  // RT-safe
-  void write_io(hal::Tick now, const hal::DigitalOutputs& io) override;                          // RT-safe
-  void read_analog(hal::Tick now, hal::AnalogInputs& analog) override;                           // RT-safe
+  void read_axes(hal::Tick now, hal::AxisFeedbacks& axes,
+                 hal::LinkStatus& link) noexcept override;                          // RT-safe
+  void write_axes(hal::Tick now, const hal::AxisCommands& axes) noexcept override;  // RT-safe
+  void read_io(hal::Tick now, const hal::AxisFeedbacks& axes,
+               hal::DigitalInputs& io) noexcept override;                         // RT-safe
+  void write_io(hal::Tick now, const hal::DigitalOutputs& io) noexcept override;  // RT-safe
+  void read_analog(hal::Tick now, hal::AnalogInputs& analog) noexcept override;   // RT-safe
 
   // Start the machine where a previous run left it (restart after a power loss): axis positions in SI
   // and the heald frames' positions (0 retracted … 1 extended). Configure-time only.
@@ -106,6 +109,11 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
 
  private:
   void apply_injected_faults(hal::Tick now) noexcept;
+  // read_axes once a fault has struck (or with CAN latency): through the history, losses and silences.
+  void read_struck(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) noexcept;
+  // The device-fault events of what read_axes hands out (fault_events.hpp): a drive's fault report begins
+  // or changes its code, the link's begins. A value the read left untouched is the same report.
+  void raise_fault_events(hal::AxisFeedbacks& axes, hal::LinkStatus& link) noexcept;
   bool stalled(hal::Tick now) const noexcept { return now < stall_until_; }
   void step_axis(std::size_t slot, const hal::AxisCommand& cmd) noexcept;
   void step_homing(std::size_t slot) noexcept;
@@ -143,6 +151,8 @@ class SimWorld final : public hal::AxisPort, public hal::IoPort {
   std::vector<hal::AxisFeedback> history_;
   bool bus_off_ = false;
   std::array<hal::Tick, hal::kMaxAxes> silent_since_{};  // heartbeat loss (-1: heard; set in the constructor)
+  std::array<hal::AxisFaultEdge, hal::kMaxAxes> fault_edges_{};  // the drives' last fault reports
+  hal::LinkFaultEdge link_edge_;                                 // and the link's
   std::array<int, hal::kMaxAxes> glitch_left_{};
   std::array<double, hal::kMaxAxes> glitch_jump_{};
   std::optional<LoadCellMode> load_cell_failed_;
