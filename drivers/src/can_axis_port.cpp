@@ -76,12 +76,21 @@ Status CanAxisPort::configure(CanBus& bus, ConfigureClock& clock) {
 Status CanAxisPort::configure(std::span<CanBus* const> buses, ConfigureClock& clock) {
   d_.network.unconfigure();
   d_.notes.clear();
+  if (Status s = check(buses.size()); !s) return s;
+  if (Status s = d_.network.configure(buses, clock); !s) return s;  // every bus, in order
+  for (std::size_t i = 0; i < d_.n_axes; ++i) {
+    d_.notes.insert(d_.notes.end(), d_.axes[i].notes().begin(), d_.axes[i].notes().end());
+  }
+  return Status::ok();
+}
+
+Status CanAxisPort::check(std::size_t interfaces) {
   const std::size_t n_buses = d_.network.bus_count();
   if (Status s = validate(d_.config); !s) return Status::error("CAN axis configuration: " + s.message());
-  if (buses.size() != n_buses) {
+  if (interfaces != n_buses) {
     return Status::error("the axes use " + std::to_string(n_buses) +
                          " CAN bus(es) (highest axes.<name>.bus = " + std::to_string(n_buses - 1) + ") but " +
-                         std::to_string(buses.size()) + " interface(s) were given");
+                         std::to_string(interfaces) + " interface(s) were given");
   }
   for (std::size_t b = 0; b < n_buses; ++b) {
     d_.bus_loads[b] = planned_bus_load(d_.config, b);
@@ -103,11 +112,6 @@ Status CanAxisPort::configure(std::span<CanBus* const> buses, ConfigureClock& cl
   if (expected != 0) return Status::error("an attached node shares its node id with another node on its bus");
   d_.consumer_ticks = ceil_ticks(d_.config.heartbeat_consumer_s, d_.config.cycle_period_s);
   d_.state_timeout_ticks = ceil_ticks(d_.config.state_timeout_s, d_.config.cycle_period_s);
-
-  if (Status s = d_.network.configure(buses, clock); !s) return s;  // every bus, in order
-  for (std::size_t i = 0; i < d_.n_axes; ++i) {
-    d_.notes.insert(d_.notes.end(), d_.axes[i].notes().begin(), d_.axes[i].notes().end());
-  }
   return Status::ok();
 }
 

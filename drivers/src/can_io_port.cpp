@@ -311,14 +311,14 @@ NodeTiming CanIoPort::timing() const {
   return NodeTiming{config_.boot_timeout_s, config_.operational_timeout_s, config_.heartbeat_consumer_s};
 }
 
-Status CanIoPort::configure(CanBus& bus, ConfigureClock& clock) {
-  if (Status s = validate(config_); !s) return Status::error("CAN I/O configuration: " + s.message());
-  // The module alone on its bus: a master of its own (no SYNC or heartbeat of its own until a port uses
-  // the bus), the same one NMT sequence every bus is brought up with.
-  CanMaster master(CanMasterConfig{config_.cycle_period_s, config_.sdo_timeout_s, config_.boot_timeout_s,
-                                   config_.operational_timeout_s, 0, 0.0});
-  master.add(*this);
-  return master.bring_up(bus, clock);
+CanMasterConfig CanIoPort::master_config() const {
+  // The module's cycle and timeouts; no master heartbeat (node 0, period 0): nothing but the module.
+  return CanMasterConfig{config_.cycle_period_s,
+                         config_.sdo_timeout_s,
+                         config_.boot_timeout_s,
+                         config_.operational_timeout_s,
+                         0,
+                         0.0};
 }
 
 void CanIoPort::bring_up_started() {

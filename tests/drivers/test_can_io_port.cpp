@@ -9,6 +9,7 @@
 
 #include "drive_rig.hpp"
 #include "loom/drivers/can_io_port.hpp"
+#include "loom/drivers/can_network.hpp"
 #include "loom/drivers/cia402.hpp"
 #include "loom/drivers/emcy.hpp"
 #include "loom/drivers/nmt.hpp"
@@ -29,6 +30,13 @@ bool contains(const std::string& s, const std::string& part) {
 }
 bool any_note(const std::vector<std::string>& notes, const std::string& part) {
   return std::any_of(notes.begin(), notes.end(), [&](const std::string& n) { return contains(n, part); });
+}
+
+// The module brought up on a network of its own (a re-arm, or a node that must be refused).
+drivers::Status bring_up_alone(CanIoPort& port, drivers::CanBus& bus, drivers::ConfigureClock& clock) {
+  drivers::CanNetwork alone(port.master_config(), 1);
+  if (!alone.add(port)) return drivers::Status::error("the module could not be registered");
+  return alone.configure(bus, clock);
 }
 
 // The DLC of the last frame on the wire with `id` (the I/O node's TPDO1 is 0x184), −1 none.
@@ -432,7 +440,7 @@ TEST(CanIoPort, ActiveLowInputsReadFalseBeforeTheFirstTpdo) {
   EXPECT_TRUE(r.in.io.button_start);
   EXPECT_FALSE(r.in.io.estop_ok);
   // Re-armed: nothing seen again until the next TPDO.
-  ASSERT_TRUE(r.port.configure(r.rig.master, r.rig.clock));
+  ASSERT_TRUE(bring_up_alone(r.port, r.rig.master, r.rig.clock));
   expect_nothing_seen();
 }
 
@@ -519,7 +527,7 @@ TEST(CanIoPort, RefusesAModuleThatIsNotCiA401) {
   CanIoConfig pc;
   pc.node_id = 1;  // a servo drive: device type 0x00020192
   CanIoPort wrong(pc);
-  s = wrong.configure(r.rig.master, r.rig.clock);
+  s = bring_up_alone(wrong, r.rig.master, r.rig.clock);
   ASSERT_FALSE(s);
   EXPECT_TRUE(contains(s.message(), "node 1 (I/O node): 0x1000 device type = 0x00020192")) << s.message();
 }

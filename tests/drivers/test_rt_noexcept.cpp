@@ -201,7 +201,7 @@ TEST(RtNoexcept, TheProbeTellsConfigureTimeCallsApart) {
   // Configure-time: may allocate (messages, notes), so not noexcept; were the probe always true, the
   // static_asserts above would prove nothing.
   EXPECT_FALSE(noexcept(obj<CanAxisPort>().configure(obj<CanBus>())));
-  EXPECT_FALSE(noexcept(obj<CanIoPort>().configure(obj<CanBus>(), obj<ConfigureClock>())));
+  EXPECT_FALSE(noexcept(obj<CanNetwork>().configure(obj<CanBus>(), obj<ConfigureClock>())));
   EXPECT_FALSE(noexcept(obj<CanMaster>().bring_up(obj<CanBus>(), obj<ConfigureClock>())));
   EXPECT_TRUE(noexcept(obj<CanAxisPort>().read_axes(now(), fbs(), link())));
 }

@@ -35,7 +35,7 @@
 //     the last TPDO2 of at least 2 bytes; no load cell fitted = never valid;
 //   - the link fault follows the heartbeat rules (boot-up = 0xFF02, stopped/pre-operational = 0xFF03,
 //     silence > 125 ticks = 0x8130) and, once latched, keeps its code: acknowledge() does not clear it
-//     (only re-arming, configure(), does), while it does clear the last EMCY code;
+//     (only re-arming, the bring-up, does), while it does clear the last EMCY code;
 //   - heard_again; rx_errors; tx_dropped; the RPDO written is the requested outputs by hand — the safe
 //     outputs (valves off, red lamp on) while a link fault is latched.
 #include <fuzzer/FuzzedDataProvider.h>
@@ -51,6 +51,7 @@
 #include "fake_can_network.hpp"
 #include "fuzzed_frame.hpp"
 #include "loom/drivers/can_io_port.hpp"
+#include "loom/drivers/can_network.hpp"
 #include "loom/drivers/emcy.hpp"
 #include "loom/sim_can/sim_io_node.hpp"
 
@@ -178,7 +179,7 @@ struct Template {
   drivers::IoWiring model_wiring;  // what the model reads the port through (written out by hand)
   std::int64_t now_us = 0;
 
-  // Virtual time for configure(): every idle() lets 100 µs pass on the network and the module.
+  // Virtual time for the bring-up: every idle() lets 100 µs pass on the network and the module.
   class Clock final : public drivers::ConfigureClock {
    public:
     explicit Clock(Template& t) : t_(t) {}
@@ -210,7 +211,12 @@ struct Template {
     module.power_on(now_us);
     bus.relay = &master;
     Clock clock(*this);
-    const drivers::Status s = port.configure(bus, clock);
+    // Brought up as every module is, by a network (here of the module alone); afterwards the harness hands
+    // the port its frames itself.
+    drivers::CanNetwork network(port.master_config(), 1);
+    const bool added = network.add(port);
+    const drivers::Status s =
+        added ? network.configure(bus, clock) : drivers::Status::error("not registered");
     if (!s.is_ok()) {
       std::fprintf(stderr, "bring-up against the simulated I/O node failed: %s\n", s.message().c_str());
       std::abort();
@@ -274,12 +280,12 @@ struct Model {
           counts = static_cast<std::int16_t>(static_cast<std::uint16_t>(f.data[0] | (f.data[1] << 8)));
           analog_refreshed = now;
         } else {
-          ++rx_errors;  // short, RTR, or a TPDO configure() disabled
+          ++rx_errors;  // short, RTR, or a TPDO the bring-up disabled
         }
         return;
       case kTpdo3Id:
       case kTpdo4Id:
-        ++rx_errors;  // disabled by configure()
+        ++rx_errors;  // disabled by the bring-up
         return;
       case kEmcyId:
         if (data && f.dlc == 8) {

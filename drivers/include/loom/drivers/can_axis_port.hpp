@@ -87,6 +87,11 @@ class CanAxisPort final : public hal::AxisPort {
   std::uint32_t heartbeat_consumer_ticks() const noexcept { return d_.consumer_ticks; }
 
  private:
+  // Configure-time. The port's own checks, before any frame is sent: the configuration, `interfaces` ==
+  // the buses the axes use, each bus' load, the attached nodes' buses and ids (the network's node tables
+  // rebuilt); then the heartbeat-consumer and state timeouts in ticks. configure() makes them, then has
+  // the network bring every bus up.
+  Status check(std::size_t interfaces);
   void relink();  // the network's node tables from the axes and the attached nodes
   bool any_fault() const noexcept;
 

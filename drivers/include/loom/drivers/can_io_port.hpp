@@ -39,14 +39,14 @@ class CanIoPort final : public hal::IoPort, public CanNode {
   // Configure-time only.
   explicit CanIoPort(CanIoConfig config);
 
-  // Configure-time only; blocks with timeouts. The module alone on a master of its own, for a bring-up
-  // check only (nothing polls that master afterwards): NMT reset-node → boot-up → configure_profile() →
-  // NMT start → operational heartbeat. Errors name node, object and step. To use the module, register it
-  // on a CanNetwork (can_network.hpp; no axis port needed) or attach it to the CanAxisPort of its bus,
-  // whose network brings it up with the drives; the network then polls it every tick.
-  Status configure(CanBus& bus, ConfigureClock& clock);
+  // Configure-time only. The master settings of a network of this module alone (its cycle and timeouts,
+  // no master heartbeat): a module is brought up only by a CanNetwork (can_network.hpp) it is registered
+  // on — alone, or on its bus beside the drives (CanAxisPort::attach) — in that bus' one NMT sequence:
+  // reset-node → boot-up → configure_profile() → NMT start → operational heartbeat. The network then polls
+  // it every tick.
+  CanMasterConfig master_config() const;
 
-  // What configure() found optional and absent, or accepted instead of what it asked for (one line each).
+  // What the bring-up found optional and absent, or accepted instead of what it asked for (one line each).
   const std::vector<std::string>& notes() const { return notes_; }
 
   // hal::IoPort (RT-safe).
@@ -78,7 +78,7 @@ class CanIoPort final : public hal::IoPort, public CanNode {
   std::uint32_t tx_dropped() const noexcept { return tx_dropped_; }
 
  private:
-  // Where one object sits in the PDOs the module actually uses (after configure()).
+  // Where one object sits in the PDOs the module actually uses (after the bring-up).
   struct Slot {
     int pdo = -1;  // 0..3, −1 = not mapped
     std::uint8_t offset = 0;
