@@ -54,15 +54,7 @@ struct IoAloneRig {
     advance(kPeriodUs);
   }
 
-  class VirtualClock final : public drivers::ConfigureClock {
-   public:
-    explicit VirtualClock(IoAloneRig& rig) : rig_(rig) {}
-    std::int64_t now_us() override { return rig_.now_us; }
-    void idle() override { rig_.advance(100); }
-
-   private:
-    IoAloneRig& rig_;
-  };
+  using VirtualClock = RigClock<IoAloneRig>;
 
   FakeCanNetwork net;
   FakeCanNetwork::Endpoint& master;

@@ -180,15 +180,7 @@ struct Template {
   std::int64_t now_us = 0;
 
   // Virtual time for the bring-up: every idle() lets 100 µs pass on the network and the module.
-  class Clock final : public drivers::ConfigureClock {
-   public:
-    explicit Clock(Template& t) : t_(t) {}
-    std::int64_t now_us() override { return t_.now_us; }
-    void idle() override { t_.advance(100); }
-
-   private:
-    Template& t_;
-  };
+  using Clock = loom::test::RigClock<Template>;
 
   void advance(std::int64_t dt_us) {
     const std::int64_t end = now_us + dt_us;

@@ -100,15 +100,7 @@ class DriveRig {
     return out;
   }
 
-  class VirtualClock final : public drivers::ConfigureClock {
-   public:
-    explicit VirtualClock(DriveRig& rig) : rig_(rig) {}
-    std::int64_t now_us() override { return rig_.now_us; }
-    void idle() override { rig_.advance(100); }
-
-   private:
-    DriveRig& rig_;
-  };
+  using VirtualClock = RigClock<DriveRig>;
 
   FakeCanNetwork net;
   FakeCanNetwork::Endpoint& master;  // endpoint 0

@@ -10,8 +10,22 @@
 #include <vector>
 
 #include "loom/drivers/can_frame.hpp"
+#include "loom/drivers/configure_clock.hpp"
 
 namespace loom::test {
+
+// Virtual time for a bring-up on a fake network: every idle() lets 100 µs pass on the rig (its network and
+// the simulated nodes behind it). `Rig` has `std::int64_t now_us` and `advance(std::int64_t dt_us)`.
+template <typename Rig>
+class RigClock final : public drivers::ConfigureClock {
+ public:
+  explicit RigClock(Rig& rig) : rig_(rig) {}
+  std::int64_t now_us() override { return rig_.now_us; }
+  void idle() override { rig_.advance(100); }
+
+ private:
+  Rig& rig_;
+};
 
 class FakeCanNetwork {
  public:
