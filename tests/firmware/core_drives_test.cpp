@@ -91,7 +91,8 @@ TEST(CoreDrives, TheShippedLoomNamesADriveForEachCoreAxisAndFitsIt) {
 TEST(CoreDrives, TheCranksLinkageLoadIsTheReducedModelsTorqueAtItsTopSpeed) {
   const LoomConfig c = default_loom_config();
   const loom::motion::ProfileSet set(c.profile);
-  const CoreDriveFit* crank = fit_of(core_drive_fits(c, set), "beat_crank");
+  const std::vector<CoreDriveFit> fits = core_drive_fits(c, set);
+  const CoreDriveFit* crank = fit_of(fits, "beat_crank");
   ASSERT_TRUE(crank);
   const auto& m = c.machine_spec;
   const loom::motion::BeatUpDynamics dyn(m.beatup, loom::motion::beatup_masses(m.beatup, m.beater_mass_kg));
