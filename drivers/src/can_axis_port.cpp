@@ -29,64 +29,58 @@ std::uint32_t ceil_ticks(double seconds, double period_s) {
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------------
-// The port: one CiA 402 profile per axis on the port's network (one master per bus)
+// The port: one CiA 402 profile per axis, registered on the network (one master per bus)
 // ---------------------------------------------------------------------------------------------------
-CanAxisPort::CanAxisPort(CanAxisPortConfig config) {
+CanMasterConfig can_master_config(const CanAxisPortConfig& config) {
+  return CanMasterConfig{config.cycle_period_s,        config.sdo_timeout_s,  config.boot_timeout_s,
+                         config.operational_timeout_s, config.master_node_id, config.master_heartbeat_s};
+}
+
+CanAxisPort::CanAxisPort(CanNetwork& network, CanAxisPortConfig config) : network_(&network) {
   d_.config = std::move(config);
   d_.n_axes = std::min(d_.config.axes.size(), hal::kMaxAxes);
-  const CanMasterConfig mc{d_.config.cycle_period_s, d_.config.sdo_timeout_s,
-                           d_.config.boot_timeout_s, d_.config.operational_timeout_s,
-                           d_.config.master_node_id, d_.config.master_heartbeat_s};
-  d_.network = CanNetwork(mc, drivers::bus_count(d_.config));
   for (std::size_t i = 0; i < d_.n_axes; ++i) d_.axes[i].setup(d_.config.axes[i], d_.config);
-  relink();
+  register_axes();
 }
 
-CanAxisPort::CanAxisPort(const CanAxisPort& other) : hal::AxisPort(other), d_(other.d_) {
-  relink();
+CanAxisPort::CanAxisPort(const CanAxisPort& configured, CanNetwork& network)
+    : hal::AxisPort(configured), network_(&network), d_(configured.d_) {
+  register_axes();
 }
 
-CanAxisPort& CanAxisPort::operator=(const CanAxisPort& other) {
-  d_ = other.d_;
-  relink();
-  return *this;
-}
-
-void CanAxisPort::relink() {
-  d_.network.clear_nodes();
-  for (std::size_t i = 0; i < d_.n_axes; ++i) d_.network.add(d_.axes[i], d_.axes[i].bus());
-  for (std::size_t k = 0; k < d_.n_attached; ++k) d_.network.add(*d_.attached[k].node, d_.attached[k].bus);
-}
-
-void CanAxisPort::attach(CanNode& node, std::size_t bus) {
-  if (d_.n_attached < d_.attached.size()) d_.attached[d_.n_attached++] = {&node, bus};
-  relink();
-}
-
-Status CanAxisPort::configure(CanBus& bus) {
-  MonotonicConfigureClock clock;
-  return configure(bus, clock);
-}
-
-Status CanAxisPort::configure(CanBus& bus, ConfigureClock& clock) {
-  CanBus* const one[] = {&bus};
-  return configure(std::span<CanBus* const>(one), clock);
-}
-
-Status CanAxisPort::configure(std::span<CanBus* const> buses, ConfigureClock& clock) {
-  d_.network.unconfigure();
-  d_.notes.clear();
-  if (Status s = check(buses.size()); !s) return s;
-  if (Status s = d_.network.configure(buses, clock); !s) return s;  // every bus, in order
+void CanAxisPort::register_axes() {
+  d_.n_registered = 0;
   for (std::size_t i = 0; i < d_.n_axes; ++i) {
-    d_.notes.insert(d_.notes.end(), d_.axes[i].notes().begin(), d_.axes[i].notes().end());
+    if (network_->add(d_.axes[i], d_.axes[i].bus())) ++d_.n_registered;
   }
-  return Status::ok();
+}
+
+Status bring_up(CanNetwork& network, CanAxisPort& axes, std::span<CanBus* const> buses,
+                ConfigureClock& clock) {
+  if (Status s = axes.check(buses.size()); !s) return s;
+  return network.configure(buses, clock);  // every bus, in order
+}
+
+Status bring_up(CanNetwork& network, CanAxisPort& axes, CanBus& bus, ConfigureClock& clock) {
+  CanBus* const one[] = {&bus};
+  return bring_up(network, axes, std::span<CanBus* const>(one), clock);
+}
+
+std::vector<std::string> CanAxisPort::notes() const {
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < d_.n_axes; ++i)
+    out.insert(out.end(), d_.axes[i].notes().begin(), d_.axes[i].notes().end());
+  return out;
 }
 
 Status CanAxisPort::check(std::size_t interfaces) {
-  const std::size_t n_buses = d_.network.bus_count();
+  network_->unconfigure();
+  const std::size_t n_buses = drivers::bus_count(d_.config);
   if (Status s = validate(d_.config); !s) return Status::error("CAN axis configuration: " + s.message());
+  if (network_->bus_count() != n_buses) {
+    return Status::error("the axes use " + std::to_string(n_buses) + " CAN bus(es) but their network has " +
+                         std::to_string(network_->bus_count()));
+  }
   if (interfaces != n_buses) {
     return Status::error("the axes use " + std::to_string(n_buses) +
                          " CAN bus(es) (highest axes.<name>.bus = " + std::to_string(n_buses - 1) + ") but " +
@@ -98,18 +92,11 @@ Status CanAxisPort::check(std::size_t interfaces) {
       return n_buses == 1 ? s : Status::error("bus " + std::to_string(b) + ": " + s.message());
     }
   }
-  for (std::size_t k = 0; k < d_.n_attached; ++k) {
-    if (d_.attached[k].bus >= n_buses) {
-      return Status::error(d_.attached[k].node->label() + " is attached to bus " +
-                           std::to_string(d_.attached[k].bus) + " but the port has " +
-                           std::to_string(n_buses) +
-                           " bus(es): its frames are not in other_frames_per_cycle");
-    }
+  if (d_.n_registered != d_.n_axes) {
+    return Status::error(
+        "an axis shares its node id with another node on its bus, or its bus is not one of "
+        "the network's");
   }
-  relink();
-  std::size_t expected = d_.n_axes + d_.n_attached;
-  expected -= d_.network.node_count();
-  if (expected != 0) return Status::error("an attached node shares its node id with another node on its bus");
   d_.consumer_ticks = ceil_ticks(d_.config.heartbeat_consumer_s, d_.config.cycle_period_s);
   d_.state_timeout_ticks = ceil_ticks(d_.config.state_timeout_s, d_.config.cycle_period_s);
   return Status::ok();
@@ -119,18 +106,17 @@ Status CanAxisPort::check(std::size_t interfaces) {
 // Per tick (RT-safe)
 // ---------------------------------------------------------------------------------------------------
 void CanAxisPort::read_axes(hal::Tick now, hal::AxisFeedbacks& axes, hal::LinkStatus& link) noexcept {
-  d_.network.poll(now);
-  d_.network.read_link(now, link);
-  const bool configured = d_.network.configured();
+  network_->read_link(now, link);
+  const bool configured = network_->configured();
   for (std::size_t i = 0; i < d_.n_axes; ++i) {
-    const CanMaster& m = d_.network.master(d_.axes[i].bus());
+    const CanMaster& m = network_->master(d_.axes[i].bus());
     d_.axes[i].fill_feedback(now, axes[i], m.bus_off(), configured && m.configured());
     link.rx_errors += d_.axes[i].rx_errors();
   }
 }
 
 bool CanAxisPort::any_fault() const noexcept {
-  if (d_.network.any_fault()) return true;
+  if (network_->any_fault()) return true;
   for (std::size_t i = 0; i < d_.n_axes; ++i) {
     if (d_.axes[i].faulted()) return true;
   }
@@ -138,17 +124,16 @@ bool CanAxisPort::any_fault() const noexcept {
 }
 
 void CanAxisPort::write_axes(hal::Tick now, const hal::AxisCommands& commands) noexcept {
-  if (!d_.network.configured()) return;
+  if (!network_->configured()) return;
   bool reset = false;
   for (std::size_t i = 0; i < d_.n_axes; ++i)
     reset = reset || commands[i].request == AxisRequest::kFaultReset;
-  if (reset) d_.network.acknowledge();
+  if (reset) network_->acknowledge();
   // Any fault anywhere (EMCY from any node, a lost node, following error, a bus-off on any bus) stops
   // every axis in this very tick, whatever the sequencer asked and whatever the drives' statuswords say.
   const bool stop_all = any_fault();
-  d_.network.start_cycle(now);
   for (std::size_t i = 0; i < d_.n_axes; ++i) {
-    CanMaster& m = d_.network.master(d_.axes[i].bus());
+    CanMaster& m = network_->master(d_.axes[i].bus());
     CanFrame rpdo1{};
     // (A profile-position axis' RPDO1 goes out only when it changed.)
     if (d_.axes[i].command(now, commands[i], stop_all, m.bus_off(), d_.state_timeout_ticks, rpdo1))

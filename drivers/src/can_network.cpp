@@ -96,6 +96,7 @@ void CanNetwork::read_link(hal::Tick now, hal::LinkStatus& link) noexcept {
 }
 
 void CanNetwork::start_cycle(hal::Tick now) noexcept {
+  if (!configured_) return;
   for (std::size_t b = 0; b < n_buses_; ++b) masters_[b].start_cycle(now);
 }
 

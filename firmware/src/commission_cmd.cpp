@@ -17,8 +17,8 @@
 #include "loom/config/config.hpp"
 #include "loom/config/toml_edit.hpp"
 #include "loom/config/toml_reader.hpp"
-#include "loom/firmware/durable_file.hpp"
 #include "loom/firmware/session.hpp"
+#include "loom/state/durable_file.hpp"
 
 namespace loom::firmware {
 namespace {
@@ -171,7 +171,7 @@ class Commissioning {
       next = set_toml_values(text_, captured_, changes);
       parse_loom_config(next,
                         a_.config);  // the file must still be a valid loom before it replaces the old one
-      write_file_durably(a_.config, next);
+      state::write_file_durably(a_.config, next);
     } catch (const std::exception& e) {  // an invalid result (ConfigError) or a failed write
       std::fprintf(stderr, "loomctl commission: %s: not written: %s\n", a_.config.c_str(), e.what());
       return kExitBadInput;

@@ -12,8 +12,8 @@
 
 #include "loom/config/config.hpp"
 #include "loom/config/eds_nodes.hpp"
-#include "loom/firmware/durable_file.hpp"
 #include "loom/firmware/session.hpp"
+#include "loom/state/durable_file.hpp"
 
 namespace loom::firmware {
 
@@ -68,7 +68,7 @@ int run_dcf(const DcfArgs& a) {
       return kExitBadInput;
     }
     for (std::size_t i = 0; i < files.size(); ++i) {
-      write_file_durably(files[i].first, files[i].second);
+      state::write_file_durably(files[i].first, files[i].second);
       std::printf("%s: %s (node %u on bus %u), %zu configured values\n", files[i].first.c_str(),
                   nodes[i].key.c_str(), nodes[i].node_id, nodes[i].bus, nodes[i].writes.size());
     }
@@ -76,7 +76,7 @@ int run_dcf(const DcfArgs& a) {
   } catch (const ConfigError& e) {
     std::fprintf(stderr, "loomctl: %s\n", e.what());
     return kExitBadInput;
-  } catch (const DurableWriteError& e) {
+  } catch (const state::DurableWriteError& e) {
     std::fprintf(stderr, "loomctl: dcf: %s\n", e.what());
     return kExitBadInput;
   }

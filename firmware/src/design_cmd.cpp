@@ -13,8 +13,8 @@
 #include "loom/config/config.hpp"
 #include "loom/design/design.hpp"
 #include "loom/design/picture.hpp"
-#include "loom/firmware/durable_file.hpp"
 #include "loom/firmware/session.hpp"
+#include "loom/state/durable_file.hpp"
 
 namespace loom::firmware {
 namespace {
@@ -117,16 +117,16 @@ Yarns loom_yarns(const LoomConfig& c, bool from_magazines) {
 }
 
 std::string read_picture_file(const std::string& path) {
-  const StateFileRead r = read_state_file(path, kMaxPictureBytes);
+  const state::StateFileRead r = state::read_state_file(path, kMaxPictureBytes);
   switch (r.outcome) {
-    case StateFileRead::Outcome::kRead:
+    case state::StateFileRead::Outcome::kRead:
       return r.text;
-    case StateFileRead::Outcome::kAbsent:
+    case state::StateFileRead::Outcome::kAbsent:
       throw Refusal(path + ": no such file");
-    case StateFileRead::Outcome::kCannotOpen:
-    case StateFileRead::Outcome::kCannotRead:
+    case state::StateFileRead::Outcome::kCannotOpen:
+    case state::StateFileRead::Outcome::kCannotRead:
       throw Refusal(path + ": cannot read: " + r.error);
-    case StateFileRead::Outcome::kNotRegular:
+    case state::StateFileRead::Outcome::kNotRegular:
       break;
   }
   throw Refusal(path + ": not a regular file of at most " + std::to_string(kMaxPictureBytes >> 20) + " MiB");
@@ -146,8 +146,8 @@ void write_both(const std::string& csv_path, const std::string& csv, const std::
   const std::string csv_new = csv_path + ".fit-new", png_new = png_path + ".fit-new";
   std::error_code ignored;
   try {
-    write_file_durably(csv_new, csv);
-    write_file_durably(png_new, png);
+    state::write_file_durably(csv_new, csv);
+    state::write_file_durably(png_new, png);
     std::filesystem::rename(csv_new, csv_path);
     std::filesystem::rename(png_new, png_path);
   } catch (const std::exception& e) {

@@ -159,30 +159,37 @@ void Machine::build_can_hal(const MachineOptions& opt) {
     buses_.push_back(std::move(bus.value()));
     bus_ptrs.push_back(buses_.back().get());
   }
-  can_port_ = std::make_unique<drivers::CanAxisPort>(cc);
+  // The network of the buses; the axis port and each I/O module registered on it, brought up together
+  // (each bus in its one NMT sequence) once the axis port's own checks pass.
+  network_ = std::make_unique<drivers::CanNetwork>(drivers::can_master_config(cc), buses);
+  can_port_ = std::make_unique<drivers::CanAxisPort>(*network_, cc);
   if (io_kind == IoKind::kCan) {
     io_port_ = std::make_unique<drivers::CanIoModules>();
     for (std::size_t k = 0; k < io_configs.size(); ++k) {
       io_modules_.push_back(std::make_unique<drivers::CanIoPort>(io_configs[k]));
-      can_port_->attach(*io_modules_.back(), io_buses[k]);
+      if (!network_->add(*io_modules_.back(), io_buses[k])) {
+        throw ConfigError(cfg_.source + ": " + io_modules_.back()->label() + " cannot join CAN bus " +
+                          std::to_string(io_buses[k]) +
+                          ": its node id is taken there or the bus table is full");
+      }
       io_port_->add(*io_modules_.back());
     }
   }
   drivers::MonotonicConfigureClock clock;
-  if (const drivers::Status st = can_port_->configure(bus_ptrs, clock); !st)
+  if (const drivers::Status st = drivers::bring_up(*network_, *can_port_, bus_ptrs, clock); !st)
     throw std::runtime_error(st.message());
   for (std::size_t b = 0; b < buses; ++b) {
     notes_.push_back("CAN bus load (" + ifaces[b] +
                      "): " + drivers::describe_bus_load(can_port_->bus_load(b)));
   }
-  notes_.insert(notes_.end(), can_port_->notes().begin(), can_port_->notes().end());
+  for (const std::string& note : can_port_->notes()) notes_.push_back(note);
   if (io_port_) {  // each module brought up by its bus' master in the same NMT sequence as the drives
     for (const auto& m : io_modules_) notes_.insert(notes_.end(), m->notes().begin(), m->notes().end());
-    hal_ = std::make_unique<hal::PortHal>(*can_port_, *io_port_);
+    hal_ = std::make_unique<drivers::CanHal>(*network_, *can_port_, *io_port_);
   } else {
     // Asked for explicitly: the simulated I/O node follows the real helix shaft for its shuttle sensors.
     banner_ = kSimulatedIoBanner;
-    hal_ = std::make_unique<hal::PortHal>(*can_port_, *sim_);
+    hal_ = std::make_unique<drivers::CanHal>(*network_, *can_port_, *sim_);
   }
 }
 

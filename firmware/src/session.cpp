@@ -81,11 +81,11 @@ ProductionRecord::ProductionRecord(std::string counters_path, const LoomConfig& 
       design_name_(cfg.recipe.design ? cfg.recipe.design->name() : std::string()),
       row_saves_(std::make_unique<RowSaves>()) {
   if (path_.empty()) return;
-  store_ = std::make_unique<CounterStore>(path_);
+  store_ = std::make_unique<state::CounterStore>(path_);
   if (!design_name_.empty()) {
     const auto dir = std::filesystem::path(path_).parent_path();
-    book_ = std::make_unique<DesignBook>(dir.empty() ? std::string("designs.json")
-                                                     : (dir / "designs.json").string());
+    book_ = std::make_unique<state::DesignBook>(dir.empty() ? std::string("designs.json")
+                                                            : (dir / "designs.json").string());
   }
 }
 

@@ -15,13 +15,13 @@
 #include <vector>
 
 #include "loom/firmware/carpet_job.hpp"
-#include "loom/firmware/carpet_png.hpp"
 #include "loom/firmware/job_feed.hpp"
 #include "loom/firmware/job_recorder.hpp"
 #include "loom/firmware/serve/state_lock.hpp"
 #include "loom/firmware/session.hpp"
 #include "loom/firmware/sim_weaver.hpp"
 #include "loom/motion/angles.hpp"
+#include "loom/report/carpet_png.hpp"
 #include "loom/report/run_report.hpp"
 
 namespace loom::firmware {
@@ -400,8 +400,8 @@ void write_carpet(const WeaveArgs& a, const LoomConfig& cfg, Machine& m) {
     // Every row the counters say was woven since the carpet began is compared, knotted or not.
     const std::uint32_t woven = m.sequencer().counters().rows;
     const int rows_woven = woven > k->first_row() ? static_cast<int>(woven - k->first_row()) : 0;
-    const CarpetCheck cc =
-        write_carpet_png(*k, *m.knot_program(), *cfg.recipe.design, k->first_row(), png, rows_woven);
+    const report::CarpetCheck cc =
+        report::write_carpet_png(*k, *m.knot_program(), *cfg.recipe.design, k->first_row(), png, rows_woven);
     std::printf(
         "carpet: %s: %d rows from production row %u (design row %d), %d knots (%d by hand); %s\n",
         png.c_str(), cc.rows, k->first_row(), m.knot_program()->design_row(k->first_row()) + 1, cc.knots,

@@ -36,10 +36,12 @@ void BM_CanAxisPortTick(benchmark::State& state) {
   for (std::size_t i = 0; i < 3; ++i) nodes[i].node_id = static_cast<std::uint8_t>(i + 1);
   sim_can::SimDriveRack rack(drives, nodes);
   test::RelayBus relay(master);
-  drivers::CanAxisPort port{drivers::CanAxisPortConfig{}};
+  const drivers::CanAxisPortConfig config{};
+  drivers::CanNetwork network(drivers::can_master_config(config), 1);
+  drivers::CanAxisPort port(network, config);
   Clock clock(net, rack);
   rack.power_on(0);
-  if (!port.configure(relay, clock).is_ok()) {
+  if (!drivers::bring_up(network, port, relay, clock).is_ok()) {
     state.SkipWithError("configure failed");
     return;
   }
@@ -54,8 +56,10 @@ void BM_CanAxisPortTick(benchmark::State& state) {
   hal::Tick k = 0;
   for (auto _ : state) {
     for (const auto& f : tpdo) relay.push_rx(f);
+    network.poll(k);
     port.read_axes(k, fb, link);
     for (std::size_t i = 0; i < 3; ++i) cmd[i].target_position = fb[i].position + 1e-3;
+    network.start_cycle(k);
     port.write_axes(k, cmd);
     relay.clear_tx();
     ++k;

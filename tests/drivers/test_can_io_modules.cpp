@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "drive_rig.hpp"
+#include "loom/drivers/can_hal.hpp"
 #include "loom/drivers/can_io_modules.hpp"
 #include "loom/drivers/can_io_port.hpp"
 #include "loom/sim_can/sim_io_node.hpp"
@@ -60,8 +61,8 @@ struct TwoModuleRig {
         0, 2, drivers::kDefaultCountsPerRad, drivers::kDefaultCountsPerRad, {}};
     rig.rack.attach_io(io4, src);
     rig.rack.attach_io(io5, src);
-    rig.port.attach(m0);
-    rig.port.attach(m1);
+    EXPECT_TRUE(rig.network.add(m0));
+    EXPECT_TRUE(rig.network.add(m1));
     io.add(m0);
     io.add(m1);
   }
@@ -78,7 +79,7 @@ struct TwoModuleRig {
     return c;
   }
   void tick(AxisRequest r, const hal::DigitalOutputs& out = {}) {
-    hal::PortHal hal(rig.port, io);
+    drivers::CanHal hal(rig.network, rig.port, io);
     hal.read(rig.tick_index, in);
     rig.feedback = in.axes;
     rig.link = in.link;

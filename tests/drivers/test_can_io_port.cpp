@@ -8,6 +8,7 @@
 #include <string>
 
 #include "drive_rig.hpp"
+#include "loom/drivers/can_hal.hpp"
 #include "loom/drivers/can_io_port.hpp"
 #include "loom/drivers/can_network.hpp"
 #include "loom/drivers/cia402.hpp"
@@ -55,7 +56,7 @@ struct IoRig {
                  drivers::CanAxisPortConfig axis_cfg = {}, CanIoConfig port_cfg = {})
       : rig(std::move(drives), with_io_frames(axis_cfg, port_cfg)), io(rig.drives, io_cfg), port(port_cfg) {
     rig.rack.attach_io(io, {0, 2, drivers::kDefaultCountsPerRad, drivers::kDefaultCountsPerRad});
-    rig.port.attach(port);
+    EXPECT_TRUE(rig.network.add(port));
   }
   static drivers::CanAxisPortConfig with_io_frames(drivers::CanAxisPortConfig c, const CanIoConfig& io) {
     c.other_frames_per_cycle[0] = drivers::io_frames_per_cycle(io.wiring);
@@ -65,7 +66,7 @@ struct IoRig {
   drivers::Status configure() { return rig.configure(); }
   // One RT cycle through the joined HAL, as the control loop runs it.
   void tick(AxisRequest r, const hal::DigitalOutputs& out = {}) {
-    hal::PortHal hal(rig.port, port);
+    drivers::CanHal hal(rig.network, rig.port, port);
     hal.read(rig.tick_index, in);
     rig.feedback = in.axes;
     hal::HalOutputs o;
@@ -812,7 +813,7 @@ TEST(FaultReaction, FollowingErrorScalesWithCommandedSpeedAndKeepsAHighWaterMark
   // Ramp the helix at 100 rad/s: the ideal drive lags one to two cycles (0.2..0.4 rad) < max(0.5, 1.0).
   hal::HalOutputs o;
   double target = r.in.axes[2].position;
-  hal::PortHal hal(r.rig.port, r.port);
+  drivers::CanHal hal(r.rig.network, r.rig.port, r.port);
   for (int i = 0; i < 100; ++i) {
     hal.read(r.rig.tick_index, r.in);
     for (std::size_t k = 0; k < 3; ++k) {

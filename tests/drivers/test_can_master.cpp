@@ -16,6 +16,7 @@
 #include "drive_rig.hpp"
 #include "fake_can_network.hpp"
 #include "loom/drivers/can_axis_port.hpp"
+#include "loom/drivers/can_io_config.hpp"
 #include "loom/drivers/emcy.hpp"
 #include "loom/drivers/node_supervisor.hpp"
 #include "loom/drivers/pdo.hpp"
@@ -127,6 +128,7 @@ struct Bus {
 
 struct TwoBusRig final : drivers::ConfigureClock {
   std::vector<std::unique_ptr<Bus>> buses;
+  drivers::CanNetwork network;
   drivers::CanAxisPort port;
   std::int64_t now = 0;
   hal::Tick tick_index = 0;
@@ -134,7 +136,8 @@ struct TwoBusRig final : drivers::ConfigureClock {
   hal::LinkStatus link{};
   hal::AxisCommands cmd{};
 
-  explicit TwoBusRig(drivers::CanAxisPortConfig c = four_axes_two_buses()) : port(std::move(c)) {
+  explicit TwoBusRig(drivers::CanAxisPortConfig c = four_axes_two_buses())
+      : network(drivers::can_master_config(c), drivers::bus_count(c)), port(network, std::move(c)) {
     std::vector<sim_can::SimDriveConfig> b0(3), b1(1);
     for (std::size_t i = 0; i < 3; ++i) b0[i].node_id = static_cast<std::uint8_t>(i + 1);
     b0[0].initial_position = 1000;
@@ -158,14 +161,16 @@ struct TwoBusRig final : drivers::ConfigureClock {
   drivers::Status configure() {
     for (auto& b : buses) b->rack.power_on(now);
     drivers::CanBus* const list[] = {&buses[0]->master, &buses[1]->master};
-    return port.configure(std::span<drivers::CanBus* const>(list), *this);
+    return drivers::bring_up(network, port, std::span<drivers::CanBus* const>(list), *this);
   }
   void tick(AxisRequest r, double take_up_offset = 0.0) {
+    network.poll(tick_index);
     port.read_axes(tick_index, fb, link);
     for (std::size_t i = 0; i < port.axis_count(); ++i) {
       cmd[i].request = r;
       cmd[i].target_position = fb[i].position + (i == 3 ? take_up_offset : 0.0);
     }
+    network.start_cycle(tick_index);
     port.write_axes(tick_index, cmd);
     ++tick_index;
     advance(2000);
@@ -252,7 +257,7 @@ TEST(CanMasterTwoBuses, TheNumberOfInterfacesMustMatchTheBuses) {
   TwoBusRig r;
   for (auto& b : r.buses) b->rack.power_on(0);
   drivers::CanBus* const one[] = {&r.buses[0]->master};
-  const drivers::Status s = r.port.configure(std::span<drivers::CanBus* const>(one), r);
+  const drivers::Status s = drivers::bring_up(r.network, r.port, std::span<drivers::CanBus* const>(one), r);
   ASSERT_FALSE(s);
   EXPECT_NE(s.message().find("2 CAN bus(es)"), std::string::npos) << s.message();
   EXPECT_NE(s.message().find("1 interface(s)"), std::string::npos) << s.message();

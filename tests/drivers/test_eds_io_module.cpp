@@ -127,7 +127,7 @@ struct DescribedIoRig {
   explicit DescribedIoRig(sim_can::SimIoConfig sim, bool store)
       : rig(test::three_drives(), frames()), io(rig.drives, std::move(sim)), port(config(store)) {
     rig.rack.attach_io(io, {0, 2, kDefaultCountsPerRad, kDefaultCountsPerRad});
-    rig.port.attach(port);
+    EXPECT_TRUE(rig.network.add(port));
   }
   static CanIoConfig config(bool store) {
     CanIoConfig c;
@@ -248,7 +248,7 @@ TEST(IoInputGroups, AnEightBitMasterCannotMapTheSixteenBitModule) {
   c.node_id = kIoNode;
   CanIoPort port(c);
   rig.rack.attach_io(io, {0, 2, kDefaultCountsPerRad, kDefaultCountsPerRad});
-  rig.port.attach(port);
+  ASSERT_TRUE(rig.network.add(port));
   const Status s = rig.configure();
   ASSERT_FALSE(s.is_ok());
   EXPECT_TRUE(has(s.message(), "0x6000:01")) << s.message();

@@ -7,6 +7,7 @@
 #include "alloc_counter.hpp"
 #include "fake_can_network.hpp"
 #include "loom/drivers/can_axis_port.hpp"
+#include "loom/drivers/can_hal.hpp"
 #include "loom/drivers/can_io_modules.hpp"
 #include "loom/drivers/can_io_port.hpp"
 #include "loom/hal/hal.hpp"
@@ -42,11 +43,13 @@ TEST(CanAxisPortRt, TwentyThousandTicksWithoutAllocation) {
   for (std::size_t i = 0; i < 3; ++i) nodes[i].node_id = static_cast<std::uint8_t>(i + 1);
   sim_can::SimDriveRack rack(drives, nodes);
   RelayBus relay(master);
-  drivers::CanAxisPort port{drivers::CanAxisPortConfig{}};
+  const drivers::CanAxisPortConfig config{};
+  drivers::CanNetwork network(drivers::can_master_config(config), 1);
+  drivers::CanAxisPort port(network, config);
   std::int64_t now = 0;
   Clock clock(net, rack, now);
   rack.power_on(now);
-  ASSERT_TRUE(port.configure(relay, clock).is_ok());
+  ASSERT_TRUE(drivers::bring_up(network, port, relay, clock).is_ok());
   relay.set_passthrough(false);
 
   hal::AxisFeedbacks fb{};
@@ -59,6 +62,7 @@ TEST(CanAxisPortRt, TwentyThousandTicksWithoutAllocation) {
     if (k == 15'000) rack.node(1).power_off();
     const long before = static_cast<long>(allocations());
     count_allocations(true);
+    network.poll(k);
     port.read_axes(k, fb, link);
     for (std::size_t i = 0; i < 3; ++i) {
       cmd[i].request =
@@ -66,6 +70,7 @@ TEST(CanAxisPortRt, TwentyThousandTicksWithoutAllocation) {
       cmd[i].target_position =
           fb[i].position + (fb[i].state == hal::DriveState::kOperationEnabled ? 1e-4 : 0.0);
     }
+    network.start_cycle(k);
     port.write_axes(k, cmd);
     count_allocations(false);
     worst = std::max(worst, static_cast<long>(allocations()) - before);
@@ -86,7 +91,7 @@ TEST(CanAxisPortRt, TwentyThousandTicksWithoutAllocation) {
   EXPECT_EQ(worst, 0);
 }
 
-// The I/O node's per-tick path (on_frame through the axis port's drain, read_io with both channels of
+// The I/O node's per-tick path (on_frame through the network's drain, read_io with both channels of
 // every safety sensor, write_io) allocates nothing either, with the default wiring's three input bytes
 // and a switch sticking and freeing on the way — through CanIoModules, as the machine runs it.
 TEST(CanIoPortRt, FiveThousandTicksWithoutAllocation) {
@@ -102,18 +107,19 @@ TEST(CanIoPortRt, FiveThousandTicksWithoutAllocation) {
   RelayBus relay(master);
   drivers::CanAxisPortConfig axis_cfg;
   axis_cfg.other_frames_per_cycle[0] = drivers::io_frames_per_cycle(drivers::IoWiring{});
-  drivers::CanAxisPort port{axis_cfg};
+  drivers::CanNetwork network(drivers::can_master_config(axis_cfg), 1);
+  drivers::CanAxisPort port(network, axis_cfg);
   drivers::CanIoPort io_port{drivers::CanIoConfig{}};
-  port.attach(io_port);
+  ASSERT_TRUE(network.add(io_port));
   std::int64_t now = 0;
   Clock clock(net, rack, now);
   rack.power_on(now);
-  ASSERT_TRUE(port.configure(relay, clock).is_ok());
+  ASSERT_TRUE(drivers::bring_up(network, port, relay, clock).is_ok());
   relay.set_passthrough(false);
 
   drivers::CanIoModules modules;
   modules.add(io_port);
-  hal::PortHal hal(port, modules);
+  drivers::CanHal hal(network, port, modules);
   hal::HalInputs in{};
   hal::HalOutputs out{};
   long worst = 0;

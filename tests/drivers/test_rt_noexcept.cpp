@@ -13,6 +13,7 @@
 #include "loom/drivers/can_axis_port.hpp"
 #include "loom/drivers/can_error_frame.hpp"
 #include "loom/drivers/can_frame.hpp"
+#include "loom/drivers/can_hal.hpp"
 #include "loom/drivers/can_io_modules.hpp"
 #include "loom/drivers/can_io_port.hpp"
 #include "loom/drivers/can_master.hpp"
@@ -99,7 +100,9 @@ static_assert(noexcept(obj<CanBus>().receive(frame())));
 static_assert(noexcept(obj<SocketCanBus>().send(frame())));
 static_assert(noexcept(obj<SocketCanBus>().receive(frame())));
 
-// ---- The CAN axis port -----------------------------------------------------------------------------
+// ---- The CAN HAL and its axis port ------------------------------------------------------------------
+static_assert(noexcept(obj<CanHal>().read(now(), obj<hal::HalInputs>())));
+static_assert(noexcept(obj<CanHal>().write(now(), cobj<hal::HalOutputs>())));
 static_assert(noexcept(obj<CanAxisPort>().read_axes(now(), fbs(), link())));
 static_assert(noexcept(obj<CanAxisPort>().write_axes(now(), cmds())));
 static_assert(noexcept(cobj<CanAxisPort>().configured()));
@@ -200,7 +203,9 @@ static_assert(noexcept(frame_bits_worst(8)));
 TEST(RtNoexcept, TheProbeTellsConfigureTimeCallsApart) {
   // Configure-time: may allocate (messages, notes), so not noexcept; were the probe always true, the
   // static_asserts above would prove nothing.
-  EXPECT_FALSE(noexcept(obj<CanAxisPort>().configure(obj<CanBus>())));
+  EXPECT_FALSE(noexcept(obj<CanAxisPort>().check(0)));
+  EXPECT_FALSE(
+      noexcept(bring_up(obj<CanNetwork>(), obj<CanAxisPort>(), obj<CanBus>(), obj<ConfigureClock>())));
   EXPECT_FALSE(noexcept(obj<CanNetwork>().configure(obj<CanBus>(), obj<ConfigureClock>())));
   EXPECT_FALSE(noexcept(obj<CanMaster>().bring_up(obj<CanBus>(), obj<ConfigureClock>())));
   EXPECT_TRUE(noexcept(obj<CanAxisPort>().read_axes(now(), fbs(), link())));

@@ -83,7 +83,7 @@ TEST(ProductionRecord, CountersThatAreNotThisLoomsAreRefusedNamingTheFileAndFiel
   ProductionRecord record(path, cfg);
   const std::uint32_t too_many = cfg.recipe.picks_per_row + 1;
   // Written by the store itself, so only the picks in the row are wrong.
-  firmware::CounterStore(path).save({.rows = 1, .picks = 9, .beats = 15, .picks_in_row = too_many});
+  state::CounterStore(path).save({.rows = 1, .picks = 9, .beats = 15, .picks_in_row = too_many});
   try {
     (void)record.load();
     FAIL() << "counters with more picks in the row than the recipe has were taken";

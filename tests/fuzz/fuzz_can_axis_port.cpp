@@ -104,7 +104,7 @@ struct Template {
   Template() {
     rig.rack.power_on(rig.now_us);
     bus.relay = &rig.master;
-    const drivers::Status s = rig.port.configure(bus, rig.clock);
+    const drivers::Status s = drivers::bring_up(rig.network, rig.port, bus, rig.clock);
     if (!s.is_ok()) {
       std::fprintf(stderr, "bring-up against the simulated drives failed: %s\n", s.message().c_str());
       std::abort();
@@ -127,7 +127,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   static Template* const tmpl = new Template();  // process lifetime; never freed (libFuzzer exits)
   FuzzBus& bus = tmpl->bus;
   bus.reset();
-  drivers::CanAxisPort port = tmpl->rig.port;  // configured, drives enabled, bound to `bus`
+  // The configured network (bound to `bus`) and port with the drives enabled, copied: the copy's node
+  // tables are its own port's axes.
+  drivers::CanNetwork network = tmpl->rig.network;
+  network.clear_nodes();
+  drivers::CanAxisPort port(tmpl->rig.port, network);
   hal::Tick now = tmpl->tick;
   hal::AxisFeedbacks feedback{};
   hal::LinkStatus link{};
@@ -164,6 +168,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       }
       case 3: {  // one RT cycle
         const auto request = static_cast<hal::AxisRequest>(in.ConsumeIntegralInRange<int>(0, 4));
+        network.poll(now);
         port.read_axes(now, feedback, link);
         for (std::size_t i = 0; i < feedback.size(); ++i) {
           const auto& fb = feedback[i];
@@ -176,6 +181,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         if (bus_off_queued && bus.pending() == 0 && !link.link_fault)
           fail("bus-off read but no link fault", 0, 0.0);
         test::DriveRig::hold(request)(feedback, commands);
+        network.start_cycle(now);
         port.write_axes(now, commands);
         ++now;
         break;

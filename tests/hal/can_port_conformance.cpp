@@ -1,6 +1,7 @@
 // The conformance suite (port_conformance.hpp) over the CAN ports as `--hal socketcan` joins them:
-// drivers::CanAxisPort for three CiA 402 drives and drivers::CanIoModules over one drivers::CanIoPort, on
-// the in-memory CAN network of tests/support with the simulated nodes of sim_hal/can_drive as the plant
+// drivers::CanAxisPort for three CiA 402 drives and drivers::CanIoModules over one drivers::CanIoPort,
+// joined by drivers::CanHal on their drivers::CanNetwork, on the in-memory CAN network of tests/support
+// with the simulated nodes of sim_hal/can_drive as the plant
 // (their own object dictionaries and frame layouts: a peer that does not share the master's code). The
 // port talks through a RelayBus with fixed arrays, so the allocation check measures the port alone (the
 // in-memory network allocates as it queues); frames cross between ticks.
@@ -11,6 +12,7 @@
 #include "../drivers/relay_bus.hpp"
 #include "fake_can_network.hpp"
 #include "loom/drivers/can_axis_port.hpp"
+#include "loom/drivers/can_hal.hpp"
 #include "loom/drivers/can_io_modules.hpp"
 #include "loom/drivers/can_io_port.hpp"
 #include "loom/drivers/emcy.hpp"
@@ -47,20 +49,21 @@ class CanPortRig final : public PortRig {
     relay_ = std::make_unique<RelayBus>(master);
     drivers::CanAxisPortConfig axis_cfg;
     axis_cfg.other_frames_per_cycle[0] = drivers::io_frames_per_cycle(drivers::IoWiring{});
-    axes_ = std::make_unique<drivers::CanAxisPort>(axis_cfg);
+    network_ = std::make_unique<drivers::CanNetwork>(drivers::can_master_config(axis_cfg), 1);
+    axes_ = std::make_unique<drivers::CanAxisPort>(*network_, axis_cfg);
     io_port_ = std::make_unique<drivers::CanIoPort>(drivers::CanIoConfig{});
-    axes_->attach(*io_port_);
+    ASSERT_TRUE(network_->add(*io_port_));
     modules_ = std::make_unique<drivers::CanIoModules>();
     modules_->add(*io_port_);
+    hal_ = std::make_unique<drivers::CanHal>(*network_, *axes_, *modules_);
     devices_ = &devices;
     rack_->power_on(now_us_);
     Clock clock(*this);
-    const drivers::Status s = axes_->configure(*relay_, clock);
+    const drivers::Status s = drivers::bring_up(*network_, *axes_, *relay_, clock);
     ASSERT_TRUE(s) << s.message();
     relay_->set_passthrough(false);
   }
-  hal::AxisPort& axis_port() override { return *axes_; }
-  hal::IoPort& io_port() override { return *modules_; }
+  hal::Hal& hal() override { return *hal_; }
   std::size_t axis_count() const override { return axes_->axis_count(); }
   void between_ticks(hal::Tick now) override {
     relay_->exchange();  // what the port sent goes on the wire
@@ -128,9 +131,11 @@ class CanPortRig final : public PortRig {
   std::unique_ptr<sim_can::SimDriveRack> rack_;
   std::unique_ptr<sim_can::SimIoNode> io_;
   std::unique_ptr<RelayBus> relay_;
+  std::unique_ptr<drivers::CanNetwork> network_;
   std::unique_ptr<drivers::CanAxisPort> axes_;
   std::unique_ptr<drivers::CanIoPort> io_port_;
   std::unique_ptr<drivers::CanIoModules> modules_;
+  std::unique_ptr<drivers::CanHal> hal_;
 };
 
 // ctest names each case PortConformance.<case><loom::test::CanPortRig>.

@@ -66,8 +66,9 @@ class PortRig {
   virtual ~PortRig() = default;
   // Configure time: build the plant as `plan` says and the port over it, configured and ready to tick.
   virtual void make(const PortPlan& plan) = 0;
-  virtual hal::AxisPort& axis_port() = 0;
-  virtual hal::IoPort& io_port() = 0;
+  // The port's axis and I/O sides as the machine assembles them into its HAL (for CAN, with the network
+  // polled before they read and its cycle started before they write).
+  virtual hal::Hal& hal() = 0;
   virtual std::size_t axis_count() const = 0;
   // After tick `now`'s write: one period of plant time passes (frames travel, drives and valves move), and
   // the planned event strikes when its tick comes. Not part of the measured RT path.
@@ -99,7 +100,7 @@ class PortConformance : public ::testing::Test {
   // One tick as ControlLoop::cycle runs it: read, decide, write; the port's calls counted for allocations.
   template <class Decide>
   void tick(Decide&& decide) {
-    hal::PortHal hal(rig_.axis_port(), rig_.io_port());
+    hal::Hal& hal = rig_.hal();
     count_allocations(true);
     hal.read(now_, in_);
     count_allocations(false);

@@ -27,9 +27,9 @@ class SimPortRig final : public PortRig {
     hal::AxisFeedbacks at{};
     for (std::size_t i = 0; i < hal::kCoreAxisCount; ++i) at[i].position = plan.start[i];
     world_->set_initial_state(at, {0.0, 0.0});
+    hal_ = std::make_unique<hal::PortHal>(*world_, *world_);
   }
-  hal::AxisPort& axis_port() override { return *world_; }
-  hal::IoPort& io_port() override { return *world_; }
+  hal::Hal& hal() override { return *hal_; }
   std::size_t axis_count() const override { return machine_.axis_count; }
   void between_ticks(hal::Tick) override {}  // write() integrated the period already
   double plant_position(std::size_t slot) const override { return world_->axis(slot).position; }
@@ -59,6 +59,7 @@ class SimPortRig final : public PortRig {
  private:
   sim_hal::SimMachine machine_{};
   std::unique_ptr<sim_hal::SimWorld> world_;
+  std::unique_ptr<hal::PortHal> hal_;  // the world as both ports, as the machine joins them
 };
 
 // ctest names each case PortConformance.<case><loom::test::SimPortRig>.

@@ -17,11 +17,11 @@
 #include <vector>
 
 #include "loom/config/config.hpp"
-#include "loom/firmware/carpet_png.hpp"
 #include "loom/firmware/machine.hpp"
 #include "loom/firmware/runner.hpp"
 #include "loom/firmware/session.hpp"
 #include "loom/hal/motion_outputs.hpp"
+#include "loom/report/carpet_png.hpp"
 
 using namespace loom;
 
@@ -86,7 +86,7 @@ struct Woven {
   sequencer::Counters counters{};
   std::vector<sequencer::WeaverRequest> requests;
   std::vector<std::uint32_t> request_cycles;  // the row's knot cycles done when each request was made
-  firmware::CarpetCheck check{};
+  report::CarpetCheck check{};
   Rgba png;
 };
 
@@ -112,7 +112,7 @@ Woven weave(const firmware::LoomConfig& cfg, const firmware::Scene& sc, std::uin
   w.fault_axis = m.sequencer().fault_axis();
   w.counters = m.sequencer().counters();
   const std::string png = testing::TempDir() + "/carpet_" + std::to_string(::getpid()) + ".png";
-  w.check = firmware::write_carpet_png(*m.sim().knotter(), *m.knot_program(), *cfg.recipe.design, 0, png);
+  w.check = report::write_carpet_png(*m.sim().knotter(), *m.knot_program(), *cfg.recipe.design, 0, png);
   w.png = read_png(png);
   std::filesystem::remove(png);
   return w;

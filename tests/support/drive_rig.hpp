@@ -1,6 +1,8 @@
-// Test rig: drivers::CanAxisPort on one endpoint of the fake CAN network, simulated CiA 402 drives on
-// another, all in virtual time. configure() runs on a virtual ConfigureClock whose idle() advances time
-// and steps the drives; tick() is one RT cycle (read → decide → write) followed by one cycle period.
+// Test rig: drivers::CanAxisPort on its drivers::CanNetwork on one endpoint of the fake CAN network,
+// simulated CiA 402 drives on another, all in virtual time. Other nodes (I/O modules) join the rig's
+// network before configure(). configure() runs on a virtual ConfigureClock whose idle() advances time and
+// steps the drives; tick() is one RT cycle as drivers::CanHal runs it (poll → read → decide → cycle →
+// write) followed by one cycle period.
 #pragma once
 
 #include <cstdint>
@@ -34,12 +36,13 @@ class DriveRig {
       : master(net.add_endpoint()),
         drives(net.add_endpoint()),
         rack(drives, nodes),
-        port(std::move(config)),
+        network(drivers::can_master_config(config), drivers::bus_count(config)),
+        port(network, std::move(config)),
         clock(*this) {}
 
   drivers::Status configure() {
     rack.power_on(now_us);
-    return port.configure(master, clock);
+    return drivers::bring_up(network, port, master, clock);
   }
 
   // Let `dt_us` of virtual time pass in 100 µs steps: the network delivers, the drives react.
@@ -54,8 +57,10 @@ class DriveRig {
 
   // One RT cycle.
   void tick(const Policy& policy) {
+    network.poll(tick_index);
     port.read_axes(tick_index, feedback, link);
     policy(feedback, commands);
+    network.start_cycle(tick_index);
     port.write_axes(tick_index, commands);
     ++tick_index;
     advance(period_us());
@@ -106,6 +111,7 @@ class DriveRig {
   FakeCanNetwork::Endpoint& master;  // endpoint 0
   FakeCanNetwork::Endpoint& drives;  // endpoint 1
   sim_can::SimDriveRack rack;
+  drivers::CanNetwork network;  // the rig's one bus
   drivers::CanAxisPort port;
   VirtualClock clock;
   std::int64_t now_us = 0;

@@ -10,9 +10,9 @@
 #include <utility>
 
 #include "loom/design/design.hpp"
-#include "loom/firmware/durable_file.hpp"
 #include "loom/job/design_hash.hpp"
 #include "loom/sequencer/knot_plan.hpp"
+#include "loom/state/durable_file.hpp"
 
 namespace loom::job {
 namespace {
@@ -306,8 +306,8 @@ JobQueue JobQueue::parse(const std::string& text, const std::string& source) {
 }
 
 JobQueue JobQueue::load(const std::string& path) {
-  const firmware::StateFileRead r = firmware::read_state_file(path, kMaxQueueBytes);
-  using O = firmware::StateFileRead::Outcome;
+  const state::StateFileRead r = state::read_state_file(path, kMaxQueueBytes);
+  using O = state::StateFileRead::Outcome;
   switch (r.outcome) {
     case O::kAbsent:
       return JobQueue(path);
@@ -350,7 +350,7 @@ Job& JobQueue::mutable_current(const char* what) {
 }
 
 void JobQueue::save() const {
-  firmware::write_file_durably(path_, format(jobs_, next_id_));
+  state::write_file_durably(path_, format(jobs_, next_id_));
 }
 
 namespace {
@@ -360,8 +360,8 @@ struct DesignRead {
   std::string error;  // "" when read
 };
 DesignRead read_design(const std::string& path) {
-  const firmware::StateFileRead r = firmware::read_state_file(path, kMaxDesignBytes);
-  using O = firmware::StateFileRead::Outcome;
+  const state::StateFileRead r = state::read_state_file(path, kMaxDesignBytes);
+  using O = state::StateFileRead::Outcome;
   switch (r.outcome) {
     case O::kAbsent:
       return {{}, "no such file"};

@@ -9,8 +9,8 @@
 #include <map>
 #include <sstream>
 
-#include "loom/firmware/durable_file.hpp"
 #include "loom/job/job_queue.hpp"
+#include "loom/state/durable_file.hpp"
 
 namespace loom::job {
 namespace {
@@ -167,8 +167,8 @@ YarnStock YarnStock::parse(const std::string& text, const std::string& source) {
 }
 
 std::optional<YarnStock> YarnStock::load(const std::string& path) {
-  const firmware::StateFileRead r = firmware::read_state_file(path, 64 * 1024);
-  using O = firmware::StateFileRead::Outcome;
+  const state::StateFileRead r = state::read_state_file(path, 64 * 1024);
+  using O = state::StateFileRead::Outcome;
   switch (r.outcome) {
     case O::kAbsent:
       return std::nullopt;
@@ -185,7 +185,7 @@ std::optional<YarnStock> YarnStock::load(const std::string& path) {
 }
 
 void YarnStock::save(const std::string& path) const {
-  firmware::write_file_durably(path, format(*this));
+  state::write_file_durably(path, format(*this));
 }
 
 std::vector<SlotEmpty> forecast_empty_slots(const YarnStock& stock, const sequencer::KnotProgram& program,

@@ -14,7 +14,7 @@
 #include <stdexcept>
 
 #include "loom/config/config.hpp"
-#include "loom/firmware/durable_file.hpp"
+#include "loom/state/durable_file.hpp"
 
 namespace loom::firmware::serve {
 namespace {
@@ -204,26 +204,26 @@ LatchedFault LatchedFaultStore::parse(const std::string& text, const std::string
 }
 
 std::optional<LatchedFault> LatchedFaultStore::load() const {
-  const StateFileRead r = read_state_file(path_, kMaxBytes);
+  const state::StateFileRead r = state::read_state_file(path_, kMaxBytes);
   switch (r.outcome) {
-    case StateFileRead::Outcome::kAbsent:
+    case state::StateFileRead::Outcome::kAbsent:
       return std::nullopt;
-    case StateFileRead::Outcome::kCannotOpen:
+    case state::StateFileRead::Outcome::kCannotOpen:
       throw ConfigError(path_ + ": latched-fault record exists but cannot be read: " + r.error +
                         " (refusing to arm: a fault may still be latched)");
-    case StateFileRead::Outcome::kNotRegular:
+    case state::StateFileRead::Outcome::kNotRegular:
       throw ConfigError(path_ + ":1: file = \"" + path_ +
                         "\": not a latched-fault record (not a regular file of at most 4 KiB)");
-    case StateFileRead::Outcome::kCannotRead:
+    case state::StateFileRead::Outcome::kCannotRead:
       throw ConfigError(path_ + ": latched-fault record cannot be read: " + r.error);
-    case StateFileRead::Outcome::kRead:
+    case state::StateFileRead::Outcome::kRead:
       break;
   }
   return parse(r.text, path_);
 }
 
 void LatchedFaultStore::save(const LatchedFault& f) const {
-  write_file_durably(path_, format(f), reserve_);
+  state::write_file_durably(path_, format(f), reserve_);
 }
 
 void LatchedFaultStore::clear() const {

@@ -41,7 +41,7 @@ class CanIoPort final : public hal::IoPort, public CanNode {
 
   // Configure-time only. The master settings of a network of this module alone (its cycle and timeouts,
   // no master heartbeat): a module is brought up only by a CanNetwork (can_network.hpp) it is registered
-  // on — alone, or on its bus beside the drives (CanAxisPort::attach) — in that bus' one NMT sequence:
+  // on — alone, or on its bus beside the drives (CanNetwork::add) — in that bus' one NMT sequence:
   // reset-node → boot-up → configure_profile() → NMT start → operational heartbeat. The network then polls
   // it every tick.
   CanMasterConfig master_config() const;

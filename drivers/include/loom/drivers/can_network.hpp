@@ -1,8 +1,9 @@
-// The machine's CAN network: one CanMaster per bus (can_master.hpp), the nodes registered on it by the
-// ports that use them (CanAxisPort's drives, CanIoPort's modules), brought up once (configure(): every
-// bus in one NMT sequence each) and polled once per tick. The link status is the network's: bus-off, a
-// lost node, an EMCY of a node that does not report its own, with the recovery state and the link's
-// fault event. A port is a view on the nodes it registered; an I/O module needs no axis port.
+// The machine's CAN network: one CanMaster per bus (can_master.hpp), the nodes registered on it (the
+// drives by the CanAxisPort constructed on it, each CanIoPort by whoever assembles the machine), brought
+// up once (configure(): every bus in one NMT sequence each) and, by the HAL (can_hal.hpp), polled once
+// per tick before the ports read and its cycle started before they write. The link status is the
+// network's: bus-off, a lost node, an EMCY of a node that does not report its own, with the recovery state
+// and the link's fault event. The ports are views on the nodes they hold; an I/O module needs no axis port.
 #pragma once
 
 #include <array>
@@ -27,7 +28,7 @@ class CanNetwork {
 
   // Configure-time. The node tables (not the RT state): add() is false when `bus` is not one of the
   // network's, the bus' table is full or the node's id is taken on it. The nodes are not owned: a copy's
-  // tables still name the original's nodes until its owner registers its own (CanAxisPort's copies do).
+  // tables still name the original's nodes until they are cleared and its own are registered.
   bool add(CanNode& node, std::size_t bus = 0);
   void clear_nodes();
   std::size_t node_count() const;
@@ -48,6 +49,7 @@ class CanNetwork {
   // the first faulted bus; the worst recovery state over the buses; fault_raised when its report begins.
   void read_link(hal::Tick now, hal::LinkStatus& link) noexcept;
   // RT-safe. Once per tick, before the ports write: SYNC on every bus, and the master heartbeat when due.
+  // Nothing before configure() succeeded.
   void start_cycle(hal::Tick now) noexcept;
   // RT-safe. The operator acknowledged: every master's and node's latches whose cause is gone.
   void acknowledge() noexcept;

@@ -3,7 +3,7 @@
 // only (SDO configuration of the mode, interpolation period, heartbeat producer, master consumer and the
 // PDO mapping; the power-state machine; the RPDO1/TPDO1/TPDO2 exchange; following-error supervision in
 // CSP, set-point acknowledge and target-reached supervision in PP).
-// Heartbeats, boot-ups and EMCYs are the master's NodeSupervisor's. CanAxisPort owns one per axis.
+// Heartbeats, boot-ups and EMCYs are the master's NodeSupervisor's. CanAxisPort holds one per axis.
 #pragma once
 
 #include <cstdint>

@@ -10,8 +10,10 @@
 
 #include "loom/config/config.hpp"
 #include "loom/drivers/can_axis_port.hpp"
+#include "loom/drivers/can_hal.hpp"
 #include "loom/drivers/can_io_modules.hpp"
 #include "loom/drivers/can_io_port.hpp"
+#include "loom/drivers/can_network.hpp"
 #include "loom/drivers/socket_can_bus.hpp"
 #include "loom/firmware/control_loop.hpp"
 #include "loom/motion/profile_set.hpp"
@@ -69,7 +71,6 @@ class Machine {
   // Non-RT. Free a recipe the loop has retired. Call now and then (after each row is enough).
   void collect_retired_recipes() { slot_->collect(); }
   telemetry::Telemetry* telemetry() { return telemetry_.get(); }
-  const drivers::CanAxisPort* can() const { return can_port_.get(); }
   // Non-empty when the caller must print it on every start (kSimulatedIoBanner).
   const std::string& banner() const { return banner_; }
   // What bring-up found optional and absent or accepted as read back (0x1016, fixed mappings), and the
@@ -101,12 +102,13 @@ class Machine {
   std::unique_ptr<sim_hal::SimWorld> sim_;
   std::unique_ptr<SimWeaver> sim_weaver_;                      // the simulated HAL only
   std::vector<std::unique_ptr<drivers::SocketCanBus>> buses_;  // bus i = the i-th --iface name
+  std::unique_ptr<drivers::CanNetwork> network_;  // the masters, one per bus; the ports are views on it
   std::unique_ptr<drivers::CanAxisPort> can_port_;
   std::vector<std::unique_ptr<drivers::CanIoPort>> io_modules_;  // module k = can_io_configs()[k]
   std::unique_ptr<drivers::CanIoModules> io_port_;               // the modules as the loop's one I/O port
   std::string banner_;
   std::vector<std::string> notes_;
-  std::unique_ptr<hal::PortHal> hal_;
+  std::unique_ptr<hal::Hal> hal_;  // the simulated ports, or the CAN network and its ports
   std::unique_ptr<telemetry::Telemetry> telemetry_;
   std::unique_ptr<ControlLoop> loop_;
 };

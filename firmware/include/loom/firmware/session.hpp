@@ -23,11 +23,11 @@
 
 #include "loom/config/config.hpp"
 #include "loom/firmware/carpet_job.hpp"
-#include "loom/firmware/counter_store.hpp"
-#include "loom/firmware/design_book.hpp"
 #include "loom/firmware/machine.hpp"
 #include "loom/firmware/runner.hpp"
 #include "loom/firmware/severity.hpp"
+#include "loom/state/counter_store.hpp"
+#include "loom/state/design_book.hpp"
 
 namespace loom::firmware {
 
@@ -150,8 +150,8 @@ class ProductionRecord {
   std::string path_;
   std::uint32_t picks_per_row_;
   std::string design_name_;  // "" without a design
-  std::unique_ptr<CounterStore> store_;
-  std::unique_ptr<DesignBook> book_;
+  std::unique_ptr<state::CounterStore> store_;
+  std::unique_ptr<state::DesignBook> book_;
   std::unique_ptr<RowSaves> row_saves_;
   std::unique_ptr<CarpetJob> jobs_;
   bool carpet_done_ = false;

@@ -3,7 +3,7 @@
 // fault latched when serve stopped is latched again when it arms, `ctl status` shows it, starting
 // commands are refused, and only `ctl ack` or the ack button clears it (and this file).
 //
-// The file (STATE/latched-fault) is written with write_file_durably when the fault latches and removed
+// The file (STATE/latched-fault) is written with state::write_file_durably when the fault latches and removed
 // (the folder fsync'd) when it is acknowledged. One `key = value` per line, `#` comments:
 //   kind = fault              fault | overrun_stop
 //   fault = drive_fault       a name of the fault table other than none
@@ -22,9 +22,9 @@
 #include <optional>
 #include <string>
 
-#include "loom/firmware/durable_file.hpp"
 #include "loom/firmware/serve/fault_history.hpp"
 #include "loom/sequencer/faults.hpp"
+#include "loom/state/durable_file.hpp"
 
 namespace loom::firmware::serve {
 
@@ -59,7 +59,7 @@ class LatchedFaultStore {
 
  private:
   std::string path_;
-  DiskReserve reserve_;
+  state::DiskReserve reserve_;
 };
 
 }  // namespace loom::firmware::serve

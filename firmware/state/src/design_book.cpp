@@ -1,14 +1,17 @@
 // See design_book.hpp. JSON through nlohmann, checked field by field: a book is never half-trusted.
-#include "loom/firmware/design_book.hpp"
+#include "loom/state/design_book.hpp"
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "loom/config/config.hpp"
 #include "loom/config/toml_reader.hpp"
-#include "loom/firmware/durable_file.hpp"
+#include "loom/state/durable_file.hpp"
 
-namespace loom::firmware {
+namespace loom::state {
+
+using firmware::ConfigError;
+using firmware::read_config_file;
 
 std::string DesignBook::format(const std::string& active, std::uint32_t at_rows,
                                const std::map<std::string, std::uint64_t>& designs) {
@@ -95,4 +98,4 @@ std::uint64_t DesignBook::rows_done() const {
   return it == designs_.end() ? 0 : it->second;
 }
 
-}  // namespace loom::firmware
+}  // namespace loom::state

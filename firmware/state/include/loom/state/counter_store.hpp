@@ -12,7 +12,7 @@
 
 #include "loom/sequencer/sequencer.hpp"
 
-namespace loom::firmware {
+namespace loom::state {
 
 class CounterStore {
  public:
@@ -33,4 +33,4 @@ class CounterStore {
   std::string path_;
 };
 
-}  // namespace loom::firmware
+}  // namespace loom::state

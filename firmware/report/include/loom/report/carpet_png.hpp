@@ -10,7 +10,7 @@
 #include "loom/sequencer/knot_program.hpp"
 #include "loom/sim_hal/knotter.hpp"
 
-namespace loom::firmware {
+namespace loom::report {
 
 struct CarpetCheck {
   int rows = 0;   // rows compared: every row knotted and every row woven, whichever is more
@@ -31,4 +31,4 @@ CarpetCheck write_carpet_png(const sim_hal::SimKnotter& carpet, const sequencer:
                              const design::Design& design, std::uint32_t first_row, const std::string& path,
                              int rows_woven = 0);
 
-}  // namespace loom::firmware
+}  // namespace loom::report

@@ -1,5 +1,5 @@
 // The knotted carpet as a PNG (see carpet_png.hpp), through libpng's simplified API.
-#include "loom/firmware/carpet_png.hpp"
+#include "loom/report/carpet_png.hpp"
 
 #include <png.h>
 
@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <vector>
 
-namespace loom::firmware {
+namespace loom::report {
 
 CarpetCheck write_carpet_png(const sim_hal::SimKnotter& carpet, const sequencer::KnotProgram& program,
                              const design::Design& design, std::uint32_t first_row, const std::string& path,
@@ -62,4 +62,4 @@ CarpetCheck write_carpet_png(const sim_hal::SimKnotter& carpet, const sequencer:
   return c;
 }
 
-}  // namespace loom::firmware
+}  // namespace loom::report

@@ -13,7 +13,7 @@
 #include <map>
 #include <string>
 
-namespace loom::firmware {
+namespace loom::state {
 
 class DesignBook {
  public:
@@ -44,4 +44,4 @@ class DesignBook {
   std::map<std::string, std::uint64_t> designs_;
 };
 
-}  // namespace loom::firmware
+}  // namespace loom::state

@@ -3,7 +3,7 @@
 // "knot_cycles_done"); a file written before the heads existed lacks them, and they were zero then.
 // The parser accepts exactly that shape (whitespace aside): four distinct keys, each a whole number
 // in the 32-bit range; 1.5, -1, 1e3, 4294967296 and duplicates are refused, never rounded or wrapped.
-#include "loom/firmware/counter_store.hpp"
+#include "loom/state/counter_store.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -21,9 +21,11 @@
 #include <stdexcept>
 
 #include "loom/config/config.hpp"
-#include "loom/firmware/durable_file.hpp"
+#include "loom/state/durable_file.hpp"
 
-namespace loom::firmware {
+namespace loom::state {
+
+using firmware::ConfigError;
 namespace {
 
 // A cursor over the text that reports the column of what it could not accept.
@@ -219,4 +221,4 @@ void CounterStore::save(const sequencer::Counters& c) const {
   write_file_durably(path_, format(c));
 }
 
-}  // namespace loom::firmware
+}  // namespace loom::state

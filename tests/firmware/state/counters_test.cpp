@@ -14,7 +14,7 @@
 
 #include "cli_run.hpp"
 #include "loom/config/config.hpp"
-#include "loom/firmware/counter_store.hpp"
+#include "loom/state/counter_store.hpp"
 
 using namespace loom::firmware;
 namespace fs = std::filesystem;
@@ -23,7 +23,7 @@ namespace {
 
 std::string parse_error(const std::string& text) {
   try {
-    (void)CounterStore::parse(text, "c.json");
+    (void)loom::state::CounterStore::parse(text, "c.json");
   } catch (const ConfigError& e) {
     return e.what();
   }
@@ -51,28 +51,30 @@ std::string slurp(const fs::path& p) {
 
 TEST(Counters, RoundTripAndStrictShape) {
   const loom::sequencer::Counters c{7, 9, 105, 2};
-  const loom::sequencer::Counters back = CounterStore::parse(CounterStore::format(c), "c.json");
+  const loom::sequencer::Counters back =
+      loom::state::CounterStore::parse(loom::state::CounterStore::format(c), "c.json");
   EXPECT_EQ(back.rows, 7u);
   EXPECT_EQ(back.picks, 9u);
   EXPECT_EQ(back.beats, 105u);
   EXPECT_EQ(back.picks_in_row, 2u);
-  EXPECT_EQ(
-      CounterStore::parse(" { \"picks_in_row\" : 0 , \"beats\":4294967295,\"rows\":1,\"picks\":1}\n", "c")
-          .beats,
-      4294967295u);
+  EXPECT_EQ(loom::state::CounterStore::parse(
+                " { \"picks_in_row\" : 0 , \"beats\":4294967295,\"rows\":1,\"picks\":1}\n", "c")
+                .beats,
+            4294967295u);
 }
 
 TEST(Counters, TheKnottingHeadsCountsComeTogetherAndAgree) {
   loom::sequencer::Counters c{4, 8, 60, 0, {}};
   // A loom without heads writes what it always wrote.
-  EXPECT_EQ(CounterStore::format(c), "{\"rows\":4,\"picks\":8,\"beats\":60,\"picks_in_row\":0}\n");
+  EXPECT_EQ(loom::state::CounterStore::format(c),
+            "{\"rows\":4,\"picks\":8,\"beats\":60,\"picks_in_row\":0}\n");
   c.knot = {1400, 12, 3, 17, 16};
-  const std::string text = CounterStore::format(c);
+  const std::string text = loom::state::CounterStore::format(c);
   EXPECT_NE(text.find("\"knots\":1400,\"knots_retried\":12,\"knots_by_hand\":3,\"knot_cycles_started\":17,"
                       "\"knot_cycles_done\":16"),
             std::string::npos)
       << text;
-  const loom::sequencer::Counters back = CounterStore::parse(text, "c.json");
+  const loom::sequencer::Counters back = loom::state::CounterStore::parse(text, "c.json");
   EXPECT_EQ(back.knot.tied, 1400u);
   EXPECT_EQ(back.knot.retried, 12u);
   EXPECT_EQ(back.knot.by_hand, 3u);
@@ -94,15 +96,16 @@ TEST(Counters, TheKnottingHeadsCountsComeTogetherAndAgree) {
 TEST(Counters, TheRowInProgressKeepsItsKnotsAcrossARestart) {
   loom::sequencer::Counters c{4, 8, 60, 0, {}};
   c.knot = {1400, 12, 3, 17, 16, 0, 40, 2, 1};
-  const std::string text = CounterStore::format(c);
+  const std::string text = loom::state::CounterStore::format(c);
   EXPECT_NE(text.find("\"row_knots\":40,\"row_knots_retried\":2,\"row_knots_by_hand\":1"), std::string::npos)
       << text;
-  const loom::sequencer::Counters back = CounterStore::parse(text, "c.json");
+  const loom::sequencer::Counters back = loom::state::CounterStore::parse(text, "c.json");
   EXPECT_EQ(back.knot.row_tied, 40u);
   EXPECT_EQ(back.knot.row_retried, 2u);
   EXPECT_EQ(back.knot.row_by_hand, 1u);
   c.knot.row_tied = c.knot.row_retried = c.knot.row_by_hand = 0;
-  EXPECT_EQ(CounterStore::format(c).find("row_knots"), std::string::npos);  // between rows: as before
+  EXPECT_EQ(loom::state::CounterStore::format(c).find("row_knots"),
+            std::string::npos);  // between rows: as before
   EXPECT_NE(
       parse_error("{\"rows\":4,\"picks\":8,\"beats\":60,\"picks_in_row\":0,\"knots\":5,\"knots_retried\":0,"
                   "\"knots_by_hand\":0,\"knot_cycles_started\":2,\"knot_cycles_done\":1,\"row_knots\":6,"
@@ -149,21 +152,21 @@ TEST(Counters, CountsThatContradictEachOtherAreRefused) {
 
 TEST(Counters, MissingStartsFromZeroButUnreadableIsAnError) {
   const fs::path d = temp_dir("load");
-  EXPECT_FALSE(CounterStore((d / "none.json").string()).load().has_value());
+  EXPECT_FALSE(loom::state::CounterStore((d / "none.json").string()).load().has_value());
   // A directory where the file should be: it exists, and cannot be a counters file.
   fs::create_directories(d / "dir.json");
-  EXPECT_THROW((void)CounterStore((d / "dir.json").string()).load(), ConfigError);
+  EXPECT_THROW((void)loom::state::CounterStore((d / "dir.json").string()).load(), ConfigError);
   fs::remove_all(d);
 }
 
 TEST(Counters, FailedSaveThrowsAndLeavesThePreviousFile) {
   const fs::path d = temp_dir("save");
-  const CounterStore store((d / "c.json").string());
+  const loom::state::CounterStore store((d / "c.json").string());
   store.save({1, 1, 15, 0});
   fs::create_directories(d / "c.json.tmp");  // the temp file cannot be created now
   EXPECT_THROW(store.save({2, 2, 30, 0}), std::runtime_error);
   EXPECT_EQ(slurp(d / "c.json"), "{\"rows\":1,\"picks\":1,\"beats\":15,\"picks_in_row\":0}\n");
-  EXPECT_THROW(CounterStore((d / "no" / "c.json").string()).save({}), std::runtime_error);
+  EXPECT_THROW(loom::state::CounterStore((d / "no" / "c.json").string()).save({}), std::runtime_error);
   fs::remove_all(d);
 }
 

@@ -1,4 +1,4 @@
-#include "loom/firmware/durable_file.hpp"
+#include "loom/state/durable_file.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -8,7 +8,7 @@
 #include <cstring>
 #include <stdexcept>
 
-namespace loom::firmware {
+namespace loom::state {
 namespace {
 
 [[noreturn]] void sys_fail(const std::string& what, const std::string& path) {
@@ -129,4 +129,4 @@ StateFileRead read_state_file(const std::string& path, std::size_t max_bytes) {
   return r;
 }
 
-}  // namespace loom::firmware
+}  // namespace loom::state

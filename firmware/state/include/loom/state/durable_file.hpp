@@ -8,7 +8,7 @@
 #include <string>
 #include <utility>
 
-namespace loom::firmware {
+namespace loom::state {
 
 // A failed durable write: the message names the path and the errno text; `error` is the errno.
 struct DurableWriteError : std::runtime_error {
@@ -58,4 +58,4 @@ class DiskReserve {
 // once more: for the records that must not be lost to a full disk.
 void write_file_durably(const std::string& path, const std::string& body, const DiskReserve& reserve);
 
-}  // namespace loom::firmware
+}  // namespace loom::state
