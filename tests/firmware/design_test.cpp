@@ -11,6 +11,7 @@
 
 #include "loom/config/config.hpp"
 #include "loom/telemetry/encode.hpp"
+#include "test_dir.hpp"
 
 namespace {
 
@@ -165,12 +166,7 @@ TEST(DesignTelemetry, CarriesTheRowKnottedLastTheNextAndTwoAfter) {
 
 class DesignFiles : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("loom_design_files_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir_);
-  }
+  void SetUp() override { dir_ = loom::test::fresh_test_dir("design_files"); }
   void TearDown() override { std::filesystem::remove_all(dir_); }
   std::filesystem::path dir_;
 };

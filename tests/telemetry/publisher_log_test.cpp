@@ -14,6 +14,7 @@
 #include "log_reader.hpp"
 #include "loom/telemetry/telemetry.hpp"
 #include "synthetic_loom.hpp"
+#include "test_dir.hpp"
 
 namespace {
 
@@ -23,12 +24,7 @@ namespace fs = std::filesystem;
 
 class PublisherLog : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("loom_telemetry_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
+  void SetUp() override { dir_ = loom::test::fresh_test_dir("telemetry"); }
   void TearDown() override { fs::remove_all(dir_); }
   std::string log_path() const { return (dir_ / "run.lcmlog").string(); }
   PublisherConfig config(const Decimation& d) const {

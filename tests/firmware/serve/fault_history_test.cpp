@@ -9,17 +9,13 @@
 #include <filesystem>
 
 #include "loom/firmware/serve/journal.hpp"
+#include "test_dir.hpp"
 
 using namespace loom::firmware::serve;
 
 namespace {
 std::string temp_dir() {
-  const auto d = std::filesystem::temp_directory_path() /
-                 ("loom_fh_" + std::to_string(getpid()) + "_" +
-                  ::testing::UnitTest::GetInstance()->current_test_info()->name());
-  std::filesystem::remove_all(d);
-  std::filesystem::create_directories(d);
-  return d.string();
+  return loom::test::fresh_test_dir("fh").string();
 }
 FaultRecord record(std::uint32_t rows) {
   FaultRecord r;

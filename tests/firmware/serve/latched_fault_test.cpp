@@ -10,6 +10,7 @@
 #include <fstream>
 
 #include "loom/config/config.hpp"
+#include "test_dir.hpp"
 
 using namespace loom::firmware::serve;
 using loom::firmware::ConfigError;
@@ -18,12 +19,7 @@ using loom::sequencer::Fault;
 namespace {
 
 std::string temp_dir() {
-  const auto d = std::filesystem::temp_directory_path() /
-                 ("loom_lf_" + std::to_string(getpid()) + "_" +
-                  ::testing::UnitTest::GetInstance()->current_test_info()->name());
-  std::filesystem::remove_all(d);
-  std::filesystem::create_directories(d);
-  return d.string();
+  return loom::test::fresh_test_dir("lf").string();
 }
 
 LatchedFault drive_fault() {

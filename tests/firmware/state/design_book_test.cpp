@@ -12,16 +12,14 @@
 #include <string>
 
 #include "loom/config/config.hpp"
+#include "test_dir.hpp"
 
 namespace {
 
 class DesignBookTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("loom_design_book_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir_);
+    dir_ = loom::test::fresh_test_dir("design_book");
     path_ = (dir_ / "designs.json").string();
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
