@@ -687,12 +687,12 @@ void Sequencer::enabling(hal::Tick now, const hal::HalInputs& in) noexcept {
     return;
   }
   request_all(cmd_, n_axes_, AxisRequest::kEnable);
-  // Until every drive is enabled the targets follow the measured positions: enabling never jumps.
+  // The targets stay where idle left them, at the positions read when the start came: each drive enables
+  // holding where its axis stands. They do not follow the readings while the drives enable: a drive enables
+  // on the target of that tick, so a reading that lies then (an encoder glitch within the plausible step)
+  // would become motion, with the frames wherever they are.
   bool all = true;
-  for (std::size_t i = 0; i < n_axes_; ++i) {
-    cmd_.axes[i].target_position = in.axes[i].position;
-    all = all && in.axes[i].state == DriveState::kOperationEnabled;
-  }
+  for (std::size_t i = 0; i < n_axes_; ++i) all = all && in.axes[i].state == DriveState::kOperationEnabled;
   if (!all) {
     if (now - state_since_ > enable_timeout_ticks_) latch(Fault::kEnableTimeout, now);
     return;
@@ -729,11 +729,12 @@ void Sequencer::begin_homing(hal::Tick now, const hal::HalInputs& in) noexcept {
 }
 
 void Sequencer::homing(hal::Tick now, const hal::HalInputs& in) noexcept {
-  // The drive runs the homing by itself; every target follows its measured position so that nothing
-  // jumps when an axis goes back to following targets.
+  // The homing drive runs its homing by itself; its target follows its measured position so that nothing
+  // jumps when it goes back to following targets. The other drives are enabled and hold their targets (a
+  // target that followed their readings would turn a lying reading into motion).
   request_all(cmd_, n_axes_, AxisRequest::kEnable);
-  for (std::size_t i = 0; i < n_axes_; ++i) cmd_.axes[i].target_position = in.axes[i].position;
   const auto k = static_cast<std::size_t>(homing_axis_);
+  cmd_.axes[k].target_position = in.axes[k].position;
   const hal::AxisFeedback& a = in.axes[k];
   if (a.referenced) {
     begin_homing(now, in);

@@ -404,3 +404,29 @@ TEST(SequencerFaults, ConfigurationRefusalsCarryTheirField) {
   c.debounce_ticks = 0;
   expect(c, sequencer::SequencerField::kDebounceTicks, "timing.debounce_ticks");
 }
+
+// A reading that lies while the drives enable (an encoder glitch within the plausible step, so no fault)
+// must not become motion: a drive enables on the target of its tick, and the frames are closed. Found by
+// the safety campaign (seed 110157238, run 53251: the helix turned 0.069 rad with its lag, at tick 1).
+TEST(SequencerFaults, AReadingThatLiesWhileTheDrivesEnableMovesNothing) {
+  Rig r;
+  sim_hal::FaultInjection glitch;
+  glitch.kind = sim_hal::InjectedFault::kEncoderGlitch;
+  glitch.axis = hal::index(hal::CoreAxis::kHelix);
+  glitch.axis_name = "helix";
+  glitch.at_s = 0.5 * r.cfg.period_s;  // read from tick 1 on, when the loom starts enabling
+  glitch.jump = 0.3;                   // rad: within one tick's plausible step of the helix
+  glitch.ticks = 4;
+  r.scene.faults.push_back(glitch);
+  r.build(1);
+  const std::size_t helix = hal::index(hal::CoreAxis::kHelix);
+  const double at_rest = r.world->axis(helix).position;
+  bool glitch_read = false;
+  for (int t = 0; t < 10; ++t) {
+    r.run(1);
+    glitch_read = glitch_read || std::abs(r.in.axes[helix].position - at_rest) > 0.29;
+    EXPECT_EQ(r.world->axis(helix).position, at_rest)
+        << "tick " << t << ", state " << sequencer::state_name(r.seq->state());
+  }
+  EXPECT_TRUE(glitch_read) << "the glitch was never read: the test shows nothing";
+}

@@ -115,6 +115,37 @@ TEST(Referencing, AnIncrementalLoomPowersUpAnywhereHomesInMachineOrderThenWeaves
   }
 }
 
+// While one drive homes by itself the others are enabled and hold their targets: a reading of the helix that
+// lies meanwhile (an encoder glitch within one tick's plausible step) turns nothing. Truth is the plant.
+TEST(Referencing, TheDrivesThatDoNotHomeHoldWhatEverTheirReadingsSay) {
+  const firmware::LoomConfig cfg = incremental_loom();
+  constexpr std::size_t kHelix = 2;
+  firmware::MachineOptions opt;
+  opt.telemetry = false;
+  opt.rows = 1;
+  firmware::Machine m(cfg,
+                      scene(3,
+                            "[[fault]]\nkind = \"encoder_glitch\"\nat_s = 0.05\naxis = \"helix\"\n"
+                            "jump = 0.3\nticks = 4\n"),
+                      opt, {});
+  hal::AxisFeedbacks start{};
+  start[kCrank].position = 1.0;
+  start[kCarriage].position = 0.3;
+  m.sim().set_initial_state(start, {0.0, 0.0});
+  m.sequencer().request_start();
+  const double helix_at = m.sim().axis(kHelix).position;
+  bool glitch_read_while_homing = false;
+  for (hal::Tick t = 0; t < 2000; ++t) {
+    m.loop().cycle(t);
+    if (m.sequencer().state() != State::kHoming) continue;
+    const double read = m.loop().inputs().axes[kHelix].position;
+    glitch_read_while_homing = glitch_read_while_homing || std::abs(read - helix_at) > 0.29;
+    ASSERT_EQ(m.sim().axis(kHelix).position, helix_at) << "tick " << t;
+  }
+  EXPECT_TRUE(glitch_read_while_homing)
+      << "the glitch was not read while an axis homed: the test shows nothing";
+}
+
 TEST(Referencing, AnAbsoluteLoomNeverHomes) {
   const Trace tr = run(firmware::default_loom_config(), scene(1), 1);
   EXPECT_TRUE(tr.homing_order.empty());
