@@ -57,6 +57,7 @@ void CanAxisPort::register_axes() {
 
 Status bring_up(CanNetwork& network, CanAxisPort& axes, std::span<CanBus* const> buses,
                 ConfigureClock& clock) {
+  network.unconfigure();  // a refused port leaves no network up (recovery: a fresh bring-up)
   if (Status s = axes.check(buses.size()); !s) return s;
   return network.configure(buses, clock);  // every bus, in order
 }
@@ -74,7 +75,6 @@ std::vector<std::string> CanAxisPort::notes() const {
 }
 
 Status CanAxisPort::check(std::size_t interfaces) {
-  network_->unconfigure();
   const std::size_t n_buses = drivers::bus_count(d_.config);
   if (Status s = validate(d_.config); !s) return Status::error("CAN axis configuration: " + s.message());
   if (network_->bus_count() != n_buses) {
